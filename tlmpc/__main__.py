@@ -1,0 +1,5 @@
+"""``python -m tlmpc``."""
+
+from tlmpc.cli import main
+
+raise SystemExit(main())

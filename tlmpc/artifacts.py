@@ -1,0 +1,106 @@
+"""Reading, writing and validating the JSON artifacts every stage produces.
+
+Schemas live in the top-level ``schemas/`` folder of the repository (one source of truth);
+the wheel carries them as ``tlmpc/schemas/``.  Artifacts are written canonically: sorted
+keys, two-space indent, a trailing newline, so they diff and golden-test well.
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+import math
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+from tlmpc.errors import UsageError, error
+
+
+def schema_dir() -> Path:
+    """The folder holding the JSON Schemas (packaged copy first, then the source tree)."""
+    packaged = resources.files("tlmpc") / "schemas"
+    if packaged.is_dir():
+        return Path(str(packaged))
+    return Path(__file__).resolve().parent.parent / "schemas"
+
+
+@functools.cache
+def load_schema(name: str) -> dict[str, Any]:
+    """The schema ``schemas/<name>.schema.json`` (e.g. ``"mission"``, ``"abstraction"``)."""
+    path = schema_dir() / f"{name}.schema.json"
+    with path.open(encoding="utf-8") as handle:
+        schema: dict[str, Any] = json.load(handle)
+    return schema
+
+
+def validation_errors(document: Any, name: str) -> list[str]:
+    """Messages for every way ``document`` violates schema ``name`` (empty when valid)."""
+    import jsonschema
+
+    validator = jsonschema.Draft202012Validator(load_schema(name))
+    return [
+        f"{err.json_path}: {err.message}"
+        for err in sorted(validator.iter_errors(document), key=lambda e: list(e.path))
+    ]
+
+
+def _finite(value: Any) -> Any:
+    """Replace non-finite floats (JSON has none) by strings ``"inf"``/``"-inf"``/``"nan"``."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return "nan" if math.isnan(value) else ("inf" if value > 0 else "-inf")
+    if isinstance(value, dict):
+        return {k: _finite(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_finite(v) for v in value]
+    return value
+
+
+def dumps(document: Any) -> str:
+    """Canonical JSON text of ``document``."""
+    return json.dumps(_finite(document), indent=2, sort_keys=True, allow_nan=False) + "\n"
+
+
+def write_json(path: Path, document: Any) -> None:
+    """Write ``document`` canonically to ``path``."""
+    path.write_text(dumps(document), encoding="utf-8")
+
+
+def read_json(path: Path, expected_format: str | None = None) -> dict[str, Any]:
+    """Read an artifact, checking its ``format`` prefix (e.g. ``"tlmpc.trace/"``).
+
+    Raises :class:`UsageError` (exit 2) for unreadable files, bad JSON or another format.
+    """
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise UsageError(
+            error("U001", f"cannot read {path}: {exc}", hint="check the path", file=str(path))
+        ) from exc
+    try:
+        document = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise UsageError(
+            error(
+                "U002",
+                f"not valid JSON: {exc.msg}",
+                file=str(path),
+                line=exc.lineno,
+                col=exc.colno,
+                hint="artifacts are written by `tlmpc compile`; was this file edited?",
+            )
+        ) from exc
+    if not isinstance(document, dict):
+        raise UsageError(error("U003", "expected a JSON object", file=str(path)))
+    if expected_format is not None:
+        fmt = document.get("format")
+        if not isinstance(fmt, str) or not fmt.startswith(expected_format):
+            raise UsageError(
+                error(
+                    "U003",
+                    f"expected a {expected_format}* document, found format {fmt!r}",
+                    file=str(path),
+                    hint="pass the artifact this command expects",
+                )
+            )
+    return document

@@ -1,0 +1,145 @@
+"""Diagnostics and the exception hierarchy shared by every stage.
+
+A :class:`Diagnostic` is one problem with a location, a stable code and a hint.  Stages collect
+all the diagnostics they can find and raise one :class:`TlmpcError` carrying them, best first;
+the CLI prints them as ``FILE:LINE:COL: error[CODE]: message`` followed by ``  hint: ...``.
+
+Code prefixes, one per stage (the full list is in ``docs/errors.md``):
+
+====  ==================================================
+ U    usage and I/O (unreadable file, bad flags)
+ Y    YAML syntax and structure (duplicate keys)
+ S    schema violations of a mission or artifact
+ G    geometry of the workspace and regions
+ L    LTL formulas
+ T    task phrases
+ A    abstraction (triangulation, transition system)
+ B    Büchi automata (translation, HOA reading)
+ P    planning (no plan explanations)
+ C    control synthesis
+ V    verification of traces
+ I    internal errors (bugs)
+====  ==================================================
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass
+from typing import Any, Literal
+
+Severity = Literal["error", "warning", "note"]
+
+#: Exit codes of every ``tlmpc`` command (documented in ``docs/cli.md``).
+EXIT_OK = 0
+EXIT_NEGATIVE = 1  # ran fine, the answer is "no": invalid mission, no plan, trace violates
+EXIT_USAGE = 2  # could not run: bad flags, unreadable input, bad trace file
+EXIT_INTERNAL = 3  # a bug or a solver failure
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Diagnostic:
+    """One problem found in the user's input, with where it is and what to do about it.
+
+    ``line`` and ``col`` are 1-based; ``path`` is a JSON path into the document
+    (``$.regions.p1``) when the problem belongs to a value rather than to text.
+    """
+
+    code: str
+    message: str
+    hint: str | None = None
+    file: str | None = None
+    line: int | None = None
+    col: int | None = None
+    path: str | None = None
+    severity: Severity = "error"
+
+    def location(self) -> str:
+        """``file:line:col`` with whatever parts are known (``<input>`` when no file)."""
+        parts = [self.file or "<input>"]
+        if self.line is not None:
+            parts.append(str(self.line))
+            if self.col is not None:
+                parts.append(str(self.col))
+        return ":".join(parts)
+
+    def format(self) -> str:
+        """The human form: ``FILE:LINE:COL: error[CODE]: message`` and an indented hint."""
+        text = f"{self.location()}: {self.severity}[{self.code}]: {self.message}"
+        if self.hint:
+            text += f"\n  hint: {self.hint}"
+        return text
+
+    def to_json(self) -> dict[str, Any]:
+        """A JSON-able dict (keys with no value are left out)."""
+        data: dict[str, Any] = {
+            "code": self.code,
+            "severity": self.severity,
+            "message": self.message,
+        }
+        for key in ("hint", "file", "line", "col", "path"):
+            value = getattr(self, key)
+            if value is not None:
+                data[key] = value
+        return data
+
+    def sort_key(self) -> tuple[int, str, int, int, str]:
+        """Order used for "best first": errors before warnings, then by position."""
+        rank = {"error": 0, "warning": 1, "note": 2}[self.severity]
+        return (rank, self.file or "", self.line or 0, self.col or 0, self.code)
+
+
+class TlmpcError(Exception):
+    """Base of every error tlmpc raises on purpose; carries one or more diagnostics."""
+
+    exit_code: int = EXIT_NEGATIVE
+
+    def __init__(self, diagnostics: Diagnostic | Iterable[Diagnostic]) -> None:
+        if isinstance(diagnostics, Diagnostic):
+            diagnostics = [diagnostics]
+        self.diagnostics: tuple[Diagnostic, ...] = tuple(diagnostics)
+        if not self.diagnostics:
+            raise ValueError(f"{type(self).__name__} needs at least one diagnostic")
+        super().__init__("\n".join(d.format() for d in self.diagnostics))
+
+
+class InvalidInputError(TlmpcError):
+    """The user's mission, formula or trace is invalid (exit 1)."""
+
+
+class UsageError(TlmpcError):
+    """The command could not run: bad flags, unreadable or malformed file (exit 2)."""
+
+    exit_code = EXIT_USAGE
+
+
+class NoPlanError(TlmpcError):
+    """The mission is valid but no trajectory can satisfy it; diagnostics say why (exit 1)."""
+
+
+class SolverError(TlmpcError):
+    """A numerical solver failed where it should not have (exit 3)."""
+
+    exit_code = EXIT_INTERNAL
+
+
+def error(
+    code: str,
+    message: str,
+    *,
+    hint: str | None = None,
+    file: str | None = None,
+    line: int | None = None,
+    col: int | None = None,
+    path: str | None = None,
+) -> Diagnostic:
+    """Shorthand for an error-severity :class:`Diagnostic`."""
+    return Diagnostic(
+        code=code, message=message, hint=hint, file=file, line=line, col=col, path=path
+    )
+
+
+def best_first(diagnostics: Iterable[Diagnostic]) -> list[Diagnostic]:
+    """Sort diagnostics errors-first, then by file position; drop exact duplicates."""
+    unique = list(dict.fromkeys(diagnostics))
+    return sorted(unique, key=Diagnostic.sort_key)

@@ -1,0 +1,197 @@
+"""The LTL abstract syntax tree: frozen, hashable nodes with optional source spans.
+
+Every stage that reads formulas (task phrases, the automaton translator, the verifier) shares
+these nodes.  ``And``/``Or`` are n-ary (at least two operands); the parser flattens chains
+``a & b & c`` into one node.  Spans never take part in equality or hashing, so two formulas
+parsed from different places compare equal when they mean the same tree.
+
+There is deliberately no ``Next`` node: Next has no meaning in continuous time.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+
+
+@dataclass(frozen=True, slots=True)
+class Span:
+    """Where a node came from: 1-based line/column of its first and last character."""
+
+    line: int
+    col: int
+    end_line: int
+    end_col: int
+
+
+@dataclass(frozen=True, slots=True)
+class Formula:
+    """Base class of all LTL nodes."""
+
+    def children(self) -> tuple[Formula, ...]:
+        """Direct sub-formulas, left to right."""
+        return ()
+
+    def walk(self) -> Iterator[Formula]:
+        """This node and every sub-formula, pre-order."""
+        stack: list[Formula] = [self]
+        while stack:
+            node = stack.pop()
+            yield node
+            stack.extend(reversed(node.children()))
+
+    def props(self) -> frozenset[str]:
+        """Names of the atomic propositions that occur in the formula."""
+        return frozenset(n.name for n in self.walk() if isinstance(n, Prop))
+
+    def __str__(self) -> str:
+        from tlmpc.ltl.printer import to_text
+
+        return to_text(self)
+
+
+@dataclass(frozen=True, slots=True)
+class Const(Formula):
+    """``true`` or ``false``."""
+
+    value: bool
+    span: Span | None = field(default=None, compare=False, repr=False)
+
+
+@dataclass(frozen=True, slots=True)
+class Prop(Formula):
+    """An atomic proposition: the robot is in the region (or group) of this name."""
+
+    name: str
+    span: Span | None = field(default=None, compare=False, repr=False)
+
+
+@dataclass(frozen=True, slots=True)
+class Not(Formula):
+    """``!arg``."""
+
+    arg: Formula
+    span: Span | None = field(default=None, compare=False, repr=False)
+
+    def children(self) -> tuple[Formula, ...]:
+        return (self.arg,)
+
+
+@dataclass(frozen=True, slots=True)
+class And(Formula):
+    """``a & b & ...`` (two or more operands)."""
+
+    args: tuple[Formula, ...]
+    span: Span | None = field(default=None, compare=False, repr=False)
+
+    def children(self) -> tuple[Formula, ...]:
+        return self.args
+
+
+@dataclass(frozen=True, slots=True)
+class Or(Formula):
+    """``a | b | ...`` (two or more operands)."""
+
+    args: tuple[Formula, ...]
+    span: Span | None = field(default=None, compare=False, repr=False)
+
+    def children(self) -> tuple[Formula, ...]:
+        return self.args
+
+
+@dataclass(frozen=True, slots=True)
+class _Binary(Formula):
+    left: Formula
+    right: Formula
+    span: Span | None = field(default=None, compare=False, repr=False)
+
+    def children(self) -> tuple[Formula, ...]:
+        return (self.left, self.right)
+
+
+@dataclass(frozen=True, slots=True)
+class Implies(_Binary):
+    """``left -> right``."""
+
+
+@dataclass(frozen=True, slots=True)
+class Equiv(_Binary):
+    """``left <-> right``."""
+
+
+@dataclass(frozen=True, slots=True)
+class Until(_Binary):
+    """``left U right`` (strong, non-strict until)."""
+
+
+@dataclass(frozen=True, slots=True)
+class Release(_Binary):
+    """``left R right``: right holds until and including when left holds (or forever)."""
+
+
+@dataclass(frozen=True, slots=True)
+class WeakUntil(_Binary):
+    """``left W right`` = ``(left U right) | G left``."""
+
+
+@dataclass(frozen=True, slots=True)
+class StrongRelease(_Binary):
+    """``left M right`` = ``(left R right) & F left``."""
+
+
+@dataclass(frozen=True, slots=True)
+class Eventually(Formula):
+    """``F arg`` (also written ``<>``)."""
+
+    arg: Formula
+    span: Span | None = field(default=None, compare=False, repr=False)
+
+    def children(self) -> tuple[Formula, ...]:
+        return (self.arg,)
+
+
+@dataclass(frozen=True, slots=True)
+class Globally(Formula):
+    """``G arg`` (also written ``[]``)."""
+
+    arg: Formula
+    span: Span | None = field(default=None, compare=False, repr=False)
+
+    def children(self) -> tuple[Formula, ...]:
+        return (self.arg,)
+
+
+TRUE = Const(True)
+FALSE = Const(False)
+
+BINARY_TEMPORAL = (Until, Release, WeakUntil, StrongRelease)
+UNARY_TEMPORAL = (Eventually, Globally)
+
+
+def is_propositional(formula: Formula) -> bool:
+    """True when the formula has no temporal operator."""
+    return not any(isinstance(n, (*BINARY_TEMPORAL, *UNARY_TEMPORAL)) for n in formula.walk())
+
+
+def conjoin(parts: list[Formula] | tuple[Formula, ...]) -> Formula:
+    """The conjunction of ``parts`` (``true`` when empty, the part itself when one)."""
+    flat: list[Formula] = []
+    for part in parts:
+        flat.extend(part.args if isinstance(part, And) else (part,))
+    if not flat:
+        return TRUE
+    if len(flat) == 1:
+        return flat[0]
+    return And(tuple(flat))
+
+
+def disjoin(parts: list[Formula] | tuple[Formula, ...]) -> Formula:
+    """The disjunction of ``parts`` (``false`` when empty, the part itself when one)."""
+    flat: list[Formula] = []
+    for part in parts:
+        flat.extend(part.args if isinstance(part, Or) else (part,))
+    if not flat:
+        return FALSE
+    if len(flat) == 1:
+        return flat[0]
+    return Or(tuple(flat))

@@ -1,0 +1,126 @@
+"""The loaded mission (stage 1 output): typed, validated, positions resolved.
+
+Shapes given as ``{rect: [xmin, ymin, xmax, ymax]}`` are already expanded to point lists here,
+counter-clockwise from ``(xmin, ymin)``; point lists keep the user's order and orientation.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+from tlmpc.ltl.ast import Formula
+
+Point = tuple[float, float]
+Polygon = tuple[Point, ...]
+
+CostMetric = Literal["length", "hops"]
+BoundaryConvention = Literal["right", "closed"]
+
+#: Defaults of ``options`` (documented in docs/mission-format.md).
+DEFAULT_MIN_ANGLE = 20.0
+DEFAULT_BETA = 1.0
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Region:
+    """A named region of interest: a closed simple polygon; regions may overlap."""
+
+    name: str
+    polygon: Polygon
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Workspace:
+    """The outer boundary and the holes (obstacles that are never traversable)."""
+
+    boundary: Polygon
+    holes: tuple[Polygon, ...] = ()
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Robot:
+    """The fully actuated point robot x' = u, |u| <= max_speed."""
+
+    start: Point
+    max_speed: float = 1.0
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Options:
+    """Compiler options.
+
+    ``min_angle``/``max_area`` are the triangulation quality bounds (``None`` turns a bound
+    off; both off gives the plain constrained Delaunay triangulation); ``cost`` is the witness
+    metric; ``beta`` weighs the cycle against the prefix (cost = prefix + beta * cycle);
+    ``boundary`` is the labelling convention used when verifying.
+    """
+
+    min_angle: float | None = DEFAULT_MIN_ANGLE
+    max_area: float | None = None
+    cost: CostMetric = "length"
+    beta: float = DEFAULT_BETA
+    boundary: BoundaryConvention = "right"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Mission:
+    """A validated mission.
+
+    ``formula`` is the whole task: the conjunction of the task phrases' LTL and the raw
+    ``ltl``, with group names already expanded to disjunctions of their regions.
+    """
+
+    name: str
+    workspace: Workspace
+    regions: tuple[Region, ...]
+    robot: Robot
+    formula: Formula
+    groups: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
+    task: tuple[str, ...] = ()
+    ltl: str | None = None
+    options: Options = field(default_factory=Options)
+    source: str | None = None
+
+    @property
+    def region_names(self) -> tuple[str, ...]:
+        """Region names in file order."""
+        return tuple(r.name for r in self.regions)
+
+    def region(self, name: str) -> Region:
+        """The region called ``name`` (KeyError if there is none)."""
+        for region in self.regions:
+            if region.name == name:
+                return region
+        raise KeyError(name)
+
+    def to_json(self) -> dict[str, Any]:
+        """The ``mission.json`` artifact (``tlmpc.mission/1``)."""
+        from tlmpc.ltl.printer import to_text
+
+        def poly(p: Polygon) -> list[list[float]]:
+            return [[x, y] for x, y in p]
+
+        return {
+            "format": "tlmpc.mission/1",
+            "name": self.name,
+            "source": self.source,
+            "workspace": {
+                "boundary": poly(self.workspace.boundary),
+                "holes": [poly(h) for h in self.workspace.holes],
+            },
+            "regions": {r.name: poly(r.polygon) for r in self.regions},
+            "groups": {k: list(v) for k, v in self.groups.items()},
+            "robot": {"start": list(self.robot.start), "max_speed": self.robot.max_speed},
+            "task": list(self.task),
+            "ltl": self.ltl,
+            "formula": to_text(self.formula),
+            "options": {
+                "min_angle": self.options.min_angle,
+                "max_area": self.options.max_area,
+                "cost": self.options.cost,
+                "beta": self.options.beta,
+                "boundary": self.options.boundary,
+            },
+        }

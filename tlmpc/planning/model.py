@@ -1,0 +1,34 @@
+"""The witness: an accepting lasso of the product D x A, projected on triangles (stage 5).
+
+The robot's discrete run is ``prefix + cycle + cycle + ...``.  ``prefix[0]`` is the start
+triangle unless the start triangle opens the cycle (then ``prefix`` is empty).  Consecutive
+triangles are distinct and adjacent, the last of ``cycle`` is adjacent to its first, and no
+plan bounces (``path[i-1] != path[i+1]``, across the wrap too).  A cycle of one triangle is
+a *stay*: the robot converges to a point inside it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Witness:
+    """A minimum-cost accepting lasso (see docs/planning.md for the optimality statement)."""
+
+    prefix: tuple[int, ...]
+    cycle: tuple[int, ...]
+    prefix_states: tuple[int, ...]  # automaton state after reading each prefix triangle
+    cycle_states: tuple[int, ...]  # automaton state after reading each cycle triangle
+    word: tuple[tuple[str, ...], ...]  # label set of each triangle of prefix + cycle
+    cost: float
+    metric: Literal["length", "hops"]
+    beta: float
+    prefix_cost: float
+    cycle_cost: float
+
+    @property
+    def is_stay(self) -> bool:
+        """True when the plan ends by converging inside one triangle."""
+        return len(self.cycle) == 1
