@@ -1,0 +1,56 @@
+"""The command-line shell: help, version, usage errors, exit codes."""
+
+from __future__ import annotations
+
+import io
+
+import pytest
+
+from tlmpc import __version__
+from tlmpc.cli import COMMAND_MODULES, main
+
+
+def run(*argv: str) -> tuple[int, str, str]:
+    out, err = io.StringIO(), io.StringIO()
+    return main(list(argv), out=out, err=err), out.getvalue(), err.getvalue()
+
+
+def test_help_lists_every_command_and_the_exit_codes() -> None:
+    code, out, _ = run("--help")
+    assert code == 0
+    for name in COMMAND_MODULES:
+        assert name in out
+    assert "exit codes" in out
+    assert "3  internal error" in out
+
+
+def test_version() -> None:
+    code, out, _ = run("--version")
+    assert code == 0
+    assert __version__ in out
+
+
+@pytest.mark.parametrize("argv", [(), ("frobnicate",), ("compile",), ("compile", "x", "--until", "nope")])
+def test_usage_errors_exit_2(argv: tuple[str, ...]) -> None:
+    code, _, err = run(*argv)
+    assert code == 2
+    assert "usage:" in err
+
+
+def test_missing_mission_file_exits_2(tmp_path: object) -> None:
+    code, _, err = run("compile", "/nonexistent/mission.yaml", "-o", "/tmp/tlmpc-never-written")
+    assert code == 2
+    assert "error[U" in err
+
+
+def test_internal_errors_exit_3_with_a_report_hint(monkeypatch: pytest.MonkeyPatch) -> None:
+    import tlmpc.commands.compile as compile_command
+
+    def explode(*_: object, **__: object) -> int:
+        raise ZeroDivisionError("boom")
+
+    monkeypatch.setattr(compile_command, "run", explode)
+    code, _, err = run("compile", "whatever.yaml")
+    assert code == 3
+    assert "internal error" in err
+    assert "ZeroDivisionError" in err

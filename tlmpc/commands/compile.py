@@ -1,0 +1,90 @@
+"""``tlmpc compile MISSION -o OUT``: run the pipeline and write every artifact atomically."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+from typing import TextIO
+
+NAME = "compile"
+HELP = "compile a mission into a verified plan, controllers and trajectory"
+DESCRIPTION = """\
+Lower MISSION through every stage (load, abstraction, automaton, plan, control, simulate,
+verify, plot) and write the artifacts into OUT: mission.json, abstraction.json,
+automaton.json, automaton.hoa, witness.json, controllers.json, trace.json, verdict.json,
+summary.json, plan.png and plan.svg.  Output is atomic: a failed run leaves OUT untouched."""
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Register the command's flags."""
+    from tlmpc.pipeline import stage_names
+
+    parser.add_argument("mission", type=Path, help="mission file (YAML)")
+    parser.add_argument(
+        "-o", "--out", type=Path, default=Path("out"), help="output directory (default: out)"
+    )
+    parser.add_argument(
+        "--until",
+        choices=stage_names(),
+        metavar="STAGE",
+        help="stop after STAGE (one of: %(choices)s)",
+    )
+    parser.add_argument(
+        "--force",
+        action="store_true",
+        help="write into OUT even if it is a non-empty directory that tlmpc did not create",
+    )
+    parser.add_argument("--json", action="store_true", help="print summary.json on stdout")
+    parser.add_argument("-q", "--quiet", action="store_true", help="no progress lines")
+
+
+def _format_sizes(sizes: dict[str, object]) -> str:
+    return ", ".join(f"{value} {key}" for key, value in sizes.items() if key != "formula")
+
+
+def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
+    """Compile ``args.mission`` into ``args.out``."""
+    from tlmpc.output import check_destination, commit, staging_directory, write_artifacts
+    from tlmpc.pipeline import StageReport, compile_mission
+
+    destination: Path = args.out
+    check_destination(destination, force=args.force)
+
+    def progress(index: int, total: int, report: StageReport) -> None:
+        if not args.quiet:
+            sizes = _format_sizes(dict(report.sizes))
+            err.write(
+                f"[{index}/{total}] {report.name:<11} {report.seconds:8.3f} s"
+                + (f"  {sizes}" if sizes else "")
+                + "\n"
+            )
+            err.flush()
+
+    result = compile_mission(args.mission, until=args.until, progress=progress)
+    for warning in result.warnings:
+        err.write(warning.format() + "\n")
+
+    with staging_directory(destination) as staging:
+        artifacts = dict(result.artifacts)
+        summary = result.summary()
+        if args.until is None or args.until == "plot":
+            from tlmpc.plot import render_plan
+
+            png, svg = render_plan(artifacts)
+            artifacts["plan.png"] = png
+            artifacts["plan.svg"] = svg
+            summary["artifacts"] = sorted([*artifacts, "summary.json"])
+        artifacts["summary.json"] = summary
+        write_artifacts(staging, artifacts)
+        commit(staging, destination, force=args.force)
+
+    if args.json:
+        out.write(json.dumps(summary, indent=2, sort_keys=True) + "\n")
+    elif not args.quiet:
+        verdict = summary.get("verdict")
+        tail = ""
+        if verdict is not None:
+            tail = f"; trace verifies (robustness {verdict['robustness']:.4g})"
+        err.write(f"wrote {len(artifacts)} artifacts to {destination}{tail}\n")
+    return 0

@@ -1,0 +1,76 @@
+"""``tlmpc plot OUT``: re-draw ``plan.png``/``plan.svg`` from a compile output's artifacts."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import tempfile
+from pathlib import Path
+from typing import Any, TextIO
+
+from tlmpc.errors import UsageError, error
+
+NAME = "plot"
+HELP = "re-draw plan.png and plan.svg from the artifacts in a compile output directory"
+
+_INPUTS = {
+    "mission.json": "tlmpc.mission/",
+    "abstraction.json": "tlmpc.abstraction/",
+    "witness.json": "tlmpc.witness/",
+    "trace.json": "tlmpc.trace/",
+}
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Register the command's flags."""
+    parser.add_argument("out", type=Path, help="a directory written by `tlmpc compile`")
+    parser.add_argument(
+        "--format",
+        choices=("png", "svg", "both"),
+        default="both",
+        help="which figure files to write (default: both)",
+    )
+
+
+def _replace(path: Path, data: bytes) -> None:
+    # Write beside the target and rename, so a reader never sees half a picture.
+    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    try:
+        with os.fdopen(handle, "wb") as stream:
+            stream.write(data)
+        os.replace(temporary, path)
+    except BaseException:
+        Path(temporary).unlink(missing_ok=True)
+        raise
+
+
+def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
+    """Read the artifacts of ``args.out`` and write the figures next to them."""
+    from tlmpc.artifacts import read_json
+    from tlmpc.plot import render_plan
+
+    directory: Path = args.out
+    if not (directory / "mission.json").is_file():
+        raise UsageError(
+            error(
+                "U020",
+                f"{directory} has no mission.json",
+                hint="pass a directory written by `tlmpc compile MISSION -o DIR`",
+                file=str(directory),
+            )
+        )
+    artifacts: dict[str, Any] = {}
+    for name, fmt in _INPUTS.items():
+        path = directory / name
+        if path.is_file():
+            artifacts[name] = read_json(path, fmt)
+    png, svg = render_plan(artifacts)
+    written = []
+    if args.format in ("png", "both"):
+        _replace(directory / "plan.png", png)
+        written.append("plan.png")
+    if args.format in ("svg", "both"):
+        _replace(directory / "plan.svg", svg)
+        written.append("plan.svg")
+    err.write(f"wrote {', '.join(written)} to {directory}\n")
+    return 0

@@ -1,0 +1,134 @@
+"""Figures of a compiled mission, drawn from its artifacts alone (headless, reproducible).
+
+``render_plan`` draws the workspace, holes, regions with their names, the triangulation, the
+discrete plan (prefix solid, cycle dashed) and the simulated trajectory coloured by time, and
+returns PNG and SVG bytes.  The same artifacts always give the same bytes: no timestamps, a
+fixed SVG hash salt, no software tag.
+"""
+
+from __future__ import annotations
+
+import io
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+# Colours for regions, cycled; chosen to stay readable on top of each other when translucent.
+_REGION_COLOURS = (
+    "#4e79a7",
+    "#f28e2b",
+    "#59a14f",
+    "#e15759",
+    "#76b7b2",
+    "#edc948",
+    "#b07aa1",
+    "#ff9da7",
+    "#9c755f",
+)
+_MAX_REGION_NAMES = 60  # beyond this many regions the names only clutter the picture
+
+
+def _polygon_xy(points: Sequence[Sequence[float]]) -> tuple[list[float], list[float]]:
+    xs = [float(p[0]) for p in points]
+    ys = [float(p[1]) for p in points]
+    return [*xs, xs[0]], [*ys, ys[0]]
+
+
+def _centroids(abstraction: Mapping[str, Any], triangles: Sequence[int]) -> list[list[float]]:
+    vertices = abstraction["vertices"]
+    tris = abstraction["triangles"]
+    result = []
+    for t in triangles:
+        corners = [vertices[i] for i in tris[t]]
+        result.append([sum(c[0] for c in corners) / 3.0, sum(c[1] for c in corners) / 3.0])
+    return result
+
+
+def draw_plan(axes: Any, artifacts: Mapping[str, Any]) -> None:
+    """Draw everything the artifacts in ``artifacts`` (file name -> document) describe."""
+    from matplotlib.collections import LineCollection
+    from matplotlib.patches import Polygon as PolygonPatch
+
+    mission = artifacts["mission.json"]
+    workspace = mission["workspace"]
+    boundary = workspace["boundary"]
+    axes.add_patch(PolygonPatch(boundary, closed=True, facecolor="white", edgecolor="black",
+                                linewidth=1.2, zorder=0))
+    for hole in workspace.get("holes", []):
+        axes.add_patch(PolygonPatch(hole, closed=True, facecolor="#9a9a9a", edgecolor="black",
+                                    hatch="//", linewidth=0.8, zorder=3))
+    regions: Mapping[str, Any] = mission["regions"]
+    for index, (name, polygon) in enumerate(sorted(regions.items())):
+        colour = _REGION_COLOURS[index % len(_REGION_COLOURS)]
+        axes.add_patch(PolygonPatch(polygon, closed=True, facecolor=colour, alpha=0.30,
+                                    edgecolor=colour, linewidth=0.8, zorder=1))
+        if len(regions) <= _MAX_REGION_NAMES:
+            xs, ys = _polygon_xy(polygon)
+            axes.text(sum(xs[:-1]) / (len(xs) - 1), sum(ys[:-1]) / (len(ys) - 1), name,
+                      ha="center", va="center", fontsize=8, zorder=6,
+                      bbox={"boxstyle": "round,pad=0.15", "fc": "white", "alpha": 0.7, "lw": 0})
+
+    abstraction = artifacts.get("abstraction.json")
+    if abstraction is not None:
+        vertices = abstraction["vertices"]
+        xs = [v[0] for v in vertices]
+        ys = [v[1] for v in vertices]
+        axes.triplot(xs, ys, abstraction["triangles"], color="#b0b0b0", linewidth=0.3, zorder=2)
+
+    witness = artifacts.get("witness.json")
+    if witness is not None and abstraction is not None:
+        prefix = list(witness["prefix"])
+        cycle = list(witness["cycle"])
+        path = _centroids(abstraction, [*prefix, *cycle[:1]]) if prefix else []
+        if len(path) >= 2:
+            axes.plot([p[0] for p in path], [p[1] for p in path], color="#1f3b73",
+                      linewidth=1.0, marker=".", markersize=3, zorder=4, label="plan prefix")
+        loop = _centroids(abstraction, [*cycle, cycle[0]])
+        axes.plot([p[0] for p in loop], [p[1] for p in loop], color="#c0392b", linewidth=1.0,
+                  linestyle="--", marker=".", markersize=3, zorder=4,
+                  label="plan cycle" if len(cycle) > 1 else "stay")
+
+    trace = artifacts.get("trace.json")
+    if trace is not None:
+        points = trace["points"]
+        segments = [[(a[1], a[2]), (b[1], b[2])] for a, b in zip(points, points[1:], strict=False)]
+        times = [0.5 * (a[0] + b[0]) for a, b in zip(points, points[1:], strict=False)]
+        if segments:
+            lines = LineCollection(segments, cmap="viridis", linewidth=1.8, zorder=5)
+            lines.set_array(times)
+            axes.add_collection(lines)
+            axes.figure.colorbar(lines, ax=axes, fraction=0.046, pad=0.04, label="time [s]")
+
+    start = mission["robot"]["start"]
+    axes.plot([start[0]], [start[1]], marker="o", color="black", markersize=6, zorder=7,
+              linestyle="none", label="start")
+    bx, by = _polygon_xy(boundary)
+    margin = 0.02 * max(max(bx) - min(bx), max(by) - min(by))
+    axes.set_xlim(min(bx) - margin, max(bx) + margin)
+    axes.set_ylim(min(by) - margin, max(by) + margin)
+    axes.set_aspect("equal")
+    axes.set_xlabel("x")
+    axes.set_ylabel("y")
+    axes.set_title(mission.get("name") or "tlmpc plan", fontsize=10)
+    axes.legend(loc="upper right", fontsize=7, framealpha=0.8)
+
+
+def render_plan(artifacts: Mapping[str, Any]) -> tuple[bytes, bytes]:
+    """PNG and SVG bytes of :func:`draw_plan` (reproducible byte for byte)."""
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    from matplotlib import rc_context
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    with rc_context({"svg.hashsalt": "tlmpc", "svg.fonttype": "path", "path.simplify": False}):
+        figure = Figure(figsize=(7.0, 6.0), dpi=150)
+        FigureCanvasAgg(figure)
+        axes = figure.add_subplot(1, 1, 1)
+        draw_plan(axes, artifacts)
+        figure.tight_layout()
+        png = io.BytesIO()
+        figure.savefig(png, format="png", metadata={"Software": None})
+        svg = io.BytesIO()
+        figure.savefig(svg, format="svg", metadata={"Date": None, "Creator": None})
+    return png.getvalue(), svg.getvalue()
