@@ -1,1 +1,16 @@
-"""mission stage."""
+"""Mission files: the format, loading with positions, validation."""
+
+from tlmpc.mission.load import check_file, check_text, load_mission, load_mission_text
+from tlmpc.mission.model import Mission, Options, Region, Robot, Workspace
+
+__all__ = [
+    "Mission",
+    "Options",
+    "Region",
+    "Robot",
+    "Workspace",
+    "check_file",
+    "check_text",
+    "load_mission",
+    "load_mission_text",
+]

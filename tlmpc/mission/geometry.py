@@ -1,0 +1,145 @@
+"""Geometry checks of a mission with shapely: shapes, holes, regions, start point."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import shapely
+from shapely.geometry import Point as ShapelyPoint
+from shapely.geometry import Polygon as ShapelyPolygon
+from shapely.validation import explain_validity
+
+from tlmpc.errors import Diagnostic, error
+from tlmpc.mission.model import Polygon
+from tlmpc.mission.yamlpos import Path, json_path
+
+#: Relative tolerance for "zero area" (relative to the squared size of the shape).
+AREA_TOLERANCE = 1e-12
+
+Locate = Callable[[Path], tuple[int, int]]
+
+
+def shape_points(shape: Any) -> Polygon:
+    """The vertices of a shape: a point list as given, or a rectangle counter-clockwise."""
+    if isinstance(shape, dict):
+        x0, y0, x1, y1 = (float(v) for v in shape["rect"])
+        return ((x0, y0), (x1, y0), (x1, y1), (x0, y1))
+    points: list[tuple[float, float]] = []
+    for x, y in shape:
+        point = (float(x), float(y))
+        if not points or points[-1] != point:
+            points.append(point)
+    if len(points) > 1 and points[0] == points[-1]:
+        points.pop()  # a closed ring given with its first point repeated
+    return tuple(points)
+
+
+def _collinear(points: Polygon, size: float) -> bool:
+    x0, y0 = points[0]
+    x1, y1 = max(points, key=lambda p: (p[0] - x0) ** 2 + (p[1] - y0) ** 2)
+    dx, dy = x1 - x0, y1 - y0
+    length = (dx * dx + dy * dy) ** 0.5
+    if length == 0.0:
+        return True
+    return all(abs(dx * (y - y0) - dy * (x - x0)) / length <= 1e-12 * size for x, y in points)
+
+
+@dataclass(frozen=True, slots=True)
+class CheckedShape:
+    """A shape that passed its own checks, as points and as a shapely polygon."""
+
+    points: Polygon
+    polygon: ShapelyPolygon
+    path: Path
+
+
+def check_shape(
+    shape: Any, path: Path, what: str, file: str, locate: Locate
+) -> tuple[CheckedShape | None, list[Diagnostic]]:
+    """Validate one shape; return it when usable, with the problems found."""
+    line, col = locate(path)
+    where = {"file": file, "line": line, "col": col, "path": json_path(path)}
+    if isinstance(shape, dict):
+        x0, y0, x1, y1 = (float(v) for v in shape["rect"])
+        if not (x0 < x1 and y0 < y1):
+            return None, [error("G001", f"{what}: rect needs xmin < xmax and ymin < ymax, got "
+                                f"[{x0:g}, {y0:g}, {x1:g}, {y1:g}]",
+                                hint="write {rect: [xmin, ymin, xmax, ymax]}", **where)]
+    points = shape_points(shape)
+    if len(set(points)) < 3:
+        return None, [error("G002", f"{what}: a polygon needs at least 3 distinct points",
+                            hint="list the corners as [[x, y], ...]", **where)]
+    polygon = ShapelyPolygon(points)
+    minx, miny, maxx, maxy = polygon.bounds
+    size = max(maxx - minx, maxy - miny, 1e-300)
+    if _collinear(points, size):
+        return None, [error("G003", f"{what}: the polygon has zero area",
+                            hint="its points are collinear; give a proper polygon", **where)]
+    if not polygon.is_valid:
+        reason = explain_validity(polygon)
+        return None, [error("G004", f"{what}: the polygon is self-intersecting or not simple "
+                            f"({reason})", hint="edges must not cross or touch; list the "
+                            "corners in order around the shape", **where)]
+    if abs(polygon.area) <= AREA_TOLERANCE * size * size:
+        return None, [error("G003", f"{what}: the polygon has zero area",
+                            hint="give a polygon with a positive area", **where)]
+    return CheckedShape(points=points, polygon=polygon, path=path), []
+
+
+def check_layout(
+    boundary: CheckedShape | None,
+    holes: Sequence[CheckedShape],
+    regions: dict[str, CheckedShape],
+    start: tuple[float, float] | None,
+    start_path: Path,
+    file: str,
+    locate: Locate,
+) -> list[Diagnostic]:
+    """Relations between shapes: containment, hole overlaps, the start point."""
+    problems: list[Diagnostic] = []
+
+    def at(path: Path, code: str, message: str, hint: str) -> Diagnostic:
+        line, col = locate(path)
+        return error(code, message, hint=hint, file=file, line=line, col=col,
+                     path=json_path(path))
+
+    hole_union = shapely.union_all([h.polygon for h in holes]) if holes else None
+    if boundary is not None:
+        outer = boundary.polygon
+        for index, hole in enumerate(holes):
+            if not outer.covers(hole.polygon):
+                problems.append(at(hole.path, "G005", f"hole {index} extends outside the "
+                                   "workspace boundary",
+                                   "holes must lie inside the boundary; clip the hole"))
+        for name, region in regions.items():
+            if not outer.covers(region.polygon):
+                problems.append(at(region.path, "G007", f"region {name!r} extends outside the "
+                                   "workspace boundary",
+                                   "regions must lie inside the boundary; clip the region"))
+    for i, first in enumerate(holes):
+        for j in range(i + 1, len(holes)):
+            second = holes[j]
+            overlap = first.polygon.intersection(second.polygon)
+            if overlap.area > AREA_TOLERANCE * max(first.polygon.area, second.polygon.area):
+                problems.append(at(second.path, "G006", f"holes {i} and {j} overlap",
+                                   "merge overlapping obstacles into one hole"))
+    if hole_union is not None:
+        for name, region in regions.items():
+            free = region.polygon.difference(hole_union)
+            if free.area <= AREA_TOLERANCE * region.polygon.area:
+                problems.append(at(region.path, "G008", f"region {name!r} lies entirely inside "
+                                   "holes, so the robot can never be in it",
+                                   "move the region or shrink the holes"))
+    if start is not None:
+        point = ShapelyPoint(start)
+        if boundary is not None and not boundary.polygon.covers(point):
+            problems.append(at(start_path, "G009", f"the start point ({start[0]:g}, "
+                               f"{start[1]:g}) is outside the workspace boundary",
+                               "the robot must start in the free workspace"))
+        elif hole_union is not None and hole_union.covers(point):
+            problems.append(at(start_path, "G010", f"the start point ({start[0]:g}, "
+                               f"{start[1]:g}) is inside a hole",
+                               "holes are obstacles; start the robot in the free workspace"))
+    return problems

@@ -1,0 +1,292 @@
+"""Load a mission file: YAML → schema → geometry → task, every problem with its position.
+
+All problems of a file are reported in one run, best first.  Later checks are skipped only
+where they would be meaningless (the geometry of a shape that failed the schema, say).
+"""
+
+from __future__ import annotations
+
+import difflib
+from collections.abc import Mapping
+from pathlib import Path as FilePath
+from typing import Any
+
+import jsonschema
+from jsonschema.exceptions import ValidationError, best_match
+
+from tlmpc.artifacts import load_schema
+from tlmpc.errors import Diagnostic, InvalidInputError, UsageError, best_first, error
+from tlmpc.ltl.ast import Formula, Or, Prop, conjoin
+from tlmpc.ltl.parser import parse_ltl
+from tlmpc.ltl.transform import substitute
+from tlmpc.mission.geometry import CheckedShape, check_layout, check_shape
+from tlmpc.mission.model import Mission, Options, Region, Robot, Workspace
+from tlmpc.mission.yamlpos import Path, PositionedDocument, json_path, load_positioned
+from tlmpc.tasks.compiler import compile_phrases
+
+#: Files larger than this are refused before parsing (a mission is at most a few MB).
+MAX_BYTES = 64 * 1024 * 1024
+
+
+def _schema_diagnostics(doc: PositionedDocument, file: str) -> list[Diagnostic]:
+    validator = jsonschema.Draft202012Validator(load_schema("mission"))
+    problems: list[Diagnostic] = []
+    for err in validator.iter_errors(doc.data):
+        problems.extend(_describe(err, doc, file))
+    return problems
+
+
+def _describe(err: ValidationError, doc: PositionedDocument, file: str) -> list[Diagnostic]:
+    path: Path = tuple(err.absolute_path)
+    if err.validator == "additionalProperties" and isinstance(err.instance, dict):
+        allowed = list(err.schema.get("properties", {}))
+        result = []
+        for key in err.instance:
+            if key in allowed:
+                continue
+            close = difflib.get_close_matches(str(key), allowed, n=1)
+            line, col = doc.key_at((*path, key))
+            hint = f"did you mean {close[0]!r}?" if close else f"allowed keys: {', '.join(allowed)}"
+            result.append(error("S001", f"unknown key {key!r}" + (
+                f" in {json_path(path)}" if path else ""), hint=hint, file=file, line=line,
+                col=col, path=json_path((*path, key))))
+        return result
+    if err.validator == "anyOf" and err.context:
+        if list(err.schema.get("anyOf", [{}])[0]) == ["required"]:
+            line, col = doc.value_at(path)
+            return [error("S003", "the mission has no task: give `task` phrases, `ltl`, or both",
+                          hint="for example  task: [visit goal]", file=file, line=line, col=col,
+                          path=json_path(path))]
+        deepest = best_match(err.context)
+        if deepest is not None and not isinstance(err.instance, list | dict):
+            deepest = err
+        if deepest is not None and deepest is not err:
+            return _describe(deepest, doc, file)
+        line, col = doc.value_at(path)
+        return [error("S004", f"{json_path(path)} is not a shape",
+                      hint="a shape is a list of [x, y] points or {rect: [xmin, ymin, xmax, ymax]}",
+                      file=file, line=line, col=col, path=json_path(path))]
+    if err.validator == "required":
+        line, col = doc.value_at(path)
+        return [error("S002", err.message.replace("is a required property",
+                                                  "is missing (required)"),
+                      hint="see docs/mission-format.md for the keys", file=file, line=line,
+                      col=col, path=json_path(path))]
+    if err.validator == "propertyNames" or (path and err.validator in ("pattern", "not")
+                                            and err.instance in (doc.data or {})):
+        line, col = doc.key_at(path)
+    elif err.validator in ("pattern", "not") and isinstance(err.instance, str) and path == ():
+        line, col = doc.value_at(path)
+    else:
+        line, col = doc.value_at(path)
+    code = {"type": "S005", "const": "S006", "enum": "S007", "pattern": "S008", "not": "S008",
+            "minItems": "S009", "maxItems": "S009", "minimum": "S010", "maximum": "S010",
+            "exclusiveMinimum": "S010", "minProperties": "S009", "minLength": "S009"}.get(
+                str(err.validator), "S000")
+    message = err.message
+    hint = None
+    if err.validator == "const" and path == ("version",):
+        message = f"unsupported mission format version {err.instance!r}"
+        hint = "this tlmpc reads `version: 1`"
+    elif err.validator in ("pattern", "not"):
+        message = f"{err.instance!r} is not a valid name"
+        hint = "names are identifiers (letters, digits, _) and not LTL keywords " \
+               "(F G X N U R W M V true false)"
+    if err.validator == "propertyNames":
+        return []  # reported by the pattern/not sub-error on the name itself
+    return [error(code, f"{json_path(path)}: {message}", hint=hint, file=file, line=line,
+                  col=col, path=json_path(path))]
+
+
+def _ltl_position(doc: PositionedDocument, path: Path) -> tuple[int, int]:
+    line, col = doc.value_at(path)
+    if doc.quoted.get(path):
+        col += 1
+    if doc.block.get(path):
+        line, col = line + 1, 1  # block scalars start on the next line; indentation is lost
+    return line, col
+
+
+def _check_task(
+    data: Mapping[str, Any], doc: PositionedDocument, file: str, names: set[str],
+    groups: Mapping[str, list[str]],
+) -> tuple[Formula | None, list[Diagnostic]]:
+    problems: list[Diagnostic] = []
+    parts: list[Formula] = []
+    phrases = data.get("task")
+    if isinstance(phrases, list) and phrases and all(isinstance(p, str) for p in phrases):
+        positions = [_ltl_position(doc, ("task", i)) for i in range(len(phrases))]
+        try:
+            parts.append(compile_phrases(phrases, groups=groups, file=file, positions=positions))
+        except InvalidInputError as exc:
+            problems.extend(exc.diagnostics)
+    ltl = data.get("ltl")
+    if isinstance(ltl, str) and ltl.strip():
+        line, col = _ltl_position(doc, ("ltl",))
+        try:
+            parts.append(parse_ltl(ltl, file=file, line=line, col=col))
+        except InvalidInputError as exc:
+            problems.extend(exc.diagnostics)
+    known = sorted(names | set(groups))
+    for part in parts:
+        for node in part.walk():
+            if isinstance(node, Prop) and node.name not in names and node.name not in groups:
+                close = difflib.get_close_matches(node.name, known, n=1, cutoff=0.5)
+                span = node.span
+                problems.append(
+                    error("L010", f"unknown region {node.name!r}",
+                          hint=(f"did you mean {close[0]!r}? " if close else "")
+                          + "regions and groups are declared under `regions:` and `groups:`",
+                          file=file, line=span.line if span else None,
+                          col=span.col if span else None)
+                )
+    if problems or not parts:
+        return None, problems
+    expand: dict[str, Formula] = {
+        g: Or(tuple(Prop(m) for m in members)) if len(members) > 1 else Prop(members[0])
+        for g, members in groups.items()
+    }
+    return substitute(conjoin(parts), expand), []
+
+
+def _shapes(
+    data: Mapping[str, Any], doc: PositionedDocument, file: str
+) -> tuple[CheckedShape | None, list[CheckedShape], dict[str, CheckedShape], list[Diagnostic]]:
+    problems: list[Diagnostic] = []
+    workspace = data.get("workspace") or {}
+    boundary, found = check_shape(workspace.get("boundary"), ("workspace", "boundary"),
+                                  "workspace boundary", file, doc.value_at)
+    problems.extend(found)
+    holes: list[CheckedShape] = []
+    for index, hole in enumerate(workspace.get("holes") or []):
+        checked, found = check_shape(hole, ("workspace", "holes", index), f"hole {index}", file,
+                                     doc.value_at)
+        problems.extend(found)
+        if checked is not None:
+            holes.append(checked)
+    regions: dict[str, CheckedShape] = {}
+    for name, shape in (data.get("regions") or {}).items():
+        checked, found = check_shape(shape, ("regions", name), f"region {name!r}", file,
+                                     doc.value_at)
+        problems.extend(found)
+        if checked is not None:
+            regions[name] = checked
+    return boundary, holes, regions, problems
+
+
+def _groups(data: Mapping[str, Any], doc: PositionedDocument, file: str,
+            names: set[str]) -> tuple[dict[str, list[str]], list[Diagnostic]]:
+    problems: list[Diagnostic] = []
+    groups: dict[str, list[str]] = {}
+    for group, members in (data.get("groups") or {}).items():
+        if group in names:
+            line, col = doc.key_at(("groups", group))
+            problems.append(error("S012", f"{group!r} names both a region and a group",
+                                  hint="rename one of them", file=file, line=line, col=col))
+        for index, member in enumerate(members):
+            if member not in names:
+                line, col = doc.value_at(("groups", group, index))
+                close = difflib.get_close_matches(member, sorted(names), n=1)
+                problems.append(error("S011", f"group {group!r} lists unknown region {member!r}",
+                                      hint=f"did you mean {close[0]!r}?" if close else
+                                      "groups list region names", file=file, line=line,
+                                      col=col))
+        groups[group] = list(dict.fromkeys(members))
+    return groups, problems
+
+
+def _load(text: str, file: str, stem: str) -> tuple[Mission | None, list[Diagnostic]]:
+    doc, problems = load_positioned(text, file)
+    if doc is None:
+        return None, problems
+    if problems:  # non-finite numbers, duplicate keys: the schema would mislead after these
+        return None, problems
+    if not isinstance(doc.data, dict):
+        return None, [error("S005", "a mission must be a mapping of keys to values",
+                                       hint="start the file with `version: 1`", file=file,
+                                       line=1, col=1)]
+    problems.extend(_schema_diagnostics(doc, file))
+    if problems:
+        return None, problems
+    data: dict[str, Any] = doc.data
+    boundary, holes, regions, found = _shapes(data, doc, file)
+    problems.extend(found)
+    robot = data["robot"]
+    start = (float(robot["start"][0]), float(robot["start"][1]))
+    problems.extend(check_layout(boundary, holes, regions, start, ("robot", "start"), file,
+                                 doc.value_at))
+    names = set(data["regions"])
+    groups, found = _groups(data, doc, file, names)
+    problems.extend(found)
+    formula, found = _check_task(data, doc, file, names, groups)
+    problems.extend(found)
+    if problems or boundary is None or formula is None:
+        return None, problems
+    options = data.get("options") or {}
+    defaults = Options()
+    mission = Mission(
+        name=str(data.get("name") or stem),
+        workspace=Workspace(boundary=boundary.points, holes=tuple(h.points for h in holes)),
+        regions=tuple(Region(name=n, polygon=regions[n].points) for n in data["regions"]),
+        robot=Robot(start=start, max_speed=float(robot.get("max_speed", 1.0))),
+        formula=formula,
+        groups={g: tuple(m) for g, m in groups.items()},
+        task=tuple(data.get("task") or ()),
+        ltl=data.get("ltl"),
+        options=Options(
+            min_angle=options.get("min_angle", defaults.min_angle),
+            max_area=options.get("max_area", defaults.max_area),
+            cost=options.get("cost", defaults.cost),
+            beta=float(options.get("beta", defaults.beta)),
+            boundary=options.get("boundary", defaults.boundary),
+        ),
+        source=file,
+    )
+    return mission, []
+
+
+def _read(path: str | FilePath) -> str:
+    file = str(path)
+    try:
+        raw = FilePath(path).read_bytes()
+    except OSError as exc:
+        raise UsageError(error("U001", f"cannot read {file}: {exc.strerror or exc}",
+                               hint="check the path", file=file)) from None
+    if len(raw) > MAX_BYTES:
+        raise UsageError(error("U004", f"{file} is larger than {MAX_BYTES // 2**20} MiB",
+                               file=file))
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise InvalidInputError(error("Y008", f"the file is not UTF-8 text ({exc.reason} at "
+                                      f"byte {exc.start})", hint="save it as UTF-8",
+                                      file=file, line=1, col=1)) from None
+
+
+def check_text(text: str, filename: str = "<string>") -> list[Diagnostic]:
+    """Every problem of the mission ``text`` (empty when valid), best first."""
+    _, problems = _load(text, filename, FilePath(filename).stem)
+    return best_first(problems)
+
+
+def check_file(path: str | FilePath) -> list[Diagnostic]:
+    """Every problem of the mission file at ``path``; raises UsageError if unreadable."""
+    try:
+        text = _read(path)
+    except InvalidInputError as exc:
+        return list(exc.diagnostics)
+    return check_text(text, str(path))
+
+
+def load_mission_text(text: str, filename: str = "<string>") -> Mission:
+    """Load a mission from YAML text; raises InvalidInputError with all the problems."""
+    mission, problems = _load(text, filename, FilePath(filename).stem)
+    if mission is None:
+        raise InvalidInputError(best_first(problems) or [error("S000", "invalid mission",
+                                                               file=filename)])
+    return mission
+
+
+def load_mission(path: str | FilePath) -> Mission:
+    """Load the mission file at ``path`` (UsageError if unreadable, InvalidInputError if bad)."""
+    return load_mission_text(_read(path), str(path))

@@ -1,0 +1,232 @@
+"""Compile task phrases ("visit a then b while avoiding c") to LTL.
+
+Each phrase is parsed with the grammar ``tasks.lark`` and lowered to one formula; the phrases
+of a mission are conjoined.  Props keep spans pointing at the name inside the phrase, so the
+mission loader can report an unknown region exactly where it is written.  The phrase → LTL
+table is in docs/task-phrases.md (a test keeps it true).
+"""
+
+from __future__ import annotations
+
+import difflib
+import functools
+from collections.abc import Mapping, Sequence
+from importlib import resources
+from typing import Any
+
+from lark import Lark, Token, Tree
+from lark.exceptions import LarkError
+
+from tlmpc.errors import Diagnostic, InvalidInputError, error
+from tlmpc.ltl.ast import (
+    And,
+    Eventually,
+    Formula,
+    Globally,
+    Implies,
+    Not,
+    Prop,
+    Span,
+    Until,
+    conjoin,
+    disjoin,
+)
+
+#: The phrase forms, as shown to users when a phrase is not understood.
+KNOWN_PHRASES = (
+    "visit A",
+    "visit A then B then C",
+    "visit A then B then return to C",
+    "visit A, B and C",
+    "visit A then B while avoiding C, D",
+    "visit all GROUP",
+    "visit any GROUP",
+    "visit A infinitely often",
+    "avoid A, B",
+    "never visit A",
+    "avoid A until B",
+    "patrol A, B",
+    "stay in A",
+    "eventually stay in A",
+    "always stay in A",
+    "whenever A, visit B",
+)
+_LEADING_WORDS = ("visit", "avoid", "never", "patrol", "stay", "eventually", "always", "whenever")
+
+
+@functools.cache
+def _parser() -> Lark:
+    grammar = (resources.files("tlmpc.tasks") / "tasks.lark").read_text(encoding="utf-8")
+    return Lark(grammar, parser="earley", ambiguity="resolve", propagate_positions=True)
+
+
+class _Lowering:
+    """Lowers one phrase's parse tree to LTL, keeping name positions."""
+
+    def __init__(
+        self, groups: Mapping[str, Sequence[str]], file: str | None, line: int, col: int
+    ) -> None:
+        self.groups = groups
+        self.file = file
+        self.line = line
+        self.col = col
+        self.problems: list[Diagnostic] = []
+
+    def _where(self, token: Token) -> tuple[int, int]:
+        return self.line, self.col + (token.column or 1) - 1
+
+    def name(self, tree: Tree[Any]) -> Prop:
+        token = tree.children[0]
+        assert isinstance(token, Token)
+        line, col = self._where(token)
+        return Prop(str(token), span=Span(line, col, line, col + len(token)))
+
+    def names(self, tree: Tree[Any]) -> list[Prop]:
+        return [self.name(child) for child in tree.children if isinstance(child, Tree)]
+
+    def group(self, tree: Tree[Any]) -> list[Formula]:
+        prop = self.name(tree)
+        members = self.groups.get(prop.name)
+        if members is None:
+            line, col = self._where(tree.children[0])  # type: ignore[arg-type]
+            close = difflib.get_close_matches(prop.name, list(self.groups), n=1)
+            self.problems.append(
+                error(
+                    "T002",
+                    f"{prop.name!r} is not a group",
+                    hint=(f"did you mean {close[0]!r}? " if close else "")
+                    + "groups are declared under `groups:` in the mission",
+                    file=self.file,
+                    line=line,
+                    col=col,
+                )
+            )
+            return [prop]
+        return [Prop(m, span=prop.span) for m in members]
+
+    def lower(self, tree: Tree[Any]) -> Formula:
+        kind = tree.data
+        children = [c for c in tree.children if isinstance(c, Tree)]
+        if kind == "visit_set":
+            return conjoin([Eventually(p) for p in self.names(children[0])])
+        if kind == "visit_all":
+            return conjoin([Eventually(p) for p in self.group(children[0])])
+        if kind == "visit_any":
+            return Eventually(disjoin(self.group(children[0])))
+        if kind == "visit_often":
+            return conjoin([Globally(Eventually(p)) for p in self.names(children[0])])
+        if kind == "visit_guarded":
+            avoided = self._avoided(children[1])
+            return Until(avoided, self.name(children[0]))
+        if kind == "visit_sequence":
+            return self._sequence(children)
+        if kind == "avoid":
+            return conjoin([Globally(Not(p)) for p in self.names(children[0])])
+        if kind == "avoid_until":
+            avoided = conjoin([Not(p) for p in self.names(children[0])])
+            return Until(avoided, self.name(children[1]))
+        if kind == "patrol":
+            return conjoin([Globally(Eventually(p)) for p in self.names(children[0])])
+        if kind == "stay":
+            return Eventually(Globally(self.name(children[0])))
+        if kind == "always_stay":
+            return Globally(self.name(children[0]))
+        if kind == "whenever":
+            return Globally(Implies(self.name(children[0]), Eventually(self.name(children[1]))))
+        raise ValueError(f"unknown phrase kind {kind}")  # pragma: no cover - grammar is closed
+
+    def _avoided(self, avoiding: Tree[Any]) -> Formula:
+        names_tree = next(c for c in avoiding.children if isinstance(c, Tree))
+        return conjoin([Not(p) for p in self.names(names_tree)])
+
+    def _sequence(self, children: list[Tree[Any]]) -> Formula:
+        avoiding = children[-1] if children[-1].data == "avoiding" else None
+        steps = children[:-1] if avoiding is not None else children
+        targets = [self.name(next(c for c in s.children if isinstance(c, Tree))) for s in steps]
+        ends_with_return = steps[-1].data == "return_step"
+        avoided = self._avoided(avoiding) if avoiding is not None else None
+        # "... then return to X while avoiding C": the avoidance belongs to the return leg
+        # (the paper's "finally, return to p1 while avoiding p2 and p3"); after a plain
+        # sequence it holds until the sequence ends.
+        formula: Formula = targets[-1]
+        if avoided is not None:
+            formula = Until(avoided, formula)
+        else:
+            formula = Eventually(formula)
+        for index in range(len(targets) - 2, -1, -1):
+            inner = And((targets[index], formula))
+            if avoided is not None and not ends_with_return:
+                formula = Until(avoided, inner)
+            else:
+                formula = Eventually(inner)
+        return formula
+
+
+def _unknown_phrase(phrase: str, file: str | None, line: int, col: int, at: int) -> Diagnostic:
+    first = phrase.strip().split(" ", 1)[0].lower() if phrase.strip() else ""
+    close = difflib.get_close_matches(first, _LEADING_WORDS, n=1)
+    hint = "known phrases: " + "; ".join(KNOWN_PHRASES)
+    if close and close[0] != first:
+        hint = f"did you mean {close[0]!r}? " + hint
+    return error(
+        "T001",
+        f"cannot understand the task phrase {phrase!r}",
+        hint=hint,
+        file=file,
+        line=line,
+        col=col + at,
+    )
+
+
+def compile_phrase(
+    phrase: str,
+    *,
+    groups: Mapping[str, Sequence[str]] | None = None,
+    file: str | None = None,
+    line: int = 1,
+    col: int = 1,
+) -> Formula:
+    """Compile one phrase to LTL (raises :class:`InvalidInputError` with T-codes)."""
+    if not isinstance(phrase, str) or not phrase.strip():
+        raise InvalidInputError(
+            error("T001", "empty task phrase", hint="known phrases: " + "; ".join(KNOWN_PHRASES),
+                  file=file, line=line, col=col)
+        )
+    try:
+        tree = _parser().parse(phrase)
+    except LarkError as exc:
+        at = int(getattr(exc, "column", 1) or 1) - 1
+        raise InvalidInputError(_unknown_phrase(phrase, file, line, col, max(at, 0))) from None
+    lowering = _Lowering(groups or {}, file, line, col)
+    formula = lowering.lower(tree.children[0])  # type: ignore[arg-type]
+    if lowering.problems:
+        raise InvalidInputError(lowering.problems)
+    return formula
+
+
+def compile_phrases(
+    phrases: Sequence[str],
+    *,
+    groups: Mapping[str, Sequence[str]] | None = None,
+    file: str | None = None,
+    positions: Sequence[tuple[int, int]] | None = None,
+) -> Formula:
+    """Compile every phrase and conjoin them; report the problems of all phrases at once.
+
+    Args:
+        phrases: the task phrases.
+        groups: group name -> member region names (for ``visit all/any GROUP``).
+        file: the file name for diagnostics.
+        positions: (line, col) where each phrase starts in ``file``.
+    """
+    formulas: list[Formula] = []
+    problems: list[Diagnostic] = []
+    for index, phrase in enumerate(phrases):
+        line, col = positions[index] if positions is not None else (1, 1)
+        try:
+            formulas.append(compile_phrase(phrase, groups=groups, file=file, line=line, col=col))
+        except InvalidInputError as exc:
+            problems.extend(exc.diagnostics)
+    if problems:
+        raise InvalidInputError(problems)
+    return conjoin(formulas)
