@@ -1,6 +1,12 @@
 """Mission files: the format, loading with positions, validation."""
 
-from tlmpc.mission.load import check_file, check_text, load_mission, load_mission_text
+from tlmpc.mission.load import (
+    check_file,
+    check_text,
+    inspect_file,
+    load_mission,
+    load_mission_text,
+)
 from tlmpc.mission.model import Mission, Options, Region, Robot, Workspace
 
 __all__ = [
@@ -11,6 +17,7 @@ __all__ = [
     "Workspace",
     "check_file",
     "check_text",
+    "inspect_file",
     "load_mission",
     "load_mission_text",
 ]

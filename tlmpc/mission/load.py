@@ -269,13 +269,22 @@ def check_text(text: str, filename: str = "<string>") -> list[Diagnostic]:
     return best_first(problems)
 
 
-def check_file(path: str | FilePath) -> list[Diagnostic]:
-    """Every problem of the mission file at ``path``; raises UsageError if unreadable."""
+def inspect_file(path: str | FilePath) -> tuple[Mission | None, list[Diagnostic]]:
+    """The mission at ``path`` (None when invalid) and its problems, best first.
+
+    Raises UsageError when the file cannot be read at all.
+    """
     try:
         text = _read(path)
     except InvalidInputError as exc:
-        return list(exc.diagnostics)
-    return check_text(text, str(path))
+        return None, list(exc.diagnostics)
+    mission, problems = _load(text, str(path), FilePath(path).stem)
+    return mission, best_first(problems)
+
+
+def check_file(path: str | FilePath) -> list[Diagnostic]:
+    """Every problem of the mission file at ``path``; raises UsageError if unreadable."""
+    return inspect_file(path)[1]
 
 
 def load_mission_text(text: str, filename: str = "<string>") -> Mission:

@@ -1,0 +1,153 @@
+"""Stage 3: the transition system D (triangles, adjacency, labels, start, components)."""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+import numpy as np
+import shapely
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
+from shapely.geometry import Polygon as ShapelyPolygon
+
+from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
+from tlmpc.abstraction.triangulate import triangulate
+from tlmpc.errors import Diagnostic, InvalidInputError, error
+from tlmpc.mission.model import Mission
+
+
+def locate(abstraction: Abstraction, point: tuple[float, float]) -> int:
+    """Index of the triangle containing ``point`` (-1 if none); ties go to the lowest index."""
+    return locate_in(abstraction.vertices, abstraction.triangles, point)
+
+
+def locate_in(vertices: FloatArray, triangles: IntArray, point: tuple[float, float]) -> int:
+    """:func:`locate` on raw arrays."""
+    corners = vertices[triangles]
+    a, b, c = corners[:, 0], corners[:, 1], corners[:, 2]
+    p = np.asarray(point, dtype=np.float64)
+
+    def cross(u: FloatArray, v: FloatArray, w: FloatArray) -> FloatArray:
+        return (v[:, 0] - u[:, 0]) * (w[..., 1] - u[:, 1]) - (v[:, 1] - u[:, 1]) * (
+            w[..., 0] - u[:, 0]
+        )
+
+    scale = np.abs(cross(a, b, c))
+    tolerance = -1e-12 * scale
+    inside = (
+        (cross(a, b, p) >= tolerance) & (cross(b, c, p) >= tolerance) & (cross(c, a, p) >= tolerance)
+    )
+    found = np.flatnonzero(inside)
+    return int(found[0]) if len(found) else -1
+
+
+
+def _labels(
+    mission: Mission, vertices: FloatArray, triangles: IntArray
+) -> tuple[IntArray, tuple[tuple[str, ...], ...]]:
+    centroids = vertices[triangles].mean(axis=1)
+    names = [r.name for r in mission.regions]
+    tree = shapely.STRtree([ShapelyPolygon(r.polygon) for r in mission.regions])
+    hits = tree.query(shapely.points(centroids), predicate="within")
+    order = np.lexsort((hits[1], hits[0]))
+    tri_of, region_of = hits[0][order], hits[1][order]
+    letters: dict[tuple[str, ...], int] = {(): 0}
+    letter_of = np.zeros(len(triangles), dtype=np.int64)
+    if len(tri_of):
+        boundaries = np.flatnonzero(np.diff(tri_of)) + 1
+        starts = np.concatenate([[0], boundaries])
+        ends = np.concatenate([boundaries, [len(tri_of)]])
+        for start, end in zip(starts.tolist(), ends.tolist(), strict=True):
+            key = tuple(sorted(names[i] for i in region_of[start:end].tolist()))
+            letter_of[tri_of[start]] = letters.setdefault(key, len(letters))
+    ordered = sorted(letters, key=lambda k: (len(k), k))
+    remap = np.array([0] * len(letters), dtype=np.int64)
+    for new_index, key in enumerate(ordered):
+        remap[letters[key]] = new_index
+    return remap[letter_of], tuple(ordered)
+
+
+def _components(neighbors: IntArray) -> IntArray:
+    count = len(neighbors)
+    rows = np.repeat(np.arange(count), 3)
+    cols = neighbors.reshape(-1)
+    keep = cols >= 0
+    graph = coo_matrix(
+        (np.ones(int(keep.sum()), dtype=np.int8), (rows[keep], cols[keep])), shape=(count, count)
+    )
+    _, labels = connected_components(graph, directed=False)
+    return np.asarray(labels, dtype=np.int64)
+
+
+def build_abstraction(mission: Mission) -> Abstraction:
+    """Triangulate ``mission``'s workspace and build the transition system D."""
+    started = time.perf_counter()
+    vertices, triangles, neighbors = triangulate(mission)
+    letter_of, letters = _labels(mission, vertices, triangles)
+    start = locate_in(vertices, triangles, mission.robot.start)
+    if start < 0:
+        raise InvalidInputError(
+            error("A002", f"the start point {mission.robot.start} is not in the free workspace",
+                  hint="start the robot inside the boundary and outside every hole",
+                  file=mission.source)
+        )
+    component = _components(neighbors)
+    corners = vertices[triangles]
+    angles = _min_angle(corners)
+    for array in (vertices, triangles, neighbors, letter_of, component):
+        array.setflags(write=False)
+    stats: dict[str, Any] = {
+        "vertices": int(len(vertices)),
+        "triangles": int(len(triangles)),
+        "edges": int((neighbors >= 0).sum() // 2),
+        "letters": len(letters),
+        "components": int(component.max() + 1) if len(component) else 0,
+        "min_angle_deg": round(float(angles.min()), 6) if len(angles) else None,
+        "seconds": round(time.perf_counter() - started, 6),
+    }
+    return Abstraction(
+        vertices=vertices,
+        triangles=triangles,
+        neighbors=neighbors,
+        letter_of=letter_of,
+        letters=letters,
+        start=start,
+        component=component,
+        regions={r.name: r.polygon for r in mission.regions},
+        stats=stats,
+    )
+
+
+def _min_angle(corners: FloatArray) -> FloatArray:
+    def angle(p: FloatArray, q: FloatArray, r: FloatArray) -> FloatArray:
+        u, v = q - p, r - p
+        cos = (u * v).sum(axis=1) / (np.linalg.norm(u, axis=1) * np.linalg.norm(v, axis=1))
+        return np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
+
+    a, b, c = corners[:, 0], corners[:, 1], corners[:, 2]
+    return np.minimum(np.minimum(angle(a, b, c), angle(b, c, a)), angle(c, a, b))
+
+
+def abstraction_diagnostics(abstraction: Abstraction, mission: Mission) -> list[Diagnostic]:
+    """Warnings: regions that got no triangle, regions unreachable from the start."""
+    present: dict[str, np.ndarray[Any, Any]] = {}
+    for index, letter in enumerate(abstraction.letters):
+        for name in letter:
+            present.setdefault(name, np.zeros(len(abstraction.letters), dtype=bool))[index] = True
+    start_component = abstraction.component[abstraction.start]
+    problems = []
+    for region in mission.regions:
+        mask = present.get(region.name)
+        if mask is None:
+            problems.append(Diagnostic(code="A010", severity="warning", file=mission.source,
+                                       message=f"region {region.name!r} got no triangle",
+                                       hint="it lies in holes or is too thin to triangulate"))
+            continue
+        triangles = mask[abstraction.letter_of]
+        if not np.any(abstraction.component[triangles] == start_component):
+            problems.append(Diagnostic(code="A011", severity="warning", file=mission.source,
+                                       message=f"region {region.name!r} is not reachable from "
+                                       "the start: holes separate it from the robot",
+                                       hint="open a passage or move the start"))
+    return problems
