@@ -1,0 +1,281 @@
+"""Post-processing of a TGBA: merge parallel edges, trim, SCC pruning, state merging."""
+
+from __future__ import annotations
+
+from collections import defaultdict
+from collections.abc import Sequence
+
+from tlmpc.automata.guards import holds
+from tlmpc.automata.model import Automaton, Edge
+from tlmpc.ltl.ast import TRUE, Formula, disjoin
+
+
+def merge_parallel(edges: Sequence[Edge]) -> list[Edge]:
+    """One edge per (source, target, marks): the disjunction of the guards."""
+    grouped: dict[tuple[int, int, frozenset[int]], list[Formula]] = defaultdict(list)
+    for edge in edges:
+        grouped[(edge.src, edge.dst, edge.marks)].append(edge.guard)
+    merged = []
+    for (src, dst, marks), guards in grouped.items():
+        unique = list(dict.fromkeys(guards))
+        guard = TRUE if TRUE in unique else disjoin(unique)
+        merged.append(Edge(src=src, dst=dst, guard=guard, marks=marks))
+    return merged
+
+
+def sccs(num_states: int, edges: Sequence[Edge], initial: int) -> list[int]:
+    """SCC id of every state reachable from ``initial`` (-1 for unreachable); iterative Tarjan."""
+    succ: list[list[int]] = [[] for _ in range(num_states)]
+    for edge in edges:
+        succ[edge.src].append(edge.dst)
+    index = [-1] * num_states
+    low = [0] * num_states
+    on_stack = [False] * num_states
+    component = [-1] * num_states
+    stack: list[int] = []
+    counter = 0
+    count = 0
+    work: list[tuple[int, int]] = [(initial, 0)]
+    while work:
+        node, child = work.pop()
+        if child == 0:
+            index[node] = low[node] = counter
+            counter += 1
+            stack.append(node)
+            on_stack[node] = True
+        recursed = False
+        for position in range(child, len(succ[node])):
+            target = succ[node][position]
+            if index[target] == -1:
+                work.append((node, position + 1))
+                work.append((target, 0))
+                recursed = True
+                break
+            if on_stack[target]:
+                low[node] = min(low[node], index[target])
+        if recursed:
+            continue
+        if low[node] == index[node]:
+            while True:
+                member = stack.pop()
+                on_stack[member] = False
+                component[member] = count
+                if member == node:
+                    break
+            count += 1
+        if work:
+            parent = work[-1][0]
+            low[parent] = min(low[parent], low[node])
+    return component
+
+
+def trim(automaton: Automaton) -> Automaton:
+    """Keep the states that can reach an accepting cycle; drop marks on acyclic edges."""
+    edges = automaton.edges
+    component = sccs(automaton.num_states, edges, automaton.initial)
+    all_marks = frozenset(range(automaton.num_acc))
+    internal: dict[int, set[int]] = defaultdict(set)
+    cyclic: set[int] = set()
+    for edge in edges:
+        if component[edge.src] >= 0 and component[edge.src] == component[edge.dst]:
+            cyclic.add(component[edge.src])
+            internal[component[edge.src]].update(edge.marks)
+    accepting = {c for c in cyclic if internal[c] >= all_marks}
+    # States that can reach an accepting SCC (backwards search).
+    preds: dict[int, list[int]] = defaultdict(list)
+    for edge in edges:
+        preds[edge.dst].append(edge.src)
+    useful = {s for s in range(automaton.num_states) if component[s] in accepting}
+    frontier = list(useful)
+    while frontier:
+        state = frontier.pop()
+        for source in preds[state]:
+            if source not in useful and component[source] >= 0:
+                useful.add(source)
+                frontier.append(source)
+    kept = [
+        Edge(
+            src=e.src,
+            dst=e.dst,
+            guard=e.guard,
+            marks=e.marks if component[e.src] == component[e.dst] else frozenset(),
+        )
+        for e in edges
+        if e.src in useful and e.dst in useful
+    ]
+    return _renumber(automaton, kept, useful)
+
+
+def _renumber(automaton: Automaton, edges: Sequence[Edge], keep: set[int]) -> Automaton:
+    """Keep ``keep`` states, numbered in breadth-first order from the initial state."""
+    if automaton.initial not in keep:
+        return Automaton(
+            aps=automaton.aps,
+            num_states=1,
+            initial=0,
+            edges=(),
+            num_acc=0,
+            state_names=("false",),
+            formula=automaton.formula,
+            state_based=automaton.state_based,
+        )
+    out: dict[int, list[Edge]] = defaultdict(list)
+    for edge in edges:
+        out[edge.src].append(edge)
+    order = {automaton.initial: 0}
+    queue = [automaton.initial]
+    for state in queue:
+        for edge in sorted(out[state], key=lambda e: (e.dst, sorted(e.marks))):
+            if edge.dst not in order:
+                order[edge.dst] = len(order)
+                queue.append(edge.dst)
+    renumbered = sorted(
+        (
+            Edge(src=order[e.src], dst=order[e.dst], guard=e.guard, marks=e.marks)
+            for e in edges
+            if e.src in order and e.dst in order
+        ),
+        key=lambda e: (e.src, e.dst, sorted(e.marks), str(e.guard)),
+    )
+    names = automaton.state_names
+    new_names = [""] * len(order)
+    for old, new in order.items():
+        new_names[new] = names[old] if old < len(names) else str(old)
+    return Automaton(
+        aps=automaton.aps,
+        num_states=len(order),
+        initial=0,
+        edges=tuple(renumbered),
+        num_acc=automaton.num_acc,
+        state_names=tuple(new_names),
+        formula=automaton.formula,
+        state_based=automaton.state_based,
+    )
+
+
+def _reduce_marks(automaton: Automaton) -> Automaton:
+    """Drop acceptance sets carried by every cycle edge and merge sets used identically."""
+    component = sccs(automaton.num_states, automaton.edges, automaton.initial)
+    cycle_edges = [e for e in automaton.edges if component[e.src] == component[e.dst]]
+    keep: list[int] = []
+    seen: dict[frozenset[int], int] = {}
+    for mark in range(automaton.num_acc):
+        carriers = frozenset(i for i, e in enumerate(cycle_edges) if mark in e.marks)
+        if len(carriers) == len(cycle_edges):
+            continue  # visited by every cycle: no constraint
+        if carriers in seen:
+            continue  # same edges as an earlier set
+        seen[carriers] = mark
+        keep.append(mark)
+    if len(keep) == automaton.num_acc:
+        return automaton
+    new_index = {old: new for new, old in enumerate(keep)}
+    edges = tuple(
+        Edge(
+            src=e.src,
+            dst=e.dst,
+            guard=e.guard,
+            marks=frozenset(new_index[m] for m in e.marks if m in new_index),
+        )
+        for e in automaton.edges
+    )
+    return Automaton(
+        aps=automaton.aps,
+        num_states=automaton.num_states,
+        initial=automaton.initial,
+        edges=edges,
+        num_acc=len(keep),
+        state_names=automaton.state_names,
+        formula=automaton.formula,
+        state_based=automaton.state_based,
+    )
+
+
+def _merge_states(
+    automaton: Automaton, letters: Sequence[frozenset[str]] | None
+) -> Automaton:
+    """Quotient by the coarsest partition where equivalent states have equal signatures."""
+    n = automaton.num_states
+    out: dict[int, list[Edge]] = defaultdict(list)
+    for edge in automaton.edges:
+        out[edge.src].append(edge)
+    enabled: dict[int, frozenset[int]] = {}
+    if letters is not None:
+        for index, edge in enumerate(automaton.edges):
+            enabled[index] = frozenset(
+                i for i, letter in enumerate(letters) if holds(edge.guard, letter)
+            )
+    edge_index = {id(e): i for i, e in enumerate(automaton.edges)}
+    block = [0] * n
+    while True:
+        signatures: dict[object, int] = {}
+        new_block = [0] * n
+        for state in range(n):
+            if letters is not None:
+                per_letter: dict[int, set[tuple[frozenset[int], int]]] = defaultdict(set)
+                for edge in out[state]:
+                    for letter in enabled[edge_index[id(edge)]]:
+                        per_letter[letter].add((edge.marks, block[edge.dst]))
+                signature: object = frozenset((k, frozenset(v)) for k, v in per_letter.items())
+            else:
+                grouped: dict[tuple[frozenset[int], int], set[Formula]] = defaultdict(set)
+                for edge in out[state]:
+                    grouped[(edge.marks, block[edge.dst])].add(edge.guard)
+                signature = frozenset((k, frozenset(v)) for k, v in grouped.items())
+            key = (block[state], signature)
+            new_block[state] = signatures.setdefault(key, len(signatures))
+        if len(set(new_block)) == len(set(block)):
+            break
+        block = new_block
+    if len(set(block)) == n:
+        return automaton
+    representative: dict[int, int] = {}
+    for state in range(n):
+        representative.setdefault(block[state], state)
+    keep = set(representative.values())
+    edges = merge_parallel(
+        [
+            Edge(
+                src=e.src,
+                dst=representative[block[e.dst]],
+                guard=e.guard,
+                marks=e.marks,
+            )
+            for e in automaton.edges
+            if e.src in keep
+        ]
+    )
+    initial_rep = representative[block[automaton.initial]]
+    merged = Automaton(
+        aps=automaton.aps,
+        num_states=n,
+        initial=initial_rep,
+        edges=tuple(edges),
+        num_acc=automaton.num_acc,
+        state_names=automaton.state_names,
+        formula=automaton.formula,
+        state_based=automaton.state_based,
+    )
+    return _renumber(merged, merged.edges, keep)
+
+
+def postprocess(automaton: Automaton, letters: Sequence[frozenset[str]] | None) -> Automaton:
+    """Trim, prune SCCs, reduce acceptance sets and merge equivalent states (to a fixpoint)."""
+    current = Automaton(
+        aps=automaton.aps,
+        num_states=automaton.num_states,
+        initial=automaton.initial,
+        edges=tuple(merge_parallel(automaton.edges)),
+        num_acc=automaton.num_acc,
+        state_names=automaton.state_names,
+        formula=automaton.formula,
+        state_based=automaton.state_based,
+    )
+    for _ in range(8):
+        before = (current.num_states, len(current.edges), current.num_acc)
+        current = trim(current)
+        current = _reduce_marks(current)
+        current = _merge_states(current, letters)
+        if (current.num_states, len(current.edges), current.num_acc) == before:
+            break
+    return current
