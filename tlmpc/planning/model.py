@@ -9,8 +9,9 @@ a *stay*: the robot converges to a point inside it.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Literal
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any, Literal
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -27,6 +28,7 @@ class Witness:
     beta: float
     prefix_cost: float
     cycle_cost: float
+    stats: Mapping[str, Any] = field(default_factory=dict)
 
     @property
     def is_stay(self) -> bool:

@@ -1,0 +1,178 @@
+"""Stage 5: a minimum-cost accepting lasso of D × A, or an explanation of why none exists.
+
+Cost of a lasso = prefix + beta * cycle.  Automata with two or more acceptance sets are
+degeneralized first, so every search below handles one set (see docs/planning.md for the
+optimality statement).  Two kinds of cycles are considered:
+
+* a *stay*: the robot converges inside one triangle whose stutter loop is accepting (cost 0);
+* a *moving cycle* through an accepting product edge ``u -> v``: one Dijkstra from the
+  initial nodes gives every prefix cost d0(u); candidates are taken in increasing order of the
+  lower bound d0(u) + beta * w(u, v), each closed by a Dijkstra from v back to u, and the
+  search stops when the bound reaches the best lasso found.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+import numpy as np
+from scipy.sparse.csgraph import dijkstra
+
+from tlmpc.abstraction.model import Abstraction, IntArray
+from tlmpc.automata.degeneralize import degeneralize
+from tlmpc.automata.model import Automaton
+from tlmpc.errors import NoPlanError
+from tlmpc.ltl.ast import Formula
+from tlmpc.mission.model import Options
+from tlmpc.planning.explain import explain_no_plan, invariant_mask
+from tlmpc.planning.model import Witness
+from tlmpc.planning.product import SLOTS, Product, build_product
+
+#: At most this many cycle candidates are closed with a Dijkstra search; past it the
+#: witness is the best found and records ``optimal: false``.
+MAX_CYCLE_SEARCHES = 40
+
+
+def _path(predecessors: IntArray, target: int) -> list[int]:
+    path = [target]
+    while predecessors[path[-1]] >= 0:
+        path.append(int(predecessors[path[-1]]))
+    path.reverse()
+    return path
+
+
+def _collapse(nodes: list[int], nq: int) -> tuple[list[int], list[int]]:
+    """Triangles of a product path with stutter steps merged, and the automaton state after
+    reading each triangle (the last one of its stutter group)."""
+    triangles: list[int] = []
+    states: list[int] = []
+    for node in nodes:
+        tri = (node // nq) // SLOTS
+        q = node % nq
+        if triangles and triangles[-1] == tri:
+            states[-1] = q
+        else:
+            triangles.append(tri)
+            states.append(q)
+    return triangles, states
+
+
+def _path_cost(product: Product, nodes: list[int]) -> float:
+    graph = product.graph
+    return float(sum(graph[a, b] for a, b in zip(nodes, nodes[1:], strict=False)))
+
+
+def plan(
+    abstraction: Abstraction,
+    automaton: Automaton,
+    *,
+    formula: Formula,
+    options: Options,
+    start_point: tuple[float, float] | None = None,
+) -> Witness:
+    """A minimum-cost accepting lasso (raises :class:`NoPlanError` with an explanation)."""
+    started = time.perf_counter()
+    allowed = invariant_mask(abstraction, formula)
+    working = degeneralize(automaton) if automaton.num_acc >= 2 else automaton
+    if start_point is None:
+        start_point = tuple(abstraction.corners(abstraction.start).mean(axis=0).tolist())  # type: ignore[assignment]
+    assert start_point is not None
+    product = build_product(
+        abstraction, working, allowed=allowed, start_point=start_point, metric=options.cost
+    )
+    nq = product.num_automaton_states
+    if len(product.initial) == 0 or not working.edges:
+        raise NoPlanError(explain_no_plan(abstraction, automaton, formula, allowed))
+    dist, pred, _ = dijkstra(
+        product.graph, indices=product.initial, min_only=True, return_predecessors=True
+    )
+    best: tuple[float, list[int], list[int]] | None = None  # cost, prefix nodes, cycle nodes
+    # Stays: an accepting stutter loop.
+    stay_nodes = np.flatnonzero(product.stutter_accepting & np.isfinite(dist))
+    if len(stay_nodes):
+        goal = int(stay_nodes[np.argmin(dist[stay_nodes])])
+        best = (float(dist[goal]), _path(pred, goal), [goal])
+    # Moving cycles through accepting edges.
+    acc = product.accepting.tocoo()
+    us, vs = acc.row.astype(np.int64), acc.col.astype(np.int64)
+    reachable = np.isfinite(dist[us])
+    us, vs = us[reachable], vs[reachable]
+    searches = 0
+    exhausted = True
+    if len(us):
+        edge_w = np.asarray(product.graph[us, vs]).ravel()
+        bound = dist[us] + options.beta * edge_w
+        order = np.argsort(bound, kind="stable")
+        for index in order.tolist():
+            if best is not None and bound[index] >= best[0]:
+                break
+            v = int(vs[index])
+            u = int(us[index])
+            if searches >= MAX_CYCLE_SEARCHES:
+                exhausted = False
+                break
+            searches += 1
+            limit = np.inf if best is None else (best[0] - bound[index]) / max(options.beta, 1e-12)
+            back, back_pred = dijkstra(
+                product.graph, indices=v, return_predecessors=True, limit=limit
+            )
+            if not np.isfinite(back[u]):
+                continue
+            total = float(dist[u] + options.beta * (edge_w[index] + back[u]))
+            if best is None or total < best[0] - 1e-12:
+                back_path = _path(back_pred, u)  # v, ..., u
+                best = (total, _path(pred, u), [u, *back_path[:-1]])
+    if best is None:
+        raise NoPlanError(explain_no_plan(abstraction, automaton, formula, allowed))
+    return _witness(
+        abstraction, product, best, options, started, searches, exhausted, working
+    )
+
+
+def _witness(
+    abstraction: Abstraction,
+    product: Product,
+    best: tuple[float, list[int], list[int]],
+    options: Options,
+    started: float,
+    searches: int,
+    exhausted: bool,
+    automaton: Automaton,
+) -> Witness:
+    _, prefix_nodes, cycle_nodes = best
+    nq = product.num_automaton_states
+    anchor = cycle_nodes[0]
+    # prefix_nodes ends at the anchor; the cycle starts at the anchor's triangle.
+    prefix_tris, prefix_states = _collapse(prefix_nodes, nq)
+    cycle_tris, cycle_states = _collapse(cycle_nodes, nq)
+    anchor_tri = (anchor // nq) // SLOTS
+    # Drop the anchor's own triangle from the prefix: it opens the cycle.
+    if prefix_tris and prefix_tris[-1] == anchor_tri:
+        prefix_tris, prefix_states = prefix_tris[:-1], prefix_states[:-1]
+    # A moving cycle whose last triangle equals its first (stutter at the anchor) is merged.
+    if len(cycle_tris) > 1 and cycle_tris[-1] == cycle_tris[0]:
+        cycle_tris, cycle_states = cycle_tris[:-1], cycle_states[:-1]
+    prefix_cost = _path_cost(product, prefix_nodes)
+    cycle_cost = 0.0 if len(cycle_nodes) == 1 else _path_cost(product, [*cycle_nodes, anchor])
+    stats: dict[str, Any] = {
+        "product_nodes": product.num_nodes,
+        "product_edges": int(product.graph.nnz),
+        "cycle_searches": searches,
+        "optimal": exhausted,
+        "automaton_states": automaton.num_states,
+        "seconds": round(time.perf_counter() - started, 6),
+    }
+    return Witness(
+        prefix=tuple(prefix_tris),
+        cycle=tuple(cycle_tris),
+        prefix_states=tuple(prefix_states),
+        cycle_states=tuple(cycle_states),
+        word=tuple(abstraction.labels(t) for t in (*prefix_tris, *cycle_tris)),
+        cost=prefix_cost + options.beta * cycle_cost,
+        metric=options.cost,
+        beta=options.beta,
+        prefix_cost=prefix_cost,
+        cycle_cost=cycle_cost,
+        stats=stats,
+    )
