@@ -25,7 +25,7 @@ if TYPE_CHECKING:
     from tlmpc.errors import Diagnostic
     from tlmpc.mission.model import Mission
     from tlmpc.planning.model import Witness
-    from tlmpc.simulate.model import Trace
+    from tlmpc.simulate.exact import Trace
     from tlmpc.verify.model import Verdict
 
 

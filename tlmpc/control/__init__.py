@@ -1,1 +1,7 @@
-"""control stage."""
+"""Stage 6: affine feedback controllers per plan step (vertex second-order-cone programs)."""
+
+from tlmpc.control.io import controllers_to_json
+from tlmpc.control.model import Controllers, StepController, VelocityJump
+from tlmpc.control.synthesize import synthesize
+
+__all__ = ["Controllers", "StepController", "VelocityJump", "controllers_to_json", "synthesize"]

@@ -1,0 +1,70 @@
+"""Triangle geometry for the controllers: facets, outward normals, heights, barycentrics.
+
+Facet ``i`` is the edge opposite vertex ``i`` (the same convention as ``neighbors``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from tlmpc.abstraction.model import FloatArray
+
+
+@dataclass(frozen=True, slots=True)
+class TriangleGeometry:
+    """Outward unit normals ``n[i]``, offsets ``c[i]`` (n_i·x = c_i on facet i), heights."""
+
+    vertices: FloatArray  # (3, 2) counter-clockwise
+    normals: FloatArray  # (3, 2)
+    offsets: FloatArray  # (3,)
+    heights: FloatArray  # (3,)
+
+    def barycentric(self, point: FloatArray) -> FloatArray:
+        """λ_i(x) = (c_i - n_i·x) / h_i; they sum to one."""
+        return (self.offsets - self.normals @ point) / self.heights
+
+    def incenter(self) -> FloatArray:
+        """The point farthest from the three edges."""
+        lengths = np.array(
+            [np.linalg.norm(self.vertices[(i + 1) % 3] - self.vertices[(i + 2) % 3])
+             for i in range(3)]
+        )
+        return (lengths[:, None] * self.vertices).sum(axis=0) / lengths.sum()  # type: ignore[no-any-return]
+
+
+def triangle_geometry(vertices: FloatArray) -> TriangleGeometry:
+    """Geometry of a counter-clockwise triangle."""
+    v = np.asarray(vertices, dtype=np.float64)
+    normals = np.empty((3, 2))
+    offsets = np.empty(3)
+    heights = np.empty(3)
+    for i in range(3):
+        a, b = v[(i + 1) % 3], v[(i + 2) % 3]
+        edge = b - a
+        normal = np.array([edge[1], -edge[0]])  # outward for a counter-clockwise triangle
+        normal /= np.linalg.norm(normal)
+        normals[i] = normal
+        offsets[i] = normal @ a
+        heights[i] = offsets[i] - normal @ v[i]
+    return TriangleGeometry(vertices=v, normals=normals, offsets=offsets, heights=heights)
+
+
+def affine_law(vertices: FloatArray, velocities: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """K, g with K v_i + g = w_i for the three vertices (the unique affine interpolant)."""
+    system = np.hstack([vertices, np.ones((3, 1))])
+    solution = np.linalg.solve(system, velocities)  # rows: K^T (2 rows), g^T
+    return solution[:2].T.copy(), solution[2].copy()
+
+
+def half_plane_feasible(normals: list[FloatArray]) -> bool:
+    """True when some w has a·w > 0 for every a in ``normals`` (cones intersect).
+
+    The normals must fit in an open half-plane: their directions span less than 180°.
+    """
+    if len(normals) <= 1:
+        return True
+    angles = np.sort(np.array([np.arctan2(a[1], a[0]) for a in normals]))
+    gaps = np.diff(np.concatenate([angles, [angles[0] + 2 * np.pi]]))
+    return bool(gaps.max() > np.pi + 1e-9)

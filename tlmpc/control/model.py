@@ -1,0 +1,54 @@
+"""Controllers (stage 6 output): one affine feedback law u = Kx + g per plan step."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+from tlmpc.abstraction.model import FloatArray
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class StepController:
+    """The field used while the plan is at ``step``: in ``triangle``, leaving by ``exit_edge``.
+
+    ``exit_edge`` is the index of the facet opposite that vertex (None for a stay, which
+    converges to ``target``).  ``exit_speed`` is the guaranteed speed across the exit edge
+    (for a stay: the guaranteed inward speed on every edge); ``exit_time_bound`` bounds the
+    time to leave from any point of the closed triangle.
+    """
+
+    step: int
+    triangle: int
+    exit_edge: int | None
+    next_triangle: int | None
+    vertices: FloatArray = field(compare=False)  # (3, 2)
+    velocities: FloatArray = field(compare=False)  # (3, 2), at the vertices
+    gain: FloatArray = field(compare=False)  # K (2, 2)
+    offset: FloatArray = field(compare=False)  # g (2,)
+    exit_speed: float
+    exit_time_bound: float
+    target: tuple[float, float] | None = None
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class VelocityJump:
+    """A vertex where the field is discontinuous between two consecutive steps, and why."""
+
+    step: int
+    vertex: int
+    position: tuple[float, float]
+    reason: str
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Controllers:
+    """Every step's controller; ``loop_start`` is the first step of a moving cycle."""
+
+    steps: tuple[StepController, ...]
+    loop_start: int | None
+    max_speed: float
+    margin: float
+    jumps: tuple[VelocityJump, ...] = ()
+    stats: Mapping[str, Any] = field(default_factory=dict)

@@ -1,0 +1,289 @@
+"""Stage 6: affine feedback fields per plan step (Belta–Isler–Pappas vertex programs).
+
+Every plan step is a triangle and the edge to leave it by.  The vertex velocities w_i of a
+step must (1) keep the two other facets invariant with a margin, n_j·w_i <= -margin * s,
+(2) push across the exit facet, n_e·w_i >= s for all three vertices (then every state of the
+closed triangle leaves through the exit edge in finite time), and (3) respect the speed
+bound exactly, |w_i| <= max_speed (second-order cones).  The field inside the triangle is
+the affine interpolation of the w_i, so the bound holds everywhere.
+
+Continuity: a vertex shared by consecutive steps keeps one velocity for as long as the
+constraints it collects stay compatible (their normals fit in an open half-plane: a fan of
+less than 180°); otherwise the velocity jumps there, which is reported.  All steps are one
+second-order-cone program solved once by Clarabel through cvxpy.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+
+from tlmpc.abstraction.model import Abstraction, FloatArray
+from tlmpc.control.geometry import (
+    TriangleGeometry,
+    affine_law,
+    half_plane_feasible,
+    triangle_geometry,
+)
+from tlmpc.control.model import Controllers, StepController, VelocityJump
+from tlmpc.errors import InvalidInputError, SolverError, error
+from tlmpc.mission.model import Robot
+from tlmpc.planning.model import Witness
+
+#: Invariance margin: non-exit facets are pushed inward at least MARGIN times the exit speed.
+MARGIN = 0.3
+
+
+@dataclass(slots=True)
+class _Step:
+    triangle: int
+    exit_edge: int | None
+    next_triangle: int | None
+    geometry: TriangleGeometry
+    runs: list[int] = field(default_factory=list)  # run id per local vertex
+
+
+def plan_steps(abstraction: Abstraction, witness: Witness) -> tuple[list[_Step], int | None]:
+    """The (triangle, exit edge) steps of the lasso, and the first step of a moving cycle."""
+    path = [*witness.prefix, *witness.cycle]
+    stay = witness.is_stay
+    steps: list[_Step] = []
+    for index, tri in enumerate(path):
+        if stay and index == len(path) - 1:
+            nxt = None
+        elif index + 1 < len(path):
+            nxt = path[index + 1]
+        else:
+            nxt = witness.cycle[0]
+        exit_edge = None
+        if nxt is not None:
+            matches = np.flatnonzero(abstraction.neighbors[tri] == nxt)
+            if len(matches) != 1:
+                raise InvalidInputError(
+                    error("C001", f"plan step {index}: triangles {tri} and {nxt} are not "
+                          "adjacent", hint="the witness does not belong to this abstraction")
+                )
+            exit_edge = int(matches[0])
+            entries = {path[index - 1]} if index > 0 else set()
+            if not stay and index == len(witness.prefix):
+                entries.add(witness.cycle[-1])  # later laps enter from the cycle's end
+            if nxt in entries:
+                raise InvalidInputError(
+                    error("C002", f"plan step {index} bounces: it enters triangle {tri} from "
+                          f"{nxt} and leaves back to {nxt}",
+                          hint="an affine field cannot leave a triangle through its entry edge")
+                )
+        geometry = triangle_geometry(abstraction.corners(tri))
+        steps.append(_Step(tri, exit_edge, nxt, geometry))
+    loop_start = None if stay else len(witness.prefix)
+    return steps, loop_start
+
+
+def _normals(step: _Step, local: int) -> list[tuple[FloatArray, float]]:
+    """(a, c) pairs meaning a·w >= c·s for the velocity at local vertex ``local``."""
+    geometry = step.geometry
+    rows: list[tuple[FloatArray, float]] = []
+    for facet in range(3):
+        if facet == local:
+            continue  # the vertex is not on the facet opposite it
+        if facet == step.exit_edge:
+            continue
+        rows.append((-geometry.normals[facet], MARGIN))
+    if step.exit_edge is not None:
+        rows.append((geometry.normals[step.exit_edge], 1.0))
+    return rows
+
+
+class _Runs:
+    """Union-find over (vertex, run) variables with the constraint normals each collects."""
+
+    def __init__(self) -> None:
+        self.parent: list[int] = []
+        self.normals: list[list[FloatArray]] = []
+
+    def new(self, normals: list[FloatArray]) -> int:
+        self.parent.append(len(self.parent))
+        self.normals.append(list(normals))
+        return len(self.parent) - 1
+
+    def find(self, run: int) -> int:
+        while self.parent[run] != run:
+            self.parent[run] = self.parent[self.parent[run]]
+            run = self.parent[run]
+        return run
+
+    def try_extend(self, run: int, normals: list[FloatArray]) -> bool:
+        root = self.find(run)
+        if half_plane_feasible(self.normals[root] + normals):
+            self.normals[root].extend(normals)
+            return True
+        return False
+
+    def try_merge(self, first: int, second: int) -> bool:
+        a, b = self.find(first), self.find(second)
+        if a == b:
+            return True
+        if not half_plane_feasible(self.normals[a] + self.normals[b]):
+            return False
+        self.parent[b] = a
+        self.normals[a].extend(self.normals[b])
+        return True
+
+
+def _assign_runs(
+    abstraction: Abstraction, steps: list[_Step], loop_start: int | None
+) -> tuple[_Runs, list[VelocityJump]]:
+    runs = _Runs()
+    jumps: list[VelocityJump] = []
+    previous: dict[int, int] = {}  # global vertex -> run id at the previous step
+    for index, step in enumerate(steps):
+        vertices = abstraction.triangles[step.triangle].tolist()
+        current: dict[int, int] = {}
+        for local, vertex in enumerate(vertices):
+            normals = [a for a, _ in _normals(step, local)]
+            run = previous.get(vertex)
+            reason = None
+            if run is not None and step.exit_edge is None:
+                reason = "the stay field has its own vertex velocities"
+            elif run is not None and not runs.try_extend(run, normals):
+                reason = "the path turns 180° or more around this vertex"
+            if run is None or reason is not None:
+                if reason is not None:
+                    x, y = abstraction.vertices[vertex].tolist()
+                    jumps.append(VelocityJump(step=index, vertex=vertex, position=(x, y),
+                                              reason=reason))
+                run = runs.new(normals)
+            current[vertex] = run
+            step.runs.append(run)
+        previous = current
+    if loop_start is not None:
+        first = steps[loop_start]
+        first_vertices = abstraction.triangles[first.triangle].tolist()
+        for local, vertex in enumerate(first_vertices):
+            if vertex in previous and not runs.try_merge(previous[vertex], first.runs[local]):
+                x, y = abstraction.vertices[vertex].tolist()
+                jumps.append(VelocityJump(step=loop_start, vertex=vertex, position=(x, y),
+                                          reason="the cycle turns 180° or more around this "
+                                          "vertex"))
+    for step in steps:
+        step.runs = [runs.find(r) for r in step.runs]
+    return runs, jumps
+
+
+def _solve(steps: list[_Step], max_speed: float) -> tuple[FloatArray, FloatArray]:
+    """Velocities per run (R, 2) and guaranteed speeds per step (N,)."""
+    import cvxpy as cp
+
+    roots = sorted({r for step in steps for r in step.runs})
+    column = {r: i for i, r in enumerate(roots)}
+    count, n_steps = len(roots), len(steps)
+    rows, cols, vals = [], [], []
+    eq_rows, eq_cols, eq_vals = [], [], []
+    row = eq_row = 0
+    for k, step in enumerate(steps):
+        for local, run in enumerate(step.runs):
+            base = 2 * column[run]
+            for normal, coefficient in _normals(step, local):
+                rows += [row, row, row]
+                cols += [base, base + 1, 2 * count + k]
+                vals += [normal[0], normal[1], -coefficient]
+                row += 1
+        if step.exit_edge is None:
+            weights = step.geometry.barycentric(step.geometry.incenter())
+            for dim in range(2):
+                for local, run in enumerate(step.runs):
+                    eq_rows.append(eq_row)
+                    eq_cols.append(2 * column[run] + dim)
+                    eq_vals.append(weights[local])
+                eq_row += 1
+    size = 2 * count + n_steps
+    inequality = sp.csr_matrix((vals, (rows, cols)), shape=(row, size))
+    z = cp.Variable(size)
+    floor = cp.Variable()
+    velocities = cp.reshape(z[: 2 * count], (count, 2), order="C")
+    speeds = z[2 * count:]
+    constraints = [
+        inequality @ z >= 0,
+        cp.norm(velocities, 2, axis=1) <= max_speed,
+        speeds >= floor,
+    ]
+    if eq_row:
+        equality = sp.csr_matrix((eq_vals, (eq_rows, eq_cols)), shape=(eq_row, size))
+        constraints.append(equality @ z == 0)
+    problem = cp.Problem(cp.Maximize(floor + 0.1 * cp.sum(speeds) / n_steps), constraints)
+    try:
+        problem.solve(solver=cp.CLARABEL)
+    except cp.error.SolverError as exc:
+        raise SolverError(error("C003", f"the controller program failed: {exc}",
+                                hint="please report this mission")) from None
+    if problem.status not in ("optimal", "optimal_inaccurate") or z.value is None:
+        raise SolverError(error("C003", f"the controller program is {problem.status}",
+                                hint="please report this mission"))
+    values = np.asarray(z.value, dtype=np.float64)
+    return values[: 2 * count].reshape(count, 2), values[2 * count:]
+
+
+def synthesize(abstraction: Abstraction, witness: Witness, robot: Robot) -> Controllers:
+    """One affine field per plan step realising ``witness`` under ``robot.max_speed``."""
+    started = time.perf_counter()
+    steps, loop_start = plan_steps(abstraction, witness)
+    _, jumps = _assign_runs(abstraction, steps, loop_start)
+    built = time.perf_counter()
+    velocities, _ = _solve(steps, robot.max_speed)
+    solved = time.perf_counter()
+    roots = sorted({r for step in steps for r in step.runs})
+    column = {r: i for i, r in enumerate(roots)}
+    controllers = []
+    for index, step in enumerate(steps):
+        w = np.array([velocities[column[r]] for r in step.runs])
+        geometry = step.geometry
+        target = None
+        if step.exit_edge is None:
+            center = geometry.incenter()
+            gain, offset = affine_law(geometry.vertices, w)
+            inward = min(-geometry.normals[j] @ w[i] for i in range(3) for j in range(3)
+                         if j != i)
+            if inward <= 0 or np.max(np.linalg.eigvals(gain).real) >= 0:
+                # The program's optimum is degenerate here: use the radial field to x*.
+                kappa = robot.max_speed / max(np.linalg.norm(center - v)
+                                              for v in geometry.vertices)
+                w = kappa * (center - geometry.vertices)
+                inward = min(-geometry.normals[j] @ w[i] for i in range(3) for j in range(3)
+                             if j != i)
+            gain, offset = affine_law(geometry.vertices, w)
+            speed, bound = float(inward), float("inf")
+            target = (float(center[0]), float(center[1]))
+        else:
+            gain, offset = affine_law(geometry.vertices, w)
+            delta = float(min(geometry.normals[step.exit_edge] @ w[i] for i in range(3)))
+            speed = delta
+            bound = float(geometry.heights[step.exit_edge] / delta) if delta > 0 else float("inf")
+        controllers.append(
+            StepController(
+                step=index, triangle=step.triangle, exit_edge=step.exit_edge,
+                next_triangle=step.next_triangle, vertices=geometry.vertices, velocities=w,
+                gain=gain, offset=offset, exit_speed=speed, exit_time_bound=bound,
+                target=target,
+            )
+        )
+    if any(c.exit_speed <= 0 for c in controllers):
+        worst = min(controllers, key=lambda c: c.exit_speed)
+        raise SolverError(error("C004", f"plan step {worst.step} has no positive exit speed",
+                                hint="the triangle may be degenerate; raise options.min_angle"))
+    return Controllers(
+        steps=tuple(controllers),
+        loop_start=loop_start,
+        max_speed=robot.max_speed,
+        margin=MARGIN,
+        jumps=tuple(jumps),
+        stats={
+            "steps": len(controllers),
+            "variables": 2 * len(roots) + len(controllers),
+            "prepare_seconds": round(built - started, 6),
+            "solve_seconds": round(solved - built, 6),
+            "min_exit_speed": min(c.exit_speed for c in controllers),
+        },
+    )

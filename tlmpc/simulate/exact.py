@@ -1,0 +1,199 @@
+"""Stage 7: the exact closed-loop trajectory of the plan's affine fields.
+
+Within a step, x' = Kx + g is solved exactly with the matrix exponential of the augmented
+matrix M = [[K, g], [0, 0]]: [x(t); 1] = expm(tM) [x0; 1].  The exit time is the first root of
+h(t) = n_e·x(t) - c_e, bracketed on a grid (h grows at least at the guaranteed exit speed
+inside the triangle, so the root comes before the exit-time bound) and refined with brentq;
+the exit point is snapped onto the exit edge.  Samples: every edge crossing plus evenly
+spaced points per step.  A lasso's cycle is simulated twice; the second lap is the loop.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.linalg import expm
+from scipy.optimize import brentq
+
+from tlmpc.abstraction.model import Abstraction, FloatArray
+from tlmpc.control.geometry import triangle_geometry
+from tlmpc.control.model import Controllers, StepController
+from tlmpc.errors import SolverError, error
+from tlmpc.mission.model import Mission
+
+#: Evenly spaced samples per step (besides the crossings).
+SAMPLES_PER_STEP = 8
+#: A stay is simulated until the distance to its target shrinks by this factor.
+STAY_CONTRACTION = 1e-6
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Trace:
+    """Samples ``(t, x, y)``, the plan step and triangle of each, and the loop's start."""
+
+    times: FloatArray = field(compare=False)
+    points: FloatArray = field(compare=False)  # (n, 2)
+    steps: tuple[int, ...]
+    triangles: tuple[int, ...]
+    loop_start: int | None
+    crossings: tuple[int, ...] = ()
+
+
+def _augmented(controller: StepController) -> FloatArray:
+    matrix = np.zeros((3, 3))
+    matrix[:2, :2] = controller.gain
+    matrix[:2, 2] = controller.offset
+    return matrix
+
+
+def _flow(matrix: FloatArray, x0: FloatArray, t: float) -> FloatArray:
+    return (expm(t * matrix) @ np.array([x0[0], x0[1], 1.0]))[:2]  # type: ignore[no-any-return]
+
+
+def _exit_step(controller: StepController, x0: FloatArray) -> tuple[list[float], list[FloatArray]]:
+    """Times and points of one exit step, ending with the crossing (snapped to the edge)."""
+    assert controller.exit_edge is not None
+    geometry = triangle_geometry(controller.vertices)
+    normal = geometry.normals[controller.exit_edge]
+    offset = geometry.offsets[controller.exit_edge]
+    matrix = _augmented(controller)
+    gap = offset - normal @ x0
+    horizon = max(gap, 0.0) / controller.exit_speed
+    if horizon <= 0.0:
+        return [0.0], [x0]
+    grid = max(32, int(math.ceil(horizon * np.linalg.norm(controller.gain, 2) * 10)))
+    grid = min(grid, 4096)
+    dt = horizon * 1.02 / grid
+    step_matrix = expm(dt * matrix)
+    state = np.array([x0[0], x0[1], 1.0])
+    previous_t, previous_h = 0.0, float(normal @ x0 - offset)
+    crossing = None
+    for j in range(1, grid + 1):
+        state = step_matrix @ state
+        h = float(normal @ state[:2] - offset)
+        if h >= 0.0:
+            crossing = brentq(
+                lambda t: float(normal @ _flow(matrix, x0, t) - offset),
+                previous_t,
+                j * dt,
+                xtol=1e-14,
+                rtol=1e-14,
+            )
+            break
+        previous_t, previous_h = j * dt, h
+    if crossing is None:
+        raise SolverError(error("C010", f"plan step {controller.step}: the trajectory did not "
+                                "leave its triangle within the exit-time bound",
+                                hint="please report this mission"))
+    del previous_h
+    times = [float(t) for t in np.linspace(0.0, crossing, SAMPLES_PER_STEP + 1)[1:-1]]
+    points = [_flow(matrix, x0, t) for t in times]
+    end = _flow(matrix, x0, crossing)
+    # Snap onto the exit edge (the root is exact to ~1e-14; this removes the residue).
+    a = geometry.vertices[(controller.exit_edge + 1) % 3]
+    b = geometry.vertices[(controller.exit_edge + 2) % 3]
+    along = float(np.clip((end - a) @ (b - a) / ((b - a) @ (b - a)), 0.0, 1.0))
+    end = a + along * (b - a)
+    return [*times, float(crossing)], [*points, end]
+
+
+def _stay_step(controller: StepController, x0: FloatArray,
+               max_speed: float) -> tuple[list[float], list[FloatArray]]:
+    """Convergence to the target: samples on a geometric time grid, then the limit point."""
+    assert controller.target is not None
+    target = np.asarray(controller.target)
+    rate = -float(np.max(np.linalg.eigvals(controller.gain).real))
+    if rate <= 0:
+        raise SolverError(error("C011", f"plan step {controller.step}: the stay field does not "
+                                "converge", hint="please report this mission"))
+    horizon = math.log(1.0 / STAY_CONTRACTION) / rate
+    times = [float(t) for t in horizon * (np.geomspace(1.0, 1001.0, 4 * SAMPLES_PER_STEP) - 1.0)
+             / 1000.0][1:]
+    points = [target + expm(t * controller.gain) @ (x0 - target) for t in times]
+    # The limit point itself, reached "at infinity": placed after the last sample at a time
+    # that keeps the stated speed bound.
+    last = points[-1]
+    times.append(times[-1] + max(float(np.linalg.norm(last - target)) / max_speed, 1e-9) + 1e-9)
+    points.append(target)
+    return times, points
+
+
+def simulate(abstraction: Abstraction, controllers: Controllers, mission: Mission) -> Trace:
+    """The trajectory from ``mission.robot.start`` under ``controllers``."""
+    del abstraction  # the controllers carry their triangles' geometry
+    steps = list(controllers.steps)
+    order = list(range(len(steps)))
+    loop_start_step = controllers.loop_start
+    if loop_start_step is not None:
+        cycle = order[loop_start_step:]
+        order = [*order, *cycle]  # the cycle twice
+    x = np.asarray(mission.robot.start, dtype=np.float64)
+    times: list[float] = [0.0]
+    points: list[FloatArray] = [x]
+    step_of: list[int] = [order[0]]
+    triangle_of: list[int] = [steps[order[0]].triangle]
+    crossings: list[int] = []
+    loop_index: int | None = None
+    now = 0.0
+    for position, index in enumerate(order):
+        controller = steps[index]
+        if (loop_start_step is not None and index == loop_start_step
+                and position == len(steps)):
+            loop_index = len(points) - 1  # the crossing into the second lap
+        if controller.exit_edge is None:
+            rel_times, rel_points = _stay_step(controller, x, controllers.max_speed)
+        else:
+            rel_times, rel_points = _exit_step(controller, x)
+        for offset, (t, point) in enumerate(zip(rel_times, rel_points, strict=True)):
+            if t <= 0.0:  # already on the exit edge: the current sample is the crossing
+                if controller.next_triangle is not None:
+                    triangle_of[-1] = controller.next_triangle
+                crossings.append(len(points) - 1)
+                continue
+            times.append(now + t)
+            points.append(point)
+            is_crossing = controller.exit_edge is not None and offset == len(rel_times) - 1
+            step_of.append(index)
+            triangle_of.append(controller.next_triangle if is_crossing and
+                               controller.next_triangle is not None else controller.triangle)
+            if is_crossing:
+                crossings.append(len(points) - 1)
+        now = times[-1]
+        x = points[-1]
+    if loop_start_step is not None and loop_index is None:  # pragma: no cover - defensive
+        raise SolverError(error("C012", "could not mark the loop of the trajectory"))
+    return Trace(
+        times=np.asarray(times),
+        points=np.asarray(points),
+        steps=tuple(step_of),
+        triangles=tuple(triangle_of),
+        loop_start=loop_index,
+        crossings=tuple(crossings),
+    )
+
+
+def trace_to_json(trace: Trace, mission: Mission) -> dict[str, object]:
+    """``trace.json`` (``tlmpc.trace/1``): self-contained, so it verifies on its own."""
+    from tlmpc.ltl.printer import to_text
+
+    def poly(points: tuple[tuple[float, float], ...]) -> list[list[float]]:
+        return [[x, y] for x, y in points]
+
+    return {
+        "format": "tlmpc.trace/1",
+        "ltl": to_text(mission.formula),
+        "regions": {r.name: poly(r.polygon) for r in mission.regions},
+        "workspace": {
+            "boundary": poly(mission.workspace.boundary),
+            "holes": [poly(h) for h in mission.workspace.holes],
+        },
+        "boundary": mission.options.boundary,
+        "max_speed": mission.robot.max_speed,
+        "points": np.column_stack([trace.times, trace.points]).tolist(),
+        "loop_start": trace.loop_start,
+        "steps": list(trace.steps),
+        "triangles": list(trace.triangles),
+        "crossings": list(trace.crossings),
+    }
