@@ -40,7 +40,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _format_sizes(sizes: dict[str, object]) -> str:
-    return ", ".join(f"{value} {key}" for key, value in sizes.items() if key != "formula")
+    return ", ".join(f"{key} {value}" for key, value in sizes.items() if key != "formula")
 
 
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
