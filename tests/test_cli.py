@@ -30,7 +30,9 @@ def test_version() -> None:
     assert __version__ in out
 
 
-@pytest.mark.parametrize("argv", [(), ("frobnicate",), ("compile",), ("compile", "x", "--until", "nope")])
+@pytest.mark.parametrize(
+    "argv", [(), ("frobnicate",), ("compile",), ("compile", "x", "--until", "nope")]
+)
 def test_usage_errors_exit_2(argv: tuple[str, ...]) -> None:
     code, _, err = run(*argv)
     assert code == 2

@@ -16,8 +16,17 @@ SCHEMAS = sorted((ROOT / "schemas").glob("*.schema.json"))
 
 def test_schemas_are_shipped() -> None:
     names = {p.name.removesuffix(".schema.json") for p in SCHEMAS}
-    assert {"mission", "abstraction", "automaton", "witness", "controllers", "trace",
-            "verdict", "summary", "mission-artifact"} <= names
+    assert {
+        "mission",
+        "abstraction",
+        "automaton",
+        "witness",
+        "controllers",
+        "trace",
+        "verdict",
+        "summary",
+        "mission-artifact",
+    } <= names
 
 
 @pytest.mark.parametrize("path", SCHEMAS, ids=lambda p: p.name)

@@ -162,7 +162,7 @@ def _simulate(c: Compilation) -> StageResult:
     controllers: Controllers = _require(c.controllers, "controllers")
     trace = simulate(abstraction, controllers, mission)
     document = trace_to_json(trace, mission)
-    points = document["points"]
+    points: list[list[float]] = document["points"]  # type: ignore[assignment]
     return StageResult(
         compilation=dataclasses.replace(c, trace=trace, trace_document=document),
         artifacts={"trace.json": document},

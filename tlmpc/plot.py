@@ -9,6 +9,7 @@ fixed SVG hash salt, no software tag.
 from __future__ import annotations
 
 import io
+import itertools
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -51,21 +52,49 @@ def draw_plan(axes: Any, artifacts: Mapping[str, Any]) -> None:
     mission = artifacts["mission.json"]
     workspace = mission["workspace"]
     boundary = workspace["boundary"]
-    axes.add_patch(PolygonPatch(boundary, closed=True, facecolor="white", edgecolor="black",
-                                linewidth=1.2, zorder=0))
+    axes.add_patch(
+        PolygonPatch(
+            boundary, closed=True, facecolor="white", edgecolor="black", linewidth=1.2, zorder=0
+        )
+    )
     for hole in workspace.get("holes", []):
-        axes.add_patch(PolygonPatch(hole, closed=True, facecolor="#9a9a9a", edgecolor="black",
-                                    hatch="//", linewidth=0.8, zorder=3))
+        axes.add_patch(
+            PolygonPatch(
+                hole,
+                closed=True,
+                facecolor="#9a9a9a",
+                edgecolor="black",
+                hatch="//",
+                linewidth=0.8,
+                zorder=3,
+            )
+        )
     regions: Mapping[str, Any] = mission["regions"]
     for index, (name, polygon) in enumerate(sorted(regions.items())):
         colour = _REGION_COLOURS[index % len(_REGION_COLOURS)]
-        axes.add_patch(PolygonPatch(polygon, closed=True, facecolor=colour, alpha=0.30,
-                                    edgecolor=colour, linewidth=0.8, zorder=1))
+        axes.add_patch(
+            PolygonPatch(
+                polygon,
+                closed=True,
+                facecolor=colour,
+                alpha=0.30,
+                edgecolor=colour,
+                linewidth=0.8,
+                zorder=1,
+            )
+        )
         if len(regions) <= _MAX_REGION_NAMES:
             xs, ys = _polygon_xy(polygon)
-            axes.text(sum(xs[:-1]) / (len(xs) - 1), sum(ys[:-1]) / (len(ys) - 1), name,
-                      ha="center", va="center", fontsize=8, zorder=6,
-                      bbox={"boxstyle": "round,pad=0.15", "fc": "white", "alpha": 0.7, "lw": 0})
+            axes.text(
+                sum(xs[:-1]) / (len(xs) - 1),
+                sum(ys[:-1]) / (len(ys) - 1),
+                name,
+                ha="center",
+                va="center",
+                fontsize=8,
+                zorder=6,
+                bbox={"boxstyle": "round,pad=0.15", "fc": "white", "alpha": 0.7, "lw": 0},
+            )
 
     abstraction = artifacts.get("abstraction.json")
     if abstraction is not None:
@@ -80,18 +109,34 @@ def draw_plan(axes: Any, artifacts: Mapping[str, Any]) -> None:
         cycle = list(witness["cycle"])
         path = _centroids(abstraction, [*prefix, *cycle[:1]]) if prefix else []
         if len(path) >= 2:
-            axes.plot([p[0] for p in path], [p[1] for p in path], color="#1f3b73",
-                      linewidth=1.0, marker=".", markersize=3, zorder=4, label="plan prefix")
+            axes.plot(
+                [p[0] for p in path],
+                [p[1] for p in path],
+                color="#1f3b73",
+                linewidth=1.0,
+                marker=".",
+                markersize=3,
+                zorder=4,
+                label="plan prefix",
+            )
         loop = _centroids(abstraction, [*cycle, cycle[0]])
-        axes.plot([p[0] for p in loop], [p[1] for p in loop], color="#c0392b", linewidth=1.0,
-                  linestyle="--", marker=".", markersize=3, zorder=4,
-                  label="plan cycle" if len(cycle) > 1 else "stay")
+        axes.plot(
+            [p[0] for p in loop],
+            [p[1] for p in loop],
+            color="#c0392b",
+            linewidth=1.0,
+            linestyle="--",
+            marker=".",
+            markersize=3,
+            zorder=4,
+            label="plan cycle" if len(cycle) > 1 else "stay",
+        )
 
     trace = artifacts.get("trace.json")
     if trace is not None:
         points = trace["points"]
-        segments = [[(a[1], a[2]), (b[1], b[2])] for a, b in zip(points, points[1:], strict=False)]
-        times = [0.5 * (a[0] + b[0]) for a, b in zip(points, points[1:], strict=False)]
+        segments = [[(a[1], a[2]), (b[1], b[2])] for a, b in itertools.pairwise(points)]
+        times = [0.5 * (a[0] + b[0]) for a, b in itertools.pairwise(points)]
         if segments:
             lines = LineCollection(segments, cmap="viridis", linewidth=1.8, zorder=5)
             lines.set_array(times)
@@ -99,8 +144,16 @@ def draw_plan(axes: Any, artifacts: Mapping[str, Any]) -> None:
             axes.figure.colorbar(lines, ax=axes, fraction=0.046, pad=0.04, label="time [s]")
 
     start = mission["robot"]["start"]
-    axes.plot([start[0]], [start[1]], marker="o", color="black", markersize=6, zorder=7,
-              linestyle="none", label="start")
+    axes.plot(
+        [start[0]],
+        [start[1]],
+        marker="o",
+        color="black",
+        markersize=6,
+        zorder=7,
+        linestyle="none",
+        label="start",
+    )
     bx, by = _polygon_xy(boundary)
     margin = 0.02 * max(max(bx) - min(bx), max(by) - min(by))
     axes.set_xlim(min(bx) - margin, max(bx) + margin)

@@ -77,9 +77,7 @@ def test_every_compiled_trace_verifies(compiled: dict[str, Path], spec: str) -> 
 def test_trace_verifies_under_closed_convention_too(compiled: dict[str, Path], spec: str) -> None:
     # Strict margins keep compiled trajectories off region boundaries except at crossings,
     # so only formulas that forbid a handover could differ; none of the specs does.
-    code, _, err = run_cli(
-        "verify", str(compiled[spec] / "trace.json"), "--boundary", "closed"
-    )
+    code, _, err = run_cli("verify", str(compiled[spec] / "trace.json"), "--boundary", "closed")
     assert code == 0, err
 
 
@@ -127,12 +125,19 @@ def test_plot_is_reproducible_byte_for_byte(compiled: dict[str, Path], tmp_path:
 def test_until_abstraction_stops_early(tmp_path: Path) -> None:
     out = tmp_path / "out"
     code, stdout, err = run_cli(
-        "compile", str(ROOT / "specs" / "example1.yaml"), "-o", str(out), "--until",
-        "abstraction", "--json",
+        "compile",
+        str(ROOT / "specs" / "example1.yaml"),
+        "-o",
+        str(out),
+        "--until",
+        "abstraction",
+        "--json",
     )
     assert code == 0, err
     assert sorted(p.name for p in out.iterdir()) == [
-        "abstraction.json", "mission.json", "summary.json"
+        "abstraction.json",
+        "mission.json",
+        "summary.json",
     ]
     summary = json.loads(stdout)
     assert [s["name"] for s in summary["stages"]] == ["load", "abstraction"]
@@ -144,11 +149,11 @@ def test_progress_lines_and_quiet(tmp_path: Path) -> None:
     code, _, err = run_cli("compile", spec, "-o", str(tmp_path / "a"), "--until", "automaton")
     assert code == 0
     assert [line.split()[1] for line in err.splitlines() if line.startswith("[")] == [
-        "load", "abstraction", "automaton"
+        "load",
+        "abstraction",
+        "automaton",
     ]
-    code, _, err = run_cli(
-        "compile", spec, "-o", str(tmp_path / "b"), "--until", "automaton", "-q"
-    )
+    code, _, err = run_cli("compile", spec, "-o", str(tmp_path / "b"), "--until", "automaton", "-q")
     assert code == 0
     assert err == ""
 
@@ -197,9 +202,21 @@ def test_failed_run_keeps_previous_output(tmp_path: Path) -> None:
 
 def test_python_dash_m_entry_point(tmp_path: Path) -> None:
     completed = subprocess.run(
-        [sys.executable, "-m", "tlmpc", "compile", str(ROOT / "specs" / "example1.yaml"),
-         "-o", str(tmp_path / "out"), "--until", "automaton", "-q"],
-        capture_output=True, text=True, check=False,
+        [
+            sys.executable,
+            "-m",
+            "tlmpc",
+            "compile",
+            str(ROOT / "specs" / "example1.yaml"),
+            "-o",
+            str(tmp_path / "out"),
+            "--until",
+            "automaton",
+            "-q",
+        ],
+        capture_output=True,
+        text=True,
+        check=False,
     )
     assert completed.returncode == 0, completed.stderr
     assert (tmp_path / "out" / "automaton.hoa").exists()

@@ -42,8 +42,9 @@ def missions(draw: st.DrawFn) -> dict[str, Any]:
         y0 = draw(st.integers(0, 5))
         w = draw(st.integers(1, 3))
         h = draw(st.integers(1, 3))
-        regions[f"r{k}"] = {"rect": [x0 + 0.25, y0 + 0.25, min(x0 + w, 12) - 0.25,
-                                     min(y0 + h, 8) - 0.25]}
+        regions[f"r{k}"] = {
+            "rect": [x0 + 0.25, y0 + 0.25, min(x0 + w, 12) - 0.25, min(y0 + h, 8) - 0.25]
+        }
     holes = []
     if draw(st.booleans()):
         holes.append({"rect": [5.5, 3.5, 6.5, 4.5]})
@@ -68,7 +69,8 @@ def test_every_compiled_trace_verifies(document: dict[str, Any], tmp_path: Path)
     try:
         result = compile_mission(path, until="simulate")
     except NoPlanError as exc:
-        assert all(d.code.startswith("P") for d in exc.diagnostics)
+        codes = [d.code for d in exc.diagnostics]
+        assert all(code.startswith("P") for code in codes), codes
         return
     trace = result.compilation.trace_document
     assert trace is not None

@@ -36,9 +36,14 @@ def test_failure_inside_staging_leaves_previous_output_untouched(tmp_path: Path)
     (out / "summary.json").write_text('{"format": "tlmpc.summary/1"}')
     (out / "trace.json").write_text("old")
     before = _snapshot(out)
-    with pytest.raises(KeyboardInterrupt), staging_directory(out) as staging:
-        write_artifacts(staging, {"trace.json": {"new": True}})
-        raise KeyboardInterrupt
+
+    def interrupted_run() -> None:
+        with staging_directory(out) as staging:
+            write_artifacts(staging, {"trace.json": {"new": True}})
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        interrupted_run()
     assert _snapshot(out) == before
     assert [p.name for p in tmp_path.iterdir()] == ["out"]
 

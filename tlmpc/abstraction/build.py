@@ -36,11 +36,12 @@ def locate_in(vertices: FloatArray, triangles: IntArray, point: tuple[float, flo
     scale = np.abs(cross(a, b, c))
     tolerance = -1e-12 * scale
     inside = (
-        (cross(a, b, p) >= tolerance) & (cross(b, c, p) >= tolerance) & (cross(c, a, p) >= tolerance)
+        (cross(a, b, p) >= tolerance)
+        & (cross(b, c, p) >= tolerance)
+        & (cross(c, a, p) >= tolerance)
     )
     found = np.flatnonzero(inside)
     return int(found[0]) if len(found) else -1
-
 
 
 def _labels(
@@ -88,9 +89,12 @@ def build_abstraction(mission: Mission) -> Abstraction:
     start = locate_in(vertices, triangles, mission.robot.start)
     if start < 0:
         raise InvalidInputError(
-            error("A002", f"the start point {mission.robot.start} is not in the free workspace",
-                  hint="start the robot inside the boundary and outside every hole",
-                  file=mission.source)
+            error(
+                "A002",
+                f"the start point {mission.robot.start} is not in the free workspace",
+                hint="start the robot inside the boundary and outside every hole",
+                file=mission.source,
+            )
         )
     component = _components(neighbors)
     corners = vertices[triangles]
@@ -98,8 +102,8 @@ def build_abstraction(mission: Mission) -> Abstraction:
     for array in (vertices, triangles, neighbors, letter_of, component):
         array.setflags(write=False)
     stats: dict[str, Any] = {
-        "vertices": int(len(vertices)),
-        "triangles": int(len(triangles)),
+        "vertices": len(vertices),
+        "triangles": len(triangles),
         "edges": int((neighbors >= 0).sum() // 2),
         "letters": len(letters),
         "components": int(component.max() + 1) if len(component) else 0,
@@ -123,7 +127,8 @@ def _min_angle(corners: FloatArray) -> FloatArray:
     def angle(p: FloatArray, q: FloatArray, r: FloatArray) -> FloatArray:
         u, v = q - p, r - p
         cos = (u * v).sum(axis=1) / (np.linalg.norm(u, axis=1) * np.linalg.norm(v, axis=1))
-        return np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
+        degrees: FloatArray = np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
+        return degrees
 
     a, b, c = corners[:, 0], corners[:, 1], corners[:, 2]
     return np.minimum(np.minimum(angle(a, b, c), angle(b, c, a)), angle(c, a, b))
@@ -140,14 +145,26 @@ def abstraction_diagnostics(abstraction: Abstraction, mission: Mission) -> list[
     for region in mission.regions:
         mask = present.get(region.name)
         if mask is None:
-            problems.append(Diagnostic(code="A010", severity="warning", file=mission.source,
-                                       message=f"region {region.name!r} got no triangle",
-                                       hint="it lies in holes or is too thin to triangulate"))
+            problems.append(
+                Diagnostic(
+                    code="A010",
+                    severity="warning",
+                    file=mission.source,
+                    message=f"region {region.name!r} got no triangle",
+                    hint="it lies in holes or is too thin to triangulate",
+                )
+            )
             continue
         triangles = mask[abstraction.letter_of]
         if not np.any(abstraction.component[triangles] == start_component):
-            problems.append(Diagnostic(code="A011", severity="warning", file=mission.source,
-                                       message=f"region {region.name!r} is not reachable from "
-                                       "the start: holes separate it from the robot",
-                                       hint="open a passage or move the start"))
+            problems.append(
+                Diagnostic(
+                    code="A011",
+                    severity="warning",
+                    file=mission.source,
+                    message=f"region {region.name!r} is not reachable from "
+                    "the start: holes separate it from the robot",
+                    hint="open a passage or move the start",
+                )
+            )
     return problems

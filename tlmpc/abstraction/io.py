@@ -32,7 +32,7 @@ def abstraction_to_json(abstraction: Abstraction) -> dict[str, Any]:
 
 def abstraction_from_json(document: Mapping[str, Any]) -> Abstraction:
     """Rebuild the :class:`Abstraction` written by :func:`abstraction_to_json`."""
-    arrays = {
+    arrays: dict[str, Any] = {
         "vertices": np.asarray(document["vertices"], dtype=np.float64).reshape(-1, 2),
         "triangles": np.asarray(document["triangles"], dtype=np.int64).reshape(-1, 3),
         "neighbors": np.asarray(document["neighbors"], dtype=np.int64).reshape(-1, 3),

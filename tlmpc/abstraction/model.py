@@ -53,4 +53,5 @@ class Abstraction:
 
     def corners(self, triangle: int) -> FloatArray:
         """The (3, 2) vertex coordinates of ``triangle``, counter-clockwise."""
-        return self.vertices[self.triangles[triangle]]
+        corners: FloatArray = self.vertices[self.triangles[triangle]]
+        return corners

@@ -37,8 +37,12 @@ def free_space(mission: Mission) -> ShapelyPolygon | MultiPolygon:
     free = boundary.difference(holes)
     if free.is_empty:
         raise InvalidInputError(
-            error("A001", "the holes cover the whole workspace: there is no free space",
-                  hint="shrink the holes", file=mission.source)
+            error(
+                "A001",
+                "the holes cover the whole workspace: there is no free space",
+                hint="shrink the holes",
+                file=mission.source,
+            )
         )
     return free
 

@@ -56,8 +56,7 @@ def _build(automaton: Automaton, enter_at_top: bool) -> Automaton:
                 queue.append(target)
             edges.append((index[(state, level)], index[target], edge))
     accepting = {
-        i for (state, level), i in index.items()
-        if level == k and component[state] in accepting_scc
+        i for (state, level), i in index.items() if level == k and component[state] in accepting_scc
     }
     names = [
         f"{automaton.state_names[s] if s < len(automaton.state_names) else s} [{lvl}]"
@@ -70,8 +69,12 @@ def _build(automaton: Automaton, enter_at_top: bool) -> Automaton:
         edges=tuple(
             merge_parallel(
                 [
-                    Edge(src=s, dst=d, guard=e.guard,
-                         marks=frozenset({0}) if s in accepting else frozenset())
+                    Edge(
+                        src=s,
+                        dst=d,
+                        guard=e.guard,
+                        marks=frozenset({0}) if s in accepting else frozenset(),
+                    )
                     for s, d, e in edges
                 ]
             )
@@ -89,8 +92,12 @@ def _build(automaton: Automaton, enter_at_top: bool) -> Automaton:
         num_states=trimmed.num_states,
         initial=trimmed.initial,
         edges=tuple(
-            Edge(src=e.src, dst=e.dst, guard=e.guard,
-                 marks=frozenset({0}) if e.src in marked else frozenset())
+            Edge(
+                src=e.src,
+                dst=e.dst,
+                guard=e.guard,
+                marks=frozenset({0}) if e.src in marked else frozenset(),
+            )
             for e in trimmed.edges
         ),
         num_acc=1,

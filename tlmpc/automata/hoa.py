@@ -148,11 +148,18 @@ def _unquote(token: str) -> str:
 def parse_hoa(text: str, *, file: str | None = None) -> Automaton:
     """Read one automaton written in HOA v1 (the subset described in the module doc)."""
     try:
-        tree = _parser().parse(text)
+        tree: Any = _parser().parse(text)
     except UnexpectedInput as exc:
-        raise InvalidInputError(error("B001", f"not a HOA automaton: unexpected input",
-                                      hint="expected HOA v1 (header, --BODY--, --END--)",
-                                      file=file, line=exc.line, col=exc.column)) from None
+        raise InvalidInputError(
+            error(
+                "B001",
+                "not a HOA automaton: unexpected input",
+                hint="expected HOA v1 (header, --BODY--, --END--)",
+                file=file,
+                line=exc.line,
+                col=exc.column,
+            )
+        ) from None
     except LarkError as exc:
         raise InvalidInputError(error("B001", f"not a HOA automaton: {exc}", file=file)) from None
     header: dict[str, list[Any]] = {}
@@ -165,7 +172,10 @@ def parse_hoa(text: str, *, file: str | None = None) -> Automaton:
             else:
                 values.append(child)
         header.setdefault(key, []).append(values)
-    if header.get("HOA") != [[Token("IDENT", "v1")]] and str(header.get("HOA", [[""]])[0][0]) != "v1":
+    if (
+        header.get("HOA") != [[Token("IDENT", "v1")]]
+        and str(header.get("HOA", [[""]])[0][0]) != "v1"
+    ):
         raise InvalidInputError(error("B002", "unsupported HOA version", file=file))
     aps_values = header.get("AP", [[0]])[0]
     aps = [_unquote(str(v)) for v in aps_values[1:]]
@@ -213,8 +223,13 @@ def parse_hoa(text: str, *, file: str | None = None) -> Automaton:
 
 def to_dot(automaton: Automaton) -> str:
     """Graphviz DOT of the automaton (acceptance marks as {i} on edges or double circles)."""
-    lines = ["digraph automaton {", "  rankdir=LR;", '  node [shape=circle, fontsize=10];',
-             '  init [shape=point, label=""];', f"  init -> {automaton.initial};"]
+    lines = [
+        "digraph automaton {",
+        "  rankdir=LR;",
+        "  node [shape=circle, fontsize=10];",
+        '  init [shape=point, label=""];',
+        f"  init -> {automaton.initial};",
+    ]
     accepting = {e.src for e in automaton.edges if automaton.state_based and e.marks}
     for state in range(automaton.num_states):
         shape = "doublecircle" if state in accepting else "circle"

@@ -43,8 +43,9 @@ def automaton_from_json(document: Mapping[str, Any]) -> Automaton:
         num_states=len(document["states"]),
         initial=int(document["initial"]),
         edges=tuple(
-            Edge(src=e["src"], dst=e["dst"], guard=parse_ltl(e["guard"]),
-                 marks=frozenset(e["marks"]))
+            Edge(
+                src=e["src"], dst=e["dst"], guard=parse_ltl(e["guard"]), marks=frozenset(e["marks"])
+            )
             for e in document["edges"]
         ),
         num_acc=int(acceptance["sets"]),

@@ -191,9 +191,7 @@ def _reduce_marks(automaton: Automaton) -> Automaton:
     )
 
 
-def _merge_states(
-    automaton: Automaton, letters: Sequence[frozenset[str]] | None
-) -> Automaton:
+def _merge_states(automaton: Automaton, letters: Sequence[frozenset[str]] | None) -> Automaton:
     """Quotient by the coarsest partition where equivalent states have equal signatures."""
     n = automaton.num_states
     out: dict[int, list[Edge]] = defaultdict(list)

@@ -151,7 +151,7 @@ def make_g(a: T) -> T:
 def make_binary(kind: str, a: T, b: T) -> T:
     """a U/R/W/M b with the usual constant and idempotence rules."""
     if kind == "U":
-        if b in (TRUE, FALSE) or a == FALSE or a == b:
+        if b in (TRUE, FALSE) or a in (FALSE, b):
             return b
         if a == TRUE:
             return make_f(b)
@@ -160,7 +160,7 @@ def make_binary(kind: str, a: T, b: T) -> T:
         if b[0] == "U" and b[1] == a:  # a U (a U b) = a U b
             return b
     elif kind == "R":
-        if b in (TRUE, FALSE) or a == TRUE or a == b:
+        if b in (TRUE, FALSE) or a in (TRUE, b):
             return b
         if a == FALSE:
             return make_g(b)
@@ -169,7 +169,7 @@ def make_binary(kind: str, a: T, b: T) -> T:
     elif kind == "W":
         if b == TRUE or a == TRUE:
             return TRUE
-        if a == FALSE or a == b:
+        if a in (FALSE, b):
             return b
         if b == FALSE:
             return make_g(a)
@@ -208,17 +208,16 @@ def _convert(f: Formula) -> T:
         return make_f(_convert(f.arg))
     if isinstance(f, Globally):
         return make_g(_convert(f.arg))
-    kinds = {Until: "U", Release: "R", WeakUntil: "W", StrongRelease: "M"}
-    for cls, kind in kinds.items():
-        if isinstance(f, cls):
-            return make_binary(kind, _convert(f.left), _convert(f.right))  # type: ignore[attr-defined]
+    if isinstance(f, Until | Release | WeakUntil | StrongRelease):
+        kind = {Until: "U", Release: "R", WeakUntil: "W", StrongRelease: "M"}[type(f)]
+        return make_binary(kind, _convert(f.left), _convert(f.right))
     raise TypeError(f"unexpected node {f!r}")
 
 
 @functools.cache
 def implies(f: T, g: T) -> bool:
     """A sound syntactic implication check f ⇒ g (incomplete; used to shrink states)."""
-    if f == g or g == TRUE or f == FALSE:
+    if f in (g, FALSE) or g == TRUE:
         return True
     fk, gk = f[0], g[0]
     if gk == "&":
@@ -239,7 +238,7 @@ def implies(f: T, g: T) -> bool:
         return True
     if gk == "U" and implies(f, g[2]):
         return True
-    if gk == "W" and (implies(f, g[2]) or implies(f, g[1]) and fk == "G"):
+    if gk == "W" and (implies(f, g[2]) or (implies(f, g[1]) and fk == "G")):
         return True
     if fk == "U" and gk == "U" and implies(f[1], g[1]) and implies(f[2], g[2]):
         return True

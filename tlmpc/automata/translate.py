@@ -24,8 +24,8 @@ from tlmpc.automata.terms import (
     simplify_state,
     to_text,
 )
-from tlmpc.ltl.ast import Formula, Not, Prop, conjoin, disjoin
 from tlmpc.ltl.ast import TRUE as AST_TRUE
+from tlmpc.ltl.ast import Formula, Not, Prop, conjoin, disjoin
 from tlmpc.ltl.printer import to_text as formula_text
 
 State = frozenset[T]
@@ -121,7 +121,8 @@ def translate(
                     queue.append(target)
                 raw_edges.append((source, states[target], cube, marks))
     edges = tuple(
-        Edge(src=s, dst=d, guard=cube_formula(*cube), marks=marks) for s, d, cube, marks in raw_edges
+        Edge(src=s, dst=d, guard=cube_formula(*cube), marks=marks)
+        for s, d, cube, marks in raw_edges
     )
     automaton = Automaton(
         aps=aps,
@@ -137,8 +138,9 @@ def translate(
     return automaton
 
 
-def _state_terms(state: State) -> list[tuple[frozenset[str], frozenset[str], frozenset[T],
-                                             frozenset[T]]]:
+def _state_terms(
+    state: State,
+) -> list[tuple[frozenset[str], frozenset[str], frozenset[T], frozenset[T]]]:
     terms: list[Any] = [(frozenset(), frozenset(), frozenset(), frozenset())]
     for part in sorted(state, key=repr):
         combined = []
@@ -166,4 +168,3 @@ def guard_or(guards: Sequence[Formula]) -> Formula:
     if any(g == AST_TRUE for g in guards):
         return AST_TRUE
     return disjoin(list(dict.fromkeys(guards)))
-

@@ -32,11 +32,17 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     directory: Path = args.out
     for name in ("abstraction.json", "mission.json"):
         if not (directory / name).is_file():
-            raise UsageError(error("U020", f"{directory} has no {name}",
-                                   hint="run `tlmpc compile MISSION -o DIR --until abstraction`"
-                                   " first", file=str(directory)))
-    abstraction = abstraction_from_json(read_json(directory / "abstraction.json",
-                                                  "tlmpc.abstraction/"))
+            raise UsageError(
+                error(
+                    "U020",
+                    f"{directory} has no {name}",
+                    hint="run `tlmpc compile MISSION -o DIR --until abstraction` first",
+                    file=str(directory),
+                )
+            )
+    abstraction = abstraction_from_json(
+        read_json(directory / "abstraction.json", "tlmpc.abstraction/")
+    )
     mission = read_json(directory / "mission.json", "tlmpc.mission/")
     formula = parse_ltl(mission["formula"])
     title = str(mission.get("name", "mission"))

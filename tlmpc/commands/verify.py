@@ -53,11 +53,15 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         out.write(f"  robustness: {verdict.robustness:.6g}")
         if verdict.certificate_bound is not None:
             if verdict.certified:
-                out.write(f" > max_speed * max gap = {verdict.certificate_bound:.4g}: the "
-                          "verdict is robust (certified)\n")
+                out.write(
+                    f" > max_speed * max gap = {verdict.certificate_bound:.4g}: the "
+                    "verdict is robust (certified)\n"
+                )
             else:
-                out.write(f" (certificate needs > max_speed * max gap = "
-                          f"{verdict.certificate_bound:.4g}; not certified)\n")
+                out.write(
+                    f" (certificate needs > max_speed * max gap = "
+                    f"{verdict.certificate_bound:.4g}; not certified)\n"
+                )
         else:
             out.write("\n")
         for example in (verdict.workspace_violation, verdict.counterexample):

@@ -28,8 +28,10 @@ class TriangleGeometry:
     def incenter(self) -> FloatArray:
         """The point farthest from the three edges."""
         lengths = np.array(
-            [np.linalg.norm(self.vertices[(i + 1) % 3] - self.vertices[(i + 2) % 3])
-             for i in range(3)]
+            [
+                np.linalg.norm(self.vertices[(i + 1) % 3] - self.vertices[(i + 2) % 3])
+                for i in range(3)
+            ]
         )
         return (lengths[:, None] * self.vertices).sum(axis=0) / lengths.sum()  # type: ignore[no-any-return]
 
@@ -54,8 +56,10 @@ def triangle_geometry(vertices: FloatArray) -> TriangleGeometry:
 def affine_law(vertices: FloatArray, velocities: FloatArray) -> tuple[FloatArray, FloatArray]:
     """K, g with K v_i + g = w_i for the three vertices (the unique affine interpolant)."""
     system = np.hstack([vertices, np.ones((3, 1))])
-    solution = np.linalg.solve(system, velocities)  # rows: K^T (2 rows), g^T
-    return solution[:2].T.copy(), solution[2].copy()
+    solution = np.asarray(np.linalg.solve(system, velocities), dtype=np.float64)
+    gain: FloatArray = solution[:2].T.copy()
+    offset: FloatArray = solution[2].copy()
+    return gain, offset
 
 
 def half_plane_feasible(normals: list[FloatArray]) -> bool:

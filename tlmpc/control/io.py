@@ -35,8 +35,7 @@ def controllers_to_json(controllers: Controllers) -> dict[str, Any]:
             for c in controllers.steps
         ],
         "jumps": [
-            {"step": j.step, "vertex": j.vertex, "position": list(j.position),
-             "reason": j.reason}
+            {"step": j.step, "vertex": j.vertex, "position": list(j.position), "reason": j.reason}
             for j in controllers.jumps
         ],
         "stats": dict(controllers.stats),

@@ -63,8 +63,11 @@ def plan_steps(abstraction: Abstraction, witness: Witness) -> tuple[list[_Step],
             matches = np.flatnonzero(abstraction.neighbors[tri] == nxt)
             if len(matches) != 1:
                 raise InvalidInputError(
-                    error("C001", f"plan step {index}: triangles {tri} and {nxt} are not "
-                          "adjacent", hint="the witness does not belong to this abstraction")
+                    error(
+                        "C001",
+                        f"plan step {index}: triangles {tri} and {nxt} are not adjacent",
+                        hint="the witness does not belong to this abstraction",
+                    )
                 )
             exit_edge = int(matches[0])
             entries = {path[index - 1]} if index > 0 else set()
@@ -72,9 +75,12 @@ def plan_steps(abstraction: Abstraction, witness: Witness) -> tuple[list[_Step],
                 entries.add(witness.cycle[-1])  # later laps enter from the cycle's end
             if nxt in entries:
                 raise InvalidInputError(
-                    error("C002", f"plan step {index} bounces: it enters triangle {tri} from "
-                          f"{nxt} and leaves back to {nxt}",
-                          hint="an affine field cannot leave a triangle through its entry edge")
+                    error(
+                        "C002",
+                        f"plan step {index} bounces: it enters triangle {tri} from "
+                        f"{nxt} and leaves back to {nxt}",
+                        hint="an affine field cannot leave a triangle through its entry edge",
+                    )
                 )
         geometry = triangle_geometry(abstraction.corners(tri))
         steps.append(_Step(tri, exit_edge, nxt, geometry))
@@ -153,8 +159,9 @@ def _assign_runs(
             if run is None or reason is not None:
                 if reason is not None:
                     x, y = abstraction.vertices[vertex].tolist()
-                    jumps.append(VelocityJump(step=index, vertex=vertex, position=(x, y),
-                                              reason=reason))
+                    jumps.append(
+                        VelocityJump(step=index, vertex=vertex, position=(x, y), reason=reason)
+                    )
                 run = runs.new(normals)
             current[vertex] = run
             step.runs.append(run)
@@ -165,9 +172,14 @@ def _assign_runs(
         for local, vertex in enumerate(first_vertices):
             if vertex in previous and not runs.try_merge(previous[vertex], first.runs[local]):
                 x, y = abstraction.vertices[vertex].tolist()
-                jumps.append(VelocityJump(step=loop_start, vertex=vertex, position=(x, y),
-                                          reason="the cycle turns 180° or more around this "
-                                          "vertex"))
+                jumps.append(
+                    VelocityJump(
+                        step=loop_start,
+                        vertex=vertex,
+                        position=(x, y),
+                        reason="the cycle turns 180° or more around this vertex",
+                    )
+                )
     for step in steps:
         step.runs = [runs.find(r) for r in step.runs]
     return runs, jumps
@@ -204,7 +216,7 @@ def _solve(steps: list[_Step], max_speed: float) -> tuple[FloatArray, FloatArray
     z = cp.Variable(size)
     floor = cp.Variable()
     velocities = cp.reshape(z[: 2 * count], (count, 2), order="C")
-    speeds = z[2 * count:]
+    speeds = z[2 * count :]
     constraints = [
         inequality @ z >= 0,
         cp.norm(velocities, 2, axis=1) <= max_speed,
@@ -217,13 +229,21 @@ def _solve(steps: list[_Step], max_speed: float) -> tuple[FloatArray, FloatArray
     try:
         problem.solve(solver=cp.CLARABEL)
     except cp.error.SolverError as exc:
-        raise SolverError(error("C003", f"the controller program failed: {exc}",
-                                hint="please report this mission")) from None
+        raise SolverError(
+            error(
+                "C003", f"the controller program failed: {exc}", hint="please report this mission"
+            )
+        ) from None
     if problem.status not in ("optimal", "optimal_inaccurate") or z.value is None:
-        raise SolverError(error("C003", f"the controller program is {problem.status}",
-                                hint="please report this mission"))
+        raise SolverError(
+            error(
+                "C003",
+                f"the controller program is {problem.status}",
+                hint="please report this mission",
+            )
+        )
     values = np.asarray(z.value, dtype=np.float64)
-    return values[: 2 * count].reshape(count, 2), values[2 * count:]
+    return values[: 2 * count].reshape(count, 2), values[2 * count :]
 
 
 def synthesize(abstraction: Abstraction, witness: Witness, robot: Robot) -> Controllers:
@@ -244,15 +264,14 @@ def synthesize(abstraction: Abstraction, witness: Witness, robot: Robot) -> Cont
         if step.exit_edge is None:
             center = geometry.incenter()
             gain, offset = affine_law(geometry.vertices, w)
-            inward = min(-geometry.normals[j] @ w[i] for i in range(3) for j in range(3)
-                         if j != i)
+            inward = min(-geometry.normals[j] @ w[i] for i in range(3) for j in range(3) if j != i)
             if inward <= 0 or np.max(np.linalg.eigvals(gain).real) >= 0:
                 # The program's optimum is degenerate here: use the radial field to x*.
-                kappa = robot.max_speed / max(np.linalg.norm(center - v)
-                                              for v in geometry.vertices)
+                kappa = robot.max_speed / max(np.linalg.norm(center - v) for v in geometry.vertices)
                 w = kappa * (center - geometry.vertices)
-                inward = min(-geometry.normals[j] @ w[i] for i in range(3) for j in range(3)
-                             if j != i)
+                inward = min(
+                    -geometry.normals[j] @ w[i] for i in range(3) for j in range(3) if j != i
+                )
             gain, offset = affine_law(geometry.vertices, w)
             speed, bound = float(inward), float("inf")
             target = (float(center[0]), float(center[1]))
@@ -263,16 +282,28 @@ def synthesize(abstraction: Abstraction, witness: Witness, robot: Robot) -> Cont
             bound = float(geometry.heights[step.exit_edge] / delta) if delta > 0 else float("inf")
         controllers.append(
             StepController(
-                step=index, triangle=step.triangle, exit_edge=step.exit_edge,
-                next_triangle=step.next_triangle, vertices=geometry.vertices, velocities=w,
-                gain=gain, offset=offset, exit_speed=speed, exit_time_bound=bound,
+                step=index,
+                triangle=step.triangle,
+                exit_edge=step.exit_edge,
+                next_triangle=step.next_triangle,
+                vertices=geometry.vertices,
+                velocities=w,
+                gain=gain,
+                offset=offset,
+                exit_speed=speed,
+                exit_time_bound=bound,
                 target=target,
             )
         )
     if any(c.exit_speed <= 0 for c in controllers):
         worst = min(controllers, key=lambda c: c.exit_speed)
-        raise SolverError(error("C004", f"plan step {worst.step} has no positive exit speed",
-                                hint="the triangle may be degenerate; raise options.min_angle"))
+        raise SolverError(
+            error(
+                "C004",
+                f"plan step {worst.step} has no positive exit speed",
+                hint="the triangle may be degenerate; raise options.min_angle",
+            )
+        )
     return Controllers(
         steps=tuple(controllers),
         loop_start=loop_start,

@@ -215,7 +215,8 @@ def _max_depth(text: str) -> int:
 def _syntax_diagnostic(exc: LarkError, text: str, file: str | None, pos: _Positions) -> Diagnostic:
     if isinstance(exc, UnexpectedCharacters):
         line, col = pos.at(exc.line, exc.column)
-        char = text[exc.pos_in_stream] if 0 <= exc.pos_in_stream < len(text) else "?"
+        index = exc.pos_in_stream if exc.pos_in_stream is not None else -1
+        char = text[index] if 0 <= index < len(text) else "?"
         return error(
             "L001",
             f"unexpected character {char!r} in LTL formula",
@@ -261,8 +262,9 @@ def _next_operators(tokens: list[Token], pos: _Positions, file: str | None) -> l
     found = []
     for token in tokens:
         if token.type == "UNARY_CHAIN" and ("X" in token or "N" in token):
-            line, col = pos.at(token.line or 1, (token.column or 1) + str(token).find(
-                "X" if "X" in token else "N"))
+            line, col = pos.at(
+                token.line or 1, (token.column or 1) + str(token).find("X" if "X" in token else "N")
+            )
             found.append(
                 error(
                     "L004",
@@ -290,18 +292,30 @@ def parse_ltl(text: str, *, file: str | None = None, line: int = 1, col: int = 1
     """
     pos = _Positions(line, col)
     if not isinstance(text, str):
-        raise InvalidInputError(error("L003", "an LTL formula must be a string", file=file,
-                                      line=line, col=col))
+        raise InvalidInputError(
+            error("L003", "an LTL formula must be a string", file=file, line=line, col=col)
+        )
     if not text.strip():
         raise InvalidInputError(
-            error("L002", "the LTL formula is empty", hint="write a formula such as `F goal`",
-                  file=file, line=line, col=col)
+            error(
+                "L002",
+                "the LTL formula is empty",
+                hint="write a formula such as `F goal`",
+                file=file,
+                line=line,
+                col=col,
+            )
         )
     if _max_depth(text) > MAX_DEPTH:
         raise InvalidInputError(
-            error("L005", f"the LTL formula is nested more than {MAX_DEPTH} levels deep",
-                  hint="split the task into several phrases or conjuncts", file=file,
-                  line=line, col=col)
+            error(
+                "L005",
+                f"the LTL formula is nested more than {MAX_DEPTH} levels deep",
+                hint="split the task into several phrases or conjuncts",
+                file=file,
+                line=line,
+                col=col,
+            )
         )
     parser = _parser()
     try:

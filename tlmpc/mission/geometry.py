@@ -60,31 +60,60 @@ def check_shape(
 ) -> tuple[CheckedShape | None, list[Diagnostic]]:
     """Validate one shape; return it when usable, with the problems found."""
     line, col = locate(path)
-    where = {"file": file, "line": line, "col": col, "path": json_path(path)}
+    where: dict[str, Any] = {"file": file, "line": line, "col": col, "path": json_path(path)}
     if isinstance(shape, dict):
         x0, y0, x1, y1 = (float(v) for v in shape["rect"])
         if not (x0 < x1 and y0 < y1):
-            return None, [error("G001", f"{what}: rect needs xmin < xmax and ymin < ymax, got "
-                                f"[{x0:g}, {y0:g}, {x1:g}, {y1:g}]",
-                                hint="write {rect: [xmin, ymin, xmax, ymax]}", **where)]
+            return None, [
+                error(
+                    "G001",
+                    f"{what}: rect needs xmin < xmax and ymin < ymax, got "
+                    f"[{x0:g}, {y0:g}, {x1:g}, {y1:g}]",
+                    hint="write {rect: [xmin, ymin, xmax, ymax]}",
+                    **where,
+                )
+            ]
     points = shape_points(shape)
     if len(set(points)) < 3:
-        return None, [error("G002", f"{what}: a polygon needs at least 3 distinct points",
-                            hint="list the corners as [[x, y], ...]", **where)]
+        return None, [
+            error(
+                "G002",
+                f"{what}: a polygon needs at least 3 distinct points",
+                hint="list the corners as [[x, y], ...]",
+                **where,
+            )
+        ]
     polygon = ShapelyPolygon(points)
     minx, miny, maxx, maxy = polygon.bounds
     size = max(maxx - minx, maxy - miny, 1e-300)
     if _collinear(points, size):
-        return None, [error("G003", f"{what}: the polygon has zero area",
-                            hint="its points are collinear; give a proper polygon", **where)]
+        return None, [
+            error(
+                "G003",
+                f"{what}: the polygon has zero area",
+                hint="its points are collinear; give a proper polygon",
+                **where,
+            )
+        ]
     if not polygon.is_valid:
         reason = explain_validity(polygon)
-        return None, [error("G004", f"{what}: the polygon is self-intersecting or not simple "
-                            f"({reason})", hint="edges must not cross or touch; list the "
-                            "corners in order around the shape", **where)]
+        return None, [
+            error(
+                "G004",
+                f"{what}: the polygon is self-intersecting or not simple ({reason})",
+                hint="edges must not cross or touch; list the corners in order around the shape",
+                **where,
+            )
+        ]
     if abs(polygon.area) <= AREA_TOLERANCE * size * size:
-        return None, [error("G003", f"{what}: the polygon has zero area",
-                            hint="give a polygon with a positive area", **where)]
+        return None, [
+            error(
+                "G003",
+                f"{what}: the polygon has zero area",
+                hint="give a polygon with a positive area",
+                **where,
+            )
+        ]
     return CheckedShape(points=points, polygon=polygon, path=path), []
 
 
@@ -102,44 +131,76 @@ def check_layout(
 
     def at(path: Path, code: str, message: str, hint: str) -> Diagnostic:
         line, col = locate(path)
-        return error(code, message, hint=hint, file=file, line=line, col=col,
-                     path=json_path(path))
+        return error(code, message, hint=hint, file=file, line=line, col=col, path=json_path(path))
 
     hole_union = shapely.union_all([h.polygon for h in holes]) if holes else None
     if boundary is not None:
         outer = boundary.polygon
         for index, hole in enumerate(holes):
             if not outer.covers(hole.polygon):
-                problems.append(at(hole.path, "G005", f"hole {index} extends outside the "
-                                   "workspace boundary",
-                                   "holes must lie inside the boundary; clip the hole"))
+                problems.append(
+                    at(
+                        hole.path,
+                        "G005",
+                        f"hole {index} extends outside the workspace boundary",
+                        "holes must lie inside the boundary; clip the hole",
+                    )
+                )
         for name, region in regions.items():
             if not outer.covers(region.polygon):
-                problems.append(at(region.path, "G007", f"region {name!r} extends outside the "
-                                   "workspace boundary",
-                                   "regions must lie inside the boundary; clip the region"))
+                problems.append(
+                    at(
+                        region.path,
+                        "G007",
+                        f"region {name!r} extends outside the workspace boundary",
+                        "regions must lie inside the boundary; clip the region",
+                    )
+                )
     for i, first in enumerate(holes):
         for j in range(i + 1, len(holes)):
             second = holes[j]
             overlap = first.polygon.intersection(second.polygon)
             if overlap.area > AREA_TOLERANCE * max(first.polygon.area, second.polygon.area):
-                problems.append(at(second.path, "G006", f"holes {i} and {j} overlap",
-                                   "merge overlapping obstacles into one hole"))
+                problems.append(
+                    at(
+                        second.path,
+                        "G006",
+                        f"holes {i} and {j} overlap",
+                        "merge overlapping obstacles into one hole",
+                    )
+                )
     if hole_union is not None:
         for name, region in regions.items():
             free = region.polygon.difference(hole_union)
             if free.area <= AREA_TOLERANCE * region.polygon.area:
-                problems.append(at(region.path, "G008", f"region {name!r} lies entirely inside "
-                                   "holes, so the robot can never be in it",
-                                   "move the region or shrink the holes"))
+                problems.append(
+                    at(
+                        region.path,
+                        "G008",
+                        f"region {name!r} lies entirely inside "
+                        "holes, so the robot can never be in it",
+                        "move the region or shrink the holes",
+                    )
+                )
     if start is not None:
         point = ShapelyPoint(start)
         if boundary is not None and not boundary.polygon.covers(point):
-            problems.append(at(start_path, "G009", f"the start point ({start[0]:g}, "
-                               f"{start[1]:g}) is outside the workspace boundary",
-                               "the robot must start in the free workspace"))
+            problems.append(
+                at(
+                    start_path,
+                    "G009",
+                    f"the start point ({start[0]:g}, "
+                    f"{start[1]:g}) is outside the workspace boundary",
+                    "the robot must start in the free workspace",
+                )
+            )
         elif hole_union is not None and hole_union.covers(point):
-            problems.append(at(start_path, "G010", f"the start point ({start[0]:g}, "
-                               f"{start[1]:g}) is inside a hole",
-                               "holes are obstacles; start the robot in the free workspace"))
+            problems.append(
+                at(
+                    start_path,
+                    "G010",
+                    f"the start point ({start[0]:g}, {start[1]:g}) is inside a hole",
+                    "holes are obstacles; start the robot in the free workspace",
+                )
+            )
     return problems

@@ -39,63 +39,120 @@ def _schema_diagnostics(doc: PositionedDocument, file: str) -> list[Diagnostic]:
 def _describe(err: ValidationError, doc: PositionedDocument, file: str) -> list[Diagnostic]:
     path: Path = tuple(err.absolute_path)
     if err.validator == "additionalProperties" and isinstance(err.instance, dict):
-        allowed = list(err.schema.get("properties", {}))
+        schema: Any = err.schema
+        allowed = list(schema.get("properties", {}))
         result = []
         for key in err.instance:
             if key in allowed:
                 continue
             close = difflib.get_close_matches(str(key), allowed, n=1)
             line, col = doc.key_at((*path, key))
-            hint = f"did you mean {close[0]!r}?" if close else f"allowed keys: {', '.join(allowed)}"
-            result.append(error("S001", f"unknown key {key!r}" + (
-                f" in {json_path(path)}" if path else ""), hint=hint, file=file, line=line,
-                col=col, path=json_path((*path, key))))
+            suggestion = (
+                f"did you mean {close[0]!r}?" if close else f"allowed keys: {', '.join(allowed)}"
+            )
+            result.append(
+                error(
+                    "S001",
+                    f"unknown key {key!r}" + (f" in {json_path(path)}" if path else ""),
+                    hint=suggestion,
+                    file=file,
+                    line=line,
+                    col=col,
+                    path=json_path((*path, key)),
+                )
+            )
         return result
     if err.validator == "anyOf" and err.context:
-        if list(err.schema.get("anyOf", [{}])[0]) == ["required"]:
+        schema_any: Any = err.schema
+        if list(schema_any.get("anyOf", [{}])[0]) == ["required"]:
             line, col = doc.value_at(path)
-            return [error("S003", "the mission has no task: give `task` phrases, `ltl`, or both",
-                          hint="for example  task: [visit goal]", file=file, line=line, col=col,
-                          path=json_path(path))]
+            return [
+                error(
+                    "S003",
+                    "the mission has no task: give `task` phrases, `ltl`, or both",
+                    hint="for example  task: [visit goal]",
+                    file=file,
+                    line=line,
+                    col=col,
+                    path=json_path(path),
+                )
+            ]
         deepest = best_match(err.context)
         if deepest is not None and not isinstance(err.instance, list | dict):
             deepest = err
         if deepest is not None and deepest is not err:
             return _describe(deepest, doc, file)
         line, col = doc.value_at(path)
-        return [error("S004", f"{json_path(path)} is not a shape",
-                      hint="a shape is a list of [x, y] points or {rect: [xmin, ymin, xmax, ymax]}",
-                      file=file, line=line, col=col, path=json_path(path))]
+        return [
+            error(
+                "S004",
+                f"{json_path(path)} is not a shape",
+                hint="a shape is a list of [x, y] points or {rect: [xmin, ymin, xmax, ymax]}",
+                file=file,
+                line=line,
+                col=col,
+                path=json_path(path),
+            )
+        ]
     if err.validator == "required":
         line, col = doc.value_at(path)
-        return [error("S002", err.message.replace("is a required property",
-                                                  "is missing (required)"),
-                      hint="see docs/mission-format.md for the keys", file=file, line=line,
-                      col=col, path=json_path(path))]
-    if err.validator == "propertyNames" or (path and err.validator in ("pattern", "not")
-                                            and err.instance in (doc.data or {})):
+        return [
+            error(
+                "S002",
+                err.message.replace("is a required property", "is missing (required)"),
+                hint="see docs/mission-format.md for the keys",
+                file=file,
+                line=line,
+                col=col,
+                path=json_path(path),
+            )
+        ]
+    if err.validator == "propertyNames" or (
+        path and err.validator in ("pattern", "not") and err.instance in (doc.data or {})
+    ):
         line, col = doc.key_at(path)
     elif err.validator in ("pattern", "not") and isinstance(err.instance, str) and path == ():
         line, col = doc.value_at(path)
     else:
         line, col = doc.value_at(path)
-    code = {"type": "S005", "const": "S006", "enum": "S007", "pattern": "S008", "not": "S008",
-            "minItems": "S009", "maxItems": "S009", "minimum": "S010", "maximum": "S010",
-            "exclusiveMinimum": "S010", "minProperties": "S009", "minLength": "S009"}.get(
-                str(err.validator), "S000")
+    code = {
+        "type": "S005",
+        "const": "S006",
+        "enum": "S007",
+        "pattern": "S008",
+        "not": "S008",
+        "minItems": "S009",
+        "maxItems": "S009",
+        "minimum": "S010",
+        "maximum": "S010",
+        "exclusiveMinimum": "S010",
+        "minProperties": "S009",
+        "minLength": "S009",
+    }.get(str(err.validator), "S000")
     message = err.message
-    hint = None
+    hint: str | None = None
     if err.validator == "const" and path == ("version",):
         message = f"unsupported mission format version {err.instance!r}"
         hint = "this tlmpc reads `version: 1`"
     elif err.validator in ("pattern", "not"):
         message = f"{err.instance!r} is not a valid name"
-        hint = "names are identifiers (letters, digits, _) and not LTL keywords " \
-               "(F G X N U R W M V true false)"
+        hint = (
+            "names are identifiers (letters, digits, _) and not LTL keywords "
+            "(F G X N U R W M V true false)"
+        )
     if err.validator == "propertyNames":
         return []  # reported by the pattern/not sub-error on the name itself
-    return [error(code, f"{json_path(path)}: {message}", hint=hint, file=file, line=line,
-                  col=col, path=json_path(path))]
+    return [
+        error(
+            code,
+            f"{json_path(path)}: {message}",
+            hint=hint,
+            file=file,
+            line=line,
+            col=col,
+            path=json_path(path),
+        )
+    ]
 
 
 def _ltl_position(doc: PositionedDocument, path: Path) -> tuple[int, int]:
@@ -108,7 +165,10 @@ def _ltl_position(doc: PositionedDocument, path: Path) -> tuple[int, int]:
 
 
 def _check_task(
-    data: Mapping[str, Any], doc: PositionedDocument, file: str, names: set[str],
+    data: Mapping[str, Any],
+    doc: PositionedDocument,
+    file: str,
+    names: set[str],
     groups: Mapping[str, list[str]],
 ) -> tuple[Formula | None, list[Diagnostic]]:
     problems: list[Diagnostic] = []
@@ -134,11 +194,15 @@ def _check_task(
                 close = difflib.get_close_matches(node.name, known, n=1, cutoff=0.5)
                 span = node.span
                 problems.append(
-                    error("L010", f"unknown region {node.name!r}",
-                          hint=(f"did you mean {close[0]!r}? " if close else "")
-                          + "regions and groups are declared under `regions:` and `groups:`",
-                          file=file, line=span.line if span else None,
-                          col=span.col if span else None)
+                    error(
+                        "L010",
+                        f"unknown region {node.name!r}",
+                        hint=(f"did you mean {close[0]!r}? " if close else "")
+                        + "regions and groups are declared under `regions:` and `groups:`",
+                        file=file,
+                        line=span.line if span else None,
+                        col=span.col if span else None,
+                    )
                 )
     if problems or not parts:
         return None, problems
@@ -154,43 +218,65 @@ def _shapes(
 ) -> tuple[CheckedShape | None, list[CheckedShape], dict[str, CheckedShape], list[Diagnostic]]:
     problems: list[Diagnostic] = []
     workspace = data.get("workspace") or {}
-    boundary, found = check_shape(workspace.get("boundary"), ("workspace", "boundary"),
-                                  "workspace boundary", file, doc.value_at)
+    boundary, found = check_shape(
+        workspace.get("boundary"),
+        ("workspace", "boundary"),
+        "workspace boundary",
+        file,
+        doc.value_at,
+    )
     problems.extend(found)
     holes: list[CheckedShape] = []
     for index, hole in enumerate(workspace.get("holes") or []):
-        checked, found = check_shape(hole, ("workspace", "holes", index), f"hole {index}", file,
-                                     doc.value_at)
+        checked, found = check_shape(
+            hole, ("workspace", "holes", index), f"hole {index}", file, doc.value_at
+        )
         problems.extend(found)
         if checked is not None:
             holes.append(checked)
     regions: dict[str, CheckedShape] = {}
     for name, shape in (data.get("regions") or {}).items():
-        checked, found = check_shape(shape, ("regions", name), f"region {name!r}", file,
-                                     doc.value_at)
+        checked, found = check_shape(
+            shape, ("regions", name), f"region {name!r}", file, doc.value_at
+        )
         problems.extend(found)
         if checked is not None:
             regions[name] = checked
     return boundary, holes, regions, problems
 
 
-def _groups(data: Mapping[str, Any], doc: PositionedDocument, file: str,
-            names: set[str]) -> tuple[dict[str, list[str]], list[Diagnostic]]:
+def _groups(
+    data: Mapping[str, Any], doc: PositionedDocument, file: str, names: set[str]
+) -> tuple[dict[str, list[str]], list[Diagnostic]]:
     problems: list[Diagnostic] = []
     groups: dict[str, list[str]] = {}
     for group, members in (data.get("groups") or {}).items():
         if group in names:
             line, col = doc.key_at(("groups", group))
-            problems.append(error("S012", f"{group!r} names both a region and a group",
-                                  hint="rename one of them", file=file, line=line, col=col))
+            problems.append(
+                error(
+                    "S012",
+                    f"{group!r} names both a region and a group",
+                    hint="rename one of them",
+                    file=file,
+                    line=line,
+                    col=col,
+                )
+            )
         for index, member in enumerate(members):
             if member not in names:
                 line, col = doc.value_at(("groups", group, index))
                 close = difflib.get_close_matches(member, sorted(names), n=1)
-                problems.append(error("S011", f"group {group!r} lists unknown region {member!r}",
-                                      hint=f"did you mean {close[0]!r}?" if close else
-                                      "groups list region names", file=file, line=line,
-                                      col=col))
+                problems.append(
+                    error(
+                        "S011",
+                        f"group {group!r} lists unknown region {member!r}",
+                        hint=f"did you mean {close[0]!r}?" if close else "groups list region names",
+                        file=file,
+                        line=line,
+                        col=col,
+                    )
+                )
         groups[group] = list(dict.fromkeys(members))
     return groups, problems
 
@@ -202,9 +288,16 @@ def _load(text: str, file: str, stem: str) -> tuple[Mission | None, list[Diagnos
     if problems:  # non-finite numbers, duplicate keys: the schema would mislead after these
         return None, problems
     if not isinstance(doc.data, dict):
-        return None, [error("S005", "a mission must be a mapping of keys to values",
-                                       hint="start the file with `version: 1`", file=file,
-                                       line=1, col=1)]
+        return None, [
+            error(
+                "S005",
+                "a mission must be a mapping of keys to values",
+                hint="start the file with `version: 1`",
+                file=file,
+                line=1,
+                col=1,
+            )
+        ]
     problems.extend(_schema_diagnostics(doc, file))
     if problems:
         return None, problems
@@ -213,8 +306,9 @@ def _load(text: str, file: str, stem: str) -> tuple[Mission | None, list[Diagnos
     problems.extend(found)
     robot = data["robot"]
     start = (float(robot["start"][0]), float(robot["start"][1]))
-    problems.extend(check_layout(boundary, holes, regions, start, ("robot", "start"), file,
-                                 doc.value_at))
+    problems.extend(
+        check_layout(boundary, holes, regions, start, ("robot", "start"), file, doc.value_at)
+    )
     names = set(data["regions"])
     groups, found = _groups(data, doc, file, names)
     problems.extend(found)
@@ -250,17 +344,31 @@ def _read(path: str | FilePath) -> str:
     try:
         raw = FilePath(path).read_bytes()
     except OSError as exc:
-        raise UsageError(error("U001", f"cannot read {file}: {exc.strerror or exc}",
-                               hint="check the path", file=file)) from None
+        raise UsageError(
+            error(
+                "U001",
+                f"cannot read {file}: {exc.strerror or exc}",
+                hint="check the path",
+                file=file,
+            )
+        ) from None
     if len(raw) > MAX_BYTES:
-        raise UsageError(error("U004", f"{file} is larger than {MAX_BYTES // 2**20} MiB",
-                               file=file))
+        raise UsageError(
+            error("U004", f"{file} is larger than {MAX_BYTES // 2**20} MiB", file=file)
+        )
     try:
         return raw.decode("utf-8")
     except UnicodeDecodeError as exc:
-        raise InvalidInputError(error("Y008", f"the file is not UTF-8 text ({exc.reason} at "
-                                      f"byte {exc.start})", hint="save it as UTF-8",
-                                      file=file, line=1, col=1)) from None
+        raise InvalidInputError(
+            error(
+                "Y008",
+                f"the file is not UTF-8 text ({exc.reason} at byte {exc.start})",
+                hint="save it as UTF-8",
+                file=file,
+                line=1,
+                col=1,
+            )
+        ) from None
 
 
 def check_text(text: str, filename: str = "<string>") -> list[Diagnostic]:
@@ -291,8 +399,9 @@ def load_mission_text(text: str, filename: str = "<string>") -> Mission:
     """Load a mission from YAML text; raises InvalidInputError with all the problems."""
     mission, problems = _load(text, filename, FilePath(filename).stem)
     if mission is None:
-        raise InvalidInputError(best_first(problems) or [error("S000", "invalid mission",
-                                                               file=filename)])
+        raise InvalidInputError(
+            best_first(problems) or [error("S000", "invalid mission", file=filename)]
+        )
     return mission
 
 

@@ -72,8 +72,14 @@ class _Converter:
         except (yaml.YAMLError, ValueError, OverflowError) as exc:
             line, col = _mark(node)
             self.problems.append(
-                error("Y004", f"cannot read the value {node.value!r}: {exc}", file=self.file,
-                      line=line, col=col, path=json_path(path))
+                error(
+                    "Y004",
+                    f"cannot read the value {node.value!r}: {exc}",
+                    file=self.file,
+                    line=line,
+                    col=col,
+                    path=json_path(path),
+                )
             )
             return None
         if isinstance(value, int) and not isinstance(value, bool) and abs(value) > 10**15:
@@ -81,9 +87,15 @@ class _Converter:
         if isinstance(value, float) and not math.isfinite(value):
             line, col = _mark(node)
             self.problems.append(
-                error("Y005", f"the number {node.value!r} is not finite", hint="use a finite "
-                      "number (no .nan, .inf, or values too large for a float)", file=self.file,
-                      line=line, col=col, path=json_path(path))
+                error(
+                    "Y005",
+                    f"the number {node.value!r} is not finite",
+                    hint="use a finite number (no .nan, .inf, or values too large for a float)",
+                    file=self.file,
+                    line=line,
+                    col=col,
+                    path=json_path(path),
+                )
             )
         return value
 
@@ -96,15 +108,26 @@ class _Converter:
             self.count += 1
             if self.count > MAX_NODES:
                 self.problems.append(
-                    error("Y003", "the document is too large (alias expansion?)", file=self.file,
-                          line=1, col=1, hint="missions do not need YAML aliases")
+                    error(
+                        "Y003",
+                        "the document is too large (alias expansion?)",
+                        file=self.file,
+                        line=1,
+                        col=1,
+                        hint="missions do not need YAML aliases",
+                    )
                 )
                 return None
             if depth > MAX_DEPTH:
                 line, col = _mark(node)
                 self.problems.append(
-                    error("Y003", f"the document is nested more than {MAX_DEPTH} levels deep",
-                          file=self.file, line=line, col=col)
+                    error(
+                        "Y003",
+                        f"the document is nested more than {MAX_DEPTH} levels deep",
+                        file=self.file,
+                        line=line,
+                        col=col,
+                    )
                 )
                 return None
             self.doc.values[path] = _mark(node)
@@ -123,8 +146,14 @@ class _Converter:
                     if not isinstance(key_node, yaml.ScalarNode):
                         line, col = _mark(key_node)
                         self.problems.append(
-                            error("Y006", "mapping keys must be plain names", file=self.file,
-                                  line=line, col=col, path=json_path(path))
+                            error(
+                                "Y006",
+                                "mapping keys must be plain names",
+                                file=self.file,
+                                line=line,
+                                col=col,
+                                path=json_path(path),
+                            )
                         )
                         continue
                     key = str(key_node.value)
@@ -132,10 +161,16 @@ class _Converter:
                         line, col = _mark(key_node)
                         first = seen[key]
                         self.problems.append(
-                            error("Y002", f"duplicate key {key!r}", file=self.file, line=line,
-                                  col=col, path=json_path((*path, key)),
-                                  hint=f"it was already given at line {first[0]}; YAML would "
-                                  "silently keep only the last one")
+                            error(
+                                "Y002",
+                                f"duplicate key {key!r}",
+                                file=self.file,
+                                line=line,
+                                col=col,
+                                path=json_path((*path, key)),
+                                hint=f"it was already given at line {first[0]}; YAML would "
+                                "silently keep only the last one",
+                            )
                         )
                         continue
                     seen[key] = _mark(key_node)
@@ -162,16 +197,24 @@ def load_positioned(text: str, file: str) -> tuple[PositionedDocument | None, li
         hint = "check indentation (spaces only, no tabs), quotes and brackets"
         if "\t" in problem or "tab" in problem:
             hint = "YAML does not allow tabs for indentation: use spaces"
-        return None, [error("Y001", f"YAML syntax error: {problem}", hint=hint, file=file,
-                            line=line, col=col)]
+        return None, [
+            error("Y001", f"YAML syntax error: {problem}", hint=hint, file=file, line=line, col=col)
+        ]
     except yaml.YAMLError as exc:
         return None, [error("Y001", f"YAML syntax error: {exc}", file=file, line=1, col=1)]
     except RecursionError:
-        return None, [error("Y003", "the document is nested too deeply", file=file, line=1,
-                            col=1)]
+        return None, [error("Y003", "the document is nested too deeply", file=file, line=1, col=1)]
     if root is None:
-        return None, [error("Y007", "the file is empty", file=file, line=1, col=1,
-                            hint="a mission starts with `version: 1`")]
+        return None, [
+            error(
+                "Y007",
+                "the file is empty",
+                file=file,
+                line=1,
+                col=1,
+                hint="a mission starts with `version: 1`",
+            )
+        ]
     converter = _Converter(file)
     converter.convert(root)
     return converter.doc, converter.problems

@@ -53,12 +53,16 @@ def _reachable(abstraction: Abstraction, allowed: BoolArray) -> BoolArray:
 
 
 def _positive_props(formula: Formula) -> list[str]:
-    negated = {n.arg.name for n in nnf(formula).walk() if isinstance(n, Not) and
-               isinstance(n.arg, Prop)}
+    negated = {
+        n.arg.name for n in nnf(formula).walk() if isinstance(n, Not) and isinstance(n.arg, Prop)
+    }
     positive = {n.name for n in nnf(formula).walk() if isinstance(n, Prop)}
     names = [n.name for n in formula.walk() if isinstance(n, Prop)]
-    return [p for p in dict.fromkeys(names) if p in positive and p not in negated or
-            (p in positive and p in negated)]
+    return [
+        p
+        for p in dict.fromkeys(names)
+        if (p in positive and p not in negated) or (p in positive and p in negated)
+    ]
 
 
 def explain_no_plan(
@@ -69,24 +73,45 @@ def explain_no_plan(
 
     text = to_text(formula)
     if not translate(formula).edges:
-        return [error("P001", f"the task is unsatisfiable on its own: no trajectory on any map "
-                      f"can satisfy `{text}`",
-                      hint="look for contradicting parts, such as `visit a` with `avoid a`")]
+        return [
+            error(
+                "P001",
+                f"the task is unsatisfiable on its own: no trajectory on any map "
+                f"can satisfy `{text}`",
+                hint="look for contradicting parts, such as `visit a` with `avoid a`",
+            )
+        ]
     if not automaton.edges:
-        return [error("P006", "the task needs label combinations this map does not have "
-                      "(regions that would have to overlap)", hint="check which regions the "
-                      "task asks the robot to be in at the same time")]
+        return [
+            error(
+                "P006",
+                "the task needs label combinations this map does not have "
+                "(regions that would have to overlap)",
+                hint="check which regions the task asks the robot to be in at the same time",
+            )
+        ]
     start_labels = abstraction.labels(abstraction.start)
     where = f"in {', '.join(start_labels)}" if start_labels else "in free space"
     if not allowed[abstraction.start]:
         broken = [p for p in invariants(formula) if not holds(p, set(start_labels))]
-        return [error("P002", f"the robot starts {where}, but the task requires "
-                      f"`G {to_text(broken[0]) if broken else '...'}` from the start",
-                      hint="move the start or relax the task")]
-    if not any(e.src == automaton.initial and holds(e.guard, set(start_labels))
-               for e in automaton.edges):
-        return [error("P003", f"the task already fails where the robot starts ({where})",
-                      hint=f"`{text}` constrains the first instant; move the start or the task")]
+        return [
+            error(
+                "P002",
+                f"the robot starts {where}, but the task requires "
+                f"`G {to_text(broken[0]) if broken else '...'}` from the start",
+                hint="move the start or relax the task",
+            )
+        ]
+    if not any(
+        e.src == automaton.initial and holds(e.guard, set(start_labels)) for e in automaton.edges
+    ):
+        return [
+            error(
+                "P003",
+                f"the task already fails where the robot starts ({where})",
+                hint=f"`{text}` constrains the first instant; move the start or the task",
+            )
+        ]
     reachable_ok = _reachable(abstraction, allowed)
     reachable_any = _reachable(abstraction, np.ones(abstraction.num_triangles, dtype=bool))
     problems = []
@@ -94,22 +119,41 @@ def explain_no_plan(
         with_region = np.array([name in letter for letter in abstraction.letters], dtype=bool)
         triangles = with_region[abstraction.letter_of]
         if not triangles.any():
-            problems.append(error("P004", f"region {name!r} has no free space: it lies in "
-                                  "holes", hint="move the region or the holes"))
+            problems.append(
+                error(
+                    "P004",
+                    f"region {name!r} has no free space: it lies in holes",
+                    hint="move the region or the holes",
+                )
+            )
         elif not (triangles & reachable_ok).any():
             if (triangles & reachable_any).any():
                 forbidden = ", ".join(f"`G {to_text(p)}`" for p in invariants(formula))
-                problems.append(error("P005", f"region {name!r} can only be reached through "
-                                      f"regions the task forbids ({forbidden})",
-                                      hint="open a path that avoids the forbidden regions"))
+                problems.append(
+                    error(
+                        "P005",
+                        f"region {name!r} can only be reached through "
+                        f"regions the task forbids ({forbidden})",
+                        hint="open a path that avoids the forbidden regions",
+                    )
+                )
             else:
-                problems.append(error("P005", f"region {name!r} cannot be reached from the "
-                                      "start: holes separate it from the robot",
-                                      hint="open a passage through the holes or move the "
-                                      "start"))
+                problems.append(
+                    error(
+                        "P005",
+                        f"region {name!r} cannot be reached from the "
+                        "start: holes separate it from the robot",
+                        hint="open a passage through the holes or move the start",
+                    )
+                )
     if problems:
         return problems
-    return [error("P007", f"no trajectory on this map satisfies `{text}`: the parts of the "
-                  "task that must hold forever cannot be reached",
-                  hint="a patrol needs a loop of at least three triangles through its "
-                  "regions; check that the regions can be visited in the required order")]
+    return [
+        error(
+            "P007",
+            f"no trajectory on this map satisfies `{text}`: the parts of the "
+            "task that must hold forever cannot be reached",
+            hint="a patrol needs a loop of at least three triangles through its "
+            "regions; check that the regions can be visited in the required order",
+        )
+    ]

@@ -86,8 +86,9 @@ def to_dot_graph(abstraction: Abstraction, name: str = "mission") -> str:
         x, y = centroids[triangle].tolist()
         extra = ', style=filled, fillcolor="#ddeeff"' if labels else ""
         start = ", penwidth=3" if triangle == abstraction.start else ""
-        lines.append(f'  {triangle} [label="{triangle}\\n{labels}", pos="{x:.4g},{y:.4g}!"'
-                     f"{extra}{start}];")
+        lines.append(
+            f'  {triangle} [label="{triangle}\\n{labels}", pos="{x:.4g},{y:.4g}!"{extra}{start}];'
+        )
     for triangle in range(abstraction.num_triangles):
         for other in abstraction.neighbors[triangle].tolist():
             if other > triangle:

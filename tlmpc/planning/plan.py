@@ -13,6 +13,7 @@ optimality statement).  Two kinds of cycles are considered:
 
 from __future__ import annotations
 
+import itertools
 import time
 from typing import Any
 
@@ -60,7 +61,7 @@ def _collapse(nodes: list[int], nq: int) -> tuple[list[int], list[int]]:
 
 def _path_cost(product: Product, nodes: list[int]) -> float:
     graph = product.graph
-    return float(sum(graph[a, b] for a, b in zip(nodes, nodes[1:], strict=False)))
+    return float(sum(graph[a, b] for a, b in itertools.pairwise(nodes)))
 
 
 def plan(
@@ -76,12 +77,11 @@ def plan(
     allowed = invariant_mask(abstraction, formula)
     working = degeneralize(automaton) if automaton.num_acc >= 2 else automaton
     if start_point is None:
-        start_point = tuple(abstraction.corners(abstraction.start).mean(axis=0).tolist())  # type: ignore[assignment]
-    assert start_point is not None
+        x, y = abstraction.corners(abstraction.start).mean(axis=0).tolist()
+        start_point = (float(x), float(y))
     product = build_product(
         abstraction, working, allowed=allowed, start_point=start_point, metric=options.cost
     )
-    nq = product.num_automaton_states
     if len(product.initial) == 0 or not working.edges:
         raise NoPlanError(explain_no_plan(abstraction, automaton, formula, allowed))
     dist, pred, _ = dijkstra(
@@ -125,9 +125,7 @@ def plan(
                 best = (total, _path(pred, u), [u, *back_path[:-1]])
     if best is None:
         raise NoPlanError(explain_no_plan(abstraction, automaton, formula, allowed))
-    return _witness(
-        abstraction, product, best, options, started, searches, exhausted, working
-    )
+    return _witness(abstraction, product, best, options, started, searches, exhausted, working)
 
 
 def _witness(

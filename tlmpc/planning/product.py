@@ -41,16 +41,6 @@ class Product:
     num_nodes: int
 
 
-def triangle_of(node: int | IntArray, num_states: int) -> int | IntArray:
-    """Triangle index of a product node."""
-    return (node // num_states) // SLOTS  # type: ignore[no-any-return]
-
-
-def automaton_state_of(node: int | IntArray, num_states: int) -> int | IntArray:
-    """Automaton state of a product node."""
-    return node % num_states  # type: ignore[no-any-return]
-
-
 def edge_midpoints(abstraction: Abstraction) -> FloatArray:
     """(m, 3, 2): midpoint of the edge opposite each vertex of each triangle."""
     corners = abstraction.vertices[abstraction.triangles]
@@ -171,8 +161,12 @@ def build_product(
     )
     start_row = class_rows[int(tri_class[abstraction.start])]
     initial = np.array(
-        sorted({(abstraction.start * SLOTS + START_SLOT) * nq + q for q, _ in
-                start_row[automaton.initial]}),
+        sorted(
+            {
+                (abstraction.start * SLOTS + START_SLOT) * nq + q
+                for q, _ in start_row[automaton.initial]
+            }
+        ),
         dtype=np.int64,
     )
     if not allowed[abstraction.start]:

@@ -63,7 +63,7 @@ def _exit_step(controller: StepController, x0: FloatArray) -> tuple[list[float],
     horizon = max(gap, 0.0) / controller.exit_speed
     if horizon <= 0.0:
         return [0.0], [x0]
-    grid = max(32, int(math.ceil(horizon * np.linalg.norm(controller.gain, 2) * 10)))
+    grid = max(32, math.ceil(horizon * np.linalg.norm(controller.gain, 2) * 10))
     grid = min(grid, 4096)
     dt = horizon * 1.02 / grid
     step_matrix = expm(dt * matrix)
@@ -84,9 +84,14 @@ def _exit_step(controller: StepController, x0: FloatArray) -> tuple[list[float],
             break
         previous_t, previous_h = j * dt, h
     if crossing is None:
-        raise SolverError(error("C010", f"plan step {controller.step}: the trajectory did not "
-                                "leave its triangle within the exit-time bound",
-                                hint="please report this mission"))
+        raise SolverError(
+            error(
+                "C010",
+                f"plan step {controller.step}: the trajectory did not "
+                "leave its triangle within the exit-time bound",
+                hint="please report this mission",
+            )
+        )
     del previous_h
     times = [float(t) for t in np.linspace(0.0, crossing, SAMPLES_PER_STEP + 1)[1:-1]]
     points = [_flow(matrix, x0, t) for t in times]
@@ -99,18 +104,25 @@ def _exit_step(controller: StepController, x0: FloatArray) -> tuple[list[float],
     return [*times, float(crossing)], [*points, end]
 
 
-def _stay_step(controller: StepController, x0: FloatArray,
-               max_speed: float) -> tuple[list[float], list[FloatArray]]:
+def _stay_step(
+    controller: StepController, x0: FloatArray, max_speed: float
+) -> tuple[list[float], list[FloatArray]]:
     """Convergence to the target: samples on a geometric time grid, then the limit point."""
     assert controller.target is not None
     target = np.asarray(controller.target)
     rate = -float(np.max(np.linalg.eigvals(controller.gain).real))
     if rate <= 0:
-        raise SolverError(error("C011", f"plan step {controller.step}: the stay field does not "
-                                "converge", hint="please report this mission"))
+        raise SolverError(
+            error(
+                "C011",
+                f"plan step {controller.step}: the stay field does not converge",
+                hint="please report this mission",
+            )
+        )
     horizon = math.log(1.0 / STAY_CONTRACTION) / rate
-    times = [float(t) for t in horizon * (np.geomspace(1.0, 1001.0, 4 * SAMPLES_PER_STEP) - 1.0)
-             / 1000.0][1:]
+    times = [
+        float(t) for t in horizon * (np.geomspace(1.0, 1001.0, 4 * SAMPLES_PER_STEP) - 1.0) / 1000.0
+    ][1:]
     points = [target + expm(t * controller.gain) @ (x0 - target) for t in times]
     # The limit point itself, reached "at infinity": placed after the last sample at a time
     # that keeps the stated speed bound.
@@ -139,8 +151,7 @@ def simulate(abstraction: Abstraction, controllers: Controllers, mission: Missio
     now = 0.0
     for position, index in enumerate(order):
         controller = steps[index]
-        if (loop_start_step is not None and index == loop_start_step
-                and position == len(steps)):
+        if loop_start_step is not None and index == loop_start_step and position == len(steps):
             loop_index = len(points) - 1  # the crossing into the second lap
         if controller.exit_edge is None:
             rel_times, rel_points = _stay_step(controller, x, controllers.max_speed)
@@ -156,8 +167,11 @@ def simulate(abstraction: Abstraction, controllers: Controllers, mission: Missio
             points.append(point)
             is_crossing = controller.exit_edge is not None and offset == len(rel_times) - 1
             step_of.append(index)
-            triangle_of.append(controller.next_triangle if is_crossing and
-                               controller.next_triangle is not None else controller.triangle)
+            triangle_of.append(
+                controller.next_triangle
+                if is_crossing and controller.next_triangle is not None
+                else controller.triangle
+            )
             if is_crossing:
                 crossings.append(len(points) - 1)
         now = times[-1]

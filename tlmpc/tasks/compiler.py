@@ -189,8 +189,14 @@ def compile_phrase(
     """Compile one phrase to LTL (raises :class:`InvalidInputError` with T-codes)."""
     if not isinstance(phrase, str) or not phrase.strip():
         raise InvalidInputError(
-            error("T001", "empty task phrase", hint="known phrases: " + "; ".join(KNOWN_PHRASES),
-                  file=file, line=line, col=col)
+            error(
+                "T001",
+                "empty task phrase",
+                hint="known phrases: " + "; ".join(KNOWN_PHRASES),
+                file=file,
+                line=line,
+                col=col,
+            )
         )
     try:
         tree = _parser().parse(phrase)

@@ -12,8 +12,9 @@ from tlmpc.verify.trace_input import TraceInput, from_csv, from_document
 from tlmpc.verify.verdict import Counterexample, Verdict, verdict_to_json, verify_trace
 
 
-def verify_document(document: Mapping[str, Any], *, boundary: str | None = None,
-                    file: str | None = None) -> Verdict:
+def verify_document(
+    document: Mapping[str, Any], *, boundary: str | None = None, file: str | None = None
+) -> Verdict:
     """Verify a ``tlmpc.trace/1`` document (``boundary`` overrides its convention)."""
     return verify_trace(from_document(document, file=file, convention=boundary))
 

@@ -94,7 +94,8 @@ class LassoEvaluator:
         if isinstance(f, Implies):
             return ~self(f.left) | self(f.right)
         if isinstance(f, Equiv):
-            return self(f.left) == self(f.right)
+            equal: BoolArray = self(f.left) == self(f.right)
+            return equal
         if isinstance(f, Until):
             return self._until(self(f.left), self(f.right))
         if isinstance(f, Eventually):

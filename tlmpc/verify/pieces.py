@@ -36,7 +36,7 @@ class Pieces:
 
 
 def _edges(polygons: Sequence[FloatArray]) -> tuple[FloatArray, FloatArray]:
-    starts = np.concatenate([p for p in polygons])
+    starts = np.concatenate(list(polygons))
     ends = np.concatenate([np.roll(p, -1, axis=0) for p in polygons])
     return starts, ends
 
@@ -152,8 +152,9 @@ def build_pieces(
         # The last sample coincides (in label word) with the loop start: drop it.
         kinds, labels = kinds[:-1], labels[:-1]
         piece_times, piece_pos = piece_times[:-1], piece_pos[:-1]
-    return Pieces(is_point=kinds, times=piece_times, positions=piece_pos, labels=labels,
-                  loop_start=loop_piece)
+    return Pieces(
+        is_point=kinds, times=piece_times, positions=piece_pos, labels=labels, loop_start=loop_piece
+    )
 
 
 def merge_pieces(pieces: Pieces, convention: str) -> Pieces:
@@ -171,10 +172,13 @@ def merge_pieces(pieces: Pieces, convention: str) -> Pieces:
         if pieces.loop_start is not None:
             protected = {pieces.loop_start - 1, pieces.loop_start, pieces.loop_start + 1}
         for index in range(1, k - 1):
-            if (pieces.is_point[index] and index not in protected
-                    and index + 1 not in protected
-                    and np.array_equal(labels[index - 1], labels[index])
-                    and np.array_equal(labels[index], labels[index + 1])):
+            if (
+                pieces.is_point[index]
+                and index not in protected
+                and index + 1 not in protected
+                and np.array_equal(labels[index - 1], labels[index])
+                and np.array_equal(labels[index], labels[index + 1])
+            ):
                 keep[index] = False
                 keep[index + 1] = False
     if pieces.loop_start is not None and convention == "right":

@@ -40,12 +40,16 @@ def signed_distance(polygon: FloatArray, points: FloatArray) -> FloatArray:
     geoms = shapely.points(points)
     distance = shapely.distance(shape.exterior, geoms)
     inside = shapely.contains_xy(shape, points[:, 0], points[:, 1])
-    return np.where(inside, distance, -shapely.distance(shape, geoms)).astype(np.float64)
+    result: FloatArray = np.where(inside, distance, -shapely.distance(shape, geoms)).astype(
+        np.float64
+    )
+    return result
 
 
 class _Robustness:
-    def __init__(self, points: FloatArray, loop_start: int | None,
-                 regions: Mapping[str, FloatArray]) -> None:
+    def __init__(
+        self, points: FloatArray, loop_start: int | None, regions: Mapping[str, FloatArray]
+    ) -> None:
         self.points = points
         self.size = len(points)
         self.loop = loop_start
@@ -60,8 +64,8 @@ class _Robustness:
     def _eventually(self, b: FloatArray) -> FloatArray:
         result = np.maximum.accumulate(b[::-1])[::-1]
         if self.loop is not None:
-            result[self.loop:] = np.maximum(result[self.loop:], b[self.loop:].max())
-        return result  # type: ignore[no-any-return]
+            result[self.loop :] = np.maximum(result[self.loop :], b[self.loop :].max())
+        return np.asarray(result, dtype=np.float64)
 
     def _until(self, a: FloatArray, b: FloatArray) -> FloatArray:
         values = np.full(self.size, -np.inf)
@@ -111,8 +115,13 @@ class _Robustness:
         raise TypeError(f"not an LTL node: {f!r}")
 
 
-def robustness(formula: Formula, times: FloatArray, points: FloatArray,
-               loop_start: int | None, regions: Mapping[str, FloatArray]) -> float:
+def robustness(
+    formula: Formula,
+    times: FloatArray,
+    points: FloatArray,
+    loop_start: int | None,
+    regions: Mapping[str, FloatArray],
+) -> float:
     """Robustness of ``formula`` at the first sample."""
     del times
     return float(_Robustness(points, loop_start, regions)(formula)[0])

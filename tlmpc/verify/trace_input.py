@@ -40,8 +40,9 @@ class TraceInput:
     source: str | None = None
 
 
-def _fail(code: str, message: str, file: str | None, hint: str | None = None,
-          line: int | None = None) -> UsageError:
+def _fail(
+    code: str, message: str, file: str | None, hint: str | None = None, line: int | None = None
+) -> UsageError:
     return UsageError(error(code, message, hint=hint, file=file, line=line))
 
 
@@ -69,15 +70,23 @@ def _samples(rows: Any, file: str | None, lines: list[int] | None = None) -> Flo
     bad = np.flatnonzero(~np.all(np.isfinite(array), axis=1))
     if len(bad):
         row = int(bad[0])
-        raise _fail("V003", f"sample {row} has a non-finite value (NaN or infinity)", file,
-                    line=lines[row] if lines else None)
+        raise _fail(
+            "V003",
+            f"sample {row} has a non-finite value (NaN or infinity)",
+            file,
+            line=lines[row] if lines else None,
+        )
     order = np.flatnonzero(np.diff(array[:, 0]) <= 0)
     if len(order):
         row = int(order[0]) + 1
-        raise _fail("V005", f"time does not increase at sample {row} "
-                    f"(t = {array[row - 1, 0]:g} then {array[row, 0]:g})", file,
-                    hint="samples must be sorted by strictly increasing time",
-                    line=lines[row] if lines else None)
+        raise _fail(
+            "V005",
+            f"time does not increase at sample {row} "
+            f"(t = {array[row - 1, 0]:g} then {array[row, 0]:g})",
+            file,
+            hint="samples must be sorted by strictly increasing time",
+            line=lines[row] if lines else None,
+        )
     return array
 
 
@@ -92,35 +101,47 @@ def _formula(text: Any, names: set[str], file: str | None) -> Formula:
         raise UsageError(exc.diagnostics) from None
     unknown = sorted(formula.props() - names)
     if unknown:
-        raise _fail("V007", f"the task names unknown regions: {', '.join(unknown)}", file,
-                    hint="every region in `ltl` must be defined under `regions`")
+        raise _fail(
+            "V007",
+            f"the task names unknown regions: {', '.join(unknown)}",
+            file,
+            hint="every region in `ltl` must be defined under `regions`",
+        )
     return formula
 
 
-def from_document(document: Mapping[str, Any], *, file: str | None = None,
-                  convention: str | None = None) -> TraceInput:
+def from_document(
+    document: Mapping[str, Any], *, file: str | None = None, convention: str | None = None
+) -> TraceInput:
     """Validate a ``tlmpc.trace/1`` document."""
     fmt = document.get("format")
     if not isinstance(fmt, str) or not fmt.startswith("tlmpc.trace/"):
-        raise _fail("V001", f"not a tlmpc trace (format {fmt!r})", file,
-                    hint="pass a trace.json written by `tlmpc compile`, or a CSV with --mission")
+        raise _fail(
+            "V001",
+            f"not a tlmpc trace (format {fmt!r})",
+            file,
+            hint="pass a trace.json written by `tlmpc compile`, or a CSV with --mission",
+        )
     regions_doc = document.get("regions")
     if not isinstance(regions_doc, dict):
         raise _fail("V004", "the trace has no `regions`", file)
     regions = {str(k): _polygon(v, f"region {k!r}", file) for k, v in regions_doc.items()}
     samples = _samples(document.get("points"), file)
     loop = document.get("loop_start")
-    if loop is not None and (not isinstance(loop, int) or isinstance(loop, bool)
-                             or not 0 <= loop < len(samples)):
+    if loop is not None and (
+        not isinstance(loop, int) or isinstance(loop, bool) or not 0 <= loop < len(samples)
+    ):
         raise _fail("V008", f"loop_start {loop!r} is not a sample index", file)
     workspace = document.get("workspace") or {}
     boundary = workspace.get("boundary")
-    holes = tuple(_polygon(h, f"hole {i}", file) for i, h in enumerate(workspace.get("holes")
-                                                                         or []))
+    holes = tuple(
+        _polygon(h, f"hole {i}", file) for i, h in enumerate(workspace.get("holes") or [])
+    )
     chosen = convention or document.get("boundary") or "right"
     if chosen not in ("right", "closed"):
-        raise _fail("V009", f"unknown boundary convention {chosen!r}", file,
-                    hint="use right or closed")
+        raise _fail(
+            "V009", f"unknown boundary convention {chosen!r}", file, hint="use right or closed"
+        )
     speed = document.get("max_speed")
     return TraceInput(
         times=samples[:, 0].copy(),
@@ -131,8 +152,7 @@ def from_document(document: Mapping[str, Any], *, file: str | None = None,
         boundary_polygon=_polygon(boundary, "workspace boundary", file) if boundary else None,
         holes=holes,
         convention=chosen,
-        max_speed=float(speed) if isinstance(speed, int | float) and math.isfinite(speed)
-        else None,
+        max_speed=float(speed) if isinstance(speed, int | float) and math.isfinite(speed) else None,
         source=file,
     )
 
@@ -151,8 +171,9 @@ def read_csv(path: Path) -> tuple[FloatArray, list[int]]:
         if number == 1 and [c.strip().lower() for c in row] == ["t", "x", "y"]:
             continue
         if len(row) != 3:
-            raise _fail("V002", f"expected 3 columns t,x,y, found {len(row)}", str(path),
-                        line=number)
+            raise _fail(
+                "V002", f"expected 3 columns t,x,y, found {len(row)}", str(path), line=number
+            )
         try:
             rows.append([float(cell) for cell in row])
         except ValueError:
@@ -164,8 +185,9 @@ def read_csv(path: Path) -> tuple[FloatArray, list[int]]:
 def from_csv(path: Path, mission_path: Path | None, convention: str | None) -> TraceInput:
     """A CSV trajectory checked against a mission file's regions and task."""
     if mission_path is None:
-        raise _fail("V010", "a CSV trace needs --mission MISSION.yaml for its regions and task",
-                    str(path))
+        raise _fail(
+            "V010", "a CSV trace needs --mission MISSION.yaml for its regions and task", str(path)
+        )
     from tlmpc.errors import InvalidInputError
     from tlmpc.ltl.printer import to_text
     from tlmpc.mission.load import load_mission
@@ -189,5 +211,3 @@ def from_csv(path: Path, mission_path: Path | None, convention: str | None) -> T
         "loop_start": None,
     }
     return from_document(document, file=str(path), convention=convention)
-
-

@@ -62,46 +62,67 @@ def _first(mask: npt.NDArray[np.bool_]) -> int | None:
     return int(found[0]) if len(found) else None
 
 
-def _explain(conjunct: Formula, evaluator: LassoEvaluator, pieces: Pieces,
-             names: list[str]) -> Counterexample:
+def _explain(
+    conjunct: Formula, evaluator: LassoEvaluator, pieces: Pieces, names: list[str]
+) -> Counterexample:
     text = to_text(conjunct)
     if isinstance(conjunct, Globally):
         bad = _first(~evaluator(conjunct.arg))
         if bad is not None:
             time, position = _where(pieces, bad)
             inside = [names[i] for i in np.flatnonzero(pieces.labels[bad])]
-            forbidden = [n.arg.name for n in conjunct.arg.walk()
-                         if isinstance(n, Not) and isinstance(n.arg, Prop)
-                         and n.arg.name in inside]
+            forbidden = [
+                n.arg.name
+                for n in conjunct.arg.walk()
+                if isinstance(n, Not) and isinstance(n.arg, Prop) and n.arg.name in inside
+            ]
             if forbidden:
-                message = (f"entered {forbidden[0]} at t={time:.4g} s at "
-                           f"({position[0]:.4g}, {position[1]:.4g}) while `{text}` must hold")
+                message = (
+                    f"entered {forbidden[0]} at t={time:.4g} s at "
+                    f"({position[0]:.4g}, {position[1]:.4g}) while `{text}` must hold"
+                )
             else:
                 where = ", ".join(inside) if inside else "free space"
-                message = (f"`{to_text(conjunct.arg)}` stops holding at t={time:.4g} s at "
-                           f"({position[0]:.4g}, {position[1]:.4g}) (in {where}) while "
-                           f"`{text}` must hold")
+                message = (
+                    f"`{to_text(conjunct.arg)}` stops holding at t={time:.4g} s at "
+                    f"({position[0]:.4g}, {position[1]:.4g}) (in {where}) while "
+                    f"`{text}` must hold"
+                )
             return Counterexample(conjunct=text, time=time, position=position, message=message)
     if isinstance(conjunct, Eventually):
-        return Counterexample(conjunct=text, time=None, position=None,
-                              message=f"`{to_text(conjunct.arg)}` never holds, so `{text}` "
-                              "fails")
+        return Counterexample(
+            conjunct=text,
+            time=None,
+            position=None,
+            message=f"`{to_text(conjunct.arg)}` never holds, so `{text}` fails",
+        )
     if isinstance(conjunct, Until):
         left = evaluator(conjunct.left)
         right = evaluator(conjunct.right)
         if not right.any():
-            return Counterexample(conjunct=text, time=None, position=None,
-                                  message=f"`{to_text(conjunct.right)}` never holds, so "
-                                  f"`{text}` fails")
+            return Counterexample(
+                conjunct=text,
+                time=None,
+                position=None,
+                message=f"`{to_text(conjunct.right)}` never holds, so `{text}` fails",
+            )
         bad = _first(~left & ~right)
         if bad is not None:
             time, position = _where(pieces, bad)
-            return Counterexample(conjunct=text, time=time, position=position,
-                                  message=f"`{to_text(conjunct.left)}` stops holding at "
-                                  f"t={time:.4g} s at ({position[0]:.4g}, {position[1]:.4g}) "
-                                  f"before `{to_text(conjunct.right)}` holds")
-    return Counterexample(conjunct=text, time=None, position=None,
-                          message=f"`{text}` does not hold on this trajectory")
+            return Counterexample(
+                conjunct=text,
+                time=time,
+                position=position,
+                message=f"`{to_text(conjunct.left)}` stops holding at "
+                f"t={time:.4g} s at ({position[0]:.4g}, {position[1]:.4g}) "
+                f"before `{to_text(conjunct.right)}` holds",
+            )
+    return Counterexample(
+        conjunct=text,
+        time=None,
+        position=None,
+        message=f"`{text}` does not hold on this trajectory",
+    )
 
 
 def _workspace_violation(trace: TraceInput) -> Counterexample | None:
@@ -135,16 +156,18 @@ def _workspace_violation(trace: TraceInput) -> Counterexample | None:
     in_hole = any(shapely.Polygon(h).intersects(segments[bad]) for h in trace.holes)
     where = "entered a hole (an obstacle)" if in_hole else "left the workspace"
     x, y = float(entry[0]), float(entry[1])
-    return Counterexample(conjunct="workspace", time=time, position=(x, y),
-                          message=f"the trajectory {where} at t={time:.4g} s at "
-                          f"({x:.4g}, {y:.4g})")
+    return Counterexample(
+        conjunct="workspace",
+        time=time,
+        position=(x, y),
+        message=f"the trajectory {where} at t={time:.4g} s at ({x:.4g}, {y:.4g})",
+    )
 
 
 def verify_trace(trace: TraceInput) -> Verdict:
     """Check ``trace`` against its task under its boundary convention."""
     names = list(trace.regions)
-    raw = build_pieces(trace.times, trace.points, trace.loop_start, trace.regions,
-                       trace.convention)
+    raw = build_pieces(trace.times, trace.points, trace.loop_start, trace.regions, trace.convention)
     pieces = merge_pieces(raw, trace.convention)
     loop = pieces.loop_start if pieces.loop_start is not None else len(pieces.is_point) - 1
     evaluator = LassoEvaluator(
