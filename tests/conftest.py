@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import os
 import shutil
+import sys
 from pathlib import Path
 
 import pytest
@@ -48,3 +49,6 @@ def spin_path() -> str | None:
 
 
 requires_spin = pytest.mark.skipif(spin_path() is None, reason="spin is not installed")
+
+# Shared test oracles (independent re-implementations) are importable by module name.
+sys.path.insert(0, str(Path(__file__).resolve().parent / "oracles"))

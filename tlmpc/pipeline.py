@@ -127,7 +127,13 @@ def _plan(c: Compilation) -> StageResult:
     mission: Mission = _require(c.mission, "mission")
     abstraction: Abstraction = _require(c.abstraction, "abstraction")
     automaton: Automaton = _require(c.automaton, "automaton")
-    witness = plan(abstraction, automaton, formula=mission.formula, options=mission.options)
+    witness = plan(
+        abstraction,
+        automaton,
+        formula=mission.formula,
+        options=mission.options,
+        start_point=mission.robot.start,
+    )
     return StageResult(
         compilation=dataclasses.replace(c, witness=witness),
         artifacts={"witness.json": witness_to_json(witness, abstraction)},
