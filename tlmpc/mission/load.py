@@ -107,12 +107,9 @@ def _describe(err: ValidationError, doc: PositionedDocument, file: str) -> list[
                 path=json_path(path),
             )
         ]
-    if err.validator == "propertyNames" or (
-        path and err.validator in ("pattern", "not") and err.instance in (doc.data or {})
-    ):
+    if "propertyNames" in err.absolute_schema_path and isinstance(err.instance, str):
+        path = (*path, err.instance)  # point at the offending name itself
         line, col = doc.key_at(path)
-    elif err.validator in ("pattern", "not") and isinstance(err.instance, str) and path == ():
-        line, col = doc.value_at(path)
     else:
         line, col = doc.value_at(path)
     code = {
@@ -140,8 +137,6 @@ def _describe(err: ValidationError, doc: PositionedDocument, file: str) -> list[
             "names are identifiers (letters, digits, _) and not LTL keywords "
             "(F G X N U R W M V true false)"
         )
-    if err.validator == "propertyNames":
-        return []  # reported by the pattern/not sub-error on the name itself
     return [
         error(
             code,

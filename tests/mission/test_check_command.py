@@ -1,0 +1,79 @@
+"""`tlmpc check`: exit codes, --json, --explain, speed-sensitive imports."""
+
+from __future__ import annotations
+
+import io
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+from tlmpc.cli import main
+
+ROOT = Path(__file__).resolve().parents[2]
+SPECS = sorted(str(p) for p in (ROOT / "specs").glob("*.yaml"))
+BAD = Path(__file__).parent / "bad"
+
+
+def run(*argv: str) -> tuple[int, str, str]:
+    out, err = io.StringIO(), io.StringIO()
+    return main(["check", *argv], out=out, err=err), out.getvalue(), err.getvalue()
+
+
+def test_specs_are_valid() -> None:
+    code, _, err = run(*SPECS)
+    assert code == 0, err
+    assert f"{len(SPECS)} of {len(SPECS)} mission file(s) valid" in err
+
+
+def test_explain_prints_the_ltl() -> None:
+    code, out, _ = run(str(ROOT / "specs" / "example1.yaml"), "--explain")
+    assert code == 0
+    assert "F(p2 & F(p3 & F(p4 & ((!p2 & !p3) U p1))))" in out
+
+
+def test_issue_examples_exit_1_with_positions() -> None:
+    for name, code_ in [("unknown-top-key", "S001"), ("bow-tie", "G004"),
+                        ("start-in-hole", "G010"), ("next-operator", "L004")]:
+        path = BAD / f"{name}.yaml"
+        code, _, err = run(str(path))
+        assert code == 1
+        assert f"{path}:" in err
+        assert f"error[{code_}]" in err
+        assert "hint:" in err
+
+
+def test_json_is_one_document_on_stdout() -> None:
+    code, out, _ = run(SPECS[0], str(BAD / "bow-tie.yaml"), "--json")
+    assert code == 1
+    document = json.loads(out)
+    assert document["ok"] is False
+    assert [f["ok"] for f in document["files"]] == [True, False]
+    assert document["files"][1]["diagnostics"][0]["code"] == "G004"
+    assert document["files"][0]["ltl"]
+
+
+def test_unreadable_file_exits_2() -> None:
+    code, _, err = run(SPECS[0], "/nonexistent/mission.yaml")
+    assert code == 2
+    assert "error[U001]" in err
+
+
+def test_check_imports_no_heavy_packages() -> None:
+    script = (
+        "import sys, io\n"
+        "from tlmpc.cli import main\n"
+        f"code = main(['check', {SPECS[0]!r}], io.StringIO(), io.StringIO())\n"
+        "heavy = sorted(m for m in sys.modules if m.split('.')[0] in "
+        "('scipy', 'cvxpy', 'triangle', 'matplotlib', 'clarabel'))\n"
+        "print(code, heavy)\n"
+    )
+    completed = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                               check=True)
+    assert completed.stdout.strip() == "0 []"
+
+
+def test_console_entry_point_runs() -> None:
+    completed = subprocess.run([sys.executable, "-m", "tlmpc", "check", SPECS[0]],
+                               capture_output=True, text=True, check=False)
+    assert completed.returncode == 0, completed.stderr
