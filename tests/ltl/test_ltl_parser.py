@@ -81,8 +81,15 @@ def test_next_is_rejected_with_an_explanation(text: str) -> None:
 
 @pytest.mark.parametrize(
     ("text", "code", "col"),
-    [("a & ", "L002", 5), ("a $ b", "L001", 3), ("", "L002", 1), ("a b", "L003", 3),
-     (")", "L003", 1), ("(" * 500 + "a" + ")" * 500, "L005", 1), ("a U " * 2000 + "b", "L005", 1)],
+    [
+        ("a & ", "L002", 5),
+        ("a $ b", "L001", 3),
+        ("", "L002", 1),
+        ("a b", "L003", 3),
+        (")", "L003", 1),
+        ("(" * 500 + "a" + ")" * 500, "L005", 1),
+        ("a U " * 2000 + "b", "L005", 1),
+    ],
 )
 def test_syntax_errors_have_positions(text: str, code: str, col: int) -> None:
     with pytest.raises(InvalidInputError) as caught:
@@ -109,9 +116,16 @@ def test_nnf_preserves_meaning(formula: object, lasso: tuple[list[frozenset[str]
 
 @pytest.mark.parametrize(
     ("text", "cosafe", "safety"),
-    [("F a & F b", True, False), ("G !o", False, True), ("a U b", True, False),
-     ("a W b", False, True), ("G F a", False, False), ("!(a U b)", False, True),
-     ("a & !b", True, True), ("F(p2 & F(p3 & F(p4 & ((!p2 & !p3) U p1))))", True, False)],
+    [
+        ("F a & F b", True, False),
+        ("G !o", False, True),
+        ("a U b", True, False),
+        ("a W b", False, True),
+        ("G F a", False, False),
+        ("!(a U b)", False, True),
+        ("a & !b", True, True),
+        ("F(p2 & F(p3 & F(p4 & ((!p2 & !p3) U p1))))", True, False),
+    ],
 )
 def test_syntactic_classes(text: str, cosafe: bool, safety: bool) -> None:
     formula = parse_ltl(text)

@@ -33,8 +33,12 @@ def test_explain_prints_the_ltl() -> None:
 
 
 def test_issue_examples_exit_1_with_positions() -> None:
-    for name, code_ in [("unknown-top-key", "S001"), ("bow-tie", "G004"),
-                        ("start-in-hole", "G010"), ("next-operator", "L004")]:
+    for name, code_ in [
+        ("unknown-top-key", "S001"),
+        ("bow-tie", "G004"),
+        ("start-in-hole", "G010"),
+        ("next-operator", "L004"),
+    ]:
         path = BAD / f"{name}.yaml"
         code, _, err = run(str(path))
         assert code == 1
@@ -68,12 +72,17 @@ def test_check_imports_no_heavy_packages() -> None:
         "('scipy', 'cvxpy', 'triangle', 'matplotlib', 'clarabel'))\n"
         "print(code, heavy)\n"
     )
-    completed = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
-                               check=True)
+    completed = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, check=True
+    )
     assert completed.stdout.strip() == "0 []"
 
 
 def test_console_entry_point_runs() -> None:
-    completed = subprocess.run([sys.executable, "-m", "tlmpc", "check", SPECS[0]],
-                               capture_output=True, text=True, check=False)
+    completed = subprocess.run(
+        [sys.executable, "-m", "tlmpc", "check", SPECS[0]],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
     assert completed.returncode == 0, completed.stderr

@@ -85,13 +85,17 @@ def test_generated_example8_is_up_to_date() -> None:
 
 
 yaml_scalars = st.one_of(
-    st.integers(-(10**30), 10**30), st.floats(allow_nan=True, allow_infinity=True),
-    st.text(max_size=8), st.booleans(), st.none(),
+    st.integers(-(10**30), 10**30),
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.text(max_size=8),
+    st.booleans(),
+    st.none(),
 )
 yaml_values = st.recursive(
     yaml_scalars,
-    lambda inner: st.one_of(st.lists(inner, max_size=4),
-                            st.dictionaries(st.text(max_size=6), inner, max_size=4)),
+    lambda inner: st.one_of(
+        st.lists(inner, max_size=4), st.dictionaries(st.text(max_size=6), inner, max_size=4)
+    ),
     max_leaves=20,
 )
 
@@ -108,9 +112,26 @@ def test_random_bytes_never_crash(data: bytes) -> None:
 
 
 @settings(deadline=None)
-@given(st.dictionaries(st.sampled_from(["version", "workspace", "regions", "robot", "task",
-                                        "ltl", "options", "groups", "name", "x"]),
-                       yaml_values, max_size=8))
+@given(
+    st.dictionaries(
+        st.sampled_from(
+            [
+                "version",
+                "workspace",
+                "regions",
+                "robot",
+                "task",
+                "ltl",
+                "options",
+                "groups",
+                "name",
+                "x",
+            ]
+        ),
+        yaml_values,
+        max_size=8,
+    )
+)
 def test_random_structures_never_crash(document: dict[str, object]) -> None:
     import json
 

@@ -44,8 +44,9 @@ def formulas(props: tuple[str, ...] = PROPS, max_leaves: int = 12) -> st.SearchS
 
 
 @st.composite
-def lassos(draw: st.DrawFn, props: tuple[str, ...] = PROPS,
-           letters: list[frozenset[str]] | None = None) -> tuple[list[frozenset[str]], int]:
+def lassos(
+    draw: st.DrawFn, props: tuple[str, ...] = PROPS, letters: list[frozenset[str]] | None = None
+) -> tuple[list[frozenset[str]], int]:
     """A lasso word (letters, loop start); letters drawn from ``letters`` when given."""
     if letters is None:
         letter = st.frozensets(st.sampled_from(props), max_size=len(props))

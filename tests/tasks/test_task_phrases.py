@@ -57,8 +57,9 @@ def test_keywords_are_case_insensitive() -> None:
 def test_phrases_are_conjoined_and_all_problems_reported() -> None:
     assert compile_phrases(["visit a", "avoid o"]) == parse_ltl("F a & G !o")
     with pytest.raises(InvalidInputError) as caught:
-        compile_phrases(["vist a", "visit b", "go somewhere"], file="m.yaml",
-                        positions=[(4, 5), (5, 5), (6, 5)])
+        compile_phrases(
+            ["vist a", "visit b", "go somewhere"], file="m.yaml", positions=[(4, 5), (5, 5), (6, 5)]
+        )
     lines = [d.line for d in caught.value.diagnostics]
     assert lines == [4, 6]
 

@@ -9,7 +9,6 @@ import numpy as np
 import shapely
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
-from shapely.geometry import Polygon as ShapelyPolygon
 
 from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
 from tlmpc.abstraction.triangulate import triangulate
@@ -45,11 +44,11 @@ def locate_in(vertices: FloatArray, triangles: IntArray, point: tuple[float, flo
 
 
 def _labels(
-    mission: Mission, vertices: FloatArray, triangles: IntArray
+    mission: Mission, vertices: FloatArray, triangles: IntArray, shapes: list[Any]
 ) -> tuple[IntArray, tuple[tuple[str, ...], ...]]:
     centroids = vertices[triangles].mean(axis=1)
     names = [r.name for r in mission.regions]
-    tree = shapely.STRtree([ShapelyPolygon(r.polygon) for r in mission.regions])
+    tree = shapely.STRtree(shapes)
     hits = tree.query(shapely.points(centroids), predicate="within")
     order = np.lexsort((hits[1], hits[0]))
     tri_of, region_of = hits[0][order], hits[1][order]
@@ -84,8 +83,8 @@ def _components(neighbors: IntArray) -> IntArray:
 def build_abstraction(mission: Mission) -> Abstraction:
     """Triangulate ``mission``'s workspace and build the transition system D."""
     started = time.perf_counter()
-    vertices, triangles, neighbors = triangulate(mission)
-    letter_of, letters = _labels(mission, vertices, triangles)
+    vertices, triangles, neighbors, shapes = triangulate(mission)
+    letter_of, letters = _labels(mission, vertices, triangles, shapes)
     start = locate_in(vertices, triangles, mission.robot.start)
     if start < 0:
         raise InvalidInputError(

@@ -8,6 +8,7 @@ chain of constraint segments, each triangle lies wholly inside or wholly outside
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from typing import Any
 
@@ -15,7 +16,6 @@ import numpy as np
 import numpy.typing as npt
 import shapely
 import triangle
-from shapely.geometry import MultiPolygon
 from shapely.geometry import Polygon as ShapelyPolygon
 
 from tlmpc.errors import InvalidInputError, error
@@ -24,18 +24,36 @@ from tlmpc.mission.model import Mission
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
 
-#: Vertices closer than this fraction of the workspace size are merged before Triangle runs.
-SNAP = 1e-10
+#: Steiner point budget of quality refinement: at least MIN_STEINER, else this many per input
+#: vertex (a cap, far above what well-shaped inputs need, so refinement always terminates).
+MIN_STEINER = 20_000
+STEINER_PER_VERTEX = 50
+
+#: Snapping grid, relative to the workspace's extent: closer features are merged.
+GRID = 1e-9
 
 
-def free_space(mission: Mission) -> ShapelyPolygon | MultiPolygon:
-    """The workspace boundary minus the holes."""
-    boundary = ShapelyPolygon(mission.workspace.boundary)
-    if not mission.workspace.holes:
-        return shapely.normalize(boundary)
-    holes = shapely.union_all([ShapelyPolygon(h) for h in mission.workspace.holes])
-    free = boundary.difference(holes)
-    if free.is_empty:
+def grid_size(mission: Mission) -> float:
+    """The snapping grid: a power of ten near a billionth of the workspace's extent.
+
+    A power of ten keeps decimal coordinates (the ones users write) exactly where they are.
+    """
+    minx, miny, maxx, maxy = ShapelyPolygon(mission.workspace.boundary).bounds
+    extent = max(maxx - minx, maxy - miny)
+    return float(10.0 ** math.floor(math.log10(extent * GRID)))
+
+
+def _snapped(points: Sequence[tuple[float, float]], grid: float) -> Any:
+    return shapely.set_precision(ShapelyPolygon(points), grid)
+
+
+def free_space(mission: Mission, grid: float) -> Any:
+    """The workspace boundary minus the holes, snapped to ``grid``."""
+    boundary = _snapped(mission.workspace.boundary, grid)
+    if mission.workspace.holes:
+        holes = shapely.union_all([_snapped(h, grid) for h in mission.workspace.holes])
+        boundary = shapely.set_precision(boundary.difference(holes), grid)
+    if boundary.is_empty:
         raise InvalidInputError(
             error(
                 "A001",
@@ -44,7 +62,7 @@ def free_space(mission: Mission) -> ShapelyPolygon | MultiPolygon:
                 file=mission.source,
             )
         )
-    return free
+    return boundary
 
 
 def _polygons(geometry: Any) -> list[ShapelyPolygon]:
@@ -64,19 +82,15 @@ def _rings(polygon: ShapelyPolygon) -> list[Any]:
 
 def _segments_of(lines: Sequence[Any]) -> FloatArray:
     """All straight segments of the given linework as an (s, 2, 2) array."""
-    coords = shapely.get_coordinates(lines, return_index=True)
-    points, owner = coords
+    points, owner = shapely.get_coordinates(lines, return_index=True)
     if len(points) < 2:
         return np.zeros((0, 2, 2))
     same = owner[1:] == owner[:-1]
-    starts = points[:-1][same]
-    ends = points[1:][same]
-    return np.stack([starts, ends], axis=1)
+    return np.stack([points[:-1][same], points[1:][same]], axis=1)
 
 
-def _needs_noding(free_rings: list[Any], region_polygons: list[ShapelyPolygon]) -> bool:
-    """True when some region boundary crosses or touches another ring (noding required)."""
-    rings = [*free_rings, *(p.exterior for p in region_polygons)]
+def _needs_noding(rings: list[Any]) -> bool:
+    """True when some ring crosses or touches another (then the linework must be noded)."""
     if len(rings) <= 1:
         return False
     tree = shapely.STRtree(rings)
@@ -84,50 +98,65 @@ def _needs_noding(free_rings: list[Any], region_polygons: list[ShapelyPolygon]) 
     return bool(np.any(pairs[0] != pairs[1]))
 
 
-def pslg(mission: Mission) -> tuple[FloatArray, IntArray, FloatArray]:
-    """The planar straight-line graph: vertices, segments (index pairs), hole seed points."""
-    free = free_space(mission)
+def pslg(mission: Mission) -> tuple[FloatArray, IntArray, FloatArray, list[Any]]:
+    """The planar straight-line graph and the snapped region shapes.
+
+    Returns vertices, segments (index pairs), hole seed points, and each region's polygon
+    after snapping to the grid (the shapes whose boundaries are the constraint segments).
+    All geometry is snap-rounded to a grid of a billionth of the workspace's extent, so
+    nearly touching or nearly collinear input becomes exactly touching or collinear.
+    """
+    grid = grid_size(mission)
+    free = free_space(mission, grid)
     parts = _polygons(free)
     free_rings = [ring for part in parts for ring in _rings(part)]
-    regions = [ShapelyPolygon(r.polygon) for r in mission.regions]
-    region_lines: list[Any] = []
-    if _needs_noding(free_rings, regions):
-        clipped = [shapely.intersection(shapely.boundary(r), free) for r in regions]
-        region_lines = [c for c in clipped if not c.is_empty]
-        linework = shapely.node(shapely.union_all([*free_rings, *region_lines]))
+    regions = [_snapped(r.polygon, grid) for r in mission.regions]
+    region_rings = [
+        ring for region in regions for part in _polygons(region) for ring in _rings(part)
+    ]
+    if _needs_noding([*free_rings, *region_rings]):
+        clipped = [shapely.intersection(shapely.boundary(r), free, grid_size=grid) for r in regions]
+        linework = shapely.union_all(
+            [*free_rings, *(c for c in clipped if not c.is_empty)], grid_size=grid
+        )
         segments = _segments_of(list(shapely.get_parts(linework)))
     else:
-        segments = _segments_of([*free_rings, *(r.exterior for r in regions)])
-    minx, miny, maxx, maxy = free.bounds
-    scale = max(maxx - minx, maxy - miny)
-    step = scale * SNAP
+        segments = _segments_of([*free_rings, *region_rings])
+    minx, miny, _, _ = free.bounds
     flat = segments.reshape(-1, 2)
-    keys = np.round((flat - np.array([minx, miny])) / step).astype(np.int64)
-    unique_keys, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
+    keys = np.round((flat - np.array([minx, miny])) / grid).astype(np.int64)
+    _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
     vertices = flat[first]
     edges = inverse.reshape(-1, 2)
     edges = edges[edges[:, 0] != edges[:, 1]]
     edges = np.unique(np.sort(edges, axis=1), axis=0)
     seeds = []
-    free_union = shapely.union_all(parts)
     for part in parts:
         for interior in part.interiors:
-            inside = ShapelyPolygon(interior).difference(free_union)
+            inside = ShapelyPolygon(interior).difference(free)
             if not inside.is_empty:
                 point = inside.representative_point()
                 seeds.append((point.x, point.y))
-    del unique_keys
-    return vertices.astype(np.float64), edges.astype(np.int64), np.array(seeds, dtype=np.float64)
+    return (
+        vertices.astype(np.float64),
+        edges.astype(np.int64),
+        np.array(seeds, dtype=np.float64),
+        regions,
+    )
 
 
 def triangulate(
     mission: Mission,
-) -> tuple[FloatArray, IntArray, IntArray]:
-    """Vertices, counter-clockwise triangles and neighbours of the constrained triangulation."""
-    vertices, segments, seeds = pslg(mission)
+) -> tuple[FloatArray, IntArray, IntArray, list[Any]]:
+    """Vertices, counter-clockwise triangles and neighbours of the constrained triangulation,
+    and the snapped region shapes (use these to label the triangles)."""
+    vertices, segments, seeds, regions = pslg(mission)
     options = "pznQ"
     if mission.options.min_angle is not None and mission.options.min_angle > 0:
         options += f"q{mission.options.min_angle:g}"
+        # Input angles smaller than the bound can make refinement run away (Triangle's
+        # guarantee needs input angles >= 60 degrees); cap the Steiner points it may add.
+        options += f"S{max(MIN_STEINER, STEINER_PER_VERTEX * len(vertices))}"
     if mission.options.max_area is not None:
         options += f"a{mission.options.max_area:.17g}"
     data: dict[str, Any] = {"vertices": vertices, "segments": segments}
@@ -137,4 +166,4 @@ def triangulate(
     points = np.asarray(result["vertices"], dtype=np.float64)
     triangles = np.asarray(result["triangles"], dtype=np.int64)
     neighbors = np.asarray(result["neighbors"], dtype=np.int64)
-    return points, triangles, neighbors
+    return points, triangles, neighbors, regions

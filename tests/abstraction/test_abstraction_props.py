@@ -1,0 +1,212 @@
+"""The transition system D: observation preservation, areas, neighbours (properties)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import shapely
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from shapely.geometry import Polygon
+
+from tlmpc.abstraction import (
+    abstraction_diagnostics,
+    abstraction_from_json,
+    abstraction_to_json,
+    build_abstraction,
+    locate,
+)
+from tlmpc.abstraction.model import Abstraction
+from tlmpc.artifacts import validation_errors
+from tlmpc.errors import InvalidInputError
+from tlmpc.ltl.ast import TRUE
+from tlmpc.mission import load_mission
+from tlmpc.mission.model import Mission, Options, Region, Robot, Workspace
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def rect(x0: float, y0: float, x1: float, y1: float) -> tuple[tuple[float, float], ...]:
+    return ((x0, y0), (x1, y0), (x1, y1), (x0, y1))
+
+
+def mission_of(boundary, holes, regions, start, options=None) -> Mission:  # type: ignore[no-untyped-def]
+    return Mission(
+        name="t",
+        workspace=Workspace(boundary=boundary, holes=tuple(holes)),
+        regions=tuple(Region(name=n, polygon=p) for n, p in regions.items()),
+        robot=Robot(start=start),
+        formula=TRUE,
+        options=options or Options(),
+    )
+
+
+@st.composite
+def workspaces(draw: st.DrawFn) -> Mission:
+    """A box with up to two holes and up to four overlapping regions (convex or star)."""
+    width = draw(st.integers(6, 12))
+    height = draw(st.integers(5, 10))
+    holes = []
+    if draw(st.booleans()):
+        holes.append(rect(1.0, 1.0, 2.0, 2.5))
+    if draw(st.booleans()):
+        holes.append(rect(width - 2.5, height - 2.0, width - 1.5, height - 1.0))
+    regions = {}
+    for k in range(draw(st.integers(1, 4))):
+        x0 = draw(st.floats(0.0, width - 2.0))
+        y0 = draw(st.floats(0.0, height - 2.0))
+        w = draw(st.floats(0.5, 3.0))
+        h = draw(st.floats(0.5, 3.0))
+        if draw(st.booleans()):
+            regions[f"r{k}"] = rect(x0, y0, min(x0 + w, width), min(y0 + h, height))
+        else:  # a triangle-ish star polygon
+            regions[f"r{k}"] = (
+                (x0, y0),
+                (min(x0 + w, width), y0 + h / 3),
+                (x0 + w / 2, min(y0 + h, height)),
+            )
+    start = (width - 0.1, 0.1)
+    min_angle = draw(st.sampled_from([None, 20.0]))
+    return mission_of(
+        rect(0, 0, width, height), holes, regions, start, Options(min_angle=min_angle)
+    )
+
+
+def _triangle_polygons(a: Abstraction) -> list[Polygon]:
+    return [Polygon(c) for c in a.vertices[a.triangles]]
+
+
+@settings(deadline=None, max_examples=40)
+@given(workspaces())
+def test_observation_preserving(mission: Mission) -> None:
+    a = build_abstraction(mission)
+    triangles = _triangle_polygons(a)
+    centroids = a.vertices[a.triangles].mean(axis=1)
+    for region in mission.regions:
+        shape = Polygon(region.polygon)
+        inside = np.array([region.name in a.labels(t) for t in range(a.num_triangles)])
+        centroid_in = shapely.contains_xy(shape, centroids[:, 0], centroids[:, 1])
+        assert np.array_equal(inside, centroid_in)
+        for t, polygon in enumerate(triangles):
+            overlap = polygon.intersection(shape).area
+            # Wholly inside or wholly outside, never crossed by the region boundary (up to
+            # the snapping grid, a billionth of the workspace's extent).
+            assert overlap == pytest.approx(polygon.area if inside[t] else 0.0, abs=1e-7), (
+                region,
+                t,
+            )
+
+
+@settings(deadline=None, max_examples=40)
+@given(workspaces())
+def test_areas_sum_to_the_free_area_and_none_is_degenerate(mission: Mission) -> None:
+    a = build_abstraction(mission)
+    free = Polygon(mission.workspace.boundary)
+    for hole in mission.workspace.holes:
+        free = free.difference(Polygon(hole))
+    corners = a.vertices[a.triangles]
+    signed = 0.5 * (
+        (corners[:, 1, 0] - corners[:, 0, 0]) * (corners[:, 2, 1] - corners[:, 0, 1])
+        - (corners[:, 2, 0] - corners[:, 0, 0]) * (corners[:, 1, 1] - corners[:, 0, 1])
+    )
+    assert np.all(signed > 0), "triangles are counter-clockwise with positive area"
+    assert signed.sum() == pytest.approx(free.area, rel=1e-9)
+    for hole in mission.workspace.holes:
+        hole_shape = Polygon(hole)
+        for polygon in _triangle_polygons(a):
+            assert polygon.intersection(hole_shape).area <= 1e-12
+
+
+@settings(deadline=None, max_examples=40)
+@given(workspaces())
+def test_neighbours_are_symmetric_and_share_one_edge(mission: Mission) -> None:
+    a = build_abstraction(mission)
+    for t in range(a.num_triangles):
+        for i in range(3):
+            n = int(a.neighbors[t, i])
+            if n < 0:
+                continue
+            assert t in a.neighbors[n].tolist()
+            edge = {int(a.triangles[t, (i + 1) % 3]), int(a.triangles[t, (i + 2) % 3])}
+            shared = edge & set(a.triangles[n].tolist())
+            assert len(shared) == 2
+            p, q = a.vertices[sorted(shared)]
+            assert np.linalg.norm(p - q) > 0
+
+
+def test_paper_example8_has_the_papers_9250_triangles() -> None:
+    a = build_abstraction(load_mission(ROOT / "specs" / "example8.yaml"))
+    assert a.num_triangles == 9250
+    assert len(a.letters) == 34 * 34 + 1
+
+
+def test_quality_options_refine() -> None:
+    base = mission_of(
+        rect(0, 0, 10, 4), [], {"a": rect(1, 1, 2, 2)}, (5, 2), Options(min_angle=None)
+    )
+    coarse = build_abstraction(base)
+    fine = build_abstraction(
+        mission_of(
+            rect(0, 0, 10, 4),
+            [],
+            {"a": rect(1, 1, 2, 2)},
+            (5, 2),
+            Options(min_angle=30.0, max_area=0.5),
+        )
+    )
+    assert fine.num_triangles > coarse.num_triangles
+    assert fine.stats["min_angle_deg"] >= 30.0 - 1e-6
+    assert (fine.vertices[fine.triangles].max(axis=1) >= 0).all()
+
+
+def test_overlapping_regions_are_split_at_their_intersections() -> None:
+    mission = mission_of(
+        rect(0, 0, 6, 6), [], {"a": rect(1, 1, 4, 4), "b": rect(2, 2, 5, 5)}, (0.5, 0.5)
+    )
+    a = build_abstraction(mission)
+    assert {("a",), ("b",), ("a", "b"), ()} <= set(a.letters)
+
+
+def test_hole_touching_the_boundary_and_a_region_sharing_a_hole_edge() -> None:
+    mission = mission_of(rect(0, 0, 6, 4), [rect(2, 0, 3, 2)], {"a": rect(3, 0, 4, 1)}, (0.5, 3))
+    a = build_abstraction(mission)
+    free = Polygon(rect(0, 0, 6, 4)).difference(Polygon(rect(2, 0, 3, 2)))
+    assert sum(p.area for p in _triangle_polygons(a)) == pytest.approx(free.area)
+
+
+def test_start_and_locate() -> None:
+    mission = mission_of(rect(0, 0, 4, 4), [], {"a": rect(1, 1, 2, 2)}, (1.5, 1.5))
+    a = build_abstraction(mission)
+    assert a.labels(a.start) == ("a",)
+    assert locate(a, (10, 10)) == -1
+
+
+def test_start_outside_is_an_error() -> None:
+    mission = mission_of(rect(0, 0, 4, 4), [rect(1, 1, 3, 3)], {"a": rect(0, 0, 1, 1)}, (2, 2))
+    with pytest.raises(InvalidInputError) as caught:
+        build_abstraction(mission)
+    assert caught.value.diagnostics[0].code == "A002"
+
+
+def test_unreachable_region_is_reported() -> None:
+    # a wall of holes splits the box in two
+    mission = mission_of(
+        rect(0, 0, 6, 4), [rect(2, 0, 3, 4)], {"far": rect(4, 1, 5, 2)}, (0.5, 0.5)
+    )
+    a = build_abstraction(mission)
+    warnings = abstraction_diagnostics(a, mission)
+    assert [w.code for w in warnings] == ["A011"]
+    assert "far" in warnings[0].message
+    assert a.stats["components"] == 2
+
+
+def test_artifact_round_trip_and_schema() -> None:
+    a = build_abstraction(load_mission(ROOT / "specs" / "example6.yaml"))
+    document = abstraction_to_json(a)
+    assert validation_errors(document, "abstraction") == []
+    back = abstraction_from_json(document)
+    assert back == a
+    for name in ("vertices", "triangles", "neighbors", "letter_of", "component"):
+        assert np.array_equal(getattr(back, name), getattr(a, name))
