@@ -42,6 +42,7 @@ class Compilation:
     trace: Trace | None = None
     trace_document: Mapping[str, Any] | None = None
     verdict: Verdict | None = None
+    documents: Mapping[str, Any] = field(default_factory=dict)  # artifacts written so far
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -195,14 +196,21 @@ def _verify(c: Compilation) -> StageResult:
     return StageResult(
         compilation=dataclasses.replace(c, verdict=verdict),
         artifacts={"verdict.json": verdict_json},
-        sizes={"robustness": verdict_json.get("robustness")},
+        sizes={"robustness": round(float(verdict.robustness), 6)},
     )
 
 
 def _plot(c: Compilation) -> StageResult:
-    # Plots are drawn in `compile_mission` from the artifacts themselves (the same code as
-    # `tlmpc plot`), so the picture always shows what was written.
-    return StageResult(compilation=c)
+    # Drawn from the artifacts themselves (the same code as `tlmpc plot`), so the picture
+    # always shows what was written.
+    from tlmpc.plot import render_plan
+
+    png, svg = render_plan(c.documents)
+    return StageResult(
+        compilation=c,
+        artifacts={"plan.png": png, "plan.svg": svg},
+        sizes={"png bytes": len(png), "svg bytes": len(svg)},
+    )
 
 
 class SelfCheckError(TlmpcError):
@@ -316,8 +324,8 @@ def compile_mission(
         report = StageReport(
             name=stage.name, seconds=time.perf_counter() - started, sizes=result.sizes
         )
-        compilation = result.compilation
         artifacts.update(result.artifacts)
+        compilation = dataclasses.replace(result.compilation, documents=dict(artifacts))
         warnings.extend(result.warnings)
         reports.append(report)
         if progress is not None:

@@ -68,13 +68,6 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     with staging_directory(destination) as staging:
         artifacts = dict(result.artifacts)
         summary = result.summary()
-        if args.until is None or args.until == "plot":
-            from tlmpc.plot import render_plan
-
-            png, svg = render_plan(artifacts)
-            artifacts["plan.png"] = png
-            artifacts["plan.svg"] = svg
-            summary["artifacts"] = sorted([*artifacts, "summary.json"])
         artifacts["summary.json"] = summary
         write_artifacts(staging, artifacts)
         commit(staging, destination, force=args.force)
