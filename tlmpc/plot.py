@@ -26,6 +26,7 @@ _REGION_COLOURS = (
     "#9c755f",
 )
 _MAX_REGION_NAMES = 60  # beyond this many regions the names only clutter the picture
+_MAX_MESH_TRIANGLES = 20_000  # a denser mesh is a grey blur at any printable size
 
 
 def _polygon_xy(points: Sequence[Sequence[float]]) -> tuple[list[float], list[float]]:
@@ -46,7 +47,7 @@ def _centroids(abstraction: Mapping[str, Any], triangles: Sequence[int]) -> list
 
 def draw_plan(axes: Any, artifacts: Mapping[str, Any]) -> None:
     """Draw everything the artifacts in ``artifacts`` (file name -> document) describe."""
-    from matplotlib.collections import LineCollection
+    from matplotlib.collections import LineCollection, PolyCollection
     from matplotlib.patches import Polygon as PolygonPatch
 
     mission = artifacts["mission.json"]
@@ -97,7 +98,7 @@ def draw_plan(axes: Any, artifacts: Mapping[str, Any]) -> None:
             )
 
     abstraction = artifacts.get("abstraction.json")
-    if abstraction is not None:
+    if abstraction is not None and len(abstraction["triangles"]) <= _MAX_MESH_TRIANGLES:
         vertices = abstraction["vertices"]
         xs = [v[0] for v in vertices]
         ys = [v[1] for v in vertices]
