@@ -98,7 +98,8 @@ def _markdown(rows: list[dict[str, Any]]) -> str:
         spin = "–" if r["spin_trim_states"] is None else str(r["spin_trim_states"])
         line = (
             f"| {r['name']} | {r['tgba_states']} | {r['tgba_edges']} | {r['acc_sets']} | "
-            f"{r['ba_states']} | {spin} | {r['seconds'] * 1000:.1f} | {r['ba_seconds'] * 1000:.1f} |"
+            f"{r['ba_states']} | {spin} | {r['seconds'] * 1000:.1f} | "
+            f"{r['ba_seconds'] * 1000:.1f} |"
         )
         if live:
             s = r.get("spin_seconds")

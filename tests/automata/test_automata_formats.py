@@ -11,8 +11,8 @@ from pathlib import Path
 
 import pytest
 from hypothesis import given, settings
-
 from test_automata_props import formulas
+
 from tlmpc.artifacts import validation_errors
 from tlmpc.automata import (
     Automaton,
@@ -82,10 +82,12 @@ def test_hoa_header() -> None:
     assert 'tool: "tlmpc"' in text
     assert "acc-name: generalized-Buchi 2" in text
     assert "Acceptance: 2 Inf(0)&Inf(1)" in text
-    assert "trans-acc" in text and "tlmpc-ltl:" in text
+    assert "trans-acc" in text
+    assert "tlmpc-ltl:" in text
     assert text.rstrip().endswith("--END--")
     ba = to_hoa(degeneralize(translate(parse_ltl("G F a & G F b"))))
-    assert "acc-name: Buchi" in ba and "state-acc" in ba
+    assert "acc-name: Buchi" in ba
+    assert "state-acc" in ba
 
 
 def test_parse_spot_style_hoa() -> None:
@@ -103,13 +105,39 @@ State: 1
 --END--
 """
     aut = parse_hoa(text)
-    assert aut.num_states == 2 and aut.aps == ("a",)
+    assert aut.num_states == 2
+    assert aut.aps == ("a",)
     assert all(e.marks == frozenset({0}) for e in aut.edges if e.src == 0)
+
+
+BODY = "--BODY--\nState: 0\n[0] 0 {0}\n--END--\n"
 
 
 @pytest.mark.parametrize(
     "text",
-    ["", "HOA: v2\n--BODY--\n--END--\n", "HOA: v1\nAcceptance: 1 Inf(0)\n--BODY--\nState: 0\n[0 &] 0\n--END--\n"],
+    [
+        "HOA: v1\nStates: 1\nStart: 0\nAP: 0\nAcceptance: 1 Inf(0)\n" + BODY,
+        'HOA: v1\nStates: 1\nStart: 0\nAP: 1 "a"\nAcceptance: 1 Fin(0)\n' + BODY,
+        'HOA: v1\nStates: 1\nStart: 3\nAP: 1 "a"\nAcceptance: 1 Inf(0)\n' + BODY,
+        'HOA: v1\nStates: 1\nStart: 0\nAP: 1 "a"\nAcceptance: 1 Inf(0)\n'
+        "--BODY--\nState: 0\n[0] 4 {0}\n--END--\n",
+        'HOA: v1\nStates: 1\nStart: 0\nAP: 1 "a"\nAcceptance: 1 Inf(0)\n'
+        "--BODY--\nState: 0\n[0] 0 {2}\n--END--\n",
+    ],
+)
+def test_unsupported_hoa_gives_b003(text: str) -> None:
+    with pytest.raises(InvalidInputError) as info:
+        parse_hoa(text)
+    assert {d.code for d in info.value.diagnostics} == {"B003"}
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        "",
+        "HOA: v2\n--BODY--\n--END--\n",
+        "HOA: v1\nAcceptance: 1 Inf(0)\n--BODY--\nState: 0\n[0 &] 0\n--END--\n",
+    ],
 )
 def test_bad_hoa_gives_b_codes(text: str) -> None:
     with pytest.raises(InvalidInputError) as info:
@@ -140,7 +168,8 @@ def test_successor_table() -> None:
     aut = translate(parse_ltl("F (a & F b)"))
     letters = [(), ("a",), ("b",), ("a", "z")]
     table = successor_table(aut, letters)
-    assert len(table) == 4 and all(len(row) == aut.num_states for row in table)
+    assert len(table) == 4
+    assert all(len(row) == aut.num_states for row in table)
     for i, letter in enumerate(letters):
         for q in range(aut.num_states):
             expected = {
@@ -162,16 +191,20 @@ def run_command(*argv: str) -> tuple[int, str, str]:
 
 def test_command_formats() -> None:
     code, out, _ = run_command("G F a & G F b")
-    assert code == 0 and out.startswith("HOA: v1")
+    assert code == 0
+    assert out.startswith("HOA: v1")
     assert parse_hoa(out).num_states == 1
     code, out, _ = run_command("F a & F b", "--format", "json", "--ba")
     document = json.loads(out)
-    assert code == 0 and validation_errors(document, "automaton") == []
+    assert code == 0
+    assert validation_errors(document, "automaton") == []
     assert document["acceptance"]["state_based"] is True
     code, out, _ = run_command("F a", "--format", "dot")
-    assert code == 0 and out.startswith("digraph")
+    assert code == 0
+    assert out.startswith("digraph")
     code, out, _ = run_command("F a & F b & F c", "--stats")
-    assert code == 0 and "states: 8" in out
+    assert code == 0
+    assert "states: 8" in out
     code, out, _ = run_command("F a & F b & F c", "--stats", "--json")
     assert json.loads(out)["states"] == 8
 

@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
+from automata_oracles import accepts, evaluate
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from automata_oracles import accepts, evaluate
 from tlmpc.automata import degeneralize, translate
 from tlmpc.ltl.ast import (
     And,
@@ -49,9 +49,7 @@ def formulas(max_leaves: int = 12) -> st.SearchStrategy[Formula]:
 
 
 letters_all = st.frozensets(st.sampled_from(PROPS))
-words = st.tuples(
-    st.lists(letters_all, max_size=4), st.lists(letters_all, min_size=1, max_size=4)
-)
+words = st.tuples(st.lists(letters_all, max_size=4), st.lists(letters_all, min_size=1, max_size=4))
 
 
 def depth(f: Formula) -> int:
@@ -62,7 +60,8 @@ def depth(f: Formula) -> int:
 def test_tgba_and_ba_agree_with_evaluator(formula: Formula, samples: list) -> None:
     tgba = translate(formula)
     ba = degeneralize(tgba)
-    assert ba.state_based and ba.num_acc == 1
+    assert ba.state_based
+    assert ba.num_acc == 1
     for prefix, loop in samples:
         expected = evaluate(formula, prefix, loop)
         assert accepts(tgba, prefix, loop) == expected, (str(formula), prefix, loop)
@@ -72,10 +71,12 @@ def test_tgba_and_ba_agree_with_evaluator(formula: Formula, samples: list) -> No
 @settings(max_examples=100)
 @given(
     formulas(),
-    st.lists(st.frozensets(st.sampled_from(PROPS + ("z",))), min_size=1, max_size=5, unique=True),
+    st.lists(st.frozensets(st.sampled_from((*PROPS, "z"))), min_size=1, max_size=5, unique=True),
     st.data(),
 )
-def test_letter_restricted_translation(formula: Formula, letter_sets: list, data: st.DataObject) -> None:
+def test_letter_restricted_translation(
+    formula: Formula, letter_sets: list, data: st.DataObject
+) -> None:
     letters = [tuple(sorted(s)) for s in letter_sets]
     tgba = translate(formula, letters=letters)
     ba = degeneralize(tgba)

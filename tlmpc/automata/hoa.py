@@ -124,10 +124,24 @@ def _parser() -> Lark:
 
 def _formula(tree: Any, aps: list[str]) -> Formula:
     if isinstance(tree, Token):
+        if int(tree) >= len(aps):
+            raise InvalidInputError(
+                error("B003", f"label uses AP {int(tree)} but only {len(aps)} are declared")
+            )
         return Prop(aps[int(tree)])
     kind = tree.data
     if kind == "ap":
-        return Prop(aps[int(tree.children[0])])
+        number = int(tree.children[0])
+        if number >= len(aps):
+            raise InvalidInputError(
+                error(
+                    "B003",
+                    f"label uses AP {number} but only {len(aps)} are declared",
+                    line=tree.meta.line,
+                    col=tree.meta.column,
+                )
+            )
+        return Prop(aps[number])
     if kind == "true":
         return TRUE
     if kind == "false":
@@ -209,6 +223,7 @@ def parse_hoa(text: str, *, file: str | None = None) -> Automaton:
                 edges.append(Edge(src=number, dst=dst, guard=guard, marks=marks))
     if "all" in acc_name:
         num_acc = 0
+    _check(acceptance, num_acc, aps, count, starts, edges, file)
     return Automaton(
         aps=tuple(aps),
         num_states=max(count, 1),
@@ -219,6 +234,43 @@ def parse_hoa(text: str, *, file: str | None = None) -> Automaton:
         formula=formula,
         state_based=state_based,
     )
+
+
+def _check(
+    acceptance: list[Any],
+    num_acc: int,
+    aps: list[str],
+    count: int,
+    starts: list[list[Any]],
+    edges: list[Edge],
+    file: str | None,
+) -> None:
+    """Reject what the reader cannot represent faithfully (B003), instead of misreading it."""
+    condition = "".join(
+        str(v.children[0]) if isinstance(v, Tree) else str(v) for v in acceptance[1:]
+    )
+    expected = "&".join(f"Inf({i})" for i in range(num_acc)) if num_acc else "t"
+    problems: list[str] = []
+    if condition and condition != expected and not (num_acc == 0 and condition == "t"):
+        problems.append(
+            f"acceptance condition {condition!r} is not generalized Büchi ({expected!r})"
+        )
+    if len(starts) != 1 or len(starts[0]) != 1:
+        problems.append("exactly one initial state is supported")
+    elif not 0 <= int(str(starts[0][0])) < max(count, 1):
+        problems.append(f"initial state {starts[0][0]} is out of range")
+    for edge in edges:
+        if not 0 <= edge.dst < count:
+            problems.append(f"edge {edge.src} -> {edge.dst}: no state {edge.dst}")
+        if any(m >= num_acc for m in edge.marks) and num_acc:
+            problems.append(f"edge {edge.src} -> {edge.dst}: acceptance set out of range")
+    if problems:
+        raise InvalidInputError(
+            [
+                error("B003", p, hint="tlmpc reads (generalized) Büchi HOA", file=file)
+                for p in problems
+            ]
+        )
 
 
 def to_dot(automaton: Automaton) -> str:

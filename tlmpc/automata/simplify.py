@@ -7,7 +7,7 @@ from collections.abc import Sequence
 
 from tlmpc.automata.guards import holds
 from tlmpc.automata.model import Automaton, Edge
-from tlmpc.ltl.ast import TRUE, Formula, disjoin
+from tlmpc.ltl.ast import TRUE, And, Formula, Not, Or, Prop, conjoin, disjoin
 
 
 def merge_parallel(edges: Sequence[Edge]) -> list[Edge]:
@@ -17,10 +17,40 @@ def merge_parallel(edges: Sequence[Edge]) -> list[Edge]:
         grouped[(edge.src, edge.dst, edge.marks)].append(edge.guard)
     merged = []
     for (src, dst, marks), guards in grouped.items():
-        unique = list(dict.fromkeys(guards))
+        unique = _absorb(list(dict.fromkeys(guards)))
         guard = TRUE if TRUE in unique else disjoin(unique)
         merged.append(Edge(src=src, dst=dst, guard=guard, marks=marks))
     return merged
+
+
+def _literals(guard: Formula) -> frozenset[Formula] | None:
+    """The literals of a cube guard (``true`` = no literals); None for other guards."""
+    if guard == TRUE:
+        return frozenset()
+    if isinstance(guard, Prop) or (isinstance(guard, Not) and isinstance(guard.arg, Prop)):
+        return frozenset([guard])
+    if isinstance(guard, And) and all(_literals(a) is not None for a in guard.args):
+        return frozenset(guard.args)
+    return None
+
+
+def _absorb(guards: list[Formula]) -> list[Formula]:
+    """Drop disjuncts implied by another disjunct (``a | a & b`` = ``a``)."""
+    if len(guards) == 1 and not isinstance(guards[0], Or):
+        return guards
+    flat = [g for guard in guards for g in (guard.args if isinstance(guard, Or) else (guard,))]
+    cubes = [_literals(g) for g in flat]
+    kept = []
+    for i, guard in enumerate(flat):
+        mine = cubes[i]
+        absorbed = mine is not None and any(
+            other is not None and other <= mine and (other != mine or j < i)
+            for j, other in enumerate(cubes)
+            if j != i
+        )
+        if not absorbed:
+            kept.append(guard)
+    return kept
 
 
 def sccs(num_states: int, edges: Sequence[Edge], initial: int) -> list[int]:
@@ -129,13 +159,20 @@ def _renumber(automaton: Automaton, edges: Sequence[Edge], keep: set[int]) -> Au
             if edge.dst not in order:
                 order[edge.dst] = len(order)
                 queue.append(edge.dst)
+    texts: dict[Formula, str] = {}
+
+    def text(guard: Formula) -> str:
+        if guard not in texts:
+            texts[guard] = str(guard)
+        return texts[guard]
+
     renumbered = sorted(
         (
             Edge(src=order[e.src], dst=order[e.dst], guard=e.guard, marks=e.marks)
             for e in edges
             if e.src in order and e.dst in order
         ),
-        key=lambda e: (e.src, e.dst, sorted(e.marks), str(e.guard)),
+        key=lambda e: (e.src, e.dst, sorted(e.marks), text(e.guard)),
     )
     names = automaton.state_names
     new_names = [""] * len(order)
@@ -154,36 +191,64 @@ def _renumber(automaton: Automaton, edges: Sequence[Edge], keep: set[int]) -> Au
 
 
 def _reduce_marks(automaton: Automaton) -> Automaton:
-    """Drop acceptance sets carried by every cycle edge and merge sets used identically."""
-    component = sccs(automaton.num_states, automaton.edges, automaton.initial)
-    cycle_edges = [e for e in automaton.edges if component[e.src] == component[e.dst]]
-    keep: list[int] = []
-    seen: dict[frozenset[int], int] = {}
-    for mark in range(automaton.num_acc):
-        carriers = frozenset(i for i, e in enumerate(cycle_edges) if mark in e.marks)
-        if len(carriers) == len(cycle_edges):
-            continue  # visited by every cycle: no constraint
-        if carriers in seen:
-            continue  # same edges as an earlier set
-        seen[carriers] = mark
-        keep.append(mark)
-    if len(keep) == automaton.num_acc:
+    """Keep marks only inside accepting SCCs, then drop or merge redundant acceptance sets.
+
+    A run is accepted iff it ends in an accepting SCC and sees every set there, so marks
+    elsewhere are useless.  A set carried by every edge of every accepting SCC is then
+    implied by staying in one; it is dropped, except that one set must survive whenever some
+    cycle lies outside the accepting SCCs (with no sets left every cycle would accept).
+    Sets carried by the same edges are merged.
+    """
+    k = automaton.num_acc
+    if k == 0:
         return automaton
+    component = sccs(automaton.num_states, automaton.edges, automaton.initial)
+    everything = frozenset(range(k))
+    internal: dict[int, set[int]] = defaultdict(set)
+    cyclic: set[int] = set()
+    for e in automaton.edges:
+        if component[e.src] == component[e.dst]:
+            cyclic.add(component[e.src])
+            internal[component[e.src]].update(e.marks)
+    accepting = {c for c in cyclic if internal[c] >= everything}
+    stripped = [
+        e.marks
+        if component[e.src] == component[e.dst] and component[e.src] in accepting
+        else frozenset()
+        for e in automaton.edges
+    ]
+    inside = [
+        i
+        for i, e in enumerate(automaton.edges)
+        if component[e.src] in accepting and component[e.src] == component[e.dst]
+    ]
+    keep: list[int] = []
+    seen: set[frozenset[int]] = set()
+    for mark in range(k):
+        carriers = frozenset(i for i in inside if mark in stripped[i])
+        if len(carriers) == len(inside) or carriers in seen:
+            continue
+        seen.add(carriers)
+        keep.append(mark)
+    if not keep and (cyclic - accepting):
+        keep = [0]
     new_index = {old: new for new, old in enumerate(keep)}
     edges = tuple(
         Edge(
             src=e.src,
             dst=e.dst,
             guard=e.guard,
-            marks=frozenset(new_index[m] for m in e.marks if m in new_index),
+            marks=frozenset(new_index[m] for m in marks if m in new_index),
         )
-        for e in automaton.edges
+        for e, marks in zip(automaton.edges, stripped, strict=True)
     )
+    if edges == automaton.edges and len(keep) == k:
+        return automaton
     return Automaton(
         aps=automaton.aps,
         num_states=automaton.num_states,
         initial=automaton.initial,
-        edges=edges,
+        edges=tuple(merge_parallel(edges)),
         num_acc=len(keep),
         state_names=automaton.state_names,
         formula=automaton.formula,
@@ -276,4 +341,51 @@ def postprocess(automaton: Automaton, letters: Sequence[frozenset[str]] | None) 
         current = _merge_states(current, letters)
         if (current.num_states, len(current.edges), current.num_acc) == before:
             break
+    if letters is not None:
+        current = _simplify_guards(current, letters)
     return current
+
+
+def _simplify_guards(automaton: Automaton, letters: Sequence[frozenset[str]]) -> Automaton:
+    """Shorten guards without changing which of ``letters`` enable them.
+
+    Each cube drops literals while its set of enabled letters stays the same (with exclusive
+    regions ``a & !b`` becomes ``a``); a guard every letter enables becomes ``true``.
+    """
+
+    def enabled(guard: Formula) -> frozenset[int]:
+        return frozenset(i for i, letter in enumerate(letters) if holds(guard, letter))
+
+    everything = frozenset(range(len(letters)))
+    edges = []
+    for edge in automaton.edges:
+        target = enabled(edge.guard)
+        if target == everything:
+            edges.append(Edge(src=edge.src, dst=edge.dst, guard=TRUE, marks=edge.marks))
+            continue
+        parts = edge.guard.args if isinstance(edge.guard, Or) else (edge.guard,)
+        shortened = []
+        for part in parts:
+            literals = _literals(part)
+            if literals is None:
+                shortened.append(part)
+                continue
+            mine = enabled(part)
+            kept = sorted(literals, key=str)
+            for literal in list(kept):
+                trial = [x for x in kept if x != literal]
+                if enabled(conjoin(trial)) & target == mine and enabled(conjoin(trial)) <= target:
+                    kept = trial
+            shortened.append(conjoin(kept))
+        guard = disjoin(_absorb(list(dict.fromkeys(shortened))))
+        edges.append(Edge(src=edge.src, dst=edge.dst, guard=guard, marks=edge.marks))
+    return Automaton(
+        aps=automaton.aps,
+        num_states=automaton.num_states,
+        initial=automaton.initial,
+        edges=tuple(edges),
+        num_acc=automaton.num_acc,
+        state_names=automaton.state_names,
+        formula=automaton.formula,
+        state_based=automaton.state_based,
+    )

@@ -51,16 +51,19 @@ def _dominated(
     """
     unique = list(dict.fromkeys(terms))
     kept = []
-    for cube, target, marks in unique:
-        dominated = any(
-            (other_cube, other_target, other_marks) != (cube, target, marks)
-            and other_cube[0] <= cube[0]
-            and other_cube[1] <= cube[1]
-            and other_target <= target
-            and other_marks >= marks
-            for other_cube, other_target, other_marks in unique
-        )
-        if not dominated:
+    # Distinct terms cannot dominate each other both ways, so "any other term" is safe.
+    for i, (cube, target, marks) in enumerate(unique):
+        pos, neg = cube
+        for j, (other_cube, other_target, other_marks) in enumerate(unique):
+            if (
+                j != i
+                and other_target <= target
+                and other_cube[0] <= pos
+                and other_cube[1] <= neg
+                and other_marks >= marks
+            ):
+                break
+        else:
             kept.append((cube, target, marks))
     return kept
 
