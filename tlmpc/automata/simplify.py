@@ -353,10 +353,26 @@ def _simplify_guards(automaton: Automaton, letters: Sequence[frozenset[str]]) ->
     regions ``a & !b`` becomes ``a``); a guard every letter enables becomes ``true``.
     """
 
-    def enabled(guard: Formula) -> frozenset[int]:
-        return frozenset(i for i, letter in enumerate(letters) if holds(guard, letter))
+    def enabled(guard: Formula) -> int:
+        """Bitmask of the letters that enable ``guard``."""
+        mask = 0
+        for i, letter in enumerate(letters):
+            if holds(guard, letter):
+                mask |= 1 << i
+        return mask
 
-    everything = frozenset(range(len(letters)))
+    literal_masks: dict[Formula, int] = {}
+
+    def cube_mask(literals: list[Formula]) -> int:
+        # A conjunction of literals is enabled where all of them are: intersect cached masks.
+        mask = everything
+        for literal in literals:
+            if literal not in literal_masks:
+                literal_masks[literal] = enabled(literal)
+            mask &= literal_masks[literal]
+        return mask
+
+    everything = (1 << len(letters)) - 1
     edges = []
     for edge in automaton.edges:
         target = enabled(edge.guard)
@@ -370,11 +386,12 @@ def _simplify_guards(automaton: Automaton, letters: Sequence[frozenset[str]]) ->
             if literals is None:
                 shortened.append(part)
                 continue
-            mine = enabled(part)
             kept = sorted(literals, key=str)
+            mine = cube_mask(kept)
             for literal in list(kept):
                 trial = [x for x in kept if x != literal]
-                if enabled(conjoin(trial)) & target == mine and enabled(conjoin(trial)) <= target:
+                widened = cube_mask(trial)
+                if widened & target == mine and widened & ~target == 0:
                     kept = trial
             shortened.append(conjoin(kept))
         guard = disjoin(_absorb(list(dict.fromkeys(shortened))))

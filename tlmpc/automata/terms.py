@@ -53,6 +53,12 @@ def make_and(parts: list[T] | tuple[T, ...]) -> T:
     for part in flat:
         if part[0] == "p" and ("n", part[1]) in flat:
             return FALSE
+    always = [part for part in flat if part[0] == "G"]
+    if len(always) > 1:
+        # G a & G b = G(a & b): one obligation instead of many (fifty `avoid` phrases would
+        # otherwise multiply into fifty conjuncts in every state).
+        flat.difference_update(always)
+        flat.add(("G", make_and([part[1] for part in always])))
     if not flat:
         return TRUE
     if len(flat) == 1:
@@ -138,11 +144,10 @@ def make_f(a: T) -> T:
 
 
 def make_g(a: T) -> T:
-    """G a, simplified: G true = true, G(universality) = itself, G(a & b) = G a & G b."""
+    """G a, simplified: G true = true, G(universality) = itself (conjunctions of G merge in
+    :func:`make_and`)."""
     if a in (TRUE, FALSE) or _pure_universality(a):
         return a
-    if a[0] == "&":
-        return make_and([make_g(x) for x in a[1]])
     if a[0] == "F" and _pure_universality(a[1]):
         return a
     return ("G", a)
