@@ -27,6 +27,7 @@ _REGION_COLOURS = (
 )
 _MAX_REGION_NAMES = 60  # beyond this many regions the names only clutter the picture
 _MAX_MESH_TRIANGLES = 20_000  # a denser mesh is a grey blur at any printable size
+_MAX_VECTOR_SEGMENTS = 500  # longer trajectories go into the SVG as an embedded image
 
 
 def _polygon_xy(points: Sequence[Sequence[float]]) -> tuple[list[float], list[float]]:
@@ -71,20 +72,37 @@ def draw_plan(axes: Any, artifacts: Mapping[str, Any]) -> None:
             )
         )
     regions: Mapping[str, Any] = mission["regions"]
-    for index, (name, polygon) in enumerate(sorted(regions.items())):
-        colour = _REGION_COLOURS[index % len(_REGION_COLOURS)]
-        axes.add_patch(
-            PolygonPatch(
-                polygon,
-                closed=True,
-                facecolor=colour,
-                alpha=0.30,
-                edgecolor=colour,
-                linewidth=0.8,
-                zorder=1,
+    ordered = sorted(regions.items())
+    colours = [_REGION_COLOURS[i % len(_REGION_COLOURS)] for i in range(len(ordered))]
+    axes.add_collection(
+        PolyCollection(
+            [polygon for _, polygon in ordered],
+            facecolors=colours,
+            edgecolors=colours,
+            alpha=0.30,
+            linewidths=0.8,
+            zorder=1,
+            rasterized=len(ordered) > _MAX_REGION_NAMES,
+        )
+    )
+    # The regions the task names are emphasised and always labelled (Example 8's black rooms).
+    from tlmpc.ltl.parser import parse_ltl
+
+    named = parse_ltl(mission["formula"]).props() if mission.get("formula") else frozenset()
+    emphasised = [(n, p) for n, p in ordered if n in named]
+    if emphasised and len(regions) > _MAX_REGION_NAMES:
+        axes.add_collection(
+            PolyCollection(
+                [p for _, p in emphasised],
+                facecolors="#1f1f1f",
+                edgecolors="black",
+                alpha=0.8,
+                linewidths=0.8,
+                zorder=1.5,
             )
         )
-        if len(regions) <= _MAX_REGION_NAMES:
+    for name, polygon in ordered:
+        if len(regions) <= _MAX_REGION_NAMES or name in named:
             xs, ys = _polygon_xy(polygon)
             axes.text(
                 sum(xs[:-1]) / (len(xs) - 1),
@@ -102,7 +120,15 @@ def draw_plan(axes: Any, artifacts: Mapping[str, Any]) -> None:
         vertices = abstraction["vertices"]
         xs = [v[0] for v in vertices]
         ys = [v[1] for v in vertices]
-        axes.triplot(xs, ys, abstraction["triangles"], color="#b0b0b0", linewidth=0.3, zorder=2)
+        axes.triplot(
+            xs,
+            ys,
+            abstraction["triangles"],
+            color="#b0b0b0",
+            linewidth=0.3,
+            zorder=2,
+            rasterized=len(abstraction["triangles"]) > 2_000,
+        )
 
     witness = artifacts.get("witness.json")
     if witness is not None and abstraction is not None:
@@ -139,7 +165,13 @@ def draw_plan(axes: Any, artifacts: Mapping[str, Any]) -> None:
         segments = [[(a[1], a[2]), (b[1], b[2])] for a, b in itertools.pairwise(points)]
         times = [0.5 * (a[0] + b[0]) for a, b in itertools.pairwise(points)]
         if segments:
-            lines = LineCollection(segments, cmap="viridis", linewidth=1.8, zorder=5)
+            lines = LineCollection(
+                segments,
+                cmap="viridis",
+                linewidth=1.8,
+                zorder=5,
+                rasterized=len(segments) > _MAX_VECTOR_SEGMENTS,
+            )
             lines.set_array(times)
             axes.add_collection(lines)
             axes.figure.colorbar(lines, ax=axes, fraction=0.046, pad=0.04, label="time [s]")
@@ -180,7 +212,8 @@ def render_plan(artifacts: Mapping[str, Any]) -> tuple[bytes, bytes]:
         FigureCanvasAgg(figure)
         axes = figure.add_subplot(1, 1, 1)
         draw_plan(axes, artifacts)
-        figure.tight_layout()
+        # Fixed margins: a layout engine would draw the figure once more just to measure it.
+        figure.subplots_adjust(left=0.08, right=0.9, bottom=0.08, top=0.94)
         png = io.BytesIO()
         figure.savefig(png, format="png", metadata={"Software": None})
         svg = io.BytesIO()
