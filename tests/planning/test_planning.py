@@ -1,0 +1,181 @@
+"""Planning: witnesses satisfy the task, never bounce, cost metrics, explanations."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+from pathlib import Path
+from typing import Any
+
+import pytest
+import yaml
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from lasso_ltl import holds
+
+from tlmpc.abstraction import build_abstraction
+from tlmpc.artifacts import validation_errors
+from tlmpc.automata import translate
+from tlmpc.errors import NoPlanError
+from tlmpc.mission import load_mission_text
+from tlmpc.mission.model import Mission, Options
+from tlmpc.planning import plan, witness_from_json, witness_to_json
+from tlmpc.planning.export import to_promela
+
+BASE = """\
+version: 1
+workspace:
+  boundary: {rect: [0, 0, 12, 8]}
+  holes: [HOLES]
+regions:
+  a: {rect: [1, 1, 3, 3]}
+  b: {rect: [9, 5, 11, 7]}
+  c: {rect: [5, 2, 7, 6]}
+robot: {start: [0.5, 7.5]}
+TASK
+"""
+
+
+def mission(task: str, holes: str = "", options: str = "") -> Mission:
+    text = BASE.replace("HOLES", holes).replace("TASK", task) + options
+    return load_mission_text(text, "m.yaml")
+
+
+def compile_plan(m: Mission) -> tuple[Any, Any, Any]:
+    abstraction = build_abstraction(m)
+    automaton = translate(m.formula, letters=abstraction.letters)
+    witness = plan(abstraction, automaton, formula=m.formula, options=m.options,
+                   start_point=m.robot.start)
+    return abstraction, automaton, witness
+
+
+def check_lasso(abstraction: Any, witness: Any) -> None:
+    path = [*witness.prefix, *witness.cycle]
+    assert path[0] == abstraction.start or (not witness.prefix and
+                                            witness.cycle[0] == abstraction.start)
+    for x, y in zip(path, path[1:], strict=False):
+        assert y in abstraction.neighbors[x].tolist(), "consecutive triangles are adjacent"
+    for i in range(1, len(path) - 1):
+        assert path[i - 1] != path[i + 1], "no bounce"
+    cycle = list(witness.cycle)
+    assert len(cycle) == 1 or len(cycle) >= 3, "a 2-triangle cycle bounces"
+    if len(cycle) > 1:
+        assert cycle[0] in abstraction.neighbors[cycle[-1]].tolist()
+        loop = [cycle[-1], *cycle, cycle[0]]
+        for i in range(1, len(loop) - 1):
+            assert loop[i - 1] != loop[i + 1], "no bounce across the wrap"
+        before = witness.prefix[-1] if witness.prefix else cycle[-1]
+        assert before != cycle[1 % len(cycle)]
+
+
+TASKS = ["visit a", "visit a then b", "visit a, b and c", "patrol a, b",
+         "visit b while avoiding c", "stay in b", "whenever a, visit b", "avoid c until b",
+         "visit a then b then return to a"]
+
+
+@settings(deadline=None, max_examples=30)
+@given(st.sampled_from(TASKS), st.sampled_from(["", "{rect: [4, 6.5, 8, 7.5]}"]),
+       st.sampled_from(["length", "hops"]))
+def test_witness_satisfies_the_task_and_never_bounces(task: str, hole: str, cost: str) -> None:
+    m = mission(f"task: [{json.dumps(task)}]", hole, f"options: {{cost: {cost}}}\n")
+    abstraction, _, witness = compile_plan(m)
+    check_lasso(abstraction, witness)
+    word = [frozenset(abstraction.labels(t)) for t in (*witness.prefix, *witness.cycle)]
+    assert holds(m.formula, word, len(witness.prefix))
+    assert witness.cost == pytest.approx(witness.prefix_cost + witness.beta * witness.cycle_cost)
+
+
+def test_cosafe_tasks_end_in_a_stay_and_patrols_loop() -> None:
+    _, _, witness = compile_plan(mission("task: [visit a then b]"))
+    assert witness.is_stay
+    assert witness.cycle_cost == 0.0
+    abstraction, _, witness = compile_plan(mission('task: ["patrol a, b"]'))
+    assert len(witness.cycle) >= 3
+    labels = {name for t in witness.cycle for name in abstraction.labels(t)}
+    assert {"a", "b"} <= labels
+
+
+def test_hops_counts_moves() -> None:
+    _, _, witness = compile_plan(mission("task: [visit b]", options="options: {cost: hops}\n"))
+    assert witness.prefix_cost == pytest.approx(len(witness.prefix), abs=1e-6)
+
+
+def test_length_is_shorter_in_metres_than_hops_plan() -> None:
+    _, _, by_length = compile_plan(mission("task: [visit b]"))
+    _, _, by_hops = compile_plan(mission("task: [visit b]", options="options: {cost: hops}\n"))
+    assert len(by_hops.prefix) <= len(by_length.prefix)
+
+
+def test_invariants_are_respected() -> None:
+    abstraction, _, witness = compile_plan(mission("task: [visit b, avoid c]"))
+    assert all("c" not in abstraction.labels(t) for t in (*witness.prefix, *witness.cycle))
+
+
+@pytest.mark.parametrize(
+    ("task", "holes", "code", "words"),
+    [
+        ("task: [visit a, avoid a]", "", "P001", "unsatisfiable"),
+        ('ltl: "G !o & F a"', "", "P002", "starts in"),
+        ('ltl: "c U b"', "", "P003", "fails where the robot starts"),
+        ("task: [visit b]", "{rect: [4, 0, 5, 8]}", "P005", "holes separate"),
+        ("task: [visit b, avoid c]", "{rect: [4, 0, 5, 2]}, {rect: [4, 6, 5, 8]}", "P005",
+         "forbids"),
+    ],
+)
+def test_no_plan_explanations(task: str, holes: str, code: str, words: str) -> None:
+    text = BASE.replace("HOLES", holes).replace("TASK", task)
+    if "o &" in task:
+        text = text.replace("  c: {rect: [5, 2, 7, 6]}", "  c: {rect: [5, 2, 7, 6]}\n  o: {rect: [0, 7, 1, 8]}")
+    if "c U b" in task:
+        text = text.replace("robot: {start: [0.5, 7.5]}", "robot: {start: [0.5, 0.5]}")
+    m = load_mission_text(text, "m.yaml")
+    with pytest.raises(NoPlanError) as caught:
+        compile_plan(m)
+    diagnostic = caught.value.diagnostics[0]
+    assert diagnostic.code == code
+    assert words in diagnostic.message
+
+
+def test_witness_artifact() -> None:
+    abstraction, _, witness = compile_plan(mission('task: ["patrol a, b"]'))
+    document = witness_to_json(witness, abstraction)
+    assert validation_errors(document, "witness") == []
+    assert witness_from_json(document) == witness
+
+
+@pytest.mark.skipif(shutil.which("spin") is None or shutil.which("gcc") is None,
+                    reason="spin (and gcc) are not installed")
+@pytest.mark.parametrize(("task", "plan_exists"), [
+    ("task: [visit a then b]", True),
+    ('task: ["patrol a, b"]', True),
+    ("task: [visit a, avoid a]", False),
+    ('ltl: "G !c & F c"', False),
+])
+def test_spin_agrees_on_plan_or_no_plan(tmp_path: Path, task: str, plan_exists: bool) -> None:
+    m = mission(task, options="options: {min_angle: null}\n")
+    abstraction = build_abstraction(m)
+    (tmp_path / "model.pml").write_text(to_promela(abstraction, m.formula))
+    subprocess.run(["spin", "-a", "model.pml"], cwd=tmp_path, check=True, capture_output=True)
+    subprocess.run(["gcc", "-O1", "-DNOREDUCE", "-o", "pan", "pan.c"], cwd=tmp_path, check=True,
+                   capture_output=True)
+    result = subprocess.run(["./pan", "-a", "-m100000"], cwd=tmp_path, capture_output=True,
+                            text=True, check=False, timeout=120)
+    found = "acceptance cycle" in result.stdout or "errors: 1" in result.stdout
+    assert found is plan_exists, result.stdout[-800:]
+    automaton = translate(m.formula, letters=abstraction.letters)
+    if plan_exists:
+        plan(abstraction, automaton, formula=m.formula, options=m.options)
+    else:
+        with pytest.raises(NoPlanError):
+            plan(abstraction, automaton, formula=m.formula, options=m.options)
+
+
+def test_example8_plan_is_found(specs_dir: Path) -> None:
+    text = (specs_dir / "example8.yaml").read_text()
+    m = load_mission_text(text, "example8.yaml")
+    abstraction, _, witness = compile_plan(m)
+    check_lasso(abstraction, witness)
+    assert abstraction.num_triangles == 9250
+    assert yaml.safe_load(text)["task"]
+    assert isinstance(m.options, Options)
