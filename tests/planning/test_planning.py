@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import json
 import shutil
 import subprocess
@@ -45,16 +46,18 @@ def mission(task: str, holes: str = "", options: str = "") -> Mission:
 def compile_plan(m: Mission) -> tuple[Any, Any, Any]:
     abstraction = build_abstraction(m)
     automaton = translate(m.formula, letters=abstraction.letters)
-    witness = plan(abstraction, automaton, formula=m.formula, options=m.options,
-                   start_point=m.robot.start)
+    witness = plan(
+        abstraction, automaton, formula=m.formula, options=m.options, start_point=m.robot.start
+    )
     return abstraction, automaton, witness
 
 
 def check_lasso(abstraction: Any, witness: Any) -> None:
     path = [*witness.prefix, *witness.cycle]
-    assert path[0] == abstraction.start or (not witness.prefix and
-                                            witness.cycle[0] == abstraction.start)
-    for x, y in zip(path, path[1:], strict=False):
+    assert path[0] == abstraction.start or (
+        not witness.prefix and witness.cycle[0] == abstraction.start
+    )
+    for x, y in itertools.pairwise(path):
         assert y in abstraction.neighbors[x].tolist(), "consecutive triangles are adjacent"
     for i in range(1, len(path) - 1):
         assert path[i - 1] != path[i + 1], "no bounce"
@@ -69,14 +72,25 @@ def check_lasso(abstraction: Any, witness: Any) -> None:
         assert before != cycle[1 % len(cycle)]
 
 
-TASKS = ["visit a", "visit a then b", "visit a, b and c", "patrol a, b",
-         "visit b while avoiding c", "stay in b", "whenever a, visit b", "avoid c until b",
-         "visit a then b then return to a"]
+TASKS = [
+    "visit a",
+    "visit a then b",
+    "visit a, b and c",
+    "patrol a, b",
+    "visit b while avoiding c",
+    "stay in b",
+    "whenever a, visit b",
+    "avoid c until b",
+    "visit a then b then return to a",
+]
 
 
 @settings(deadline=None, max_examples=30)
-@given(st.sampled_from(TASKS), st.sampled_from(["", "{rect: [4, 6.5, 8, 7.5]}"]),
-       st.sampled_from(["length", "hops"]))
+@given(
+    st.sampled_from(TASKS),
+    st.sampled_from(["", "{rect: [4, 6.5, 8, 7.5]}"]),
+    st.sampled_from(["length", "hops"]),
+)
 def test_witness_satisfies_the_task_and_never_bounces(task: str, hole: str, cost: str) -> None:
     m = mission(f"task: [{json.dumps(task)}]", hole, f"options: {{cost: {cost}}}\n")
     abstraction, _, witness = compile_plan(m)
@@ -119,14 +133,20 @@ def test_invariants_are_respected() -> None:
         ('ltl: "G !o & F a"', "", "P002", "starts in"),
         ('ltl: "c U b"', "", "P003", "fails where the robot starts"),
         ("task: [visit b]", "{rect: [4, 0, 5, 8]}", "P005", "holes separate"),
-        ("task: [visit b, avoid c]", "{rect: [4, 0, 5, 2]}, {rect: [4, 6, 5, 8]}", "P005",
-         "forbids"),
+        (
+            "task: [visit b, avoid c]",
+            "{rect: [4, 0, 5, 2]}, {rect: [4, 6, 5, 8]}",
+            "P005",
+            "forbids",
+        ),
     ],
 )
 def test_no_plan_explanations(task: str, holes: str, code: str, words: str) -> None:
     text = BASE.replace("HOLES", holes).replace("TASK", task)
     if "o &" in task:
-        text = text.replace("  c: {rect: [5, 2, 7, 6]}", "  c: {rect: [5, 2, 7, 6]}\n  o: {rect: [0, 7, 1, 8]}")
+        text = text.replace(
+            "  c: {rect: [5, 2, 7, 6]}", "  c: {rect: [5, 2, 7, 6]}\n  o: {rect: [0, 7, 1, 8]}"
+        )
     if "c U b" in task:
         text = text.replace("robot: {start: [0.5, 7.5]}", "robot: {start: [0.5, 0.5]}")
     m = load_mission_text(text, "m.yaml")
@@ -144,23 +164,38 @@ def test_witness_artifact() -> None:
     assert witness_from_json(document) == witness
 
 
-@pytest.mark.skipif(shutil.which("spin") is None or shutil.which("gcc") is None,
-                    reason="spin (and gcc) are not installed")
-@pytest.mark.parametrize(("task", "plan_exists"), [
-    ("task: [visit a then b]", True),
-    ('task: ["patrol a, b"]', True),
-    ("task: [visit a, avoid a]", False),
-    ('ltl: "G !c & F c"', False),
-])
+@pytest.mark.skipif(
+    shutil.which("spin") is None or shutil.which("gcc") is None,
+    reason="spin (and gcc) are not installed",
+)
+@pytest.mark.parametrize(
+    ("task", "plan_exists"),
+    [
+        ("task: [visit a then b]", True),
+        ('task: ["patrol a, b"]', True),
+        ("task: [visit a, avoid a]", False),
+        ('ltl: "G !c & F c"', False),
+    ],
+)
 def test_spin_agrees_on_plan_or_no_plan(tmp_path: Path, task: str, plan_exists: bool) -> None:
     m = mission(task, options="options: {min_angle: null}\n")
     abstraction = build_abstraction(m)
     (tmp_path / "model.pml").write_text(to_promela(abstraction, m.formula))
     subprocess.run(["spin", "-a", "model.pml"], cwd=tmp_path, check=True, capture_output=True)
-    subprocess.run(["gcc", "-O1", "-DNOREDUCE", "-o", "pan", "pan.c"], cwd=tmp_path, check=True,
-                   capture_output=True)
-    result = subprocess.run(["./pan", "-a", "-m100000"], cwd=tmp_path, capture_output=True,
-                            text=True, check=False, timeout=120)
+    subprocess.run(
+        ["gcc", "-O1", "-DNOREDUCE", "-o", "pan", "pan.c"],
+        cwd=tmp_path,
+        check=True,
+        capture_output=True,
+    )
+    result = subprocess.run(
+        ["./pan", "-a", "-m100000"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        check=False,
+        timeout=120,
+    )
     found = "acceptance cycle" in result.stdout or "errors: 1" in result.stdout
     assert found is plan_exists, result.stdout[-800:]
     automaton = translate(m.formula, letters=abstraction.letters)

@@ -40,19 +40,33 @@ def _plain_shape(value: Any) -> bool:
     """A quick structural check equivalent to the schema's `shape` for valid shapes."""
     if isinstance(value, dict):
         rect = value.get("rect")
-        return (len(value) == 1 and isinstance(rect, list) and len(rect) == 4
-                and all(_number(v) for v in rect))
-    return (isinstance(value, list) and len(value) >= 3 and all(
-        isinstance(p, list) and len(p) == 2 and _number(p[0]) and _number(p[1]) for p in value))
+        return (
+            len(value) == 1
+            and isinstance(rect, list)
+            and len(rect) == 4
+            and all(_number(v) for v in rect)
+        )
+    return (
+        isinstance(value, list)
+        and len(value) >= 3
+        and all(
+            isinstance(p, list) and len(p) == 2 and _number(p[0]) and _number(p[1]) for p in value
+        )
+    )
 
 
 def _schema_diagnostics(doc: PositionedDocument, file: str) -> list[Diagnostic]:
     validator = jsonschema.Draft202012Validator(load_schema("mission"))
     data = doc.data
     regions = data.get("regions") if isinstance(data, dict) else None
-    if (isinstance(regions, dict) and len(regions) > 1
-            and all(isinstance(k, str) and _NAME.match(k) and k not in KEYWORDS
-                    and _plain_shape(v) for k, v in regions.items())):
+    if (
+        isinstance(regions, dict)
+        and len(regions) > 1
+        and all(
+            isinstance(k, str) and _NAME.match(k) and k not in KEYWORDS and _plain_shape(v)
+            for k, v in regions.items()
+        )
+    ):
         # Maps with thousands of rooms: every region already has the schema's shape, so
         # validate the rest of the document with one representative region (same verdict,
         # a hundred times faster than descending into every region).

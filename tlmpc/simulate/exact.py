@@ -103,9 +103,10 @@ def _exit_step(controller: StepController, x0: FloatArray) -> tuple[list[float],
     offset = geometry.offsets[controller.exit_edge]
     matrix = _augmented(controller)
     gap = offset - normal @ x0
-    horizon = max(gap, 0.0) / controller.exit_speed
-    if horizon <= 0.0:
-        return [0.0], [x0]
+    scale = float(np.abs(geometry.vertices).max()) + float(geometry.heights.max())
+    if gap <= 1e-12 * scale:
+        return [0.0], [x0]  # already on the exit edge (to rounding): the crossing is now
+    horizon = gap / controller.exit_speed
     # h(t) < 0 until the crossing and grows at least at the exit speed inside the triangle, so
     # the first grid point with h >= 0 brackets the crossing (one matrix exponential for the
     # grid step, then matrix-vector products).
@@ -119,18 +120,26 @@ def _exit_step(controller: StepController, x0: FloatArray) -> tuple[list[float],
             upper = j * dt
             break
     if upper is None:
-        raise SolverError(error("C010", f"plan step {controller.step}: the trajectory did not "
-                                "leave its triangle within the exit-time bound",
-                                hint="please report this mission"))
+        raise SolverError(
+            error(
+                "C010",
+                f"plan step {controller.step}: the trajectory did not "
+                "leave its triangle within the exit-time bound",
+                hint="please report this mission",
+            )
+        )
     lower = upper - dt
     flow = _Flow(matrix, x0)
-    crossing = brentq(
-        lambda t: float(normal @ flow(t) - offset),
-        lower,
-        upper,
-        xtol=1e-14,
-        rtol=1e-14,
-    )
+
+    def height(t: float) -> float:
+        return float(normal @ flow(t) - offset)
+
+    if height(lower) >= 0.0:
+        crossing = lower  # rounding put the bracket's start on the edge already
+    elif height(upper) < 0.0:
+        crossing = upper  # the grid's iterates and the direct flow differ by rounding
+    else:
+        crossing = brentq(height, lower, upper, xtol=1e-14, rtol=1e-14)
     times = [float(t) for t in np.linspace(0.0, crossing, SAMPLES_PER_STEP + 1)[1:-1]]
     points = [flow(t) for t in times]
     end = flow(crossing)

@@ -1,0 +1,249 @@
+"""Controllers realise the plan: the paper's bisimulation requirement, as properties.
+
+Every state of a triangle leaves through the planned edge, never touching the other two,
+before the exit-time bound, at a speed within the bound; stay fields converge inside; the exact
+simulation matches a fine RK45 integration.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
+from scipy.integrate import solve_ivp
+
+from tlmpc.abstraction.model import Abstraction
+from tlmpc.artifacts import validation_errors
+from tlmpc.control import controllers_to_json, synthesize
+from tlmpc.control.geometry import triangle_geometry
+from tlmpc.control.model import StepController
+from tlmpc.errors import InvalidInputError
+from tlmpc.mission.model import Robot
+from tlmpc.planning.model import Witness
+from tlmpc.simulate.exact import _exit_step, _Flow, _stay_step, expm_small
+
+
+def _min_angle(v: np.ndarray) -> float:
+    angles = []
+    for i in range(3):
+        a, b = v[(i + 1) % 3] - v[i], v[(i + 2) % 3] - v[i]
+        cos = a @ b / (np.linalg.norm(a) * np.linalg.norm(b))
+        angles.append(math.degrees(math.acos(max(-1.0, min(1.0, cos)))))
+    return min(angles)
+
+
+@st.composite
+def triangles(draw: st.DrawFn) -> np.ndarray:
+    """Random counter-clockwise triangles, thin and obtuse ones included (angles >= 3 deg)."""
+    coords = [draw(st.floats(-5, 5)) for _ in range(6)]
+    v = np.array(coords).reshape(3, 2)
+    cross = (v[1, 0] - v[0, 0]) * (v[2, 1] - v[0, 1]) - (v[2, 0] - v[0, 0]) * (v[1, 1] - v[0, 1])
+    assume(abs(cross) > 1e-2)
+    if cross < 0:
+        v = v[[0, 2, 1]]
+    assume(_min_angle(v) >= 3.0)
+    return v
+
+
+def two_triangle_plan(v: np.ndarray, exit_edge: int, *, stay: bool) -> tuple[Abstraction, Witness]:
+    """Triangle 0 = v; triangle 1 its mirror image across facet ``exit_edge``."""
+    a, b = v[(exit_edge + 1) % 3], v[(exit_edge + 2) % 3]
+    d = b - a
+    apex = v[exit_edge]
+    foot = a + ((apex - a) @ d) / (d @ d) * d
+    mirror = 2 * foot - apex
+    vertices = np.array([*v, mirror])
+    tri0 = [0, 1, 2]
+    ia, ib = (exit_edge + 1) % 3, (exit_edge + 2) % 3
+    tri1 = [ib, ia, 3]  # counter-clockwise: the shared edge reversed
+    neighbors = np.full((2, 3), -1, dtype=np.int64)
+    neighbors[0, exit_edge] = 1
+    neighbors[1, 2] = 0
+    abstraction = Abstraction(
+        vertices=vertices,
+        triangles=np.array([tri0, tri1], dtype=np.int64),
+        neighbors=neighbors,
+        letter_of=np.zeros(2, dtype=np.int64),
+        letters=((),),
+        start=0,
+        component=np.zeros(2, dtype=np.int64),
+        regions={},
+    )
+    witness = Witness(
+        prefix=(0,) if stay else (),
+        cycle=(1,) if stay else (0,),
+        prefix_states=(0,) if stay else (),
+        cycle_states=(0,),
+        word=((), ()),
+        cost=0.0,
+        metric="length",
+        beta=1.0,
+        prefix_cost=0.0,
+        cycle_cost=0.0,
+    )
+    return abstraction, witness
+
+
+def _random_point(draw: st.DrawFn, v: np.ndarray) -> np.ndarray:
+    weights = np.array([draw(st.floats(0, 1)) for _ in range(3)]) + 1e-12
+    weights /= weights.sum()
+    return weights @ v  # type: ignore[no-any-return]
+
+
+def _exit_controller(v: np.ndarray, exit_edge: int, speed: float) -> StepController:
+    abstraction, witness = two_triangle_plan(v, exit_edge, stay=True)
+    return synthesize(abstraction, witness, Robot(start=(0.0, 0.0), max_speed=speed)).steps[0]
+
+
+@settings(deadline=None, max_examples=60)
+@given(triangles(), st.integers(0, 2), st.floats(0.2, 3.0), st.data())
+def test_every_state_leaves_through_the_planned_edge(
+    v: np.ndarray, exit_edge: int, speed: float, data: st.DataObject
+) -> None:
+    controller = _exit_controller(v, exit_edge, speed)
+    geometry = triangle_geometry(v)
+    # speed bound at random points of the triangle (the field is affine: vertices suffice,
+    # random points check the interpolation)
+    for _ in range(5):
+        x = _random_point(data.draw, v)
+        assert np.linalg.norm(controller.gain @ x + controller.offset) <= speed * (1 + 1e-7)
+    x0 = _random_point(data.draw, v)
+    times, points = _exit_step(controller, x0)
+    crossing_time, exit_point = times[-1], points[-1]
+    assert crossing_time <= controller.exit_time_bound * (1 + 1e-9)
+    # the exit point is on the planned edge, strictly between its end points
+    lam = geometry.barycentric(exit_point)
+    assert abs(lam[exit_edge]) <= 1e-9
+    # before the crossing the trajectory stays inside, away from the two other edges
+    flow = _Flow(np.block([[controller.gain, controller.offset[:, None]], [np.zeros((1, 3))]]), x0)
+    for t in np.linspace(0.0, crossing_time, 50)[1:-1]:
+        inside = geometry.barycentric(flow(t))
+        others = [j for j in range(3) if j != exit_edge]
+        assert min(inside[j] for j in others) > -1e-9
+        assert inside[exit_edge] > -1e-9
+    for j in (j for j in range(3) if j != exit_edge):
+        assert lam[j] > -1e-9
+
+
+@settings(deadline=None, max_examples=40)
+@given(triangles(), st.integers(0, 2), st.data())
+def test_exact_simulation_matches_rk45(v: np.ndarray, exit_edge: int, data: st.DataObject) -> None:
+    controller = _exit_controller(v, exit_edge, 1.0)
+    x0 = _random_point(data.draw, v)
+    times, points = _exit_step(controller, x0)
+    geometry = triangle_geometry(v)
+    normal, offset = geometry.normals[exit_edge], geometry.offsets[exit_edge]
+
+    def crossing(_: float, x: np.ndarray) -> float:
+        return float(normal @ x - offset)
+
+    crossing.terminal = True  # type: ignore[attr-defined]
+    crossing.direction = 1  # type: ignore[attr-defined]
+    if crossing(0.0, x0) >= -1e-12:
+        return  # starts on the exit edge: nothing to integrate
+    solution = solve_ivp(
+        lambda _t, x: controller.gain @ x + controller.offset,
+        (0.0, 2 * controller.exit_time_bound + 1.0),
+        x0,
+        method="RK45",
+        rtol=1e-12,
+        atol=1e-13,
+        events=crossing,
+    )
+    assert solution.t_events[0].size == 1
+    assert solution.t_events[0][0] == pytest.approx(times[-1], rel=1e-8, abs=1e-9)
+    assert np.allclose(solution.y_events[0][0], points[-1], atol=1e-8)
+
+
+@settings(deadline=None, max_examples=40)
+@given(triangles(), st.data())
+def test_stay_fields_converge_inside(v: np.ndarray, data: st.DataObject) -> None:
+    abstraction, witness = two_triangle_plan(v, 0, stay=False)
+    witness = Witness(
+        prefix=(),
+        cycle=(0,),
+        prefix_states=(),
+        cycle_states=(0,),
+        word=((),),
+        cost=0.0,
+        metric="length",
+        beta=1.0,
+        prefix_cost=0.0,
+        cycle_cost=0.0,
+    )
+    controller = synthesize(abstraction, witness, Robot(start=(0.0, 0.0))).steps[0]
+    assert controller.exit_edge is None
+    assert controller.target is not None
+    assert np.max(np.linalg.eigvals(controller.gain).real) < 0, "K is Hurwitz"
+    target = np.asarray(controller.target)
+    assert np.allclose(controller.gain @ target + controller.offset, 0.0, atol=1e-7)
+    geometry = triangle_geometry(v)
+    x0 = _random_point(data.draw, v)
+    _, points = _stay_step(controller, x0, 1.0)
+    for point in points:
+        assert geometry.barycentric(point).min() > -1e-9
+    assert np.linalg.norm(points[-2] - target) <= 1e-5 * max(1.0, np.linalg.norm(x0 - target))
+
+
+def test_small_matrix_exponential_matches_scipy() -> None:
+    from scipy.linalg import expm
+
+    rng = np.random.default_rng(7)
+    for _ in range(300):
+        matrix = np.zeros((3, 3))
+        matrix[:2] = rng.normal(size=(2, 3)) * rng.uniform(0.01, 5.0)
+        ours, reference = expm_small(matrix), expm(matrix)
+        assert np.abs(ours - reference).max() <= 1e-10 * np.abs(reference).max()
+        assert np.array_equal(ours[2], [0.0, 0.0, 1.0])  # the affine structure is exact
+
+
+def test_a_bounce_is_rejected() -> None:
+    v = np.array([[0.0, 0.0], [2.0, 0.0], [0.0, 2.0]])
+    abstraction, _ = two_triangle_plan(v, 0, stay=True)
+    bounce = Witness(
+        prefix=(0, 1),
+        cycle=(0,),
+        prefix_states=(0, 0),
+        cycle_states=(0,),
+        word=((), (), ()),
+        cost=0.0,
+        metric="length",
+        beta=1.0,
+        prefix_cost=0.0,
+        cycle_cost=0.0,
+    )
+    with pytest.raises(InvalidInputError) as caught:
+        synthesize(abstraction, bounce, Robot(start=(0.5, 0.5)))
+    assert caught.value.diagnostics[0].code == "C002"
+
+
+def test_continuity_and_jumps_on_a_real_plan(specs_dir: object) -> None:
+    from pathlib import Path
+
+    from tlmpc.pipeline import compile_mission
+
+    result = compile_mission(Path(str(specs_dir)) / "patrol.yaml", until="control")
+    controllers = result.compilation.controllers
+    assert controllers is not None
+    document = controllers_to_json(controllers)
+    assert validation_errors(document, "controllers") == []
+    jumped = {(j.step, j.vertex) for j in controllers.jumps}
+    abstraction = result.compilation.abstraction
+    assert abstraction is not None
+    steps = controllers.steps
+    shared_equal = 0
+    for k in range(1, len(steps)):
+        previous, current = steps[k - 1], steps[k]
+        if current.exit_edge is None:
+            continue
+        for i, vertex in enumerate(abstraction.triangles[current.triangle].tolist()):
+            corners = abstraction.triangles[previous.triangle].tolist()
+            if vertex in corners and (k, vertex) not in jumped:
+                j = corners.index(vertex)
+                assert np.allclose(previous.velocities[j], current.velocities[i], atol=1e-6)
+                shared_equal += 1
+    assert shared_equal > 0
+    assert all(c.exit_speed > 0 for c in steps)
