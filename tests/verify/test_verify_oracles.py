@@ -104,7 +104,8 @@ def test_agrees_with_rtamt_discrete_time(formula: Formula, word: list[frozenset[
 
 
 @given(formulas, words, st.data())
-def test_lassos_agree_with_the_definition(formula: Formula, word: list[frozenset[str]],
-                                          data: st.DataObject) -> None:
+def test_lassos_agree_with_the_definition(
+    formula: Formula, word: list[frozenset[str]], data: st.DataObject
+) -> None:
     loop = data.draw(st.integers(0, len(word) - 1))
     assert _ours(formula, word, loop) == holds(formula, word, loop)

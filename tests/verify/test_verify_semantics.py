@@ -17,11 +17,15 @@ ROOT = Path(__file__).resolve().parents[2]
 A = [[0, 0], [2, 0], [2, 2], [0, 2]]
 B = [[2, 0], [4, 0], [4, 2], [2, 2]]
 C = [[5, 3], [6, 3], [6, 4], [5, 4]]
-WORKSPACE = {"boundary": [[0, 0], [10, 0], [10, 10], [0, 10]], "holes": [[[7, 7], [8, 7], [8, 8], [7, 8]]]}
+WORKSPACE = {
+    "boundary": [[0, 0], [10, 0], [10, 10], [0, 10]],
+    "holes": [[[7, 7], [8, 7], [8, 8], [7, 8]]],
+}
 
 
-def trace(points: list[list[float]], ltl: str, loop_start: int | None = None,
-          boundary: str = "right") -> dict[str, Any]:
+def trace(
+    points: list[list[float]], ltl: str, loop_start: int | None = None, boundary: str = "right"
+) -> dict[str, Any]:
     return {
         "format": "tlmpc.trace/1",
         "ltl": ltl,
@@ -199,8 +203,14 @@ def test_csv_with_mission(tmp_path: Path) -> None:
 
 
 def test_verify_imports_nothing_from_the_planner() -> None:
-    forbidden = ("tlmpc.automata", "tlmpc.planning", "tlmpc.control", "tlmpc.simulate",
-                 "tlmpc.abstraction", "tlmpc.pipeline")
+    forbidden = (
+        "tlmpc.automata",
+        "tlmpc.planning",
+        "tlmpc.control",
+        "tlmpc.simulate",
+        "tlmpc.abstraction",
+        "tlmpc.pipeline",
+    )
     for path in (ROOT / "tlmpc" / "verify").glob("*.py"):
         tree = ast.parse(path.read_text())
         for node in ast.walk(tree):

@@ -108,20 +108,24 @@ def build_pieces(
     polygons = [np.asarray(regions[n], dtype=np.float64) for n in names]
     shapes = [shapely.Polygon(p) for p in polygons]
     cuts = crossing_parameters(points, polygons)
-    # Breakpoints: every sample and every crossing, in order.
-    bp_time: list[float] = []
-    bp_pos: list[FloatArray] = []
-    sample_bp: list[int] = []
-    for i in range(len(points)):
-        sample_bp.append(len(bp_time))
-        bp_time.append(float(times[i]))
-        bp_pos.append(points[i])
-        if i + 1 < len(points):
-            for sigma in cuts[i]:
-                bp_time.append(float(times[i] + sigma * (times[i + 1] - times[i])))
-                bp_pos.append(points[i] + sigma * (points[i + 1] - points[i]))
-    bp_positions = np.asarray(bp_pos)
-    bp_times = np.asarray(bp_time)
+    # Breakpoints: every sample and every crossing, in order (vectorised: the crossings of
+    # segment i follow sample i).
+    n = len(points)
+    per_seg = np.array([len(c) for c in cuts] + [0] * (n - len(cuts)), dtype=np.int64)[:n]
+    sample_idx = np.arange(n, dtype=np.int64) + np.concatenate(([0], np.cumsum(per_seg)[:-1]))
+    count = n + int(per_seg.sum())
+    bp_times = np.empty(count)
+    bp_positions = np.empty((count, 2))
+    bp_times[sample_idx] = times
+    bp_positions[sample_idx] = points
+    if count > n:
+        seg = np.repeat(np.arange(n, dtype=np.int64), per_seg)
+        sigma = np.fromiter((s for c in cuts for s in c), dtype=np.float64, count=count - n)
+        rank = np.arange(count - n) - np.repeat(np.cumsum(per_seg) - per_seg, per_seg)
+        slots = sample_idx[seg] + 1 + rank
+        bp_times[slots] = times[seg] + sigma * (times[seg + 1] - times[seg])
+        bp_positions[slots] = points[seg] + sigma[:, None] * (points[seg + 1] - points[seg])
+    sample_bp = sample_idx.tolist()
     count = len(bp_times)
     mids = (bp_positions[:-1] + bp_positions[1:]) / 2.0 if count > 1 else np.zeros((0, 2))
     open_labels = region_membership(shapes, mids, closed=True)

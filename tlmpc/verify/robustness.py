@@ -34,15 +34,21 @@ from tlmpc.ltl.ast import (
 FloatArray = npt.NDArray[np.float64]
 
 
-def signed_distance(polygon: FloatArray, points: FloatArray) -> FloatArray:
-    """+distance to the boundary inside (closed) the polygon, -distance to it outside."""
+def signed_distance(
+    polygon: FloatArray, points: FloatArray, geoms: npt.NDArray[np.object_] | None = None
+) -> FloatArray:
+    """+distance to the boundary inside (closed) the polygon, -distance to it outside.
+
+    Regions have no holes, so the distance to the polygon from outside equals the distance to
+    its exterior ring: one distance computation serves both signs.
+    """
     shape = shapely.Polygon(polygon)
-    geoms = shapely.points(points)
-    distance = shapely.distance(shape.exterior, geoms)
+    if geoms is None:
+        geoms = shapely.points(points)
+    distance = np.asarray(shapely.distance(shape.exterior, geoms), dtype=np.float64)
     inside = shapely.contains_xy(shape, points[:, 0], points[:, 1])
-    result: FloatArray = np.where(inside, distance, -shapely.distance(shape, geoms)).astype(
-        np.float64
-    )
+    # Boundary points are inside a closed region: distance 0, sign irrelevant.
+    result: FloatArray = np.where(inside, distance, -distance)
     return result
 
 
@@ -51,6 +57,7 @@ class _Robustness:
         self, points: FloatArray, loop_start: int | None, regions: Mapping[str, FloatArray]
     ) -> None:
         self.points = points
+        self.geoms = shapely.points(points)
         self.size = len(points)
         self.loop = loop_start
         self.regions = regions
@@ -86,7 +93,7 @@ class _Robustness:
         if isinstance(f, Const):
             return np.full(self.size, np.inf if f.value else -np.inf)
         if isinstance(f, Prop):
-            return signed_distance(np.asarray(self.regions[f.name]), self.points)
+            return signed_distance(np.asarray(self.regions[f.name]), self.points, self.geoms)
         if isinstance(f, Not):
             return -self(f.arg)
         if isinstance(f, And):

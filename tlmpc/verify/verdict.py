@@ -131,6 +131,8 @@ def _workspace_violation(trace: TraceInput) -> Counterexample | None:
     free = shapely.Polygon(trace.boundary_polygon)
     if trace.holes:
         free = free.difference(shapely.union_all([shapely.Polygon(h) for h in trace.holes]))
+    # Prepared: the bulk `covers` below then uses an indexed test per segment.
+    shapely.prepare(free)
     points = trace.points
     if len(points) == 1:
         segments = shapely.points(points)
@@ -166,8 +168,13 @@ def _workspace_violation(trace: TraceInput) -> Counterexample | None:
 
 def verify_trace(trace: TraceInput) -> Verdict:
     """Check ``trace`` against its task under its boundary convention."""
-    names = list(trace.regions)
-    raw = build_pieces(trace.times, trace.points, trace.loop_start, trace.regions, trace.convention)
+    # Only the regions the task mentions can change its truth (no Next: the semantics is
+    # stutter-invariant), so crossings of other regions are not split at; this keeps the label
+    # matrix small on large maps.
+    mentioned = trace.formula.props()
+    regions = {n: p for n, p in trace.regions.items() if n in mentioned}
+    names = list(regions)
+    raw = build_pieces(trace.times, trace.points, trace.loop_start, regions, trace.convention)
     pieces = merge_pieces(raw, trace.convention)
     loop = pieces.loop_start if pieces.loop_start is not None else len(pieces.is_point) - 1
     evaluator = LassoEvaluator(
@@ -179,7 +186,7 @@ def verify_trace(trace: TraceInput) -> Verdict:
         failing = [c for c in _conjuncts(trace.formula) if not evaluator(c)[0]]
         counterexample = _explain(failing[0], evaluator, pieces, names)
     violation = _workspace_violation(trace)
-    rho = robustness(trace.formula, trace.times, trace.points, trace.loop_start, trace.regions)
+    rho = robustness(trace.formula, trace.times, trace.points, trace.loop_start, regions)
     gaps = np.diff(trace.times)
     max_gap = float(gaps.max()) if len(gaps) else 0.0
     bound = None if trace.max_speed is None else trace.max_speed * max_gap
