@@ -61,9 +61,6 @@ def run(repeats: int = 3) -> list[dict[str, Any]]:
 
 
 if __name__ == "__main__":
-    rows = run()
-    keys = list(rows[0])
-    print("| " + " | ".join(keys) + " |")
-    print("|" + "---|" * len(keys))
-    for row in rows:
-        print("| " + " | ".join(str(row[k]) for k in keys) + " |")
+    from bench.tables import markdown_table
+
+    print(markdown_table(run()))

@@ -78,9 +78,6 @@ options: {min_angle: 30, max_area: 0.5}
 
 
 if __name__ == "__main__":
-    rows = run()
-    keys = list(rows[0])
-    print("| " + " | ".join(keys) + " |")
-    print("|" + "---|" * len(keys))
-    for row in rows:
-        print("| " + " | ".join(str(row[k]) for k in keys) + " |")
+    from bench.tables import markdown_table
+
+    print(markdown_table(run()))

@@ -152,16 +152,9 @@ def run(repeats: int = 3) -> list[dict[str, Any]]:
     return planning_rows(repeats) + spin_rows(repeats)
 
 
-def _table(rows: list[dict[str, Any]]) -> str:
-    keys: list[str] = []
-    for row in rows:
-        keys.extend(k for k in row if k not in keys)
-    lines = ["| " + " | ".join(keys) + " |", "|" + "---|" * len(keys)]
-    lines += ["| " + " | ".join(str(row.get(k, "")) for k in keys) + " |" for row in rows]
-    return "\n".join(lines)
-
-
 if __name__ == "__main__":
-    print(_table(planning_rows(3)))
+    from bench.tables import markdown_table
+
+    print(markdown_table(planning_rows(3)))
     print()
-    print(_table(spin_rows(3)))
+    print(markdown_table(spin_rows(3)))

@@ -23,6 +23,7 @@ ROOT = Path(__file__).resolve().parent.parent
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
+from bench.tables import markdown_table  # noqa: E402
 from bench.workloads import grid_of_rooms, sequence_avoiding, write_mission  # noqa: E402
 
 STAGE_MODULES = (
@@ -101,22 +102,6 @@ def _compile_table(rows: list[dict[str, Any]]) -> str:
     return "\n".join(lines)
 
 
-def _generic_table(rows: list[dict[str, Any]]) -> str:
-    if not rows:
-        return "(no rows)"
-    keys: list[str] = []
-    for row in rows:
-        keys.extend(k for k in row if k not in keys)
-    lines = ["| " + " | ".join(keys) + " |", "|" + "---|" * len(keys)]
-    for row in rows:
-        cells = []
-        for key in keys:
-            value = row.get(key, "")
-            cells.append(f"{value:.4g}" if isinstance(value, float) else str(value))
-        lines.append("| " + " | ".join(cells) + " |")
-    return "\n".join(lines)
-
-
 def main(argv: list[str] | None = None) -> int:
     """Run the suite; ``--quick`` skips the 300k grid and uses one repeat."""
     parser = argparse.ArgumentParser(prog="python -m bench", description=__doc__)
@@ -171,7 +156,7 @@ def main(argv: list[str] | None = None) -> int:
                 stage_rows = module.run(repeats=max(repeats, 3) if not args.quick else 1)
                 report["stages"][module_name.split(".")[-1]] = stage_rows
                 print(f"## {module_name.split('.')[-1]}\n")
-                print(_generic_table(stage_rows) + "\n")
+                print(markdown_table(stage_rows) + "\n")
     args.results.write_text(json.dumps(report, indent=2, sort_keys=True) + "\n", encoding="utf-8")
     print(f"results written to {args.results}", file=sys.stderr)
     return 0
