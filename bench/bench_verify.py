@@ -86,6 +86,10 @@ def run(repeats: int = 3) -> list[dict[str, Any]]:
 
 
 if __name__ == "__main__":
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
     from bench.tables import markdown_table
 
     print(markdown_table(run()))
