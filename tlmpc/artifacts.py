@@ -2,7 +2,7 @@
 
 Schemas live in the top-level ``schemas/`` folder of the repository (one source of truth);
 the wheel carries them as ``tlmpc/schemas/``.  Artifacts are written canonically: sorted
-keys, two-space indent, a trailing newline, so they diff and golden-test well.
+keys and a trailing newline; small documents indented, large ones (meshes, traces) compact.
 """
 
 from __future__ import annotations
@@ -56,9 +56,21 @@ def _finite(value: Any) -> Any:
     return value
 
 
+#: Documents shorter than this (in compact form) are written indented, for people to read;
+#: larger ones (meshes, traces) compactly, which is several times faster to write.
+INDENT_BELOW = 20_000
+
+
 def dumps(document: Any) -> str:
-    """Canonical JSON text of ``document``."""
-    return json.dumps(_finite(document), indent=2, sort_keys=True, allow_nan=False) + "\n"
+    """Canonical JSON text of ``document``: sorted keys, non-finite floats as strings."""
+    try:
+        text = json.dumps(document, sort_keys=True, separators=(",", ":"), allow_nan=False)
+    except ValueError:  # a non-finite float somewhere: JSON has none
+        document = _finite(document)
+        text = json.dumps(document, sort_keys=True, separators=(",", ":"), allow_nan=False)
+    if len(text) < INDENT_BELOW:
+        text = json.dumps(document, indent=2, sort_keys=True, allow_nan=False)
+    return text + "\n"
 
 
 def write_json(path: Path, document: Any) -> None:
