@@ -7,7 +7,9 @@ same transition system and negated task go through ``tlmpc export --format prome
 
 from __future__ import annotations
 
+import os
 import shutil
+import signal
 import statistics
 import subprocess
 import sys
@@ -82,11 +84,23 @@ def planning_rows(repeats: int) -> list[dict[str, Any]]:
 
 
 def _timed(command: list[str], cwd: Path, timeout: float) -> tuple[float, str]:
+    """Run ``command``; on timeout kill its whole process group (gcc leaves cc1 behind)."""
     started = time.perf_counter()
-    completed = subprocess.run(
-        command, cwd=cwd, capture_output=True, text=True, check=False, timeout=timeout
+    process = subprocess.Popen(
+        command,
+        cwd=cwd,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        start_new_session=True,
     )
-    return time.perf_counter() - started, completed.stdout + completed.stderr
+    try:
+        output, _ = process.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        os.killpg(process.pid, signal.SIGKILL)
+        process.communicate()
+        raise
+    return time.perf_counter() - started, output
 
 
 def spin_rows(repeats: int, timeout: float = 180.0) -> list[dict[str, Any]]:
