@@ -135,15 +135,21 @@ def _min_angle(corners: FloatArray) -> FloatArray:
 
 def abstraction_diagnostics(abstraction: Abstraction, mission: Mission) -> list[Diagnostic]:
     """Warnings: regions that got no triangle, regions unreachable from the start."""
-    present: dict[str, np.ndarray[Any, Any]] = {}
-    for index, letter in enumerate(abstraction.letters):
-        for name in letter:
-            present.setdefault(name, np.zeros(len(abstraction.letters), dtype=bool))[index] = True
+    used = set(np.unique(abstraction.letter_of).tolist())
     start_component = abstraction.component[abstraction.start]
+    reachable = set(
+        np.unique(abstraction.letter_of[abstraction.component == start_component]).tolist()
+    )
+    present: set[str] = set()
+    near: set[str] = set()
+    for index, letter in enumerate(abstraction.letters):
+        if index in used:
+            present.update(letter)
+        if index in reachable:
+            near.update(letter)
     problems = []
     for region in mission.regions:
-        mask = present.get(region.name)
-        if mask is None:
+        if region.name not in present:
             problems.append(
                 Diagnostic(
                     code="A010",
@@ -153,9 +159,7 @@ def abstraction_diagnostics(abstraction: Abstraction, mission: Mission) -> list[
                     hint="it lies in holes or is too thin to triangulate",
                 )
             )
-            continue
-        triangles = mask[abstraction.letter_of]
-        if not np.any(abstraction.component[triangles] == start_component):
+        elif region.name not in near:
             problems.append(
                 Diagnostic(
                     code="A011",
