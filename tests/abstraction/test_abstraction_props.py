@@ -55,18 +55,15 @@ def workspaces(draw: st.DrawFn) -> Mission:
         holes.append(rect(width - 2.5, height - 2.0, width - 1.5, height - 1.0))
     regions = {}
     for k in range(draw(st.integers(1, 4))):
-        x0 = draw(st.floats(0.0, width - 2.0))
-        y0 = draw(st.floats(0.0, height - 2.0))
+        # Regions may stick out of the boundary, lie beyond it, or sit in a hole.
+        x0 = draw(st.floats(-1.0, width + 1.0))
+        y0 = draw(st.floats(-1.0, height - 2.0))
         w = draw(st.floats(0.5, 3.0))
         h = draw(st.floats(0.5, 3.0))
         if draw(st.booleans()):
-            regions[f"r{k}"] = rect(x0, y0, min(x0 + w, width), min(y0 + h, height))
+            regions[f"r{k}"] = rect(x0, y0, x0 + w, y0 + h)
         else:  # a triangle-ish star polygon
-            regions[f"r{k}"] = (
-                (x0, y0),
-                (min(x0 + w, width), y0 + h / 3),
-                (x0 + w / 2, min(y0 + h, height)),
-            )
+            regions[f"r{k}"] = ((x0, y0), (x0 + w, y0 + h / 3), (x0 + w / 2, y0 + h))
     start = (width - 0.1, 0.1)
     min_angle = draw(st.sampled_from([None, 20.0]))
     return mission_of(
@@ -210,3 +207,27 @@ def test_artifact_round_trip_and_schema() -> None:
     assert back == a
     for name in ("vertices", "triangles", "neighbors", "letter_of", "component"):
         assert np.array_equal(getattr(back, name), getattr(a, name))
+
+
+@pytest.mark.parametrize(
+    ("holes", "region"),
+    [
+        ([rect(2, 2, 6, 6)], rect(3, 3, 4, 4)),  # inside a hole
+        ([], rect(12, 3, 14, 4)),  # beyond the boundary
+        ([rect(2, 2, 6, 6)], rect(1, 1, 7, 7)),  # encloses a hole
+    ],
+)
+def test_region_rings_outside_the_free_space_are_no_segments(
+    holes: list[tuple[tuple[float, float], ...]], region: tuple[tuple[float, float], ...]
+) -> None:
+    mission = mission_of(rect(0, 0, 10, 10), holes, {"a": region}, (8.5, 8.5))
+    a = build_abstraction(mission)
+    free = Polygon(rect(0, 0, 10, 10))
+    for hole in holes:
+        free = free.difference(Polygon(hole))
+    assert sum(p.area for p in _triangle_polygons(a)) == pytest.approx(free.area, rel=1e-12)
+    expected = Polygon(region).intersection(free).area
+    labelled = sum(p.area for t, p in enumerate(_triangle_polygons(a)) if "a" in a.labels(t))
+    assert labelled == pytest.approx(expected, abs=1e-12)
+    codes = [d.code for d in abstraction_diagnostics(a, mission)]
+    assert codes == ([] if expected > 0 else ["A010"])

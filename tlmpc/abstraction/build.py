@@ -156,7 +156,7 @@ def abstraction_diagnostics(abstraction: Abstraction, mission: Mission) -> list[
                     severity="warning",
                     file=mission.source,
                     message=f"region {region.name!r} got no triangle",
-                    hint="it lies in holes or is too thin to triangulate",
+                    hint="it lies outside the boundary or in holes, or is too thin to triangulate",
                 )
             )
         elif region.name not in near:

@@ -117,6 +117,15 @@ def _needs_noding(rings: list[Any]) -> bool:
     return bool(np.any(pairs[0] != pairs[1]))
 
 
+def _inside(free: Any, rings: list[Any]) -> list[Any]:
+    """The rings (none meeting ``free``'s boundary) that lie in ``free``."""
+    if not rings:
+        return []
+    first = shapely.get_coordinates(shapely.get_point(np.asarray(rings, dtype=object), 0))
+    keep = shapely.intersects_xy(free, first[:, 0], first[:, 1])
+    return [ring for ring, k in zip(rings, keep.tolist(), strict=True) if k]
+
+
 def pslg(mission: Mission) -> tuple[FloatArray, IntArray, FloatArray, list[Any]]:
     """The planar straight-line graph and the snapped region shapes.
 
@@ -140,7 +149,10 @@ def pslg(mission: Mission) -> tuple[FloatArray, IntArray, FloatArray, list[Any]]
         )
         segments = _segments_of(list(shapely.get_parts(linework)))
     else:
-        segments = _segments_of([*free_rings, *region_rings])
+        # No region ring meets the free space's boundary, so each ring lies wholly inside the
+        # free space or wholly outside it (in a hole, or beyond the boundary).  Rings outside
+        # must not become segments: Triangle would keep the triangles they enclose.
+        segments = _segments_of([*free_rings, *_inside(free, region_rings)])
     minx, miny, _, _ = free.bounds
     flat = segments.reshape(-1, 2)
     keys = np.round((flat - np.array([minx, miny])) / grid).astype(np.int64)
