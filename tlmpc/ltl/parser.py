@@ -184,11 +184,38 @@ _EXPECTED_NAMES = {
 }
 
 
-def _describe_expected(expected: set[str] | frozenset[str]) -> str:
-    names = sorted({_EXPECTED_NAMES.get(e, e) for e in expected})
-    if len(names) > 6:
-        return "an operand or an operator"
-    return ", ".join(names[:-1]) + (" or " if len(names) > 1 else "") + names[-1]
+_OPERAND_STARTS = frozenset(
+    {"NAME", "STRING", "TRUE", "FALSE", "LPAR", "NOT", "UNARY_CHAIN", "EVENTUALLY", "ALWAYS"}
+)
+_OPERAND = "an operand (a region name, true, false, '(' or one of ! F G [] <>)"
+
+
+def _describe_expected(expected: set[str] | frozenset[str], open_parens: int = 1) -> str:
+    expected = set(expected)
+    if open_parens <= 0:
+        # LALR merges lookaheads, so ')' shows up even where no '(' is open.
+        expected.discard("RPAR")
+    parts: list[str] = []
+    if expected & _OPERAND_STARTS:
+        parts.append(_OPERAND)
+        expected -= _OPERAND_STARTS
+    if expected & {"AND", "OR", "IMPLIES", "EQUIV", "BINTEMP"} == {
+        "AND",
+        "OR",
+        "IMPLIES",
+        "EQUIV",
+        "BINTEMP",
+    }:
+        parts.append("a binary operator (& | -> <-> U R W M)")
+        expected -= {"AND", "OR", "IMPLIES", "EQUIV", "BINTEMP"}
+    parts.extend(sorted(_EXPECTED_NAMES.get(e, e) for e in expected))
+    if not parts:
+        return "something else"
+    return ", ".join(parts[:-1]) + (" or " if len(parts) > 1 else "") + parts[-1]
+
+
+def _open_parens(text: str, end: int) -> int:
+    return text[:end].count("(") - text[:end].count(")")
 
 
 def _tree_depth(tree: Tree[Token]) -> int:
@@ -197,7 +224,11 @@ def _tree_depth(tree: Tree[Token]) -> int:
     while stack:
         node, depth = stack.pop()
         deepest = max(deepest, depth)
-        stack.extend((c, depth + 1) for c in node.children if isinstance(c, Tree))
+        # `FGFG a` is one token but as many AST levels as letters.
+        step = sum(
+            len(c) for c in node.children if isinstance(c, Token) and c.type == "UNARY_CHAIN"
+        )
+        stack.extend((c, depth + max(step, 1)) for c in node.children if isinstance(c, Tree))
     return deepest
 
 
@@ -233,7 +264,7 @@ def _syntax_diagnostic(exc: LarkError, text: str, file: str | None, pos: _Positi
             return error(
                 "L002",
                 "the LTL formula ends too early",
-                hint=f"expected {_describe_expected(exc.expected)}",
+                hint=f"expected {_describe_expected(exc.expected, _open_parens(text, len(text)))}",
                 file=file,
                 line=line,
                 col=col,
@@ -242,14 +273,23 @@ def _syntax_diagnostic(exc: LarkError, text: str, file: str | None, pos: _Positi
         return error(
             "L003",
             f"unexpected {str(token)!r} in LTL formula",
-            hint=f"expected {_describe_expected(exc.expected)} here",
+            hint="expected "
+            + _describe_expected(exc.expected, _open_parens(text, token.start_pos or 0))
+            + " here",
             file=file,
             line=line,
             col=col,
         )
     if isinstance(exc, UnexpectedEOF):
         line, col = pos.at(*_end_position(text))
-        return error("L002", "the LTL formula ends too early", file=file, line=line, col=col)
+        return error(
+            "L002",
+            "the LTL formula ends too early",
+            hint="complete the formula (an operand or a closing ')' is missing)",
+            file=file,
+            line=line,
+            col=col,
+        )
     return error("L003", f"cannot parse LTL formula: {exc}", file=file, line=pos.line, col=pos.col)
 
 

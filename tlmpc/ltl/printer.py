@@ -25,16 +25,14 @@ from tlmpc.ltl.ast import (
     WeakUntil,
 )
 
-# Binding strength, loosest first (Spot's order).
-_EQUIV, _IMPLIES, _OR, _AND, _BINTEMP, _UNARY, _ATOM = range(1, 8)
+# Binding strength, loosest first (Spot's order; `->` and `<->` share a level, right-assoc).
+_IMPLIES, _OR, _AND, _BINTEMP, _UNARY, _ATOM = range(1, 7)
 
 _TEMPORAL_SYMBOL = {Until: "U", Release: "R", WeakUntil: "W", StrongRelease: "M"}
 
 
 def _level(formula: Formula) -> int:
-    if isinstance(formula, Equiv):
-        return _EQUIV
-    if isinstance(formula, Implies):
+    if isinstance(formula, Implies | Equiv):
         return _IMPLIES
     if isinstance(formula, Or):
         return _OR
@@ -77,14 +75,11 @@ def _print(formula: Formula) -> str:
         return " & ".join(_operand(a, _AND + 1, boolean_parent=True) for a in formula.args)
     if isinstance(formula, Or):
         return " | ".join(_operand(a, _OR + 1, boolean_parent=True) for a in formula.args)
-    if isinstance(formula, Implies):
+    if isinstance(formula, Implies | Equiv):
+        symbol = "->" if isinstance(formula, Implies) else "<->"
         left = _operand(formula.left, _IMPLIES + 1, boolean_parent=True)
         right = _operand(formula.right, _IMPLIES, boolean_parent=True)
-        return f"{left} -> {right}"
-    if isinstance(formula, Equiv):
-        left = _operand(formula.left, _EQUIV, boolean_parent=True)
-        right = _operand(formula.right, _EQUIV + 1, boolean_parent=True)
-        return f"{left} <-> {right}"
+        return f"{left} {symbol} {right}"
     if isinstance(formula, Until | Release | WeakUntil | StrongRelease):
         symbol = _TEMPORAL_SYMBOL[type(formula)]
         left = _operand(formula.left, _BINTEMP + 1)

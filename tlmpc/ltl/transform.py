@@ -127,6 +127,13 @@ def is_safety(formula: Formula) -> bool:
     return _only(formula, (Release, WeakUntil, Globally))
 
 
+def _flatten(kind: type[And] | type[Or], parts: list[Formula]) -> list[Formula]:
+    flat: list[Formula] = []
+    for part in parts:
+        flat.extend(part.args if isinstance(part, kind) else (part,))
+    return flat
+
+
 def simplify(formula: Formula) -> Formula:
     """Constant folding and flattening (meaning-preserving, cheap)."""
     f = formula
@@ -140,13 +147,13 @@ def simplify(formula: Formula) -> Formula:
             return arg.arg
         return Not(arg, span=f.span)
     if isinstance(f, And):
-        parts = [simplify(a) for a in f.args]
+        parts = _flatten(And, [simplify(a) for a in f.args])
         if any(p == FALSE for p in parts):
             return FALSE
         kept = list(dict.fromkeys(p for p in parts if p != TRUE))
         return conjoin(kept)
     if isinstance(f, Or):
-        parts = [simplify(a) for a in f.args]
+        parts = _flatten(Or, [simplify(a) for a in f.args])
         if any(p == TRUE for p in parts):
             return TRUE
         kept = list(dict.fromkeys(p for p in parts if p != FALSE))

@@ -73,6 +73,8 @@ class _Lowering:
         self.problems: list[Diagnostic] = []
 
     def _where(self, token: Token) -> tuple[int, int]:
+        if (token.line or 1) > 1:  # a phrase spread over several lines (a YAML block scalar)
+            return self.line + (token.line or 1) - 1, token.column or 1
         return self.line, self.col + (token.column or 1) - 1
 
     def name(self, tree: Tree[Any]) -> Prop:
