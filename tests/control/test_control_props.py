@@ -247,3 +247,36 @@ def test_continuity_and_jumps_on_a_real_plan(specs_dir: object) -> None:
                 shared_equal += 1
     assert shared_equal > 0
     assert all(c.exit_speed > 0 for c in steps)
+
+
+def test_lasso_without_prefix_loops_from_the_second_lap(specs_dir: object) -> None:
+    """A cycle that starts in the start triangle: lap one is the transient, lap two the loop."""
+    import dataclasses
+    from pathlib import Path
+
+    from tlmpc.pipeline import compile_mission
+    from tlmpc.simulate import simulate, trace_to_json
+    from tlmpc.verify import verify_document
+
+    result = compile_mission(Path(str(specs_dir)) / "patrol.yaml", until="plan")
+    abstraction, witness, mission = (
+        result.compilation.abstraction,
+        result.compilation.witness,
+        result.compilation.mission,
+    )
+    assert abstraction is not None
+    assert witness is not None
+    assert mission is not None
+    loop = dataclasses.replace(witness, prefix=(), prefix_states=())
+    x, y = abstraction.corners(loop.cycle[0]).mean(axis=0).tolist()
+    robot = dataclasses.replace(mission.robot, start=(x, y))
+    moved = dataclasses.replace(mission, robot=robot)
+    controllers = synthesize(abstraction, loop, robot)
+    assert controllers.loop_start == 0
+    trace = simulate(abstraction, controllers, moved)
+    assert trace.loop_start is not None
+    assert 0 < trace.loop_start < len(trace.times) - 1
+    # the loop starts and ends at the crossing into the cycle's first triangle
+    assert trace.triangles[trace.loop_start] == loop.cycle[0]
+    assert trace.triangles[-1] == loop.cycle[0]
+    assert verify_document(trace_to_json(trace, moved)).satisfied
