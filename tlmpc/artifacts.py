@@ -73,11 +73,6 @@ def dumps(document: Any) -> str:
     return text + "\n"
 
 
-def write_json(path: Path, document: Any) -> None:
-    """Write ``document`` canonically to ``path``."""
-    path.write_text(dumps(document), encoding="utf-8")
-
-
 def read_json(path: Path, expected_format: str | None = None) -> dict[str, Any]:
     """Read an artifact, checking its ``format`` prefix (e.g. ``"tlmpc.trace/"``).
 

@@ -24,8 +24,7 @@ from tlmpc.automata.terms import (
     simplify_state,
     to_text,
 )
-from tlmpc.ltl.ast import TRUE as AST_TRUE
-from tlmpc.ltl.ast import Formula, Not, Prop, conjoin, disjoin
+from tlmpc.ltl.ast import Formula, Not, Prop, conjoin
 from tlmpc.ltl.printer import to_text as formula_text
 
 State = frozenset[T]
@@ -164,10 +163,3 @@ def _state_name(state: State) -> str:
     if not state:
         return "true"
     return " & ".join(to_text(f) for f in sorted(state, key=repr))
-
-
-def guard_or(guards: Sequence[Formula]) -> Formula:
-    """Disjunction of guards, ``true`` absorbing."""
-    if any(g == AST_TRUE for g in guards):
-        return AST_TRUE
-    return disjoin(list(dict.fromkeys(guards)))

@@ -8,8 +8,6 @@ tlmpc's plans on maps where the shortest route bounces.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-
 from tlmpc.abstraction.model import Abstraction
 from tlmpc.ltl.ast import Formula, Prop
 from tlmpc.ltl.printer import to_spin
@@ -95,6 +93,3 @@ def to_dot_graph(abstraction: Abstraction, name: str = "mission") -> str:
                 lines.append(f"  {triangle} -- {other};")
     lines.append("}")
     return "\n".join(lines) + "\n"
-
-
-EXPORTERS: Mapping[str, str] = {"promela": ".pml", "smv": ".smv", "dot": ".dot"}

@@ -91,10 +91,6 @@ class _Flow:
         return np.asarray((weighted @ np.exp(values * t)).real[:2], dtype=np.float64)
 
 
-def _flow(matrix: FloatArray, x0: FloatArray, t: float) -> FloatArray:
-    return _Flow(matrix, x0)(t)
-
-
 def _exit_step(controller: StepController, x0: FloatArray) -> tuple[list[float], list[FloatArray]]:
     """Times and points of one exit step, ending with the crossing (snapped to the edge)."""
     assert controller.exit_edge is not None
