@@ -2,16 +2,13 @@
 
 ``python bench/bench_planning.py`` prints a markdown table.  With SPIN (and gcc) installed, the
 same transition system and negated task go through ``tlmpc export --format promela``,
-``spin -a``, ``gcc`` and ``./pan -a``, each phase timed, against tlmpc's planning time.
+``spin -a``, ``gcc`` and ``./pan -a`` (and the shortest-trail mode ``-DREACH`` + ``./pan -a -i``),
+each phase timed, against tlmpc's planning time, with the witness lengths side by side.
 """
 
 from __future__ import annotations
 
-import os
-import shutil
-import signal
 import statistics
-import subprocess
 import sys
 import tempfile
 import time
@@ -83,30 +80,23 @@ def planning_rows(repeats: int) -> list[dict[str, Any]]:
     return rows
 
 
-def _timed(command: list[str], cwd: Path, timeout: float) -> tuple[float, str]:
-    """Run ``command``; on timeout kill its whole process group (gcc leaves cc1 behind)."""
-    started = time.perf_counter()
-    process = subprocess.Popen(
-        command,
-        cwd=cwd,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.STDOUT,
-        text=True,
-        start_new_session=True,
-    )
-    try:
-        output, _ = process.communicate(timeout=timeout)
-    except subprocess.TimeoutExpired:
-        os.killpg(process.pid, signal.SIGKILL)
-        process.communicate()
-        raise
-    return time.perf_counter() - started, output
+def _spin_phase_row(trail: Any, prefix: str) -> dict[str, Any]:
+    return {f"{prefix} {phase} s": round(seconds, 3) for phase, seconds in trail.seconds.items()}
 
 
-def spin_rows(repeats: int, timeout: float = 180.0) -> list[dict[str, Any]]:
-    """SPIN on the exported model versus tlmpc's planning, per phase."""
-    if shutil.which("spin") is None or shutil.which("gcc") is None:
+def spin_rows(repeats: int, timeout: float = 600.0) -> list[dict[str, Any]]:
+    """SPIN on the exported model versus tlmpc's planning: phases, totals, witness lengths.
+
+    Both sides plan over the same D (no-bounce rule in the export) with the same objective:
+    tlmpc with ``cost: hops, beta: 1``, SPIN's first trail (``./pan -a``) and its shortest-trail
+    mode (``-DREACH``, ``./pan -a -i``).
+    """
+    from tlmpc.planning import spin
+
+    if not spin.available():
         return [{"workload": "spin", "note": "spin or gcc not installed: skipped"}]
+    from dataclasses import replace
+
     from tlmpc.abstraction import build_abstraction
     from tlmpc.automata import translate
     from tlmpc.mission import load_mission
@@ -114,50 +104,55 @@ def spin_rows(repeats: int, timeout: float = 180.0) -> list[dict[str, Any]]:
     from tlmpc.planning.export import to_promela
 
     rows = []
-    for spec in ("example1", "example7", "example8"):
+    for spec in ("example1", "example6", "example7", "example8"):
         mission = load_mission(ROOT / "specs" / f"{spec}.yaml")
         abstraction = build_abstraction(mission)
+        options = replace(mission.options, cost="hops", beta=1.0)
 
-        def ours(mission: Any = mission, abstraction: Any = abstraction) -> Any:
+        def ours(
+            mission: Any = mission, abstraction: Any = abstraction, options: Any = options
+        ) -> Any:
             automaton = translate(mission.formula, letters=abstraction.letters)
             return plan(
                 abstraction,
                 automaton,
                 formula=mission.formula,
-                options=mission.options,
+                options=options,
                 start_point=mission.robot.start,
             )
 
         seconds, witness = _median_time(ours, repeats)
+        row: dict[str, Any] = {
+            "workload": spec,
+            "triangles": abstraction.num_triangles,
+            "tlmpc plan s": round(seconds, 4),
+            "tlmpc hops": round(witness.cost),
+        }
         with tempfile.TemporaryDirectory() as tmp:
-            work = Path(tmp)
+            model = Path(tmp) / "model.pml"
             started = time.perf_counter()
-            (work / "model.pml").write_text(to_promela(abstraction, mission.formula, spec))
-            export = time.perf_counter() - started
+            model.write_text(to_promela(abstraction, mission.formula, spec))
+            row["export s"] = round(time.perf_counter() - started, 4)
             try:
-                generate, _ = _timed(["spin", "-a", "model.pml"], work, timeout)
-                compile_, _ = _timed(
-                    ["gcc", "-O2", "-DNOREDUCE", "-o", "pan", "pan.c"], work, timeout
+                first = spin.run_spin(model, timeout=timeout, max_depth=10_000_000)
+                row |= _spin_phase_row(first, "first:")
+                row["first: hops"] = first.moves if first.found else "no plan"
+                total = row["export s"] + sum(first.seconds.values()) - first.seconds["spin -t"]
+                row["spin total s"] = round(total, 3)
+                row["speed-up"] = round(total / seconds, 1)
+            except spin.SpinError as failed:
+                row["note"] = f"first trail: {failed}"
+                rows.append(row)
+                continue
+            try:
+                shortest = spin.run_spin(
+                    model, shortest=True, timeout=timeout, max_depth=10_000_000
                 )
-                search, output = _timed(["./pan", "-a", "-m1000000"], work, timeout)
-                found = "acceptance cycle" in output or "errors: 1" in output
-                total = export + generate + compile_ + search
-                rows.append(
-                    {
-                        "workload": spec,
-                        "triangles": abstraction.num_triangles,
-                        "tlmpc plan s": round(seconds, 4),
-                        "export s": round(export, 4),
-                        "spin -a s": round(generate, 3),
-                        "gcc s": round(compile_, 3),
-                        "pan -a s": round(search, 3),
-                        "spin total s": round(total, 3),
-                        "speed-up": round(total / seconds, 1),
-                        "both find a plan": found and bool(witness.cycle),
-                    }
-                )
-            except subprocess.TimeoutExpired:
-                rows.append({"workload": spec, "note": f"spin phase timed out ({timeout} s)"})
+                row |= _spin_phase_row(shortest, "shortest:")
+                row["shortest: hops"] = shortest.moves if shortest.found else "no plan"
+            except spin.SpinError as failed:
+                row["note"] = f"shortest trail: {failed}"
+        rows.append(row)
     return rows
 
 

@@ -37,6 +37,19 @@ KNOWN_ARTIFACTS = frozenset(
 )
 
 
+def replace_file(path: Path, data: bytes) -> None:
+    """Write ``path`` beside itself and rename, so a reader never sees half a file and a
+    failed write leaves the old file as it was."""
+    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    try:
+        with os.fdopen(handle, "wb") as stream:
+            stream.write(data)
+        os.replace(temporary, path)
+    except BaseException:
+        Path(temporary).unlink(missing_ok=True)
+        raise
+
+
 def is_tlmpc_output(directory: Path) -> bool:
     """True when ``directory`` is empty or holds a previous tlmpc output and nothing else."""
     entries = {p.name for p in directory.iterdir()}

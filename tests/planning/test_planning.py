@@ -4,8 +4,6 @@ from __future__ import annotations
 
 import itertools
 import json
-import shutil
-import subprocess
 from pathlib import Path
 from typing import Any
 
@@ -21,7 +19,7 @@ from tlmpc.automata import translate
 from tlmpc.errors import NoPlanError
 from tlmpc.mission import load_mission_text
 from tlmpc.mission.model import Mission, Options
-from tlmpc.planning import plan, witness_from_json, witness_to_json
+from tlmpc.planning import plan, spin, witness_from_json, witness_to_json
 from tlmpc.planning.export import to_promela
 
 BASE = """\
@@ -164,46 +162,94 @@ def test_witness_artifact() -> None:
     assert witness_from_json(document) == witness
 
 
-@pytest.mark.skipif(
-    shutil.which("spin") is None or shutil.which("gcc") is None,
-    reason="spin (and gcc) are not installed",
-)
+needs_spin = pytest.mark.skipif(not spin.available(), reason="spin (and gcc) are not installed")
+
+HOPS = "options: {min_angle: null, cost: hops, beta: 1}\n"
+
+
+def spin_and_ours(
+    tmp_path: Path, m: Mission, *, bounce: bool = False
+) -> tuple[Any, spin.SpinTrail, Any]:
+    abstraction = build_abstraction(m)
+    model = tmp_path / "model.pml"
+    model.write_text(to_promela(abstraction, m.formula, bounce=bounce))
+    trail = spin.run_spin(model, shortest=True, timeout=120, max_depth=100_000)
+    try:
+        _, _, witness = compile_plan(m)
+    except NoPlanError:
+        witness = None
+    return abstraction, trail, witness
+
+
+def check_spin_trail(abstraction: Any, trail: spin.SpinTrail, *, bounce: bool) -> bool:
+    """SPIN's trail is a run of the exported D; returns whether it bounces."""
+    path = [abstraction.start, *trail.entered]
+    bounces = False
+    for before, here, after in itertools.zip_longest(path, path[1:], path[2:]):
+        if here is not None:
+            assert here in abstraction.neighbors[before].tolist()
+        if after is not None:
+            bounces |= before == after
+    assert bounce or not bounces
+    return bounces
+
+
+@needs_spin
 @pytest.mark.parametrize(
-    ("task", "plan_exists"),
+    ("task", "holes", "start", "co_safe"),  # co_safe None: no plan
     [
-        ("task: [visit a then b]", True),
-        ('task: ["patrol a, b"]', True),
-        ("task: [visit a, avoid a]", False),
-        ('ltl: "G !c & F c"', False),
+        ("task: [visit a then b]", "", "[0.5, 7.5]", True),
+        ("task: [visit b then a]", "{rect: [4, 1, 5, 7]}", "[0.5, 7.5]", True),
+        ("task: [visit a, visit b, visit c]", "", "[11.5, 0.5]", True),
+        ("task: [visit b, avoid c]", "{rect: [8, 0, 8.5, 6]}", "[6, 7]", False),
+        ('ltl: "!c U b"', "", "[3.5, 4.5]", True),
+        ("task: [visit a, avoid a]", "", "[0.5, 7.5]", None),
+        ('ltl: "G !c & F c"', "", "[0.5, 7.5]", None),
+        ('task: ["patrol a, b"]', "", "[0.5, 7.5]", False),
+        ('task: ["patrol a, b, c", avoid d]', "", "[6, 0.5]", False),
+        ('ltl: "G F a & G (a -> F c)"', "{rect: [4, 1, 5, 7]}", "[11.5, 7.5]", False),
     ],
 )
-def test_spin_agrees_on_plan_or_no_plan(tmp_path: Path, task: str, plan_exists: bool) -> None:
-    m = mission(task, options="options: {min_angle: null}\n")
-    abstraction = build_abstraction(m)
-    (tmp_path / "model.pml").write_text(to_promela(abstraction, m.formula))
-    subprocess.run(["spin", "-a", "model.pml"], cwd=tmp_path, check=True, capture_output=True)
-    subprocess.run(
-        ["gcc", "-O1", "-DNOREDUCE", "-o", "pan", "pan.c"],
-        cwd=tmp_path,
-        check=True,
-        capture_output=True,
-    )
-    result = subprocess.run(
-        ["./pan", "-a", "-m100000"],
-        cwd=tmp_path,
-        capture_output=True,
-        text=True,
-        check=False,
-        timeout=120,
-    )
-    found = "acceptance cycle" in result.stdout or "errors: 1" in result.stdout
-    assert found is plan_exists, result.stdout[-800:]
-    automaton = translate(m.formula, letters=abstraction.letters)
-    if plan_exists:
-        plan(abstraction, automaton, formula=m.formula, options=m.options)
+def test_spin_agrees_on_plan_and_shortest_hops(
+    tmp_path: Path, task: str, holes: str, start: str, co_safe: bool | None
+) -> None:
+    text = BASE.replace("HOLES", holes).replace("TASK", task) + HOPS
+    text = text.replace("start: [0.5, 7.5]", f"start: {start}")
+    if "avoid d" in task:
+        text = text.replace("regions:\n", "regions:\n  d: {rect: [5, 6.5, 7, 8]}\n")
+    m = load_mission_text(text, "m.yaml")
+    abstraction, trail, witness = spin_and_ours(tmp_path, m)
+    assert trail.found is (witness is not None)
+    assert (co_safe is None) is (witness is None)
+    if witness is None:
+        return
+    check_spin_trail(abstraction, trail, bounce=False)
+    hops = round(witness.cost)
+    if co_safe:
+        # A finite trail: SPIN's claim ended on a safety violation, so -DREACH -i made it the
+        # shortest one; a co-safe task's cheapest lasso is its shortest good prefix, then a stay.
+        assert trail.cycle_from is None
+        assert witness.is_stay
+        assert hops == trail.moves
     else:
-        with pytest.raises(NoPlanError):
-            plan(abstraction, automaton, formula=m.formula, options=m.options)
+        # SPIN's lasso is one plan among many (-i gives no shortest acceptance cycle), so ours,
+        # optimal over all lassos of the same D, costs at most as much.
+        assert trail.cycle_from is not None
+        assert witness.stats["optimal"]
+        assert hops <= trail.moves
+
+
+@needs_spin
+@pytest.mark.parametrize("task", ["task: [visit a then b]", "task: [visit c then a then b]"])
+def test_spin_on_the_bouncing_d_is_shorter_only_by_bouncing(tmp_path: Path, task: str) -> None:
+    m = mission(task, options=HOPS)
+    abstraction, trail, witness = spin_and_ours(tmp_path, m, bounce=True)
+    assert trail.found
+    assert witness is not None
+    bounces = check_spin_trail(abstraction, trail, bounce=True)
+    hops = round(witness.cost)
+    assert trail.moves <= hops
+    assert bounces or trail.moves == hops
 
 
 def test_example8_plan_is_found(specs_dir: Path) -> None:

@@ -19,6 +19,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("out", type=Path, help="a directory written by `tlmpc compile`")
     parser.add_argument("--format", choices=("promela", "smv", "dot"), default="promela")
     parser.add_argument("-o", "--output", type=Path, help="write to this file (default: stdout)")
+    parser.add_argument(
+        "--bounce",
+        action="store_true",
+        help="promela/smv: the paper's plain D, which may leave a triangle through the edge it "
+        "entered by (default: tlmpc's no-bounce rule, so the checker plans what tlmpc can realise)",
+    )
 
 
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
@@ -27,9 +33,19 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     from tlmpc.artifacts import read_json
     from tlmpc.errors import UsageError, error
     from tlmpc.ltl import parse_ltl
+    from tlmpc.output import replace_file
     from tlmpc.planning.export import to_dot_graph, to_promela, to_smv
 
     directory: Path = args.out
+    if args.output is not None and not args.output.parent.is_dir():
+        raise UsageError(
+            error(
+                "U021",
+                f"cannot write {args.output}: {args.output.parent} is not a directory",
+                hint="create the directory first, or leave out -o to print the model",
+                file=str(args.output),
+            )
+        )
     for name in ("abstraction.json", "mission.json"):
         if not (directory / name).is_file():
             raise UsageError(
@@ -47,13 +63,13 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     formula = parse_ltl(mission["formula"])
     title = str(mission.get("name", "mission"))
     if args.format == "promela":
-        text = to_promela(abstraction, formula, title)
+        text = to_promela(abstraction, formula, title, bounce=args.bounce)
     elif args.format == "smv":
-        text = to_smv(abstraction, formula, title)
+        text = to_smv(abstraction, formula, title, bounce=args.bounce)
     else:
         text = to_dot_graph(abstraction, title)
     if args.output is not None:
-        args.output.write_text(text, encoding="utf-8")
+        replace_file(args.output, text.encode("utf-8"))
         err.write(f"wrote {args.output}\n")
     else:
         out.write(text)

@@ -3,8 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import os
-import tempfile
 from pathlib import Path
 from typing import Any, TextIO
 
@@ -32,21 +30,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def _replace(path: Path, data: bytes) -> None:
-    # Write beside the target and rename, so a reader never sees half a picture.
-    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
-    try:
-        with os.fdopen(handle, "wb") as stream:
-            stream.write(data)
-        os.replace(temporary, path)
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise
-
-
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Read the artifacts of ``args.out`` and write the figures next to them."""
     from tlmpc.artifacts import read_json
+    from tlmpc.output import replace_file
     from tlmpc.plot import render_plan
 
     directory: Path = args.out
@@ -67,10 +54,10 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     png, svg = render_plan(artifacts)
     written = []
     if args.format in ("png", "both"):
-        _replace(directory / "plan.png", png)
+        replace_file(directory / "plan.png", png)
         written.append("plan.png")
     if args.format in ("svg", "both"):
-        _replace(directory / "plan.svg", svg)
+        replace_file(directory / "plan.svg", svg)
         written.append("plan.svg")
     err.write(f"wrote {', '.join(written)} to {directory}\n")
     return 0

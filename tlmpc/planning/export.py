@@ -1,9 +1,10 @@
 """The paper's route: the transition system D and the negated task for SPIN and NuSMV.
 
 A counterexample to ``!task`` is a run of D satisfying the task.  D keeps its stutter
-self-loops (the robot may stay in a triangle).  The exported models do not know tlmpc's
-no-bounce rule (see docs/model-checkers.md), so their shortest trails can be shorter than
-tlmpc's plans on maps where the shortest route bounces.
+self-loops (the robot may stay in a triangle) and, by default, tlmpc's no-bounce rule (a run
+never leaves a triangle through the edge it came in by), so a model checker plans over exactly
+the runs tlmpc's planner considers; ``bounce=True`` gives the paper's plain D, whose shortest
+trails can be shorter on maps where the shortest route bounces (see docs/model-checkers.md).
 """
 
 from __future__ import annotations
@@ -28,23 +29,69 @@ def _members(abstraction: Abstraction) -> dict[str, list[int]]:
     return members
 
 
-def to_promela(abstraction: Abstraction, formula: Formula, name: str = "mission") -> str:
-    """A Promela model of D with the never claim source ``ltl task { !(formula) }``."""
-    lines = [
-        f"/* tlmpc export of {name}: the transition system D ({abstraction.num_triangles} "
-        "triangles, stutter included). */",
-        "/* SPIN's counterexample to the negated task is a plan for the task. */",
-        "int t;",
+#: Assignments per ``d_step``: SPIN rejects longer ones ("d_step sequence too long").
+D_STEP_CHUNK = 1000
+
+
+def _adjacency_steps(abstraction: Abstraction) -> list[str]:
+    """``d_step`` blocks setting ``nb[3*t + i] = n`` for every neighbour ``n`` of every
+    triangle, a dozen assignments per line."""
+    assignments = [
+        f"nb[{3 * triangle + i}] = {int(n)};"
+        for triangle in range(abstraction.num_triangles)
+        for i, n in enumerate(abstraction.neighbors[triangle].tolist())
+        if n >= 0
     ]
+    lines: list[str] = []
+    for chunk in range(0, len(assignments), D_STEP_CHUNK):
+        part = assignments[chunk : chunk + D_STEP_CHUNK]
+        lines.append("  d_step {")
+        lines += ["    " + " ".join(part[k : k + 12]) for k in range(0, len(part), 12)]
+        lines.append("  }")
+    return lines
+
+
+def to_promela(
+    abstraction: Abstraction, formula: Formula, name: str = "mission", *, bounce: bool = False
+) -> str:
+    """A Promela model of D with the never claim source ``ltl task { !(formula) }``.
+
+    The model moves ``t`` to a neighbour or stays (one step each), and never leaves a triangle
+    through the edge it entered by (the variable ``prev``), as tlmpc's planner; ``bounce=True``
+    drops that rule and gives the paper's plain D.  Adjacency lives in a ``hidden`` array set
+    once by a few ``d_step`` blocks, so the model (and ``pan.c``) stays linear in the number
+    of triangles and the state vector holds only ``t`` and ``prev``.  Every move prints
+    ``tlmpc: t = N``, so ``spin -t`` replays a trail as a list of triangles.
+    """
+    m = abstraction.num_triangles
+    rule = "" if bounce else " && nb[K] != prev"
+    entry = "" if bounce else "prev = t; "
+    kind = "bounces allowed" if bounce else "no bounce"
+    lines = [
+        f"/* tlmpc export of {name}: the transition system D ({m} triangles, stutter, {kind}). */",
+        "/* SPIN's counterexample to the negated task is a plan for the task. */",
+        f"hidden int nb[{3 * m}] = -1;  /* nb[3*t + i]: neighbour of t across edge i */",
+        f"int t = {abstraction.start};  /* the triangle the robot is in */",
+    ]
+    if not bounce:
+        lines.append("int prev = -1;  /* the triangle t was entered from (no bounce) */")
     for region, triangles in _members(abstraction).items():
         condition = " || ".join(f"t == {i}" for i in triangles) or "false"
         lines.append(f"#define {PREFIX}{region} ({condition})")
-    lines += ["", "active proctype robot() {", f"  t = {abstraction.start};", "  do"]
-    for triangle in range(abstraction.num_triangles):
-        successors = [int(n) for n in abstraction.neighbors[triangle] if n >= 0]
-        options = " ".join(f":: t = {n}" for n in successors)
-        lines.append(f"  :: t == {triangle} -> if {options} :: skip fi")
-    lines += ["  od", "}", "", f"ltl task {{ !({to_spin(_prefixed(formula))}) }}", ""]
+    lines += ["", "active proctype robot() {", *_adjacency_steps(abstraction), "  do"]
+    for i in range(3):
+        k = f"3*t + {i}"
+        guard = f"nb[{k}] >= 0" + rule.replace("K", k)
+        move = f'{entry}t = nb[{k}]; printf("tlmpc: t = %d\\n", t)'
+        lines.append(f"  :: d_step {{ {guard} -> {move} }}")
+    lines += [
+        "  :: t >= 0 -> skip  /* stutter (a bare skip would be an unconditional self-loop) */",
+        "  od",
+        "}",
+        "",
+        f"ltl task {{ !({to_spin(_prefixed(formula))}) }}",
+        "",
+    ]
     return "\n".join(lines)
 
 
@@ -53,21 +100,34 @@ def _smv(formula: Formula) -> str:
     return spin.replace("[]", "G ").replace("<>", "F ").replace("&&", "&").replace("||", "|")
 
 
-def to_smv(abstraction: Abstraction, formula: Formula, name: str = "mission") -> str:
-    """A NuSMV model of D with ``LTLSPEC !(formula)``."""
+def to_smv(
+    abstraction: Abstraction, formula: Formula, name: str = "mission", *, bounce: bool = False
+) -> str:
+    """A NuSMV model of D with ``LTLSPEC !(formula)``; ``prev`` and a ``TRANS`` constraint
+    keep tlmpc's no-bounce rule unless ``bounce=True`` (see :func:`to_promela`)."""
     n = abstraction.num_triangles
+    kind = "bounces allowed" if bounce else "no bounce"
     lines = [
-        f"-- tlmpc export of {name}: the transition system D ({n} triangles).",
+        f"-- tlmpc export of {name}: the transition system D ({n} triangles, stutter, {kind}).",
         "MODULE main",
         f"VAR t : 0..{n - 1};",
-        "ASSIGN",
-        f"  init(t) := {abstraction.start};",
-        "  next(t) := case",
     ]
+    if not bounce:
+        lines.append(f"VAR prev : -1..{n - 1};  -- the triangle t was entered from")
+    lines += ["ASSIGN", f"  init(t) := {abstraction.start};"]
+    if not bounce:
+        lines += [
+            "  init(prev) := -1;",
+            "  next(prev) := case next(t) = t : prev; TRUE : t; esac;",
+        ]
+    lines.append("  next(t) := case")
     for triangle in range(n):
         successors = [triangle, *(int(x) for x in abstraction.neighbors[triangle] if x >= 0)]
         lines.append(f"    t = {triangle} : {{{', '.join(str(s) for s in successors)}}};")
-    lines += ["  esac;", "DEFINE"]
+    lines.append("  esac;")
+    if not bounce:
+        lines.append("TRANS next(t) = t | next(t) != prev;")
+    lines.append("DEFINE")
     for region, triangles in _members(abstraction).items():
         members = ", ".join(str(i) for i in triangles)
         lines.append(f"  {PREFIX}{region} := {'t in {' + members + '}' if triangles else 'FALSE'};")
