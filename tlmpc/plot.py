@@ -215,7 +215,10 @@ def render_plan(artifacts: Mapping[str, Any]) -> tuple[bytes, bytes]:
         # Fixed margins: a layout engine would draw the figure once more just to measure it.
         figure.subplots_adjust(left=0.08, right=0.9, bottom=0.08, top=0.94)
         png = io.BytesIO()
-        figure.savefig(png, format="png", metadata={"Software": None})
+        # zlib level 3: a tenth larger than the default 6, in two thirds of the time.
+        figure.savefig(
+            png, format="png", metadata={"Software": None}, pil_kwargs={"compress_level": 3}
+        )
         svg = io.BytesIO()
         figure.savefig(svg, format="svg", metadata={"Date": None, "Creator": None})
     return png.getvalue(), svg.getvalue()

@@ -20,6 +20,13 @@ from tlmpc.artifacts import validation_errors
 from tlmpc.control import controllers_to_json, synthesize
 from tlmpc.control.geometry import triangle_geometry
 from tlmpc.control.model import StepController
+from tlmpc.control.synthesize import (
+    VertexProgram,
+    _assign_runs,
+    plan_steps,
+    solve_vertex_program,
+    vertex_program,
+)
 from tlmpc.errors import InvalidInputError
 from tlmpc.mission.model import Robot
 from tlmpc.planning.model import Witness
@@ -280,3 +287,52 @@ def test_lasso_without_prefix_loops_from_the_second_lap(specs_dir: object) -> No
     assert trace.triangles[trace.loop_start] == loop.cycle[0]
     assert trace.triangles[-1] == loop.cycle[0]
     assert verify_document(trace_to_json(trace, moved)).satisfied
+
+
+def _cvxpy_optimum(program: VertexProgram) -> float:
+    """The same program stated in cvxpy, an independent canonicalisation, solved by Clarabel."""
+    import cvxpy as cp
+
+    z = cp.Variable(program.inequality.shape[1])
+    floor = cp.Variable()
+    velocities = cp.reshape(z[: 2 * program.runs], (program.runs, 2), order="C")
+    speeds = z[2 * program.runs :]
+    constraints = [
+        program.inequality @ z >= 0,
+        cp.norm(velocities, 2, axis=1) <= program.max_speed,
+        speeds >= floor,
+    ]
+    if program.equality is not None:
+        constraints.append(program.equality @ z == 0)
+    problem = cp.Problem(cp.Maximize(floor + 0.1 * cp.sum(speeds) / program.steps), constraints)
+    problem.solve(solver=cp.CLARABEL)
+    assert problem.status == "optimal"
+    return float(problem.value)
+
+
+@pytest.mark.parametrize(
+    ("spec", "max_speed"),
+    [("example1", 1.0), ("example7", 0.5), ("patrol", 2.0), ("reach-avoid", 1.0)],
+)
+def test_clarabel_conic_form_matches_cvxpy(specs_dir: object, spec: str, max_speed: float) -> None:
+    from pathlib import Path
+
+    from tlmpc.pipeline import compile_mission
+
+    result = compile_mission(Path(str(specs_dir)) / f"{spec}.yaml", until="plan")
+    abstraction, witness = result.compilation.abstraction, result.compilation.witness
+    assert abstraction is not None
+    assert witness is not None
+    steps, loop_start = plan_steps(abstraction, witness)
+    _assign_runs(abstraction, steps, loop_start)
+    program, _ = vertex_program(steps, max_speed)
+    velocities, speeds = solve_vertex_program(program)
+    z = np.concatenate([velocities.ravel(), speeds])
+    tolerance = 1e-6 * max_speed
+    assert (program.inequality @ z).min() >= -tolerance
+    if program.equality is not None:
+        assert np.abs(program.equality @ z).max() <= tolerance
+    assert np.linalg.norm(velocities, axis=1).max() <= max_speed * (1 + 1e-7)
+    ours = program.objective(z, float(speeds.min()))
+    assert ours == pytest.approx(_cvxpy_optimum(program), rel=1e-6, abs=1e-8)
+    assert speeds.min() > 0

@@ -221,3 +221,19 @@ def test_python_dash_m_entry_point(tmp_path: Path) -> None:
     )
     assert completed.returncode == 0, completed.stderr
     assert (tmp_path / "out" / "automaton.hoa").exists()
+
+
+def test_a_compile_never_imports_cvxpy(tmp_path: Path) -> None:
+    """cvxpy is a test oracle only: importing it would add about 0.5 s to every compile."""
+    script = (
+        "import sys, io\n"
+        "from tlmpc.cli import main\n"
+        f"argv = ['compile', {str(ROOT / 'specs' / 'example1.yaml')!r}, '-o', "
+        f"{str(tmp_path / 'out')!r}, '-q']\n"
+        "code = main(argv, io.StringIO(), io.StringIO())\n"
+        "print(code, sorted(m for m in sys.modules if m.split('.')[0] == 'cvxpy'))\n"
+    )
+    completed = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, check=True
+    )
+    assert completed.stdout.strip() == "0 []"

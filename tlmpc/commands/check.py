@@ -1,6 +1,6 @@
 """``tlmpc check FILE...``: validate mission files (fast enough for a pre-commit hook).
 
-Imports only the mission loader (lark, PyYAML, jsonschema, shapely); never scipy, cvxpy or
+Imports only the mission loader (lark, PyYAML, jsonschema, shapely); never scipy, clarabel or
 triangle.  Exit 0 when every file is valid, 1 when some file is invalid, 2 when some file
 could not be read (unreadable wins over invalid: the run could not do its job).
 """

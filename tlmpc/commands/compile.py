@@ -46,7 +46,7 @@ def _format_sizes(sizes: dict[str, object]) -> str:
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Compile ``args.mission`` into ``args.out``."""
     from tlmpc.output import check_destination, commit, staging_directory, write_artifacts
-    from tlmpc.pipeline import StageReport, compile_mission
+    from tlmpc.pipeline import StageReport, collector_paused, compile_mission
 
     destination: Path = args.out
     check_destination(destination, force=args.force)
@@ -65,7 +65,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     for warning in result.warnings:
         err.write(warning.format() + "\n")
 
-    with staging_directory(destination) as staging:
+    with collector_paused(), staging_directory(destination) as staging:
         artifacts = dict(result.artifacts)
         summary = result.summary()
         artifacts["summary.json"] = summary

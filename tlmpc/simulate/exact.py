@@ -51,21 +51,32 @@ def _augmented(controller: StepController) -> FloatArray:
     return matrix
 
 
-def expm_small(matrix: FloatArray) -> FloatArray:
-    """exp(A) of a small matrix by scaling and squaring with a degree-18 Taylor polynomial.
+#: 1/k! for the Taylor degrees expm_small may use.
+_INVERSE_FACTORIALS = tuple(1.0 / math.factorial(k) for k in range(20))
+#: Truncation error allowed in the scaled series (far below rounding of an O(1) result).
+_TAYLOR_TOLERANCE = 1e-18
 
-    The scaled matrix has norm <= 1/2, where the truncated series' error is below 1e-22;
-    squaring amplifies rounding to about 1e-11 relative for the gains that occur here (checked
-    against scipy's ``expm`` in the tests), and it is many times faster than a general call.
+
+def expm_small(matrix: FloatArray) -> FloatArray:
+    """exp(A) of a small matrix by scaling and squaring with a Taylor polynomial (Horner form).
+
+    The matrix is scaled to norm s <= 1/2 and the series is cut at the first degree m with
+    s^(m+1)/(m+1)! <= 1e-18 (m <= 18; small steps need far fewer terms).  Squaring amplifies
+    rounding to about 1e-11 relative for the gains that occur here (checked against scipy's
+    ``expm`` in the tests), and it is many times faster than a general call.
     """
     norm = float(np.abs(matrix).sum(axis=0).max())
     squarings = max(0, math.ceil(math.log2(norm)) + 1) if norm > 0.5 else 0
-    scaled = matrix / (2.0**squarings)
-    result = np.eye(matrix.shape[0])
-    term = np.eye(matrix.shape[0])
-    for k in range(1, 19):
-        term = term @ scaled / k
-        result = result + term
+    scale = 0.5**squarings
+    scaled = matrix * scale
+    s = norm * scale
+    degree = 1
+    while degree < 18 and s ** (degree + 1) * _INVERSE_FACTORIALS[degree + 1] > _TAYLOR_TOLERANCE:
+        degree += 1
+    identity = np.eye(matrix.shape[0])
+    result = identity + scaled / degree
+    for k in range(degree - 1, 0, -1):
+        result = identity + (scaled @ result) / k
     for _ in range(squarings):
         result = result @ result
     return result
@@ -109,9 +120,10 @@ def _exit_step(controller: StepController, x0: FloatArray) -> tuple[list[float],
     dt = horizon * 1.02 / GRID_POINTS
     step = expm_small(dt * matrix)
     state = np.array([x0[0], x0[1], 1.0])
+    before = state
     upper = None
     for j in range(1, GRID_POINTS + 1):
-        state = step @ state
+        before, state = state, step @ state
         if normal @ state[:2] - offset >= 0.0:
             upper = j * dt
             break
@@ -125,20 +137,22 @@ def _exit_step(controller: StepController, x0: FloatArray) -> tuple[list[float],
             )
         )
     lower = upper - dt
+
+    # The root is sought from the bracket's start: x(lower + s) = expm(sM) x(lower) with
+    # s <= dt, a short series; at s = dt it reproduces the grid's own step, so
+    # h(0) < 0 <= h(dt) holds exactly and brentq always has a bracket.
+    def advance(s: float) -> FloatArray:
+        return np.asarray(expm_small(s * matrix) @ before, dtype=np.float64)
+
+    def height(s: float) -> float:
+        return float(normal @ advance(s)[:2] - offset)
+
+    within = brentq(height, 0.0, dt, xtol=1e-14, rtol=1e-14)
+    crossing = lower + within
+    end = advance(within)[:2]
     flow = _Flow(matrix, x0)
-
-    def height(t: float) -> float:
-        return float(normal @ flow(t) - offset)
-
-    if height(lower) >= 0.0:
-        crossing = lower  # rounding put the bracket's start on the edge already
-    elif height(upper) < 0.0:
-        crossing = upper  # the grid's iterates and the direct flow differ by rounding
-    else:
-        crossing = brentq(height, lower, upper, xtol=1e-14, rtol=1e-14)
     times = [float(t) for t in np.linspace(0.0, crossing, SAMPLES_PER_STEP + 1)[1:-1]]
     points = [flow(t) for t in times]
-    end = flow(crossing)
     # Snap onto the exit edge (the root is exact to ~1e-14; this removes the residue).
     a = geometry.vertices[(controller.exit_edge + 1) % 3]
     b = geometry.vertices[(controller.exit_edge + 2) % 3]
