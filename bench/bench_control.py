@@ -33,7 +33,7 @@ def _rows_for(name: str, mission: Any, repeats: int) -> dict[str, Any]:
         options=mission.options,
         start_point=mission.robot.start,
     )
-    synthesize(abstraction, witness, mission.robot)  # warm: cvxpy import and first solve
+    synthesize(abstraction, witness, mission.robot)  # warm: clarabel import and first solve
     control_times, simulate_times = [], []
     controllers = None
     for _ in range(repeats):

@@ -84,7 +84,9 @@ def _spin_phase_row(trail: Any, prefix: str) -> dict[str, Any]:
     return {f"{prefix} {phase} s": round(seconds, 3) for phase, seconds in trail.seconds.items()}
 
 
-def spin_rows(repeats: int, timeout: float = 600.0) -> list[dict[str, Any]]:
+def spin_rows(
+    repeats: int, timeout: float = 600.0, shortest_timeout: float = 300.0
+) -> list[dict[str, Any]]:
     """SPIN on the exported model versus tlmpc's planning: phases, totals, witness lengths.
 
     Both sides plan over the same D (no-bounce rule in the export) with the same objective:
@@ -146,7 +148,7 @@ def spin_rows(repeats: int, timeout: float = 600.0) -> list[dict[str, Any]]:
                 continue
             try:
                 shortest = spin.run_spin(
-                    model, shortest=True, timeout=timeout, max_depth=10_000_000
+                    model, shortest=True, timeout=shortest_timeout, max_depth=10_000_000
                 )
                 row |= _spin_phase_row(shortest, "shortest:")
                 row["shortest: hops"] = shortest.moves if shortest.found else "no plan"

@@ -1,6 +1,6 @@
 """Run ``tlmpc compile`` twice in one fresh interpreter and print timings as JSON.
 
-The first run is what a user's command line costs (imports of numpy, scipy, cvxpy, ...
+The first run is what a user's command line costs (imports of numpy, scipy, clarabel, ...
 included: ``cold``); the second, with the libraries loaded, is the compiler's own work
 (``warm``).  Peak RSS is the process's.
 """

@@ -14,6 +14,7 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
+from scipy.linalg import expm
 
 from tlmpc.abstraction.model import Abstraction
 from tlmpc.artifacts import validation_errors
@@ -30,7 +31,7 @@ from tlmpc.control.synthesize import (
 from tlmpc.errors import InvalidInputError
 from tlmpc.mission.model import Robot
 from tlmpc.planning.model import Witness
-from tlmpc.simulate.exact import _exit_step, _Flow, _stay_step, expm_small
+from tlmpc.simulate.exact import _exit_step, _stay_step, bracketed_root, expm_small
 
 
 def _min_angle(v: np.ndarray) -> float:
@@ -125,9 +126,9 @@ def test_every_state_leaves_through_the_planned_edge(
     lam = geometry.barycentric(exit_point)
     assert abs(lam[exit_edge]) <= 1e-9
     # before the crossing the trajectory stays inside, away from the two other edges
-    flow = _Flow(np.block([[controller.gain, controller.offset[:, None]], [np.zeros((1, 3))]]), x0)
+    augmented = np.block([[controller.gain, controller.offset[:, None]], [np.zeros((1, 3))]])
     for t in np.linspace(0.0, crossing_time, 50)[1:-1]:
-        inside = geometry.barycentric(flow(t))
+        inside = geometry.barycentric((expm(t * augmented) @ [*x0, 1.0])[:2])
         others = [j for j in range(3) if j != exit_edge]
         assert min(inside[j] for j in others) > -1e-9
         assert inside[exit_edge] > -1e-9
@@ -159,10 +160,15 @@ def test_exact_simulation_matches_rk45(v: np.ndarray, exit_edge: int, data: st.D
         rtol=1e-12,
         atol=1e-13,
         events=crossing,
+        dense_output=True,
     )
     assert solution.t_events[0].size == 1
     assert solution.t_events[0][0] == pytest.approx(times[-1], rel=1e-8, abs=1e-9)
     assert np.allclose(solution.y_events[0][0], points[-1], atol=1e-8)
+    assert times == sorted(times)
+    for t, point in zip(times[:-1], points[:-1], strict=True):
+        assert 0.0 < t < times[-1]
+        assert np.allclose(solution.sol(t), point, atol=1e-8)
 
 
 @settings(deadline=None, max_examples=40)
@@ -196,8 +202,6 @@ def test_stay_fields_converge_inside(v: np.ndarray, data: st.DataObject) -> None
 
 
 def test_small_matrix_exponential_matches_scipy() -> None:
-    from scipy.linalg import expm
-
     rng = np.random.default_rng(7)
     for _ in range(300):
         matrix = np.zeros((3, 3))
@@ -336,3 +340,24 @@ def test_clarabel_conic_form_matches_cvxpy(specs_dir: object, spec: str, max_spe
     ours = program.objective(z, float(speeds.min()))
     assert ours == pytest.approx(_cvxpy_optimum(program), rel=1e-6, abs=1e-8)
     assert speeds.min() > 0
+
+
+@settings(deadline=None, max_examples=200)
+@given(
+    st.floats(0.001, 0.999),
+    st.sampled_from([1, 2, 3, 5, 9]),
+    st.floats(1e-6, 1e3),
+    st.floats(0.0, 50.0),
+)
+def test_bracketed_root_matches_brentq(root: float, power: int, scale: float, tilt: float) -> None:
+    from scipy.optimize import brentq
+
+    def function(x: float) -> float:
+        # monotone, flat or steep near the root, with an exponential factor
+        return scale * math.copysign(abs(x - root) ** power, x - root) * math.exp(tilt * x)
+
+    ours = bracketed_root(function, 0.0, 1.0)
+    assert 0.0 <= ours <= 1.0
+    assert function(ours) >= 0.0
+    reference = brentq(function, 0.0, 1.0, xtol=1e-14, rtol=1e-14, maxiter=1000)
+    assert ours == pytest.approx(reference, abs=1e-12)

@@ -61,16 +61,18 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             )
             err.flush()
 
-    result = compile_mission(args.mission, until=args.until, progress=progress)
-    for warning in result.warnings:
-        err.write(warning.format() + "\n")
-
-    with collector_paused(), staging_directory(destination) as staging:
-        artifacts = dict(result.artifacts)
-        summary = result.summary()
-        artifacts["summary.json"] = summary
-        write_artifacts(staging, artifacts)
-        commit(staging, destination, force=args.force)
+    # One pause for compiling and writing: re-enabling in between would trigger a full
+    # collection over everything the compilation still holds.
+    with collector_paused():
+        result = compile_mission(args.mission, until=args.until, progress=progress)
+        for warning in result.warnings:
+            err.write(warning.format() + "\n")
+        with staging_directory(destination) as staging:
+            artifacts = dict(result.artifacts)
+            summary = result.summary()
+            artifacts["summary.json"] = summary
+            write_artifacts(staging, artifacts)
+            commit(staging, destination, force=args.force)
 
     if args.json:
         out.write(json.dumps(summary, indent=2, sort_keys=True) + "\n")
