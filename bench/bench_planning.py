@@ -158,9 +158,9 @@ def spin_rows(
     return rows
 
 
-def run(repeats: int = 3) -> list[dict[str, Any]]:
-    """All rows (for bench/run.py)."""
-    return planning_rows(repeats) + spin_rows(repeats)
+def run(repeats: int = 3) -> dict[str, list[dict[str, Any]]]:
+    """Two tables (for bench/run.py): planning on the Example 8 map, and SPIN side by side."""
+    return {"planning": planning_rows(repeats), "spin": spin_rows(repeats)}
 
 
 if __name__ == "__main__":

@@ -102,6 +102,16 @@ def _compile_table(rows: list[dict[str, Any]]) -> str:
     return "\n".join(lines)
 
 
+def stage_tables(name: str, rows: list[dict[str, Any]] | dict[str, list[dict[str, Any]]]) -> str:
+    """A stage benchmark's markdown: one table, or one per part when it returns several."""
+    if isinstance(rows, dict):
+        return "".join(
+            f"## {name}: {part}\n\n{markdown_table(part_rows)}\n\n"
+            for part, part_rows in rows.items()
+        )
+    return f"## {name}\n\n{markdown_table(rows)}\n\n"
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the suite; ``--quick`` skips the 300k grid and uses one repeat."""
     parser = argparse.ArgumentParser(prog="python -m bench", description=__doc__)
@@ -154,9 +164,9 @@ def main(argv: list[str] | None = None) -> int:
                     continue
                 print(f"running {module_name} ...", file=sys.stderr, flush=True)
                 stage_rows = module.run(repeats=max(repeats, 3) if not args.quick else 1)
-                report["stages"][module_name.split(".")[-1]] = stage_rows
-                print(f"## {module_name.split('.')[-1]}\n")
-                print(markdown_table(stage_rows) + "\n")
+                name = module_name.split(".")[-1]
+                report["stages"][name] = stage_rows
+                print(stage_tables(name, stage_rows))
     args.results.write_text(json.dumps(report, indent=2, sort_keys=True) + "\n", encoding="utf-8")
     print(f"results written to {args.results}", file=sys.stderr)
     return 0
