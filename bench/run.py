@@ -83,18 +83,20 @@ def compile_workload(name: str, mission: Path, repeats: int, scratch: Path) -> d
 def _compile_table(rows: list[dict[str, Any]]) -> str:
     stages = ["load", "abstraction", "automaton", "plan", "control", "simulate", "verify"]
     header = (
-        "| workload | triangles | aut. states | witness | "
+        "| workload | triangles | aut. states | product nodes (reached) | witness | "
         + " | ".join(stages)
         + " | plot | pipeline s | compile s | cold s | peak MB |"
     )
-    lines = [header, "|" + "---|" * (len(stages) + 9)]
+    lines = [header, "|" + "---|" * (len(stages) + 10)]
     for row in rows:
         sizes = row["sizes"]
         witness = f"{sizes.get('plan.prefix', '?')}+{sizes.get('plan.cycle', '?')}"
         cells = [f"{row['stage_seconds'].get(s, float('nan')):.3f}" for s in [*stages, "plot"]]
         lines.append(
             f"| {row['workload']} | {sizes.get('abstraction.triangles', '?')} | "
-            f"{sizes.get('automaton.states', '?')} | {witness} | "
+            f"{sizes.get('automaton.states', '?')} | "
+            f"{sizes.get('plan.product nodes', '?')} ({sizes.get('plan.reached', '?')}) | "
+            f"{witness} | "
             + " | ".join(cells)
             + f" | {row['pipeline_seconds']:.3f} | {row['compile_seconds']:.3f} | "
             f"{row['cold_seconds']:.2f} | {row['peak_rss_mb']:.0f} |"

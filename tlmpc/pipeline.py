@@ -144,6 +144,8 @@ def _plan(c: Compilation) -> StageResult:
             "prefix": len(witness.prefix),
             "cycle": len(witness.cycle),
             "cost": round(witness.cost, 6),
+            "product nodes": witness.stats.get("product_nodes"),
+            "reached": witness.stats.get("product_reached"),
         },
     )
 

@@ -7,6 +7,7 @@ simulation matches a fine RK45 integration.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -361,3 +362,23 @@ def test_bracketed_root_matches_brentq(root: float, power: int, scale: float, ti
     assert function(ours) >= 0.0
     reference = brentq(function, 0.0, 1.0, xtol=1e-14, rtol=1e-14, maxiter=1000)
     assert ours == pytest.approx(reference, abs=1e-12)
+
+
+@settings(deadline=None, max_examples=40)
+@given(triangles(), st.integers(0, 2), st.sampled_from([1e3, -4e4, 2.5e5]), st.data())
+def test_exit_steps_far_from_the_origin_are_translates(
+    v: np.ndarray, exit_edge: int, shift: float, data: st.DataObject
+) -> None:
+    """Far from the origin the offset dominates the flow's matrix and the exit search takes the
+    matrix-exponential path; the result must be the translate of the search near the origin."""
+    near = _exit_controller(v, exit_edge, 1.0)
+    # The same field, moved: x' = K (x - shift) + g.
+    far = dataclasses.replace(
+        near, vertices=near.vertices + shift, offset=near.offset - near.gain @ [shift, shift]
+    )
+    x0 = _random_point(data.draw, v)
+    near_times, near_points = _exit_step(near, x0)
+    far_times, far_points = _exit_step(far, x0 + shift)
+    # rounding of coordinates of size |shift| moves the crossing by ~1e-16 |shift| / speed
+    assert far_times[-1] == pytest.approx(near_times[-1], rel=1e-9, abs=1e-11 * abs(shift))
+    assert np.allclose(far_points[-1] - shift, near_points[-1], atol=1e-12 * abs(shift) + 1e-12)

@@ -76,7 +76,7 @@ def check_shape(
         size = max(x1 - x0, y1 - y0)
         if (x1 - x0) * (y1 - y0) > AREA_TOLERANCE * size * size:
             # A proper rect is simple, valid and not collinear: skip the general checks
-            # (Example 8 has 1,157 rects; they cost a third of the load stage).
+            # (Example 8's 1,156 rect regions cost a third of the load stage).
             points = shape_points(shape)
             return CheckedShape(points=points, polygon=ShapelyPolygon(points), path=path), []
     points = shape_points(shape)

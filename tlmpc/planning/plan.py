@@ -125,7 +125,10 @@ def plan(
                 best = (total, _path(pred, u), [u, *back_path[:-1]])
     if best is None:
         raise NoPlanError(explain_no_plan(abstraction, automaton, formula, allowed))
-    return _witness(abstraction, product, best, options, started, searches, exhausted, working)
+    reached = int(np.isfinite(dist).sum())
+    return _witness(
+        abstraction, product, best, options, started, searches, exhausted, working, reached
+    )
 
 
 def _witness(
@@ -137,6 +140,7 @@ def _witness(
     searches: int,
     exhausted: bool,
     automaton: Automaton,
+    reached: int,
 ) -> Witness:
     _, prefix_nodes, cycle_nodes = best
     nq = product.num_automaton_states
@@ -155,6 +159,7 @@ def _witness(
     cycle_cost = 0.0 if len(cycle_nodes) == 1 else _path_cost(product, [*cycle_nodes, anchor])
     stats: dict[str, Any] = {
         "product_nodes": product.num_nodes,
+        "product_reached": reached,
         "product_edges": int(product.graph.nnz),
         "cycle_searches": searches,
         "optimal": exhausted,

@@ -6,8 +6,10 @@ of h(t) = n_e·x(t) - c_e, bracketed on a grid of exact states expm(dt M)^j [x0;
 at least at the guaranteed exit speed inside the triangle, so the root comes before the
 exit-time bound) and refined by regula falsi on the Taylor polynomial of the flow from the
 bracket's start (exact to rounding over one grid step); the exit point is snapped onto the
-exit edge.  Samples: every edge crossing plus grid states near evenly spaced times.  A
-lasso's cycle is simulated twice; the second lap is the loop.
+exit edge.  Each exit step works relative to its triangle's centre, so precision does not
+depend on how far the map lies from the origin.  Samples: every edge crossing plus grid
+states near evenly spaced times.  A lasso's cycle is simulated twice; the second lap is the
+loop.
 """
 
 from __future__ import annotations
@@ -48,10 +50,10 @@ class Trace:
     crossings: tuple[int, ...] = ()
 
 
-def _augmented(controller: StepController) -> FloatArray:
+def _augmented(gain: FloatArray, offset: FloatArray) -> FloatArray:
     matrix = np.zeros((3, 3))
-    matrix[:2, :2] = controller.gain
-    matrix[:2, 2] = controller.offset
+    matrix[:2, :2] = gain
+    matrix[:2, 2] = offset
     return matrix
 
 
@@ -91,9 +93,10 @@ def bracketed_root(
 ) -> float:
     """A root of ``function`` in [low, high], where function(low) < 0 <= function(high).
 
-    Regula falsi with the Illinois modification (superlinear, never leaves the bracket), a
-    bisection whenever a step would not halve the bracket twice in a row.  Our own 20 lines
-    instead of scipy's brentq: importing scipy.optimize took 0.2 s of every compile.
+    Regula falsi with the Illinois modification (superlinear on simple roots, never leaves
+    the bracket), and a bisection step when one end has stayed put three times running.  Our
+    own 30 lines instead of scipy's brentq: importing scipy.optimize took 0.2 s of every
+    compile (the tests compare the two).
     """
     f_low, f_high = function(low), function(high)
     if f_high == 0.0:
@@ -169,12 +172,17 @@ def _exit_step(controller: StepController, x0: FloatArray) -> tuple[list[float],
     assert controller.exit_edge is not None
     geometry = triangle_geometry(controller.vertices)
     normal = geometry.normals[controller.exit_edge]
-    offset = geometry.offsets[controller.exit_edge]
-    matrix = _augmented(controller)
-    gap = offset - normal @ x0
     scale = float(np.abs(geometry.vertices).max()) + float(geometry.heights.max())
-    if gap <= 1e-12 * scale:
+    if geometry.offsets[controller.exit_edge] - normal @ x0 <= 1e-12 * scale:
         return [0.0], [x0]  # already on the exit edge (to rounding): the crossing is now
+    # Coordinates relative to the triangle: y = x - center obeys y' = K y + v(center), whose
+    # augmented matrix has the size of the field, not of the map's coordinates (far from the
+    # origin the global offset g would dominate it and scaling and squaring would lose digits).
+    center = geometry.vertices.mean(axis=0)
+    matrix = _augmented(controller.gain, controller.gain @ center + controller.offset)
+    offset = float(geometry.offsets[controller.exit_edge] - normal @ center)
+    y0 = x0 - center
+    gap = offset - normal @ y0
     horizon = gap / controller.exit_speed
     # h(t) < 0 until the crossing and grows at least at the exit speed inside the triangle, so
     # the first grid point with h >= 0 brackets the crossing (one matrix exponential for the
@@ -185,7 +193,7 @@ def _exit_step(controller: StepController, x0: FloatArray) -> tuple[list[float],
     for _ in range(GRID_CHUNK - 1):
         powers.append(step @ powers[-1])
     stack = np.stack(powers)  # step^1 .. step^GRID_CHUNK: a chunk of grid points at once
-    state = np.array([x0[0], x0[1], 1.0])
+    state = np.array([y0[0], y0[1], 1.0])
     inside: list[FloatArray] = []  # grid states before the crossing, in chunks
     bracket = None
     for first in range(0, GRID_POINTS, GRID_CHUNK):
@@ -216,13 +224,13 @@ def _exit_step(controller: StepController, x0: FloatArray) -> tuple[list[float],
     else:
         within = bracketed_root(height, 0.0, dt)
     crossing = lower + within
-    end = point(within)[:2]
+    end = point(within)[:2] + center
     # Samples: the grid points nearest to evenly spaced times (exact states, no extra work).
     grid = np.concatenate(inside)
     wanted = np.rint(np.arange(1, SAMPLES_PER_STEP) * (crossing / SAMPLES_PER_STEP) / dt)
     indices = np.unique(wanted[(wanted >= 1) & (wanted <= len(grid))].astype(np.int64))
     times = [float(j * dt) for j in indices.tolist()]
-    points = [grid[j - 1, :2].copy() for j in indices.tolist()]
+    points = [grid[j - 1, :2] + center for j in indices.tolist()]
     # Snap onto the exit edge (the root is exact to ~1e-14; this removes the residue).
     a = geometry.vertices[(controller.exit_edge + 1) % 3]
     b = geometry.vertices[(controller.exit_edge + 2) % 3]
