@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 from hypothesis import strategies as st
 
 from tlmpc.ltl.ast import (
@@ -55,3 +57,58 @@ def lassos(
     word = draw(st.lists(letter, min_size=1, max_size=7))
     loop = draw(st.integers(0, len(word) - 1))
     return word, loop
+
+
+#: Task phrase templates for random missions; ``{a}``, ``{b}``, ``{c}`` are distinct regions.
+TEMPLATES = (
+    "visit {a}",
+    "visit {a} then {b}",
+    "visit {a}, {b} and {c}",
+    "avoid {c}",
+    "patrol {a}, {b}",
+    "stay in {a}",
+    "visit {a} then {b} while avoiding {c}",
+    "whenever {a}, visit {b}",
+    "avoid {c} until {a}",
+)
+
+
+#: The templates whose LTL is co-safe: every satisfying run has a finite good prefix.
+CO_SAFE_TEMPLATES = frozenset(TEMPLATES[i] for i in (0, 1, 2, 8))
+
+
+@st.composite
+def missions_with_template(draw: st.DrawFn) -> tuple[dict[str, Any], str]:
+    """A 12 x 8 box with up to one hole and three to five disjoint-or-overlapping regions, and
+    the template its task phrase came from."""
+    regions: dict[str, Any] = {}
+    count = draw(st.integers(3, 5))
+    for k in range(count):
+        x0 = draw(st.integers(0, 9))
+        y0 = draw(st.integers(0, 5))
+        w = draw(st.integers(1, 3))
+        h = draw(st.integers(1, 3))
+        regions[f"r{k}"] = {
+            "rect": [x0 + 0.25, y0 + 0.25, min(x0 + w, 12) - 0.25, min(y0 + h, 8) - 0.25]
+        }
+    holes = []
+    if draw(st.booleans()):
+        holes.append({"rect": [5.5, 3.5, 6.5, 4.5]})
+    names = sorted(regions)
+    picks = draw(st.permutations(names))
+    template = draw(st.sampled_from(TEMPLATES))
+    task = template.format(a=picks[0], b=picks[1], c=picks[2])
+    document = {
+        "version": 1,
+        "name": "random",
+        "workspace": {"boundary": {"rect": [0, 0, 12, 8]}, "holes": holes},
+        "regions": regions,
+        "robot": {"start": [0.1, 7.9], "max_speed": 1.0},
+        "task": [task],
+    }
+    return document, template
+
+
+def missions() -> st.SearchStrategy[dict[str, Any]]:
+    """Random mission documents (see :func:`missions_with_template`)."""
+    return missions_with_template().map(lambda pair: pair[0])

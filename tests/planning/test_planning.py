@@ -9,9 +9,10 @@ from typing import Any
 
 import pytest
 import yaml
-from hypothesis import given, settings
+from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from lasso_ltl import holds
+from strategies import CO_SAFE_TEMPLATES, missions_with_template
 
 from tlmpc.abstraction import build_abstraction
 from tlmpc.artifacts import validation_errors
@@ -260,3 +261,27 @@ def test_example8_plan_is_found(specs_dir: Path) -> None:
     assert abstraction.num_triangles == 9250
     assert yaml.safe_load(text)["task"]
     assert isinstance(m.options, Options)
+
+
+@needs_spin
+@settings(max_examples=8, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(drawn=missions_with_template())
+def test_spin_agrees_on_random_missions(
+    drawn: tuple[dict[str, Any], str], tmp_path_factory: pytest.TempPathFactory
+) -> None:
+    """Random maps and tasks: the same verdict, and on co-safe tasks the same shortest hop
+    count; otherwise tlmpc's optimal lasso is never longer than SPIN's trail."""
+    document, template = drawn
+    document = {**document, "options": {"min_angle": None, "cost": "hops", "beta": 1}}
+    m = load_mission_text(yaml.safe_dump(document), "random.yaml")
+    abstraction, trail, witness = spin_and_ours(tmp_path_factory.mktemp("spin"), m)
+    assert trail.found is (witness is not None), document["task"]
+    if witness is None:
+        return
+    check_spin_trail(abstraction, trail, bounce=False)
+    assert witness.stats["optimal"]
+    hops = round(witness.cost)
+    assert hops <= trail.moves, document["task"]
+    if template in CO_SAFE_TEMPLATES:
+        assert trail.cycle_from is None
+        assert hops == trail.moves, document["task"]
