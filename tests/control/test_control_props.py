@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import assume, given, settings
+from hypothesis import assume, example, given, settings
 from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
 from scipy.linalg import expm
@@ -32,7 +32,13 @@ from tlmpc.control.synthesize import (
 from tlmpc.errors import InvalidInputError
 from tlmpc.mission.model import Robot
 from tlmpc.planning.model import Witness
-from tlmpc.simulate.exact import _exit_step, _stay_step, bracketed_root, expm_small
+from tlmpc.simulate.exact import (
+    _exit_step,
+    _local_flow,
+    _stay_step,
+    bracketed_root,
+    expm_small,
+)
 
 
 def _min_angle(v: np.ndarray) -> float:
@@ -369,8 +375,9 @@ def test_bracketed_root_matches_brentq(root: float, power: int, scale: float, ti
 def test_exit_steps_far_from_the_origin_are_translates(
     v: np.ndarray, exit_edge: int, shift: float, data: st.DataObject
 ) -> None:
-    """Far from the origin the offset dominates the flow's matrix and the exit search takes the
-    matrix-exponential path; the result must be the translate of the search near the origin."""
+    """Far from the origin the global offset dominates the flow's matrix; an exit step must
+    still be the translate of the same step near the origin (in the global frame the crossing
+    time drifted by ~1e-6 at a shift of 2.5e5)."""
     near = _exit_controller(v, exit_edge, 1.0)
     # The same field, moved: x' = K (x - shift) + g.
     far = dataclasses.replace(
@@ -382,3 +389,27 @@ def test_exit_steps_far_from_the_origin_are_translates(
     # rounding of coordinates of size |shift| moves the crossing by ~1e-16 |shift| / speed
     assert far_times[-1] == pytest.approx(near_times[-1], rel=1e-9, abs=1e-11 * abs(shift))
     assert np.allclose(far_points[-1] - shift, near_points[-1], atol=1e-12 * abs(shift) + 1e-12)
+
+
+@settings(deadline=None, max_examples=60)
+@example([0.5, -0.2, 0.1, 0.3, 0.4, -0.6], [0.5, -0.5], 0.05)  # the polynomial path
+@example([3.0, -2.0, 3.0, 1.5, -3.0, 2.5], [1.0, 2.0], 2.5)  # |reach M| > SERIES_RADIUS
+@given(
+    st.lists(st.floats(-3.0, 3.0), min_size=6, max_size=6),
+    st.lists(st.floats(-2.0, 2.0), min_size=2, max_size=2),
+    st.floats(0.01, 3.0),
+)
+def test_local_flow_matches_scipy_on_both_paths(
+    entries: list[float], start: list[float], reach: float
+) -> None:
+    """The exit search's flow from a grid state: the Taylor polynomial when |reach M| is small,
+    the matrix exponential otherwise; both must be exp(sM) base."""
+    matrix = np.zeros((3, 3))
+    matrix[:2] = np.reshape(entries, (2, 3))
+    base = np.array([*start, 1.0])
+    normal = np.array([0.6, 0.8])
+    point, height = _local_flow(matrix, base, reach, normal, 0.25)
+    for s in (0.0, 0.3 * reach, reach):
+        exact = expm(s * matrix) @ base
+        assert np.allclose(point(s), exact, rtol=1e-10, atol=1e-10)
+        assert height(s) == pytest.approx(normal @ exact[:2] - 0.25, rel=1e-10, abs=1e-10)

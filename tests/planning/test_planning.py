@@ -171,12 +171,16 @@ HOPS = "options: {min_angle: null, cost: hops, beta: 1}\n"
 def spin_and_ours(
     tmp_path: Path, m: Mission, *, bounce: bool = False
 ) -> tuple[Any, spin.SpinTrail, Any]:
+    """SPIN's shortest trail on the exported model, and tlmpc's plan (None: no plan)."""
     abstraction = build_abstraction(m)
     model = tmp_path / "model.pml"
     model.write_text(to_promela(abstraction, m.formula, bounce=bounce))
     trail = spin.run_spin(model, shortest=True, timeout=120, max_depth=100_000)
+    automaton = translate(m.formula, letters=abstraction.letters)
     try:
-        _, _, witness = compile_plan(m)
+        witness = plan(
+            abstraction, automaton, formula=m.formula, options=m.options, start_point=m.robot.start
+        )
     except NoPlanError:
         witness = None
     return abstraction, trail, witness
@@ -185,12 +189,9 @@ def spin_and_ours(
 def check_spin_trail(abstraction: Any, trail: spin.SpinTrail, *, bounce: bool) -> bool:
     """SPIN's trail is a run of the exported D; returns whether it bounces."""
     path = [abstraction.start, *trail.entered]
-    bounces = False
-    for before, here, after in itertools.zip_longest(path, path[1:], path[2:]):
-        if here is not None:
-            assert here in abstraction.neighbors[before].tolist()
-        if after is not None:
-            bounces |= before == after
+    for before, here in itertools.pairwise(path):
+        assert here in abstraction.neighbors[before].tolist()
+    bounces = any(before == after for before, after in zip(path, path[2:], strict=False))
     assert bounce or not bounces
     return bounces
 

@@ -64,7 +64,6 @@ def to_promela(
     ``tlmpc: t = N``, so ``spin -t`` replays a trail as a list of triangles.
     """
     m = abstraction.num_triangles
-    rule = "" if bounce else " && nb[K] != prev"
     entry = "" if bounce else "prev = t; "
     kind = "bounces allowed" if bounce else "no bounce"
     lines = [
@@ -81,7 +80,7 @@ def to_promela(
     lines += ["", "active proctype robot() {", *_adjacency_steps(abstraction), "  do"]
     for i in range(3):
         k = f"3*t + {i}"
-        guard = f"nb[{k}] >= 0" + rule.replace("K", k)
+        guard = f"nb[{k}] >= 0" + ("" if bounce else f" && nb[{k}] != prev")
         move = f'{entry}t = nb[{k}]; printf("tlmpc: t = %d\\n", t)'
         lines.append(f"  :: d_step {{ {guard} -> {move} }}")
     lines += [

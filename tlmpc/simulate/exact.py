@@ -57,10 +57,22 @@ def _augmented(gain: FloatArray, offset: FloatArray) -> FloatArray:
     return matrix
 
 
-#: 1/k! for the Taylor degrees expm_small may use.
-_INVERSE_FACTORIALS = tuple(1.0 / math.factorial(k) for k in range(20))
-#: Truncation error allowed in the scaled series (far below rounding of an O(1) result).
+#: 1/k! for the Taylor degrees used here.
+_INVERSE_FACTORIALS = tuple(1.0 / math.factorial(k) for k in range(42))
+#: Truncation error allowed in a series (far below rounding of an O(1) result).
 _TAYLOR_TOLERANCE = 1e-18
+
+
+def _taylor_degree(radius: float, cap: int) -> int:
+    """The first degree m <= cap with radius^(m+1)/(m+1)! <= 1e-18: where the exponential series
+    of a matrix of norm ``radius`` is cut, the first neglected term is below 1e-18."""
+    degree = 1
+    while (
+        degree < cap
+        and radius ** (degree + 1) * _INVERSE_FACTORIALS[degree + 1] > _TAYLOR_TOLERANCE
+    ):
+        degree += 1
+    return degree
 
 
 def expm_small(matrix: FloatArray) -> FloatArray:
@@ -75,10 +87,7 @@ def expm_small(matrix: FloatArray) -> FloatArray:
     squarings = max(0, math.ceil(math.log2(norm)) + 1) if norm > 0.5 else 0
     scale = 0.5**squarings
     scaled = matrix * scale
-    s = norm * scale
-    degree = 1
-    while degree < 18 and s ** (degree + 1) * _INVERSE_FACTORIALS[degree + 1] > _TAYLOR_TOLERANCE:
-        degree += 1
+    degree = _taylor_degree(norm * scale, 18)
     identity = np.eye(matrix.shape[0])
     result = identity + scaled / degree
     for k in range(degree - 1, 0, -1):
@@ -143,9 +152,7 @@ def _local_flow(
             return float(normal @ far_point(s)[:2] - offset)
 
         return far_point, far_height
-    degree = 1
-    while degree < 40 and radius ** (degree + 1) / math.factorial(degree + 1) > _TAYLOR_TOLERANCE:
-        degree += 1
+    degree = _taylor_degree(radius, 40)
     terms = [base]
     for k in range(1, degree + 1):
         terms.append(matrix @ terms[-1] / k)
