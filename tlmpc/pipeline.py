@@ -36,6 +36,7 @@ class Compilation:
     """Everything the stages have produced so far (``None`` = not yet)."""
 
     source: Path
+    text: str | None = None  # the mission's YAML when it does not come from ``source``
     mission: Mission | None = None
     abstraction: Abstraction | None = None
     automaton: Automaton | None = None
@@ -73,9 +74,12 @@ def _require(value: Any, what: str) -> Any:
 
 
 def _load(c: Compilation) -> StageResult:
-    from tlmpc.mission import load_mission
+    from tlmpc.mission import load_mission, load_mission_text
 
-    mission = load_mission(c.source)
+    if c.text is not None:
+        mission = load_mission_text(c.text, str(c.source))
+    else:
+        mission = load_mission(c.source)
     return StageResult(
         compilation=dataclasses.replace(c, mission=mission),
         artifacts={"mission.json": mission.to_json()},
@@ -327,16 +331,19 @@ def collector_paused() -> Iterator[None]:
 def compile_mission(
     source: Path | str,
     *,
+    text: str | None = None,
     until: str | None = None,
     progress: ProgressFn | None = None,
 ) -> CompileResult:
     """Run the stages of :data:`STAGES` (up to ``until``) on the mission file ``source``.
 
+    With ``text``, the mission is that YAML text and ``source`` only names it in diagnostics.
+
     Raises the stage's :class:`~tlmpc.errors.TlmpcError` when one fails; nothing is written
     here (the CLI writes the returned artifacts atomically).
     """
     stages = stages_until(until)
-    compilation = Compilation(source=Path(source))
+    compilation = Compilation(source=Path(source), text=text)
     artifacts: dict[str, Any] = {}
     reports: list[StageReport] = []
     warnings: list[Diagnostic] = []

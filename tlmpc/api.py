@@ -1,0 +1,273 @@
+"""The Python facade of tlmpc: compile missions, read outputs, verify trajectories, translate LTL.
+
+Everything here is also what the command line does, minus the printing::
+
+    import tlmpc
+
+    result = tlmpc.compile({"version": 1, "name": "demo", ...})   # a dict, YAML text or a path
+    result.summary["plan"]                                        # plan shape and cost
+    result.write("out")                                           # the artifacts, atomically
+    verdict = tlmpc.verify_trace(result)                          # re-check the trajectory
+    automaton = tlmpc.translate("G F a & G F b")
+
+Failures raise :class:`~tlmpc.errors.TlmpcError` subclasses carrying the same diagnostics the
+command line prints (``error.diagnostics``); ``error.exit_code`` is the CLI's exit code.
+Results render in Jupyter (``_repr_svg_`` / ``_repr_html_``).
+
+This module imports only the standard library at import time; each function imports the stages
+it needs, so ``import tlmpc`` stays cheap.
+"""
+
+from __future__ import annotations
+
+import html
+import os
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from tlmpc.errors import Diagnostic, InvalidInputError, UsageError, error
+
+if TYPE_CHECKING:
+    from tlmpc.automata.model import Automaton
+    from tlmpc.verify.verdict import Verdict
+
+MissionSource = str | os.PathLike[str] | Mapping[str, Any]
+"""A mission: a path to a YAML file, YAML text, or the mission as a dict."""
+
+#: The artifacts an output directory may hold, in pipeline order.
+ARTIFACT_NAMES = (
+    "mission.json",
+    "abstraction.json",
+    "automaton.json",
+    "automaton.hoa",
+    "witness.json",
+    "controllers.json",
+    "trace.json",
+    "verdict.json",
+    "summary.json",
+)
+
+
+def _mission_text(mission: MissionSource) -> tuple[str | None, Path]:
+    """(YAML text or None when ``mission`` is a file, the path diagnostics will name)."""
+    if isinstance(mission, Mapping):
+        import yaml
+
+        return yaml.safe_dump(dict(mission), sort_keys=False), Path("<mission>")
+    if isinstance(mission, os.PathLike):
+        return None, Path(mission)
+    if "\n" in mission or (":" in mission and not Path(mission).exists()):
+        return mission, Path("<mission>")
+    return None, Path(mission)
+
+
+@dataclass(frozen=True)
+class Compiled:
+    """A compiled mission: its artifacts (parsed JSON documents, HOA text) and summary.
+
+    ``artifacts`` maps file names (``"witness.json"``) to documents exactly as ``tlmpc
+    compile`` writes them; :meth:`write` writes them into a directory.
+    """
+
+    artifacts: Mapping[str, Any]
+    source: str = "<mission>"
+    warnings: tuple[Diagnostic, ...] = ()
+    _figure: dict[str, str] = field(default_factory=dict, repr=False, compare=False)
+
+    @property
+    def summary(self) -> Mapping[str, Any]:
+        """``summary.json``: sizes and seconds per stage, plan shape and cost, verdict."""
+        return dict(self.artifacts.get("summary.json", {}))
+
+    @property
+    def formula(self) -> str:
+        """The whole task as one LTL formula."""
+        return str(self.artifacts["mission.json"]["formula"])
+
+    @property
+    def plan(self) -> Mapping[str, Any] | None:
+        """``witness.json`` (prefix and cycle of triangles), or None before the plan stage."""
+        witness: Mapping[str, Any] | None = self.artifacts.get("witness.json")
+        return witness
+
+    @property
+    def trajectory(self) -> list[list[float]]:
+        """The simulated ``[t, x, y]`` samples (empty before the simulate stage)."""
+        trace = self.artifacts.get("trace.json")
+        return [list(map(float, row)) for row in trace["points"]] if trace else []
+
+    def write(self, out: str | os.PathLike[str], *, force: bool = False) -> Path:
+        """Write every artifact (and the figure, when drawn) into ``out`` atomically."""
+        from tlmpc.output import check_destination, commit, staging_directory, write_artifacts
+
+        destination = Path(out)
+        check_destination(destination, force=force)
+        with staging_directory(destination) as staging:
+            write_artifacts(staging, dict(self.artifacts))
+            commit(staging, destination, force=force)
+        return destination
+
+    def svg(self) -> str:
+        """The plan figure as SVG text (drawn on first use)."""
+        if "svg" not in self._figure:
+            from tlmpc.plot import render_plan
+
+            _, svg = render_plan(self.artifacts)
+            self._figure["svg"] = svg.decode("utf-8")
+        return self._figure["svg"]
+
+    def _repr_svg_(self) -> str | None:
+        if "trace.json" not in self.artifacts:
+            return None
+        return self.svg()
+
+    def _repr_html_(self) -> str:
+        summary = self.summary
+        rows = [("formula", self.formula if "mission.json" in self.artifacts else "")]
+        plan = summary.get("plan")
+        if plan:
+            rows.append(("plan", f"prefix {plan['prefix_length']}, cycle {plan['cycle_length']}"))
+            rows.append(("cost", f"{plan['cost']:.4g} ({plan['metric']})"))
+        verdict = summary.get("verdict")
+        if verdict:
+            rows.append(("verdict", "satisfied" if verdict["satisfied"] else "violated"))
+        table = "".join(
+            f"<tr><th style='text-align:left'>{html.escape(k)}</th>"
+            f"<td style='text-align:left'>{html.escape(str(v))}</td></tr>"
+            for k, v in rows
+        )
+        figure = self._repr_svg_() or ""
+        return f"<div><table>{table}</table>{figure}</div>"
+
+
+def compile(
+    mission: MissionSource,
+    *,
+    until: str | None = None,
+) -> Compiled:
+    """Compile ``mission`` through every stage (or up to the stage ``until``).
+
+    ``mission`` is a path to a YAML file, YAML text, or a dict with the same keys as the
+    YAML format.  Raises :class:`~tlmpc.errors.TlmpcError` (with diagnostics) when the mission
+    is invalid, has no plan, or a stage fails.  Nothing is written: call
+    :meth:`Compiled.write`.
+    """
+    from tlmpc.pipeline import compile_mission
+
+    text, source = _mission_text(mission)
+    if until is not None:
+        from tlmpc.pipeline import stage_names
+
+        if until not in stage_names():
+            raise UsageError(
+                error(
+                    "U010",
+                    f"unknown stage {until!r}",
+                    hint="one of: " + ", ".join(stage_names()),
+                )
+            )
+    result = compile_mission(source, text=text, until=until)
+    artifacts = dict(result.artifacts)
+    artifacts["summary.json"] = result.summary()
+    return Compiled(artifacts=artifacts, source=str(source), warnings=result.warnings)
+
+
+def read_output(directory: str | os.PathLike[str]) -> Compiled:
+    """Read the artifacts of an output directory written by ``tlmpc compile``.
+
+    Each JSON artifact is checked against its schema; raises
+    :class:`~tlmpc.errors.UsageError` when the directory holds no tlmpc output.
+    """
+    from tlmpc.artifacts import read_json, validation_errors
+
+    root = Path(directory)
+    artifacts: dict[str, Any] = {}
+    for name in ARTIFACT_NAMES:
+        path = root / name
+        if not path.is_file():
+            continue
+        if name.endswith(".hoa"):
+            artifacts[name] = path.read_text(encoding="utf-8")
+            continue
+        document = read_json(path)
+        schema = name.removesuffix(".json")
+        schema = "mission-artifact" if schema == "mission" else schema
+        problems = validation_errors(document, schema)
+        if problems:
+            raise InvalidInputError(
+                error(
+                    "U003",
+                    f"{name} does not match its schema: {problems[0]}",
+                    file=str(path),
+                    hint="artifacts are written by `tlmpc compile`; was this file edited?",
+                )
+            )
+        artifacts[name] = document
+    if "mission.json" not in artifacts:
+        raise UsageError(
+            error(
+                "U001",
+                f"{root} holds no tlmpc output (no mission.json)",
+                file=str(root),
+                hint="pass the directory given to `tlmpc compile -o`",
+            )
+        )
+    return Compiled(artifacts=artifacts, source=str(root))
+
+
+def verify_trace(
+    trace: Compiled | str | os.PathLike[str] | Mapping[str, Any],
+    *,
+    mission: str | os.PathLike[str] | None = None,
+    boundary: str | None = None,
+) -> Verdict:
+    """Verify a trajectory against its task under continuous-time semantics.
+
+    ``trace`` is a :class:`Compiled` result, a ``trace.json`` document (dict), or a path to a
+    ``trace.json`` or a CSV log (then ``mission`` names the mission file whose task and regions
+    apply).  ``boundary`` overrides the labelling convention (``"right"`` or ``"closed"``).
+    The verifier shares no code with the planner.
+    """
+    from tlmpc.verify import from_csv, from_document
+    from tlmpc.verify import verify_trace as check_trace
+
+    if isinstance(trace, Compiled):
+        document = trace.artifacts.get("trace.json")
+        if document is None:
+            raise UsageError(
+                error("U010", "this compilation stopped before the simulate stage")
+            )
+        return check_trace(from_document(document, convention=boundary))
+    if isinstance(trace, Mapping):
+        return check_trace(from_document(trace, convention=boundary))
+    path = Path(trace)
+    if path.suffix.lower() == ".csv":
+        return check_trace(
+            from_csv(path, Path(mission) if mission is not None else None, boundary)
+        )
+    from tlmpc.artifacts import read_json
+
+    return check_trace(from_document(read_json(path), file=str(path), convention=boundary))
+
+
+def translate(formula: str) -> Automaton:
+    """Translate a Next-free LTL formula into a transition-based generalized Büchi automaton.
+
+    Raises :class:`~tlmpc.errors.InvalidInputError` with located diagnostics for bad syntax.
+    """
+    from tlmpc.automata import translate as translate_formula
+    from tlmpc.ltl import parse_ltl
+
+    return translate_formula(parse_ltl(formula))
+
+
+def check(mission: MissionSource) -> list[Diagnostic]:
+    """Every problem of ``mission`` (schema, geometry, task), best first; empty when valid."""
+    from tlmpc.mission.load import check_file, check_text
+
+    text, source = _mission_text(mission)
+    if text is None:
+        return check_file(source)
+    return check_text(text, str(source))
