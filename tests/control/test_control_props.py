@@ -413,3 +413,39 @@ def test_local_flow_matches_scipy_on_both_paths(
         exact = expm(s * matrix) @ base
         assert np.allclose(point(s), exact, rtol=1e-10, atol=1e-10)
         assert height(s) == pytest.approx(normal @ exact[:2] - 0.25, rel=1e-10, abs=1e-10)
+
+
+def _outward_normal(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Unit outward normal of edge a->b of a counter-clockwise triangle (own geometry)."""
+    d = b - a
+    n = np.array([d[1], -d[0]])
+    return n / float(np.linalg.norm(n))
+
+
+@pytest.mark.parametrize("spec", ["example1.yaml", "example6.yaml", "reach-avoid.yaml"])
+def test_solved_fields_meet_the_stated_vertex_conditions(specs_dir: object, spec: str) -> None:
+    """Re-check every step after solving: exit at the reported speed, invariance, speed bound."""
+    from pathlib import Path
+
+    from tlmpc.pipeline import compile_mission
+
+    result = compile_mission(Path(str(specs_dir)) / spec, until="control")
+    controllers = result.compilation.controllers
+    assert controllers is not None
+    tolerance = 1e-6 * controllers.max_speed
+    for c in controllers.steps:
+        v = c.vertices
+        for i in range(3):  # the field is affine: it takes the vertex velocities at the vertices
+            assert np.allclose(c.gain @ v[i] + c.offset, c.velocities[i], atol=tolerance)
+            assert float(np.linalg.norm(c.velocities[i])) <= controllers.max_speed + tolerance
+        if c.exit_edge is None:
+            continue
+        normals = [_outward_normal(v[(j + 1) % 3], v[(j + 2) % 3]) for j in range(3)]
+        assert c.exit_speed > 0
+        for i in range(3):
+            assert normals[c.exit_edge] @ c.velocities[i] >= c.exit_speed - tolerance
+            for facet in range(3):
+                if facet in (i, c.exit_edge):
+                    continue
+                pushed_in = -(normals[facet] @ c.velocities[i])
+                assert pushed_in >= controllers.margin * c.exit_speed - tolerance
