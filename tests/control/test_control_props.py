@@ -449,3 +449,29 @@ def test_solved_fields_meet_the_stated_vertex_conditions(specs_dir: object, spec
                     continue
                 # strictly inward: the field never slides along or leaves by another facet
                 assert -(normals[facet] @ c.velocities[i]) > tolerance
+
+
+@settings(deadline=None, max_examples=30)
+@given(triangles(), st.integers(0, 2), st.floats(0.2, 3.0))
+def test_exit_speed_is_the_best_the_vertex_conditions_allow(
+    v: np.ndarray, exit_edge: int, speed: float
+) -> None:
+    """An independent program from the raw triangle: no field does better than tlmpc's."""
+    import cvxpy as cp
+
+    abstraction, witness = two_triangle_plan(v, exit_edge, stay=True)
+    controllers = synthesize(abstraction, witness, Robot(start=(0.0, 0.0), max_speed=speed))
+    step = controllers.steps[0]
+    normals = [_outward_normal(v[(j + 1) % 3], v[(j + 2) % 3]) for j in range(3)]
+    w = cp.Variable((3, 2))
+    s = cp.Variable()
+    constraints = []
+    for i in range(3):
+        constraints.append(cp.norm(w[i]) <= speed)
+        constraints.append(normals[exit_edge] @ w[i] >= s)
+        for facet in range(3):
+            if facet not in (i, exit_edge):
+                constraints.append(-(normals[facet] @ w[i]) >= controllers.margin * s)
+    best = cp.Problem(cp.Maximize(s), constraints).solve(solver=cp.CLARABEL)
+    assert best is not None and best > 0
+    assert step.exit_speed >= float(best) * (1 - 1e-5)
