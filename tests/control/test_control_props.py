@@ -473,5 +473,6 @@ def test_exit_speed_is_the_best_the_vertex_conditions_allow(
             if facet not in (i, exit_edge):
                 constraints.append(-(normals[facet] @ w[i]) >= controllers.margin * s)
     best = cp.Problem(cp.Maximize(s), constraints).solve(solver=cp.CLARABEL)
-    assert best is not None and best > 0
+    assert best is not None
+    assert best > 0
     assert step.exit_speed >= float(best) * (1 - 1e-5)
