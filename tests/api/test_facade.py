@@ -15,7 +15,7 @@ import tlmpc
 ROOT = Path(__file__).resolve().parents[2]
 
 
-def _dead_end_free_mission() -> dict[str, Any]:
+def _mission() -> dict[str, Any]:
     return {
         "version": 1,
         "name": "notebook",
@@ -27,7 +27,7 @@ def _dead_end_free_mission() -> dict[str, Any]:
 
 
 def test_notebook_style_compile_and_verify_a_dict_mission(tmp_path: Path) -> None:
-    result = tlmpc.compile(_dead_end_free_mission())
+    result = tlmpc.compile(_mission())
     assert result.formula == "F(dock & F home)"
     assert result.plan is not None
     assert result.summary["verdict"]["satisfied"] is True
@@ -37,7 +37,8 @@ def test_notebook_style_compile_and_verify_a_dict_mission(tmp_path: Path) -> Non
     points = result.trajectory
     assert any(8 <= x <= 9.5 and 4 <= y <= 5.5 for _, x, y in points)
     _, x_end, y_end = points[-1]
-    assert 0.5 <= x_end <= 2 and 0.5 <= y_end <= 2
+    assert 0.5 <= x_end <= 2
+    assert 0.5 <= y_end <= 2
     # Written and read back, the same artifacts.
     out = result.write(tmp_path / "out")
     again = tlmpc.read_output(out)
@@ -46,19 +47,20 @@ def test_notebook_style_compile_and_verify_a_dict_mission(tmp_path: Path) -> Non
 
 
 def test_yaml_text_and_path_give_the_same_plan(tmp_path: Path) -> None:
-    text = yaml.safe_dump(_dead_end_free_mission())
+    text = yaml.safe_dump(_mission())
     path = tmp_path / "m.yaml"
     path.write_text(text, encoding="utf-8")
     from_text = tlmpc.compile(text, until="plan")
     from_path = tlmpc.compile(path, until="plan")
-    assert from_text.plan is not None and from_path.plan is not None
+    assert from_text.plan is not None
+    assert from_path.plan is not None
     for key in ("prefix", "cycle", "cost"):
         assert from_text.plan[key] == from_path.plan[key]
     assert "trace.json" not in from_text.artifacts
 
 
 def test_errors_are_typed_and_carry_diagnostics(tmp_path: Path) -> None:
-    mission = _dead_end_free_mission()
+    mission = _mission()
     mission["task"] = ["visit nowhere"]
     with pytest.raises(tlmpc.InvalidInputError) as caught:
         tlmpc.compile(mission)
@@ -69,11 +71,11 @@ def test_errors_are_typed_and_carry_diagnostics(tmp_path: Path) -> None:
     with pytest.raises(tlmpc.UsageError):
         tlmpc.read_output(tmp_path)
     with pytest.raises(tlmpc.UsageError):
-        tlmpc.compile(_dead_end_free_mission(), until="no-such-stage")
+        tlmpc.compile(_mission(), until="no-such-stage")
 
 
 def test_impossible_mission_raises_no_plan() -> None:
-    mission = _dead_end_free_mission()
+    mission = _mission()
     mission["task"] = ["visit dock", "avoid dock"]
     with pytest.raises(tlmpc.TlmpcError) as caught:
         tlmpc.compile(mission)
@@ -81,9 +83,10 @@ def test_impossible_mission_raises_no_plan() -> None:
 
 
 def test_check_reports_problems_without_raising() -> None:
-    assert tlmpc.check(_dead_end_free_mission()) == []
+    assert tlmpc.check(_mission()) == []
     problems = tlmpc.check("version: 1\nname: x\n")
-    assert problems and problems[0].severity == "error"
+    assert problems
+    assert problems[0].severity == "error"
 
 
 def test_translate() -> None:
@@ -93,11 +96,11 @@ def test_translate() -> None:
 
 
 def test_jupyter_representations() -> None:
-    result = tlmpc.compile(_dead_end_free_mission())
+    result = tlmpc.compile(_mission())
     page = result._repr_html_()
     assert "F(dock &amp; F home)" in page
     assert "<svg" in page
-    assert tlmpc.compile(_dead_end_free_mission(), until="plan")._repr_svg_() is None
+    assert tlmpc.compile(_mission(), until="plan")._repr_svg_() is None
 
 
 def test_import_tlmpc_is_light() -> None:
