@@ -28,7 +28,7 @@ if TYPE_CHECKING:
     from tlmpc.mission.model import Mission
     from tlmpc.planning.model import Witness
     from tlmpc.simulate.exact import Trace
-    from tlmpc.verify.model import Verdict
+    from tlmpc.verify.verdict import Verdict
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
