@@ -12,10 +12,10 @@ import contextlib
 import dataclasses
 import gc
 import time
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
 from tlmpc import __version__
 from tlmpc.errors import TlmpcError, error
@@ -27,50 +27,139 @@ if TYPE_CHECKING:
     from tlmpc.errors import Diagnostic
     from tlmpc.mission.model import Mission
     from tlmpc.planning.model import Witness
-    from tlmpc.simulate.exact import Trace
-    from tlmpc.verify.verdict import Verdict
+
+
+T = TypeVar("T")
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Product(Generic[T]):
+    """A typed slot of a compilation: the IR one stage provides and later stages require.
+
+    ``artifact`` is the file the IR is written to and ``read`` rebuilds the IR from that
+    file's document, so a stage can run alone from its input artifacts.
+    """
+
+    name: str
+    artifact: str
+    schema: str
+    read: Callable[[Mapping[str, Any]], T]
+
+    def __repr__(self) -> str:
+        return f"Product({self.name})"
+
+
+def _read_mission(document: Mapping[str, Any]) -> Mission:
+    from tlmpc.mission.io import mission_from_json
+
+    return mission_from_json(document)
+
+
+def _read_abstraction(document: Mapping[str, Any]) -> Abstraction:
+    from tlmpc.abstraction.io import abstraction_from_json
+
+    return abstraction_from_json(document)
+
+
+def _read_automaton(document: Mapping[str, Any]) -> Automaton:
+    from tlmpc.automata.io import automaton_from_json
+
+    return automaton_from_json(document)
+
+
+def _read_witness(document: Mapping[str, Any]) -> Witness:
+    from tlmpc.planning.io import witness_from_json
+
+    return witness_from_json(document)
+
+
+def _read_controllers(document: Mapping[str, Any]) -> Controllers:
+    from tlmpc.control.io import controllers_from_json
+
+    return controllers_from_json(document)
+
+
+def _read_trace(document: Mapping[str, Any]) -> Mapping[str, Any]:
+    # The verifier reads the self-contained document itself (it shares no IR with the planner).
+    return document
+
+
+MISSION: Product[Mission] = Product("mission", "mission.json", "mission-artifact", _read_mission)
+ABSTRACTION: Product[Abstraction] = Product(
+    "abstraction", "abstraction.json", "abstraction", _read_abstraction
+)
+AUTOMATON: Product[Automaton] = Product(
+    "automaton", "automaton.json", "automaton", _read_automaton
+)
+WITNESS: Product[Witness] = Product("witness", "witness.json", "witness", _read_witness)
+CONTROLLERS: Product[Controllers] = Product(
+    "controllers", "controllers.json", "controllers", _read_controllers
+)
+TRACE: Product[Mapping[str, Any]] = Product("trace", "trace.json", "trace", _read_trace)
+
+
+class MissingProductError(TlmpcError):
+    """A stage was asked to run without the artifacts it needs (exit 2)."""
+
+    exit_code = 2
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Compilation:
-    """Everything the stages have produced so far (``None`` = not yet)."""
+    """What the stages have produced so far: typed products and the artifacts written.
+
+    ``text`` is the mission's YAML when it does not come from the file ``source``.
+    """
 
     source: Path
-    text: str | None = None  # the mission's YAML when it does not come from ``source``
-    mission: Mission | None = None
-    abstraction: Abstraction | None = None
-    automaton: Automaton | None = None
-    witness: Witness | None = None
-    controllers: Controllers | None = None
-    trace: Trace | None = None
-    trace_document: Mapping[str, Any] | None = None
-    verdict: Verdict | None = None
+    text: str | None = None
+    products: Mapping[Product[Any], Any] = field(default_factory=dict)
     documents: Mapping[str, Any] = field(default_factory=dict)  # artifacts written so far
+
+    def get(self, product: Product[T]) -> T:
+        """The IR of ``product``; a stage only asks for what its ``requires`` declares."""
+        try:
+            value: T = self.products[product]
+        except KeyError:
+            raise MissingProductError(
+                error(
+                    "U012",
+                    f"the {product.name} is not available ({product.artifact} is missing)",
+                    hint="run the earlier stages first (tlmpc compile --until ...)",
+                )
+            ) from None
+        return value
+
+    def find(self, product: Product[T]) -> T | None:
+        """The IR of ``product``, or None when no stage has provided it."""
+        value: T | None = self.products.get(product)
+        return value
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class StageResult:
-    """What one stage returns: the updated compilation, its artifacts and sizes to report."""
+    """What one stage returns: its products, its artifacts and sizes to report."""
 
-    compilation: Compilation
+    products: Mapping[Product[Any], Any] = field(default_factory=dict)
     artifacts: Mapping[str, Any] = field(default_factory=dict)  # file name -> JSON doc | text
     sizes: Mapping[str, Any] = field(default_factory=dict)
     warnings: tuple[Diagnostic, ...] = ()
 
 
+def provide(product: Product[T], value: T) -> dict[Product[Any], Any]:
+    """``{product: value}``, with the value's type checked against the product's."""
+    return {product: value}
+
+
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Stage:
-    """A named lowering step of the compiler."""
+    """A named lowering step: reads ``requires``, returns ``provides`` (checked when run)."""
 
     name: str
     run: Callable[[Compilation], StageResult]
+    requires: tuple[Product[Any], ...] = ()
+    provides: tuple[Product[Any], ...] = ()
     aliases: tuple[str, ...] = ()
-
-
-def _require(value: Any, what: str) -> Any:
-    if value is None:  # a programming error: stages run in order
-        raise RuntimeError(f"stage input missing: {what}")
-    return value
 
 
 def _load(c: Compilation) -> StageResult:
@@ -81,7 +170,7 @@ def _load(c: Compilation) -> StageResult:
     else:
         mission = load_mission(c.source)
     return StageResult(
-        compilation=dataclasses.replace(c, mission=mission),
+        products=provide(MISSION, mission),
         artifacts={"mission.json": mission.to_json()},
         sizes={"regions": len(mission.regions), "formula": str(mission.formula)},
     )
@@ -94,10 +183,10 @@ def _abstraction(c: Compilation) -> StageResult:
         build_abstraction,
     )
 
-    mission: Mission = _require(c.mission, "mission")
+    mission = c.get(MISSION)
     abstraction = build_abstraction(mission)
     return StageResult(
-        compilation=dataclasses.replace(c, abstraction=abstraction),
+        products=provide(ABSTRACTION, abstraction),
         artifacts={"abstraction.json": abstraction_to_json(abstraction)},
         sizes={
             "triangles": abstraction.num_triangles,
@@ -111,11 +200,11 @@ def _abstraction(c: Compilation) -> StageResult:
 def _automaton(c: Compilation) -> StageResult:
     from tlmpc.automata import automaton_to_json, to_hoa, translate
 
-    mission: Mission = _require(c.mission, "mission")
-    abstraction: Abstraction = _require(c.abstraction, "abstraction")
+    mission = c.get(MISSION)
+    abstraction = c.get(ABSTRACTION)
     automaton = translate(mission.formula, letters=abstraction.letters)
     return StageResult(
-        compilation=dataclasses.replace(c, automaton=automaton),
+        products=provide(AUTOMATON, automaton),
         artifacts={
             "automaton.json": automaton_to_json(automaton),
             "automaton.hoa": to_hoa(automaton),
@@ -131,9 +220,9 @@ def _automaton(c: Compilation) -> StageResult:
 def _plan(c: Compilation) -> StageResult:
     from tlmpc.planning import plan, witness_to_json
 
-    mission: Mission = _require(c.mission, "mission")
-    abstraction: Abstraction = _require(c.abstraction, "abstraction")
-    automaton: Automaton = _require(c.automaton, "automaton")
+    mission = c.get(MISSION)
+    abstraction = c.get(ABSTRACTION)
+    automaton = c.get(AUTOMATON)
     witness = plan(
         abstraction,
         automaton,
@@ -142,7 +231,7 @@ def _plan(c: Compilation) -> StageResult:
         start_point=mission.robot.start,
     )
     return StageResult(
-        compilation=dataclasses.replace(c, witness=witness),
+        products=provide(WITNESS, witness),
         artifacts={"witness.json": witness_to_json(witness, abstraction)},
         sizes={
             "prefix": len(witness.prefix),
@@ -157,13 +246,13 @@ def _plan(c: Compilation) -> StageResult:
 def _control(c: Compilation) -> StageResult:
     from tlmpc.control import controllers_to_json, synthesize
 
-    mission: Mission = _require(c.mission, "mission")
-    abstraction: Abstraction = _require(c.abstraction, "abstraction")
-    witness: Witness = _require(c.witness, "witness")
+    mission = c.get(MISSION)
+    abstraction = c.get(ABSTRACTION)
+    witness = c.get(WITNESS)
     controllers = synthesize(abstraction, witness, mission.robot)
     document = controllers_to_json(controllers)
     return StageResult(
-        compilation=dataclasses.replace(c, controllers=controllers),
+        products=provide(CONTROLLERS, controllers),
         artifacts={"controllers.json": document},
         sizes={"steps": len(document["steps"]), "jumps": len(document.get("jumps", []))},
     )
@@ -172,14 +261,14 @@ def _control(c: Compilation) -> StageResult:
 def _simulate(c: Compilation) -> StageResult:
     from tlmpc.simulate import simulate, trace_to_json
 
-    mission: Mission = _require(c.mission, "mission")
-    abstraction: Abstraction = _require(c.abstraction, "abstraction")
-    controllers: Controllers = _require(c.controllers, "controllers")
+    mission = c.get(MISSION)
+    abstraction = c.get(ABSTRACTION)
+    controllers = c.get(CONTROLLERS)
     trace = simulate(abstraction, controllers, mission)
     document = trace_to_json(trace, mission)
     points: list[list[float]] = document["points"]  # type: ignore[assignment]
     return StageResult(
-        compilation=dataclasses.replace(c, trace=trace, trace_document=document),
+        products=provide(TRACE, document),
         artifacts={"trace.json": document},
         sizes={"samples": len(points), "duration": round(float(points[-1][0]), 3)},
     )
@@ -188,7 +277,7 @@ def _simulate(c: Compilation) -> StageResult:
 def _verify(c: Compilation) -> StageResult:
     from tlmpc.verify import verdict_to_json, verify_document
 
-    document: Mapping[str, Any] = _require(c.trace_document, "trace")
+    document = c.get(TRACE)
     verdict = verify_document(dict(document))
     verdict_json = verdict_to_json(verdict)
     if not verdict_json["satisfied"]:
@@ -202,7 +291,6 @@ def _verify(c: Compilation) -> StageResult:
             )
         )
     return StageResult(
-        compilation=dataclasses.replace(c, verdict=verdict),
         artifacts={"verdict.json": verdict_json},
         sizes={"robustness": round(float(verdict.robustness), 6)},
     )
@@ -215,7 +303,6 @@ def _plot(c: Compilation) -> StageResult:
 
     png, svg = render_plan(c.documents)
     return StageResult(
-        compilation=c,
         artifacts={"plan.png": png, "plan.svg": svg},
         sizes={"png bytes": len(png), "svg bytes": len(svg)},
     )
@@ -228,14 +315,37 @@ class SelfCheckError(TlmpcError):
 
 
 STAGES: tuple[Stage, ...] = (
-    Stage(name="load", run=_load, aliases=("mission",)),
-    Stage(name="abstraction", run=_abstraction),
-    Stage(name="automaton", run=_automaton),
-    Stage(name="plan", run=_plan, aliases=("witness", "planning")),
-    Stage(name="control", run=_control, aliases=("controllers",)),
-    Stage(name="simulate", run=_simulate, aliases=("trace",)),
-    Stage(name="verify", run=_verify, aliases=("verdict",)),
-    Stage(name="plot", run=_plot),
+    Stage(name="load", run=_load, provides=(MISSION,), aliases=("mission",)),
+    Stage(name="abstraction", run=_abstraction, requires=(MISSION,), provides=(ABSTRACTION,)),
+    Stage(
+        name="automaton",
+        run=_automaton,
+        requires=(MISSION, ABSTRACTION),
+        provides=(AUTOMATON,),
+    ),
+    Stage(
+        name="plan",
+        run=_plan,
+        requires=(MISSION, ABSTRACTION, AUTOMATON),
+        provides=(WITNESS,),
+        aliases=("witness", "planning"),
+    ),
+    Stage(
+        name="control",
+        run=_control,
+        requires=(MISSION, ABSTRACTION, WITNESS),
+        provides=(CONTROLLERS,),
+        aliases=("controllers",),
+    ),
+    Stage(
+        name="simulate",
+        run=_simulate,
+        requires=(MISSION, ABSTRACTION, CONTROLLERS),
+        provides=(TRACE,),
+        aliases=("trace",),
+    ),
+    Stage(name="verify", run=_verify, requires=(TRACE,), aliases=("verdict",)),
+    Stage(name="plot", run=_plot, requires=(MISSION, ABSTRACTION, WITNESS, TRACE)),
 )
 
 
@@ -274,13 +384,14 @@ class CompileResult:
 
     def summary(self) -> dict[str, Any]:
         """The ``summary.json`` document (``tlmpc.summary/1``)."""
-        c = self.compilation
+        mission = self.compilation.find(MISSION)
+        witness = self.compilation.find(WITNESS)
         summary: dict[str, Any] = {
             "format": "tlmpc.summary/1",
             "tool": {"name": "tlmpc", "version": __version__},
-            "mission": c.mission.name if c.mission else None,
-            "source": str(c.source),
-            "formula": str(c.mission.formula) if c.mission else None,
+            "mission": mission.name if mission else None,
+            "source": str(self.compilation.source),
+            "formula": str(mission.formula) if mission else None,
             "stages": [
                 {"name": r.name, "seconds": round(r.seconds, 6), "sizes": dict(r.sizes)}
                 for r in self.reports
@@ -289,13 +400,13 @@ class CompileResult:
             "artifacts": sorted([*self.artifacts, "summary.json"]),
             "warnings": [w.to_json() for w in self.warnings],
         }
-        if c.witness is not None:
+        if witness is not None:
             summary["plan"] = {
-                "prefix_length": len(c.witness.prefix),
-                "cycle_length": len(c.witness.cycle),
-                "stay": c.witness.is_stay,
-                "cost": c.witness.cost,
-                "metric": c.witness.metric,
+                "prefix_length": len(witness.prefix),
+                "cycle_length": len(witness.cycle),
+                "stay": witness.is_stay,
+                "cost": witness.cost,
+                "metric": witness.metric,
             }
         verdict_doc = self.artifacts.get("verdict.json")
         if verdict_doc is not None:
@@ -328,6 +439,47 @@ def collector_paused() -> Iterator[None]:
             gc.enable()
 
 
+def run_stages(
+    stages: Sequence[Stage],
+    compilation: Compilation,
+    *,
+    progress: ProgressFn | None = None,
+) -> CompileResult:
+    """Run ``stages`` in order on ``compilation``, checking each one's requires and provides."""
+    artifacts: dict[str, Any] = dict(compilation.documents)
+    written: dict[str, Any] = {}
+    products: dict[Product[Any], Any] = dict(compilation.products)
+    reports: list[StageReport] = []
+    warnings: list[Diagnostic] = []
+    for index, stage in enumerate(stages, start=1):
+        for product in stage.requires:
+            compilation.get(product)  # a clear error instead of a failure deep inside
+        started = time.perf_counter()
+        result = stage.run(compilation)
+        report = StageReport(
+            name=stage.name, seconds=time.perf_counter() - started, sizes=result.sizes
+        )
+        missing = [p.name for p in stage.provides if p not in result.products]
+        if missing:  # a programming error: the stage list and the stage disagree
+            raise RuntimeError(f"stage {stage.name} did not provide {', '.join(missing)}")
+        products.update(result.products)
+        artifacts.update(result.artifacts)
+        written.update(result.artifacts)
+        compilation = dataclasses.replace(
+            compilation, products=dict(products), documents=dict(artifacts)
+        )
+        warnings.extend(result.warnings)
+        reports.append(report)
+        if progress is not None:
+            progress(index, len(stages), report)
+    return CompileResult(
+        compilation=compilation,
+        artifacts=written,
+        reports=tuple(reports),
+        warnings=tuple(warnings),
+    )
+
+
 def compile_mission(
     source: Path | str,
     *,
@@ -338,31 +490,63 @@ def compile_mission(
     """Run the stages of :data:`STAGES` (up to ``until``) on the mission file ``source``.
 
     With ``text``, the mission is that YAML text and ``source`` only names it in diagnostics.
-
     Raises the stage's :class:`~tlmpc.errors.TlmpcError` when one fails; nothing is written
     here (the CLI writes the returned artifacts atomically).
     """
-    stages = stages_until(until)
     compilation = Compilation(source=Path(source), text=text)
-    artifacts: dict[str, Any] = {}
-    reports: list[StageReport] = []
-    warnings: list[Diagnostic] = []
-    with collector_paused():
-        for index, stage in enumerate(stages, start=1):
-            started = time.perf_counter()
-            result = stage.run(compilation)
-            report = StageReport(
-                name=stage.name, seconds=time.perf_counter() - started, sizes=result.sizes
+    return run_stages(stages_until(until), compilation, progress=progress)
+
+
+def stage_named(name: str) -> Stage:
+    """The stage called ``name`` (or one of its aliases); ValueError when there is none."""
+    for stage in STAGES:
+        if name == stage.name or name in stage.aliases:
+            return stage
+    raise ValueError(name)
+
+
+def compilation_from_artifacts(directory: Path, needed: Sequence[Product[Any]]) -> Compilation:
+    """A compilation holding the ``needed`` products, read from the artifacts in ``directory``.
+
+    Every artifact is checked against its schema first; a missing or invalid one is a
+    diagnostic naming the file.
+    """
+    from tlmpc.artifacts import read_json, validation_errors
+
+    products: dict[Product[Any], Any] = {}
+    documents: dict[str, Any] = {}
+    for product in needed:
+        path = directory / product.artifact
+        if not path.is_file():
+            raise MissingProductError(
+                error(
+                    "U012",
+                    f"{path} is missing: the {product.name} is needed",
+                    file=str(path),
+                    hint="run the earlier stages first (tlmpc compile --until ...)",
+                )
             )
-            artifacts.update(result.artifacts)
-            compilation = dataclasses.replace(result.compilation, documents=dict(artifacts))
-            warnings.extend(result.warnings)
-            reports.append(report)
-            if progress is not None:
-                progress(index, len(stages), report)
-    return CompileResult(
-        compilation=compilation,
-        artifacts=artifacts,
-        reports=tuple(reports),
-        warnings=tuple(warnings),
-    )
+        document = read_json(path)
+        problems = validation_errors(document, product.schema)
+        if problems:
+            raise MissingProductError(
+                error(
+                    "U003",
+                    f"{product.artifact} does not match its schema: {problems[0]}",
+                    file=str(path),
+                    hint="artifacts are written by `tlmpc compile`; was this file edited?",
+                )
+            )
+        products[product] = product.read(document)
+        documents[product.artifact] = document
+    source = Path(str(documents.get("mission.json", {}).get("source") or directory))
+    return Compilation(source=source, products=products, documents=documents)
+
+
+def run_stage_from_artifacts(
+    name: str, directory: Path, *, progress: ProgressFn | None = None
+) -> CompileResult:
+    """Run the one stage ``name`` on the input artifacts found in ``directory``."""
+    stage = stage_named(name)
+    compilation = compilation_from_artifacts(directory, stage.requires)
+    return run_stages([stage], compilation, progress=progress)

@@ -31,6 +31,7 @@ from tlmpc.control.synthesize import (
 )
 from tlmpc.errors import InvalidInputError
 from tlmpc.mission.model import Robot
+from tlmpc.pipeline import ABSTRACTION, CONTROLLERS, MISSION, WITNESS
 from tlmpc.planning.model import Witness
 from tlmpc.simulate.exact import (
     _exit_step,
@@ -244,13 +245,11 @@ def test_continuity_and_jumps_on_a_real_plan(specs_dir: object) -> None:
     from tlmpc.pipeline import compile_mission
 
     result = compile_mission(Path(str(specs_dir)) / "patrol.yaml", until="control")
-    controllers = result.compilation.controllers
-    assert controllers is not None
+    controllers = result.compilation.get(CONTROLLERS)
     document = controllers_to_json(controllers)
     assert validation_errors(document, "controllers") == []
     jumped = {(j.step, j.vertex) for j in controllers.jumps}
-    abstraction = result.compilation.abstraction
-    assert abstraction is not None
+    abstraction = result.compilation.get(ABSTRACTION)
     steps = controllers.steps
     shared_equal = 0
     for k in range(1, len(steps)):
@@ -278,13 +277,10 @@ def test_lasso_without_prefix_loops_from_the_second_lap(specs_dir: object) -> No
 
     result = compile_mission(Path(str(specs_dir)) / "patrol.yaml", until="plan")
     abstraction, witness, mission = (
-        result.compilation.abstraction,
-        result.compilation.witness,
-        result.compilation.mission,
+        result.compilation.get(ABSTRACTION),
+        result.compilation.get(WITNESS),
+        result.compilation.get(MISSION),
     )
-    assert abstraction is not None
-    assert witness is not None
-    assert mission is not None
     loop = dataclasses.replace(witness, prefix=(), prefix_states=())
     x, y = abstraction.corners(loop.cycle[0]).mean(axis=0).tolist()
     robot = dataclasses.replace(mission.robot, start=(x, y))
@@ -331,9 +327,7 @@ def test_clarabel_conic_form_matches_cvxpy(specs_dir: object, spec: str, max_spe
     from tlmpc.pipeline import compile_mission
 
     result = compile_mission(Path(str(specs_dir)) / f"{spec}.yaml", until="plan")
-    abstraction, witness = result.compilation.abstraction, result.compilation.witness
-    assert abstraction is not None
-    assert witness is not None
+    abstraction, witness = result.compilation.get(ABSTRACTION), result.compilation.get(WITNESS)
     steps, loop_start = plan_steps(abstraction, witness)
     _assign_runs(abstraction, steps, loop_start)
     program, _ = vertex_program(steps, max_speed)
@@ -430,8 +424,7 @@ def test_solved_fields_meet_the_stated_vertex_conditions(specs_dir: object, spec
     from tlmpc.pipeline import compile_mission
 
     result = compile_mission(Path(str(specs_dir)) / spec, until="control")
-    controllers = result.compilation.controllers
-    assert controllers is not None
+    controllers = result.compilation.get(CONTROLLERS)
     tolerance = 1e-6 * controllers.max_speed
     for c in controllers.steps:
         v = c.vertices

@@ -16,7 +16,7 @@ from hypothesis import HealthCheck, given, settings
 from strategies import missions
 
 from tlmpc.errors import NoPlanError
-from tlmpc.pipeline import compile_mission
+from tlmpc.pipeline import TRACE, compile_mission
 from tlmpc.verify import verdict_to_json, verify_document
 
 
@@ -31,7 +31,7 @@ def test_every_compiled_trace_verifies(document: dict[str, Any], tmp_path: Path)
         codes = [d.code for d in exc.diagnostics]
         assert all(code.startswith("P") for code in codes), codes
         return
-    trace = result.compilation.trace_document
+    trace = result.compilation.get(TRACE)
     assert trace is not None
     for boundary in ("right", "closed"):
         verdict = verdict_to_json(verify_document(dict(trace), boundary=boundary))

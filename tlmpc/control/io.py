@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from typing import Any
 
-from tlmpc.control.model import Controllers
+import numpy as np
+
+from tlmpc.control.model import Controllers, StepController, VelocityJump
 
 FORMAT = "tlmpc.controllers/1"
 
@@ -40,3 +43,50 @@ def controllers_to_json(controllers: Controllers) -> dict[str, Any]:
         ],
         "stats": dict(controllers.stats),
     }
+
+
+def _array(value: Any, shape: tuple[int, ...]) -> np.ndarray[Any, np.dtype[np.float64]]:
+    array = np.asarray(value, dtype=np.float64).reshape(shape)
+    array.setflags(write=False)
+    return array
+
+
+def _point(value: Any) -> tuple[float, float]:
+    return float(value[0]), float(value[1])
+
+
+def controllers_from_json(document: Mapping[str, Any]) -> Controllers:
+    """Rebuild the :class:`Controllers` written by :func:`controllers_to_json`."""
+    return Controllers(
+        steps=tuple(
+            StepController(
+                step=int(s["step"]),
+                triangle=int(s["triangle"]),
+                exit_edge=s["exit_edge"],
+                next_triangle=s["next_triangle"],
+                vertices=_array(s["vertices"], (3, 2)),
+                velocities=_array(s["vertex_velocities"], (3, 2)),
+                gain=_array(s["K"], (2, 2)),
+                offset=_array(s["g"], (2,)),
+                exit_speed=float(s["exit_speed"]),
+                exit_time_bound=(
+                    math.inf if s["exit_time_bound"] is None else float(s["exit_time_bound"])
+                ),
+                target=None if s["target"] is None else _point(s["target"]),
+            )
+            for s in document["steps"]
+        ),
+        loop_start=document["loop_start"],
+        max_speed=float(document["max_speed"]),
+        margin=float(document["margin"]),
+        jumps=tuple(
+            VelocityJump(
+                step=int(j["step"]),
+                vertex=int(j["vertex"]),
+                position=_point(j["position"]),
+                reason=j["reason"],
+            )
+            for j in document["jumps"]
+        ),
+        stats=dict(document.get("stats", {})),
+    )

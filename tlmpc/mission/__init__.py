@@ -1,5 +1,6 @@
 """Mission files: the format, loading with positions, validation."""
 
+from tlmpc.mission.io import mission_from_json
 from tlmpc.mission.load import (
     check_file,
     check_text,
@@ -20,4 +21,5 @@ __all__ = [
     "inspect_file",
     "load_mission",
     "load_mission_text",
+    "mission_from_json",
 ]

@@ -1,0 +1,47 @@
+"""``mission.json`` (``tlmpc.mission/1``) read back into a :class:`Mission`."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+from tlmpc.mission.model import Mission, Options, Polygon, Region, Robot, Workspace
+
+
+def _polygon(points: Sequence[Sequence[float]]) -> Polygon:
+    return tuple((float(x), float(y)) for x, y in points)
+
+
+def mission_from_json(document: Mapping[str, Any]) -> Mission:
+    """Rebuild the :class:`Mission` written by :meth:`Mission.to_json`.
+
+    The formula is parsed again from its text (positions then refer to ``mission.json``).
+    """
+    from tlmpc.ltl.parser import parse_ltl
+
+    options = document["options"]
+    robot = document["robot"]
+    return Mission(
+        name=document["name"],
+        workspace=Workspace(
+            boundary=_polygon(document["workspace"]["boundary"]),
+            holes=tuple(_polygon(h) for h in document["workspace"]["holes"]),
+        ),
+        regions=tuple(
+            Region(name=name, polygon=_polygon(points))
+            for name, points in document["regions"].items()
+        ),
+        robot=Robot(start=_polygon([robot["start"]])[0], max_speed=float(robot["max_speed"])),
+        formula=parse_ltl(document["formula"], file="mission.json"),
+        groups={name: tuple(members) for name, members in document["groups"].items()},
+        task=tuple(document["task"]),
+        ltl=document["ltl"],
+        options=Options(
+            min_angle=options["min_angle"],
+            max_area=options["max_area"],
+            cost=options["cost"],
+            beta=float(options["beta"]),
+            boundary=options["boundary"],
+        ),
+        source=document["source"],
+    )
