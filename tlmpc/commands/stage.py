@@ -1,0 +1,71 @@
+"""``tlmpc stage NAME DIR``: run one stage alone on the input artifacts of an output directory."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+from typing import Any, TextIO
+
+NAME = "stage"
+HELP = "run one compiler stage alone from its input artifacts"
+DESCRIPTION = """\
+Run the stage NAME (load is the only stage that reads the mission file; every other stage
+reads its inputs from the artifacts in DIR, each checked against its schema) and write the
+artifacts it produces into DIR, or into OUT with -o.  Each file is replaced atomically, so a
+failed run leaves DIR as it was.  For example, after editing controllers.json by hand,
+`tlmpc stage simulate out` re-simulates and `tlmpc stage verify out` re-checks."""
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Register the command's flags."""
+    from tlmpc.pipeline import STAGES
+
+    names = [stage.name for stage in STAGES if stage.requires]
+    parser.add_argument("name", choices=names, metavar="NAME", help="one of: %(choices)s")
+    parser.add_argument("directory", type=Path, metavar="DIR", help="a tlmpc output directory")
+    parser.add_argument(
+        "-o", "--out", type=Path, help="write the new artifacts here instead (an existing dir)"
+    )
+    parser.add_argument("--json", action="store_true", help="print the stage report as JSON")
+
+
+def _bytes(content: Any) -> bytes:
+    from tlmpc.artifacts import dumps
+
+    if isinstance(content, bytes):
+        return content
+    if isinstance(content, str):
+        return content.encode("utf-8")
+    return dumps(content).encode("utf-8")
+
+
+def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
+    """Run the stage and write what it produced."""
+    from tlmpc.errors import UsageError, error
+    from tlmpc.output import replace_file
+    from tlmpc.pipeline import run_stage_from_artifacts
+
+    target: Path = args.out if args.out is not None else args.directory
+    if not target.is_dir():
+        raise UsageError(
+            error("U021", f"{target} is not a directory", hint="create it first", file=str(target))
+        )
+    result = run_stage_from_artifacts(args.name, args.directory)
+    for warning in result.warnings:
+        err.write(warning.format() + "\n")
+    for name, content in result.artifacts.items():
+        replace_file(target / name, _bytes(content))
+    report = result.reports[0]
+    if args.json:
+        document = {
+            "stage": report.name,
+            "seconds": report.seconds,
+            "sizes": dict(report.sizes),
+            "artifacts": sorted(result.artifacts),
+        }
+        out.write(json.dumps(document, indent=2, sort_keys=True, default=str) + "\n")
+    else:
+        written = ", ".join(sorted(result.artifacts)) or "nothing"
+        err.write(f"{report.name}: {report.seconds:.3f} s; wrote {written} to {target}\n")
+    return 0
