@@ -54,11 +54,18 @@ def triangle_geometry(vertices: FloatArray) -> TriangleGeometry:
 
 
 def affine_law(vertices: FloatArray, velocities: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """K, g with K v_i + g = w_i for the three vertices (the unique affine interpolant)."""
-    system = np.hstack([vertices, np.ones((3, 1))])
+    """K, g with K v_i + g = w_i for the three vertices (the unique affine interpolant).
+
+    Solved in the triangle's own frame (centred, unit size): in map coordinates the system
+    mixes the triangle's size with its distance from the origin and loses digits far out.
+    """
+    center = vertices.mean(axis=0)
+    size = float(np.abs(vertices - center).max())
+    local = (vertices - center) / size
+    system = np.hstack([local, np.ones((3, 1))])
     solution = np.asarray(np.linalg.solve(system, velocities), dtype=np.float64)
-    gain: FloatArray = solution[:2].T.copy()
-    offset: FloatArray = solution[2].copy()
+    gain: FloatArray = np.ascontiguousarray(solution[:2].T / size)
+    offset: FloatArray = solution[2] - gain @ center
     return gain, offset
 
 

@@ -273,7 +273,10 @@ def solve_vertex_program(program: VertexProgram) -> tuple[FloatArray, FloatArray
         )
     )
     cone_offsets = np.zeros(3 * count)
-    cone_offsets[::3] = program.max_speed
+    # Solved at unit speed and scaled back below: the solver's absolute tolerances (1e-8) are
+    # then relative to max_speed, whatever its magnitude (at 1e-9 m/s they would swamp it).
+    # Triangle sizes never enter: the rows hold unit normals and barycentric weights.
+    cone_offsets[::3] = 1.0
     offsets.append(cone_offsets)
     cones += [clarabel.SecondOrderConeT(3)] * count
     constraints = sp.vstack(blocks, format="csc")
@@ -300,8 +303,54 @@ def solve_vertex_program(program: VertexProgram) -> tuple[FloatArray, FloatArray
                 hint="please report this mission",
             )
         )
-    values = np.asarray(solution.x, dtype=np.float64)
-    return values[: 2 * count].reshape(count, 2), values[2 * count : size]
+    values = np.asarray(solution.x, dtype=np.float64) * program.max_speed
+    velocities, speeds = values[: 2 * count].reshape(count, 2), values[2 * count : size]
+    # The solver meets |w| <= 1 only to its tolerance.  Every other constraint is homogeneous,
+    # so one common scale makes the speed bound exact and keeps them all.
+    largest = float(np.linalg.norm(velocities, axis=1).max()) if count else 0.0
+    if largest > program.max_speed:
+        shrink = program.max_speed / largest * (1.0 - 4 * np.finfo(np.float64).eps)
+        velocities, speeds = velocities * shrink, speeds * shrink
+    return velocities, speeds
+
+
+#: The re-check after solving demands each guarantee with this much to spare, relative to
+#: max_speed: a condition met only to the solver's tolerance is not met.
+RECHECK_TOLERANCE = 1e-9
+
+
+def _violated_condition(controller: StepController, max_speed: float) -> str | None:
+    """Which vertex condition the solved field breaks (None when all hold), re-derived from the
+    triangle: speed bound, exit across the planned facet, invariance of the two others; for a
+    stay, inward on every facet, equilibrium at its target and a Hurwitz gain."""
+    geometry = triangle_geometry(controller.vertices)
+    w = controller.velocities
+    floor = RECHECK_TOLERANCE * max_speed
+    fastest = float(np.linalg.norm(w, axis=1).max())
+    if fastest > max_speed * (1.0 + RECHECK_TOLERANCE):
+        return f"a vertex speed {fastest:.6g} exceeds max_speed {max_speed:.6g}"
+    for i in range(3):
+        for facet in range(3):
+            if facet == i:
+                continue
+            across = float(geometry.normals[facet] @ w[i])
+            if facet == controller.exit_edge and across <= floor:
+                return f"vertex {i} does not move across the exit facet (speed {across:.3g})"
+            if facet != controller.exit_edge and -across <= floor:
+                return f"vertex {i} is not pushed inside facet {facet} (inward {-across:.3g})"
+    if controller.exit_edge is not None:
+        if float(geometry.normals[controller.exit_edge] @ w[controller.exit_edge]) <= floor:
+            return "the vertex opposite the exit does not move toward it"
+        return None
+    assert controller.target is not None
+    target = np.asarray(controller.target)
+    if float(np.linalg.norm(controller.gain @ target + controller.offset)) > floor:
+        return "the stay field does not vanish at its target"
+    if float(geometry.barycentric(target).min()) <= 0.0:
+        return "the stay target is not inside the triangle"
+    if float(np.max(np.linalg.eigvals(controller.gain).real)) >= 0.0:
+        return "the stay field's gain is not Hurwitz"
+    return None
 
 
 def synthesize(abstraction: Abstraction, witness: Witness, robot: Robot) -> Controllers:
@@ -331,7 +380,10 @@ def synthesize(abstraction: Abstraction, witness: Witness, robot: Robot) -> Cont
                 )
             gain, offset = affine_law(geometry.vertices, w)
             speed, bound = float(inward), float("inf")
-            target = (float(center[0]), float(center[1]))
+            # The field's own equilibrium (the program puts it at the incenter, to the
+            # solver's tolerance): the state converges there, so that is the target.
+            equilibrium = np.linalg.solve(gain, -offset)
+            target = (float(equilibrium[0]), float(equilibrium[1]))
         else:
             gain, offset = affine_law(geometry.vertices, w)
             delta = float(min(geometry.normals[step.exit_edge] @ w[i] for i in range(3)))
@@ -352,6 +404,18 @@ def synthesize(abstraction: Abstraction, witness: Witness, robot: Robot) -> Cont
                 target=target,
             )
         )
+    for controller in controllers:
+        problem = _violated_condition(controller, robot.max_speed)
+        if problem is not None:
+            raise SolverError(
+                error(
+                    "C030",
+                    f"plan step {controller.step} (triangle {controller.triangle}): the solved "
+                    f"field fails the re-check: {problem}",
+                    hint="the triangle may be a needle: raise options.min_angle, or report "
+                    "this mission",
+                )
+            )
     if any(c.exit_speed <= 0 for c in controllers):
         worst = min(controllers, key=lambda c: c.exit_speed)
         raise SolverError(

@@ -17,6 +17,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import NoReturn
 
 import numpy as np
 
@@ -34,6 +35,9 @@ GRID_POINTS = 128
 GRID_CHUNK = 16
 #: Largest |sM| over which the exit is sought with a Taylor polynomial in s (else expm).
 SERIES_RADIUS = 2.0
+#: How far (relative to the triangle's size) a state may lie beyond a facet it must not cross
+#: before the simulation reports a wrong exit: rounding, not dynamics, at this scale.
+WRONG_FACET_TOLERANCE = 1e-9
 #: A stay is simulated until the distance to its target shrinks by this factor.
 STAY_CONTRACTION = 1e-6
 
@@ -203,9 +207,19 @@ def _exit_step(controller: StepController, x0: FloatArray) -> tuple[list[float],
     state = np.array([y0[0], y0[1], 1.0])
     inside: list[FloatArray] = []  # grid states before the crossing, in chunks
     bracket = None
+    # The other two facets, watched too: a field that leaves by an unplanned facet is a bug the
+    # simulation must report, not hide by snapping the crossing onto the planned edge.
+    others = [j for j in range(3) if j != controller.exit_edge]
+    other_normals = geometry.normals[others]
+    other_offsets = geometry.offsets[others] - other_normals @ center
+    slack = WRONG_FACET_TOLERANCE * float(geometry.heights.max())
     for first in range(0, GRID_POINTS, GRID_CHUNK):
         states = stack @ state
         hits = np.flatnonzero(states[:, :2] @ normal - offset >= 0.0)
+        beyond = (states[:, :2] @ other_normals.T - other_offsets).max(axis=1)
+        outside = np.flatnonzero(beyond > slack)
+        if outside.size and (not hits.size or outside[0] < hits[0]):
+            _wrong_exit(controller, others, states[int(outside[0]), :2] + center)
         if hits.size:
             k = int(hits[0])
             inside.append(states[:k])
@@ -241,9 +255,23 @@ def _exit_step(controller: StepController, x0: FloatArray) -> tuple[list[float],
     # Snap onto the exit edge (the root is exact to ~1e-14; this removes the residue).
     a = geometry.vertices[(controller.exit_edge + 1) % 3]
     b = geometry.vertices[(controller.exit_edge + 2) % 3]
-    along = float(np.clip((end - a) @ (b - a) / ((b - a) @ (b - a)), 0.0, 1.0))
-    end = a + along * (b - a)
+    along = float((end - a) @ (b - a) / ((b - a) @ (b - a)))
+    if not -WRONG_FACET_TOLERANCE <= along <= 1.0 + WRONG_FACET_TOLERANCE:
+        _wrong_exit(controller, others, end)
+    end = a + float(np.clip(along, 0.0, 1.0)) * (b - a)
     return [*times, float(crossing)], [*points, end]
+
+
+def _wrong_exit(controller: StepController, facets: list[int], where: FloatArray) -> NoReturn:
+    raise SolverError(
+        error(
+            "C031",
+            f"plan step {controller.step}: the field leaves triangle {controller.triangle} "
+            f"across facet {' or '.join(map(str, facets))} near ({where[0]:.6g}, {where[1]:.6g}), "
+            f"not through the planned exit facet {controller.exit_edge}",
+            hint="please report this mission; the controllers do not realise the plan",
+        )
+    )
 
 
 def _stay_step(
