@@ -469,3 +469,23 @@ def test_exit_speed_is_the_best_the_vertex_conditions_allow(
     assert best is not None
     assert best > 0
     assert step.exit_speed >= float(best) * (1 - 1e-5)
+
+
+@settings(deadline=None, max_examples=30)
+@given(triangles(), st.integers(0, 2), st.integers(1, 2), st.data())
+def test_a_field_leaving_by_an_unplanned_facet_is_reported(
+    v: np.ndarray, exit_edge: int, shift: int, data: st.DataObject
+) -> None:
+    """The simulator never snaps a wrong exit onto the planned edge."""
+    from tlmpc.errors import SolverError
+
+    controller = _exit_controller(v, exit_edge, 1.0)
+    wrong = dataclasses.replace(controller, exit_edge=(exit_edge + shift) % 3)
+    x0 = _random_point(data.draw, v)
+    geometry = triangle_geometry(v)
+    assume(geometry.barycentric(x0).min() > 1e-3)  # strictly inside: the real exit comes later
+    with pytest.raises(SolverError) as caught:
+        _exit_step(wrong, x0)
+    # C031 when it crosses the wrong facet within the horizon, C010 when the horizon (set by
+    # the planned edge) ends first: an error either way, never a crossing snapped into place
+    assert caught.value.diagnostics[0].code in {"C031", "C010"}
