@@ -163,7 +163,7 @@ def compile(
         if until not in stage_names():
             raise UsageError(
                 error(
-                    "U010",
+                    "U072",
                     f"unknown stage {until!r}",
                     hint="one of: " + ", ".join(stage_names()),
                 )
@@ -198,7 +198,7 @@ def read_output(directory: str | os.PathLike[str]) -> Compiled:
         if problems:
             raise InvalidInputError(
                 error(
-                    "U003",
+                    "U071",
                     f"{name} does not match its schema: {problems[0]}",
                     file=str(path),
                     hint="artifacts are written by `tlmpc compile`; was this file edited?",
@@ -208,7 +208,7 @@ def read_output(directory: str | os.PathLike[str]) -> Compiled:
     if "mission.json" not in artifacts:
         raise UsageError(
             error(
-                "U001",
+                "U020",
                 f"{root} holds no tlmpc output (no mission.json)",
                 file=str(root),
                 hint="pass the directory given to `tlmpc compile -o`",
@@ -237,7 +237,7 @@ def verify_trace(
         document = trace.artifacts.get("trace.json")
         if document is None:
             raise UsageError(
-                error("U010", "this compilation stopped before the simulate stage")
+                error("U073", "this compilation stopped before the simulate stage")
             )
         return check_trace(from_document(document, convention=boundary))
     if isinstance(trace, Mapping):

@@ -123,7 +123,7 @@ class Compilation:
         except KeyError:
             raise MissingProductError(
                 error(
-                    "U012",
+                    "U070",
                     f"the {product.name} is not available ({product.artifact} is missing)",
                     hint="run the earlier stages first (tlmpc compile --until ...)",
                 )
@@ -520,7 +520,7 @@ def compilation_from_artifacts(directory: Path, needed: Sequence[Product[Any]]) 
         if not path.is_file():
             raise MissingProductError(
                 error(
-                    "U012",
+                    "U070",
                     f"{path} is missing: the {product.name} is needed",
                     file=str(path),
                     hint="run the earlier stages first (tlmpc compile --until ...)",
@@ -531,7 +531,7 @@ def compilation_from_artifacts(directory: Path, needed: Sequence[Product[Any]]) 
         if problems:
             raise MissingProductError(
                 error(
-                    "U003",
+                    "U071",
                     f"{product.artifact} does not match its schema: {problems[0]}",
                     file=str(path),
                     hint="artifacts are written by `tlmpc compile`; was this file edited?",

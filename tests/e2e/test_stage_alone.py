@@ -53,7 +53,7 @@ def test_a_stage_without_its_inputs_names_the_missing_artifact(tmp_path: Path) -
         cwd=ROOT,
     )
     assert done.returncode == 2
-    assert "error[U012]" in done.stderr
+    assert "error[U070]" in done.stderr
     assert "witness.json" in done.stderr
     assert "Traceback" not in done.stderr
 
@@ -72,4 +72,4 @@ def test_a_tampered_input_artifact_is_rejected_by_its_schema(tmp_path: Path) -> 
     )
     assert done.returncode == 2
     assert "controllers.json" in done.stderr
-    assert "error[U003]" in done.stderr
+    assert "error[U071]" in done.stderr

@@ -49,7 +49,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     target: Path = args.out if args.out is not None else args.directory
     if not target.is_dir():
         raise UsageError(
-            error("U021", f"{target} is not a directory", hint="create it first", file=str(target))
+            error("U074", f"{target} is not a directory", hint="create it first", file=str(target))
         )
     result = run_stage_from_artifacts(args.name, args.directory)
     for warning in result.warnings:
