@@ -489,3 +489,36 @@ def test_a_field_leaving_by_an_unplanned_facet_is_reported(
     # C031 when it crosses the wrong facet within the horizon, C010 when the horizon (set by
     # the planned edge) ends first: an error either way, never a crossing snapped into place
     assert caught.value.diagnostics[0].code in {"C031", "C010"}
+
+
+@settings(deadline=None, max_examples=30)
+@given(triangles(), st.integers(0, 2))
+def test_the_recheck_finds_every_broken_vertex_condition(v: np.ndarray, exit_edge: int) -> None:
+    """The re-check after solving rejects a field that breaks any one vertex condition."""
+    from tlmpc.control.geometry import affine_law
+    from tlmpc.control.synthesize import _violated_condition
+
+    controller = _exit_controller(v, exit_edge, 1.0)
+    assert _violated_condition(controller, 1.0) is None
+    geometry = triangle_geometry(v)
+
+    def with_velocity(vertex: int, velocity: np.ndarray) -> StepController:
+        w = controller.velocities.copy()
+        w[vertex] = velocity
+        gain, offset = affine_law(v, w)
+        return dataclasses.replace(controller, velocities=w, gain=gain, offset=offset)
+
+    too_fast = with_velocity(
+        0, controller.velocities[0] * 1.01 / np.linalg.norm(controller.velocities[0])
+    )
+    assert _violated_condition(too_fast, 1.0) is not None
+    for vertex in range(3):
+        for facet in range(3):
+            if facet == vertex:
+                continue
+            tangent = v[(facet + 2) % 3] - v[(facet + 1) % 3]
+            sliding = with_velocity(vertex, 0.5 * tangent / np.linalg.norm(tangent))
+            # Along a facet: neither across the exit nor strictly inside another facet.
+            assert _violated_condition(sliding, 1.0) is not None, (vertex, facet)
+    backwards = with_velocity(exit_edge, -0.5 * geometry.normals[exit_edge])
+    assert _violated_condition(backwards, 1.0) is not None
