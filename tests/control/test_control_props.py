@@ -103,8 +103,8 @@ def two_triangle_plan(v: np.ndarray, exit_edge: int, *, stay: bool) -> tuple[Abs
     return abstraction, witness
 
 
-def _random_point(draw: st.DrawFn, v: np.ndarray) -> np.ndarray:
-    weights = np.array([draw(st.floats(0, 1)) for _ in range(3)]) + 1e-12
+def _random_point(data: st.DataObject, v: np.ndarray) -> np.ndarray:
+    weights = np.array([data.draw(st.floats(0, 1)) for _ in range(3)]) + 1e-12
     weights /= weights.sum()
     return weights @ v  # type: ignore[no-any-return]
 
@@ -124,9 +124,9 @@ def test_every_state_leaves_through_the_planned_edge(
     # speed bound at random points of the triangle (the field is affine: vertices suffice,
     # random points check the interpolation)
     for _ in range(5):
-        x = _random_point(data.draw, v)
+        x = _random_point(data, v)
         assert np.linalg.norm(controller.gain @ x + controller.offset) <= speed * (1 + 1e-7)
-    x0 = _random_point(data.draw, v)
+    x0 = _random_point(data, v)
     times, points = _exit_step(controller, x0)
     crossing_time, exit_point = times[-1], points[-1]
     assert crossing_time <= controller.exit_time_bound * (1 + 1e-9)
@@ -148,7 +148,7 @@ def test_every_state_leaves_through_the_planned_edge(
 @given(triangles(), st.integers(0, 2), st.data())
 def test_exact_simulation_matches_rk45(v: np.ndarray, exit_edge: int, data: st.DataObject) -> None:
     controller = _exit_controller(v, exit_edge, 1.0)
-    x0 = _random_point(data.draw, v)
+    x0 = _random_point(data, v)
     times, points = _exit_step(controller, x0)
     geometry = triangle_geometry(v)
     normal, offset = geometry.normals[exit_edge], geometry.offsets[exit_edge]
@@ -202,11 +202,12 @@ def test_stay_fields_converge_inside(v: np.ndarray, data: st.DataObject) -> None
     target = np.asarray(controller.target)
     assert np.allclose(controller.gain @ target + controller.offset, 0.0, atol=1e-7)
     geometry = triangle_geometry(v)
-    x0 = _random_point(data.draw, v)
+    x0 = _random_point(data, v)
     _, points = _stay_step(controller, x0, 1.0)
     for point in points:
         assert geometry.barycentric(point).min() > -1e-9
-    assert np.linalg.norm(points[-2] - target) <= 1e-5 * max(1.0, np.linalg.norm(x0 - target))
+    distance = float(np.linalg.norm(x0 - target))
+    assert np.linalg.norm(points[-2] - target) <= 1e-5 * max(1.0, distance)
 
 
 def test_small_matrix_exponential_matches_scipy() -> None:
@@ -377,7 +378,7 @@ def test_exit_steps_far_from_the_origin_are_translates(
     far = dataclasses.replace(
         near, vertices=near.vertices + shift, offset=near.offset - near.gain @ [shift, shift]
     )
-    x0 = _random_point(data.draw, v)
+    x0 = _random_point(data, v)
     near_times, near_points = _exit_step(near, x0)
     far_times, far_points = _exit_step(far, x0 + shift)
     # rounding of coordinates of size |shift| moves the crossing by ~1e-16 |shift| / speed
@@ -481,7 +482,7 @@ def test_a_field_leaving_by_an_unplanned_facet_is_reported(
 
     controller = _exit_controller(v, exit_edge, 1.0)
     wrong = dataclasses.replace(controller, exit_edge=(exit_edge + shift) % 3)
-    x0 = _random_point(data.draw, v)
+    x0 = _random_point(data, v)
     geometry = triangle_geometry(v)
     assume(geometry.barycentric(x0).min() > 1e-3)  # strictly inside: the real exit comes later
     with pytest.raises(SolverError) as caught:
