@@ -249,7 +249,7 @@ def _control(c: Compilation) -> StageResult:
     mission = c.get(MISSION)
     abstraction = c.get(ABSTRACTION)
     witness = c.get(WITNESS)
-    controllers = synthesize(abstraction, witness, mission.robot)
+    controllers = synthesize(abstraction, witness, mission.robot, source=mission.source)
     document = controllers_to_json(controllers)
     return StageResult(
         products=provide(CONTROLLERS, controllers),

@@ -79,3 +79,25 @@ def half_plane_feasible(normals: list[FloatArray]) -> bool:
     angles = np.sort(np.array([np.arctan2(a[1], a[0]) for a in normals]))
     gaps = np.diff(np.concatenate([angles, [angles[0] + 2 * np.pi]]))
     return bool(gaps.max() > np.pi + 1e-9)
+
+
+def best_push(normals: list[FloatArray], max_speed: float) -> float:
+    """max over |w| <= max_speed of min_k a_k·w, for unit normals a_k (exact, in the plane).
+
+    The largest speed a vertex velocity can guarantee along every normal at once: a disturbance
+    bounded by less than this can be rejected there.  The maximiser of a minimum of linear
+    functions over a disc points along one normal or along the bisector of two, so those
+    directions are the only candidates.
+    """
+    if not normals:
+        return max_speed
+    directions = [np.asarray(a, dtype=np.float64) for a in normals]
+    for i, a in enumerate(normals):
+        for b in normals[i + 1 :]:
+            bisector = np.asarray(a) + np.asarray(b)
+            length = float(np.linalg.norm(bisector))
+            if length > 1e-12:
+                directions.append(bisector / length)
+    return max(
+        min(float(np.asarray(a) @ u) for a in normals) * max_speed for u in directions
+    )

@@ -28,6 +28,7 @@ from tlmpc.abstraction.model import Abstraction, FloatArray
 from tlmpc.control.geometry import (
     TriangleGeometry,
     affine_law,
+    best_push,
     half_plane_feasible,
     triangle_geometry,
 )
@@ -109,9 +110,17 @@ def _normals(step: _Step, local: int) -> list[tuple[FloatArray, float]]:
 class _Runs:
     """Union-find over (vertex, run) variables with the constraint normals each collects."""
 
-    def __init__(self) -> None:
+    def __init__(self, push: float = 0.0, max_speed: float = 1.0) -> None:
         self.parent: list[int] = []
         self.normals: list[list[FloatArray]] = []
+        # With a disturbance, one velocity must push at least ``push`` along every normal it
+        # collects, not merely be positive along each.
+        self.push, self.max_speed = push, max_speed
+
+    def compatible(self, normals: list[FloatArray]) -> bool:
+        if self.push <= 0.0:
+            return half_plane_feasible(normals)
+        return best_push(normals, self.max_speed) > self.push
 
     def new(self, normals: list[FloatArray]) -> int:
         self.parent.append(len(self.parent))
@@ -126,7 +135,7 @@ class _Runs:
 
     def try_extend(self, run: int, normals: list[FloatArray]) -> bool:
         root = self.find(run)
-        if half_plane_feasible(self.normals[root] + normals):
+        if self.compatible(self.normals[root] + normals):
             self.normals[root].extend(normals)
             return True
         return False
@@ -135,7 +144,7 @@ class _Runs:
         a, b = self.find(first), self.find(second)
         if a == b:
             return True
-        if not half_plane_feasible(self.normals[a] + self.normals[b]):
+        if not self.compatible(self.normals[a] + self.normals[b]):
             return False
         self.parent[b] = a
         self.normals[a].extend(self.normals[b])
@@ -143,9 +152,14 @@ class _Runs:
 
 
 def _assign_runs(
-    abstraction: Abstraction, steps: list[_Step], loop_start: int | None
+    abstraction: Abstraction,
+    steps: list[_Step],
+    loop_start: int | None,
+    *,
+    push: float = 0.0,
+    max_speed: float = 1.0,
 ) -> tuple[_Runs, list[VelocityJump]]:
-    runs = _Runs()
+    runs = _Runs(push, max_speed)
     jumps: list[VelocityJump] = []
     previous: dict[int, int] = {}  # global vertex -> run id at the previous step
     for index, step in enumerate(steps):
@@ -201,13 +215,16 @@ class VertexProgram:
     runs: int
     steps: int
     max_speed: float
+    disturbance: float = 0.0  # every inequality row must hold with this much to spare
 
     def objective(self, z: FloatArray, floor: float) -> float:
         """The maximised value at a candidate solution."""
         return float(floor + 0.1 * z[2 * self.runs :].sum() / self.steps)
 
 
-def vertex_program(steps: list[_Step], max_speed: float) -> tuple[VertexProgram, dict[int, int]]:
+def vertex_program(
+    steps: list[_Step], max_speed: float, disturbance: float = 0.0
+) -> tuple[VertexProgram, dict[int, int]]:
     """The program of ``steps`` and the column of each run's root."""
     roots = sorted({r for step in steps for r in step.runs})
     column = {r: i for i, r in enumerate(roots)}
@@ -236,7 +253,7 @@ def vertex_program(steps: list[_Step], max_speed: float) -> tuple[VertexProgram,
     equality = (
         sp.csr_matrix((eq_vals, (eq_rows, eq_cols)), shape=(eq_row, size)) if eq_row else None
     )
-    program = VertexProgram(inequality, equality, count, n_steps, max_speed)
+    program = VertexProgram(inequality, equality, count, n_steps, max_speed, disturbance)
     return program, column
 
 
@@ -263,7 +280,9 @@ def solve_vertex_program(program: VertexProgram) -> tuple[FloatArray, FloatArray
     inequality_rows = program.inequality.shape[0]
     blocks.append(sp.hstack([-program.inequality, sp.csr_matrix((inequality_rows, 1))]))
     blocks.append(sp.hstack([speeds, floor_column]))
-    offsets.append(np.zeros(inequality_rows + n_steps))
+    # Robust rows: a·w >= c·s + disturbance, i.e. a·(w + δ) >= c·s for every |δ| <= it.
+    spare = program.disturbance / program.max_speed
+    offsets.append(np.concatenate([np.full(inequality_rows, -spare), np.zeros(n_steps)]))
     cones.append(clarabel.NonnegativeConeT(inequality_rows + n_steps))
     # (max_speed, w_r) in the cone: rows (0; -e_2r; -e_2r+1), offsets (max_speed; 0; 0).
     soc_rows = np.arange(3 * count).reshape(count, 3)[:, 1:].ravel()
@@ -276,7 +295,9 @@ def solve_vertex_program(program: VertexProgram) -> tuple[FloatArray, FloatArray
     # Solved at unit speed and scaled back below: the solver's absolute tolerances (1e-8) are
     # then relative to max_speed, whatever its magnitude (at 1e-9 m/s they would swamp it).
     # Triangle sizes never enter: the rows hold unit normals and barycentric weights.
-    cone_offsets[::3] = 1.0
+    # With a disturbance the rows are not homogeneous and the shrink below would break them:
+    # solve inside a disc smaller than the solver's tolerance instead.
+    cone_offsets[::3] = 1.0 if program.disturbance == 0.0 else 1.0 - 1e-7
     offsets.append(cone_offsets)
     cones += [clarabel.SecondOrderConeT(3)] * count
     constraints = sp.vstack(blocks, format="csc")
@@ -308,7 +329,7 @@ def solve_vertex_program(program: VertexProgram) -> tuple[FloatArray, FloatArray
     # The solver meets |w| <= 1 only to its tolerance.  Every other constraint is homogeneous,
     # so one common scale makes the speed bound exact and keeps them all.
     largest = float(np.linalg.norm(velocities, axis=1).max()) if count else 0.0
-    if largest > program.max_speed:
+    if largest > program.max_speed and program.disturbance == 0.0:
         shrink = program.max_speed / largest * (1.0 - 4 * np.finfo(np.float64).eps)
         velocities, speeds = velocities * shrink, speeds * shrink
     return velocities, speeds
@@ -319,13 +340,15 @@ def solve_vertex_program(program: VertexProgram) -> tuple[FloatArray, FloatArray
 RECHECK_TOLERANCE = 1e-9
 
 
-def _violated_condition(controller: StepController, max_speed: float) -> str | None:
+def _violated_condition(
+    controller: StepController, max_speed: float, disturbance: float = 0.0
+) -> str | None:
     """Which vertex condition the solved field breaks (None when all hold), re-derived from the
     triangle: speed bound, exit across the planned facet, invariance of the two others; for a
     stay, inward on every facet, equilibrium at its target and a Hurwitz gain."""
     geometry = triangle_geometry(controller.vertices)
     w = controller.velocities
-    floor = RECHECK_TOLERANCE * max_speed
+    floor = disturbance + RECHECK_TOLERANCE * max_speed
     fastest = float(np.linalg.norm(w, axis=1).max())
     if fastest > max_speed * (1.0 + RECHECK_TOLERANCE):
         return f"a vertex speed {fastest:.6g} exceeds max_speed {max_speed:.6g}"
@@ -345,9 +368,13 @@ def _violated_condition(controller: StepController, max_speed: float) -> str | N
     assert controller.target is not None
     target = np.asarray(controller.target)
     # Far from the origin K x and g are large and cancel: allow their rounding, no more.
-    rounding = 8 * float(np.finfo(np.float64).eps) * (
-        float(np.abs(controller.gain).sum() * np.abs(target).max())
-        + float(np.abs(controller.offset).max())
+    rounding = (
+        8
+        * float(np.finfo(np.float64).eps)
+        * (
+            float(np.abs(controller.gain).sum() * np.abs(target).max())
+            + float(np.abs(controller.offset).max())
+        )
     )
     residual = float(np.linalg.norm(controller.gain @ target + controller.offset))
     if residual > floor + rounding:
@@ -359,12 +386,67 @@ def _violated_condition(controller: StepController, max_speed: float) -> str | N
     return None
 
 
-def synthesize(abstraction: Abstraction, witness: Witness, robot: Robot) -> Controllers:
-    """One affine field per plan step realising ``witness`` under ``robot.max_speed``."""
+def _check_rejectable(
+    abstraction: Abstraction, steps: list[_Step], robot: Robot, source: str | None
+) -> None:
+    """Located errors where no vertex velocity can reject ``robot.disturbance`` (C032/C033)."""
+    if robot.disturbance >= robot.max_speed:
+        raise InvalidInputError(
+            error(
+                "C033",
+                f"robot.disturbance {robot.disturbance:g} is not below max_speed "
+                f"{robot.max_speed:g}: no controller can reject it",
+                hint="the disturbance bound must be smaller than max_speed",
+                file=source,
+                path="$.robot.disturbance",
+            )
+        )
+    problems = []
+    for index, step in enumerate(steps):
+        corners = abstraction.triangles[step.triangle].tolist()
+        for local in range(3):
+            normals = [a for a, _ in _normals(step, local)]
+            best = best_push(normals, robot.max_speed)
+            if best <= robot.disturbance * (1.0 + RECHECK_TOLERANCE):
+                x, y = abstraction.vertices[corners[local]].tolist()
+                problems.append(
+                    error(
+                        "C032",
+                        f"plan step {index} (triangle {step.triangle}): at the corner "
+                        f"({x:.6g}, {y:.6g}) a velocity within max_speed pushes at most "
+                        f"{best:.4g} along every facet it must, not more than the "
+                        f"disturbance {robot.disturbance:g}",
+                        hint="lower robot.disturbance, raise max_speed, or raise "
+                        "options.min_angle (sharp corners leave little room)",
+                        file=source,
+                        path="$.robot.disturbance",
+                    )
+                )
+    if problems:
+        raise InvalidInputError(problems[:10])
+
+
+def synthesize(
+    abstraction: Abstraction, witness: Witness, robot: Robot, *, source: str | None = None
+) -> Controllers:
+    """One affine field per plan step realising ``witness`` under ``robot.max_speed``, robust
+    to any additive velocity disturbance up to ``robot.disturbance``.
+
+    ``source`` names the mission file in diagnostics.
+    """
     started = time.perf_counter()
     steps, loop_start = plan_steps(abstraction, witness)
-    _, jumps = _assign_runs(abstraction, steps, loop_start)
-    program, column = vertex_program(steps, robot.max_speed)
+    if robot.disturbance > 0.0:
+        _check_rejectable(abstraction, steps, robot, source)
+    push = robot.disturbance * (1.0 + RECHECK_TOLERANCE) + RECHECK_TOLERANCE * robot.max_speed
+    _, jumps = _assign_runs(
+        abstraction,
+        steps,
+        loop_start,
+        push=push if robot.disturbance else 0.0,
+        max_speed=robot.max_speed,
+    )
+    program, column = vertex_program(steps, robot.max_speed, robot.disturbance)
     built = time.perf_counter()
     velocities, _ = solve_vertex_program(program)
     solved = time.perf_counter()
@@ -411,7 +493,7 @@ def synthesize(abstraction: Abstraction, witness: Witness, robot: Robot) -> Cont
             )
         )
     for controller in controllers:
-        problem = _violated_condition(controller, robot.max_speed)
+        problem = _violated_condition(controller, robot.max_speed, robot.disturbance)
         if problem is not None:
             raise SolverError(
                 error(

@@ -31,7 +31,11 @@ def mission_from_json(document: Mapping[str, Any]) -> Mission:
             Region(name=name, polygon=_polygon(points))
             for name, points in document["regions"].items()
         ),
-        robot=Robot(start=_polygon([robot["start"]])[0], max_speed=float(robot["max_speed"])),
+        robot=Robot(
+            start=_polygon([robot["start"]])[0],
+            max_speed=float(robot["max_speed"]),
+            disturbance=float(robot.get("disturbance", 0.0)),
+        ),
         formula=parse_ltl(document["formula"], file="mission.json"),
         groups={name: tuple(members) for name, members in document["groups"].items()},
         task=tuple(document["task"]),

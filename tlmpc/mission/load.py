@@ -359,7 +359,11 @@ def _load(text: str, file: str, stem: str) -> tuple[Mission | None, list[Diagnos
         name=str(data.get("name") or stem),
         workspace=Workspace(boundary=boundary.points, holes=tuple(h.points for h in holes)),
         regions=tuple(Region(name=n, polygon=regions[n].points) for n in data["regions"]),
-        robot=Robot(start=start, max_speed=float(robot.get("max_speed", 1.0))),
+        robot=Robot(
+            start=start,
+            max_speed=float(robot.get("max_speed", 1.0)),
+            disturbance=float(robot.get("disturbance", 0.0)),
+        ),
         formula=formula,
         groups={g: tuple(m) for g, m in groups.items()},
         task=tuple(data.get("task") or ()),

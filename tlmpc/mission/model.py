@@ -41,10 +41,15 @@ class Workspace:
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Robot:
-    """The fully actuated point robot x' = u, |u| <= max_speed."""
+    """The fully actuated point robot x' = u + w, |u| <= max_speed, |w| <= disturbance.
+
+    ``disturbance`` bounds an unknown additive velocity (wind, slip, tracking error) that the
+    controllers must reject: every guarantee holds for every such w.
+    """
 
     start: Point
     max_speed: float = 1.0
+    disturbance: float = 0.0
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -112,7 +117,11 @@ class Mission:
             },
             "regions": {r.name: poly(r.polygon) for r in self.regions},
             "groups": {k: list(v) for k, v in self.groups.items()},
-            "robot": {"start": list(self.robot.start), "max_speed": self.robot.max_speed},
+            "robot": {
+                "start": list(self.robot.start),
+                "max_speed": self.robot.max_speed,
+                "disturbance": self.robot.disturbance,
+            },
             "task": list(self.task),
             "ltl": self.ltl,
             "formula": to_text(self.formula),
