@@ -1,8 +1,9 @@
 """``tlmpc check FILE...``: validate mission files (fast enough for a pre-commit hook).
 
 Imports only the mission loader (lark, PyYAML, jsonschema, shapely) and tlmpc's own pure-Python
-automata (for the contradiction check); never scipy, clarabel, triangle, cvxpy or matplotlib.  Exit 0 when every file is valid, 1 when some file is invalid, 2 when some file
-could not be read (unreadable wins over invalid: the run could not do its job).
+automata (for the contradiction check); never scipy, clarabel, triangle, cvxpy or matplotlib.
+Exit 0 when every file is valid, 1 when some file is invalid, 2 when some file could not be read
+(unreadable wins over invalid: the run could not do its job).
 """
 
 from __future__ import annotations
