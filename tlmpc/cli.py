@@ -31,6 +31,7 @@ COMMAND_MODULES = (
     "automaton",
     "export",
     "plot",
+    "view",
 )
 
 EPILOG = """\
