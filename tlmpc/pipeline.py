@@ -11,6 +11,7 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import gc
+import sys
 import time
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
@@ -19,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 
 from tlmpc import __version__
 from tlmpc.errors import TlmpcError, error
+from tlmpc.progress import heartbeat
 
 if TYPE_CHECKING:
     from tlmpc.abstraction.model import Abstraction
@@ -74,12 +76,14 @@ def _require(value: Any, what: str) -> Any:
 
 def _load(c: Compilation) -> StageResult:
     from tlmpc.mission import load_mission
+    from tlmpc.mission.holes import workspace_notes
 
-    mission = load_mission(c.source)
+    mission, notes = workspace_notes(load_mission(c.source))  # holes merged; narrow passages
     return StageResult(
         compilation=dataclasses.replace(c, mission=mission),
         artifacts={"mission.json": mission.to_json()},
         sizes={"regions": len(mission.regions), "formula": str(mission.formula)},
+        warnings=tuple(notes),
     )
 
 
@@ -343,7 +347,8 @@ def compile_mission(
     with collector_paused():
         for index, stage in enumerate(stages, start=1):
             started = time.perf_counter()
-            result = stage.run(compilation)
+            with heartbeat(stage.name, sys.stderr) if progress else contextlib.nullcontext():
+                result = stage.run(compilation)
             report = StageReport(
                 name=stage.name, seconds=time.perf_counter() - started, sizes=result.sizes
             )

@@ -49,7 +49,7 @@ def test_scene_of_a_log_marks_segments_through_holes(tmp_path: Path) -> None:
     verdict = scene["verdict"]
     assert verdict["satisfied"] is False  # the verifier rejects leaving the workspace too
     assert verdict["workspace_violation"] is not None
-    assert len(scene["trajectory"]) == 7  # type: ignore[arg-type]
+    assert len(scene["trajectory"]) == 7
 
 
 def test_view_usage(tmp_path: Path) -> None:

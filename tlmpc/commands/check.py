@@ -38,6 +38,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     results: list[dict[str, Any]] = []
     unreadable = invalid = 0
     for path in args.files:
+        notices: list[Any] = []
         entry: dict[str, Any] = {"file": str(path), "ok": False, "diagnostics": [], "ltl": None}
         try:
             mission, diagnostics = inspect_file(path)
@@ -47,6 +48,10 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         else:
             if mission is not None and not diagnostics:
                 diagnostics = _contradictions(path, mission)
+                if not diagnostics:
+                    from tlmpc.mission.holes import workspace_notes
+
+                    notices = workspace_notes(mission)[1]
             if diagnostics:
                 invalid += 1
             else:
@@ -54,9 +59,9 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
                 if mission is not None:
                     entry["ltl"] = to_text(mission.formula)
                     entry["avoid_scopes"] = _scopes(mission)
-        entry["diagnostics"] = [d.to_json() for d in diagnostics]
+        entry["diagnostics"] = [d.to_json() for d in [*diagnostics, *notices]]
         results.append(entry)
-        for diagnostic in diagnostics:
+        for diagnostic in [*diagnostics, *notices]:
             err.write(diagnostic.format() + "\n")
         if entry["ok"] and args.explain and not args.json:
             out.write(f"{path}: {entry['ltl']}\n")
