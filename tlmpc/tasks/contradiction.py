@@ -39,33 +39,14 @@ class TaskPart:
     col: int | None = None
 
 
-def _cube_satisfiable(guard: Formula) -> bool:
-    positive: set[str] = set()
-    negative: set[str] = set()
-    stack = [guard]
-    while stack:
-        node = stack.pop()
-        if isinstance(node, Const):
-            if not node.value:
-                return False
-        elif isinstance(node, Prop):
-            positive.add(node.name)
-        elif isinstance(node, Not) and isinstance(node.arg, Prop):
-            negative.add(node.arg.name)
-        elif isinstance(node, And):
-            stack.extend(node.args)
-        else:  # pragma: no cover - translate() emits cubes only
-            return True
-    return not positive & negative
-
-
 def is_satisfiable(formula: Formula) -> bool:
     """Whether some infinite word over all letters satisfies ``formula`` (LTL without X)."""
+    # the translation's edges carry consistent cubes only (a & !a is never emitted), so every
+    # edge is enabled by some letter and emptiness is a graph question
     automaton = translate(formula, simplify=False)
     successors: dict[int, list[tuple[int, frozenset[int]]]] = {}
     for edge in automaton.edges:
-        if _cube_satisfiable(edge.guard):
-            successors.setdefault(edge.src, []).append((edge.dst, edge.marks))
+        successors.setdefault(edge.src, []).append((edge.dst, edge.marks))
     components = _reachable_components(automaton.initial, successors)
     wanted = frozenset(range(automaton.num_acc))
     for component in components:
