@@ -171,3 +171,12 @@ def test_no_heartbeat_into_a_pipe() -> None:
     with heartbeat("meshing", stream, first=0.0, every=0.01):
         pass
     assert stream.getvalue() == ""
+
+
+def test_a_narrow_gap_between_holes_is_reported_at_the_hole(tmp_path: Path) -> None:
+    path = _mission(
+        tmp_path, ["{rect: [2, 2, 5, 6]}", "{rect: [1, 8, 2, 9]}", "{rect: [5.00001, 2, 8, 6]}"]
+    )
+    err = io.StringIO()
+    assert main(["check", str(path)], out=io.StringIO(), err=err) == 0
+    assert f"{path}:7: warning[G021]: a passage only 1e-05 wide at (5, " in err.getvalue()

@@ -125,7 +125,8 @@ def narrow_passages(
     rings.  Edges of the
     boundary and holes are compared pairwise (through a spatial index); a pair counts when the
     segment joining their closest points crosses free space, so a thin obstacle or a sharp
-    corner is no passage.  Neighbouring edges (sharing a vertex) are skipped.
+    corner is no passage.  Edges that touch (neighbours sharing a vertex) are at distance 0 and
+    skipped.
     """
     from shapely import LineString, STRtree, prepared, shortest_line
     from shapely import Polygon as ShapelyPolygon
@@ -146,11 +147,11 @@ def narrow_passages(
     pair_of: dict[int, tuple[int, int]] = {}
     pairs = tree.query(lines, predicate="dwithin", distance=limit)
     for i, j in zip(pairs[0].tolist(), pairs[1].tolist(), strict=True):
-        if j <= i or set(segments[i]) & set(segments[j]):
+        if j <= i:
             continue
         gap = shortest_line(lines[i], lines[j])
         width = gap.length
-        if width <= 0.0 or width >= limit:
+        if width <= 0.0 or width >= limit:  # 0: neighbouring edges, or edges that touch
             continue
         middle = gap.interpolate(0.5, normalized=True)
         if not inside.contains(middle):
