@@ -88,6 +88,11 @@ def test_example8_view(browser: Browser, tmp_path: Path) -> None:
     assert browser.evaluate("tlmpcView.time()") == paused
     moved = browser.evaluate("[+robot.getAttribute('cx'), +robot.getAttribute('cy')]")
     assert moved != start
+    # between two samples the robot is on the segment joining them, in proportion to time
+    (t1, x1, y1), (t2, x2, y2) = trace["points"][10], trace["points"][11]
+    browser.evaluate(f"tlmpcView.seek({(t1 + t2) / 2 - trace['points'][0][0]})")
+    middle = browser.evaluate("[+robot.getAttribute('cx'), +robot.getAttribute('cy')]")
+    assert middle == pytest.approx([(x1 + x2) / 2, -(y1 + y2) / 2])
     # scrubbing to the end puts the robot on the last sample
     browser.evaluate(
         "(() => { const s = document.getElementById('scrub'); s.value = 1000;"

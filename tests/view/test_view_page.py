@@ -21,10 +21,13 @@ def _embedded(page: str) -> dict[str, object]:
 
 
 def test_text_in_the_scene_cannot_close_the_script() -> None:
-    scene = {"title": "</script><script>alert(1)</script> & <b>", "trajectory": []}
+    scene = {"title": "</script><script>alert(1)</script> <!--<script> & <b>", "trajectory": []}
     page = render_html(scene)
     assert page.count("</script>") == 2  # the template's own two script elements
     assert _embedded(page) == scene
+    start = page.index('<script id="scene" type="application/json">') + 43
+    data = page[start : page.index("</script>", start)]
+    assert not set("<>&") & set(data)  # nothing the HTML parser could take for markup
 
 
 def test_the_page_needs_no_network() -> None:
