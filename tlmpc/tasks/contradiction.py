@@ -22,10 +22,11 @@ from tlmpc.ltl.ast import And, Const, Formula, Not, Or, Prop, conjoin
 from tlmpc.ltl.printer import to_text
 from tlmpc.ltl.transform import substitute
 
-#: Tasks with more temporal operators than this are not checked (the translation is
-#: exponential in the worst case and the hook must stay fast); ``tlmpc compile`` still
-#: reports an impossible task as "no plan".
-MAX_TEMPORAL_OPERATORS = 60
+#: Conjuncts are checked in groups that share regions (groups over disjoint regions are
+#: independent, since every letter is allowed); a group with more temporal operators than this
+#: is not checked (the translation is exponential in the worst case and the hook must stay
+#: fast); ``tlmpc compile`` still reports an impossible task as "no plan".
+MAX_TEMPORAL_OPERATORS = 8
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -106,6 +107,38 @@ def _temporal_size(formula: Formula) -> int:
     return sum(1 for node in formula.walk() if not isinstance(node, (Prop, Not, And, Or, Const)))
 
 
+def _conjuncts(formula: Formula) -> list[Formula]:
+    if isinstance(formula, And):
+        return [c for arg in formula.args for c in _conjuncts(arg)]
+    return [formula]
+
+
+def _independent_groups(formulas: Sequence[Formula]) -> list[list[Formula]]:
+    """The conjuncts of ``formulas`` grouped by shared propositions (connected components)."""
+    conjuncts = [c for f in formulas for c in _conjuncts(f)]
+    groups: list[tuple[set[str], list[Formula]]] = []
+    for conjunct in conjuncts:
+        props = set(conjunct.props())
+        touching = [g for g in groups if g[0] & props]
+        merged_props = props.union(*(g[0] for g in touching))
+        merged = [f for g in touching for f in g[1]] + [conjunct]
+        groups = [g for g in groups if not g[0] & props] + [(merged_props, merged)]
+    return [members for _, members in groups]
+
+
+def contradictory(formulas: Sequence[Formula]) -> bool:
+    """Whether the conjunction of ``formulas`` is certainly unsatisfiable.
+
+    False also when a group of dependent conjuncts is too large to check.
+    """
+    for group in _independent_groups(formulas):
+        if sum(_temporal_size(f) for f in group) > MAX_TEMPORAL_OPERATORS:
+            continue
+        if not is_satisfiable(conjoin(group)):
+            return True
+    return False
+
+
 def find_contradiction(
     parts: Sequence[TaskPart],
     *,
@@ -121,13 +154,12 @@ def find_contradiction(
         if members
     }
     formulas = [substitute(p.formula, expand) for p in parts]
-    whole = conjoin(formulas)
-    if _temporal_size(whole) > MAX_TEMPORAL_OPERATORS or is_satisfiable(whole):
+    if not contradictory(formulas):
         return None
     core = list(range(len(parts)))
     for candidate in range(len(parts)):
         rest = [i for i in core if i != candidate]
-        if rest and not is_satisfiable(conjoin([formulas[i] for i in rest])):
+        if rest and contradictory([formulas[i] for i in rest]):
             core = rest
     first = parts[core[0]]
     others = [parts[i] for i in core[1:]]
