@@ -11,6 +11,7 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import gc
+import sys
 import time
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -19,6 +20,7 @@ from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
 from tlmpc import __version__
 from tlmpc.errors import TlmpcError, error
+from tlmpc.progress import heartbeat
 
 if TYPE_CHECKING:
     from tlmpc.abstraction.model import Abstraction
@@ -164,15 +166,18 @@ class Stage:
 
 def _load(c: Compilation) -> StageResult:
     from tlmpc.mission import load_mission, load_mission_text
+    from tlmpc.mission.holes import workspace_notes
 
     if c.text is not None:
-        mission = load_mission_text(c.text, str(c.source))
+        loaded = load_mission_text(c.text, str(c.source))
     else:
-        mission = load_mission(c.source)
+        loaded = load_mission(c.source)
+    mission, notes = workspace_notes(loaded)  # holes merged; narrow passages
     return StageResult(
         products=provide(MISSION, mission),
         artifacts={"mission.json": mission.to_json()},
         sizes={"regions": len(mission.regions), "formula": str(mission.formula)},
+        warnings=tuple(notes),
     )
 
 
@@ -455,7 +460,8 @@ def run_stages(
         for product in stage.requires:
             compilation.get(product)  # a clear error instead of a failure deep inside
         started = time.perf_counter()
-        result = stage.run(compilation)
+        with heartbeat(stage.name, sys.stderr) if progress else contextlib.nullcontext():
+            result = stage.run(compilation)
         report = StageReport(
             name=stage.name, seconds=time.perf_counter() - started, sizes=result.sizes
         )

@@ -1,8 +1,9 @@
 """``tlmpc check FILE...``: validate mission files (fast enough for a pre-commit hook).
 
-Imports only the mission loader (lark, PyYAML, jsonschema, shapely); never scipy, clarabel or
-triangle.  Exit 0 when every file is valid, 1 when some file is invalid, 2 when some file
-could not be read (unreadable wins over invalid: the run could not do its job).
+Imports only the mission loader (lark, PyYAML, jsonschema, shapely) and tlmpc's own pure-Python
+automata (for the contradiction check); never scipy, clarabel, triangle, cvxpy or matplotlib.
+Exit 0 when every file is valid, 1 when some file is invalid, 2 when some file could not be read
+(unreadable wins over invalid: the run could not do its job).
 """
 
 from __future__ import annotations
@@ -37,6 +38,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     results: list[dict[str, Any]] = []
     unreadable = invalid = 0
     for path in args.files:
+        notices: list[Any] = []
         entry: dict[str, Any] = {"file": str(path), "ok": False, "diagnostics": [], "ltl": None}
         try:
             mission, diagnostics = inspect_file(path)
@@ -44,18 +46,27 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             unreadable += 1
             diagnostics = list(exc.diagnostics)
         else:
+            if mission is not None and not diagnostics:
+                diagnostics = _contradictions(path, mission)
+                if not diagnostics:
+                    from tlmpc.mission.holes import workspace_notes
+
+                    notices = workspace_notes(mission)[1]
             if diagnostics:
                 invalid += 1
             else:
                 entry["ok"] = True
                 if mission is not None:
                     entry["ltl"] = to_text(mission.formula)
-        entry["diagnostics"] = [d.to_json() for d in diagnostics]
+                    entry["avoid_scopes"] = _scopes(mission)
+        entry["diagnostics"] = [d.to_json() for d in [*diagnostics, *notices]]
         results.append(entry)
-        for diagnostic in diagnostics:
+        for diagnostic in [*diagnostics, *notices]:
             err.write(diagnostic.format() + "\n")
         if entry["ok"] and args.explain and not args.json:
             out.write(f"{path}: {entry['ltl']}\n")
+            for scope in entry.get("avoid_scopes", []):
+                out.write(f"  {scope}\n")
     code = 2 if unreadable else (1 if invalid else 0)
     if args.json:
         document = {
@@ -75,3 +86,48 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             summary += f", {unreadable} unreadable"
         err.write(summary + "\n")
     return code
+
+
+def _scopes(mission: Any) -> list[str]:
+    """Every avoidance of the mission's phrases with its scope in words."""
+    from tlmpc.tasks import avoid_scopes
+
+    scopes: list[str] = []
+    for phrase in mission.task:
+        scopes.extend(avoid_scopes(phrase, groups=mission.groups))
+    return scopes
+
+
+def _contradictions(path: Path, mission: Any) -> list[Any]:
+    """A T011/L020 diagnostic when no behaviour at all satisfies the mission's task."""
+    from tlmpc.ltl import parse_ltl
+    from tlmpc.mission.yamlpos import load_positioned
+    from tlmpc.tasks import compile_phrase
+    from tlmpc.tasks.contradiction import TaskPart, find_contradiction
+
+    file = str(path)
+    doc, _ = load_positioned(path.read_text(encoding="utf-8"), file)
+    parts: list[TaskPart] = []
+
+    def where(key: tuple[str | int, ...]) -> tuple[int, int]:
+        if doc is None:
+            return (1, 1)
+        line, col = doc.value_at(key)
+        if doc.quoted.get(key):
+            col += 1
+        if doc.block.get(key):
+            line, col = line + 1, 1
+        return line, col
+
+    for index, phrase in enumerate(mission.task):
+        line, col = where(("task", index))
+        formula = compile_phrase(phrase, groups=mission.groups, file=file, line=line, col=col)
+        parts.append(TaskPart(formula=formula, text=phrase, kind="phrase", line=line, col=col))
+    if mission.ltl and mission.ltl.strip():
+        line, col = where(("ltl",))
+        parts.append(
+            TaskPart(formula=parse_ltl(mission.ltl), text=mission.ltl.strip(), kind="ltl",
+                     line=line, col=col)
+        )
+    found = find_contradiction(parts, groups=mission.groups, file=file)
+    return [found] if found is not None else []

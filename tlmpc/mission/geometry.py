@@ -132,7 +132,7 @@ def check_layout(
     file: str,
     locate: Locate,
 ) -> list[Diagnostic]:
-    """Relations between shapes: containment, hole overlaps, the start point."""
+    """Relations between shapes: containment, the start point (hole overlaps are merged)."""
     problems: list[Diagnostic] = []
 
     def at(path: Path, code: str, message: str, hint: str) -> Diagnostic:
@@ -162,19 +162,7 @@ def check_layout(
                         "regions must lie inside the boundary; clip the region",
                     )
                 )
-    for i, first in enumerate(holes):
-        for j in range(i + 1, len(holes)):
-            second = holes[j]
-            overlap = first.polygon.intersection(second.polygon)
-            if overlap.area > AREA_TOLERANCE * max(first.polygon.area, second.polygon.area):
-                problems.append(
-                    at(
-                        second.path,
-                        "G006",
-                        f"holes {i} and {j} overlap",
-                        "merge overlapping obstacles into one hole",
-                    )
-                )
+    # overlapping or touching holes are merged later, with a note (tlmpc.mission.holes)
     if hole_union is not None:
         for name, region in regions.items():
             free = region.polygon.difference(hole_union)

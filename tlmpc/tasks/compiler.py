@@ -38,8 +38,10 @@ KNOWN_PHRASES = (
     "visit A then B then C",
     "visit A then B then return to C",
     "visit A, B and C",
+    "visit A, B and C then go to D",
     "visit A then B while avoiding C, D",
     "visit all GROUP",
+    "visit all GROUP then A",
     "visit any GROUP",
     "visit A infinitely often",
     "avoid A, B",
@@ -71,6 +73,8 @@ class _Lowering:
         self.line = line
         self.col = col
         self.problems: list[Diagnostic] = []
+        #: each avoidance's scope in words, for ``tlmpc check --explain``
+        self.scopes: list[str] = []
 
     def _where(self, token: Token) -> tuple[int, int]:
         if (token.line or 1) > 1:  # a phrase spread over several lines (a YAML block scalar)
@@ -117,16 +121,17 @@ class _Lowering:
             return Eventually(disjoin(self.group(children[0])))
         if kind == "visit_often":
             return conjoin([Globally(Eventually(p)) for p in self.names(children[0])])
-        if kind == "visit_guarded":
-            avoided = self._avoided(children[1])
-            return Until(avoided, self.name(children[0]))
         if kind == "visit_sequence":
             return self._sequence(children)
         if kind == "avoid":
-            return conjoin([Globally(Not(p)) for p in self.names(children[0])])
+            props = self.names(children[0])
+            self._scope(props, "always")
+            return conjoin([Globally(Not(p)) for p in props])
         if kind == "avoid_until":
-            avoided = conjoin([Not(p) for p in self.names(children[0])])
-            return Until(avoided, self.name(children[1]))
+            props = self.names(children[0])
+            target = self.name(children[1])
+            self._scope(props, f"until the first visit to {target.name}")
+            return Until(conjoin([Not(p) for p in props]), target)
         if kind == "patrol":
             return conjoin([Globally(Eventually(p)) for p in self.names(children[0])])
         if kind == "stay":
@@ -137,31 +142,104 @@ class _Lowering:
             return Globally(Implies(self.name(children[0]), Eventually(self.name(children[1]))))
         raise ValueError(f"unknown phrase kind {kind}")  # pragma: no cover - grammar is closed
 
-    def _avoided(self, avoiding: Tree[Any]) -> Formula:
+    def _avoided_names(self, avoiding: Tree[Any]) -> list[Prop]:
         names_tree = next(c for c in avoiding.children if isinstance(c, Tree))
-        return conjoin([Not(p) for p in self.names(names_tree)])
+        return self.names(names_tree)
+
+    def _members(self, name: str) -> set[str]:
+        """The regions a name stands for (a group stands for its members)."""
+        return set(self.groups.get(name, (name,)))
+
+    def _step(self, step: Tree[Any]) -> list[Prop]:
+        inner = next(c for c in step.children if isinstance(c, Tree))
+        if step.data == "all_step":
+            return [p for p in self.group(inner) if isinstance(p, Prop)]
+        if step.data == "return_step":
+            return [self.name(inner)]
+        return self.names(inner)
 
     def _sequence(self, children: list[Tree[Any]]) -> Formula:
+        """Steps S1 then S2 ... then Sn, each a set visited in any order after the previous set.
+
+        ``Φ_k = ⋀_{s ∈ S_k} F(s & Φ_{k+1})``: each region of a step is visited after every
+        region of the previous step (a later visit of a step's region serves all of it).
+
+        ``while avoiding X`` never weakens into something a reader would not expect: a name the
+        phrase never visits is avoided always (``G !X``); a name the phrase must visit is
+        avoided on the last leg — after the last intermediate visit, until the final target
+        (the paper's "finally, return to p1 while avoiding p2 and p3").  Avoiding a final
+        target is a contradiction and is reported (T010).
+        """
         avoiding = children[-1] if children[-1].data == "avoiding" else None
-        steps = children[:-1] if avoiding is not None else children
-        targets = [self.name(next(c for c in s.children if isinstance(c, Tree))) for s in steps]
-        ends_with_return = steps[-1].data == "return_step"
-        avoided = self._avoided(avoiding) if avoiding is not None else None
-        # "... then return to X while avoiding C": the avoidance belongs to the return leg
-        # (the paper's "finally, return to p1 while avoiding p2 and p3"); after a plain
-        # sequence it holds until the sequence ends.
-        formula: Formula = targets[-1]
-        if avoided is not None:
-            formula = Until(avoided, formula)
-        else:
-            formula = Eventually(formula)
-        for index in range(len(targets) - 2, -1, -1):
-            inner = And((targets[index], formula))
-            if avoided is not None and not ends_with_return:
-                formula = Until(avoided, inner)
-            else:
-                formula = Eventually(inner)
-        return formula
+        steps = [self._step(s) for s in (children[:-1] if avoiding is not None else children)]
+        visited: set[str] = set()
+        for step in steps:
+            for prop in step:
+                visited |= self._members(prop.name)
+        always: list[Prop] = []
+        last_leg: list[Prop] = []
+        if avoiding is not None:
+            final = {m for p in steps[-1] for m in self._members(p.name)}
+            for prop in self._avoided_names(avoiding):
+                members = self._members(prop.name)
+                if members & final:
+                    self._avoid_final(prop, steps[-1])
+                elif members & visited:
+                    last_leg.append(prop)
+                else:
+                    always.append(prop)
+        guard = conjoin([Not(p) for p in last_leg]) if last_leg else None
+        leaving = {m for p in last_leg for m in self._members(p.name)}
+        formula: Formula = conjoin(
+            [Until(guard, s) if guard is not None else Eventually(s) for s in steps[-1]]
+        )
+        for index in range(len(steps) - 2, -1, -1):
+            parts: list[Formula] = []
+            for prop in steps[index]:
+                after: Formula = formula
+                if index == len(steps) - 2 and self._members(prop.name) & leaving:
+                    # leaving an avoided region: stay in it until the avoidance starts
+                    after = Until(prop, formula)
+                parts.append(Eventually(And((prop, after))))
+            formula = conjoin(parts)
+        self._scope(always, "always (the phrase never visits {it})")
+        if last_leg:
+            before = steps[-2] if len(steps) > 1 else []
+            start = (
+                "after the last visit, from " + _listing(before)
+                if before
+                else "from the start"
+            )
+            self._scope(
+                last_leg,
+                f"on the last leg only, {start} until {_listing(steps[-1])} "
+                "(the phrase visits {it} earlier)",
+            )
+        return conjoin([formula, *[Globally(Not(p)) for p in always]])
+
+    def _avoid_final(self, prop: Prop, final: list[Prop]) -> None:
+        line, col = (prop.span.line, prop.span.col) if prop.span else (self.line, self.col)
+        self.problems.append(
+            error(
+                "T010",
+                f"the phrase must reach {_listing(final)} while avoiding {prop.name!r}",
+                hint="a region cannot be both the destination and avoided on the way; "
+                "drop it from `while avoiding` or write a separate `avoid` phrase",
+                file=self.file,
+                line=line,
+                col=col,
+            )
+        )
+
+    def _scope(self, props: list[Prop], scope: str) -> None:
+        if props:
+            it = "it" if len(props) == 1 else "them"
+            self.scopes.append(f"avoid {_listing(props)}: " + scope.replace("{it}", it))
+
+
+def _listing(props: Sequence[Prop]) -> str:
+    names = [p.name for p in props]
+    return names[0] if len(names) == 1 else ", ".join(names[:-1]) + " and " + names[-1]
 
 
 def _unknown_phrase(phrase: str, file: str | None, line: int, col: int, at: int) -> Diagnostic:
@@ -189,6 +267,24 @@ def compile_phrase(
     col: int = 1,
 ) -> Formula:
     """Compile one phrase to LTL (raises :class:`InvalidInputError` with T-codes)."""
+    return _compile(phrase, groups=groups, file=file, line=line, col=col)[0]
+
+
+def avoid_scopes(
+    phrase: str, *, groups: Mapping[str, Sequence[str]] | None = None
+) -> list[str]:
+    """Each avoidance in ``phrase`` with its scope in words (``avoid c: always``)."""
+    return _compile(phrase, groups=groups, file=None, line=1, col=1)[1]
+
+
+def _compile(
+    phrase: str,
+    *,
+    groups: Mapping[str, Sequence[str]] | None,
+    file: str | None,
+    line: int,
+    col: int,
+) -> tuple[Formula, list[str]]:
     if not isinstance(phrase, str) or not phrase.strip():
         raise InvalidInputError(
             error(
@@ -209,7 +305,7 @@ def compile_phrase(
     formula = lowering.lower(tree.children[0])  # type: ignore[arg-type]
     if lowering.problems:
         raise InvalidInputError(lowering.problems)
-    return formula
+    return formula, lowering.scopes
 
 
 def compile_phrases(

@@ -1,0 +1,177 @@
+"""Phrase meanings checked against Spot: readers' formulas, safety never weakened, any order.
+
+Spot is an independent oracle here: formulas are compared by language (``are_equivalent``) or
+by inclusion, never by their text.
+"""
+
+from __future__ import annotations
+
+import itertools
+
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from tlmpc.errors import InvalidInputError
+from tlmpc.ltl import to_text
+from tlmpc.tasks import avoid_scopes, compile_phrase
+
+spot = pytest.importorskip("spot")
+
+GROUPS = {"exhibits": ["e1", "e2", "e3"]}
+
+#: Held-out sentences and the formula a reader expects, written independently of the compiler.
+HELD_OUT = [
+    (
+        "visit p2 then p3 then p4 then return to p1 while avoiding p2 and p3",
+        "F(p2 & F(p3 & F(p4 & ((!p2 & !p3) U p1))))",
+    ),
+    (
+        "Visit area p2 then area p3 then area p4 and, finally, return to region p1 "
+        "while avoiding areas p2 and p3",
+        "F(p2 & F(p3 & F(p4 & ((!p2 & !p3) U p1))))",
+    ),
+    (
+        "visit pickup then dropoff then return to dock while avoiding forklift_lane",
+        "G !forklift_lane & F(pickup & F(dropoff & F dock))",
+    ),
+    ("visit all exhibits then exit", "F(e1 & F exit) & F(e2 & F exit) & F(e3 & F exit)"),
+    ("visit a, b and c then go to d", "F(a & F d) & F(b & F d) & F(c & F d)"),
+    ("visit a and b, then visit c", "F(a & F c) & F(b & F c)"),
+    ("go to kitchen while avoiding stairs", "F kitchen & G !stairs"),
+    (
+        "visit a then b then return to h while avoiding a, x",
+        "G !x & F(a & F(b & (!a U h)))",
+    ),
+    ("avoid stairs until kitchen", "!stairs U kitchen"),
+    # "visit a, b then c": some visit of c after both a and b, however far apart
+    ("visit a, b then c", "F((a & F(b & F c)) | (b & F(a & F c)))"),
+]
+
+
+def _same_language(mine: str, expected: str) -> bool:
+    return bool(spot.are_equivalent(spot.formula(mine), spot.formula(expected)))
+
+
+@pytest.mark.parametrize(("phrase", "expected"), HELD_OUT)
+def test_held_out_sentences_mean_what_readers_expect(phrase: str, expected: str) -> None:
+    assert _same_language(to_text(compile_phrase(phrase, groups=GROUPS)), expected)
+
+
+def test_the_papers_sentence_is_the_papers_formula_exactly() -> None:
+    sentence = "visit p2 then p3 then p4 then return to p1 while avoiding p2 and p3"
+    assert to_text(compile_phrase(sentence)) == "F(p2 & F(p3 & F(p4 & ((!p2 & !p3) U p1))))"
+
+
+def test_avoiding_the_region_being_left_starts_when_it_is_left() -> None:
+    # a visited region avoided on the last leg may be the one the leg starts from
+    automaton = spot.formula(
+        to_text(compile_phrase("visit a then return to h while avoiding a"))
+    ).translate()
+
+    def accepts(word: str) -> bool:
+        return bool(automaton.intersects(spot.parse_word(word).as_automaton()))
+
+    assert accepts("!a&!h; a&!h; a&!h; !a&!h; !a&h; cycle{!a&!h}")
+    assert accepts("!a&!h; a&!h; !a&!h; a&!h; !a&h; cycle{!a&!h}")  # after the last visit
+    assert not accepts("!a&h; a&!h; cycle{!a&!h}")  # home only before a
+    assert not accepts("a&!h; cycle{!a&!h}")  # never home
+
+
+def test_avoiding_the_final_target_is_an_error() -> None:
+    with pytest.raises(InvalidInputError) as caught:
+        compile_phrase("visit a then b while avoiding b", file="m.yaml", line=4, col=5)
+    diagnostic = caught.value.diagnostics[0]
+    assert diagnostic.code == "T010"
+    assert (diagnostic.line, diagnostic.col) == (4, 5 + len("visit a then b while avoiding "))
+
+
+def test_scopes_are_stated_in_words() -> None:
+    scopes = avoid_scopes("visit p then q then return to h while avoiding p, lane")
+    assert scopes == [
+        "avoid lane: always (the phrase never visits it)",
+        "avoid p: on the last leg only, after the last visit, from q until h "
+        "(the phrase visits it earlier)",
+    ]
+    assert avoid_scopes("avoid a, b") == ["avoid a and b: always"]
+    assert avoid_scopes("visit a then b") == []
+
+
+NAMES = ("r1", "r2", "r3", "r4", "r5", "r6")
+
+
+@st.composite
+def sequences(draw: st.DrawFn) -> tuple[str, list[list[str]], list[str], bool]:
+    """A random sequence phrase: steps (sets of names), avoided names, return or not."""
+    steps = draw(
+        st.lists(
+            st.lists(st.sampled_from(NAMES), min_size=1, max_size=2, unique=True),
+            min_size=1,
+            max_size=3,
+        )
+    )
+    returns = len(steps) > 1 and len(steps[-1]) == 1 and draw(st.booleans())
+    final = set(steps[-1])
+    avoided = draw(
+        st.lists(st.sampled_from([n for n in NAMES if n not in final]), max_size=2, unique=True)
+    )
+    if len(steps) == 1 and not avoided:
+        avoided = []
+    words = []
+    for index, step in enumerate(steps):
+        listing = step[0] if len(step) == 1 else ", ".join(step[:-1]) + " and " + step[-1]
+        if index == 0:
+            words.append(f"visit {listing}")
+        elif index == len(steps) - 1 and returns:
+            words.append(f"then return to {listing}")
+        else:
+            words.append(f"then {draw(st.sampled_from(['', 'go to ', 'visit ']))}{listing}")
+    if avoided:
+        words.append("while avoiding " + " and ".join(avoided))
+    return " ".join(words), steps, avoided, returns
+
+
+def _chains(steps: list[list[str]], last_leg: str | None) -> str:
+    """Every chain s1 -> s2 -> ... -> sn, one per choice of a region in each step."""
+    parts = []
+    for chain in itertools.product(*steps):
+        text = chain[-1] if last_leg is None else f"(({last_leg}) U {chain[-1]})"
+        if last_leg is None:
+            text = f"F {text}"
+        for position in range(len(chain) - 2, -1, -1):
+            name = chain[position]
+            if last_leg is not None and position == len(chain) - 2 and f"!{name}" in last_leg:
+                text = f"({name} U {text})"
+            text = f"F({name} & {text})"
+        parts.append(text)
+    return " & ".join(parts)
+
+
+@given(sequences())
+def test_sequences_never_weaken_a_visible_avoidance(
+    case: tuple[str, list[list[str]], list[str], bool],
+) -> None:
+    phrase, steps, avoided, _ = case
+    mine = spot.formula(to_text(compile_phrase(phrase)))
+    visited = {name for step in steps for name in step}
+    for name in avoided:
+        if name not in visited:
+            # the compiled task implies "never in name", from the first instant to forever
+            assert spot.contains(spot.formula(f"G !{name}"), mine), (phrase, name)
+    assert not mine.translate().is_empty(), phrase
+
+
+@given(sequences())
+def test_sequences_are_every_chain_in_order(
+    case: tuple[str, list[list[str]], list[str], bool],
+) -> None:
+    phrase, steps, avoided, _ = case
+    visited = {name for step in steps for name in step}
+    scoped = [n for n in avoided if n in visited]
+    if scoped and len(steps[-1]) > 1:
+        return  # several final targets under one avoidance: not a chain property
+    last_leg = " & ".join(f"!{n}" for n in scoped) if scoped else None
+    expected = _chains(steps, last_leg)
+    always = [f"G !{n}" for n in avoided if n not in visited]
+    expected = " & ".join([expected, *always])
+    assert _same_language(to_text(compile_phrase(phrase)), expected), phrase

@@ -1,0 +1,61 @@
+"""``tlmpc view OUT`` / ``tlmpc view --log LOG --mission M``: one self-contained HTML page.
+
+Exit 0 when the page is written (whatever the verdict it shows), 2 when the input cannot be
+read.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import TextIO
+
+NAME = "view"
+HELP = "write an interactive HTML view of a compile output or of a verified log"
+DESCRIPTION = """\
+Write one self-contained HTML page (no network needed to open it): the map, the regions, the
+triangulation on demand, the trajectory animated over time (play, pause, scrub), the regions and
+triangle under the pointer, and the counterexample of a failed verification highlighted.
+Either OUT, a directory written by `tlmpc compile`, or --log LOG (a CSV of t,x,y rows or a
+trace.json) with --mission MISSION, verified here."""
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Register the command's flags."""
+    parser.add_argument("out", type=Path, nargs="?", help="a `tlmpc compile` output directory")
+    parser.add_argument("--log", type=Path, help="a robot log (CSV t,x,y or trace.json)")
+    parser.add_argument("--mission", type=Path, help="the mission file the log is checked against")
+    parser.add_argument(
+        "-o",
+        "--output",
+        type=Path,
+        help="the HTML file to write (default: OUT/view.html, or LOG with .html)",
+    )
+
+
+def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
+    """Build the scene, render it and write the page atomically."""
+    from tlmpc.errors import EXIT_USAGE
+    from tlmpc.view import render_html, scene_from_log, scene_from_output
+
+    if (args.out is None) == (args.log is None) or (args.log is not None) != (
+        args.mission is not None
+    ):
+        # a usage error, reported the way argparse reports one
+        err.write("tlmpc view: error: give either OUT, or --log LOG with --mission MISSION\n")
+        return EXIT_USAGE
+    if args.log is not None:
+        scene = scene_from_log(args.log, args.mission)
+        target = args.output or args.log.with_suffix(".html")
+    else:
+        scene = scene_from_output(args.out)
+        target = args.output or args.out / "view.html"
+    page = render_html(scene)
+    if not target.parent.is_dir():
+        err.write(f"tlmpc view: error: the directory of {target} does not exist\n")
+        return EXIT_USAGE
+    temporary = target.with_name(f".{target.name}.tmp")
+    temporary.write_text(page, encoding="utf-8")
+    temporary.replace(target)
+    out.write(f"wrote {target}\n")
+    return 0

@@ -1,0 +1,158 @@
+"""The scene a view draws: plain JSON built from tlmpc's artifacts or from a log and a mission.
+
+A scene holds the workspace, the regions, the triangulation (when there is one), the trajectory
+as ``[t, x, y]`` samples and the verdict.  Where the trajectory leaves the workspace or enters a
+hole, the offending sample intervals are listed, so the page can draw them in the violation
+colour next to the verifier's counterexample.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+from tlmpc.errors import UsageError, error
+
+
+def _points(value: Any) -> list[list[float]]:
+    return [[float(x), float(y)] for x, y in value]
+
+
+def _finite(value: Any) -> Any:
+    """JSON without NaN/inf (the page's JSON.parse would reject them)."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return None if math.isnan(value) else ("inf" if value > 0 else "-inf")
+    if isinstance(value, dict):
+        return {k: _finite(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_finite(v) for v in value]
+    return value
+
+
+def _outside_intervals(
+    samples: list[list[float]], boundary: list[list[float]], holes: list[list[list[float]]]
+) -> list[list[int]]:
+    """Index ranges ``[first, last]`` of the segments (sample k to k+1) that leave the
+    workspace or cross a hole; a lone sample outside counts as the segment from it."""
+    from shapely import LineString, Point, Polygon, prepared
+
+    area = prepared.prep(Polygon(boundary, holes))
+    ranges: list[list[int]] = []
+    for index in range(max(len(samples) - 1, 1)):
+        a = samples[index]
+        b = samples[min(index + 1, len(samples) - 1)]
+        piece = Point(a[1], a[2]) if a[1:] == b[1:] else LineString([a[1:], b[1:]])
+        if area.covers(piece):
+            continue
+        if ranges and ranges[-1][1] == index - 1:
+            ranges[-1][1] = index
+        else:
+            ranges.append([index, index])
+    return ranges
+
+
+def _scene(
+    *,
+    title: str,
+    workspace: dict[str, Any],
+    regions: dict[str, Any],
+    samples: list[list[float]],
+    loop_start: int | None,
+    verdict: dict[str, Any] | None,
+    mesh: dict[str, Any] | None,
+    formula: str,
+) -> dict[str, Any]:
+    boundary = _points(workspace["boundary"])
+    holes = [_points(h) for h in workspace.get("holes", [])]
+    scene: dict[str, Any] = _finite(
+        {
+            "format": "tlmpc.view/1",
+            "title": title,
+            "formula": formula,
+            "workspace": {"boundary": boundary, "holes": holes},
+            "regions": {name: _points(poly) for name, poly in regions.items()},
+            "mesh": mesh,
+            "trajectory": samples,
+            "loop_start": loop_start,
+            "verdict": verdict,
+            "outside": _outside_intervals(samples, boundary, holes) if samples else [],
+        }
+    )
+    return scene
+
+
+def scene_from_output(directory: Path) -> dict[str, Any]:
+    """The scene of a ``tlmpc compile`` output directory (mesh, trajectory, verdict)."""
+    from tlmpc.artifacts import read_json
+
+    if not (directory / "mission.json").is_file():
+        raise UsageError(
+            error(
+                "U020",
+                f"{directory} has no mission.json",
+                hint="pass a directory written by `tlmpc compile MISSION -o DIR`, "
+                "or a log with `--log LOG --mission MISSION`",
+                file=str(directory),
+            )
+        )
+    mission = read_json(directory / "mission.json", "tlmpc.mission/")
+    mesh = None
+    if (directory / "abstraction.json").is_file():
+        abstraction = read_json(directory / "abstraction.json", "tlmpc.abstraction/")
+        mesh = {
+            "vertices": _points(abstraction["vertices"]),
+            "triangles": [list(map(int, t)) for t in abstraction["triangles"]],
+            "labels": [list(map(str, label)) for label in abstraction["labels"]],
+        }
+    samples: list[list[float]] = []
+    loop_start = None
+    if (directory / "trace.json").is_file():
+        trace = read_json(directory / "trace.json", "tlmpc.trace/")
+        samples = [[float(t), float(x), float(y)] for t, x, y in trace["points"]]
+        loop_start = trace.get("loop_start")
+    verdict = None
+    if (directory / "verdict.json").is_file():
+        verdict = read_json(directory / "verdict.json", "tlmpc.verdict/")
+    return _scene(
+        title=str(mission.get("name") or directory.name),
+        workspace=mission["workspace"],
+        regions=mission["regions"],
+        samples=samples,
+        loop_start=loop_start,
+        verdict=verdict,
+        mesh=mesh,
+        formula=str(mission.get("formula", "")),
+    )
+
+
+def scene_from_log(log: Path, mission_path: Path) -> dict[str, Any]:
+    """The scene of a robot's log (CSV ``t,x,y`` or ``trace.json``) verified against a mission."""
+    from tlmpc.artifacts import read_json
+    from tlmpc.ltl.printer import to_text
+    from tlmpc.mission.load import load_mission
+    from tlmpc.verify import from_csv, from_document, verdict_to_json, verify_trace
+
+    mission = load_mission(mission_path)
+    if log.suffix.lower() == ".csv":
+        trace = from_csv(log, mission_path, None)
+    else:
+        trace = from_document(read_json(log), file=str(log), convention=None)
+    verdict = verdict_to_json(verify_trace(trace))
+    samples = [
+        [float(t), float(x), float(y)]
+        for t, (x, y) in zip(trace.times.tolist(), trace.points.tolist(), strict=True)
+    ]
+    return _scene(
+        title=f"{log.name} against {mission.name}",
+        workspace={
+            "boundary": mission.workspace.boundary,
+            "holes": list(mission.workspace.holes),
+        },
+        regions={r.name: r.polygon for r in mission.regions},
+        samples=samples,
+        loop_start=trace.loop_start,
+        verdict=verdict,
+        mesh=None,
+        formula=to_text(mission.formula),
+    )
