@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import time
 from collections import defaultdict
 from collections.abc import Sequence
 
+from tlmpc.automata import simulation
 from tlmpc.automata.guards import holds
 from tlmpc.automata.model import Automaton, Edge
 from tlmpc.ltl.ast import TRUE, And, Formula, Not, Or, Prop, conjoin, disjoin
@@ -21,6 +23,20 @@ def merge_parallel(edges: Sequence[Edge]) -> list[Edge]:
         guard = TRUE if TRUE in unique else disjoin(unique)
         merged.append(Edge(src=src, dst=dst, guard=guard, marks=marks))
     return merged
+
+
+def merge_parallel_automaton(automaton: Automaton) -> Automaton:
+    """The automaton with :func:`merge_parallel` applied to its edges."""
+    return Automaton(
+        aps=automaton.aps,
+        num_states=automaton.num_states,
+        initial=automaton.initial,
+        edges=tuple(merge_parallel(automaton.edges)),
+        num_acc=automaton.num_acc,
+        state_names=automaton.state_names,
+        formula=automaton.formula,
+        state_based=automaton.state_based,
+    )
 
 
 def _literals(guard: Formula) -> frozenset[Formula] | None:
@@ -322,8 +338,39 @@ def _merge_states(automaton: Automaton, letters: Sequence[frozenset[str]] | None
     return _renumber(merged, merged.edges, keep)
 
 
-def postprocess(automaton: Automaton, letters: Sequence[frozenset[str]] | None) -> Automaton:
-    """Trim, prune SCCs, reduce acceptance sets and merge equivalent states (to a fixpoint)."""
+def reduce_by_simulation(
+    automaton: Automaton, letters: Sequence[frozenset[str]] | None, deadline: float
+) -> Automaton:
+    """Quotient by direct-simulation equivalence, then prune dominated edges (see
+    :mod:`tlmpc.automata.simulation`); the input unchanged when the deadline passes first."""
+    if letters is None and len(automaton.aps) > simulation.MAX_APS:
+        return automaton
+    alphabet = simulation.Alphabet(automaton.aps, letters)
+    try:
+        current = simulation.saturate(
+            automaton, sccs(automaton.num_states, automaton.edges, automaton.initial)
+        )
+        relation = simulation.simulation(current, alphabet, deadline)
+        merged = simulation.quotient(current, relation)
+        if merged is not current:
+            keep = {e.src for e in merged.edges} | {merged.initial}
+            current = _renumber(merged, merged.edges, keep)
+            current = simulation.saturate(
+                current, sccs(current.num_states, current.edges, current.initial)
+            )
+            relation = simulation.simulation(current, alphabet, deadline)
+        return simulation.prune(current, alphabet, relation)
+    except simulation.OutOfTime:
+        return automaton
+
+
+def postprocess(
+    automaton: Automaton,
+    letters: Sequence[frozenset[str]] | None,
+    deadline: float | None = None,
+) -> Automaton:
+    """Trim, prune SCCs, reduce acceptance sets and merge equivalent states (to a fixpoint),
+    then reduce by direct simulation while ``deadline`` (a ``time.perf_counter`` value) allows."""
     current = Automaton(
         aps=automaton.aps,
         num_states=automaton.num_states,
@@ -336,6 +383,19 @@ def postprocess(automaton: Automaton, letters: Sequence[frozenset[str]] | None) 
     )
     for _ in range(8):
         before = (current.num_states, len(current.edges), current.num_acc)
+        current = trim(current)
+        current = _reduce_marks(current)
+        current = _merge_states(current, letters)
+        if (current.num_states, len(current.edges), current.num_acc) == before:
+            break
+    for _ in range(4):
+        if deadline is not None and time.perf_counter() > deadline:
+            break
+        before = (current.num_states, len(current.edges), current.num_acc)
+        current = reduce_by_simulation(
+            current, letters, deadline if deadline is not None else float("inf")
+        )
+        current = merge_parallel_automaton(current)
         current = trim(current)
         current = _reduce_marks(current)
         current = _merge_states(current, letters)
