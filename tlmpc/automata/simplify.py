@@ -6,7 +6,7 @@ import time
 from collections import defaultdict
 from collections.abc import Sequence
 
-from tlmpc.automata import simulation
+from tlmpc.automata import simulation, wdba
 from tlmpc.automata.guards import holds
 from tlmpc.automata.model import Automaton, Edge
 from tlmpc.ltl.ast import TRUE, And, Formula, Not, Or, Prop, conjoin, disjoin
@@ -175,21 +175,25 @@ def _renumber(automaton: Automaton, edges: Sequence[Edge], keep: set[int]) -> Au
             if edge.dst not in order:
                 order[edge.dst] = len(order)
                 queue.append(edge.dst)
-    texts: dict[Formula, str] = {}
-
-    def text(guard: Formula) -> str:
-        if guard not in texts:
-            texts[guard] = str(guard)
-        return texts[guard]
-
     renumbered = sorted(
         (
             Edge(src=order[e.src], dst=order[e.dst], guard=e.guard, marks=e.marks)
             for e in edges
             if e.src in order and e.dst in order
         ),
-        key=lambda e: (e.src, e.dst, sorted(e.marks), text(e.guard)),
+        key=lambda e: (e.src, e.dst, sorted(e.marks)),
     )
+    # Parallel edges with equal marks keep a deterministic order (set iteration order of
+    # names depends on the hash seed): sort each run of ties by guard text.
+    start = 0
+    for end in range(1, len(renumbered) + 1):
+        if end == len(renumbered) or (
+            (renumbered[end].src, renumbered[end].dst, renumbered[end].marks)
+            != (renumbered[start].src, renumbered[start].dst, renumbered[start].marks)
+        ):
+            if end - start > 1:
+                renumbered[start:end] = sorted(renumbered[start:end], key=lambda e: str(e.guard))
+            start = end
     names = automaton.state_names
     new_names = [""] * len(order)
     for old, new in order.items():
@@ -359,7 +363,7 @@ def reduce_by_simulation(
                 current, sccs(current.num_states, current.edges, current.initial)
             )
             relation = simulation.simulation(current, alphabet, deadline)
-        return simulation.prune(current, alphabet, relation)
+        return simulation.prune(current, alphabet, relation, deadline)
     except simulation.OutOfTime:
         return automaton
 
@@ -368,6 +372,8 @@ def postprocess(
     automaton: Automaton,
     letters: Sequence[frozenset[str]] | None,
     deadline: float | None = None,
+    *,
+    obligation: bool = False,
 ) -> Automaton:
     """Trim, prune SCCs, reduce acceptance sets and merge equivalent states (to a fixpoint),
     then reduce by direct simulation while ``deadline`` (a ``time.perf_counter`` value) allows."""
@@ -401,6 +407,15 @@ def postprocess(
         current = _merge_states(current, letters)
         if (current.num_states, len(current.edges), current.num_acc) == before:
             break
+    if obligation and (deadline is None or time.perf_counter() < deadline):
+        # Obligation formulas: the minimized weak deterministic automaton when not larger.
+        candidate = wdba.minimize_obligation(
+            current, letters, deadline if deadline is not None else float("inf")
+        )
+        if candidate is not None:
+            candidate = _merge_states(_reduce_marks(trim(candidate)), letters)
+            if candidate.num_states <= current.num_states:
+                current = candidate
     if letters is not None:
         current = _simplify_guards(current, letters)
     return current

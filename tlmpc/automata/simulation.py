@@ -184,7 +184,9 @@ def quotient(automaton: Automaton, sim: list[list[bool]]) -> Automaton:
     )
 
 
-def prune(automaton: Automaton, alphabet: Alphabet, sim: list[list[bool]]) -> Automaton:
+def prune(
+    automaton: Automaton, alphabet: Alphabet, sim: list[list[bool]], deadline: float
+) -> Automaton:
     """Drop the cubes whose every letter has a strictly better alternative edge."""
     out: dict[int, list[Edge]] = defaultdict(list)
     for e in automaton.edges:
@@ -192,7 +194,10 @@ def prune(automaton: Automaton, alphabet: Alphabet, sim: list[list[bool]]) -> Au
     kept: list[Edge] = []
     for src, edges in out.items():
         facts = [(alphabet.mask(e.guard), _bits(e.marks), e.dst) for e in edges]
+        _check(deadline)
         for e, (_letters, marks, target) in zip(edges, facts, strict=True):
+            if len(facts) > 64:
+                _check(deadline)
             better = 0
             for other_letters, other_marks, other_target in facts:
                 if marks & ~other_marks or not sim[target][other_target]:

@@ -59,6 +59,22 @@ def make_and(parts: list[T] | tuple[T, ...]) -> T:
         # otherwise multiply into fifty conjuncts in every state).
         flat.difference_update(always)
         flat.add(("G", make_and([part[1] for part in always])))
+    persistent = [part for part in flat if part[0] == "F" and part[1][0] == "G"]
+    if len(persistent) > 1:
+        # F G a & F G b = F G(a & b)
+        flat.difference_update(persistent)
+        flat.add(("F", ("G", make_and([part[1][1] for part in persistent]))))
+    suspendable = [part for part in flat if _pure_eventuality(part) and _pure_universality(part)]
+    eventual = sorted(
+        (part for part in flat if part[0] == "F" and part not in suspendable), key=repr
+    )
+    if suspendable and eventual:
+        # F a & F b & s = F(a & s) & F(b & s) for s both a pure eventuality and a pure
+        # universality (its truth does not depend on the prefix): s is checked once the
+        # last of a, b is reached, not all along.
+        flat.difference_update(suspendable)
+        flat.difference_update(eventual)
+        flat.update(("F", make_and([part[1], *suspendable])) for part in eventual)
     if not flat:
         return TRUE
     if len(flat) == 1:
@@ -81,12 +97,17 @@ def make_or(parts: list[T] | tuple[T, ...]) -> T:
     for part in flat:
         if part[0] == "p" and ("n", part[1]) in flat:
             return TRUE
-    eventual = [part for part in flat if part[0] == "F"]
-    if len(eventual) > 1:
-        # F a | F b = F(a | b) (Spot's rule): one eventuality, and the initial state loops
-        # instead of guessing the disjunct at the first step.
+    recurrent = [part for part in flat if part[0] == "G" and part[1][0] == "F"]
+    if len(recurrent) > 1:
+        # G F a | G F b = G F(a | b): one recurrence instead of a choice between them.
+        flat.difference_update(recurrent)
+        flat.add(("G", ("F", make_or([part[1][1] for part in recurrent]))))
+    eventual = [part for part in flat if part[0] == "F" or _pure_eventuality(part)]
+    if len(eventual) > 1 and any(part[0] == "F" for part in eventual):
+        # F a | F b = F(a | b), and F a | e = F(a | e) for a pure eventuality e (= F e):
+        # one eventuality, and the state loops instead of guessing a disjunct at once.
         flat.difference_update(eventual)
-        flat.add(("F", make_or([part[1] for part in eventual])))
+        flat.add(("F", make_or([part[1] if part[0] == "F" else part for part in eventual])))
     if not flat:
         return FALSE
     if len(flat) == 1:
@@ -144,11 +165,6 @@ def make_f(a: T) -> T:
     """F a, simplified: F true = true, F false = false, F(eventuality) = itself."""
     if a in (TRUE, FALSE) or _pure_eventuality(a):
         return a
-    if a[0] == "|":  # pure eventualities leave the F: F(e | b) = e | F b
-        events = [x for x in a[1] if _pure_eventuality(x)]
-        if events:
-            rest = [x for x in a[1] if not _pure_eventuality(x)]
-            return make_or([*events, make_f(make_or(rest))])
     return ("F", a)
 
 
@@ -285,6 +301,16 @@ def simplify_state(parts: frozenset[T]) -> frozenset[T] | None:
         )
         if not redundant:
             kept.append(item)
+    # s & F(a & s) = F(a & s) for a suspendable s (prefix-independent): the F's fulfilment
+    # starts tracking s itself, so s need not be tracked meanwhile.  (General implied
+    # eventualities cannot be dropped like this: their promises would go unchecked.)
+    inside = {x for item in kept if item[0] == "F" and item[1][0] == "&" for x in item[1][1]}
+    if inside:
+        kept = [
+            item
+            for item in kept
+            if not (item in inside and _pure_eventuality(item) and _pure_universality(item))
+        ]
     return frozenset(kept)
 
 

@@ -26,6 +26,7 @@ from tlmpc.automata.terms import (
     simplify_state,
     to_text,
 )
+from tlmpc.automata.wdba import is_obligation
 from tlmpc.ltl.ast import Formula, Not, Prop, conjoin
 from tlmpc.ltl.printer import to_text as formula_text
 
@@ -34,6 +35,9 @@ DEFAULT_BUDGET = 0.5
 
 #: Above this many expansion terms in one state, dominated terms are left to the simulation.
 MAX_DOMINATION_TERMS = 600
+
+#: The same for each partial product of a state's conjuncts (checked more often).
+MAX_PARTIAL_DOMINATION_TERMS = 150
 
 State = frozenset[T]
 Cube = tuple[frozenset[str], frozenset[str]]
@@ -163,7 +167,7 @@ def translate(
         formula=formula_text(formula),
     )
     if simplify:
-        automaton = postprocess(automaton, letter_sets, deadline)
+        automaton = postprocess(automaton, letter_sets, deadline, obligation=is_obligation(root))
     if letter_sets is not None:
         automaton = dataclasses.replace(
             automaton, letters=tuple(sorted(tuple(sorted(x)) for x in letter_sets))
@@ -222,7 +226,7 @@ def _undominated_partial(terms: list[Any]) -> list[Any]:
     promises): whatever completes the dominated one completes the other one better, so
     pruning here keeps the product of the conjuncts from growing needlessly."""
     unique = _merge_adjacent(list(dict.fromkeys(terms)))
-    if len(unique) < 2 or len(unique) > MAX_DOMINATION_TERMS:
+    if len(unique) < 2 or len(unique) > MAX_PARTIAL_DOMINATION_TERMS:
         return unique
     index: dict[Any, int] = {}
     keys = []
