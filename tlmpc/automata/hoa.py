@@ -104,8 +104,8 @@ item: HEADER_NAME value*
 ?value: INT -> int_value
       | STRING -> string_value
       | IDENT -> ident_value
-      | "t" -> ident_value
-      | "f" -> ident_value
+      | T_CONST -> ident_value
+      | F_CONST -> ident_value
       | acc_cond
 acc_cond: ACC_ATOM
 body: state*
@@ -118,8 +118,11 @@ marks: "{" INT* "}"
 ?lit: "!" lit -> neg
     | "(" disj ")"
     | INT -> ap
-    | "t" -> true
-    | "f" -> false
+    | T_CONST -> true
+    | F_CONST -> false
+// `t`/`f` only as whole words: not the first letter of `tool:` or `trans-acc`.
+T_CONST.2: /t(?![A-Za-z0-9_:-])/
+F_CONST.2: /f(?![A-Za-z0-9_:-])/
 HEADER_NAME: /[A-Za-z@][A-Za-z0-9_-]*:/
 ACC_ATOM: /(Inf|Fin)\(!?\d+\)([&|](Inf|Fin)\(!?\d+\))*/
 IDENT: /[A-Za-z_][A-Za-z0-9_-]*/
