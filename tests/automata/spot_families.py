@@ -40,7 +40,7 @@ def to_tlmpc(f: Any) -> str:
     if kind == spot.op_ff:
         return "false"
     if kind == spot.op_ap:
-        name = f.ap_name()
+        name = str(f.ap_name())
         return name if name.isascii() and name.isidentifier() else '"' + name + '"'
     if kind == spot.op_Not:
         return "!(" + to_tlmpc(f[0]) + ")"

@@ -11,6 +11,9 @@ from tlmpc.automata.guards import holds
 from tlmpc.automata.model import Automaton, Edge
 from tlmpc.ltl.ast import TRUE, And, Formula, Not, Or, Prop, conjoin, disjoin
 
+#: Guards with more cubes than this are left unabsorbed (the check is quadratic).
+MAX_ABSORB = 256
+
 
 def merge_parallel(edges: Sequence[Edge]) -> list[Edge]:
     """One edge per (source, target, marks): the disjunction of the guards."""
@@ -55,6 +58,8 @@ def _absorb(guards: list[Formula]) -> list[Formula]:
     if len(guards) == 1 and not isinstance(guards[0], Or):
         return guards
     flat = [g for guard in guards for g in (guard.args if isinstance(guard, Or) else (guard,))]
+    if len(flat) > MAX_ABSORB:
+        return flat  # quadratic; a longer guard is still the same guard
     cubes = [_literals(g) for g in flat]
     kept = []
     for i, guard in enumerate(flat):
