@@ -13,6 +13,7 @@ from __future__ import annotations
 import shutil
 import statistics
 import subprocess
+import sys
 import time
 from pathlib import Path
 from typing import Any
@@ -109,6 +110,7 @@ def _spot_families() -> Any:
     assert spec is not None
     assert spec.loader is not None
     module = importlib.util.module_from_spec(spec)
+    sys.modules["spot_families"] = module
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DeprecationWarning)
         spec.loader.exec_module(module)
@@ -124,8 +126,8 @@ def run_spot(
     Both sides are transition-based generalized Büchi automata over the full alphabet (every
     valuation of the propositions): tlmpc's ``translate(f)`` against Spot's
     ``translate(f, "TGBA", "Small", "High")``; equivalence by ``spot.are_equivalent`` on
-    tlmpc's HOA.  ``held-out`` is a separate random sample (another seed) never used while
-    tuning the translator.
+    tlmpc's HOA.  ``held-out`` continues the random stream: formulas never used while tuning
+    the translator.
     """
     import spot
 
@@ -134,8 +136,7 @@ def run_spot(
     from tlmpc.ltl import parse_ltl
 
     families = _spot_families()
-    groups = families.families(random_count=random_count, random_seed=0)
-    groups["held-out"] = families.random_formulas(held_out, 2)
+    groups = families.families(random_count=random_count, random_seed=0, held_out=held_out)
     rows = []
     for family, texts in groups.items():
         ours_total = theirs_total = larger = wrong = 0
@@ -220,8 +221,6 @@ def _markdown(rows: list[dict[str, Any]]) -> str:
 
 
 if __name__ == "__main__":
-    import sys
-
     if "--no-spot" not in sys.argv:
         print(_spot_markdown(run_spot()))
         print()
