@@ -419,7 +419,10 @@ def postprocess(
         )
         if candidate is not None:
             candidate = _merge_states(_reduce_marks(trim(candidate)), letters)
-            if candidate.num_states <= current.num_states:
+            if (candidate.num_states, len(candidate.edges)) <= (
+                current.num_states,
+                len(current.edges),
+            ) or candidate.num_states < current.num_states:
                 current = candidate
     if letters is not None:
         current = _simplify_guards(current, letters)
