@@ -1,4 +1,7 @@
-"""Translator benchmark: TGBA/BA sizes and times beside spin's measured sizes.
+"""Translator benchmark: sizes and times beside Spot's (per family), and TGBA/BA sizes beside
+spin's measured sizes (per formula).
+
+``python bench/bench_automata.py [--spot-only | --no-spot] [--no-spin]``.
 
 Formulas and spin's reference numbers (trimmed state count and ``spin -f`` time, Debian spin
 6.5.2, from ``research/spin-sizes.md``) live in ``tests/automata/formulas.txt`` so the tests use
@@ -10,6 +13,7 @@ from __future__ import annotations
 import shutil
 import statistics
 import subprocess
+import sys
 import time
 from pathlib import Path
 from typing import Any
@@ -86,6 +90,105 @@ def run(
     return rows
 
 
+#: Before the simulation/rewriting work (first measured on this machine, same families and
+#: seeds): family -> (formulas, tlmpc states, Spot states, formulas larger than Spot, max s).
+BEFORE = {
+    "dac": (60, 219, 200, 12, 1.206),
+    "eh": (12, 43, 37, 2, 0.002),
+    "sb": (38, 169, 112, 18, 0.005),
+    "robotics": (52, 404, 378, 4, 5.585),
+    "random": (200, 1002, 731, 81, 0.081),
+}
+
+
+def _spot_families() -> Any:
+    import importlib.util
+    import warnings
+
+    path = FORMULAS.with_name("spot_families.py")
+    spec = importlib.util.spec_from_file_location("spot_families", path)
+    assert spec is not None
+    assert spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules["spot_families"] = module
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DeprecationWarning)
+        spec.loader.exec_module(module)
+    return module
+
+
+def run_spot(
+    *, random_count: int = 200, held_out: int = 500, budget: float | None = None
+) -> list[dict[str, Any]]:
+    """Per family: formulas, total states (tlmpc, Spot), formulas larger than Spot, the
+    largest tlmpc translation time, and formulas not equivalent (must be 0).
+
+    Both sides are transition-based generalized Büchi automata over the full alphabet (every
+    valuation of the propositions): tlmpc's ``translate(f)`` against Spot's
+    ``translate(f, "TGBA", "Small", "High")``; equivalence by ``spot.are_equivalent`` on
+    tlmpc's HOA.  ``held-out`` continues the random stream: formulas never used while tuning
+    the translator.
+    """
+    import spot
+
+    from tlmpc.automata import to_hoa, translate
+    from tlmpc.automata.translate import DEFAULT_BUDGET
+    from tlmpc.ltl import parse_ltl
+
+    families = _spot_families()
+    groups = families.families(random_count=random_count, random_seed=0, held_out=held_out)
+    rows = []
+    for family, texts in groups.items():
+        ours_total = theirs_total = larger = wrong = 0
+        slowest = spot_slowest = 0.0
+        for text in texts:
+            formula = parse_ltl(families.to_tlmpc(spot.formula(text)))
+            _clear_caches()
+            started = time.perf_counter()
+            ours = translate(formula, budget=DEFAULT_BUDGET if budget is None else budget)
+            slowest = max(slowest, time.perf_counter() - started)
+            started = time.perf_counter()
+            theirs = families.spot_automaton(text)
+            spot_slowest = max(spot_slowest, time.perf_counter() - started)
+            ours_total += ours.num_states
+            theirs_total += theirs.num_states()
+            larger += ours.num_states > theirs.num_states()
+            wrong += not spot.are_equivalent(spot.automaton(to_hoa(ours)), theirs)
+        rows.append(
+            {
+                "family": family,
+                "formulas": len(texts),
+                "tlmpc states": ours_total,
+                "Spot states": theirs_total,
+                "larger than Spot": larger,
+                "larger %": round(100 * larger / max(len(texts), 1), 1),
+                "max s": round(slowest, 3),
+                "Spot max s": round(spot_slowest, 3),
+                "not equivalent": wrong,
+            }
+        )
+    return rows
+
+
+def _spot_markdown(rows: list[dict[str, Any]]) -> str:
+    lines = [
+        "| family | formulas | tlmpc states (before) | Spot states | larger than Spot (before)"
+        " | max s (before) | Spot max s | not equivalent |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|",
+    ]
+    for r in rows:
+        before = BEFORE.get(r["family"])
+        old_states = f" ({before[1]})" if before else ""
+        old_larger = f" ({before[3]})" if before else ""
+        old_time = f" ({before[4]})" if before else ""
+        lines.append(
+            f"| {r['family']} | {r['formulas']} | {r['tlmpc states']}{old_states} | "
+            f"{r['Spot states']} | {r['larger than Spot']}{old_larger} | "
+            f"{r['max s']}{old_time} | {r['Spot max s']} | {r['not equivalent']} |"
+        )
+    return "\n".join(lines)
+
+
 def _markdown(rows: list[dict[str, Any]]) -> str:
     live = any("spin_seconds" in r for r in rows)
     head = "| name | TGBA st | edges | acc | BA st | spin trim st | ms | BA ms |"
@@ -118,6 +221,8 @@ def _markdown(rows: list[dict[str, Any]]) -> str:
 
 
 if __name__ == "__main__":
-    import sys
-
-    print(_markdown(run(live_spin="--no-spin" not in sys.argv)))
+    if "--no-spot" not in sys.argv:
+        print(_spot_markdown(run_spot()))
+        print()
+    if "--spot-only" not in sys.argv:
+        print(_markdown(run(live_spin="--no-spin" not in sys.argv)))

@@ -10,6 +10,8 @@ each state suffices), and entering an accepting SCC may start at level 0 or at l
 
 from __future__ import annotations
 
+import dataclasses
+
 from tlmpc.automata.model import Automaton, Edge
 from tlmpc.automata.simplify import merge_parallel, sccs, trim
 
@@ -109,6 +111,10 @@ def _build(automaton: Automaton, enter_at_top: bool) -> Automaton:
 
 def degeneralize(automaton: Automaton) -> Automaton:
     """An equivalent state-based Büchi automaton (one acceptance set, marks on states)."""
+    return dataclasses.replace(_degeneralize(automaton), letters=automaton.letters)
+
+
+def _degeneralize(automaton: Automaton) -> Automaton:
     if automaton.num_acc == 0 and automaton.edges:
         # Every infinite run accepts: mark every state of the (already trimmed) automaton.
         return Automaton(

@@ -8,6 +8,7 @@ edges per state.  Aliases and implicit labels are not supported (B002).
 from __future__ import annotations
 
 import functools
+import re
 from typing import Any
 
 from lark import Lark, Token, Tree
@@ -46,8 +47,22 @@ def to_hoa(automaton: Automaton) -> str:
     k = automaton.num_acc
     lines = ["HOA: v1", f'tool: "tlmpc" "{__version__}"']
     if automaton.formula:
-        lines.append(f"name: {_quote(automaton.formula)}")
+        name = automaton.formula
+        if automaton.letters is not None:
+            # Other tools read `name:` as the automaton's language; say it is only the
+            # formula's on the map's letters (the letters follow in `tlmpc-letters:`).
+            name = f"{name} (restricted to {len(automaton.letters)} letters)"
+        lines.append(f"name: {_quote(name)}")
         lines.append(f"tlmpc-ltl: {_quote(automaton.formula)}")
+    if automaton.letters is not None:
+        lines.append(
+            "tlmpc-letters: "
+            + str(len(automaton.letters))
+            + "".join(
+                " " + _quote(" ".join(str(index[a]) for a in letter if a in index))
+                for letter in automaton.letters
+            )
+        )
     lines.append(f"States: {automaton.num_states}")
     lines.append(f"Start: {automaton.initial}")
     lines.append(f"AP: {len(automaton.aps)}" + "".join(f" {_quote(a)}" for a in automaton.aps))
@@ -89,8 +104,8 @@ item: HEADER_NAME value*
 ?value: INT -> int_value
       | STRING -> string_value
       | IDENT -> ident_value
-      | "t" -> ident_value
-      | "f" -> ident_value
+      | T_CONST -> ident_value
+      | F_CONST -> ident_value
       | acc_cond
 acc_cond: ACC_ATOM
 body: state*
@@ -103,8 +118,11 @@ marks: "{" INT* "}"
 ?lit: "!" lit -> neg
     | "(" disj ")"
     | INT -> ap
-    | "t" -> true
-    | "f" -> false
+    | T_CONST -> true
+    | F_CONST -> false
+// `t`/`f` only as whole words: not the first letter of `tool:` or `trans-acc`.
+T_CONST.2: /t(?![A-Za-z0-9_:-])/
+F_CONST.2: /f(?![A-Za-z0-9_:-])/
 HEADER_NAME: /[A-Za-z@][A-Za-z0-9_-]*:/
 ACC_ATOM: /(Inf|Fin)\(!?\d+\)([&|](Inf|Fin)\(!?\d+\))*/
 IDENT: /[A-Za-z_][A-Za-z0-9_-]*/
@@ -156,7 +174,8 @@ def _formula(tree: Any, aps: list[str]) -> Formula:
 
 
 def _unquote(token: str) -> str:
-    return token[1:-1].replace('\\"', '"').replace("\\\\", "\\")
+    # One left-to-right pass: `\\"` is a backslash then the closing quote's escape...
+    return re.sub(r"\\(.)", r"\1", token[1:-1], flags=re.DOTALL)
 
 
 def parse_hoa(text: str, *, file: str | None = None) -> Automaton:
@@ -197,6 +216,7 @@ def parse_hoa(text: str, *, file: str | None = None) -> Automaton:
     num_acc = int(str(acceptance[0]))
     acc_name = " ".join(str(v) for v in header.get("acc-name", [[""]])[0])
     state_based = "state-acc" in " ".join(str(v) for v in header.get("properties", [[]])[0])
+    letters = _letters(header.get("tlmpc-letters"), aps)
     formula_values = header.get("tlmpc-ltl") or header.get("name") or [[""]]
     formula = _unquote(str(formula_values[0][0])) if formula_values[0] else ""
     starts = header.get("Start", [[0]])
@@ -233,7 +253,19 @@ def parse_hoa(text: str, *, file: str | None = None) -> Automaton:
         state_names=tuple(names.get(i, "") for i in range(max(count, 1))),
         formula=formula,
         state_based=state_based,
+        letters=letters,
     )
+
+
+def _letters(values: list[list[Any]] | None, aps: list[str]) -> tuple[tuple[str, ...], ...] | None:
+    """The ``tlmpc-letters:`` header (a count, then each letter as AP indices in a string)."""
+    if not values or not values[0]:
+        return None
+    out = []
+    for value in values[0][1:]:
+        indices = _unquote(str(value)).split()
+        out.append(tuple(aps[int(i)] for i in indices if i.isdigit() and int(i) < len(aps)))
+    return tuple(out)
 
 
 def _check(

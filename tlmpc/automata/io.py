@@ -14,7 +14,7 @@ FORMAT = "tlmpc.automaton/1"
 
 def automaton_to_json(automaton: Automaton) -> dict[str, Any]:
     """The artifact document: states, edges (guards as LTL text), acceptance."""
-    return {
+    document: dict[str, Any] = {
         "format": FORMAT,
         "formula": automaton.formula,
         "aps": list(automaton.aps),
@@ -33,6 +33,9 @@ def automaton_to_json(automaton: Automaton) -> dict[str, Any]:
             for e in automaton.edges
         ],
     }
+    if automaton.letters is not None:
+        document["letters"] = [list(letter) for letter in automaton.letters]
+    return document
 
 
 def automaton_from_json(document: Mapping[str, Any]) -> Automaton:
@@ -52,4 +55,9 @@ def automaton_from_json(document: Mapping[str, Any]) -> Automaton:
         state_names=tuple(s["name"] for s in document["states"]),
         formula=str(document.get("formula", "")),
         state_based=bool(acceptance.get("state_based", False)),
+        letters=(
+            None
+            if document.get("letters") is None
+            else tuple(tuple(str(x) for x in letter) for letter in document["letters"])
+        ),
     )

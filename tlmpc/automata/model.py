@@ -39,3 +39,7 @@ class Automaton:
     state_names: tuple[str, ...] = ()
     formula: str = ""
     state_based: bool = False
+    #: The label sets the automaton was built for (each the names true at once), when the
+    #: translation was restricted to a map's letters: its language is then the formula's
+    #: only on words over these letters.  None: every valuation of ``aps`` is a letter.
+    letters: tuple[tuple[str, ...], ...] | None = None

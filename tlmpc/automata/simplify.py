@@ -2,12 +2,17 @@
 
 from __future__ import annotations
 
+import time
 from collections import defaultdict
 from collections.abc import Sequence
 
+from tlmpc.automata import simulation, wdba
 from tlmpc.automata.guards import holds
 from tlmpc.automata.model import Automaton, Edge
 from tlmpc.ltl.ast import TRUE, And, Formula, Not, Or, Prop, conjoin, disjoin
+
+#: Guards with more cubes than this are left unabsorbed (the check is quadratic).
+MAX_ABSORB = 256
 
 
 def merge_parallel(edges: Sequence[Edge]) -> list[Edge]:
@@ -21,6 +26,20 @@ def merge_parallel(edges: Sequence[Edge]) -> list[Edge]:
         guard = TRUE if TRUE in unique else disjoin(unique)
         merged.append(Edge(src=src, dst=dst, guard=guard, marks=marks))
     return merged
+
+
+def merge_parallel_automaton(automaton: Automaton) -> Automaton:
+    """The automaton with :func:`merge_parallel` applied to its edges."""
+    return Automaton(
+        aps=automaton.aps,
+        num_states=automaton.num_states,
+        initial=automaton.initial,
+        edges=tuple(merge_parallel(automaton.edges)),
+        num_acc=automaton.num_acc,
+        state_names=automaton.state_names,
+        formula=automaton.formula,
+        state_based=automaton.state_based,
+    )
 
 
 def _literals(guard: Formula) -> frozenset[Formula] | None:
@@ -39,6 +58,8 @@ def _absorb(guards: list[Formula]) -> list[Formula]:
     if len(guards) == 1 and not isinstance(guards[0], Or):
         return guards
     flat = [g for guard in guards for g in (guard.args if isinstance(guard, Or) else (guard,))]
+    if len(flat) > MAX_ABSORB:
+        return flat  # quadratic; a longer guard is still the same guard
     cubes = [_literals(g) for g in flat]
     kept = []
     for i, guard in enumerate(flat):
@@ -159,21 +180,25 @@ def _renumber(automaton: Automaton, edges: Sequence[Edge], keep: set[int]) -> Au
             if edge.dst not in order:
                 order[edge.dst] = len(order)
                 queue.append(edge.dst)
-    texts: dict[Formula, str] = {}
-
-    def text(guard: Formula) -> str:
-        if guard not in texts:
-            texts[guard] = str(guard)
-        return texts[guard]
-
     renumbered = sorted(
         (
             Edge(src=order[e.src], dst=order[e.dst], guard=e.guard, marks=e.marks)
             for e in edges
             if e.src in order and e.dst in order
         ),
-        key=lambda e: (e.src, e.dst, sorted(e.marks), text(e.guard)),
+        key=lambda e: (e.src, e.dst, sorted(e.marks)),
     )
+    # Parallel edges with equal marks keep a deterministic order (set iteration order of
+    # names depends on the hash seed): sort each run of ties by guard text.
+    start = 0
+    for end in range(1, len(renumbered) + 1):
+        if end == len(renumbered) or (
+            (renumbered[end].src, renumbered[end].dst, renumbered[end].marks)
+            != (renumbered[start].src, renumbered[start].dst, renumbered[start].marks)
+        ):
+            if end - start > 1:
+                renumbered[start:end] = sorted(renumbered[start:end], key=lambda e: str(e.guard))
+            start = end
     names = automaton.state_names
     new_names = [""] * len(order)
     for old, new in order.items():
@@ -322,8 +347,41 @@ def _merge_states(automaton: Automaton, letters: Sequence[frozenset[str]] | None
     return _renumber(merged, merged.edges, keep)
 
 
-def postprocess(automaton: Automaton, letters: Sequence[frozenset[str]] | None) -> Automaton:
-    """Trim, prune SCCs, reduce acceptance sets and merge equivalent states (to a fixpoint)."""
+def reduce_by_simulation(
+    automaton: Automaton, letters: Sequence[frozenset[str]] | None, deadline: float
+) -> Automaton:
+    """Quotient by direct-simulation equivalence, then prune dominated edges (see
+    :mod:`tlmpc.automata.simulation`); the input unchanged when the deadline passes first."""
+    if letters is None and len(automaton.aps) > simulation.MAX_APS:
+        return automaton
+    alphabet = simulation.Alphabet(automaton.aps, letters)
+    try:
+        current = simulation.saturate(
+            automaton, sccs(automaton.num_states, automaton.edges, automaton.initial)
+        )
+        relation = simulation.simulation(current, alphabet, deadline)
+        merged = simulation.quotient(current, relation)
+        if merged is not current:
+            keep = {e.src for e in merged.edges} | {merged.initial}
+            current = _renumber(merged, merged.edges, keep)
+            current = simulation.saturate(
+                current, sccs(current.num_states, current.edges, current.initial)
+            )
+            relation = simulation.simulation(current, alphabet, deadline)
+        return simulation.prune(current, alphabet, relation, deadline)
+    except simulation.OutOfTime:
+        return automaton
+
+
+def postprocess(
+    automaton: Automaton,
+    letters: Sequence[frozenset[str]] | None,
+    deadline: float | None = None,
+    *,
+    obligation: bool = False,
+) -> Automaton:
+    """Trim, prune SCCs, reduce acceptance sets and merge equivalent states (to a fixpoint),
+    then reduce by direct simulation while ``deadline`` (a ``time.perf_counter`` value) allows."""
     current = Automaton(
         aps=automaton.aps,
         num_states=automaton.num_states,
@@ -341,6 +399,31 @@ def postprocess(automaton: Automaton, letters: Sequence[frozenset[str]] | None) 
         current = _merge_states(current, letters)
         if (current.num_states, len(current.edges), current.num_acc) == before:
             break
+    for _ in range(4):
+        if deadline is not None and time.perf_counter() > deadline:
+            break
+        before = (current.num_states, len(current.edges), current.num_acc)
+        current = reduce_by_simulation(
+            current, letters, deadline if deadline is not None else float("inf")
+        )
+        current = merge_parallel_automaton(current)
+        current = trim(current)
+        current = _reduce_marks(current)
+        current = _merge_states(current, letters)
+        if (current.num_states, len(current.edges), current.num_acc) == before:
+            break
+    if obligation and (deadline is None or time.perf_counter() < deadline):
+        # Obligation formulas: the minimized weak deterministic automaton when not larger.
+        candidate = wdba.minimize_obligation(
+            current, letters, deadline if deadline is not None else float("inf")
+        )
+        if candidate is not None:
+            candidate = _merge_states(_reduce_marks(trim(candidate)), letters)
+            if (candidate.num_states, len(candidate.edges)) <= (
+                current.num_states,
+                len(current.edges),
+            ) or candidate.num_states < current.num_states:
+                current = candidate
     if letters is not None:
         current = _simplify_guards(current, letters)
     return current

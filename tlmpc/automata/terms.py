@@ -59,6 +59,22 @@ def make_and(parts: list[T] | tuple[T, ...]) -> T:
         # otherwise multiply into fifty conjuncts in every state).
         flat.difference_update(always)
         flat.add(("G", make_and([part[1] for part in always])))
+    persistent = [part for part in flat if part[0] == "F" and part[1][0] == "G"]
+    if len(persistent) > 1:
+        # F G a & F G b = F G(a & b)
+        flat.difference_update(persistent)
+        flat.add(("F", ("G", make_and([part[1][1] for part in persistent]))))
+    suspendable = [part for part in flat if _pure_eventuality(part) and _pure_universality(part)]
+    eventual = sorted(
+        (part for part in flat if part[0] == "F" and part not in suspendable), key=repr
+    )
+    if suspendable and eventual:
+        # F a & F b & s = F(a & s) & F(b & s) for s both a pure eventuality and a pure
+        # universality (its truth does not depend on the prefix): s is checked once the
+        # last of a, b is reached, not all along.
+        flat.difference_update(suspendable)
+        flat.difference_update(eventual)
+        flat.update(("F", make_and([part[1], *suspendable])) for part in eventual)
     if not flat:
         return TRUE
     if len(flat) == 1:
@@ -81,6 +97,17 @@ def make_or(parts: list[T] | tuple[T, ...]) -> T:
     for part in flat:
         if part[0] == "p" and ("n", part[1]) in flat:
             return TRUE
+    recurrent = [part for part in flat if part[0] == "G" and part[1][0] == "F"]
+    if len(recurrent) > 1:
+        # G F a | G F b = G F(a | b): one recurrence instead of a choice between them.
+        flat.difference_update(recurrent)
+        flat.add(("G", ("F", make_or([part[1][1] for part in recurrent]))))
+    eventual = [part for part in flat if part[0] == "F" or _pure_eventuality(part)]
+    if len(eventual) > 1 and any(part[0] == "F" for part in eventual):
+        # F a | F b = F(a | b), and F a | e = F(a | e) for a pure eventuality e (= F e):
+        # one eventuality, and the state loops instead of guessing a disjunct at once.
+        flat.difference_update(eventual)
+        flat.add(("F", make_or([part[1] if part[0] == "F" else part for part in eventual])))
     if not flat:
         return FALSE
     if len(flat) == 1:
@@ -138,8 +165,6 @@ def make_f(a: T) -> T:
     """F a, simplified: F true = true, F false = false, F(eventuality) = itself."""
     if a in (TRUE, FALSE) or _pure_eventuality(a):
         return a
-    if a[0] == "|":  # F(a | b) = F a | F b keeps states small and eventualities shared
-        return make_or([make_f(x) for x in a[1]])
     return ("F", a)
 
 
@@ -254,6 +279,7 @@ def implies(f: T, g: T) -> bool:
     return bool(fk == "M" and implies(f[1], g) and implies(f[2], g))
 
 
+@functools.lru_cache(maxsize=1 << 16)
 def simplify_state(parts: frozenset[T]) -> frozenset[T] | None:
     """Drop conjuncts implied by others; None when the conjunction is false."""
     flat: set[T] = set()
@@ -275,6 +301,16 @@ def simplify_state(parts: frozenset[T]) -> frozenset[T] | None:
         )
         if not redundant:
             kept.append(item)
+    # s & F(a & s) = F(a & s) for a suspendable s (prefix-independent): the F's fulfilment
+    # starts tracking s itself, so s need not be tracked meanwhile.  (General implied
+    # eventualities cannot be dropped like this: their promises would go unchecked.)
+    inside = {x for item in kept if item[0] == "F" and item[1][0] == "&" for x in item[1][1]}
+    if inside:
+        kept = [
+            item
+            for item in kept
+            if not (item in inside and _pure_eventuality(item) and _pure_universality(item))
+        ]
     return frozenset(kept)
 
 
@@ -291,6 +327,19 @@ def _combine(left: list[Term], right: list[Term]) -> list[Term]:
 
 
 _EMPTY: frozenset[Any] = frozenset()
+
+
+def _unless(terms: list[Term] | tuple[Term, ...], alternatives: list[T]) -> list[Term]:
+    """``terms`` restricted to the letters where the literal ``alternatives`` are false.
+
+    Sound whenever a literal alternative's own term (that literal, nothing else) is also
+    among the expansion terms: it dominates every restricted-away letter.  Non-literal
+    alternatives are ignored."""
+    pos = frozenset(x[1] for x in alternatives if x[0] == "n")
+    neg = frozenset(x[1] for x in alternatives if x[0] == "p")
+    if not pos and not neg:
+        return list(terms)
+    return [(p | pos, n | neg, x, pr) for p, n, x, pr in terms if not (p | pos) & (n | neg)]
 
 
 @functools.cache
@@ -311,22 +360,35 @@ def expand(f: T) -> tuple[Term, ...]:
             result = _combine(result, list(expand(arg)))
         return tuple(result)
     if kind == "|":
-        return tuple(t for arg in f[1] for t in expand(arg))
+        # Literal disjuncts make the other disjuncts' terms exclusive: where a literal holds,
+        # its own term (no obligation, no promise) dominates theirs.
+        literals = [arg for arg in f[1] if arg[0] in ("p", "n")]
+        others = [t for arg in f[1] if arg[0] not in ("p", "n") for t in expand(arg)]
+        return (
+            *(t for arg in literals for t in expand(arg)),
+            *_unless(others, literals),
+        )
     later: Term = (_EMPTY, _EMPTY, frozenset([f]), _EMPTY)
     promise: Term = (_EMPTY, _EMPTY, frozenset([f]), frozenset([f]))
-    if kind == "F":  # b | (P & N(F b))
-        return (*expand(f[1]), promise)
+    if kind == "F":  # b | (!b & P & N(F b)) -- `!b` only when b is a literal
+        return (*expand(f[1]), *_unless([promise], [f[1]]))
     if kind == "G":  # a & N(G a)
         return tuple(_combine(list(expand(f[1])), [later]))
     a, b = f[1], f[2]
     if kind == "U":  # b | (a & P & N(a U b))
-        return (*expand(b), *_combine(list(expand(a)), [promise]))
+        return (*expand(b), *_unless(_combine(list(expand(a)), [promise]), [b]))
     if kind == "M":  # (a & b) | (b & P & N(a M b))
-        return (*_combine(list(expand(a)), list(expand(b))), *_combine(list(expand(b)), [promise]))
+        return (
+            *_combine(list(expand(a)), list(expand(b))),
+            *_unless(_combine(list(expand(b)), [promise]), [a]),
+        )
     if kind == "R":  # (a & b) | (b & N(a R b))
-        return (*_combine(list(expand(a)), list(expand(b))), *_combine(list(expand(b)), [later]))
+        return (
+            *_combine(list(expand(a)), list(expand(b))),
+            *_unless(_combine(list(expand(b)), [later]), [a]),
+        )
     if kind == "W":  # b | (a & N(a W b))
-        return (*expand(b), *_combine(list(expand(a)), [later]))
+        return (*expand(b), *_unless(_combine(list(expand(a)), [later]), [b]))
     raise ValueError(f"unknown formula kind {kind!r}")
 
 

@@ -10,6 +10,8 @@ are dropped, and states with the same outgoing behaviour are merged.  See docs/a
 
 from __future__ import annotations
 
+import dataclasses
+import time
 from collections.abc import Iterable, Sequence
 from typing import Any
 
@@ -24,8 +26,18 @@ from tlmpc.automata.terms import (
     simplify_state,
     to_text,
 )
+from tlmpc.automata.wdba import is_obligation
 from tlmpc.ltl.ast import Formula, Not, Prop, conjoin
 from tlmpc.ltl.printer import to_text as formula_text
+
+#: Seconds of optional reduction work per translation (see :func:`translate`).
+DEFAULT_BUDGET = 0.5
+
+#: Above this many expansion terms in one state, dominated terms are left to the simulation.
+MAX_DOMINATION_TERMS = 600
+
+#: The same for each partial product of a state's conjuncts (checked more often).
+MAX_PARTIAL_DOMINATION_TERMS = 150
 
 State = frozenset[T]
 Cube = tuple[frozenset[str], frozenset[str]]
@@ -39,7 +51,7 @@ def cube_formula(pos: Iterable[str], neg: Iterable[str]) -> Formula:
 
 
 def _dominated(
-    terms: list[tuple[Cube, State, frozenset[int]]],
+    terms: list[tuple[Cube, State, frozenset[int]]], num_acc: int
 ) -> list[tuple[Cube, State, frozenset[int]]]:
     """Drop every term that another term dominates.
 
@@ -49,21 +61,36 @@ def _dominated(
     so the undominated terms remain.
     """
     unique = list(dict.fromkeys(terms))
+    if len(unique) > MAX_DOMINATION_TERMS:
+        # The check is quadratic; the simulation-based pruning later does the same job
+        # within the time budget.
+        return unique
+    names = sorted({p for (pos, neg), _t, _m in unique for p in pos | neg})
+    bit = {name: 1 << i for i, name in enumerate(names)}
+    width = len(names)
+    # Term A dominates B iff key(A) is a bit subset of key(B) and A's target a subset of B's:
+    # key = positive literals | negative literals | marks *not* carried.
+    keys = []
+    for (pos, neg), _target, marks in unique:
+        key = 0
+        for p in pos:
+            key |= bit[p]
+        for n in neg:
+            key |= bit[n] << width
+        missing = 0
+        for m in range(num_acc):
+            if m not in marks:
+                missing |= 1 << m
+        keys.append(key | missing << (2 * width))
     kept = []
     # Distinct terms cannot dominate each other both ways, so "any other term" is safe.
-    for i, (cube, target, marks) in enumerate(unique):
-        pos, neg = cube
-        for j, (other_cube, other_target, other_marks) in enumerate(unique):
-            if (
-                j != i
-                and other_target <= target
-                and other_cube[0] <= pos
-                and other_cube[1] <= neg
-                and other_marks >= marks
-            ):
+    for i, term in enumerate(unique):
+        key, target = keys[i], term[1]
+        for j, other in enumerate(unique):
+            if j != i and keys[j] & ~key == 0 and other[1] <= target:
                 break
         else:
-            kept.append((cube, target, marks))
+            kept.append(term)
     return kept
 
 
@@ -79,6 +106,7 @@ def translate(
     *,
     letters: Sequence[Sequence[str]] | None = None,
     simplify: bool = True,
+    budget: float | None = DEFAULT_BUDGET,
 ) -> Automaton:
     """Translate ``formula`` (no X) into a TGBA.
 
@@ -88,7 +116,10 @@ def translate(
             true at once; all others false).  Edges no letter enables are dropped and states are
             merged with respect to these letters only.
         simplify: run the post-processing (trim, SCC pruning, merging).
+        budget: seconds after which the optional reductions (simulation) stop and the
+            automaton reduced so far, which is always correct, is returned; None = no limit.
     """
+    deadline = None if budget is None else time.perf_counter() + budget
     root = from_ast(formula)
     aps = tuple(sorted(formula.props()))
     letter_sets = (
@@ -116,7 +147,7 @@ def translate(
                     continue
                 marks = frozenset(i for e, i in event_index.items() if e not in promises)
                 terms.append(((pos, neg), target, marks))
-            for cube, target, marks in _dominated(terms):
+            for cube, target, marks in _dominated(terms, len(events)):
                 if target not in states:
                     states[target] = len(states)
                     names.append(_state_name(target))
@@ -136,7 +167,11 @@ def translate(
         formula=formula_text(formula),
     )
     if simplify:
-        automaton = postprocess(automaton, letter_sets)
+        automaton = postprocess(automaton, letter_sets, deadline, obligation=is_obligation(root))
+    if letter_sets is not None:
+        automaton = dataclasses.replace(
+            automaton, letters=tuple(sorted(tuple(sorted(x)) for x in letter_sets))
+        )
     return automaton
 
 
@@ -153,10 +188,64 @@ def _state_terms(
                 if p & n:
                     continue
                 combined.append((p, n, nxt | x2, prom | pr2))
-        terms = combined
+        terms = _undominated_partial(combined)
         if not terms:
             break
     return terms
+
+
+def _merge_adjacent(terms: list[Any]) -> list[Any]:
+    """Merge terms with the same obligations and promises whose cubes differ in the sign of
+    one proposition only (``a & b`` and ``a & !b`` give ``a``), until none is left."""
+    groups: dict[tuple[Any, Any], set[tuple[frozenset[str], frozenset[str]]]] = {}
+    for pos, neg, nxt, prom in terms:
+        groups.setdefault((nxt, prom), set()).add((pos, neg))
+    if len(groups) == len(terms):
+        return terms
+    out: list[Any] = []
+    for (nxt, prom), cubes in groups.items():
+        changed = len(cubes) > 1
+        while changed:
+            changed = False
+            for pos, neg in list(cubes):
+                if (pos, neg) not in cubes:
+                    continue
+                for name in pos:
+                    flipped = (pos - {name}, neg | {name})
+                    if flipped in cubes:
+                        cubes -= {(pos, neg), flipped}
+                        cubes.add((pos - {name}, neg))
+                        changed = True
+                        break
+        out.extend((pos, neg, nxt, prom) for pos, neg in cubes)
+    return out
+
+
+def _undominated_partial(terms: list[Any]) -> list[Any]:
+    """Drop partial products dominated by another one (weaker cube, fewer obligations, fewer
+    promises): whatever completes the dominated one completes the other one better, so
+    pruning here keeps the product of the conjuncts from growing needlessly."""
+    unique = _merge_adjacent(list(dict.fromkeys(terms)))
+    if len(unique) < 2 or len(unique) > MAX_PARTIAL_DOMINATION_TERMS:
+        return unique
+    index: dict[Any, int] = {}
+    keys = []
+    for pos, neg, nxt, prom in unique:
+        key = 0
+        for item in pos:
+            key |= 1 << index.setdefault(("p", item), len(index))
+        for item in neg:
+            key |= 1 << index.setdefault(("n", item), len(index))
+        for item in nxt:
+            key |= 1 << index.setdefault(("x", item), len(index))
+        for item in prom:
+            key |= 1 << index.setdefault(("P", item), len(index))
+        keys.append(key)
+    return [
+        term
+        for i, term in enumerate(unique)
+        if not any(j != i and keys[j] & ~keys[i] == 0 for j in range(len(unique)))
+    ]
 
 
 def _state_name(state: State) -> str:

@@ -95,10 +95,29 @@ def _token_span(pos: _Positions, token: Token) -> Span:
     )
 
 
+def unquote(token: str) -> str:
+    """The name inside a quoted proposition: ``\\n`` is a newline, ``\\x`` is ``x``."""
+    body = token[1:-1]
+    if "\\" not in body:
+        return body
+    out = []
+    chars = iter(body)
+    for char in chars:
+        if char == "\\":
+            escaped = next(chars, "")
+            out.append("\n" if escaped == "n" else escaped)
+        else:
+            out.append(char)
+    return "".join(out)
+
+
 class _ToAst(Transformer[Token, Formula]):
-    def __init__(self, pos: _Positions) -> None:
+    def __init__(self, pos: _Positions, file: str | None) -> None:
         super().__init__()
         self.pos = pos
+        self.file = file
+        #: Operator keywords used as bare proposition names (L030), reported after the walk.
+        self.keyword_names: list[Diagnostic] = []
 
     def _span(self, meta: Any) -> Span | None:
         if getattr(meta, "empty", True):
@@ -115,11 +134,25 @@ class _ToAst(Transformer[Token, Formula]):
 
     @v_args(meta=True)
     def prop(self, meta: Any, children: list[Token]) -> Formula:
-        return Prop(str(children[0]), span=_token_span(self.pos, children[0]))
+        name = str(children[0])
+        span = _token_span(self.pos, children[0])
+        if name in KEYWORDS:
+            # The contextual lexer reads `U` as a name where no operator can stand (`U U U`).
+            self.keyword_names.append(
+                error(
+                    "L030",
+                    f"{name!r} is an operator of the language, not a proposition name",
+                    hint=f'write "{name}" in double quotes to name a region {name}',
+                    file=self.file,
+                    line=span.line,
+                    col=span.col,
+                )
+            )
+        return Prop(name, span=span)
 
     @v_args(meta=True)
     def quoted_prop(self, meta: Any, children: list[Token]) -> Formula:
-        return Prop(str(children[0])[1:-1], span=_token_span(self.pos, children[0]))
+        return Prop(unquote(str(children[0])), span=_token_span(self.pos, children[0]))
 
     @v_args(meta=True)
     def not_op(self, meta: Any, children: list[Any]) -> Formula:
@@ -379,10 +412,13 @@ def parse_ltl(text: str, *, file: str | None = None, line: int = 1, col: int = 1
     )
     if _tree_depth(tree) > MAX_DEPTH:
         raise InvalidInputError(too_deep)
+    transformer = _ToAst(pos, file)
     try:
-        formula = _ToAst(pos).transform(tree)
+        formula = transformer.transform(tree)
     except (RecursionError, VisitError):
         raise InvalidInputError(too_deep) from None
+    if transformer.keyword_names:
+        raise InvalidInputError(transformer.keyword_names)
     if not isinstance(formula, Formula):  # pragma: no cover - the grammar always yields one
         raise InvalidInputError(error("L003", "cannot parse LTL formula", file=file))
     return formula

@@ -8,6 +8,8 @@ the precedence would not need it: ``p4 & ((!p2 & !p3) U p1)``.
 
 from __future__ import annotations
 
+import re
+
 from tlmpc.ltl.ast import (
     And,
     Const,
@@ -29,6 +31,22 @@ from tlmpc.ltl.ast import (
 _IMPLIES, _OR, _AND, _BINTEMP, _UNARY, _ATOM = range(1, 7)
 
 _TEMPORAL_SYMBOL = {Until: "U", Release: "R", WeakUntil: "W", StrongRelease: "M"}
+
+
+_BARE_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+_OPERATOR_CHAIN = re.compile(r"[FGXN]+")
+#: Words the lexer reads as operators or constants wherever they may stand.
+_RESERVED = frozenset({"U", "R", "W", "M", "V", "true", "false"})
+
+
+def proposition_text(name: str) -> str:
+    """``name`` as the parser reads it back: bare when it is an ASCII identifier that is no
+    operator or constant (``U``, ``true``, ``FG``), else in double quotes with ``\\``,
+    ``"`` and newlines escaped."""
+    if _BARE_NAME.fullmatch(name) and name not in _RESERVED and not _OPERATOR_CHAIN.fullmatch(name):
+        return name
+    escaped = name.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n")
+    return f'"{escaped}"'
 
 
 def _level(formula: Formula) -> int:
@@ -64,7 +82,7 @@ def _print(formula: Formula) -> str:
     if isinstance(formula, Const):
         return "true" if formula.value else "false"
     if isinstance(formula, Prop):
-        return formula.name if formula.name.isidentifier() else f'"{formula.name}"'
+        return proposition_text(formula.name)
     if isinstance(formula, Not):
         return "!" + _operand(formula.arg, _UNARY)
     if isinstance(formula, Eventually | Globally):

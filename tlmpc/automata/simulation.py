@@ -1,0 +1,218 @@
+"""Direct-simulation reduction of a TGBA (Spot's ``simul``; Somenzi–Bloem "little brothers").
+
+State ``q`` directly simulates ``p`` when every edge ``p --a/M--> p'`` is matched, for the same
+letter ``a``, by an edge ``q --a/M'--> q'`` with ``M ⊆ M'`` and ``q'`` simulating ``p'``.  The
+largest such relation is computed by fixpoint refinement over explicit letter sets (bitmasks over
+the 2^|AP| valuations, or over the map's letters when the translation is restricted to them).
+Two language-preserving reductions follow (Etessami–Wilke–Schuller; Clemente–Mayr):
+
+* **quotient** by simulation equivalence (states simulating each other are merged);
+* **pruning**: a cube of an edge is dropped when, for each of its letters, another edge of the
+  same source goes to a strictly better target with at least its marks.
+
+Edges that lie on no cycle are taken at most once by a run, so their marks do not matter; they
+are given every mark first ("saturation"), which lets them dominate and be dominated more often.
+
+Every step checks a deadline; when it passes, the automaton reduced so far (always correct) is
+returned.
+"""
+
+from __future__ import annotations
+
+import time
+from collections import defaultdict
+from collections.abc import Sequence
+
+from tlmpc.automata.model import Automaton, Edge
+from tlmpc.ltl.ast import And, Const, Formula, Not, Or, Prop, disjoin
+
+#: Above this many propositions the full alphabet is too large to enumerate; no reduction.
+MAX_APS = 14
+
+
+class Alphabet:
+    """Letter bitmasks of guards, over explicit letters or all valuations of ``aps``."""
+
+    def __init__(self, aps: Sequence[str], letters: Sequence[frozenset[str]] | None) -> None:
+        self.literal: dict[str, int] = {}
+        if letters is None:
+            n = len(aps)
+            size = 1 << n
+            self.full = (1 << size) - 1
+            for i, ap in enumerate(aps):
+                mask = 0
+                for valuation in range(size):
+                    if valuation >> i & 1:
+                        mask |= 1 << valuation
+                self.literal[ap] = mask
+        else:
+            self.full = (1 << len(letters)) - 1
+            for ap in aps:
+                mask = 0
+                for i, letter in enumerate(letters):
+                    if ap in letter:
+                        mask |= 1 << i
+                self.literal[ap] = mask
+        self._cache: dict[Formula, int] = {}
+
+    def mask(self, guard: Formula) -> int:
+        """The letters that enable ``guard``."""
+        cached = self._cache.get(guard)
+        if cached is not None:
+            return cached
+        if isinstance(guard, Const):
+            result = self.full if guard.value else 0
+        elif isinstance(guard, Prop):
+            result = self.literal.get(guard.name, 0)
+        elif isinstance(guard, Not):
+            result = self.full & ~self.mask(guard.arg)
+        elif isinstance(guard, And):
+            result = self.full
+            for arg in guard.args:
+                result &= self.mask(arg)
+        elif isinstance(guard, Or):
+            result = 0
+            for arg in guard.args:
+                result |= self.mask(arg)
+        else:
+            raise ValueError(f"guards are propositional, got {guard!r}")
+        self._cache[guard] = result
+        return result
+
+
+class OutOfTime(Exception):
+    """The reduction's deadline passed."""
+
+
+def _check(deadline: float) -> None:
+    if time.perf_counter() > deadline:
+        raise OutOfTime
+
+
+def _bits(marks: frozenset[int]) -> int:
+    value = 0
+    for mark in marks:
+        value |= 1 << mark
+    return value
+
+
+def saturate(automaton: Automaton, component: Sequence[int]) -> Automaton:
+    """Give every mark to edges between SCCs (taken at most once, so the language stays)."""
+    everything = frozenset(range(automaton.num_acc))
+    edges = tuple(
+        e
+        if component[e.src] == component[e.dst]
+        else Edge(src=e.src, dst=e.dst, guard=e.guard, marks=everything)
+        for e in automaton.edges
+    )
+    return _with_edges(automaton, edges)
+
+
+def _with_edges(automaton: Automaton, edges: Sequence[Edge]) -> Automaton:
+    return Automaton(
+        aps=automaton.aps,
+        num_states=automaton.num_states,
+        initial=automaton.initial,
+        edges=tuple(edges),
+        num_acc=automaton.num_acc,
+        state_names=automaton.state_names,
+        formula=automaton.formula,
+        state_based=automaton.state_based,
+    )
+
+
+def simulation(automaton: Automaton, alphabet: Alphabet, deadline: float) -> list[list[bool]]:
+    """``sim[p][q]``: ``q`` directly simulates ``p`` (largest relation)."""
+    n = automaton.num_states
+    out: list[list[tuple[int, int, int]]] = [[] for _ in range(n)]
+    for e in automaton.edges:
+        out[e.src].append((alphabet.mask(e.guard), _bits(e.marks), e.dst))
+    # Letters a state enables at all: a necessary condition, checked first.
+    enabled = [0] * n
+    for state in range(n):
+        for letters, _marks, _dst in out[state]:
+            enabled[state] |= letters
+    sim = [[(enabled[p] & ~enabled[q]) == 0 for q in range(n)] for p in range(n)]
+    changed = True
+    while changed:
+        changed = False
+        _check(deadline)
+        for p in range(n):
+            _check(deadline)
+            row = sim[p]
+            for q in range(n):
+                if p == q or not row[q]:
+                    continue
+                for letters, marks, target in out[p]:
+                    covered = 0
+                    target_row = sim[target]
+                    for other_letters, other_marks, other_target in out[q]:
+                        if marks & ~other_marks == 0 and target_row[other_target]:
+                            covered |= other_letters
+                    if letters & ~covered:
+                        row[q] = False
+                        changed = True
+                        break
+    return sim
+
+
+def quotient(automaton: Automaton, sim: list[list[bool]]) -> Automaton:
+    """Merge states that simulate each other (edges keep their guards and marks)."""
+    n = automaton.num_states
+    representative = list(range(n))
+    for p in range(n):
+        for q in range(p):
+            if representative[q] == q and sim[p][q] and sim[q][p]:
+                representative[p] = q
+                break
+    if all(representative[p] == p for p in range(n)):
+        return automaton
+    edges = [
+        Edge(src=e.src, dst=representative[e.dst], guard=e.guard, marks=e.marks)
+        for e in automaton.edges
+        if representative[e.src] == e.src
+    ]
+    return Automaton(
+        aps=automaton.aps,
+        num_states=n,
+        initial=representative[automaton.initial],
+        edges=tuple(edges),
+        num_acc=automaton.num_acc,
+        state_names=automaton.state_names,
+        formula=automaton.formula,
+        state_based=automaton.state_based,
+    )
+
+
+def prune(
+    automaton: Automaton, alphabet: Alphabet, sim: list[list[bool]], deadline: float
+) -> Automaton:
+    """Drop the cubes whose every letter has a strictly better alternative edge."""
+    out: dict[int, list[Edge]] = defaultdict(list)
+    for e in automaton.edges:
+        out[e.src].append(e)
+    kept: list[Edge] = []
+    for src, edges in out.items():
+        facts = [(alphabet.mask(e.guard), _bits(e.marks), e.dst) for e in edges]
+        _check(deadline)
+        for e, (_letters, marks, target) in zip(edges, facts, strict=True):
+            if len(facts) > 64:
+                _check(deadline)
+            better = 0
+            for other_letters, other_marks, other_target in facts:
+                if marks & ~other_marks or not sim[target][other_target]:
+                    continue
+                # Strictly better: not also dominated the other way round.
+                if other_marks & ~marks == 0 and sim[other_target][target]:
+                    continue
+                better |= other_letters
+            if better == 0:
+                kept.append(e)
+                continue
+            cubes = e.guard.args if isinstance(e.guard, Or) else (e.guard,)
+            remaining = [c for c in cubes if alphabet.mask(c) & ~better]
+            if len(remaining) == len(cubes):
+                kept.append(e)
+            elif remaining:
+                kept.append(Edge(src=src, dst=e.dst, guard=disjoin(remaining), marks=e.marks))
+    return _with_edges(automaton, kept)
