@@ -88,9 +88,7 @@ def _print(path: Path, verdict: Verdict, out: TextIO) -> None:
         "loop": "the loop repeats forever",
     }[verdict.ending]
     out.write(f"{path}: {status[verdict.outcome]}: {verdict.formula}\n")
-    out.write(
-        f"  boundary convention: {verdict.convention}; {ending}; {verdict.pieces} pieces\n"
-    )
+    out.write(f"  boundary convention: {verdict.convention}; {ending}; {verdict.pieces} pieces\n")
     if len(verdict.conjuncts) > 1 or verdict.ending == "open":
         for report in verdict.conjuncts:
             out.write(f"  {report.conjunct}: {report.outcome}: {report.progress}\n")

@@ -81,9 +81,7 @@ class IntervalEvaluator:
 
     def _until_side(self, a: FloatArray, b: FloatArray) -> FloatArray:
         size, loop = self.size, self.loop
-        point = (
-            self.is_point.tolist() if self.is_point is not None else [False] * size
-        )
+        point = self.is_point.tolist() if self.is_point is not None else [False] * size
         a_list, b_list = a.tolist(), b.tolist()
         values = [-np.inf] * size
         # A self-loop on the last position needs one pass (its fixpoint is b there).

@@ -1,4 +1,4 @@
-"""The verifier's answer: verdict, per-conjunct progress, every violation, robustness, certificate."""
+"""The verifier's answer: verdict, per-conjunct progress, violations, robustness, certificate."""
 
 from __future__ import annotations
 

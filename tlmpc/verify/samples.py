@@ -51,7 +51,9 @@ def sample_diagnostics(
     bad = np.flatnonzero(~np.all(np.isfinite(values), axis=1))
     for index in bad[:MAX_PER_KIND].tolist():
         what, line = _where(index, lines)
-        columns = [n for n, v in zip("txy", values[index].tolist(), strict=True) if not np.isfinite(v)]
+        columns = [
+            n for n, v in zip("txy", values[index].tolist(), strict=True) if not np.isfinite(v)
+        ]
         found.append(
             error(
                 "V003",

@@ -59,9 +59,10 @@ def _last_point_unknown(
         return None
     shapes = [shapely.Polygon(p) for p in regions.values()]
     last = pieces.positions[-1:]
-    on_boundary = region_membership(shapes, last, closed=True)[0] & ~region_membership(
-        shapes, last, closed=False
-    )[0]
+    on_boundary = (
+        region_membership(shapes, last, closed=True)[0]
+        & ~region_membership(shapes, last, closed=False)[0]
+    )
     if not on_boundary.any():
         return None
     unknown = np.zeros_like(pieces.labels)
@@ -72,7 +73,9 @@ def _last_point_unknown(
 class _Truth:
     """Three-valued truth on the pieces, with the unknown future after an open log."""
 
-    def __init__(self, trace: TraceInput, pieces: Pieces, names: list[str], unknown: BoolArray | None) -> None:
+    def __init__(
+        self, trace: TraceInput, pieces: Pieces, names: list[str], unknown: BoolArray | None
+    ) -> None:
         size = len(pieces.is_point)
         self.size = size
         is_point = pieces.is_point if trace.convention == "closed" else None
@@ -136,13 +139,19 @@ def workspace_violations(trace: TraceInput) -> tuple[list[Violation], float | No
             previous_bad = False
             continue
         outside = shapely.difference(segments[index], free) if len(points) > 1 else segments[index]
-        coords = shapely.get_coordinates(outside) if not shapely.is_empty(outside) else points[index : index + 1]
+        coords = (
+            shapely.get_coordinates(outside)
+            if not shapely.is_empty(outside)
+            else points[index : index + 1]
+        )
         if len(points) > 1:
             middles = (points[index] + points[index + 1]) / 2.0
             probes = np.vstack([coords, middles[None, :]])
             outside_probes = probes[~shapely.covers(free, shapely.points(probes))]
             if len(outside_probes):
-                depth = max(depth, float(np.max(shapely.distance(free, shapely.points(outside_probes)))))
+                depth = max(
+                    depth, float(np.max(shapely.distance(free, shapely.points(outside_probes))))
+                )
         if previous_bad:
             continue
         previous_bad = True
@@ -170,9 +179,7 @@ def workspace_violations(trace: TraceInput) -> tuple[list[Violation], float | No
     return found, -depth
 
 
-def certify(
-    trace: TraceInput, regions: dict[str, FloatArray], outcome: Outcome
-) -> Certificate:
+def certify(trace: TraceInput, regions: dict[str, FloatArray], outcome: Outcome) -> Certificate:
     """Check the speed assumption, then bound the robustness of every motion it allows."""
     times, points = trace.times, trace.points
     gaps = np.diff(times)
@@ -252,7 +259,11 @@ def verify_trace(trace: TraceInput) -> Verdict:
     if loop_start is not None and size:
         ends[-1] = trace.times[-1]
     line = Timeline(
-        starts=pieces.times, ends=ends, positions=pieces.positions, labels=pieces.labels, names=names
+        starts=pieces.times,
+        ends=ends,
+        positions=pieces.positions,
+        labels=pieces.labels,
+        names=names,
     )
     reports, violations = conjunct_reports(conjuncts, outcomes, truth, line)
     excursions, workspace_rho = workspace_violations(trace)
