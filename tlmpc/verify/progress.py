@@ -111,15 +111,9 @@ def _other_violation(
     if isinstance(conjunct, Until):
         right_never = value(conjunct.right)[1][:size] < 0
         left_fails = value(conjunct.left)[1][:size] < 0
-        if right_never.all():
-            return Violation(
-                conjunct=text,
-                time=None,
-                position=None,
-                message=f"`{to_text(conjunct.right)}` never holds, so `{text}` fails",
-            )
         bad = np.flatnonzero(left_fails & right_never)
-        if len(bad):
+        # the first instant where neither holds, if b never held before it
+        if len(bad) and right_never[: int(bad[0]) + 1].all():
             time, position = _at(line, int(bad[0]))
             return Violation(
                 conjunct=text,
@@ -127,6 +121,13 @@ def _other_violation(
                 position=position,
                 message=f"`{to_text(conjunct.left)}` stops holding at t={time:.4g} s at "
                 f"{_place(position)} before `{to_text(conjunct.right)}` holds",
+            )
+        if right_never.all():
+            return Violation(
+                conjunct=text,
+                time=None,
+                position=None,
+                message=f"`{to_text(conjunct.right)}` never holds, so `{text}` fails",
             )
     return Violation(
         conjunct=text, time=None, position=None, message=f"`{text}` does not hold on this trace"
