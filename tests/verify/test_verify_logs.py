@@ -165,7 +165,7 @@ def test_csv_logs_with_bad_samples(tmp_path: Path) -> None:
 
 def test_all_sample_problems_at_once(tmp_path: Path) -> None:
     path = tmp_path / "t.json"
-    points = [[0, 1, 1], [1, 1, 1], [1, 1, 2], [0.5, 1, 1], [2, 1, 1], [2, 1, 1]]
+    points = [[0.0, 1, 1], [1.0, 1, 1], [1.0, 1, 2], [0.5, 1, 1], [2.0, 1, 1], [2.0, 1, 1]]
     path.write_text(json.dumps(log(points, "F a")))
     status, _, err = run(str(path))
     assert status == 2

@@ -20,6 +20,7 @@ from __future__ import annotations
 import itertools
 
 import numpy as np
+import numpy.typing as npt
 from hypothesis import given
 from hypothesis import strategies as st
 from lasso_ltl import holds
@@ -50,7 +51,7 @@ letters = st.frozensets(st.sampled_from(PROPS))
 ALL_LETTERS = [frozenset(s) for n in range(3) for s in itertools.combinations(PROPS, n)]
 
 
-def _labels(word: Word) -> np.ndarray:  # type: ignore[type-arg]
+def _labels(word: Word) -> npt.NDArray[np.bool_]:
     return np.array([[p in letter for p in PROPS] for letter in word], dtype=bool).reshape(
         len(word), len(PROPS)
     )
@@ -311,7 +312,7 @@ def _continuations(length: int, closed: bool) -> list[tuple[Word, list[bool], in
     Closed: open, point, open, ...; it ends in a stay on a point piece, or loops from a point
     piece round to an open one.  Right: any letters, any loop.
     """
-    found = []
+    found: list[tuple[Word, list[bool], int]] = []
     for letters_ in itertools.product(ALL_LETTERS, repeat=length):
         is_point = [(k % 2 == 1) if closed else False for k in range(length)]
         if not closed:
