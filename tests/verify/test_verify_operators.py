@@ -343,3 +343,13 @@ def test_open_verdict_is_sound_on_closed_pieces_by_brute_force(
         assert closed_holds(formula, full, points, len(word) + loop, 0) == (ours == 1), to_text(
             formula
         )
+
+
+def test_until_wraps_around_the_loop() -> None:
+    # the only b is the loop's first piece: from every later piece, a U b needs the wrap
+    word = _word(["b", "a", "a", "a"])
+    for is_point in (None, np.array([True, False, True, False])):
+        truth = lasso_truth(Until(a, b), _labels(word), list(PROPS), 0, is_point)
+        assert truth.tolist() == [True, True, True, True]
+        released = lasso_truth(Release(Not(a), Not(b)), _labels(word), list(PROPS), 0, is_point)
+        assert released.tolist() == [False, False, False, False]

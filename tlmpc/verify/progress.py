@@ -51,6 +51,10 @@ def _place(position: tuple[float, float]) -> str:
     return f"({position[0]:.4g}, {position[1]:.4g})"
 
 
+def _times(count: int) -> str:
+    return "once" if count == 1 else f"{count} times"
+
+
 def _visits(line: Timeline, held: BoolArray) -> tuple[int, float | None, float]:
     """Visits (runs where ``held``), when the last began, and the longest time between them.
 
@@ -76,6 +80,13 @@ def _globally_violations(
     found = []
     for first, last in runs(broken):
         time, position = _at(line, first)
+        if isinstance(inner, Eventually):
+            message = (
+                f"`{to_text(inner.arg)}` never holds again after t={time:.4g} s "
+                f"(from {_place(position)}), so `{text}` fails"
+            )
+            found.append(Violation(conjunct=text, time=time, position=position, message=message))
+            continue
         inside = [line.names[i] for i in np.flatnonzero(line.labels[first])]
         forbidden = [
             n.arg.name
@@ -147,7 +158,7 @@ def _progress(
     if isinstance(conjunct, Globally) and isinstance(conjunct.arg, Eventually):
         count, last, gap = _visits(line, held(conjunct.arg.arg))
         if count:
-            progress = f"visited {count} times, last at t={last:.4g} s, longest gap {gap:.4g} s"
+            progress = f"visited {_times(count)}, last at t={last:.4g} s, longest gap {gap:.4g} s"
         else:
             progress = f"never visited in {gap:.4g} s"
         return ConjunctReport(
@@ -170,7 +181,7 @@ def _progress(
         broken = runs(value(conjunct.arg)[1][:size] < 0)
         if broken:
             time = float(line.starts[broken[0][0]])
-            progress = f"broken {len(broken)} times, first at t={time:.4g} s"
+            progress = f"broken {_times(len(broken))}, first at t={time:.4g} s"
         else:
             progress = "held so far" if outcome == "inconclusive" else "held throughout"
         return ConjunctReport(conjunct=text, outcome=outcome, progress=progress)
