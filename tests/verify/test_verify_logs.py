@@ -184,3 +184,43 @@ def test_compiled_traces_are_satisfied_and_certified(spec: str, tmp_path: Path) 
     assert verdict["verdict"] == "satisfied"
     assert verdict["certificate"]["certified"], verdict["certificate"]["reason"]
     assert verdict["ending"] in ("stay", "loop")
+
+
+def test_robustness_at_a_rounded_boundary_point_keeps_the_label_sign() -> None:
+    # (0.21, 0.07) lies on the slanted edge of `slant` mathematically, but rounding puts it a
+    # hair outside; under the right convention it carries the label of where the robot goes
+    # (inside), so the task `slant` holds and robustness must not be negative
+    document = log([[0.0, 0.21, 0.21 / 3], [1.0, 1.0, 2.0]], "slant", end="stay")
+    document["regions"]["slant"] = [[0.0, 0.0], [3.0, 1.0], [3.0, 3.0], [0.0, 3.0]]
+    verdict = verify_document(document)
+    assert verdict.outcome == "satisfied"
+    assert verdict.robustness >= 0
+
+
+def test_the_certificate_covers_the_gap_before_the_last_sample() -> None:
+    # at 0.05 m/s (max_speed 0.1) over 10 s the robot may have strayed 0.5 from either sample;
+    # the last sample is 0.5 inside a, so leaving a in between cannot be ruled out
+    slow = log([[0.0, 1.0, 1.0], [10.0, 1.5, 1.0]], "G a", end="stay", max_speed=0.1)
+    verdict = verify_document(slow)
+    assert verdict.outcome == "satisfied"
+    assert not verdict.certified
+
+
+def test_an_open_log_ending_on_a_boundary_does_not_know_the_next_label() -> None:
+    # the log stops exactly on b's west edge: under the right convention whether it enters b
+    # is up to what comes next; under the closed convention the point itself is in b
+    points = [[0.0, 5.0, 1.0], [1.0, 6.0, 1.0]]
+    assert verify_document(log(points, "F b")).outcome == "inconclusive"
+    assert verify_document(log(points, "G !b")).outcome == "inconclusive"
+    assert verify_document(log(points, "F b"), boundary="closed").outcome == "satisfied"
+    assert verify_document(log(points, "G !b"), boundary="closed").outcome == "violated"
+
+
+def test_every_workspace_excursion_is_listed() -> None:
+    # out through the east side twice (x > 10), back in between
+    points = [[0.0, 9.0, 5.0], [1.0, 11.0, 5.0], [2.0, 9.0, 6.0], [3.0, 9.0, 7.0], [4, 11, 7]]
+    verdict = verify_document(log(points, "true", end="stay"))
+    excursions = [v for v in verdict.violations if v.conjunct == "workspace"]
+    assert [v.time for v in excursions] == pytest.approx([0.5, 3.5])
+    assert verdict.outcome == "violated"
+    assert verdict.robustness < 0

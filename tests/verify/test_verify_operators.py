@@ -175,7 +175,7 @@ TWO_PIECE_CASES = [
     (And((a, b)), ["ab", "a"]),
     (Or((a, b)), ["", "a"]),
     (Implies(a, b), ["a", ""]),
-    (Equiv(a, b), ["", "b"]),
+    (Equiv(a, b), ["b", ""]),
     (Until(a, b), ["a", "b"]),
     (Release(a, b), ["b", "a"]),
     (WeakUntil(a, b), ["a", "a"]),
