@@ -173,7 +173,9 @@ def test_all_sample_problems_at_once(tmp_path: Path) -> None:
     assert err.count("error[V005]") == 1
 
 
-@pytest.mark.parametrize("spec", ["example1", "example6", "example7", "patrol", "reach-avoid"])
+@pytest.mark.parametrize(
+    "spec", ["example1", "example6", "example7", "example8", "patrol", "reach-avoid"]
+)
 def test_compiled_traces_are_satisfied_and_certified(spec: str, tmp_path: Path) -> None:
     from tlmpc.pipeline import compile_mission
 
@@ -218,9 +220,27 @@ def test_an_open_log_ending_on_a_boundary_does_not_know_the_next_label() -> None
 
 def test_every_workspace_excursion_is_listed() -> None:
     # out through the east side twice (x > 10), back in between
-    points = [[0.0, 9.0, 5.0], [1.0, 11.0, 5.0], [2.0, 9.0, 6.0], [3.0, 9.0, 7.0], [4, 11, 7]]
+    points = [[0.0, 9.0, 5.0], [1.0, 11.0, 5.0], [2.0, 9.0, 6.0], [3.0, 9.0, 7.0], [4.0, 11.0, 7.0]]
     verdict = verify_document(log(points, "true", end="stay"))
     excursions = [v for v in verdict.violations if v.conjunct == "workspace"]
     assert [v.time for v in excursions] == pytest.approx([0.5, 3.5])
     assert verdict.outcome == "violated"
     assert verdict.robustness < 0
+
+
+@given(
+    st.lists(st.tuples(st.floats(-5, 5), st.floats(-5, 5)), min_size=3, max_size=8, unique=True),
+    st.lists(st.tuples(st.floats(-9, 9), st.floats(-9, 9)), min_size=1, max_size=20),
+)
+def test_direct_edge_distances_match_shapely(
+    corners: list[tuple[float, float]], probes: list[tuple[float, float]]
+) -> None:
+    import numpy as np
+    import shapely
+
+    from tlmpc.verify.robustness import _ring_distance
+
+    ring = np.asarray(corners)
+    points = np.asarray(probes)
+    expected = shapely.distance(shapely.LinearRing(ring), shapely.points(points))
+    assert np.allclose(_ring_distance(ring, points), expected, atol=1e-9)

@@ -81,18 +81,25 @@ class IntervalEvaluator:
 
     def _until_side(self, a: FloatArray, b: FloatArray) -> FloatArray:
         size, loop = self.size, self.loop
-        point = self.is_point.tolist() if self.is_point is not None else [False] * size
+        point = self.is_point.tolist() if self.is_point is not None else None
         a_list, b_list = a.tolist(), b.tolist()
         values = [-np.inf] * size
         # A self-loop on the last position needs one pass (its fixpoint is b there).
         passes = 1 if loop == size - 1 else 2
+        # Plain comparisons instead of min/max: this loop is the verifier's hot spot.
         for _ in range(passes):
+            following = values[loop]
             for k in range(size - 1, -1, -1):
-                nxt = k + 1 if k + 1 < size else loop
-                step = min(a_list[k], values[nxt])
-                if point[k]:
-                    step = min(step, a_list[nxt])
-                values[k] = max(b_list[k], step)
+                step = a_list[k]
+                if following < step:
+                    step = following
+                if point is not None and point[k]:
+                    after = a_list[k + 1] if k + 1 < size else a_list[loop]
+                    if after < step:
+                        step = after
+                here = b_list[k]
+                following = here if here > step else step
+                values[k] = following
         return np.asarray(values, dtype=np.float64)
 
     def until(self, a: Value, b: Value) -> Value:
