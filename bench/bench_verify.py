@@ -58,6 +58,7 @@ def workload(samples: int = 100_000, cols: int = 40, rows: int = 25) -> dict[str
         "max_speed": 10.0,
         "points": np.column_stack([t, x_all, y_all]).tolist(),
         "loop_start": None,
+        "end": "stay",
     }
 
 

@@ -35,6 +35,7 @@ EXIT_OK = 0
 EXIT_NEGATIVE = 1  # ran fine, the answer is "no": invalid mission, no plan, trace violates
 EXIT_USAGE = 2  # could not run: bad flags, unreadable input, bad trace file
 EXIT_INTERNAL = 3  # a bug or a solver failure
+EXIT_INCONCLUSIVE = 4  # ran fine, no answer yet: a log whose continuation decides (verify)
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -24,9 +24,17 @@ WORKSPACE = {
 
 
 def trace(
-    points: list[list[float]], ltl: str, loop_start: int | None = None, boundary: str = "right"
+    points: list[list[float]],
+    ltl: str,
+    loop_start: int | None = None,
+    boundary: str = "right",
+    end: str | None = None,
 ) -> dict[str, Any]:
+    """A trace document; without a loop it stays at its last point unless ``end`` says."""
+    if end is None:
+        end = "loop" if loop_start is not None else "stay"
     return {
+        "end": end,
         "format": "tlmpc.trace/1",
         "ltl": ltl,
         "regions": {"a": A, "b": B, "c": C},
@@ -154,7 +162,7 @@ def test_cli_exit_codes(tmp_path: Path) -> None:
     code, out, _ = run(str(bad))
     assert code == 1
     assert "VIOLATED" in out
-    assert "counterexample" in out
+    assert "violation: " in out
     code, out, _ = run(str(bad), "--json")
     assert json.loads(out)["satisfied"] is False
 
@@ -163,7 +171,8 @@ def test_cli_exit_codes(tmp_path: Path) -> None:
     ("points", "code"),
     [
         ([], "V002"),
-        ([[0, 1, 1], [0, 2, 1]], "V005"),
+        ([[0, 1, 1], [0, 2, 1]], "V020"),
+        ([[0, 1, 1], [1, 2, 1], [0.5, 2, 2]], "V005"),
         ([[0, 1, 1], [1, float("nan"), 1]], "V003"),
         ([[0, 1], [1, 2]], "V002"),
         ("nope", "V002"),
@@ -193,6 +202,9 @@ def test_csv_with_mission(tmp_path: Path) -> None:
     log = tmp_path / "robot.csv"
     log.write_text("t,x,y\n0,1.5,1.5\n10,1.5,7.5\n")  # from p1 up into p2, then stays
     status, out, _ = run(str(log), "--mission", str(mission))
+    assert status == 4  # a log that may go on: p3, p4 and p1 may still come
+    assert "inconclusive" in out
+    status, out, _ = run(str(log), "--mission", str(mission), "--assume-stay")
     assert status == 1  # p2 visited but not p3, p4
     assert "never holds" in out or "does not hold" in out
     assert run(str(log))[0] == 2  # a CSV needs --mission

@@ -1,6 +1,7 @@
 """``tlmpc verify TRACE``: re-check a trajectory against its task in continuous time.
 
-Exit 0 when the task holds, 1 when it is violated, 2 when the trace cannot be read.
+Exit 0 when the task holds, 1 when it is violated, 4 when a log that may go on is
+inconclusive, 2 when the trace cannot be read.
 """
 
 from __future__ import annotations
@@ -8,15 +9,23 @@ from __future__ import annotations
 import argparse
 import json
 from pathlib import Path
-from typing import TextIO
+from typing import TYPE_CHECKING, TextIO
+
+if TYPE_CHECKING:
+    from tlmpc.verify.model import Verdict
 
 NAME = "verify"
 HELP = "check a trajectory (trace.json, or a CSV log with --mission) against its task"
 DESCRIPTION = """\
 Check TRACE against its task under the continuous-time semantics of LTL (docs/semantics.md).
 TRACE is a trace.json written by `tlmpc compile` (self-contained), or a CSV file of t,x,y rows
-(an optional header line `t,x,y`), whose regions and task come from --mission.  Prints the
-verdict, the robustness and, for a violation, what fails, when and where."""
+(an optional header line `t,x,y`), whose regions and task come from --mission.
+
+A log that simply ends gets a three-valued verdict: satisfied (no continuation can break the
+task), violated (none can repair it) or inconclusive; --assume-stay reads it as staying at its
+last point forever, --loop-from T as repeating its part from time T on.  Prints the verdict,
+each conjunct's own verdict and progress, every violation (when and where), the robustness
+and whether the verdict is certified for the real robot between samples."""
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -28,13 +37,32 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         choices=("right", "closed"),
         help="labelling convention at region boundaries (default: the trace's, else right)",
     )
+    ending = parser.add_mutually_exclusive_group()
+    ending.add_argument(
+        "--assume-stay",
+        action="store_true",
+        help="read the log as staying at its last point forever (two-valued verdict)",
+    )
+    ending.add_argument(
+        "--loop-from",
+        type=float,
+        metavar="T",
+        help="the part of the log from time T to its end repeats forever (two-valued verdict)",
+    )
     parser.add_argument("--json", action="store_true", help="print the verdict as JSON")
 
 
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Verify and report."""
     from tlmpc.artifacts import read_json
-    from tlmpc.verify import from_csv, from_document, verdict_to_json, verify_trace
+    from tlmpc.errors import EXIT_INCONCLUSIVE, EXIT_NEGATIVE, EXIT_OK
+    from tlmpc.verify import (
+        declare_ending,
+        from_csv,
+        from_document,
+        verdict_to_json,
+        verify_trace,
+    )
 
     path: Path = args.trace
     if path.suffix.lower() == ".csv":
@@ -42,29 +70,31 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     else:
         document = read_json(path)
         trace = from_document(document, file=str(path), convention=args.boundary)
+    trace = declare_ending(trace, assume_stay=args.assume_stay, loop_from=args.loop_from)
     verdict = verify_trace(trace)
-    document = verdict_to_json(verdict)
     if args.json:
-        out.write(json.dumps(document, indent=2, sort_keys=True) + "\n")
+        out.write(json.dumps(verdict_to_json(verdict), indent=2, sort_keys=True) + "\n")
     else:
-        status = "satisfied" if verdict.satisfied else "VIOLATED"
-        out.write(f"{path}: {status}: {verdict.formula}\n")
-        out.write(f"  boundary convention: {verdict.convention}; {verdict.pieces} pieces\n")
-        out.write(f"  robustness: {verdict.robustness:.6g}")
-        if verdict.certificate_bound is not None:
-            if verdict.certified:
-                out.write(
-                    f" > max_speed * max gap = {verdict.certificate_bound:.4g}: the "
-                    "verdict is robust (certified)\n"
-                )
-            else:
-                out.write(
-                    f" (certificate needs > max_speed * max gap = "
-                    f"{verdict.certificate_bound:.4g}; not certified)\n"
-                )
-        else:
-            out.write("\n")
-        for example in (verdict.workspace_violation, verdict.counterexample):
-            if example is not None:
-                out.write(f"  counterexample: {example.message}\n")
-    return 0 if verdict.satisfied else 1
+        _print(path, verdict, out)
+    codes = {"satisfied": EXIT_OK, "violated": EXIT_NEGATIVE, "inconclusive": EXIT_INCONCLUSIVE}
+    return codes[verdict.outcome]
+
+
+def _print(path: Path, verdict: Verdict, out: TextIO) -> None:
+    status = {"satisfied": "satisfied", "violated": "VIOLATED", "inconclusive": "inconclusive"}
+    ending = {
+        "open": "the log ends here (three-valued verdict)",
+        "stay": "the robot stays at its last point forever",
+        "loop": "the loop repeats forever",
+    }[verdict.ending]
+    out.write(f"{path}: {status[verdict.outcome]}: {verdict.formula}\n")
+    out.write(f"  boundary convention: {verdict.convention}; {ending}; {verdict.pieces} pieces\n")
+    if len(verdict.conjuncts) > 1 or verdict.ending == "open":
+        for report in verdict.conjuncts:
+            out.write(f"  {report.conjunct}: {report.outcome}: {report.progress}\n")
+    for violation in verdict.violations:
+        out.write(f"  violation: {violation.message}\n")
+    out.write(f"  robustness: {verdict.robustness:.6g}\n")
+    certificate = verdict.certificate
+    word = "certified" if certificate.certified else "not certified"
+    out.write(f"  {word}: {certificate.reason}\n")

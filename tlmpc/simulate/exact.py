@@ -377,6 +377,8 @@ def trace_to_json(trace: Trace, mission: Mission) -> dict[str, object]:
         "max_speed": mission.robot.max_speed,
         "points": np.column_stack([trace.times, trace.points]).tolist(),
         "loop_start": trace.loop_start,
+        # A plan's run is infinite: the trace either loops or ends in a stay.
+        "end": "stay" if trace.loop_start is None else "loop",
         "steps": list(trace.steps),
         "triangles": list(trace.triangles),
         "crossings": list(trace.crossings),

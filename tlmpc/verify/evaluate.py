@@ -1,15 +1,24 @@
-"""Direct LTL evaluation on a lasso of pieces (the verifier's own semantics).
+"""Direct LTL evaluation on a lasso of positions, with interval values (the verifier's semantics).
 
-Positions are pieces; the successor of the last piece is the loop start (for a finite
-trace: the last piece itself, which lasts forever).  Until is the least fixpoint of
-U_k = b_k | (a_k & [a_{k+1} if k is a point piece under the closed convention] & U_{k+1}),
-computed with two backward passes around the loop.  Other operators reduce to it:
-F b = true U b, G a = !F !a, a R b = !(!a U !b), a W b = (a U b) | G a, a M b = b U (a & b).
+One evaluator serves every question the verifier asks.  A value is a pair of arrays
+``(lo, hi)`` over the positions: the formula's value is known to lie in ``[lo, hi]``.
+
+* Two-valued truth: atoms are +1 (in the region) or -1, ``lo == hi``.
+* Three-valued truth (a log that may go on): an unknown atom is ``(-1, +1)``; a value with
+  ``lo > 0`` is true for every continuation, ``hi < 0`` false for every one, else unknown.
+* Robustness: atoms are signed distances (``lo == hi``), or tubes ``(d - e, d + e)``.
+
+Negation maps ``[lo, hi]`` to ``[-hi, -lo]``; ``&``/``|`` take min/max of both ends.
+Positions form a lasso: the successor of the last position is ``loop``.  Until is the least
+fixpoint of ``U_k = max(b_k, min(a_k, [a_{k+1} if k is a point piece], U_{k+1}))`` (the bracket
+only under the closed convention: an open piece has no first instant), computed with two
+backward passes around the loop.  The other operators are their definitions: ``F b = true U b``,
+``G a = !F !a``, ``a R b = !(!a U !b)``, ``a W b = (a U b) | G a``, ``a M b = b U (a & b)``.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable
 
 import numpy as np
 import numpy.typing as npt
@@ -31,100 +40,210 @@ from tlmpc.ltl.ast import (
     WeakUntil,
 )
 
+FloatArray = npt.NDArray[np.float64]
 BoolArray = npt.NDArray[np.bool_]
+Value = tuple[FloatArray, FloatArray]
+
+#: The value of an atom that nothing is known about.
+UNKNOWN = (-np.inf, np.inf)
 
 
-class LassoEvaluator:
-    """Truth of formulas at every piece of ``labels`` (pieces × regions), memoised."""
+class IntervalEvaluator:
+    """Interval values of formulas at every position of a lasso, memoised per formula.
+
+    ``atoms(name)`` gives a proposition's ``(lo, hi)`` arrays; ``is_point`` marks point pieces
+    under the closed convention (None: every position has a first instant).
+    """
 
     def __init__(
         self,
-        labels: BoolArray,
-        names: list[str],
-        loop_start: int,
+        atoms: Callable[[str], Value],
+        size: int,
+        loop: int,
         is_point: BoolArray | None = None,
     ) -> None:
-        self.labels = labels
-        self.column = {name: i for i, name in enumerate(names)}
-        self.size = labels.shape[0]
-        self.loop_start = loop_start
-        self.is_point = is_point  # None: half-open pieces (right-continuous convention)
-        self.cache: dict[Formula, BoolArray] = {}
+        if not 0 <= loop < size:
+            raise ValueError(f"loop {loop} outside 0..{size - 1}")
+        self.atoms = atoms
+        self.size = size
+        self.loop = loop
+        self.is_point = is_point
+        self.cache: dict[Formula, Value] = {}
 
-    def successor(self, k: int) -> int:
-        """The piece after ``k``."""
-        return k + 1 if k + 1 < self.size else self.loop_start
-
-    def __call__(self, formula: Formula) -> BoolArray:
+    def __call__(self, formula: Formula) -> Value:
         cached = self.cache.get(formula)
         if cached is None:
             cached = self._eval(formula)
             self.cache[formula] = cached
         return cached
 
-    def _until(self, a: BoolArray, b: BoolArray) -> BoolArray:
-        result = np.zeros(self.size, dtype=bool)
-        needs_next_a = self.is_point if self.is_point is not None else np.zeros(self.size, bool)
-        a_list, b_list, point_list = a.tolist(), b.tolist(), needs_next_a.tolist()
-        values = result.tolist()
-        for _ in range(2):  # two passes reach the least fixpoint around the loop
-            for k in range(self.size - 1, -1, -1):
-                nxt = k + 1 if k + 1 < self.size else self.loop_start
-                step = a_list[k] and values[nxt] and (not point_list[k] or a_list[nxt])
-                values[k] = b_list[k] or step
-        return np.array(values, dtype=bool)
+    # -- the one recursion ------------------------------------------------------------------
 
-    def _eval(self, f: Formula) -> BoolArray:
+    def _until_side(self, a: FloatArray, b: FloatArray) -> FloatArray:
+        size, loop = self.size, self.loop
+        point = self.is_point.tolist() if self.is_point is not None else None
+        a_list, b_list = a.tolist(), b.tolist()
+        values = [-np.inf] * size
+        # A self-loop on the last position needs one pass (its fixpoint is b there).
+        passes = 1 if loop == size - 1 else 2
+        # Plain comparisons instead of min/max: this loop is the verifier's hot spot.
+        for _ in range(passes):
+            following = values[loop]
+            for k in range(size - 1, -1, -1):
+                step = a_list[k]
+                if following < step:
+                    step = following
+                if point is not None and point[k]:
+                    after = a_list[k + 1] if k + 1 < size else a_list[loop]
+                    if after < step:
+                        step = after
+                here = b_list[k]
+                following = here if here > step else step
+                values[k] = following
+        return np.asarray(values, dtype=np.float64)
+
+    def until(self, a: Value, b: Value) -> Value:
+        """``a U b`` from the values of ``a`` and ``b``."""
+        lo = self._until_side(a[0], b[0])
+        if a[0] is a[1] and b[0] is b[1]:
+            return lo, lo
+        return lo, self._until_side(a[1], b[1])
+
+    def _eventually_side(self, b: FloatArray) -> FloatArray:
+        result = np.maximum.accumulate(b[::-1])[::-1].copy()
+        result[self.loop :] = np.max(b[self.loop :])
+        return np.asarray(result, dtype=np.float64)
+
+    def eventually(self, b: Value) -> Value:
+        """``F b`` (``true U b``: no point rule applies since ``true`` holds everywhere)."""
+        lo = self._eventually_side(b[0])
+        return (lo, lo) if b[0] is b[1] else (lo, self._eventually_side(b[1]))
+
+    # -- connectives -------------------------------------------------------------------------
+
+    @staticmethod
+    def negate(a: Value) -> Value:
+        """``!a``."""
+        if a[0] is a[1]:
+            neg = -a[0]
+            return neg, neg
+        return -a[1], -a[0]
+
+    @staticmethod
+    def meet(values: list[Value]) -> Value:
+        """``&``: the minimum of both ends."""
+        lo = np.minimum.reduce([v[0] for v in values])
+        if all(v[0] is v[1] for v in values):
+            return lo, lo
+        return lo, np.minimum.reduce([v[1] for v in values])
+
+    @staticmethod
+    def join(values: list[Value]) -> Value:
+        """``|``: the maximum of both ends."""
+        lo = np.maximum.reduce([v[0] for v in values])
+        if all(v[0] is v[1] for v in values):
+            return lo, lo
+        return lo, np.maximum.reduce([v[1] for v in values])
+
+    def _eval(self, f: Formula) -> Value:
         if isinstance(f, Const):
-            return np.full(self.size, f.value)
+            filled = np.full(self.size, np.inf if f.value else -np.inf)
+            return filled, filled
         if isinstance(f, Prop):
-            return self.labels[:, self.column[f.name]].copy()
+            return self.atoms(f.name)
         if isinstance(f, Not):
-            return ~self(f.arg)
+            return self.negate(self(f.arg))
         if isinstance(f, And):
-            result = np.ones(self.size, dtype=bool)
-            for arg in f.args:
-                result &= self(arg)
-            return result
+            return self.meet([self(a) for a in f.args])
         if isinstance(f, Or):
-            result = np.zeros(self.size, dtype=bool)
-            for arg in f.args:
-                result |= self(arg)
-            return result
+            return self.join([self(a) for a in f.args])
         if isinstance(f, Implies):
-            return ~self(f.left) | self(f.right)
+            return self.join([self.negate(self(f.left)), self(f.right)])
         if isinstance(f, Equiv):
-            equal: BoolArray = self(f.left) == self(f.right)
-            return equal
+            left, right = self(f.left), self(f.right)
+            return self.meet(
+                [
+                    self.join([self.negate(left), right]),
+                    self.join([left, self.negate(right)]),
+                ]
+            )
         if isinstance(f, Until):
-            return self._until(self(f.left), self(f.right))
+            return self.until(self(f.left), self(f.right))
         if isinstance(f, Eventually):
-            return self._until(np.ones(self.size, dtype=bool), self(f.arg))
+            return self.eventually(self(f.arg))
         if isinstance(f, Globally):
-            return ~self._until(np.ones(self.size, dtype=bool), ~self(f.arg))
+            return self.negate(self.eventually(self.negate(self(f.arg))))
         if isinstance(f, Release):
-            return ~self._until(~self(f.left), ~self(f.right))
+            return self.negate(self.until(self.negate(self(f.left)), self.negate(self(f.right))))
         if isinstance(f, WeakUntil):
             left = self(f.left)
-            always = ~self._until(np.ones(self.size, dtype=bool), ~left)
-            return self._until(left, self(f.right)) | always
+            always = self.negate(self.eventually(self.negate(left)))
+            return self.join([self.until(left, self(f.right)), always])
         if isinstance(f, StrongRelease):
             right = self(f.right)
-            return self._until(right, self(f.left) & right)
+            return self.until(right, self.meet([self(f.left), right]))
         raise TypeError(f"not an LTL node: {f!r}")
 
 
-def evaluate(
+def truth_atoms(
+    labels: BoolArray, names: list[str], unknown: BoolArray | None = None
+) -> Callable[[str], Value]:
+    """Atoms from a label matrix (positions × regions): +1 in, -1 out, (-1, +1) unknown."""
+    column = {name: i for i, name in enumerate(names)}
+
+    def atom(name: str) -> Value:
+        index = column[name]
+        known = np.where(labels[:, index], 1.0, -1.0)
+        if unknown is None or not unknown[:, index].any():
+            return known, known
+        lo = np.where(unknown[:, index], -1.0, known)
+        hi = np.where(unknown[:, index], 1.0, known)
+        return lo, hi
+
+    return atom
+
+
+def lasso_truth(
     formula: Formula,
     labels: BoolArray,
     names: list[str],
-    loop_start: int | None,
+    loop_start: int,
     is_point: BoolArray | None = None,
-    cache: Mapping[Formula, BoolArray] | None = None,
-) -> bool:
-    """Truth of ``formula`` at the first piece (finite trace when ``loop_start`` is None)."""
-    start = labels.shape[0] - 1 if loop_start is None else loop_start
-    evaluator = LassoEvaluator(labels, names, start, is_point)
-    if cache:
-        evaluator.cache.update(cache)
-    return bool(evaluator(formula)[0])
+) -> BoolArray:
+    """Two-valued truth of ``formula`` at every position of the lasso ``labels``."""
+    evaluator = IntervalEvaluator(truth_atoms(labels, names), labels.shape[0], loop_start, is_point)
+    lo, _ = evaluator(formula)
+    truth: BoolArray = lo > 0
+    return truth
+
+
+def open_truth(
+    formula: Formula,
+    labels: BoolArray,
+    names: list[str],
+    is_point: BoolArray | None = None,
+    unknown: BoolArray | None = None,
+) -> npt.NDArray[np.int8]:
+    """Three-valued truth (+1 true, 0 unknown, -1 false) on a finite word that goes on.
+
+    After the last position comes an unknown future: a sentinel position, looping on itself,
+    where every atom is unknown.  The sentinel stands for every future instant at once, so a
+    value known there is known all along the future: the answer is sound (a prefix called good
+    is good for every continuation, one called bad for none), though conjunctions of
+    obligations that contradict each other in the future (``F a & G !a``) stay unknown.
+    """
+    size = labels.shape[0]
+    padded = np.vstack([labels, np.zeros((1, labels.shape[1]), dtype=bool)])
+    unknown_all = np.zeros_like(padded)
+    if unknown is not None:
+        unknown_all[:size] = unknown
+    unknown_all[size] = True
+    points = None
+    if is_point is not None:
+        points = np.concatenate([is_point, [False]])
+    evaluator = IntervalEvaluator(truth_atoms(padded, names, unknown_all), size + 1, size, points)
+    lo, hi = evaluator(formula)
+    result = np.zeros(size, dtype=np.int8)
+    result[lo[:size] > 0] = 1
+    result[hi[:size] < 0] = -1
+    return result

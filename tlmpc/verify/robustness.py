@@ -1,37 +1,53 @@
-"""Spatial robustness (Fainekos–Pappas) of a sampled trajectory.
+"""Spatial robustness (Fainekos–Pappas) on the pieces of the trajectory, and the certificate.
 
-A proposition's robustness at a sample is its signed distance to the region's boundary
-(positive inside); negation flips the sign, and/or take min/max, and until is the max-min
-recursion rho(i) = max(rho_b(i), min(rho_a(i), rho(i+1))) with the last sample repeated (a
-finite trace) or the loop wrapped (a lasso).  F and G are reverse running max/min.
+Robustness of a proposition at a position is the signed distance to its region's boundary
+(positive inside).  Two evaluations use it, both through :class:`IntervalEvaluator`:
+
+* **The reported robustness** is evaluated on the same pieces as the verdict (every sample and
+  every boundary crossing of the piecewise-linear trajectory, and the stretches between them,
+  each stretch represented by its midpoint), with each distance's sign forced to agree with the
+  piece's label (a boundary point, at distance 0, may carry either label).  Since the recursion
+  is the verdict's own, by induction over the formula robustness > 0 implies the verdict holds
+  and < 0 that it fails: the two never disagree in sign.
+* **The certificate** is evaluated on the samples as the robot may really have moved between
+  them: at speed at most ``max_speed``, the robot is within ``r_i = max_speed × (half the longer
+  of the gaps next to sample i)`` of sample i throughout the time nearer to it than to its
+  neighbours, so each proposition's distance there lies in ``[d_i - r_i, d_i + r_i]``.
+  Interval evaluation of the formula then bounds the robustness of every such motion: a lower
+  bound > 0 proves the task holds, an upper bound < 0 that it fails.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 
 import numpy as np
 import numpy.typing as npt
 import shapely
 
-from tlmpc.ltl.ast import (
-    And,
-    Const,
-    Equiv,
-    Eventually,
-    Formula,
-    Globally,
-    Implies,
-    Not,
-    Or,
-    Prop,
-    Release,
-    StrongRelease,
-    Until,
-    WeakUntil,
-)
+from tlmpc.ltl.ast import Formula
+from tlmpc.verify.evaluate import UNKNOWN, IntervalEvaluator, Value
 
 FloatArray = npt.NDArray[np.float64]
+BoolArray = npt.NDArray[np.bool_]
+
+
+#: Polygons with at most this many edges get their distances from numpy directly (shapely's
+#: per-point distance dominates the run time on long logs against small regions).
+DIRECT_EDGES = 32
+
+
+def _ring_distance(polygon: FloatArray, points: FloatArray) -> FloatArray:
+    """Distance from each point to the polygon's boundary, edge by edge."""
+    best = np.full(len(points), np.inf)
+    for start, end in zip(polygon, np.roll(polygon, -1, axis=0), strict=True):
+        edge = end - start
+        length = float(edge @ edge)
+        offset = points - start
+        along = np.clip(offset @ edge / length, 0.0, 1.0) if length > 0 else np.zeros(len(points))
+        gap = offset - along[:, None] * edge
+        np.minimum(best, np.hypot(gap[:, 0], gap[:, 1]), out=best)
+    return best
 
 
 def signed_distance(
@@ -43,92 +59,90 @@ def signed_distance(
     its exterior ring: one distance computation serves both signs.
     """
     shape = shapely.Polygon(polygon)
-    if geoms is None:
-        geoms = shapely.points(points)
-    distance = np.asarray(shapely.distance(shape.exterior, geoms), dtype=np.float64)
+    if len(polygon) <= DIRECT_EDGES:
+        distance = _ring_distance(np.asarray(polygon, dtype=np.float64), points)
+    else:
+        if geoms is None:
+            geoms = shapely.points(points)
+        distance = np.asarray(shapely.distance(shape.exterior, geoms), dtype=np.float64)
     inside = shapely.contains_xy(shape, points[:, 0], points[:, 1])
-    # Boundary points are inside a closed region: distance 0, sign irrelevant.
     result: FloatArray = np.where(inside, distance, -distance)
     return result
 
 
-class _Robustness:
-    def __init__(
-        self, points: FloatArray, loop_start: int | None, regions: Mapping[str, FloatArray]
-    ) -> None:
-        self.points = points
-        self.geoms = shapely.points(points)
-        self.size = len(points)
-        self.loop = loop_start
-        self.regions = regions
-        self.cache: dict[Formula, FloatArray] = {}
-
-    def __call__(self, f: Formula) -> FloatArray:
-        if f not in self.cache:
-            self.cache[f] = self._eval(f)
-        return self.cache[f]
-
-    def _eventually(self, b: FloatArray) -> FloatArray:
-        result = np.maximum.accumulate(b[::-1])[::-1]
-        if self.loop is not None:
-            result[self.loop :] = np.maximum(result[self.loop :], b[self.loop :].max())
-        return np.asarray(result, dtype=np.float64)
-
-    def _until(self, a: FloatArray, b: FloatArray) -> FloatArray:
-        values = np.full(self.size, -np.inf)
-        a_list, b_list = a.tolist(), b.tolist()
-        out = values.tolist()
-        last = self.size - 1
-        passes = 2 if self.loop is not None else 1
-        for _ in range(passes):
-            for i in range(last, -1, -1):
-                if i == last:
-                    following = out[self.loop] if self.loop is not None else b_list[i]
-                else:
-                    following = out[i + 1]
-                out[i] = max(b_list[i], min(a_list[i], following))
-        return np.asarray(out)
-
-    def _eval(self, f: Formula) -> FloatArray:
-        if isinstance(f, Const):
-            return np.full(self.size, np.inf if f.value else -np.inf)
-        if isinstance(f, Prop):
-            return signed_distance(np.asarray(self.regions[f.name]), self.points, self.geoms)
-        if isinstance(f, Not):
-            return -self(f.arg)
-        if isinstance(f, And):
-            return np.minimum.reduce([self(a) for a in f.args])  # type: ignore[no-any-return]
-        if isinstance(f, Or):
-            return np.maximum.reduce([self(a) for a in f.args])  # type: ignore[no-any-return]
-        if isinstance(f, Implies):
-            return np.maximum(-self(f.left), self(f.right))
-        if isinstance(f, Equiv):
-            a, b = self(f.left), self(f.right)
-            return np.minimum(np.maximum(-a, b), np.maximum(a, -b))
-        if isinstance(f, Eventually):
-            return self._eventually(self(f.arg))
-        if isinstance(f, Globally):
-            return -self._eventually(-self(f.arg))
-        if isinstance(f, Until):
-            return self._until(self(f.left), self(f.right))
-        if isinstance(f, Release):
-            return -self._until(-self(f.left), -self(f.right))
-        if isinstance(f, WeakUntil):
-            left = self(f.left)
-            return np.maximum(self._until(left, self(f.right)), -self._eventually(-left))
-        if isinstance(f, StrongRelease):
-            right = self(f.right)
-            return self._until(right, np.minimum(self(f.left), right))
-        raise TypeError(f"not an LTL node: {f!r}")
-
-
-def robustness(
+def evaluate_with_ending(
     formula: Formula,
-    times: FloatArray,
-    points: FloatArray,
-    loop_start: int | None,
+    atoms: Callable[[str], Value],
+    size: int,
+    loop: int | None,
+    is_point: BoolArray | None = None,
+) -> Value:
+    """Interval value of ``formula`` at position 0.
+
+    ``loop`` is the loop's first position (a stay is a loop on the last position); None means
+    the trace is open: an unknown future (every atom ``(-inf, +inf)``) follows the last position.
+    """
+    if loop is not None:
+        evaluator = IntervalEvaluator(atoms, size, loop, is_point)
+        lo, hi = evaluator(formula)
+        return lo[:1], hi[:1]
+
+    def padded(name: str) -> Value:
+        lo, hi = atoms(name)
+        lo2, hi2 = np.append(lo, UNKNOWN[0]), np.append(hi, UNKNOWN[1])
+        return lo2, hi2
+
+    points = None if is_point is None else np.append(is_point, False)
+    evaluator = IntervalEvaluator(padded, size + 1, size, points)
+    lo, hi = evaluator(formula)
+    return lo[:1], hi[:1]
+
+
+def piece_atoms(
     regions: Mapping[str, FloatArray],
-) -> float:
-    """Robustness of ``formula`` at the first sample."""
-    del times
-    return float(_Robustness(points, loop_start, regions)(formula)[0])
+    positions: FloatArray,
+    labels: BoolArray,
+    unknown: BoolArray | None,
+) -> Callable[[str], Value]:
+    """Signed distances at the pieces' positions, signs forced to the pieces' labels."""
+    names = list(regions)
+    geoms = None
+    cache: dict[str, Value] = {}
+
+    def atom(name: str) -> Value:
+        if name not in cache:
+            index = names.index(name)
+            distance = signed_distance(np.asarray(regions[name]), positions, geoms)
+            # Rounding can put a point a hair outside a region its label says it is in.
+            value = np.where(labels[:, index], np.maximum(distance, 0.0), np.minimum(distance, 0.0))
+            if unknown is not None:
+                value = np.where(unknown[:, index], 0.0, value)
+            cache[name] = (value, value)
+        return cache[name]
+
+    return atom
+
+
+def tube_radii(times: FloatArray, max_speed: float) -> FloatArray:
+    """How far the robot may be from each sample while that sample is the nearest in time."""
+    gaps = np.diff(times)
+    before = np.concatenate([[0.0], gaps])
+    after = np.concatenate([gaps, [0.0]])
+    radii: FloatArray = max_speed * np.maximum(before, after) / 2.0
+    return radii
+
+
+def tube_atoms(
+    regions: Mapping[str, FloatArray], points: FloatArray, radii: FloatArray
+) -> Callable[[str], Value]:
+    """Signed distance ± the sample's radius: bounds on the distance around each sample."""
+    geoms = None
+    cache: dict[str, Value] = {}
+
+    def atom(name: str) -> Value:
+        if name not in cache:
+            distance = signed_distance(np.asarray(regions[name]), points, geoms)
+            cache[name] = (distance - radii, distance + radii)
+        return cache[name]
+
+    return atom

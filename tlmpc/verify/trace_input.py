@@ -20,6 +20,8 @@ import numpy.typing as npt
 from tlmpc.errors import UsageError, error
 from tlmpc.ltl.ast import Formula
 from tlmpc.ltl.parser import parse_ltl
+from tlmpc.verify.model import Ending
+from tlmpc.verify.samples import check_samples
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -36,6 +38,7 @@ class TraceInput:
     boundary_polygon: FloatArray | None = field(compare=False)
     holes: tuple[FloatArray, ...] = ()
     convention: str = "right"
+    ending: Ending = "open"
     max_speed: float | None = None
     source: str | None = None
 
@@ -65,28 +68,7 @@ def _samples(rows: Any, file: str | None, lines: list[int] | None = None) -> Flo
         raise _fail("V002", "points must be rows of three numbers [t, x, y]", file) from None
     if array.ndim != 2 or array.shape[1] != 3:
         raise _fail("V002", "points must be rows of three numbers [t, x, y]", file)
-    if len(array) == 0:
-        raise _fail("V002", "the trace has no samples", file, hint="record at least one sample")
-    bad = np.flatnonzero(~np.all(np.isfinite(array), axis=1))
-    if len(bad):
-        row = int(bad[0])
-        raise _fail(
-            "V003",
-            f"sample {row} has a non-finite value (NaN or infinity)",
-            file,
-            line=lines[row] if lines else None,
-        )
-    order = np.flatnonzero(np.diff(array[:, 0]) <= 0)
-    if len(order):
-        row = int(order[0]) + 1
-        raise _fail(
-            "V005",
-            f"time does not increase at sample {row} "
-            f"(t = {array[row - 1, 0]:g} then {array[row, 0]:g})",
-            file,
-            hint="samples must be sorted by strictly increasing time",
-            line=lines[row] if lines else None,
-        )
+    check_samples(array[:, 0], array[:, 1], array[:, 2], file=file, lines=lines)
     return array
 
 
@@ -143,6 +125,19 @@ def from_document(
             "V009", f"unknown boundary convention {chosen!r}", file, hint="use right or closed"
         )
     speed = document.get("max_speed")
+    end = document.get("end")
+    if (
+        end not in (None, "stay", "open", "loop")
+        or (end == "loop" and loop is None)
+        or (end in ("stay", "open") and loop is not None)
+    ):
+        raise _fail(
+            "V021",
+            f"`end` is {end!r} with loop_start {loop!r}",
+            file,
+            hint="`end` is stay or open without a loop_start, loop with one (or leave it out)",
+        )
+    ending: Ending = "loop" if loop is not None else ("stay" if end == "stay" else "open")
     return TraceInput(
         times=samples[:, 0].copy(),
         points=samples[:, 1:].copy(),
@@ -152,6 +147,7 @@ def from_document(
         boundary_polygon=_polygon(boundary, "workspace boundary", file) if boundary else None,
         holes=holes,
         convention=chosen,
+        ending=ending,
         max_speed=float(speed) if isinstance(speed, int | float) and math.isfinite(speed) else None,
         source=file,
     )

@@ -1,0 +1,221 @@
+"""Per-conjunct progress and every violation, read off the evaluated pieces."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+from tlmpc.ltl.ast import Eventually, Formula, Globally, Not, Prop, Until
+from tlmpc.ltl.printer import to_text
+from tlmpc.verify.evaluate import Value
+from tlmpc.verify.model import ConjunctReport, Outcome, Violation
+
+BoolArray = npt.NDArray[np.bool_]
+FloatArray = npt.NDArray[np.float64]
+
+
+@dataclass(frozen=True, slots=True)
+class Timeline:
+    """The pieces in time: when each starts and ends, where it is, what it is labelled."""
+
+    starts: FloatArray
+    ends: FloatArray
+    positions: FloatArray
+    labels: BoolArray
+    names: list[str]
+
+    @property
+    def size(self) -> int:
+        """Number of pieces."""
+        return len(self.starts)
+
+
+def runs(mask: BoolArray) -> list[tuple[int, int]]:
+    """Maximal runs ``[first, last]`` of True in ``mask``."""
+    padded = np.concatenate([[False], mask, [False]]).astype(np.int8)
+    edges = np.diff(padded)
+    firsts = np.flatnonzero(edges == 1)
+    lasts = np.flatnonzero(edges == -1) - 1
+    return list(zip(firsts.tolist(), lasts.tolist(), strict=True))
+
+
+def _at(line: Timeline, k: int) -> tuple[float, tuple[float, float]]:
+    x, y = line.positions[k].tolist()
+    return float(line.starts[k]), (float(x), float(y))
+
+
+def _place(position: tuple[float, float]) -> str:
+    return f"({position[0]:.4g}, {position[1]:.4g})"
+
+
+def _times(count: int) -> str:
+    return "once" if count == 1 else f"{count} times"
+
+
+def _visits(line: Timeline, held: BoolArray) -> tuple[int, float | None, float]:
+    """Visits (runs where ``held``), when the last began, and the longest time between them.
+
+    Gaps run from the start of the trace to the first visit, between visits, and from the
+    last visit to the end of the trace.
+    """
+    found = runs(held)
+    begin, finish = float(line.starts[0]), float(line.ends[-1])
+    if not found:
+        return 0, None, finish - begin
+    marks = [begin]
+    for first, last in found:
+        marks.extend([float(line.starts[first]), float(line.ends[last])])
+    marks.append(finish)
+    gaps = [marks[i + 1] - marks[i] for i in range(0, len(marks), 2)]
+    return len(found), float(line.starts[found[-1][0]]), max(gaps)
+
+
+def _globally_violations(
+    conjunct: Formula, inner: Formula, broken: BoolArray, line: Timeline
+) -> list[Violation]:
+    text = to_text(conjunct)
+    found = []
+    for first, last in runs(broken):
+        time, position = _at(line, first)
+        if isinstance(inner, Eventually):
+            message = (
+                f"`{to_text(inner.arg)}` never holds again after t={time:.4g} s "
+                f"(from {_place(position)}), so `{text}` fails"
+            )
+            found.append(Violation(conjunct=text, time=time, position=position, message=message))
+            continue
+        inside = [line.names[i] for i in np.flatnonzero(line.labels[first])]
+        forbidden = [
+            n.arg.name
+            for n in inner.walk()
+            if isinstance(n, Not) and isinstance(n.arg, Prop) and n.arg.name in inside
+        ]
+        if forbidden:
+            message = f"entered {forbidden[0]} at t={time:.4g} s at {_place(position)}"
+        else:
+            where = ", ".join(inside) if inside else "free space"
+            message = (
+                f"`{to_text(inner)}` stops holding at t={time:.4g} s at {_place(position)} "
+                f"(in {where})"
+            )
+        duration = float(line.ends[last]) - time
+        message += f" for {duration:.4g} s while `{text}` must hold"
+        found.append(Violation(conjunct=text, time=time, position=position, message=message))
+    return found
+
+
+def _other_violation(
+    conjunct: Formula, value: Callable[[Formula], Value], line: Timeline
+) -> Violation:
+    text = to_text(conjunct)
+    size = line.size
+    if isinstance(conjunct, Eventually):
+        return Violation(
+            conjunct=text,
+            time=None,
+            position=None,
+            message=f"`{to_text(conjunct.arg)}` never holds, so `{text}` fails",
+        )
+    if isinstance(conjunct, Until):
+        right_never = value(conjunct.right)[1][:size] < 0
+        left_fails = value(conjunct.left)[1][:size] < 0
+        bad = np.flatnonzero(left_fails & right_never)
+        # the first instant where neither holds, if b never held before it
+        if len(bad) and right_never[: int(bad[0]) + 1].all():
+            time, position = _at(line, int(bad[0]))
+            return Violation(
+                conjunct=text,
+                time=time,
+                position=position,
+                message=f"`{to_text(conjunct.left)}` stops holding at t={time:.4g} s at "
+                f"{_place(position)} before `{to_text(conjunct.right)}` holds",
+            )
+        if right_never.all():
+            return Violation(
+                conjunct=text,
+                time=None,
+                position=None,
+                message=f"`{to_text(conjunct.right)}` never holds, so `{text}` fails",
+            )
+    return Violation(
+        conjunct=text, time=None, position=None, message=f"`{text}` does not hold on this trace"
+    )
+
+
+def _progress(
+    conjunct: Formula, outcome: Outcome, value: Callable[[Formula], Value], line: Timeline
+) -> ConjunctReport:
+    text = to_text(conjunct)
+    size = line.size
+
+    def held(f: Formula) -> BoolArray:
+        truth: BoolArray = value(f)[0][:size] > 0
+        return truth
+
+    if isinstance(conjunct, Globally) and isinstance(conjunct.arg, Eventually):
+        count, last, gap = _visits(line, held(conjunct.arg.arg))
+        if count:
+            progress = f"visited {_times(count)}, last at t={last:.4g} s, longest gap {gap:.4g} s"
+        else:
+            progress = f"never visited in {gap:.4g} s"
+        return ConjunctReport(
+            conjunct=text,
+            outcome=outcome,
+            progress=progress,
+            visits=count,
+            last_visit=last,
+            longest_gap=gap,
+        )
+    if isinstance(conjunct, Eventually):
+        found = runs(held(conjunct.arg))
+        if found:
+            time = float(line.starts[found[0][0]])
+            progress = f"done at t={time:.4g} s"
+        else:
+            progress = "pending" if outcome == "inconclusive" else "never done"
+        return ConjunctReport(conjunct=text, outcome=outcome, progress=progress, visits=len(found))
+    if isinstance(conjunct, Globally):
+        broken = runs(value(conjunct.arg)[1][:size] < 0)
+        if broken:
+            time = float(line.starts[broken[0][0]])
+            progress = f"broken {_times(len(broken))}, first at t={time:.4g} s"
+        else:
+            progress = "held so far" if outcome == "inconclusive" else "held throughout"
+        return ConjunctReport(conjunct=text, outcome=outcome, progress=progress)
+    if isinstance(conjunct, Until):
+        found = runs(held(conjunct.right))
+        if found and outcome == "satisfied":
+            progress = f"`{to_text(conjunct.right)}` reached at t={line.starts[found[0][0]]:.4g} s"
+        else:
+            progress = {"satisfied": "holds", "violated": "fails", "inconclusive": "pending"}[
+                outcome
+            ]
+        return ConjunctReport(conjunct=text, outcome=outcome, progress=progress)
+    words = {"satisfied": "holds", "violated": "fails", "inconclusive": "pending"}
+    return ConjunctReport(conjunct=text, outcome=outcome, progress=words[outcome])
+
+
+def conjunct_reports(
+    conjuncts: list[Formula],
+    outcomes: list[Outcome],
+    value: Callable[[Formula], Value],
+    line: Timeline,
+) -> tuple[list[ConjunctReport], list[Violation]]:
+    """A report per conjunct, and every violation (each run of a broken ``G``, for instance)."""
+    reports = []
+    violations: list[Violation] = []
+    for conjunct, outcome in zip(conjuncts, outcomes, strict=True):
+        reports.append(_progress(conjunct, outcome, value, line))
+        if outcome != "violated":
+            continue
+        if isinstance(conjunct, Globally):
+            broken = value(conjunct.arg)[1][: line.size] < 0
+            found = _globally_violations(conjunct, conjunct.arg, broken, line)
+            if found:
+                violations.extend(found)
+                continue
+        violations.append(_other_violation(conjunct, value, line))
+    return reports, violations

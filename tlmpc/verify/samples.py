@@ -1,0 +1,109 @@
+"""Checks on a log's parsed samples (times and positions), whatever file they came from.
+
+Every reader of trajectories (trace.json, CSV, recorded bags) hands its arrays to
+:func:`check_samples` before verification, so every log source gets the same diagnostics:
+no samples (V002), a non-finite value (V003), time going backwards (V005), repeated time
+stamps (V020).  All problems are reported at once (a few of each kind), with the source line of
+each sample when the reader knows it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+import numpy.typing as npt
+
+from tlmpc.errors import Diagnostic, UsageError, error
+
+FloatArray = npt.NDArray[np.float64]
+
+#: At most this many diagnostics of one kind (a broken log can have thousands).
+MAX_PER_KIND = 3
+
+
+def _where(index: int, lines: Sequence[int] | None) -> tuple[str, int | None]:
+    if lines is not None and index < len(lines):
+        return f"sample {index} (line {lines[index]})", lines[index]
+    return f"sample {index}", None
+
+
+def sample_diagnostics(
+    t: FloatArray,
+    x: FloatArray,
+    y: FloatArray,
+    *,
+    file: str | None,
+    lines: Sequence[int] | None = None,
+) -> list[Diagnostic]:
+    """Every problem with the samples ``(t[i], x[i], y[i])`` (empty list: they are usable)."""
+    found: list[Diagnostic] = []
+    if len(t) == 0:
+        return [
+            error(
+                "V002",
+                "the trace has no samples",
+                hint="record at least one sample (t, x, y)",
+                file=file,
+            )
+        ]
+    values = np.column_stack([t, x, y])
+    bad = np.flatnonzero(~np.all(np.isfinite(values), axis=1))
+    for index in bad[:MAX_PER_KIND].tolist():
+        what, line = _where(index, lines)
+        columns = [
+            n for n, v in zip("txy", values[index].tolist(), strict=True) if not np.isfinite(v)
+        ]
+        found.append(
+            error(
+                "V003",
+                f"{what} has a non-finite {'/'.join(columns)} (NaN or infinity)",
+                hint="drop or repair the sample; the verifier does not guess missing values",
+                file=file,
+                line=line,
+            )
+        )
+    if len(bad):
+        return found  # order checks on NaN times would only repeat the same rows
+    steps = np.diff(t)
+    for index in (np.flatnonzero(steps < 0)[:MAX_PER_KIND] + 1).tolist():
+        what, line = _where(index, lines)
+        found.append(
+            error(
+                "V005",
+                f"time goes backwards at {what}: t = {t[index - 1]:g} then {t[index]:g}",
+                hint="sort the samples by time (the verifier does not reorder a log)",
+                file=file,
+                line=line,
+            )
+        )
+    repeated = np.flatnonzero(steps == 0) + 1
+    for index in repeated[:MAX_PER_KIND].tolist():
+        what, line = _where(index, lines)
+        same = bool(x[index] == x[index - 1] and y[index] == y[index - 1])
+        found.append(
+            error(
+                "V020",
+                f"{what} repeats the time stamp t = {t[index]:g} "
+                + ("(same position)" if same else "at a different position")
+                + (f"; {len(repeated)} repeated time stamps in all" if len(repeated) > 1 else ""),
+                hint="drop duplicate samples; two positions at one instant are not a trajectory",
+                file=file,
+                line=line,
+            )
+        )
+    return found
+
+
+def check_samples(
+    t: FloatArray,
+    x: FloatArray,
+    y: FloatArray,
+    *,
+    file: str | None,
+    lines: Sequence[int] | None = None,
+) -> None:
+    """Raise :class:`UsageError` (exit 2) with every problem of the samples, if any."""
+    found = sample_diagnostics(t, x, y, file=file, lines=lines)
+    if found:
+        raise UsageError(found)
