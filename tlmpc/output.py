@@ -14,7 +14,7 @@ Safety rules, each of which guards a way user data was once lost:
   left by a killed run are cleaned up by the next run (an ``-old`` one is restored when ``OUT``
   itself is missing, since it is the previous output).
 * The swap is one ``renameat2(RENAME_EXCHANGE)`` on Linux; elsewhere two renames with SIGINT,
-  SIGTERM and SIGHUP blocked in between, so Ctrl-C cannot strand ``OUT`` half-way.
+  SIGTERM and SIGHUP deferred in between, so Ctrl-C cannot strand ``OUT`` half-way.
 * ``-o`` must not be a symbolic link or anything but a directory; files written by ``export -o``
   and ``plot`` must be regular files (or not exist yet).
 * Every operating-system error on the output path becomes a U033 diagnostic with a hint.
@@ -361,13 +361,28 @@ def _exchange(a: Path, b: Path) -> bool:
 
 @contextlib.contextmanager
 def _signals_blocked() -> Iterator[None]:
-    """Delay SIGINT, SIGTERM and SIGHUP until the block ends (delivered afterwards)."""
-    blocked = {signal.SIGINT, signal.SIGTERM, signal.SIGHUP}
-    previous = signal.pthread_sigmask(signal.SIG_BLOCK, blocked)
+    """Defer SIGINT, SIGTERM and SIGHUP until the block ends, then deliver them.
+
+    Python-level handlers run only in the main thread between bytecodes, so swapping them
+    for a recorder defers the signal whichever thread the kernel delivered it to.
+    """
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    received: list[int] = []
+    kinds = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+    previous = {kind: signal.getsignal(kind) for kind in kinds}
+    for kind in kinds:
+        signal.signal(kind, lambda number, frame: received.append(number))
     try:
         yield
     finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+        for kind, handler in previous.items():
+            signal.signal(kind, handler)
+        for number in received:
+            signal.raise_signal(number)
 
 
 def commit(staging: Path, out: Path, *, force: bool) -> None:
