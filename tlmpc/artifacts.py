@@ -73,6 +73,11 @@ def dumps(document: Any) -> str:
     return text + "\n"
 
 
+def json_text(document: Any) -> str:
+    """Indented JSON for ``--json`` output: strict JSON (non-finite floats as strings)."""
+    return json.dumps(_finite(document), indent=2, sort_keys=True, allow_nan=False) + "\n"
+
+
 def read_json(path: Path, expected_format: str | None = None) -> dict[str, Any]:
     """Read an artifact, checking its ``format`` prefix (e.g. ``"tlmpc.trace/"``).
 

@@ -8,9 +8,10 @@ could not be read (unreadable wins over invalid: the run could not do its job).
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
 from typing import Any, TextIO
+
+from tlmpc.artifacts import json_text
 
 NAME = "check"
 HELP = "validate mission files: schema, geometry and task (pre-commit hook)"
@@ -65,7 +66,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             "ok": code == 0,
             "files": results,
         }
-        out.write(json.dumps(document, indent=2, sort_keys=True) + "\n")
+        out.write(json_text(document))
     else:
         valid = len(results) - invalid - unreadable
         summary = f"{valid} of {len(results)} mission file(s) valid"

@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
 from typing import TextIO
+
+from tlmpc.artifacts import json_text
 
 NAME = "compile"
 HELP = "compile a mission into a verified plan, controllers and trajectory"
@@ -93,7 +94,7 @@ def _run_locked(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             commit(staging, destination, force=args.force)
 
     if args.json:
-        out.write(json.dumps(summary, indent=2, sort_keys=True) + "\n")
+        out.write(json_text(summary))
     elif not args.quiet:
         verdict = summary.get("verdict")
         tail = ""

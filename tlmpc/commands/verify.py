@@ -6,9 +6,10 @@ Exit 0 when the task holds, 1 when it is violated, 2 when the trace cannot be re
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
 from typing import TextIO
+
+from tlmpc.artifacts import json_text
 
 NAME = "verify"
 HELP = "check a trajectory (trace.json, or a CSV log with --mission) against its task"
@@ -45,7 +46,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     verdict = verify_trace(trace)
     document = verdict_to_json(verdict)
     if args.json:
-        out.write(json.dumps(document, indent=2, sort_keys=True) + "\n")
+        out.write(json_text(document))
     else:
         status = "satisfied" if verdict.satisfied else "VIOLATED"
         out.write(f"{path}: {status}: {verdict.formula}\n")
