@@ -126,10 +126,12 @@ def _automaton(c: Compilation) -> StageResult:
 
 def _plan(c: Compilation) -> StageResult:
     from tlmpc.planning import plan, witness_to_json
+    from tlmpc.planning.budget import check_product_size
 
     mission: Mission = _require(c.mission, "mission")
     abstraction: Abstraction = _require(c.abstraction, "abstraction")
     automaton: Automaton = _require(c.automaton, "automaton")
+    check_product_size(abstraction, automaton)  # a diagnostic, not an exhausted machine
     witness = plan(
         abstraction,
         automaton,

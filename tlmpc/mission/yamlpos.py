@@ -189,8 +189,7 @@ class _Converter:
                         number = int(event.value)
                     if number is not None:
                         self.count += 1
-                        mark = event.start_mark
-                        values[(*frame.path, len(items))] = (mark.line + 1, mark.column + 1)
+                        values[(*frame.path, len(items))] = _mark(event)
                         items.append(number)
                         frame.size += 1
                         continue
