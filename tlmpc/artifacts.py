@@ -78,20 +78,49 @@ def json_text(document: Any) -> str:
     return json.dumps(_finite(document), indent=2, sort_keys=True, allow_nan=False) + "\n"
 
 
+#: Artifacts larger than this are refused while reading (the largest real ones, traces of
+#: long missions, are a few MB; a parsed sample costs ~200 bytes, so memory stays < 1 GB).
+MAX_ARTIFACT_BYTES = 64 * 1024 * 1024
+
+
 def read_json(path: Path, expected_format: str | None = None) -> dict[str, Any]:
     """Read an artifact, checking its ``format`` prefix (e.g. ``"tlmpc.trace/"``).
 
     Raises :class:`UsageError` (exit 2) for unreadable files, bad JSON or another format.
     """
     try:
-        text = path.read_text(encoding="utf-8")
+        with open(path, "rb") as stream:  # bounded: never read() a device or a huge file whole
+            raw = stream.read(MAX_ARTIFACT_BYTES + 1)
+        text = raw.decode("utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         raise UsageError(
             error("U001", f"cannot read {path}: {exc}", hint="check the path", file=str(path))
-        ) from exc
+        ) from None
+    if len(raw) > MAX_ARTIFACT_BYTES:
+        raise UsageError(
+            error(
+                "U040",
+                f"{path} is larger than {MAX_ARTIFACT_BYTES // 2**20} MiB",
+                hint="artifacts are written by `tlmpc compile`; is this the right file?",
+                file=str(path),
+            )
+        )
     try:
         document = json.loads(text)
-    except json.JSONDecodeError as exc:
+    except RecursionError:
+        raise UsageError(
+            error(
+                "U040",
+                "the JSON is nested too deeply to read",
+                hint="artifacts are written by `tlmpc compile`; was this file edited?",
+                file=str(path),
+            )
+        ) from None
+    except ValueError as exc:  # e.g. an integer of more than 4,300 digits
+        if not isinstance(exc, json.JSONDecodeError):
+            raise UsageError(
+                error("U002", f"not readable JSON: {exc}", file=str(path), line=1, col=1)
+            ) from None
         raise UsageError(
             error(
                 "U002",
@@ -101,7 +130,7 @@ def read_json(path: Path, expected_format: str | None = None) -> dict[str, Any]:
                 col=exc.colno,
                 hint="artifacts are written by `tlmpc compile`; was this file edited?",
             )
-        ) from exc
+        ) from None
     if not isinstance(document, dict):
         raise UsageError(error("U003", "expected a JSON object", file=str(path)))
     if expected_format is not None:
