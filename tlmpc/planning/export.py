@@ -24,14 +24,17 @@ PREFIX = "p_"  # region macros get a prefix so no region name clashes with a key
 IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,63}")
 
 #: Characters a user's text keeps in a model comment: none can open, close or end a comment
-#: (no ``*``, ``/``, ``-``, newline) or start a quoted string or escape in any of the formats.
-_COMMENT_SAFE = re.compile(r"[^A-Za-z0-9_ .,:;()+=]")
+#: (no ``*``, ``/``, ``--``, newline) or start a quoted string or escape in any of the formats.
+_COMMENT_SAFE = re.compile(r"[^A-Za-z0-9_ .,:;()+=-]")
 
 
 def comment_text(text: str, limit: int = 80) -> str:
     """``text`` reduced to characters that cannot close or end a comment in Promela
     (``/* */``), NuSMV (``--`` to end of line) or DOT (``/* */``); others become ``?``."""
-    return _COMMENT_SAFE.sub("?", text[:limit])
+    safe = _COMMENT_SAFE.sub("?", text[:limit])
+    while "--" in safe:  # an SMV comment cannot be closed, but keep the text plain
+        safe = safe.replace("--", "-?")
+    return safe
 
 
 def checked_regions(abstraction: Abstraction, formula: Formula) -> None:
