@@ -178,6 +178,8 @@ def read_output(directory: Path, names: tuple[str, ...]) -> dict[str, dict[str, 
     for name in names:
         path = directory / name
         if not path.is_file():
+            if path.exists() or path.is_symlink():
+                raise _tampered(path, f"{name} is not a regular file", "U041")
             continue
         fmt, schema = ARTIFACT_SCHEMAS[name]
         document = read_json(path, fmt)
