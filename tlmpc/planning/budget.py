@@ -1,8 +1,8 @@
 """How big the product will be, estimated before it is built.
 
 The product of the transition system (``m`` triangles, four entry slots each) and the
-automaton (``Q`` states, ``K`` acceptance sets, degeneralized into at most ``Q * K`` states)
-is built as numpy arrays: about 40 bytes per edge while building and 16 in the final sparse
+automaton (``Q`` states, ``K`` acceptance sets, degeneralized into at most
+``Q * (K + 1)`` states) is built as numpy arrays: about 40 bytes per edge while building and 16 in the final sparse
 matrix, plus Dijkstra's arrays per node.  An estimate from the sizes alone lets a too-large
 mission stop with a diagnostic (P040) instead of exhausting the machine's memory.
 """
@@ -20,7 +20,7 @@ MAX_PRODUCT_NODES = 40_000_000
 MAX_PRODUCT_EDGES = 40_000_000
 
 SLOTS = 4  # as in tlmpc.planning.product: three entry edges and the start
-MOVES_PER_NODE = 3  # leave through an edge (two when it is the entry edge) or stutter
+MOVES_PER_NODE = 4  # leave through one of three edges (two after entering) or stutter
 
 
 @dataclass(frozen=True, slots=True)
@@ -38,7 +38,8 @@ class ProductSize:
 
 def estimate_product(abstraction: Abstraction, automaton: Automaton) -> ProductSize:
     """Upper bounds on the product's size, from the input sizes alone (nothing is built)."""
-    copies = max(automaton.num_acc, 1)  # the degeneralization counter
+    # Degeneralization keeps a counter 0..K beside each state (K + 1 copies) when K >= 2.
+    copies = automaton.num_acc + 1 if automaton.num_acc >= 2 else 1
     states = max(automaton.num_states, 1) * copies
     edges = max(len(automaton.edges), 1) * copies
     triangles = abstraction.num_triangles
