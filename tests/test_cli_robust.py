@@ -8,7 +8,6 @@ import os
 import signal
 import subprocess
 import sys
-import time
 import typing
 from pathlib import Path
 
@@ -89,20 +88,23 @@ def test_ctrl_c_during_start_up_is_130(monkeypatch: pytest.MonkeyPatch) -> None:
     assert err == "tlmpc: interrupted\n"
 
 
-def test_sigint_to_a_running_check_is_130(tmp_path: Path) -> None:
-    big = tmp_path / "big.yaml"
-    rows = "\n".join(f"  r{i}: {{rect: [{i}, 0, {i + 0.5}, 0.5]}}" for i in range(20000))
-    big.write_text(
-        "version: 1\nworkspace: {boundary: {rect: [0, 0, 20001, 1]}}\nregions:\n"
-        + rows
-        + "\nrobot: {start: [0.75, 0.75]}\ntask: [visit r1]\n"
+def test_sigint_to_a_running_compile_is_130(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    process = tlmpc(
+        "compile",
+        "specs/example8.yaml",
+        "-o",
+        str(out),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
     )
-    process = tlmpc("check", str(big), stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-    time.sleep(1.0)
+    assert process.stderr is not None
+    process.stderr.readline()  # started: Python's handlers are installed
     process.send_signal(signal.SIGINT)
     _, err = process.communicate(timeout=120)
     assert process.returncode in (0, 130), err
     assert b"Traceback" not in err
+    assert [p.name for p in tmp_path.iterdir() if p.name != "out"] == []
 
 
 def test_control_characters_are_escaped_in_diagnostics(tmp_path: Path) -> None:
@@ -133,3 +135,10 @@ def test_json_output_is_strict_json() -> None:
         raise AssertionError(f"non-standard JSON constant {constant}")
 
     assert json.loads(text, parse_constant=refuse) == {"a": "inf", "b": ["nan", "-inf"], "c": 1.5}
+
+
+def test_terminal_stream_escapes_what_commands_print() -> None:
+    sink = io.StringIO()
+    stream = cli.TerminalText(sink, "standard output")
+    stream.write("region \x1b[31mred\x1b[0m\r\n")
+    assert sink.getvalue() == "region \\x1b[31mred\\x1b[0m\\x0d\n"

@@ -167,3 +167,11 @@ def test_large_boundary_geometry_is_checked_without_pairwise_loops() -> None:
     expected += ["G005" for h in holes if h is not None and not boundary.polygon.covers(h.polygon)]
     assert sorted(d.code for d in found) == sorted(expected)
     assert expected  # the layout has problems to find
+
+
+def test_yaml_11_integer_forms_match_pyyaml() -> None:
+    text = "a: [012, 0x1f, 1_000, 0o17, -0, +5, 190:20:30, 0b101, 007, 1.5, -.5, 1_0.5]\n"
+    doc, problems = load_positioned(text, "x")
+    assert problems == []
+    assert doc is not None
+    assert _same(doc.data, yaml.safe_load(text))

@@ -19,8 +19,11 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from tlmpc.abstraction import abstraction_from_json
 from tlmpc.cli import main
-from tlmpc.planning.export import comment_text
+from tlmpc.errors import UsageError
+from tlmpc.ltl import parse_ltl
+from tlmpc.planning.export import comment_text, to_dot_graph, to_promela, to_smv
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -214,3 +217,18 @@ def test_tampered_region_name_is_refused(hostile_output: Path, tmp_path: Path) -
         assert code == 2, (fmt, err)
         assert model == ""
         assert re.search(r"error\[(U03\d|U04\d|S0[23]\d)\]", err), err
+
+
+def test_exporters_refuse_non_identifier_regions_themselves(hostile_output: Path) -> None:
+    document = json.loads((hostile_output / "abstraction.json").read_text())
+    document["regions"]['x"];evil'] = document["regions"].pop("a")
+    document["letters"] = [
+        ['x"];evil' if n == "a" else n for n in letter] for letter in document["letters"]
+    ]
+    abstraction = abstraction_from_json(document)
+    for export in (to_promela, to_smv):
+        with pytest.raises(UsageError) as caught:
+            export(abstraction, parse_ltl("F b"))
+        assert caught.value.diagnostics[0].code == "U039"
+    with pytest.raises(UsageError):
+        to_dot_graph(abstraction)

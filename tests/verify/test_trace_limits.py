@@ -98,3 +98,8 @@ def test_hostile_json_traces_are_diagnostics(tmp_path: Path, text: str) -> None:
     assert code == 2
     assert "Traceback" not in err
     assert "error[" in err
+
+
+def test_a_robot_that_cannot_move_certifies_nothing() -> None:
+    still = trace(points=[[0, 1, 1], [1, 1, 1], [2, 1, 1]], max_speed=0)
+    assert from_document(still).max_speed is None
