@@ -1,10 +1,10 @@
 """How big the product will be, estimated before it is built.
 
 The product of the transition system (``m`` triangles, four entry slots each) and the
-automaton (``Q`` states, ``K`` acceptance sets, degeneralized into at most
-``Q * (K + 1)`` states) is built as numpy arrays: about 40 bytes per edge while building and 16 in the final sparse
-matrix, plus Dijkstra's arrays per node.  An estimate from the sizes alone lets a too-large
-mission stop with a diagnostic (P040) instead of exhausting the machine's memory.
+automaton (``Q`` states, ``K`` acceptance sets, degeneralized into at most ``Q * (K + 1)``
+states) is built as numpy arrays: about 40 bytes per edge while building and 16 in the final
+sparse matrix, plus Dijkstra's arrays per node.  An estimate from the sizes alone lets a
+too-large mission stop with a diagnostic (P040) instead of exhausting the machine's memory.
 """
 
 from __future__ import annotations
