@@ -31,7 +31,7 @@ from tlmpc.errors import Diagnostic, InvalidInputError, UsageError, error
 
 if TYPE_CHECKING:
     from tlmpc.automata.model import Automaton
-    from tlmpc.verify.verdict import Verdict
+    from tlmpc.verify.model import Verdict
 
 MissionSource = str | os.PathLike[str] | Mapping[str, Any]
 """A mission: a path to a YAML file, YAML text, or the mission as a dict."""

@@ -10,9 +10,12 @@ from __future__ import annotations
 import functools
 import json
 import math
+import re
 from importlib import resources
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 from tlmpc.errors import UsageError, error
 
@@ -73,20 +76,54 @@ def dumps(document: Any) -> str:
     return text + "\n"
 
 
+def json_text(document: Any) -> str:
+    """Indented JSON for ``--json`` output: strict JSON (non-finite floats as strings)."""
+    return json.dumps(_finite(document), indent=2, sort_keys=True, allow_nan=False) + "\n"
+
+
+#: Artifacts larger than this are refused while reading (the largest real ones, traces of
+#: long missions, are a few MB; a parsed sample costs ~200 bytes, so memory stays < 1 GB).
+MAX_ARTIFACT_BYTES = 64 * 1024 * 1024
+
+
 def read_json(path: Path, expected_format: str | None = None) -> dict[str, Any]:
     """Read an artifact, checking its ``format`` prefix (e.g. ``"tlmpc.trace/"``).
 
     Raises :class:`UsageError` (exit 2) for unreadable files, bad JSON or another format.
     """
     try:
-        text = path.read_text(encoding="utf-8")
+        with open(path, "rb") as stream:  # bounded: never read() a device or a huge file whole
+            raw = stream.read(MAX_ARTIFACT_BYTES + 1)
+        text = raw.decode("utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         raise UsageError(
             error("U001", f"cannot read {path}: {exc}", hint="check the path", file=str(path))
-        ) from exc
+        ) from None
+    if len(raw) > MAX_ARTIFACT_BYTES:
+        raise UsageError(
+            error(
+                "U040",
+                f"{path} is larger than {MAX_ARTIFACT_BYTES // 2**20} MiB",
+                hint="artifacts are written by `tlmpc compile`; is this the right file?",
+                file=str(path),
+            )
+        )
     try:
         document = json.loads(text)
-    except json.JSONDecodeError as exc:
+    except RecursionError:
+        raise UsageError(
+            error(
+                "U040",
+                "the JSON is nested too deeply to read",
+                hint="artifacts are written by `tlmpc compile`; was this file edited?",
+                file=str(path),
+            )
+        ) from None
+    except ValueError as exc:  # e.g. an integer of more than 4,300 digits
+        if not isinstance(exc, json.JSONDecodeError):
+            raise UsageError(
+                error("U002", f"not readable JSON: {exc}", file=str(path), line=1, col=1)
+            ) from None
         raise UsageError(
             error(
                 "U002",
@@ -96,7 +133,7 @@ def read_json(path: Path, expected_format: str | None = None) -> dict[str, Any]:
                 col=exc.colno,
                 hint="artifacts are written by `tlmpc compile`; was this file edited?",
             )
-        ) from exc
+        ) from None
     if not isinstance(document, dict):
         raise UsageError(error("U003", "expected a JSON object", file=str(path)))
     if expected_format is not None:
@@ -111,3 +148,149 @@ def read_json(path: Path, expected_format: str | None = None) -> dict[str, Any]:
                 )
             )
     return document
+
+
+#: The schema each artifact read back from an output folder is checked against.
+ARTIFACT_SCHEMAS = {
+    "mission.json": ("tlmpc.mission/", "mission-artifact"),
+    "abstraction.json": ("tlmpc.abstraction/", "abstraction"),
+    "witness.json": ("tlmpc.witness/", "witness"),
+    "trace.json": ("tlmpc.trace/", "trace"),
+}
+
+
+def _tampered(path: Path, message: str, code: str = "U042") -> UsageError:
+    return UsageError(
+        error(
+            code,
+            f"{message}",
+            hint="this output was edited or damaged; compile the mission again",
+            file=str(path),
+        )
+    )
+
+
+def read_output(directory: Path, names: tuple[str, ...]) -> dict[str, dict[str, Any]]:
+    """The artifacts ``names`` that exist in the output ``directory``, each checked against
+    its schema (U041) and against each other (U042: indices in range, the task's regions
+    defined), so ``plot`` and ``export`` never work on a tampered or mixed-up output."""
+    documents: dict[str, dict[str, Any]] = {}
+    for name in names:
+        path = directory / name
+        if not path.is_file():
+            if path.exists() or path.is_symlink():
+                raise _tampered(path, f"{name} is not a regular file", "U041")
+            continue
+        fmt, schema = ARTIFACT_SCHEMAS[name]
+        document = read_json(path, fmt)
+        problems = validation_errors(_skeleton(path, document), schema)
+        if problems:
+            shown = "; ".join(problems[:3]) + (" ..." if len(problems) > 3 else "")
+            raise _tampered(path, f"{name} does not match its schema: {shown}", "U041")
+        documents[name] = document
+    _cross_check(directory, documents)
+    return documents
+
+
+def _skeleton(path: Path, document: dict[str, Any]) -> dict[str, Any]:
+    """``document`` with each long numeric array cut to one representative item.
+
+    jsonschema descends into every item (seconds on a large mesh); numpy checks instead that
+    an array is rectangular, numeric and finite, and the schema then sees one item of the
+    same kind (an integer row if all are integers, else a float row)."""
+    small = dict(document)
+    for key, value in document.items():
+        if not isinstance(value, list) or len(value) < 2:
+            continue
+        try:
+            array = np.asarray(value)
+        except ValueError:  # ragged: let the schema report it
+            continue
+        if array.dtype.kind not in "iuf" or array.ndim == 0:
+            continue
+        if array.dtype.kind == "f" and not np.all(np.isfinite(array)):
+            raise _tampered(path, f"{path.name}: {key} holds a non-finite number", "U041")
+        small[key] = array[:1].tolist()
+    return small
+
+
+def _indices(values: Any, bound: int, low: int = 0) -> bool:
+    """True when ``values`` (nested lists) are all integers in ``[low, bound)``."""
+    stack = [values]
+    while stack:
+        value = stack.pop()
+        if isinstance(value, list):
+            stack.extend(value)
+        elif isinstance(value, bool) or not isinstance(value, int) or not low <= value < bound:
+            return False
+    return True
+
+
+def _cross_check(directory: Path, documents: dict[str, dict[str, Any]]) -> None:
+    from tlmpc.errors import TlmpcError
+    from tlmpc.ltl.parser import parse_ltl
+
+    identifier = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+    abstraction = documents.get("abstraction.json")
+    regions: set[str] | None = None
+    triangles = 0
+    if abstraction is not None:
+        path = directory / "abstraction.json"
+        vertices = abstraction["vertices"]
+        triangles = len(abstraction["triangles"])
+        letters = abstraction["letters"]
+        regions = set(abstraction["regions"])
+        checks = [
+            (all(isinstance(v, list) and len(v) == 2 for v in vertices), "vertices are [x, y]"),
+            (
+                all(len(t) == 3 for t in abstraction["triangles"])
+                and _indices(abstraction["triangles"], len(vertices)),
+                "triangles index vertices",
+            ),
+            (
+                len(abstraction["neighbors"]) == triangles
+                and all(len(n) == 3 for n in abstraction["neighbors"])
+                and _indices(abstraction["neighbors"], triangles, -1),
+                "neighbors index triangles",
+            ),
+            (
+                len(abstraction["letter_of"]) == triangles
+                and _indices(abstraction["letter_of"], len(letters)),
+                "letter_of indexes letters",
+            ),
+            (
+                len(abstraction["components"]) == triangles
+                and _indices(abstraction["components"], triangles + 1),
+                "components has one entry per triangle",
+            ),
+            (_indices(abstraction["start"], triangles), "start is a triangle"),
+            (
+                all(isinstance(n, str) and n in regions for letter in letters for n in letter),
+                "letters name declared regions",
+            ),
+            (all(identifier.fullmatch(n) for n in regions), "region names are identifiers"),
+        ]
+        for ok, what in checks:
+            if not ok:
+                raise _tampered(path, f"abstraction.json is inconsistent: not every {what}")
+    mission = documents.get("mission.json")
+    if mission is not None:
+        path = directory / "mission.json"
+        try:
+            formula = parse_ltl(mission["formula"])
+        except TlmpcError as exc:
+            raise _tampered(path, f"mission.json has an unreadable formula: {exc}") from None
+        names = set(mission["regions"]) if isinstance(mission["regions"], dict) else set()
+        known = names if regions is None else regions
+        unknown = sorted(formula.props() - known)
+        if unknown:
+            raise _tampered(
+                path, f"the formula names regions the output does not have: {', '.join(unknown)}"
+            )
+    witness = documents.get("witness.json")
+    if witness is not None and abstraction is not None:
+        for key in ("prefix", "cycle"):
+            if not _indices(witness[key], triangles):
+                raise _tampered(
+                    directory / "witness.json", f"witness.json: {key} names a missing triangle"
+                )

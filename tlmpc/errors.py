@@ -38,6 +38,18 @@ EXIT_INTERNAL = 3  # a bug or a solver failure
 EXIT_INCONCLUSIVE = 4  # ran fine, no answer yet: a log whose continuation decides (verify)
 
 
+def printable(text: str, keep: str = "\n\t") -> str:
+    """``text`` with control characters (C0 but ``keep``, DEL, C1) as ``\\xNN`` escapes."""
+    if text.isprintable() and not keep:
+        return text
+    return "".join(
+        ch
+        if ch in keep or not ("\x00" <= ch < " " or "\x7f" <= ch <= "\x9f")
+        else f"\\x{ord(ch):02x}"
+        for ch in text
+    )
+
+
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Diagnostic:
     """One problem found in the user's input, with where it is and what to do about it.
@@ -65,10 +77,14 @@ class Diagnostic:
         return ":".join(parts)
 
     def format(self) -> str:
-        """The human form: ``FILE:LINE:COL: error[CODE]: message`` and an indented hint."""
-        text = f"{self.location()}: {self.severity}[{self.code}]: {self.message}"
+        """The human form: ``FILE:LINE:COL: error[CODE]: message`` and an indented hint.
+
+        Control characters are escaped (newlines too, in the file name and message), so a
+        hostile file name can neither forge a diagnostic line nor drive the terminal."""
+        location = printable(self.location(), keep="")
+        text = f"{location}: {self.severity}[{self.code}]: {printable(self.message, keep='')}"
         if self.hint:
-            text += f"\n  hint: {self.hint}"
+            text += f"\n  hint: {printable(self.hint)}"
         return text
 
     def to_json(self) -> dict[str, Any]:

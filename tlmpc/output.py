@@ -1,16 +1,36 @@
 """Atomic output directories: all artifacts appear together, or none do.
 
-Artifacts are written into a fresh temporary directory next to ``OUT`` (same file system, so
-the final rename is atomic) and moved into place only when every one was written.  A failed
-or interrupted run removes the temporary directory and leaves ``OUT`` exactly as it was.
+Artifacts are written into a fresh temporary directory beside ``OUT`` (same file system, so
+the final rename is atomic) and swapped into place only when every one was written.  A failed
+or interrupted run removes its temporary directory and leaves ``OUT`` exactly as it was.
+
+Safety rules, each of which guards a way user data was once lost:
+
+* A directory is a tlmpc output only when it holds the marker file :data:`MARKER` (written by
+  tlmpc into every output); file names are never used to guess.
+* One run at a time per ``OUT``: a lock file beside it (``.OUT.tlmpc-lock``, removed when the
+  run ends) makes a second run stop with U032 instead of racing.
+* Temporary folders have unique names (``.OUT.tlmpc-new-XXXX``, ``.OUT.tlmpc-old-XXXX``); those
+  left by a killed run are cleaned up by the next run (an ``-old`` one is restored when ``OUT``
+  itself is missing, since it is the previous output).
+* The swap is one ``renameat2(RENAME_EXCHANGE)`` on Linux; elsewhere two renames with SIGINT,
+  SIGTERM and SIGHUP deferred in between, so Ctrl-C cannot strand ``OUT`` half-way.
+* ``-o`` must not be a symbolic link or anything but a directory; files written by ``export -o``
+  and ``plot`` must be regular files (or not exist yet).
+* Every operating-system error on the output path becomes a U033 diagnostic with a hint.
+* Directories and files get the usual permissions (``0777``/``0666`` minus the umask).
 """
 
 from __future__ import annotations
 
 import contextlib
-import json
+import ctypes
+import ctypes.util
+import errno
 import os
 import shutil
+import signal
+import stat
 import tempfile
 from collections.abc import Iterator, Mapping
 from pathlib import Path
@@ -19,7 +39,12 @@ from typing import Any
 from tlmpc.artifacts import dumps
 from tlmpc.errors import UsageError, error
 
-#: Every file name ``tlmpc compile`` may write; a directory holding only these is ours.
+#: The marker file every output directory holds; its first line starts with MARKER_FORMAT.
+MARKER = ".tlmpc-output"
+MARKER_FORMAT = "tlmpc.output/"
+_MARKER_TEXT = MARKER_FORMAT + "1\n"
+
+#: Every file name ``tlmpc compile`` may write (used by ``--force`` and documentation only).
 KNOWN_ARTIFACTS = frozenset(
     {
         "mission.json",
@@ -36,41 +61,76 @@ KNOWN_ARTIFACTS = frozenset(
     }
 )
 
+_HINTS = {
+    errno.EACCES: "you have no permission to write there; choose another -o",
+    errno.EPERM: "the operation is not permitted there; choose another -o",
+    errno.EROFS: "the file system is read-only; choose another -o",
+    errno.ENOSPC: "the disk is full; free some space or choose another -o",
+    errno.EDQUOT: "your disk quota is exhausted; free some space or choose another -o",
+    errno.EXDEV: "OUT is on another file system than its parent (a mount point?); "
+    "choose a directory inside it",
+    errno.EBUSY: "OUT is busy (a mount point?); choose a directory inside it",
+    errno.ENAMETOOLONG: "the path is too long; choose a shorter -o",
+    errno.ENOTDIR: "a part of the path is not a directory",
+    errno.EISDIR: "a directory is in the way",
+}
 
-def replace_file(path: Path, data: bytes) -> None:
-    """Write ``path`` beside itself and rename, so a reader never sees half a file and a
-    failed write leaves the old file as it was."""
-    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+
+def io_error(exc: OSError, path: Path, action: str) -> UsageError:
+    """A U033 diagnostic for an operating-system error while writing output at ``path``."""
+    reason = exc.strerror or str(exc)
+    hint = _HINTS.get(exc.errno or 0, "check the path, its permissions and the free space")
+    return UsageError(error("U033", f"cannot {action} {path}: {reason}", hint=hint))
+
+
+def _umask() -> int:
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def _absolute(path: Path) -> Path:
+    """``path`` made absolute without resolving symbolic links (``-o .`` names the cwd)."""
+    return Path(os.path.abspath(path))
+
+
+def _is_marker(path: Path) -> bool:
     try:
-        with os.fdopen(handle, "wb") as stream:
-            stream.write(data)
-        os.replace(temporary, path)
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise
+        if not stat.S_ISREG(os.lstat(path).st_mode):
+            return False
+        with path.open("rb") as stream:
+            return stream.read(64).startswith(MARKER_FORMAT.encode())
+    except OSError:
+        return False
 
 
 def is_tlmpc_output(directory: Path) -> bool:
-    """True when ``directory`` is empty or holds a previous tlmpc output and nothing else."""
-    entries = {p.name for p in directory.iterdir()}
-    if not entries:
-        return True
-    if not entries <= KNOWN_ARTIFACTS:
+    """True when ``directory`` is empty or holds tlmpc's marker file (a previous output)."""
+    try:
+        if not any(directory.iterdir()):
+            return True
+    except OSError:
         return False
-    summary = directory / "summary.json"
-    if summary.exists():
-        try:
-            fmt = json.loads(summary.read_text(encoding="utf-8")).get("format", "")
-        except (OSError, ValueError, AttributeError):
-            return False
-        return isinstance(fmt, str) and fmt.startswith("tlmpc.summary/")
-    return True
+    return _is_marker(directory / MARKER)
 
 
 def check_destination(out: Path, *, force: bool) -> None:
-    """Refuse (exit 2) to replace something that is not a tlmpc output, unless ``force``."""
+    """Refuse (exit 2) an ``-o`` that is a link, not a directory, or someone else's folder."""
+    out = _absolute(out)
+    if out.is_symlink():
+        raise UsageError(
+            error(
+                "U030",
+                f"{out} is a symbolic link; refusing to write through it or replace it",
+                hint="pass the directory it points to, or choose another -o",
+            )
+        )
+    if out.parent == out:
+        raise UsageError(
+            error("U011", f"{out} cannot be an output directory", hint="choose another -o")
+        )
     if not out.exists():
-        if not out.parent.exists():
+        if not out.parent.is_dir():
             raise UsageError(
                 error(
                     "U010",
@@ -87,11 +147,149 @@ def check_destination(out: Path, *, force: bool) -> None:
         raise UsageError(
             error(
                 "U012",
-                f"{out} is not empty and does not look like a tlmpc output",
+                f"{out} is not empty and is not a tlmpc output (it has no {MARKER} file)",
                 hint="choose another -o, or pass --force to add the artifacts to it "
                 "(other files in it are kept)",
             )
         )
+
+
+def refuse_overwriting(out: Path, names: list[str], source: Path | None = None) -> None:
+    """Refuse (U031) when writing ``names`` into ``out`` would replace ``source`` (the
+    mission being compiled) or an entry that is not a regular file (with ``--force``)."""
+    out = _absolute(out)
+    source_id: os.stat_result | None = None
+    if source is not None:
+        with contextlib.suppress(OSError):
+            source_id = os.stat(source)
+    if source is not None:
+        with contextlib.suppress(OSError):
+            if out.resolve() in Path(source).resolve().parents:
+                raise UsageError(
+                    error(
+                        "U031",
+                        f"the mission being compiled is inside {out}, which would be replaced",
+                        hint="choose an -o outside the mission's folder",
+                        file=str(source),
+                    )
+                )
+    for name in names:
+        target = out / name
+        try:
+            info = os.lstat(target)
+        except FileNotFoundError:
+            continue
+        except OSError as exc:
+            raise io_error(exc, target, "inspect") from None
+        if source_id is not None and (info.st_dev, info.st_ino) == (
+            source_id.st_dev,
+            source_id.st_ino,
+        ):
+            raise UsageError(
+                error(
+                    "U031",
+                    f"writing {name} into {out} would overwrite the mission being compiled",
+                    hint="choose another -o",
+                    file=str(source),
+                )
+            )
+        if not stat.S_ISREG(info.st_mode) and not is_tlmpc_output(out):
+            raise UsageError(
+                error(
+                    "U031",
+                    f"{target} exists and is not a regular file; refusing to replace it",
+                    hint="move it away, or choose another -o",
+                )
+            )
+
+
+def _lock_name(out: Path) -> Path:
+    return out.parent / f".{out.name}.tlmpc-lock"
+
+
+@contextlib.contextmanager
+def output_lock(out: Path) -> Iterator[None]:
+    """Hold the lock of ``out`` for one run; a second run gets U032 instead of a race.
+
+    The lock file is removed when the run ends; after taking the lock we check that the file
+    we locked is still the one at the path (another run may have removed it meanwhile).
+    """
+    import fcntl
+
+    out = _absolute(out)
+    lock = _lock_name(out)
+    while True:
+        try:
+            fd = os.open(lock, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_CLOEXEC, 0o666)
+        except OSError as exc:
+            if exc.errno == errno.ENOENT and not out.parent.is_dir():
+                raise UsageError(
+                    error(
+                        "U010",
+                        f"the parent directory of {out} does not exist",
+                        hint="create it first, or choose another -o",
+                    )
+                ) from None
+            raise io_error(exc, lock, "create the lock file") from None
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            os.close(fd)
+            raise UsageError(
+                error(
+                    "U032",
+                    f"another tlmpc run is writing {out}",
+                    hint=f"wait for it to finish (if none is running, delete {lock})",
+                )
+            ) from None
+        try:
+            same = os.path.samestat(os.fstat(fd), os.stat(lock, follow_symlinks=False))
+        except OSError:
+            same = False
+        if same:
+            break
+        os.close(fd)  # the file was replaced while we waited: lock the new one
+    try:
+        yield
+    finally:
+        with contextlib.suppress(OSError):
+            os.unlink(lock)
+        os.close(fd)
+
+
+def clean_stale(out: Path) -> list[str]:
+    """Remove temporary folders that killed runs left beside ``out`` (call under the lock).
+
+    A ``-new`` folder is an unfinished output; an ``-old`` folder is a previous output that a
+    run killed mid-swap had moved aside: restored when ``OUT`` is missing, else removed.
+    Returns what was done, one line each.
+    """
+    out = _absolute(out)
+    done: list[str] = []
+    prefix = f".{out.name}.tlmpc-"
+    try:
+        entries = sorted(out.parent.iterdir())
+    except OSError:
+        return done
+    for entry in entries:
+        kind = entry.name[len(prefix) : len(prefix) + 4]
+        if not entry.name.startswith(prefix) or kind not in ("new-", "old-"):
+            continue
+        if entry.is_symlink() or not entry.is_dir():
+            continue
+        if not is_tlmpc_output(entry):
+            done.append(f"left {entry} alone: it is not a tlmpc output")
+            continue
+        try:
+            if kind == "old-" and not os.path.lexists(out):
+                os.rename(entry, out)
+                done.append(f"restored {out} from {entry.name}, left by an interrupted run")
+            else:
+                shutil.rmtree(entry)
+                done.append(f"removed {entry.name}, left by an interrupted run")
+        except OSError as exc:
+            done.append(f"could not clean {entry}: {exc.strerror or exc}")
+    return done
 
 
 def _write(path: Path, content: Any) -> None:
@@ -105,9 +303,19 @@ def _write(path: Path, content: Any) -> None:
 
 @contextlib.contextmanager
 def staging_directory(out: Path) -> Iterator[Path]:
-    """A temporary directory beside ``out``; removed on exit unless it was committed."""
-    parent = out.resolve().parent
-    staging = Path(tempfile.mkdtemp(prefix=f".{out.name}.tlmpc-", dir=parent))
+    """A new temporary directory beside ``out`` holding the marker; removed on exit unless
+    it was committed."""
+    out = _absolute(out)
+    try:
+        staging = Path(tempfile.mkdtemp(prefix=f".{out.name}.tlmpc-new-", dir=out.parent))
+    except OSError as exc:
+        raise io_error(exc, out.parent, "create a temporary directory in") from None
+    try:
+        os.chmod(staging, 0o777 & ~_umask())
+        (staging / MARKER).write_text(_MARKER_TEXT, encoding="utf-8")
+    except OSError as exc:
+        shutil.rmtree(staging, ignore_errors=True)
+        raise io_error(exc, staging, "write") from None
     try:
         yield staging
     finally:
@@ -117,7 +325,64 @@ def staging_directory(out: Path) -> Iterator[Path]:
 def write_artifacts(staging: Path, artifacts: Mapping[str, Any]) -> None:
     """Write each artifact (JSON document, text or bytes) into ``staging``."""
     for name, content in artifacts.items():
-        _write(staging / name, content)
+        try:
+            _write(staging / name, content)
+        except OSError as exc:
+            raise io_error(exc, staging / name, "write") from None
+
+
+_RENAME_EXCHANGE = 2
+_AT_FDCWD = -100
+
+
+def _exchange(a: Path, b: Path) -> bool:
+    """Swap two paths atomically (Linux ``renameat2``); False when the system cannot."""
+    try:
+        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
+        renameat2 = libc.renameat2
+    except (OSError, AttributeError):
+        return False
+    renameat2.argtypes = [
+        ctypes.c_int,
+        ctypes.c_char_p,
+        ctypes.c_int,
+        ctypes.c_char_p,
+        ctypes.c_uint,
+    ]
+    renameat2.restype = ctypes.c_int
+    result = renameat2(_AT_FDCWD, os.fsencode(a), _AT_FDCWD, os.fsencode(b), _RENAME_EXCHANGE)
+    if result == 0:
+        return True
+    code = ctypes.get_errno()
+    if code in (errno.EINVAL, errno.ENOSYS, errno.EOPNOTSUPP):
+        return False
+    raise OSError(code, os.strerror(code), str(b))
+
+
+@contextlib.contextmanager
+def _signals_blocked() -> Iterator[None]:
+    """Defer SIGINT, SIGTERM and SIGHUP until the block ends, then deliver them.
+
+    Python-level handlers run only in the main thread between bytecodes, so swapping them
+    for a recorder defers the signal whichever thread the kernel delivered it to.
+    """
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    received: list[int] = []
+    kinds = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+    previous = {kind: signal.getsignal(kind) for kind in kinds}
+    for kind in kinds:
+        signal.signal(kind, lambda number, frame: received.append(number))
+    try:
+        yield
+    finally:
+        for kind, handler in previous.items():
+            signal.signal(kind, handler)
+        for number in received:
+            signal.raise_signal(number)
 
 
 def commit(staging: Path, out: Path, *, force: bool) -> None:
@@ -126,20 +391,78 @@ def commit(staging: Path, out: Path, *, force: bool) -> None:
     A previous tlmpc output (or an empty directory) is swapped out whole; a foreign directory
     (accepted only with ``force``) receives the files one by one and keeps its other files.
     """
+    out = _absolute(out)
+    try:
+        _commit(staging, out, force=force)
+    except OSError as exc:
+        raise io_error(exc, out, "write the output to") from None
+
+
+def _commit(staging: Path, out: Path, *, force: bool) -> None:
+    if out.is_symlink():
+        raise UsageError(error("U030", f"{out} became a symbolic link; nothing was written"))
     if out.exists() and not is_tlmpc_output(out):
         if not force:  # checked before compiling too; a race must not lose user files
             raise UsageError(error("U012", f"{out} changed and is no longer a tlmpc output"))
+        refuse_overwriting(out, [p.name for p in staging.iterdir() if p.name != MARKER])
         for item in staging.iterdir():
-            os.replace(item, out / item.name)
+            if item.name != MARKER:
+                os.replace(item, out / item.name)
         return
-    final = staging.parent / f".{out.name}.tlmpc-final"
-    shutil.rmtree(final, ignore_errors=True)
-    os.replace(staging, final)
-    if out.exists():
-        backup = staging.parent / f".{out.name}.tlmpc-old"
+    with _signals_blocked():
+        if not out.exists():
+            os.rename(staging, out)
+            return
+        if _exchange(staging, out):
+            shutil.rmtree(staging, ignore_errors=True)  # now the previous output
+            return
+        backup = Path(tempfile.mkdtemp(prefix=f".{out.name}.tlmpc-old-", dir=out.parent))
+        os.rename(out, backup)  # replaces the empty directory mkdtemp made
+        try:
+            os.rename(staging, out)
+        except OSError:
+            os.rename(backup, out)
+            raise
         shutil.rmtree(backup, ignore_errors=True)
-        os.replace(out, backup)
-        os.replace(final, out)
-        shutil.rmtree(backup, ignore_errors=True)
-    else:
-        os.replace(final, out)
+
+
+def replace_file(path: Path, data: bytes) -> None:
+    """Write ``path`` beside itself and rename, so a reader never sees half a file and a
+    failed write leaves the old file as it was.
+
+    Refuses (U034) a target that is a symbolic link or exists and is not a regular file (a
+    device, a directory, a FIFO), and turns I/O errors into U033.  A replaced file keeps its
+    permissions; a new one gets ``0666`` minus the umask.
+    """
+    path = _absolute(path)
+    try:
+        info: os.stat_result | None = os.lstat(path)
+    except FileNotFoundError:
+        info = None
+    except OSError as exc:
+        raise io_error(exc, path, "inspect") from None
+    if info is not None and not stat.S_ISREG(info.st_mode):
+        kind = "a symbolic link" if stat.S_ISLNK(info.st_mode) else "not a regular file"
+        raise UsageError(
+            error(
+                "U034",
+                f"{path} is {kind}; refusing to replace it",
+                hint="choose another output file",
+            )
+        )
+    mode = stat.S_IMODE(info.st_mode) if info is not None else 0o666 & ~_umask()
+    try:
+        handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    except OSError as exc:
+        raise io_error(exc, path.parent, "create a temporary file in") from None
+    try:
+        with os.fdopen(handle, "wb") as stream:
+            stream.write(data)
+        os.chmod(temporary, mode)
+        os.replace(temporary, path)
+    except OSError as exc:
+        Path(temporary).unlink(missing_ok=True)
+        raise io_error(exc, path, "write") from None
+    except BaseException:
+        Path(temporary).unlink(missing_ok=True)
+        raise

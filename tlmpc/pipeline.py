@@ -224,10 +224,12 @@ def _automaton(c: Compilation) -> StageResult:
 
 def _plan(c: Compilation) -> StageResult:
     from tlmpc.planning import plan, witness_to_json
+    from tlmpc.planning.budget import check_product_size
 
     mission = c.get(MISSION)
     abstraction = c.get(ABSTRACTION)
     automaton = c.get(AUTOMATON)
+    check_product_size(abstraction, automaton)  # a diagnostic, not an exhausted machine
     witness = plan(
         abstraction,
         automaton,

@@ -194,7 +194,8 @@ def draw_plan(axes: Any, artifacts: Mapping[str, Any]) -> None:
     axes.set_aspect("equal")
     axes.set_xlabel("x")
     axes.set_ylabel("y")
-    axes.set_title(mission.get("name") or "tlmpc plan", fontsize=10)
+    # A literal title: a `$` in a mission name must not start matplotlib's mathtext.
+    axes.set_title(str(mission.get("name") or "tlmpc plan").replace("$", r"\$"), fontsize=10)
     axes.legend(loc="upper right", fontsize=7, framealpha=0.8)
 
 

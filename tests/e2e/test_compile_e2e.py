@@ -136,6 +136,7 @@ def test_until_abstraction_stops_early(tmp_path: Path) -> None:
     )
     assert code == 0, err
     assert sorted(p.name for p in out.iterdir()) == [
+        ".tlmpc-output",
         "abstraction.json",
         "mission.json",
         "summary.json",

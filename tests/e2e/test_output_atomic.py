@@ -8,6 +8,7 @@ import pytest
 
 from tlmpc.errors import UsageError
 from tlmpc.output import (
+    MARKER,
     check_destination,
     commit,
     is_tlmpc_output,
@@ -26,13 +27,14 @@ def test_new_directory_receives_all_artifacts(tmp_path: Path) -> None:
     with staging_directory(out) as staging:
         write_artifacts(staging, {"mission.json": {"format": "tlmpc.mission/1"}, "plan.png": b"x"})
         commit(staging, out, force=False)
-    assert sorted(p.name for p in out.iterdir()) == ["mission.json", "plan.png"]
+    assert sorted(p.name for p in out.iterdir()) == [MARKER, "mission.json", "plan.png"]
     assert [p.name for p in tmp_path.iterdir()] == ["out"]  # no staging leftovers
 
 
 def test_failure_inside_staging_leaves_previous_output_untouched(tmp_path: Path) -> None:
     out = tmp_path / "out"
     out.mkdir()
+    (out / MARKER).write_text("tlmpc.output/1\n")
     (out / "summary.json").write_text('{"format": "tlmpc.summary/1"}')
     (out / "trace.json").write_text("old")
     before = _snapshot(out)
@@ -51,12 +53,13 @@ def test_failure_inside_staging_leaves_previous_output_untouched(tmp_path: Path)
 def test_previous_output_is_replaced_whole(tmp_path: Path) -> None:
     out = tmp_path / "out"
     out.mkdir()
+    (out / MARKER).write_text("tlmpc.output/1\n")
     (out / "summary.json").write_text('{"format": "tlmpc.summary/1"}')
     (out / "controllers.json").write_text("stale")
     with staging_directory(out) as staging:
         write_artifacts(staging, {"summary.json": {"format": "tlmpc.summary/1"}})
         commit(staging, out, force=False)
-    assert sorted(p.name for p in out.iterdir()) == ["summary.json"]
+    assert sorted(p.name for p in out.iterdir()) == [MARKER, "summary.json"]
 
 
 def test_foreign_directory_is_refused_without_force(tmp_path: Path) -> None:

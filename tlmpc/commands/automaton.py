@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 import argparse
-import json
 import time
 from typing import TextIO
+
+from tlmpc.artifacts import json_text
 
 NAME = "automaton"
 HELP = "translate an LTL formula to a generalized Büchi automaton (HOA, DOT or JSON)"
@@ -49,7 +50,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             "seconds": round(seconds, 6),
         }
         if args.json:
-            out.write(json.dumps(stats, indent=2, sort_keys=True) + "\n")
+            out.write(json_text(stats))
         else:
             out.write(
                 f"states: {stats['states']}\nedges: {stats['edges']}\n"
@@ -62,5 +63,5 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     elif args.format == "dot":
         out.write(to_dot(automaton))
     else:
-        out.write(json.dumps(automaton_to_json(automaton), indent=2, sort_keys=True) + "\n")
+        out.write(json_text(automaton_to_json(automaton)))
     return 0

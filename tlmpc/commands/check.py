@@ -9,9 +9,10 @@ Exit 0 when every file is valid, 1 when some file is invalid, 2 when some file c
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
 from typing import Any, TextIO
+
+from tlmpc.artifacts import json_text
 
 NAME = "check"
 HELP = "validate mission files: schema, geometry and task (pre-commit hook)"
@@ -76,7 +77,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             "ok": code == 0,
             "files": results,
         }
-        out.write(json.dumps(document, indent=2, sort_keys=True) + "\n")
+        out.write(json_text(document))
     else:
         valid = len(results) - invalid - unreadable
         summary = f"{valid} of {len(results)} mission file(s) valid"

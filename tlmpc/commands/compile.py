@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
 from typing import TextIO
+
+from tlmpc.artifacts import json_text
 
 NAME = "compile"
 HELP = "compile a mission into a verified plan, controllers and trajectory"
@@ -45,11 +46,29 @@ def _format_sizes(sizes: dict[str, object]) -> str:
 
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Compile ``args.mission`` into ``args.out``."""
-    from tlmpc.output import check_destination, commit, staging_directory, write_artifacts
+    from tlmpc.output import output_lock
+
+    with output_lock(args.out):
+        return _run_locked(args, out, err)
+
+
+def _run_locked(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
+    from tlmpc.output import (
+        KNOWN_ARTIFACTS,
+        check_destination,
+        clean_stale,
+        commit,
+        refuse_overwriting,
+        staging_directory,
+        write_artifacts,
+    )
     from tlmpc.pipeline import StageReport, collector_paused, compile_mission
 
     destination: Path = args.out
     check_destination(destination, force=args.force)
+    refuse_overwriting(destination, sorted(KNOWN_ARTIFACTS), args.mission)
+    for note in clean_stale(destination):
+        err.write(f"tlmpc: note: {note}\n")
 
     def progress(index: int, total: int, report: StageReport) -> None:
         if not args.quiet:
@@ -75,7 +94,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             commit(staging, destination, force=args.force)
 
     if args.json:
-        out.write(json.dumps(summary, indent=2, sort_keys=True) + "\n")
+        out.write(json_text(summary))
     elif not args.quiet:
         verdict = summary.get("verdict")
         tail = ""

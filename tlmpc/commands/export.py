@@ -30,7 +30,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Read the artifacts and print (or write) the model."""
     from tlmpc.abstraction import abstraction_from_json
-    from tlmpc.artifacts import read_json
+    from tlmpc.artifacts import read_output
     from tlmpc.errors import UsageError, error
     from tlmpc.ltl import parse_ltl
     from tlmpc.output import replace_file
@@ -56,10 +56,9 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
                     file=str(directory),
                 )
             )
-    abstraction = abstraction_from_json(
-        read_json(directory / "abstraction.json", "tlmpc.abstraction/")
-    )
-    mission = read_json(directory / "mission.json", "tlmpc.mission/")
+    documents = read_output(directory, ("mission.json", "abstraction.json"))
+    abstraction = abstraction_from_json(documents["abstraction.json"])
+    mission = documents["mission.json"]
     formula = parse_ltl(mission["formula"])
     title = str(mission.get("name", "mission"))
     if args.format == "promela":

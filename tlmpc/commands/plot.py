@@ -32,7 +32,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Read the artifacts of ``args.out`` and write the figures next to them."""
-    from tlmpc.artifacts import read_json
+    from tlmpc.artifacts import read_output
     from tlmpc.output import replace_file
     from tlmpc.plot import render_plan
 
@@ -46,11 +46,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
                 file=str(directory),
             )
         )
-    artifacts: dict[str, Any] = {}
-    for name, fmt in _INPUTS.items():
-        path = directory / name
-        if path.is_file():
-            artifacts[name] = read_json(path, fmt)
+    artifacts: dict[str, Any] = read_output(directory, tuple(_INPUTS))
     png, svg = render_plan(artifacts)
     written = []
     if args.format in ("png", "both"):

@@ -7,12 +7,13 @@ inconclusive, 2 when the trace cannot be read.
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
 from typing import TYPE_CHECKING, TextIO
 
 if TYPE_CHECKING:
     from tlmpc.verify.model import Verdict
+
+from tlmpc.artifacts import json_text
 
 NAME = "verify"
 HELP = "check a trajectory (trace.json, or a CSV log with --mission) against its task"
@@ -73,7 +74,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     trace = declare_ending(trace, assume_stay=args.assume_stay, loop_from=args.loop_from)
     verdict = verify_trace(trace)
     if args.json:
-        out.write(json.dumps(verdict_to_json(verdict), indent=2, sort_keys=True) + "\n")
+        out.write(json_text(verdict_to_json(verdict)))
     else:
         _print(path, verdict, out)
     codes = {"satisfied": EXIT_OK, "violated": EXIT_NEGATIVE, "inconclusive": EXIT_INCONCLUSIVE}

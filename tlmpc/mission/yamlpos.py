@@ -9,6 +9,8 @@ too deep nesting and non-finite numbers become diagnostics instead of surprises.
 from __future__ import annotations
 
 import math
+import re
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -21,9 +23,10 @@ Path = tuple[str | int, ...]
 #: libyaml's loader when PyYAML was built with it (ten times faster), same nodes and marks.
 _LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 
-#: Refuse documents that expand to more nodes than this (a "billion laughs" alias bomb).
-MAX_NODES = 2_000_000
-#: Refuse nesting deeper than this (PyYAML's composer is recursive).
+#: Refuse documents that expand to more values than this (a "billion laughs" alias bomb, or
+#: a map too large to check in seconds); a 10^5-vertex boundary has 300,001.
+MAX_NODES = 1_000_000
+#: Refuse nesting deeper than this (no mission nests more than 6 levels).
 MAX_DEPTH = 64
 
 
@@ -57,141 +60,278 @@ def json_path(path: Path) -> str:
     return text
 
 
-def _mark(node: yaml.Node) -> tuple[int, int]:
+def _mark(node: Any) -> tuple[int, int]:
     return node.start_mark.line + 1, node.start_mark.column + 1
 
 
+#: A plain scalar YAML 1.1 reads as text although it looks like a number (``1e-6``,
+#: ``1.5e3``: PyYAML's floats need a dot and a signed exponent).
+_NUMBER_LIKE = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)")
+
+
+#: Plain numbers that YAML 1.1 reads exactly as Python does (no octal, no ``_``, no
+#: sexagesimal, at most 15 digits so they are finite and within the integer limit).
+_FAST_INT = re.compile(r"-?(?:0|[1-9][0-9]{0,14})")
+_FAST_FLOAT = re.compile(r"[-+]?[0-9]{1,15}\.[0-9]{0,17}")
+
+
+class _Frame:
+    """An open mapping or sequence while the event stream is read."""
+
+    __slots__ = ("anchor", "container", "key", "path", "seen", "size")
+
+    def __init__(self, container: Any, path: Path, anchor: str | None) -> None:
+        self.container = container
+        self.path = path
+        self.anchor = anchor
+        self.key: Any = _NO_KEY  # a mapping's pending key (text) or a bad-key marker
+        self.seen: dict[str, tuple[int, int]] = {}
+        self.size = 1  # nodes in this subtree, aliases expanded
+
+
+_NO_KEY = object()
+_BAD_KEY = object()
+
+
+class _TooBig(Exception):
+    """Stop reading: the problem that stopped it is recorded."""
+
+
 class _Converter:
+    """Plain data and positions from PyYAML's event stream, iteratively.
+
+    Reading events instead of composing PyYAML's node graph avoids the composer's
+    recursion (libyaml's composer crashes the interpreter on documents nested ~25,000 deep)
+    and lets alias expansion be counted as it happens: an alias adds the size of its anchor
+    without copying it, so a "billion laughs" stops after MAX_NODES at the cost of a few
+    additions.  Aliased data is shared, never copied; positions inside it are the alias's.
+    """
+
     def __init__(self, file: str) -> None:
         self.file = file
         self.doc = PositionedDocument(data=None)
         self.problems: list[Diagnostic] = []
         self.count = 0
         self.constructor = yaml.SafeLoader("")
+        self.resolver = yaml.resolver.Resolver()
+        self.anchors: dict[str, tuple[Any, int]] = {}
 
-    def scalar(self, node: yaml.ScalarNode, path: Path) -> Any:
+    def problem(
+        self, code: str, message: str, at: Any, path: Path | None = None, **kw: Any
+    ) -> None:
+        line, col = _mark(at)
+        self.problems.append(
+            error(
+                code,
+                message,
+                file=self.file,
+                line=line,
+                col=col,
+                path=None if path is None else json_path(path),
+                **kw,
+            )
+        )
+
+    def scalar(self, event: Any, path: Path) -> Any:
+        tag = event.tag
+        if tag is None or tag == "!":
+            tag = self.resolver.resolve(yaml.ScalarNode, event.value, event.implicit)  # type: ignore[no-untyped-call]
+        if tag == "tag:yaml.org,2002:str":
+            if not event.style and _NUMBER_LIKE.fullmatch(event.value):
+                self.problem(
+                    "Y010",
+                    f"{event.value!r} is text in YAML 1.1, not a number",
+                    event,
+                    path,
+                    hint=f"write the exponent's sign and a decimal point, e.g. "
+                    f"{_as_yaml_float(event.value)}",
+                )
+            return event.value
+        node = yaml.ScalarNode(tag, event.value, event.start_mark, event.end_mark, event.style)
         try:
             value = self.constructor.construct_object(node, deep=True)
         except (yaml.YAMLError, ValueError, OverflowError) as exc:
-            line, col = _mark(node)
-            self.problems.append(
-                error(
-                    "Y004",
-                    f"cannot read the value {node.value!r}: {exc}",
-                    file=self.file,
-                    line=line,
-                    col=col,
-                    path=json_path(path),
-                )
-            )
+            self.problem("Y004", f"cannot read the value {event.value!r}: {exc}", event, path)
             return None
         if isinstance(value, int) and not isinstance(value, bool) and abs(value) > 10**15:
             value = float("inf") if value > 0 else float("-inf")
         if isinstance(value, float) and not math.isfinite(value):
-            line, col = _mark(node)
-            self.problems.append(
-                error(
-                    "Y005",
-                    f"the number {node.value!r} is not finite",
-                    hint="use a finite number (no .nan, .inf, or values too large for a float)",
-                    file=self.file,
-                    line=line,
-                    col=col,
-                    path=json_path(path),
-                )
+            self.problem(
+                "Y005",
+                f"the number {event.value!r} is not finite",
+                event,
+                path,
+                hint="use a finite number (no .nan, .inf, or values too large for a float)",
             )
         return value
 
-    def convert(self, root: yaml.Node) -> Any:
-        # Iterative on purpose: documents can be deep and the Python stack is not.
-        result: dict[str, Any] = {}
-        stack: list[tuple[yaml.Node, Path, Any, Any, int]] = [(root, (), result, "root", 0)]
-        while stack:
-            node, path, parent, slot, depth = stack.pop()
-            self.count += 1
-            if self.count > MAX_NODES:
-                self.problems.append(
-                    error(
-                        "Y003",
-                        "the document is too large (alias expansion?)",
-                        file=self.file,
-                        line=1,
-                        col=1,
-                        hint="missions do not need YAML aliases",
-                    )
-                )
-                return None
-            if depth > MAX_DEPTH:
-                line, col = _mark(node)
-                self.problems.append(
-                    error(
-                        "Y003",
-                        f"the document is nested more than {MAX_DEPTH} levels deep",
-                        file=self.file,
-                        line=line,
-                        col=col,
-                    )
-                )
-                return None
-            self.doc.values[path] = _mark(node)
-            if isinstance(node, yaml.ScalarNode):
-                value: Any = self.scalar(node, path)
-                self.doc.quoted[path] = node.style in ("'", '"')
-                self.doc.block[path] = node.style in ("|", ">")
-            elif isinstance(node, yaml.SequenceNode):
-                value = [None] * len(node.value)
-                for index in range(len(node.value) - 1, -1, -1):
-                    stack.append((node.value[index], (*path, index), value, index, depth + 1))
-            elif isinstance(node, yaml.MappingNode):
-                value = {}
-                seen: dict[str, tuple[int, int]] = {}
-                for key_node, value_node in node.value:
-                    if not isinstance(key_node, yaml.ScalarNode):
-                        line, col = _mark(key_node)
-                        self.problems.append(
-                            error(
-                                "Y006",
-                                "mapping keys must be plain names",
-                                file=self.file,
-                                line=line,
-                                col=col,
-                                path=json_path(path),
-                            )
-                        )
+    def convert(self, events: Iterator[Any]) -> bool:
+        """Read one document; False when the stream holds no document."""
+        stack: list[_Frame] = []
+        documents = 0
+        values = self.doc.values
+        for event in events:
+            if type(event) is yaml.ScalarEvent and stack:  # fast path: a number in a list
+                frame = stack[-1]
+                items = frame.container
+                if (
+                    type(items) is list
+                    and not event.style
+                    and event.tag is None
+                    and event.anchor is None
+                    and len(frame.path) < MAX_DEPTH
+                    and self.count < MAX_NODES
+                ):
+                    number: float | int | None = None
+                    if _FAST_FLOAT.fullmatch(event.value):
+                        number = float(event.value)
+                    elif _FAST_INT.fullmatch(event.value):
+                        number = int(event.value)
+                    if number is not None:
+                        self.count += 1
+                        values[(*frame.path, len(items))] = _mark(event)
+                        items.append(number)
+                        frame.size += 1
                         continue
-                    key = str(key_node.value)
-                    if key in seen:
-                        line, col = _mark(key_node)
-                        first = seen[key]
-                        self.problems.append(
-                            error(
-                                "Y002",
-                                f"duplicate key {key!r}",
-                                file=self.file,
-                                line=line,
-                                col=col,
-                                path=json_path((*path, key)),
-                                hint=f"it was already given at line {first[0]}; YAML would "
-                                "silently keep only the last one",
-                            )
-                        )
-                        continue
-                    seen[key] = _mark(key_node)
-                    self.doc.keys[(*path, key)] = _mark(key_node)
-                    value[key] = None
-                    stack.append((value_node, (*path, key), value, key, depth + 1))
-            else:  # pragma: no cover - the composer yields only these node kinds
-                value = None
-            if isinstance(parent, dict | list):
-                parent[slot] = value
-        self.doc.data = result.get("root")
-        return self.doc.data
+            if isinstance(event, yaml.DocumentStartEvent):
+                documents += 1
+                if documents > 1:
+                    self.problem("Y001", "YAML syntax error: expected a single document", event)
+                    raise _TooBig
+                continue
+            if isinstance(
+                event, (yaml.StreamStartEvent, yaml.StreamEndEvent, yaml.DocumentEndEvent)
+            ):
+                continue
+            if isinstance(event, (yaml.MappingEndEvent, yaml.SequenceEndEvent)):
+                frame = stack.pop()
+                if frame.anchor is not None:
+                    self.anchors[frame.anchor] = (frame.container, frame.size)
+                if stack:
+                    stack[-1].size += frame.size
+                continue
+            parent = stack[-1] if stack else None
+            path = self._child_path(parent)
+            if path is None:  # a mapping key
+                assert parent is not None
+                self._key(parent, event)
+                if isinstance(event, (yaml.MappingStartEvent, yaml.SequenceStartEvent)):
+                    stack.append(_Frame(None, parent.path, None))  # skipped: not a name
+                continue
+            if isinstance(event, yaml.AliasEvent):
+                if event.anchor not in self.anchors:
+                    self.problem(
+                        "Y001", f"YAML syntax error: undefined alias {event.anchor!r}", event
+                    )
+                    raise _TooBig
+                value, size = self.anchors[event.anchor]
+                self._count(size, event)
+                self.doc.values[path] = _mark(event)
+                self._store(parent, value, size)
+                continue
+            self._count(1, event)
+            if parent is not None and parent.container is None:  # inside a skipped key
+                if isinstance(event, (yaml.MappingStartEvent, yaml.SequenceStartEvent)):
+                    stack.append(_Frame(None, parent.path, None))
+                continue
+            if len(path) > MAX_DEPTH:
+                self.problem(
+                    "Y003", f"the document is nested more than {MAX_DEPTH} levels deep", event
+                )
+                raise _TooBig
+            self.doc.values[path] = _mark(event)
+            if isinstance(event, yaml.ScalarEvent):
+                self.doc.quoted[path] = event.style in ("'", '"')
+                self.doc.block[path] = event.style in ("|", ">")
+                value = self.scalar(event, path)
+                if event.anchor is not None:
+                    self.anchors[event.anchor] = (value, 1)
+                self._store(parent, value, 1)
+            else:
+                container: Any = {} if isinstance(event, yaml.MappingStartEvent) else []
+                self._store(parent, container, 0)
+                stack.append(_Frame(container, path, event.anchor))
+        return documents > 0
+
+    def _count(self, size: int, event: Any) -> None:
+        self.count += size
+        if self.count > MAX_NODES:
+            self.problem(
+                "Y003",
+                f"the document is too large (more than {MAX_NODES:,} values, aliases expanded)",
+                event,
+                hint="missions do not need YAML aliases; split very large maps",
+            )
+            raise _TooBig
+
+    def _child_path(self, parent: _Frame | None) -> Path | None:
+        """The path of the next value in ``parent``; None when the next event is a key."""
+        if parent is None:
+            return ()
+        if isinstance(parent.container, list):
+            return (*parent.path, len(parent.container))
+        if parent.key is _NO_KEY:
+            return None
+        if parent.key is _BAD_KEY:
+            return (*parent.path, "?")
+        return (*parent.path, parent.key)
+
+    def _key(self, parent: _Frame, event: Any) -> None:
+        if parent.container is None:
+            parent.key = _BAD_KEY
+            return
+        if not isinstance(event, yaml.ScalarEvent):
+            self.problem("Y006", "mapping keys must be plain names", event, parent.path)
+            parent.key = _BAD_KEY
+            return
+        key = str(event.value)
+        if key in parent.seen:
+            first = parent.seen[key]
+            self.problem(
+                "Y002",
+                f"duplicate key {key!r}",
+                event,
+                (*parent.path, key),
+                hint=f"it was already given at line {first[0]}; YAML would "
+                "silently keep only the last one",
+            )
+            parent.key = _BAD_KEY
+            return
+        parent.seen[key] = _mark(event)
+        self.doc.keys[(*parent.path, key)] = _mark(event)
+        parent.key = key
+
+    def _store(self, parent: _Frame | None, value: Any, size: int) -> None:
+        if parent is None:
+            self.doc.data = value
+            return
+        parent.size += size
+        if isinstance(parent.container, list):
+            parent.container.append(value)
+        elif isinstance(parent.container, dict):
+            if parent.key is not _BAD_KEY:
+                parent.container[parent.key] = value
+            parent.key = _NO_KEY
+        else:
+            parent.key = _NO_KEY
+
+
+def _as_yaml_float(text: str) -> str:
+    mantissa, _, exponent = text.lower().partition("e")
+    if "." not in mantissa:
+        mantissa += ".0"
+    if exponent[:1] not in ("+", "-"):
+        exponent = "+" + exponent
+    return f"{mantissa}e{exponent}"
 
 
 def load_positioned(text: str, file: str) -> tuple[PositionedDocument | None, list[Diagnostic]]:
     """Parse YAML ``text``; return the data with positions, or None and the diagnostics."""
+    converter = _Converter(file)
     try:
-        root = yaml.compose(text, Loader=_LOADER)
+        found = converter.convert(yaml.parse(text, Loader=_LOADER))
+    except _TooBig:
+        return None, converter.problems
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
         line = mark.line + 1 if mark is not None else 1
@@ -205,9 +345,7 @@ def load_positioned(text: str, file: str) -> tuple[PositionedDocument | None, li
         ]
     except yaml.YAMLError as exc:
         return None, [error("Y001", f"YAML syntax error: {exc}", file=file, line=1, col=1)]
-    except RecursionError:
-        return None, [error("Y003", "the document is nested too deeply", file=file, line=1, col=1)]
-    if root is None:
+    if not found or (converter.doc.data is None and not converter.problems):
         return None, [
             error(
                 "Y007",
@@ -218,6 +356,4 @@ def load_positioned(text: str, file: str) -> tuple[PositionedDocument | None, li
                 hint="a mission starts with `version: 1`",
             )
         ]
-    converter = _Converter(file)
-    converter.convert(root)
     return converter.doc, converter.problems

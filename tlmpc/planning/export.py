@@ -9,12 +9,60 @@ trails can be shorter on maps where the shortest route bounces (see docs/model-c
 
 from __future__ import annotations
 
+import re
+
 from tlmpc.abstraction.model import Abstraction
-from tlmpc.ltl.ast import Formula, Prop
+from tlmpc.errors import UsageError, error
+from tlmpc.ltl.ast import TRUE, Formula, Prop
 from tlmpc.ltl.printer import to_spin
 from tlmpc.ltl.transform import nnf, substitute
 
 PREFIX = "p_"  # region macros get a prefix so no region name clashes with a keyword
+
+#: The only names that may reach a model as identifiers: the mission language's own rule,
+#: which is also a subset of Promela's, NuSMV's and DOT's identifier grammars.
+IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,63}")
+
+#: Characters a user's text keeps in a model comment: none can open, close or end a comment
+#: (no ``*``, ``/``, ``--``, newline) or start a quoted string or escape in any of the formats.
+_COMMENT_SAFE = re.compile(r"[^A-Za-z0-9_ .,:;()+=-]")
+
+
+def comment_text(text: str, limit: int = 80) -> str:
+    """``text`` reduced to characters that cannot close or end a comment in Promela
+    (``/* */``), NuSMV (``--`` to end of line) or DOT (``/* */``); others become ``?``."""
+    safe = _COMMENT_SAFE.sub("?", text[:limit])
+    while "--" in safe:  # an SMV comment cannot be closed, but keep the text plain
+        safe = safe.replace("--", "-?")
+    return safe
+
+
+def checked_regions(abstraction: Abstraction, formula: Formula) -> None:
+    """Refuse (U039) a region or proposition name that is not a plain identifier.
+
+    The mission schema allows only identifiers, so only an edited ``abstraction.json`` or
+    ``mission.json`` can get here; such a name must never reach a model as code.
+    """
+    names = [*abstraction.regions, *sorted({n for letter in abstraction.letters for n in letter})]
+    names += sorted(formula.props())
+    for name in names:
+        if not IDENTIFIER.fullmatch(name):
+            raise UsageError(
+                error(
+                    "U039",
+                    f"region name {name!r} is not an identifier; refusing to export it",
+                    hint="region names are letters, digits and _ (was the output edited?)",
+                )
+            )
+    unknown = sorted(formula.props() - set(abstraction.regions))
+    if unknown:
+        raise UsageError(
+            error(
+                "U039",
+                f"the task names regions the abstraction does not have: {', '.join(unknown)}",
+                hint="mission.json and abstraction.json come from different compiles",
+            )
+        )
 
 
 def _prefixed(formula: Formula) -> Formula:
@@ -63,11 +111,13 @@ def to_promela(
     of triangles and the state vector holds only ``t`` and ``prev``.  Every move prints
     ``tlmpc: t = N``, so ``spin -t`` replays a trail as a list of triangles.
     """
+    checked_regions(abstraction, formula)
     m = abstraction.num_triangles
     entry = "" if bounce else "prev = t; "
     kind = "bounces allowed" if bounce else "no bounce"
     lines = [
-        f"/* tlmpc export of {name}: the transition system D ({m} triangles, stutter, {kind}). */",
+        f"/* tlmpc export of {comment_text(name)}: the transition system D ({m} triangles, "
+        f"stutter, {kind}). */",
         "/* SPIN's counterexample to the negated task is a plan for the task. */",
         f"hidden int nb[{3 * m}] = -1;  /* nb[3*t + i]: neighbour of t across edge i */",
         f"int t = {abstraction.start};  /* the triangle the robot is in */",
@@ -104,10 +154,12 @@ def to_smv(
 ) -> str:
     """A NuSMV model of D with ``LTLSPEC !(formula)``; ``prev`` and a ``TRANS`` constraint
     keep tlmpc's no-bounce rule unless ``bounce=True`` (see :func:`to_promela`)."""
+    checked_regions(abstraction, formula)
     n = abstraction.num_triangles
     kind = "bounces allowed" if bounce else "no bounce"
     lines = [
-        f"-- tlmpc export of {name}: the transition system D ({n} triangles, stutter, {kind}).",
+        f"-- tlmpc export of {comment_text(name)}: the transition system D ({n} triangles, "
+        f"stutter, {kind}).",
         "MODULE main",
         f"VAR t : 0..{n - 1};",
     ]
@@ -135,8 +187,15 @@ def to_smv(
 
 
 def to_dot_graph(abstraction: Abstraction, name: str = "mission") -> str:
-    """Graphviz DOT of D: one node per triangle labelled with its regions."""
-    lines = [f'graph "{name}" {{', "  node [shape=circle, fontsize=8];"]
+    """Graphviz DOT of D: one node per triangle labelled with its regions.
+
+    The graph gets a fixed identifier; the mission name appears only in a comment."""
+    checked_regions(abstraction, TRUE)
+    lines = [
+        "graph D {",
+        f"  /* tlmpc export of {comment_text(name)} */",
+        "  node [shape=circle, fontsize=8];",
+    ]
     centroids = abstraction.vertices[abstraction.triangles].mean(axis=1)
     for triangle in range(abstraction.num_triangles):
         labels = ",".join(abstraction.labels(triangle))

@@ -72,6 +72,18 @@ def _samples(rows: Any, file: str | None, lines: list[int] | None = None) -> Flo
     return array
 
 
+def _certifying_speed(speed: Any) -> float | None:
+    """``max_speed`` when it can back the robustness certificate, else None.
+
+    The certificate assumes the robot moves at most ``max_speed`` between samples: a speed
+    that is not a positive finite number vouches for nothing.  (Whether the samples themselves
+    move faster is checked by the certificate, which then says where.)
+    """
+    if isinstance(speed, bool) or not isinstance(speed, int | float) or not math.isfinite(speed):
+        return None
+    return float(speed) if speed > 0 else None
+
+
 def _formula(text: Any, names: set[str], file: str | None) -> Formula:
     if not isinstance(text, str):
         raise _fail("V006", "the trace has no `ltl` task", file)
@@ -126,6 +138,9 @@ def from_document(
         )
     speed = document.get("max_speed")
     end = document.get("end")
+    if loop is not None and loop == len(samples) - 1:
+        # A loop of the last sample alone: the robot stays there forever.
+        loop, end = None, ("stay" if end in (None, "loop") else end)
     if (
         end not in (None, "stay", "open", "loop")
         or (end == "loop" and loop is None)
@@ -148,7 +163,7 @@ def from_document(
         holes=holes,
         convention=chosen,
         ending=ending,
-        max_speed=float(speed) if isinstance(speed, int | float) and math.isfinite(speed) else None,
+        max_speed=_certifying_speed(speed),
         source=file,
     )
 
@@ -178,6 +193,52 @@ def read_csv(path: Path) -> tuple[FloatArray, list[int]]:
     return _samples(rows if rows else np.zeros((0, 3)), str(path), lines), lines
 
 
+#: Bounds checked on the file before a CSV trace is parsed, so memory stays bounded: a
+#: sample costs a few hundred bytes once parsed.
+MAX_CSV_BYTES = 256 * 1024 * 1024
+MAX_CSV_ROWS = 2_000_000
+MAX_CSV_LINE = 4096
+
+
+def check_csv_file(path: Path) -> None:
+    """Refuse (U038) a CSV trace too large to verify, reading it in chunks (never whole)."""
+    rows = 0
+    longest = 0
+    current = 0
+    size = 0
+    try:
+        with open(path, "rb") as stream:  # chunks: /dev/zero or a huge log stop early
+            while chunk := stream.read(1 << 20):
+                size += len(chunk)
+                lines = chunk.split(b"\n")
+                rows += len(lines) - 1
+                if len(lines) == 1:
+                    current += len(lines[0])
+                else:
+                    longest = max(longest, current + len(lines[0]), *map(len, lines[1:-1]))
+                    current = len(lines[-1])
+                longest = max(longest, current)
+                if size > MAX_CSV_BYTES or rows > MAX_CSV_ROWS or longest > MAX_CSV_LINE:
+                    break
+    except OSError as exc:
+        raise _fail("U001", f"cannot read {path}: {exc.strerror or exc}", str(path)) from None
+    if size > MAX_CSV_BYTES or rows > MAX_CSV_ROWS:
+        raise _fail(
+            "U038",
+            f"the CSV trace is too large (more than {MAX_CSV_ROWS:,} rows or "
+            f"{MAX_CSV_BYTES // 2**20} MiB)",
+            str(path),
+            hint="downsample the log (every k-th row) before verifying it",
+        )
+    if longest > MAX_CSV_LINE:
+        raise _fail(
+            "U038",
+            f"the CSV trace has a line longer than {MAX_CSV_LINE} bytes",
+            str(path),
+            hint="a CSV trace has short t,x,y rows; is this the right file?",
+        )
+
+
 def from_csv(path: Path, mission_path: Path | None, convention: str | None) -> TraceInput:
     """A CSV trajectory checked against a mission file's regions and task."""
     if mission_path is None:
@@ -192,7 +253,11 @@ def from_csv(path: Path, mission_path: Path | None, convention: str | None) -> T
         mission = load_mission(mission_path)
     except InvalidInputError as exc:
         raise UsageError(exc.diagnostics) from None
-    samples, _ = read_csv(path)
+    check_csv_file(path)
+    try:
+        samples, _ = read_csv(path)
+    except csv.Error as exc:
+        raise _fail("U038", f"cannot read the CSV: {exc}", str(path)) from None
     document = {
         "format": "tlmpc.trace/1",
         "ltl": to_text(mission.formula),
