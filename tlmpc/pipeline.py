@@ -125,27 +125,41 @@ def _automaton(c: Compilation) -> StageResult:
 
 
 def _plan(c: Compilation) -> StageResult:
-    from tlmpc.planning import plan, witness_to_json
+    from tlmpc.abstraction import abstraction_to_json
+    from tlmpc.planning import witness_to_json
+    from tlmpc.planning.complete import plan_complete
 
     mission: Mission = _require(c.mission, "mission")
-    abstraction: Abstraction = _require(c.abstraction, "abstraction")
+    built: Abstraction = _require(c.abstraction, "abstraction")
     automaton: Automaton = _require(c.automaton, "automaton")
-    witness = plan(
-        abstraction,
+    # The plan may need U-turns: then it comes on a locally refined mesh, which replaces the
+    # built one (and its artifact) for every later stage.
+    abstraction, witness = plan_complete(
+        built,
         automaton,
         formula=mission.formula,
         options=mission.options,
         start_point=mission.robot.start,
+        parts=mission.parts,
+        file=mission.source,
     )
+    artifacts: dict[str, Any] = {"witness.json": witness_to_json(witness, abstraction)}
+    if abstraction is not built:
+        artifacts["abstraction.json"] = abstraction_to_json(abstraction)
     return StageResult(
-        compilation=dataclasses.replace(c, witness=witness),
-        artifacts={"witness.json": witness_to_json(witness, abstraction)},
+        compilation=dataclasses.replace(c, abstraction=abstraction, witness=witness),
+        artifacts=artifacts,
         sizes={
             "prefix": len(witness.prefix),
             "cycle": len(witness.cycle),
             "cost": round(witness.cost, 6),
             "product nodes": witness.stats.get("product_nodes"),
             "reached": witness.stats.get("product_reached"),
+            **(
+                {"triangles after U-turn splits": abstraction.num_triangles}
+                if abstraction is not built
+                else {}
+            ),
         },
     )
 

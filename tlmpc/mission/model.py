@@ -65,6 +65,19 @@ class Options:
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
+class TaskPart:
+    """One part of the task as the user wrote it, with where it is (for explanations).
+
+    A task phrase is one part; raw ``ltl`` gives one part per top-level conjunct.
+    """
+
+    text: str
+    formula: Formula
+    line: int | None = None
+    col: int | None = None
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Mission:
     """A validated mission.
 
@@ -82,6 +95,7 @@ class Mission:
     ltl: str | None = None
     options: Options = field(default_factory=Options)
     source: str | None = None
+    parts: tuple[TaskPart, ...] = ()
 
     @property
     def region_names(self) -> tuple[str, ...]:

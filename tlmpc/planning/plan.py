@@ -18,7 +18,7 @@ import time
 from typing import Any
 
 import numpy as np
-from scipy.sparse.csgraph import dijkstra
+from scipy.sparse.csgraph import connected_components, dijkstra
 
 from tlmpc.abstraction.model import Abstraction, IntArray
 from tlmpc.automata.degeneralize import degeneralize
@@ -71,8 +71,13 @@ def plan(
     formula: Formula,
     options: Options,
     start_point: tuple[float, float] | None = None,
+    bounces: bool = False,
 ) -> Witness:
-    """A minimum-cost accepting lasso (raises :class:`NoPlanError` with an explanation)."""
+    """A minimum-cost accepting lasso (raises :class:`NoPlanError` with an explanation).
+
+    With ``bounces=True`` the lasso may leave a triangle through its entry edge (a U-turn the
+    controllers cannot realise on this mesh; :mod:`tlmpc.planning.complete` refines those).
+    """
     started = time.perf_counter()
     allowed = invariant_mask(abstraction, formula)
     working = degeneralize(automaton) if automaton.num_acc >= 2 else automaton
@@ -80,7 +85,12 @@ def plan(
         x, y = abstraction.corners(abstraction.start).mean(axis=0).tolist()
         start_point = (float(x), float(y))
     product = build_product(
-        abstraction, working, allowed=allowed, start_point=start_point, metric=options.cost
+        abstraction,
+        working,
+        allowed=allowed,
+        start_point=start_point,
+        metric=options.cost,
+        bounces=bounces,
     )
     if len(product.initial) == 0 or not working.edges:
         raise NoPlanError(explain_no_plan(abstraction, automaton, formula, allowed))
@@ -96,8 +106,11 @@ def plan(
     # Moving cycles through accepting edges.
     acc = product.accepting.tocoo()
     us, vs = acc.row.astype(np.int64), acc.col.astype(np.int64)
-    reachable = np.isfinite(dist[us])
-    us, vs = us[reachable], vs[reachable]
+    # Only edges inside one strongly connected component close into a cycle: every closing
+    # search below then succeeds, and the cap can never hide the existence of a lasso.
+    _, scc = connected_components(product.graph, directed=True, connection="strong")
+    closable = np.isfinite(dist[us]) & (scc[us] == scc[vs])
+    us, vs = us[closable], vs[closable]
     searches = 0
     exhausted = True
     if len(us):
