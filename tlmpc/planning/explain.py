@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from typing import Any
 
@@ -189,7 +190,7 @@ def explain_infeasible(
     The blamed parts are a minimal set of task parts (phrases, top-level LTL conjuncts) that
     already has no plan on this map: dropping any one of them would make the rest possible.
     """
-    if any(d.code in _EXACT for d in fallback) or not parts:
+    if not parts:
         return list(fallback)
     from tlmpc.automata.translate import translate
     from tlmpc.planning.plan import plan
@@ -219,6 +220,14 @@ def explain_infeasible(
     first = core[0]
     where: dict[str, Any] = {"file": file, "line": first.line, "col": first.col}
     quoted = ", ".join(f"`{p.text}`" + _at(file, p) for p in core)
+    exact = [d for d in fallback if d.code in _EXACT]
+    if exact:
+        # The reason is already exact (e.g. the start violates an invariant); point it at
+        # the parts that cause it.
+        involved = f"; the parts involved: {quoted}" if len(core) > 1 else ""
+        return [
+            dataclasses.replace(d, hint=(d.hint or "") + involved, **where) for d in exact
+        ]
     facts = "; ".join(d.message for d in _region_facts(abstraction, blamed, where))
     if len(core) == 1:
         headline = error(
