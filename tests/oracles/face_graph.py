@@ -10,10 +10,9 @@ neither the triangulation nor tlmpc's product is used here.
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-
-import warnings
 
 import shapely
 from shapely.geometry import Point, Polygon
@@ -49,9 +48,7 @@ def face_graph(
         free = free.difference(Polygon(hole))
     shapes = {name: Polygon(points) for name, points in regions.items()}
     lines = unary_union([free.boundary, *(s.boundary for s in shapes.values())])
-    faces = [
-        f for f in polygonize(lines) if f.area > 0 and free.contains(f.representative_point())
-    ]
+    faces = [f for f in polygonize(lines) if f.area > 0 and free.contains(f.representative_point())]
     labels = []
     for face in faces:
         inside = face.representative_point()
@@ -85,7 +82,7 @@ def _letter_test(automaton: spot.twa_graph) -> Callable[[object, frozenset[str]]
             for n in names
         ]
         cube = spot.formula_to_bdd(spot.formula.And(literals), d, automaton)
-        return bool((cond & cube) != false)  # type: ignore[operator]
+        return bool((cond & cube) != false)
 
     return test
 
@@ -94,7 +91,8 @@ def satisfiable_on(graph: FaceGraph, ltl: str) -> bool:
     """True iff some run of the face graph (stays allowed) satisfies ``ltl`` (Spot syntax)."""
     automaton = spot.translate(ltl, "BA")
     edges = [
-        (e.src, e.dst, e.cond, bool(e.acc.count())) for s in range(automaton.num_states())
+        (e.src, e.dst, e.cond, bool(e.acc.count()))
+        for s in range(automaton.num_states())
         for e in automaton.out(s)
     ]
     init = automaton.get_init_state_number()

@@ -37,6 +37,8 @@ TEMPLATES = (
     "G(!A | F B)",
 )
 
+RETURNS = ("F(A & F B)", "F(B & F A)", "G F A & G F B", "F(A & F(B & F A))", "G !C & G F A & G F B")
+
 
 @dataclass(frozen=True)
 class FaceMap:
@@ -56,7 +58,7 @@ class FaceMap:
                 "version": 1,
                 "name": f"face-{self.kind}",
                 "workspace": {"boundary": self.boundary, "holes": self.holes},
-                "regions": {n: p for n, p in self.regions.items()},
+                "regions": dict(self.regions),
                 "robot": {"start": list(self.start), "max_speed": 1.0},
                 "ltl": self.ltl,
             }
@@ -105,10 +107,13 @@ def face_maps(draw: st.DrawFn) -> FaceMap:
     outer = Polygon(free.exterior)
     names = ["a", "b", "c"][: draw(st.integers(2, 3))]
     regions: dict[str, Coords] = {}
+    ends = [(p.x, p.y) for p in skeleton.boundary.geoms]  # dead ends of corridors and bays
     for name in names:
-        along = draw(st.integers(0, 20)) / 20 * skeleton.length
-        centre = skeleton.interpolate(along)
-        cx, cy = round(centre.x, 2), round(centre.y, 2)
+        if draw(st.booleans()) and ends:
+            cx, cy = draw(st.sampled_from(ends))
+        else:
+            centre = skeleton.interpolate(draw(st.integers(0, 20)) / 20 * skeleton.length)
+            cx, cy = round(centre.x, 2), round(centre.y, 2)
         shape = draw(st.sampled_from(["small", "sliver", "block", "room"]))
         half = {"small": (0.3, 0.3), "sliver": (0.025, 0.6), "block": (0.6, 0.6), "room": (1, 1)}
         hx, hy = (w * width if shape != "room" else w for w in half[shape])
@@ -116,12 +121,21 @@ def face_maps(draw: st.DrawFn) -> FaceMap:
             hx, hy = hy, hx
         rect = box(cx - hx, cy - hy, cx + hx, cy + hy)
         if not outer.covers(rect):
-            rect = box(cx - 0.025, cy - 0.025, cx + 0.025, cy + 0.025)
+            # Clipped to the map: a region filling the end of a corridor or a bay.
+            clipped = rect.intersection(outer)
+            if clipped.geom_type == "Polygon" and not clipped.interiors and clipped.area > 0:
+                rect = clipped.simplify(0)
+            else:
+                rect = box(cx - 0.025, cy - 0.025, cx + 0.025, cy + 0.025)
         regions[name] = _coords(rect.exterior)
-    start_along = draw(st.integers(0, 20)) / 20 * skeleton.length
-    point = skeleton.interpolate(start_along)
-    start = (round(point.x + 0.0123 * width, 6), round(point.y + 0.0071 * width, 6))
-    template = draw(st.sampled_from(TEMPLATES))
+    if draw(st.booleans()) and ends:
+        sx, sy = draw(st.sampled_from(ends))
+    else:
+        point = skeleton.interpolate(draw(st.integers(0, 20)) / 20 * skeleton.length)
+        sx, sy = point.x, point.y
+    start = (round(sx + 0.0123 * width, 6), round(sy + 0.0071 * width, 6))
+    # Half the tasks go somewhere and come back: the U-turns that need refinement.
+    template = draw(st.sampled_from(RETURNS if draw(st.booleans()) else TEMPLATES))
     placeholders = {"A": names[0], "B": names[1], "C": names[-1]}
     if len(names) == 2 and "C" in template:
         placeholders["C"] = draw(st.sampled_from(names))

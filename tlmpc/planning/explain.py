@@ -225,9 +225,7 @@ def explain_infeasible(
         # The reason is already exact (e.g. the start violates an invariant); point it at
         # the parts that cause it.
         involved = f"; the parts involved: {quoted}" if len(core) > 1 else ""
-        return [
-            dataclasses.replace(d, hint=(d.hint or "") + involved, **where) for d in exact
-        ]
+        return [dataclasses.replace(d, hint=(d.hint or "") + involved, **where) for d in exact]
     facts = "; ".join(d.message for d in _region_facts(abstraction, blamed, where))
     if len(core) == 1:
         headline = error(
