@@ -44,7 +44,7 @@ def _tlmpc_verdict(mission: FaceMap, tmp: Path, record: Callable[[str], None]) -
 
 def _oracle_verdict(mission: FaceMap) -> bool:
     graph = face_graph(mission.boundary, mission.holes, mission.regions, mission.start)
-    return satisfiable_on(graph, mission.ltl)
+    return bool(satisfiable_on(graph, mission.ltl))
 
 
 def _check_explanation(mission: FaceMap, text: str) -> None:
