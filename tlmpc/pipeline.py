@@ -126,6 +126,7 @@ def _automaton(c: Compilation) -> StageResult:
 
 def _plan(c: Compilation) -> StageResult:
     from tlmpc.abstraction import abstraction_to_json
+    from tlmpc.mission.parts import task_parts
     from tlmpc.planning import witness_to_json
     from tlmpc.planning.complete import plan_complete
 
@@ -140,7 +141,7 @@ def _plan(c: Compilation) -> StageResult:
         formula=mission.formula,
         options=mission.options,
         start_point=mission.robot.start,
-        parts=mission.parts,
+        parts=lambda: task_parts(mission),
         file=mission.source,
     )
     artifacts: dict[str, Any] = {"witness.json": witness_to_json(witness, abstraction)}

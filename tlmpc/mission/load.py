@@ -17,12 +17,11 @@ from jsonschema.exceptions import ValidationError, best_match
 
 from tlmpc.artifacts import load_schema
 from tlmpc.errors import Diagnostic, InvalidInputError, UsageError, best_first, error
-from tlmpc.ltl.ast import And, Formula, Or, Prop, conjoin
+from tlmpc.ltl.ast import Formula, Or, Prop, conjoin
 from tlmpc.ltl.parser import KEYWORDS, parse_ltl
-from tlmpc.ltl.printer import to_text
 from tlmpc.ltl.transform import substitute
 from tlmpc.mission.geometry import CheckedShape, check_layout, check_shape
-from tlmpc.mission.model import Mission, Options, Region, Robot, TaskPart, Workspace
+from tlmpc.mission.model import Mission, Options, Region, Robot, Workspace
 from tlmpc.mission.yamlpos import Path, PositionedDocument, json_path, load_positioned
 from tlmpc.tasks.compiler import compile_phrases
 
@@ -251,40 +250,15 @@ def _check_task(
     return substitute(conjoin(parts), expand), []
 
 
-def _task_parts(
-    data: Mapping[str, Any],
-    doc: PositionedDocument,
-    file: str,
-    groups: Mapping[str, list[str]],
-) -> tuple[TaskPart, ...]:
-    """Each task phrase, and each top-level conjunct of ``ltl``, with its position.
-
-    Only called on a task that compiled, so nothing here can fail.
-    """
-    expand: dict[str, Formula] = {
-        g: Or(tuple(Prop(m) for m in members)) if len(members) > 1 else Prop(members[0])
-        for g, members in groups.items()
-    }
-    parts: list[TaskPart] = []
-    for index, phrase in enumerate(data.get("task") or []):
-        line, col = _ltl_position(doc, ("task", index))
-        formula = compile_phrases([phrase], groups=groups, file=file, positions=[(line, col)])
-        parts.append(TaskPart(text=phrase, formula=substitute(formula, expand), line=line, col=col))
+def _task_positions(
+    data: Mapping[str, Any], doc: PositionedDocument
+) -> tuple[tuple[int, int], ...]:
+    """Where each task phrase, then the ``ltl`` string, starts (for explanations)."""
+    positions = [_ltl_position(doc, ("task", i)) for i in range(len(data.get("task") or []))]
     ltl = data.get("ltl")
     if isinstance(ltl, str) and ltl.strip():
-        line, col = _ltl_position(doc, ("ltl",))
-        whole = parse_ltl(ltl, file=file, line=line, col=col)
-        for conjunct in whole.args if isinstance(whole, And) else (whole,):
-            span = getattr(conjunct, "span", None)
-            parts.append(
-                TaskPart(
-                    text=to_text(conjunct),
-                    formula=substitute(conjunct, expand),
-                    line=span.line if span else line,
-                    col=span.col if span else col,
-                )
-            )
-    return tuple(parts)
+        positions.append(_ltl_position(doc, ("ltl",)))
+    return tuple(positions)
 
 
 def _shapes(
@@ -409,7 +383,7 @@ def _load(text: str, file: str, stem: str) -> tuple[Mission | None, list[Diagnos
             boundary=options.get("boundary", defaults.boundary),
         ),
         source=file,
-        parts=_task_parts(data, doc, file, groups),
+        task_positions=_task_positions(data, doc),
     )
     return mission, []
 

@@ -95,7 +95,8 @@ class Mission:
     ltl: str | None = None
     options: Options = field(default_factory=Options)
     source: str | None = None
-    parts: tuple[TaskPart, ...] = ()
+    #: (line, col) of each task phrase, then of the ``ltl`` string (see :mod:`.parts`).
+    task_positions: tuple[tuple[int, int], ...] = ()
 
     @property
     def region_names(self) -> tuple[str, ...]:

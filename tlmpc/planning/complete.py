@@ -12,7 +12,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 from tlmpc.abstraction.model import Abstraction
 from tlmpc.abstraction.refine import split_triangles
@@ -43,12 +43,13 @@ def plan_complete(
     formula: Formula,
     options: Options,
     start_point: tuple[float, float],
-    parts: Sequence[TaskPart] = (),
+    parts: Callable[[], Sequence[TaskPart]] = tuple,
     file: str | None = None,
 ) -> tuple[Abstraction, Witness]:
     """A witness on ``abstraction`` or on a locally refined copy of it (returned with it).
 
-    Raises :class:`NoPlanError` only when no trajectory in the plane satisfies the task.
+    Raises :class:`NoPlanError` only when no trajectory in the plane satisfies the task;
+    ``parts`` gives the task's parts for that explanation (called only then).
     """
 
     def attempt(mesh: Abstraction, bounces: bool) -> Witness:
@@ -78,7 +79,7 @@ def plan_complete(
                         formula=formula,
                         options=options,
                         start_point=start_point,
-                        parts=parts,
+                        parts=parts(),
                         file=file,
                         fallback=no_bounce_failure.diagnostics,
                     )
