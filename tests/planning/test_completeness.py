@@ -21,7 +21,9 @@ from shapely.geometry import Point, Polygon
 from tlmpc.errors import InvalidInputError, NoPlanError
 from tlmpc.ltl.parser import parse_ltl
 from tlmpc.pipeline import compile_mission
+from tlmpc.planning.complete import bounce_triangles
 from tlmpc.planning.explain import _positive_props
+from tlmpc.planning.model import Witness
 
 BLAME = re.compile(r"region '([a-z]+)' (?:cannot be reached|can only be reached|has no free)")
 
@@ -192,3 +194,26 @@ def test_held_out_missions_agree_with_the_face_graph(name: str, tmp_path: Path) 
 
 def test_the_dead_end_mission_compiles(tmp_path: Path) -> None:
     assert _agree(HELD_OUT["dead end, issue example"], tmp_path)
+
+
+def test_bounces_are_found_in_the_prefix_at_the_junction_and_across_the_wrap() -> None:
+    def witness(prefix: tuple[int, ...], cycle: tuple[int, ...]) -> Witness:
+        return Witness(
+            prefix=prefix,
+            cycle=cycle,
+            prefix_states=(0,) * len(prefix),
+            cycle_states=(0,) * len(cycle),
+            word=((),) * (len(prefix) + len(cycle)),
+            cost=0.0,
+            metric="hops",
+            beta=1.0,
+            prefix_cost=0.0,
+            cycle_cost=0.0,
+        )
+
+    assert bounce_triangles(witness((0, 1, 0, 2), (3,))) == [1]
+    assert bounce_triangles(witness((0, 1), (2, 1, 5))) == [2]  # prefix 1 -> 2 -> 1
+    assert bounce_triangles(witness((0,), (1, 2))) == [1, 2]  # a two-triangle cycle
+    assert bounce_triangles(witness((0,), (1, 2, 3, 2))) == [1, 3]  # 2,1,2 across the wrap
+    assert bounce_triangles(witness((0, 1, 2), (3, 4, 5))) == []
+    assert bounce_triangles(witness((), (7,))) == []

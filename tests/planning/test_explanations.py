@@ -91,4 +91,6 @@ def test_task_phrases_are_located_at_their_phrase(tmp_path: Path) -> None:
     assert "`avoid c`" in first.message
     assert "`patrol a, b`" in first.message
     assert "`visit a`" not in first.message, "only the parts that fail together"
+    assert "region 'c'" not in first.message + (first.hint or ""), "c is only forbidden"
+    assert "region 'b' can only be reached through regions the task forbids" in (first.hint or "")
     assert (first.line, first.col) == (len(lines) - 1, _col(lines, len(lines) - 1, "avoid c"))
