@@ -223,29 +223,44 @@ def _automaton(c: Compilation) -> StageResult:
 
 
 def _plan(c: Compilation) -> StageResult:
-    from tlmpc.planning import plan, witness_to_json
+    from tlmpc.abstraction import abstraction_to_json
+    from tlmpc.mission.parts import task_parts
+    from tlmpc.planning import witness_to_json
     from tlmpc.planning.budget import check_product_size
+    from tlmpc.planning.complete import plan_complete
 
     mission = c.get(MISSION)
-    abstraction = c.get(ABSTRACTION)
+    built = c.get(ABSTRACTION)
     automaton = c.get(AUTOMATON)
-    check_product_size(abstraction, automaton)  # a diagnostic, not an exhausted machine
-    witness = plan(
-        abstraction,
+    check_product_size(built, automaton)  # a diagnostic, not an exhausted machine
+    # The plan may need U-turns: then it comes on a locally refined mesh, which replaces the
+    # built one (and its artifact) for every later stage.
+    abstraction, witness = plan_complete(
+        built,
         automaton,
         formula=mission.formula,
         options=mission.options,
         start_point=mission.robot.start,
+        parts=lambda: task_parts(mission),
+        file=mission.source,
     )
+    artifacts: dict[str, Any] = {"witness.json": witness_to_json(witness, abstraction)}
+    if abstraction is not built:
+        artifacts["abstraction.json"] = abstraction_to_json(abstraction)
     return StageResult(
-        products=provide(WITNESS, witness),
-        artifacts={"witness.json": witness_to_json(witness, abstraction)},
+        products={**provide(ABSTRACTION, abstraction), **provide(WITNESS, witness)},
+        artifacts=artifacts,
         sizes={
             "prefix": len(witness.prefix),
             "cycle": len(witness.cycle),
             "cost": round(witness.cost, 6),
             "product nodes": witness.stats.get("product_nodes"),
             "reached": witness.stats.get("product_reached"),
+            **(
+                {"triangles after U-turn splits": abstraction.num_triangles}
+                if abstraction is not built
+                else {}
+            ),
         },
     )
 
@@ -334,7 +349,7 @@ STAGES: tuple[Stage, ...] = (
         name="plan",
         run=_plan,
         requires=(MISSION, ABSTRACTION, AUTOMATON),
-        provides=(WITNESS,),
+        provides=(WITNESS, ABSTRACTION),  # the mesh, refined where the plan turns around
         aliases=("witness", "planning"),
     ),
     Stage(

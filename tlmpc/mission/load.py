@@ -278,6 +278,17 @@ def _check_task(
     return substitute(conjoin(parts), expand), []
 
 
+def _task_positions(
+    data: Mapping[str, Any], doc: PositionedDocument
+) -> tuple[tuple[int, int], ...]:
+    """Where each task phrase, then the ``ltl`` string, starts (for explanations)."""
+    positions = [_ltl_position(doc, ("task", i)) for i in range(len(data.get("task") or []))]
+    ltl = data.get("ltl")
+    if isinstance(ltl, str) and ltl.strip():
+        positions.append(_ltl_position(doc, ("ltl",)))
+    return tuple(positions)
+
+
 def _shapes(
     data: Mapping[str, Any], doc: PositionedDocument, file: str
 ) -> tuple[CheckedShape | None, list[CheckedShape], dict[str, CheckedShape], list[Diagnostic]]:
@@ -404,6 +415,7 @@ def _load(text: str, file: str, stem: str) -> tuple[Mission | None, list[Diagnos
             boundary=options.get("boundary", defaults.boundary),
         ),
         source=file,
+        task_positions=_task_positions(data, doc),
     )
     return mission, []
 

@@ -70,6 +70,19 @@ class Options:
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
+class TaskPart:
+    """One part of the task as the user wrote it, with where it is (for explanations).
+
+    A task phrase is one part; raw ``ltl`` gives one part per top-level conjunct.
+    """
+
+    text: str
+    formula: Formula
+    line: int | None = None
+    col: int | None = None
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Mission:
     """A validated mission.
 
@@ -87,6 +100,8 @@ class Mission:
     ltl: str | None = None
     options: Options = field(default_factory=Options)
     source: str | None = None
+    #: (line, col) of each task phrase, then of the ``ltl`` string (see :mod:`.parts`).
+    task_positions: tuple[tuple[int, int], ...] = ()
 
     @property
     def region_names(self) -> tuple[str, ...]:

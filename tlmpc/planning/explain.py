@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+import dataclasses
+from collections.abc import Sequence
+from typing import Any
+
 import numpy as np
 import numpy.typing as npt
 from scipy.sparse import coo_matrix
@@ -10,10 +14,11 @@ from scipy.sparse.csgraph import breadth_first_order
 from tlmpc.abstraction.model import Abstraction
 from tlmpc.automata.guards import holds
 from tlmpc.automata.model import Automaton
-from tlmpc.errors import Diagnostic, error
-from tlmpc.ltl.ast import And, Formula, Globally, Not, Prop, is_propositional
+from tlmpc.errors import Diagnostic, NoPlanError, error
+from tlmpc.ltl.ast import And, Formula, Globally, Not, Prop, conjoin, is_propositional
 from tlmpc.ltl.printer import to_text
 from tlmpc.ltl.transform import nnf
+from tlmpc.mission.model import Options, TaskPart
 
 BoolArray = npt.NDArray[np.bool_]
 
@@ -53,16 +58,21 @@ def _reachable(abstraction: Abstraction, allowed: BoolArray) -> BoolArray:
 
 
 def _positive_props(formula: Formula) -> list[str]:
-    negated = {
-        n.arg.name for n in nnf(formula).walk() if isinstance(n, Not) and isinstance(n.arg, Prop)
-    }
-    positive = {n.name for n in nnf(formula).walk() if isinstance(n, Prop)}
+    """Regions the formula mentions outside a negation (in negation normal form).
+
+    Only these can be *needed*: a region that occurs only negated (``G !c``, ``!moat | goal``)
+    is one the task forbids or allows, never one it asks the robot to reach.
+    """
+    positive: set[str] = set()
+    stack = [nnf(formula)]
+    while stack:
+        node = stack.pop()
+        if isinstance(node, Prop):
+            positive.add(node.name)
+        elif not isinstance(node, Not):  # in NNF a negation holds a proposition only
+            stack.extend(node.children())
     names = [n.name for n in formula.walk() if isinstance(n, Prop)]
-    return [
-        p
-        for p in dict.fromkeys(names)
-        if (p in positive and p not in negated) or (p in positive and p in negated)
-    ]
+    return [p for p in dict.fromkeys(names) if p in positive]
 
 
 def explain_no_plan(
@@ -151,9 +161,140 @@ def explain_no_plan(
     return [
         error(
             "P007",
-            f"no trajectory on this map satisfies `{text}`: the parts of the "
-            "task that must hold forever cannot be reached",
-            hint="a patrol needs a loop of at least three triangles through its "
-            "regions; check that the regions can be visited in the required order",
+            f"no trajectory on this map satisfies `{text}`",
+            hint="check that the regions can be visited in the required order",
         )
     ]
+
+
+#: Codes of explanations that are exact facts about the whole task (kept as they are).
+_EXACT = {"P001", "P002", "P003", "P006"}
+#: A minimal blamed set of parts is sought only for tasks of at most this many parts.
+MAX_CORE_PARTS = 12
+
+
+def explain_infeasible(
+    abstraction: Abstraction,
+    automaton: Automaton,
+    *,
+    formula: Formula,
+    options: Options,
+    start_point: tuple[float, float],
+    parts: Sequence[TaskPart],
+    file: str | None,
+    fallback: Sequence[Diagnostic],
+) -> list[Diagnostic]:
+    """Why no trajectory in the plane satisfies the task, blaming the parts that fail.
+
+    Called only once planning *with U-turns* failed, which is exact (see docs/planning.md).
+    The blamed parts are a minimal set of task parts (phrases, top-level LTL conjuncts) that
+    already has no plan on this map: dropping any one of them would make the rest possible.
+    """
+    if not parts:
+        return list(fallback)
+    from tlmpc.automata.translate import translate
+    from tlmpc.planning.plan import plan
+
+    def feasible(chosen: Sequence[TaskPart]) -> bool:
+        conjunction = conjoin([p.formula for p in chosen])
+        try:
+            plan(
+                abstraction,
+                translate(conjunction, letters=abstraction.letters),
+                formula=conjunction,
+                options=options,
+                start_point=start_point,
+                bounces=True,
+            )
+        except NoPlanError:
+            return False
+        return True
+
+    core = list(parts)
+    if 1 < len(parts) <= MAX_CORE_PARTS:
+        for part in list(parts):
+            rest = [p for p in core if p is not part]
+            if rest and not feasible(rest):
+                core = rest
+    blamed = conjoin([p.formula for p in core])
+    first = core[0]
+    where: dict[str, Any] = {"file": file, "line": first.line, "col": first.col}
+    quoted = ", ".join(f"`{p.text}`" + _at(file, p) for p in core)
+    exact = [d for d in fallback if d.code in _EXACT]
+    if exact:
+        # The reason is already exact (e.g. the start violates an invariant); point it at
+        # the parts that cause it.
+        involved = f"; the parts involved: {quoted}" if len(core) > 1 else ""
+        return [dataclasses.replace(d, hint=(d.hint or "") + involved, **where) for d in exact]
+    facts = "; ".join(d.message for d in _region_facts(abstraction, blamed, where))
+    if len(core) == 1:
+        headline = error(
+            "P010",
+            f"no trajectory on this map satisfies the task part `{first.text}`"
+            + (f" ({to_text(first.formula)})" if to_text(first.formula) != first.text else ""),
+            hint=facts
+            or "no route through the map's regions (U-turns allowed) visits them as it asks",
+            **where,
+        )
+    else:
+        headline = error(
+            "P011",
+            f"these parts of the task cannot all hold on this map: {quoted}",
+            hint="each is possible without the others; "
+            + (facts or "relax one of them or change the map"),
+            **where,
+        )
+    return [headline]
+
+
+def _at(file: str | None, part: TaskPart) -> str:
+    if part.line is None:
+        return ""
+    return f" ({file or '<input>'}:{part.line}:{part.col})"
+
+
+def _region_facts(
+    abstraction: Abstraction, formula: Formula, where: dict[str, Any]
+) -> list[Diagnostic]:
+    """Regions the blamed parts need that have no free space or cannot be reached."""
+    allowed = invariant_mask(abstraction, formula)
+    if not allowed[abstraction.start]:
+        return []
+    reachable_ok = _reachable(abstraction, allowed)
+    reachable_any = _reachable(abstraction, np.ones(abstraction.num_triangles, dtype=bool))
+    facts: list[Diagnostic] = []
+    for name in _positive_props(formula):
+        with_region = np.array([name in letter for letter in abstraction.letters], dtype=bool)
+        triangles = with_region[abstraction.letter_of]
+        if not triangles.any():
+            facts.append(
+                error(
+                    "P004",
+                    f"region {name!r} has no free space: it lies in holes",
+                    hint="move the region or the holes",
+                    **where,
+                )
+            )
+        elif not (triangles & reachable_ok).any():
+            if (triangles & reachable_any).any():
+                forbidden = ", ".join(f"`G {to_text(p)}`" for p in invariants(formula))
+                facts.append(
+                    error(
+                        "P005",
+                        f"region {name!r} can only be reached through "
+                        f"regions the task forbids ({forbidden})",
+                        hint="open a path that avoids the forbidden regions",
+                        **where,
+                    )
+                )
+            else:
+                facts.append(
+                    error(
+                        "P005",
+                        f"region {name!r} cannot be reached from the "
+                        "start: holes separate it from the robot",
+                        hint="open a passage through the holes or move the start",
+                        **where,
+                    )
+                )
+    return facts

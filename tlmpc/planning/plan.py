@@ -18,9 +18,9 @@ import time
 from typing import Any
 
 import numpy as np
-from scipy.sparse.csgraph import dijkstra
+from scipy.sparse.csgraph import connected_components, dijkstra
 
-from tlmpc.abstraction.model import Abstraction, IntArray
+from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
 from tlmpc.automata.degeneralize import degeneralize
 from tlmpc.automata.model import Automaton
 from tlmpc.errors import NoPlanError
@@ -71,8 +71,13 @@ def plan(
     formula: Formula,
     options: Options,
     start_point: tuple[float, float] | None = None,
+    bounces: bool = False,
 ) -> Witness:
-    """A minimum-cost accepting lasso (raises :class:`NoPlanError` with an explanation)."""
+    """A minimum-cost accepting lasso (raises :class:`NoPlanError` with an explanation).
+
+    With ``bounces=True`` the lasso may leave a triangle through its entry edge (a U-turn the
+    controllers cannot realise on this mesh; :mod:`tlmpc.planning.complete` refines those).
+    """
     started = time.perf_counter()
     allowed = invariant_mask(abstraction, formula)
     working = degeneralize(automaton) if automaton.num_acc >= 2 else automaton
@@ -80,7 +85,12 @@ def plan(
         x, y = abstraction.corners(abstraction.start).mean(axis=0).tolist()
         start_point = (float(x), float(y))
     product = build_product(
-        abstraction, working, allowed=allowed, start_point=start_point, metric=options.cost
+        abstraction,
+        working,
+        allowed=allowed,
+        start_point=start_point,
+        metric=options.cost,
+        bounces=bounces,
     )
     if len(product.initial) == 0 or not working.edges:
         raise NoPlanError(explain_no_plan(abstraction, automaton, formula, allowed))
@@ -98,37 +108,62 @@ def plan(
     us, vs = acc.row.astype(np.int64), acc.col.astype(np.int64)
     reachable = np.isfinite(dist[us])
     us, vs = us[reachable], vs[reachable]
-    searches = 0
-    exhausted = True
-    if len(us):
-        edge_w = np.asarray(product.graph[us, vs]).ravel()
-        bound = dist[us] + options.beta * edge_w
-        order = np.argsort(bound, kind="stable")
-        for index in order.tolist():
-            if best is not None and bound[index] >= best[0]:
-                break
-            v = int(vs[index])
-            u = int(us[index])
-            if searches >= MAX_CYCLE_SEARCHES:
-                exhausted = False
-                break
-            searches += 1
-            limit = np.inf if best is None else (best[0] - bound[index]) / max(options.beta, 1e-12)
-            back, back_pred = dijkstra(
-                product.graph, indices=v, return_predecessors=True, limit=limit
-            )
-            if not np.isfinite(back[u]):
-                continue
-            total = float(dist[u] + options.beta * (edge_w[index] + back[u]))
-            if best is None or total < best[0] - 1e-12:
-                back_path = _path(back_pred, u)  # v, ..., u
-                best = (total, _path(pred, u), [u, *back_path[:-1]])
+    best, searches, exhausted = _close_cycles(product, dist, pred, us, vs, best, options.beta)
+    if best is None and not exhausted:
+        # The cap stopped the search before any cycle closed.  Only edges inside one strongly
+        # connected component close; keeping those, the first search succeeds, so the cap
+        # never hides the existence of a lasso (computed only here: it costs a graph pass).
+        _, scc = connected_components(product.graph, directed=True, connection="strong")
+        closable = scc[us] == scc[vs]
+        best, more, exhausted = _close_cycles(
+            product, dist, pred, us[closable], vs[closable], None, options.beta
+        )
+        searches += more
     if best is None:
         raise NoPlanError(explain_no_plan(abstraction, automaton, formula, allowed))
     reached = int(np.isfinite(dist).sum())
     return _witness(
         abstraction, product, best, options, started, searches, exhausted, working, reached
     )
+
+
+def _close_cycles(
+    product: Product,
+    dist: FloatArray,
+    pred: IntArray,
+    us: IntArray,
+    vs: IntArray,
+    best: tuple[float, list[int], list[int]] | None,
+    beta: float,
+) -> tuple[tuple[float, list[int], list[int]] | None, int, bool]:
+    """Close accepting edges ``u -> v`` in order of their lower bound (see the module doc).
+
+    Returns the best lasso (or the incumbent ``best``), the searches made, and whether the
+    candidates were exhausted (False when :data:`MAX_CYCLE_SEARCHES` cut the search).
+    """
+    searches = 0
+    if not len(us):
+        return best, searches, True
+    edge_w = np.asarray(product.graph[us, vs]).ravel()
+    bound = dist[us] + beta * edge_w
+    order = np.argsort(bound, kind="stable")
+    for index in order.tolist():
+        if best is not None and bound[index] >= best[0]:
+            break
+        v = int(vs[index])
+        u = int(us[index])
+        if searches >= MAX_CYCLE_SEARCHES:
+            return best, searches, False
+        searches += 1
+        limit = np.inf if best is None else (best[0] - bound[index]) / max(beta, 1e-12)
+        back, back_pred = dijkstra(product.graph, indices=v, return_predecessors=True, limit=limit)
+        if not np.isfinite(back[u]):
+            continue
+        total = float(dist[u] + beta * (edge_w[index] + back[u]))
+        if best is None or total < best[0] - 1e-12:
+            back_path = _path(back_pred, u)  # v, ..., u
+            best = (total, _path(pred, u), [u, *back_path[:-1]])
+    return best, searches, True
 
 
 def _witness(

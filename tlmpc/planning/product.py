@@ -56,11 +56,15 @@ def build_product(
     allowed: BoolArray,
     start_point: tuple[float, float],
     metric: str,
+    bounces: bool = False,
 ) -> Product:
     """The product graph restricted to ``allowed`` triangles.
 
     ``metric`` is ``"length"`` (Euclidean length through the crossed edges' midpoints,
-    starting at ``start_point``) or ``"hops"`` (one per move).
+    starting at ``start_point``) or ``"hops"`` (one per move).  ``bounces=True`` also allows
+    leaving a triangle through its entry edge: that graph is stutter-equivalent to the face
+    graph of the region arrangement, so it decides whether *any* continuous trajectory
+    satisfies the task (see docs/planning.md); its bounces are realised by refinement.
     """
     m = abstraction.num_triangles
     nq = automaton.num_states
@@ -83,7 +87,7 @@ def build_product(
     s = np.tile(np.repeat(np.arange(SLOTS, dtype=np.int64), 3), m)
     i = np.tile(np.arange(3, dtype=np.int64), m * SLOTS)
     n = neighbors[t, i]
-    valid = (n >= 0) & (i != s)
+    valid = (n >= 0) & ((i != s) | bounces)
     valid &= (s != START_SLOT) | (t == abstraction.start)
     t, s, i, n = t[valid], s[valid], i[valid], n[valid]
     keep = allowed[t] & allowed[n]

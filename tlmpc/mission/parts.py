@@ -1,0 +1,49 @@
+"""The task split into the parts the user wrote, with their positions (for explanations).
+
+Computed on demand (only when no plan exists), so loading a mission pays nothing for it.
+"""
+
+from __future__ import annotations
+
+from tlmpc.ltl.ast import And, Formula, Or, Prop
+from tlmpc.ltl.parser import parse_ltl
+from tlmpc.ltl.printer import to_text
+from tlmpc.ltl.transform import substitute
+from tlmpc.mission.model import Mission, TaskPart
+from tlmpc.tasks.compiler import compile_phrases
+
+
+def task_parts(mission: Mission) -> tuple[TaskPart, ...]:
+    """Each task phrase, and each top-level conjunct of ``ltl``, with where it starts.
+
+    Group names are expanded as in :attr:`Mission.formula`.  The mission loaded, so its task
+    compiles and nothing here can fail.
+    """
+    expand: dict[str, Formula] = {
+        g: Or(tuple(Prop(m) for m in members)) if len(members) > 1 else Prop(members[0])
+        for g, members in mission.groups.items()
+    }
+    groups = {g: list(members) for g, members in mission.groups.items()}
+    positions = list(mission.task_positions)
+    parts: list[TaskPart] = []
+    for index, phrase in enumerate(mission.task):
+        line, col = positions[index] if index < len(positions) else (1, 1)
+        formula = compile_phrases(
+            [phrase], groups=groups, file=mission.source, positions=[(line, col)]
+        )
+        parts.append(TaskPart(text=phrase, formula=substitute(formula, expand), line=line, col=col))
+    if mission.ltl and mission.ltl.strip():
+        index = len(mission.task)
+        line, col = positions[index] if index < len(positions) else (1, 1)
+        whole = parse_ltl(mission.ltl, file=mission.source, line=line, col=col)
+        for conjunct in whole.args if isinstance(whole, And) else (whole,):
+            span = getattr(conjunct, "span", None)
+            parts.append(
+                TaskPart(
+                    text=to_text(conjunct),
+                    formula=substitute(conjunct, expand),
+                    line=span.line if span else line,
+                    col=span.col if span else col,
+                )
+            )
+    return tuple(parts)

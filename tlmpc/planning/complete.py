@@ -1,0 +1,106 @@
+"""Complete planning: a plan whenever some continuous trajectory satisfies the task.
+
+1. Plan on D without bounces (the usual case: nothing changes, the mesh stays as built).
+2. If that fails, plan with bounces allowed.  That product is stutter-equivalent to the face
+   graph of the region arrangement (see docs/planning.md), so failing here means that no
+   trajectory in the plane satisfies the task: the explanation is computed against it.
+3. Otherwise every triangle where the bouncing lasso turns around is split into a fan of three
+   (:func:`tlmpc.abstraction.refine.split_triangles`), and the no-bounce planner runs again on
+   the refined mesh, where the fan lets the robot circle back; the returned abstraction is the
+   refined one, and the controllers, simulation and self-check all use it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+
+from tlmpc.abstraction.model import Abstraction
+from tlmpc.abstraction.refine import split_triangles
+from tlmpc.automata.model import Automaton
+from tlmpc.errors import NoPlanError, TlmpcError, error
+from tlmpc.ltl.ast import Formula
+from tlmpc.mission.model import Options, TaskPart
+from tlmpc.planning.explain import explain_infeasible
+from tlmpc.planning.model import Witness
+from tlmpc.planning.plan import plan
+
+#: Rounds of refinement before giving up (one always suffices; see the module docstring).
+MAX_ROUNDS = 3
+
+
+def bounce_triangles(witness: Witness) -> list[int]:
+    """Triangles where the run ``prefix + cycle^omega`` enters and leaves by the same edge."""
+    run = [*witness.prefix, *witness.cycle]
+    if len(witness.cycle) > 1:
+        run += [*witness.cycle, witness.cycle[0]]
+    return sorted({run[i] for i in range(1, len(run) - 1) if run[i - 1] == run[i + 1]})
+
+
+def plan_complete(
+    abstraction: Abstraction,
+    automaton: Automaton,
+    *,
+    formula: Formula,
+    options: Options,
+    start_point: tuple[float, float],
+    parts: Callable[[], Sequence[TaskPart]] = tuple,
+    file: str | None = None,
+) -> tuple[Abstraction, Witness]:
+    """A witness on ``abstraction`` or on a locally refined copy of it (returned with it).
+
+    Raises :class:`NoPlanError` only when no trajectory in the plane satisfies the task;
+    ``parts`` gives the task's parts for that explanation (called only then).
+    """
+
+    def attempt(mesh: Abstraction, bounces: bool) -> Witness:
+        return plan(
+            mesh,
+            automaton,
+            formula=formula,
+            options=options,
+            start_point=start_point,
+            bounces=bounces,
+        )
+
+    try:
+        return abstraction, attempt(abstraction, False)
+    except NoPlanError as first:
+        no_bounce_failure = first
+    mesh = abstraction
+    for _ in range(MAX_ROUNDS):
+        try:
+            bouncing = attempt(mesh, True)
+        except NoPlanError:
+            if mesh is abstraction:
+                raise NoPlanError(
+                    explain_infeasible(
+                        abstraction,
+                        automaton,
+                        formula=formula,
+                        options=options,
+                        start_point=start_point,
+                        parts=parts(),
+                        file=file,
+                        fallback=no_bounce_failure.diagnostics,
+                    )
+                ) from None
+            break
+        mesh = split_triangles(mesh, bounce_triangles(bouncing), start_point)
+        try:
+            witness = attempt(mesh, False)
+        except NoPlanError:
+            continue
+        return mesh, witness
+    raise RefinementError(
+        error(
+            "A020",
+            "a plan with U-turns exists but refining the mesh did not realise it",
+            hint="this is a bug in tlmpc; please report this mission",
+        )
+    )
+
+
+class RefinementError(TlmpcError):
+    """Refinement for U-turns failed to give a no-bounce plan (an internal error, exit 3)."""
+
+    exit_code = 3
