@@ -31,6 +31,8 @@ COMMAND_MODULES = (
     "automaton",
     "export",
     "plot",
+    "import_map",
+    "export_plan",
 )
 
 EPILOG = """\

@@ -14,12 +14,15 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
+import shapely
 from shapely.geometry import Point as ShapelyPoint
 from shapely.geometry import Polygon
 from shapely.geometry.base import BaseGeometry
@@ -31,7 +34,6 @@ from tlmpc.importers.polygonize import (
     drop_small_holes,
     erode,
     polygons,
-    simplify,
     to_world,
 )
 
@@ -83,64 +85,115 @@ def free_geometry(grid: OccupancyGrid) -> BaseGeometry:
     return to_world(cells_to_geometry(grid.values == FREE), grid.resolution, grid.origin)
 
 
-def _workspace(
-    grid: OccupancyGrid, settings: ImportSettings, tolerance: float, min_area: float
-) -> tuple[Polygon, int]:
-    free = erode(free_geometry(grid), settings.radius)
+def _to_grid(grid: OccupancyGrid, point: Point) -> Point:
+    """World coordinates to grid coordinates (cells, y up): the inverse of ``to_world``."""
+    ox, oy, yaw = grid.origin
+    dx, dy = point[0] - ox, point[1] - oy
+    c, s = math.cos(yaw), math.sin(yaw)
+    return (c * dx + s * dy) / grid.resolution, (-s * dx + c * dy) / grid.resolution
+
+
+def _free_piece(grid: OccupancyGrid, radius: float, start: Point | None) -> Polygon:
+    """The eroded free piece containing ``start`` (else the largest), in grid units."""
+    free = erode(cells_to_geometry(grid.values == FREE), radius / grid.resolution)
     pieces = polygons(free)
     if not pieces:
         raise _fail(
             "M010",
             "the map has no free space"
-            + (f" left after eroding by the radius {settings.radius:g}" if settings.radius else ""),
+            + (f" left after eroding by the radius {radius:g}" if radius else ""),
             grid.source,
             hint="free cells are those with occupancy below free_thresh; "
             "check negate, the thresholds and the radius",
         )
-    chosen = None
-    if settings.start is not None:
-        point = ShapelyPoint(settings.start)
+    if start is not None:
+        point = ShapelyPoint(_to_grid(grid, start))
         chosen = next((p for p in pieces if p.covers(point)), None)
-    if chosen is None:
-        chosen = max(pieces, key=lambda p: p.area)
-    before = len(chosen.interiors)
-    filled = drop_small_holes(chosen, min_area)
-    simplified = simplify(filled, tolerance)
-    if simplified is None:
-        raise _fail("M011", "the free space vanishes when simplified", grid.source)
-    result = drop_small_holes(simplified, min_area)
-    return result, before - len(result.interiors)
+        if chosen is not None:
+            return chosen
+    return max(pieces, key=lambda p: p.area)
 
 
-def _mask_regions(
-    mask: OccupancyGrid,
-    boundary: Polygon,
-    workspace: Polygon,
-    prefix: str,
-    values: list[int],
-    tolerance: float,
-    min_area: float,
-) -> dict[str, dict[str, Ring]]:
-    """Per value, the pieces of the mask with that value, clipped to the boundary ring."""
-    found: dict[str, dict[str, Ring]] = {}
-    for value in values:
-        group = prefix if prefix == "keepout" else f"{prefix}_{value}"
-        cells = to_world(cells_to_geometry(mask.values == value), mask.resolution, mask.origin)
-        pieces: list[Polygon] = []
-        for piece in polygons(cells):
-            if piece.area < min_area:
-                continue
-            smooth = simplify(Polygon(piece.exterior), tolerance)
-            if smooth is None:
-                continue
-            for clipped in polygons(smooth.intersection(boundary)):
-                outer = Polygon(clipped.exterior)
-                if outer.area >= min_area and outer.intersection(workspace).area > 0.0:
-                    pieces.append(outer)
-        pieces.sort(key=lambda p: (-p.area, p.bounds))
-        if pieces:
-            found[group] = {f"{group}_{k}": _ring(p.exterior) for k, p in enumerate(pieces, 1)}
-    return found
+def _labels(grid: OccupancyGrid, masks: list[npt.NDArray[np.int16]]) -> npt.NDArray[np.int64]:
+    """One label per distinct combination of mask values (0 where no mask applies)."""
+    if not masks:
+        return np.zeros(grid.shape, dtype=np.int64)
+    stacked = np.stack([m.astype(np.int64) + 1 for m in masks], axis=-1)  # -1..100 -> 0..101
+    codes = np.zeros(grid.shape, dtype=np.int64)
+    for layer in range(stacked.shape[-1]):
+        codes = codes * 102 + stacked[..., layer]
+    _, inverse = np.unique(codes, return_inverse=True)
+    return inverse.reshape(grid.shape).astype(np.int64)
+
+
+def _faces(linework: BaseGeometry) -> list[Polygon]:
+    parts = getattr(linework, "geoms", None)
+    lines = list(parts) if parts is not None else [linework]
+    return polygons(shapely.polygonize(lines))
+
+
+def _coverage(
+    workspace: Polygon, labels: npt.NDArray[np.int64], tolerance: float
+) -> tuple[Polygon, dict[int, list[BaseGeometry]]]:
+    """The workspace cut by the label cells, simplified as one coverage (shared edges shared).
+
+    Simplifying the workspace and each mask piece on its own would leave region edges running
+    beside walls a fraction of a cell away, or crossing them at tiny angles: slivers that
+    explode a quality mesh.  Instead the workspace's rings and the label boundaries inside it
+    are noded into one linework, merged into chains between junctions, and the chains are
+    simplified together by Douglas-Peucker with topology preserved (junctions stay, no chain
+    crosses another): every edge moves once for all the faces that share it, by at most
+    ``tolerance``.  The faces are then polygonized and matched to the exact faces by overlap.
+    """
+    present = [int(v) for v in np.unique(labels)]
+    lines: list[BaseGeometry] = [workspace.boundary]
+    if len(present) > 1:
+        for label in present:
+            edges = cells_to_geometry(labels == label).boundary
+            lines.append(shapely.intersection(edges, workspace))
+    noded = shapely.line_merge(shapely.union_all(lines))
+    exact: list[Polygon] = []
+    exact_labels: list[int | None] = []
+    rows, cols = labels.shape
+    for face in _faces(noded):
+        inside = face.representative_point()
+        exact.append(face)
+        if workspace.covers(inside):
+            row = min(max(math.floor(inside.y), 0), rows - 1)
+            col = min(max(math.floor(inside.x), 0), cols - 1)
+            exact_labels.append(int(labels[row, col]))
+        else:
+            exact_labels.append(None)  # the inside of a hole
+    faces, face_labels = exact, exact_labels
+    if tolerance > 0:
+        simple = _faces(noded.simplify(tolerance, preserve_topology=True))
+        tree = shapely.STRtree(exact)
+        matched: list[int | None] = []
+        for face in simple:
+            candidates = tree.query(face)
+            overlaps = [face.intersection(exact[int(k)]).area for k in candidates]
+            best = int(candidates[int(np.argmax(overlaps))]) if len(candidates) else -1
+            matched.append(exact_labels[best] if best >= 0 and max(overlaps) > 0 else None)
+        kept_area = sum(f.area for f, lab in zip(simple, matched, strict=True) if lab is not None)
+        # Each edge moved by at most the tolerance, so the area cannot change by more than
+        # tolerance x total edge length; more means the simplified linework lost a junction.
+        if abs(kept_area - workspace.area) <= tolerance * workspace.length + 1e-9:
+            faces, face_labels = simple, matched
+    kept = [f for f, lab in zip(faces, face_labels, strict=True) if lab is not None]
+    merged = polygons(shapely.union_all(kept))
+    if not merged:
+        raise _fail("M011", "the free space vanishes when simplified", "")
+    union = max(merged, key=lambda p: p.area)
+    by_label: dict[int, list[BaseGeometry]] = {}
+    for face, face_label in zip(faces, face_labels, strict=True):
+        if face_label is not None:
+            by_label.setdefault(face_label, []).append(face)
+    return union, by_label
+
+
+def _exact_free(grid: OccupancyGrid, settings: ImportSettings, min_area_cells: float) -> Polygon:
+    piece = _free_piece(grid, settings.radius, settings.start)
+    return drop_small_holes(piece, min_area_cells)
 
 
 def import_map(
@@ -162,10 +215,9 @@ def import_map(
     )
     if tolerance < 0 or min_area < 0:
         raise _fail("M012", "tolerance and min_area must not be negative", str(map_path))
-    workspace, dropped = _workspace(grid, settings, tolerance, min_area)
-    boundary = Polygon(workspace.exterior)
-    regions: dict[str, Ring] = {}
-    groups: dict[str, tuple[str, ...]] = {}
+    cell_area = grid.cell_area()
+    exact = _exact_free(grid, settings, min_area / cell_area)
+    mask_grids: list[tuple[str, Path, OccupancyGrid]] = []
     for prefix, path in (("keepout", keepout), ("speed", speed)):
         if path is None:
             continue
@@ -178,16 +230,44 @@ def import_map(
                 str(path),
                 hint="a mask must have the map's size, resolution and origin",
             )
+        mask_grids.append((prefix, path, mask))
+    layers = [m.values for _, _, m in mask_grids]
+    labels = _labels(grid, layers)
+    union, pieces = _coverage(exact, labels, tolerance / grid.resolution)
+    workspace_cells = drop_small_holes(union, min_area / cell_area)
+    dropped = len(union.interiors) - len(workspace_cells.interiors)
+    outer_cells = Polygon(workspace_cells.exterior)
+    regions: dict[str, Ring] = {}
+    groups: dict[str, tuple[str, ...]] = {}
+    for prefix, _, mask in mask_grids:
         if prefix == "keepout":
-            values = [OCCUPIED]
+            wanted = [OCCUPIED]
         else:
-            present = np.unique(mask.values)
-            values = [int(v) for v in present if 0 < v <= OCCUPIED]
-        for group, members in _mask_regions(
-            mask, boundary, workspace, prefix, values, tolerance, min_area
-        ).items():
-            regions.update(members)
-            groups[group] = tuple(members)
+            wanted = sorted({int(v) for v in np.unique(mask.values) if 0 < v <= OCCUPIED})
+        for value in wanted:
+            group = prefix if prefix == "keepout" else f"{prefix}_{value}"
+            members = [
+                piece
+                for label, faces in pieces.items()
+                if np.any(mask.values[labels == label] == value)
+                for piece in faces
+            ]
+            if not members:
+                continue
+            merged = polygons(shapely.union_all(members))
+            outers = [
+                Polygon(p.exterior)
+                for p in merged
+                if p.area >= min_area / cell_area and outer_cells.covers(p)
+            ]
+            outers = [to_world(p, grid.resolution, grid.origin) for p in outers]
+            outers.sort(key=lambda p: (-p.area, p.bounds))
+            if outers:
+                names = {f"{group}_{k}": _ring(p.exterior) for k, p in enumerate(outers, 1)}
+                regions.update(names)
+                groups[group] = tuple(names)
+    workspace = to_world(workspace_cells, grid.resolution, grid.origin)
+    assert isinstance(workspace, Polygon)
     free_cells = float(np.count_nonzero(grid.values == FREE)) * grid.cell_area()
     return ImportedMap(
         boundary=_ring(workspace.exterior),
