@@ -205,7 +205,8 @@ def test_ambiguous_missing_and_wrong_topics_are_explained(tmp_path: Path) -> Non
         read_log(two)
     diagnostic = caught.value.diagnostics[0]
     assert diagnostic.code == "M064"
-    assert diagnostic.hint is not None and "/odom" in diagnostic.hint
+    assert diagnostic.hint is not None
+    assert "/odom" in diagnostic.hint
     assert "/amcl_pose" in diagnostic.hint
     assert np.array_equal(read_log(two, topic="/amcl_pose").samples, expected(ROWS))
     with pytest.raises(UsageError) as caught:
@@ -261,13 +262,15 @@ def test_verify_flags_reach_the_reader(tmp_path: Path) -> None:
     code, _, err = run("verify", str(csv), "--mission", str(mission), "--columns", "stamp,a,b")
     assert code == 0, err
     code, _, err = run("verify", str(csv), "--mission", str(mission), "--columns", "stamp,a")
-    assert code == 2 and "error[M051]" in err
+    assert code == 2
+    assert "error[M051]" in err
     code, _, err = run(
         "verify", str(csv), "--mission", str(mission), "--columns", "1,2,3", "--transform", "0,9,0"
     )
     assert code == 1  # moved 9 up: never in a
     code, _, err = run("verify", str(csv), "--mission", str(mission), "--topic", "/odom")
-    assert code == 2 and "error[M058]" in err
+    assert code == 2
+    assert "error[M058]" in err
 
 
 # --- the real robot bags --------------------------------------------------------------------------
@@ -299,9 +302,7 @@ def test_real_bag_forms_and_their_csv_agree(tmp_path: Path) -> None:
     for log in logs[1:]:
         assert np.array_equal(log.samples, reference)
     csv = tmp_path / "jackal.csv"
-    csv.write_text(
-        "time,x,y\n" + "".join(f"{t!r},{x!r},{y!r}\n" for t, x, y in reference.tolist())
-    )
+    csv.write_text("time,x,y\n" + "".join(f"{t!r},{x!r},{y!r}\n" for t, x, y in reference.tolist()))
     assert np.array_equal(read_log(csv).samples, reference)
     for name, task in HELD_OUT.items():
         mission = tmp_path / f"{name}.yaml"
