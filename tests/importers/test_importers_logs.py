@@ -318,3 +318,25 @@ def test_real_bag_forms_and_their_csv_agree(tmp_path: Path) -> None:
             assert code in (0, 1), err
             outcomes.add((code, out))
         assert len(outcomes) == 1, name
+
+
+def test_log_reader_imports_nothing_from_the_planner(tmp_path: Path) -> None:
+    import subprocess
+    import sys
+
+    csv = tmp_path / "log.csv"
+    csv.write_text("t,x,y\n0,1,2\n")
+    bag = write_bag(tmp_path / "b", "mcap", {"/odom": (POSE_TYPES[0], ROWS)})
+    script = (
+        "import sys\n"
+        "from pathlib import Path\n"
+        "from tlmpc.importers.logs import read_log\n"
+        f"read_log(Path({str(csv)!r})); read_log(Path({str(bag)!r}))\n"
+        "bad = [m for m in sys.modules if m.startswith(('tlmpc.automata', 'tlmpc.planning', "
+        "'tlmpc.control', 'tlmpc.simulate', 'tlmpc.abstraction', 'tlmpc.pipeline', 'scipy'))]\n"
+        "print(bad)\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, check=True
+    )
+    assert done.stdout.strip() == "[]"

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import shapely
-from hypothesis import given
+from hypothesis import example, given
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 from robot_data import components, image_from_free, nav2_cell, require_shared, write_map
@@ -198,6 +198,21 @@ def test_masks_become_regions_and_groups(tmp_path: Path) -> None:
     assert keep_union.equals(box(2, 14, 6, 18).union(box(20, 5, 25, 10)))
     (band,) = imported.groups["speed_50"]
     assert Polygon(imported.regions[band]).equals(box(10, 1, 15, 19))
+    # With a radius the regions are the mask cells within the eroded (curved) workspace: a
+    # pixel disc, whose staircase erodes into arcs that the mask edges cross.
+    rows, cols = np.mgrid[0:20, 0:30]
+    disc = (rows - 9.5) ** 2 + (cols - 14.5) ** 2 < 9.3**2
+    path = write_map(tmp_path, "disc", image_from_free(disc), resolution=1.0)
+    eroded = import_map(
+        path, ImportSettings(radius=0.35, tolerance=0.0, min_area=0.0), keepout=keepout, speed=speed
+    )
+    free_space = Polygon(eroded.boundary, eroded.holes)
+    pieces = [Polygon(eroded.regions[n]) for n in eroded.groups["keepout"]]
+    want = box(2, 14, 6, 18).union(box(20, 5, 25, 10)).intersection(free_space)
+    assert shapely.union_all(pieces).symmetric_difference(want).area < 1e-9
+    (band,) = eroded.groups["speed_50"]
+    want_band = box(10, 1, 15, 19).intersection(free_space)
+    assert Polygon(eroded.regions[band]).symmetric_difference(want_band).area < 1e-9
 
 
 # --- the mission form and the command -------------------------------------------------------
@@ -375,3 +390,91 @@ def test_real_maps_import_into_valid_missions(
     code, _, err = run(*args)
     assert code == 0, err
     assert check_file(out) == []
+
+
+def test_check_of_a_map_mission_imports_no_heavy_packages(tmp_path: Path) -> None:
+    import subprocess
+    import sys
+
+    _depot_like(tmp_path)
+    mission = tmp_path / "mission.yaml"
+    mission.write_text(
+        "version: 1\nworkspace: {map: floor.yaml, keepout: floor_keepout.yaml}\n"
+        "regions:\n  goal: {rect: [4.5, 0.5, 5.5, 1.5]}\n"
+        "robot: {start: [0.5, 0.5]}\ntask: [visit goal, avoid keepout]\n"
+    )
+    script = (
+        "import sys, io\n"
+        "from tlmpc.cli import main\n"
+        f"code = main(['check', {str(mission)!r}], io.StringIO(), io.StringIO())\n"
+        "heavy = [m for m in ('scipy', 'cvxpy', 'triangle', 'matplotlib', 'clarabel', 'rosbags')"
+        " if m in sys.modules]\n"
+        "print(code, heavy)\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, check=True
+    )
+    assert done.stdout.strip() == "0 []"
+
+
+@pytest.mark.slow
+def test_real_depot_mission_form_compiles_and_verifies(tmp_path: Path) -> None:
+    maps = require_shared("maps")
+    mission = tmp_path / "depot.yaml"
+    mission.write_text(
+        f"version: 1\nworkspace: {{map: {maps / 'depot.yaml'}, "
+        f"keepout: {maps / 'depot_keepout.yaml'}, speed: {maps / 'depot_speed.yaml'}, "
+        "inflate: 0.1}\n"
+        "regions:\n  dock: {rect: [2, 2, 3, 3]}\n"
+        "robot: {start: [5, 5]}\n"
+        "task: [avoid keepout, visit speed_50 then dock]\n"
+    )
+    code, out, err = run("compile", str(mission), "-o", str(tmp_path / "out"), "--until", "verify")
+    assert code == 0, err
+    assert "trace verifies" in err + out
+
+
+@example(
+    pillars=[(2, 2), (1, 3), (6, 4), (3, 5)],
+    corner=(7, 3),
+    radius=0.38834985812647604,
+    tolerance=0.0,
+)
+@given(
+    pillars=st.lists(st.tuples(st.integers(1, 13), st.integers(1, 13)), max_size=5),
+    corner=st.tuples(st.integers(0, 10), st.integers(0, 10)),
+    radius=st.floats(0.0, 0.6),
+    tolerance=st.sampled_from([0.0, 0.5]),
+)
+def test_keepout_regions_are_the_mask_within_free_space(
+    tmp_path_factory: pytest.TempPathFactory,
+    pillars: list[tuple[int, int]],
+    corner: tuple[int, int],
+    radius: float,
+    tolerance: float,
+) -> None:
+    free = np.ones((16, 16), dtype=bool)
+    free[0, :] = free[-1, :] = free[:, 0] = free[:, -1] = False
+    for r, c in pillars:
+        free[r : r + 2, c : c + 3] = False
+    directory = tmp_path_factory.mktemp("keep")
+    path = write_map(directory, "m", image_from_free(free), resolution=1.0)
+    keep = np.full((16, 16), 254, dtype=np.uint8)
+    r, c = corner
+    keep[r : r + 5, c : c + 6] = 0
+    mask = write_map(directory, "k", keep, resolution=1.0)
+    try:
+        imported = import_map(
+            path,
+            ImportSettings(radius=radius, tolerance=tolerance, min_area=0.0),
+            keepout=mask,
+        )
+    except UsageError:
+        return  # eroded away entirely
+    free_space = Polygon(imported.boundary, imported.holes)
+    names = imported.groups.get("keepout", ())
+    got = shapely.union_all([Polygon(imported.regions[n]) for n in names]).intersection(free_space)
+    want = box(c, 16 - (r + 5), c + 6, 16 - r).intersection(free_space)
+    # Exact without simplification; within the tolerance's band along the region's edges with.
+    slack = 1e-9 if tolerance == 0 else tolerance * (want.length + got.length + 4 * 6)
+    assert got.symmetric_difference(want).area <= slack

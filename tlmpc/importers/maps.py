@@ -148,9 +148,13 @@ def _coverage(
     present = [int(v) for v in np.unique(labels)]
     lines: list[BaseGeometry] = [workspace.boundary]
     if len(present) > 1:
+        # Label edges are clipped to a cell beyond the workspace, not to the workspace itself:
+        # a clipped end computed in floating point would stop a hair short of the wall and be
+        # dropped by polygonize as a dangle; crossing the wall, the noding splits it exactly.
+        reach = workspace.buffer(1.0, quad_segs=2)
         for label in present:
             edges = cells_to_geometry(labels == label).boundary
-            lines.append(shapely.intersection(edges, workspace))
+            lines.append(shapely.intersection(edges, reach))
     noded = shapely.line_merge(shapely.union_all(lines))
     exact: list[Polygon] = []
     exact_labels: list[int | None] = []
