@@ -50,6 +50,16 @@ def test_cell_values_follow_nav2(
         assert got[r, c] == want
 
 
+def test_thresholds_are_strict() -> None:
+    # nav2: occupied when occ > occupied_thresh, free when occ < free_thresh; equal is neither.
+    shade = np.array([[102 / 255.0, 204 / 255.0, 101 / 255.0, 205 / 255.0]])
+    occupied, free = 1.0 - 102 / 255.0, 1.0 - 204 / 255.0
+    got = cell_values(
+        shade, None, mode="trinary", negate=False, occupied_thresh=occupied, free_thresh=free
+    )
+    assert got.tolist() == [[-1, -1, 100, 0]]
+
+
 def test_unknown_is_not_free_and_the_image_is_flipped(tmp_path: Path) -> None:
     image = np.full((4, 6), 205, dtype=np.uint8)  # unknown everywhere
     image[0, 0:2] = 254  # free, top-left of the image: the top of the map
@@ -151,12 +161,12 @@ def test_specks_are_filled_by_the_area_threshold(tmp_path: Path) -> None:
     free[0, :] = free[-1, :] = free[:, 0] = free[:, -1] = False
     free[5, 5] = False  # a one-cell speck
     free[10:13, 10:13] = False  # a 9-cell pillar
+    free[15:17, 4:6] = False  # a 4-cell post: exactly the threshold below, so kept
     path = write_map(tmp_path, "m", image_from_free(free), resolution=0.5)
     kept = import_map(path, ImportSettings(tolerance=0.0, min_area=0.0))
-    assert len(kept.holes) == 2
+    assert len(kept.holes) == 3
     filled = import_map(path, ImportSettings(tolerance=0.0, min_area=1.0))  # 4 cells of 0.25
-    assert len(filled.holes) == 1
-    assert Polygon(filled.holes[0]).area == pytest.approx(9 * 0.25)
+    assert sorted(Polygon(h).area for h in filled.holes) == pytest.approx([4 * 0.25, 9 * 0.25])
 
 
 def test_radius_erodes_free_space(tmp_path: Path) -> None:
