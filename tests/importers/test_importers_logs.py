@@ -181,9 +181,17 @@ def test_a_bare_mcap_file_and_a_db3_file_read_like_their_bags(tmp_path: Path) ->
     assert np.array_equal(read_log(db3_file).samples, expected(ROWS))
 
 
-def test_stamps_are_sorted_and_repeats_dropped(tmp_path: Path) -> None:
+@pytest.mark.parametrize("kind", KINDS)
+def test_stamps_are_sorted_and_repeats_dropped(tmp_path: Path, kind: str) -> None:
+    # Received in this order (log times increase) but stamped out of order, one stamp twice.
     rows = [ROWS[2], ROWS[0], ROWS[1], (ROWS[1][0], 9.0, 9.0)]
-    path = write_bag(bag_path(tmp_path, "sqlite3"), "sqlite3", {"/odom": (POSE_TYPES[0], rows)})
+    received = [5_000_000_000 + i for i in range(len(rows))]
+    path = write_bag(
+        bag_path(tmp_path, kind),
+        kind,
+        {"/odom": (POSE_TYPES[0], rows)},
+        log_times={"/odom": received},
+    )
     assert np.array_equal(read_log(path).samples, expected(ROWS[:3]))
 
 

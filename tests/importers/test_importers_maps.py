@@ -156,6 +156,17 @@ def test_simplified_boundary_stays_within_the_tolerance(
                 assert workspace.covers(centre) == exact.covers(centre)
 
 
+def test_the_workspace_is_the_piece_the_robot_starts_in(tmp_path: Path) -> None:
+    free = np.zeros((10, 20), dtype=bool)
+    free[1:9, 1:12] = True  # the big room
+    free[1:9, 13:19] = True  # the small room, behind a wall
+    path = write_map(tmp_path, "m", image_from_free(free), resolution=1.0)
+    big = import_map(path, ImportSettings(tolerance=0.0))
+    assert Polygon(big.boundary).equals(box(1, 1, 12, 9))
+    small = import_map(path, ImportSettings(tolerance=0.0, start=(15.0, 5.0)))
+    assert Polygon(small.boundary).equals(box(13, 1, 19, 9))
+
+
 def test_specks_are_filled_by_the_area_threshold(tmp_path: Path) -> None:
     free = np.ones((20, 20), dtype=bool)
     free[0, :] = free[-1, :] = free[:, 0] = free[:, -1] = False
@@ -192,6 +203,7 @@ def test_masks_become_regions_and_groups(tmp_path: Path) -> None:
     keep = np.full((20, 30), 254, dtype=np.uint8)
     keep[2:6, 2:6] = 0  # image rows 2..5 -> map rows 14..17
     keep[10:15, 20:25] = 0
+    keep[17, 2:10] = 0  # a strip one cell high: image row 17 -> map row 2
     keepout = write_map(tmp_path, "keep", keep, resolution=1.0)
     speed_image = np.full((20, 30), 254, dtype=np.uint8)
     speed_image[:, 10:15] = 127  # scale mode: 50
@@ -205,7 +217,7 @@ def test_masks_become_regions_and_groups(tmp_path: Path) -> None:
     keep_union = shapely.union_all(
         [Polygon(imported.regions[n]) for n in imported.groups["keepout"]]
     )
-    assert keep_union.equals(box(2, 14, 6, 18).union(box(20, 5, 25, 10)))
+    assert keep_union.equals(box(2, 14, 6, 18).union(box(20, 5, 25, 10)).union(box(2, 2, 10, 3)))
     (band,) = imported.groups["speed_50"]
     assert Polygon(imported.regions[band]).equals(box(10, 1, 15, 19))
     # With a radius the regions are the mask cells within the eroded (curved) workspace: a
@@ -218,7 +230,8 @@ def test_masks_become_regions_and_groups(tmp_path: Path) -> None:
     )
     free_space = Polygon(eroded.boundary, eroded.holes)
     pieces = [Polygon(eroded.regions[n]) for n in eroded.groups["keepout"]]
-    want = box(2, 14, 6, 18).union(box(20, 5, 25, 10)).intersection(free_space)
+    want = box(2, 14, 6, 18).union(box(20, 5, 25, 10)).union(box(2, 2, 10, 3))
+    want = want.intersection(free_space)
     assert shapely.union_all(pieces).symmetric_difference(want).area < 1e-9
     (band,) = eroded.groups["speed_50"]
     want_band = box(10, 1, 15, 19).intersection(free_space)

@@ -123,9 +123,11 @@ def write_bag(
     path: Path,
     kind: str,
     messages: dict[str, tuple[str, list[tuple[int, float, float]]]],
+    log_times: dict[str, list[int]] | None = None,
 ) -> Path:
     """A bag of ``kind`` ros1 / sqlite3 / mcap: per topic, (type, [(stamp ns, x, y), ...]).
 
+    ``log_times`` gives a topic's log (receive) times when they differ from the header stamps.
     Types: ``nav_msgs/msg/Odometry``, ``geometry_msgs/msg/PoseStamped``,
     ``geometry_msgs/msg/PoseWithCovarianceStamped``, ``std_msgs/msg/String`` (not a pose).
     """
@@ -174,9 +176,10 @@ def write_bag(
         with Writer1(path) as writer1:
             for topic, (msgtype, rows) in messages.items():
                 connection = writer1.add_connection(topic, msgtype, typestore=store)
-                for ns, x, y in rows:
+                logged = (log_times or {}).get(topic) or [ns for ns, _, _ in rows]
+                for (ns, x, y), log_ns in zip(rows, logged, strict=True):
                     data = store.serialize_ros1(make(msgtype, ns, x, y), msgtype)
-                    writer1.write(connection, ns, data)
+                    writer1.write(connection, log_ns, data)
         return path
     from rosbags.rosbag2 import StoragePlugin, Writer
 
@@ -184,7 +187,8 @@ def write_bag(
     with Writer(path, version=9, storage_plugin=plugin) as writer:
         for topic, (msgtype, rows) in messages.items():
             connection = writer.add_connection(topic, msgtype, typestore=store)
-            for ns, x, y in rows:
+            logged = (log_times or {}).get(topic) or [ns for ns, _, _ in rows]
+            for (ns, x, y), log_ns in zip(rows, logged, strict=True):
                 data = store.serialize_cdr(make(msgtype, ns, x, y), msgtype)
-                writer.write(connection, ns, data)
+                writer.write(connection, log_ns, data)
     return path
