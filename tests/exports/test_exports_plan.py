@@ -166,6 +166,12 @@ def test_waypoint_thinning_keeps_the_ends_the_loop_and_the_spacing(
             assert math.dist(samples[previous, 1:], samples[skipped, 1:]) < spacing
 
 
+def test_a_sample_exactly_the_spacing_away_is_kept() -> None:
+    samples = np.array([[0.0, 0.0, 0.0], [1.0, 1.0, 0.0], [2.0, 1.5, 0.0], [3.0, 2.5, 0.0]])
+    points, _ = waypoints(_plan(samples, None), 1.0)
+    assert [p.t for p in points] == [0.0, 1.0, 3.0]
+
+
 def test_bad_export_requests_get_diagnostics(compiled: Path, tmp_path: Path) -> None:
     code, _, err = run("export-plan", str(tmp_path))
     assert code == 2

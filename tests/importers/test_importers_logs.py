@@ -65,6 +65,7 @@ def expected(rows: list[tuple[int, float, float]]) -> np.ndarray:
         "time x y\n0 1 2\n1 3 4\n",
         "0,1,2\n1,3,4\n",
         "x,y,stamp\n1,2,0\n3,4,1\n",
+        "time,x,y,2\n0,1,2,9\n1,3,4,9\n",  # a header is any line with a non-number
         "field.header.stamp,field.pose.position.x,field.pose.position.y\n0,1,2\n1,3,4\n",
     ],
 )
