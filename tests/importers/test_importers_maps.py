@@ -501,3 +501,18 @@ def test_keepout_regions_are_the_mask_within_free_space(
     # Exact without simplification; within the tolerance's band along the region's edges with.
     slack = 1e-9 if tolerance == 0 else tolerance * (want.length + got.length + 4 * 6)
     assert got.symmetric_difference(want).area <= slack
+
+
+def test_default_start_avoids_keepout(tmp_path: Path) -> None:
+    from tlmpc.importers.mission import default_start
+
+    free = np.zeros((20, 20), dtype=bool)
+    free[1:19, 1:19] = True
+    path = write_map(tmp_path, "m", image_from_free(free), resolution=1.0)
+    keep = np.full((20, 20), 254, dtype=np.uint8)
+    keep[6:14, 6:14] = 0  # the middle of the room, where the farthest-from-walls point is
+    mask = write_map(tmp_path, "k", keep, resolution=1.0)
+    imported = import_map(path, ImportSettings(tolerance=0.0), keepout=mask)
+    start = Point(default_start(imported))
+    assert Polygon(imported.boundary).covers(start)
+    assert not box(6, 6, 14, 14).covers(start)
