@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -68,7 +68,6 @@ class ImportedMap:
     tolerance: float
     source: str
     speckles_dropped: int = 0
-    notes: tuple[str, ...] = field(default=())
 
 
 def _ring(polygon_ring: Any) -> Ring:
