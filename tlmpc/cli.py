@@ -38,6 +38,8 @@ COMMAND_MODULES = (
     "plot",
     "stage",
     "view",
+    "import_map",
+    "export_plan",
 )
 
 EPILOG = """\

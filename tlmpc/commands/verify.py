@@ -16,11 +16,14 @@ if TYPE_CHECKING:
 from tlmpc.artifacts import json_text
 
 NAME = "verify"
-HELP = "check a trajectory (trace.json, or a CSV log with --mission) against its task"
+HELP = "check a trajectory (trace.json, or a CSV/ROS bag log with --mission) against its task"
 DESCRIPTION = """\
 Check TRACE against its task under the continuous-time semantics of LTL (docs/semantics.md).
-TRACE is a trace.json written by `tlmpc compile` (self-contained), or a CSV file of t,x,y rows
-(an optional header line `t,x,y`), whose regions and task come from --mission.
+TRACE is a trace.json written by `tlmpc compile` (self-contained), or a robot log whose
+regions and task come from --mission: a CSV (header naming t/time, x, y, extra columns ignored,
+--columns to choose; comments and , ; tab or space separators), a ROS 1 .bag, a ROS 2 bag
+directory (sqlite3 or MCAP) or a .mcap file (pose topic chosen with --topic); see
+docs/robot-data.md.
 
 A log that simply ends gets a three-valued verdict: satisfied (no continuation can break the
 task), violated (none can repair it) or inconclusive; --assume-stay reads it as staying at its
@@ -31,7 +34,7 @@ and whether the verdict is certified for the real robot between samples."""
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Register the command's flags."""
-    parser.add_argument("trace", type=Path, help="trace.json or a CSV of t,x,y rows")
+    parser.add_argument("trace", type=Path, help="trace.json, a CSV log or a ROS bag")
     parser.add_argument("--mission", type=Path, help="mission file (needed for CSV traces)")
     parser.add_argument(
         "--boundary",
@@ -51,12 +54,26 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="the part of the log from time T to its end repeats forever (two-valued verdict)",
     )
     parser.add_argument("--json", action="store_true", help="print the verdict as JSON")
+    parser.add_argument(
+        "--topic", help="bags: the pose topic (needed when several topics carry poses)"
+    )
+    parser.add_argument(
+        "--columns",
+        metavar="TIME,X,Y",
+        help="CSV logs: the time and position columns, by name or 1-based number",
+    )
+    parser.add_argument(
+        "--transform",
+        metavar="X,Y,YAW",
+        help="logs: map the log's frame into the mission's (p = R(YAW) p_log + (X, Y))",
+    )
 
 
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Verify and report."""
     from tlmpc.artifacts import read_json
     from tlmpc.errors import EXIT_INCONCLUSIVE, EXIT_NEGATIVE, EXIT_OK
+    from tlmpc.importers.logs import is_log, parse_columns, parse_transform
     from tlmpc.verify import (
         declare_ending,
         from_csv,
@@ -66,8 +83,15 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     )
 
     path: Path = args.trace
-    if path.suffix.lower() == ".csv":
-        trace = from_csv(path, args.mission, args.boundary)
+    if is_log(path):
+        trace = from_csv(
+            path,
+            args.mission,
+            args.boundary,
+            topic=args.topic,
+            columns=parse_columns(args.columns) if args.columns else None,
+            transform=parse_transform(args.transform) if args.transform else None,
+        )
     else:
         document = read_json(path)
         trace = from_document(document, file=str(path), convention=args.boundary)

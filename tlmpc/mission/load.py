@@ -294,6 +294,22 @@ def _shapes(
 ) -> tuple[CheckedShape | None, list[CheckedShape], dict[str, CheckedShape], list[Diagnostic]]:
     problems: list[Diagnostic] = []
     workspace = data.get("workspace") or {}
+    if "map" in workspace:
+        return _map_shapes(data, doc, file)
+    if "boundary" not in workspace:
+        line, col = doc.value_at(("workspace",))
+        problems.append(
+            error(
+                "S002",
+                "'boundary' is missing (required): give workspace.boundary or workspace.map",
+                hint="see docs/mission-format.md for the keys",
+                file=file,
+                line=line,
+                col=col,
+                path="$.workspace",
+            )
+        )
+        return None, [], {}, problems
     boundary, found = check_shape(
         workspace.get("boundary"),
         ("workspace", "boundary"),
@@ -319,6 +335,16 @@ def _shapes(
         if checked is not None:
             regions[name] = checked
     return boundary, holes, regions, problems
+
+
+def _map_shapes(
+    data: Mapping[str, Any], doc: PositionedDocument, file: str
+) -> tuple[CheckedShape | None, list[CheckedShape], dict[str, CheckedShape], list[Diagnostic]]:
+    """``workspace: {map: FILE.yaml, ...}``: the workspace and mask regions of a map."""
+    from tlmpc.mission.map_workspace import map_shapes
+
+    assert isinstance(data, dict)
+    return map_shapes(data, doc, file)
 
 
 def _groups(
@@ -385,7 +411,7 @@ def _load(text: str, file: str, stem: str) -> tuple[Mission | None, list[Diagnos
     problems.extend(
         check_layout(boundary, holes, regions, start, ("robot", "start"), file, doc.value_at)
     )
-    names = set(data["regions"])
+    names = set(regions) | set(data["regions"])
     groups, found = _groups(data, doc, file, names)
     problems.extend(found)
     formula, found = _check_task(data, doc, file, names, groups)
@@ -397,7 +423,7 @@ def _load(text: str, file: str, stem: str) -> tuple[Mission | None, list[Diagnos
     mission = Mission(
         name=str(data.get("name") or stem),
         workspace=Workspace(boundary=boundary.points, holes=tuple(h.points for h in holes)),
-        regions=tuple(Region(name=n, polygon=regions[n].points) for n in data["regions"]),
+        regions=tuple(Region(name=n, polygon=shape.points) for n, shape in regions.items()),
         robot=Robot(
             start=start,
             max_speed=float(robot.get("max_speed", 1.0)),

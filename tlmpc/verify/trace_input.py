@@ -6,10 +6,8 @@ traces) and shared error types are used.
 
 from __future__ import annotations
 
-import csv
-import io
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -168,29 +166,13 @@ def from_document(
     )
 
 
-def read_csv(path: Path) -> tuple[FloatArray, list[int]]:
-    """Rows ``t,x,y`` (an optional header line naming t, x, y), with their line numbers."""
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise _fail("U001", f"cannot read {path}: {exc}", str(path)) from None
-    rows: list[list[float]] = []
-    lines: list[int] = []
-    for number, row in enumerate(csv.reader(io.StringIO(text)), start=1):
-        if not row or all(not cell.strip() for cell in row):
-            continue
-        if number == 1 and [c.strip().lower() for c in row] == ["t", "x", "y"]:
-            continue
-        if len(row) != 3:
-            raise _fail(
-                "V002", f"expected 3 columns t,x,y, found {len(row)}", str(path), line=number
-            )
-        try:
-            rows.append([float(cell) for cell in row])
-        except ValueError:
-            raise _fail("V002", f"not a number in row {row}", str(path), line=number) from None
-        lines.append(number)
-    return _samples(rows if rows else np.zeros((0, 3)), str(path), lines), lines
+def read_csv(path: Path, columns: Sequence[str] | None = None) -> tuple[FloatArray, list[int]]:
+    """A CSV log's ``[t, x, y]`` rows (see :mod:`tlmpc.importers.logs`), with line numbers."""
+    from tlmpc.importers.logs import read_csv_log
+
+    log = read_csv_log(path, columns)
+    lines = list(log.lines)
+    return _samples(log.samples, str(path), lines), lines
 
 
 #: Bounds checked on the file before a CSV trace is parsed, so memory stays bounded: a
@@ -239,13 +221,22 @@ def check_csv_file(path: Path) -> None:
         )
 
 
-def from_csv(path: Path, mission_path: Path | None, convention: str | None) -> TraceInput:
-    """A CSV trajectory checked against a mission file's regions and task."""
+def from_csv(
+    path: Path,
+    mission_path: Path | None,
+    convention: str | None,
+    *,
+    topic: str | None = None,
+    columns: Sequence[str] | None = None,
+    transform: tuple[float, float, float] | None = None,
+) -> TraceInput:
+    """A logged trajectory (CSV or ROS bag) checked against a mission file's regions and task."""
     if mission_path is None:
         raise _fail(
             "V010", "a CSV trace needs --mission MISSION.yaml for its regions and task", str(path)
         )
     from tlmpc.errors import InvalidInputError
+    from tlmpc.importers.logs import CSV_SUFFIXES, read_log
     from tlmpc.ltl.printer import to_text
     from tlmpc.mission.load import load_mission
 
@@ -253,11 +244,10 @@ def from_csv(path: Path, mission_path: Path | None, convention: str | None) -> T
         mission = load_mission(mission_path)
     except InvalidInputError as exc:
         raise UsageError(exc.diagnostics) from None
-    check_csv_file(path)
-    try:
-        samples, _ = read_csv(path)
-    except csv.Error as exc:
-        raise _fail("U038", f"cannot read the CSV: {exc}", str(path)) from None
+    if path.suffix.lower() in CSV_SUFFIXES and path.is_file():
+        check_csv_file(path)  # bounded before parsing
+    log = read_log(path, topic=topic, columns=columns, transform=transform)
+    samples = _samples(log.samples, str(path), list(log.lines) or None)
     document = {
         "format": "tlmpc.trace/1",
         "ltl": to_text(mission.formula),

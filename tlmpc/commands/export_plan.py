@@ -1,0 +1,80 @@
+"""``tlmpc export-plan OUT --format ...``: a compiled plan for a navigation stack."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import TextIO
+
+NAME = "export-plan"
+HELP = "export a compiled plan as waypoints (YAML, CSV), a nav_msgs/Path MCAP file or GeoJSON"
+DESCRIPTION = """\
+Export the plan of a compiled mission (OUT holds trace.json and mission.json, written by
+`tlmpc compile`) for a navigation stack: waypoints as YAML or CSV (with the loop start, so a
+patrol can repeat its cycle), a nav_msgs/Path message in an MCAP file, or GeoJSON of the map,
+regions, trajectory and waypoints.  Coordinates are the mission's (the map frame for imported
+maps).  See docs/robot-data.md."""
+
+FORMATS = ("waypoints-yaml", "waypoints-csv", "path-mcap", "geojson")
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Register the command's flags."""
+    parser.add_argument("out", type=Path, help="a directory written by `tlmpc compile`")
+    parser.add_argument("--format", choices=FORMATS, default="waypoints-yaml")
+    parser.add_argument(
+        "-o", "--output", type=Path, help="write to this file (default: stdout; required for MCAP)"
+    )
+    parser.add_argument(
+        "--spacing",
+        type=float,
+        default=0.0,
+        help="keep waypoints at least this far apart (default 0: every trajectory sample)",
+    )
+    parser.add_argument("--frame-id", default="map", help="frame of the poses (default: map)")
+    parser.add_argument("--topic", default="/plan", help="path-mcap: the topic (default: /plan)")
+
+
+def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
+    """Read the plan and write the chosen format."""
+    import math
+
+    from tlmpc.errors import UsageError, error
+    from tlmpc.exports.formats import geojson, path_mcap, waypoints_csv, waypoints_yaml
+    from tlmpc.exports.plan import read_plan, waypoints
+    from tlmpc.output import replace_file
+
+    if not math.isfinite(args.spacing) or args.spacing < 0:
+        raise UsageError(
+            error("M082", f"--spacing must be a non-negative number, got {args.spacing:g}")
+        )
+    if args.output is not None and not args.output.parent.is_dir():
+        raise UsageError(
+            error(
+                "M083",
+                f"cannot write {args.output}: {args.output.parent} is not a directory",
+                hint="create the directory first",
+                file=str(args.output),
+            )
+        )
+    if args.format == "path-mcap" and args.output is None:
+        raise UsageError(
+            error("M083", "path-mcap is binary: give -o FILE.mcap", hint="-o plan.mcap")
+        )
+    plan = read_plan(args.out)
+    points, loop = waypoints(plan, args.spacing)
+    data: bytes
+    if args.format == "waypoints-yaml":
+        data = waypoints_yaml(plan, points, loop, args.frame_id).encode("utf-8")
+    elif args.format == "waypoints-csv":
+        data = waypoints_csv(plan, points, loop).encode("utf-8")
+    elif args.format == "geojson":
+        data = geojson(plan, points, loop).encode("utf-8")
+    else:
+        data = path_mcap(plan, points, args.topic, args.frame_id)
+    if args.output is None:
+        out.write(data.decode("utf-8"))
+    else:
+        replace_file(args.output, data)
+        err.write(f"wrote {args.output} ({len(points)} waypoints)\n")
+    return 0

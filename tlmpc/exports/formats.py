@@ -1,0 +1,175 @@
+"""Writers of an exported plan: waypoints (YAML, CSV), GeoJSON, nav_msgs/Path in MCAP."""
+
+from __future__ import annotations
+
+import io
+import json
+import math
+from typing import Any
+
+import yaml
+
+from tlmpc.exports.plan import Plan, Ring, Waypoint
+
+
+def _quaternion(yaw: float) -> dict[str, float]:
+    return {"x": 0.0, "y": 0.0, "z": math.sin(yaw / 2.0), "w": math.cos(yaw / 2.0)}
+
+
+def waypoints_yaml(
+    plan: Plan, points: list[Waypoint], loop: int | None, frame_id: str = "map"
+) -> str:
+    """``tlmpc.waypoints/1``: frame, loop start and poses (yaw and quaternion) with plan times."""
+    document: dict[str, Any] = {
+        "format": "tlmpc.waypoints/1",
+        "mission": plan.name,
+        "task": plan.formula,
+        "frame_id": frame_id,
+        "loop_start": loop,
+        "waypoints": [
+            {
+                "t": w.t,
+                "x": w.x,
+                "y": w.y,
+                "yaw": w.yaw,
+                "orientation": _quaternion(w.yaw),
+            }
+            for w in points
+        ],
+    }
+    return yaml.safe_dump(document, sort_keys=False, default_flow_style=None)
+
+
+def waypoints_csv(plan: Plan, points: list[Waypoint], loop: int | None) -> str:
+    """``t,x,y,yaw`` rows; comment lines give the mission and the loop start (row index)."""
+    out = io.StringIO()
+    out.write(f"# tlmpc.waypoints/1 mission {plan.name}\n")
+    out.write(f"# loop_start: {'none' if loop is None else loop}\n")
+    out.write("t,x,y,yaw\n")
+    for w in points:
+        out.write(f"{w.t!r},{w.x!r},{w.y!r},{w.yaw!r}\n")
+    return out.getvalue()
+
+
+def _closed(ring: Ring) -> list[list[float]]:
+    coords = [[x, y] for x, y in ring]
+    return [*coords, coords[0]]
+
+
+def _oriented(ring: Ring, ccw: bool) -> Ring:
+    area = sum(
+        x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in zip(ring, ring[1:] + ring[:1], strict=True)
+    )
+    return ring if (area > 0) == ccw else tuple(reversed(ring))
+
+
+def geojson(plan: Plan, points: list[Waypoint], loop: int | None) -> str:
+    """A FeatureCollection in the map frame (metres): workspace, regions, trajectory, waypoints.
+
+    Rings follow RFC 7946's right-hand rule (outer counter-clockwise, holes clockwise).
+    """
+    features: list[dict[str, Any]] = [
+        {
+            "type": "Feature",
+            "properties": {"kind": "workspace", "name": plan.name},
+            "geometry": {
+                "type": "Polygon",
+                "coordinates": [_closed(_oriented(plan.boundary, True))]
+                + [_closed(_oriented(h, False)) for h in plan.holes],
+            },
+        }
+    ]
+    for name, ring in plan.regions.items():
+        features.append(
+            {
+                "type": "Feature",
+                "properties": {"kind": "region", "name": name},
+                "geometry": {"type": "Polygon", "coordinates": [_closed(_oriented(ring, True))]},
+            }
+        )
+    samples = plan.samples
+    features.append(
+        {
+            "type": "Feature",
+            "properties": {
+                "kind": "trajectory",
+                "task": plan.formula,
+                "loop_start": plan.loop_start,
+                "times": samples[:, 0].tolist(),
+            },
+            "geometry": {
+                "type": "LineString" if len(samples) > 1 else "Point",
+                "coordinates": samples[:, 1:].tolist()
+                if len(samples) > 1
+                else samples[0, 1:].tolist(),
+            },
+        }
+    )
+    features.append(
+        {
+            "type": "Feature",
+            "properties": {
+                "kind": "waypoints",
+                "loop_start": loop,
+                "yaw": [w.yaw for w in points],
+                "times": [w.t for w in points],
+            },
+            "geometry": {"type": "MultiPoint", "coordinates": [[w.x, w.y] for w in points]},
+        }
+    )
+    return json.dumps({"type": "FeatureCollection", "features": features}, indent=1) + "\n"
+
+
+PATH_TYPE = "nav_msgs/msg/Path"
+
+
+def path_mcap(
+    plan: Plan, points: list[Waypoint], topic: str = "/plan", frame_id: str = "map"
+) -> bytes:
+    """An MCAP file with one ``nav_msgs/msg/Path`` (CDR, ROS 2 schema) on ``topic``.
+
+    Pose stamps are the plan's times; the message's log time is the first of them.
+    """
+    from mcap.writer import Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    types: Any = store.types
+    time_type, header_type = types["builtin_interfaces/msg/Time"], types["std_msgs/msg/Header"]
+    pose_stamped, pose_type = (
+        types["geometry_msgs/msg/PoseStamped"],
+        types["geometry_msgs/msg/Pose"],
+    )
+    point_type, quat_type = types["geometry_msgs/msg/Point"], types["geometry_msgs/msg/Quaternion"]
+
+    def stamp(seconds: float) -> Any:
+        nanoseconds = max(0, round(seconds * 1e9))
+        return time_type(sec=nanoseconds // 1_000_000_000, nanosec=nanoseconds % 1_000_000_000)
+
+    poses = [
+        pose_stamped(
+            header=header_type(stamp=stamp(w.t), frame_id=frame_id),
+            pose=pose_type(
+                position=point_type(x=w.x, y=w.y, z=0.0),
+                orientation=quat_type(**_quaternion(w.yaw)),
+            ),
+        )
+        for w in points
+    ]
+    first = points[0].t if points else 0.0
+    message = types[PATH_TYPE](
+        header=header_type(stamp=stamp(first), frame_id=frame_id), poses=poses
+    )
+    data = bytes(store.serialize_cdr(message, PATH_TYPE))
+    definition, _ = store.generate_msgdef(PATH_TYPE, ros_version=2)
+    buffer = io.BytesIO()
+    writer = Writer(buffer)
+    writer.start(profile="ros2", library="tlmpc")
+    schema = writer.register_schema(
+        name=PATH_TYPE, encoding="ros2msg", data=definition.encode("utf-8")
+    )
+    channel = writer.register_channel(topic=topic, message_encoding="cdr", schema_id=schema)
+    log_time = max(0, round(first * 1e9))
+    writer.add_message(channel, log_time=log_time, data=data, publish_time=log_time, sequence=0)
+    writer.finish()  # type: ignore[no-untyped-call]
+    return buffer.getvalue()

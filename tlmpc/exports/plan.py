@@ -1,0 +1,127 @@
+"""The plan to export: the exact trajectory of a compiled mission and its map."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from tlmpc.errors import UsageError, error
+
+FloatArray = npt.NDArray[np.float64]
+Point = tuple[float, float]
+Ring = tuple[Point, ...]
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Plan:
+    """Samples ``[t, x, y]`` of the planned trajectory; ``loop_start`` begins the repeated cycle."""
+
+    samples: FloatArray = field(compare=False)
+    loop_start: int | None
+    name: str
+    boundary: Ring
+    holes: tuple[Ring, ...]
+    regions: dict[str, Ring]
+    formula: str
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Waypoint:
+    """A pose to drive to: position, heading towards the next waypoint, planned time."""
+
+    t: float
+    x: float
+    y: float
+    yaw: float
+
+
+def _fail(code: str, message: str, file: str, hint: str | None = None) -> UsageError:
+    return UsageError(error(code, message, hint=hint, file=file))
+
+
+def _ring(value: Any) -> Ring:
+    return tuple((float(p[0]), float(p[1])) for p in value)
+
+
+def read_plan(directory: Path) -> Plan:
+    """Read ``trace.json`` and ``mission.json`` of a ``tlmpc compile`` output directory."""
+    from tlmpc.artifacts import read_json
+
+    for name in ("trace.json", "mission.json"):
+        if not (directory / name).is_file():
+            raise _fail(
+                "M080",
+                f"{directory} has no {name}",
+                str(directory),
+                hint="run `tlmpc compile MISSION -o DIR` first and export from DIR",
+            )
+    trace = read_json(directory / "trace.json", "tlmpc.trace/")
+    mission = read_json(directory / "mission.json", "tlmpc.mission/")
+    try:
+        samples = np.asarray(trace["points"], dtype=np.float64).reshape(-1, 3)
+        loop = trace.get("loop_start")
+        workspace = mission["workspace"]
+        plan = Plan(
+            samples=samples,
+            loop_start=int(loop) if loop is not None else None,
+            name=str(mission.get("name") or "mission"),
+            boundary=_ring(workspace["boundary"]),
+            holes=tuple(_ring(h) for h in workspace.get("holes") or []),
+            regions={str(k): _ring(v) for k, v in mission["regions"].items()},
+            formula=str(mission.get("formula", "")),
+        )
+    except (KeyError, TypeError, ValueError, IndexError) as exc:
+        raise _fail(
+            "M081", f"the plan in {directory} is malformed: {exc}", str(directory)
+        ) from None
+    if len(plan.samples) == 0 or not np.all(np.isfinite(plan.samples)):
+        raise _fail("M081", f"the trajectory in {directory} is empty or not finite", str(directory))
+    return plan
+
+
+def waypoints(plan: Plan, spacing: float = 0.0) -> tuple[list[Waypoint], int | None]:
+    """Samples at least ``spacing`` apart (the first, the last and the loop start always kept).
+
+    Returns the waypoints and the index of the loop start among them (``None`` when the plan
+    does not loop).  Each heading points to the next waypoint (the last keeps its predecessor's,
+    a looping plan's last points back to the loop start).
+    """
+    samples = plan.samples
+    count = len(samples)
+    keep: list[int] = []
+    for index in range(count):
+        forced = index in (0, count - 1) or index == plan.loop_start
+        if forced or not keep:
+            keep.append(index)
+            continue
+        last = samples[keep[-1]]
+        if math.hypot(samples[index, 1] - last[1], samples[index, 2] - last[2]) >= spacing:
+            keep.append(index)
+    loop = keep.index(plan.loop_start) if plan.loop_start is not None else None
+    result: list[Waypoint] = []
+    for position, index in enumerate(keep):
+        if position + 1 < len(keep):
+            target = samples[keep[position + 1]]
+        elif loop is not None:
+            target = samples[keep[loop]]
+        else:
+            target = samples[index]
+        dx, dy = target[1] - samples[index, 1], target[2] - samples[index, 2]
+        if dx == 0.0 and dy == 0.0:
+            yaw = result[-1].yaw if result else 0.0
+        else:
+            yaw = math.atan2(dy, dx)
+        result.append(
+            Waypoint(
+                t=float(samples[index, 0]),
+                x=float(samples[index, 1]),
+                y=float(samples[index, 2]),
+                yaw=yaw,
+            )
+        )
+    return result, loop

@@ -1,0 +1,390 @@
+"""Robot logs → ``[t, x, y]`` sample arrays for the verifier.
+
+* CSV (``.csv``, ``.tsv``, ``.txt``): ``#`` comment lines and blank lines are skipped; the
+  separator is the first of ``,`` ``;`` tab found on the first data line, else whitespace; a
+  header names the columns (``t``/``time``/``timestamp``/``stamp``, ``x``, ``y``, or names
+  ending in ``.x``/``.y``/``_x``/``_y`` such as ``pose.position.x``), extra columns are
+  ignored; ``columns`` chooses them by name or by 1-based number.  Without a header the file
+  must have exactly three columns ``t, x, y`` unless ``columns`` gives their numbers.
+* ROS 1 ``.bag``, ROS 2 bag directories (sqlite3 or MCAP storage) and ``.mcap`` files, read
+  with the pure-Python ``rosbags``: the pose of ``nav_msgs/Odometry``,
+  ``geometry_msgs/PoseStamped`` or ``geometry_msgs/PoseWithCovarianceStamped`` messages on
+  ``topic`` (needed only when several topics carry poses), stamped with the message header
+  (the log time when the header stamp is zero).  Samples are sorted by time; a repeated
+  stamp keeps its first sample.
+
+An optional rigid ``transform`` ``(x, y, yaw)`` maps the log's frame into the mission's
+(e.g. ``odom`` into ``map``): ``p_mission = R(yaw) p_log + (x, y)``.
+
+This module imports nothing from the planning stages; ``rosbags`` is imported only for bags.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from tlmpc.errors import UsageError, error
+
+FloatArray = npt.NDArray[np.float64]
+
+CSV_SUFFIXES = (".csv", ".tsv", ".txt")
+BAG_SUFFIXES = (".bag", ".mcap", ".db3")
+POSE_TYPES = {
+    "nav_msgs/msg/Odometry": "pose.pose",
+    "geometry_msgs/msg/PoseStamped": "pose",
+    "geometry_msgs/msg/PoseWithCovarianceStamped": "pose.pose",
+}
+TIME_NAMES = ("t", "time", "timestamp", "stamp")
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Log:
+    """Samples ``[t, x, y]`` (bags: sorted by stamp) and where each came from."""
+
+    samples: FloatArray = field(compare=False)
+    lines: tuple[int, ...] = ()  # CSV line of each sample (empty for bags)
+    source: str = ""
+    topic: str | None = None
+
+
+def is_log(path: Path) -> bool:
+    """Whether ``path`` is read by :func:`read_log` (a CSV, a bag file or a bag directory)."""
+    suffix = path.suffix.lower()
+    return suffix in CSV_SUFFIXES or suffix in BAG_SUFFIXES or path.is_dir()
+
+
+def _fail(
+    code: str, message: str, file: str, hint: str | None = None, line: int | None = None
+) -> UsageError:
+    return UsageError(error(code, message, hint=hint, file=file, line=line))
+
+
+def _apply(samples: FloatArray, transform: tuple[float, float, float] | None) -> FloatArray:
+    if transform is None or len(samples) == 0:
+        return samples
+    tx, ty, yaw = transform
+    c, s = math.cos(yaw), math.sin(yaw)
+    out = samples.copy()
+    out[:, 1] = c * samples[:, 1] - s * samples[:, 2] + tx
+    out[:, 2] = s * samples[:, 1] + c * samples[:, 2] + ty
+    return out
+
+
+def read_log(
+    path: Path,
+    *,
+    topic: str | None = None,
+    columns: Sequence[str] | None = None,
+    transform: tuple[float, float, float] | None = None,
+) -> Log:
+    """Read a CSV log or a ROS bag; raise :class:`UsageError` (M050–M079) on bad input."""
+    file = str(path)
+    if not path.exists():
+        raise _fail("M050", f"cannot read {file}: no such file or directory", file)
+    if path.suffix.lower() in CSV_SUFFIXES and not path.is_dir():
+        if topic is not None:
+            raise _fail("M058", "--topic applies to bags, not to CSV logs", file)
+        log = read_csv_log(path, columns)
+    else:
+        if columns is not None:
+            raise _fail("M058", "--columns applies to CSV logs, not to bags", file)
+        log = read_bag(path, topic)
+    if transform is None:
+        return log
+    return Log(
+        samples=_apply(log.samples, transform), lines=log.lines, source=log.source, topic=log.topic
+    )
+
+
+# --- CSV -------------------------------------------------------------------------------------
+
+_SEPARATORS = (",", ";", "\t")
+
+
+def _split(line: str, separator: str | None) -> list[str]:
+    cells = line.split(separator) if separator else line.split()
+    return [c.strip().strip('"').strip("'").strip() for c in cells]
+
+
+def _is_number(cell: str) -> bool:
+    try:
+        float(cell)
+    except ValueError:
+        return False
+    return True
+
+
+def _pick(names: list[str], wanted: str, file: str, line: int) -> int:
+    if wanted.isdigit():
+        index = int(wanted) - 1
+        if not 0 <= index < len(names):
+            raise _fail(
+                "M052",
+                f"column {wanted} does not exist: the log has {len(names)} columns",
+                file,
+                line=line,
+            )
+        return index
+    lowered = [n.lower() for n in names]
+    if wanted.lower() in lowered:
+        return lowered.index(wanted.lower())
+    raise _fail(
+        "M052",
+        f"no column named {wanted!r}; the columns are {', '.join(names) or '(none)'}",
+        file,
+        hint="choose with --columns TIME,X,Y (names or 1-based numbers)",
+        line=line,
+    )
+
+
+def _guess(names: list[str], file: str, line: int) -> tuple[int, int, int]:
+    lowered = [n.lower() for n in names]
+
+    def find(exact: tuple[str, ...], suffixes: tuple[str, ...], what: str) -> int:
+        for name in exact:
+            if name in lowered:
+                return lowered.index(name)
+        hits = [i for i, n in enumerate(lowered) if n.endswith(suffixes)]
+        if len(hits) == 1:
+            return hits[0]
+        found = ", ".join(names)
+        if hits:
+            choices = ", ".join(names[i] for i in hits)
+            message = f"several columns could be {what}: {choices}"
+        else:
+            message = f"no {what} column among: {found}"
+        raise _fail(
+            "M052",
+            message,
+            file,
+            hint="name the columns t (or time), x, y, or choose them with --columns TIME,X,Y",
+            line=line,
+        )
+
+    time_index = find(TIME_NAMES, ("_time", ".time", ".stamp", "_stamp"), "time")
+    x_index = find(("x",), (".x", "_x"), "x")
+    y_index = find(("y",), (".y", "_y"), "y")
+    return time_index, x_index, y_index
+
+
+def parse_columns(text: str) -> tuple[str, str, str]:
+    """``--columns TIME,X,Y``: three names or 1-based numbers."""
+    parts = [p.strip() for p in text.split(",")]
+    if len(parts) != 3 or not all(parts):
+        raise _fail(
+            "M051",
+            f"--columns needs three comma-separated names or numbers, got {text!r}",
+            "<command line>",
+            hint="for example --columns time,pos_x,pos_y or --columns 1,3,4",
+        )
+    return parts[0], parts[1], parts[2]
+
+
+def read_csv_log(path: Path, columns: Sequence[str] | None = None) -> Log:
+    """A CSV/TSV/whitespace log; see the module docstring for the accepted forms."""
+    file = str(path)
+    try:
+        text = path.read_text(encoding="utf-8-sig")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise _fail("M050", f"cannot read {file}: {exc}", file) from None
+    separator: str | None = None
+    indices: tuple[int, int, int] | None = None
+    rows: list[list[float]] = []
+    lines: list[int] = []
+    first = True
+    for number, raw in enumerate(text.splitlines(), start=1):
+        stripped = raw.strip()
+        if not stripped or stripped.startswith("#"):
+            continue
+        if first:
+            separator = next((s for s in _SEPARATORS if s in stripped), None)
+        cells = _split(stripped, separator)
+        if first:
+            first = False
+            header = not all(_is_number(c) for c in cells if c)
+            if header:
+                if columns is not None:
+                    chosen = tuple(_pick(cells, c, file, number) for c in columns)
+                    indices = (chosen[0], chosen[1], chosen[2])
+                else:
+                    indices = _guess(cells, file, number)
+                continue
+            if columns is not None:
+                if not all(c.isdigit() for c in columns):
+                    raise _fail(
+                        "M052",
+                        "the log has no header line, so --columns must give column numbers",
+                        file,
+                        hint="for example --columns 1,2,3",
+                        line=number,
+                    )
+                chosen = tuple(_pick(cells, c, file, number) for c in columns)
+                indices = (chosen[0], chosen[1], chosen[2])
+            elif len(cells) != 3:
+                raise _fail(
+                    "M052",
+                    f"no header line and {len(cells)} columns: cannot tell which are t, x, y",
+                    file,
+                    hint="add a header line naming t (or time), x, y, or pass --columns",
+                    line=number,
+                )
+            else:
+                indices = (0, 1, 2)
+        assert indices is not None
+        if len(cells) <= max(indices):
+            raise _fail(
+                "M053",
+                f"row has {len(cells)} columns, expected at least {max(indices) + 1}",
+                file,
+                line=number,
+            )
+        try:
+            rows.append([float(cells[i]) for i in indices])
+        except ValueError:
+            bad = next(cells[i] for i in indices if not _is_number(cells[i]))
+            raise _fail("M053", f"not a number: {bad!r}", file, line=number) from None
+        lines.append(number)
+    samples = np.asarray(rows, dtype=np.float64).reshape(-1, 3)
+    return Log(samples=samples, lines=tuple(lines), source=file)
+
+
+# --- ROS bags ---------------------------------------------------------------------------------
+
+
+def _bag_paths(path: Path) -> Path:
+    """The path rosbags opens: a ROS 2 ``.db3`` file opens through its bag directory."""
+    if path.suffix.lower() == ".db3" and (path.parent / "metadata.yaml").is_file():
+        return path.parent
+    return path
+
+
+def _listing(connections: Sequence[tuple[str, str, int]]) -> str:
+    return "; ".join(f"{topic} ({kind}, {count} messages)" for topic, kind, count in connections)
+
+
+def read_bag(path: Path, topic: str | None = None) -> Log:
+    """Poses from a ROS 1 bag, a ROS 2 bag directory or an MCAP file."""
+    from rosbags.highlevel import AnyReader
+    from rosbags.typesys import Stores, get_typestore
+
+    file = str(path)
+    try:
+        reader = AnyReader([_bag_paths(path)], default_typestore=get_typestore(Stores.ROS2_HUMBLE))
+        reader.open()
+    except Exception as exc:
+        raise _fail(
+            "M060",
+            f"cannot open the bag: {type(exc).__name__}: {exc}",
+            file,
+            hint="expected a ROS 1 .bag, a ROS 2 bag directory (sqlite3 or MCAP) or a .mcap file",
+        ) from None
+    try:
+        everything = [(c.topic, c.msgtype, c.msgcount) for c in reader.connections]
+        poses = [c for c in reader.connections if c.msgtype in POSE_TYPES]
+        if topic is not None:
+            chosen = [c for c in reader.connections if c.topic == topic]
+            if not chosen:
+                raise _fail(
+                    "M062",
+                    f"the bag has no topic {topic!r}",
+                    file,
+                    hint=f"topics: {_listing(everything) or '(none)'}",
+                )
+            wrong = [c for c in chosen if c.msgtype not in POSE_TYPES]
+            if wrong:
+                listing = _listing([(c.topic, c.msgtype, c.msgcount) for c in poses])
+                raise _fail(
+                    "M063",
+                    f"topic {topic!r} carries {wrong[0].msgtype}, not a pose",
+                    file,
+                    hint="pose topics carry "
+                    + ", ".join(POSE_TYPES)
+                    + (f"; this bag has {listing}" if poses else ""),
+                )
+        else:
+            topics = sorted({c.topic for c in poses})
+            if not topics:
+                raise _fail(
+                    "M061",
+                    "the bag has no pose topic (nav_msgs/Odometry, geometry_msgs/PoseStamped "
+                    "or PoseWithCovarianceStamped)",
+                    file,
+                    hint=f"topics: {_listing(everything) or '(none)'}",
+                )
+            if len(topics) > 1:
+                listing = _listing([(c.topic, c.msgtype, c.msgcount) for c in poses])
+                raise _fail(
+                    "M064",
+                    f"the bag has {len(topics)} pose topics; choose one with --topic",
+                    file,
+                    hint=listing,
+                )
+            chosen = [c for c in poses if c.topic == topics[0]]
+            topic = topics[0]
+        rows: list[tuple[int, float, float]] = []
+        try:
+            for connection, log_time, raw in reader.messages(connections=chosen):
+                message: Any = reader.deserialize(raw, connection.msgtype)
+                pose: Any = message
+                for part in POSE_TYPES[connection.msgtype].split("."):
+                    pose = getattr(pose, part)
+                stamp = message.header.stamp
+                nanoseconds = int(stamp.sec) * 1_000_000_000 + int(stamp.nanosec)
+                rows.append(
+                    (
+                        nanoseconds if nanoseconds else int(log_time),
+                        float(pose.position.x),
+                        float(pose.position.y),
+                    )
+                )
+        except UsageError:
+            raise
+        except Exception as exc:
+            raise _fail(
+                "M065", f"cannot read the bag's messages: {type(exc).__name__}: {exc}", file
+            ) from None
+    finally:
+        reader.close()
+    return Log(samples=_sorted_samples(rows), source=file, topic=topic)
+
+
+def _sorted_samples(rows: list[tuple[int, float, float]]) -> FloatArray:
+    """Sorted by integer nanoseconds (exact), first of a repeated stamp kept, then seconds."""
+    rows.sort(key=lambda r: r[0])
+    kept: list[tuple[int, float, float]] = []
+    for row in rows:
+        if not kept or row[0] != kept[-1][0]:
+            kept.append(row)
+    samples = np.empty((len(kept), 3), dtype=np.float64)
+    for i, (ns, x, y) in enumerate(kept):
+        samples[i] = (ns / 1e9, x, y)
+    return samples
+
+
+_TRANSFORM = re.compile(r"^\s*(\S+)\s*,\s*(\S+)\s*,\s*(\S+)\s*$")
+
+
+def parse_transform(text: str) -> tuple[float, float, float]:
+    """``--transform X,Y,YAW`` (yaw in radians)."""
+    match = _TRANSFORM.match(text)
+    try:
+        if match is None:
+            raise ValueError
+        values = tuple(float(v) for v in match.groups())
+        if not all(math.isfinite(v) for v in values):
+            raise ValueError
+    except ValueError:
+        raise _fail(
+            "M051",
+            f"--transform needs X,Y,YAW (numbers, yaw in radians), got {text!r}",
+            "<command line>",
+        ) from None
+    return values[0], values[1], values[2]

@@ -1,0 +1,286 @@
+"""Occupancy-grid maps and nav2 keepout / speed masks → a polygonal workspace and regions.
+
+* Free space is the cells of value 0 (unknown space is *not* free), as the exact union of their
+  squares (:mod:`tlmpc.importers.polygonize`).
+* ``radius`` erodes free space by the robot's radius (configuration space of a disc robot).
+* The workspace is the free piece containing ``start`` (else the largest); its outer ring is
+  the boundary, its inner rings the holes; holes smaller than ``min_area`` are filled (specks).
+* Rings are simplified within ``tolerance`` (default: one cell), never moving the boundary by
+  more than that.
+* A keepout mask's occupied cells (value 100) and a speed mask's limited cells (values 1..100)
+  become regions ``keepout_1``, ``keepout_2``, ... and ``speed_<value>_<k>``, with groups
+  ``keepout`` and ``speed_<value>`` naming all the pieces.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+import shapely
+from shapely.geometry import Point as ShapelyPoint
+from shapely.geometry import Polygon
+from shapely.geometry.base import BaseGeometry
+
+from tlmpc.errors import UsageError, error
+from tlmpc.importers.occupancy import FREE, OCCUPIED, OccupancyGrid, read_map
+from tlmpc.importers.polygonize import (
+    cells_to_geometry,
+    drop_small_holes,
+    erode,
+    polygons,
+    to_world,
+)
+
+Point = tuple[float, float]
+Ring = tuple[Point, ...]
+
+#: Default speck threshold, in cells: obstacle specks and region pieces smaller are dropped.
+DEFAULT_MIN_CELLS = 4.0
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ImportSettings:
+    """How a map becomes polygons (every length in map units, metres for ROS maps)."""
+
+    radius: float = 0.0
+    tolerance: float | None = None  # default: one cell
+    min_area: float | None = None  # default: DEFAULT_MIN_CELLS cells
+    start: Point | None = None
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class ImportedMap:
+    """A workspace and regions read from a map and its masks."""
+
+    boundary: Ring
+    holes: tuple[Ring, ...]
+    regions: Mapping[str, Ring]
+    groups: Mapping[str, tuple[str, ...]]
+    free_cells_area: float
+    workspace_area: float
+    resolution: float
+    tolerance: float
+    source: str
+    speckles_dropped: int = 0
+
+
+def _ring(polygon_ring: Any) -> Ring:
+    coords = list(polygon_ring.coords)[:-1]
+    return tuple((float(x), float(y)) for x, y in coords)
+
+
+def _fail(code: str, message: str, file: str, hint: str | None = None) -> UsageError:
+    return UsageError(error(code, message, hint=hint, file=file))
+
+
+def free_geometry(grid: OccupancyGrid) -> BaseGeometry:
+    """World-coordinate free space (cells of value 0) of a grid."""
+    return to_world(cells_to_geometry(grid.values == FREE), grid.resolution, grid.origin)
+
+
+def _to_grid(grid: OccupancyGrid, point: Point) -> Point:
+    """World coordinates to grid coordinates (cells, y up): the inverse of ``to_world``."""
+    ox, oy, yaw = grid.origin
+    dx, dy = point[0] - ox, point[1] - oy
+    c, s = math.cos(yaw), math.sin(yaw)
+    return (c * dx + s * dy) / grid.resolution, (-s * dx + c * dy) / grid.resolution
+
+
+def _free_piece(grid: OccupancyGrid, radius: float, start: Point | None) -> Polygon:
+    """The eroded free piece containing ``start`` (else the largest), in grid units."""
+    free = erode(cells_to_geometry(grid.values == FREE), radius / grid.resolution)
+    pieces = polygons(free)
+    if not pieces:
+        raise _fail(
+            "M010",
+            "the map has no free space"
+            + (f" left after eroding by the radius {radius:g}" if radius else ""),
+            grid.source,
+            hint="free cells are those with occupancy below free_thresh; "
+            "check negate, the thresholds and the radius",
+        )
+    if start is not None:
+        point = ShapelyPoint(_to_grid(grid, start))
+        chosen = next((p for p in pieces if p.covers(point)), None)
+        if chosen is not None:
+            return chosen
+    return max(pieces, key=lambda p: p.area)
+
+
+def _labels(grid: OccupancyGrid, masks: list[npt.NDArray[np.int16]]) -> npt.NDArray[np.int64]:
+    """One label per distinct combination of mask values (0 where no mask applies)."""
+    if not masks:
+        return np.zeros(grid.shape, dtype=np.int64)
+    stacked = np.stack([m.astype(np.int64) + 1 for m in masks], axis=-1)  # -1..100 -> 0..101
+    codes = np.zeros(grid.shape, dtype=np.int64)
+    for layer in range(stacked.shape[-1]):
+        codes = codes * 102 + stacked[..., layer]
+    _, inverse = np.unique(codes, return_inverse=True)
+    return inverse.reshape(grid.shape).astype(np.int64)
+
+
+def _faces(linework: BaseGeometry) -> list[Polygon]:
+    parts = getattr(linework, "geoms", None)
+    lines = list(parts) if parts is not None else [linework]
+    return polygons(shapely.polygonize(lines))
+
+
+def _coverage(
+    workspace: Polygon, labels: npt.NDArray[np.int64], tolerance: float
+) -> tuple[Polygon, dict[int, list[BaseGeometry]]]:
+    """The workspace cut by the label cells, simplified as one coverage (shared edges shared).
+
+    Simplifying the workspace and each mask piece on its own would leave region edges running
+    beside walls a fraction of a cell away, or crossing them at tiny angles: slivers that
+    explode a quality mesh.  Instead the workspace's rings and the label boundaries inside it
+    are noded into one linework, merged into chains between junctions, and the chains are
+    simplified together by Douglas-Peucker with topology preserved (junctions stay, no chain
+    crosses another): every edge moves once for all the faces that share it, by at most
+    ``tolerance``.  The faces are then polygonized and matched to the exact faces by overlap.
+    """
+    present = [int(v) for v in np.unique(labels)]
+    lines: list[BaseGeometry] = [workspace.boundary]
+    if len(present) > 1:
+        # Label edges are clipped to a cell beyond the workspace, not to the workspace itself:
+        # a clipped end computed in floating point would stop a hair short of the wall and be
+        # dropped by polygonize as a dangle; crossing the wall, the noding splits it exactly.
+        reach = workspace.buffer(1.0, quad_segs=2)
+        for label in present:
+            edges = cells_to_geometry(labels == label).boundary
+            lines.append(shapely.intersection(edges, reach))
+    noded = shapely.line_merge(shapely.union_all(lines))
+    exact: list[Polygon] = []
+    exact_labels: list[int | None] = []
+    rows, cols = labels.shape
+    for face in _faces(noded):
+        inside = face.representative_point()
+        exact.append(face)
+        if workspace.covers(inside):
+            row = min(max(math.floor(inside.y), 0), rows - 1)
+            col = min(max(math.floor(inside.x), 0), cols - 1)
+            exact_labels.append(int(labels[row, col]))
+        else:
+            exact_labels.append(None)  # the inside of a hole
+    faces, face_labels = exact, exact_labels
+    if tolerance > 0:
+        simple = _faces(noded.simplify(tolerance, preserve_topology=True))
+        tree = shapely.STRtree(exact)
+        matched: list[int | None] = []
+        for face in simple:
+            candidates = tree.query(face)
+            overlaps = [face.intersection(exact[int(k)]).area for k in candidates]
+            best = int(candidates[int(np.argmax(overlaps))]) if len(candidates) else -1
+            matched.append(exact_labels[best] if best >= 0 and max(overlaps) > 0 else None)
+        kept_area = sum(f.area for f, lab in zip(simple, matched, strict=True) if lab is not None)
+        # Each edge moved by at most the tolerance, so the area cannot change by more than
+        # tolerance x total edge length; more means the simplified linework lost a junction.
+        if abs(kept_area - workspace.area) <= tolerance * workspace.length + 1e-9:
+            faces, face_labels = simple, matched
+    kept = [f for f, lab in zip(faces, face_labels, strict=True) if lab is not None]
+    merged = polygons(shapely.union_all(kept))
+    if not merged:
+        raise _fail("M011", "the free space vanishes when simplified", "")
+    union = max(merged, key=lambda p: p.area)
+    by_label: dict[int, list[BaseGeometry]] = {}
+    for face, face_label in zip(faces, face_labels, strict=True):
+        if face_label is not None:
+            by_label.setdefault(face_label, []).append(face)
+    return union, by_label
+
+
+def _exact_free(grid: OccupancyGrid, settings: ImportSettings, min_area_cells: float) -> Polygon:
+    piece = _free_piece(grid, settings.radius, settings.start)
+    return drop_small_holes(piece, min_area_cells)
+
+
+def import_map(
+    map_path: Path,
+    settings: ImportSettings = ImportSettings(),
+    *,
+    keepout: Path | None = None,
+    speed: Path | None = None,
+) -> ImportedMap:
+    """Read a map (and masks) and build the workspace and regions."""
+    grid = read_map(map_path)
+    if settings.radius < 0:
+        raise _fail(
+            "M012", f"the radius must not be negative, got {settings.radius:g}", str(map_path)
+        )
+    tolerance = grid.resolution if settings.tolerance is None else settings.tolerance
+    min_area = (
+        DEFAULT_MIN_CELLS * grid.cell_area() if settings.min_area is None else settings.min_area
+    )
+    if tolerance < 0 or min_area < 0:
+        raise _fail("M012", "tolerance and min_area must not be negative", str(map_path))
+    cell_area = grid.cell_area()
+    exact = _exact_free(grid, settings, min_area / cell_area)
+    mask_grids: list[tuple[str, Path, OccupancyGrid]] = []
+    for prefix, path in (("keepout", keepout), ("speed", speed)):
+        if path is None:
+            continue
+        mask = read_map(path)
+        if mask.shape != grid.shape or mask.resolution != grid.resolution:
+            raise _fail(
+                "M013",
+                f"the mask is {mask.shape[1]}x{mask.shape[0]} cells at {mask.resolution:g}, "
+                f"the map {grid.shape[1]}x{grid.shape[0]} at {grid.resolution:g}",
+                str(path),
+                hint="a mask must have the map's size, resolution and origin",
+            )
+        mask_grids.append((prefix, path, mask))
+    layers = [m.values for _, _, m in mask_grids]
+    labels = _labels(grid, layers)
+    union, pieces = _coverage(exact, labels, tolerance / grid.resolution)
+    workspace_cells = drop_small_holes(union, min_area / cell_area)
+    dropped = len(union.interiors) - len(workspace_cells.interiors)
+    outer_cells = Polygon(workspace_cells.exterior)
+    regions: dict[str, Ring] = {}
+    groups: dict[str, tuple[str, ...]] = {}
+    for prefix, _, mask in mask_grids:
+        if prefix == "keepout":
+            wanted = [OCCUPIED]
+        else:
+            wanted = sorted({int(v) for v in np.unique(mask.values) if 0 < v <= OCCUPIED})
+        for value in wanted:
+            group = prefix if prefix == "keepout" else f"{prefix}_{value}"
+            members = [
+                piece
+                for label, faces in pieces.items()
+                if np.any(mask.values[labels == label] == value)
+                for piece in faces
+            ]
+            if not members:
+                continue
+            merged = polygons(shapely.union_all(members))
+            outers = [
+                Polygon(p.exterior)
+                for p in merged
+                if p.area >= min_area / cell_area and outer_cells.covers(p)
+            ]
+            outers = [to_world(p, grid.resolution, grid.origin) for p in outers]
+            outers.sort(key=lambda p: (-p.area, p.bounds))
+            if outers:
+                names = {f"{group}_{k}": _ring(p.exterior) for k, p in enumerate(outers, 1)}
+                regions.update(names)
+                groups[group] = tuple(names)
+    workspace = to_world(workspace_cells, grid.resolution, grid.origin)
+    assert isinstance(workspace, Polygon)
+    free_cells = float(np.count_nonzero(grid.values == FREE)) * grid.cell_area()
+    return ImportedMap(
+        boundary=_ring(workspace.exterior),
+        holes=tuple(_ring(r) for r in workspace.interiors),
+        regions=regions,
+        groups=groups,
+        free_cells_area=free_cells,
+        workspace_area=float(workspace.area),
+        resolution=grid.resolution,
+        tolerance=tolerance,
+        source=str(map_path),
+        speckles_dropped=dropped,
+    )

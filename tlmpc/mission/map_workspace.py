@@ -1,0 +1,123 @@
+"""``workspace: {map: FILE.yaml, ...}``: a mission's workspace taken from an occupancy-grid map.
+
+The map (and its optional ``keepout`` / ``speed`` masks) is read by :mod:`tlmpc.importers`,
+only when a mission uses this form, so plain missions never load an image library.  Paths
+are relative to the mission file.  Imported mask regions and groups join the mission's own.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path as FilePath
+from typing import Any
+
+from shapely.geometry import Polygon as ShapelyPolygon
+
+from tlmpc.errors import Diagnostic, TlmpcError, error
+from tlmpc.mission.geometry import CheckedShape, check_shape
+from tlmpc.mission.yamlpos import PositionedDocument
+
+
+def _resolve(mission_file: str, value: str) -> FilePath:
+    path = FilePath(value)
+    if path.is_absolute():
+        return path
+    return FilePath(mission_file).parent / path
+
+
+def map_shapes(
+    data: dict[str, Any], doc: PositionedDocument, file: str
+) -> tuple[CheckedShape | None, list[CheckedShape], dict[str, CheckedShape], list[Diagnostic]]:
+    """The boundary, holes and regions (imported first, then the mission's own)."""
+    from tlmpc.importers.maps import ImportSettings, import_map
+
+    workspace: dict[str, Any] = data["workspace"]
+    where = ("workspace", "map")
+    line, col = doc.value_at(where)
+    if "boundary" in workspace or "holes" in workspace:
+        key = "boundary" if "boundary" in workspace else "holes"
+        kline, kcol = doc.key_at(("workspace", key))
+        return (
+            None,
+            [],
+            {},
+            [
+                error(
+                    "M014",
+                    f"workspace.{key} cannot be combined with workspace.map",
+                    hint="the map gives the boundary and holes; remove one of the two",
+                    file=file,
+                    line=kline,
+                    col=kcol,
+                )
+            ],
+        )
+    start = data["robot"]["start"]
+    settings = ImportSettings(
+        radius=float(workspace.get("inflate", 0.0)),
+        tolerance=workspace.get("tolerance"),
+        min_area=workspace.get("min_area"),
+        start=(float(start[0]), float(start[1])),
+    )
+    masks = {
+        key: _resolve(file, workspace[key]) for key in ("keepout", "speed") if key in workspace
+    }
+    try:
+        imported = import_map(
+            _resolve(file, workspace["map"]),
+            settings,
+            keepout=masks.get("keepout"),
+            speed=masks.get("speed"),
+        )
+    except TlmpcError as exc:
+        return (
+            None,
+            [],
+            {},
+            [
+                error(
+                    d.code,
+                    f"{d.file}: {d.message}" if d.file and d.file != file else d.message,
+                    hint=d.hint,
+                    file=file,
+                    line=line,
+                    col=col,
+                    path="$.workspace.map",
+                )
+                for d in exc.diagnostics
+            ],
+        )
+    problems: list[Diagnostic] = []
+
+    def shape(points: tuple[tuple[float, float], ...]) -> CheckedShape:
+        return CheckedShape(points=points, polygon=ShapelyPolygon(points), path=where)
+
+    boundary = shape(imported.boundary)
+    holes = [shape(h) for h in imported.holes]
+    regions = {name: shape(points) for name, points in imported.regions.items()}
+    user_groups: dict[str, Any] = dict(data.get("groups") or {})
+    for name in list(data["regions"]) + list(user_groups):
+        if name in regions or name in imported.groups:
+            kline, kcol = doc.key_at(
+                ("regions", name) if name in data["regions"] else ("groups", name)
+            )
+            problems.append(
+                error(
+                    "M015",
+                    f"{name!r} is also the name of a region or group imported from a mask",
+                    hint="imported names are keepout, keepout_K, speed_V and speed_V_K; "
+                    "rename yours",
+                    file=file,
+                    line=kline,
+                    col=kcol,
+                )
+            )
+    for name, value in data["regions"].items():
+        checked, found = check_shape(
+            value, ("regions", name), f"region {name!r}", file, doc.value_at
+        )
+        problems.extend(found)
+        if checked is not None:
+            regions[name] = checked
+    if not problems:
+        data["groups"] = {**{g: list(m) for g, m in imported.groups.items()}, **user_groups}
+    return boundary, holes, regions, problems
