@@ -45,6 +45,7 @@ class Compilation:
     trace_document: Mapping[str, Any] | None = None
     verdict: Verdict | None = None
     documents: Mapping[str, Any] = field(default_factory=dict)  # artifacts written so far
+    figures: tuple[str, ...] = ("svg",)  # which plan pictures the plot stage draws
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -207,13 +208,18 @@ def _verify(c: Compilation) -> StageResult:
 def _plot(c: Compilation) -> StageResult:
     # Drawn from the artifacts themselves (the same code as `tlmpc plot`), so the picture
     # always shows what was written.
-    from tlmpc.plot import render_plan
+    # plan.svg is written directly (cheap); plan.png needs matplotlib, so only on request.
+    from tlmpc.plot import render_png, render_svg
 
-    png, svg = render_plan(c.documents)
+    pictures: dict[str, bytes] = {}
+    if "svg" in c.figures:
+        pictures["plan.svg"] = render_svg(c.documents)
+    if "png" in c.figures:
+        pictures["plan.png"] = render_png(c.documents)
     return StageResult(
         compilation=c,
-        artifacts={"plan.png": png, "plan.svg": svg},
-        sizes={"png bytes": len(png), "svg bytes": len(svg)},
+        artifacts=pictures,
+        sizes={f"{name[5:]} bytes": len(data) for name, data in pictures.items()},
     )
 
 
@@ -329,14 +335,16 @@ def compile_mission(
     *,
     until: str | None = None,
     progress: ProgressFn | None = None,
+    figures: tuple[str, ...] = ("svg",),
 ) -> CompileResult:
     """Run the stages of :data:`STAGES` (up to ``until``) on the mission file ``source``.
 
-    Raises the stage's :class:`~tlmpc.errors.TlmpcError` when one fails; nothing is written
-    here (the CLI writes the returned artifacts atomically).
+    ``figures`` names the pictures the plot stage draws (``"svg"``, ``"png"``).  Raises the
+    stage's :class:`~tlmpc.errors.TlmpcError` when one fails; nothing is written here (the
+    CLI writes the returned artifacts atomically).
     """
     stages = stages_until(until)
-    compilation = Compilation(source=Path(source))
+    compilation = Compilation(source=Path(source), figures=figures)
     artifacts: dict[str, Any] = {}
     reports: list[StageReport] = []
     warnings: list[Diagnostic] = []

@@ -13,7 +13,8 @@ DESCRIPTION = """\
 Lower MISSION through every stage (load, abstraction, automaton, plan, control, simulate,
 verify, plot) and write the artifacts into OUT: mission.json, abstraction.json,
 automaton.json, automaton.hoa, witness.json, controllers.json, trace.json, verdict.json,
-summary.json, plan.png and plan.svg.  Output is atomic: a failed run leaves OUT untouched."""
+summary.json and the picture plan.svg (plus plan.png with --png).  Output is atomic: a
+failed run leaves OUT untouched."""
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -34,6 +35,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--force",
         action="store_true",
         help="write into OUT even if it is a non-empty directory that tlmpc did not create",
+    )
+    parser.add_argument(
+        "--png",
+        action="store_true",
+        help="also draw plan.png with matplotlib (slower; plan.svg is always written)",
     )
     parser.add_argument("--json", action="store_true", help="print summary.json on stdout")
     parser.add_argument("-q", "--quiet", action="store_true", help="no progress lines")
@@ -64,7 +70,12 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     # One pause for compiling and writing: re-enabling in between would trigger a full
     # collection over everything the compilation still holds.
     with collector_paused():
-        result = compile_mission(args.mission, until=args.until, progress=progress)
+        result = compile_mission(
+            args.mission,
+            until=args.until,
+            progress=progress,
+            figures=("svg", "png") if args.png else ("svg",),
+        )
         for warning in result.warnings:
             err.write(warning.format() + "\n")
         with staging_directory(destination) as staging:
