@@ -6,7 +6,6 @@ import argparse
 import io
 import itertools
 import json
-import time
 from pathlib import Path
 
 import pytest
@@ -146,12 +145,12 @@ def test_bad_hoa_gives_b_codes(text: str) -> None:
 
 
 @pytest.mark.parametrize(("name", "spin_states", "text"), benchmark())
-def test_benchmark_sizes_and_speed(name: str, spin_states: int | None, text: str) -> None:
+def test_benchmark_sizes(name: str, spin_states: int | None, text: str) -> None:
+    # Sizes only: speed is shown by bench/bench_automata.py, never asserted here (the suite
+    # must pass on a loaded machine).
     formula = parse_ltl(text)
-    started = time.perf_counter()
     tgba = translate(formula)
     ba = degeneralize(tgba)
-    elapsed = time.perf_counter() - started
     if spin_states is not None:
         assert ba.num_states <= spin_states, (name, ba.num_states, spin_states)
     if name.startswith("patrol"):
@@ -160,8 +159,6 @@ def test_benchmark_sizes_and_speed(name: str, spin_states: int | None, text: str
         assert tgba.num_states == 2 ** int(name[5:])
     if name == "paper-fkp05":
         assert ba.num_states <= 5
-    if not name.startswith(("cover7", "cover8")):
-        assert elapsed < 1.0, (name, elapsed)  # 100 ms target, generous for loaded CI machines
 
 
 def test_successor_table() -> None:
