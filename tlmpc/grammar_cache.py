@@ -44,8 +44,6 @@ def lalr_parser(grammar: str, **options: Any) -> Any:
     directory = cache_directory()
     if directory is None:
         return Lark(grammar, parser="lalr", **options)
-    key = "\0".join(
-        [grammar, repr(sorted(options.items())), lark_version, sys.version.split()[0]]
-    )
+    key = "\0".join([grammar, repr(sorted(options.items())), lark_version, sys.version.split()[0]])
     digest = hashlib.sha256(key.encode("utf-8")).hexdigest()[:24]
     return Lark(grammar, parser="lalr", cache=str(directory / f"lark-{digest}.cache"), **options)

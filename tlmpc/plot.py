@@ -266,6 +266,12 @@ def draw_scene(axes: Any, scene: Scene) -> list[Any]:
     axes.set_aspect("equal")
     axes.tick_params(labelsize=7)
     axes.set_title(scene.title, fontsize=9)
+    if scene.regions_omitted:
+        handles.append(
+            Line2D(
+                [], [], linestyle="none", label=f"{scene.regions_omitted:,} other regions not drawn"
+            )
+        )
     if scene.mesh_omitted:
         handles.append(
             Line2D(

@@ -41,6 +41,8 @@ REGION_COLOURS = (
 MAX_REGION_NAMES = 60
 #: A denser mesh (inside the view) is a grey blur at any printable size.
 MAX_MESH_TRIANGLES = 20_000
+#: Beyond this many regions in the view only the task's are drawn (the rest is a blur).
+MAX_DRAWN_REGIONS = 20_000
 
 #: Viridis at eleven evenly spaced stops (matplotlib's table), for the arc-length colouring.
 _VIRIDIS = (
@@ -76,7 +78,7 @@ class Region:
     colour: str
     named_by_task: bool
     labelled: bool
-    label_at: Point
+    label_at: Point  # where the name goes (when labelled)
 
 
 @dataclass(frozen=True, slots=True)
@@ -109,6 +111,7 @@ class Scene:
     emphasise_task_regions: bool
     mesh_edges: FloatArray = field(compare=False)  # rows x0, y0, x1, y1
     mesh_omitted: int  # triangles in the view not drawn (mesh too dense), 0 when drawn
+    regions_omitted: int  # regions in the view not drawn (too many), 0 when all are
     plan_prefix: tuple[Point, ...]
     plan_cycle: tuple[Point, ...]
     plan_stays: bool
@@ -156,14 +159,20 @@ def _bbox(points: Sequence[Point]) -> tuple[float, float, float, float]:
 
 
 def _mesh(
-    abstraction: Mapping[str, Any], view: tuple[float, float, float, float]
+    abstraction: Mapping[str, Any],
+    view: tuple[float, float, float, float],
+    *,
+    view_is_whole_map: bool,
 ) -> tuple[FloatArray, int]:
     """The mesh's unique edges inside ``view`` as rows ``x0, y0, x1, y1`` (and 0), or no
     edges and the number of triangles in the view when there are too many to draw."""
     import numpy as np
 
     empty = np.zeros((0, 4))
-    triangles = np.asarray(abstraction["triangles"], dtype=np.int64).reshape(-1, 3)
+    listed = abstraction["triangles"]
+    if len(listed) > MAX_MESH_TRIANGLES and view_is_whole_map:
+        return empty, len(listed)  # not even converted: a million triangles cost a second
+    triangles = np.asarray(listed, dtype=np.int64).reshape(-1, 3)
     if len(triangles) == 0:
         return empty, 0
     vertices = np.asarray(abstraction["vertices"], dtype=np.float64).reshape(-1, 2)
@@ -260,21 +269,26 @@ def build_scene(
     regions = []
     for index, (name, points) in enumerate(sorted(mission["regions"].items())):
         polygon = _polygon(points)
+        labelled = not many or name in named
         regions.append(
             Region(
                 name=name,
                 polygon=polygon,
                 colour=REGION_COLOURS[index % len(REGION_COLOURS)],
                 named_by_task=name in named,
-                labelled=not many or name in named,
-                label_at=_label_point(polygon),
+                labelled=labelled,
+                label_at=_label_point(polygon) if labelled else polygon[0],
             )
         )
     visible_regions = tuple(r for r in regions if _inside_view(_bbox(r.polygon), view))
+    regions_omitted = 0
+    if len(visible_regions) > MAX_DRAWN_REGIONS:
+        regions_omitted = sum(1 for r in visible_regions if not r.named_by_task)
+        visible_regions = tuple(r for r in visible_regions if r.named_by_task)
 
     abstraction = artifacts.get("abstraction.json")
     if abstraction is not None:
-        mesh_edges, omitted = _mesh(abstraction, view)
+        mesh_edges, omitted = _mesh(abstraction, view, view_is_whole_map=zoom is None)
     else:
         import numpy as np
 
@@ -304,6 +318,7 @@ def build_scene(
         emphasise_task_regions=many,
         mesh_edges=mesh_edges,
         mesh_omitted=omitted,
+        regions_omitted=regions_omitted,
         plan_prefix=prefix,
         plan_cycle=cycle,
         plan_stays=stays,

@@ -211,6 +211,12 @@ def _legend(scene: Scene, x: float, y: float) -> tuple[list[str], float]:
             f"{scene.trajectory.length:.4g}</text>"
         )
         row += 6
+    if scene.regions_omitted:
+        row += 12
+        out.append(
+            f'<text x="{_fmt(x)}" y="{_fmt(row)}" font-size="9">{scene.regions_omitted:,} '
+            "other regions not drawn</text>"
+        )
     if scene.mesh_omitted:
         row += 12
         out.append(

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import gc
 import json
 from pathlib import Path
 from typing import TextIO
@@ -84,6 +85,10 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             artifacts["summary.json"] = summary
             write_artifacts(staging, artifacts)
             commit(staging, destination, force=args.force)
+        # The process ends soon: hand everything allocated so far to the permanent
+        # generation, so that re-enabling the collector does not walk it all once more
+        # (a tenth of Example 8's compile; seconds on a million triangles).
+        gc.freeze()
 
     if args.json:
         out.write(json.dumps(summary, indent=2, sort_keys=True) + "\n")
