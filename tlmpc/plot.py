@@ -249,18 +249,23 @@ def draw_scene(axes: Any, scene: Scene) -> list[Any]:
                 label=f"violation {number}: {violation.message[:60]}",
             )
         )
+    x0, y0, x1, y1 = scene.view
     for region in scene.regions:
         if region.labelled:
+            xs = [p[0] for p in region.polygon]
+            ys = [p[1] for p in region.polygon]
+            # A region narrower than its name gets the name just above it, not over it.
+            small = max(xs) - min(xs) < 0.012 * len(region.name) * (x1 - x0)
             axes.text(
-                *region.label_at,
+                region.label_at[0],
+                max(ys) if small else region.label_at[1],
                 region.name,
                 ha="center",
-                va="center",
+                va="bottom" if small else "center",
                 fontsize=7,
                 zorder=6,
                 bbox={"boxstyle": "round,pad=0.1", "fc": "white", "alpha": 0.6, "lw": 0},
             )
-    x0, y0, x1, y1 = scene.view
     axes.set_xlim(x0, x1)
     axes.set_ylim(y0, y1)
     axes.set_aspect("equal")
