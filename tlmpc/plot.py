@@ -60,14 +60,14 @@ def render_png(
         map_width = 7.0 / aspect
     legend_width = 2.6
     figure_width = map_width + legend_width + 0.9
-    figure_height = max(map_height + 0.9, 3.2)
+    figure_height = max(map_height + 0.9, 2.8)  # room for the legend beside a wide map
     with rc_context({"path.simplify": False}):
         figure = Figure(figsize=(figure_width, figure_height), dpi=150)
         FigureCanvasAgg(figure)
         axes = figure.add_axes(
             (
                 0.6 / figure_width,
-                0.45 / figure_height,
+                (figure_height - 0.45 - map_height) / figure_height,  # top-aligned
                 map_width / figure_width,
                 map_height / figure_height,
             )
@@ -82,7 +82,9 @@ def render_png(
             frameon=False,
         )
         if scene.trajectory is not None:
-            _colour_scale(figure, scene, legend_left, figure_width, figure_height)
+            # Just under the legend (about 0.19 inch per entry at this font size).
+            bar_bottom = max(figure_height - 0.35 - 0.19 * len(handles) - 0.6, 0.35)
+            _colour_scale(figure, scene, legend_left, figure_width, figure_height, bar_bottom)
         png = io.BytesIO()
         figure.savefig(
             png, format="png", metadata={"Software": None}, pil_kwargs={"compress_level": 3}
@@ -91,14 +93,24 @@ def render_png(
 
 
 def _colour_scale(
-    figure: Any, scene: Scene, left: float, figure_width: float, figure_height: float
+    figure: Any,
+    scene: Scene,
+    left: float,
+    figure_width: float,
+    figure_height: float,
+    bottom: float,
 ) -> None:
     """A small horizontal colour bar under the legend: 0 to the path's length."""
     from matplotlib.colors import LinearSegmentedColormap
 
     assert scene.trajectory is not None
     bar = figure.add_axes(
-        (left + 0.05 / figure_width, 0.5 / figure_height, 1.6 / figure_width, 0.12 / figure_height)
+        (
+            left + 0.05 / figure_width,
+            bottom / figure_height,
+            1.6 / figure_width,
+            0.12 / figure_height,
+        )
     )
     cmap = LinearSegmentedColormap.from_list("arc", [viridis(i / 10) for i in range(11)])
     bar.imshow([[i / 255 for i in range(256)]], aspect="auto", cmap=cmap, extent=(0, 1, 0, 1))
