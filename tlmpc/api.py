@@ -112,10 +112,9 @@ class Compiled:
     def svg(self) -> str:
         """The plan figure as SVG text (drawn on first use)."""
         if "svg" not in self._figure:
-            from tlmpc.plot import render_plan
+            from tlmpc.plot import render_svg
 
-            _, svg = render_plan(self.artifacts)
-            self._figure["svg"] = svg.decode("utf-8")
+            self._figure["svg"] = render_svg(self.artifacts).decode("utf-8")
         return self._figure["svg"]
 
     def _repr_svg_(self) -> str | None:

@@ -117,6 +117,7 @@ class Compilation:
     text: str | None = None
     products: Mapping[Product[Any], Any] = field(default_factory=dict)
     documents: Mapping[str, Any] = field(default_factory=dict)  # artifacts written so far
+    figures: tuple[str, ...] = ("svg",)  # which plan pictures the plot stage draws
 
     def get(self, product: Product[T]) -> T:
         """The IR of ``product``; a stage only asks for what its ``requires`` declares."""
@@ -321,12 +322,17 @@ def _verify(c: Compilation) -> StageResult:
 def _plot(c: Compilation) -> StageResult:
     # Drawn from the artifacts themselves (the same code as `tlmpc plot`), so the picture
     # always shows what was written.
-    from tlmpc.plot import render_plan
+    # plan.svg is written directly (cheap); plan.png needs matplotlib, so only on request.
+    from tlmpc.plot import render_png, render_svg
 
-    png, svg = render_plan(c.documents)
+    pictures: dict[str, bytes] = {}
+    if "svg" in c.figures:
+        pictures["plan.svg"] = render_svg(c.documents)
+    if "png" in c.figures:
+        pictures["plan.png"] = render_png(c.documents)
     return StageResult(
-        artifacts={"plan.png": png, "plan.svg": svg},
-        sizes={"png bytes": len(png), "svg bytes": len(svg)},
+        artifacts=pictures,
+        sizes={f"{name[5:]} bytes": len(data) for name, data in pictures.items()},
     )
 
 
@@ -509,14 +515,16 @@ def compile_mission(
     text: str | None = None,
     until: str | None = None,
     progress: ProgressFn | None = None,
+    figures: tuple[str, ...] = ("svg",),
 ) -> CompileResult:
     """Run the stages of :data:`STAGES` (up to ``until``) on the mission file ``source``.
 
     With ``text``, the mission is that YAML text and ``source`` only names it in diagnostics.
-    Raises the stage's :class:`~tlmpc.errors.TlmpcError` when one fails; nothing is written
-    here (the CLI writes the returned artifacts atomically).
+    ``figures`` names the pictures the plot stage draws (``"svg"``, ``"png"``).  Raises the
+    stage's :class:`~tlmpc.errors.TlmpcError` when one fails; nothing is written here (the
+    CLI writes the returned artifacts atomically).
     """
-    compilation = Compilation(source=Path(source), text=text)
+    compilation = Compilation(source=Path(source), text=text, figures=figures)
     return run_stages(stages_until(until), compilation, progress=progress)
 
 

@@ -1,9 +1,14 @@
 """Figures of a compiled mission, drawn from its artifacts alone (headless, reproducible).
 
-``render_plan`` draws the workspace, holes, regions with their names, the triangulation, the
-discrete plan (prefix solid, cycle dashed) and the simulated trajectory coloured by time, and
-returns PNG and SVG bytes.  The same artifacts always give the same bytes: no timestamps, a
-fixed SVG hash salt, no software tag.
+Both pictures draw the same :class:`~tlmpc.plot_scene.Scene`: the workspace, holes, regions
+with their names, the triangulation, the discrete plan, the simulated trajectory coloured by
+distance travelled, the start, and optionally a recorded log and its violations.
+
+- :func:`render_svg` writes ``plan.svg`` directly (no plotting library): cheap enough that
+  every compile draws it.
+- :func:`render_png` draws ``plan.png`` with matplotlib (imported only here), on request.
+
+The same artifacts always give the same bytes: no timestamps, no software tag.
 """
 
 from __future__ import annotations
@@ -13,194 +18,33 @@ import itertools
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-# Colours for regions, cycled; chosen to stay readable on top of each other when translucent.
-_REGION_COLOURS = (
-    "#4e79a7",
-    "#f28e2b",
-    "#59a14f",
-    "#e15759",
-    "#76b7b2",
-    "#edc948",
-    "#b07aa1",
-    "#ff9da7",
-    "#9c755f",
-)
-_MAX_REGION_NAMES = 60  # beyond this many regions the names only clutter the picture
-_MAX_MESH_TRIANGLES = 20_000  # a denser mesh is a grey blur at any printable size
-_MAX_VECTOR_SEGMENTS = 500  # longer trajectories go into the SVG as an embedded image
+from tlmpc.plot_scene import Scene, build_scene, viridis
+
+View = tuple[float, float, float, float]
 
 
-def _polygon_xy(points: Sequence[Sequence[float]]) -> tuple[list[float], list[float]]:
-    xs = [float(p[0]) for p in points]
-    ys = [float(p[1]) for p in points]
-    return [*xs, xs[0]], [*ys, ys[0]]
+def render_svg(
+    artifacts: Mapping[str, Any],
+    *,
+    zoom: View | None = None,
+    log: Sequence[Sequence[float]] | None = None,
+    verdict: Mapping[str, Any] | None = None,
+) -> bytes:
+    """``plan.svg`` of a compile output's artifacts (see :func:`~tlmpc.plot_scene.build_scene`)."""
+    from tlmpc.plot_svg import render_svg as draw
+
+    return draw(build_scene(artifacts, zoom=zoom, log=log, verdict=verdict))
 
 
-def _centroids(abstraction: Mapping[str, Any], triangles: Sequence[int]) -> list[list[float]]:
-    vertices = abstraction["vertices"]
-    tris = abstraction["triangles"]
-    result = []
-    for t in triangles:
-        corners = [vertices[i] for i in tris[t]]
-        result.append([sum(c[0] for c in corners) / 3.0, sum(c[1] for c in corners) / 3.0])
-    return result
-
-
-def draw_plan(axes: Any, artifacts: Mapping[str, Any]) -> None:
-    """Draw everything the artifacts in ``artifacts`` (file name -> document) describe."""
-    from matplotlib.collections import LineCollection, PolyCollection
-    from matplotlib.patches import Polygon as PolygonPatch
-
-    mission = artifacts["mission.json"]
-    workspace = mission["workspace"]
-    boundary = workspace["boundary"]
-    axes.add_patch(
-        PolygonPatch(
-            boundary, closed=True, facecolor="white", edgecolor="black", linewidth=1.2, zorder=0
-        )
-    )
-    for hole in workspace.get("holes", []):
-        axes.add_patch(
-            PolygonPatch(
-                hole,
-                closed=True,
-                facecolor="#9a9a9a",
-                edgecolor="black",
-                hatch="//",
-                linewidth=0.8,
-                zorder=3,
-            )
-        )
-    regions: Mapping[str, Any] = mission["regions"]
-    ordered = sorted(regions.items())
-    colours = [_REGION_COLOURS[i % len(_REGION_COLOURS)] for i in range(len(ordered))]
-    axes.add_collection(
-        PolyCollection(
-            [polygon for _, polygon in ordered],
-            facecolors=colours,
-            edgecolors=colours,
-            alpha=0.30,
-            linewidths=0.8,
-            zorder=1,
-            rasterized=len(ordered) > _MAX_REGION_NAMES,
-        )
-    )
-    # The regions the task names are emphasised and always labelled (Example 8's black rooms).
-    from tlmpc.ltl.parser import parse_ltl
-
-    named = parse_ltl(mission["formula"]).props() if mission.get("formula") else frozenset()
-    emphasised = [(n, p) for n, p in ordered if n in named]
-    if emphasised and len(regions) > _MAX_REGION_NAMES:
-        axes.add_collection(
-            PolyCollection(
-                [p for _, p in emphasised],
-                facecolors="#1f1f1f",
-                edgecolors="black",
-                alpha=0.8,
-                linewidths=0.8,
-                zorder=1.5,
-            )
-        )
-    for name, polygon in ordered:
-        if len(regions) <= _MAX_REGION_NAMES or name in named:
-            xs, ys = _polygon_xy(polygon)
-            axes.text(
-                sum(xs[:-1]) / (len(xs) - 1),
-                sum(ys[:-1]) / (len(ys) - 1),
-                name,
-                ha="center",
-                va="center",
-                fontsize=8,
-                zorder=6,
-                bbox={"boxstyle": "round,pad=0.15", "fc": "white", "alpha": 0.7, "lw": 0},
-            )
-
-    abstraction = artifacts.get("abstraction.json")
-    if abstraction is not None and len(abstraction["triangles"]) <= _MAX_MESH_TRIANGLES:
-        vertices = abstraction["vertices"]
-        xs = [v[0] for v in vertices]
-        ys = [v[1] for v in vertices]
-        axes.triplot(
-            xs,
-            ys,
-            abstraction["triangles"],
-            color="#b0b0b0",
-            linewidth=0.3,
-            zorder=2,
-            rasterized=len(abstraction["triangles"]) > 2_000,
-        )
-
-    witness = artifacts.get("witness.json")
-    if witness is not None and abstraction is not None:
-        prefix = list(witness["prefix"])
-        cycle = list(witness["cycle"])
-        path = _centroids(abstraction, [*prefix, *cycle[:1]]) if prefix else []
-        if len(path) >= 2:
-            axes.plot(
-                [p[0] for p in path],
-                [p[1] for p in path],
-                color="#1f3b73",
-                linewidth=1.0,
-                marker=".",
-                markersize=3,
-                zorder=4,
-                label="plan prefix",
-            )
-        loop = _centroids(abstraction, [*cycle, cycle[0]])
-        axes.plot(
-            [p[0] for p in loop],
-            [p[1] for p in loop],
-            color="#c0392b",
-            linewidth=1.0,
-            linestyle="--",
-            marker=".",
-            markersize=3,
-            zorder=4,
-            label="plan cycle" if len(cycle) > 1 else "stay",
-        )
-
-    trace = artifacts.get("trace.json")
-    if trace is not None:
-        points = trace["points"]
-        segments = [[(a[1], a[2]), (b[1], b[2])] for a, b in itertools.pairwise(points)]
-        times = [0.5 * (a[0] + b[0]) for a, b in itertools.pairwise(points)]
-        if segments:
-            lines = LineCollection(
-                segments,
-                cmap="viridis",
-                linewidth=1.8,
-                zorder=5,
-                rasterized=len(segments) > _MAX_VECTOR_SEGMENTS,
-            )
-            lines.set_array(times)
-            axes.add_collection(lines)
-            axes.figure.colorbar(lines, ax=axes, fraction=0.046, pad=0.04, label="time [s]")
-
-    start = mission["robot"]["start"]
-    axes.plot(
-        [start[0]],
-        [start[1]],
-        marker="o",
-        color="black",
-        markersize=6,
-        zorder=7,
-        linestyle="none",
-        label="start",
-    )
-    bx, by = _polygon_xy(boundary)
-    margin = 0.02 * max(max(bx) - min(bx), max(by) - min(by))
-    axes.set_xlim(min(bx) - margin, max(bx) + margin)
-    axes.set_ylim(min(by) - margin, max(by) + margin)
-    axes.set_aspect("equal")
-    axes.set_xlabel("x")
-    axes.set_ylabel("y")
-    # A literal title: a `$` in a mission name must not start matplotlib's mathtext.
-    axes.set_title(str(mission.get("name") or "tlmpc plan").replace("$", r"\$"), fontsize=10)
-    axes.legend(loc="upper right", fontsize=7, framealpha=0.8)
-
-
-def render_plan(artifacts: Mapping[str, Any]) -> tuple[bytes, bytes]:
-    """PNG and SVG bytes of :func:`draw_plan` (reproducible byte for byte)."""
+def render_png(
+    artifacts: Mapping[str, Any],
+    *,
+    zoom: View | None = None,
+    log: Sequence[Sequence[float]] | None = None,
+    verdict: Mapping[str, Any] | None = None,
+) -> bytes:
+    """``plan.png`` of the same scene, drawn with matplotlib (reproducible byte for byte)."""
+    scene = build_scene(artifacts, zoom=zoom, log=log, verdict=verdict)
     import matplotlib
 
     matplotlib.use("Agg", force=False)
@@ -208,18 +52,250 @@ def render_plan(artifacts: Mapping[str, Any]) -> tuple[bytes, bytes]:
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    with rc_context({"svg.hashsalt": "tlmpc", "svg.fonttype": "path", "path.simplify": False}):
-        figure = Figure(figsize=(7.0, 6.0), dpi=150)
+    x0, y0, x1, y1 = scene.view
+    aspect = (y1 - y0) / max(x1 - x0, 1e-12)
+    map_width = 6.0
+    map_height = min(max(map_width * aspect, 0.6), 7.0)
+    if map_width * aspect > 7.0:
+        map_width = 7.0 / aspect
+    legend_width = 2.6
+    figure_width = map_width + legend_width + 0.9
+    figure_height = max(map_height + 0.9, 2.8)  # room for the legend beside a wide map
+    with rc_context({"path.simplify": False}):
+        figure = Figure(figsize=(figure_width, figure_height), dpi=150)
         FigureCanvasAgg(figure)
-        axes = figure.add_subplot(1, 1, 1)
-        draw_plan(axes, artifacts)
-        # Fixed margins: a layout engine would draw the figure once more just to measure it.
-        figure.subplots_adjust(left=0.08, right=0.9, bottom=0.08, top=0.94)
+        axes = figure.add_axes(
+            (
+                0.6 / figure_width,
+                (figure_height - 0.45 - map_height) / figure_height,  # top-aligned
+                map_width / figure_width,
+                map_height / figure_height,
+            )
+        )
+        handles = draw_scene(axes, scene)
+        legend_left = (0.75 + map_width) / figure_width
+        figure.legend(
+            handles=handles,
+            loc="upper left",
+            bbox_to_anchor=(legend_left, 1 - 0.35 / figure_height),
+            fontsize=7,
+            frameon=False,
+        )
+        if scene.trajectory is not None:
+            # Just under the legend (about 0.19 inch per entry at this font size).
+            bar_bottom = max(figure_height - 0.35 - 0.19 * len(handles) - 0.6, 0.35)
+            _colour_scale(figure, scene, legend_left, figure_width, figure_height, bar_bottom)
         png = io.BytesIO()
-        # zlib level 3: a tenth larger than the default 6, in two thirds of the time.
         figure.savefig(
             png, format="png", metadata={"Software": None}, pil_kwargs={"compress_level": 3}
         )
-        svg = io.BytesIO()
-        figure.savefig(svg, format="svg", metadata={"Date": None, "Creator": None})
-    return png.getvalue(), svg.getvalue()
+    return png.getvalue()
+
+
+def _colour_scale(
+    figure: Any,
+    scene: Scene,
+    left: float,
+    figure_width: float,
+    figure_height: float,
+    bottom: float,
+) -> None:
+    """A small horizontal colour bar under the legend: 0 to the path's length."""
+    from matplotlib.colors import LinearSegmentedColormap
+
+    assert scene.trajectory is not None
+    bar = figure.add_axes(
+        (
+            left + 0.05 / figure_width,
+            bottom / figure_height,
+            1.6 / figure_width,
+            0.12 / figure_height,
+        )
+    )
+    cmap = LinearSegmentedColormap.from_list("arc", [viridis(i / 10) for i in range(11)])
+    bar.imshow([[i / 255 for i in range(256)]], aspect="auto", cmap=cmap, extent=(0, 1, 0, 1))
+    bar.set_yticks([])
+    bar.set_xticks([0, 1], ["0", f"{scene.trajectory.length:.4g}"], fontsize=7)
+    bar.set_title("trajectory: distance travelled", fontsize=7)
+
+
+def draw_scene(axes: Any, scene: Scene) -> list[Any]:
+    """Draw ``scene`` on matplotlib ``axes``; return the legend's handles."""
+    from matplotlib.collections import LineCollection, PolyCollection
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+    from matplotlib.patches import Polygon as PolygonPatch
+
+    handles: list[Any] = []
+    axes.add_patch(PolygonPatch(scene.boundary, closed=True, facecolor="white", zorder=0))
+    emphasised = [r for r in scene.regions if scene.emphasise_task_regions and r.named_by_task]
+    plain = [r for r in scene.regions if r not in emphasised]
+    if plain:
+        axes.add_collection(
+            PolyCollection(
+                [r.polygon for r in plain],
+                facecolors=[r.colour for r in plain],
+                edgecolors=[r.colour for r in plain],
+                alpha=0.30,
+                linewidths=0.6,
+                zorder=1,
+            )
+        )
+        handles.append(Patch(facecolor=plain[0].colour, alpha=0.4, label="region"))
+    if emphasised:
+        axes.add_collection(
+            PolyCollection(
+                [r.polygon for r in emphasised],
+                facecolors="#1f1f1f",
+                edgecolors="black",
+                alpha=0.8,
+                linewidths=0.8,
+                zorder=1.5,
+            )
+        )
+        handles.append(Patch(facecolor="#1f1f1f", alpha=0.8, label="task region"))
+    if len(scene.mesh_edges):
+        axes.add_collection(
+            LineCollection(
+                list(scene.mesh_edges.reshape(-1, 2, 2)), colors="#b0b0b0", linewidths=0.3, zorder=2
+            )
+        )
+        handles.append(Line2D([], [], color="#b0b0b0", linewidth=0.6, label="triangulation"))
+    if scene.holes:
+        # Line widths are in points: a hole thinner than a pixel still shows as a wall.
+        axes.add_collection(
+            PolyCollection(
+                list(scene.holes),
+                facecolors="#9a9a9a",
+                edgecolors="black",
+                linewidths=0.9,
+                zorder=3,
+            )
+        )
+        handles.append(Patch(facecolor="#9a9a9a", edgecolor="black", label="obstacle (hole)"))
+    axes.add_patch(
+        PolygonPatch(scene.boundary, closed=True, fill=False, edgecolor="black", linewidth=1.2)
+    )
+    if len(scene.plan_prefix) >= 2:
+        axes.plot(
+            *zip(*scene.plan_prefix, strict=True),
+            color="#1f3b73",
+            linewidth=0.8,
+            alpha=0.7,
+            zorder=4,
+        )
+        handles.append(Line2D([], [], color="#1f3b73", linewidth=0.8, label="plan (triangles)"))
+    if len(scene.plan_cycle) >= 2 and not scene.plan_stays:
+        axes.plot(
+            *zip(*scene.plan_cycle, strict=True),
+            color="#c0392b",
+            linewidth=0.8,
+            linestyle="--",
+            zorder=4,
+        )
+        handles.append(
+            Line2D([], [], color="#c0392b", linewidth=0.8, linestyle="--", label="plan cycle")
+        )
+    if scene.trajectory is not None and len(scene.trajectory.points) >= 2:
+        points = scene.trajectory.points
+        fractions = scene.trajectory.fractions
+        lines = LineCollection(
+            list(itertools.pairwise(points)),
+            colors=[viridis(0.5 * (a + b)) for a, b in itertools.pairwise(fractions)],
+            linewidths=1.6,
+            zorder=5,
+        )
+        axes.add_collection(lines)
+        handles.append(Line2D([], [], color=viridis(0.5), linewidth=1.6, label="trajectory"))
+    if scene.log is not None:
+        axes.plot(
+            *zip(*scene.log.points, strict=True),
+            color="#e4007c",
+            linewidth=1.2,
+            alpha=0.85,
+            zorder=5.5,
+        )
+        handles.append(Line2D([], [], color="#e4007c", linewidth=1.2, label="recorded log"))
+    if scene.start is not None:
+        axes.plot(
+            [scene.start[0]],
+            [scene.start[1]],
+            marker="o",
+            markerfacecolor="white",
+            markeredgecolor="black",
+            markersize=4,
+            linestyle="none",
+            zorder=5.8,
+        )
+        handles.append(
+            Line2D(
+                [],
+                [],
+                marker="o",
+                markerfacecolor="white",
+                markeredgecolor="black",
+                markersize=4,
+                linestyle="none",
+                label="start",
+            )
+        )
+    for number, violation in enumerate(scene.violations, start=1):
+        vx, vy = violation.position
+        axes.plot([vx], [vy], marker="x", color="#d00", markersize=8, markeredgewidth=2, zorder=7)
+        axes.annotate(
+            str(number),
+            (vx, vy),
+            xytext=(5, 5),
+            textcoords="offset points",
+            color="#d00",
+            fontsize=8,
+            zorder=7,
+        )
+        handles.append(
+            Line2D(
+                [],
+                [],
+                marker="x",
+                color="#d00",
+                linestyle="none",
+                label=f"violation {number}: {violation.message[:60]}",
+            )
+        )
+    x0, y0, x1, y1 = scene.view
+    for region in scene.regions:
+        if region.labelled:
+            xs = [p[0] for p in region.polygon]
+            ys = [p[1] for p in region.polygon]
+            # A region narrower than its name gets the name just above it, not over it.
+            small = max(xs) - min(xs) < 0.012 * len(region.name) * (x1 - x0)
+            axes.text(
+                region.label_at[0],
+                max(ys) if small else region.label_at[1],
+                region.name,
+                ha="center",
+                va="bottom" if small else "center",
+                fontsize=7,
+                zorder=6,
+                bbox={"boxstyle": "round,pad=0.1", "fc": "white", "alpha": 0.6, "lw": 0},
+            )
+    axes.set_xlim(x0, x1)
+    axes.set_ylim(y0, y1)
+    axes.set_aspect("equal")
+    axes.tick_params(labelsize=7)
+    axes.set_title(scene.title, fontsize=9)
+    if scene.regions_omitted:
+        handles.append(
+            Line2D(
+                [], [], linestyle="none", label=f"{scene.regions_omitted:,} other regions not drawn"
+            )
+        )
+    if scene.mesh_omitted:
+        handles.append(
+            Line2D(
+                [],
+                [],
+                linestyle="none",
+                label=f"mesh of {scene.mesh_omitted:,} triangles not drawn",
+            )
+        )
+    return handles

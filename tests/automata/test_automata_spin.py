@@ -84,7 +84,7 @@ def spin_guard(guard: str, letter: frozenset[str]) -> bool:
 
 
 def spin_claim(text: str) -> Claim:
-    done = subprocess.run(["spin", "-f", text], capture_output=True, text=True, timeout=5)
+    done = subprocess.run(["spin", "-f", text], capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stdout + done.stderr
     return parse_never_claim(done.stdout)
 

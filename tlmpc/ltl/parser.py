@@ -23,6 +23,7 @@ from lark.exceptions import (
 )
 
 from tlmpc.errors import Diagnostic, InvalidInputError, error
+from tlmpc.grammar_cache import lalr_parser
 from tlmpc.ltl.ast import (
     And,
     Const,
@@ -65,7 +66,8 @@ _BINARY_TEMPORAL: dict[str, Callable[..., Formula]] = {
 @functools.cache
 def _parser() -> Lark:
     grammar = (resources.files("tlmpc.ltl") / "ltl.lark").read_text(encoding="utf-8")
-    return Lark(grammar, parser="lalr", propagate_positions=True, maybe_placeholders=False)
+    parser: Lark = lalr_parser(grammar, propagate_positions=True, maybe_placeholders=False)
+    return parser
 
 
 class _Positions:

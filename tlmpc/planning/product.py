@@ -92,7 +92,9 @@ def build_product(
     t, s, i, n = t[valid], s[valid], i[valid], n[valid]
     keep = allowed[t] & allowed[n]
     t, s, i, n = t[keep], s[keep], i[keep], n[keep]
-    slot = np.argmax(neighbors[n] == t[:, None], axis=1).astype(np.int64)
+    # The slot of t among n's neighbours (argmax over a 3-wide boolean axis is slow).
+    back = neighbors[n]
+    slot = np.where(back[:, 0] == t, 0, np.where(back[:, 1] == t, 1, 2)).astype(np.int64)
     if metric == "hops":
         weight = np.ones(len(t))
     else:
@@ -127,8 +129,12 @@ def build_product(
         moves = np.flatnonzero(move_class == cls)
         stays = np.flatnonzero(stay_class == cls)
         for q in range(nq):
+            # Parallel automaton edges would give duplicate pairs: keep one per successor,
+            # accepting if any is (every (node, node') pair is then unique: no sort needed).
+            successors: dict[int, bool] = {}
             for q_next, mask in rows[q]:
-                accepting = mask == full
+                successors[q_next] = successors.get(q_next, False) or mask == full
+            for q_next, accepting in successors.items():
                 if len(moves):
                     sources.append(move_src[moves] * nq + q)
                     targets.append(move_dst[moves] * nq + q_next)
@@ -153,16 +159,12 @@ def build_product(
         src = dst = np.zeros(0, dtype=np.int64)
         wgt = np.zeros(0)
         acc = np.zeros(0, dtype=bool)
-    # Parallel automaton edges give duplicate pairs: keep one (same weight), accepting if any.
-    order = np.lexsort((~acc, dst, src))
-    src, dst, wgt, acc = src[order], dst[order], wgt[order], acc[order]
-    first = np.ones(len(src), dtype=bool)
-    first[1:] = (src[1:] != src[:-1]) | (dst[1:] != dst[:-1])
-    src, dst, wgt, acc = src[first], dst[first], wgt[first], acc[first]
     graph = csr_matrix((wgt, (src, dst)), shape=(size, size))
+    graph.sort_indices()  # canonical order: the searches break ties as they always did
     accepting_graph = csr_matrix(
         (np.ones(int(acc.sum())), (src[acc], dst[acc])), shape=(size, size)
     )
+    accepting_graph.sort_indices()
     start_row = class_rows[int(tri_class[abstraction.start])]
     initial = np.array(
         sorted(
