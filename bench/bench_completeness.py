@@ -37,14 +37,14 @@ CHILD = """\
 import json, sys, time
 sys.path.insert(0, sys.argv[1])
 from tlmpc.errors import TlmpcError
-from tlmpc.pipeline import compile_mission
+from tlmpc.pipeline import ABSTRACTION, compile_mission
 compile_mission(sys.argv[2], until="verify")  # warm the imports and caches
 rows = {}
 for path in sys.argv[2:]:
     started = time.process_time()
     try:
         result = compile_mission(path, until="verify")
-        triangles = result.compilation.abstraction.num_triangles
+        triangles = result.compilation.get(ABSTRACTION).num_triangles
     except TlmpcError as exc:
         triangles = exc.diagnostics[0].code
     rows[path] = [triangles, time.process_time() - started]

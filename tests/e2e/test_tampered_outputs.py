@@ -101,7 +101,7 @@ def test_tampered_output_is_rejected(compiled: Path, tmp_path: Path, tampering: 
         TAMPERINGS[tampering](copy)
     except UnicodeEncodeError:
         (copy / "mission.json").write_bytes(b'{"format": "\xff"}')
-    png = (copy / "plan.png").read_bytes()
+    picture = (copy / "plan.svg").read_bytes()
     for argv in (("plot", str(copy)), *(("export", str(copy), "--format", f) for f in FORMATS)):
         code, out, err = run_cli(*argv)
         if tampering in ("witness index", "trace NaN") and argv[0] == "export":
@@ -111,7 +111,7 @@ def test_tampered_output_is_rejected(compiled: Path, tmp_path: Path, tampering: 
         assert "error[U0" in err, err
         assert "Traceback" not in err
         assert out == ""
-    assert (copy / "plan.png").read_bytes() == png
+    assert (copy / "plan.svg").read_bytes() == picture
 
 
 FORMATS = ("promela", "smv", "dot")

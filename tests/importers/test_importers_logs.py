@@ -256,7 +256,9 @@ def test_verify_gives_identical_verdicts_for_every_form(tmp_path: Path) -> None:
     )
     verdicts = []
     for path in [*paths, csv]:
-        code, out, err = run("verify", str(path), "--mission", str(mission), "--json")
+        code, out, err = run(
+            "verify", str(path), "--mission", str(mission), "--json", "--assume-stay"
+        )
         assert code == 0, err
         verdicts.append(json.loads(out))
     assert all(v == verdicts[0] for v in verdicts)
@@ -268,7 +270,9 @@ def test_verify_flags_reach_the_reader(tmp_path: Path) -> None:
     mission.write_text(MISSION)
     csv = tmp_path / "log.csv"
     csv.write_text("stamp,a,b\n0,-3,0\n1,-1,0\n2,1,0\n")
-    code, _, err = run("verify", str(csv), "--mission", str(mission), "--columns", "stamp,a,b")
+    code, _, err = run(
+        "verify", str(csv), "--mission", str(mission), "--columns", "stamp,a,b", "--assume-stay"
+    )
     assert code == 0, err
     code, _, err = run("verify", str(csv), "--mission", str(mission), "--columns", "stamp,a")
     assert code == 2
