@@ -15,6 +15,7 @@ import time
 from collections.abc import Iterable, Sequence
 from typing import Any
 
+from tlmpc.automata.containment import simplify_by_containment
 from tlmpc.automata.model import Automaton, Edge
 from tlmpc.automata.simplify import postprocess
 from tlmpc.automata.terms import (
@@ -29,9 +30,12 @@ from tlmpc.automata.terms import (
 from tlmpc.automata.wdba import is_obligation
 from tlmpc.ltl.ast import Formula, Not, Prop, conjoin
 from tlmpc.ltl.printer import to_text as formula_text
+from tlmpc.ltl.transform import nnf
 
 #: Seconds of optional reduction work per translation (see :func:`translate`).
 DEFAULT_BUDGET = 0.5
+#: At most this long for the language-containment simplification of the formula.
+CONTAINMENT_BUDGET = 0.2
 
 #: Above this many expansion terms in one state, dominated terms are left to the simulation.
 MAX_DOMINATION_TERMS = 600
@@ -107,6 +111,7 @@ def translate(
     letters: Sequence[Sequence[str]] | None = None,
     simplify: bool = True,
     budget: float | None = DEFAULT_BUDGET,
+    containment: bool = True,
 ) -> Automaton:
     """Translate ``formula`` (no X) into a TGBA.
 
@@ -119,9 +124,15 @@ def translate(
         budget: seconds after which the optional reductions (simulation) stop and the
             automaton reduced so far, which is always correct, is returned; None = no limit.
     """
-    deadline = None if budget is None else time.perf_counter() + budget
+    started = time.perf_counter()
+    deadline = None if budget is None else started + budget
+    original = formula
+    if simplify and containment:
+        # Half the budget at most for the containment checks (each one a small translation).
+        share = CONTAINMENT_BUDGET if budget is None else min(CONTAINMENT_BUDGET, budget / 2)
+        formula = simplify_by_containment(nnf(formula), _is_empty, started + share)
     root = from_ast(formula)
-    aps = tuple(sorted(formula.props()))
+    aps = tuple(sorted(original.props()))
     letter_sets = (
         None
         if letters is None
@@ -164,7 +175,7 @@ def translate(
         edges=edges,
         num_acc=len(events),
         state_names=tuple(names) if names else ("false",),
-        formula=formula_text(formula),
+        formula=formula_text(original),
     )
     if simplify:
         automaton = postprocess(automaton, letter_sets, deadline, obligation=is_obligation(root))
@@ -173,6 +184,11 @@ def translate(
             automaton, letters=tuple(sorted(tuple(sorted(x)) for x in letter_sets))
         )
     return automaton
+
+
+def _is_empty(formula: Formula) -> bool:
+    """No word satisfies ``formula`` (its trimmed automaton has no edge)."""
+    return not translate(formula, budget=CONTAINMENT_BUDGET, containment=False).edges
 
 
 def _state_terms(
