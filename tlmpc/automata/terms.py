@@ -314,13 +314,40 @@ def simplify_state(parts: frozenset[T]) -> frozenset[T] | None:
     return frozenset(kept)
 
 
+#: The letters a translation is restricted to (each the set of propositions true at once), or
+#: None.  Combining terms only adds literals, so a partial term that no letter allows can be
+#: dropped as soon as it is formed: without this, ``G(F a_1 & ... & F a_n)`` over a map where
+#: regions never overlap builds 2^n terms before the map's n + 1 letters rule all but a few out.
+_LETTERS: list[frozenset[str]] | None = None
+
+
+def cube_allowed(pos: frozenset[str], neg: frozenset[str]) -> bool:
+    """Some letter of the current restriction makes ``pos`` true and ``neg`` false."""
+    if pos & neg:
+        return False
+    if _LETTERS is None:
+        return True
+    return any(pos <= letter and not neg & letter for letter in _LETTERS)
+
+
+def restrict_letters(letters: list[frozenset[str]] | None) -> list[frozenset[str]] | None:
+    """Restrict the expansion to ``letters`` (None: every letter); returns the previous value.
+
+    The expansion cache depends on the restriction, so it is cleared on every change."""
+    global _LETTERS
+    previous, _LETTERS = _LETTERS, letters
+    if previous != letters:
+        expand.cache_clear()
+    return previous
+
+
 def _combine(left: list[Term], right: list[Term]) -> list[Term]:
     out: list[Term] = []
     for lp, ln, lx, lprom in left:
         for rp, rn, rx, rprom in right:
             pos = lp | rp
             neg = ln | rn
-            if pos & neg:
+            if not cube_allowed(pos, neg):
                 continue
             out.append((pos, neg, lx | rx, lprom | rprom))
     return out
@@ -339,7 +366,7 @@ def _unless(terms: list[Term] | tuple[Term, ...], alternatives: list[T]) -> list
     neg = frozenset(x[1] for x in alternatives if x[0] == "p")
     if not pos and not neg:
         return list(terms)
-    return [(p | pos, n | neg, x, pr) for p, n, x, pr in terms if not (p | pos) & (n | neg)]
+    return [(p | pos, n | neg, x, pr) for p, n, x, pr in terms if cube_allowed(p | pos, n | neg)]
 
 
 @functools.cache

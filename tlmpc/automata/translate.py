@@ -21,9 +21,11 @@ from tlmpc.automata.simplify import postprocess
 from tlmpc.automata.terms import (
     FALSE,
     T,
+    cube_allowed,
     eventualities,
     expand,
     from_ast,
+    restrict_letters,
     simplify_state,
     to_text,
 )
@@ -139,8 +141,30 @@ def translate(
         else list(dict.fromkeys(frozenset(x for x in letter if x in aps) for letter in letters))
     )
     events = eventualities(root)
-    event_index = {e: i for i, e in enumerate(events)}
     initial = simplify_state(frozenset([root])) if root != FALSE else None
+    previous_letters = restrict_letters(letter_sets)
+    try:
+        automaton = _explore(initial, events, letter_sets, formula_text(original), aps)
+    finally:
+        restrict_letters(previous_letters)
+    if simplify:
+        automaton = postprocess(automaton, letter_sets, deadline, obligation=is_obligation(root))
+    if letter_sets is not None:
+        automaton = dataclasses.replace(
+            automaton, letters=tuple(sorted(tuple(sorted(x)) for x in letter_sets))
+        )
+    return automaton
+
+
+def _explore(
+    initial: State | None,
+    events: list[Any],
+    letter_sets: list[frozenset[str]] | None,
+    text: str,
+    aps: tuple[str, ...],
+) -> Automaton:
+    """The raw TGBA: states reached from ``initial`` by the expansion terms letters allow."""
+    event_index = {e: i for i, e in enumerate(events)}
     states: dict[State, int] = {}
     names: list[str] = []
     raw_edges: list[tuple[int, int, Cube, frozenset[int]]] = []
@@ -168,22 +192,15 @@ def translate(
         Edge(src=s, dst=d, guard=cube_formula(*cube), marks=marks)
         for s, d, cube, marks in raw_edges
     )
-    automaton = Automaton(
+    return Automaton(
         aps=aps,
         num_states=max(len(states), 1),
         initial=0,
         edges=edges,
         num_acc=len(events),
         state_names=tuple(names) if names else ("false",),
-        formula=formula_text(original),
+        formula=text,
     )
-    if simplify:
-        automaton = postprocess(automaton, letter_sets, deadline, obligation=is_obligation(root))
-    if letter_sets is not None:
-        automaton = dataclasses.replace(
-            automaton, letters=tuple(sorted(tuple(sorted(x)) for x in letter_sets))
-        )
-    return automaton
 
 
 def _is_empty(formula: Formula) -> bool:
@@ -201,7 +218,7 @@ def _state_terms(
             for p2, n2, x2, pr2 in expand(part):
                 p = pos | p2
                 n = neg | n2
-                if p & n:
+                if not cube_allowed(p, n):
                     continue
                 combined.append((p, n, nxt | x2, prom | pr2))
         terms = _undominated_partial(combined)
