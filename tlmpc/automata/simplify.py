@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import time
 from collections import defaultdict
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 
 from tlmpc.automata import simulation, wdba
 from tlmpc.automata.guards import holds
@@ -79,6 +79,14 @@ def sccs(num_states: int, edges: Sequence[Edge], initial: int) -> list[int]:
     succ: list[list[int]] = [[] for _ in range(num_states)]
     for edge in edges:
         succ[edge.src].append(edge.dst)
+    return strongly_connected(succ, [initial])
+
+
+def strongly_connected(succ: Sequence[Sequence[int]], roots: Iterable[int]) -> list[int]:
+    """SCC id of every state reachable from ``roots`` (-1 for the others), in Tarjan's order
+    (a component's id is smaller than those of the components that reach it).  Iterative, so
+    long chains cannot exhaust the interpreter's stack."""
+    num_states = len(succ)
     index = [-1] * num_states
     low = [0] * num_states
     on_stack = [False] * num_states
@@ -86,37 +94,40 @@ def sccs(num_states: int, edges: Sequence[Edge], initial: int) -> list[int]:
     stack: list[int] = []
     counter = 0
     count = 0
-    work: list[tuple[int, int]] = [(initial, 0)]
-    while work:
-        node, child = work.pop()
-        if child == 0:
-            index[node] = low[node] = counter
-            counter += 1
-            stack.append(node)
-            on_stack[node] = True
-        recursed = False
-        for position in range(child, len(succ[node])):
-            target = succ[node][position]
-            if index[target] == -1:
-                work.append((node, position + 1))
-                work.append((target, 0))
-                recursed = True
-                break
-            if on_stack[target]:
-                low[node] = min(low[node], index[target])
-        if recursed:
+    for root in roots:
+        if index[root] != -1:
             continue
-        if low[node] == index[node]:
-            while True:
-                member = stack.pop()
-                on_stack[member] = False
-                component[member] = count
-                if member == node:
+        work: list[tuple[int, int]] = [(root, 0)]
+        while work:
+            node, child = work.pop()
+            if child == 0:
+                index[node] = low[node] = counter
+                counter += 1
+                stack.append(node)
+                on_stack[node] = True
+            recursed = False
+            for position in range(child, len(succ[node])):
+                target = succ[node][position]
+                if index[target] == -1:
+                    work.append((node, position + 1))
+                    work.append((target, 0))
+                    recursed = True
                     break
-            count += 1
-        if work:
-            parent = work[-1][0]
-            low[parent] = min(low[parent], low[node])
+                if on_stack[target]:
+                    low[node] = min(low[node], index[target])
+            if recursed:
+                continue
+            if low[node] == index[node]:
+                while True:
+                    member = stack.pop()
+                    on_stack[member] = False
+                    component[member] = count
+                    if member == node:
+                        break
+                count += 1
+            if work:
+                parent = work[-1][0]
+                low[parent] = min(low[parent], low[node])
     return component
 
 

@@ -176,52 +176,10 @@ def _minimize(
 
 
 def _sccs(delta: list[list[int]]) -> list[int]:
-    """SCC number of every state (iterative Tarjan)."""
-    n = len(delta)
-    index = [-1] * n
-    low = [0] * n
-    on_stack = [False] * n
-    component = [-1] * n
-    stack: list[int] = []
-    counter = count = 0
-    for root in range(n):
-        if index[root] != -1:
-            continue
-        work = [(root, 0)]
-        while work:
-            node, child = work.pop()
-            if child == 0:
-                index[node] = low[node] = counter
-                counter += 1
-                stack.append(node)
-                on_stack[node] = True
-            recursed = False
-            row = delta[node]
-            for position in range(child, len(row)):
-                target = row[position]
-                if target < 0:
-                    continue
-                if index[target] == -1:
-                    work.append((node, position + 1))
-                    work.append((target, 0))
-                    recursed = True
-                    break
-                if on_stack[target]:
-                    low[node] = min(low[node], index[target])
-            if recursed:
-                continue
-            if low[node] == index[node]:
-                while True:
-                    member = stack.pop()
-                    on_stack[member] = False
-                    component[member] = count
-                    if member == node:
-                        break
-                count += 1
-            if work:
-                parent = work[-1][0]
-                low[parent] = min(low[parent], low[node])
-    return component
+    """SCC number of every state (a negative entry of ``delta`` is a missing transition)."""
+    from tlmpc.automata.simplify import strongly_connected  # simplify imports this module
+
+    return strongly_connected([[t for t in row if t >= 0] for row in delta], range(len(delta)))
 
 
 def _bfs_tree(delta: list[list[int]]) -> list[tuple[int, int]]:
