@@ -42,7 +42,7 @@ def test_markdown_links_resolve() -> None:
 
 # --- shown outputs are the code's, and docs speak of this repository only -------------------
 
-from tests.docs_outputs import PAGES, normalise, page_outputs, shown_runs  # noqa: E402
+from docs_outputs import PAGES, normalise, page_outputs, shown_runs  # noqa: E402
 
 
 @pytest.mark.slow

@@ -57,7 +57,9 @@ def depth(f: Formula) -> int:
 
 
 @given(formulas(), st.lists(words, min_size=1, max_size=6))
-def test_tgba_and_ba_agree_with_evaluator(formula: Formula, samples: list) -> None:
+def test_tgba_and_ba_agree_with_evaluator(
+    formula: Formula, samples: list[tuple[list[frozenset[str]], list[frozenset[str]]]]
+) -> None:
     tgba = translate(formula)
     ba = degeneralize(tgba)
     assert ba.state_based
@@ -75,7 +77,7 @@ def test_tgba_and_ba_agree_with_evaluator(formula: Formula, samples: list) -> No
     st.data(),
 )
 def test_letter_restricted_translation(
-    formula: Formula, letter_sets: list, data: st.DataObject
+    formula: Formula, letter_sets: list[frozenset[str]], data: st.DataObject
 ) -> None:
     letters = [tuple(sorted(s)) for s in letter_sets]
     tgba = translate(formula, letters=letters)
@@ -91,7 +93,7 @@ def test_letter_restricted_translation(
 
 def test_evaluator_sanity() -> None:
     a, b = Prop("a"), Prop("b")
-    A, B, E = frozenset({"a"}), frozenset({"b"}), frozenset()
+    A, B, E = frozenset({"a"}), frozenset({"b"}), frozenset[str]()
     assert evaluate(Eventually(b), [A, A], [B])
     assert not evaluate(Eventually(b), [], [A])
     assert evaluate(Globally(Eventually(a)), [E], [E, A])

@@ -78,7 +78,9 @@ def spin_guard(guard: str, letter: frozenset[str]) -> bool:
     expr = guard.replace("&&", " and ").replace("||", " or ").replace("!", " not ")
     expr = re.sub(r"\btrue\b", "True", re.sub(r"\bfalse\b", "False", expr))
     expr = re.sub(r"\b1\b", "True", re.sub(r"\b0\b", "False", expr))
-    env = {name: (name in letter) for name in re.findall(r"[A-Za-z_]\w*", expr)}
+    env: dict[str, bool | None] = {
+        name: (name in letter) for name in re.findall(r"[A-Za-z_]\w*", expr)
+    }
     env.update({"True": True, "False": False, "and": None, "or": None, "not": None})
     return bool(eval(expr, {"__builtins__": {}}, {k: v for k, v in env.items() if v is not None}))
 

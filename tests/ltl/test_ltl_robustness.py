@@ -77,8 +77,10 @@ def test_spans_cover_binary_nodes() -> None:
     assert formula.span is not None
     assert (formula.span.line, formula.span.col) == (2, 3)
     assert isinstance(formula.right, And)
-    assert formula.right.args[1].span is not None
-    assert formula.right.args[1].span.col == 3 + 9
+    second = formula.right.args[1]
+    assert isinstance(second, Prop)
+    assert second.span is not None
+    assert second.span.col == 3 + 9
 
 
 def test_hints_name_what_was_expected() -> None:

@@ -10,8 +10,8 @@ from pathlib import Path
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
+from strategies import formulas
 
-from tests.oracles.strategies import formulas
 from tlmpc.cli import main
 from tlmpc.ltl import parse_ltl, to_text
 from tlmpc.ltl.ast import Formula

@@ -4,13 +4,14 @@ from __future__ import annotations
 
 import importlib.util
 from pathlib import Path
+from types import ModuleType
 
 from tlmpc.verify import verify_document
 
 BENCH = Path(__file__).resolve().parents[2] / "bench" / "bench_verify.py"
 
 
-def _bench():  # type: ignore[no-untyped-def]
+def _bench() -> ModuleType:
     spec = importlib.util.spec_from_file_location("bench_verify", BENCH)
     assert spec is not None
     assert spec.loader is not None

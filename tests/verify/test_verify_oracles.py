@@ -96,7 +96,7 @@ def test_agrees_with_rtamt_discrete_time(formula: Formula, word: list[frozenset[
     # rtamt treats the trace as finite; repeat the last letter long enough to stand for
     # "forever" (a formula of depth d cannot tell more than d repetitions apart)
     padded = [*word, *[word[-1]] * 10]
-    signal = {"time": list(range(len(padded)))}
+    signal: dict[str, list[float]] = {"time": [float(t) for t in range(len(padded))]}
     for p in PROPS:
         signal[p] = [1.0 if p in letter else -1.0 for letter in padded]
     robustness = spec.evaluate(signal)[0][1]

@@ -5,6 +5,7 @@ from __future__ import annotations
 import ast
 import io
 import json
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -24,7 +25,7 @@ WORKSPACE = {
 
 
 def trace(
-    points: list[list[float]],
+    points: Sequence[Sequence[float]],
     ltl: str,
     loop_start: int | None = None,
     boundary: str = "right",
@@ -133,7 +134,7 @@ def test_leaving_the_workspace_is_a_violation() -> None:
 
 def test_robustness_and_certificate() -> None:
     # deep inside a, slowly: robust and certified
-    points = [[0, 1, 1], [0.1, 1.01, 1]]
+    points: list[list[float]] = [[0, 1, 1], [0.1, 1.01, 1]]
     verdict = verify_document(trace(points, "G a"))
     assert verdict.robustness == pytest.approx(0.99, abs=1e-9)
     assert verdict.certified

@@ -14,8 +14,8 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
+from chromium import Browser, find_chromium
 
-from tests.view.chromium import Browser, find_chromium
 from tlmpc.cli import main
 
 ROOT = Path(__file__).resolve().parents[2]
