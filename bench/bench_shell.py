@@ -105,9 +105,11 @@ def _warm(tree: Path, mission: Path, out: Path, cwd: Path) -> float:
 
 def _spin_pipeline(mission: Path, scratch: Path) -> dict[str, float] | None:
     """Export + spin -a + gcc + pan (first trail) on the model of ``mission``."""
+    from bench.bench_planning import spin_runner
     from tlmpc.abstraction import build_abstraction
     from tlmpc.mission import load_mission
-    from tlmpc.planning import spin
+
+    spin = spin_runner()
     from tlmpc.planning.export import to_promela
 
     if not spin.available():

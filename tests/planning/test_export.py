@@ -6,9 +6,9 @@ import io
 from pathlib import Path
 
 import pytest
+from spin_runner import parse_trail
 
 from tlmpc.cli import main
-from tlmpc.planning.spin import parse_trail
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+import spin_runner as spin
 import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -20,7 +21,7 @@ from tlmpc.automata import translate
 from tlmpc.errors import NoPlanError
 from tlmpc.mission import load_mission_text
 from tlmpc.mission.model import Mission, Options
-from tlmpc.planning import plan, spin, witness_from_json, witness_to_json
+from tlmpc.planning import plan, witness_from_json, witness_to_json
 from tlmpc.planning.export import to_promela
 
 BASE = """\
