@@ -15,8 +15,6 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from tlmpc.errors import UsageError, error
 
 
@@ -198,6 +196,8 @@ def _skeleton(path: Path, document: dict[str, Any]) -> dict[str, Any]:
     jsonschema descends into every item (seconds on a large mesh); numpy checks instead that
     an array is rectangular, numeric and finite, and the schema then sees one item of the
     same kind (an integer row if all are integers, else a float row)."""
+    import numpy as np  # here, not at the top: `tlmpc check` never reads artifacts
+
     small = dict(document)
     for key, value in document.items():
         if not isinstance(value, list) or len(value) < 2:
