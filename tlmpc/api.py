@@ -112,9 +112,12 @@ class Compiled:
     def svg(self) -> str:
         """The plan figure as SVG text (drawn on first use)."""
         if "svg" not in self._figure:
-            from tlmpc.plot import render_svg
+            drawn = self.artifacts.get("plan.svg")
+            if not isinstance(drawn, bytes):
+                from tlmpc.plot import render_svg
 
-            self._figure["svg"] = render_svg(self.artifacts).decode("utf-8")
+                drawn = render_svg(self.artifacts)
+            self._figure["svg"] = drawn.decode("utf-8")
         return self._figure["svg"]
 
     def _repr_svg_(self) -> str | None:
