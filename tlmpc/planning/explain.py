@@ -125,40 +125,7 @@ def explain_no_plan(
                 hint=f"`{text}` constrains the first instant; move the start or the task",
             )
         ]
-    reachable_ok = _reachable(abstraction, allowed)
-    reachable_any = _reachable(abstraction, np.ones(abstraction.num_triangles, dtype=bool))
-    problems = []
-    for name in _positive_props(formula):
-        with_region = np.array([name in letter for letter in abstraction.letters], dtype=bool)
-        triangles = with_region[abstraction.letter_of]
-        if not triangles.any():
-            problems.append(
-                error(
-                    "P004",
-                    f"region {name!r} has no free space: it lies in holes",
-                    hint="move the region or the holes",
-                )
-            )
-        elif not (triangles & reachable_ok).any():
-            if (triangles & reachable_any).any():
-                forbidden = ", ".join(f"`G {to_text(p)}`" for p in invariants(formula))
-                problems.append(
-                    error(
-                        "P005",
-                        f"region {name!r} can only be reached through "
-                        f"regions the task forbids ({forbidden})",
-                        hint="open a path that avoids the forbidden regions",
-                    )
-                )
-            else:
-                problems.append(
-                    error(
-                        "P005",
-                        f"region {name!r} cannot be reached from the "
-                        "start: holes separate it from the robot",
-                        hint="open a passage through the holes or move the start",
-                    )
-                )
+    problems = _region_facts(abstraction, formula, {})
     if problems:
         return problems
     return [
