@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from tlmpc.errors import Diagnostic, InvalidInputError, UsageError, error
+from tlmpc.errors import Diagnostic, UsageError, error
 
 if TYPE_CHECKING:
     from tlmpc.automata.model import Automaton
@@ -36,18 +36,6 @@ if TYPE_CHECKING:
 MissionSource = str | os.PathLike[str] | Mapping[str, Any]
 """A mission: a path to a YAML file, YAML text, or the mission as a dict."""
 
-#: The artifacts an output directory may hold, in pipeline order.
-ARTIFACT_NAMES = (
-    "mission.json",
-    "abstraction.json",
-    "automaton.json",
-    "automaton.hoa",
-    "witness.json",
-    "controllers.json",
-    "trace.json",
-    "verdict.json",
-    "summary.json",
-)
 
 
 def _mission_text(mission: MissionSource) -> tuple[str | None, Path]:
@@ -182,31 +170,15 @@ def read_output(directory: str | os.PathLike[str]) -> Compiled:
     Each JSON artifact is checked against its schema; raises
     :class:`~tlmpc.errors.UsageError` when the directory holds no tlmpc output.
     """
-    from tlmpc.artifacts import read_json, validation_errors
+    from tlmpc.artifacts import ARTIFACT_SCHEMAS, read_artifact
 
     root = Path(directory)
     artifacts: dict[str, Any] = {}
-    for name in ARTIFACT_NAMES:
-        path = root / name
-        if not path.is_file():
-            continue
-        if name.endswith(".hoa"):
-            artifacts[name] = path.read_text(encoding="utf-8")
-            continue
-        document = read_json(path)
-        schema = name.removesuffix(".json")
-        schema = "mission-artifact" if schema == "mission" else schema
-        problems = validation_errors(document, schema)
-        if problems:
-            raise InvalidInputError(
-                error(
-                    "U071",
-                    f"{name} does not match its schema: {problems[0]}",
-                    file=str(path),
-                    hint="artifacts are written by `tlmpc compile`; was this file edited?",
-                )
-            )
-        artifacts[name] = document
+    for name, (_, schema) in ARTIFACT_SCHEMAS.items():
+        if (root / name).is_file():
+            artifacts[name] = read_artifact(root / name, schema)
+    if (root / "automaton.hoa").is_file():
+        artifacts["automaton.hoa"] = (root / "automaton.hoa").read_text(encoding="utf-8")
     if "mission.json" not in artifacts:
         raise UsageError(
             error(

@@ -152,9 +152,29 @@ def read_json(path: Path, expected_format: str | None = None) -> dict[str, Any]:
 ARTIFACT_SCHEMAS = {
     "mission.json": ("tlmpc.mission/", "mission-artifact"),
     "abstraction.json": ("tlmpc.abstraction/", "abstraction"),
+    "automaton.json": ("tlmpc.automaton/", "automaton"),
     "witness.json": ("tlmpc.witness/", "witness"),
+    "controllers.json": ("tlmpc.controllers/", "controllers"),
     "trace.json": ("tlmpc.trace/", "trace"),
+    "verdict.json": ("tlmpc.verdict/", "verdict"),
+    "summary.json": ("tlmpc.summary/", "summary"),
 }
+
+
+def read_artifact(path: Path, schema: str) -> dict[str, Any]:
+    """The artifact at ``path``, checked against ``schema`` (U071, exit 2, when it fails)."""
+    document = read_json(path)
+    problems = validation_errors(document, schema)
+    if problems:
+        raise UsageError(
+            error(
+                "U071",
+                f"{path.name} does not match its schema: {problems[0]}",
+                file=str(path),
+                hint="artifacts are written by `tlmpc compile`; was this file edited?",
+            )
+        )
+    return document
 
 
 def _tampered(path: Path, message: str, code: str = "U042") -> UsageError:

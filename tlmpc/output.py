@@ -36,7 +36,7 @@ from collections.abc import Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
-from tlmpc.artifacts import dumps
+from tlmpc.artifacts import ARTIFACT_SCHEMAS, dumps
 from tlmpc.errors import UsageError, error
 
 #: The marker file every output directory holds; its first line starts with MARKER_FORMAT.
@@ -45,21 +45,7 @@ MARKER_FORMAT = "tlmpc.output/"
 _MARKER_TEXT = MARKER_FORMAT + "1\n"
 
 #: Every file name ``tlmpc compile`` may write (used by ``--force`` and documentation only).
-KNOWN_ARTIFACTS = frozenset(
-    {
-        "mission.json",
-        "abstraction.json",
-        "automaton.json",
-        "automaton.hoa",
-        "witness.json",
-        "controllers.json",
-        "trace.json",
-        "verdict.json",
-        "summary.json",
-        "plan.png",
-        "plan.svg",
-    }
-)
+KNOWN_ARTIFACTS = frozenset({*ARTIFACT_SCHEMAS, "automaton.hoa", "plan.png", "plan.svg"})
 
 _HINTS = {
     errno.EACCES: "you have no permission to write there; choose another -o",

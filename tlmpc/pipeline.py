@@ -542,7 +542,7 @@ def compilation_from_artifacts(directory: Path, needed: Sequence[Product[Any]]) 
     Every artifact is checked against its schema first; a missing or invalid one is a
     diagnostic naming the file.
     """
-    from tlmpc.artifacts import read_json, validation_errors
+    from tlmpc.artifacts import read_artifact
 
     products: dict[Product[Any], Any] = {}
     documents: dict[str, Any] = {}
@@ -557,17 +557,7 @@ def compilation_from_artifacts(directory: Path, needed: Sequence[Product[Any]]) 
                     hint="run the earlier stages first (tlmpc compile --until ...)",
                 )
             )
-        document = read_json(path)
-        problems = validation_errors(document, product.schema)
-        if problems:
-            raise MissingProductError(
-                error(
-                    "U071",
-                    f"{product.artifact} does not match its schema: {problems[0]}",
-                    file=str(path),
-                    hint="artifacts are written by `tlmpc compile`; was this file edited?",
-                )
-            )
+        document = read_artifact(path, product.schema)
         products[product] = product.read(document)
         documents[product.artifact] = document
     source = Path(str(documents.get("mission.json", {}).get("source") or directory))

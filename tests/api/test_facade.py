@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 from pathlib import Path
@@ -113,3 +114,14 @@ def test_import_tlmpc_is_light() -> None:
         [sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=ROOT
     )
     assert done.stdout.strip() == "[]"
+
+
+def test_read_output_rejects_an_artifact_that_fails_its_schema(tmp_path: Path) -> None:
+    out = tlmpc.compile(_mission(), until="plan").write(tmp_path / "out")
+    witness = json.loads((out / "witness.json").read_text())
+    del witness["cycle"]
+    (out / "witness.json").write_text(json.dumps(witness))
+    with pytest.raises(tlmpc.UsageError) as caught:
+        tlmpc.read_output(out)
+    assert caught.value.diagnostics[0].code == "U071"
+    assert caught.value.diagnostics[0].file == str(out / "witness.json")
