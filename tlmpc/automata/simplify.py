@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from collections import defaultdict
 from collections.abc import Iterable, Sequence
@@ -490,13 +491,4 @@ def _simplify_guards(automaton: Automaton, letters: Sequence[frozenset[str]]) ->
             shortened.append(conjoin(kept))
         guard = disjoin(_absorb(list(dict.fromkeys(shortened))))
         edges.append(Edge(src=edge.src, dst=edge.dst, guard=guard, marks=edge.marks))
-    return Automaton(
-        aps=automaton.aps,
-        num_states=automaton.num_states,
-        initial=automaton.initial,
-        edges=tuple(edges),
-        num_acc=automaton.num_acc,
-        state_names=automaton.state_names,
-        formula=automaton.formula,
-        state_based=automaton.state_based,
-    )
+    return dataclasses.replace(automaton, edges=tuple(edges))

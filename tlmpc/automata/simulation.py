@@ -19,6 +19,7 @@ returned.
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from collections import defaultdict
 from collections.abc import Sequence
@@ -109,16 +110,7 @@ def saturate(automaton: Automaton, component: Sequence[int]) -> Automaton:
 
 
 def _with_edges(automaton: Automaton, edges: Sequence[Edge]) -> Automaton:
-    return Automaton(
-        aps=automaton.aps,
-        num_states=automaton.num_states,
-        initial=automaton.initial,
-        edges=tuple(edges),
-        num_acc=automaton.num_acc,
-        state_names=automaton.state_names,
-        formula=automaton.formula,
-        state_based=automaton.state_based,
-    )
+    return dataclasses.replace(automaton, edges=tuple(edges))
 
 
 def simulation(automaton: Automaton, alphabet: Alphabet, deadline: float) -> list[list[bool]]:
