@@ -42,16 +42,17 @@ def test_every_stage_reproduces_its_artifacts_from_its_inputs(tmp_path: Path, sp
             assert _without_timings(got) == _without_timings(expected), (stage.name, name)
 
 
+def _stage(name: str, directory: Path) -> subprocess.CompletedProcess[str]:
+    """``tlmpc stage NAME DIR`` in a fresh interpreter."""
+    command = [sys.executable, "-m", "tlmpc", "stage", name, str(directory)]
+    return subprocess.run(command, capture_output=True, text=True, cwd=ROOT)
+
+
 def test_a_stage_without_its_inputs_names_the_missing_artifact(tmp_path: Path) -> None:
     whole = compile_mission(ROOT / "specs" / "example1.yaml", until="plan")
     write_artifacts(tmp_path, whole.artifacts)
     (tmp_path / "witness.json").unlink()
-    done = subprocess.run(
-        [sys.executable, "-m", "tlmpc", "stage", "control", str(tmp_path)],
-        capture_output=True,
-        text=True,
-        cwd=ROOT,
-    )
+    done = _stage("control", tmp_path)
     assert done.returncode == 2
     assert "error[U070]" in done.stderr
     assert "witness.json" in done.stderr
@@ -64,12 +65,7 @@ def test_a_tampered_input_artifact_is_rejected_by_its_schema(tmp_path: Path) -> 
     controllers = json.loads((tmp_path / "controllers.json").read_text())
     del controllers["steps"][0]["K"]
     (tmp_path / "controllers.json").write_text(json.dumps(controllers))
-    done = subprocess.run(
-        [sys.executable, "-m", "tlmpc", "stage", "simulate", str(tmp_path)],
-        capture_output=True,
-        text=True,
-        cwd=ROOT,
-    )
+    done = _stage("simulate", tmp_path)
     assert done.returncode == 2
     assert "controllers.json" in done.stderr
     assert "error[U071]" in done.stderr
