@@ -438,14 +438,14 @@ def synthesize(
     steps, loop_start = plan_steps(abstraction, witness)
     if robot.disturbance > 0.0:
         _check_rejectable(abstraction, steps, robot, source)
-    push = robot.disturbance * (1.0 + RECHECK_TOLERANCE) + RECHECK_TOLERANCE * robot.max_speed
-    _, jumps = _assign_runs(
-        abstraction,
-        steps,
-        loop_start,
-        push=push if robot.disturbance else 0.0,
-        max_speed=robot.max_speed,
+    # A velocity shared along a vertex run must push harder than the disturbance along every
+    # facet the run collects (without one, merely positive along each: push 0).
+    push = (
+        robot.disturbance * (1.0 + RECHECK_TOLERANCE) + RECHECK_TOLERANCE * robot.max_speed
+        if robot.disturbance > 0.0
+        else 0.0
     )
+    _, jumps = _assign_runs(abstraction, steps, loop_start, push=push, max_speed=robot.max_speed)
     program, column = vertex_program(steps, robot.max_speed, robot.disturbance)
     built = time.perf_counter()
     velocities, _ = solve_vertex_program(program)
