@@ -25,7 +25,7 @@ def _without_timings(document: Any) -> Any:
     return document
 
 
-@pytest.mark.parametrize("spec", ["example1.yaml", "patrol.yaml"])
+@pytest.mark.parametrize("spec", ["example1.yaml", "patrol.yaml", "reach-avoid.yaml"])
 def test_every_stage_reproduces_its_artifacts_from_its_inputs(tmp_path: Path, spec: str) -> None:
     whole = compile_mission(ROOT / "specs" / spec, until="verify")
     write_artifacts(tmp_path, whole.artifacts)
