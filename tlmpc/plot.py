@@ -128,6 +128,26 @@ def draw_scene(axes: Any, scene: Scene) -> list[Any]:
 
     handles: list[Any] = []
     axes.add_patch(PolygonPatch(scene.boundary, closed=True, facecolor="white", zorder=0))
+    if scene.components:
+        # Pieces of free space may lie inside holes: paint the holes first, then the pieces
+        # and their own holes over them, all below the regions and the mesh.
+        for layer, (rings, colour) in enumerate(
+            (
+                (scene.holes, "#9a9a9a"),
+                (scene.components, "white"),
+                (scene.component_holes, "#9a9a9a"),
+            )
+        ):
+            if rings:
+                axes.add_collection(
+                    PolyCollection(
+                        list(rings),
+                        facecolors=colour,
+                        edgecolors="black",
+                        linewidths=0.9,
+                        zorder=0.2 + 0.1 * layer,
+                    )
+                )
     emphasised = [r for r in scene.regions if scene.emphasise_task_regions and r.named_by_task]
     plain = [r for r in scene.regions if r not in emphasised]
     if plain:
@@ -161,7 +181,7 @@ def draw_scene(axes: Any, scene: Scene) -> list[Any]:
             )
         )
         handles.append(Line2D([], [], color="#b0b0b0", linewidth=0.6, label="triangulation"))
-    if scene.holes:
+    if scene.holes and not scene.components:
         # Line widths are in points: a hole thinner than a pixel still shows as a wall.
         axes.add_collection(
             PolyCollection(
@@ -172,6 +192,7 @@ def draw_scene(axes: Any, scene: Scene) -> list[Any]:
                 zorder=3,
             )
         )
+    if scene.holes or scene.component_holes:
         handles.append(Patch(facecolor="#9a9a9a", edgecolor="black", label="obstacle (hole)"))
     axes.add_patch(
         PolygonPatch(scene.boundary, closed=True, fill=False, edgecolor="black", linewidth=1.2)

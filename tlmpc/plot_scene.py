@@ -119,6 +119,9 @@ class Scene:
     log: Path | None
     start: Point | None
     violations: tuple[Violation, ...]
+    #: further pieces of free space (workspace components): outer boundaries, and their holes
+    components: tuple[Polygon, ...] = ()
+    component_holes: tuple[Polygon, ...] = ()
 
 
 def _polygon(points: Sequence[Sequence[float]]) -> Polygon:
@@ -257,10 +260,14 @@ def build_scene(
     workspace = mission["workspace"]
     boundary = _polygon(workspace["boundary"])
     holes = tuple(_polygon(h) for h in workspace.get("holes", []))
+    components = tuple(_polygon(c["boundary"]) for c in workspace.get("components", []))
+    component_holes = tuple(
+        _polygon(h) for c in workspace.get("components", []) for h in c.get("holes", [])
+    )
     if zoom is not None:
         view = zoom
     else:
-        bx0, by0, bx1, by1 = _bbox(boundary)
+        bx0, by0, bx1, by1 = _bbox(tuple(p for ring in (boundary, *components) for p in ring))
         margin = 0.01 * max(bx1 - bx0, by1 - by0)
         view = (bx0 - margin, by0 - margin, bx1 + margin, by1 + margin)
 
@@ -326,4 +333,6 @@ def build_scene(
         log=arc_length_path(log) if log is not None else None,
         start=start,
         violations=_violations(verdict),
+        components=components,
+        component_holes=component_holes,
     )

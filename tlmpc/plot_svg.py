@@ -154,7 +154,7 @@ def _legend(scene: Scene, x: float, y: float) -> tuple[list[str], float]:
         row += 18
 
     line = '<path d="M{x} {cy}H{x2}" stroke="{colour}" stroke-width="{w}"{extra}/>'
-    if scene.holes:
+    if scene.holes or scene.component_holes:
         entry(
             '<rect x="{x}" y="{cy}" width="22" height="10" transform="translate(0,-5)" '
             'fill="#9a9a9a" stroke="#000" stroke-width="1.2"/>',
@@ -263,6 +263,17 @@ def render_svg(scene: Scene) -> bytes:
         '<g clip-path="url(#view)" fill="none" stroke-linejoin="round" stroke-linecap="round">',
         f'<path d="{_polygon_path(canvas, scene.boundary)}" fill="#fff"/>',
     ]
+    if scene.components:
+        # Pieces of free space may lie inside holes: paint the holes first, then the pieces
+        # and their own holes over them, all below the regions and the mesh.
+        for rings, colour in (
+            (scene.holes, "#9a9a9a"),
+            (scene.components, "#fff"),
+            (scene.component_holes, "#9a9a9a"),
+        ):
+            if rings:
+                d = "".join(_polygon_path(canvas, ring) for ring in rings)
+                parts.append(f'<path d="{d}" fill="{colour}" stroke="#000" stroke-width="1.2"/>')
     by_colour: dict[tuple[str, bool], list[str]] = {}
     for region in scene.regions:
         emphasised = scene.emphasise_task_regions and region.named_by_task
@@ -277,7 +288,7 @@ def render_svg(scene: Scene) -> bytes:
     if len(scene.mesh_edges):
         d = _segments(canvas, scene.mesh_edges)
         parts.append(f'<path d="{d}" stroke="#b0b0b0" stroke-width="0.4"/>')
-    if scene.holes:
+    if scene.holes and not scene.components:
         d = "".join(_polygon_path(canvas, hole) for hole in scene.holes)
         # The stroke is in pixels: a hole thinner than a pixel still shows as a 1.2 px wall.
         parts.append(f'<path d="{d}" fill="#9a9a9a" stroke="#000" stroke-width="1.2"/>')

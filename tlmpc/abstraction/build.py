@@ -166,8 +166,33 @@ def abstraction_diagnostics(abstraction: Abstraction, mission: Mission) -> list[
                     severity="warning",
                     file=mission.source,
                     message=f"region {region.name!r} is not reachable from "
-                    "the start: holes separate it from the robot",
+                    "the start: " + _separation(mission, region.polygon),
                     hint="open a passage or move the start",
                 )
             )
     return problems
+
+
+def _separation(mission: Mission, polygon: tuple[tuple[float, float], ...]) -> str:
+    """What separates a region from the robot, in the mission's terms."""
+    if not mission.workspace.components:
+        return "holes separate it from the robot"
+    from shapely.geometry import Point as ShapelyPoint
+    from shapely.geometry import Polygon as ShapelyPolygon
+
+    shape = ShapelyPolygon(polygon)
+    start = ShapelyPoint(mission.robot.start)
+    pieces = [ShapelyPolygon(p.boundary, p.holes) for p in mission.workspace.pieces]
+    inside = [k for k, piece in enumerate(pieces) if piece.intersection(shape).area > 0]
+    robot = next((k for k, piece in enumerate(pieces) if piece.covers(start)), None)
+    if inside and robot not in inside:
+        names = ", ".join(
+            "the main piece" if k == 0 else f"workspace component {k - 1}" for k in inside
+        )
+        return (
+            f"it lies in {names}, a separate piece of free space that the robot "
+            "(starting in "
+            + ("the main piece" if robot == 0 else f"workspace component {(robot or 1) - 1}")
+            + ") cannot reach"
+        )
+    return "holes separate it from the robot"

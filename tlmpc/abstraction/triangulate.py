@@ -38,7 +38,9 @@ def grid_size(mission: Mission) -> float:
 
     A power of ten keeps decimal coordinates (the ones users write) exactly where they are.
     """
-    minx, miny, maxx, maxy = ShapelyPolygon(mission.workspace.boundary).bounds
+    minx, miny, maxx, maxy = shapely.total_bounds(
+        [ShapelyPolygon(piece.boundary) for piece in mission.workspace.pieces]
+    ).tolist()
     extent = max(maxx - minx, maxy - miny)
     return float(10.0 ** math.floor(math.log10(extent * GRID)))
 
@@ -66,12 +68,23 @@ def _snapped_many(polygons: Sequence[Sequence[tuple[float, float]]], grid: float
     return list(shapes)
 
 
-def free_space(mission: Mission, grid: float) -> Any:
-    """The workspace boundary minus the holes, snapped to ``grid``."""
-    boundary = _snapped(mission.workspace.boundary, grid)
-    if mission.workspace.holes:
-        holes = shapely.union_all([_snapped(h, grid) for h in mission.workspace.holes])
+def _piece_free(boundary_points: Any, hole_points: Any, grid: float) -> Any:
+    boundary = _snapped(boundary_points, grid)
+    if hole_points:
+        holes = shapely.union_all([_snapped(h, grid) for h in hole_points])
         boundary = shapely.set_precision(boundary.difference(holes), grid)
+    return boundary
+
+
+def free_space(mission: Mission, grid: float) -> Any:
+    """The workspace boundary minus the holes, snapped to ``grid``; with further workspace
+    components, the union of every piece's boundary minus its own holes."""
+    boundary = _piece_free(mission.workspace.boundary, mission.workspace.holes, grid)
+    if mission.workspace.components:
+        pieces = [boundary] + [
+            _piece_free(c.boundary, c.holes, grid) for c in mission.workspace.components
+        ]
+        boundary = shapely.union_all(pieces, grid_size=grid)
     if boundary.is_empty:
         raise InvalidInputError(
             error(
@@ -166,8 +179,18 @@ def pslg(mission: Mission) -> tuple[FloatArray, IntArray, FloatArray, list[Any]]
         for interior in part.interiors:
             inside = ShapelyPolygon(interior).difference(free)
             if not inside.is_empty:
-                point = inside.representative_point()
-                seeds.append((point.x, point.y))
+                # one seed per piece: a hole may hold another piece of free space, which
+                # splits the rest of the hole into several pieces (a ring, or more)
+                for piece in _polygons(inside):
+                    point = piece.representative_point()
+                    seeds.append((point.x, point.y))
+    if len(parts) > 1:
+        # Pieces of free space may also enclose obstacle space between them that is no hole
+        # of any one piece (pieces touching at corners): seed every bounded gap as well.
+        hull = shapely.convex_hull(free)
+        for gap in _polygons(hull.difference(free)):
+            point = gap.representative_point()
+            seeds.append((point.x, point.y))
     return (
         vertices.astype(np.float64),
         edges.astype(np.int64),

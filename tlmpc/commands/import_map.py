@@ -80,7 +80,8 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     summary = (
         f"workspace {imported.workspace_area:.6g} (free cells {imported.free_cells_area:.6g}, "
         f"{100 * ratio:.2f}%), {len(imported.boundary)} boundary vertices, "
-        f"{len(imported.holes)} holes, {len(imported.regions)} mask regions"
+        f"{len(imported.holes)} holes, {len(imported.components)} further free components, "
+        f"{len(imported.regions)} mask regions"
     )
     if args.output is None:
         out.write(text)

@@ -3,8 +3,10 @@
 * Free space is the cells of value 0 (unknown space is *not* free), as the exact union of their
   squares (:mod:`tlmpc.importers.polygonize`).
 * ``radius`` erodes free space by the robot's radius (configuration space of a disc robot).
-* The workspace is the free piece containing ``start`` (else the largest); its outer ring is
-  the boundary, its inner rings the holes; holes smaller than ``min_area`` are filled (specks).
+* The workspace's main piece is the free piece containing ``start`` (else the largest); its
+  outer ring is the boundary, its inner rings the holes.  Every other free piece of at least
+  ``min_area`` becomes a further workspace component; holes and pieces smaller than
+  ``min_area`` are specks (holes filled, pieces dropped).
 * Rings are simplified within ``tolerance`` (default: one cell), never moving the boundary by
   more than that.
 * A keepout mask's occupied cells (value 100) and a speed mask's limited cells (values 1..100)
@@ -23,8 +25,8 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 import shapely
+from shapely.geometry import MultiPolygon, Polygon
 from shapely.geometry import Point as ShapelyPoint
-from shapely.geometry import Polygon
 from shapely.geometry.base import BaseGeometry
 
 from tlmpc.errors import UsageError, error
@@ -60,6 +62,8 @@ class ImportedMap:
 
     boundary: Ring
     holes: tuple[Ring, ...]
+    #: further free pieces (not connected to the main one), each an outer ring and its holes
+    components: tuple[tuple[Ring, tuple[Ring, ...]], ...]
     regions: Mapping[str, Ring]
     groups: Mapping[str, tuple[str, ...]]
     free_cells_area: float
@@ -92,8 +96,11 @@ def _to_grid(grid: OccupancyGrid, point: Point) -> Point:
     return (c * dx + s * dy) / grid.resolution, (-s * dx + c * dy) / grid.resolution
 
 
-def _free_piece(grid: OccupancyGrid, radius: float, start: Point | None) -> Polygon:
-    """The eroded free piece containing ``start`` (else the largest), in grid units."""
+def _free_pieces(
+    grid: OccupancyGrid, radius: float, start: Point | None, min_cells: float
+) -> tuple[Polygon, list[Polygon]]:
+    """The eroded free pieces in grid units: the one containing ``start`` (else the largest),
+    and every other piece of at least ``min_cells`` cells (smaller ones are specks)."""
     free = erode(cells_to_geometry(grid.values == FREE), radius / grid.resolution)
     pieces = polygons(free)
     if not pieces:
@@ -105,12 +112,15 @@ def _free_piece(grid: OccupancyGrid, radius: float, start: Point | None) -> Poly
             hint="free cells are those with occupancy below free_thresh; "
             "check negate, the thresholds and the radius",
         )
+    chosen: Polygon | None = None
     if start is not None:
         point = ShapelyPoint(_to_grid(grid, start))
         chosen = next((p for p in pieces if p.covers(point)), None)
-        if chosen is not None:
-            return chosen
-    return max(pieces, key=lambda p: p.area)
+    if chosen is None:
+        chosen = max(pieces, key=lambda p: p.area)
+    others = [p for p in pieces if p is not chosen and p.area >= min_cells]
+    others.sort(key=lambda p: (-p.area, p.bounds))
+    return chosen, others
 
 
 def _labels(grid: OccupancyGrid, masks: list[npt.NDArray[np.int16]]) -> npt.NDArray[np.int64]:
@@ -132,8 +142,8 @@ def _faces(linework: BaseGeometry) -> list[Polygon]:
 
 
 def _coverage(
-    workspace: Polygon, labels: npt.NDArray[np.int64], tolerance: float
-) -> tuple[Polygon, dict[int, list[BaseGeometry]]]:
+    workspace: BaseGeometry, labels: npt.NDArray[np.int64], tolerance: float
+) -> tuple[list[Polygon], dict[int, list[BaseGeometry]]]:
     """The workspace cut by the label cells, simplified as one coverage (shared edges shared).
 
     Simplifying the workspace and each mask piece on its own would leave region edges running
@@ -143,6 +153,7 @@ def _coverage(
     simplified together by Douglas-Peucker with topology preserved (junctions stay, no chain
     crosses another): every edge moves once for all the faces that share it, by at most
     ``tolerance``.  The faces are then polygonized and matched to the exact faces by overlap.
+    ``workspace`` may have several pieces (a multipolygon); every piece is returned.
     """
     present = [int(v) for v in np.unique(labels)]
     lines: list[BaseGeometry] = [workspace.boundary]
@@ -186,17 +197,20 @@ def _coverage(
     merged = polygons(shapely.union_all(kept))
     if not merged:
         raise _fail("M011", "the free space vanishes when simplified", "")
-    union = max(merged, key=lambda p: p.area)
     by_label: dict[int, list[BaseGeometry]] = {}
     for face, face_label in zip(faces, face_labels, strict=True):
         if face_label is not None:
             by_label.setdefault(face_label, []).append(face)
-    return union, by_label
+    return merged, by_label
 
 
-def _exact_free(grid: OccupancyGrid, settings: ImportSettings, min_area_cells: float) -> Polygon:
-    piece = _free_piece(grid, settings.radius, settings.start)
-    return drop_small_holes(piece, min_area_cells)
+def _exact_free(
+    grid: OccupancyGrid, settings: ImportSettings, min_area_cells: float
+) -> tuple[Polygon, list[Polygon]]:
+    main, others = _free_pieces(grid, settings.radius, settings.start, min_area_cells)
+    return drop_small_holes(main, min_area_cells), [
+        drop_small_holes(p, min_area_cells) for p in others
+    ]
 
 
 def import_map(
@@ -219,7 +233,7 @@ def import_map(
     if tolerance < 0 or min_area < 0:
         raise _fail("M012", "tolerance and min_area must not be negative", str(map_path))
     cell_area = grid.cell_area()
-    exact = _exact_free(grid, settings, min_area / cell_area)
+    exact_main, exact_others = _exact_free(grid, settings, min_area / cell_area)
     mask_grids: list[tuple[str, Path, OccupancyGrid]] = []
     for prefix, path in (("keepout", keepout), ("speed", speed)):
         if path is None:
@@ -236,10 +250,19 @@ def import_map(
         mask_grids.append((prefix, path, mask))
     layers = [m.values for _, _, m in mask_grids]
     labels = _labels(grid, layers)
-    union, pieces = _coverage(exact, labels, tolerance / grid.resolution)
-    workspace_cells = drop_small_holes(union, min_area / cell_area)
-    dropped = len(union.interiors) - len(workspace_cells.interiors)
-    outer_cells = Polygon(workspace_cells.exterior)
+    exact = MultiPolygon([exact_main, *exact_others]) if exact_others else exact_main
+    simplified, pieces = _coverage(exact, labels, tolerance / grid.resolution)
+    # the main piece is the simplified one overlapping the exact main piece most
+    main = max(simplified, key=lambda p: (p.intersection(exact_main).area, p.area))
+    others = [p for p in simplified if p is not main and p.area >= min_area / cell_area]
+    others.sort(key=lambda p: (-p.area, p.bounds))
+    kept_cells = [drop_small_holes(p, min_area / cell_area) for p in (main, *others)]
+    dropped = sum(
+        len(a.interiors) - len(b.interiors)
+        for a, b in zip((main, *others), kept_cells, strict=True)
+    )
+    outer_cells = shapely.union_all([Polygon(p.exterior) for p in kept_cells])
+    shapely.prepare(outer_cells)
     regions: dict[str, Ring] = {}
     groups: dict[str, tuple[str, ...]] = {}
     for prefix, _, mask in mask_grids:
@@ -269,16 +292,20 @@ def import_map(
                 names = {f"{group}_{k}": _ring(p.exterior) for k, p in enumerate(outers, 1)}
                 regions.update(names)
                 groups[group] = tuple(names)
-    workspace = to_world(workspace_cells, grid.resolution, grid.origin)
-    assert isinstance(workspace, Polygon)
+    world = [to_world(p, grid.resolution, grid.origin) for p in kept_cells]
+    assert all(isinstance(p, Polygon) for p in world)
+    workspace = world[0]
     free_cells = float(np.count_nonzero(grid.values == FREE)) * grid.cell_area()
     return ImportedMap(
         boundary=_ring(workspace.exterior),
         holes=tuple(_ring(r) for r in workspace.interiors),
+        components=tuple(
+            (_ring(p.exterior), tuple(_ring(r) for r in p.interiors)) for p in world[1:]
+        ),
         regions=regions,
         groups=groups,
         free_cells_area=free_cells,
-        workspace_area=float(workspace.area),
+        workspace_area=float(sum(p.area for p in world)),
         resolution=grid.resolution,
         tolerance=tolerance,
         source=str(map_path),

@@ -109,6 +109,16 @@ def mission_document(
         "workspace": {
             "boundary": _points(imported.boundary),
             "holes": [_points(h) for h in imported.holes],
+            **(
+                {
+                    "components": [
+                        {"boundary": _points(outer), "holes": [_points(h) for h in inner]}
+                        for outer, inner in imported.components
+                    ]
+                }
+                if imported.components
+                else {}
+            ),
         },
         "regions": regions,
     }

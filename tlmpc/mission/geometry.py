@@ -132,8 +132,19 @@ def check_layout(
     start_path: Path,
     file: str,
     locate: Locate,
+    components: Sequence[tuple[CheckedShape, Sequence[CheckedShape]]] = (),
 ) -> list[Diagnostic]:
-    """Relations between shapes: containment, the start point (hole overlaps are merged)."""
+    """Relations between shapes: containment, the start point (hole overlaps are merged).
+
+    With further workspace ``components``, every piece is checked by
+    :func:`tlmpc.mission.components.check_pieces`.
+    """
+    if components and boundary is not None:
+        from tlmpc.mission.components import check_pieces
+
+        return check_pieces(
+            [(boundary, holes), *components], regions, start, start_path, file, locate
+        )
     problems: list[Diagnostic] = []
 
     def at(path: Path, code: str, message: str, hint: str) -> Diagnostic:

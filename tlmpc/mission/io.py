@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-from tlmpc.mission.model import Mission, Options, Polygon, Region, Robot, Workspace
+from tlmpc.mission.model import Component, Mission, Options, Polygon, Region, Robot, Workspace
 
 
 def _polygon(points: Sequence[Sequence[float]]) -> Polygon:
@@ -26,6 +26,13 @@ def mission_from_json(document: Mapping[str, Any]) -> Mission:
         workspace=Workspace(
             boundary=_polygon(document["workspace"]["boundary"]),
             holes=tuple(_polygon(h) for h in document["workspace"]["holes"]),
+            components=tuple(
+                Component(
+                    boundary=_polygon(c["boundary"]),
+                    holes=tuple(_polygon(h) for h in c["holes"]),
+                )
+                for c in document["workspace"].get("components", ())
+            ),
         ),
         regions=tuple(
             Region(name=name, polygon=_polygon(points))

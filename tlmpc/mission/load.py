@@ -21,7 +21,7 @@ from tlmpc.ltl.ast import Formula, Or, Prop, conjoin
 from tlmpc.ltl.parser import KEYWORDS, parse_ltl
 from tlmpc.ltl.transform import substitute
 from tlmpc.mission.geometry import CheckedShape, check_layout, check_shape
-from tlmpc.mission.model import Mission, Options, Region, Robot, Workspace
+from tlmpc.mission.model import Component, Mission, Options, Region, Robot, Workspace
 from tlmpc.mission.yamlpos import Path, PositionedDocument, json_path, load_positioned
 from tlmpc.tasks.compiler import compile_phrases
 
@@ -31,6 +31,9 @@ MAX_BYTES = 16 * 1024 * 1024
 
 
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
+
+#: Further pieces of free space (``workspace.components``): each boundary with its holes.
+Pieces = list[tuple[CheckedShape, list[CheckedShape]]]
 
 
 def _number(value: Any) -> bool:
@@ -57,6 +60,19 @@ def _plain_shape(value: Any) -> bool:
 
 
 _STAND_IN = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]
+
+
+def _small_component(component: Any) -> Any:
+    """A workspace component with plain shapes replaced by a small stand-in (see below)."""
+    if not isinstance(component, dict):
+        return component
+    small = dict(component)
+    if _plain_shape(small.get("boundary")):
+        small["boundary"] = _STAND_IN
+    holes = small.get("holes")
+    if isinstance(holes, list):
+        small["holes"] = [_STAND_IN if _plain_shape(h) else h for h in holes]
+    return small
 
 
 def _schema_diagnostics(doc: PositionedDocument, file: str) -> list[Diagnostic]:
@@ -86,6 +102,9 @@ def _schema_diagnostics(doc: PositionedDocument, file: str) -> list[Diagnostic]:
         holes = small.get("holes")
         if isinstance(holes, list):
             small["holes"] = [_STAND_IN if _plain_shape(h) else h for h in holes]
+        components = small.get("components")
+        if isinstance(components, list):
+            small["components"] = [_small_component(c) for c in components]
         data = {**data, "workspace": small}
     problems: list[Diagnostic] = []
     for err in validator.iter_errors(data):
@@ -291,7 +310,9 @@ def _task_positions(
 
 def _shapes(
     data: Mapping[str, Any], doc: PositionedDocument, file: str
-) -> tuple[CheckedShape | None, list[CheckedShape], dict[str, CheckedShape], list[Diagnostic]]:
+) -> tuple[
+    CheckedShape | None, list[CheckedShape], dict[str, CheckedShape], list[Diagnostic], Pieces
+]:
     problems: list[Diagnostic] = []
     workspace = data.get("workspace") or {}
     if "map" in workspace:
@@ -309,7 +330,7 @@ def _shapes(
                 path="$.workspace",
             )
         )
-        return None, [], {}, problems
+        return None, [], {}, problems, []
     boundary, found = check_shape(
         workspace.get("boundary"),
         ("workspace", "boundary"),
@@ -326,6 +347,31 @@ def _shapes(
         problems.extend(found)
         if checked is not None:
             holes.append(checked)
+    components: Pieces = []
+    for number, component in enumerate(workspace.get("components") or []):
+        where: Path = ("workspace", "components", number)
+        piece, found = check_shape(
+            component["boundary"],
+            (*where, "boundary"),
+            f"boundary of component {number}",
+            file,
+            doc.value_at,
+        )
+        problems.extend(found)
+        piece_holes: list[CheckedShape] = []
+        for index, hole in enumerate(component.get("holes") or []):
+            checked, found = check_shape(
+                hole,
+                (*where, "holes", index),
+                f"hole {index} of component {number}",
+                file,
+                doc.value_at,
+            )
+            problems.extend(found)
+            if checked is not None:
+                piece_holes.append(checked)
+        if piece is not None:
+            components.append((piece, piece_holes))
     regions: dict[str, CheckedShape] = {}
     for name, shape in (data.get("regions") or {}).items():
         checked, found = check_shape(
@@ -334,12 +380,14 @@ def _shapes(
         problems.extend(found)
         if checked is not None:
             regions[name] = checked
-    return boundary, holes, regions, problems
+    return boundary, holes, regions, problems, components
 
 
 def _map_shapes(
     data: Mapping[str, Any], doc: PositionedDocument, file: str
-) -> tuple[CheckedShape | None, list[CheckedShape], dict[str, CheckedShape], list[Diagnostic]]:
+) -> tuple[
+    CheckedShape | None, list[CheckedShape], dict[str, CheckedShape], list[Diagnostic], Pieces
+]:
     """``workspace: {map: FILE.yaml, ...}``: the workspace and mask regions of a map."""
     from tlmpc.mission.map_workspace import map_shapes
 
@@ -404,12 +452,21 @@ def _load(text: str, file: str, stem: str) -> tuple[Mission | None, list[Diagnos
     if problems:
         return None, problems
     data: dict[str, Any] = doc.data
-    boundary, holes, regions, found = _shapes(data, doc, file)
+    boundary, holes, regions, found, components = _shapes(data, doc, file)
     problems.extend(found)
     robot = data["robot"]
     start = (float(robot["start"][0]), float(robot["start"][1]))
     problems.extend(
-        check_layout(boundary, holes, regions, start, ("robot", "start"), file, doc.value_at)
+        check_layout(
+            boundary,
+            holes,
+            regions,
+            start,
+            ("robot", "start"),
+            file,
+            doc.value_at,
+            components=components,
+        )
     )
     names = set(regions) | set(data["regions"])
     groups, found = _groups(data, doc, file, names)
@@ -422,7 +479,14 @@ def _load(text: str, file: str, stem: str) -> tuple[Mission | None, list[Diagnos
     defaults = Options()
     mission = Mission(
         name=str(data.get("name") or stem),
-        workspace=Workspace(boundary=boundary.points, holes=tuple(h.points for h in holes)),
+        workspace=Workspace(
+            boundary=boundary.points,
+            holes=tuple(h.points for h in holes),
+            components=tuple(
+                Component(boundary=b.points, holes=tuple(h.points for h in hs))
+                for b, hs in components
+            ),
+        ),
         regions=tuple(Region(name=n, polygon=shape.points) for n, shape in regions.items()),
         robot=Robot(
             start=start,

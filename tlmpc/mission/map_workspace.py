@@ -26,15 +26,23 @@ def _resolve(mission_file: str, value: str) -> FilePath:
 
 def map_shapes(
     data: dict[str, Any], doc: PositionedDocument, file: str
-) -> tuple[CheckedShape | None, list[CheckedShape], dict[str, CheckedShape], list[Diagnostic]]:
-    """The boundary, holes and regions (imported first, then the mission's own)."""
+) -> tuple[
+    CheckedShape | None,
+    list[CheckedShape],
+    dict[str, CheckedShape],
+    list[Diagnostic],
+    list[tuple[CheckedShape, list[CheckedShape]]],
+]:
+    """The boundary, holes and regions (imported first, then the mission's own), and the
+    further free components of the map, each with its holes."""
     from tlmpc.importers.maps import ImportSettings, import_map
 
     workspace: dict[str, Any] = data["workspace"]
     where = ("workspace", "map")
     line, col = doc.value_at(where)
-    if "boundary" in workspace or "holes" in workspace:
-        key = "boundary" if "boundary" in workspace else "holes"
+    drawn = [k for k in ("boundary", "holes", "components") if k in workspace]
+    if drawn:
+        key = drawn[0]
         kline, kcol = doc.key_at(("workspace", key))
         return (
             None,
@@ -50,6 +58,7 @@ def map_shapes(
                     col=kcol,
                 )
             ],
+            [],
         )
     start = data["robot"]["start"]
     settings = ImportSettings(
@@ -85,6 +94,7 @@ def map_shapes(
                 )
                 for d in exc.diagnostics
             ],
+            [],
         )
     problems: list[Diagnostic] = []
 
@@ -93,6 +103,7 @@ def map_shapes(
 
     boundary = shape(imported.boundary)
     holes = [shape(h) for h in imported.holes]
+    components = [(shape(outer), [shape(h) for h in inner]) for outer, inner in imported.components]
     regions = {name: shape(points) for name, points in imported.regions.items()}
     user_groups: dict[str, Any] = dict(data.get("groups") or {})
     for name in list(data["regions"]) + list(user_groups):
@@ -120,4 +131,4 @@ def map_shapes(
             regions[name] = checked
     if not problems:
         data["groups"] = {**{g: list(m) for g, m in imported.groups.items()}, **user_groups}
-    return boundary, holes, regions, problems
+    return boundary, holes, regions, problems, components

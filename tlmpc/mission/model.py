@@ -32,11 +32,48 @@ class Region:
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
-class Workspace:
-    """The outer boundary and the holes (obstacles that are never traversable)."""
+class Component:
+    """One connected piece of free space: an outer boundary minus its holes."""
 
     boundary: Polygon
     holes: tuple[Polygon, ...] = ()
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Workspace:
+    """The outer boundary and the holes (obstacles that are never traversable).
+
+    ``components`` are further pieces of free space, disjoint from the main one and from each
+    other (e.g. free pockets of a map enclosed by obstacles): the workspace is their union, and
+    the robot cannot cross between pieces.
+    """
+
+    boundary: Polygon
+    holes: tuple[Polygon, ...] = ()
+    components: tuple[Component, ...] = ()
+
+    @property
+    def pieces(self) -> tuple[Component, ...]:
+        """Every piece of free space, the main one (``boundary`` and ``holes``) first."""
+        return (Component(boundary=self.boundary, holes=self.holes), *self.components)
+
+    def to_json(self) -> dict[str, Any]:
+        """The ``workspace`` object of ``mission.json`` and ``trace.json`` (``components``
+        only when there are any)."""
+
+        def poly(p: Polygon) -> list[list[float]]:
+            return [[x, y] for x, y in p]
+
+        document: dict[str, Any] = {
+            "boundary": poly(self.boundary),
+            "holes": [poly(h) for h in self.holes],
+        }
+        if self.components:
+            document["components"] = [
+                {"boundary": poly(c.boundary), "holes": [poly(h) for h in c.holes]}
+                for c in self.components
+            ]
+        return document
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -126,10 +163,7 @@ class Mission:
             "format": "tlmpc.mission/1",
             "name": self.name,
             "source": self.source,
-            "workspace": {
-                "boundary": poly(self.workspace.boundary),
-                "holes": [poly(h) for h in self.workspace.holes],
-            },
+            "workspace": self.workspace.to_json(),
             "regions": {r.name: poly(r.polygon) for r in self.regions},
             "groups": {k: list(v) for k, v in self.groups.items()},
             "robot": {

@@ -258,11 +258,18 @@ def _region_facts(
                     )
                 )
             else:
+                pieces = len(np.unique(abstraction.component))
                 facts.append(
                     error(
                         "P005",
-                        f"region {name!r} cannot be reached from the "
-                        "start: holes separate it from the robot",
+                        f"region {name!r} cannot be reached from the start: "
+                        + (
+                            f"it lies in another of the {pieces} separate pieces of free "
+                            "space (workspace components, or parts that holes cut off), "
+                            "not in the robot's"
+                            if pieces > 1
+                            else "holes separate it from the robot"
+                        ),
                         hint="open a passage through the holes or move the start",
                         **where,
                     )

@@ -369,10 +369,7 @@ def trace_to_json(trace: Trace, mission: Mission) -> dict[str, object]:
         "format": "tlmpc.trace/1",
         "ltl": to_text(mission.formula),
         "regions": {r.name: poly(r.polygon) for r in mission.regions},
-        "workspace": {
-            "boundary": poly(mission.workspace.boundary),
-            "holes": [poly(h) for h in mission.workspace.holes],
-        },
+        "workspace": mission.workspace.to_json(),
         "boundary": mission.options.boundary,
         "max_speed": mission.robot.max_speed,
         "points": np.column_stack([trace.times, trace.points]).tolist(),

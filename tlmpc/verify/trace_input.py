@@ -35,6 +35,10 @@ class TraceInput:
     regions: Mapping[str, FloatArray]
     boundary_polygon: FloatArray | None = field(compare=False)
     holes: tuple[FloatArray, ...] = ()
+    #: further pieces of free space: each an outer boundary and its holes
+    components: tuple[tuple[FloatArray, tuple[FloatArray, ...]], ...] = field(
+        default=(), compare=False
+    )
     convention: str = "right"
     ending: Ending = "open"
     max_speed: float | None = None
@@ -129,6 +133,21 @@ def from_document(
     holes = tuple(
         _polygon(h, f"hole {i}", file) for i, h in enumerate(workspace.get("holes") or [])
     )
+    components_doc = workspace.get("components") or []
+    if not isinstance(components_doc, list) or not all(
+        isinstance(c, dict) and "boundary" in c for c in components_doc
+    ):
+        raise _fail("V004", "workspace.components is not a list of {boundary, holes}", file)
+    components = tuple(
+        (
+            _polygon(c["boundary"], f"boundary of component {k}", file),
+            tuple(
+                _polygon(h, f"hole {i} of component {k}", file)
+                for i, h in enumerate(c.get("holes") or [])
+            ),
+        )
+        for k, c in enumerate(components_doc)
+    )
     chosen = convention or document.get("boundary") or "right"
     if chosen not in ("right", "closed"):
         raise _fail(
@@ -159,6 +178,7 @@ def from_document(
         regions=regions,
         boundary_polygon=_polygon(boundary, "workspace boundary", file) if boundary else None,
         holes=holes,
+        components=components if boundary else (),
         convention=chosen,
         ending=ending,
         max_speed=_certifying_speed(speed),
@@ -252,10 +272,7 @@ def from_csv(
         "format": "tlmpc.trace/1",
         "ltl": to_text(mission.formula),
         "regions": {r.name: [list(p) for p in r.polygon] for r in mission.regions},
-        "workspace": {
-            "boundary": [list(p) for p in mission.workspace.boundary],
-            "holes": [[list(p) for p in h] for h in mission.workspace.holes],
-        },
+        "workspace": mission.workspace.to_json(),
         "boundary": mission.options.boundary,
         "max_speed": mission.robot.max_speed,
         "points": samples.tolist(),

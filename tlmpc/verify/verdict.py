@@ -103,9 +103,14 @@ class _Truth:
 def _free_space(trace: TraceInput) -> shapely.Geometry | None:
     if trace.boundary_polygon is None:
         return None
-    free = shapely.Polygon(trace.boundary_polygon)
-    if trace.holes:
-        free = free.difference(shapely.union_all([shapely.Polygon(h) for h in trace.holes]))
+    pieces = [(trace.boundary_polygon, trace.holes), *trace.components]
+    free_pieces = []
+    for boundary, holes in pieces:
+        free = shapely.Polygon(boundary)
+        if holes:
+            free = free.difference(shapely.union_all([shapely.Polygon(h) for h in holes]))
+        free_pieces.append(free)
+    free = free_pieces[0] if len(free_pieces) == 1 else shapely.union_all(free_pieces)
     shapely.prepare(free)
     return free
 
@@ -165,7 +170,10 @@ def workspace_violations(trace: TraceInput) -> tuple[list[Violation], float | No
             time = float(trace.times[index] + fraction * gap)
         else:
             time = float(trace.times[0])
-        in_hole = any(shapely.Polygon(h).intersects(segments[index]) for h in trace.holes)
+        in_hole = any(
+            shapely.Polygon(h).intersects(segments[index])
+            for h in (*trace.holes, *(h for _, holes in trace.components for h in holes))
+        )
         where = "entered a hole (an obstacle)" if in_hole else "left the workspace"
         x, y = float(entry[0]), float(entry[1])
         found.append(
