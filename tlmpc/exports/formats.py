@@ -63,6 +63,21 @@ def _oriented(ring: Ring, ccw: bool) -> Ring:
     return ring if (area > 0) == ccw else tuple(reversed(ring))
 
 
+def _rings(boundary: Ring, holes: tuple[Ring, ...]) -> list[list[list[float]]]:
+    return [_closed(_oriented(boundary, True))] + [_closed(_oriented(h, False)) for h in holes]
+
+
+def _workspace_geometry(plan: Plan) -> dict[str, Any]:
+    """A Polygon, or a MultiPolygon when the workspace has further components."""
+    if not plan.components:
+        return {"type": "Polygon", "coordinates": _rings(plan.boundary, plan.holes)}
+    return {
+        "type": "MultiPolygon",
+        "coordinates": [_rings(plan.boundary, plan.holes)]
+        + [_rings(outer, inner) for outer, inner in plan.components],
+    }
+
+
 def geojson(plan: Plan, points: list[Waypoint], loop: int | None) -> str:
     """A FeatureCollection in the map frame (metres): workspace, regions, trajectory, waypoints.
 
@@ -72,11 +87,7 @@ def geojson(plan: Plan, points: list[Waypoint], loop: int | None) -> str:
         {
             "type": "Feature",
             "properties": {"kind": "workspace", "name": plan.name},
-            "geometry": {
-                "type": "Polygon",
-                "coordinates": [_closed(_oriented(plan.boundary, True))]
-                + [_closed(_oriented(h, False)) for h in plan.holes],
-            },
+            "geometry": _workspace_geometry(plan),
         }
     ]
     for name, ring in plan.regions.items():

@@ -28,6 +28,8 @@ class Plan:
     holes: tuple[Ring, ...]
     regions: dict[str, Ring]
     formula: str
+    #: further pieces of free space (workspace components): outer ring and holes
+    components: tuple[tuple[Ring, tuple[Ring, ...]], ...] = ()
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -72,6 +74,10 @@ def read_plan(directory: Path) -> Plan:
             name=str(mission.get("name") or "mission"),
             boundary=_ring(workspace["boundary"]),
             holes=tuple(_ring(h) for h in workspace.get("holes") or []),
+            components=tuple(
+                (_ring(c["boundary"]), tuple(_ring(h) for h in c.get("holes") or []))
+                for c in workspace.get("components") or []
+            ),
             regions={str(k): _ring(v) for k, v in mission["regions"].items()},
             formula=str(mission.get("formula", "")),
         )

@@ -31,13 +31,20 @@ def _finite(value: Any) -> Any:
 
 
 def _outside_intervals(
-    samples: list[list[float]], boundary: list[list[float]], holes: list[list[list[float]]]
+    samples: list[list[float]],
+    boundary: list[list[float]],
+    holes: list[list[list[float]]],
+    components: list[dict[str, Any]] | None = None,
 ) -> list[list[int]]:
     """Index ranges ``[first, last]`` of the segments (sample k to k+1) that leave the
-    workspace or cross a hole; a lone sample outside counts as the segment from it."""
-    from shapely import LineString, Point, Polygon, prepared
+    workspace (every piece of it) or cross a hole; a lone sample outside counts as the segment
+    from it."""
+    from shapely import LineString, Point, Polygon, prepared, union_all
 
-    area = prepared.prep(Polygon(boundary, holes))
+    pieces = [Polygon(boundary, holes)] + [
+        Polygon(c["boundary"], c["holes"]) for c in components or []
+    ]
+    area = prepared.prep(pieces[0] if len(pieces) == 1 else union_all(pieces))
     ranges: list[list[int]] = []
     for index in range(max(len(samples) - 1, 1)):
         a = samples[index]
@@ -65,18 +72,22 @@ def _scene(
 ) -> dict[str, Any]:
     boundary = _points(workspace["boundary"])
     holes = [_points(h) for h in workspace.get("holes", [])]
+    components = [
+        {"boundary": _points(c["boundary"]), "holes": [_points(h) for h in c.get("holes", [])]}
+        for c in workspace.get("components", [])
+    ]
     scene: dict[str, Any] = _finite(
         {
             "format": "tlmpc.view/1",
             "title": title,
             "formula": formula,
-            "workspace": {"boundary": boundary, "holes": holes},
+            "workspace": {"boundary": boundary, "holes": holes, "components": components},
             "regions": {name: _points(poly) for name, poly in regions.items()},
             "mesh": mesh,
             "trajectory": samples,
             "loop_start": loop_start,
             "verdict": verdict,
-            "outside": _outside_intervals(samples, boundary, holes) if samples else [],
+            "outside": _outside_intervals(samples, boundary, holes, components) if samples else [],
         }
     )
     return scene
@@ -145,10 +156,7 @@ def scene_from_log(log: Path, mission_path: Path) -> dict[str, Any]:
     ]
     return _scene(
         title=f"{log.name} against {mission.name}",
-        workspace={
-            "boundary": mission.workspace.boundary,
-            "holes": list(mission.workspace.holes),
-        },
+        workspace=mission.workspace.to_json(),
         regions={r.name: r.polygon for r in mission.regions},
         samples=samples,
         loop_start=trace.loop_start,
