@@ -17,7 +17,7 @@ from shapely.geometry import Point, Polygon, box
 
 from tlmpc.cli import main
 from tlmpc.errors import UsageError
-from tlmpc.importers.maps import ImportSettings, import_map
+from tlmpc.importers.maps import ImportedMap, ImportSettings, import_map
 from tlmpc.importers.occupancy import cell_values, read_map
 from tlmpc.mission.load import check_file, load_mission
 
@@ -122,6 +122,55 @@ def test_exact_import_is_the_largest_free_component(
     for r, c in largest:
         assert workspace.covers(Point(c + 0.5, r + 0.5))
     assert imported.free_cells_area == pytest.approx(int(free.sum()))
+
+
+def pieces_of(imported: ImportedMap) -> list[Polygon]:
+    return [Polygon(imported.boundary, imported.holes)] + [
+        Polygon(outer, inner) for outer, inner in imported.components
+    ]
+
+
+@given(free=grids)
+def test_exact_import_keeps_every_free_component(
+    tmp_path_factory: pytest.TempPathFactory, free: np.ndarray
+) -> None:
+    parts = components(free)
+    if not parts:
+        return
+    directory = tmp_path_factory.mktemp("map")
+    path = write_map(directory, "m", image_from_free(free), resolution=1.0)
+    imported = import_map(path, ImportSettings(tolerance=0.0, min_area=0.0))
+    pieces = pieces_of(imported)
+    assert len(pieces) == len(parts)
+    assert all(p.is_valid for p in pieces)
+    # one piece per 4-connected component, covering exactly its cells
+    for part in parts:
+        cells = shapely.union_all([box(c, r, c + 1, r + 1) for r, c in part])
+        matches = [p for p in pieces if p.intersection(cells).area > 0]
+        assert len(matches) == 1
+        assert matches[0].symmetric_difference(cells).area == pytest.approx(0.0, abs=1e-9)
+    assert imported.workspace_area == pytest.approx(int(free.sum()))
+    # pieces are interior-disjoint and share no edge (they may touch at corners)
+    for i, a in enumerate(pieces):
+        for b in pieces[i + 1 :]:
+            assert a.intersection(b).area == 0
+            assert a.boundary.intersection(b.boundary).length == 0
+
+
+def test_small_free_pieces_are_specks(tmp_path: Path) -> None:
+    free = np.zeros((12, 20), dtype=bool)
+    free[1:11, 1:10] = True  # the room: 90 cells
+    free[1:5, 12:15] = True  # a 12-cell pocket
+    free[8, 12:14] = True  # a 2-cell speck
+    free[8, 17] = True  # a 1-cell speck
+    path = write_map(tmp_path, "m", image_from_free(free), resolution=0.5)
+    every = import_map(path, ImportSettings(tolerance=0.0, min_area=0.0))
+    assert sorted(Polygon(o).area for o, _ in every.components) == pytest.approx([0.25, 0.5, 3.0])
+    default = import_map(path, ImportSettings(tolerance=0.0))  # 4 cells of 0.25
+    assert [Polygon(o).area for o, _ in default.components] == pytest.approx([3.0])
+    assert default.workspace_area == pytest.approx(0.25 * (90 + 12))
+    large = import_map(path, ImportSettings(tolerance=0.0, min_area=3.5))
+    assert large.components == ()
 
 
 @given(free=grids, tolerance=st.sampled_from([0.5, 1.0, 2.0]))
@@ -385,6 +434,22 @@ REAL_MAPS = (
 )
 
 
+def free_cells_oracle(map_yaml: Path) -> float:
+    """The free area of a trinary map_server map, from its image with numpy alone."""
+    import yaml
+    from PIL import Image
+
+    info = yaml.safe_load(map_yaml.read_text())
+    assert info.get("mode", "trinary") == "trinary"
+    pixels = np.asarray(Image.open(map_yaml.parent / info["image"]), dtype=np.float64)
+    if pixels.ndim == 3:
+        pixels = pixels[..., : 1 if pixels.shape[2] <= 2 else 3].mean(axis=2)
+    shade = pixels / 255.0
+    occupancy = shade if info.get("negate", 0) else 1.0 - shade
+    free = occupancy < float(info["free_thresh"])
+    return float(np.count_nonzero(free)) * float(info["resolution"]) ** 2
+
+
 @pytest.mark.parametrize(("name", "keepout", "speed"), REAL_MAPS)
 def test_real_maps_import_into_valid_missions(
     tmp_path: Path, name: str, keepout: str | None, speed: str | None
@@ -395,13 +460,14 @@ def test_real_maps_import_into_valid_missions(
         keepout=maps / f"{keepout}.yaml" if keepout else None,
         speed=maps / f"{speed}.yaml" if speed else None,
     )
-    workspace = Polygon(imported.boundary, imported.holes)
-    assert workspace.is_valid
-    grid = read_map(maps / f"{name}.yaml")
-    parts = components(grid.values == 0)
-    largest = max(len(p) for p in parts) * grid.cell_area()
-    # The robot's free piece, simplified within one cell and specks filled: within 2%.
-    assert workspace.area == pytest.approx(largest, rel=0.02)
+    pieces = pieces_of(imported)
+    assert all(p.is_valid for p in pieces)
+    # Every free piece above the speck threshold, simplified within one cell and specks
+    # filled: within 2% of the map's free cells, counted here from the image itself.
+    free_area = free_cells_oracle(maps / f"{name}.yaml")
+    assert imported.free_cells_area == pytest.approx(free_area)
+    assert sum(p.area for p in pieces) == pytest.approx(free_area, rel=0.02)
+    assert imported.workspace_area == pytest.approx(sum(p.area for p in pieces))
     if keepout:
         assert imported.groups["keepout"]
     out = tmp_path / f"{name}.yaml"

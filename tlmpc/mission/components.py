@@ -1,6 +1,7 @@
 """Geometry checks of a workspace with several pieces of free space (``workspace.components``).
 
-Each piece is a boundary minus its own holes; pieces must not overlap (they may touch), a
+Each piece is a boundary minus its own holes; pieces must not overlap nor share an edge (they
+may touch at points), a
 piece may sit inside another's hole (a free pocket enclosed by an obstacle), and regions and the
 start are checked against the union of the pieces' free space.
 """
@@ -67,18 +68,33 @@ def check_pieces(
             continue
         shared = free[i].intersection(free[j]).area
         scale = min(free[i].area, free[j].area)
-        if shared > AREA_TOLERANCE * max(scale, 1e-300) and shared > 0:
-            reported.add(j)
-            problems.append(
-                at(
-                    pieces[j][0].path,
-                    "M100",
-                    f"the free space of {_label(j)} overlaps that of {_label(i)} "
-                    f"(by {shared:.6g} square units)",
-                    "workspace components are disjoint pieces of free space; a component may "
-                    "lie inside another's hole, or touch it, but not overlap its free space",
+        if not (shared > AREA_TOLERANCE * max(scale, 1e-300) and shared > 0):
+            # not overlapping: touching at points is fine, along an edge it is one piece
+            edge = free[i].boundary.intersection(free[j].boundary).length
+            if edge > 0:
+                reported.add(j)
+                problems.append(
+                    at(
+                        pieces[j][0].path,
+                        "M101",
+                        f"{_label(j)} shares an edge with {_label(i)} "
+                        f"({edge:.6g} long): the robot could cross it",
+                        "pieces may touch only at points; join pieces that share an edge "
+                        "into one boundary",
+                    )
                 )
+            continue
+        reported.add(j)
+        problems.append(
+            at(
+                pieces[j][0].path,
+                "M100",
+                f"the free space of {_label(j)} overlaps that of {_label(i)} "
+                f"(by {shared:.6g} square units)",
+                "workspace components are disjoint pieces of free space; a component may "
+                "lie inside another's hole, or touch it, but not overlap its free space",
             )
+        )
     union = shapely.union_all(free)
     shapely.prepare(union)
     outers = shapely.union_all([boundary.polygon for boundary, _ in pieces])
