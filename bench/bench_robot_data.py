@@ -4,7 +4,8 @@ For each map in the shared data folder (``$TLMPC_SHARED_DATA``, else ``<repo>/..
 skipped when absent): ``tlmpc import-map`` (with the keepout and speed masks where the map has
 them), ``tlmpc check``, ``tlmpc compile`` (which verifies its trace) with the task "avoid keepout,
 visit a goal", each in a fresh interpreter (wall time); the workspace area against the map's
-free cells (all of them, and those of the free piece the robot is in).  Then each form of the
+free cells (all of them, and the main piece's against the free piece the robot is in), and
+how many further free pieces the workspace keeps.  Then each form of the
 real Jackal bag (ROS 1, ROS 2 sqlite3, ROS 2 MCAP, the bare .mcap file) and a CSV written from
 it are verified against a mission, and the verdicts and trajectories compared.
 
@@ -73,6 +74,8 @@ def _goal(imported: ImportedMap) -> tuple[float, float, float, float]:
 
 def map_rows(data: Path, radius: float, work: Path) -> list[dict[str, Any]]:
     """Import, check, compile and verify each real map."""
+    from shapely.geometry import Polygon
+
     from tlmpc.importers.maps import ImportSettings, free_geometry, import_map
     from tlmpc.importers.occupancy import read_map
     from tlmpc.importers.polygonize import polygons
@@ -138,7 +141,8 @@ def map_rows(data: Path, radius: float, work: Path) -> list[dict[str, Any]]:
         ok_check = "ok" if checked.returncode == 0 else "FAIL"
         ok_compile = "ok" if compiled.returncode == 0 else "FAIL"
         ratio_all = 100 * imported.workspace_area / imported.free_cells_area
-        ratio_piece = 100 * imported.workspace_area / main_piece
+        # the main piece alone against the largest exact free piece (the robot's, at r=0)
+        ratio_piece = 100 * Polygon(imported.boundary, imported.holes).area / main_piece
         rows.append(
             {
                 "map": name,
@@ -148,7 +152,9 @@ def map_rows(data: Path, radius: float, work: Path) -> list[dict[str, Any]]:
                 "compile+verify s": f"{seconds_compile:.2f} ({ok_compile})",
                 "verdict": "satisfied" if verdict.get("satisfied") else "VIOLATED/none",
                 "area / free cells (r=0)": f"{ratio_all:.2f}%",
-                "area / robot's free piece (r=0)": f"{ratio_piece:.2f}%",
+                "main piece / robot's free piece (r=0)": f"{ratio_piece:.2f}%",
+                "further pieces (r=0 / r)": f"{len(imported.components)} / "
+                f"{len(draft.components)}",
                 "triangles": triangles,
             }
         )

@@ -29,7 +29,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--tolerance", type=float, help="simplification tolerance (default: one cell)"
     )
     parser.add_argument(
-        "--min-area", type=float, help="drop obstacle specks smaller than this (default: 4 cells)"
+        "--min-area",
+        type=float,
+        help="drop obstacle specks and free pieces smaller than this (default: 4 cells)",
     )
     parser.add_argument(
         "--start",
