@@ -67,6 +67,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="X,Y,YAW",
         help="logs: map the log's frame into the mission's (p = R(YAW) p_log + (X, Y))",
     )
+    parser.add_argument(
+        "--frame",
+        metavar="FRAME",
+        help="bags: express the poses in FRAME (e.g. map) through the bag's /tf and /tf_static "
+        "(default: the poses' own frame)",
+    )
 
 
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
@@ -91,6 +97,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             topic=args.topic,
             columns=parse_columns(args.columns) if args.columns else None,
             transform=parse_transform(args.transform) if args.transform else None,
+            frame=args.frame,
         )
     else:
         document = read_json(path)

@@ -14,7 +14,9 @@
   stamp keeps its first sample.
 
 An optional rigid ``transform`` ``(x, y, yaw)`` maps the log's frame into the mission's
-(e.g. ``odom`` into ``map``): ``p_mission = R(yaw) p_log + (x, y)``.
+(e.g. ``odom`` into ``map``): ``p_mission = R(yaw) p_log + (x, y)``.  For bags, ``frame``
+instead looks the transform up in the bag's ``/tf`` and ``/tf_static`` at each pose's stamp
+(:mod:`tlmpc.importers.frames`).
 
 This module imports nothing from the planning stages; ``rosbags`` is imported only for bags.
 """
@@ -84,19 +86,35 @@ def read_log(
     topic: str | None = None,
     columns: Sequence[str] | None = None,
     transform: tuple[float, float, float] | None = None,
+    frame: str | None = None,
 ) -> Log:
-    """Read a CSV log or a ROS bag; raise :class:`UsageError` (M050–M079) on bad input."""
+    """Read a CSV log or a ROS bag; raise :class:`UsageError` (M050–M079, M102–M106) on bad
+    input.  ``frame`` (bags): express the poses in that frame through the bag's tf."""
     file = str(path)
     if not path.exists():
         raise _fail("M050", f"cannot read {file}: no such file or directory", file)
+    if frame is not None and transform is not None:
+        raise _fail(
+            "M105",
+            "--frame and --transform both given",
+            file,
+            hint="--frame takes the transform from the bag's tf; --transform gives a fixed one",
+        )
     if path.suffix.lower() in CSV_SUFFIXES and not path.is_dir():
         if topic is not None:
             raise _fail("M058", "--topic applies to bags, not to CSV logs", file)
+        if frame is not None:
+            raise _fail(
+                "M105",
+                "--frame applies to bags, not to CSV logs (a CSV carries no frames)",
+                file,
+                hint="use --transform X,Y,YAW to move a CSV log into the mission's frame",
+            )
         log = read_csv_log(path, columns)
     else:
         if columns is not None:
             raise _fail("M058", "--columns applies to CSV logs, not to bags", file)
-        log = read_bag(path, topic)
+        log = read_bag(path, topic, frame)
     if transform is None:
         return log
     return Log(
@@ -270,8 +288,12 @@ def _listing(connections: Sequence[tuple[str, str, int]]) -> str:
     return "; ".join(f"{topic} ({kind}, {count} messages)" for topic, kind, count in connections)
 
 
-def read_bag(path: Path, topic: str | None = None) -> Log:
-    """Poses from a ROS 1 bag, a ROS 2 bag directory or an MCAP file."""
+def read_bag(path: Path, topic: str | None = None, frame: str | None = None) -> Log:
+    """Poses from a ROS 1 bag, a ROS 2 bag directory or an MCAP file.
+
+    With ``frame``, each pose is expressed in that frame through the bag's ``/tf`` and
+    ``/tf_static`` at its stamp (see :mod:`tlmpc.importers.frames`).
+    """
     from rosbags.highlevel import AnyReader
     from rosbags.typesys import Stores, get_typestore
 
@@ -330,6 +352,7 @@ def read_bag(path: Path, topic: str | None = None) -> Log:
             chosen = [c for c in poses if c.topic == topics[0]]
             topic = topics[0]
         rows: list[tuple[int, float, float]] = []
+        frames: list[tuple[int, float, float, float, str]] = []
         try:
             for connection, log_time, raw in reader.messages(connections=chosen):
                 message: Any = reader.deserialize(raw, connection.msgtype)
@@ -338,13 +361,20 @@ def read_bag(path: Path, topic: str | None = None) -> Log:
                     pose = getattr(pose, part)
                 stamp = message.header.stamp
                 nanoseconds = int(stamp.sec) * 1_000_000_000 + int(stamp.nanosec)
-                rows.append(
-                    (
-                        nanoseconds if nanoseconds else int(log_time),
-                        float(pose.position.x),
-                        float(pose.position.y),
+                when = nanoseconds if nanoseconds else int(log_time)
+                rows.append((when, float(pose.position.x), float(pose.position.y)))
+                if frame is not None:
+                    frames.append(
+                        (
+                            when,
+                            float(pose.position.x),
+                            float(pose.position.y),
+                            float(pose.position.z),
+                            str(message.header.frame_id),
+                        )
                     )
-                )
+            if frame is not None:
+                rows = _in_frame(reader, frames, frame, file)
         except UsageError:
             raise
         except Exception as exc:
@@ -354,6 +384,54 @@ def read_bag(path: Path, topic: str | None = None) -> Log:
     finally:
         reader.close()
     return Log(samples=_sorted_samples(rows), source=file, topic=topic)
+
+
+def _in_frame(
+    reader: Any, poses: list[tuple[int, float, float, float, str]], frame: str, file: str
+) -> list[tuple[int, float, float]]:
+    """The poses (stamp, x, y, z, frame id) expressed in ``frame`` through the bag's tf."""
+    from tlmpc.importers.frames import TF_TYPE, TransformCollector, frame_name
+
+    if all(frame_name(f) == frame_name(frame) for *_, f in poses):
+        return [(t, x, y) for t, x, y, _, _ in poses]
+    connections = [c for c in reader.connections if c.msgtype == TF_TYPE]
+    if not connections:
+        logged = sorted({f for *_, f in poses})
+        raise _fail(
+            "M102",
+            f"--frame {frame}: the poses are in {', '.join(map(repr, logged))} and the bag has "
+            "no /tf or /tf_static (tf2_msgs/TFMessage) to transform them with",
+            file,
+            hint="record /tf and /tf_static with the poses, or give a fixed transform with "
+            "--transform X,Y,YAW instead of --frame",
+        )
+    collector = TransformCollector(file)
+    for connection, _, raw in reader.messages(connections=connections):
+        message: Any = reader.deserialize(raw, connection.msgtype)
+        static = connection.topic.rstrip("/").endswith("tf_static")
+        for transform in message.transforms:
+            stamp = transform.header.stamp
+            t, r = transform.transform.translation, transform.transform.rotation
+            collector.add(
+                parent=str(transform.header.frame_id),
+                child=str(transform.child_frame_id),
+                stamp=int(stamp.sec) * 1_000_000_000 + int(stamp.nanosec),
+                translation=(float(t.x), float(t.y), float(t.z)),
+                rotation=(float(r.x), float(r.y), float(r.z), float(r.w)),
+                static=static,
+            )
+    tree = collector.tree()
+    stamps = np.asarray([p[0] for p in poses], dtype=np.int64)
+    positions = np.asarray([p[1:4] for p in poses], dtype=np.float64).reshape(-1, 3)
+    sources = np.asarray([frame_name(p[4]) for p in poses])
+    result = np.empty_like(positions)
+    for source in sorted(set(sources.tolist())):
+        chosen = sources == source
+        result[chosen] = tree.express(frame, source, stamps[chosen], positions[chosen])
+    return [
+        (int(t), float(x), float(y))
+        for t, (x, y) in zip(stamps.tolist(), result[:, :2].tolist(), strict=True)
+    ]
 
 
 def _sorted_samples(rows: list[tuple[int, float, float]]) -> FloatArray:

@@ -249,8 +249,11 @@ def from_csv(
     topic: str | None = None,
     columns: Sequence[str] | None = None,
     transform: tuple[float, float, float] | None = None,
+    frame: str | None = None,
 ) -> TraceInput:
-    """A logged trajectory (CSV or ROS bag) checked against a mission file's regions and task."""
+    """A logged trajectory (CSV or ROS bag) checked against a mission file's regions and task.
+
+    ``frame`` (bags): the poses are expressed in that frame through the bag's tf."""
     if mission_path is None:
         raise _fail(
             "V010", "a CSV trace needs --mission MISSION.yaml for its regions and task", str(path)
@@ -266,7 +269,7 @@ def from_csv(
         raise UsageError(exc.diagnostics) from None
     if path.suffix.lower() in CSV_SUFFIXES and path.is_file():
         check_csv_file(path)  # bounded before parsing
-    log = read_log(path, topic=topic, columns=columns, transform=transform)
+    log = read_log(path, topic=topic, columns=columns, transform=transform, frame=frame)
     samples = _samples(log.samples, str(path), list(log.lines) or None)
     document = {
         "format": "tlmpc.trace/1",
