@@ -163,14 +163,20 @@ def test_small_free_pieces_are_specks(tmp_path: Path) -> None:
     free[1:5, 12:15] = True  # a 12-cell pocket
     free[8, 12:14] = True  # a 2-cell speck
     free[8, 17] = True  # a 1-cell speck
+    free[10, 12:16] = True  # a 4-cell piece: exactly the threshold, so kept
     path = write_map(tmp_path, "m", image_from_free(free), resolution=0.5)
     every = import_map(path, ImportSettings(tolerance=0.0, min_area=0.0))
-    assert sorted(Polygon(o).area for o, _ in every.components) == pytest.approx([0.25, 0.5, 3.0])
+    assert sorted(Polygon(o).area for o, _ in every.components) == pytest.approx(
+        [0.25, 0.5, 1.0, 3.0]
+    )
     default = import_map(path, ImportSettings(tolerance=0.0))  # 4 cells of 0.25
-    assert [Polygon(o).area for o, _ in default.components] == pytest.approx([3.0])
-    assert default.workspace_area == pytest.approx(0.25 * (90 + 12))
+    assert [Polygon(o).area for o, _ in default.components] == pytest.approx([3.0, 1.0])
+    assert default.workspace_area == pytest.approx(0.25 * (90 + 12 + 4))
     large = import_map(path, ImportSettings(tolerance=0.0, min_area=3.5))
     assert large.components == ()
+    # with the default tolerance (one cell) the pieces are simplified, and still kept
+    simplified = import_map(path, ImportSettings())
+    assert len(simplified.components) == 2
 
 
 @given(free=grids, tolerance=st.sampled_from([0.5, 1.0, 2.0]))

@@ -247,6 +247,31 @@ def multi_piece_missions(draw: st.DrawFn) -> Mission:
     )
 
 
+def test_obstacle_space_enclosed_by_pieces_touching_at_corners_gets_no_triangle() -> None:
+    """Four triangles touching at the corners of a diamond: the diamond is no piece's hole."""
+    corners = [
+        ((0.0, 0.0), (1.0, 0.0), (0.0, 1.0)),
+        ((1.0, 0.0), (2.0, 0.0), (2.0, 1.0)),
+        ((2.0, 1.0), (2.0, 2.0), (1.0, 2.0)),
+        ((1.0, 2.0), (0.0, 2.0), (0.0, 1.0)),
+    ]
+    mission = Mission(
+        name="diamond",
+        workspace=Workspace(
+            boundary=corners[0], components=tuple(Component(boundary=c) for c in corners[1:])
+        ),
+        regions=(Region(name="r", polygon=((0.1, 0.1), (0.4, 0.1), (0.1, 0.4))),),
+        robot=Robot(start=(0.2, 0.2)),
+        formula=TRUE,
+        options=Options(min_angle=None),
+    )
+    abstraction = build_abstraction(mission)
+    triangles = [Polygon(c) for c in abstraction.vertices[abstraction.triangles]]
+    assert sum(t.area for t in triangles) == pytest.approx(4 * 0.5)
+    diamond = Polygon([(1, 0), (2, 1), (1, 2), (0, 1)])
+    assert all(t.intersection(diamond).area < 1e-12 for t in triangles)
+
+
 def piece_polygons(mission: Mission) -> list[Any]:
     return [
         Polygon(p.boundary).difference(shapely.union_all([Polygon(h) for h in p.holes]))
