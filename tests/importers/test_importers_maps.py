@@ -293,6 +293,58 @@ def test_masks_become_regions_and_groups(tmp_path: Path) -> None:
     assert Polygon(eroded.regions[band]).symmetric_difference(want_band).area < 1e-9
 
 
+@pytest.mark.parametrize("pocket_marked", [False, True])
+def test_mask_regions_around_a_free_pocket_label_it_only_if_the_mask_does(
+    tmp_path: Path, pocket_marked: bool
+) -> None:
+    """A keepout ring around a rack whose free pocket (another workspace piece) is or is not
+    in the keepout mask: the pocket's free space is in a keepout region exactly when marked."""
+    free = np.ones((20, 20), dtype=bool)
+    free[0, :] = free[-1, :] = free[:, 0] = free[:, -1] = False
+    free[6:14, 6:14] = False  # the rack
+    free[9:11, 9:11] = True  # a free pocket inside it
+    path = write_map(tmp_path, "m", image_from_free(free), resolution=1.0)
+    mask = np.zeros((20, 20), dtype=bool)
+    mask[4:16, 4:16] = True  # keepout around the rack ...
+    if not pocket_marked:
+        mask[9:11, 9:11] = False  # ... but not its pocket
+    keepout = write_map(tmp_path, "keep", image_from_free(~mask), resolution=1.0)
+    imported = import_map(
+        path, ImportSettings(tolerance=0.0, min_area=0.0, start=(1.5, 1.5)), keepout=keepout
+    )
+    assert len(imported.components) == 1
+    pocket = Polygon(*imported.components[0])
+    assert pocket.equals(box(9, 9, 11, 11))
+    regions = [Polygon(imported.regions[n]) for n in imported.groups["keepout"]]
+    assert all(r.is_valid and not r.interiors for r in regions)
+    covered = shapely.union_all(regions)
+    free_space = shapely.union_all([Polygon(imported.boundary, imported.holes), pocket])
+    cells = shapely.union_all(
+        [box(c, r, c + 1, r + 1) for r, c in zip(*np.nonzero(mask & free), strict=True)]
+    )
+    # the keepout regions' free part is exactly the marked free cells
+    assert covered.intersection(free_space).symmetric_difference(cells).area < 1e-9
+    # and the mission is valid and compiles with the pocket labelled as the mask says
+    out = tmp_path / "m-mission.yaml"
+    code, _, err = run(
+        "import-map",
+        str(path),
+        "--keepout",
+        str(keepout),
+        "--start",
+        "1.5",
+        "1.5",
+        "--tolerance",
+        "0",
+        "--min-area",
+        "0",
+        "-o",
+        str(out),
+    )
+    assert code == 0, err
+    assert check_file(out) == []
+
+
 # --- the mission form and the command -------------------------------------------------------
 
 

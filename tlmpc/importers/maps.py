@@ -25,9 +25,10 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 import shapely
-from shapely.geometry import MultiPolygon, Polygon
+from shapely.geometry import LineString, MultiPolygon, Polygon
 from shapely.geometry import Point as ShapelyPoint
 from shapely.geometry.base import BaseGeometry
+from shapely.ops import split
 
 from tlmpc.errors import UsageError, error
 from tlmpc.importers.occupancy import FREE, OCCUPIED, OccupancyGrid, read_map
@@ -204,6 +205,33 @@ def _coverage(
     return merged, by_label
 
 
+def _simple_parts(piece: Polygon, free: BaseGeometry, members: BaseGeometry) -> list[Polygon]:
+    """Simple polygons (regions have no holes) covering ``piece`` and its fillable holes.
+
+    A hole of a mask piece is usually an obstacle, which the region may cover: only its outer
+    ring is kept.  But a hole may enclose free space of another workspace piece (a free pocket
+    inside a rack) that the mask does not mark; filling that hole would label the pocket
+    wrongly.  Such a piece is cut by a vertical line through the hole, opening it, until every
+    hole left is fillable.
+    """
+
+    def fillable(ring: Any) -> bool:
+        inside = Polygon(ring).intersection(free)
+        return bool(inside.difference(members).area <= 1e-9 * max(inside.area, 1.0))
+
+    blocking = [ring for ring in piece.interiors if not fillable(ring)]
+    if not blocking:
+        return [Polygon(piece.exterior)]
+    x = Polygon(blocking[0]).representative_point().x  # strictly inside the hole
+    _, miny, _, maxy = piece.bounds
+    cut = LineString([(x, miny - 1.0), (x, maxy + 1.0)])
+    return [
+        simple
+        for part in polygons(split(piece, cut))
+        for simple in _simple_parts(part, free, members)
+    ]
+
+
 def _exact_free(
     grid: OccupancyGrid, settings: ImportSettings, min_area_cells: float
 ) -> tuple[Polygon, list[Polygon]]:
@@ -263,6 +291,7 @@ def import_map(
     )
     outer_cells = shapely.union_all([Polygon(p.exterior) for p in kept_cells])
     shapely.prepare(outer_cells)
+    free_union = shapely.union_all(kept_cells)
     regions: dict[str, Ring] = {}
     groups: dict[str, tuple[str, ...]] = {}
     for prefix, _, mask in mask_grids:
@@ -280,11 +309,15 @@ def import_map(
             ]
             if not members:
                 continue
-            merged = polygons(shapely.union_all(members))
+            covered = shapely.union_all(members)
+            merged = polygons(covered)
             outers = [
-                Polygon(p.exterior)
+                simple
                 for p in merged
-                if p.area >= min_area / cell_area and outer_cells.covers(p)
+                if p.area >= min_area / cell_area
+                and outer_cells.covers(p)
+                and p.intersection(free_union).area > 0
+                for simple in _simple_parts(p, free_union, covered)
             ]
             outers = [to_world(p, grid.resolution, grid.origin) for p in outers]
             outers.sort(key=lambda p: (-p.area, p.bounds))
