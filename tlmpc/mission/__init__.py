@@ -8,9 +8,10 @@ from tlmpc.mission.load import (
     load_mission,
     load_mission_text,
 )
-from tlmpc.mission.model import Mission, Options, Region, Robot, Workspace
+from tlmpc.mission.model import Component, Mission, Options, Region, Robot, Workspace
 
 __all__ = [
+    "Component",
     "Mission",
     "Options",
     "Region",
