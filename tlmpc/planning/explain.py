@@ -265,8 +265,8 @@ def _region_facts(
                         f"region {name!r} cannot be reached from the start: "
                         + (
                             f"it lies in another of the {pieces} separate pieces of free "
-                            "space (workspace components, or parts that holes cut off), "
-                            "not in the robot's"
+                            "space (holes separate it from the robot's piece, or it is a "
+                            "separate workspace component)"
                             if pieces > 1
                             else "holes separate it from the robot"
                         ),
