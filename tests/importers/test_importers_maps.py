@@ -377,6 +377,29 @@ def test_mission_form_loads_and_compiles(tmp_path: Path) -> None:
     assert code == 0, err
 
 
+def test_mission_form_keeps_the_free_pockets_as_components(tmp_path: Path) -> None:
+    free = np.ones((30, 30), dtype=bool)
+    free[0, :] = free[-1, :] = free[:, 0] = free[:, -1] = False
+    free[8:22, 8:22] = False  # a rack ...
+    free[12:18, 12:18] = True  # ... with a free pocket inside
+    write_map(tmp_path, "rack", image_from_free(free), resolution=0.1)
+    mission = tmp_path / "mission.yaml"
+    mission.write_text(
+        "version: 1\nworkspace: {map: rack.yaml}\n"
+        "regions:\n  goal: {rect: [2.5, 2.5, 2.9, 2.9]}\n  inside: {rect: [1.3, 1.3, 1.7, 1.7]}\n"
+        "robot: {start: [0.5, 0.5]}\ntask: [visit goal]\n"
+    )
+    assert check_file(mission) == []
+    loaded = load_mission(mission)
+    (pocket,) = loaded.workspace.components
+    assert Polygon(pocket.boundary).symmetric_difference(box(1.2, 1.2, 1.8, 1.8)).area < 1e-12
+    code, _, err = run("compile", str(mission), "-o", str(tmp_path / "out"), "--until", "verify")
+    assert code == 0, err
+    assert (
+        "region 'inside' is not reachable from the start: it lies in workspace component 0" in err
+    )
+
+
 @pytest.mark.parametrize(
     ("workspace", "code"),
     [
