@@ -212,7 +212,6 @@ def test_the_adversary_pushes_out_of_the_nearest_guarded_facet_or_against_the_ex
         exit_b = vertices[(step.exit_edge + 2) % 3]
         exit_normal = np.array([exit_b[1] - exit_a[1], exit_a[0] - exit_b[0]])
         exit_normal /= np.linalg.norm(exit_normal)
-        centroid = vertices.mean(axis=0)
         for weights in rng.dirichlet(np.ones(3), size=8):
             point = weights @ vertices
             direction = adversarial_direction(executor, point)
@@ -227,9 +226,11 @@ def test_the_adversary_pushes_out_of_the_nearest_guarded_facet_or_against_the_ex
                 (i for i in range(3) if i != step.exit_edge), key=lambda i: facet_distance[i]
             )
             if facet_distance[guarded] < facet_distance[step.exit_edge] - 1e-9:
-                # Outward through that facet: away from the triangle's inside.
-                assert direction @ (centroid - point) < 0 or facet_distance[guarded] > 0
-                assert direction @ exit_normal <= 1.0
+                # Straight out through that facet: perpendicular to it, away from the vertex
+                # opposite it.
+                a, b = vertices[(guarded + 1) % 3], vertices[(guarded + 2) % 3]
+                assert abs(float(direction @ (b - a))) < 1e-9
+                assert float(direction @ (vertices[guarded] - a)) < 0
             elif facet_distance[step.exit_edge] < facet_distance[guarded] - 1e-9:
                 assert np.allclose(direction, -exit_normal)
 
