@@ -77,7 +77,7 @@ def test_a_run_cut_before_a_lap_is_inconclusive_exit_4(patrol: Path) -> None:
 
 
 def test_pushing_above_the_declared_bound_says_so(patrol: Path) -> None:
-    code, out, err = run("simulate", str(patrol), "--disturbance", "0.3", "--cycles", "1")
+    code, _, err = run("simulate", str(patrol), "--disturbance", "0.3", "--cycles", "1")
     assert "guarantee the task for |w| <= 0.1" in err
     assert code in (0, 1, 4)
 
