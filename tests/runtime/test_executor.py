@@ -165,6 +165,29 @@ def test_a_push_past_the_goal_replans_from_the_tracked_automaton_state() -> None
     assert verdict.satisfied, verdict.violations
 
 
+def test_a_robot_found_past_the_goal_after_losing_track_replans_instead_of_reentering() -> None:
+    """Localisation lost (the pose outside the map), then found on a plan triangle that the
+    plan reaches only after ``a``: the robot has not seen ``a``, so re-entering there would
+    skip it; the executor must re-plan, and the new plan must go through ``a``."""
+    executor = tlmpc.executor(_compiled("visit a then b"))
+    labels = executor.abstraction.labels
+    steps = executor.plan.steps
+    first_a = next(i for i, s in enumerate(steps) if "a" in labels(s.triangle))
+    before = {s.triangle for s in steps[: first_a + 1]}
+    after = next(s for s in steps[first_a + 1 :] if s.triangle not in before)
+    executor.command(executor.mission.robot.start, 0.0)
+    executor.command((-5.0, -5.0), 0.1)
+    lost = executor.progress
+    assert lost.status == "outside"
+    executor.command(tuple(executor.abstraction.corners(after.triangle).mean(axis=0)), 0.2)
+    assert [r.kind for r in executor.recoveries] == ["replan"]
+    found = executor.progress
+    assert found.status == "following"
+    new_labels = [labels(s.triangle) for s in executor.plan.steps]
+    goal_a = next(i for i, names in enumerate(new_labels) if "a" in names)
+    assert any("b" in names for names in new_labels[goal_a:])
+
+
 def test_a_push_back_along_the_cycle_reenters_the_plan() -> None:
     """GF a & GF b: pushed back onto an earlier triangle of the cycle, the executor re-enters
     there (every cycle state is consistent with any history that reached the cycle)."""
