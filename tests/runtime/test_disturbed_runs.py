@@ -17,7 +17,8 @@ import numpy as np
 import pytest
 import shapely
 import yaml
-from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import HealthCheck, assume, event, given, settings
+from hypothesis import strategies as st
 from strategies import missions
 
 import tlmpc
@@ -166,3 +167,58 @@ def test_a_disturbed_unicycle_satisfies_its_task(model: str) -> None:
         run, _ = _run(compiled, model, 0.1, seed, heading=1.0)
         _check_satisfied(run)
         assert run.recoveries == ()
+
+
+class _Shove:
+    """At ``at`` seconds, moves the robot to ``target`` in one sample (unless the straight
+    shove would cross an obstacle): a push far above any bound, continuous in the trace."""
+
+    def __init__(self, at: float, target: FloatArray, dt: float, holes: list[Any]) -> None:
+        self.at, self.target, self.dt, self.holes = at, target, dt, holes
+        self.done = False
+
+    def __call__(self, t: float, point: FloatArray, executor: Executor) -> FloatArray:
+        if self.done or t < self.at:
+            return np.zeros(2)
+        self.done = True
+        shove = shapely.LineString([tuple(point), tuple(self.target)])
+        if any(shove.intersects(hole) for hole in self.holes):
+            return np.zeros(2)
+        velocity: FloatArray = (self.target - point) / self.dt - executor.velocity(point)
+        return velocity
+
+
+@settings(
+    max_examples=max(3, settings().max_examples // 20),
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much],
+)
+@given(
+    missions(),
+    st.floats(0.0, 30.0),
+    st.floats(0.05, 11.95),
+    st.floats(0.05, 7.95),
+)
+def test_a_shoved_run_recovers_soundly_on_a_generated_mission(
+    document: dict[str, Any], at: float, x: float, y: float
+) -> None:
+    """Shoved anywhere at any time: whenever the executor completes its run it satisfies the
+    task (re-entries and re-plans are sound), and when it reports the task violated, the
+    verifier agrees."""
+    try:
+        compiled = tlmpc.compile(document)
+    except tlmpc.TlmpcError:
+        assume(False)
+    executor = tlmpc.executor(compiled)
+    holes = [shapely.Polygon(h) for h in compiled.artifacts["mission.json"]["workspace"]["holes"]]
+    target = np.array([x, y])
+    assume(not any(hole.buffer(1e-6).covers(shapely.Point(x, y)) for hole in holes))
+    dt = default_dt(executor.plan, executor.mission.robot.max_speed)
+    run = run_closed_loop(executor, _Shove(at, target, dt, holes), bound=0.0, dt=dt, cycles=1)
+    verdict = verify_document(run.trace)
+    event(f"status {run.progress.status}, completed {run.completed}")
+    event(f"recovered {bool(run.recoveries)}")
+    if run.completed and run.progress.status == "following":
+        assert verdict.satisfied, [v.message for v in verdict.violations]
+        assert _stays_in_free_space(run.trace)
+    if run.progress.status == "violated":
+        assert not verdict.satisfied
