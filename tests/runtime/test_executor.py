@@ -188,6 +188,22 @@ def test_a_robot_found_past_the_goal_after_losing_track_replans_instead_of_reent
     assert any("b" in names for names in new_labels[goal_a:])
 
 
+def test_a_replan_starts_from_the_goals_already_reached() -> None:
+    """After ``a`` was reached, a robot found again back near the start re-plans from the
+    tracked automaton state: straight to ``b``, never back to ``a``."""
+    executor = tlmpc.executor(_compiled("visit a then b"))
+    labels = executor.abstraction.labels
+    executor.command(executor.mission.robot.start, 0.0)
+    executor.command((5.0, 3.5), 1.0)  # inside a
+    assert executor.progress.visits["a"] == 1
+    executor.command((-5.0, -5.0), 2.0)  # localisation lost
+    executor.command((0.5, 0.3), 3.0)  # found again in the bottom-left corner
+    assert executor.recoveries[-1].kind == "replan"
+    ahead = [labels(s.triangle) for s in executor.plan.steps[executor.progress.step :]]
+    assert not any("a" in names for names in ahead)
+    assert "b" in ahead[-1]
+
+
 def test_a_push_back_along_the_cycle_reenters_the_plan() -> None:
     """GF a & GF b: pushed back onto an earlier triangle of the cycle, the executor re-enters
     there (every cycle state is consistent with any history that reached the cycle)."""
