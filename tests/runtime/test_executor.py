@@ -344,3 +344,19 @@ def test_the_executor_needs_the_control_stage() -> None:
     with pytest.raises(tlmpc.UsageError) as caught:
         tlmpc.executor(partial)
     assert caught.value.diagnostics[0].code == "R020"
+
+
+@pytest.mark.parametrize(
+    ("pose", "robot"),
+    [
+        ((1.0, 1.0, 0.0), {}),
+        ((1.0,), {}),
+        ((float("nan"), 1.0), {}),
+        ((1.0, 1.0), {"model": "unicycle", "offset": 0.2}),
+    ],
+)
+def test_a_malformed_pose_is_R023(pose: tuple[float, ...], robot: dict[str, Any]) -> None:
+    executor = tlmpc.executor(_compiled("visit a then b", **robot))
+    with pytest.raises(tlmpc.UsageError) as caught:
+        executor.command(pose, 0.0)
+    assert caught.value.diagnostics[0].code == "R023"

@@ -20,6 +20,7 @@ step).  Each :meth:`Executor.command` call
 from __future__ import annotations
 
 import dataclasses
+import math
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -210,6 +211,17 @@ class Executor:
     def command(self, pose: Sequence[float], t: float) -> tuple[float, float]:
         """The command for ``pose`` at time ``t``: ``(vx, vy)``, or ``(v, omega)`` for a
         unicycle.  Updates the plan step, the task progress and recovers when needed."""
+        expected = 3 if self.is_unicycle else 2
+        if len(pose) != expected or not all(math.isfinite(float(v)) for v in (*pose, t)):
+            shape = "(x, y, theta)" if self.is_unicycle else "(x, y)"
+            raise UsageError(
+                error(
+                    "R023",
+                    f"a pose of this {self.mission.robot.model} robot is {shape} of finite "
+                    f"numbers with a finite time, not {tuple(pose)!r} at t={t!r}",
+                    hint="pass the measured pose in the mission's frame",
+                )
+            )
         point = self.reference_point(pose)
         self._time = float(t)
         self.observe(point)
