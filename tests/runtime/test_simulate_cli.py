@@ -113,3 +113,10 @@ def test_an_unwritable_trace_path_is_U083(patrol: Path, tmp_path: Path) -> None:
     status, _, err = run("simulate", str(patrol), "--cycles", "1", "-o", str(tmp_path))
     assert status == 2
     assert "error[U083]" in err
+
+
+def test_a_unicycle_simulation_exits_0(tmp_path: Path) -> None:
+    out = _compile(tmp_path, "example1", model="unicycle", offset=0.2)
+    code, out_text, err = run("simulate", str(out), "--heading", "1.5", "--cycles", "1")
+    assert code == 0, out_text + err
+    assert ": satisfied:" in out_text
