@@ -13,7 +13,15 @@ The Python facade (see ``docs/python-api.md``)::
 
 __version__ = "0.1.0"
 
-from tlmpc.api import Compiled, check, compile, read_output, translate, verify_trace
+from tlmpc.api import (
+    Compiled,
+    check,
+    compile,
+    executor,
+    read_output,
+    translate,
+    verify_trace,
+)
 from tlmpc.errors import (
     Diagnostic,
     InvalidInputError,
@@ -34,6 +42,7 @@ __all__ = [
     "__version__",
     "check",
     "compile",
+    "executor",
     "read_output",
     "translate",
     "verify_trace",

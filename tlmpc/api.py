@@ -31,6 +31,7 @@ from tlmpc.errors import Diagnostic, UsageError, error
 
 if TYPE_CHECKING:
     from tlmpc.automata.model import Automaton
+    from tlmpc.runtime import Executor
     from tlmpc.verify.model import Verdict
 
 MissionSource = str | os.PathLike[str] | Mapping[str, Any]
@@ -245,3 +246,15 @@ def check(mission: MissionSource) -> list[Diagnostic]:
     if text is None:
         return check_file(source)
     return check_text(text, str(source))
+
+
+def executor(output: Compiled | str | os.PathLike[str]) -> Executor:
+    """The runtime executor of a compiled mission (an output folder or a :class:`Compiled`).
+
+    ``executor(out).command(pose, t)`` returns the velocity to apply (``(vx, vy)``, or
+    ``(v, omega)`` for a unicycle), tracking the plan step and recovering when the robot is
+    pushed off its plan; ``.progress`` reports the task's progress.  See docs/python-api.md.
+    """
+    from tlmpc.runtime import Executor
+
+    return Executor.from_output(output)

@@ -40,6 +40,7 @@ COMMAND_MODULES = (
     "view",
     "import_map",
     "export_plan",
+    "simulate",
 )
 
 EPILOG = """\

@@ -42,6 +42,8 @@ def mission_from_json(document: Mapping[str, Any]) -> Mission:
             start=_polygon([robot["start"]])[0],
             max_speed=float(robot["max_speed"]),
             disturbance=float(robot.get("disturbance", 0.0)),
+            model=robot.get("model", "point"),
+            offset=float(robot.get("offset", 0.0)),
         ),
         formula=parse_ltl(document["formula"], file="mission.json"),
         groups={name: tuple(members) for name, members in document["groups"].items()},

@@ -492,6 +492,8 @@ def _load(text: str, file: str, stem: str) -> tuple[Mission | None, list[Diagnos
             start=start,
             max_speed=float(robot.get("max_speed", 1.0)),
             disturbance=float(robot.get("disturbance", 0.0)),
+            model=robot.get("model", "point"),
+            offset=float(robot.get("offset", 0.0)),
         ),
         formula=formula,
         groups={g: tuple(m) for g, m in groups.items()},

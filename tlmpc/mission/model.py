@@ -17,6 +17,7 @@ Polygon = tuple[Point, ...]
 
 CostMetric = Literal["length", "hops"]
 BoundaryConvention = Literal["right", "closed"]
+RobotModel = Literal["point", "unicycle"]
 
 #: Defaults of ``options`` (documented in docs/mission-format.md).
 DEFAULT_MIN_ANGLE = 20.0
@@ -82,11 +83,17 @@ class Robot:
 
     ``disturbance`` bounds an unknown additive velocity (wind, slip, tracking error) that the
     controllers must reject: every guarantee holds for every such w.
+
+    ``model`` is ``"point"`` or ``"unicycle"`` (differential drive): a unicycle tracks the
+    planned field with the point ``offset`` ahead of its axle, which is the point ``start``,
+    the labels and the trace refer to (see docs/control.md).
     """
 
     start: Point
     max_speed: float = 1.0
     disturbance: float = 0.0
+    model: RobotModel = "point"
+    offset: float = 0.0
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -170,6 +177,8 @@ class Mission:
                 "start": list(self.robot.start),
                 "max_speed": self.robot.max_speed,
                 "disturbance": self.robot.disturbance,
+                "model": self.robot.model,
+                "offset": self.robot.offset,
             },
             "task": list(self.task),
             "ltl": self.ltl,

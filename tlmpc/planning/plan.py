@@ -13,6 +13,7 @@ optimality statement).  Two kinds of cycles are considered:
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import time
 from typing import Any
@@ -28,7 +29,7 @@ from tlmpc.ltl.ast import Formula
 from tlmpc.mission.model import Options
 from tlmpc.planning.explain import explain_no_plan, invariant_mask
 from tlmpc.planning.model import Witness
-from tlmpc.planning.product import SLOTS, Product, build_product
+from tlmpc.planning.product import SLOTS, START_SLOT, Product, build_product
 
 #: At most this many cycle candidates are closed with a Dijkstra search; past it the
 #: witness is the best found and records ``optimal: false``.
@@ -72,11 +73,14 @@ def plan(
     options: Options,
     start_point: tuple[float, float] | None = None,
     bounces: bool = False,
+    resume: frozenset[int] | None = None,
 ) -> Witness:
     """A minimum-cost accepting lasso (raises :class:`NoPlanError` with an explanation).
 
     With ``bounces=True`` the lasso may leave a triangle through its entry edge (a U-turn the
     controllers cannot realise on this mesh; :mod:`tlmpc.planning.complete` refines those).
+    ``resume`` re-plans a run under way: the robot is in the start triangle and has already
+    read its label, the (degeneralized) automaton being in any of these states.
     """
     started = time.perf_counter()
     allowed = invariant_mask(abstraction, formula)
@@ -92,6 +96,12 @@ def plan(
         metric=options.cost,
         bounces=bounces,
     )
+    if resume is not None:
+        nodes = sorted(
+            (abstraction.start * SLOTS + START_SLOT) * working.num_states + q for q in resume
+        )
+        initial = np.array(nodes if allowed[abstraction.start] else [], dtype=np.int64)
+        product = dataclasses.replace(product, initial=initial)
     if len(product.initial) == 0 or not working.edges:
         raise NoPlanError(explain_no_plan(abstraction, automaton, formula, allowed))
     dist, pred, _ = dijkstra(
