@@ -71,7 +71,7 @@ def test_every_artifact_validates_against_its_schema(compiled: dict[str, Path], 
 def test_every_compiled_trace_verifies(compiled: dict[str, Path], spec: str) -> None:
     code, out, err = run_cli("verify", str(compiled[spec] / "trace.json"), "--json")
     assert code == 0, err
-    verdict = json.loads(out)
+    verdict = json.loads(out)["result"]
     assert verdict["satisfied"] is True
 
 
@@ -149,7 +149,7 @@ def test_until_abstraction_stops_early(tmp_path: Path) -> None:
         "mission.json",
         "summary.json",
     ]
-    summary = json.loads(stdout)
+    summary = json.loads(stdout)["result"]
     assert [s["name"] for s in summary["stages"]] == ["load", "abstraction"]
     assert "[2/2] abstraction" in err
 
