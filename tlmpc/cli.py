@@ -227,14 +227,14 @@ def _main(argv: Sequence[str] | None, out: TextIO, err: TextIO) -> int:
             "tlmpc: internal error (exit 3). Please report it with the input that caused it:\n"
         )
         err.write(traceback.format_exc())
-        # the traceback above stays the text report; the envelope gets one diagnostic
-        reporter.diagnostics.append(
-            error(
-                "U090",
-                f"internal error: {type(exc).__name__}: {exc}",
-                hint="please report it with the input that caused it (the traceback is on "
-                "standard error)",
-            )
+        reporter.diagnose(
+            [
+                error(
+                    "U090",
+                    f"internal error: {type(exc).__name__}: {exc}",
+                    hint="please report it with the input that caused it (the traceback is above)",
+                )
+            ]
         )
         return reporter.finish(EXIT_INTERNAL)
 
