@@ -68,7 +68,8 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             explained.extend(f"  {scope}\n" for scope in entry.get("avoid_scopes", []))
     # unreadable wins over invalid: the run could not do its job
     code = EXIT_USAGE if unreadable else (EXIT_NEGATIVE if invalid else EXIT_OK)
-    if not args.json:
+    report.finish(code, {"files": results}, "".join(explained))
+    if not args.json:  # the tally comes last, after the explanations
         valid = len(results) - invalid - unreadable
         summary = f"{valid} of {len(results)} mission file(s) valid"
         if invalid:
@@ -76,7 +77,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         if unreadable:
             summary += f", {unreadable} unreadable"
         report.note(summary)
-    return report.finish(code, {"files": results}, "".join(explained))
+    return code
 
 
 def _scopes(mission: Any) -> list[str]:
