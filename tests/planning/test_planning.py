@@ -10,6 +10,7 @@ from typing import Any
 import pytest
 import spin_runner as spin
 import yaml
+from ci_oracles import oracle_required
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from lasso_ltl import holds
@@ -164,7 +165,7 @@ def test_witness_artifact() -> None:
     assert witness_from_json(document) == witness
 
 
-needs_spin = pytest.mark.skipif(not spin.available(), reason="spin (and gcc) are not installed")
+needs_spin = oracle_required(spin.available(), "spin (and gcc)")
 
 HOPS = "options: {min_angle: null, cost: hops, beta: 1}\n"
 
