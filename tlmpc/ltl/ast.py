@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import dataclass, field
-from typing import TypeAlias, cast
+from typing import TypeAlias, assert_never, cast
 
 
 @dataclass(frozen=True, slots=True)
@@ -191,9 +191,20 @@ BINARY_TEMPORAL = (Until, Release, WeakUntil, StrongRelease)
 UNARY_TEMPORAL = (Eventually, Globally)
 
 
+def is_temporal(node: Formula) -> bool:
+    """True for a temporal operator node (``U R W M F G``), False for the others."""
+    match node:
+        case Until() | Release() | WeakUntil() | StrongRelease() | Eventually() | Globally():
+            return True
+        case Const() | Prop() | Not() | And() | Or() | Implies() | Equiv():
+            return False
+        case _:
+            assert_never(node)
+
+
 def is_propositional(formula: Formula) -> bool:
     """True when the formula has no temporal operator."""
-    return not any(isinstance(n, (*BINARY_TEMPORAL, *UNARY_TEMPORAL)) for n in formula.walk())
+    return not any(is_temporal(n) for n in formula.walk())
 
 
 def conjoin(parts: list[Formula] | tuple[Formula, ...]) -> Formula:
