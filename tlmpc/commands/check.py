@@ -118,13 +118,8 @@ def _contradictions(path: Path, mission: Any) -> list[Any]:
     if mission.ltl and mission.ltl.strip():
         line, col = where(("ltl",))
         parts.append(
-            TaskPart(
-                formula=parse_ltl(mission.ltl),
-                text=mission.ltl.strip(),
-                kind="ltl",
-                line=line,
-                col=col,
-            )
+            TaskPart(formula=parse_ltl(mission.ltl), text=mission.ltl.strip(), kind="ltl",
+                     line=line, col=col)
         )
     found = find_contradiction(parts, groups=mission.groups, file=file)
     return [found] if found is not None else []
