@@ -242,3 +242,13 @@ def test_commands_do_not_print_or_pick_exit_codes_themselves() -> None:
         assert "out.write(" not in source, module_name
         assert "json_text(" not in source or module_name == "automaton", module_name
         assert not re.search(r"^\s+return \d+\s*$", source, flags=re.MULTILINE), module_name
+
+
+def test_infinite_robustness_is_a_string_in_the_envelope(compiled: Path, tmp_path: Path) -> None:
+    trace = json.loads((compiled / "trace.json").read_text())
+    trace["ltl"] = "true"  # holds with infinite margin: the robustness is +inf
+    path = tmp_path / "trace.json"
+    path.write_text(json.dumps(trace))
+    code, document, _ = run_json("verify", str(path), "--json")
+    assert code == 0
+    assert document["result"]["robustness"] == "inf"
