@@ -252,3 +252,17 @@ def test_infinite_robustness_is_a_string_in_the_envelope(compiled: Path, tmp_pat
     code, document, _ = run_json("verify", str(path), "--json")
     assert code == 0
     assert document["result"]["robustness"] == "inf"
+
+
+def test_a_run_prints_one_document_even_if_it_finishes_twice() -> None:
+    # A command that finished and then failed (say, a late I/O error) must not print a second
+    # envelope after the first one.
+    from tlmpc.errors import UsageError, error
+    from tlmpc.report import Reporter
+
+    out, err = io.StringIO(), io.StringIO()
+    reporter = Reporter(command="verify", json=True, out=out, err=err)
+    assert reporter.finish(0, {"verdict": "satisfied"}) == 0
+    assert reporter.fail(UsageError(error("U001", "late"))) == 2
+    assert _strict(out.getvalue())["exit_code"] == 0
+    assert "error[U001]: late" in err.getvalue()
