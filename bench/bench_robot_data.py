@@ -189,7 +189,7 @@ def bag_rows(data: Path, work: Path) -> list[dict[str, Any]]:
     rows = []
     for label, path in forms.items():
         seconds, done = _tlmpc("verify", str(path), "--mission", str(mission), "--json")
-        verdict = json.loads(done.stdout) if done.stdout else {}
+        verdict = (json.loads(done.stdout)["result"] or {}) if done.stdout else {}
         samples = read_log(path).samples
         rows.append(
             {

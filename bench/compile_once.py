@@ -22,7 +22,7 @@ def _compile(mission: str, out: str) -> tuple[int, float, dict[str, object] | No
     stdout, stderr = io.StringIO(), io.StringIO()
     code = tlmpc_main(["compile", mission, "-o", out, "-q", "--json", "--force"], stdout, stderr)
     seconds = time.perf_counter() - started
-    summary = json.loads(stdout.getvalue()) if code == 0 else None
+    summary = json.loads(stdout.getvalue())["result"] if code == 0 else None
     return code, seconds, summary, stderr.getvalue()[-2000:]
 
 

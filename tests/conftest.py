@@ -8,7 +8,6 @@ All profiles are derandomized so a failure reproduces on every machine.
 from __future__ import annotations
 
 import os
-import shutil
 import sys
 from pathlib import Path
 
@@ -43,12 +42,18 @@ def specs_dir() -> Path:
     return SPECS
 
 
-def spin_path() -> str | None:
-    """Path of the SPIN binary, or None when it is not installed."""
-    return shutil.which("spin")
-
-
-requires_spin = pytest.mark.skipif(spin_path() is None, reason="spin is not installed")
-
 # Shared test oracles (independent re-implementations) are importable by module name.
 sys.path.insert(0, str(Path(__file__).resolve().parent / "oracles"))
+
+from ci_oracles import MISSING_MARK  # noqa: E402
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    config.addinivalue_line(
+        "markers", f"{MISSING_MARK}(what): the test's oracle is missing in CI (fails the test)"
+    )
+
+
+def pytest_runtest_setup(item: pytest.Item) -> None:
+    for mark in item.iter_markers(MISSING_MARK):
+        pytest.fail(f"{mark.args[0]} is not installed, and CI must run this oracle", pytrace=False)

@@ -25,8 +25,8 @@ from types import ModuleType
 from typing import Any, TextIO
 
 from tlmpc import __version__
-from tlmpc.artifacts import json_text
-from tlmpc.errors import EXIT_INTERNAL, EXIT_USAGE, TlmpcError, best_first, error, printable
+from tlmpc.errors import EXIT_INTERNAL, EXIT_USAGE, TlmpcError, error, printable
+from tlmpc.report import EXIT_INTERRUPTED, EXIT_TERMINATED, Reporter, exit_code_epilog
 
 #: Subcommand modules, in the order ``--help`` lists them.
 COMMAND_MODULES = (
@@ -43,13 +43,7 @@ COMMAND_MODULES = (
     "simulate",
 )
 
-EPILOG = """\
-exit codes:
-  0  success
-  1  valid input, negative answer (invalid mission, no plan, trace violates the task)
-  2  could not run (bad flags, unreadable or malformed file)
-  3  internal error (please report it with the input that caused it)
-"""
+EPILOG = exit_code_epilog()
 
 
 def _command(name: str) -> ModuleType:
@@ -79,21 +73,6 @@ def build_parser() -> argparse.ArgumentParser:
         module.add_arguments(command_parser)
         command_parser.set_defaults(_run=module.run)
     return parser
-
-
-def _report(exc: TlmpcError, args: argparse.Namespace, out: TextIO, err: TextIO) -> None:
-    diagnostics = best_first(exc.diagnostics)
-    if getattr(args, "json", False):
-        document = {
-            "tool": "tlmpc",
-            "version": __version__,
-            "command": getattr(args, "command", None),
-            "ok": False,
-            "diagnostics": [d.to_json() for d in diagnostics],
-        }
-        out.write(json_text(document))
-    for diagnostic in diagnostics:
-        err.write(diagnostic.format() + "\n")
 
 
 class _OutputLost(Exception):
@@ -178,11 +157,11 @@ def main(
     except KeyboardInterrupt:
         with contextlib.suppress(Exception):
             safe_err.write("tlmpc: interrupted\n")
-        return 130
+        return EXIT_INTERRUPTED
     except _Terminated:
         with contextlib.suppress(Exception):
             safe_err.write("tlmpc: terminated\n")
-        return 143
+        return EXIT_TERMINATED
     except _OutputLost as lost:
         _silence(raw_out if lost.stream == "standard output" else raw_err)
         if lost.stream == "standard output" and not isinstance(lost.cause, BrokenPipeError):
@@ -202,42 +181,83 @@ def main(
 
 def _main(argv: Sequence[str] | None, out: TextIO, err: TextIO) -> int:
     parser = build_parser()
+    arguments = list(sys.argv[1:] if argv is None else argv)
+    usage = io.StringIO()
     try:
-        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-            args = parser.parse_args(None if argv is None else list(argv))
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(usage):
+            args = parser.parse_args(arguments)
     except SystemExit as exc:  # argparse exits 0 for --help/--version and 2 for bad usage
-        return int(exc.code) if isinstance(exc.code, int) else EXIT_USAGE
-    try:
-        code: int = args._run(args, out, err)
+        err.write(usage.getvalue())
+        code = int(exc.code) if isinstance(exc.code, int) else EXIT_USAGE
+        if code != 0 and "--json" in arguments[: _end_of_options(arguments)]:
+            return _usage_envelope(arguments, usage.getvalue(), code, out)
         return code
+    err.write(usage.getvalue())
+    reporter = Reporter.for_args(args, out, err)
+    try:
+        result: int = args._run(args, out, err)
+        return result
     except TlmpcError as exc:
-        _report(exc, args, out, err)
-        return exc.exit_code
+        return reporter.fail(exc)
     except (KeyboardInterrupt, _Terminated, _OutputLost):
         raise
     except RecursionError:  # a pathological input nested beyond what a stage handles
-        err.write(
-            error(
-                "U036",
-                "the input is nested too deeply to process",
-                hint="flatten the input (no real mission or trace nests this deep)",
-            ).format()
-            + "\n"
+        reporter.diagnose(
+            [
+                error(
+                    "U036",
+                    "the input is nested too deeply to process",
+                    hint="flatten the input (no real mission or trace nests this deep)",
+                )
+            ]
         )
-        return EXIT_USAGE
+        return reporter.finish(EXIT_USAGE)
     except MemoryError:
-        err.write(
-            error(
-                "U037",
-                "the input needs more memory than this machine has",
-                hint="make the input smaller (fewer regions, a coarser mesh, a shorter trace)",
-            ).format()
-            + "\n"
+        reporter.diagnose(
+            [
+                error(
+                    "U037",
+                    "the input needs more memory than this machine has",
+                    hint="make the input smaller (fewer regions, a coarser mesh, a shorter trace)",
+                )
+            ]
         )
-        return EXIT_USAGE
-    except Exception:  # a bug: say so, never a bare traceback without context
+        return reporter.finish(EXIT_USAGE)
+    except Exception as exc:  # a bug: say so, never a bare traceback without context
         err.write(
             "tlmpc: internal error (exit 3). Please report it with the input that caused it:\n"
         )
         err.write(traceback.format_exc())
-        return EXIT_INTERNAL
+        reporter.diagnose(
+            [
+                error(
+                    "U090",
+                    f"internal error: {type(exc).__name__}: {exc}",
+                    hint="please report it with the input that caused it (the traceback is above)",
+                )
+            ]
+        )
+        return reporter.finish(EXIT_INTERNAL)
+
+
+def _end_of_options(arguments: list[str]) -> int:
+    """Where ``--`` ends the options (a formula or file named ``--json`` after it is data)."""
+    return arguments.index("--") if "--" in arguments else len(arguments)
+
+
+def _usage_envelope(arguments: list[str], message: str, code: int, out: TextIO) -> int:
+    """A bad command line with ``--json``: argparse's complaint as a U091 diagnostic."""
+    names = {_command(name).NAME for name in COMMAND_MODULES}
+    command = next((a for a in arguments if a in names), None)
+    lines = [line for line in message.splitlines() if line.strip()]
+    reporter = Reporter(command=command, json=True, out=out, err=io.StringIO())
+    reporter.diagnose(
+        [
+            error(
+                "U091",
+                lines[-1] if lines else "bad command line",
+                hint=f"see `tlmpc {command or ''} --help`".replace("  ", " "),
+            )
+        ]
+    )
+    return reporter.finish(code)

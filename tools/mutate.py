@@ -107,6 +107,10 @@ def run_mutant(mutant: Mutant, files: list[str], timeout: float) -> Outcome:
     seconds = time.perf_counter() - started
     lines = [line for line in done.stdout.splitlines() if line.strip()]
     detail = lines[-1] if lines else done.stderr.strip()[-200:]
+    # The test that killed the mutant (pytest's short summary), so a report can name it.
+    killer = next((line for line in lines if line.startswith("FAILED ")), None)
+    if killer is not None:
+        detail = f"{killer.removeprefix('FAILED ').split(' - ')[0]}; {detail}"
     if done.returncode == 1:
         return Outcome(mutant, "killed", seconds, detail)
     if done.returncode == 0:

@@ -66,7 +66,7 @@ def evaluate(formula: Formula, prefix: Sequence[Letter], loop: Sequence[Letter])
         if isinstance(f, Globally):
             a = ev(f.arg)
             return fix(lambda i, v: a[i] and v[succ[i]], True)
-        left, right = ev(f.left), ev(f.right)  # type: ignore[attr-defined]
+        left, right = ev(f.left), ev(f.right)
         if isinstance(f, Implies):
             return [not x or y for x, y in zip(left, right, strict=True)]
         if isinstance(f, Equiv):

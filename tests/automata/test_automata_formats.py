@@ -203,7 +203,7 @@ def test_command_formats() -> None:
     assert code == 0
     assert "states: 8" in out
     code, out, _ = run_command("F a & F b & F c", "--stats", "--json")
-    assert json.loads(out)["states"] == 8
+    assert json.loads(out)["result"]["stats"]["states"] == 8
 
 
 def test_command_bad_formula() -> None:

@@ -14,6 +14,7 @@ import subprocess
 
 import pytest
 from automata_oracles import accepting_cycle
+from ci_oracles import oracle_required
 from test_automata_formats import benchmark
 
 from tlmpc.automata import guard_holds, translate
@@ -21,7 +22,7 @@ from tlmpc.automata.model import Automaton
 from tlmpc.ltl import parse_ltl, to_spin
 from tlmpc.ltl.ast import Not
 
-pytestmark = pytest.mark.skipif(shutil.which("spin") is None, reason="spin is not installed")
+pytestmark = oracle_required(shutil.which("spin") is not None, "spin")
 
 Claim = tuple[int, list[list[tuple[str, int]]], set[int]]  # initial, edges per state, accepting
 

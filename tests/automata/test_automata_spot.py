@@ -15,6 +15,7 @@ import warnings
 from typing import Any
 
 import pytest
+from ci_oracles import import_oracle
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -22,7 +23,7 @@ with warnings.catch_warnings():
     # Spot's SWIG modules warn on import (builtin types without __module__); the project
     # turns warnings into errors, which must not happen inside Spot's extension code.
     warnings.simplefilter("ignore", DeprecationWarning)
-    spot = pytest.importorskip("spot")
+    spot = import_oracle("spot")
     from spot_families import families, to_tlmpc
 from strategies import formulas
 

@@ -260,7 +260,7 @@ def test_verify_gives_identical_verdicts_for_every_form(tmp_path: Path) -> None:
             "verify", str(path), "--mission", str(mission), "--json", "--assume-stay"
         )
         assert code == 0, err
-        verdicts.append(json.loads(out))
+        verdicts.append(json.loads(out)["result"])
     assert all(v == verdicts[0] for v in verdicts)
     assert verdicts[0]["satisfied"] is True
 

@@ -52,9 +52,11 @@ def test_json_is_one_document_on_stdout() -> None:
     assert code == 1
     document = json.loads(out)
     assert document["ok"] is False
-    assert [f["ok"] for f in document["files"]] == [True, False]
-    assert document["files"][1]["diagnostics"][0]["code"] == "G004"
-    assert document["files"][0]["ltl"]
+    files = document["result"]["files"]
+    assert [f["ok"] for f in files] == [True, False]
+    assert files[1]["diagnostics"][0]["code"] == "G004"
+    assert files[0]["ltl"]
+    assert document["diagnostics"][0]["code"] == "G004"
 
 
 def test_unreadable_file_exits_2() -> None:

@@ -59,7 +59,10 @@ def lassos(
     return word, loop
 
 
-#: Task phrase templates for random missions; ``{a}``, ``{b}``, ``{c}`` are distinct regions.
+#: Task templates for random missions; ``{a}``, ``{b}``, ``{c}`` are distinct regions.  They
+#: cover the task language: reachability and sequences, safety only (``avoid``, a release),
+#: recurrence (``patrol``, ``infinitely often``), persistence (``stay``), response
+#: (``whenever``), until and release.  A template starting with ``ltl:`` is raw LTL.
 TEMPLATES = (
     "visit {a}",
     "visit {a} then {b}",
@@ -70,17 +73,32 @@ TEMPLATES = (
     "visit {a} then {b} while avoiding {c}",
     "whenever {a}, visit {b}",
     "avoid {c} until {a}",
+    "visit {a} infinitely often",
+    "visit {a} then return to {b}",
+    "avoid {b} and {c}",
+    "ltl: {a} R !{c}",
+    "ltl: G F {a} & ({b} R !{c})",
 )
 
 
 #: The templates whose LTL is co-safe: every satisfying run has a finite good prefix.
-CO_SAFE_TEMPLATES = frozenset(TEMPLATES[i] for i in (0, 1, 2, 8))
+CO_SAFE_TEMPLATES = frozenset(
+    {
+        "visit {a}",
+        "visit {a} then {b}",
+        "visit {a}, {b} and {c}",
+        "avoid {c} until {a}",
+        "visit {a} then return to {b}",
+    }
+)
 
 
 @st.composite
-def missions_with_template(draw: st.DrawFn) -> tuple[dict[str, Any], str]:
+def missions_with_template(
+    draw: st.DrawFn, template: str | None = None
+) -> tuple[dict[str, Any], str]:
     """A 12 x 8 box with up to one hole and three to five disjoint-or-overlapping regions, and
-    the template its task phrase came from."""
+    the template its task came from (``template`` when given, else any of ``TEMPLATES``)."""
     regions: dict[str, Any] = {}
     count = draw(st.integers(3, 5))
     for k in range(count):
@@ -96,16 +114,20 @@ def missions_with_template(draw: st.DrawFn) -> tuple[dict[str, Any], str]:
         holes.append({"rect": [5.5, 3.5, 6.5, 4.5]})
     names = sorted(regions)
     picks = draw(st.permutations(names))
-    template = draw(st.sampled_from(TEMPLATES))
+    if template is None:
+        template = draw(st.sampled_from(TEMPLATES))
     task = template.format(a=picks[0], b=picks[1], c=picks[2])
-    document = {
+    document: dict[str, Any] = {
         "version": 1,
         "name": "random",
         "workspace": {"boundary": {"rect": [0, 0, 12, 8]}, "holes": holes},
         "regions": regions,
         "robot": {"start": [0.1, 7.9], "max_speed": 1.0},
-        "task": [task],
     }
+    if task.startswith("ltl: "):
+        document["ltl"] = task.removeprefix("ltl: ")
+    else:
+        document["task"] = [task]
     return document, template
 
 

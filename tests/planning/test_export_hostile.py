@@ -16,6 +16,7 @@ import subprocess
 from pathlib import Path
 
 import pytest
+from ci_oracles import oracle_required
 from hypothesis import given
 from hypothesis import strategies as st
 
@@ -176,7 +177,7 @@ def test_smv_has_only_generated_identifiers(hostile_output: Path) -> None:
     check_smv(smv)
 
 
-@pytest.mark.skipif(shutil.which("spin") is None, reason="SPIN is not installed")
+@oracle_required(shutil.which("spin") is not None, "SPIN")
 def test_spin_parses_the_promela_and_nothing_runs(hostile_output: Path, tmp_path: Path) -> None:
     code, model, _ = run_cli("export", str(hostile_output), "--format", "promela")
     assert code == 0

@@ -10,6 +10,7 @@ from typing import Any
 import pytest
 import spin_runner as spin
 import yaml
+from ci_oracles import oracle_required
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from lasso_ltl import holds
@@ -164,7 +165,7 @@ def test_witness_artifact() -> None:
     assert witness_from_json(document) == witness
 
 
-needs_spin = pytest.mark.skipif(not spin.available(), reason="spin (and gcc) are not installed")
+needs_spin = oracle_required(spin.available(), "spin (and gcc)")
 
 HOPS = "options: {min_angle: null, cost: hops, beta: 1}\n"
 
@@ -277,13 +278,13 @@ def test_spin_agrees_on_random_missions(
     document = {**document, "options": {"min_angle": None, "cost": "hops", "beta": 1}}
     m = load_mission_text(yaml.safe_dump(document), "random.yaml")
     abstraction, trail, witness = spin_and_ours(tmp_path_factory.mktemp("spin"), m)
-    assert trail.found is (witness is not None), document["task"]
+    assert trail.found is (witness is not None), document
     if witness is None:
         return
     check_spin_trail(abstraction, trail, bounce=False)
     assert witness.stats["optimal"]
     hops = round(witness.cost)
-    assert hops <= trail.moves, document["task"]
+    assert hops <= trail.moves, document
     if template in CO_SAFE_TEMPLATES:
         assert trail.cycle_from is None
-        assert hops == trail.moves, document["task"]
+        assert hops == trail.moves, document

@@ -46,7 +46,7 @@ def test_a_log_leaving_the_map_is_drawn_with_its_violation_marked(example1: Path
         "verify", str(log), "--mission", str(ROOT / "specs" / "example1.yaml"), "--json"
     )
     assert code == 1
-    verdict = json.loads(out)
+    verdict = json.loads(out)["result"]
     messages = [
         verdict[k]["message"] for k in ("workspace_violation", "counterexample") if verdict[k]
     ]

@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from ci_oracles import import_oracle
 from hypothesis import given
 from hypothesis import strategies as st
 from strategies import formulas
@@ -23,7 +24,7 @@ from tlmpc.tasks.contradiction import (
     is_satisfiable,
 )
 
-spot = pytest.importorskip("spot")
+spot = import_oracle("spot")
 
 MISSION = """\
 version: 1

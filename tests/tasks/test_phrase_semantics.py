@@ -9,6 +9,7 @@ from __future__ import annotations
 import itertools
 
 import pytest
+from ci_oracles import import_oracle
 from hypothesis import given
 from hypothesis import strategies as st
 
@@ -16,7 +17,7 @@ from tlmpc.errors import InvalidInputError
 from tlmpc.ltl import to_text
 from tlmpc.tasks import avoid_scopes, compile_phrase
 
-spot = pytest.importorskip("spot")
+spot = import_oracle("spot")
 
 GROUPS = {"exhibits": ["e1", "e2", "e3"]}
 

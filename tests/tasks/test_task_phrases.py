@@ -85,8 +85,8 @@ def test_unknown_group() -> None:
 def test_names_keep_positions_inside_the_phrase() -> None:
     formula = compile_phrase("visit kitchen", file="m.yaml", line=9, col=5)
     prop = next(n for n in formula.walk() if hasattr(n, "name"))
-    assert prop.span is not None  # type: ignore[attr-defined]
-    assert (prop.span.line, prop.span.col) == (9, 11)  # type: ignore[attr-defined]
+    assert prop.span is not None
+    assert (prop.span.line, prop.span.col) == (9, 11)
 
 
 def test_the_documentation_table_is_true() -> None:

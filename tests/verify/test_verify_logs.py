@@ -136,7 +136,7 @@ def test_cli_endings_and_exit_codes(tmp_path: Path) -> None:
     assert run(str(path), "--assume-stay")[0] == 1
     assert run(str(path), "--loop-from", "12")[0] == 0
     code, out, _ = run(str(path), "--json")
-    document = json.loads(out)
+    document = json.loads(out)["result"]
     assert document["verdict"] == "inconclusive"
     assert document["ending"] == "open"
     code, _, err = run(str(path), "--loop-from", "99")

@@ -170,7 +170,7 @@ def test_right_convention_against_the_definition(
 a, b = Prop("a"), Prop("b")
 
 #: One formula per operator with a two-piece word.
-TWO_PIECE_CASES = [
+TWO_PIECE_CASES: list[tuple[Formula, list[str]]] = [
     (Not(a), ["a", "a"]),
     (And((a, b)), ["ab", "a"]),
     (Or((a, b)), ["", "a"]),

@@ -70,7 +70,7 @@ def verify(csv: Path, tmp_path: Path, task: str, *flags: str) -> tuple[int, dict
     out, err = io.StringIO(), io.StringIO()
     code = main(["verify", str(csv), "--mission", str(mission), "--json", *flags], out=out, err=err)
     assert err.getvalue() == "", err.getvalue()
-    document: dict[str, object] = json.loads(out.getvalue())
+    document: dict[str, object] = json.loads(out.getvalue())["result"]
     return code, document
 
 

@@ -165,7 +165,7 @@ def test_cli_exit_codes(tmp_path: Path) -> None:
     assert "VIOLATED" in out
     assert "violation: " in out
     code, out, _ = run(str(bad), "--json")
-    assert json.loads(out)["satisfied"] is False
+    assert json.loads(out)["result"]["satisfied"] is False
 
 
 @pytest.mark.parametrize(

@@ -26,13 +26,19 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--stats", action="store_true", help="print states, edges, acceptance sets and time"
     )
-    parser.add_argument("--json", action="store_true", help="with --stats: stats as JSON")
+    parser.add_argument(
+        "--json",
+        action="store_true",
+        help="one JSON document: the statistics with --stats, else the automaton (tlmpc JSON)",
+    )
 
 
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Translate and print."""
     from tlmpc.automata import automaton_to_json, degeneralize, to_dot, to_hoa, translate
+    from tlmpc.errors import EXIT_OK
     from tlmpc.ltl import parse_ltl
+    from tlmpc.report import Reporter
 
     formula = parse_ltl(args.formula, file="<formula>")
     started = time.perf_counter()
@@ -40,6 +46,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     if args.ba:
         automaton = degeneralize(automaton)
     seconds = time.perf_counter() - started
+    report = Reporter.for_args(args, out, err)
     if args.stats:
         stats = {
             "formula": automaton.formula,
@@ -49,19 +56,17 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             "state_based": automaton.state_based,
             "seconds": round(seconds, 6),
         }
-        if args.json:
-            out.write(json_text(stats))
-        else:
-            out.write(
-                f"states: {stats['states']}\nedges: {stats['edges']}\n"
-                f"acceptance sets: {stats['acceptance_sets']}\n"
-                f"time: {seconds * 1000:.2f} ms\n"
-            )
-        return 0
+        text = (
+            f"states: {stats['states']}\nedges: {stats['edges']}\n"
+            f"acceptance sets: {stats['acceptance_sets']}\n"
+            f"time: {seconds * 1000:.2f} ms\n"
+        )
+        return report.finish(EXIT_OK, {"stats": stats}, text)
+    document = automaton_to_json(automaton)
     if args.format == "hoa":
-        out.write(to_hoa(automaton))
+        text = to_hoa(automaton)
     elif args.format == "dot":
-        out.write(to_dot(automaton))
+        text = to_dot(automaton)
     else:
-        out.write(json_text(automaton_to_json(automaton)))
-    return 0
+        text = json_text(document)
+    return report.finish(EXIT_OK, {"automaton": document}, text)

@@ -12,8 +12,6 @@ import argparse
 from pathlib import Path
 from typing import Any, TextIO
 
-from tlmpc.artifacts import json_text
-
 NAME = "check"
 HELP = "validate mission files: schema, geometry and task (pre-commit hook)"
 
@@ -31,12 +29,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Check every file; report all problems of all files."""
-    from tlmpc import __version__
-    from tlmpc.errors import UsageError
+    from tlmpc.errors import EXIT_NEGATIVE, EXIT_OK, EXIT_USAGE, UsageError
     from tlmpc.ltl.printer import to_text
     from tlmpc.mission.load import inspect_file
+    from tlmpc.report import Reporter
 
+    report = Reporter.for_args(args, out, err)
     results: list[dict[str, Any]] = []
+    explained: list[str] = []
     unreadable = invalid = 0
     for path in args.files:
         notices: list[Any] = []
@@ -62,30 +62,21 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
                     entry["avoid_scopes"] = _scopes(mission)
         entry["diagnostics"] = [d.to_json() for d in [*diagnostics, *notices]]
         results.append(entry)
-        for diagnostic in [*diagnostics, *notices]:
-            err.write(diagnostic.format() + "\n")
-        if entry["ok"] and args.explain and not args.json:
-            out.write(f"{path}: {entry['ltl']}\n")
-            for scope in entry.get("avoid_scopes", []):
-                out.write(f"  {scope}\n")
-    code = 2 if unreadable else (1 if invalid else 0)
-    if args.json:
-        document = {
-            "tool": "tlmpc",
-            "version": __version__,
-            "command": "check",
-            "ok": code == 0,
-            "files": results,
-        }
-        out.write(json_text(document))
-    else:
+        report.diagnose([*diagnostics, *notices])
+        if entry["ok"] and args.explain:
+            explained.append(f"{path}: {entry['ltl']}\n")
+            explained.extend(f"  {scope}\n" for scope in entry.get("avoid_scopes", []))
+    # unreadable wins over invalid: the run could not do its job
+    code = EXIT_USAGE if unreadable else (EXIT_NEGATIVE if invalid else EXIT_OK)
+    report.finish(code, {"files": results}, "".join(explained))
+    if not args.json:  # the tally comes last, after the explanations
         valid = len(results) - invalid - unreadable
         summary = f"{valid} of {len(results)} mission file(s) valid"
         if invalid:
             summary += f", {invalid} invalid"
         if unreadable:
             summary += f", {unreadable} unreadable"
-        err.write(summary + "\n")
+        report.note(summary)
     return code
 
 

@@ -7,8 +7,6 @@ import gc
 from pathlib import Path
 from typing import TextIO
 
-from tlmpc.artifacts import json_text
-
 NAME = "compile"
 HELP = "compile a mission into a verified plan, controllers and trajectory"
 DESCRIPTION = """\
@@ -43,7 +41,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         action="store_true",
         help="also draw plan.png with matplotlib (slower; plan.svg is always written)",
     )
-    parser.add_argument("--json", action="store_true", help="print summary.json on stdout")
+    parser.add_argument(
+        "--json", action="store_true", help="print summary.json on stdout (as the result)"
+    )
     parser.add_argument("-q", "--quiet", action="store_true", help="no progress lines")
 
 
@@ -60,6 +60,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
 
 
 def _run_locked(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
+    from tlmpc.errors import EXIT_OK
     from tlmpc.output import (
         KNOWN_ARTIFACTS,
         check_destination,
@@ -70,22 +71,22 @@ def _run_locked(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         write_artifacts,
     )
     from tlmpc.pipeline import StageReport, collector_paused, compile_mission
+    from tlmpc.report import Reporter
 
+    reporter = Reporter.for_args(args, out, err)
     destination: Path = args.out
     check_destination(destination, force=args.force)
     refuse_overwriting(destination, sorted(KNOWN_ARTIFACTS), args.mission)
     for note in clean_stale(destination):
-        err.write(f"tlmpc: note: {note}\n")
+        reporter.note(f"tlmpc: note: {note}")
 
     def progress(index: int, total: int, report: StageReport) -> None:
         if not args.quiet:
             sizes = _format_sizes(dict(report.sizes))
-            err.write(
+            reporter.note(
                 f"[{index}/{total}] {report.name:<11} {report.seconds:8.3f} s"
                 + (f"  {sizes}" if sizes else "")
-                + "\n"
             )
-            err.flush()
 
     # One pause for compiling and writing: re-enabling in between would trigger a full
     # collection over everything the compilation still holds.
@@ -96,8 +97,7 @@ def _run_locked(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             progress=progress,
             figures=("svg", "png") if args.png else ("svg",),
         )
-        for warning in result.warnings:
-            err.write(warning.format() + "\n")
+        reporter.diagnose(result.warnings)
         with staging_directory(destination) as staging:
             artifacts = dict(result.artifacts)
             summary = result.summary()
@@ -109,12 +109,10 @@ def _run_locked(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         # (a tenth of Example 8's compile; seconds on a million triangles).
         gc.freeze()
 
-    if args.json:
-        out.write(json_text(summary))
-    elif not args.quiet:
+    if not args.json and not args.quiet:
         verdict = summary.get("verdict")
         tail = ""
         if verdict is not None:
             tail = f"; trace verifies (robustness {verdict['robustness']:.4g})"
-        err.write(f"wrote {len(artifacts)} artifacts to {destination}{tail}\n")
-    return 0
+        reporter.note(f"wrote {len(artifacts)} artifacts to {destination}{tail}")
+    return reporter.finish(EXIT_OK, summary)

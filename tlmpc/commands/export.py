@@ -31,7 +31,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Read the artifacts and print (or write) the model."""
     from tlmpc.abstraction import abstraction_from_json
     from tlmpc.artifacts import read_output
-    from tlmpc.errors import UsageError, error
+    from tlmpc.errors import EXIT_OK, UsageError, error
     from tlmpc.ltl import parse_ltl
     from tlmpc.output import replace_file
     from tlmpc.planning.export import to_dot_graph, to_promela, to_smv
@@ -67,9 +67,11 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         text = to_smv(abstraction, formula, title, bounce=args.bounce)
     else:
         text = to_dot_graph(abstraction, title)
-    if args.output is not None:
-        replace_file(args.output, text.encode("utf-8"))
-        err.write(f"wrote {args.output}\n")
-    else:
-        out.write(text)
-    return 0
+    from tlmpc.report import Reporter
+
+    reporter = Reporter.for_args(args, out, err)
+    if args.output is None:
+        return reporter.finish(EXIT_OK, text=text)
+    replace_file(args.output, text.encode("utf-8"))
+    reporter.note(f"wrote {args.output}")
+    return reporter.finish(EXIT_OK)

@@ -39,7 +39,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Read the plan and write the chosen format."""
     import math
 
-    from tlmpc.errors import UsageError, error
+    from tlmpc.errors import EXIT_OK, UsageError, error
     from tlmpc.exports.formats import geojson, path_mcap, waypoints_csv, waypoints_yaml
     from tlmpc.exports.plan import read_plan, waypoints
     from tlmpc.output import replace_file
@@ -72,9 +72,11 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         data = geojson(plan, points, loop).encode("utf-8")
     else:
         data = path_mcap(plan, points, args.topic, args.frame_id)
+    from tlmpc.report import Reporter
+
+    reporter = Reporter.for_args(args, out, err)
     if args.output is None:
-        out.write(data.decode("utf-8"))
-    else:
-        replace_file(args.output, data)
-        err.write(f"wrote {args.output} ({len(points)} waypoints)\n")
-    return 0
+        return reporter.finish(EXIT_OK, text=data.decode("utf-8"))
+    replace_file(args.output, data)
+    reporter.note(f"wrote {args.output} ({len(points)} waypoints)")
+    return reporter.finish(EXIT_OK)

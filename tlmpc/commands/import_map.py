@@ -57,9 +57,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Import the map and write the mission."""
+    from tlmpc.errors import EXIT_OK
     from tlmpc.importers.maps import ImportSettings, import_map
     from tlmpc.importers.mission import mission_document, mission_yaml
     from tlmpc.output import replace_file
+    from tlmpc.report import Reporter
 
     settings = ImportSettings(
         radius=args.radius,
@@ -85,12 +87,12 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         f"{len(imported.holes)} holes, {len(imported.components)} further free components, "
         f"{len(imported.regions)} mask regions"
     )
+    reporter = Reporter.for_args(args, out, err)
     if args.output is None:
-        out.write(text)
-    else:
-        replace_file(args.output, text.encode("utf-8"))
-        err.write(f"wrote {args.output}: {summary}\n")
-    return 0
+        return reporter.finish(EXIT_OK, text=text)
+    replace_file(args.output, text.encode("utf-8"))
+    reporter.note(f"wrote {args.output}: {summary}")
+    return reporter.finish(EXIT_OK)
 
 
 def _rects(values: list[list[str]]) -> dict[str, tuple[float, float, float, float]]:

@@ -67,6 +67,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--zoom", type=parse_zoom, metavar="x0,y0,x1,y1", help="draw only this window of the map"
     )
+    parser.add_argument(
+        "--json", action="store_true", help="one JSON document: the files written and the verdict"
+    )
 
 
 def _log_samples(path: Path) -> tuple[list[list[float]], dict[str, Any] | None]:
@@ -112,7 +115,9 @@ def _verify_log(
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Read the artifacts of ``args.out`` and write the picture(s) next to them."""
     from tlmpc.artifacts import read_json, read_output
+    from tlmpc.errors import EXIT_OK
     from tlmpc.output import replace_file
+    from tlmpc.report import Reporter
 
     directory: Path = args.out
     if not (directory / "mission.json").is_file():
@@ -156,5 +161,9 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         )
         status = verdict.get("verdict") or ("satisfied" if verdict.get("satisfied") else "violated")
         tail = f" ({status}; {marks} violation(s) marked)"
-    err.write(f"wrote {', '.join(written)} to {directory}{tail}\n")
-    return 0
+    reporter = Reporter.for_args(args, out, err)
+    if not args.json:
+        reporter.note(f"wrote {', '.join(written)} to {directory}{tail}")
+    return reporter.finish(
+        EXIT_OK, {"written": [str(directory / name) for name in written], "verdict": verdict}
+    )

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
 from typing import Any, TextIO
 
@@ -42,30 +41,39 @@ def _bytes(content: Any) -> bytes:
 
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Run the stage and write what it produced."""
-    from tlmpc.errors import UsageError, error
+    from tlmpc.errors import EXIT_OK, UsageError, error
     from tlmpc.output import replace_file
     from tlmpc.pipeline import run_stage_from_artifacts
+    from tlmpc.report import Reporter
 
     target: Path = args.out if args.out is not None else args.directory
     if not target.is_dir():
         raise UsageError(
             error("U074", f"{target} is not a directory", hint="create it first", file=str(target))
         )
+    reporter = Reporter.for_args(args, out, err)
     result = run_stage_from_artifacts(args.name, args.directory)
-    for warning in result.warnings:
-        err.write(warning.format() + "\n")
+    reporter.diagnose(result.warnings)
     for name, content in result.artifacts.items():
         replace_file(target / name, _bytes(content))
     report = result.reports[0]
-    if args.json:
-        document = {
-            "stage": report.name,
-            "seconds": report.seconds,
-            "sizes": dict(report.sizes),
-            "artifacts": sorted(result.artifacts),
-        }
-        out.write(json.dumps(document, indent=2, sort_keys=True, default=str) + "\n")
-    else:
+    if not args.json:
         written = ", ".join(sorted(result.artifacts)) or "nothing"
-        err.write(f"{report.name}: {report.seconds:.3f} s; wrote {written} to {target}\n")
-    return 0
+        reporter.note(f"{report.name}: {report.seconds:.3f} s; wrote {written} to {target}")
+    document = {
+        "stage": report.name,
+        "seconds": report.seconds,
+        "sizes": {key: _plain(value) for key, value in report.sizes.items()},
+        "artifacts": sorted(result.artifacts),
+        "directory": str(target),
+    }
+    return reporter.finish(EXIT_OK, document)
+
+
+def _plain(value: Any) -> Any:
+    """A stage size as JSON: numbers and strings as they are, anything else as text."""
+    if hasattr(value, "item"):  # a numpy scalar
+        value = value.item()
+    if isinstance(value, bool | int | float | str) or value is None:
+        return value
+    return str(value)

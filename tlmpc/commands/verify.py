@@ -13,8 +13,6 @@ from typing import TYPE_CHECKING, TextIO
 if TYPE_CHECKING:
     from tlmpc.verify.model import Verdict
 
-from tlmpc.artifacts import json_text
-
 NAME = "verify"
 HELP = "check a trajectory (trace.json, or a CSV/ROS bag log with --mission) against its task"
 DESCRIPTION = """\
@@ -78,8 +76,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Verify and report."""
     from tlmpc.artifacts import read_json
-    from tlmpc.errors import EXIT_INCONCLUSIVE, EXIT_NEGATIVE, EXIT_OK
     from tlmpc.importers.logs import is_log, parse_columns, parse_transform
+    from tlmpc.report import OUTCOME_EXIT, Reporter
     from tlmpc.verify import (
         declare_ending,
         from_csv,
@@ -104,29 +102,28 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         trace = from_document(document, file=str(path), convention=args.boundary)
     trace = declare_ending(trace, assume_stay=args.assume_stay, loop_from=args.loop_from)
     verdict = verify_trace(trace)
-    if args.json:
-        out.write(json_text(verdict_to_json(verdict)))
-    else:
-        _print(path, verdict, out)
-    codes = {"satisfied": EXIT_OK, "violated": EXIT_NEGATIVE, "inconclusive": EXIT_INCONCLUSIVE}
-    return codes[verdict.outcome]
+    report = Reporter.for_args(args, out, err)
+    text = _text(path, verdict)
+    return report.finish(OUTCOME_EXIT[verdict.outcome], verdict_to_json(verdict), text)
 
 
-def _print(path: Path, verdict: Verdict, out: TextIO) -> None:
+def _text(path: Path, verdict: Verdict) -> str:
+    lines: list[str] = []
     status = {"satisfied": "satisfied", "violated": "VIOLATED", "inconclusive": "inconclusive"}
     ending = {
         "open": "the log ends here (three-valued verdict)",
         "stay": "the robot stays at its last point forever",
         "loop": "the loop repeats forever",
     }[verdict.ending]
-    out.write(f"{path}: {status[verdict.outcome]}: {verdict.formula}\n")
-    out.write(f"  boundary convention: {verdict.convention}; {ending}; {verdict.pieces} pieces\n")
+    lines.append(f"{path}: {status[verdict.outcome]}: {verdict.formula}")
+    lines.append(f"  boundary convention: {verdict.convention}; {ending}; {verdict.pieces} pieces")
     if len(verdict.conjuncts) > 1 or verdict.ending == "open":
         for report in verdict.conjuncts:
-            out.write(f"  {report.conjunct}: {report.outcome}: {report.progress}\n")
+            lines.append(f"  {report.conjunct}: {report.outcome}: {report.progress}")
     for violation in verdict.violations:
-        out.write(f"  violation: {violation.message}\n")
-    out.write(f"  robustness: {verdict.robustness:.6g}\n")
+        lines.append(f"  violation: {violation.message}")
+    lines.append(f"  robustness: {verdict.robustness:.6g}")
     certificate = verdict.certificate
     word = "certified" if certificate.certified else "not certified"
-    out.write(f"  {word}: {certificate.reason}\n")
+    lines.append(f"  {word}: {certificate.reason}")
+    return "".join(line + "\n" for line in lines)

@@ -31,19 +31,26 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         type=Path,
         help="the HTML file to write (default: OUT/view.html, or LOG with .html)",
     )
+    parser.add_argument("--json", action="store_true", help="one JSON document: the page written")
 
 
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Build the scene, render it and write the page atomically."""
-    from tlmpc.errors import EXIT_USAGE
+    from tlmpc.errors import EXIT_OK, UsageError, error
+    from tlmpc.output import replace_file
+    from tlmpc.report import Reporter
     from tlmpc.view import render_html, scene_from_log, scene_from_output
 
     if (args.out is None) == (args.log is None) or (args.log is not None) != (
         args.mission is not None
     ):
-        # a usage error, reported the way argparse reports one
-        err.write("tlmpc view: error: give either OUT, or --log LOG with --mission MISSION\n")
-        return EXIT_USAGE
+        raise UsageError(
+            error(
+                "U092",
+                "give either OUT, or --log LOG with --mission MISSION",
+                hint="`tlmpc view out` or `tlmpc view --log run.csv --mission mission.yaml`",
+            )
+        )
     if args.log is not None:
         scene = scene_from_log(args.log, args.mission)
         target = args.output or args.log.with_suffix(".html")
@@ -52,10 +59,14 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         target = args.output or args.out / "view.html"
     page = render_html(scene)
     if not target.parent.is_dir():
-        err.write(f"tlmpc view: error: the directory of {target} does not exist\n")
-        return EXIT_USAGE
-    temporary = target.with_name(f".{target.name}.tmp")
-    temporary.write_text(page, encoding="utf-8")
-    temporary.replace(target)
-    out.write(f"wrote {target}\n")
-    return 0
+        raise UsageError(
+            error(
+                "U093",
+                f"cannot write {target}: {target.parent} is not a directory",
+                hint="create the directory first, or choose another file with -o",
+                file=str(target),
+            )
+        )
+    replace_file(target, page.encode("utf-8"))
+    report = Reporter.for_args(args, out, err)
+    return report.finish(EXIT_OK, {"written": [str(target)]}, f"wrote {target}\n")

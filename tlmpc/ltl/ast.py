@@ -6,12 +6,17 @@ these nodes.  ``And``/``Or`` are n-ary (at least two operands); the parser flatt
 parsed from different places compare equal when they mean the same tree.
 
 There is deliberately no ``Next`` node: Next has no meaning in continuous time.
+
+``Formula`` is a closed union of the node classes, not a base class: code that takes a formula
+apart does it with ``match`` and ends in ``case _: assert_never(formula)``, so mypy rejects a
+``match`` that forgets a node kind (a test checks that it does).
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import dataclass, field
+from typing import TypeAlias, assert_never, cast
 
 
 @dataclass(frozen=True, slots=True)
@@ -25,8 +30,8 @@ class Span:
 
 
 @dataclass(frozen=True, slots=True)
-class Formula:
-    """Base class of all LTL nodes."""
+class Node:
+    """Shared behaviour of the LTL node classes (annotate with ``Formula``, the closed union)."""
 
     def children(self) -> tuple[Formula, ...]:
         """Direct sub-formulas, left to right."""
@@ -34,7 +39,8 @@ class Formula:
 
     def walk(self) -> Iterator[Formula]:
         """This node and every sub-formula, pre-order."""
-        stack: list[Formula] = [self]
+        # Every Node subclass is a member of the Formula union (a test checks it).
+        stack: list[Formula] = [cast("Formula", self)]
         while stack:
             node = stack.pop()
             yield node
@@ -47,11 +53,11 @@ class Formula:
     def __str__(self) -> str:
         from tlmpc.ltl.printer import to_text
 
-        return to_text(self)
+        return to_text(cast("Formula", self))
 
 
 @dataclass(frozen=True, slots=True)
-class Const(Formula):
+class Const(Node):
     """``true`` or ``false``."""
 
     value: bool
@@ -59,7 +65,7 @@ class Const(Formula):
 
 
 @dataclass(frozen=True, slots=True)
-class Prop(Formula):
+class Prop(Node):
     """An atomic proposition: the robot is in the region (or group) of this name."""
 
     name: str
@@ -67,7 +73,7 @@ class Prop(Formula):
 
 
 @dataclass(frozen=True, slots=True)
-class Not(Formula):
+class Not(Node):
     """``!arg``."""
 
     arg: Formula
@@ -78,7 +84,7 @@ class Not(Formula):
 
 
 @dataclass(frozen=True, slots=True)
-class And(Formula):
+class And(Node):
     """``a & b & ...`` (two or more operands)."""
 
     args: tuple[Formula, ...]
@@ -89,7 +95,7 @@ class And(Formula):
 
 
 @dataclass(frozen=True, slots=True)
-class Or(Formula):
+class Or(Node):
     """``a | b | ...`` (two or more operands)."""
 
     args: tuple[Formula, ...]
@@ -100,7 +106,7 @@ class Or(Formula):
 
 
 @dataclass(frozen=True, slots=True)
-class _Binary(Formula):
+class _Binary(Node):
     left: Formula
     right: Formula
     span: Span | None = field(default=None, compare=False, repr=False)
@@ -140,7 +146,7 @@ class StrongRelease(_Binary):
 
 
 @dataclass(frozen=True, slots=True)
-class Eventually(Formula):
+class Eventually(Node):
     """``F arg`` (also written ``<>``)."""
 
     arg: Formula
@@ -151,7 +157,7 @@ class Eventually(Formula):
 
 
 @dataclass(frozen=True, slots=True)
-class Globally(Formula):
+class Globally(Node):
     """``G arg`` (also written ``[]``)."""
 
     arg: Formula
@@ -161,6 +167,23 @@ class Globally(Formula):
         return (self.arg,)
 
 
+Formula: TypeAlias = (
+    Const
+    | Prop
+    | Not
+    | And
+    | Or
+    | Implies
+    | Equiv
+    | Until
+    | Release
+    | WeakUntil
+    | StrongRelease
+    | Eventually
+    | Globally
+)
+"""An LTL formula: one of the node classes above (a closed union)."""
+
 TRUE = Const(True)
 FALSE = Const(False)
 
@@ -168,9 +191,20 @@ BINARY_TEMPORAL = (Until, Release, WeakUntil, StrongRelease)
 UNARY_TEMPORAL = (Eventually, Globally)
 
 
+def is_temporal(node: Formula) -> bool:
+    """True for a temporal operator node (``U R W M F G``), False for the others."""
+    match node:
+        case Until() | Release() | WeakUntil() | StrongRelease() | Eventually() | Globally():
+            return True
+        case Const() | Prop() | Not() | And() | Or() | Implies() | Equiv():
+            return False
+        case _:
+            assert_never(node)
+
+
 def is_propositional(formula: Formula) -> bool:
     """True when the formula has no temporal operator."""
-    return not any(isinstance(n, (*BINARY_TEMPORAL, *UNARY_TEMPORAL)) for n in formula.walk())
+    return not any(is_temporal(n) for n in formula.walk())
 
 
 def conjoin(parts: list[Formula] | tuple[Formula, ...]) -> Formula:

@@ -9,6 +9,7 @@ the precedence would not need it: ``p4 & ((!p2 & !p3) U p1)``.
 from __future__ import annotations
 
 import re
+from typing import assert_never
 
 from tlmpc.ltl.ast import (
     And,
@@ -50,17 +51,21 @@ def proposition_text(name: str) -> str:
 
 
 def _level(formula: Formula) -> int:
-    if isinstance(formula, Implies | Equiv):
-        return _IMPLIES
-    if isinstance(formula, Or):
-        return _OR
-    if isinstance(formula, And):
-        return _AND
-    if isinstance(formula, Until | Release | WeakUntil | StrongRelease):
-        return _BINTEMP
-    if isinstance(formula, Not | Eventually | Globally):
-        return _UNARY
-    return _ATOM
+    match formula:
+        case Implies() | Equiv():
+            return _IMPLIES
+        case Or():
+            return _OR
+        case And():
+            return _AND
+        case Until() | Release() | WeakUntil() | StrongRelease():
+            return _BINTEMP
+        case Not() | Eventually() | Globally():
+            return _UNARY
+        case Const() | Prop():
+            return _ATOM
+        case _:
+            assert_never(formula)
 
 
 def _wrap(text: str, needed: bool) -> str:
@@ -79,31 +84,36 @@ def _operand(child: Formula, minimum: int, *, boolean_parent: bool = False) -> s
 
 
 def _print(formula: Formula) -> str:
-    if isinstance(formula, Const):
-        return "true" if formula.value else "false"
-    if isinstance(formula, Prop):
-        return proposition_text(formula.name)
-    if isinstance(formula, Not):
-        return "!" + _operand(formula.arg, _UNARY)
-    if isinstance(formula, Eventually | Globally):
-        symbol = "F" if isinstance(formula, Eventually) else "G"
-        inner = _operand(formula.arg, _UNARY)
-        return f"{symbol}{inner}" if inner.startswith("(") else f"{symbol} {inner}"
-    if isinstance(formula, And):
-        return " & ".join(_operand(a, _AND + 1, boolean_parent=True) for a in formula.args)
-    if isinstance(formula, Or):
-        return " | ".join(_operand(a, _OR + 1, boolean_parent=True) for a in formula.args)
-    if isinstance(formula, Implies | Equiv):
-        symbol = "->" if isinstance(formula, Implies) else "<->"
-        left = _operand(formula.left, _IMPLIES + 1, boolean_parent=True)
-        right = _operand(formula.right, _IMPLIES, boolean_parent=True)
-        return f"{left} {symbol} {right}"
-    if isinstance(formula, Until | Release | WeakUntil | StrongRelease):
-        symbol = _TEMPORAL_SYMBOL[type(formula)]
-        left = _operand(formula.left, _BINTEMP + 1)
-        right = _operand(formula.right, _BINTEMP)
-        return f"{left} {symbol} {right}"
-    raise TypeError(f"not an LTL node: {formula!r}")
+    match formula:
+        case Const(value):
+            return "true" if value else "false"
+        case Prop(name):
+            return proposition_text(name)
+        case Not(arg):
+            return "!" + _operand(arg, _UNARY)
+        case Eventually(arg) | Globally(arg):
+            symbol = "F" if isinstance(formula, Eventually) else "G"
+            inner = _operand(arg, _UNARY)
+            return f"{symbol}{inner}" if inner.startswith("(") else f"{symbol} {inner}"
+        case And(args):
+            return " & ".join(_operand(a, _AND + 1, boolean_parent=True) for a in args)
+        case Or(args):
+            return " | ".join(_operand(a, _OR + 1, boolean_parent=True) for a in args)
+        case Implies(left, right) | Equiv(left, right):
+            symbol = "->" if isinstance(formula, Implies) else "<->"
+            left_text = _operand(left, _IMPLIES + 1, boolean_parent=True)
+            right_text = _operand(right, _IMPLIES, boolean_parent=True)
+            return f"{left_text} {symbol} {right_text}"
+        case (
+            Until(left, right)
+            | Release(left, right)
+            | WeakUntil(left, right)
+            | StrongRelease(left, right)
+        ):
+            symbol = _TEMPORAL_SYMBOL[type(formula)]
+            return f"{_operand(left, _BINTEMP + 1)} {symbol} {_operand(right, _BINTEMP)}"
+        case _:
+            assert_never(formula)
 
 
 def to_spin(formula: Formula) -> str:
@@ -112,32 +122,34 @@ def to_spin(formula: Formula) -> str:
     SPIN has no weak until or strong release: ``a W b`` is sent as ``b V (a || b)`` and
     ``a M b`` as ``b U (a && b)``.
     """
-    if isinstance(formula, Const):
-        return "true" if formula.value else "false"
-    if isinstance(formula, Prop):
-        return formula.name
-    if isinstance(formula, Not):
-        return f"!({to_spin(formula.arg)})"
-    if isinstance(formula, Eventually):
-        return f"<>({to_spin(formula.arg)})"
-    if isinstance(formula, Globally):
-        return f"[]({to_spin(formula.arg)})"
-    if isinstance(formula, And):
-        return "(" + " && ".join(to_spin(a) for a in formula.args) + ")"
-    if isinstance(formula, Or):
-        return "(" + " || ".join(to_spin(a) for a in formula.args) + ")"
-    if isinstance(formula, Implies):
-        return f"(({to_spin(formula.left)}) -> ({to_spin(formula.right)}))"
-    if isinstance(formula, Equiv):
-        return f"(({to_spin(formula.left)}) <-> ({to_spin(formula.right)}))"
-    if isinstance(formula, Until):
-        return f"(({to_spin(formula.left)}) U ({to_spin(formula.right)}))"
-    if isinstance(formula, Release):
-        return f"(({to_spin(formula.left)}) V ({to_spin(formula.right)}))"
-    if isinstance(formula, WeakUntil):
-        a, b = to_spin(formula.left), to_spin(formula.right)
-        return f"(({b}) V (({a}) || ({b})))"
-    if isinstance(formula, StrongRelease):
-        a, b = to_spin(formula.left), to_spin(formula.right)
-        return f"(({b}) U (({a}) && ({b})))"
-    raise TypeError(f"not an LTL node: {formula!r}")
+    match formula:
+        case Const(value):
+            return "true" if value else "false"
+        case Prop(name):
+            return name
+        case Not(arg):
+            return f"!({to_spin(arg)})"
+        case Eventually(arg):
+            return f"<>({to_spin(arg)})"
+        case Globally(arg):
+            return f"[]({to_spin(arg)})"
+        case And(args):
+            return "(" + " && ".join(to_spin(a) for a in args) + ")"
+        case Or(args):
+            return "(" + " || ".join(to_spin(a) for a in args) + ")"
+        case Implies(left, right):
+            return f"(({to_spin(left)}) -> ({to_spin(right)}))"
+        case Equiv(left, right):
+            return f"(({to_spin(left)}) <-> ({to_spin(right)}))"
+        case Until(left, right):
+            return f"(({to_spin(left)}) U ({to_spin(right)}))"
+        case Release(left, right):
+            return f"(({to_spin(left)}) V ({to_spin(right)}))"
+        case WeakUntil(left, right):
+            a, b = to_spin(left), to_spin(right)
+            return f"(({b}) V (({a}) || ({b})))"
+        case StrongRelease(left, right):
+            a, b = to_spin(left), to_spin(right)
+            return f"(({b}) U (({a}) && ({b})))"
+        case _:
+            assert_never(formula)

@@ -8,6 +8,7 @@ and uses the dualities ``!(a U b) = !a R !b``, ``!(a R b) = !a U !b``,
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
+from typing import assert_never
 
 from tlmpc.ltl.ast import (
     FALSE,
@@ -49,59 +50,74 @@ def nnf(formula: Formula, negate: bool = False) -> Formula:
 
     The result has no ``->``/``<->`` and negations only directly above propositions.
     """
-    f = formula
-    if isinstance(f, Const):
-        return Const(f.value != negate)
-    if isinstance(f, Prop):
-        return Not(f) if negate else Prop(f.name)
-    if isinstance(f, Not):
-        return nnf(f.arg, not negate)
-    if isinstance(f, And | Or):
-        parts = [nnf(a, negate) for a in f.args]
-        use_and = isinstance(f, And) != negate
-        return conjoin(parts) if use_and else disjoin(parts)
-    if isinstance(f, Implies):
-        # a -> b  ==  !a | b ;  !(a -> b)  ==  a & !b
-        if negate:
-            return conjoin([nnf(f.left), nnf(f.right, True)])
-        return disjoin([nnf(f.left, True), nnf(f.right)])
-    if isinstance(f, Equiv):
-        # a <-> b == (a & b) | (!a & !b);  !(a <-> b) == (a & !b) | (!a & b)
-        a, na = nnf(f.left), nnf(f.left, True)
-        b, nb = nnf(f.right), nnf(f.right, True)
-        if negate:
-            return disjoin([conjoin([a, nb]), conjoin([na, b])])
-        return disjoin([conjoin([a, b]), conjoin([na, nb])])
-    if isinstance(f, Eventually):
-        return Globally(nnf(f.arg, True)) if negate else Eventually(nnf(f.arg))
-    if isinstance(f, Globally):
-        return Eventually(nnf(f.arg, True)) if negate else Globally(nnf(f.arg))
-    if isinstance(f, Until | Release | WeakUntil | StrongRelease):
-        build = _DUAL[type(f)] if negate else _SAME[type(f)]
-        return build(nnf(f.left, negate), nnf(f.right, negate))
-    raise TypeError(f"not an LTL node: {f!r}")
+    match formula:
+        case Const(value):
+            return Const(value != negate)
+        case Prop(name):
+            return Not(formula) if negate else Prop(name)
+        case Not(arg):
+            return nnf(arg, not negate)
+        case And(args) | Or(args):
+            parts = [nnf(a, negate) for a in args]
+            use_and = isinstance(formula, And) != negate
+            return conjoin(parts) if use_and else disjoin(parts)
+        case Implies(left, right):
+            # a -> b  ==  !a | b ;  !(a -> b)  ==  a & !b
+            if negate:
+                return conjoin([nnf(left), nnf(right, True)])
+            return disjoin([nnf(left, True), nnf(right)])
+        case Equiv(left, right):
+            # a <-> b == (a & b) | (!a & !b);  !(a <-> b) == (a & !b) | (!a & b)
+            a, na = nnf(left), nnf(left, True)
+            b, nb = nnf(right), nnf(right, True)
+            if negate:
+                return disjoin([conjoin([a, nb]), conjoin([na, b])])
+            return disjoin([conjoin([a, b]), conjoin([na, nb])])
+        case Eventually(arg):
+            return Globally(nnf(arg, True)) if negate else Eventually(nnf(arg))
+        case Globally(arg):
+            return Eventually(nnf(arg, True)) if negate else Globally(nnf(arg))
+        case (
+            Until(left, right)
+            | Release(left, right)
+            | WeakUntil(left, right)
+            | StrongRelease(left, right)
+        ):
+            build = _DUAL[type(formula)] if negate else _SAME[type(formula)]
+            return build(nnf(left, negate), nnf(right, negate))
+        case _:
+            assert_never(formula)
 
 
 def substitute(formula: Formula, replace: Mapping[str, Formula]) -> Formula:
     """``formula`` with every proposition named in ``replace`` replaced (spans kept)."""
     f = formula
-    if isinstance(f, Prop):
-        return replace.get(f.name, f)
-    if isinstance(f, Const):
-        return f
-    if isinstance(f, Not):
-        return Not(substitute(f.arg, replace), span=f.span)
-    if isinstance(f, And):
-        return And(tuple(substitute(a, replace) for a in f.args), span=f.span)
-    if isinstance(f, Or):
-        return Or(tuple(substitute(a, replace) for a in f.args), span=f.span)
-    if isinstance(f, Eventually):
-        return Eventually(substitute(f.arg, replace), span=f.span)
-    if isinstance(f, Globally):
-        return Globally(substitute(f.arg, replace), span=f.span)
-    if isinstance(f, Implies | Equiv | Until | Release | WeakUntil | StrongRelease):
-        return type(f)(substitute(f.left, replace), substitute(f.right, replace), span=f.span)
-    raise TypeError(f"not an LTL node: {f!r}")
+    match f:
+        case Prop(name):
+            return replace.get(name, f)
+        case Const():
+            return f
+        case Not(arg):
+            return Not(substitute(arg, replace), span=f.span)
+        case And(args):
+            return And(tuple(substitute(a, replace) for a in args), span=f.span)
+        case Or(args):
+            return Or(tuple(substitute(a, replace) for a in args), span=f.span)
+        case Eventually(arg):
+            return Eventually(substitute(arg, replace), span=f.span)
+        case Globally(arg):
+            return Globally(substitute(arg, replace), span=f.span)
+        case (
+            Implies(left, right)
+            | Equiv(left, right)
+            | Until(left, right)
+            | Release(left, right)
+            | WeakUntil(left, right)
+            | StrongRelease(left, right)
+        ):
+            return type(f)(substitute(left, replace), substitute(right, replace), span=f.span)
+        case _:
+            assert_never(f)
 
 
 def _only(formula: Formula, allowed: tuple[type, ...]) -> bool:
@@ -137,34 +153,41 @@ def _flatten(kind: type[And] | type[Or], parts: list[Formula]) -> list[Formula]:
 def simplify(formula: Formula) -> Formula:
     """Constant folding and flattening (meaning-preserving, cheap)."""
     f = formula
-    if isinstance(f, Const | Prop):
-        return f
-    if isinstance(f, Not):
-        arg = simplify(f.arg)
-        if isinstance(arg, Const):
-            return Const(not arg.value)
-        if isinstance(arg, Not):
-            return arg.arg
-        return Not(arg, span=f.span)
-    if isinstance(f, And):
-        parts = _flatten(And, [simplify(a) for a in f.args])
-        if any(p == FALSE for p in parts):
-            return FALSE
-        kept = list(dict.fromkeys(p for p in parts if p != TRUE))
-        return conjoin(kept)
-    if isinstance(f, Or):
-        parts = _flatten(Or, [simplify(a) for a in f.args])
-        if any(p == TRUE for p in parts):
-            return TRUE
-        kept = list(dict.fromkeys(p for p in parts if p != FALSE))
-        return disjoin(kept)
-    if isinstance(f, Eventually | Globally):
-        arg = simplify(f.arg)
-        if isinstance(arg, Const):
-            return arg
-        if isinstance(arg, type(f)):  # F F a = F a, G G a = G a
-            return arg
-        return type(f)(arg, span=f.span)
-    if isinstance(f, Implies | Equiv | Until | Release | WeakUntil | StrongRelease):
-        return type(f)(simplify(f.left), simplify(f.right), span=f.span)
-    raise TypeError(f"not an LTL node: {f!r}")
+    match f:
+        case Const() | Prop():
+            return f
+        case Not(arg):
+            arg = simplify(arg)
+            if isinstance(arg, Const):
+                return Const(not arg.value)
+            if isinstance(arg, Not):
+                return arg.arg
+            return Not(arg, span=f.span)
+        case And(args):
+            parts = _flatten(And, [simplify(a) for a in args])
+            if any(p == FALSE for p in parts):
+                return FALSE
+            return conjoin(list(dict.fromkeys(p for p in parts if p != TRUE)))
+        case Or(args):
+            parts = _flatten(Or, [simplify(a) for a in args])
+            if any(p == TRUE for p in parts):
+                return TRUE
+            return disjoin(list(dict.fromkeys(p for p in parts if p != FALSE)))
+        case Eventually(arg) | Globally(arg):
+            arg = simplify(arg)
+            if isinstance(arg, Const):
+                return arg
+            if isinstance(arg, type(f)):  # F F a = F a, G G a = G a
+                return arg
+            return type(f)(arg, span=f.span)
+        case (
+            Implies(left, right)
+            | Equiv(left, right)
+            | Until(left, right)
+            | Release(left, right)
+            | WeakUntil(left, right)
+            | StrongRelease(left, right)
+        ):
+            return type(f)(simplify(left), simplify(right), span=f.span)
+        case _:
+            assert_never(f)

@@ -29,9 +29,13 @@ def invariants(formula: Formula) -> list[Formula]:
     parts = normal.args if isinstance(normal, And) else (normal,)
     found: list[Formula] = []
     for part in parts:
-        if isinstance(part, Globally) and is_propositional(part.arg):
-            inner = part.arg
-            found.extend(inner.args if isinstance(inner, And) else (inner,))
+        match part:
+            case Globally(And(args)) if is_propositional(part.arg):
+                found.extend(args)
+            case Globally(inner) if is_propositional(inner):
+                found.append(inner)
+            case _:
+                pass  # not an invariant
     return found
 
 
@@ -69,11 +73,13 @@ def _positive_props(formula: Formula) -> list[str]:
     positive: set[str] = set()
     stack = [nnf(formula)]
     while stack:
-        node = stack.pop()
-        if isinstance(node, Prop):
-            positive.add(node.name)
-        elif not isinstance(node, Not):  # in NNF a negation holds a proposition only
-            stack.extend(node.children())
+        match stack.pop():
+            case Prop(name):
+                positive.add(name)
+            case Not():
+                pass  # in NNF a negation holds a proposition only
+            case node:
+                stack.extend(node.children())
     names = [n.name for n in formula.walk() if isinstance(n, Prop)]
     return [p for p in dict.fromkeys(names) if p in positive]
 

@@ -19,6 +19,7 @@ backward passes around the loop.  The other operators are their definitions: ``F
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import assert_never
 
 import numpy as np
 import numpy.typing as npt
@@ -146,43 +147,45 @@ class IntervalEvaluator:
         return lo, np.maximum.reduce([v[1] for v in values])
 
     def _eval(self, f: Formula) -> Value:
-        if isinstance(f, Const):
-            filled = np.full(self.size, np.inf if f.value else -np.inf)
-            return filled, filled
-        if isinstance(f, Prop):
-            return self.atoms(f.name)
-        if isinstance(f, Not):
-            return self.negate(self(f.arg))
-        if isinstance(f, And):
-            return self.meet([self(a) for a in f.args])
-        if isinstance(f, Or):
-            return self.join([self(a) for a in f.args])
-        if isinstance(f, Implies):
-            return self.join([self.negate(self(f.left)), self(f.right)])
-        if isinstance(f, Equiv):
-            left, right = self(f.left), self(f.right)
-            return self.meet(
-                [
-                    self.join([self.negate(left), right]),
-                    self.join([left, self.negate(right)]),
-                ]
-            )
-        if isinstance(f, Until):
-            return self.until(self(f.left), self(f.right))
-        if isinstance(f, Eventually):
-            return self.eventually(self(f.arg))
-        if isinstance(f, Globally):
-            return self.negate(self.eventually(self.negate(self(f.arg))))
-        if isinstance(f, Release):
-            return self.negate(self.until(self.negate(self(f.left)), self.negate(self(f.right))))
-        if isinstance(f, WeakUntil):
-            left = self(f.left)
-            always = self.negate(self.eventually(self.negate(left)))
-            return self.join([self.until(left, self(f.right)), always])
-        if isinstance(f, StrongRelease):
-            right = self(f.right)
-            return self.until(right, self.meet([self(f.left), right]))
-        raise TypeError(f"not an LTL node: {f!r}")
+        match f:
+            case Const(value):
+                filled = np.full(self.size, np.inf if value else -np.inf)
+                return filled, filled
+            case Prop(name):
+                return self.atoms(name)
+            case Not(arg):
+                return self.negate(self(arg))
+            case And(args):
+                return self.meet([self(a) for a in args])
+            case Or(args):
+                return self.join([self(a) for a in args])
+            case Implies(left, right):
+                return self.join([self.negate(self(left)), self(right)])
+            case Equiv(left, right):
+                left_value, right_value = self(left), self(right)
+                return self.meet(
+                    [
+                        self.join([self.negate(left_value), right_value]),
+                        self.join([left_value, self.negate(right_value)]),
+                    ]
+                )
+            case Until(left, right):
+                return self.until(self(left), self(right))
+            case Eventually(arg):
+                return self.eventually(self(arg))
+            case Globally(arg):
+                return self.negate(self.eventually(self.negate(self(arg))))
+            case Release(left, right):
+                return self.negate(self.until(self.negate(self(left)), self.negate(self(right))))
+            case WeakUntil(left, right):
+                left_value = self(left)
+                always = self.negate(self.eventually(self.negate(left_value)))
+                return self.join([self.until(left_value, self(right)), always])
+            case StrongRelease(left, right):
+                right_value = self(right)
+                return self.until(right_value, self.meet([self(left), right_value]))
+            case _:
+                assert_never(f)
 
 
 def truth_atoms(

@@ -112,34 +112,37 @@ def _other_violation(
 ) -> Violation:
     text = to_text(conjunct)
     size = line.size
-    if isinstance(conjunct, Eventually):
-        return Violation(
-            conjunct=text,
-            time=None,
-            position=None,
-            message=f"`{to_text(conjunct.arg)}` never holds, so `{text}` fails",
-        )
-    if isinstance(conjunct, Until):
-        right_never = value(conjunct.right)[1][:size] < 0
-        left_fails = value(conjunct.left)[1][:size] < 0
-        bad = np.flatnonzero(left_fails & right_never)
-        # the first instant where neither holds, if b never held before it
-        if len(bad) and right_never[: int(bad[0]) + 1].all():
-            time, position = _at(line, int(bad[0]))
-            return Violation(
-                conjunct=text,
-                time=time,
-                position=position,
-                message=f"`{to_text(conjunct.left)}` stops holding at t={time:.4g} s at "
-                f"{_place(position)} before `{to_text(conjunct.right)}` holds",
-            )
-        if right_never.all():
+    match conjunct:
+        case Eventually(arg):
             return Violation(
                 conjunct=text,
                 time=None,
                 position=None,
-                message=f"`{to_text(conjunct.right)}` never holds, so `{text}` fails",
+                message=f"`{to_text(arg)}` never holds, so `{text}` fails",
             )
+        case Until(left, right):
+            right_never = value(right)[1][:size] < 0
+            left_fails = value(left)[1][:size] < 0
+            bad = np.flatnonzero(left_fails & right_never)
+            # the first instant where neither holds, if b never held before it
+            if len(bad) and right_never[: int(bad[0]) + 1].all():
+                time, position = _at(line, int(bad[0]))
+                return Violation(
+                    conjunct=text,
+                    time=time,
+                    position=position,
+                    message=f"`{to_text(left)}` stops holding at t={time:.4g} s at "
+                    f"{_place(position)} before `{to_text(right)}` holds",
+                )
+            if right_never.all():
+                return Violation(
+                    conjunct=text,
+                    time=None,
+                    position=None,
+                    message=f"`{to_text(right)}` never holds, so `{text}` fails",
+                )
+        case _:
+            pass  # no specific explanation for the other operators
     return Violation(
         conjunct=text, time=None, position=None, message=f"`{text}` does not hold on this trace"
     )
@@ -155,47 +158,51 @@ def _progress(
         truth: BoolArray = value(f)[0][:size] > 0
         return truth
 
-    if isinstance(conjunct, Globally) and isinstance(conjunct.arg, Eventually):
-        count, last, gap = _visits(line, held(conjunct.arg.arg))
-        if count:
-            progress = f"visited {_times(count)}, last at t={last:.4g} s, longest gap {gap:.4g} s"
-        else:
-            progress = f"never visited in {gap:.4g} s"
-        return ConjunctReport(
-            conjunct=text,
-            outcome=outcome,
-            progress=progress,
-            visits=count,
-            last_visit=last,
-            longest_gap=gap,
-        )
-    if isinstance(conjunct, Eventually):
-        found = runs(held(conjunct.arg))
-        if found:
-            time = float(line.starts[found[0][0]])
-            progress = f"done at t={time:.4g} s"
-        else:
-            progress = "pending" if outcome == "inconclusive" else "never done"
-        return ConjunctReport(conjunct=text, outcome=outcome, progress=progress, visits=len(found))
-    if isinstance(conjunct, Globally):
-        broken = runs(value(conjunct.arg)[1][:size] < 0)
-        if broken:
-            time = float(line.starts[broken[0][0]])
-            progress = f"broken {_times(len(broken))}, first at t={time:.4g} s"
-        else:
-            progress = "held so far" if outcome == "inconclusive" else "held throughout"
-        return ConjunctReport(conjunct=text, outcome=outcome, progress=progress)
-    if isinstance(conjunct, Until):
-        found = runs(held(conjunct.right))
-        if found and outcome == "satisfied":
-            progress = f"`{to_text(conjunct.right)}` reached at t={line.starts[found[0][0]]:.4g} s"
-        else:
-            progress = {"satisfied": "holds", "violated": "fails", "inconclusive": "pending"}[
-                outcome
-            ]
-        return ConjunctReport(conjunct=text, outcome=outcome, progress=progress)
     words = {"satisfied": "holds", "violated": "fails", "inconclusive": "pending"}
-    return ConjunctReport(conjunct=text, outcome=outcome, progress=words[outcome])
+    match conjunct:
+        case Globally(Eventually(goal)):
+            count, last, gap = _visits(line, held(goal))
+            if count:
+                progress = (
+                    f"visited {_times(count)}, last at t={last:.4g} s, longest gap {gap:.4g} s"
+                )
+            else:
+                progress = f"never visited in {gap:.4g} s"
+            return ConjunctReport(
+                conjunct=text,
+                outcome=outcome,
+                progress=progress,
+                visits=count,
+                last_visit=last,
+                longest_gap=gap,
+            )
+        case Eventually(arg):
+            found = runs(held(arg))
+            if found:
+                time = float(line.starts[found[0][0]])
+                progress = f"done at t={time:.4g} s"
+            else:
+                progress = "pending" if outcome == "inconclusive" else "never done"
+            return ConjunctReport(
+                conjunct=text, outcome=outcome, progress=progress, visits=len(found)
+            )
+        case Globally(arg):
+            broken = runs(value(arg)[1][:size] < 0)
+            if broken:
+                time = float(line.starts[broken[0][0]])
+                progress = f"broken {_times(len(broken))}, first at t={time:.4g} s"
+            else:
+                progress = "held so far" if outcome == "inconclusive" else "held throughout"
+            return ConjunctReport(conjunct=text, outcome=outcome, progress=progress)
+        case Until(_, right):
+            found = runs(held(right))
+            if found and outcome == "satisfied":
+                progress = f"`{to_text(right)}` reached at t={line.starts[found[0][0]]:.4g} s"
+            else:
+                progress = words[outcome]
+            return ConjunctReport(conjunct=text, outcome=outcome, progress=progress)
+        case _:
+            return ConjunctReport(conjunct=text, outcome=outcome, progress=words[outcome])
 
 
 def conjunct_reports(
