@@ -130,6 +130,11 @@ CASES: dict[str, list[tuple[str, int, Case]]] = {
         ("page", 0, lambda c, t: run_json("view", str(c), "-o", str(t / "v.html"), "--json")),
         ("no input", 2, lambda c, t: run_json("view", "--json")),
     ],
+    "simulate": [
+        ("run", 0, lambda c, t: run_json("simulate", str(c), "--cycles", "1", "--json")),
+        ("cut short", 4, lambda c, t: run_json("simulate", str(c), "--duration", "0.5", "--json")),
+        ("empty dir", 2, lambda c, t: run_json("simulate", str(t), "--json")),
+    ],
 }
 
 CASE_IDS = [(command, name) for command, cases in CASES.items() for name, _, _ in cases]
@@ -168,6 +173,8 @@ def test_json_output_follows_the_contract(
         # it could not run (or the input was refused): no result, and an error says why
         assert document["result"] is None
         assert any(d["severity"] == "error" for d in document["diagnostics"])
+    elif command == "simulate":  # a run cut short is still reported in full
+        assert document["result"]["outcome"] in ("violated", "inconclusive")
     else:  # a negative or open answer of verify is still a full verdict
         assert document["result"]["verdict"] in ("violated", "inconclusive")
 

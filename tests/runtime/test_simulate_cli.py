@@ -58,7 +58,10 @@ def test_a_run_within_the_bound_exits_0_and_its_trace_verifies(
 def test_json_report(patrol: Path) -> None:
     code, out, _ = run("simulate", str(patrol), "--cycles", "1", "--json")
     assert code == 0
-    report = json.loads(out)
+    envelope = json.loads(out)
+    assert envelope["command"] == "simulate"
+    assert envelope["exit_code"] == 0
+    report = envelope["result"]
     assert report["outcome"] == "satisfied"
     assert report["laps"] == 1
     assert report["disturbance"] == {

@@ -15,7 +15,7 @@ import tempfile
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TextIO
 
-from tlmpc.artifacts import dumps, json_text
+from tlmpc.artifacts import dumps
 from tlmpc.errors import UsageError, error
 
 if TYPE_CHECKING:
@@ -76,7 +76,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Simulate, verify and report."""
-    from tlmpc.errors import EXIT_INCONCLUSIVE, EXIT_NEGATIVE, EXIT_OK
+    from tlmpc.errors import EXIT_NEGATIVE
+    from tlmpc.report import OUTCOME_EXIT, Reporter
     from tlmpc.runtime import Executor, make_disturbance, run_closed_loop
     from tlmpc.verify import verify_document
 
@@ -124,15 +125,18 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     verdict = verify_document(result.trace)
     if args.output is not None:
         _write(args.output, result.trace)
-    report = _report(args, result, verdict, bound, declared)
-    if args.json:
-        out.write(json_text(report))
-    else:
-        _print(report, out, err)
+    document = _report(args, result, verdict, bound, declared)
+    reporter = Reporter.for_args(args, out, err)
+    if bound > declared:
+        reporter.note(
+            f"note: the controllers guarantee the task for |w| <= {declared:g} "
+            "(robot.disturbance); above it the executor recovers where it can"
+        )
     if result.progress.status in ("no_plan", "violated"):
-        return EXIT_NEGATIVE
-    codes = {"satisfied": EXIT_OK, "violated": EXIT_NEGATIVE, "inconclusive": EXIT_INCONCLUSIVE}
-    return codes[verdict.outcome]
+        code = EXIT_NEGATIVE
+    else:
+        code = OUTCOME_EXIT[verdict.outcome]
+    return reporter.finish(code, document, _text(document))
 
 
 def _write(path: Path, document: Any) -> None:
@@ -203,25 +207,18 @@ def _report(
     }
 
 
-def _print(report: dict[str, Any], out: TextIO, err: TextIO) -> None:
+def _text(report: dict[str, Any]) -> str:
     status = {"satisfied": "satisfied", "violated": "VIOLATED", "inconclusive": "inconclusive"}
     disturbance = report["disturbance"]
-    out.write(f"{report['out']}: {status[report['outcome']]}: {report['formula']}\n")
-    out.write(
+    lines = [
+        f"{report['out']}: {status[report['outcome']]}: {report['formula']}",
         f"  disturbance |w| <= {disturbance['bound']:g} ({disturbance['model']}, seed "
         f"{disturbance['seed']}); dt {report['dt']:.4g} s, {report['samples']} samples, "
-        f"{report['seconds']:.4g} s simulated; trace ends: {report['ending']}\n"
-    )
-    out.write(
+        f"{report['seconds']:.4g} s simulated; trace ends: {report['ending']}",
         f"  executor: {report['status']}, {report['laps']} lap(s) of the cycle, "
         f"{report['reentries']} re-entr{'y' if report['reentries'] == 1 else 'ies'}, "
-        f"{report['replans']} re-plan(s)\n"
-    )
-    for violation in report["violations"]:
-        out.write(f"  violation: {violation}\n")
-    out.write(f"  robustness: {report['robustness']:.6g}\n")
-    if disturbance["bound"] > disturbance["declared"]:
-        err.write(
-            f"note: the controllers guarantee the task for |w| <= {disturbance['declared']:g} "
-            "(robot.disturbance); above it the executor recovers where it can\n"
-        )
+        f"{report['replans']} re-plan(s)",
+    ]
+    lines.extend(f"  violation: {violation}" for violation in report["violations"])
+    lines.append(f"  robustness: {report['robustness']:.6g}")
+    return "\n".join(lines) + "\n"
