@@ -367,22 +367,37 @@ def reduce_by_simulation(
     if letters is None and len(automaton.aps) > simulation.MAX_APS:
         return automaton
     alphabet = simulation.Alphabet(automaton.aps, letters)
+    current = automaton
     try:
-        current = simulation.saturate(
-            automaton, sccs(automaton.num_states, automaton.edges, automaton.initial)
-        )
-        relation = simulation.simulation(current, alphabet, deadline)
-        merged = simulation.quotient(current, relation)
-        if merged is not current:
-            keep = {e.src for e in merged.edges} | {merged.initial}
-            current = _renumber(merged, merged.edges, keep)
-            current = simulation.saturate(
-                current, sccs(current.num_states, current.edges, current.initial)
-            )
-            relation = simulation.simulation(current, alphabet, deadline)
-        return simulation.prune(current, alphabet, relation, deadline)
+        for saturated in (False, True):
+            current = _simulation_round(current, alphabet, deadline, saturated=saturated)
     except simulation.OutOfTime:
-        return automaton
+        pass
+    return current
+
+
+def _simulation_round(
+    automaton: Automaton, alphabet: simulation.Alphabet, deadline: float, *, saturated: bool
+) -> Automaton:
+    """One quotient-and-prune pass.  Edges between SCCs carry no marks after trimming; with
+    ``saturated`` they carry every mark instead (both are the same language, since a run takes
+    such an edge once): the bare marks let those edges be dominated, every mark lets them
+    dominate, and each finds reductions the other misses."""
+
+    def prepared(current: Automaton) -> Automaton:
+        component = sccs(current.num_states, current.edges, current.initial)
+        if saturated:
+            return simulation.saturate(current, component)
+        return simulation.strip_transient(current, component)
+
+    current = prepared(automaton)
+    relation = simulation.simulation(current, alphabet, deadline)
+    merged = simulation.quotient(current, relation)
+    if merged is not current:
+        keep = {e.src for e in merged.edges} | {merged.initial}
+        current = prepared(_renumber(merged, merged.edges, keep))
+        relation = simulation.simulation(current, alphabet, deadline)
+    return simulation.prune(current, alphabet, relation, deadline)
 
 
 def postprocess(

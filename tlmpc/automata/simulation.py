@@ -109,6 +109,17 @@ def saturate(automaton: Automaton, component: Sequence[int]) -> Automaton:
     return _with_edges(automaton, edges)
 
 
+def strip_transient(automaton: Automaton, component: Sequence[int]) -> Automaton:
+    """Take every mark off edges between SCCs (taken at most once, so the language stays)."""
+    edges = tuple(
+        e
+        if component[e.src] == component[e.dst] or not e.marks
+        else Edge(src=e.src, dst=e.dst, guard=e.guard, marks=frozenset())
+        for e in automaton.edges
+    )
+    return _with_edges(automaton, edges)
+
+
 def _with_edges(automaton: Automaton, edges: Sequence[Edge]) -> Automaton:
     return dataclasses.replace(automaton, edges=tuple(edges))
 
