@@ -162,19 +162,39 @@ def _pure_universality(f: T) -> bool:
 
 
 def make_f(a: T) -> T:
-    """F a, simplified: F true = true, F false = false, F(eventuality) = itself."""
+    """F a, simplified: F true = true, F false = false, F(eventuality) = itself,
+    F(a U b) = F b, F(a M b) = F(a & b), F(a | F b) = F(a | b)."""
     if a in (TRUE, FALSE) or _pure_eventuality(a):
         return a
+    if a[0] == "U":
+        return make_f(a[2])
+    if a[0] == "M":
+        return make_f(make_and([a[1], a[2]]))
+    if a[0] == "|" and any(x[0] == "F" for x in a[1]):
+        return make_f(make_or([x[1] if x[0] == "F" else x for x in a[1]]))
     return ("F", a)
 
 
 def make_g(a: T) -> T:
     """G a, simplified: G true = true, G(universality) = itself (conjunctions of G merge in
-    :func:`make_and`)."""
+    :func:`make_and`), G(a R b) = G b, G(a W b) = G(a | b), G(a & G b) = G(a & b), and
+    G F(a & e) = G F a & G e for a pure eventuality e (which holds everywhere as soon as it
+    holds infinitely often)."""
     if a in (TRUE, FALSE) or _pure_universality(a):
         return a
     if a[0] == "F" and _pure_universality(a[1]):
         return a
+    if a[0] == "R":
+        return make_g(a[2])
+    if a[0] == "W":
+        return make_g(make_or([a[1], a[2]]))
+    if a[0] == "&" and any(x[0] == "G" for x in a[1]):
+        return make_g(make_and([x[1] if x[0] == "G" else x for x in a[1]]))
+    if a[0] == "F" and a[1][0] == "&":
+        eventual = [x for x in a[1][1] if _pure_eventuality(x)]
+        if eventual:
+            rest = [x for x in a[1][1] if not _pure_eventuality(x)]
+            return make_and([make_g(make_f(make_and(rest))), *(make_g(e) for e in eventual)])
     return ("G", a)
 
 
@@ -301,16 +321,10 @@ def simplify_state(parts: frozenset[T]) -> frozenset[T] | None:
         )
         if not redundant:
             kept.append(item)
-    # s & F(a & s) = F(a & s) for a suspendable s (prefix-independent): the F's fulfilment
-    # starts tracking s itself, so s need not be tracked meanwhile.  (General implied
-    # eventualities cannot be dropped like this: their promises would go unchecked.)
-    inside = {x for item in kept if item[0] == "F" and item[1][0] == "&" for x in item[1][1]}
-    if inside:
-        kept = [
-            item
-            for item in kept
-            if not (item in inside and _pure_eventuality(item) and _pure_universality(item))
-        ]
+    # (Not ``s & F(a & s) = F(a & s)`` for a suspendable ``s``, although the formulas are
+    # equivalent: reaching ``a & s`` only postpones ``s`` into the next state, so with ``s``
+    # dropped every cycle that keeps re-reaching ``a`` would accept without ``s`` ever being
+    # fulfilled, e.g. ``p2 R (F(F G !p0 & !p1) | G(F p0 & p1))`` on ``(!p0 p0)^ω``.)
     return frozenset(kept)
 
 

@@ -17,6 +17,7 @@ from typing import Any
 
 from tlmpc.automata.containment import simplify_by_containment
 from tlmpc.automata.model import Automaton, Edge
+from tlmpc.automata.rewrite import rewrite
 from tlmpc.automata.simplify import postprocess
 from tlmpc.automata.terms import (
     FALSE,
@@ -133,7 +134,7 @@ def translate(
         # Half the budget at most for the containment checks (each one a small translation).
         share = CONTAINMENT_BUDGET if budget is None else min(CONTAINMENT_BUDGET, budget / 2)
         formula = simplify_by_containment(nnf(formula), _is_empty, started + share)
-    root = from_ast(formula)
+    root = rewrite(from_ast(formula))
     aps = tuple(sorted(original.props()))
     letter_sets = (
         None
