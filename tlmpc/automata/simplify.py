@@ -5,7 +5,7 @@ from __future__ import annotations
 import dataclasses
 import time
 from collections import defaultdict
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 
 from tlmpc.automata import simulation, wdba
 from tlmpc.automata.guards import holds
@@ -406,9 +406,14 @@ def postprocess(
     deadline: float | None = None,
     *,
     obligation: bool = False,
+    verify: Callable[[Automaton, Automaton], bool] | None = None,
 ) -> Automaton:
     """Trim, prune SCCs, reduce acceptance sets and merge equivalent states (to a fixpoint),
-    then reduce by direct simulation while ``deadline`` (a ``time.perf_counter`` value) allows."""
+    then reduce by direct simulation while ``deadline`` (a ``time.perf_counter`` value) allows.
+
+    Then the minimized weak deterministic automaton replaces the result: for a syntactic
+    ``obligation`` when it is not larger, otherwise when it has fewer states and
+    ``verify(result, candidate)`` shows both recognize the same language."""
     current = Automaton(
         aps=automaton.aps,
         num_states=automaton.num_states,
@@ -439,17 +444,24 @@ def postprocess(
         current = _merge_states(current, letters)
         if (current.num_states, len(current.edges), current.num_acc) == before:
             break
-    if obligation and (deadline is None or time.perf_counter() < deadline):
-        # Obligation formulas: the minimized weak deterministic automaton when not larger.
+    worth_trying = obligation or (verify is not None and current.num_states > 1)
+    if worth_trying and (deadline is None or time.perf_counter() < deadline):
         candidate = wdba.minimize_obligation(
             current, letters, deadline if deadline is not None else float("inf")
         )
         if candidate is not None:
             candidate = _merge_states(_reduce_marks(trim(candidate)), letters)
-            if (candidate.num_states, len(candidate.edges)) <= (
-                current.num_states,
-                len(current.edges),
-            ) or candidate.num_states < current.num_states:
+            if obligation:
+                if (candidate.num_states, len(candidate.edges)) <= (
+                    current.num_states,
+                    len(current.edges),
+                ) or candidate.num_states < current.num_states:
+                    current = candidate
+            elif (
+                verify is not None
+                and candidate.num_states < current.num_states
+                and verify(current, candidate)
+            ):
                 current = candidate
     if letters is not None:
         current = _simplify_guards(current, letters)

@@ -16,6 +16,7 @@ from collections.abc import Iterable, Sequence
 from typing import Any
 
 from tlmpc.automata.containment import simplify_by_containment
+from tlmpc.automata.emptiness import equivalent_to_deterministic
 from tlmpc.automata.model import Automaton, Edge
 from tlmpc.automata.rewrite import rewrite
 from tlmpc.automata.simplify import postprocess
@@ -39,6 +40,10 @@ from tlmpc.ltl.transform import nnf
 DEFAULT_BUDGET = 0.5
 #: At most this long for the language-containment simplification of the formula.
 CONTAINMENT_BUDGET = 0.2
+
+#: At most this long for each equivalence check of a WDBA-minimized automaton (a formula that
+#: is not a syntactic obligation may still have one; the check decides).
+WDBA_CHECK_BUDGET = 0.1
 
 #: Above this many expansion terms in one state, dominated terms are left to the simulation.
 MAX_DOMINATION_TERMS = 600
@@ -127,6 +132,20 @@ def translate(
         budget: seconds after which the optional reductions (simulation) stop and the
             automaton reduced so far, which is always correct, is returned; None = no limit.
     """
+    return _translate(
+        formula, letters=letters, simplify=simplify, budget=budget, containment=containment
+    )
+
+
+def _translate(
+    formula: Formula,
+    *,
+    letters: Sequence[Sequence[str]] | None,
+    simplify: bool,
+    budget: float | None,
+    containment: bool,
+    check_wdba: bool = True,
+) -> Automaton:
     started = time.perf_counter()
     deadline = None if budget is None else started + budget
     original = formula
@@ -149,7 +168,25 @@ def translate(
     finally:
         restrict_letters(previous_letters)
     if simplify:
-        automaton = postprocess(automaton, letter_sets, deadline, obligation=is_obligation(root))
+        verify = None
+        if check_wdba:
+
+            def verify(reduced: Automaton, candidate: Automaton) -> bool:
+                # The negation's automaton, itself without this check (no recursion).
+                negation = _translate(
+                    Not(original),
+                    letters=None if letter_sets is None else [sorted(x) for x in letter_sets],
+                    simplify=True,
+                    budget=WDBA_CHECK_BUDGET,
+                    containment=False,
+                    check_wdba=False,
+                )
+                limit = time.perf_counter() + WDBA_CHECK_BUDGET
+                return equivalent_to_deterministic(reduced, candidate, negation, letter_sets, limit)
+
+        automaton = postprocess(
+            automaton, letter_sets, deadline, obligation=is_obligation(root), verify=verify
+        )
     if letter_sets is not None:
         automaton = dataclasses.replace(
             automaton, letters=tuple(sorted(tuple(sorted(x)) for x in letter_sets))
@@ -206,7 +243,15 @@ def _explore(
 
 def _is_empty(formula: Formula) -> bool:
     """No word satisfies ``formula`` (its trimmed automaton has no edge)."""
-    return not translate(formula, budget=CONTAINMENT_BUDGET, containment=False).edges
+    translated = _translate(
+        formula,
+        letters=None,
+        simplify=True,
+        budget=CONTAINMENT_BUDGET,
+        containment=False,
+        check_wdba=False,
+    )
+    return not translated.edges
 
 
 def _state_terms(
