@@ -451,6 +451,13 @@ def postprocess(
         )
         if candidate is not None:
             candidate = _merge_states(_reduce_marks(trim(candidate)), letters)
+            if deadline is None or time.perf_counter() < deadline:
+                # States on no cycle were told apart from the rest by the minimization's
+                # acceptance flag, which does not matter for them: simulation merges them.
+                reduced = reduce_by_simulation(
+                    candidate, letters, deadline if deadline is not None else float("inf")
+                )
+                candidate = _merge_states(_reduce_marks(trim(reduced)), letters)
             if obligation:
                 if (candidate.num_states, len(candidate.edges)) <= (
                     current.num_states,

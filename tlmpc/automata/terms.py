@@ -225,6 +225,8 @@ def make_binary(kind: str, a: T, b: T) -> T:
             return make_g(a)
         if _pure_universality(a):
             return make_or([a, b])
+        if _pure_eventuality(b):  # a W e = (a U e) | G a = e | G a
+            return make_or([b, make_g(a)])
     elif kind == "M":
         if b == FALSE or a == FALSE:
             return FALSE
@@ -234,6 +236,8 @@ def make_binary(kind: str, a: T, b: T) -> T:
             return b
         if _pure_eventuality(a):
             return make_and([a, b])
+        if _pure_universality(b):  # a M u = (a R u) & F a = u & F a
+            return make_and([b, make_f(a)])
     return (kind, a, b)
 
 
