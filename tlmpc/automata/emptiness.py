@@ -40,6 +40,15 @@ def moves(automaton: Automaton, alphabet: Alphabet) -> Moves:
     return out
 
 
+def _deterministic(row: list[tuple[int, int, int]]) -> bool:
+    seen = 0
+    for letters, _bits, _dst in row:
+        if seen & letters:
+            return False
+        seen |= letters
+    return True
+
+
 def completed(deterministic: Moves, full: int) -> Moves:
     """``deterministic`` with a rejecting sink (the last state) taking every missing letter."""
     sink = len(deterministic)
@@ -109,15 +118,20 @@ def equivalent_to_deterministic(
     letters: Sequence[frozenset[str]] | None,
     deadline: float,
 ) -> bool:
-    """``L(candidate) = L(automaton)``, where ``candidate`` is deterministic with one
+    """``L(candidate) = L(automaton)``, where ``candidate`` is deterministic with at most one
     acceptance set and ``negation`` is a TGBA of the formula's negation (all three over the
     same propositions and letters).  False when undecided within the deadline."""
-    if candidate.num_acc != 1 or negation.aps != automaton.aps:
+    if candidate.num_acc > 1 or negation.aps != automaton.aps:
         return False
     alphabet = Alphabet(automaton.aps, letters)
     try:
         original = moves(automaton, alphabet)
-        deterministic = completed(moves(candidate, alphabet), alphabet.full)
+        own = moves(candidate, alphabet)
+        if candidate.num_acc == 0:  # every run accepts: as if every edge carried the mark
+            own = [[(letters, 1, dst) for letters, _bits, dst in row] for row in own]
+        if not all(_deterministic(row) for row in own):
+            return False
+        deterministic = completed(own, alphabet.full)
         everything = (1 << automaton.num_acc) - 1
         missed = has_accepting_cycle(
             original,
