@@ -33,7 +33,8 @@ fulfilled at once or never needed ``a``; with ¬a ⇒ b every position before th
 
 from __future__ import annotations
 
-import functools
+import time
+from collections.abc import Callable
 
 from tlmpc.automata.terms import (
     FALSE,
@@ -49,6 +50,10 @@ from tlmpc.automata.terms import (
 
 #: Nodes with more operands are rebuilt without the pairwise checks (they are quadratic).
 MAX_OPERANDS = 12
+#: Semantic implication checks only for nodes with at most this many operands.
+MAX_SEMANTIC_OPERANDS = 4
+#: ... and for formulas over at most this many propositions (the caller checks).
+MAX_SEMANTIC_APS = 6
 
 
 def negate(f: T) -> T:
@@ -74,61 +79,110 @@ def negate(f: T) -> T:
     return make_binary(dual, negate(f[1]), negate(f[2]))
 
 
-@functools.lru_cache(maxsize=1 << 14)
-def rewrite(f: T) -> T:
-    """``f`` with the implication rules of the module docstring applied at every node."""
-    kind = f[0]
-    if kind in ("t", "f", "p", "n"):
-        return f
-    if kind in ("&", "|"):
-        args = [rewrite(a) for a in f[1]]
-        return _junction(kind, args)
-    if kind == "F":
-        return make_f(rewrite(f[1]))
-    if kind == "G":
-        return make_g(rewrite(f[1]))
-    return _binary(kind, rewrite(f[1]), rewrite(f[2]))
+def rewrite(f: T, empty: Callable[[T], bool] | None = None, deadline: float = 0.0) -> T:
+    """``f`` with the implication rules of the module docstring applied at every node.
+
+    With ``empty`` (a language-emptiness oracle), an implication the syntactic check misses is
+    also decided semantically (``a ⇒ b`` iff ``a & !b`` is empty), and a temporal node whose
+    language is empty (or universal) becomes ``false`` (``true``); only until ``deadline`` (a
+    ``time.perf_counter`` value), on formulas over at most :data:`MAX_SEMANTIC_APS`
+    propositions and nodes of at most :data:`MAX_SEMANTIC_OPERANDS` operands."""
+    return _Rewriter(empty, deadline).run(f)
 
 
-def _junction(kind: str, args: list[T]) -> T:
-    built = make_and(args) if kind == "&" else make_or(args)
-    if built[0] != kind or len(built[1]) > MAX_OPERANDS:
-        return built
-    items = list(built[1])
-    conjunction = kind == "&"
-    for index, item in enumerate(items):
-        for other in items[index + 1 :]:
-            if conjunction and (implies(item, negate(other)) or implies(other, negate(item))):
-                return FALSE
-            if not conjunction and (implies(negate(item), other) or implies(negate(other), item)):
-                return TRUE
-    # Drop, one at a time, an operand that another remaining one makes redundant (so of two
-    # equivalent operands one stays).
-    kept = list(items)
-    for item in items:
-        if any(
-            other is not item and (implies(other, item) if conjunction else implies(item, other))
-            for other in kept
-        ):
-            kept.remove(item)
-    if len(kept) == len(items):
-        return built
-    return make_and(kept) if conjunction else make_or(kept)
+class _Rewriter:
+    def __init__(self, empty: Callable[[T], bool] | None, deadline: float) -> None:
+        self.empty = empty
+        self.deadline = deadline
+        self.memo: dict[T, T] = {}
+        self.semantic_memo: dict[tuple[T, T], bool] = {}
 
+    def semantic(self) -> bool:
+        return self.empty is not None and time.perf_counter() < self.deadline
 
-def _binary(kind: str, a: T, b: T) -> T:
-    if kind in ("U", "W"):
-        if implies(a, b):
-            return b
-        if implies(negate(a), b):
-            return make_f(b) if kind == "U" else TRUE
-        if b[0] == kind and implies(a, b[1]):
-            return b
-    else:  # R, M
-        if implies(b, a):
-            return b
-        if implies(b, negate(a)):
-            return make_g(b) if kind == "R" else FALSE
-        if b[0] == kind and implies(b[1], a):
-            return b
-    return make_binary(kind, a, b)
+    def implies(self, f: T, g: T, *, small: bool = True) -> bool:
+        if implies(f, g):
+            return True
+        if not small or not self.semantic():
+            return False
+        key = (f, g)
+        known = self.semantic_memo.get(key)
+        if known is None:
+            assert self.empty is not None
+            known = self.empty(make_and([f, negate(g)]))
+            self.semantic_memo[key] = known
+        return known
+
+    def run(self, f: T) -> T:
+        done = self.memo.get(f)
+        if done is not None:
+            return done
+        kind = f[0]
+        if kind in ("t", "f", "p", "n"):
+            result = f
+        elif kind in ("&", "|"):
+            result = self.junction(kind, [self.run(a) for a in f[1]])
+        elif kind == "F":
+            result = make_f(self.run(f[1]))
+        elif kind == "G":
+            result = make_g(self.run(f[1]))
+        else:
+            result = self.binary(kind, self.run(f[1]), self.run(f[2]))
+        if result[0] in ("F", "G", "U", "R", "W", "M") and self.semantic():
+            assert self.empty is not None
+            if self.empty(result):
+                result = FALSE
+            elif self.empty(negate(result)):
+                result = TRUE
+        self.memo[f] = result
+        return result
+
+    def junction(self, kind: str, args: list[T]) -> T:
+        built = make_and(args) if kind == "&" else make_or(args)
+        if built[0] != kind or len(built[1]) > MAX_OPERANDS:
+            return built
+        items = list(built[1])
+        small = len(items) <= MAX_SEMANTIC_OPERANDS
+        conjunction = kind == "&"
+        for index, item in enumerate(items):
+            for other in items[index + 1 :]:
+                if conjunction and (implies(item, negate(other)) or implies(other, negate(item))):
+                    return FALSE
+                if not conjunction and (
+                    implies(negate(item), other) or implies(negate(other), item)
+                ):
+                    return TRUE
+        # Drop, one at a time, an operand that another remaining one makes redundant (so of
+        # two equivalent operands one stays).
+        kept = list(items)
+        for item in items:
+            if any(
+                other is not item
+                and (
+                    self.implies(other, item, small=small)
+                    if conjunction
+                    else self.implies(item, other, small=small)
+                )
+                for other in kept
+            ):
+                kept.remove(item)
+        if len(kept) == len(items):
+            return built
+        return make_and(kept) if conjunction else make_or(kept)
+
+    def binary(self, kind: str, a: T, b: T) -> T:
+        if kind in ("U", "W"):
+            if self.implies(a, b):
+                return b
+            if self.implies(negate(a), b):
+                return make_f(b) if kind == "U" else TRUE
+            if b[0] == kind and self.implies(a, b[1]):
+                return b
+        else:  # R, M
+            if self.implies(b, a):
+                return b
+            if self.implies(b, negate(a)):
+                return make_g(b) if kind == "R" else FALSE
+            if b[0] == kind and self.implies(b[1], a):
+                return b
+        return make_binary(kind, a, b)

@@ -18,8 +18,8 @@ from typing import Any
 from tlmpc.automata.containment import simplify_by_containment
 from tlmpc.automata.emptiness import equivalent_to_deterministic
 from tlmpc.automata.model import Automaton, Edge
-from tlmpc.automata.rewrite import rewrite
-from tlmpc.automata.simplify import postprocess
+from tlmpc.automata.rewrite import MAX_SEMANTIC_APS, rewrite
+from tlmpc.automata.simplify import postprocess, trim
 from tlmpc.automata.terms import (
     FALSE,
     T,
@@ -153,8 +153,13 @@ def _translate(
         # Half the budget at most for the containment checks (each one a small translation).
         share = CONTAINMENT_BUDGET if budget is None else min(CONTAINMENT_BUDGET, budget / 2)
         formula = simplify_by_containment(nnf(formula), _is_empty, started + share)
-    root = rewrite(from_ast(formula))
     aps = tuple(sorted(original.props()))
+    semantic = simplify and containment and len(aps) <= MAX_SEMANTIC_APS
+    root = rewrite(
+        from_ast(formula),
+        _is_empty_term if semantic else None,
+        time.perf_counter() + (CONTAINMENT_BUDGET if budget is None else budget / 4),
+    )
     letter_sets = (
         None
         if letters is None
@@ -252,6 +257,29 @@ def _is_empty(formula: Formula) -> bool:
         check_wdba=False,
     )
     return not translated.edges
+
+
+def _is_empty_term(root: T) -> bool:
+    """No word satisfies the internal formula ``root`` (its raw automaton, trimmed, has no
+    edge).  Over every letter: the caller's letter restriction is set aside meanwhile."""
+    if root == FALSE:
+        return True
+    aps = tuple(sorted(_props(root)))
+    previous = restrict_letters(None)
+    try:
+        raw = _explore(simplify_state(frozenset([root])), eventualities(root), None, "", aps)
+    finally:
+        restrict_letters(previous)
+    return not trim(raw).edges
+
+
+def _props(f: T) -> set[str]:
+    kind = f[0]
+    if kind in ("p", "n"):
+        return {f[1]}
+    if kind in ("&", "|"):
+        return set().union(*(_props(a) for a in f[1]))
+    return set().union(*(_props(a) for a in f[1:] if isinstance(a, tuple)))
 
 
 def _state_terms(
