@@ -268,6 +268,26 @@ def _convert(f: Formula) -> T:
     raise TypeError(f"unexpected node {f!r}")
 
 
+def to_formula(f: T) -> Formula:
+    """The AST of an internal formula (for printing and for checking rewrites)."""
+    kind = f[0]
+    if kind in ("t", "f"):
+        return Const(kind == "t")
+    if kind == "p":
+        return Prop(f[1])
+    if kind == "n":
+        return Not(Prop(f[1]))
+    if kind in ("&", "|"):
+        args = tuple(to_formula(a) for a in f[1])
+        return And(args) if kind == "&" else Or(args)
+    if kind == "F":
+        return Eventually(to_formula(f[1]))
+    if kind == "G":
+        return Globally(to_formula(f[1]))
+    node = {"U": Until, "R": Release, "W": WeakUntil, "M": StrongRelease}[kind]
+    return node(to_formula(f[1]), to_formula(f[2]))
+
+
 @functools.cache
 def implies(f: T, g: T) -> bool:
     """A sound syntactic implication check f ⇒ g (incomplete; used to shrink states)."""
