@@ -15,6 +15,7 @@ and gives up (None) rather than overrun it.
 
 from __future__ import annotations
 
+import functools
 import time
 from collections import deque
 from collections.abc import Sequence
@@ -332,8 +333,23 @@ def _cover(mask: int, n: int, aps: tuple[str, ...]) -> list[Formula]:
 
 
 def _cube_mask(fixed: dict[int, bool], n: int) -> int:
-    mask = 0
-    for valuation in range(1 << n):
-        if all(bool(valuation >> i & 1) == value for i, value in fixed.items()):
-            mask |= 1 << valuation
+    """The valuations (bit ``v`` = valuation ``v``) where each fixed proposition has its value:
+    an intersection of one precomputed mask per literal, not a scan of the 2^n valuations."""
+    literal = _literal_masks(n)
+    mask = (1 << (1 << n)) - 1
+    for i, value in fixed.items():
+        mask &= literal[i] if value else ~literal[i]
     return mask
+
+
+@functools.cache
+def _literal_masks(n: int) -> tuple[int, ...]:
+    """Per proposition ``i``, the valuations over ``n`` propositions where ``i`` is true."""
+    masks = []
+    for i in range(n):
+        mask = 0
+        for valuation in range(1 << n):
+            if valuation >> i & 1:
+                mask |= 1 << valuation
+        masks.append(mask)
+    return tuple(masks)
