@@ -35,11 +35,26 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
+from typing import assert_never
 
-from tlmpc.automata.terms import (
+from tlmpc.automata.nnf import (
     FALSE,
     TRUE,
-    T,
+    Always,
+    Binary,
+    BinaryKind,
+    Bottom,
+    Conj,
+    Disj,
+    Finally,
+    Neg,
+    Node,
+    Pos,
+    Top,
+    neg,
+    pos,
+)
+from tlmpc.automata.terms import (
     implies,
     make_and,
     make_binary,
@@ -55,31 +70,36 @@ MAX_SEMANTIC_OPERANDS = 4
 #: ... and for formulas over at most this many propositions (the caller checks).
 MAX_SEMANTIC_APS = 6
 
+_DUAL: dict[BinaryKind, BinaryKind] = {"U": "R", "R": "U", "W": "M", "M": "W"}
+_TEMPORAL = Finally | Always | Binary
 
-def negate(f: T) -> T:
+
+def negate(f: Node) -> Node:
     """The negation normal form of ``!f`` (rebuilt through the simplifying constructors)."""
-    kind = f[0]
-    if kind == "t":
-        return FALSE
-    if kind == "f":
-        return TRUE
-    if kind == "p":
-        return ("n", f[1])
-    if kind == "n":
-        return ("p", f[1])
-    if kind == "&":
-        return make_or([negate(a) for a in f[1]])
-    if kind == "|":
-        return make_and([negate(a) for a in f[1]])
-    if kind == "F":
-        return make_g(negate(f[1]))
-    if kind == "G":
-        return make_f(negate(f[1]))
-    dual = {"U": "R", "R": "U", "W": "M", "M": "W"}[kind]
-    return make_binary(dual, negate(f[1]), negate(f[2]))
+    match f:
+        case Top():
+            return FALSE
+        case Bottom():
+            return TRUE
+        case Pos(name=name):
+            return neg(name)
+        case Neg(name=name):
+            return pos(name)
+        case Conj(args=args):
+            return make_or([negate(a) for a in args])
+        case Disj(args=args):
+            return make_and([negate(a) for a in args])
+        case Finally(arg=arg):
+            return make_g(negate(arg))
+        case Always(arg=arg):
+            return make_f(negate(arg))
+        case Binary(kind=kind, left=left, right=right):
+            return make_binary(_DUAL[kind], negate(left), negate(right))
+        case _:
+            assert_never(f)
 
 
-def rewrite(f: T, empty: Callable[[T], bool] | None = None, deadline: float = 0.0) -> T:
+def rewrite(f: Node, empty: Callable[[Node], bool] | None = None, deadline: float = 0.0) -> Node:
     """``f`` with the implication rules of the module docstring applied at every node.
 
     With ``empty`` (a language-emptiness oracle), an implication the syntactic check misses is
@@ -91,16 +111,16 @@ def rewrite(f: T, empty: Callable[[T], bool] | None = None, deadline: float = 0.
 
 
 class _Rewriter:
-    def __init__(self, empty: Callable[[T], bool] | None, deadline: float) -> None:
+    def __init__(self, empty: Callable[[Node], bool] | None, deadline: float) -> None:
         self.empty = empty
         self.deadline = deadline
-        self.memo: dict[T, T] = {}
-        self.semantic_memo: dict[tuple[T, T], bool] = {}
+        self.memo: dict[Node, Node] = {}
+        self.semantic_memo: dict[tuple[Node, Node], bool] = {}
 
     def semantic(self) -> bool:
         return self.empty is not None and time.perf_counter() < self.deadline
 
-    def implies(self, f: T, g: T, *, small: bool = True) -> bool:
+    def implies(self, f: Node, g: Node, *, small: bool = True) -> bool:
         if implies(f, g):
             return True
         if not small or not self.semantic():
@@ -113,22 +133,27 @@ class _Rewriter:
             self.semantic_memo[key] = known
         return known
 
-    def run(self, f: T) -> T:
+    def run(self, f: Node) -> Node:
         done = self.memo.get(f)
         if done is not None:
             return done
-        kind = f[0]
-        if kind in ("t", "f", "p", "n"):
-            result = f
-        elif kind in ("&", "|"):
-            result = self.junction(kind, [self.run(a) for a in f[1]])
-        elif kind == "F":
-            result = make_f(self.run(f[1]))
-        elif kind == "G":
-            result = make_g(self.run(f[1]))
-        else:
-            result = self.binary(kind, self.run(f[1]), self.run(f[2]))
-        if result[0] in ("F", "G", "U", "R", "W", "M") and self.semantic():
+        result: Node
+        match f:
+            case Top() | Bottom() | Pos() | Neg():
+                result = f
+            case Conj(args=args):
+                result = self.junction(True, [self.run(a) for a in args])
+            case Disj(args=args):
+                result = self.junction(False, [self.run(a) for a in args])
+            case Finally(arg=arg):
+                result = make_f(self.run(arg))
+            case Always(arg=arg):
+                result = make_g(self.run(arg))
+            case Binary(kind=kind, left=left, right=right):
+                result = self.binary(kind, self.run(left), self.run(right))
+            case _:
+                assert_never(f)
+        if isinstance(result, _TEMPORAL) and self.semantic():
             assert self.empty is not None
             if self.empty(result):
                 result = FALSE
@@ -137,13 +162,15 @@ class _Rewriter:
         self.memo[f] = result
         return result
 
-    def junction(self, kind: str, args: list[T]) -> T:
-        built = make_and(args) if kind == "&" else make_or(args)
-        if built[0] != kind or len(built[1]) > MAX_OPERANDS:
+    def junction(self, conjunction: bool, args: list[Node]) -> Node:
+        built = make_and(args) if conjunction else make_or(args)
+        if not isinstance(built, Conj if conjunction else Disj):
             return built
-        items = list(built[1])
+        assert isinstance(built, Conj | Disj)
+        if len(built.args) > MAX_OPERANDS:
+            return built
+        items = list(built.args)
         small = len(items) <= MAX_SEMANTIC_OPERANDS
-        conjunction = kind == "&"
         for index, item in enumerate(items):
             for other in items[index + 1 :]:
                 if conjunction and (implies(item, negate(other)) or implies(other, negate(item))):
@@ -170,19 +197,19 @@ class _Rewriter:
             return built
         return make_and(kept) if conjunction else make_or(kept)
 
-    def binary(self, kind: str, a: T, b: T) -> T:
+    def binary(self, kind: BinaryKind, a: Node, b: Node) -> Node:
         if kind in ("U", "W"):
             if self.implies(a, b):
                 return b
             if self.implies(negate(a), b):
                 return make_f(b) if kind == "U" else TRUE
-            if b[0] == kind and self.implies(a, b[1]):
+            if isinstance(b, Binary) and b.kind == kind and self.implies(a, b.left):
                 return b
         else:  # R, M
             if self.implies(b, a):
                 return b
             if self.implies(b, negate(a)):
                 return make_g(b) if kind == "R" else FALSE
-            if b[0] == kind and self.implies(b[1], a):
+            if isinstance(b, Binary) and b.kind == kind and self.implies(b.left, a):
                 return b
         return make_binary(kind, a, b)

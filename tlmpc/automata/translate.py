@@ -13,20 +13,20 @@ from __future__ import annotations
 import dataclasses
 import time
 from collections.abc import Iterable, Sequence
-from typing import Any
 
 from tlmpc.automata.containment import simplify_by_containment
 from tlmpc.automata.emptiness import equivalent_to_deterministic
 from tlmpc.automata.model import Automaton, Edge
+from tlmpc.automata.nnf import FALSE, Node
 from tlmpc.automata.rewrite import MAX_SEMANTIC_APS, rewrite
 from tlmpc.automata.simplify import postprocess, trim
 from tlmpc.automata.terms import (
-    FALSE,
-    T,
+    Expansion,
     cube_allowed,
     eventualities,
     expand,
     from_ast,
+    props,
     restrict_letters,
     simplify_state,
     to_text,
@@ -51,7 +51,7 @@ MAX_DOMINATION_TERMS = 600
 #: The same for each partial product of a state's conjuncts (checked more often).
 MAX_PARTIAL_DOMINATION_TERMS = 150
 
-State = frozenset[T]
+State = frozenset[Node]
 Cube = tuple[frozenset[str], frozenset[str]]
 
 
@@ -201,7 +201,7 @@ def _translate(
 
 def _explore(
     initial: State | None,
-    events: list[Any],
+    events: list[Node],
     letter_sets: list[frozenset[str]] | None,
     text: str,
     aps: tuple[str, ...],
@@ -259,12 +259,12 @@ def _is_empty(formula: Formula) -> bool:
     return not translated.edges
 
 
-def _is_empty_term(root: T) -> bool:
+def _is_empty_term(root: Node) -> bool:
     """No word satisfies the internal formula ``root`` (its raw automaton, trimmed, has no
     edge).  Over every letter: the caller's letter restriction is set aside meanwhile."""
     if root == FALSE:
         return True
-    aps = tuple(sorted(_props(root)))
+    aps = tuple(sorted(props(root)))
     previous = restrict_letters(None)
     try:
         raw = _explore(simplify_state(frozenset([root])), eventualities(root), None, "", aps)
@@ -273,43 +273,32 @@ def _is_empty_term(root: T) -> bool:
     return not trim(raw).edges
 
 
-def _props(f: T) -> set[str]:
-    kind = f[0]
-    if kind in ("p", "n"):
-        return {f[1]}
-    if kind in ("&", "|"):
-        return set().union(*(_props(a) for a in f[1]))
-    return set().union(*(_props(a) for a in f[1:] if isinstance(a, tuple)))
-
-
-def _state_terms(
-    state: State,
-) -> list[tuple[frozenset[str], frozenset[str], frozenset[T], frozenset[T]]]:
-    terms: list[Any] = [(frozenset(), frozenset(), frozenset(), frozenset())]
+def _state_terms(state: State) -> list[Expansion]:
+    terms: list[Expansion] = [Expansion(frozenset(), frozenset(), frozenset(), frozenset())]
     for part in sorted(state, key=repr):
-        combined = []
+        combined: list[Expansion] = []
         for pos, neg, nxt, prom in terms:
             for p2, n2, x2, pr2 in expand(part):
                 p = pos | p2
                 n = neg | n2
                 if not cube_allowed(p, n):
                     continue
-                combined.append((p, n, nxt | x2, prom | pr2))
+                combined.append(Expansion(p, n, nxt | x2, prom | pr2))
         terms = _undominated_partial(combined)
         if not terms:
             break
     return terms
 
 
-def _merge_adjacent(terms: list[Any]) -> list[Any]:
+def _merge_adjacent(terms: list[Expansion]) -> list[Expansion]:
     """Merge terms with the same obligations and promises whose cubes differ in the sign of
     one proposition only (``a & b`` and ``a & !b`` give ``a``), until none is left."""
-    groups: dict[tuple[Any, Any], set[tuple[frozenset[str], frozenset[str]]]] = {}
+    groups: dict[tuple[frozenset[Node], frozenset[Node]], set[Cube]] = {}
     for pos, neg, nxt, prom in terms:
         groups.setdefault((nxt, prom), set()).add((pos, neg))
     if len(groups) == len(terms):
         return terms
-    out: list[Any] = []
+    out: list[Expansion] = []
     for (nxt, prom), cubes in groups.items():
         changed = len(cubes) > 1
         while changed:
@@ -324,29 +313,29 @@ def _merge_adjacent(terms: list[Any]) -> list[Any]:
                         cubes.add((pos - {name}, neg))
                         changed = True
                         break
-        out.extend((pos, neg, nxt, prom) for pos, neg in cubes)
+        out.extend(Expansion(pos, neg, nxt, prom) for pos, neg in cubes)
     return out
 
 
-def _undominated_partial(terms: list[Any]) -> list[Any]:
+def _undominated_partial(terms: list[Expansion]) -> list[Expansion]:
     """Drop partial products dominated by another one (weaker cube, fewer obligations, fewer
     promises): whatever completes the dominated one completes the other one better, so
     pruning here keeps the product of the conjuncts from growing needlessly."""
     unique = _merge_adjacent(list(dict.fromkeys(terms)))
     if len(unique) < 2 or len(unique) > MAX_PARTIAL_DOMINATION_TERMS:
         return unique
-    index: dict[Any, int] = {}
+    index: dict[tuple[str, str | Node], int] = {}
     keys = []
     for pos, neg, nxt, prom in unique:
         key = 0
-        for item in pos:
-            key |= 1 << index.setdefault(("p", item), len(index))
-        for item in neg:
-            key |= 1 << index.setdefault(("n", item), len(index))
-        for item in nxt:
-            key |= 1 << index.setdefault(("x", item), len(index))
-        for item in prom:
-            key |= 1 << index.setdefault(("P", item), len(index))
+        for name in pos:
+            key |= 1 << index.setdefault(("p", name), len(index))
+        for name in neg:
+            key |= 1 << index.setdefault(("n", name), len(index))
+        for node in nxt:
+            key |= 1 << index.setdefault(("x", node), len(index))
+        for node in prom:
+            key |= 1 << index.setdefault(("P", node), len(index))
         keys.append(key)
     return [
         term
