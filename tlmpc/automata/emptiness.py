@@ -84,7 +84,7 @@ def has_accepting_cycle(
     nodes = [(left_initial, right_initial)]
     succ: list[list[tuple[int, int]]] = []
     for p, q in nodes:
-        if len(nodes) > MAX_PRODUCT or time.perf_counter() > deadline:
+        if len(nodes) > MAX_PRODUCT or time.process_time() > deadline:
             return None
         row: list[tuple[int, int]] = []
         for letters, bits, p2 in left[p]:

@@ -105,7 +105,7 @@ def rewrite(f: Node, empty: Callable[[Node], bool] | None = None, deadline: floa
     With ``empty`` (a language-emptiness oracle), an implication the syntactic check misses is
     also decided semantically (``a ⇒ b`` iff ``a & !b`` is empty), and a temporal node whose
     language is empty (or universal) becomes ``false`` (``true``); only until ``deadline`` (a
-    ``time.perf_counter`` value), on formulas over at most :data:`MAX_SEMANTIC_APS`
+    ``time.process_time`` value), on formulas over at most :data:`MAX_SEMANTIC_APS`
     propositions and nodes of at most :data:`MAX_SEMANTIC_OPERANDS` operands."""
     return _Rewriter(empty, deadline).run(f)
 
@@ -118,7 +118,7 @@ class _Rewriter:
         self.semantic_memo: dict[tuple[Node, Node], bool] = {}
 
     def semantic(self) -> bool:
-        return self.empty is not None and time.perf_counter() < self.deadline
+        return self.empty is not None and time.process_time() < self.deadline
 
     def implies(self, f: Node, g: Node, *, small: bool = True) -> bool:
         if implies(f, g):

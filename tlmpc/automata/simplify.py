@@ -371,6 +371,15 @@ def reduce_by_simulation(
     try:
         for saturated in (False, True):
             current = _simulation_round(current, alphabet, deadline, saturated=saturated)
+        stripped = simulation.strip_transient(
+            current, sccs(current.num_states, current.edges, current.initial)
+        )
+        current = simulation.merge_transient(
+            stripped,
+            alphabet,
+            sccs(stripped.num_states, stripped.edges, stripped.initial),
+            deadline,
+        )
     except simulation.OutOfTime:
         pass
     return current
@@ -409,7 +418,7 @@ def postprocess(
     verify: Callable[[Automaton, Automaton], bool] | None = None,
 ) -> Automaton:
     """Trim, prune SCCs, reduce acceptance sets and merge equivalent states (to a fixpoint),
-    then reduce by direct simulation while ``deadline`` (a ``time.perf_counter`` value) allows.
+    then reduce by direct simulation while ``deadline`` (a ``time.process_time`` value) allows.
 
     Then the minimized weak deterministic automaton replaces the result: for a syntactic
     ``obligation`` when it is not larger, otherwise when it has fewer states and
@@ -432,7 +441,7 @@ def postprocess(
         if (current.num_states, len(current.edges), current.num_acc) == before:
             break
     for _ in range(4):
-        if deadline is not None and time.perf_counter() > deadline:
+        if deadline is not None and time.process_time() > deadline:
             break
         before = (current.num_states, len(current.edges), current.num_acc)
         current = reduce_by_simulation(
@@ -445,13 +454,13 @@ def postprocess(
         if (current.num_states, len(current.edges), current.num_acc) == before:
             break
     worth_trying = obligation or (verify is not None and current.num_states > 1)
-    if worth_trying and (deadline is None or time.perf_counter() < deadline):
+    if worth_trying and (deadline is None or time.process_time() < deadline):
         candidate = wdba.minimize_obligation(
             current, letters, deadline if deadline is not None else float("inf")
         )
         if candidate is not None:
             candidate = _merge_states(_reduce_marks(trim(candidate)), letters)
-            if deadline is None or time.perf_counter() < deadline:
+            if deadline is None or time.process_time() < deadline:
                 # States on no cycle were told apart from the rest by the minimization's
                 # acceptance flag, which does not matter for them: simulation merges them.
                 reduced = reduce_by_simulation(

@@ -129,8 +129,10 @@ def translate(
             true at once; all others false).  Edges no letter enables are dropped and states are
             merged with respect to these letters only.
         simplify: run the post-processing (trim, SCC pruning, merging).
-        budget: seconds after which the optional reductions (simulation) stop and the
-            automaton reduced so far, which is always correct, is returned; None = no limit.
+        budget: seconds of CPU time (of this process, so that other load on the machine
+            does not change the result) after which the optional reductions (simulation) stop
+            and the automaton reduced so far, which is always correct, is returned; None = no
+            limit.
     """
     return _translate(
         formula, letters=letters, simplify=simplify, budget=budget, containment=containment
@@ -146,7 +148,7 @@ def _translate(
     containment: bool,
     check_wdba: bool = True,
 ) -> Automaton:
-    started = time.perf_counter()
+    started = time.process_time()
     deadline = None if budget is None else started + budget
     original = formula
     if simplify and containment:
@@ -158,7 +160,7 @@ def _translate(
     root = rewrite(
         from_ast(formula),
         _is_empty_term if semantic else None,
-        time.perf_counter() + (CONTAINMENT_BUDGET if budget is None else budget / 4),
+        time.process_time() + (CONTAINMENT_BUDGET if budget is None else budget / 4),
     )
     letter_sets = (
         None
@@ -186,7 +188,7 @@ def _translate(
                     containment=False,
                     check_wdba=False,
                 )
-                limit = time.perf_counter() + WDBA_CHECK_BUDGET
+                limit = time.process_time() + WDBA_CHECK_BUDGET
                 return equivalent_to_deterministic(reduced, candidate, negation, letter_sets, limit)
 
         automaton = postprocess(
