@@ -21,7 +21,10 @@ from strategies import formulas
 
 from tlmpc.automata import to_hoa, translate
 from tlmpc.automata.emptiness import equivalent_to_deterministic
+from tlmpc.automata.model import Automaton, Edge
 from tlmpc.automata.rewrite import rewrite
+from tlmpc.automata.simplify import sccs
+from tlmpc.automata.simulation import Alphabet, merge_transient
 from tlmpc.automata.terms import from_ast, to_formula
 from tlmpc.automata.translate import _is_empty_term
 from tlmpc.ltl import parse_ltl, to_text
@@ -140,3 +143,39 @@ def test_simulation_on_bare_marks_drops_a_dominated_entry() -> None:
     automaton = translate(parse_ltl("F(!p U G p)"))
     assert automaton.num_states == 2
     assert spot.are_equivalent(spot.automaton(to_hoa(automaton)), spot.formula("F G p"))
+
+
+def test_transient_state_replaced_by_an_equivalent_one() -> None:
+    # The initial state only enters the SCC of the prefix-independent rest: Spot has one state.
+    text = "G(!p2 M (F G(G p3 | p1) R F p2))"
+    automaton = translate(parse_ltl(text))
+    assert automaton.num_states == 1
+    assert spot.are_equivalent(spot.automaton(to_hoa(automaton)), spot.formula(text))
+
+
+@given(formulas(PROPS, max_leaves=8))
+def test_reductions_agree_with_spot(formula: Formula) -> None:
+    text = to_text(formula)
+    ours = spot.automaton(to_hoa(translate(formula, budget=None)))
+    assert spot.are_equivalent(ours, spot.formula(text)), text
+
+
+def test_transient_state_never_replaced_by_a_state_that_reaches_it() -> None:
+    """q (initial) reads a, then !a into p; p reads a, then !a into the loop (a !a)^ω: both
+    accept (a !a)^ω.  Sending the edge into p back to q instead would close a cycle without
+    the acceptance mark and lose every word."""
+    a, not_a = parse_ltl("a"), parse_ltl("!a")
+    edges = (
+        Edge(src=1, dst=2, guard=a),  # q
+        Edge(src=2, dst=0, guard=not_a),  # s, into p
+        Edge(src=0, dst=3, guard=a),  # p
+        Edge(src=3, dst=4, guard=not_a),
+        Edge(src=4, dst=5, guard=a),
+        Edge(src=5, dst=4, guard=not_a, marks=frozenset({0})),
+    )
+    automaton = Automaton(aps=("a",), num_states=6, initial=1, edges=edges, num_acc=1)
+    word: tuple[list[frozenset[str]], list[frozenset[str]]] = ([], [frozenset({"a"}), frozenset()])
+    assert accepts(automaton, *word)
+    component = sccs(automaton.num_states, automaton.edges, automaton.initial)
+    merged = merge_transient(automaton, Alphabet(("a",), None), component, time.process_time() + 10)
+    assert accepts(merged, *word)

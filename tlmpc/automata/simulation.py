@@ -243,27 +243,31 @@ def prune(
 def merge_transient(
     automaton: Automaton, alphabet: Alphabet, component: Sequence[int], deadline: float
 ) -> Automaton:
-    """Replace a state on no cycle by a state of the same language that cannot reach it.
+    """Replace a state by a state of the same language that cannot reach it.
 
-    ``p`` lies on no cycle, ``q`` cannot reach ``p``, and each simulates the other with the
-    relaxed marks of :func:`simulation` (so ``L(p) = L(q)``): then every edge into ``p`` can go
-    to ``q`` instead.  A run takes such an edge at most once (after it, the run is among the
-    states ``q`` reaches, none of which leads back), and it continues from ``q`` with the same
-    words ``p`` accepted.  Typical case: an initial state ``F G F a`` whose only edge enters
-    the SCC of ``G F a``."""
+    ``q`` cannot reach ``p``, and each simulates the other with the relaxed marks of
+    :func:`simulation` (so ``L(p) = L(q)``): then every edge into ``p`` can go to ``q``
+    instead.  The redirected edges leave states that reach ``p``, which ``q`` does not reach,
+    so a run takes at most one of them and then continues from ``q`` with the same words ``p``
+    accepted.  Typical case: an initial state ``F G F a`` whose only edge enters the SCC of
+    ``G F a``."""
     relation = simulation(automaton, alphabet, deadline, component)
     n = automaton.num_states
-    cyclic = {component[e.src] for e in automaton.edges if component[e.src] == component[e.dst]}
     succ: list[set[int]] = [set() for _ in range(n)]
     for e in automaton.edges:
         succ[e.src].add(e.dst)
     edges = list(automaton.edges)
     initial = automaton.initial
+    # Replacing keeps the language of every other state, so the relation stays true of the
+    # states still there; reachability is recomputed on the edges as they are now.
+    removed: set[int] = set()
     for p in range(n):
-        if component[p] in cyclic or component[p] < 0:
+        if component[p] < 0:
             continue
         for q in range(n):
-            if q == p or not (relation[p][q] and relation[q][p]) or _reaches(succ, q, p):
+            if q == p or q in removed or not (relation[p][q] and relation[q][p]):
+                continue
+            if _reaches(succ, q, p):
                 continue
             _check(deadline)
             edges = [
@@ -276,6 +280,7 @@ def merge_transient(
                     s.discard(p)
                     s.add(q)
             succ[p] = set()
+            removed.add(p)
             if initial == p:
                 initial = q
             break
