@@ -29,6 +29,7 @@ def spin_runner() -> Any:
 
     return runner
 
+
 ROOMS = ["r31_13", "r12_30", "r5_28", "r28_4", "r20_20", "r2_17", "r17_2", "r33_33"]
 
 

@@ -30,7 +30,7 @@ def simplify_by_containment(
 
 
 def _walk(formula: Formula, empty: Callable[[Formula], bool], deadline: float) -> Formula:
-    if not isinstance(formula, And | Or) or time.perf_counter() > deadline:
+    if not isinstance(formula, And | Or) or time.process_time() > deadline:
         return formula
     args = [_walk(a, empty, deadline) for a in formula.args]
     if len(args) > MAX_OPERANDS:
@@ -39,7 +39,7 @@ def _walk(formula: Formula, empty: Callable[[Formula], bool], deadline: float) -
     kept = list(args)
     index = 0
     while index < len(kept) and len(kept) > 1:
-        if time.perf_counter() > deadline:
+        if time.process_time() > deadline:
             break
         candidate = kept[index]
         others = kept[:index] + kept[index + 1 :]
@@ -54,6 +54,6 @@ def _walk(formula: Formula, empty: Callable[[Formula], bool], deadline: float) -
         else:
             index += 1
     result = conjoin(kept) if conjunction else disjoin(kept)
-    if time.perf_counter() <= deadline and empty(result if conjunction else Not(result)):
+    if time.process_time() <= deadline and empty(result if conjunction else Not(result)):
         return FALSE if conjunction else TRUE
     return result

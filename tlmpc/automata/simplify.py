@@ -5,7 +5,7 @@ from __future__ import annotations
 import dataclasses
 import time
 from collections import defaultdict
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 
 from tlmpc.automata import simulation, wdba
 from tlmpc.automata.guards import holds
@@ -367,22 +367,46 @@ def reduce_by_simulation(
     if letters is None and len(automaton.aps) > simulation.MAX_APS:
         return automaton
     alphabet = simulation.Alphabet(automaton.aps, letters)
+    current = automaton
     try:
-        current = simulation.saturate(
-            automaton, sccs(automaton.num_states, automaton.edges, automaton.initial)
+        for saturated in (False, True):
+            current = _simulation_round(current, alphabet, deadline, saturated=saturated)
+        stripped = simulation.strip_transient(
+            current, sccs(current.num_states, current.edges, current.initial)
         )
-        relation = simulation.simulation(current, alphabet, deadline)
-        merged = simulation.quotient(current, relation)
-        if merged is not current:
-            keep = {e.src for e in merged.edges} | {merged.initial}
-            current = _renumber(merged, merged.edges, keep)
-            current = simulation.saturate(
-                current, sccs(current.num_states, current.edges, current.initial)
-            )
-            relation = simulation.simulation(current, alphabet, deadline)
-        return simulation.prune(current, alphabet, relation, deadline)
+        current = simulation.merge_transient(
+            stripped,
+            alphabet,
+            sccs(stripped.num_states, stripped.edges, stripped.initial),
+            deadline,
+        )
     except simulation.OutOfTime:
-        return automaton
+        pass
+    return current
+
+
+def _simulation_round(
+    automaton: Automaton, alphabet: simulation.Alphabet, deadline: float, *, saturated: bool
+) -> Automaton:
+    """One quotient-and-prune pass.  Edges between SCCs carry no marks after trimming; with
+    ``saturated`` they carry every mark instead (both are the same language, since a run takes
+    such an edge once): the bare marks let those edges be dominated, every mark lets them
+    dominate, and each finds reductions the other misses."""
+
+    def prepared(current: Automaton) -> Automaton:
+        component = sccs(current.num_states, current.edges, current.initial)
+        if saturated:
+            return simulation.saturate(current, component)
+        return simulation.strip_transient(current, component)
+
+    current = prepared(automaton)
+    relation = simulation.simulation(current, alphabet, deadline)
+    merged = simulation.quotient(current, relation)
+    if merged is not current:
+        keep = {e.src for e in merged.edges} | {merged.initial}
+        current = prepared(_renumber(merged, merged.edges, keep))
+        relation = simulation.simulation(current, alphabet, deadline)
+    return simulation.prune(current, alphabet, relation, deadline)
 
 
 def postprocess(
@@ -391,9 +415,14 @@ def postprocess(
     deadline: float | None = None,
     *,
     obligation: bool = False,
+    verify: Callable[[Automaton, Automaton], bool] | None = None,
 ) -> Automaton:
     """Trim, prune SCCs, reduce acceptance sets and merge equivalent states (to a fixpoint),
-    then reduce by direct simulation while ``deadline`` (a ``time.perf_counter`` value) allows."""
+    then reduce by direct simulation while ``deadline`` (a ``time.process_time`` value) allows.
+
+    Then the minimized weak deterministic automaton replaces the result: for a syntactic
+    ``obligation`` when it is not larger, otherwise when it has fewer states and
+    ``verify(result, candidate)`` shows both recognize the same language."""
     current = Automaton(
         aps=automaton.aps,
         num_states=automaton.num_states,
@@ -412,7 +441,7 @@ def postprocess(
         if (current.num_states, len(current.edges), current.num_acc) == before:
             break
     for _ in range(4):
-        if deadline is not None and time.perf_counter() > deadline:
+        if deadline is not None and time.process_time() > deadline:
             break
         before = (current.num_states, len(current.edges), current.num_acc)
         current = reduce_by_simulation(
@@ -424,17 +453,31 @@ def postprocess(
         current = _merge_states(current, letters)
         if (current.num_states, len(current.edges), current.num_acc) == before:
             break
-    if obligation and (deadline is None or time.perf_counter() < deadline):
-        # Obligation formulas: the minimized weak deterministic automaton when not larger.
+    worth_trying = obligation or (verify is not None and current.num_states > 1)
+    if worth_trying and (deadline is None or time.process_time() < deadline):
         candidate = wdba.minimize_obligation(
             current, letters, deadline if deadline is not None else float("inf")
         )
         if candidate is not None:
             candidate = _merge_states(_reduce_marks(trim(candidate)), letters)
-            if (candidate.num_states, len(candidate.edges)) <= (
-                current.num_states,
-                len(current.edges),
-            ) or candidate.num_states < current.num_states:
+            if deadline is None or time.process_time() < deadline:
+                # States on no cycle were told apart from the rest by the minimization's
+                # acceptance flag, which does not matter for them: simulation merges them.
+                reduced = reduce_by_simulation(
+                    candidate, letters, deadline if deadline is not None else float("inf")
+                )
+                candidate = _merge_states(_reduce_marks(trim(reduced)), letters)
+            if obligation:
+                if (candidate.num_states, len(candidate.edges)) <= (
+                    current.num_states,
+                    len(current.edges),
+                ) or candidate.num_states < current.num_states:
+                    current = candidate
+            elif (
+                verify is not None
+                and candidate.num_states < current.num_states
+                and verify(current, candidate)
+            ):
                 current = candidate
     if letters is not None:
         current = _simplify_guards(current, letters)

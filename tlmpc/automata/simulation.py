@@ -86,7 +86,7 @@ class OutOfTime(Exception):
 
 
 def _check(deadline: float) -> None:
-    if time.perf_counter() > deadline:
+    if time.process_time() > deadline:
         raise OutOfTime
 
 
@@ -109,16 +109,46 @@ def saturate(automaton: Automaton, component: Sequence[int]) -> Automaton:
     return _with_edges(automaton, edges)
 
 
+def strip_transient(automaton: Automaton, component: Sequence[int]) -> Automaton:
+    """Take every mark off edges between SCCs (taken at most once, so the language stays)."""
+    edges = tuple(
+        e
+        if component[e.src] == component[e.dst] or not e.marks
+        else Edge(src=e.src, dst=e.dst, guard=e.guard, marks=frozenset())
+        for e in automaton.edges
+    )
+    return _with_edges(automaton, edges)
+
+
 def _with_edges(automaton: Automaton, edges: Sequence[Edge]) -> Automaton:
     return dataclasses.replace(automaton, edges=tuple(edges))
 
 
-def simulation(automaton: Automaton, alphabet: Alphabet, deadline: float) -> list[list[bool]]:
-    """``sim[p][q]``: ``q`` directly simulates ``p`` (largest relation)."""
+def simulation(
+    automaton: Automaton,
+    alphabet: Alphabet,
+    deadline: float,
+    component: Sequence[int] | None = None,
+) -> list[list[bool]]:
+    """``sim[p][q]``: ``q`` directly simulates ``p`` (largest relation).
+
+    With ``component`` (the SCC of every state), the matching edge's marks do not matter when
+    that edge lies between SCCs (the simulating run takes such edges finitely often, so every
+    mark the simulated run sees infinitely often it still sees infinitely often): the relation
+    then only implies language inclusion, which is all :func:`merge_transient` needs; it is
+    not a direct simulation, so :func:`quotient` and :func:`prune` must not use it."""
     n = automaton.num_states
     out: list[list[tuple[int, int, int]]] = [[] for _ in range(n)]
+    every = (1 << automaton.num_acc) - 1
     for e in automaton.edges:
         out[e.src].append((alphabet.mask(e.guard), _bits(e.marks), e.dst))
+    answers = out
+    if component is not None:
+        answers = [[] for _ in range(n)]
+        for e in automaton.edges:
+            transient = component[e.src] != component[e.dst]
+            marks = every if transient else _bits(e.marks)
+            answers[e.src].append((alphabet.mask(e.guard), marks, e.dst))
     # Letters a state enables at all: a necessary condition, checked first.
     enabled = [0] * n
     for state in range(n):
@@ -138,7 +168,7 @@ def simulation(automaton: Automaton, alphabet: Alphabet, deadline: float) -> lis
                 for letters, marks, target in out[p]:
                     covered = 0
                     target_row = sim[target]
-                    for other_letters, other_marks, other_target in out[q]:
+                    for other_letters, other_marks, other_target in answers[q]:
                         if marks & ~other_marks == 0 and target_row[other_target]:
                             covered |= other_letters
                     if letters & ~covered:
@@ -208,3 +238,66 @@ def prune(
             elif remaining:
                 kept.append(Edge(src=src, dst=e.dst, guard=disjoin(remaining), marks=e.marks))
     return _with_edges(automaton, kept)
+
+
+def merge_transient(
+    automaton: Automaton, alphabet: Alphabet, component: Sequence[int], deadline: float
+) -> Automaton:
+    """Replace a state by a state of the same language that cannot reach it.
+
+    ``q`` cannot reach ``p``, and each simulates the other with the relaxed marks of
+    :func:`simulation` (so ``L(p) = L(q)``): then every edge into ``p`` can go to ``q``
+    instead.  The redirected edges leave states that reach ``p``, which ``q`` does not reach,
+    so a run takes at most one of them and then continues from ``q`` with the same words ``p``
+    accepted.  Typical case: an initial state ``F G F a`` whose only edge enters the SCC of
+    ``G F a``."""
+    relation = simulation(automaton, alphabet, deadline, component)
+    n = automaton.num_states
+    succ: list[set[int]] = [set() for _ in range(n)]
+    for e in automaton.edges:
+        succ[e.src].add(e.dst)
+    edges = list(automaton.edges)
+    initial = automaton.initial
+    # Replacing keeps the language of every other state, so the relation stays true of the
+    # states still there; reachability is recomputed on the edges as they are now.
+    removed: set[int] = set()
+    for p in range(n):
+        if component[p] < 0:
+            continue
+        for q in range(n):
+            if q == p or q in removed or not (relation[p][q] and relation[q][p]):
+                continue
+            if _reaches(succ, q, p):
+                continue
+            _check(deadline)
+            edges = [
+                e if e.dst != p else Edge(src=e.src, dst=q, guard=e.guard, marks=e.marks)
+                for e in edges
+                if e.src != p
+            ]
+            for s in succ:
+                if p in s:
+                    s.discard(p)
+                    s.add(q)
+            succ[p] = set()
+            removed.add(p)
+            if initial == p:
+                initial = q
+            break
+    if len(edges) == len(automaton.edges) and initial == automaton.initial:
+        return automaton
+    return dataclasses.replace(automaton, edges=tuple(edges), initial=initial)
+
+
+def _reaches(succ: Sequence[set[int]], source: int, target: int) -> bool:
+    seen = {source}
+    stack = [source]
+    while stack:
+        state = stack.pop()
+        if state == target:
+            return True
+        for nxt in succ[state]:
+            if nxt not in seen:
+                seen.add(nxt)
+                stack.append(nxt)
+    return False

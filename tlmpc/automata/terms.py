@@ -1,21 +1,38 @@
-"""The translator's internal formulas: hash-consed NNF tuples, syntactic implication, and the
-one-step expansion r(f) of Couvreur's construction.
+"""The translator's formula algebra: simplifying constructors, syntactic implication, and the
+one-step expansion r(f) of Couvreur's construction, over the nodes of :mod:`tlmpc.automata.nnf`.
 
-A formula is a tuple: ``("t",)``, ``("f",)``, ``("p", name)``, ``("n", name)`` (negated
-proposition), ``("&", args)``/``("|", args)`` with ``args`` a sorted tuple of distinct
-formulas, ``("U"|"R"|"W"|"M", a, b)``, ``("F", a)``, ``("G", a)``.  Equal formulas are equal
-tuples, so automaton states (conjunctions of formulas) deduplicate for free.
+Conjunctions and disjunctions are built flattened, sorted and deduplicated, so equal formulas are
+equal nodes and automaton states (conjunctions of formulas) deduplicate for free.
 
-An expansion term is ``(pos, neg, next, promises)``: the letter must make every proposition of
-``pos`` true and of ``neg`` false, the run must satisfy the conjunction ``next`` from the next
-position on, and ``promises`` are the eventualities postponed on this step.
+An expansion term (:class:`Expansion`) says how a formula can hold now: the letter must make
+every proposition of ``pos`` true and of ``neg`` false, the run must satisfy the conjunction
+``next`` from the next position on, and ``promises`` are the eventualities postponed on this
+step.
 """
 
 from __future__ import annotations
 
 import functools
-from typing import Any
+from collections.abc import Iterable
+from typing import NamedTuple, assert_never
 
+from tlmpc.automata.nnf import (
+    FALSE,
+    TRUE,
+    Always,
+    Binary,
+    BinaryKind,
+    Bottom,
+    Conj,
+    Disj,
+    Finally,
+    Neg,
+    Node,
+    Pos,
+    Top,
+    neg,
+    pos,
+)
 from tlmpc.ltl.ast import (
     And,
     Const,
@@ -32,41 +49,56 @@ from tlmpc.ltl.ast import (
 )
 from tlmpc.ltl.transform import nnf
 
-T = Any  # an internal formula tuple
-TRUE: T = ("t",)
-FALSE: T = ("f",)
-Term = tuple[frozenset[str], frozenset[str], frozenset[T], frozenset[T]]
+__all__ = ["FALSE", "TRUE", "Expansion", "Node"]
 
 
-def make_and(parts: list[T] | tuple[T, ...]) -> T:
+class Expansion(NamedTuple):
+    """One way to satisfy a formula now (see the module docstring)."""
+
+    pos: frozenset[str]
+    neg: frozenset[str]
+    next: frozenset[Node]
+    promises: frozenset[Node]
+
+
+def _sorted(nodes: Iterable[Node]) -> tuple[Node, ...]:
+    return tuple(sorted(nodes, key=repr))
+
+
+def make_and(parts: Iterable[Node]) -> Node:
     """Flattened, sorted, deduplicated conjunction with constant folding."""
-    flat: set[T] = set()
+    flat: set[Node] = set()
     for part in parts:
-        if part == FALSE:
-            return FALSE
-        if part == TRUE:
-            continue
-        if part[0] == "&":
-            flat.update(part[1])
-        else:
-            flat.add(part)
+        match part:
+            case Bottom():
+                return FALSE
+            case Top():
+                continue
+            case Conj(args=args):
+                flat.update(args)
+            case _:
+                flat.add(part)
     for part in flat:
-        if part[0] == "p" and ("n", part[1]) in flat:
+        if isinstance(part, Pos) and neg(part.name) in flat:
             return FALSE
-    always = [part for part in flat if part[0] == "G"]
+    always = [part for part in flat if isinstance(part, Always)]
     if len(always) > 1:
         # G a & G b = G(a & b): one obligation instead of many (fifty `avoid` phrases would
         # otherwise multiply into fifty conjuncts in every state).
         flat.difference_update(always)
-        flat.add(("G", make_and([part[1] for part in always])))
-    persistent = [part for part in flat if part[0] == "F" and part[1][0] == "G"]
+        flat.add(Always("G", make_and(part.arg for part in always)))
+    persistent = [
+        part for part in flat if isinstance(part, Finally) and isinstance(part.arg, Always)
+    ]
     if len(persistent) > 1:
         # F G a & F G b = F G(a & b)
         flat.difference_update(persistent)
-        flat.add(("F", ("G", make_and([part[1][1] for part in persistent]))))
+        inner = make_and(part.arg.arg for part in persistent if isinstance(part.arg, Always))
+        flat.add(Finally("F", Always("G", inner)))
     suspendable = [part for part in flat if _pure_eventuality(part) and _pure_universality(part)]
     eventual = sorted(
-        (part for part in flat if part[0] == "F" and part not in suspendable), key=repr
+        (part for part in flat if isinstance(part, Finally) and part not in suspendable),
+        key=repr,
     )
     if suspendable and eventual:
         # F a & F b & s = F(a & s) & F(b & s) for s both a pure eventuality and a pure
@@ -74,111 +106,149 @@ def make_and(parts: list[T] | tuple[T, ...]) -> T:
         # last of a, b is reached, not all along.
         flat.difference_update(suspendable)
         flat.difference_update(eventual)
-        flat.update(("F", make_and([part[1], *suspendable])) for part in eventual)
+        flat.update(Finally("F", make_and([part.arg, *suspendable])) for part in eventual)
     if not flat:
         return TRUE
     if len(flat) == 1:
         return next(iter(flat))
-    return ("&", tuple(sorted(flat, key=repr)))
+    return Conj("&", _sorted(flat))
 
 
-def make_or(parts: list[T] | tuple[T, ...]) -> T:
+def make_or(parts: Iterable[Node]) -> Node:
     """Flattened, sorted, deduplicated disjunction with constant folding."""
-    flat: set[T] = set()
+    flat: set[Node] = set()
     for part in parts:
-        if part == TRUE:
-            return TRUE
-        if part == FALSE:
-            continue
-        if part[0] == "|":
-            flat.update(part[1])
-        else:
-            flat.add(part)
+        match part:
+            case Top():
+                return TRUE
+            case Bottom():
+                continue
+            case Disj(args=args):
+                flat.update(args)
+            case _:
+                flat.add(part)
     for part in flat:
-        if part[0] == "p" and ("n", part[1]) in flat:
+        if isinstance(part, Pos) and neg(part.name) in flat:
             return TRUE
-    recurrent = [part for part in flat if part[0] == "G" and part[1][0] == "F"]
+    recurrent = [
+        part for part in flat if isinstance(part, Always) and isinstance(part.arg, Finally)
+    ]
     if len(recurrent) > 1:
         # G F a | G F b = G F(a | b): one recurrence instead of a choice between them.
         flat.difference_update(recurrent)
-        flat.add(("G", ("F", make_or([part[1][1] for part in recurrent]))))
-    eventual = [part for part in flat if part[0] == "F" or _pure_eventuality(part)]
-    if len(eventual) > 1 and any(part[0] == "F" for part in eventual):
+        inner = make_or(part.arg.arg for part in recurrent if isinstance(part.arg, Finally))
+        flat.add(Always("G", Finally("F", inner)))
+    eventual = [part for part in flat if isinstance(part, Finally) or _pure_eventuality(part)]
+    if len(eventual) > 1 and any(isinstance(part, Finally) for part in eventual):
         # F a | F b = F(a | b), and F a | e = F(a | e) for a pure eventuality e (= F e):
         # one eventuality, and the state loops instead of guessing a disjunct at once.
         flat.difference_update(eventual)
-        flat.add(("F", make_or([part[1] if part[0] == "F" else part for part in eventual])))
+        flat.add(
+            Finally(
+                "F", make_or(part.arg if isinstance(part, Finally) else part for part in eventual)
+            )
+        )
     if not flat:
         return FALSE
     if len(flat) == 1:
         return next(iter(flat))
-    return ("|", tuple(sorted(flat, key=repr)))
+    return Disj("|", _sorted(flat))
 
 
-def is_eventuality_free(f: T) -> bool:
+def is_eventuality_free(f: Node) -> bool:
     """No U/F/M inside (then G/R over it need no acceptance condition)."""
-    kind = f[0]
-    if kind in ("U", "F", "M"):
-        return False
-    if kind in ("&", "|"):
-        return all(is_eventuality_free(a) for a in f[1])
-    if kind in ("R", "W"):
-        return is_eventuality_free(f[1]) and is_eventuality_free(f[2])
-    if kind == "G":
-        return is_eventuality_free(f[1])
-    return True
+    match f:
+        case Top() | Bottom() | Pos() | Neg():
+            return True
+        case Conj(args=args) | Disj(args=args):
+            return all(is_eventuality_free(a) for a in args)
+        case Finally():
+            return False
+        case Always(arg=arg):
+            return is_eventuality_free(arg)
+        case Binary(kind=kind, left=left, right=right):
+            return kind in ("R", "W") and is_eventuality_free(left) and is_eventuality_free(right)
+        case _:
+            assert_never(f)
 
 
-def _pure_eventuality(f: T) -> bool:
+def _pure_eventuality(f: Node) -> bool:
     """Formulas e with F e == e (Etessami–Holzmann): F x, x U (F...), GF..., ..."""
-    kind = f[0]
-    if kind == "F":
-        return True
-    if kind == "U":
-        return _pure_eventuality(f[2])
-    if kind == "M":
-        return _pure_eventuality(f[1]) and _pure_eventuality(f[2])
-    if kind == "G":
-        return _pure_eventuality(f[1])
-    if kind in ("&", "|"):
-        return all(_pure_eventuality(a) for a in f[1])
-    return False
+    match f:
+        case Finally():
+            return True
+        case Binary(kind="U", right=right):
+            return _pure_eventuality(right)
+        case Binary(kind="M", left=left, right=right):
+            return _pure_eventuality(left) and _pure_eventuality(right)
+        case Always(arg=arg):
+            return _pure_eventuality(arg)
+        case Conj(args=args) | Disj(args=args):
+            return all(_pure_eventuality(a) for a in args)
+        case Top() | Bottom() | Pos() | Neg() | Binary():
+            return False
+        case _:
+            assert_never(f)
 
 
-def _pure_universality(f: T) -> bool:
+def _pure_universality(f: Node) -> bool:
     """Formulas u with G u == u: G x, x R (G...), FG..., ..."""
-    kind = f[0]
-    if kind == "G":
-        return True
-    if kind == "R":
-        return _pure_universality(f[2])
-    if kind == "W":
-        return _pure_universality(f[1]) and _pure_universality(f[2])
-    if kind == "F":
-        return _pure_universality(f[1])
-    if kind in ("&", "|"):
-        return all(_pure_universality(a) for a in f[1])
-    return False
+    match f:
+        case Always():
+            return True
+        case Binary(kind="R", right=right):
+            return _pure_universality(right)
+        case Binary(kind="W", left=left, right=right):
+            return _pure_universality(left) and _pure_universality(right)
+        case Finally(arg=arg):
+            return _pure_universality(arg)
+        case Conj(args=args) | Disj(args=args):
+            return all(_pure_universality(a) for a in args)
+        case Top() | Bottom() | Pos() | Neg() | Binary():
+            return False
+        case _:
+            assert_never(f)
 
 
-def make_f(a: T) -> T:
-    """F a, simplified: F true = true, F false = false, F(eventuality) = itself."""
+def make_f(a: Node) -> Node:
+    """F a, simplified: F true = true, F false = false, F(eventuality) = itself,
+    F(a U b) = F b, F(a M b) = F(a & b), F(a | F b) = F(a | b)."""
     if a in (TRUE, FALSE) or _pure_eventuality(a):
         return a
-    return ("F", a)
+    match a:
+        case Binary(kind="U", right=right):
+            return make_f(right)
+        case Binary(kind="M", left=left, right=right):
+            return make_f(make_and([left, right]))
+        case Disj(args=args) if any(isinstance(x, Finally) for x in args):
+            return make_f(make_or(x.arg if isinstance(x, Finally) else x for x in args))
+    return Finally("F", a)
 
 
-def make_g(a: T) -> T:
+def make_g(a: Node) -> Node:
     """G a, simplified: G true = true, G(universality) = itself (conjunctions of G merge in
-    :func:`make_and`)."""
+    :func:`make_and`), G(a R b) = G b, G(a W b) = G(a | b), G(a & G b) = G(a & b), and
+    G F(a & e) = G F a & G e for a pure eventuality e (which holds everywhere as soon as it
+    holds infinitely often)."""
     if a in (TRUE, FALSE) or _pure_universality(a):
         return a
-    if a[0] == "F" and _pure_universality(a[1]):
-        return a
-    return ("G", a)
+    match a:
+        case Finally(arg=arg) if _pure_universality(arg):
+            return a
+        case Binary(kind="R", right=right):
+            return make_g(right)
+        case Binary(kind="W", left=left, right=right):
+            return make_g(make_or([left, right]))
+        case Conj(args=args) if any(isinstance(x, Always) for x in args):
+            return make_g(make_and(x.arg if isinstance(x, Always) else x for x in args))
+        case Finally(arg=Conj(args=args)) if any(_pure_eventuality(x) for x in args):
+            eventual = [x for x in args if _pure_eventuality(x)]
+            rest = [x for x in args if not _pure_eventuality(x)]
+            return make_and([make_g(make_f(make_and(rest))), *(make_g(e) for e in eventual)])
+    return Always("G", a)
 
 
-def make_binary(kind: str, a: T, b: T) -> T:
+def make_binary(kind: BinaryKind, a: Node, b: Node) -> Node:
     """a U/R/W/M b with the usual constant and idempotence rules."""
     if kind == "U":
         if b in (TRUE, FALSE) or a in (FALSE, b):
@@ -187,7 +257,7 @@ def make_binary(kind: str, a: T, b: T) -> T:
             return make_f(b)
         if _pure_eventuality(b):
             return b
-        if b[0] == "U" and b[1] == a:  # a U (a U b) = a U b
+        if isinstance(b, Binary) and b.kind == "U" and b.left == a:  # a U (a U b) = a U b
             return b
     elif kind == "R":
         if b in (TRUE, FALSE) or a in (TRUE, b):
@@ -205,6 +275,8 @@ def make_binary(kind: str, a: T, b: T) -> T:
             return make_g(a)
         if _pure_universality(a):
             return make_or([a, b])
+        if _pure_eventuality(b):  # a W e = (a U e) | G a = e | G a
+            return make_or([b, make_g(a)])
     elif kind == "M":
         if b == FALSE or a == FALSE:
             return FALSE
@@ -214,22 +286,32 @@ def make_binary(kind: str, a: T, b: T) -> T:
             return b
         if _pure_eventuality(a):
             return make_and([a, b])
-    return (kind, a, b)
+        if _pure_universality(b):  # a M u = (a R u) & F a = u & F a
+            return make_and([b, make_f(a)])
+    return Binary(kind, a, b)
 
 
-def from_ast(formula: Formula) -> T:
+def from_ast(formula: Formula) -> Node:
     """Translate an AST to the internal form (through NNF, with the rewriting rules)."""
     return _convert(nnf(formula))
 
 
-def _convert(f: Formula) -> T:
+_BINARY_KINDS: dict[type[Formula], BinaryKind] = {
+    Until: "U",
+    Release: "R",
+    WeakUntil: "W",
+    StrongRelease: "M",
+}
+
+
+def _convert(f: Formula) -> Node:
     if isinstance(f, Const):
         return TRUE if f.value else FALSE
     if isinstance(f, Prop):
-        return ("p", f.name)
+        return pos(f.name)
     if isinstance(f, Not):
         assert isinstance(f.arg, Prop)
-        return ("n", f.arg.name)
+        return neg(f.arg.name)
     if isinstance(f, And):
         return make_and([_convert(a) for a in f.args])
     if isinstance(f, Or):
@@ -239,59 +321,96 @@ def _convert(f: Formula) -> T:
     if isinstance(f, Globally):
         return make_g(_convert(f.arg))
     if isinstance(f, Until | Release | WeakUntil | StrongRelease):
-        kind = {Until: "U", Release: "R", WeakUntil: "W", StrongRelease: "M"}[type(f)]
-        return make_binary(kind, _convert(f.left), _convert(f.right))
+        return make_binary(_BINARY_KINDS[type(f)], _convert(f.left), _convert(f.right))
     raise TypeError(f"unexpected node {f!r}")
 
 
+def to_formula(f: Node) -> Formula:
+    """The AST of an internal formula (for printing and for checking rewrites)."""
+    match f:
+        case Top():
+            return Const(True)
+        case Bottom():
+            return Const(False)
+        case Pos(name=name):
+            return Prop(name)
+        case Neg(name=name):
+            return Not(Prop(name))
+        case Conj(args=args):
+            return And(tuple(to_formula(a) for a in args))
+        case Disj(args=args):
+            return Or(tuple(to_formula(a) for a in args))
+        case Finally(arg=arg):
+            return Eventually(to_formula(arg))
+        case Always(arg=arg):
+            return Globally(to_formula(arg))
+        case Binary(kind=kind, left=left, right=right):
+            node = {"U": Until, "R": Release, "W": WeakUntil, "M": StrongRelease}[kind]
+            return node(to_formula(left), to_formula(right))
+        case _:
+            assert_never(f)
+
+
 @functools.cache
-def implies(f: T, g: T) -> bool:
+def implies(f: Node, g: Node) -> bool:
     """A sound syntactic implication check f ⇒ g (incomplete; used to shrink states)."""
     if f in (g, FALSE) or g == TRUE:
         return True
-    fk, gk = f[0], g[0]
-    if gk == "&":
-        return all(implies(f, x) for x in g[1])
-    if fk == "|":
-        return all(implies(x, g) for x in f[1])
-    if fk == "&" and any(implies(x, g) for x in f[1]):
+    if isinstance(g, Conj):
+        return all(implies(f, x) for x in g.args)
+    if isinstance(f, Disj):
+        return all(implies(x, g) for x in f.args)
+    if isinstance(f, Conj) and any(implies(x, g) for x in f.args):
         return True
-    if gk == "|" and any(implies(f, x) for x in g[1]):
+    if isinstance(g, Disj) and any(implies(f, x) for x in g.args):
         return True
-    if gk == "F" and implies(f, g[1]):
+    if isinstance(g, Finally) and implies(f, g.arg):
         return True
-    if fk == "G" and implies(f[1], g):
+    if isinstance(f, Always) and implies(f.arg, g):
         return True
-    if fk == "G" and gk == "G" and implies(f[1], g[1]):
+    if isinstance(f, Always) and isinstance(g, Always) and implies(f.arg, g.arg):
         return True
-    if fk == "F" and gk == "F" and implies(f[1], g[1]):
+    if isinstance(f, Finally) and isinstance(g, Finally) and implies(f.arg, g.arg):
         return True
-    if gk == "U" and implies(f, g[2]):
+    if isinstance(g, Binary) and g.kind == "U" and implies(f, g.right):
         return True
-    if gk == "W" and (implies(f, g[2]) or (implies(f, g[1]) and fk == "G")):
+    if (
+        isinstance(g, Binary)
+        and g.kind == "W"
+        and (implies(f, g.right) or (isinstance(f, Always) and implies(f, g.left)))
+    ):
         return True
-    if fk == "U" and gk == "U" and implies(f[1], g[1]) and implies(f[2], g[2]):
+    if not isinstance(f, Binary):
+        return False
+    if (
+        f.kind == "U"
+        and isinstance(g, Binary)
+        and g.kind == "U"
+        and implies(f.left, g.left)
+        and implies(f.right, g.right)
+    ):
         return True
-    if fk == "U" and gk == "F" and implies(f[2], g[1]):
+    if f.kind == "U" and isinstance(g, Finally) and implies(f.right, g.arg):
         return True
-    if fk == "R" and implies(f[2], g):
+    if f.kind == "R" and implies(f.right, g):
         return True
-    return bool(fk == "M" and implies(f[1], g) and implies(f[2], g))
+    return f.kind == "M" and implies(f.left, g) and implies(f.right, g)
 
 
 @functools.lru_cache(maxsize=1 << 16)
-def simplify_state(parts: frozenset[T]) -> frozenset[T] | None:
+def simplify_state(parts: frozenset[Node]) -> frozenset[Node] | None:
     """Drop conjuncts implied by others; None when the conjunction is false."""
-    flat: set[T] = set()
+    flat: set[Node] = set()
     for part in parts:
-        if part == FALSE:
-            return None
-        if part == TRUE:
-            continue
-        if part[0] == "&":
-            flat.update(part[1])
-        else:
-            flat.add(part)
+        match part:
+            case Bottom():
+                return None
+            case Top():
+                continue
+            case Conj(args=args):
+                flat.update(args)
+            case _:
+                flat.add(part)
     items = sorted(flat, key=repr)
     kept = []
     for index, item in enumerate(items):
@@ -301,16 +420,10 @@ def simplify_state(parts: frozenset[T]) -> frozenset[T] | None:
         )
         if not redundant:
             kept.append(item)
-    # s & F(a & s) = F(a & s) for a suspendable s (prefix-independent): the F's fulfilment
-    # starts tracking s itself, so s need not be tracked meanwhile.  (General implied
-    # eventualities cannot be dropped like this: their promises would go unchecked.)
-    inside = {x for item in kept if item[0] == "F" and item[1][0] == "&" for x in item[1][1]}
-    if inside:
-        kept = [
-            item
-            for item in kept
-            if not (item in inside and _pure_eventuality(item) and _pure_universality(item))
-        ]
+    # (Not ``s & F(a & s) = F(a & s)`` for a suspendable ``s``, although the formulas are
+    # equivalent: reaching ``a & s`` only postpones ``s`` into the next state, so with ``s``
+    # dropped every cycle that keeps re-reaching ``a`` would accept without ``s`` ever being
+    # fulfilled, e.g. ``p2 R (F(F G !p0 & !p1) | G(F p0 & p1))`` on ``(!p0 p0)^ω``.)
     return frozenset(kept)
 
 
@@ -341,115 +454,157 @@ def restrict_letters(letters: list[frozenset[str]] | None) -> list[frozenset[str
     return previous
 
 
-def _combine(left: list[Term], right: list[Term]) -> list[Term]:
-    out: list[Term] = []
+def _combine(left: Iterable[Expansion], right: Iterable[Expansion]) -> list[Expansion]:
+    out: list[Expansion] = []
+    right = list(right)
     for lp, ln, lx, lprom in left:
         for rp, rn, rx, rprom in right:
             pos = lp | rp
             neg = ln | rn
             if not cube_allowed(pos, neg):
                 continue
-            out.append((pos, neg, lx | rx, lprom | rprom))
+            out.append(Expansion(pos, neg, lx | rx, lprom | rprom))
     return out
 
 
-_EMPTY: frozenset[Any] = frozenset()
+_NO_NAMES: frozenset[str] = frozenset()
+_NO_NODES: frozenset[Node] = frozenset()
+_NOTHING = Expansion(_NO_NAMES, _NO_NAMES, _NO_NODES, _NO_NODES)
 
 
-def _unless(terms: list[Term] | tuple[Term, ...], alternatives: list[T]) -> list[Term]:
+def _unless(terms: Iterable[Expansion], alternatives: Iterable[Node]) -> list[Expansion]:
     """``terms`` restricted to the letters where the literal ``alternatives`` are false.
 
     Sound whenever a literal alternative's own term (that literal, nothing else) is also
     among the expansion terms: it dominates every restricted-away letter.  Non-literal
     alternatives are ignored."""
-    pos = frozenset(x[1] for x in alternatives if x[0] == "n")
-    neg = frozenset(x[1] for x in alternatives if x[0] == "p")
-    if not pos and not neg:
+    alternatives = list(alternatives)
+    must = frozenset(x.name for x in alternatives if isinstance(x, Neg))
+    must_not = frozenset(x.name for x in alternatives if isinstance(x, Pos))
+    if not must and not must_not:
         return list(terms)
-    return [(p | pos, n | neg, x, pr) for p, n, x, pr in terms if cube_allowed(p | pos, n | neg)]
+    return [
+        Expansion(p | must, n | must_not, x, pr)
+        for p, n, x, pr in terms
+        if cube_allowed(p | must, n | must_not)
+    ]
+
+
+def _literal(f: Node) -> bool:
+    return isinstance(f, Pos | Neg)
 
 
 @functools.cache
-def expand(f: T) -> tuple[Term, ...]:
+def expand(f: Node) -> tuple[Expansion, ...]:
     """r(f): the ways to satisfy ``f`` now, as expansion terms."""
-    kind = f[0]
-    if kind == "t":
-        return ((_EMPTY, _EMPTY, _EMPTY, _EMPTY),)
-    if kind == "f":
-        return ()
-    if kind == "p":
-        return ((frozenset([f[1]]), _EMPTY, _EMPTY, _EMPTY),)
-    if kind == "n":
-        return ((_EMPTY, frozenset([f[1]]), _EMPTY, _EMPTY),)
-    if kind == "&":
-        result: list[Term] = [(_EMPTY, _EMPTY, _EMPTY, _EMPTY)]
-        for arg in f[1]:
-            result = _combine(result, list(expand(arg)))
-        return tuple(result)
-    if kind == "|":
-        # Literal disjuncts make the other disjuncts' terms exclusive: where a literal holds,
-        # its own term (no obligation, no promise) dominates theirs.
-        literals = [arg for arg in f[1] if arg[0] in ("p", "n")]
-        others = [t for arg in f[1] if arg[0] not in ("p", "n") for t in expand(arg)]
-        return (
-            *(t for arg in literals for t in expand(arg)),
-            *_unless(others, literals),
-        )
-    later: Term = (_EMPTY, _EMPTY, frozenset([f]), _EMPTY)
-    promise: Term = (_EMPTY, _EMPTY, frozenset([f]), frozenset([f]))
-    if kind == "F":  # b | (!b & P & N(F b)) -- `!b` only when b is a literal
-        return (*expand(f[1]), *_unless([promise], [f[1]]))
-    if kind == "G":  # a & N(G a)
-        return tuple(_combine(list(expand(f[1])), [later]))
-    a, b = f[1], f[2]
-    if kind == "U":  # b | (a & P & N(a U b))
-        return (*expand(b), *_unless(_combine(list(expand(a)), [promise]), [b]))
-    if kind == "M":  # (a & b) | (b & P & N(a M b))
-        return (
-            *_combine(list(expand(a)), list(expand(b))),
-            *_unless(_combine(list(expand(b)), [promise]), [a]),
-        )
-    if kind == "R":  # (a & b) | (b & N(a R b))
-        return (
-            *_combine(list(expand(a)), list(expand(b))),
-            *_unless(_combine(list(expand(b)), [later]), [a]),
-        )
-    if kind == "W":  # b | (a & N(a W b))
-        return (*expand(b), *_unless(_combine(list(expand(a)), [later]), [b]))
-    raise ValueError(f"unknown formula kind {kind!r}")
+    later = Expansion(_NO_NAMES, _NO_NAMES, frozenset([f]), _NO_NODES)
+    promise = Expansion(_NO_NAMES, _NO_NAMES, frozenset([f]), frozenset([f]))
+    match f:
+        case Top():
+            return (_NOTHING,)
+        case Bottom():
+            return ()
+        case Pos(name=name):
+            return (Expansion(frozenset([name]), _NO_NAMES, _NO_NODES, _NO_NODES),)
+        case Neg(name=name):
+            return (Expansion(_NO_NAMES, frozenset([name]), _NO_NODES, _NO_NODES),)
+        case Conj(args=args):
+            result = [_NOTHING]
+            for arg in args:
+                result = _combine(result, expand(arg))
+            return tuple(result)
+        case Disj(args=args):
+            # Literal disjuncts make the other disjuncts' terms exclusive: where a literal
+            # holds, its own term (no obligation, no promise) dominates theirs.
+            literals = [arg for arg in args if _literal(arg)]
+            others = [t for arg in args if not _literal(arg) for t in expand(arg)]
+            return (*(t for arg in literals for t in expand(arg)), *_unless(others, literals))
+        case Finally(arg=arg):  # b | (!b & P & N(F b)) -- `!b` only when b is a literal
+            return (*expand(arg), *_unless([promise], [arg]))
+        case Always(arg=arg):  # a & N(G a)
+            return tuple(_combine(expand(arg), [later]))
+        case Binary(kind="U", left=a, right=b):  # b | (a & P & N(a U b))
+            return (*expand(b), *_unless(_combine(expand(a), [promise]), [b]))
+        case Binary(kind="M", left=a, right=b):  # (a & b) | (b & P & N(a M b))
+            return (
+                *_combine(expand(a), expand(b)),
+                *_unless(_combine(expand(b), [promise]), [a]),
+            )
+        case Binary(kind="R", left=a, right=b):  # (a & b) | (b & N(a R b))
+            return (
+                *_combine(expand(a), expand(b)),
+                *_unless(_combine(expand(b), [later]), [a]),
+            )
+        case Binary(kind="W", left=a, right=b):  # b | (a & N(a W b))
+            return (*expand(b), *_unless(_combine(expand(a), [later]), [b]))
+        case Binary():
+            raise ValueError(f"unknown binary operator {f.kind!r}")
+        case _:
+            assert_never(f)
 
 
-def eventualities(f: T) -> list[T]:
+def eventualities(f: Node) -> list[Node]:
     """Every U/F/M subformula of ``f`` (one acceptance set each), in a stable order."""
-    found: dict[T, None] = {}
+    found: dict[Node, None] = {}
     stack = [f]
     while stack:
         g = stack.pop()
-        kind = g[0]
-        if kind in ("U", "F", "M"):
-            found.setdefault(g, None)
-        if kind in ("&", "|"):
-            stack.extend(g[1])
-        elif kind in ("U", "R", "W", "M"):
-            stack.extend((g[1], g[2]))
-        elif kind in ("F", "G"):
-            stack.append(g[1])
+        match g:
+            case Finally(arg=arg):
+                found.setdefault(g, None)
+                stack.append(arg)
+            case Binary(kind=kind, left=left, right=right):
+                if kind in ("U", "M"):
+                    found.setdefault(g, None)
+                stack.extend((left, right))
+            case Conj(args=args) | Disj(args=args):
+                stack.extend(args)
+            case Always(arg=arg):
+                stack.append(arg)
+            case Top() | Bottom() | Pos() | Neg():
+                pass
+            case _:
+                assert_never(g)
     return sorted(found, key=repr)
 
 
-def to_text(f: T) -> str:
+def props(f: Node) -> frozenset[str]:
+    """The propositions that occur in ``f``."""
+    match f:
+        case Top() | Bottom():
+            return frozenset()
+        case Pos(name=name) | Neg(name=name):
+            return frozenset([name])
+        case Conj(args=args) | Disj(args=args):
+            return frozenset().union(*(props(a) for a in args))
+        case Finally(arg=arg) | Always(arg=arg):
+            return props(arg)
+        case Binary(left=left, right=right):
+            return props(left) | props(right)
+        case _:
+            assert_never(f)
+
+
+def to_text(f: Node) -> str:
     """Readable form of an internal formula (state names)."""
-    kind = f[0]
-    if kind == "t":
-        return "true"
-    if kind == "f":
-        return "false"
-    if kind == "p":
-        return str(f[1])
-    if kind == "n":
-        return "!" + str(f[1])
-    if kind in ("&", "|"):
-        return "(" + f" {kind} ".join(to_text(a) for a in f[1]) + ")"
-    if kind in ("F", "G"):
-        return f"{kind} {to_text(f[1])}"
-    return f"({to_text(f[1])} {kind} {to_text(f[2])})"
+    match f:
+        case Top():
+            return "true"
+        case Bottom():
+            return "false"
+        case Pos(name=name):
+            return name
+        case Neg(name=name):
+            return "!" + name
+        case Conj(args=args):
+            return "(" + " & ".join(to_text(a) for a in args) + ")"
+        case Disj(args=args):
+            return "(" + " | ".join(to_text(a) for a in args) + ")"
+        case Finally(arg=arg):
+            return f"F {to_text(arg)}"
+        case Always(arg=arg):
+            return f"G {to_text(arg)}"
+        case Binary(kind=kind, left=left, right=right):
+            return f"({to_text(left)} {kind} {to_text(right)})"
+        case _:
+            assert_never(f)

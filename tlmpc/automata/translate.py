@@ -13,18 +13,20 @@ from __future__ import annotations
 import dataclasses
 import time
 from collections.abc import Iterable, Sequence
-from typing import Any
 
 from tlmpc.automata.containment import simplify_by_containment
+from tlmpc.automata.emptiness import equivalent_to_deterministic
 from tlmpc.automata.model import Automaton, Edge
-from tlmpc.automata.simplify import postprocess
+from tlmpc.automata.nnf import FALSE, Node
+from tlmpc.automata.rewrite import MAX_SEMANTIC_APS, rewrite
+from tlmpc.automata.simplify import postprocess, trim
 from tlmpc.automata.terms import (
-    FALSE,
-    T,
+    Expansion,
     cube_allowed,
     eventualities,
     expand,
     from_ast,
+    props,
     restrict_letters,
     simplify_state,
     to_text,
@@ -39,13 +41,17 @@ DEFAULT_BUDGET = 0.5
 #: At most this long for the language-containment simplification of the formula.
 CONTAINMENT_BUDGET = 0.2
 
+#: At most this long for each equivalence check of a WDBA-minimized automaton (a formula that
+#: is not a syntactic obligation may still have one; the check decides).
+WDBA_CHECK_BUDGET = 0.1
+
 #: Above this many expansion terms in one state, dominated terms are left to the simulation.
 MAX_DOMINATION_TERMS = 600
 
 #: The same for each partial product of a state's conjuncts (checked more often).
 MAX_PARTIAL_DOMINATION_TERMS = 150
 
-State = frozenset[T]
+State = frozenset[Node]
 Cube = tuple[frozenset[str], frozenset[str]]
 
 
@@ -123,18 +129,39 @@ def translate(
             true at once; all others false).  Edges no letter enables are dropped and states are
             merged with respect to these letters only.
         simplify: run the post-processing (trim, SCC pruning, merging).
-        budget: seconds after which the optional reductions (simulation) stop and the
-            automaton reduced so far, which is always correct, is returned; None = no limit.
+        budget: seconds of CPU time (of this process, so that other load on the machine
+            does not change the result) after which the optional reductions (simulation) stop
+            and the automaton reduced so far, which is always correct, is returned; None = no
+            limit.
     """
-    started = time.perf_counter()
+    return _translate(
+        formula, letters=letters, simplify=simplify, budget=budget, containment=containment
+    )
+
+
+def _translate(
+    formula: Formula,
+    *,
+    letters: Sequence[Sequence[str]] | None,
+    simplify: bool,
+    budget: float | None,
+    containment: bool,
+    check_wdba: bool = True,
+) -> Automaton:
+    started = time.process_time()
     deadline = None if budget is None else started + budget
     original = formula
     if simplify and containment:
         # Half the budget at most for the containment checks (each one a small translation).
         share = CONTAINMENT_BUDGET if budget is None else min(CONTAINMENT_BUDGET, budget / 2)
         formula = simplify_by_containment(nnf(formula), _is_empty, started + share)
-    root = from_ast(formula)
     aps = tuple(sorted(original.props()))
+    semantic = simplify and containment and len(aps) <= MAX_SEMANTIC_APS
+    root = rewrite(
+        from_ast(formula),
+        _is_empty_term if semantic else None,
+        time.process_time() + (CONTAINMENT_BUDGET if budget is None else budget / 4),
+    )
     letter_sets = (
         None
         if letters is None
@@ -148,7 +175,25 @@ def translate(
     finally:
         restrict_letters(previous_letters)
     if simplify:
-        automaton = postprocess(automaton, letter_sets, deadline, obligation=is_obligation(root))
+        verify = None
+        if check_wdba:
+
+            def verify(reduced: Automaton, candidate: Automaton) -> bool:
+                # The negation's automaton, itself without this check (no recursion).
+                negation = _translate(
+                    Not(original),
+                    letters=None if letter_sets is None else [sorted(x) for x in letter_sets],
+                    simplify=True,
+                    budget=WDBA_CHECK_BUDGET,
+                    containment=False,
+                    check_wdba=False,
+                )
+                limit = time.process_time() + WDBA_CHECK_BUDGET
+                return equivalent_to_deterministic(reduced, candidate, negation, letter_sets, limit)
+
+        automaton = postprocess(
+            automaton, letter_sets, deadline, obligation=is_obligation(root), verify=verify
+        )
     if letter_sets is not None:
         automaton = dataclasses.replace(
             automaton, letters=tuple(sorted(tuple(sorted(x)) for x in letter_sets))
@@ -158,7 +203,7 @@ def translate(
 
 def _explore(
     initial: State | None,
-    events: list[Any],
+    events: list[Node],
     letter_sets: list[frozenset[str]] | None,
     text: str,
     aps: tuple[str, ...],
@@ -205,37 +250,57 @@ def _explore(
 
 def _is_empty(formula: Formula) -> bool:
     """No word satisfies ``formula`` (its trimmed automaton has no edge)."""
-    return not translate(formula, budget=CONTAINMENT_BUDGET, containment=False).edges
+    translated = _translate(
+        formula,
+        letters=None,
+        simplify=True,
+        budget=CONTAINMENT_BUDGET,
+        containment=False,
+        check_wdba=False,
+    )
+    return not translated.edges
 
 
-def _state_terms(
-    state: State,
-) -> list[tuple[frozenset[str], frozenset[str], frozenset[T], frozenset[T]]]:
-    terms: list[Any] = [(frozenset(), frozenset(), frozenset(), frozenset())]
+def _is_empty_term(root: Node) -> bool:
+    """No word satisfies the internal formula ``root`` (its raw automaton, trimmed, has no
+    edge).  Over every letter: the caller's letter restriction is set aside meanwhile."""
+    if root == FALSE:
+        return True
+    aps = tuple(sorted(props(root)))
+    previous = restrict_letters(None)
+    try:
+        raw = _explore(simplify_state(frozenset([root])), eventualities(root), None, "", aps)
+    finally:
+        restrict_letters(previous)
+    return not trim(raw).edges
+
+
+def _state_terms(state: State) -> list[Expansion]:
+    terms: list[Expansion] = [Expansion(frozenset(), frozenset(), frozenset(), frozenset())]
     for part in sorted(state, key=repr):
-        combined = []
+        combined: list[Expansion] = []
         for pos, neg, nxt, prom in terms:
             for p2, n2, x2, pr2 in expand(part):
                 p = pos | p2
                 n = neg | n2
                 if not cube_allowed(p, n):
                     continue
-                combined.append((p, n, nxt | x2, prom | pr2))
+                combined.append(Expansion(p, n, nxt | x2, prom | pr2))
         terms = _undominated_partial(combined)
         if not terms:
             break
     return terms
 
 
-def _merge_adjacent(terms: list[Any]) -> list[Any]:
+def _merge_adjacent(terms: list[Expansion]) -> list[Expansion]:
     """Merge terms with the same obligations and promises whose cubes differ in the sign of
     one proposition only (``a & b`` and ``a & !b`` give ``a``), until none is left."""
-    groups: dict[tuple[Any, Any], set[tuple[frozenset[str], frozenset[str]]]] = {}
+    groups: dict[tuple[frozenset[Node], frozenset[Node]], set[Cube]] = {}
     for pos, neg, nxt, prom in terms:
         groups.setdefault((nxt, prom), set()).add((pos, neg))
     if len(groups) == len(terms):
         return terms
-    out: list[Any] = []
+    out: list[Expansion] = []
     for (nxt, prom), cubes in groups.items():
         changed = len(cubes) > 1
         while changed:
@@ -250,29 +315,29 @@ def _merge_adjacent(terms: list[Any]) -> list[Any]:
                         cubes.add((pos - {name}, neg))
                         changed = True
                         break
-        out.extend((pos, neg, nxt, prom) for pos, neg in cubes)
+        out.extend(Expansion(pos, neg, nxt, prom) for pos, neg in cubes)
     return out
 
 
-def _undominated_partial(terms: list[Any]) -> list[Any]:
+def _undominated_partial(terms: list[Expansion]) -> list[Expansion]:
     """Drop partial products dominated by another one (weaker cube, fewer obligations, fewer
     promises): whatever completes the dominated one completes the other one better, so
     pruning here keeps the product of the conjuncts from growing needlessly."""
     unique = _merge_adjacent(list(dict.fromkeys(terms)))
     if len(unique) < 2 or len(unique) > MAX_PARTIAL_DOMINATION_TERMS:
         return unique
-    index: dict[Any, int] = {}
+    index: dict[tuple[str, str | Node], int] = {}
     keys = []
     for pos, neg, nxt, prom in unique:
         key = 0
-        for item in pos:
-            key |= 1 << index.setdefault(("p", item), len(index))
-        for item in neg:
-            key |= 1 << index.setdefault(("n", item), len(index))
-        for item in nxt:
-            key |= 1 << index.setdefault(("x", item), len(index))
-        for item in prom:
-            key |= 1 << index.setdefault(("P", item), len(index))
+        for name in pos:
+            key |= 1 << index.setdefault(("p", name), len(index))
+        for name in neg:
+            key |= 1 << index.setdefault(("n", name), len(index))
+        for node in nxt:
+            key |= 1 << index.setdefault(("x", node), len(index))
+        for node in prom:
+            key |= 1 << index.setdefault(("P", node), len(index))
         keys.append(key)
     return [
         term

@@ -15,13 +15,15 @@ and gives up (None) rather than overrun it.
 
 from __future__ import annotations
 
+import functools
 import time
 from collections import deque
 from collections.abc import Sequence
+from typing import assert_never
 
 from tlmpc.automata.model import Automaton, Edge
+from tlmpc.automata.nnf import Always, Binary, Bottom, Conj, Disj, Finally, Neg, Node, Pos, Top
 from tlmpc.automata.simulation import Alphabet, OutOfTime
-from tlmpc.automata.terms import T
 from tlmpc.ltl.ast import FALSE, Formula, Not, Prop, conjoin, disjoin
 
 #: Subset construction is abandoned past this many subsets (the input is kept).
@@ -30,45 +32,51 @@ MAX_SUBSETS = 400
 MAX_APS = 8
 
 
-def is_safety(f: T) -> bool:
+def is_safety(f: Node) -> bool:
     """Syntactic safety (NNF): literals, & |, and G R W over safety formulas."""
-    kind = f[0]
-    if kind in ("t", "f", "p", "n"):
-        return True
-    if kind in ("&", "|"):
-        return all(is_safety(a) for a in f[1])
-    if kind == "G":
-        return is_safety(f[1])
-    if kind in ("R", "W"):
-        return is_safety(f[1]) and is_safety(f[2])
-    return False
+    match f:
+        case Top() | Bottom() | Pos() | Neg():
+            return True
+        case Conj(args=args) | Disj(args=args):
+            return all(is_safety(a) for a in args)
+        case Always(arg=arg):
+            return is_safety(arg)
+        case Binary(kind=kind, left=left, right=right):
+            return kind in ("R", "W") and is_safety(left) and is_safety(right)
+        case Finally():
+            return False
+        case _:
+            assert_never(f)
 
 
-def is_guarantee(f: T) -> bool:
+def is_guarantee(f: Node) -> bool:
     """Syntactic guarantee (NNF): literals, & |, and F U M over guarantee formulas."""
-    kind = f[0]
-    if kind in ("t", "f", "p", "n"):
-        return True
-    if kind in ("&", "|"):
-        return all(is_guarantee(a) for a in f[1])
-    if kind == "F":
-        return is_guarantee(f[1])
-    if kind in ("U", "M"):
-        return is_guarantee(f[1]) and is_guarantee(f[2])
-    return False
+    match f:
+        case Top() | Bottom() | Pos() | Neg():
+            return True
+        case Conj(args=args) | Disj(args=args):
+            return all(is_guarantee(a) for a in args)
+        case Finally(arg=arg):
+            return is_guarantee(arg)
+        case Binary(kind=kind, left=left, right=right):
+            return kind in ("U", "M") and is_guarantee(left) and is_guarantee(right)
+        case Always():
+            return False
+        case _:
+            assert_never(f)
 
 
-def is_obligation(f: T) -> bool:
+def is_obligation(f: Node) -> bool:
     """Syntactic obligation: a Boolean combination of safety and guarantee formulas."""
     if is_safety(f) or is_guarantee(f):
         return True
-    if f[0] in ("&", "|"):
-        return all(is_obligation(a) for a in f[1])
+    if isinstance(f, Conj | Disj):
+        return all(is_obligation(a) for a in f.args)
     return False
 
 
 def _check(deadline: float) -> None:
-    if time.perf_counter() > deadline:
+    if time.process_time() > deadline:
         raise OutOfTime
 
 
@@ -332,8 +340,23 @@ def _cover(mask: int, n: int, aps: tuple[str, ...]) -> list[Formula]:
 
 
 def _cube_mask(fixed: dict[int, bool], n: int) -> int:
-    mask = 0
-    for valuation in range(1 << n):
-        if all(bool(valuation >> i & 1) == value for i, value in fixed.items()):
-            mask |= 1 << valuation
+    """The valuations (bit ``v`` = valuation ``v``) where each fixed proposition has its value:
+    an intersection of one precomputed mask per literal, not a scan of the 2^n valuations."""
+    literal = _literal_masks(n)
+    mask = (1 << (1 << n)) - 1
+    for i, value in fixed.items():
+        mask &= literal[i] if value else ~literal[i]
     return mask
+
+
+@functools.cache
+def _literal_masks(n: int) -> tuple[int, ...]:
+    """Per proposition ``i``, the valuations over ``n`` propositions where ``i`` is true."""
+    masks = []
+    for i in range(n):
+        mask = 0
+        for valuation in range(1 << n):
+            if valuation >> i & 1:
+                mask |= 1 << valuation
+        masks.append(mask)
+    return tuple(masks)

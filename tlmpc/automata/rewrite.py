@@ -1,0 +1,215 @@
+"""Implication-based rewriting of the translator's formulas (Somenzi–Bloem; the rules Spot's
+``tl_simplifier`` applies with syntactic implication checks).
+
+Bottom-up, every node is rebuilt from its rewritten operands, then the rules below apply, each
+decided by the sound syntactic implication check :func:`tlmpc.automata.terms.implies` (never
+by a translation, so the pass is cheap enough to run on every formula):
+
+==================  ====================  ======================
+node                becomes               when
+==================  ====================  ======================
+``a | b``           ``b``                 a ⇒ b
+``a | b``           ``true``              ¬a ⇒ b
+``a & b``           ``a``                 a ⇒ b
+``a & b``           ``false``             a ⇒ ¬b
+``a U b``           ``b``                 a ⇒ b
+``a U b``           ``F b``               ¬a ⇒ b
+``a W b``           ``b``                 a ⇒ b
+``a W b``           ``true``              ¬a ⇒ b
+``a R b``           ``b``                 b ⇒ a
+``a R b``           ``G b``               b ⇒ ¬a
+``a M b``           ``b``                 b ⇒ a
+``a M b``           ``false``             b ⇒ ¬a
+``a U (b U c)``     ``b U c``             a ⇒ b
+``a W (b W c)``     ``b W c``             a ⇒ b
+``a R (b R c)``     ``b R c``             b ⇒ a
+``a M (b M c)``     ``b M c``             b ⇒ a
+==================  ====================  ======================
+
+Why they hold: for ``a U b`` with a ⇒ b, wherever ``a`` holds so does ``b``, so the until is
+fulfilled at once or never needed ``a``; with ¬a ⇒ b every position before the first ``b`` has
+``a``.  The ``R``/``M`` rules are the duals (``¬(a U b) = ¬a R ¬b``, ``¬(a W b) = ¬a M ¬b``).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from typing import assert_never
+
+from tlmpc.automata.nnf import (
+    FALSE,
+    TRUE,
+    Always,
+    Binary,
+    BinaryKind,
+    Bottom,
+    Conj,
+    Disj,
+    Finally,
+    Neg,
+    Node,
+    Pos,
+    Top,
+    neg,
+    pos,
+)
+from tlmpc.automata.terms import (
+    implies,
+    make_and,
+    make_binary,
+    make_f,
+    make_g,
+    make_or,
+)
+
+#: Nodes with more operands are rebuilt without the pairwise checks (they are quadratic).
+MAX_OPERANDS = 12
+#: Semantic implication checks only for nodes with at most this many operands.
+MAX_SEMANTIC_OPERANDS = 4
+#: ... and for formulas over at most this many propositions (the caller checks).
+MAX_SEMANTIC_APS = 6
+
+_DUAL: dict[BinaryKind, BinaryKind] = {"U": "R", "R": "U", "W": "M", "M": "W"}
+_TEMPORAL = Finally | Always | Binary
+
+
+def negate(f: Node) -> Node:
+    """The negation normal form of ``!f`` (rebuilt through the simplifying constructors)."""
+    match f:
+        case Top():
+            return FALSE
+        case Bottom():
+            return TRUE
+        case Pos(name=name):
+            return neg(name)
+        case Neg(name=name):
+            return pos(name)
+        case Conj(args=args):
+            return make_or([negate(a) for a in args])
+        case Disj(args=args):
+            return make_and([negate(a) for a in args])
+        case Finally(arg=arg):
+            return make_g(negate(arg))
+        case Always(arg=arg):
+            return make_f(negate(arg))
+        case Binary(kind=kind, left=left, right=right):
+            return make_binary(_DUAL[kind], negate(left), negate(right))
+        case _:
+            assert_never(f)
+
+
+def rewrite(f: Node, empty: Callable[[Node], bool] | None = None, deadline: float = 0.0) -> Node:
+    """``f`` with the implication rules of the module docstring applied at every node.
+
+    With ``empty`` (a language-emptiness oracle), an implication the syntactic check misses is
+    also decided semantically (``a ⇒ b`` iff ``a & !b`` is empty), and a temporal node whose
+    language is empty (or universal) becomes ``false`` (``true``); only until ``deadline`` (a
+    ``time.process_time`` value), on formulas over at most :data:`MAX_SEMANTIC_APS`
+    propositions and nodes of at most :data:`MAX_SEMANTIC_OPERANDS` operands."""
+    return _Rewriter(empty, deadline).run(f)
+
+
+class _Rewriter:
+    def __init__(self, empty: Callable[[Node], bool] | None, deadline: float) -> None:
+        self.empty = empty
+        self.deadline = deadline
+        self.memo: dict[Node, Node] = {}
+        self.semantic_memo: dict[tuple[Node, Node], bool] = {}
+
+    def semantic(self) -> bool:
+        return self.empty is not None and time.process_time() < self.deadline
+
+    def implies(self, f: Node, g: Node, *, small: bool = True) -> bool:
+        if implies(f, g):
+            return True
+        if not small or not self.semantic():
+            return False
+        key = (f, g)
+        known = self.semantic_memo.get(key)
+        if known is None:
+            assert self.empty is not None
+            known = self.empty(make_and([f, negate(g)]))
+            self.semantic_memo[key] = known
+        return known
+
+    def run(self, f: Node) -> Node:
+        done = self.memo.get(f)
+        if done is not None:
+            return done
+        result: Node
+        match f:
+            case Top() | Bottom() | Pos() | Neg():
+                result = f
+            case Conj(args=args):
+                result = self.junction(True, [self.run(a) for a in args])
+            case Disj(args=args):
+                result = self.junction(False, [self.run(a) for a in args])
+            case Finally(arg=arg):
+                result = make_f(self.run(arg))
+            case Always(arg=arg):
+                result = make_g(self.run(arg))
+            case Binary(kind=kind, left=left, right=right):
+                result = self.binary(kind, self.run(left), self.run(right))
+            case _:
+                assert_never(f)
+        if isinstance(result, _TEMPORAL) and self.semantic():
+            assert self.empty is not None
+            if self.empty(result):
+                result = FALSE
+            elif self.empty(negate(result)):
+                result = TRUE
+        self.memo[f] = result
+        return result
+
+    def junction(self, conjunction: bool, args: list[Node]) -> Node:
+        built = make_and(args) if conjunction else make_or(args)
+        if not isinstance(built, Conj if conjunction else Disj):
+            return built
+        assert isinstance(built, Conj | Disj)
+        if len(built.args) > MAX_OPERANDS:
+            return built
+        items = list(built.args)
+        small = len(items) <= MAX_SEMANTIC_OPERANDS
+        for index, item in enumerate(items):
+            for other in items[index + 1 :]:
+                if conjunction and (implies(item, negate(other)) or implies(other, negate(item))):
+                    return FALSE
+                if not conjunction and (
+                    implies(negate(item), other) or implies(negate(other), item)
+                ):
+                    return TRUE
+        # Drop, one at a time, an operand that another remaining one makes redundant (so of
+        # two equivalent operands one stays).
+        kept = list(items)
+        for item in items:
+            if any(
+                other is not item
+                and (
+                    self.implies(other, item, small=small)
+                    if conjunction
+                    else self.implies(item, other, small=small)
+                )
+                for other in kept
+            ):
+                kept.remove(item)
+        if len(kept) == len(items):
+            return built
+        return make_and(kept) if conjunction else make_or(kept)
+
+    def binary(self, kind: BinaryKind, a: Node, b: Node) -> Node:
+        if kind in ("U", "W"):
+            if self.implies(a, b):
+                return b
+            if self.implies(negate(a), b):
+                return make_f(b) if kind == "U" else TRUE
+            if isinstance(b, Binary) and b.kind == kind and self.implies(a, b.left):
+                return b
+        else:  # R, M
+            if self.implies(b, a):
+                return b
+            if self.implies(b, negate(a)):
+                return make_g(b) if kind == "R" else FALSE
+            if isinstance(b, Binary) and b.kind == kind and self.implies(b.left, a):
+                return b
+        return make_binary(kind, a, b)
