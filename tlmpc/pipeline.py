@@ -205,10 +205,17 @@ def _abstraction(c: Compilation) -> StageResult:
 
 def _automaton(c: Compilation) -> StageResult:
     from tlmpc.automata import automaton_to_json, to_hoa, translate
+    from tlmpc.planning.boundary import task_formula, task_letters
 
     mission = c.get(MISSION)
     abstraction = c.get(ABSTRACTION)
-    automaton = translate(mission.formula, letters=abstraction.letters)
+    # Under the closed convention the planner reads boundary instants too (their letters and
+    # a rewritten task; see tlmpc/planning/boundary.py).
+    convention = mission.options.boundary
+    automaton = translate(
+        task_formula(mission.formula, convention),
+        letters=task_letters(abstraction, convention, mission.robot.start),
+    )
     return StageResult(
         products=provide(AUTOMATON, automaton),
         artifacts={
