@@ -16,19 +16,18 @@ Two facts the triangle graph alone does not carry:
   point instants) into a formula whose discrete meaning on the point/open word equals the
   verifier's continuous meaning under the closed convention.
 
+``StartCell`` and ``start_cells`` live in :mod:`tlmpc.abstraction.starts` (re-exported here).
 Under the right-continuous convention (the default) a point reads the label of the piece it
 opens, so neither the crossings nor the start point add a letter.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from fractions import Fraction
-
 import numpy as np
 import shapely
 
 from tlmpc.abstraction.model import Abstraction
+from tlmpc.abstraction.starts import StartCell, start_cells
 from tlmpc.ltl.ast import (
     And,
     Const,
@@ -47,69 +46,11 @@ from tlmpc.ltl.ast import (
 )
 from tlmpc.ltl.transform import nnf
 
+__all__ = ["POINT", "StartCell", "closed_task", "start_cells", "task_formula", "task_letters"]
+
 #: The proposition true exactly at point instants (crossings and the start) in the closed
 #: convention's word.  Region names are identifiers, so no region can be called this.
 POINT = "@point"
-#: A start closer than this to an edge (relative to the triangle's height over it) may cross
-#: it at once in the simulator (rounding): such an edge is blocked at t = 0 where the label
-#: changes across it.
-ON_EDGE_TOLERANCE = 1e-12
-
-
-@dataclass(frozen=True, slots=True)
-class StartCell:
-    """A triangle whose closure contains the start, and its edges that contain the start."""
-
-    triangle: int
-    blocked: tuple[int, ...]
-
-
-Exact = tuple[Fraction, Fraction]
-
-
-def _orientation(a: Exact, b: Exact, p: Exact) -> Fraction:
-    return (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0])
-
-
-def start_cells(abstraction: Abstraction, point: tuple[float, float]) -> tuple[StartCell, ...]:
-    """Every triangle containing ``point`` (decided exactly, in rationals), with blocked edges.
-
-    An edge is blocked when it contains the point exactly, or when the point lies within
-    :data:`ON_EDGE_TOLERANCE` of it and the label changes across it (rounding could make the
-    robot cross it at once and skip the triangle's label).
-    """
-    corners = abstraction.vertices[abstraction.triangles]
-    low, high = corners.min(axis=1), corners.max(axis=1)
-    x, y = float(point[0]), float(point[1])
-    candidates = np.flatnonzero(
-        (low[:, 0] <= x) & (x <= high[:, 0]) & (low[:, 1] <= y) & (y <= high[:, 1])
-    )
-    p = (Fraction(x), Fraction(y))
-    cells: list[StartCell] = []
-    for t in candidates.tolist():
-        vertices = [(Fraction(float(u)), Fraction(float(v))) for u, v in corners[t]]
-        # Edge i is opposite vertex i; a counter-clockwise triangle has every orientation
-        # of an inside point non-negative.
-        sides = [_orientation(vertices[(i + 1) % 3], vertices[(i + 2) % 3], p) for i in range(3)]
-        if min(sides) < 0:
-            continue
-        area = _orientation(vertices[0], vertices[1], vertices[2])
-        # sides[i] / area is the distance to edge i over the height above it.  A start that
-        # close to an edge may cross it at once (rounding); that matters only where the label
-        # changes across it, so only such near edges are blocked (exact ones always are).
-        label = abstraction.letter_of[t]
-        blocked = [
-            i
-            for i in range(3)
-            if sides[i] == 0
-            or (
-                sides[i] <= ON_EDGE_TOLERANCE * area
-                and abstraction.neighbors[t, i] >= 0
-                and abstraction.letter_of[abstraction.neighbors[t, i]] != label
-            )
-        ]
-        cells.append(StartCell(triangle=int(t), blocked=tuple(blocked)))
-    return tuple(cells)
 
 
 def start_point_label(abstraction: Abstraction, point: tuple[float, float]) -> tuple[str, ...]:
