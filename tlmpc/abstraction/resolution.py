@@ -44,13 +44,17 @@ def _off_grid(polygons: Sequence[Polygon], grid: float) -> list[int]:
 
 
 def _lost(raw: Any, snapped: Any, reach: float) -> bool:
-    """True when some part of ``raw`` lies farther than ``reach`` from ``snapped`` (or the
-    converse): snapping changed the feature's shape, not only its position."""
+    """True when snapping changed the feature's shape, not only moved it by under ``reach``:
+    it collapsed, or a corner of either outline lies farther than ``reach`` from the other
+    outline (a thin arm that vanished leaves its tip behind).  Point-to-outline distances
+    only, no overlay: exact enough at the grid's scale."""
     if shapely.is_empty(snapped) or shapely.area(snapped) <= 0.0:
         return True
-    away = shapely.difference(raw, shapely.buffer(snapped, reach))
-    grown = shapely.difference(snapped, shapely.buffer(raw, reach))
-    return bool(shapely.area(away) > 0.0 or shapely.area(grown) > 0.0)
+    away = shapely.distance(shapely.points(shapely.get_coordinates(raw)), shapely.boundary(snapped))
+    grown = shapely.distance(
+        shapely.points(shapely.get_coordinates(snapped)), shapely.boundary(raw)
+    )
+    return bool(max(float(np.max(away)), float(np.max(grown))) > reach)
 
 
 def subgrid_problems(mission: Mission) -> list[Diagnostic]:
