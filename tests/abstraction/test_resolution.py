@@ -58,6 +58,17 @@ def test_a_strip_thinner_than_the_grid_is_refused_at_its_line(tmp_path: Path) ->
     assert problem.file == str(tmp_path / "m.yaml")
 
 
+def test_a_region_losing_only_a_thin_arm_is_refused() -> None:
+    arm = 3.000000003
+    outline = [[2, 2], [4, 2], [4, 4], [arm, 4], [arm, 9], [3, 9], [3, 4], [2, 4]]
+    m = mission("  key: " + yaml.safe_dump(outline, default_flow_style=True).strip())
+    raw = shapely.Polygon(outline)
+    snapped = shapely.set_precision(raw, grid_size(m))
+    assert snapped.area > 0  # the square survives ...
+    assert snapped.distance(shapely.Point(3, 9)) > 1  # ... the arm's tip does not
+    assert [d.code for d in subgrid_problems(m)] == ["G030"]
+
+
 def test_a_thin_wall_hole_is_refused() -> None:
     m = mission(holes="[[[5, 0.5], [5.000000004, 0.5], [5.000000004, 9.5], [5, 9.5]]]")
     codes = [d.code for d in subgrid_problems(m)]

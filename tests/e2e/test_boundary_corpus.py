@@ -191,7 +191,7 @@ def _yaml(document: dict[str, Any]) -> str:
     return yaml.safe_dump(document)
 
 
-MESH_POINTS = _mesh_points(mission("F a", (5, 5)))
+MESH_POINTS = _mesh_points(mission("F a", (1.3, 0.7)))
 TASKS = ["F(a & F b)", "b & F a", "G !a & F b", "F a & G !b", "!a U b", "G F a & G F b"]
 
 

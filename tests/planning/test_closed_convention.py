@@ -9,13 +9,14 @@ instant.  Hypothesis draws formulas over every operator.
 
 from __future__ import annotations
 
+import pytest
 from continuous_ltl import Word, closed_holds
 from hypothesis import given
 from hypothesis import strategies as st
 from lasso_ltl import holds
 from strategies import formulas
 
-from tlmpc.ltl.ast import Formula
+from tlmpc.ltl.ast import And, Eventually, Formula, Not, Prop, Release, Until
 from tlmpc.ltl.printer import to_text
 from tlmpc.planning.boundary import POINT, closed_task
 
@@ -65,3 +66,48 @@ def test_rewrite_is_also_right_from_open_pieces(
     for k in range(len(word)):
         expected = closed_holds(formula, word, is_point, loop, k)
         assert holds(rewritten, marked, loop, k) == expected, (to_text(formula), k)
+
+
+a, b = Prop("a"), Prop("b")
+
+
+@pytest.mark.parametrize(
+    ("formula", "word", "expected"),
+    [
+        # at a point in a, then an open stretch in b only: a U b needs a on part of it
+        (Until(a, b), ["a", "b"], False),
+        (Until(a, b), ["a", "ab"], True),
+        (Until(a, b), ["b", ""], True),  # a witness at the point itself
+        # !(a U b) as a release: !a R !b holds on the same word
+        (Release(Not(a), Not(b)), ["a", "b"], True),
+        (Release(Not(a), Not(b)), ["a", "ab"], False),
+        (Eventually(And((a, b))), ["ab", "a"], True),  # F (a & b) holds at the point
+    ],
+)
+def test_named_point_open_words(formula: Formula, word: list[str], expected: bool) -> None:
+    """A point then an open stretch that stays forever (a loop on the open piece)."""
+    letters_ = [frozenset(w) for w in word]
+    is_point = [True, False]
+    assert closed_holds(formula, letters_, is_point, 1, 0) is expected  # the definition
+    marked = [letters_[0] | {POINT}, letters_[1]]
+    assert holds(closed_task(formula), marked, 1, 0) is expected
+
+
+@pytest.mark.parametrize(
+    ("formula", "word", "expected"),
+    [
+        # b released at a later point where a holds: a R b is false there (!a U !b holds)
+        (Release(a, b), ["b", "b", "a", "ab"], False),
+        (Release(a, b), ["b", "b", "ab", "a"], True),
+        # a U b with its witness at a later point where a fails: true (a on [t, s) only)
+        (Until(a, b), ["a", "a", "b", ""], True),
+        (Until(a, b), ["a", "", "b", ""], False),
+    ],
+)
+def test_named_four_piece_lassos(formula: Formula, word: list[str], expected: bool) -> None:
+    """point, open, point, open, looping from the second point."""
+    letters_ = [frozenset(w) for w in word]
+    is_point = [True, False, True, False]
+    assert closed_holds(formula, letters_, is_point, 2, 0) is expected  # the definition
+    marked = [x | {POINT} if p else x for x, p in zip(letters_, is_point, strict=True)]
+    assert holds(closed_task(formula), marked, 2, 0) is expected
