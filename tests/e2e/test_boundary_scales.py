@@ -12,6 +12,7 @@ tasks drawn always have a plan (none forbids a handover), so a "no plan" fails.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
 import yaml
@@ -56,7 +57,7 @@ def _document(
     ltl: str,
     boundary: str,
 ) -> dict[str, Any]:
-    def move(point: list[float] | tuple[float, float]) -> list[float]:
+    def move(point: Sequence[float]) -> list[float]:
         return [offset[0] + size * point[0] / 10, offset[1] + size * point[1] / 10]
 
     return {

@@ -54,13 +54,20 @@ POINT = "@point"
 
 
 def start_point_label(abstraction: Abstraction, point: tuple[float, float]) -> tuple[str, ...]:
-    """Regions whose closure contains ``point`` (the verifier's closed label of the start)."""
+    """Regions whose closure contains ``point``: the verifier's closed label of the start,
+    by its rule (within 1e-12 of the largest of the point's and the regions' coordinates)."""
+    if not abstraction.regions:
+        return ()
+    extent = max(
+        float(np.abs(np.asarray(p, dtype=np.float64)).max()) for p in abstraction.regions.values()
+    )
+    reach = 1e-12 * max(abs(float(point[0])), abs(float(point[1])), extent)
     probe = shapely.Point(point)
     return tuple(
         sorted(
             name
             for name, polygon in abstraction.regions.items()
-            if shapely.intersects(shapely.Polygon(polygon), probe)
+            if shapely.dwithin(shapely.Polygon(polygon), probe, reach)
         )
     )
 
