@@ -320,6 +320,18 @@ def _verify(c: Compilation) -> StageResult:
                 hint="please report this mission; the artifacts were not written",
             )
         )
+    certificate = verdict_json["certificate"]
+    bound = certificate["max_speed"]
+    if bound is not None and certificate["observed_speed"] > bound * (1.0 + 1e-6):
+        # The controllers promise |u| <= max_speed; a faster trace breaks the guarantee too.
+        raise SelfCheckError(
+            error(
+                "I001",
+                f"the compiled trajectory moves at {certificate['observed_speed']:.6g}, faster "
+                f"than max_speed {bound:.6g} (self-check failed)",
+                hint="please report this mission; the artifacts were not written",
+            )
+        )
     return StageResult(
         artifacts={"verdict.json": verdict_json},
         sizes={"robustness": round(float(verdict.robustness), 6)},

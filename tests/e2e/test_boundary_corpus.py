@@ -206,3 +206,25 @@ def test_starts_on_mesh_vertices_and_edges(start: tuple[float, float], ltl: str)
     assert (checked(document) is not None) == face_oracle(document), (ltl, start)
     closed = mission(ltl, start, boundary="closed")
     checked(closed)
+
+
+def test_a_compiled_trace_faster_than_max_speed_fails_the_self_check(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The verifier's speed check guards compiled traces too (the trace stays on its path and
+    satisfies the task, only twice as fast)."""
+    import dataclasses
+
+    import tlmpc.simulate
+    from tlmpc.pipeline import SelfCheckError
+
+    honest = tlmpc.simulate.simulate
+
+    def hurried(*args: Any) -> Any:
+        trace = honest(*args)
+        return dataclasses.replace(trace, times=trace.times * 0.5)
+
+    monkeypatch.setattr(tlmpc.simulate, "simulate", hurried)
+    with pytest.raises(SelfCheckError) as caught:
+        compile_mission(mission("F(a & F b)", (5, 5)), until="verify")
+    assert "faster than max_speed" in caught.value.diagnostics[0].message
