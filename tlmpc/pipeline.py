@@ -205,10 +205,17 @@ def _abstraction(c: Compilation) -> StageResult:
 
 def _automaton(c: Compilation) -> StageResult:
     from tlmpc.automata import automaton_to_json, to_hoa, translate
+    from tlmpc.planning.boundary import task_formula, task_letters
 
     mission = c.get(MISSION)
     abstraction = c.get(ABSTRACTION)
-    automaton = translate(mission.formula, letters=abstraction.letters)
+    # Under the closed convention the planner reads boundary instants too (their letters and
+    # a rewritten task; see tlmpc/planning/boundary.py).
+    convention = mission.options.boundary
+    automaton = translate(
+        task_formula(mission.formula, convention),
+        letters=task_letters(abstraction, convention, mission.robot.start),
+    )
     return StageResult(
         products=provide(AUTOMATON, automaton),
         artifacts={
@@ -310,6 +317,18 @@ def _verify(c: Compilation) -> StageResult:
                 "I001",
                 "the compiled trajectory does not satisfy the task (self-check failed): "
                 + str(verdict_json.get("counterexample")),
+                hint="please report this mission; the artifacts were not written",
+            )
+        )
+    certificate = verdict_json["certificate"]
+    bound = certificate["max_speed"]
+    if bound is not None and certificate["observed_speed"] > bound * (1.0 + 1e-6):
+        # The controllers promise |u| <= max_speed; a faster trace breaks the guarantee too.
+        raise SelfCheckError(
+            error(
+                "I001",
+                f"the compiled trajectory moves at {certificate['observed_speed']:.6g}, faster "
+                f"than max_speed {bound:.6g} (self-check failed)",
                 hint="please report this mission; the artifacts were not written",
             )
         )

@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import shapely
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from shapely.geometry import Polygon
 
@@ -19,6 +19,7 @@ from tlmpc.abstraction import (
     locate,
 )
 from tlmpc.abstraction.model import Abstraction
+from tlmpc.abstraction.resolution import subgrid_problems
 from tlmpc.artifacts import validation_errors
 from tlmpc.errors import InvalidInputError
 from tlmpc.ltl.ast import TRUE
@@ -66,9 +67,13 @@ def workspaces(draw: st.DrawFn) -> Mission:
             regions[f"r{k}"] = ((x0, y0), (x0 + w, y0 + h / 3), (x0 + w / 2, y0 + h))
     start = (width - 0.1, 0.1)
     min_angle = draw(st.sampled_from([None, 20.0]))
-    return mission_of(
+    mission = mission_of(
         rect(0, 0, width, height), holes, regions, start, Options(min_angle=min_angle)
     )
+    # Features closer than the snapping grid are refused (G030/G031, tests/abstraction/
+    # test_resolution.py); about one drawn map in thousands has one.
+    assume(not subgrid_problems(mission))
+    return mission
 
 
 def _triangle_polygons(a: Abstraction) -> list[Polygon]:

@@ -15,6 +15,7 @@ import math
 from collections.abc import Sequence
 
 import numpy as np
+from starts import start_triangles
 
 from tlmpc.abstraction.model import Abstraction
 from tlmpc.automata.guards import holds
@@ -53,6 +54,7 @@ def _successors(
     node: Node,
     start_point: Sequence[float],
     metric: str,
+    blocked: dict[int, set[int]],
 ) -> list[tuple[Node, float, bool]]:
     t, entry, q = node
     full = frozenset(range(automaton.num_acc))
@@ -60,7 +62,7 @@ def _successors(
     targets: list[tuple[int, int, float]] = [(t, entry, STUTTER)]
     for i in range(3):
         n = int(abstraction.neighbors[t, i])
-        if n < 0 or i == entry:
+        if n < 0 or i == entry or (entry == START and i in blocked.get(t, set())):
             continue
         slot = [int(x) for x in abstraction.neighbors[n]].index(t)
         targets.append((n, slot, move_cost(abstraction, t, entry, i, start_point, metric)))
@@ -98,12 +100,14 @@ def minimum_lasso_cost(
     beta: float,
 ) -> float:
     """The promised minimum (``inf`` when no lasso exists); ``automaton`` has <= 1 set."""
-    start = abstraction.start
-    letter = set(abstraction.labels(start))
+    # Every triangle holding the start point may come first; its edges through the point
+    # are not left at the first move.
+    blocked = start_triangles(abstraction, start_point)
     roots = {
         (start, START, e.dst): 0.0
+        for start in blocked
         for e in automaton.edges
-        if e.src == automaton.initial and holds(e.guard, letter)
+        if e.src == automaton.initial and holds(e.guard, set(abstraction.labels(start)))
     }
     succ: dict[Node, list[tuple[Node, float, bool]]] = {}
     stack = list(roots)
@@ -111,7 +115,7 @@ def minimum_lasso_cost(
         node = stack.pop()
         if node in succ:
             continue
-        succ[node] = _successors(abstraction, automaton, node, start_point, metric)
+        succ[node] = _successors(abstraction, automaton, node, start_point, metric, blocked)
         stack.extend(n for n, _, _ in succ[node] if n not in succ)
     d0 = _dijkstra(succ, roots)
     best = math.inf

@@ -34,6 +34,8 @@ class FaceGraph:
     labels: list[frozenset[str]]
     adjacent: list[set[int]]
     start: int
+    #: Every face whose closure holds the start (one face unless the start is on a boundary).
+    starts: tuple[int, ...] = ()
 
 
 def face_graph(
@@ -41,8 +43,14 @@ def face_graph(
     holes: Sequence[Coords],
     regions: Mapping[str, Coords],
     start: tuple[float, float],
+    *,
+    on_boundary: bool = False,
 ) -> FaceGraph:
-    """The face graph of the free space cut by every region boundary."""
+    """The face graph of the free space cut by every region boundary.
+
+    With ``on_boundary``, a start on face boundaries is allowed: it may begin in any face
+    whose closure holds it.
+    """
     free = Polygon(boundary)
     for hole in holes:
         free = free.difference(Polygon(hole))
@@ -65,9 +73,15 @@ def face_graph(
                 adjacent[j].add(i)
     point = Point(start)
     starts = [i for i, f in enumerate(faces) if f.contains(point)]
-    if len(starts) != 1:
+    if not starts and on_boundary:
+        # A start on a boundary can move into any face whose closure holds it (under the
+        # right-continuous convention its first label is that face's).
+        starts = [i for i, f in enumerate(faces) if f.intersects(point)]
+    if len(starts) != 1 and not (on_boundary and starts):
         raise ValueError("the start must lie strictly inside one face")
-    return FaceGraph(faces=faces, labels=labels, adjacent=adjacent, start=starts[0])
+    return FaceGraph(
+        faces=faces, labels=labels, adjacent=adjacent, start=starts[0], starts=tuple(starts)
+    )
 
 
 def _letter_test(automaton: spot.twa_graph) -> Callable[[object, frozenset[str]], bool]:
@@ -113,9 +127,10 @@ def satisfiable_on(graph: FaceGraph, ltl: str) -> bool:
 
     # Nodes (face, automaton state after reading that face's letter).
     roots = [
-        (graph.start, dst)
+        (start, dst)
+        for start in graph.starts or (graph.start,)
         for index, (src, dst, _, _) in enumerate(edges)
-        if src == init and accepts[index, graph.start]
+        if src == init and accepts[index, start]
     ]
     succ: dict[tuple[int, int], list[tuple[tuple[int, int], bool]]] = {}
     stack = list(dict.fromkeys(roots))

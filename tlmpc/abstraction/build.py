@@ -11,6 +11,8 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
 from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
+from tlmpc.abstraction.resolution import refuse_subgrid_features
+from tlmpc.abstraction.starts import cells_in
 from tlmpc.abstraction.triangulate import triangulate
 from tlmpc.errors import Diagnostic, InvalidInputError, error
 from tlmpc.mission.model import Mission
@@ -83,9 +85,14 @@ def _components(neighbors: IntArray) -> IntArray:
 def build_abstraction(mission: Mission) -> Abstraction:
     """Triangulate ``mission``'s workspace and build the transition system D."""
     started = time.perf_counter()
+    # One geometry for planning and verifying: refuse what snapping to the grid would reshape.
+    refuse_subgrid_features(mission)
     vertices, triangles, neighbors, shapes = triangulate(mission)
     letter_of, letters = _labels(mission, vertices, triangles, shapes)
-    start = locate_in(vertices, triangles, mission.robot.start)
+    # The lowest-numbered triangle holding the start exactly (a start on an edge or vertex
+    # lies in several: the planner starts from any of them).
+    cells = cells_in(vertices, triangles, neighbors, letter_of, mission.robot.start)
+    start = min(c.triangle for c in cells) if cells else -1
     if start < 0:
         raise InvalidInputError(
             error(

@@ -22,6 +22,7 @@ import numpy as np
 
 from tlmpc.abstraction.build import locate_in
 from tlmpc.abstraction.model import Abstraction, FloatArray
+from tlmpc.abstraction.starts import cells_in
 
 #: Interior points tried in turn (barycentric weights of the three corners): the centroid
 #: first, others when the start point would lie on a spoke of the centroid's fan.
@@ -90,7 +91,9 @@ def split_triangles(
                 nbr[n, nbr[n] == t] = s
     vertices.append(np.asarray(new_points, dtype=np.float64).reshape(-1, 2))
     all_vertices = np.vstack(vertices)
-    new_start = locate_in(all_vertices, tri, start_point)
+    cells = cells_in(all_vertices, tri, nbr, letter_of, start_point)
+    fallback = locate_in(all_vertices, tri, start_point)
+    new_start = min(c.triangle for c in cells) if cells else fallback
     for array in (all_vertices, tri, nbr, letter_of, component):
         array.setflags(write=False)
     stats: dict[str, Any] = dict(abstraction.stats)

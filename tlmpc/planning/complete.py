@@ -20,6 +20,7 @@ from tlmpc.automata.model import Automaton
 from tlmpc.errors import NoPlanError, TlmpcError, error
 from tlmpc.ltl.ast import Formula
 from tlmpc.mission.model import Options, TaskPart
+from tlmpc.planning.boundary import start_cells
 from tlmpc.planning.explain import explain_infeasible
 from tlmpc.planning.model import Witness
 from tlmpc.planning.plan import plan
@@ -28,12 +29,28 @@ from tlmpc.planning.plan import plan
 MAX_ROUNDS = 3
 
 
-def bounce_triangles(witness: Witness) -> list[int]:
-    """Triangles where the run ``prefix + cycle^omega`` enters and leaves by the same edge."""
+def bounce_triangles(
+    witness: Witness,
+    abstraction: Abstraction | None = None,
+    start_point: tuple[float, float] | None = None,
+) -> list[int]:
+    """Triangles where the run ``prefix + cycle^omega`` enters and leaves by the same edge.
+
+    With ``abstraction`` and ``start_point``, a first triangle left through an edge that
+    holds the start point counts too (the robot enters it from that edge at t = 0).
+    """
     run = [*witness.prefix, *witness.cycle]
     if len(witness.cycle) > 1:
         run += [*witness.cycle, witness.cycle[0]]
-    return sorted({run[i] for i in range(1, len(run) - 1) if run[i - 1] == run[i + 1]})
+    found = {run[i] for i in range(1, len(run) - 1) if run[i - 1] == run[i + 1]}
+    if abstraction is not None and start_point is not None and len(run) > 1:
+        first, second = run[0], run[1]
+        for cell in start_cells(abstraction, start_point):
+            if cell.triangle == first and any(
+                int(abstraction.neighbors[first, i]) == second for i in cell.blocked
+            ):
+                found.add(first)
+    return sorted(found)
 
 
 def plan_complete(
@@ -85,7 +102,7 @@ def plan_complete(
                     )
                 ) from None
             break
-        mesh = split_triangles(mesh, bounce_triangles(bouncing), start_point)
+        mesh = split_triangles(mesh, bounce_triangles(bouncing, mesh, start_point), start_point)
         try:
             witness = attempt(mesh, False)
         except NoPlanError:

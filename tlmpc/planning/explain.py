@@ -19,6 +19,7 @@ from tlmpc.ltl.ast import And, Formula, Globally, Not, Prop, conjoin, is_proposi
 from tlmpc.ltl.printer import to_text
 from tlmpc.ltl.transform import nnf
 from tlmpc.mission.model import Options, TaskPart
+from tlmpc.planning.boundary import StartCell
 
 BoolArray = npt.NDArray[np.bool_]
 
@@ -51,16 +52,19 @@ def invariant_mask(abstraction: Abstraction, formula: Formula) -> BoolArray:
     return letter_ok[abstraction.letter_of]
 
 
-def _reachable(abstraction: Abstraction, allowed: BoolArray) -> BoolArray:
+def _reachable(
+    abstraction: Abstraction, allowed: BoolArray, sources: Sequence[int] | None = None
+) -> BoolArray:
     m = abstraction.num_triangles
     rows = np.repeat(np.arange(m), 3)
     cols = abstraction.neighbors.reshape(-1)
     keep = (cols >= 0) & allowed[rows] & allowed[np.maximum(cols, 0)]
     graph = coo_matrix((np.ones(int(keep.sum())), (rows[keep], cols[keep])), shape=(m, m))
     seen = np.zeros(m, dtype=bool)
-    if allowed[abstraction.start]:
-        order = breadth_first_order(graph.tocsr(), abstraction.start, return_predecessors=False)
-        seen[order] = True
+    csr = graph.tocsr()
+    for source in [abstraction.start] if sources is None else sources:
+        if allowed[source] and not seen[source]:
+            seen[breadth_first_order(csr, source, return_predecessors=False)] = True
     return seen
 
 
@@ -85,10 +89,22 @@ def _positive_props(formula: Formula) -> list[str]:
 
 
 def explain_no_plan(
-    abstraction: Abstraction, automaton: Automaton, formula: Formula, allowed: BoolArray
+    abstraction: Abstraction,
+    automaton: Automaton,
+    formula: Formula,
+    allowed: BoolArray,
+    *,
+    starts: Sequence[StartCell] | None = None,
+    start_label: tuple[str, ...] | None = None,
 ) -> list[Diagnostic]:
-    """Why no accepting lasso exists, most specific reason first."""
+    """Why no accepting lasso exists, most specific reason first.
+
+    ``starts`` are the triangles holding the start point (default: the abstraction's start
+    triangle); ``start_label`` is the start point's own label under the closed convention
+    (None under the right-continuous one, where the start reads its first triangle's label).
+    """
     from tlmpc.automata.translate import translate
+    from tlmpc.planning.boundary import POINT
 
     text = to_text(formula)
     if not translate(formula).edges:
@@ -109,10 +125,18 @@ def explain_no_plan(
                 hint="check which regions the task asks the robot to be in at the same time",
             )
         ]
-    start_labels = abstraction.labels(abstraction.start)
-    where = f"in {', '.join(start_labels)}" if start_labels else "in free space"
-    if not allowed[abstraction.start]:
-        broken = [p for p in invariants(formula) if not holds(p, set(start_labels))]
+    cells = [abstraction.start] if starts is None else [c.triangle for c in starts]
+    # Every label the robot can have at t = 0: its first triangle's (any one holding the
+    # start), and under the closed convention the start point's own label before it.
+    firsts = sorted({abstraction.labels(t) for t in cells})
+    where = " or ".join(f"in {', '.join(x)}" if x else "in free space" for x in firsts)
+    required = invariants(formula)
+    broken = [p for p in required if start_label is not None and not holds(p, set(start_label))]
+    if broken or not any(allowed[t] for t in cells):
+        if start_label is not None and broken:
+            where = f"in {', '.join(start_label)}" if start_label else "in free space"
+        else:
+            broken = [p for p in required if not all(holds(p, set(x)) for x in firsts)]
         return [
             error(
                 "P002",
@@ -121,9 +145,8 @@ def explain_no_plan(
                 hint="move the start or relax the task",
             )
         ]
-    if not any(
-        e.src == automaton.initial and holds(e.guard, set(start_labels)) for e in automaton.edges
-    ):
+    first_words = [[(*start_label, POINT), x] if start_label is not None else [x] for x in firsts]
+    if not any(_can_start(automaton, word) for word in first_words):
         return [
             error(
                 "P003",
@@ -131,7 +154,7 @@ def explain_no_plan(
                 hint=f"`{text}` constrains the first instant; move the start or the task",
             )
         ]
-    problems = _region_facts(abstraction, formula, {})
+    problems = _region_facts(abstraction, formula, {}, cells)
     if problems:
         return problems
     return [
@@ -169,14 +192,18 @@ def explain_infeasible(
     if not parts:
         return list(fallback)
     from tlmpc.automata.translate import translate
+    from tlmpc.planning.boundary import start_cells, task_formula, task_letters
     from tlmpc.planning.plan import plan
+
+    convention = options.boundary
+    letters = task_letters(abstraction, convention, start_point)
 
     def feasible(chosen: Sequence[TaskPart]) -> bool:
         conjunction = conjoin([p.formula for p in chosen])
         try:
             plan(
                 abstraction,
-                translate(conjunction, letters=abstraction.letters),
+                translate(task_formula(conjunction, convention), letters=letters),
                 formula=conjunction,
                 options=options,
                 start_point=start_point,
@@ -202,7 +229,8 @@ def explain_infeasible(
         # the parts that cause it.
         involved = f"; the parts involved: {quoted}" if len(core) > 1 else ""
         return [dataclasses.replace(d, hint=(d.hint or "") + involved, **where) for d in exact]
-    facts = "; ".join(d.message for d in _region_facts(abstraction, blamed, where))
+    cells = [c.triangle for c in start_cells(abstraction, start_point)]
+    facts = "; ".join(d.message for d in _region_facts(abstraction, blamed, where, cells))
     if len(core) == 1:
         headline = error(
             "P010",
@@ -229,15 +257,27 @@ def _at(file: str | None, part: TaskPart) -> str:
     return f" ({file or '<input>'}:{part.line}:{part.col})"
 
 
+def _can_start(automaton: Automaton, word: Sequence[Sequence[str]]) -> bool:
+    """Whether ``automaton`` has a run over the finite ``word`` (the first instants)."""
+    states = {automaton.initial}
+    for letter in word:
+        states = {e.dst for e in automaton.edges if e.src in states and holds(e.guard, set(letter))}
+    return bool(states)
+
+
 def _region_facts(
-    abstraction: Abstraction, formula: Formula, where: dict[str, Any]
+    abstraction: Abstraction,
+    formula: Formula,
+    where: dict[str, Any],
+    cells: Sequence[int] | None = None,
 ) -> list[Diagnostic]:
     """Regions the blamed parts need that have no free space or cannot be reached."""
     allowed = invariant_mask(abstraction, formula)
-    if not allowed[abstraction.start]:
+    sources = [abstraction.start] if cells is None else list(cells)
+    if not any(allowed[t] for t in sources):
         return []
-    reachable_ok = _reachable(abstraction, allowed)
-    reachable_any = _reachable(abstraction, np.ones(abstraction.num_triangles, dtype=bool))
+    reachable_ok = _reachable(abstraction, allowed, sources)
+    reachable_any = _reachable(abstraction, np.ones(abstraction.num_triangles, dtype=bool), sources)
     facts: list[Diagnostic] = []
     for name in _positive_props(formula):
         with_region = np.array([name in letter for letter in abstraction.letters], dtype=bool)

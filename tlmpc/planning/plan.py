@@ -27,6 +27,7 @@ from tlmpc.automata.model import Automaton
 from tlmpc.errors import NoPlanError
 from tlmpc.ltl.ast import Formula
 from tlmpc.mission.model import Options
+from tlmpc.planning.boundary import start_cells, start_point_label
 from tlmpc.planning.explain import explain_no_plan, invariant_mask
 from tlmpc.planning.model import Witness
 from tlmpc.planning.product import SLOTS, START_SLOT, Product, build_product
@@ -88,14 +89,32 @@ def plan(
     if start_point is None:
         x, y = abstraction.corners(abstraction.start).mean(axis=0).tolist()
         start_point = (float(x), float(y))
+    starts = start_cells(abstraction, start_point)
+    start_label = start_point_label(abstraction, start_point)
     product = build_product(
         abstraction,
         working,
         allowed=allowed,
         start_point=start_point,
         metric=options.cost,
+        starts=starts,
+        convention=options.boundary,
+        start_label=start_label,
         bounces=bounces,
     )
+
+    def why() -> NoPlanError:
+        return NoPlanError(
+            explain_no_plan(
+                abstraction,
+                automaton,
+                formula,
+                allowed,
+                starts=starts,
+                start_label=start_label if options.boundary == "closed" else None,
+            )
+        )
+
     if resume is not None:
         nodes = sorted(
             (abstraction.start * SLOTS + START_SLOT) * working.num_states + q for q in resume
@@ -103,7 +122,7 @@ def plan(
         initial = np.array(nodes if allowed[abstraction.start] else [], dtype=np.int64)
         product = dataclasses.replace(product, initial=initial)
     if len(product.initial) == 0 or not working.edges:
-        raise NoPlanError(explain_no_plan(abstraction, automaton, formula, allowed))
+        raise why()
     dist, pred, _ = dijkstra(
         product.graph, indices=product.initial, min_only=True, return_predecessors=True
     )
@@ -130,7 +149,7 @@ def plan(
         )
         searches += more
     if best is None:
-        raise NoPlanError(explain_no_plan(abstraction, automaton, formula, allowed))
+        raise why()
     reached = int(np.isfinite(dist).sum())
     return _witness(
         abstraction, product, best, options, started, searches, exhausted, working, reached

@@ -7,6 +7,11 @@ edge but its entry edge, which is how no plan ever bounces: an affine field cann
 triangle and leave it through the same edge.  Stuttering (staying in ``t``) keeps the slot.
 
 The automaton reads the label of the triangle being entered (and of the start triangle first).
+The start may lie in several triangles (on an edge or a vertex): each is an initial triangle,
+and its edges through the start are blocked for its first move (see
+:mod:`tlmpc.planning.boundary`).  Under the closed convention a move reads two letters: the
+crossing instant's (both sides' labels and :data:`~tlmpc.planning.boundary.POINT`), then the
+entered triangle's; the start reads its point letter before its triangle's.
 """
 
 from __future__ import annotations
@@ -20,6 +25,7 @@ from scipy.sparse import csr_matrix
 from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
 from tlmpc.automata.guards import successor_table
 from tlmpc.automata.model import Automaton
+from tlmpc.planning.boundary import POINT, StartCell, crossing_letter, start_cells
 
 SLOTS = 4  # three edges, and "no entry edge yet" for the start
 START_SLOT = 3
@@ -56,6 +62,9 @@ def build_product(
     allowed: BoolArray,
     start_point: tuple[float, float],
     metric: str,
+    starts: tuple[StartCell, ...] | None = None,
+    convention: str = "right",
+    start_label: tuple[str, ...] = (),
     bounces: bool = False,
 ) -> Product:
     """The product graph restricted to ``allowed`` triangles.
@@ -65,22 +74,40 @@ def build_product(
     leaving a triangle through its entry edge: that graph is stutter-equivalent to the face
     graph of the region arrangement, so it decides whether *any* continuous trajectory
     satisfies the task (see docs/planning.md); its bounces are realised by refinement.
+    ``starts`` are the triangles containing the start point (with their blocked edges;
+    by default those of ``start_point``);
+    with ``convention="closed"`` the automaton reads crossing letters and, first of all,
+    ``start_label`` (the regions whose closure holds the start point).  A blocked edge may be
+    left at the first move only with ``bounces`` (it is a U-turn in that triangle).
     """
     m = abstraction.num_triangles
     nq = automaton.num_states
     neighbors = abstraction.neighbors
-    table = successor_table(automaton, abstraction.letters)
+    closed = convention == "closed"
+    letters = list(abstraction.letters)
+    table = successor_table(automaton, letters)
     # Letters with the same projection on the automaton's propositions behave the same.
     row_ids: dict[int, int] = {}
     letter_class = np.empty(len(table), dtype=np.int64)
     class_rows: list[list[tuple[tuple[int, int], ...]]] = []
-    for index, row in enumerate(table):
+
+    def class_of(row: list[tuple[tuple[int, int], ...]]) -> int:
         key = id(row)
         if key not in row_ids:
             row_ids[key] = len(class_rows)
             class_rows.append(row)
-        letter_class[index] = row_ids[key]
+        return row_ids[key]
+
+    for index, row in enumerate(table):
+        letter_class[index] = class_of(row)
     tri_class = letter_class[abstraction.letter_of]
+    if starts is None:
+        starts = start_cells(abstraction, start_point)
+    is_start = np.zeros(m, dtype=bool)
+    blocked = np.zeros((m, 3), dtype=bool)
+    for cell in starts:
+        is_start[cell.triangle] = True
+        blocked[cell.triangle, list(cell.blocked)] = True
 
     # --- moves of D: (t, s) --i--> (n, s') with i != s -------------------------------------
     t = np.repeat(np.arange(m, dtype=np.int64), SLOTS * 3)
@@ -88,7 +115,9 @@ def build_product(
     i = np.tile(np.arange(3, dtype=np.int64), m * SLOTS)
     n = neighbors[t, i]
     valid = (n >= 0) & ((i != s) | bounces)
-    valid &= (s != START_SLOT) | (t == abstraction.start)
+    valid &= (s != START_SLOT) | is_start[t]
+    # The start's own edges: leaving through one at t = 0 never enters the triangle.
+    valid &= (s != START_SLOT) | ~blocked[t, i] | bounces
     t, s, i, n = t[valid], s[valid], i[valid], n[valid]
     keep = allowed[t] & allowed[n]
     t, s, i, n = t[keep], s[keep], i[keep], n[keep]
@@ -107,12 +136,30 @@ def build_product(
         weight = np.linalg.norm(mids[t, i] - origin, axis=1) + STUTTER_COST
     move_src = t * SLOTS + s
     move_dst = n * SLOTS + slot
-    move_class = tri_class[n]
+    # A move's kind: the class of the entered triangle's letter, and under the closed
+    # convention the class of the crossing instant's letter read before it.
+    if closed:
+        count = len(letters)
+        pair = abstraction.letter_of[t] * count + abstraction.letter_of[n]
+        unique_pairs, pair_index = np.unique(pair, return_inverse=True)
+        crossing = [
+            crossing_letter(letters[key // count], letters[key % count])
+            for key in unique_pairs.tolist()
+        ]
+        crossing_class = np.array(
+            [class_of(row) for row in successor_table(automaton, crossing)], dtype=np.int64
+        ).reshape(-1)
+    # Kinds below ``stride`` read one letter; (c + 1) * stride + k reads c, then k.
+    stride = len(class_rows) + 1
+    if closed:
+        move_kind = (crossing_class[pair_index.reshape(-1)] + 1) * stride + tri_class[n]
+    else:
+        move_kind = tri_class[n]
 
     # --- stutter: (t, s) stays, reading its own label again --------------------------------
     stay_t = np.repeat(np.arange(m, dtype=np.int64), SLOTS)
     stay_s = np.tile(np.arange(SLOTS, dtype=np.int64), m)
-    stay_ok = allowed[stay_t] & ((stay_s != START_SLOT) | (stay_t == abstraction.start))
+    stay_ok = allowed[stay_t] & ((stay_s != START_SLOT) | is_start[stay_t])
     stay_ok &= (stay_s == START_SLOT) | (neighbors[stay_t, np.minimum(stay_s, 2)] >= 0)
     stay_t, stay_s = stay_t[stay_ok], stay_s[stay_ok]
     stay_node = stay_t * SLOTS + stay_s
@@ -125,30 +172,42 @@ def build_product(
     stutter_accepting = np.zeros(m * SLOTS * nq, dtype=bool)
     full = (1 << automaton.num_acc) - 1
 
-    for cls, rows in enumerate(class_rows):
-        moves = np.flatnonzero(move_class == cls)
+    def successors_of(kind: int, q: int) -> dict[int, bool]:
+        """Automaton successors of ``q`` over a move of ``kind`` (one or two letters).
+
+        Parallel automaton edges would give duplicate pairs: one per successor, accepting if
+        any is (every (node, node') pair is then unique: no sort needed).
+        """
+        found: dict[int, bool] = {}
+        if kind >= stride:
+            for q_mid, mask in class_rows[kind // stride - 1][q]:
+                for q_next, mask_next in class_rows[kind % stride][q_mid]:
+                    found[q_next] = found.get(q_next, False) or (mask | mask_next) == full
+            return found
+        for q_next, mask in class_rows[kind][q]:
+            found[q_next] = found.get(q_next, False) or mask == full
+        return found
+
+    for kind in np.unique(move_kind).tolist():
+        moves = np.flatnonzero(move_kind == kind)
+        for q in range(nq):
+            for q_next, accepting in successors_of(kind, q).items():
+                sources.append(move_src[moves] * nq + q)
+                targets.append(move_dst[moves] * nq + q_next)
+                weights.append(weight[moves])
+                accept.append(np.full(len(moves), accepting))
+    for cls in np.unique(stay_class).tolist():
         stays = np.flatnonzero(stay_class == cls)
         for q in range(nq):
-            # Parallel automaton edges would give duplicate pairs: keep one per successor,
-            # accepting if any is (every (node, node') pair is then unique: no sort needed).
-            successors: dict[int, bool] = {}
-            for q_next, mask in rows[q]:
-                successors[q_next] = successors.get(q_next, False) or mask == full
-            for q_next, accepting in successors.items():
-                if len(moves):
-                    sources.append(move_src[moves] * nq + q)
-                    targets.append(move_dst[moves] * nq + q_next)
-                    weights.append(weight[moves])
-                    accept.append(np.full(len(moves), accepting))
-                if len(stays):
-                    if q_next == q:
-                        if accepting:
-                            stutter_accepting[stay_node[stays] * nq + q] = True
-                        continue
-                    sources.append(stay_node[stays] * nq + q)
-                    targets.append(stay_node[stays] * nq + q_next)
-                    weights.append(np.full(len(stays), STUTTER_COST))
-                    accept.append(np.full(len(stays), accepting))
+            for q_next, accepting in successors_of(cls, q).items():
+                if q_next == q:
+                    if accepting:
+                        stutter_accepting[stay_node[stays] * nq + q] = True
+                    continue
+                sources.append(stay_node[stays] * nq + q)
+                targets.append(stay_node[stays] * nq + q_next)
+                weights.append(np.full(len(stays), STUTTER_COST))
+                accept.append(np.full(len(stays), accepting))
     size = m * SLOTS * nq
     if sources:
         src = np.concatenate(sources)
@@ -165,18 +224,20 @@ def build_product(
         (np.ones(int(acc.sum())), (src[acc], dst[acc])), shape=(size, size)
     )
     accepting_graph.sort_indices()
-    start_row = class_rows[int(tri_class[abstraction.start])]
-    initial = np.array(
-        sorted(
-            {
-                (abstraction.start * SLOTS + START_SLOT) * nq + q
-                for q, _ in start_row[automaton.initial]
-            }
-        ),
-        dtype=np.int64,
-    )
-    if not allowed[abstraction.start]:
-        initial = np.zeros(0, dtype=np.int64)
+    # Initial nodes: each start triangle after reading (the start point's letter, under the
+    # closed convention, then) its own label.
+    first = [automaton.initial]
+    if closed:
+        point_row = successor_table(automaton, [tuple(sorted({*start_label, POINT}))])[0]
+        first = list(dict.fromkeys(q for q, _ in point_row[automaton.initial]))
+    initial_nodes: set[int] = set()
+    for cell in starts:
+        if not allowed[cell.triangle]:
+            continue
+        row = class_rows[int(tri_class[cell.triangle])]
+        for q0 in first:
+            initial_nodes.update((cell.triangle * SLOTS + START_SLOT) * nq + q for q, _ in row[q0])
+    initial = np.array(sorted(initial_nodes), dtype=np.int64)
     return Product(
         graph=graph,
         accepting=accepting_graph,

@@ -243,7 +243,9 @@ def _exit_step(controller: StepController, x0: FloatArray) -> tuple[list[float],
     elif height(dt) < 0.0:
         within = dt  # the grid's iterates and the local series differ by rounding
     else:
-        within = bracketed_root(height, 0.0, dt)
+        # Sought in units of the grid step: the root finder's tolerance is relative to its
+        # bracket, so a step of 1e-13 s (a fast robot on a tiny map) is as exact as one of 1 s.
+        within = dt * bracketed_root(lambda u: height(dt * u), 0.0, 1.0)
     crossing = lower + within
     end = point(within)[:2] + center
     # Samples: the grid points nearest to evenly spaced times (exact states, no extra work).

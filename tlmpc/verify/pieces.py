@@ -96,6 +96,30 @@ def region_membership(
     return membership
 
 
+#: Under the closed convention a point within this distance (relative to the largest of its
+#: own coordinates and the regions') of a region belongs to it: a crossing computed in
+#: floating point lies on a slanted boundary only to rounding, on either side of it.  The
+#: planner labels the start point by the same rule.
+CLOSED_TOLERANCE = 1e-12
+
+
+def boundary_membership(
+    regions: Sequence[shapely.Polygon], outlines: Sequence[FloatArray], positions: FloatArray
+) -> BoolArray:
+    """(k, r): point k lies in the closure of region r, to rounding (:data:`CLOSED_TOLERANCE`)."""
+    membership = np.zeros((len(positions), len(regions)), dtype=bool)
+    if not len(positions) or not regions:
+        return membership
+    extent = max(float(np.abs(p).max()) for p in outlines)
+    scale = np.maximum(np.abs(positions).max(axis=1), extent)
+    tree = shapely.STRtree(list(regions))
+    hits = tree.query(
+        shapely.points(positions), predicate="dwithin", distance=CLOSED_TOLERANCE * scale
+    )
+    membership[hits[0], hits[1]] = True
+    return membership
+
+
 def build_pieces(
     times: FloatArray,
     points: FloatArray,
@@ -130,7 +154,7 @@ def build_pieces(
     mids = (bp_positions[:-1] + bp_positions[1:]) / 2.0 if count > 1 else np.zeros((0, 2))
     open_labels = region_membership(shapes, mids, closed=True)
     if convention == "closed":
-        point_labels = region_membership(shapes, bp_positions, closed=True)
+        point_labels = boundary_membership(shapes, polygons, bp_positions)
     else:
         point_labels = np.empty((count, len(names)), dtype=bool)
         if count > 1:
