@@ -341,6 +341,10 @@ class Executor:
         from tlmpc.planning.plan import plan
 
         abstraction = dataclasses.replace(self.abstraction, start=triangle)
+        if not self.locator.contains(triangle, point):
+            # A triangle crossed on the way to ``point``: the plan starts in it, and the
+            # planner's start triangles are those holding its start point.
+            point = abstraction.corners(triangle).mean(axis=0)
         try:
             witness = plan(
                 abstraction,
