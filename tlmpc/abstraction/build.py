@@ -10,6 +10,7 @@ import shapely
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
+from tlmpc.abstraction.layout import PlanningLayout
 from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
 from tlmpc.abstraction.triangulate import triangulate
 from tlmpc.errors import Diagnostic, InvalidInputError, error
@@ -80,10 +81,14 @@ def _components(neighbors: IntArray) -> IntArray:
     return np.asarray(labels, dtype=np.int64)
 
 
-def build_abstraction(mission: Mission) -> Abstraction:
-    """Triangulate ``mission``'s workspace and build the transition system D."""
+def build_abstraction(mission: Mission, layout: PlanningLayout | None = None) -> Abstraction:
+    """Triangulate ``mission``'s workspace and build the transition system D.
+
+    With a ``layout`` (a robot with a body, a margin), its free space and region shapes are
+    triangulated and label the triangles instead of the mission's own.
+    """
     started = time.perf_counter()
-    vertices, triangles, neighbors, shapes = triangulate(mission)
+    vertices, triangles, neighbors, shapes = triangulate(mission, layout)
     letter_of, letters = _labels(mission, vertices, triangles, shapes)
     start = locate_in(vertices, triangles, mission.robot.start)
     if start < 0:

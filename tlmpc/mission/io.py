@@ -35,6 +35,8 @@ def mission_from_json(document: Mapping[str, Any]) -> Mission:
             start=_polygon([robot["start"]])[0],
             max_speed=float(robot["max_speed"]),
             disturbance=float(robot.get("disturbance", 0.0)),
+            radius=float(robot.get("radius", 0.0)),
+            footprint=_polygon(robot["footprint"]) if robot.get("footprint") else None,
         ),
         formula=parse_ltl(document["formula"], file="mission.json"),
         groups={name: tuple(members) for name, members in document["groups"].items()},
@@ -46,6 +48,7 @@ def mission_from_json(document: Mapping[str, Any]) -> Mission:
             cost=options["cost"],
             beta=float(options["beta"]),
             boundary=options["boundary"],
+            margin=options.get("margin"),
         ),
         source=document["source"],
     )

@@ -53,7 +53,9 @@ def map_shapes(
         )
     start = data["robot"]["start"]
     settings = ImportSettings(
-        radius=float(workspace.get("inflate", 0.0)),
+        # the robot's body is the planner's business (configuration space, with robot.radius
+        # or its alias inflate): the mission keeps the map's obstacles as they are
+        radius=0.0,
         tolerance=workspace.get("tolerance"),
         min_area=workspace.get("min_area"),
         start=(float(start[0]), float(start[1])),

@@ -41,15 +41,20 @@ class Workspace:
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Robot:
-    """The fully actuated point robot x' = u + w, |u| <= max_speed, |w| <= disturbance.
+    """The fully actuated robot x' = u + w, |u| <= max_speed, |w| <= disturbance.
 
     ``disturbance`` bounds an unknown additive velocity (wind, slip, tracking error) that the
-    controllers must reject: every guarantee holds for every such w.
+    controllers must reject: every guarantee holds for every such w.  ``radius`` and
+    ``footprint`` (a polygon in the robot's frame, around its reference point) give the
+    robot a body; the planner keeps the disc of :func:`tlmpc.mission.body.body_radius` off
+    every obstacle.  Labels are always those of the reference point ``x``.
     """
 
     start: Point
     max_speed: float = 1.0
     disturbance: float = 0.0
+    radius: float = 0.0
+    footprint: Polygon | None = None
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -67,6 +72,9 @@ class Options:
     cost: CostMetric = "length"
     beta: float = DEFAULT_BETA
     boundary: BoundaryConvention = "right"
+    #: Clearance and depth objective; ``None`` is the default of
+    #: :func:`tlmpc.mission.body.requested_margin` (see docs/mission-format.md).
+    margin: float | None = None
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -136,6 +144,8 @@ class Mission:
                 "start": list(self.robot.start),
                 "max_speed": self.robot.max_speed,
                 "disturbance": self.robot.disturbance,
+                "radius": self.robot.radius,
+                "footprint": poly(self.robot.footprint) if self.robot.footprint else None,
             },
             "task": list(self.task),
             "ltl": self.ltl,
@@ -146,5 +156,6 @@ class Mission:
                 "cost": self.options.cost,
                 "beta": self.options.beta,
                 "boundary": self.options.boundary,
+                "margin": self.options.margin,
             },
         }
