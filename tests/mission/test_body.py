@@ -1,0 +1,258 @@
+"""A robot with a body: the body never meets an obstacle, narrow passages are named, margins.
+
+Every claim is checked with shapely on the compiled ``trace.json`` alone: the distance from
+each straight segment of the trace to every hole and to the boundary ring, against the
+radius; depth into a goal as the distance of trace samples to the goal's boundary.  The
+configuration space the oracle needs (to know when a plan must exist) is computed here with
+shapely's own buffer, not with tlmpc's.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+import pytest
+import shapely
+from hypothesis import assume, given
+from hypothesis import strategies as st
+
+import tlmpc
+from tlmpc.errors import InvalidInputError, NoPlanError, TlmpcError
+from tlmpc.mission.body import body_radius
+from tlmpc.mission.load import check_text
+from tlmpc.mission.model import Robot
+
+Mission = dict[str, Any]
+
+
+def _door(radius: float, *, margin: float | None = None, door: float = 1.0) -> Mission:
+    """Two rooms joined by a door of width ``door`` at x in [4.5, 5.5], around y = 3."""
+    low, high = 3.0 - door / 2.0, 3.0 + door / 2.0
+    mission: Mission = {
+        "version": 1,
+        "workspace": {
+            "boundary": {"rect": [0, 0, 10, 6]},
+            "holes": [{"rect": [4.5, 0, 5.5, low]}, {"rect": [4.5, high, 5.5, 6]}],
+        },
+        "regions": {"goal": {"rect": [7, 1, 9, 5]}, "bad": {"rect": [2, 4, 3, 5]}},
+        "robot": {"start": [1, 3], "radius": radius},
+        "task": ["visit goal", "avoid bad"],
+    }
+    if margin is not None:
+        mission["options"] = {"margin": margin}
+    return mission
+
+
+def _segments(trace: dict[str, Any]) -> list[Any]:
+    points = np.asarray(trace["points"], dtype=float)[:, 1:]
+    if len(points) == 1:
+        return [shapely.Point(points[0])]
+    return [shapely.LineString([a, b]) for a, b in zip(points[:-1], points[1:], strict=True)]
+
+
+def _body_clearance(mission: Mission, trace: dict[str, Any]) -> float:
+    """Least distance from the trace's segments to the obstacles, minus nothing (raw)."""
+    boundary = shapely.Polygon(trace["workspace"]["boundary"])
+    holes = [shapely.Polygon(h) for h in trace["workspace"]["holes"]]
+    least = math.inf
+    for segment in _segments(trace):
+        assert boundary.covers(segment), "the reference point left the workspace"
+        least = min(least, boundary.exterior.distance(segment))
+        for hole in holes:
+            least = min(least, hole.distance(segment))
+    return least
+
+
+def _codes(error: TlmpcError) -> list[str]:
+    return [d.code for d in error.diagnostics]
+
+
+def test_body_radius_of_a_footprint_is_its_circumscribed_radius() -> None:
+    footprint = ((-0.3, -0.2), (0.4, -0.2), (0.4, 0.25), (-0.3, 0.25))
+    corners = np.asarray(footprint)
+    assert body_radius(Robot(start=(0, 0), footprint=footprint)) == pytest.approx(
+        float(np.max(np.hypot(corners[:, 0], corners[:, 1])))
+    )
+    assert body_radius(Robot(start=(0, 0), radius=0.7, footprint=footprint)) == 0.7
+    assert body_radius(Robot(start=(0, 0))) == 0.0
+
+
+def test_body_keeps_its_radius_through_a_door() -> None:
+    mission = _door(0.3, margin=0.0)
+    compiled = tlmpc.compile(mission)
+    trace = compiled.artifacts["trace.json"]
+    assert trace["radius"] == 0.3
+    assert _body_clearance(mission, trace) >= 0.3
+    assert tlmpc.verify_trace(trace).satisfied  # the verifier checks the body too
+
+
+def test_a_door_narrower_than_the_robot_is_named() -> None:
+    with pytest.raises(NoPlanError) as caught:
+        tlmpc.compile(_door(0.6))
+    codes = _codes(caught.value)
+    assert "R002" in codes and "R004" in codes
+    pinch = next(d for d in caught.value.diagnostics if d.code == "R002")
+    assert "1 wide" in pinch.message and "hole 1 and hole 2" in pinch.message
+    x, y = (float(v) for v in pinch.message.split(" at (")[1].split(")")[0].split(","))
+    assert 4.5 <= x <= 5.5 and 2.5 <= y <= 3.5  # in the doorway
+
+
+def test_a_blocked_shortcut_beside_an_open_way_is_not_a_split() -> None:
+    # a slit 0.4 wide in a wall, and an open way 3 wide around the wall's end
+    mission: Mission = {
+        "version": 1,
+        "workspace": {
+            "boundary": {"rect": [0, 0, 10, 10]},
+            "holes": [{"rect": [4.5, 0, 5.5, 4.8]}, {"rect": [4.5, 5.2, 5.5, 7]}],
+        },
+        "regions": {"goal": {"rect": [7, 1, 9, 3]}},
+        "robot": {"start": [1, 1], "radius": 0.3},
+        "task": ["visit goal"],
+        "options": {"margin": 0},
+    }
+    compiled = tlmpc.compile(mission)
+    assert not [w for w in compiled.warnings if w.code == "R002"]
+    assert _body_clearance(mission, compiled.artifacts["trace.json"]) >= 0.3
+
+
+def test_start_inside_the_inflated_obstacles_is_an_error() -> None:
+    mission = _door(0.3)
+    mission["robot"]["start"] = [4.3, 1.0]  # 0.2 from hole 1
+    with pytest.raises(InvalidInputError) as caught:
+        tlmpc.compile(mission)
+    assert _codes(caught.value) == ["R001"]
+    assert "hole 1" in caught.value.diagnostics[0].message
+
+
+def test_region_within_the_radius_of_obstacles_vanishes_with_a_warning() -> None:
+    mission = _door(0.3, margin=0.0)
+    mission["regions"]["corner"] = {"rect": [9.8, 5.8, 10, 6]}
+    mission["task"] = ["visit goal"]
+    compiled = tlmpc.compile(mission)
+    assert [w.code for w in compiled.warnings if w.code.startswith("R")] == ["R003"]
+
+
+def test_inflate_is_an_alias_of_radius_and_must_agree() -> None:
+    text = (
+        "version: 1\nworkspace: {map: m.yaml, inflate: 0.2}\nregions: {a: {rect: [0,0,1,1]}}\n"
+        "robot: {start: [0.5, 0.5], radius: 0.3}\ntask: [visit a]\n"
+    )
+    codes = [d.code for d in check_text(text, "m.yaml")]
+    assert "R005" in codes
+
+
+def test_margin_is_kept_where_the_door_allows_it() -> None:
+    radius, margin = 0.3, 0.15
+    mission = _door(radius, margin=margin)
+    compiled = tlmpc.compile(mission)
+    trace = compiled.artifacts["trace.json"]
+    # independent: the doorway (1.0) is wider than 2 (radius + margin) = 0.9
+    assert _body_clearance(mission, trace) - radius >= margin
+    bad = shapely.Polygon([(2, 4), (3, 4), (3, 5), (2, 5)])
+    assert min(bad.distance(s) for s in _segments(trace)) >= margin
+    goal = shapely.Polygon([(7, 1), (9, 1), (9, 5), (7, 5)])
+    samples = shapely.points(np.asarray(trace["points"])[:, 1:])
+    depth = max(goal.boundary.distance(p) for p in samples if goal.covers(p))
+    assert depth >= margin
+    summary = compiled.summary["clearance"]
+    assert summary["margin"] == margin and summary["radius"] == radius
+    assert summary["obstacles"] >= margin and summary["depth"]["goal"]["achieved"] >= margin
+    assert not [w for w in compiled.warnings if w.code in ("R006", "R007", "R008")]
+
+
+def test_margin_the_door_cannot_give_is_a_warning_and_still_a_plan() -> None:
+    radius, margin = 0.3, 0.3  # the doorway is 1.0 < 2 (radius + margin)
+    mission = _door(radius, margin=margin)
+    compiled = tlmpc.compile(mission)
+    codes = [w.code for w in compiled.warnings]
+    assert "R008" in codes and "R006" in codes
+    trace = compiled.artifacts["trace.json"]
+    assert _body_clearance(mission, trace) >= radius  # the body is still kept off
+    near = next(w for w in compiled.warnings if w.code == "R006")
+    x = float(near.message.split("near (")[1].split(",")[0])
+    assert 4.0 <= x <= 6.0  # at the door
+
+
+def test_small_goal_is_reached_at_its_middle() -> None:
+    mission = _door(0.2, margin=0.5)
+    mission["regions"]["goal"] = {"rect": [7.5, 2.8, 7.9, 3.2]}  # inradius 0.2 < margin
+    compiled = tlmpc.compile(mission)
+    trace = compiled.artifacts["trace.json"]
+    goal = shapely.Polygon([(7.5, 2.8), (7.9, 2.8), (7.9, 3.2), (7.5, 3.2)])
+    samples = shapely.points(np.asarray(trace["points"])[:, 1:])
+    depth = max(goal.boundary.distance(p) for p in samples if goal.covers(p))
+    assert depth >= 0.1  # half the inradius at least
+    assert not [w for w in compiled.warnings if w.code == "R007"]
+
+
+def test_verifier_checks_the_body_against_obstacles() -> None:
+    trace = {
+        "format": "tlmpc.trace/1",
+        "ltl": "F a",
+        "regions": {"a": [[8, 0], [10, 0], [10, 2], [8, 2]]},
+        "workspace": {
+            "boundary": [[0, 0], [10, 0], [10, 10], [0, 10]],
+            "holes": [[[4, 2], [6, 2], [6, 4], [4, 4]]],
+        },
+        "points": [[0, 1, 1.5], [1, 9, 1.5]],  # passes 0.5 below the hole
+        "loop_start": None,
+        "end": "stay",
+    }
+    assert tlmpc.verify_trace({**trace, "radius": 0.4}).satisfied
+    verdict = tlmpc.verify_trace({**trace, "radius": 0.6})
+    assert not verdict.satisfied
+    assert verdict.robustness < 0
+
+
+@st.composite
+def _rooms(draw: st.DrawFn) -> tuple[Mission, float]:
+    radius = draw(st.floats(0.05, 0.6))
+    holes = []
+    for _ in range(draw(st.integers(1, 5))):
+        x = draw(st.floats(0.5, 8.0))
+        y = draw(st.floats(0.5, 8.0))
+        w = draw(st.floats(0.2, 2.0))
+        h = draw(st.floats(0.2, 2.0))
+        holes.append([x, y, x + w, y + h])
+    return (
+        {
+            "version": 1,
+            "workspace": {
+                "boundary": {"rect": [0, 0, 10, 10]},
+                "holes": [{"rect": h} for h in holes],
+            },
+            "regions": {},
+            "robot": {"start": [0, 0], "radius": radius},
+            "task": ["visit goal"],
+            "options": {"margin": draw(st.sampled_from([0.0, 0.1]))},
+        },
+        radius,
+    )
+
+
+@given(_rooms(), st.integers(0, 10**6))
+def test_body_never_meets_an_obstacle(case: tuple[Mission, float], seed: int) -> None:
+    mission, radius = case
+    boundary = shapely.box(0, 0, 10, 10)
+    free = boundary.difference(
+        shapely.union_all([shapely.box(*h["rect"]) for h in mission["workspace"]["holes"]])
+    )
+    # the oracle's own configuration space, a little smaller than the planner's
+    room = free.buffer(-radius * 1.1, quad_segs=16)
+    parts = [p for p in shapely.get_parts(room) if p.area > 0.05]
+    assume(parts)
+    rng = np.random.default_rng(seed)
+    home = parts[int(rng.integers(len(parts)))]
+    start = home.representative_point()
+    target = home.buffer(-0.05).representative_point() if home.area > 0.5 else start
+    assume(not home.buffer(-0.05).is_empty)
+    mission["robot"]["start"] = [start.x, start.y]
+    mission["regions"]["goal"] = {
+        "rect": [target.x - 0.05, target.y - 0.05, target.x + 0.05, target.y + 0.05]
+    }
+    compiled = tlmpc.compile(mission)  # a plan must exist: the goal is in the start's part
+    trace = compiled.artifacts["trace.json"]
+    assert _body_clearance(mission, trace) >= radius * (1 - 1e-9)
+    assert tlmpc.verify_trace(trace).satisfied
