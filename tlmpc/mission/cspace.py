@@ -15,6 +15,7 @@ where, in the user's terms:
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -25,6 +26,9 @@ import shapely
 from tlmpc.errors import Diagnostic, error
 from tlmpc.mission.body import ARC_SEGMENTS, body_radius, conservative_offset
 from tlmpc.mission.model import Mission, Point, Polygon
+
+#: At most this many R002 warnings (the last one says how many more there are).
+MAX_PINCHES = 5
 
 
 def raw_free_space(boundary: Polygon, holes: Sequence[Polygon]) -> Any:
@@ -70,7 +74,9 @@ class Pinch:
         """``a passage 0.5 wide at (x, y) between hole 2 and the boundary``."""
         names = [("the boundary" if r == 0 else f"hole {r}") for r in self.rings]
         x, y = self.middle
-        between = names[0] if names[0] == names[1] else f"{names[0]} and {names[1]}"
+        between = (
+            f"two parts of {names[0]}" if names[0] == names[1] else f"{names[0]} and {names[1]}"
+        )
         return f"a passage {self.width:.4g} wide at ({x:.6g}, {y:.6g}) between {between}"
 
 
@@ -78,7 +84,7 @@ def _parts(geometry: Any) -> list[Any]:
     return [g for g in shapely.get_parts(geometry) if not g.is_empty and g.area > 0.0]
 
 
-def splitting_pinches(mission: Mission, cspace: Any) -> list[Pinch]:
+def splitting_pinches(mission: Mission, cspace: Any, home: Any = None) -> list[Pinch]:
     """The passages narrower than the body that separate parts of the free space.
 
     Candidates are the narrowest gaps between pairs of rings (boundary, holes) that cross
@@ -86,7 +92,8 @@ def splitting_pinches(mission: Mission, cspace: Any) -> list[Pinch]:
     free space at once (a thin slit along each gap); a passage separates when the pieces on
     its two sides differ and each holds some configuration space, so a blocked shortcut
     beside an open way round is not reported, and neither of two narrow passages side by
-    side escapes.
+    side escapes.  With ``home`` (the part of the configuration space the robot starts in),
+    only passages between it and the rest count: those cut the robot off from somewhere.
     """
     from tlmpc.mission.holes import passages_narrower_than
 
@@ -101,12 +108,19 @@ def splitting_pinches(mission: Mission, cspace: Any) -> list[Pinch]:
     slit = 1e-7 * max(maxx - minx, maxy - miny)
     cuts = [shapely.LineString([a, b]) for _, a, b, _ in candidates]
     pieces = _parts(raw.difference(shapely.union_all([c.buffer(slit) for c in cuts])))
-    holds = [p.intersection(cspace).area > 0.0 for p in pieces]
+    room = [p.intersection(cspace) for p in pieces]
+    holds = [r.area > 0.0 for r in room]
+    at_home = [home is not None and r.intersection(home).area > 0.0 for r in room]
+    away = [home is None or r.difference(home).area > 0.0 for r in room]
     tree = shapely.STRtree(pieces)
     found: list[Pinch] = []
     for (width, a, b, rings), cut in zip(candidates, cuts, strict=True):
-        sides = {i for i in tree.query(cut.buffer(2.0 * slit)).tolist() if holds[i]}
-        if len(sides) >= 2:
+        sides = [i for i in tree.query(cut.buffer(2.0 * slit)).tolist() if holds[i]]
+        if home is None:
+            splits = len(set(sides)) >= 2
+        else:
+            splits = any(at_home[i] and any(away[j] for j in sides if j != i) for i in sides)
+        if splits:
             found.append(Pinch(width=width, a=a, b=b, rings=rings))
     return found
 
@@ -170,8 +184,18 @@ def body_diagnostics(mission: Mission, text: str | None = None) -> list[Diagnost
             )
         )
         return problems
-    pinches = splitting_pinches(mission, cspace)
-    for pinch in pinches:
+    parts = _parts(cspace)
+    home = next((p for p in parts if p.covers(start)), None)
+    # the widest first: a passage almost wide enough is the one a user expects to be open
+    pinches = sorted(splitting_pinches(mission, cspace, home), key=lambda p: -p.width)
+    for count, pinch in enumerate(pinches):
+        if count == MAX_PINCHES:
+            problems[-1] = dataclasses.replace(
+                problems[-1],
+                message=problems[-1].message
+                + f" (and {len(pinches) - MAX_PINCHES} more such passages)",
+            )
+            break
         ring = max(pinch.rings)
         key = ("workspace", "holes", ring - 1) if ring > 0 else ("workspace", "boundary")
         problems.append(
@@ -185,8 +209,6 @@ def body_diagnostics(mission: Mission, text: str | None = None) -> list[Diagnost
                 line=lines.get(key),
             )
         )
-    parts = _parts(cspace)
-    home = next((p for p in parts if p.covers(start)), None)
     raw = raw_free_space(mission.workspace.boundary, mission.workspace.holes)
     raw_home = next((p for p in _parts(raw) if p.covers(start)), None)
     for region in mission.regions:
