@@ -263,3 +263,89 @@ def test_body_never_meets_an_obstacle(case: tuple[Mission, float], seed: int) ->
     trace = compiled.artifacts["trace.json"]
     assert _body_clearance(mission, trace) >= radius * (1 - 1e-9)
     assert tlmpc.verify_trace(trace).satisfied
+
+
+def test_margin_from_an_avoided_region_in_the_way() -> None:
+    margin = 1.2
+    mission: Mission = {
+        "version": 1,
+        "workspace": {"boundary": {"rect": [0, 0, 12, 8]}},
+        "regions": {"goal": {"rect": [8, 1.5, 10, 3.5]}, "bad": {"rect": [4, 0, 6, 3]}},
+        "robot": {"start": [1.5, 1.5]},
+        "task": ["visit goal", "avoid bad"],
+        "options": {"margin": margin},
+    }
+    compiled = tlmpc.compile(mission)
+    trace = compiled.artifacts["trace.json"]
+    bad = shapely.box(4, 0, 6, 3)
+    assert min(bad.distance(s) for s in _segments(trace)) >= margin
+    assert compiled.summary["clearance"]["forbidden"]["bad"] >= margin
+    assert not [w for w in compiled.warnings if w.code.startswith("R")]
+    # without a margin the shortest way passes closer
+    mission["options"] = {"margin": 0}
+    plain = tlmpc.compile(mission).artifacts["trace.json"]
+    assert min(bad.distance(s) for s in _segments(plain)) < margin
+
+
+@st.composite
+def _obstacles(draw: st.DrawFn) -> tuple[list[list[tuple[float, float]]], float]:
+    """Random convex and non-convex holes (rectangles, triangles, L shapes) and a radius."""
+    holes: list[list[tuple[float, float]]] = []
+    for _ in range(draw(st.integers(1, 4))):
+        x = draw(st.floats(1.0, 7.0))
+        y = draw(st.floats(1.0, 7.0))
+        w = draw(st.floats(0.3, 2.0))
+        h = draw(st.floats(0.3, 2.0))
+        kind = draw(st.sampled_from(["rect", "triangle", "L"]))
+        if kind == "rect":
+            holes.append([(x, y), (x + w, y), (x + w, y + h), (x, y + h)])
+        elif kind == "triangle":
+            holes.append([(x, y), (x + w, y + h / 3), (x + w / 4, y + h)])
+        else:
+            holes.append(
+                [
+                    (x, y),
+                    (x + w, y),
+                    (x + w, y + h / 3),
+                    (x + w / 3, y + h / 3),
+                    (x + w / 3, y + h),
+                    (x, y + h),
+                ]
+            )
+    return holes, draw(st.floats(0.02, 0.8))
+
+
+@given(_obstacles())
+def test_every_triangle_keeps_the_radius_from_every_obstacle(
+    case: tuple[list[list[tuple[float, float]]], float],
+) -> None:
+    from tlmpc.abstraction.build import build_abstraction
+    from tlmpc.abstraction.layout import planning_layout
+    from tlmpc.ltl.parser import parse_ltl
+    from tlmpc.mission.model import Mission as MissionModel
+    from tlmpc.mission.model import Options, Region, Workspace
+
+    holes, radius = case
+    union = shapely.union_all([shapely.Polygon(h) for h in holes])
+    assume(union.geom_type == "Polygon" and not union.interiors)  # overlapping holes merge
+    boundary = ((0.0, 0.0), (10.0, 0.0), (10.0, 10.0), (0.0, 10.0))
+    free = shapely.Polygon(boundary).difference(union)
+    room = free.buffer(-1.2 * radius)
+    assume(not room.is_empty)
+    start = room.representative_point()
+    mission = MissionModel(
+        name="m",
+        workspace=Workspace(boundary=boundary, holes=(tuple(union.exterior.coords[:-1]),)),
+        regions=(Region(name="a", polygon=((0.0, 0.0), (1.0, 0.0), (1.0, 1.0))),),
+        robot=Robot(start=(start.x, start.y), radius=radius),
+        formula=parse_ltl("F a"),
+        options=Options(margin=0.0),
+    )
+    abstraction = build_abstraction(mission, planning_layout(mission, 0.0))
+    corners = abstraction.vertices[abstraction.triangles]
+    triangles = shapely.polygons(np.concatenate([corners, corners[:, :1]], axis=1))
+    walls = shapely.union(shapely.Polygon(boundary).exterior, union)
+    least = float(np.min(shapely.distance(walls, triangles)))
+    assert least >= radius * (1 - 1e-9)
+    # and the configuration space is not needlessly small: it holds every point 1.05 r away
+    assert shapely.union_all(triangles).buffer(1e-9).covers(free.buffer(-1.05 * radius))

@@ -27,7 +27,7 @@ from typing import Any
 import shapely
 
 from tlmpc.ltl.polarity import polarities
-from tlmpc.mission.body import ARC_SEGMENTS, body_radius, conservative_offset
+from tlmpc.mission.body import ARC_SEGMENTS, conservative_offset, obstacle_offset
 from tlmpc.mission.cspace import erode, raw_free_space
 from tlmpc.mission.model import Mission
 
@@ -59,7 +59,7 @@ def core(region: Any, depth: float) -> Any:
 
 def planning_layout(mission: Mission, margin: float) -> PlanningLayout | None:
     """The layout for ``mission`` with ``margin``; None for a point robot without margin."""
-    radius = body_radius(mission.robot)
+    radius = obstacle_offset(mission)
     if radius <= 0.0 and margin <= 0.0:
         return None
     raw = raw_free_space(mission.workspace.boundary, mission.workspace.holes)

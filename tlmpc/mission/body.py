@@ -33,6 +33,14 @@ def body_radius(robot: Robot) -> float:
     return radius
 
 
+def obstacle_offset(mission: Mission) -> float:
+    """How far the reference point keeps from the mission's obstacles: the body radius, plus
+    the workspace's ``map_tolerance`` for a body on an occupancy map (its simplified rings may
+    lie that far inside the occupied cells); 0 for a point robot."""
+    radius = body_radius(mission.robot)
+    return radius + mission.workspace.map_tolerance if radius > 0.0 else 0.0
+
+
 def requested_margin(mission: Mission) -> float:
     """``options.margin`` as given, else the default: the body radius (0 for a point robot)."""
     if mission.options.margin is not None:

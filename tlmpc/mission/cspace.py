@@ -24,7 +24,7 @@ from typing import Any
 import shapely
 
 from tlmpc.errors import Diagnostic, error
-from tlmpc.mission.body import ARC_SEGMENTS, body_radius, conservative_offset
+from tlmpc.mission.body import ARC_SEGMENTS, body_radius, conservative_offset, obstacle_offset
 from tlmpc.mission.model import Mission, Point, Polygon
 
 #: At most this many R002 warnings (the last one says how many more there are).
@@ -50,7 +50,7 @@ def erode(free: Any, distance: float) -> Any:
 def configuration_space(mission: Mission) -> Any:
     """Where the reference point may be: the free space eroded by the body radius."""
     free = raw_free_space(mission.workspace.boundary, mission.workspace.holes)
-    return erode(free, body_radius(mission.robot))
+    return erode(free, obstacle_offset(mission))
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -97,7 +97,7 @@ def splitting_pinches(mission: Mission, cspace: Any, home: Any = None) -> list[P
     """
     from tlmpc.mission.holes import passages_narrower_than
 
-    radius = conservative_offset(body_radius(mission.robot))
+    radius = conservative_offset(obstacle_offset(mission))
     candidates = passages_narrower_than(
         mission.workspace.boundary, mission.workspace.holes, width=2.0 * radius
     )

@@ -26,6 +26,7 @@ def mission_from_json(document: Mapping[str, Any]) -> Mission:
         workspace=Workspace(
             boundary=_polygon(document["workspace"]["boundary"]),
             holes=tuple(_polygon(h) for h in document["workspace"]["holes"]),
+            map_tolerance=float(document["workspace"].get("map_tolerance", 0.0)),
         ),
         regions=tuple(
             Region(name=name, polygon=_polygon(points))

@@ -460,7 +460,13 @@ def _load(text: str, file: str, stem: str) -> tuple[Mission | None, list[Diagnos
     defaults = Options()
     mission = Mission(
         name=str(data.get("name") or stem),
-        workspace=Workspace(boundary=boundary.points, holes=tuple(h.points for h in holes)),
+        workspace=Workspace(
+            boundary=boundary.points,
+            holes=tuple(h.points for h in holes),
+            map_tolerance=float(data["workspace"].get("tolerance", 0.0))
+            if "map" in data["workspace"]
+            else 0.0,
+        ),
         regions=tuple(Region(name=n, polygon=shape.points) for n, shape in regions.items()),
         robot=Robot(
             start=start,

@@ -122,4 +122,6 @@ def map_shapes(
             regions[name] = checked
     if not problems:
         data["groups"] = {**{g: list(m) for g, m in imported.groups.items()}, **user_groups}
+        # the rings may be this far from the cells: a body keeps that much more (body.py)
+        workspace["tolerance"] = imported.tolerance
     return boundary, holes, regions, problems

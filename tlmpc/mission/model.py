@@ -33,10 +33,15 @@ class Region:
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Workspace:
-    """The outer boundary and the holes (obstacles that are never traversable)."""
+    """The outer boundary and the holes (obstacles that are never traversable).
+
+    ``map_tolerance`` is how far the boundary and holes may lie from the true obstacles (an
+    occupancy map's simplification tolerance; 0 for polygons given in the mission).
+    """
 
     boundary: Polygon
     holes: tuple[Polygon, ...] = ()
+    map_tolerance: float = 0.0
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -137,6 +142,11 @@ class Mission:
             "workspace": {
                 "boundary": poly(self.workspace.boundary),
                 "holes": [poly(h) for h in self.workspace.holes],
+                **(
+                    {"map_tolerance": self.workspace.map_tolerance}
+                    if self.workspace.map_tolerance
+                    else {}
+                ),
             },
             "regions": {r.name: poly(r.polygon) for r in self.regions},
             "groups": {k: list(v) for k, v in self.groups.items()},
