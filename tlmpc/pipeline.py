@@ -146,6 +146,7 @@ class StageResult:
     artifacts: Mapping[str, Any] = field(default_factory=dict)  # file name -> JSON doc | text
     sizes: Mapping[str, Any] = field(default_factory=dict)
     warnings: tuple[Diagnostic, ...] = ()
+    summary: Mapping[str, Any] = field(default_factory=dict)  # keys added to summary.json
 
 
 def provide(product: Product[T], value: T) -> dict[Product[Any], Any]:
@@ -381,6 +382,7 @@ def _simulate(c: Compilation) -> StageResult:
         artifacts={"trace.json": document},
         sizes={"samples": len(points), "duration": round(float(points[-1][0]), 3)},
         warnings=tuple(margin_warnings(clearance, margin, mission.source)),
+        summary={"clearance": clearance.to_json(margin)},
     )
 
 
@@ -506,6 +508,7 @@ class CompileResult:
     artifacts: dict[str, Any]
     reports: tuple[StageReport, ...]
     warnings: tuple[Diagnostic, ...]
+    extras: Mapping[str, Any] = field(default_factory=dict)  # from the stages' ``summary``
 
     def summary(self) -> dict[str, Any]:
         """The ``summary.json`` document (``tlmpc.summary/1``)."""
@@ -533,10 +536,7 @@ class CompileResult:
                 "cost": witness.cost,
                 "metric": witness.metric,
             }
-        trace = self.compilation.find(TRACE)
-        if trace is not None and mission is not None:
-            clearance, margin = _clearance(trace, mission)
-            summary["clearance"] = clearance.to_json(margin)
+        summary.update(self.extras)
         verdict_doc = self.artifacts.get("verdict.json")
         if verdict_doc is not None:
             summary["verdict"] = {
@@ -580,6 +580,7 @@ def run_stages(
     products: dict[Product[Any], Any] = dict(compilation.products)
     reports: list[StageReport] = []
     warnings: list[Diagnostic] = []
+    extras: dict[str, Any] = {}
     for index, stage in enumerate(stages, start=1):
         for product in stage.requires:
             compilation.get(product)  # a clear error instead of a failure deep inside
@@ -599,6 +600,7 @@ def run_stages(
             compilation, products=dict(products), documents=dict(artifacts)
         )
         warnings.extend(result.warnings)
+        extras.update(result.summary)
         reports.append(report)
         if progress is not None:
             progress(index, len(stages), report)
@@ -607,6 +609,7 @@ def run_stages(
         artifacts=written,
         reports=tuple(reports),
         warnings=tuple(warnings),
+        extras=extras,
     )
 
 

@@ -108,14 +108,16 @@ def measure(trace: TraceInput) -> Clearance:
     forbidden_positions: dict[str, tuple[float, float]] = {}
     depth: dict[str, Depth] = {}
     for name, ring in trace.regions.items():
-        region = shapely.Polygon(ring)
         sign = signs.get(name)
+        if sign not in ("negative", "positive"):
+            continue
+        region = shapely.Polygon(ring)
         if sign == "negative":
             distance = np.asarray(shapely.distance(region, segments), dtype=np.float64)
             worst = int(np.argmin(distance))
             forbidden[name] = float(distance[worst])
             forbidden_positions[name] = _closest(points, worst, region)
-        elif sign == "positive":
+        else:
             inside = np.asarray(shapely.covers(region, shapely.points(points)), dtype=bool)
             if not inside.any():
                 continue
