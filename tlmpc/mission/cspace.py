@@ -211,8 +211,18 @@ def body_diagnostics(mission: Mission, text: str | None = None) -> list[Diagnost
         )
     raw = raw_free_space(mission.workspace.boundary, mission.workspace.holes)
     raw_home = next((p for p in _parts(raw) if p.covers(start)), None)
-    for region in mission.regions:
-        shape = shapely.Polygon(region.polygon)
+    shapes = [shapely.Polygon(r.polygon) for r in mission.regions]
+    # a region with an interior point inside the robot's part is reachable: the usual case,
+    # decided for all regions at once (maps with thousands of rooms)
+    inner = shapely.get_coordinates([s.representative_point() for s in shapes])
+    if home is not None and len(shapes):
+        shapely.prepare(home)
+        easy = shapely.contains_xy(home, inner[:, 0], inner[:, 1]).tolist()
+    else:
+        easy = [False] * len(shapes)
+    for region, shape, reachable in zip(mission.regions, shapes, easy, strict=True):
+        if reachable:
+            continue
         line = lines.get(("regions", region.name))
         if not cspace.intersects(shape) or cspace.intersection(shape).area <= 0.0:
             if raw.intersection(shape).area > 0.0:
