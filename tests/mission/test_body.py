@@ -11,12 +11,13 @@ from __future__ import annotations
 
 import itertools
 import math
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
 import shapely
-from hypothesis import assume, given
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 import tlmpc
@@ -349,3 +350,90 @@ def test_every_triangle_keeps_the_radius_from_every_obstacle(
     assert least >= radius * (1 - 1e-9)
     # and the configuration space is not needlessly small: it holds every point 1.05 r away
     assert shapely.union_all(triangles).buffer(1e-9).covers(free.buffer(-1.05 * radius))
+
+
+@settings(max_examples=30)  # a compile per example
+@given(
+    st.floats(2.0, 7.0),  # x of the wall
+    st.floats(0.5, 0.9),  # thickness of the wall
+    st.floats(1.0, 8.0),  # bottom of the gap
+    st.floats(0.1, 1.0),  # width of the gap
+    st.floats(0.5, 2.0),  # body diameter / gap width
+)
+def test_a_gap_narrower_than_the_body_is_named_where_it_is(
+    x: float, thickness: float, low: float, gap: float, ratio: float
+) -> None:
+    radius = ratio * gap / 2.0
+    assume(abs(ratio - 1.0) > 0.1)  # clear of the conservative offset's few percent
+    mission: Mission = {
+        "version": 1,
+        "workspace": {
+            "boundary": {"rect": [0, 0, 10, 10]},
+            "holes": [
+                {"rect": [x, 0, x + thickness, low]},
+                {"rect": [x, low + gap, x + thickness, 10]},
+            ],
+        },
+        "regions": {"goal": {"rect": [9.0, 4.5, 9.8, 5.5]}},
+        "robot": {"start": [x / 2.0, 5.0], "radius": radius},
+        "task": ["visit goal"],
+        "options": {"margin": 0},
+    }
+    assume(x / 2.0 >= 1.1 * radius and 9.0 - (x + thickness) > 2.2 * radius)
+    if ratio < 1.0:  # the body fits through
+        compiled = tlmpc.compile(mission)
+        assert not [w for w in compiled.warnings if w.code.startswith("R")]
+        assert _body_clearance(mission, compiled.artifacts["trace.json"]) >= radius * (1 - 1e-9)
+        return
+    with pytest.raises(NoPlanError) as caught:
+        tlmpc.compile(mission)
+    pinches = [d for d in caught.value.diagnostics if d.code == "R002"]
+    assert len(pinches) == 1
+    message = pinches[0].message
+    width = float(message.split("a passage ")[1].split(" wide")[0])
+    assert width == pytest.approx(gap, rel=1e-3)
+    px, py = (float(v) for v in message.split(" at (")[1].split(")")[0].split(","))
+    assert x - 1e-4 <= px <= x + thickness + 1e-4  # the message rounds to 6 digits
+    assert low - 1e-4 <= py <= low + gap + 1e-4
+    assert "hole 1 and hole 2" in message
+    assert "R004" in _codes(caught.value)
+
+
+def test_polarity_of_propositions() -> None:
+    from tlmpc.ltl.parser import parse_ltl
+    from tlmpc.ltl.polarity import polarities
+
+    assert polarities(parse_ltl("F a & G !b")) == {"a": "positive", "b": "negative"}
+    assert polarities(parse_ltl("!(a -> F b)")) == {"a": "positive", "b": "negative"}
+    assert polarities(parse_ltl("a <-> b")) == {"a": "both", "b": "both"}
+    assert polarities(parse_ltl("!b U a")) == {"a": "positive", "b": "negative"}
+    assert polarities(parse_ltl("G(a -> F c) & !(b R c)")) == {
+        "a": "negative",
+        "b": "negative",
+        "c": "both",
+    }
+
+
+def test_check_reports_the_body_diagnostics(tmp_path: Path) -> None:
+    import subprocess
+    import sys
+
+    import yaml
+
+    narrow = tmp_path / "narrow.yaml"
+    narrow.write_text(yaml.safe_dump(_door(0.6)))
+    start = _door(0.3)
+    start["robot"]["start"] = [4.3, 1.0]
+    close = tmp_path / "close.yaml"
+    close.write_text(yaml.safe_dump(start))
+    done = subprocess.run(
+        [sys.executable, "-m", "tlmpc", "check", str(narrow), str(close)],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert done.returncode == 1
+    assert "warning[R002]" in done.stderr
+    assert f"{close}:" in done.stderr
+    assert "error[R001]" in done.stderr
+    assert "1 of 2 mission file(s) valid" in done.stderr
