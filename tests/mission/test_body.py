@@ -437,3 +437,46 @@ def test_check_reports_the_body_diagnostics(tmp_path: Path) -> None:
     assert f"{close}:" in done.stderr
     assert "error[R001]" in done.stderr
     assert "1 of 2 mission file(s) valid" in done.stderr
+
+
+@settings(max_examples=40)  # a compile per example
+@given(_rooms(), st.floats(0.05, 0.5), st.integers(0, 10**6))
+def test_margin_is_kept_where_the_geometry_allows(
+    case: tuple[Mission, float], margin: float, seed: int
+) -> None:
+    mission, radius = case
+    mission["options"] = {"margin": margin}
+    boundary = shapely.box(0, 0, 10, 10)
+    free = boundary.difference(
+        shapely.union_all([shapely.box(*h["rect"]) for h in mission["workspace"]["holes"]])
+    )
+    deep = free.buffer(-1.1 * (radius + margin), quad_segs=16)  # the oracle's own offset
+    parts = [p for p in shapely.get_parts(deep) if p.area > 0.05]
+    assume(parts)
+    rng = np.random.default_rng(seed)
+    home = parts[int(rng.integers(len(parts)))]
+    start = home.representative_point()
+    corner = shapely.get_coordinates(home.exterior)[int(rng.integers(len(home.exterior.coords)))]
+    size = float(rng.uniform(0.3, 1.5))
+    goal = shapely.box(corner[0] - size, corner[1] - size, corner[0] + size, corner[1] + size)
+    assume(free.covers(goal))
+    mission["robot"]["start"] = [start.x, start.y]
+    mission["regions"]["goal"] = {"rect": list(goal.bounds)}
+    compiled = tlmpc.compile(mission)
+    codes = {w.code for w in compiled.warnings}
+    trace = compiled.artifacts["trace.json"]
+    clearance = _body_clearance(mission, trace) - radius
+    samples = shapely.points(np.asarray(trace["points"])[:, 1:])
+    depth = max(goal.boundary.distance(p) for p in samples if goal.covers(p))
+    inradius = size  # a square of side 2 * size
+    wanted = min(margin, inradius / 2)
+    # independent: the goal's core is in the start's part of the deep free space
+    core = goal.buffer(-1.1 * wanted, quad_segs=16)
+    if home.intersection(core).area > 0.0:
+        assert "R008" not in codes
+        assert clearance >= margin * (1 - 1e-9)
+        assert depth >= wanted * (1 - 1e-9)
+    # the warnings say exactly when the margin or the depth was not reached
+    assert ("R006" in codes) == (clearance < margin * (1 - 1e-9))
+    assert ("R007" in codes) == (depth < wanted * (1 - 1e-9))
+    assert _body_clearance(mission, trace) >= radius * (1 - 1e-9)

@@ -1,8 +1,9 @@
 """The geometry the planner triangulates for a robot with a body and a margin.
 
 * **Free space**: the configuration space (free space eroded by the body radius) and, with a
-  margin m, eroded by m more; near the start the plain configuration space is kept (a disc of
-  radius 2 (r + m)), so a robot that starts close to a wall can still leave it.
+  margin m, eroded by m more; when the robot starts closer than that to a wall, the plain
+  configuration space is kept in a disc around the start (twice its way out, plus m), so it can
+  still leave the wall.
 * **Regions** keep their names, and the labels are the reference point's, but the shapes that
   label the triangles change with the task (its negation normal form):
 
@@ -10,7 +11,7 @@
     region eroded by m (by half its inradius when it is smaller: then the core is a small
     patch around its pole of inaccessibility);
   - a region that occurs only negatively (avoid it) labels its **grown** shape, the region
-    dilated by m (except within 2 m of the start);
+    dilated by m (when the robot starts within m of it, except within 2 m of the start);
   - a region of both polarities, or not in the task, keeps its shape.
 
 A task is monotone in each proposition of one polarity, so a run that satisfies it with the
@@ -30,6 +31,10 @@ from tlmpc.ltl.polarity import polarities
 from tlmpc.mission.body import ARC_SEGMENTS, conservative_offset, obstacle_offset
 from tlmpc.mission.cspace import erode, raw_free_space
 from tlmpc.mission.model import Mission
+
+#: A robot that starts in a margin band may use the band within this many times the distance
+#: out of it (the straight way out may be blocked; a wider disc leaves room to turn).
+ESCAPE = 2.0
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -67,9 +72,14 @@ def planning_layout(mission: Mission, margin: float) -> PlanningLayout | None:
     free = cspace
     start = shapely.Point(mission.robot.start)
     if margin > 0.0:
-        near_start = start.buffer(2.0 * (radius + margin), quad_segs=ARC_SEGMENTS)
-        free = shapely.union(erode(raw, radius + margin), cspace.intersection(near_start))
-        free = shapely.make_valid(free)
+        # the band is closed, except on the robot's way out of it when it starts there
+        free = erode(raw, radius + margin)
+        if not free.covers(start):
+            way_out = free.distance(start) if not free.is_empty else 0.0
+            near_start = start.buffer(
+                ESCAPE * way_out + conservative_offset(margin), quad_segs=ARC_SEGMENTS
+            )
+            free = shapely.make_valid(shapely.union(free, cspace.intersection(near_start)))
     signs = polarities(mission.formula) if margin > 0.0 else {}
     shapes: list[Any] = []
     for region in mission.regions:
@@ -80,7 +90,10 @@ def planning_layout(mission: Mission, margin: float) -> PlanningLayout | None:
             shape = inner if not inner.is_empty else shape
         elif sign == "negative":
             grown = shape.buffer(conservative_offset(margin), quad_segs=ARC_SEGMENTS)
-            spared = start.buffer(2.0 * margin, quad_segs=ARC_SEGMENTS)
-            shape = shapely.union(shape, grown.difference(spared))
+            if grown.covers(start) and not shape.covers(start):
+                # the robot starts near the region: it may leave the band on its way out
+                spared = start.buffer(ESCAPE * conservative_offset(margin), quad_segs=ARC_SEGMENTS)
+                grown = grown.difference(spared)
+            shape = shapely.union(shape, grown)
         shapes.append(shape)
     return PlanningLayout(free=free, regions=tuple(shapes), margin=margin, radius=radius)
