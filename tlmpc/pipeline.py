@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
 from tlmpc import __version__
-from tlmpc.errors import TlmpcError, error
+from tlmpc.errors import NoPlanError, TlmpcError, error
 from tlmpc.progress import heartbeat
 
 if TYPE_CHECKING:
@@ -29,6 +29,7 @@ if TYPE_CHECKING:
     from tlmpc.errors import Diagnostic
     from tlmpc.mission.model import Mission
     from tlmpc.planning.model import Witness
+    from tlmpc.verify.clearance import Clearance
 
 
 T = TypeVar("T")
@@ -90,9 +91,7 @@ MISSION: Product[Mission] = Product("mission", "mission.json", "mission-artifact
 ABSTRACTION: Product[Abstraction] = Product(
     "abstraction", "abstraction.json", "abstraction", _read_abstraction
 )
-AUTOMATON: Product[Automaton] = Product(
-    "automaton", "automaton.json", "automaton", _read_automaton
-)
+AUTOMATON: Product[Automaton] = Product("automaton", "automaton.json", "automaton", _read_automaton)
 WITNESS: Product[Witness] = Product("witness", "witness.json", "witness", _read_witness)
 CONTROLLERS: Product[Controllers] = Product(
     "controllers", "controllers.json", "controllers", _read_controllers
@@ -147,6 +146,7 @@ class StageResult:
     artifacts: Mapping[str, Any] = field(default_factory=dict)  # file name -> JSON doc | text
     sizes: Mapping[str, Any] = field(default_factory=dict)
     warnings: tuple[Diagnostic, ...] = ()
+    summary: Mapping[str, Any] = field(default_factory=dict)  # keys added to summary.json
 
 
 def provide(product: Product[T], value: T) -> dict[Product[Any], Any]:
@@ -174,6 +174,7 @@ def _load(c: Compilation) -> StageResult:
     else:
         loaded = load_mission(c.source)
     mission, notes = workspace_notes(loaded)  # holes merged; narrow passages
+    notes += _body_notes(mission, c.text)
     return StageResult(
         products=provide(MISSION, mission),
         artifacts={"mission.json": mission.to_json()},
@@ -182,15 +183,32 @@ def _load(c: Compilation) -> StageResult:
     )
 
 
+def _body_notes(mission: Mission, text: str | None) -> list[Diagnostic]:
+    """R001 (raised) and the R002-R004 warnings of a robot with a body."""
+    from tlmpc.errors import InvalidInputError
+    from tlmpc.mission.cspace import body_diagnostics
+
+    found = body_diagnostics(mission, text)
+    errors = [d for d in found if d.severity == "error"]
+    if errors:
+        raise InvalidInputError(errors)
+    return found
+
+
 def _abstraction(c: Compilation) -> StageResult:
     from tlmpc.abstraction import (
         abstraction_diagnostics,
         abstraction_to_json,
         build_abstraction,
     )
+    from tlmpc.abstraction.layout import planning_layout
+    from tlmpc.mission.body import requested_margin
 
     mission = c.get(MISSION)
-    abstraction = build_abstraction(mission)
+    # A body or a margin: the configuration space, goal cores and grown avoided regions are
+    # triangulated (the body's own diagnostics came with the load stage).
+    layout = planning_layout(mission, requested_margin(mission))
+    abstraction = build_abstraction(mission, layout)
     return StageResult(
         products=provide(ABSTRACTION, abstraction),
         artifacts={"abstraction.json": abstraction_to_json(abstraction)},
@@ -199,7 +217,7 @@ def _abstraction(c: Compilation) -> StageResult:
             "vertices": int(abstraction.vertices.shape[0]),
             "letters": len(abstraction.letters),
         },
-        warnings=tuple(abstraction_diagnostics(abstraction, mission)),
+        warnings=tuple(abstraction_diagnostics(abstraction, mission)) if layout is None else (),
     )
 
 
@@ -232,6 +250,7 @@ def _automaton(c: Compilation) -> StageResult:
 
 def _plan(c: Compilation) -> StageResult:
     from tlmpc.abstraction import abstraction_to_json
+    from tlmpc.automata import automaton_to_json, to_hoa
     from tlmpc.mission.parts import task_parts
     from tlmpc.planning import witness_to_json
     from tlmpc.planning.budget import check_product_size
@@ -241,22 +260,49 @@ def _plan(c: Compilation) -> StageResult:
     built = c.get(ABSTRACTION)
     automaton = c.get(AUTOMATON)
     check_product_size(built, automaton)  # a diagnostic, not an exhausted machine
-    # The plan may need U-turns: then it comes on a locally refined mesh, which replaces the
-    # built one (and its artifact) for every later stage.
-    abstraction, witness = plan_complete(
-        built,
-        automaton,
-        formula=mission.formula,
-        options=mission.options,
-        start_point=mission.robot.start,
-        parts=lambda: task_parts(mission),
-        file=mission.source,
-    )
-    artifacts: dict[str, Any] = {"witness.json": witness_to_json(witness, abstraction)}
+
+    def attempt(on: Abstraction, with_automaton: Automaton) -> tuple[Abstraction, Witness]:
+        # The plan may need U-turns: then it comes on a locally refined mesh, which replaces
+        # the built one (and its artifact) for every later stage.
+        return plan_complete(
+            on,
+            with_automaton,
+            formula=mission.formula,
+            options=mission.options,
+            start_point=mission.robot.start,
+            parts=lambda: task_parts(mission),
+            file=mission.source,
+        )
+
+    warnings: list[Diagnostic] = []
+    products: dict[Product[Any], Any] = {}
+    artifacts: dict[str, Any] = {}
+    try:
+        abstraction, witness = attempt(built, automaton)
+    except NoPlanError as exc:
+        fallback = _without_margin(mission, exc)
+        if fallback is None:
+            raise _with_body_notes(exc, mission) from None
+        built, automaton, note = fallback
+        try:
+            abstraction, witness = attempt(built, automaton)
+        except NoPlanError as again:
+            raise _with_body_notes(again, mission) from None
+        warnings.append(note)
+        products.update(provide(AUTOMATON, automaton))
+        artifacts["automaton.json"] = automaton_to_json(automaton)
+        artifacts["automaton.hoa"] = to_hoa(automaton)
+        artifacts["abstraction.json"] = abstraction_to_json(abstraction)
+    artifacts["witness.json"] = witness_to_json(witness, abstraction)
     if abstraction is not built:
         artifacts["abstraction.json"] = abstraction_to_json(abstraction)
     return StageResult(
-        products={**provide(ABSTRACTION, abstraction), **provide(WITNESS, witness)},
+        products={
+            **products,
+            **provide(ABSTRACTION, abstraction),
+            **provide(WITNESS, witness),
+        },
+        warnings=tuple(warnings),
         artifacts=artifacts,
         sizes={
             "prefix": len(witness.prefix),
@@ -271,6 +317,44 @@ def _plan(c: Compilation) -> StageResult:
             ),
         },
     )
+
+
+def _without_margin(
+    mission: Mission, failure: NoPlanError
+) -> tuple[Abstraction, Automaton, Diagnostic] | None:
+    """When planning with the margin failed: the abstraction and automaton without it, and
+    the R008 warning; None when no margin was asked (nothing to fall back to)."""
+    from tlmpc.abstraction import build_abstraction
+    from tlmpc.abstraction.layout import planning_layout
+    from tlmpc.automata import translate
+    from tlmpc.errors import Diagnostic as Note
+    from tlmpc.mission.body import requested_margin
+
+    margin = requested_margin(mission)
+    if margin <= 0.0:
+        return None
+    abstraction = build_abstraction(mission, planning_layout(mission, 0.0))
+    automaton = translate(mission.formula, letters=abstraction.letters)
+    reason = failure.diagnostics[0].message if failure.diagnostics else "no plan"
+    note = Note(
+        code="R008",
+        severity="warning",
+        message=f"no plan keeps the margin {margin:g} ({reason}); planned without it",
+        hint="the R006/R007 warnings, if any, say where the path comes closer; lower "
+        "options.margin to plan with a smaller one",
+        file=mission.source,
+    )
+    return abstraction, automaton, note
+
+
+def _with_body_notes(failure: NoPlanError, mission: Mission) -> NoPlanError:
+    """The no-plan error with the body's diagnostics (a passage too narrow says why)."""
+    from tlmpc.mission.cspace import body_diagnostics
+
+    extra = [d for d in body_diagnostics(mission) if d.code in ("R002", "R003", "R004")]
+    if not extra:
+        return failure
+    return NoPlanError([*failure.diagnostics, *extra])
 
 
 def _control(c: Compilation) -> StageResult:
@@ -297,11 +381,26 @@ def _simulate(c: Compilation) -> StageResult:
     trace = simulate(abstraction, controllers, mission)
     document = trace_to_json(trace, mission)
     points: list[list[float]] = document["points"]  # type: ignore[assignment]
+    clearance, margin = _clearance(document, mission)
+    from tlmpc.verify.clearance import margin_warnings
+
     return StageResult(
         products=provide(TRACE, document),
         artifacts={"trace.json": document},
         sizes={"samples": len(points), "duration": round(float(points[-1][0]), 3)},
+        warnings=tuple(margin_warnings(clearance, margin, mission.source)),
+        summary={"clearance": clearance.to_json(margin)},
     )
+
+
+def _clearance(document: Mapping[str, Any], mission: Mission) -> tuple[Clearance, float]:
+    """The clearance and depth the trace achieved (measured on the trace alone), and the
+    margin the mission asked for."""
+    from tlmpc.mission.body import requested_margin
+    from tlmpc.verify.clearance import measure
+    from tlmpc.verify.trace_input import from_document
+
+    return measure(from_document(dict(document))), requested_margin(mission)
 
 
 def _verify(c: Compilation) -> StageResult:
@@ -428,6 +527,7 @@ class CompileResult:
     artifacts: dict[str, Any]
     reports: tuple[StageReport, ...]
     warnings: tuple[Diagnostic, ...]
+    extras: Mapping[str, Any] = field(default_factory=dict)  # from the stages' ``summary``
 
     def summary(self) -> dict[str, Any]:
         """The ``summary.json`` document (``tlmpc.summary/1``)."""
@@ -455,6 +555,7 @@ class CompileResult:
                 "cost": witness.cost,
                 "metric": witness.metric,
             }
+        summary.update(self.extras)
         verdict_doc = self.artifacts.get("verdict.json")
         if verdict_doc is not None:
             summary["verdict"] = {
@@ -498,6 +599,7 @@ def run_stages(
     products: dict[Product[Any], Any] = dict(compilation.products)
     reports: list[StageReport] = []
     warnings: list[Diagnostic] = []
+    extras: dict[str, Any] = {}
     for index, stage in enumerate(stages, start=1):
         for product in stage.requires:
             compilation.get(product)  # a clear error instead of a failure deep inside
@@ -517,6 +619,7 @@ def run_stages(
             compilation, products=dict(products), documents=dict(artifacts)
         )
         warnings.extend(result.warnings)
+        extras.update(result.summary)
         reports.append(report)
         if progress is not None:
             progress(index, len(stages), report)
@@ -525,6 +628,7 @@ def run_stages(
         artifacts=written,
         reports=tuple(reports),
         warnings=tuple(warnings),
+        extras=extras,
     )
 
 

@@ -10,6 +10,7 @@ import shapely
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
+from tlmpc.abstraction.layout import PlanningLayout
 from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
 from tlmpc.abstraction.resolution import refuse_subgrid_features
 from tlmpc.abstraction.starts import cells_in
@@ -82,12 +83,16 @@ def _components(neighbors: IntArray) -> IntArray:
     return np.asarray(labels, dtype=np.int64)
 
 
-def build_abstraction(mission: Mission) -> Abstraction:
-    """Triangulate ``mission``'s workspace and build the transition system D."""
+def build_abstraction(mission: Mission, layout: PlanningLayout | None = None) -> Abstraction:
+    """Triangulate ``mission``'s workspace and build the transition system D.
+
+    With a ``layout`` (a robot with a body, a margin), its free space and region shapes are
+    triangulated and label the triangles instead of the mission's own.
+    """
     started = time.perf_counter()
     # One geometry for planning and verifying: refuse what snapping to the grid would reshape.
     refuse_subgrid_features(mission)
-    vertices, triangles, neighbors, shapes = triangulate(mission)
+    vertices, triangles, neighbors, shapes = triangulate(mission, layout)
     letter_of, letters = _labels(mission, vertices, triangles, shapes)
     # The lowest-numbered triangle holding the start exactly (a start on an edge or vertex
     # lies in several: the planner starts from any of them).

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import numpy.typing as npt
@@ -20,6 +20,9 @@ from shapely.geometry import Polygon as ShapelyPolygon
 
 from tlmpc.errors import InvalidInputError, error
 from tlmpc.mission.model import Mission
+
+if TYPE_CHECKING:
+    from tlmpc.abstraction.layout import PlanningLayout
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
@@ -97,6 +100,23 @@ def free_space(mission: Mission, grid: float) -> Any:
     return boundary
 
 
+def _snapped_free(free: Any, grid: float, mission: Mission) -> Any:
+    """A layout's free space on the grid (snapping moves a vertex by half a grid step, far
+    less than the slack :func:`~tlmpc.mission.body.conservative_offset` leaves)."""
+    snapped = shapely.set_precision(free, grid)
+    if snapped.is_empty:
+        raise InvalidInputError(
+            error(
+                "R001",
+                "the robot's body fits nowhere: the free space vanishes once obstacles are "
+                "inflated by the robot's radius",
+                hint="give a smaller robot.radius / footprint, or widen the workspace",
+                file=mission.source,
+            )
+        )
+    return snapped
+
+
 def _polygons(geometry: Any) -> list[ShapelyPolygon]:
     if isinstance(geometry, ShapelyPolygon):
         return [geometry] if not geometry.is_empty else []
@@ -139,7 +159,9 @@ def _inside(free: Any, rings: list[Any]) -> list[Any]:
     return [ring for ring, k in zip(rings, keep.tolist(), strict=True) if k]
 
 
-def pslg(mission: Mission) -> tuple[FloatArray, IntArray, FloatArray, list[Any]]:
+def pslg(
+    mission: Mission, layout: PlanningLayout | None = None
+) -> tuple[FloatArray, IntArray, FloatArray, list[Any]]:
     """The planar straight-line graph and the snapped region shapes.
 
     Returns vertices, segments (index pairs), hole seed points, and each region's polygon
@@ -148,10 +170,14 @@ def pslg(mission: Mission) -> tuple[FloatArray, IntArray, FloatArray, list[Any]]
     nearly touching or nearly collinear input becomes exactly touching or collinear.
     """
     grid = grid_size(mission)
-    free = free_space(mission, grid)
+    if layout is None:
+        free = free_space(mission, grid)
+        regions = _snapped_many([r.polygon for r in mission.regions], grid)
+    else:
+        free = _snapped_free(layout.free, grid, mission)
+        regions = [shapely.set_precision(shape, grid) for shape in layout.regions]
     parts = _polygons(free)
     free_rings = [ring for part in parts for ring in _rings(part)]
-    regions = _snapped_many([r.polygon for r in mission.regions], grid)
     region_rings = [
         ring for region in regions for part in _polygons(region) for ring in _rings(part)
     ]
@@ -200,11 +226,15 @@ def pslg(mission: Mission) -> tuple[FloatArray, IntArray, FloatArray, list[Any]]
 
 
 def triangulate(
-    mission: Mission,
+    mission: Mission, layout: PlanningLayout | None = None
 ) -> tuple[FloatArray, IntArray, IntArray, list[Any]]:
     """Vertices, counter-clockwise triangles and neighbours of the constrained triangulation,
-    and the snapped region shapes (use these to label the triangles)."""
-    vertices, segments, seeds, regions = pslg(mission)
+    and the snapped region shapes (use these to label the triangles).
+
+    With a ``layout``, its free space (configuration space, margin band removed) and region
+    shapes (cores of goals, grown forbidden regions) replace the mission's.
+    """
+    vertices, segments, seeds, regions = pslg(mission, layout)
     options = "pznQ"
     if mission.options.min_angle is not None and mission.options.min_angle > 0:
         options += f"q{mission.options.min_angle:g}"

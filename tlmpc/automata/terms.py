@@ -344,9 +344,16 @@ def to_formula(f: Node) -> Formula:
             return Eventually(to_formula(arg))
         case Always(arg=arg):
             return Globally(to_formula(arg))
-        case Binary(kind=kind, left=left, right=right):
-            node = {"U": Until, "R": Release, "W": WeakUntil, "M": StrongRelease}[kind]
-            return node(to_formula(left), to_formula(right))
+        case Binary(kind="U", left=left, right=right):
+            return Until(to_formula(left), to_formula(right))
+        case Binary(kind="R", left=left, right=right):
+            return Release(to_formula(left), to_formula(right))
+        case Binary(kind="W", left=left, right=right):
+            return WeakUntil(to_formula(left), to_formula(right))
+        case Binary(kind="M", left=left, right=right):
+            return StrongRelease(to_formula(left), to_formula(right))
+        case Binary():
+            raise AssertionError(f"unknown binary operator {f.kind!r}")
         case _:
             assert_never(f)
 

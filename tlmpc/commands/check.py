@@ -50,9 +50,13 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             if mission is not None and not diagnostics:
                 diagnostics = _contradictions(path, mission)
                 if not diagnostics:
+                    from tlmpc.mission.cspace import body_diagnostics
                     from tlmpc.mission.holes import workspace_notes
 
-                    notices = workspace_notes(mission)[1]
+                    merged, notices = workspace_notes(mission)
+                    body = body_diagnostics(merged)
+                    diagnostics = [d for d in body if d.severity == "error"]
+                    notices += [d for d in body if d.severity != "error"]
             if diagnostics:
                 invalid += 1
             else:

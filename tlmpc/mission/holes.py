@@ -120,9 +120,27 @@ def narrow_passages(
 ) -> list[tuple[float, Point, Point, int]]:
     """Passages of the free space narrower than ``fraction`` × the workspace size.
 
-    Each is ``(width, a, b, ring)``: the two closest points across the passage and the ring
-    that bounds it with the higher number (0 the boundary, k the k-th hole), one per pair of
-    rings.  Edges of the
+    Each is ``(width, a, b, ring)``: see :func:`passages_narrower_than`; ``ring`` is the
+    higher of the two rings' numbers.
+    """
+    from shapely import Polygon as ShapelyPolygon
+
+    minx, miny, maxx, maxy = ShapelyPolygon(boundary).bounds
+    limit = fraction * max(maxx - minx, maxy - miny)
+    return sorted(
+        (width, a, b, rings[1])
+        for width, a, b, rings in passages_narrower_than(boundary, holes, width=limit)
+    )
+
+
+def passages_narrower_than(
+    boundary: Polygon, holes: Sequence[Polygon], *, width: float
+) -> list[tuple[float, Point, Point, tuple[int, int]]]:
+    """Passages of the free space narrower than ``width``.
+
+    Each is ``(width, a, b, (lower, higher))``: the two closest points across the passage
+    and the numbers of the two rings that bound it (0 the boundary, k the k-th hole), one
+    per pair of rings.  Edges of the
     boundary and holes are compared pairwise (through a spatial index); a pair counts when the
     segment joining their closest points crosses free space, so a thin obstacle or a sharp
     corner is no passage.  Edges that touch (neighbours sharing a vertex) are at distance 0 and
@@ -132,8 +150,7 @@ def narrow_passages(
     from shapely import Polygon as ShapelyPolygon
 
     free = ShapelyPolygon(boundary, list(holes))
-    minx, miny, maxx, maxy = ShapelyPolygon(boundary).bounds
-    limit = fraction * max(maxx - minx, maxy - miny)
+    limit = width
     segments: list[tuple[Point, Point]] = []
     rings: list[int] = []
     for number, ring in enumerate([boundary, *holes]):
@@ -143,21 +160,22 @@ def narrow_passages(
     lines = [LineString(s) for s in segments]
     tree = STRtree(lines)
     inside = prepared.prep(free)
-    found: list[tuple[float, Point, Point, int]] = []
+    found: list[tuple[float, Point, Point, tuple[int, int]]] = []
     pair_of: dict[int, tuple[int, int]] = {}
     pairs = tree.query(lines, predicate="dwithin", distance=limit)
     for i, j in zip(pairs[0].tolist(), pairs[1].tolist(), strict=True):
         if j <= i:
             continue
         gap = shortest_line(lines[i], lines[j])
-        width = gap.length
-        if width <= 0.0 or width >= limit:  # 0: neighbouring edges, or edges that touch
+        gap_width = gap.length
+        if gap_width <= 0.0 or gap_width >= limit:  # 0: neighbouring edges, or edges that touch
             continue
         middle = gap.interpolate(0.5, normalized=True)
         if not inside.contains(middle):
             continue
         (ax, ay), (bx, by) = gap.coords
-        found.append((width, (ax, ay), (bx, by), max(rings[i], rings[j])))
+        pair = (min(rings[i], rings[j]), max(rings[i], rings[j]))
+        found.append((gap_width, (ax, ay), (bx, by), pair))
         pair_of[len(found) - 1] = (min(rings[i], rings[j]), max(rings[i], rings[j]))
     # one report per pair of rings (a hole and its neighbour): the narrowest place between them
     narrowest: dict[tuple[int, int], int] = {}

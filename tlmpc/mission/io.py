@@ -33,6 +33,7 @@ def mission_from_json(document: Mapping[str, Any]) -> Mission:
                 )
                 for c in document["workspace"].get("components", ())
             ),
+            map_tolerance=float(document["workspace"].get("map_tolerance", 0.0)),
         ),
         regions=tuple(
             Region(name=name, polygon=_polygon(points))
@@ -44,6 +45,8 @@ def mission_from_json(document: Mapping[str, Any]) -> Mission:
             disturbance=float(robot.get("disturbance", 0.0)),
             model=robot.get("model", "point"),
             offset=float(robot.get("offset", 0.0)),
+            radius=float(robot.get("radius", 0.0)),
+            footprint=_polygon(robot["footprint"]) if robot.get("footprint") else None,
         ),
         formula=parse_ltl(document["formula"], file="mission.json"),
         groups={name: tuple(members) for name, members in document["groups"].items()},
@@ -55,6 +58,7 @@ def mission_from_json(document: Mapping[str, Any]) -> Mission:
             cost=options["cost"],
             beta=float(options["beta"]),
             boundary=options["boundary"],
+            margin=options.get("margin"),
         ),
         source=document["source"],
     )

@@ -21,7 +21,7 @@ from tlmpc.ltl.ast import Formula, Or, Prop, conjoin
 from tlmpc.ltl.parser import KEYWORDS, parse_ltl
 from tlmpc.ltl.transform import substitute
 from tlmpc.mission.geometry import CheckedShape, check_layout, check_shape
-from tlmpc.mission.model import Component, Mission, Options, Region, Robot, Workspace
+from tlmpc.mission.model import Component, Mission, Options, Polygon, Region, Robot, Workspace
 from tlmpc.mission.yamlpos import Path, PositionedDocument, json_path, load_positioned
 from tlmpc.tasks.compiler import compile_phrases
 
@@ -395,6 +395,42 @@ def _map_shapes(
     return map_shapes(data, doc, file)
 
 
+def _body(
+    data: Mapping[str, Any], doc: PositionedDocument, file: str
+) -> tuple[tuple[float, Polygon | None], list[Diagnostic]]:
+    """``robot.radius`` and ``robot.footprint``; ``workspace.inflate`` is a deprecated alias
+    of the radius (with a map) and must agree with it when both are given."""
+    robot = data["robot"]
+    radius = float(robot.get("radius", 0.0))
+    inflate = (data.get("workspace") or {}).get("inflate")
+    problems: list[Diagnostic] = []
+    if inflate is not None:
+        if "radius" in robot and float(inflate) != radius:
+            line, col = doc.value_at(("workspace", "inflate"))
+            problems.append(
+                error(
+                    "R005",
+                    f"workspace.inflate ({float(inflate):g}) disagrees with robot.radius "
+                    f"({radius:g})",
+                    hint="inflate is a deprecated alias of robot.radius: remove it",
+                    file=file,
+                    line=line,
+                    col=col,
+                    path="$.workspace.inflate",
+                )
+            )
+        radius = float(inflate)
+    footprint: Polygon | None = None
+    if "footprint" in robot:
+        checked, found = check_shape(
+            robot["footprint"], ("robot", "footprint"), "robot footprint", file, doc.value_at
+        )
+        problems.extend(found)
+        if checked is not None:
+            footprint = checked.points
+    return (radius, footprint), problems
+
+
 def _groups(
     data: Mapping[str, Any], doc: PositionedDocument, file: str, names: set[str]
 ) -> tuple[dict[str, list[str]], list[Diagnostic]]:
@@ -468,6 +504,8 @@ def _load(text: str, file: str, stem: str) -> tuple[Mission | None, list[Diagnos
             components=components,
         )
     )
+    body, found = _body(data, doc, file)
+    problems.extend(found)
     names = set(regions) | set(data["regions"])
     groups, found = _groups(data, doc, file, names)
     problems.extend(found)
@@ -486,6 +524,9 @@ def _load(text: str, file: str, stem: str) -> tuple[Mission | None, list[Diagnos
                 Component(boundary=b.points, holes=tuple(h.points for h in hs))
                 for b, hs in components
             ),
+            map_tolerance=float(data["workspace"].get("tolerance", 0.0))
+            if "map" in data["workspace"]
+            else 0.0,
         ),
         regions=tuple(Region(name=n, polygon=shape.points) for n, shape in regions.items()),
         robot=Robot(
@@ -494,6 +535,8 @@ def _load(text: str, file: str, stem: str) -> tuple[Mission | None, list[Diagnos
             disturbance=float(robot.get("disturbance", 0.0)),
             model=robot.get("model", "point"),
             offset=float(robot.get("offset", 0.0)),
+            radius=body[0],
+            footprint=body[1],
         ),
         formula=formula,
         groups={g: tuple(m) for g, m in groups.items()},
@@ -505,6 +548,7 @@ def _load(text: str, file: str, stem: str) -> tuple[Mission | None, list[Diagnos
             cost=options.get("cost", defaults.cost),
             beta=float(options.get("beta", defaults.beta)),
             boundary=options.get("boundary", defaults.boundary),
+            margin=float(options["margin"]) if "margin" in options else None,
         ),
         source=file,
         task_positions=_task_positions(data, doc),

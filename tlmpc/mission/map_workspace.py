@@ -62,7 +62,9 @@ def map_shapes(
         )
     start = data["robot"]["start"]
     settings = ImportSettings(
-        radius=float(workspace.get("inflate", 0.0)),
+        # the robot's body is the planner's business (configuration space, with robot.radius
+        # or its alias inflate): the mission keeps the map's obstacles as they are
+        radius=0.0,
         tolerance=workspace.get("tolerance"),
         min_area=workspace.get("min_area"),
         start=(float(start[0]), float(start[1])),
@@ -131,4 +133,6 @@ def map_shapes(
             regions[name] = checked
     if not problems:
         data["groups"] = {**{g: list(m) for g, m in imported.groups.items()}, **user_groups}
+        # the rings may be this far from the cells: a body keeps that much more (body.py)
+        workspace["tolerance"] = imported.tolerance
     return boundary, holes, regions, problems, components

@@ -47,11 +47,15 @@ class Workspace:
     ``components`` are further pieces of free space, disjoint from the main one and from each
     other (e.g. free pockets of a map enclosed by obstacles): the workspace is their union, and
     the robot cannot cross between pieces.
+
+    ``map_tolerance`` is how far the boundary and holes may lie from the true obstacles (an
+    occupancy map's simplification tolerance; 0 for polygons given in the mission).
     """
 
     boundary: Polygon
     holes: tuple[Polygon, ...] = ()
     components: tuple[Component, ...] = ()
+    map_tolerance: float = 0.0
 
     @property
     def pieces(self) -> tuple[Component, ...]:
@@ -74,15 +78,20 @@ class Workspace:
                 {"boundary": poly(c.boundary), "holes": [poly(h) for h in c.holes]}
                 for c in self.components
             ]
+        if self.map_tolerance:
+            document["map_tolerance"] = self.map_tolerance
         return document
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Robot:
-    """The fully actuated point robot x' = u + w, |u| <= max_speed, |w| <= disturbance.
+    """The fully actuated robot x' = u + w, |u| <= max_speed, |w| <= disturbance.
 
     ``disturbance`` bounds an unknown additive velocity (wind, slip, tracking error) that the
-    controllers must reject: every guarantee holds for every such w.
+    controllers must reject: every guarantee holds for every such w.  ``radius`` and
+    ``footprint`` (a polygon in the robot's frame, around its reference point) give the
+    robot a body; the planner keeps the disc of :func:`tlmpc.mission.body.body_radius` off
+    every obstacle.  Labels are always those of the reference point ``x``.
 
     ``model`` is ``"point"`` or ``"unicycle"`` (differential drive): a unicycle tracks the
     planned field with the point ``offset`` ahead of its axle, which is the point ``start``,
@@ -94,6 +103,8 @@ class Robot:
     disturbance: float = 0.0
     model: RobotModel = "point"
     offset: float = 0.0
+    radius: float = 0.0
+    footprint: Polygon | None = None
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -111,6 +122,9 @@ class Options:
     cost: CostMetric = "length"
     beta: float = DEFAULT_BETA
     boundary: BoundaryConvention = "right"
+    #: Clearance and depth objective; ``None`` is the default of
+    #: :func:`tlmpc.mission.body.requested_margin` (see docs/mission-format.md).
+    margin: float | None = None
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -179,6 +193,8 @@ class Mission:
                 "disturbance": self.robot.disturbance,
                 "model": self.robot.model,
                 "offset": self.robot.offset,
+                "radius": self.robot.radius,
+                "footprint": poly(self.robot.footprint) if self.robot.footprint else None,
             },
             "task": list(self.task),
             "ltl": self.ltl,
@@ -189,5 +205,6 @@ class Mission:
                 "cost": self.options.cost,
                 "beta": self.options.beta,
                 "boundary": self.options.boundary,
+                "margin": self.options.margin,
             },
         }

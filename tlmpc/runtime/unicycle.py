@@ -21,13 +21,8 @@ from collections.abc import Sequence
 import numpy as np
 
 from tlmpc.abstraction.model import FloatArray
+from tlmpc.mission.body import unicycle_inflation as unicycle_inflation
 from tlmpc.mission.model import Robot
-
-
-def unicycle_inflation(robot: Robot) -> float:
-    """How much farther than its reference point the robot's axle can reach: ``offset`` for
-    a unicycle, 0 for a point robot (to be added to the body radius when inflating holes)."""
-    return robot.offset if robot.model == "unicycle" else 0.0
 
 
 def reference_point(pose: Sequence[float], robot: Robot) -> FloatArray:

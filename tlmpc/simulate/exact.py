@@ -363,6 +363,7 @@ def simulate(abstraction: Abstraction, controllers: Controllers, mission: Missio
 def trace_to_json(trace: Trace, mission: Mission) -> dict[str, object]:
     """``trace.json`` (``tlmpc.trace/1``): self-contained, so it verifies on its own."""
     from tlmpc.ltl.printer import to_text
+    from tlmpc.mission.body import body_radius
 
     def poly(points: tuple[tuple[float, float], ...]) -> list[list[float]]:
         return [[x, y] for x, y in points]
@@ -374,6 +375,7 @@ def trace_to_json(trace: Trace, mission: Mission) -> dict[str, object]:
         "workspace": mission.workspace.to_json(),
         "boundary": mission.options.boundary,
         "max_speed": mission.robot.max_speed,
+        **({"radius": radius} if (radius := body_radius(mission.robot)) > 0.0 else {}),
         "points": np.column_stack([trace.times, trace.points]).tolist(),
         "loop_start": trace.loop_start,
         # A plan's run is infinite: the trace either loops or ends in a stay.

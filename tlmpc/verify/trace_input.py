@@ -43,6 +43,8 @@ class TraceInput:
     ending: Ending = "open"
     max_speed: float | None = None
     source: str | None = None
+    #: The robot's body radius: the body must stay off obstacles, not just the point.
+    radius: float = 0.0
 
 
 def _fail(
@@ -183,7 +185,21 @@ def from_document(
         ending=ending,
         max_speed=_certifying_speed(speed),
         source=file,
+        radius=_radius(document.get("radius"), file),
     )
+
+
+def _radius(value: Any, file: str | None) -> float:
+    if value is None:
+        return 0.0
+    if (
+        not isinstance(value, int | float)
+        or isinstance(value, bool)
+        or not np.isfinite(value)
+        or value < 0
+    ):
+        raise _fail("V004", f"radius {value!r} is not a number >= 0", file)
+    return float(value)
 
 
 def read_csv(path: Path, columns: Sequence[str] | None = None) -> tuple[FloatArray, list[int]]:
@@ -261,6 +277,7 @@ def from_csv(
     from tlmpc.errors import InvalidInputError
     from tlmpc.importers.logs import CSV_SUFFIXES, read_log
     from tlmpc.ltl.printer import to_text
+    from tlmpc.mission.body import body_radius
     from tlmpc.mission.load import load_mission
 
     try:
@@ -278,6 +295,7 @@ def from_csv(
         "workspace": mission.workspace.to_json(),
         "boundary": mission.options.boundary,
         "max_speed": mission.robot.max_speed,
+        "radius": body_radius(mission.robot),
         "points": samples.tolist(),
         "loop_start": None,
     }

@@ -121,6 +121,34 @@ def _segments(points: FloatArray) -> npt.NDArray[np.object_]:
     return np.asarray(shapely.linestrings(np.stack([points[:-1], points[1:]], axis=1)))
 
 
+def _body_contacts(trace: TraceInput, distances: FloatArray) -> list[Violation]:
+    """Where the body (a disc of ``trace.radius`` around the point) first meets an obstacle."""
+    assert trace.boundary_polygon is not None
+    size = float(np.ptp(trace.boundary_polygon, axis=0).max())
+    touching = np.flatnonzero(distances < trace.radius - 1e-9 * size)
+    if not len(touching):
+        return []
+    index = int(touching[0])
+    points = trace.points
+    segment = points[index : index + 2]
+    free = _free_space(trace)
+    assert free is not None
+    offsets = np.asarray(shapely.distance(free.boundary, shapely.points(segment)), dtype=np.float64)
+    closest = segment[int(np.argmin(offsets))]
+    time = float(trace.times[min(index + int(np.argmin(offsets)), len(points) - 1)])
+    x, y = float(closest[0]), float(closest[1])
+    return [
+        Counterexample(
+            conjunct="workspace",
+            time=time,
+            position=(x, y),
+            message=f"the robot's body (radius {trace.radius:g}) touches an obstacle near "
+            f"t={time:.4g} s at ({x:.4g}, {y:.4g}): the path passes "
+            f"{float(distances[index]):.4g} from it",
+        )
+    ]
+
+
 def workspace_violations(trace: TraceInput) -> tuple[list[Violation], float | None]:
     """Every excursion out of the workspace or into a hole, and the workspace robustness.
 
@@ -134,7 +162,10 @@ def workspace_violations(trace: TraceInput) -> tuple[list[Violation], float | No
     segments = _segments(points)
     inside = np.asarray(shapely.covers(free, segments), dtype=bool)
     if inside.all():
-        clearance = float(np.min(shapely.distance(free.boundary, segments)))
+        distances = np.asarray(shapely.distance(free.boundary, segments), dtype=np.float64)
+        clearance = float(np.min(distances))
+        if trace.radius > 0.0:
+            return _body_contacts(trace, distances), clearance - trace.radius
         return [], clearance
     found: list[Violation] = []
     depth = 0.0

@@ -1,0 +1,99 @@
+"""The geometry the planner triangulates for a robot with a body and a margin.
+
+* **Free space**: the configuration space (free space eroded by the body radius) and, with a
+  margin m, eroded by m more; when the robot starts closer than that to a wall, the plain
+  configuration space is kept in a disc around the start (twice its way out, plus m), so it can
+  still leave the wall.
+* **Regions** keep their names, and the labels are the reference point's, but the shapes that
+  label the triangles change with the task (its negation normal form):
+
+  - a region that occurs only positively (a goal: visit, stay, reach) labels its **core**, the
+    region eroded by m (by half its inradius when it is smaller: then the core is a small
+    patch around its pole of inaccessibility);
+  - a region that occurs only negatively (avoid it) labels its **grown** shape, the region
+    dilated by m (when the robot starts within m of it, except within 2 m of the start);
+  - a region of both polarities, or not in the task, keeps its shape.
+
+A task is monotone in each proposition of one polarity, so a run that satisfies it with the
+cores and grown shapes satisfies it with the true regions: planning here is sound, and
+every guarantee of the later stages carries over to the true labels.  It may be infeasible
+where the plain mission is not; the plan stage then plans without the margin and says so.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import shapely
+
+from tlmpc.ltl.polarity import polarities
+from tlmpc.mission.body import ARC_SEGMENTS, conservative_offset, obstacle_offset
+from tlmpc.mission.cspace import erode, workspace_free_space
+from tlmpc.mission.model import Mission
+
+#: A robot that starts in a margin band may use the band within this many times the distance
+#: out of it (the straight way out may be blocked; a wider disc leaves room to turn).
+ESCAPE = 2.0
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class PlanningLayout:
+    """Free space and region shapes to triangulate (shapely geometries, regions in order)."""
+
+    free: Any
+    regions: tuple[Any, ...]
+    margin: float
+    radius: float
+
+
+def core(region: Any, depth: float) -> Any:
+    """``region`` eroded by ``depth``, or by half its inradius when it is thinner than that."""
+    from shapely.ops import polylabel
+
+    if depth <= 0.0:
+        return region
+    size = max(region.bounds[2] - region.bounds[0], region.bounds[3] - region.bounds[1])
+    pole = polylabel(region, tolerance=1e-3 * size)
+    inradius = region.exterior.distance(pole)
+    for interior in region.interiors:
+        inradius = min(inradius, interior.distance(pole))
+    reach = conservative_offset(min(depth, 0.5 * inradius))
+    return region.buffer(-reach, quad_segs=ARC_SEGMENTS)
+
+
+def planning_layout(mission: Mission, margin: float) -> PlanningLayout | None:
+    """The layout for ``mission`` with ``margin``; None for a point robot without margin."""
+    radius = obstacle_offset(mission)
+    if radius <= 0.0 and margin <= 0.0:
+        return None
+    raw = workspace_free_space(mission)
+    cspace = erode(raw, radius)
+    free = cspace
+    start = shapely.Point(mission.robot.start)
+    if margin > 0.0:
+        # the band is closed, except on the robot's way out of it when it starts there
+        free = erode(raw, radius + margin)
+        if not free.covers(start):
+            way_out = free.distance(start) if not free.is_empty else 0.0
+            near_start = start.buffer(
+                ESCAPE * way_out + conservative_offset(margin), quad_segs=ARC_SEGMENTS
+            )
+            free = shapely.make_valid(shapely.union(free, cspace.intersection(near_start)))
+    signs = polarities(mission.formula) if margin > 0.0 else {}
+    shapes: list[Any] = []
+    for region in mission.regions:
+        shape = shapely.Polygon(region.polygon)
+        sign = signs.get(region.name)
+        if sign == "positive":
+            inner = core(shape, margin)
+            shape = inner if not inner.is_empty else shape
+        elif sign == "negative":
+            grown = shape.buffer(conservative_offset(margin), quad_segs=ARC_SEGMENTS)
+            if grown.covers(start) and not shape.covers(start):
+                # the robot starts near the region: it may leave the band on its way out
+                spared = start.buffer(ESCAPE * conservative_offset(margin), quad_segs=ARC_SEGMENTS)
+                grown = grown.difference(spared)
+            shape = shapely.union(shape, grown)
+        shapes.append(shape)
+    return PlanningLayout(free=free, regions=tuple(shapes), margin=margin, radius=radius)
