@@ -100,7 +100,10 @@ def check_pieces(
     outers = shapely.union_all([boundary.polygon for boundary, _ in pieces])
     shapely.prepare(outers)
     for name, region in regions.items():
-        if not outers.covers(region.polygon):
+        # a sliver of rounding (world coordinates of a map's cells) is not "outside"
+        if not outers.covers(region.polygon) and (
+            region.polygon.difference(outers).area > AREA_TOLERANCE * region.polygon.area
+        ):
             problems.append(
                 at(
                     region.path,
