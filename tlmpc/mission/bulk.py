@@ -71,20 +71,21 @@ class BulkList:
     col: int = 0
     _starts: list[int] | None = field(default=None, repr=False)
 
-    def locate(self, sub: Path) -> tuple[int, int]:
-        """Line and column of the value at ``sub`` (indices relative to this list)."""
-        offset = 0
+    def locate(self, sub: Path) -> tuple[int, int] | None:
+        """Line and column of the value at ``sub`` (indices relative to this list), or of its
+        deepest existing ancestor inside the list; None when not even the first step exists."""
+        offset: int | None = None
         text = self.text
         for level, index in enumerate(sub):
             if not isinstance(index, int) or index < 0:
                 break
-            found = self._item(offset, level, index)
-            if found is None:
+            found = self._item(offset or 0, level, index)
+            if found is None or text[found] in ",]":  # past the end (or a trailing comma)
                 break
             offset = found
             if text[offset] != "[":
                 break
-        return self._position(offset)
+        return None if offset is None else self._position(offset)
 
     def _item(self, start: int, level: int, index: int) -> int | None:
         """Offset of item ``index`` of the list whose ``[`` is at ``start``."""

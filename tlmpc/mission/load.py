@@ -504,16 +504,12 @@ def _read(path: str | FilePath) -> str:
     file = str(path)
     try:
         with open(path, "rb") as stream:  # a bounded read: never read() whole
-            pieces: list[bytes] = []
-            size = 0
-            while size <= MAX_BYTES:
-                piece = stream.read(min(_CHUNK, MAX_BYTES + 1 - size))
+            raw = bytearray()
+            while len(raw) <= MAX_BYTES:
+                piece = stream.read(min(_CHUNK, MAX_BYTES + 1 - len(raw)))
                 if not piece:
                     break
-                pieces.append(piece)
-                size += len(piece)
-            raw = b"".join(pieces)
-            del pieces
+                raw += piece
     except OSError as exc:
         raise UsageError(
             error(

@@ -48,9 +48,8 @@ class PositionedDocument:
         for cut in range(len(path), -1, -1):
             prefix = path[:cut]
             if prefix in self.values:
-                if cut < len(path) and prefix in self.bulk:
-                    return self.bulk[prefix].locate(path[cut:])
-                return self.values[prefix]
+                inside = self.bulk[prefix].locate(path[cut:]) if prefix in self.bulk else None
+                return inside or self.values[prefix]
         return (1, 1)
 
     def key_at(self, path: Path) -> tuple[int, int]:
