@@ -74,6 +74,7 @@ _number = st.one_of(
     st.integers(-(10**6), 10**6).map(str),
     st.floats(-1e6, 1e6, allow_nan=False).map(repr),
     st.sampled_from(["1e5", "1.5e5", "1.5e+5", "-2.0E-3", "1.0e+999", "12345678901234567", "-0"]),
+    st.sampled_from(['"far"', "true", "null", '"a,b"', '"x\\ty"', '"\u00e9t"', '"#"', "+1.5"]),
 )
 
 
@@ -191,6 +192,9 @@ def test_a_bad_coordinate_deep_in_a_big_boundary_is_located() -> None:
     written = f"[{x!r}, {y!r}]"
     assert text.count(written) == 1
     broken = text.replace(written, f'[{x!r}, "far"]')
+    doc, _ = load_positioned(broken, "m.yaml")
+    assert doc is not None
+    assert ("workspace", "boundary") in doc.bulk  # read in bulk despite the mistake
     problems = check_text(broken, "m.yaml")
     assert [d.code for d in problems] == ["S005"]
     line, col = _place(broken, '"far"')

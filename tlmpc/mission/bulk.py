@@ -179,15 +179,22 @@ def cut_out(text: str) -> tuple[str, dict[str, BulkList]]:
             value, end = _decode(text, start)
         except (ValueError, RecursionError):
             continue
-        if end > run.end() or not isinstance(value, list):
+        if not isinstance(value, list):
             continue
         span = text[start:end]
-        if ("e" in span or "E" in span) and _NOT_YAML_EXPONENT.search(span):
+        numbers: str | None = span
+        if end > run.end():
+            # Not numbers only: a mistake deep in a big list ("far", true) is still read in
+            # bulk when it is a word JSON and YAML read alike.
+            numbers = _only_numbers(span)
+        if numbers is None:
+            continue
+        if ("e" in numbers or "E" in numbers) and _NOT_YAML_EXPONENT.search(numbers):
             continue
         if "\r" in span and span.count("\r") != span.count("\r\n"):
             continue  # a lone carriage return breaks lines differently
         depth, values, points = _depth_and_count(value)
-        if values > budget:
+        if values > budget or (numbers is not span and not _plain_words(value)):
             continue
         budget -= values
         placeholder = f"{STEM}{len(lists)}__"
@@ -206,6 +213,35 @@ def cut_out(text: str) -> tuple[str, dict[str, BulkList]]:
         return text, {}
     pieces.append(text[done:])
     return "".join(pieces), lists
+
+
+_STRING = re.compile(r'"[^"\\]*"')
+_WORD = re.compile(r"true|false|null")
+_LEFT_OVER = re.compile(r"[^\[\]0-9.eE,+\- \r\n]")
+
+
+def _only_numbers(span: str) -> str | None:
+    """``span`` with its strings and true/false/null taken out, when only numbers remain."""
+    if "\\" in span or "{" in span:
+        return None  # escapes (YAML has more) and mappings (keys) go the ordinary way
+    numbers = _WORD.sub("0", _STRING.sub("0", span))
+    return None if _LEFT_OVER.search(numbers) else numbers
+
+
+def _plain_words(value: list[Any]) -> bool:
+    """Whether every text in ``value`` reads alike in JSON and YAML and cannot confuse
+    :meth:`BulkList.locate` (no brackets, commas or quotes; printable)."""
+    level = [value]
+    while level:
+        items = list(chain.from_iterable(level))
+        for item in items:
+            if type(item) is str and (not item.isprintable() or _UNSAFE.search(item)):
+                return False
+        level = [item for item in items if type(item) is list]
+    return True
+
+
+_UNSAFE = re.compile(r'[\[\],"#:]')
 
 
 def _blank_out(span: str, placeholder: str) -> str:
