@@ -141,6 +141,35 @@ def test_bulk_reader_agrees_with_the_ordinary_reader(
             assert fast_doc.value_at(path[:-1]) == slow_doc.value_at(path[:-1]), path
 
 
+_DEEP = "b: " + "[" * 70 + "]" * 70 + "\n"  # stops reading (Y003) after the list
+
+
+@pytest.mark.parametrize(
+    "place",
+    [
+        *_PLACES,
+        "? {list}\n: 1\n",
+        "? {list}\n: 1\n" + _DEEP,
+        "a: !!seq {list}\n" + _DEEP,
+        "a: x{list}\n" + _DEEP,
+        "# {list}\n" + _DEEP,
+        "a:\n" + "  " * 40 + "b: {list}\n",
+    ],
+)
+@pytest.mark.parametrize("word", ["1.5", '"far"'])
+def test_every_place_agrees(place: str, word: str) -> None:
+    body = "[" + ", ".join(f"[{k}.5, {word if k == 300 else k}]" for k in range(500)) + "]"
+    text = place.format(list=body)
+    fast_doc, fast_problems = _fast(text)
+    slow_doc, slow_problems = _ordinary(text)
+    assert fast_problems == slow_problems
+    assert (fast_doc is None) == (slow_doc is None)
+    if fast_doc is not None and slow_doc is not None:
+        assert fast_doc.data == slow_doc.data
+        for path in [("a", 300, 1), ("a", 0), ("a", "x", 300, 1), ("b", 7)]:
+            assert fast_doc.value_at(path) == slow_doc.value_at(path), path
+
+
 def _types(value: object) -> object:
     if isinstance(value, dict):
         return {k: _types(v) for k, v in value.items()}
