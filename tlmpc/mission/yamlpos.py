@@ -272,7 +272,8 @@ class _Converter:
                 "Y003",
                 f"the document is too large (more than {MAX_NODES:,} values, aliases expanded)",
                 event,
-                hint="missions do not need YAML aliases; split very large maps",
+                hint="missions do not need YAML aliases; write long point lists as one flow "
+                "list of plain decimals, [[x, y], ...] (read in bulk, not value by value)",
             )
             raise _TooBig
 
