@@ -279,6 +279,18 @@ def test_a_finely_sampled_circle_has_no_narrow_passage() -> None:
     assert narrow_passages(ring, []) == []
 
 
+def test_a_finely_rounded_corner_is_no_passage() -> None:
+    # a 100 x 100 square whose corner is rounded with radius 0.05 in 60 steps: neighbouring
+    # arc edges are closer than the limit (0.1), but the ring between them is no deeper
+    arc = [
+        (99.95 + 0.05 * math.cos(t), 99.95 + 0.05 * math.sin(t))
+        for t in (math.pi / 2 * k / 59 for k in range(60))
+    ]
+    outline = ((0.0, 0.0), (100.0, 0.0), *arc, (0.0, 100.0))
+    assert shapely.Polygon(outline).is_valid
+    assert narrow_passages(outline, []) == []
+
+
 def test_a_narrow_channel_between_finely_sampled_rooms_is_found() -> None:
     # two round rooms of 8,000 vertices each joined by a channel 0.01 wide (the limit is 0.09)
     rooms = shapely.union_all(
