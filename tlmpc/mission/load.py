@@ -90,7 +90,8 @@ def _schema_diagnostics(doc: PositionedDocument, file: str) -> list[Diagnostic]:
         # A boundary or hole with 10^5 vertices: the schema would descend into every point
         # (a minute); a plain shape has the schema's shape, so validate a small stand-in.
         small = dict(workspace)
-        small["boundary"] = _small(small.get("boundary"), ("workspace", "boundary"), bad)
+        if "boundary" in small:
+            small["boundary"] = _small(small["boundary"], ("workspace", "boundary"), bad)
         holes = small.get("holes")
         if isinstance(holes, list):
             small["holes"] = [
