@@ -152,15 +152,14 @@ def passage_search(
     import numpy as np
     import shapely
 
-    outline = np.asarray(boundary, dtype=float).reshape(-1, 2)
-    hole_rings = [shapely.linearrings(np.asarray(h, dtype=float).reshape(-1, 2)) for h in holes]
-    free = shapely.polygons(shapely.linearrings(outline), holes=hole_rings or None)
+    arrays = [np.asarray(ring, dtype=float).reshape(-1, 2) for ring in [boundary, *holes]]
+    hole_rings = [shapely.linearrings(h) for h in arrays[1:]]
+    free = shapely.polygons(shapely.linearrings(arrays[0]), holes=hole_rings or None)
     minx, miny, maxx, maxy = shapely.bounds(free).tolist()
     limit = fraction * max(maxx - minx, maxy - miny)
     starts: list[np.ndarray] = []
     ring_of: list[np.ndarray] = []
-    for number, ring in enumerate([boundary, *holes]):
-        points = np.asarray(ring, dtype=float).reshape(-1, 2)
+    for number, points in enumerate(arrays):
         if len(points) > _SIMPLIFY_ABOVE:
             # Douglas-Peucker on the ring alone (the topology-preserving variant is 15 times
             # slower); moving edges by 1/1000 of the passage limit cannot hide a passage.
