@@ -1,4 +1,4 @@
-"""``python -m bench.hostile``: hostile inputs through the CLI, with time and peak memory.
+"""``python -m bench.hostile [NAME...]``: hostile inputs through the CLI, with time and peak memory.
 
 Each case runs ``tlmpc`` in a fresh process under a 3 GB address-space limit (so a runaway case
 cannot take the machine down) and prints one row: exit code, wall seconds, peak RSS, and
@@ -15,8 +15,9 @@ import subprocess
 import sys
 import tempfile
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import Any
 
 ROOT = Path(__file__).resolve().parents[1]
 LIMIT = 3 * 1024**3
@@ -37,6 +38,74 @@ def _ring(n: int) -> str:
         for k in range(n)
     )
     return "[" + ", ".join(points) + "]"
+
+
+def _ring_points(n: int) -> list[list[float]]:
+    return [
+        [
+            round(50 + 40 * math.cos(2 * math.pi * k / n), 6),
+            round(50 + 40 * math.sin(2 * math.pi * k / n), 6),
+        ]
+        for k in range(n)
+    ]
+
+
+def _big_cases(put: Callable[[str, str | bytes], str], work: Path) -> list[tuple[str, list[str]]]:
+    """Huge inputs: 10^6-vertex boundaries written several ways, with mistakes deep inside."""
+    n = 10**6
+    points = _ring_points(n)
+    mission = {
+        "version": 1,
+        "workspace": {"boundary": points},
+        "regions": {"a": {"rect": [45, 45, 55, 55]}},
+        "robot": {"start": [50, 50]},
+        "task": ["visit a"],
+    }
+    json_path = put("ring6.json", json.dumps(mission))
+    bad: list[list[Any]] = [list(p) for p in points]
+    bad[900_000] = [bad[900_000][0], "far"]
+    bad_text = "[" + ",\n  ".join(json.dumps(p) for p in bad) + "]"
+    crossed = [list(p) for p in points]
+    crossed[950_000], crossed[950_500] = crossed[950_500], crossed[950_000]
+    block = (
+        "version: 1\nworkspace:\n  boundary:\n"
+        + "\n".join(f"  - [{x}, {y}]" for x, y in points)
+        + "\nregions: {a: {rect: [45, 45, 55, 55]}}\nrobot: {start: [50, 50]}\ntask: [visit a]\n"
+    )
+    with (work / "comment.yaml").open("w") as stream:
+        stream.write(VALID.format(boundary="{rect: [0, 0, 100, 100]}"))
+        line = "# " + "x" * 1022 + "\n"
+        for _ in range(250 * 1024):  # 250 MiB of comment, under the 256 MiB limit
+            stream.write(line)
+    with (work / "over.yaml").open("w") as stream:
+        for _ in range(260 * 1024):
+            stream.write("# " + "x" * 1022 + "\n")
+    return [
+        ("check 10^6-vertex boundary, JSON mission", ["check", json_path]),
+        (
+            "check 10^6 vertices, a bad point at 900,000",
+            ["check", put("ring6-bad.yaml", VALID.format(boundary=bad_text))],
+        ),
+        (
+            "check 10^6 vertices, a crossing at 950,000",
+            [
+                "check",
+                put(
+                    "ring6-cross.json", json.dumps({**mission, "workspace": {"boundary": crossed}})
+                ),
+            ],
+        ),
+        (
+            "check 10^6 vertices, one `- [x, y]` per line",
+            ["check", put("ring6-block.yaml", block)],
+        ),
+        (
+            "check 10^7 zeros in one list",
+            ["check", put("zeros.yaml", "a: [" + "0," * 10**7 + "0]\n")],
+        ),
+        ("check 250 MiB of comments", ["check", str(work / "comment.yaml")]),
+        ("check 260 MiB file", ["check", str(work / "over.yaml")]),
+    ]
 
 
 def build(work: Path) -> list[tuple[str, list[str]]]:
@@ -150,6 +219,7 @@ def build(work: Path) -> list[tuple[str, list[str]]]:
         ("verify CSV 10^7 rows", ["verify", str(rows), "--mission", spec]),
         ("verify loop_start = last, max_speed 0", ["verify", put("last.json", json.dumps(trace))]),
         ("compile -o /proc/x", ["compile", spec, "-o", "/proc/tlmpc-x", "--until", "load", "-q"]),
+        *_big_cases(put, work),
     ]
 
 
@@ -178,14 +248,17 @@ def run_case(argv: list[str], work: Path) -> tuple[int, float, float, float, str
     return process.returncode, seconds, cpu, usage.ru_maxrss / 1024, err
 
 
-def main(report: Callable[[str], object] = print) -> int:
-    """Run the corpus and print the table; exit 1 when a case misses the bar."""
+def main(report: Callable[[str], object] = print, only: Sequence[str] = ()) -> int:
+    """Run the corpus (the cases whose name contains one of ``only``, when given) and print
+    the table; exit 1 when a case misses the bar."""
     failures = 0
     with tempfile.TemporaryDirectory() as folder:
         work = Path(folder)
         report("| case | exit | wall s | CPU s | peak MB | ok | first diagnostic |")
         report("|---|---|---|---|---|---|---|")
         for name, argv in build(work):
+            if only and not any(part in name for part in only):
+                continue
             code, seconds, cpu, peak, err = run_case(argv, work)
             # CPU time, not wall time, against the 10 s bar: the machine may be shared.
             ok = code in (0, 1, 2) and "Traceback" not in err and cpu < 10 and peak < 2048
@@ -202,4 +275,4 @@ def main(report: Callable[[str], object] = print) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    raise SystemExit(main(only=sys.argv[1:]))

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-import resource
 from pathlib import Path
 
 import pytest
@@ -12,8 +11,9 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from tlmpc.errors import UsageError
+from tlmpc.mission import load
 from tlmpc.mission.geometry import check_layout, check_shape
-from tlmpc.mission.load import MAX_BYTES, check_text, inspect_file
+from tlmpc.mission.load import check_text, inspect_file
 from tlmpc.mission.yamlpos import MAX_DEPTH, MAX_NODES, load_positioned
 
 VALID = """\
@@ -116,12 +116,26 @@ def test_second_document_and_undefined_alias_are_y001() -> None:
     assert codes("a: *nowhere\n") == ["Y001"]
 
 
-def test_endless_file_is_refused_while_reading() -> None:
+def test_endless_file_is_refused_while_reading(monkeypatch: pytest.MonkeyPatch) -> None:
+    # (the memory bound is measured in a child process in test_big_missions)
+    monkeypatch.setattr(load, "MAX_BYTES", 8 << 20)
     with pytest.raises(UsageError) as caught:
         inspect_file(Path("/dev/zero"))
     assert caught.value.diagnostics[0].code == "U004"
-    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
-    assert peak < 40 * MAX_BYTES  # bounded by the limit, not by the (endless) file
+    assert "8 MiB" in caught.value.diagnostics[0].message
+
+
+def test_a_file_of_exactly_the_limit_is_read(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    monkeypatch.setattr(load, "MAX_BYTES", 1 << 20)
+    path = tmp_path / "m.yaml"
+    path.write_text(VALID + "#" * ((1 << 20) - len(VALID) - 1) + "\n")
+    assert path.stat().st_size == 1 << 20
+    assert inspect_file(path)[1] == []
+    path.write_text(VALID + "#" * ((1 << 20) - len(VALID)) + "\n")
+    with pytest.raises(UsageError):
+        inspect_file(path)
 
 
 def test_large_boundary_geometry_is_checked_without_pairwise_loops() -> None:

@@ -97,23 +97,19 @@ def _scopes(mission: Any) -> list[str]:
 def _contradictions(path: Path, mission: Any) -> list[Any]:
     """A T011/L020 diagnostic when no behaviour at all satisfies the mission's task."""
     from tlmpc.ltl import parse_ltl
-    from tlmpc.mission.yamlpos import load_positioned
     from tlmpc.tasks import compile_phrase
     from tlmpc.tasks.contradiction import TaskPart, find_contradiction
 
     file = str(path)
-    doc, _ = load_positioned(path.read_text(encoding="utf-8"), file)
     parts: list[TaskPart] = []
+    # Where each phrase, then the ltl string, starts: kept by the loader (reading the file
+    # again would cost as much as the check itself for a large map).
+    positions = list(mission.task_positions)
 
     def where(key: tuple[str | int, ...]) -> tuple[int, int]:
-        if doc is None:
-            return (1, 1)
-        line, col = doc.value_at(key)
-        if doc.quoted.get(key):
-            col += 1
-        if doc.block.get(key):
-            line, col = line + 1, 1
-        return line, col
+        index = key[1] if key[0] == "task" else len(mission.task)
+        assert isinstance(index, int)
+        return positions[index] if index < len(positions) else (1, 1)
 
     for index, phrase in enumerate(mission.task):
         line, col = where(("task", index))
@@ -122,8 +118,13 @@ def _contradictions(path: Path, mission: Any) -> list[Any]:
     if mission.ltl and mission.ltl.strip():
         line, col = where(("ltl",))
         parts.append(
-            TaskPart(formula=parse_ltl(mission.ltl), text=mission.ltl.strip(), kind="ltl",
-                     line=line, col=col)
+            TaskPart(
+                formula=parse_ltl(mission.ltl),
+                text=mission.ltl.strip(),
+                kind="ltl",
+                line=line,
+                col=col,
+            )
         )
     found = find_contradiction(parts, groups=mission.groups, file=file)
     return [found] if found is not None else []

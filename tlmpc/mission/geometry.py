@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -27,24 +28,65 @@ def shape_points(shape: Any) -> Polygon:
     if isinstance(shape, dict):
         x0, y0, x1, y1 = (float(v) for v in shape["rect"])
         return ((x0, y0), (x1, y0), (x1, y1), (x0, y1))
-    points: list[tuple[float, float]] = []
-    for x, y in shape:
-        point = (float(x), float(y))
-        if not points or points[-1] != point:
-            points.append(point)
-    if len(points) > 1 and points[0] == points[-1]:
-        points.pop()  # a closed ring given with its first point repeated
-    return tuple(points)
+    return tuple(map(tuple, _vertices(shape)[0].tolist()))
 
 
-def _collinear(points: Polygon, size: float) -> bool:
+Array = np.ndarray[Any, np.dtype[Any]]
+
+
+def _vertices(shape: Any) -> tuple[Array, Array]:
+    """A point list as an n×2 array, repeats of the previous point and a closing point dropped,
+    and the index in ``shape`` of each vertex kept.
+
+    Array operations throughout: a boundary may have a million vertices.
+    """
+    points = np.asarray(shape, dtype=float).reshape(-1, 2)
+    index = np.arange(len(points))
+    if len(points) > 1:
+        kept = np.concatenate(([True], np.any(points[1:] != points[:-1], axis=1)))
+        points, index = points[kept], index[kept]
+    if len(points) > 1 and np.array_equal(points[0], points[-1]):
+        points, index = points[:-1], index[:-1]  # a closed ring given with its first point again
+    return points, index
+
+
+def _three_distinct(points: Array) -> bool:
+    """Whether ``points`` holds three different points (linear; sorting a million is not)."""
+    if len(points) < 3:
+        return False
+    other = np.any(points != points[0], axis=1)
+    if not other.any():
+        return False
+    second = points[int(np.argmax(other))]
+    return bool(np.any(other & np.any(points != second, axis=1)))
+
+
+def _collinear(points: Array, size: float) -> bool:
     x0, y0 = points[0]
-    x1, y1 = max(points, key=lambda p: (p[0] - x0) ** 2 + (p[1] - y0) ** 2)
+    dx_all = points[:, 0] - x0
+    dy_all = points[:, 1] - y0
+    x1, y1 = points[int(np.argmax(dx_all**2 + dy_all**2))]
     dx, dy = x1 - x0, y1 - y0
-    length = (dx * dx + dy * dy) ** 0.5
+    length = float(dx * dx + dy * dy) ** 0.5
     if length == 0.0:
         return True
-    return all(abs(dx * (y - y0) - dy * (x - x0)) / length <= 1e-12 * size for x, y in points)
+    return bool(np.all(np.abs(dx * dy_all - dy * dx_all) / length <= 1e-12 * size))
+
+
+def _crossing_vertex(points: Array, reason: str) -> int | None:
+    """The vertex starting the edge nearest the place ``explain_validity`` names, if any."""
+    found = re.search(r"\[\s*([-+0-9.eE]+)\s+([-+0-9.eE]+)", reason)
+    if found is None or len(points) < 2:
+        return None
+    x, y = float(found.group(1)), float(found.group(2))
+    start = points
+    end = np.roll(points, -1, axis=0)
+    edge = end - start
+    squared = np.einsum("ij,ij->i", edge, edge)
+    squared[squared == 0.0] = 1.0
+    t = np.clip(((x - start[:, 0]) * edge[:, 0] + (y - start[:, 1]) * edge[:, 1]) / squared, 0, 1)
+    gap = np.hypot(start[:, 0] + t * edge[:, 0] - x, start[:, 1] + t * edge[:, 1] - y)
+    return int(np.argmin(gap))
 
 
 @dataclass(frozen=True, slots=True)
@@ -80,8 +122,8 @@ def check_shape(
             # (Example 8's 1,156 rect regions cost a third of the load stage).
             points = shape_points(shape)
             return CheckedShape(points=points, polygon=ShapelyPolygon(points), path=path), []
-    points = shape_points(shape)
-    if len(set(points)) < 3:
+    array, written = _vertices(shape)
+    if not _three_distinct(array):
         return None, [
             error(
                 "G002",
@@ -90,10 +132,10 @@ def check_shape(
                 **where,
             )
         ]
-    polygon = shapely.polygons(np.asarray(points, dtype=float))  # linear, unlike a list
+    polygon = shapely.polygons(array)  # linear, unlike a list
     minx, miny, maxx, maxy = polygon.bounds
     size = max(maxx - minx, maxy - miny, 1e-300)
-    if _collinear(points, size):
+    if _collinear(array, size):
         return None, [
             error(
                 "G003",
@@ -104,6 +146,12 @@ def check_shape(
         ]
     if not polygon.is_valid:
         reason = explain_validity(polygon)
+        vertex = _crossing_vertex(array, reason)
+        if vertex is not None:
+            # Point at the edge itself: in a boundary of a million vertices, "line 3" is useless.
+            at = (*path, int(written[vertex]))
+            line, col = locate(at)
+            where = {**where, "line": line, "col": col, "path": json_path(at)}
         return None, [
             error(
                 "G004",
@@ -121,6 +169,7 @@ def check_shape(
                 **where,
             )
         ]
+    points = tuple(map(tuple, array.tolist()))
     return CheckedShape(points=points, polygon=polygon, path=path), []
 
 

@@ -7,12 +7,15 @@ where they would be meaningless (the geometry of a shape that failed the schema,
 from __future__ import annotations
 
 import difflib
+import gc
 import re
 from collections.abc import Mapping
+from itertools import chain
 from pathlib import Path as FilePath
 from typing import Any
 
 import jsonschema
+import numpy as np
 from jsonschema.exceptions import ValidationError, best_match
 
 from tlmpc.artifacts import load_schema
@@ -26,8 +29,10 @@ from tlmpc.mission.yamlpos import Path, PositionedDocument, json_path, load_posi
 from tlmpc.tasks.compiler import compile_phrases
 
 #: Files larger than this are refused while reading, before parsing (Example 8, a thousand
-#: rooms, is 52 KB; a 10^5-vertex boundary 2.4 MB).
-MAX_BYTES = 16 * 1024 * 1024
+#: rooms, is 52 KB; a 10^6-vertex boundary 24 to 45 MB, depending on the digits written).
+MAX_BYTES = 256 * 1024 * 1024
+#: Read in pieces of this size, so an endless stream stops at the limit, not at its end.
+_CHUNK = 4 * 1024 * 1024
 
 
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
@@ -50,28 +55,31 @@ def _plain_shape(value: Any) -> bool:
             and len(rect) == 4
             and all(_number(v) for v in rect)
         )
-    return (
-        isinstance(value, list)
-        and len(value) >= 3
-        and all(
-            isinstance(p, list) and len(p) == 2 and _number(p[0]) and _number(p[1]) for p in value
-        )
-    )
+    if not isinstance(value, list) or len(value) < 3:
+        return False
+    # Type by type at C speed (a boundary may have a million points): every point a list of
+    # two ints or floats (not bools), each at most 1e9 in size.
+    if set(map(type, value)) != {list} or set(map(len, value)) != {2}:
+        return False
+    coordinates = list(chain.from_iterable(value))
+    if not set(map(type, coordinates)) <= {int, float}:
+        return False
+    return bool(np.abs(np.asarray(coordinates, dtype=float)).max() <= 1e9)
 
 
 _STAND_IN = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]
 
 
-def _small_component(component: Any) -> Any:
-    """A workspace component with plain shapes replaced by a small stand-in (see below)."""
+def _small_component(component: Any, path: Path, bad: list[Path]) -> Any:
+    """A workspace component with its shapes replaced by small stand-ins (see ``_small``)."""
     if not isinstance(component, dict):
         return component
     small = dict(component)
-    if _plain_shape(small.get("boundary")):
-        small["boundary"] = _STAND_IN
+    if "boundary" in small:
+        small["boundary"] = _small(small["boundary"], (*path, "boundary"), bad)
     holes = small.get("holes")
     if isinstance(holes, list):
-        small["holes"] = [_STAND_IN if _plain_shape(h) else h for h in holes]
+        small["holes"] = [_small(h, (*path, "holes", i), bad) for i, h in enumerate(holes)]
     return small
 
 
@@ -92,28 +100,66 @@ def _schema_diagnostics(doc: PositionedDocument, file: str) -> list[Diagnostic]:
         # a hundred times faster than descending into every region).
         first = next(iter(regions))
         data = {**data, "regions": {first: regions[first]}}
+    bad: list[Path] = []
     workspace = data.get("workspace") if isinstance(data, dict) else None
     if isinstance(workspace, dict):
         # A boundary or hole with 10^5 vertices: the schema would descend into every point
         # (a minute); a plain shape has the schema's shape, so validate a small stand-in.
         small = dict(workspace)
-        if _plain_shape(small.get("boundary")):
-            small["boundary"] = _STAND_IN
+        if "boundary" in small:
+            small["boundary"] = _small(small["boundary"], ("workspace", "boundary"), bad)
         holes = small.get("holes")
         if isinstance(holes, list):
-            small["holes"] = [_STAND_IN if _plain_shape(h) else h for h in holes]
+            small["holes"] = [
+                _small(h, ("workspace", "holes", i), bad) for i, h in enumerate(holes)
+            ]
         components = small.get("components")
         if isinstance(components, list):
-            small["components"] = [_small_component(c) for c in components]
+            small["components"] = [
+                _small_component(c, ("workspace", "components", i), bad)
+                for i, c in enumerate(components)
+            ]
         data = {**data, "workspace": small}
-    problems: list[Diagnostic] = []
+    problems = [p for path in bad for p in _point_problem(path, doc, file)]
     for err in validator.iter_errors(data):
         problems.extend(_describe(err, doc, file))
     return problems
 
 
-def _describe(err: ValidationError, doc: PositionedDocument, file: str) -> list[Diagnostic]:
-    path: Path = tuple(err.absolute_path)
+#: Point lists longer than this with a bad point are checked point by point, not by the schema.
+_LONG = 1000
+
+
+def _small(shape: Any, path: Path, bad: list[Path]) -> Any:
+    """A stand-in for a long point list: three points; a bad point's path goes to ``bad``."""
+    if _plain_shape(shape):
+        return _STAND_IN
+    if not isinstance(shape, list) or len(shape) <= _LONG:
+        return shape
+    for index, point in enumerate(shape):
+        if not (
+            isinstance(point, list) and len(point) == 2 and _number(point[0]) and _number(point[1])
+        ):
+            bad.append((*path, index))  # the first bad point, as the schema reports one
+            break
+    return _STAND_IN
+
+
+def _point_problem(path: Path, doc: PositionedDocument, file: str) -> list[Diagnostic]:
+    """The schema's verdict on the point at ``path`` alone, described at its place."""
+    point: Any = doc.data
+    for part in path:
+        point = point[part]
+    definitions: Any = load_schema("mission")["$defs"]
+    schema = {"$ref": "#/$defs/point", "$defs": definitions}
+    alone = jsonschema.Draft202012Validator(schema)
+    return [d for err in alone.iter_errors(point) for d in _describe(err, doc, file, path)]
+
+
+def _describe(
+    err: ValidationError, doc: PositionedDocument, file: str, prefix: Path = ()
+) -> list[Diagnostic]:
+    path: Path = (*prefix, *err.absolute_path)
     if err.validator == "additionalProperties" and isinstance(err.instance, dict):
         schema: Any = err.schema
         allowed = list(schema.get("properties", {}))
@@ -157,7 +203,7 @@ def _describe(err: ValidationError, doc: PositionedDocument, file: str) -> list[
         if deepest is not None and not isinstance(err.instance, list | dict):
             deepest = err
         if deepest is not None and deepest is not err:
-            return _describe(deepest, doc, file)
+            return _describe(deepest, doc, file, prefix)
         line, col = doc.value_at(path)
         return [
             error(
@@ -468,6 +514,18 @@ def _groups(
 
 
 def _load(text: str, file: str, stem: str) -> tuple[Mission | None, list[Diagnostic]]:
+    # Reading a large map builds millions of small lists and tuples, none of them in a cycle;
+    # the cyclic collector would walk the growing heap again and again (half the time).
+    paused = gc.isenabled()
+    gc.disable()
+    try:
+        return _load_data(text, file, stem)
+    finally:
+        if paused:
+            gc.enable()
+
+
+def _load_data(text: str, file: str, stem: str) -> tuple[Mission | None, list[Diagnostic]]:
     doc, problems = load_positioned(text, file)
     if doc is None:
         return None, problems
@@ -560,7 +618,12 @@ def _read(path: str | FilePath) -> str:
     file = str(path)
     try:
         with open(path, "rb") as stream:  # a bounded read: never read() whole
-            raw = stream.read(MAX_BYTES + 1)
+            raw = bytearray()
+            while len(raw) <= MAX_BYTES:
+                piece = stream.read(min(_CHUNK, MAX_BYTES + 1 - len(raw)))
+                if not piece:
+                    break
+                raw += piece
     except OSError as exc:
         raise UsageError(
             error(

@@ -17,6 +17,7 @@ from typing import Any
 import yaml
 
 from tlmpc.errors import Diagnostic, error
+from tlmpc.mission.bulk import STEM, BulkList, cut_out
 
 Path = tuple[str | int, ...]
 
@@ -39,12 +40,16 @@ class PositionedDocument:
     keys: dict[Path, tuple[int, int]] = field(default_factory=dict)
     quoted: dict[Path, bool] = field(default_factory=dict)
     block: dict[Path, bool] = field(default_factory=dict)
+    #: Long number lists read in bulk: positions inside them are found on demand.
+    bulk: dict[Path, BulkList] = field(default_factory=dict)
 
     def value_at(self, path: Path) -> tuple[int, int]:
         """Position of the value at ``path``, or of its deepest known ancestor."""
         for cut in range(len(path), -1, -1):
-            if path[:cut] in self.values:
-                return self.values[path[:cut]]
+            prefix = path[:cut]
+            if prefix in self.values:
+                inside = self.bulk[prefix].locate(path[cut:]) if prefix in self.bulk else None
+                return inside or self.values[prefix]
         return (1, 1)
 
     def key_at(self, path: Path) -> tuple[int, int]:
@@ -107,8 +112,12 @@ class _Converter:
     additions.  Aliased data is shared, never copied; positions inside it are the alias's.
     """
 
-    def __init__(self, file: str) -> None:
+    def __init__(self, file: str, lists: dict[str, BulkList] | None = None) -> None:
         self.file = file
+        #: Lists cut out of the text (see tlmpc.mission.bulk) by placeholder, until met.
+        self.lists = dict(lists or {})
+        #: A placeholder was met where a whole list could not be: read the original text.
+        self.mismatch = False
         self.doc = PositionedDocument(data=None)
         self.problems: list[Diagnostic] = []
         self.count = 0
@@ -240,6 +249,9 @@ class _Converter:
                 )
                 raise _TooBig
             self.doc.values[path] = _mark(event)
+            if self.lists and isinstance(event, yaml.ScalarEvent) and STEM in event.value:
+                self._bulk(parent, event, path)
+                continue
             if isinstance(event, yaml.ScalarEvent):
                 self.doc.quoted[path] = event.style in ("'", '"')
                 self.doc.block[path] = event.style in ("|", ">")
@@ -260,7 +272,8 @@ class _Converter:
                 "Y003",
                 f"the document is too large (more than {MAX_NODES:,} values, aliases expanded)",
                 event,
-                hint="missions do not need YAML aliases; split very large maps",
+                hint="missions do not need YAML aliases; write long point lists as one flow "
+                "list of plain decimals, [[x, y], ...] (read in bulk, not value by value)",
             )
             raise _TooBig
 
@@ -285,6 +298,8 @@ class _Converter:
             parent.key = _BAD_KEY
             return
         key = str(event.value)
+        if self.lists and STEM in key:
+            self.mismatch = True
         if key in parent.seen:
             first = parent.seen[key]
             self.problem(
@@ -300,6 +315,27 @@ class _Converter:
         parent.seen[key] = _mark(event)
         self.doc.keys[(*parent.path, key)] = _mark(event)
         parent.key = key
+
+    def _bulk(self, parent: _Frame | None, event: Any, path: Path) -> None:
+        """Put the list cut out for the placeholder ``event`` in its place."""
+        bulk = self.lists.pop(event.value, None)
+        if (
+            bulk is None
+            or event.style
+            or event.tag is not None
+            or len(path) + bulk.depth > MAX_DEPTH
+        ):
+            self.mismatch = True  # not a whole list in a value's place: read the original
+            self._store(parent, None, 1)
+            return
+        # The list's "[" (the event starts at an anchor, when there is one).
+        bulk.line = event.end_mark.line + 1
+        bulk.col = event.end_mark.column + 1 - len(bulk.placeholder)
+        self.doc.bulk[path] = bulk
+        self.doc.quoted[path] = self.doc.block[path] = False
+        if event.anchor is not None:
+            self.anchors[event.anchor] = (bulk.value, bulk.values)
+        self._store(parent, bulk.value, bulk.values)
 
     def _store(self, parent: _Frame | None, value: Any, size: int) -> None:
         if parent is None:
@@ -327,25 +363,61 @@ def _as_yaml_float(text: str) -> str:
 
 def load_positioned(text: str, file: str) -> tuple[PositionedDocument | None, list[Diagnostic]]:
     """Parse YAML ``text``; return the data with positions, or None and the diagnostics."""
+    cut, lists = cut_out(text)
+    if lists:
+        converter = _Converter(file, lists)
+        outcome = _convert(converter, cut)
+        # The answer stands when every placeholder met was a whole list in a value's place:
+        # the text up to where reading stopped then means the same as the original.
+        if not converter.mismatch:
+            if isinstance(outcome, yaml.YAMLError):
+                mark = getattr(outcome, "problem_mark", None)
+                if mark is not None and not _unmet_before(converter, cut, mark):
+                    return _result(converter, outcome, file)
+            elif outcome is None or not converter.lists:  # a limit stopped it, or all met
+                return _result(converter, outcome, file)
     converter = _Converter(file)
+    return _result(converter, _convert(converter, text), file)
+
+
+def _unmet_before(converter: _Converter, cut: str, mark: Any) -> bool:
+    """Whether a list not yet met starts on or before the line of ``mark``."""
+    for bulk in converter.lists.values():
+        start = cut.find(bulk.placeholder)
+        if cut.count("\n", 0, start) <= mark.line:
+            return True
+    return False
+
+
+def _convert(converter: _Converter, text: str) -> bool | yaml.YAMLError | None:
+    """Whether ``text`` held a document; None when a limit stopped reading; or the error."""
     try:
-        found = converter.convert(yaml.parse(text, Loader=_LOADER))
+        return converter.convert(yaml.parse(text, Loader=_LOADER))
     except _TooBig:
+        return None
+    except yaml.YAMLError as exc:
+        return exc
+
+
+def _result(
+    converter: _Converter, outcome: bool | yaml.YAMLError | None, file: str
+) -> tuple[PositionedDocument | None, list[Diagnostic]]:
+    if outcome is None:
         return None, converter.problems
-    except yaml.MarkedYAMLError as exc:
-        mark = exc.problem_mark or exc.context_mark
+    if isinstance(outcome, yaml.MarkedYAMLError):
+        mark = outcome.problem_mark or outcome.context_mark
         line = mark.line + 1 if mark is not None else 1
         col = mark.column + 1 if mark is not None else 1
-        problem = exc.problem or "invalid YAML"
+        problem = outcome.problem or "invalid YAML"
         hint = "check indentation (spaces only, no tabs), quotes and brackets"
         if "\t" in problem or "tab" in problem:
             hint = "YAML does not allow tabs for indentation: use spaces"
         return None, [
             error("Y001", f"YAML syntax error: {problem}", hint=hint, file=file, line=line, col=col)
         ]
-    except yaml.YAMLError as exc:
-        return None, [error("Y001", f"YAML syntax error: {exc}", file=file, line=1, col=1)]
-    if not found or (converter.doc.data is None and not converter.problems):
+    if isinstance(outcome, yaml.YAMLError):
+        return None, [error("Y001", f"YAML syntax error: {outcome}", file=file, line=1, col=1)]
+    if not outcome or (converter.doc.data is None and not converter.problems):
         return None, [
             error(
                 "Y007",
