@@ -372,7 +372,11 @@ def load_positioned(text: str, file: str) -> tuple[PositionedDocument | None, li
         if not converter.mismatch:
             if isinstance(outcome, yaml.YAMLError):
                 mark = getattr(outcome, "problem_mark", None)
-                if mark is not None and not _unmet_before(converter, cut, mark):
+                if (
+                    mark is not None
+                    and not _unmet_before(converter, cut, mark)
+                    and not _ends_on_line(converter, mark)
+                ):
                     return _result(converter, outcome, file)
             elif outcome is None or not converter.lists:  # a limit stopped it, or all met
                 return _result(converter, outcome, file)
@@ -387,6 +391,15 @@ def _unmet_before(converter: _Converter, cut: str, mark: Any) -> bool:
         if cut.count("\n", 0, start) <= mark.line:
             return True
     return False
+
+
+def _ends_on_line(converter: _Converter, mark: Any) -> bool:
+    """Whether a list read in bulk ends on the line of ``mark``: the error may be about what
+    follows the list (a multi-line list used as a key, say), which the stand-in does not
+    reproduce word for word."""
+    return any(
+        bulk.line + bulk.text.count("\n") == mark.line + 1 for bulk in converter.doc.bulk.values()
+    )
 
 
 def _convert(converter: _Converter, text: str) -> bool | yaml.YAMLError | None:
