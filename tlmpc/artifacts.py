@@ -37,6 +37,10 @@ def load_schema(name: str) -> dict[str, Any]:
 
 def validation_errors(document: Any, name: str) -> list[str]:
     """Messages for every way ``document`` violates schema ``name`` (empty when valid)."""
+    from tlmpc.schema_check import is_valid
+
+    if is_valid(document, name):
+        return []  # jsonschema is imported only to word the problems
     import jsonschema
 
     validator = jsonschema.Draft202012Validator(load_schema(name))

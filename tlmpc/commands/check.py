@@ -101,31 +101,21 @@ def _scopes(mission: Any) -> list[str]:
 
 def _contradictions(path: Path, mission: Any) -> list[Any]:
     """A T011/L020 diagnostic when no behaviour at all satisfies the mission's task."""
-    from tlmpc.ltl import parse_ltl
-    from tlmpc.mission.yamlpos import load_positioned
     from tlmpc.tasks import compile_phrase
     from tlmpc.tasks.contradiction import TaskPart, find_contradiction
 
     file = str(path)
-    doc, _ = load_positioned(path.read_text(encoding="utf-8"), file)
     parts: list[TaskPart] = []
-
-    def where(key: tuple[str | int, ...]) -> tuple[int, int]:
-        if doc is None:
-            return (1, 1)
-        line, col = doc.value_at(key)
-        if doc.quoted.get(key):
-            col += 1
-        if doc.block.get(key):
-            line, col = line + 1, 1
-        return line, col
-
+    # where each phrase, then the `ltl` string, starts: the loader kept them (no second read)
+    positions = list(mission.task_positions)
     for index, phrase in enumerate(mission.task):
-        line, col = where(("task", index))
+        line, col = positions[index]
         formula = compile_phrase(phrase, groups=mission.groups, file=file, line=line, col=col)
         parts.append(TaskPart(formula=formula, text=phrase, kind="phrase", line=line, col=col))
     if mission.ltl and mission.ltl.strip():
-        line, col = where(("ltl",))
+        from tlmpc.ltl.parser import parse_ltl  # lark: only for missions with `ltl`
+
+        line, col = positions[len(mission.task)]
         parts.append(
             TaskPart(formula=parse_ltl(mission.ltl), text=mission.ltl.strip(), kind="ltl",
                      line=line, col=col)

@@ -1,18 +1,18 @@
-"""Geometry checks of a mission with shapely: shapes, holes, regions, start point."""
+"""Geometry checks of a mission: shapes, holes, regions, start point.
+
+Shapely decides; small plain missions (no holes, a rectangular boundary, polygons of a few
+dozen vertices) are decided exactly in pure Python first (:mod:`tlmpc.mission.plain_geometry`),
+so that ``tlmpc check`` of such a mission imports neither shapely nor numpy.
+"""
 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any
-
-import numpy as np
-import shapely
-from shapely.geometry import Point as ShapelyPoint
-from shapely.geometry import Polygon as ShapelyPolygon
-from shapely.validation import explain_validity
+from typing import TYPE_CHECKING, Any
 
 from tlmpc.errors import Diagnostic, error
+from tlmpc.mission import plain_geometry
 from tlmpc.mission.model import Polygon
 from tlmpc.mission.yamlpos import Path, json_path
 
@@ -20,6 +20,9 @@ from tlmpc.mission.yamlpos import Path, json_path
 AREA_TOLERANCE = 1e-12
 
 Locate = Callable[[Path], tuple[int, int]]
+
+if TYPE_CHECKING:
+    from shapely.geometry import Polygon as ShapelyPolygon
 
 
 def shape_points(shape: Any) -> Polygon:
@@ -49,11 +52,23 @@ def _collinear(points: Polygon, size: float) -> bool:
 
 @dataclass(frozen=True, slots=True)
 class CheckedShape:
-    """A shape that passed its own checks, as points and as a shapely polygon."""
+    """A shape that passed its own checks, as points and (built on first use) a shapely polygon."""
 
     points: Polygon
-    polygon: ShapelyPolygon
+    polygon: ShapelyPolygon | None
     path: Path
+
+
+def shapely_polygon(shape: CheckedShape) -> ShapelyPolygon:
+    """The shape's shapely polygon, built once when a check first needs it."""
+    if shape.polygon is None:
+        import numpy as np
+        import shapely
+
+        # shapely.polygons on an array is linear in the vertices, unlike a list of tuples
+        object.__setattr__(shape, "polygon", shapely.polygons(np.asarray(shape.points, float)))
+    assert shape.polygon is not None
+    return shape.polygon
 
 
 def check_shape(
@@ -79,7 +94,7 @@ def check_shape(
             # A proper rect is simple, valid and not collinear: skip the general checks
             # (Example 8's 1,156 rect regions cost a third of the load stage).
             points = shape_points(shape)
-            return CheckedShape(points=points, polygon=ShapelyPolygon(points), path=path), []
+            return CheckedShape(points=points, polygon=None, path=path), []
     points = shape_points(shape)
     if len(set(points)) < 3:
         return None, [
@@ -90,9 +105,9 @@ def check_shape(
                 **where,
             )
         ]
-    polygon = shapely.polygons(np.asarray(points, dtype=float))  # linear, unlike a list
-    minx, miny, maxx, maxy = polygon.bounds
-    size = max(maxx - minx, maxy - miny, 1e-300)
+    xs = [p[0] for p in points]
+    ys = [p[1] for p in points]
+    size = max(max(xs) - min(xs), max(ys) - min(ys), 1e-300)
     if _collinear(points, size):
         return None, [
             error(
@@ -102,7 +117,15 @@ def check_shape(
                 **where,
             )
         ]
+    checked = CheckedShape(points=points, polygon=None, path=path)
+    if plain_geometry.certainly_simple(points) and abs(
+        plain_geometry.shoelace_area(points)
+    ) > 2 * AREA_TOLERANCE * size * size:
+        return checked, []  # what shapely would say: valid, with an area well above zero
+    polygon = shapely_polygon(checked)
     if not polygon.is_valid:
+        from shapely.validation import explain_validity
+
         reason = explain_validity(polygon)
         return None, [
             error(
@@ -121,7 +144,7 @@ def check_shape(
                 **where,
             )
         ]
-    return CheckedShape(points=points, polygon=polygon, path=path), []
+    return checked, []
 
 
 def check_layout(
@@ -140,17 +163,45 @@ def check_layout(
         line, col = locate(path)
         return error(code, message, hint=hint, file=file, line=line, col=col, path=json_path(path))
 
+    rect = plain_geometry.axis_rectangle(boundary.points) if boundary is not None else None
+    if rect is not None and not holes:
+        # A rectangular workspace without holes: containment in a closed convex shape is
+        # exactly "every vertex inside", decided by comparisons alone (what shapely answers)
+        for name, region in regions.items():
+            if not plain_geometry.inside_rectangle(region.points, rect):
+                problems.append(
+                    at(
+                        region.path,
+                        "G007",
+                        f"region {name!r} extends outside the workspace boundary",
+                        "regions must lie inside the boundary; clip the region",
+                    )
+                )
+        if start is not None and not plain_geometry.inside_rectangle([start], rect):
+            problems.append(
+                at(
+                    start_path,
+                    "G009",
+                    f"the start point ({start[0]:g}, "
+                    f"{start[1]:g}) is outside the workspace boundary",
+                    "the robot must start in the free workspace",
+                )
+            )
+        return problems
+    import shapely
+    from shapely.geometry import Point as ShapelyPoint
+
     # Near-linear on large inputs: the boundary is prepared once (an indexed edge set, so each
     # containment test is logarithmic in its vertices), and overlap tests run only on pairs a
     # spatial index reports as candidates, never on all pairs.
-    hole_union = shapely.union_all([h.polygon for h in holes]) if holes else None
+    hole_union = shapely.union_all([shapely_polygon(h) for h in holes]) if holes else None
     if hole_union is not None:
         shapely.prepare(hole_union)
     if boundary is not None:
-        outer = boundary.polygon
+        outer = shapely_polygon(boundary)
         shapely.prepare(outer)
         for index, hole in enumerate(holes):
-            if not outer.covers(hole.polygon):
+            if not outer.covers(shapely_polygon(hole)):
                 problems.append(
                     at(
                         hole.path,
@@ -160,7 +211,7 @@ def check_layout(
                     )
                 )
         for name, region in regions.items():
-            if not outer.covers(region.polygon):
+            if not outer.covers(shapely_polygon(region)):
                 problems.append(
                     at(
                         region.path,
@@ -172,10 +223,10 @@ def check_layout(
     # overlapping or touching holes are merged later, with a note (tlmpc.mission.holes)
     if hole_union is not None:
         for name, region in regions.items():
-            if not hole_union.intersects(region.polygon):
+            if not hole_union.intersects(shapely_polygon(region)):
                 continue
-            free = region.polygon.difference(hole_union)
-            if free.area <= AREA_TOLERANCE * region.polygon.area:
+            free = shapely_polygon(region).difference(hole_union)
+            if free.area <= AREA_TOLERANCE * shapely_polygon(region).area:
                 problems.append(
                     at(
                         region.path,
@@ -187,7 +238,7 @@ def check_layout(
                 )
     if start is not None:
         point = ShapelyPoint(start)
-        if boundary is not None and not boundary.polygon.covers(point):
+        if boundary is not None and not shapely_polygon(boundary).covers(point):
             problems.append(
                 at(
                     start_path,

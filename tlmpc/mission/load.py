@@ -10,19 +10,20 @@ import difflib
 import re
 from collections.abc import Mapping
 from pathlib import Path as FilePath
-from typing import Any
-
-import jsonschema
-from jsonschema.exceptions import ValidationError, best_match
+from typing import TYPE_CHECKING, Any
 
 from tlmpc.artifacts import load_schema
 from tlmpc.errors import Diagnostic, InvalidInputError, UsageError, best_first, error
 from tlmpc.ltl.ast import Formula, Or, Prop, conjoin
-from tlmpc.ltl.parser import KEYWORDS, parse_ltl
+from tlmpc.ltl.keywords import KEYWORDS
 from tlmpc.ltl.transform import substitute
 from tlmpc.mission.geometry import CheckedShape, check_layout, check_shape
 from tlmpc.mission.model import Mission, Options, Region, Robot, Workspace
 from tlmpc.mission.yamlpos import Path, PositionedDocument, json_path, load_positioned
+from tlmpc.schema_check import is_valid
+
+if TYPE_CHECKING:
+    from jsonschema.exceptions import ValidationError
 from tlmpc.tasks.compiler import compile_phrases
 
 #: Files larger than this are refused while reading, before parsing (Example 8, a thousand
@@ -60,7 +61,6 @@ _STAND_IN = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]
 
 
 def _schema_diagnostics(doc: PositionedDocument, file: str) -> list[Diagnostic]:
-    validator = jsonschema.Draft202012Validator(load_schema("mission"))
     data = doc.data
     regions = data.get("regions") if isinstance(data, dict) else None
     if (
@@ -87,6 +87,11 @@ def _schema_diagnostics(doc: PositionedDocument, file: str) -> list[Diagnostic]:
         if isinstance(holes, list):
             small["holes"] = [_STAND_IN if _plain_shape(h) else h for h in holes]
         data = {**data, "workspace": small}
+    if is_valid(data, "mission"):
+        return []  # jsonschema (a tenth of a second to import) is needed only to word problems
+    import jsonschema
+
+    validator = jsonschema.Draft202012Validator(load_schema("mission"))
     problems: list[Diagnostic] = []
     for err in validator.iter_errors(data):
         problems.extend(_describe(err, doc, file))
@@ -134,6 +139,8 @@ def _describe(err: ValidationError, doc: PositionedDocument, file: str) -> list[
                     path=json_path(path),
                 )
             ]
+        from jsonschema.exceptions import best_match
+
         deepest = best_match(err.context)
         if deepest is not None and not isinstance(err.instance, list | dict):
             deepest = err
@@ -247,6 +254,8 @@ def _check_task(
             )
         )
     if isinstance(ltl, str) and ltl.strip():
+        from tlmpc.ltl.parser import parse_ltl  # lark: only for missions with `ltl`
+
         line, col = _ltl_position(doc, ("ltl",))
         try:
             parts.append(parse_ltl(ltl, file=file, line=line, col=col))
