@@ -91,7 +91,7 @@ class _Compiler:
             return checks[0]
         return lambda v: all(check(v) for check in checks)
 
-    def keyword(self, key: str, value: Any, schema: Mapping[str, Any]) -> Check:  # noqa: C901
+    def keyword(self, key: str, value: Any, schema: Mapping[str, Any]) -> Check:
         if key == "$ref":
             return self.ref(value)
         if key == "type":
