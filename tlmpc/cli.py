@@ -55,8 +55,12 @@ def _command(name: str) -> ModuleType:
     return importlib.import_module(f"tlmpc.commands.{name}")
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The argparse parser with every subcommand registered."""
+def build_parser(only: str | None = None) -> argparse.ArgumentParser:
+    """The argparse parser with every subcommand registered.
+
+    With ``only``, only that subcommand gets its arguments (the run parses no other; some
+    commands' flags import modules, e.g. ``compile --until`` lists the pipeline's stages).
+    """
     parser = argparse.ArgumentParser(
         prog="tlmpc",
         description="Temporal logic motion planning compiler and verifier.",
@@ -75,7 +79,8 @@ def build_parser() -> argparse.ArgumentParser:
             epilog=EPILOG,
             formatter_class=argparse.RawDescriptionHelpFormatter,
         )
-        module.add_arguments(command_parser)
+        if only is None or only == module.NAME:
+            module.add_arguments(command_parser)
         command_parser.set_defaults(_run=module.run)
     return parser
 
@@ -200,7 +205,8 @@ def main(
 
 
 def _main(argv: Sequence[str] | None, out: TextIO, err: TextIO) -> int:
-    parser = build_parser()
+    words = sys.argv[1:] if argv is None else list(argv)
+    parser = build_parser(only=next((w for w in words if not w.startswith("-")), None))
     try:
         with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
             args = parser.parse_args(None if argv is None else list(argv))

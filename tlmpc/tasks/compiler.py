@@ -86,6 +86,7 @@ class PhraseSyntaxError(Exception):
         self.column = column
 
 
+@functools.lru_cache(maxsize=4096)  # trees are immutable; a check compiles each phrase thrice
 def parse_tree(phrase: str) -> Node:
     """The parse tree of one phrase (rule ``start``); :class:`PhraseSyntaxError` when none.
 
