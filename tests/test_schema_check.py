@@ -164,3 +164,12 @@ def test_json_equality_keeps_true_apart_from_one() -> None:
     assert _equal(1, 1.0)
     assert _equal([1, {"a": None}], [1.0, {"a": None}])
     assert not _equal(math.nan, 0)
+
+
+@pytest.mark.parametrize(("value", "valid"), [(2, True), (2.0, True), (2.5, False), (True, False),
+                                               (-1, False), ("2", False)])
+def test_integer_items_as_jsonschema_reads_them(value: Any, valid: bool) -> None:
+    witness = copy.deepcopy(_artifacts()["witness.json"])
+    witness["cycle"] = [value]
+    assert _oracle(witness, "witness") is valid
+    assert is_valid(witness, "witness") is valid
