@@ -9,11 +9,11 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING, Any
 
-# imported now: the submodule of the same name would otherwise shadow the function
+# imported now: the submodules of the same names would otherwise shadow the functions
+from tlmpc.automata.degeneralize import degeneralize
 from tlmpc.automata.translate import translate
 
 if TYPE_CHECKING:
-    from tlmpc.automata.degeneralize import degeneralize
     from tlmpc.automata.guards import guard_holds, successor_table
     from tlmpc.automata.hoa import parse_hoa, to_dot, to_hoa
     from tlmpc.automata.io import automaton_from_json, automaton_to_json
@@ -24,7 +24,6 @@ _HOMES = {
     "Edge": "tlmpc.automata.model",
     "automaton_from_json": "tlmpc.automata.io",
     "automaton_to_json": "tlmpc.automata.io",
-    "degeneralize": "tlmpc.automata.degeneralize",
     "guard_holds": "tlmpc.automata.guards",
     "parse_hoa": "tlmpc.automata.hoa",
     "successor_table": "tlmpc.automata.guards",
