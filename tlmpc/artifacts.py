@@ -11,7 +11,6 @@ import functools
 import json
 import math
 import re
-from importlib import resources
 from pathlib import Path
 from typing import Any
 
@@ -20,6 +19,12 @@ from tlmpc.errors import UsageError, error
 
 def schema_dir() -> Path:
     """The folder holding the JSON Schemas (packaged copy first, then the source tree)."""
+    package = Path(__file__).resolve().parent
+    for folder in (package / "schemas", package.parent / "schemas"):  # installed, source tree
+        if folder.is_dir():
+            return folder
+    from importlib import resources  # not at the top: it imports tempfile, shutil, random
+
     packaged = resources.files("tlmpc") / "schemas"
     if packaged.is_dir():
         return Path(str(packaged))

@@ -11,7 +11,6 @@ from __future__ import annotations
 import difflib
 import functools
 from collections.abc import Mapping, Sequence
-from importlib import resources
 from typing import TYPE_CHECKING, Any
 
 from tlmpc.errors import Diagnostic, InvalidInputError, error
@@ -59,6 +58,8 @@ _LEADING_WORDS = ("visit", "avoid", "never", "patrol", "stay", "eventually", "al
 
 @functools.cache
 def _parser() -> Lark:
+    from importlib import resources
+
     from lark import Lark
 
     grammar = (resources.files("tlmpc.tasks") / "tasks.lark").read_text(encoding="utf-8")
