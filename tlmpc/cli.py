@@ -58,9 +58,13 @@ def _command(name: str) -> ModuleType:
 def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     """The argparse parser with every subcommand registered.
 
-    With ``only``, only that subcommand gets its arguments (the run parses no other; some
-    commands' flags import modules, e.g. ``compile --until`` lists the pipeline's stages).
+    With ``only`` naming a command, only that subcommand is registered (the run parses no
+    other; some commands' flags import modules, e.g. ``compile --until`` lists the pipeline's
+    stages); with any other ``only`` (a typo), every command is listed, without arguments, so
+    that argparse can name the valid choices.
     """
+    wanted = only.replace("-", "_") if only is not None and "_" not in only else None
+    known = wanted in COMMAND_MODULES
     parser = argparse.ArgumentParser(
         prog="tlmpc",
         description="Temporal logic motion planning compiler and verifier.",
@@ -71,6 +75,8 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
     for name in COMMAND_MODULES:
+        if known and name != wanted:
+            continue
         module = _command(name)
         command_parser = sub.add_parser(
             module.NAME,
