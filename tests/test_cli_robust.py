@@ -79,7 +79,7 @@ def test_sigterm_during_compile_leaves_no_temporary_folder(tmp_path: Path) -> No
 
 
 def test_ctrl_c_during_start_up_is_130(monkeypatch: pytest.MonkeyPatch) -> None:
-    def interrupted() -> None:
+    def interrupted(only: str | None = None) -> None:
         raise KeyboardInterrupt
 
     monkeypatch.setattr(cli, "build_parser", interrupted)

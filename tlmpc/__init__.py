@@ -11,17 +11,12 @@ The Python facade (see ``docs/python-api.md``)::
     tlmpc.verify_trace(result).satisfied
 """
 
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
 __version__ = "0.1.0"
 
-from tlmpc.api import (
-    Compiled,
-    check,
-    compile,
-    executor,
-    read_output,
-    translate,
-    verify_trace,
-)
 from tlmpc.errors import (
     Diagnostic,
     InvalidInputError,
@@ -30,6 +25,31 @@ from tlmpc.errors import (
     TlmpcError,
     UsageError,
 )
+
+if TYPE_CHECKING:
+    from tlmpc.api import (
+        Compiled,
+        check,
+        compile,
+        executor,
+        read_output,
+        translate,
+        verify_trace,
+    )
+
+_FACADE = frozenset(
+    {"Compiled", "check", "compile", "executor", "read_output", "translate", "verify_trace"}
+)
+
+
+def __getattr__(name: str) -> Any:
+    # the facade is loaded on first use: the command line does not need it to start
+    if name in _FACADE:
+        from tlmpc import api
+
+        return getattr(api, name)
+    raise AttributeError(f"module 'tlmpc' has no attribute {name!r}")
+
 
 __all__ = [
     "Compiled",

@@ -11,7 +11,6 @@ import functools
 import json
 import math
 import re
-from importlib import resources
 from pathlib import Path
 from typing import Any
 
@@ -20,6 +19,12 @@ from tlmpc.errors import UsageError, error
 
 def schema_dir() -> Path:
     """The folder holding the JSON Schemas (packaged copy first, then the source tree)."""
+    package = Path(__file__).resolve().parent
+    for folder in (package / "schemas", package.parent / "schemas"):  # installed, source tree
+        if folder.is_dir():
+            return folder
+    from importlib import resources  # not at the top: it imports tempfile, shutil, random
+
     packaged = resources.files("tlmpc") / "schemas"
     if packaged.is_dir():
         return Path(str(packaged))
@@ -37,6 +42,10 @@ def load_schema(name: str) -> dict[str, Any]:
 
 def validation_errors(document: Any, name: str) -> list[str]:
     """Messages for every way ``document`` violates schema ``name`` (empty when valid)."""
+    from tlmpc.schema_check import is_valid
+
+    if is_valid(document, name):
+        return []  # jsonschema is imported only to word the problems
     import jsonschema
 
     validator = jsonschema.Draft202012Validator(load_schema(name))

@@ -50,8 +50,16 @@ def _command(name: str) -> ModuleType:
     return importlib.import_module(f"tlmpc.commands.{name}")
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The argparse parser with every subcommand registered."""
+def build_parser(only: str | None = None) -> argparse.ArgumentParser:
+    """The argparse parser with every subcommand registered.
+
+    With ``only`` naming a command, only that subcommand is registered (the run parses no
+    other; some commands' flags import modules, e.g. ``compile --until`` lists the pipeline's
+    stages); with any other ``only`` (a typo), every command is listed, without arguments, so
+    that argparse can name the valid choices.
+    """
+    wanted = only.replace("-", "_") if only is not None and "_" not in only else None
+    known = wanted in COMMAND_MODULES
     parser = argparse.ArgumentParser(
         prog="tlmpc",
         description="Temporal logic motion planning compiler and verifier.",
@@ -62,6 +70,8 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
     for name in COMMAND_MODULES:
+        if known and name != wanted:
+            continue
         module = _command(name)
         command_parser = sub.add_parser(
             module.NAME,
@@ -70,7 +80,8 @@ def build_parser() -> argparse.ArgumentParser:
             epilog=EPILOG,
             formatter_class=argparse.RawDescriptionHelpFormatter,
         )
-        module.add_arguments(command_parser)
+        if only is None or only == module.NAME:
+            module.add_arguments(command_parser)
         command_parser.set_defaults(_run=module.run)
     return parser
 
@@ -180,8 +191,8 @@ def main(
 
 
 def _main(argv: Sequence[str] | None, out: TextIO, err: TextIO) -> int:
-    parser = build_parser()
     arguments = list(sys.argv[1:] if argv is None else argv)
+    parser = build_parser(only=next((w for w in arguments if not w.startswith("-")), None))
     usage = io.StringIO()
     try:
         with contextlib.redirect_stdout(out), contextlib.redirect_stderr(usage):

@@ -9,16 +9,16 @@ from __future__ import annotations
 
 import functools
 import re
-from typing import Any
-
-from lark import Lark, Token, Tree
-from lark.exceptions import LarkError, UnexpectedInput
+from typing import TYPE_CHECKING, Any
 
 from tlmpc import __version__
 from tlmpc.automata.model import Automaton, Edge
 from tlmpc.errors import InvalidInputError, error
 from tlmpc.ltl.ast import TRUE, And, Const, Formula, Not, Or, Prop, conjoin, disjoin
 from tlmpc.ltl.printer import to_text
+
+if TYPE_CHECKING:  # lark is imported by the reader only: writing HOA (every compile) needs none
+    from lark import Lark
 
 
 def _label(guard: Formula, index: dict[str, int]) -> str:
@@ -137,10 +137,14 @@ COMMENT: /\/\*(.|\n)*?\*\//
 
 @functools.cache
 def _parser() -> Lark:
+    from lark import Lark
+
     return Lark(_GRAMMAR, parser="earley", propagate_positions=True)
 
 
 def _formula(tree: Any, aps: list[str]) -> Formula:
+    from lark import Token
+
     if isinstance(tree, Token):
         if int(tree) >= len(aps):
             raise InvalidInputError(
@@ -180,6 +184,9 @@ def _unquote(token: str) -> str:
 
 def parse_hoa(text: str, *, file: str | None = None) -> Automaton:
     """Read one automaton written in HOA v1 (the subset described in the module doc)."""
+    from lark import Token, Tree
+    from lark.exceptions import LarkError, UnexpectedInput
+
     try:
         tree: Any = _parser().parse(text)
     except UnexpectedInput as exc:
@@ -278,6 +285,8 @@ def _check(
     file: str | None,
 ) -> None:
     """Reject what the reader cannot represent faithfully (B003), instead of misreading it."""
+    from lark import Tree
+
     condition = "".join(
         str(v.children[0]) if isinstance(v, Tree) else str(v) for v in acceptance[1:]
     )

@@ -6,7 +6,6 @@ from collections.abc import Mapping
 from typing import Any
 
 from tlmpc.automata.model import Automaton, Edge
-from tlmpc.ltl.parser import parse_ltl
 from tlmpc.ltl.printer import to_text
 
 FORMAT = "tlmpc.automaton/1"
@@ -40,6 +39,8 @@ def automaton_to_json(automaton: Automaton) -> dict[str, Any]:
 
 def automaton_from_json(document: Mapping[str, Any]) -> Automaton:
     """Rebuild the automaton written by :func:`automaton_to_json`."""
+    from tlmpc.ltl.parser import parse_ltl  # lark: only when reading an automaton back
+
     acceptance = document["acceptance"]
     return Automaton(
         aps=tuple(document["aps"]),

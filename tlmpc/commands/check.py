@@ -96,27 +96,21 @@ def _scopes(mission: Any) -> list[str]:
 
 def _contradictions(path: Path, mission: Any) -> list[Any]:
     """A T011/L020 diagnostic when no behaviour at all satisfies the mission's task."""
-    from tlmpc.ltl import parse_ltl
     from tlmpc.tasks import compile_phrase
     from tlmpc.tasks.contradiction import TaskPart, find_contradiction
 
     file = str(path)
     parts: list[TaskPart] = []
-    # Where each phrase, then the ltl string, starts: kept by the loader (reading the file
-    # again would cost as much as the check itself for a large map).
+    # where each phrase, then the `ltl` string, starts: the loader kept them (no second read)
     positions = list(mission.task_positions)
-
-    def where(key: tuple[str | int, ...]) -> tuple[int, int]:
-        index = key[1] if key[0] == "task" else len(mission.task)
-        assert isinstance(index, int)
-        return positions[index] if index < len(positions) else (1, 1)
-
     for index, phrase in enumerate(mission.task):
-        line, col = where(("task", index))
+        line, col = positions[index]
         formula = compile_phrase(phrase, groups=mission.groups, file=file, line=line, col=col)
         parts.append(TaskPart(formula=formula, text=phrase, kind="phrase", line=line, col=col))
     if mission.ltl and mission.ltl.strip():
-        line, col = where(("ltl",))
+        from tlmpc.ltl.parser import parse_ltl  # lark: only for missions with `ltl`
+
+        line, col = positions[len(mission.task)]
         parts.append(
             TaskPart(
                 formula=parse_ltl(mission.ltl),

@@ -41,9 +41,7 @@ from tlmpc.ltl.ast import (
     Until,
     WeakUntil,
 )
-
-#: Words that cannot name a region: they are operators or constants of the language.
-KEYWORDS = frozenset({"F", "G", "X", "N", "U", "R", "W", "M", "V", "true", "false"})
+from tlmpc.ltl.keywords import KEYWORDS  # re-exported: words that cannot name a region
 
 #: Nesting deeper than this is refused (L005) instead of exhausting the Python stack.
 MAX_DEPTH = 400

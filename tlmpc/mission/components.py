@@ -15,7 +15,7 @@ import shapely
 from shapely.geometry import Point as ShapelyPoint
 
 from tlmpc.errors import Diagnostic, error
-from tlmpc.mission.geometry import AREA_TOLERANCE, CheckedShape
+from tlmpc.mission.geometry import AREA_TOLERANCE, CheckedShape, shapely_polygon
 from tlmpc.mission.yamlpos import Path, json_path
 
 Locate = Callable[[Path], tuple[int, int]]
@@ -46,10 +46,10 @@ def check_pieces(
 
     free = []
     for index, (boundary, holes) in enumerate(pieces):
-        outer = boundary.polygon
+        outer = shapely_polygon(boundary)
         shapely.prepare(outer)
         for number, hole in enumerate(holes):
-            if not outer.covers(hole.polygon):
+            if not outer.covers(shapely_polygon(hole)):
                 problems.append(
                     at(
                         hole.path,
@@ -58,7 +58,7 @@ def check_pieces(
                         "holes must lie inside the boundary of their own piece; clip the hole",
                     )
                 )
-        cut = shapely.union_all([h.polygon for h in holes]) if holes else None
+        cut = shapely.union_all([shapely_polygon(h) for h in holes]) if holes else None
         free.append(outer.difference(cut) if cut is not None else outer)
     tree = shapely.STRtree(free)
     left, right = tree.query(free, predicate="intersects")
@@ -97,12 +97,13 @@ def check_pieces(
         )
     union = shapely.union_all(free)
     shapely.prepare(union)
-    outers = shapely.union_all([boundary.polygon for boundary, _ in pieces])
+    outers = shapely.union_all([shapely_polygon(boundary) for boundary, _ in pieces])
     shapely.prepare(outers)
     for name, region in regions.items():
         # a sliver of rounding (world coordinates of a map's cells) is not "outside"
-        if not outers.covers(region.polygon) and (
-            region.polygon.difference(outers).area > AREA_TOLERANCE * region.polygon.area
+        polygon = shapely_polygon(region)
+        if not outers.covers(polygon) and (
+            polygon.difference(outers).area > AREA_TOLERANCE * polygon.area
         ):
             problems.append(
                 at(
@@ -112,7 +113,7 @@ def check_pieces(
                     "regions must lie inside the boundary of a workspace piece; clip the region",
                 )
             )
-        elif region.polygon.intersection(union).area <= AREA_TOLERANCE * region.polygon.area:
+        elif polygon.intersection(union).area <= AREA_TOLERANCE * polygon.area:
             problems.append(
                 at(
                     region.path,
@@ -124,7 +125,7 @@ def check_pieces(
     if start is not None:
         point = ShapelyPoint(start)
         if not union.covers(point):
-            inside = bool(np.any(shapely.covers([b.polygon for b, _ in pieces], point)))
+            inside = bool(np.any(shapely.covers([shapely_polygon(b) for b, _ in pieces], point)))
             problems.append(
                 at(
                     start_path,

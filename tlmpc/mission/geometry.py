@@ -1,19 +1,19 @@
-"""Geometry checks of a mission with shapely: shapes, holes, regions, start point."""
+"""Geometry checks of a mission: shapes, holes, regions, start point.
+
+Shapely decides; small plain missions (no holes, a rectangular boundary, polygons of a few
+dozen vertices) are decided exactly in pure Python first (:mod:`tlmpc.mission.plain_geometry`),
+so that ``tlmpc check`` of such a mission imports neither shapely nor numpy.
+"""
 
 from __future__ import annotations
 
 import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any
-
-import numpy as np
-import shapely
-from shapely.geometry import Point as ShapelyPoint
-from shapely.geometry import Polygon as ShapelyPolygon
-from shapely.validation import explain_validity
+from typing import TYPE_CHECKING, Any
 
 from tlmpc.errors import Diagnostic, error
+from tlmpc.mission import plain_geometry
 from tlmpc.mission.model import Polygon
 from tlmpc.mission.yamlpos import Path, json_path
 
@@ -22,24 +22,40 @@ AREA_TOLERANCE = 1e-12
 
 Locate = Callable[[Path], tuple[int, int]]
 
+if TYPE_CHECKING:
+    from shapely.geometry import Polygon as ShapelyPolygon
+
+
+#: Point lists longer than this are checked with array operations (numpy, shapely); shorter
+#: ones in pure Python first, so that a plain mission's check imports neither.
+ARRAY_ABOVE = 64
+
 
 def shape_points(shape: Any) -> Polygon:
     """The vertices of a shape: a point list as given, or a rectangle counter-clockwise."""
     if isinstance(shape, dict):
         x0, y0, x1, y1 = (float(v) for v in shape["rect"])
         return ((x0, y0), (x1, y0), (x1, y1), (x0, y1))
-    return tuple(map(tuple, _vertices(shape)[0].tolist()))
+    if len(shape) > ARRAY_ABOVE:
+        return tuple(map(tuple, _vertices(shape)[0].tolist()))
+    points: list[tuple[float, float]] = []
+    for x, y in shape:
+        point = (float(x), float(y))
+        if not points or points[-1] != point:
+            points.append(point)
+    if len(points) > 1 and points[0] == points[-1]:
+        points.pop()  # a closed ring given with its first point repeated
+    return tuple(points)
 
 
-Array = np.ndarray[Any, np.dtype[Any]]
-
-
-def _vertices(shape: Any) -> tuple[Array, Array]:
+def _vertices(shape: Any) -> tuple[Any, Any]:
     """A point list as an n×2 array, repeats of the previous point and a closing point dropped,
     and the index in ``shape`` of each vertex kept.
 
     Array operations throughout: a boundary may have a million vertices.
     """
+    import numpy as np
+
     points = np.asarray(shape, dtype=float).reshape(-1, 2)
     index = np.arange(len(points))
     if len(points) > 1:
@@ -50,8 +66,10 @@ def _vertices(shape: Any) -> tuple[Array, Array]:
     return points, index
 
 
-def _three_distinct(points: Array) -> bool:
+def _three_distinct(points: Any) -> bool:
     """Whether ``points`` holds three different points (linear; sorting a million is not)."""
+    import numpy as np
+
     if len(points) < 3:
         return False
     other = np.any(points != points[0], axis=1)
@@ -61,7 +79,9 @@ def _three_distinct(points: Array) -> bool:
     return bool(np.any(other & np.any(points != second, axis=1)))
 
 
-def _collinear(points: Array, size: float) -> bool:
+def _collinear_array(points: Any, size: float) -> bool:
+    import numpy as np
+
     x0, y0 = points[0]
     dx_all = points[:, 0] - x0
     dy_all = points[:, 1] - y0
@@ -73,8 +93,20 @@ def _collinear(points: Array, size: float) -> bool:
     return bool(np.all(np.abs(dx * dy_all - dy * dx_all) / length <= 1e-12 * size))
 
 
-def _crossing_vertex(points: Array, reason: str) -> int | None:
+def _collinear(points: Polygon, size: float) -> bool:
+    x0, y0 = points[0]
+    x1, y1 = max(points, key=lambda p: (p[0] - x0) ** 2 + (p[1] - y0) ** 2)
+    dx, dy = x1 - x0, y1 - y0
+    length = (dx * dx + dy * dy) ** 0.5
+    if length == 0.0:
+        return True
+    return all(abs(dx * (y - y0) - dy * (x - x0)) / length <= 1e-12 * size for x, y in points)
+
+
+def _crossing_vertex(points: Any, reason: str) -> int | None:
     """The vertex starting the edge nearest the place ``explain_validity`` names, if any."""
+    import numpy as np
+
     found = re.search(r"\[\s*([-+0-9.eE]+)\s+([-+0-9.eE]+)", reason)
     if found is None or len(points) < 2:
         return None
@@ -91,11 +123,23 @@ def _crossing_vertex(points: Array, reason: str) -> int | None:
 
 @dataclass(frozen=True, slots=True)
 class CheckedShape:
-    """A shape that passed its own checks, as points and as a shapely polygon."""
+    """A shape that passed its own checks, as points and (built on first use) a shapely polygon."""
 
     points: Polygon
-    polygon: ShapelyPolygon
+    polygon: ShapelyPolygon | None
     path: Path
+
+
+def shapely_polygon(shape: CheckedShape) -> ShapelyPolygon:
+    """The shape's shapely polygon, built once when a check first needs it."""
+    if shape.polygon is None:
+        import numpy as np
+        import shapely
+
+        # shapely.polygons on an array is linear in the vertices, unlike a list of tuples
+        object.__setattr__(shape, "polygon", shapely.polygons(np.asarray(shape.points, float)))
+    assert shape.polygon is not None
+    return shape.polygon
 
 
 def check_shape(
@@ -120,57 +164,105 @@ def check_shape(
         if (x1 - x0) * (y1 - y0) > AREA_TOLERANCE * size * size:
             # A proper rect is simple, valid and not collinear: skip the general checks
             # (Example 8's 1,156 rect regions cost a third of the load stage).
-            points = shape_points(shape)
-            return CheckedShape(points=points, polygon=ShapelyPolygon(points), path=path), []
+            return CheckedShape(points=shape_points(shape), polygon=None, path=path), []
+    elif len(shape) > ARRAY_ABOVE:
+        return _check_long_shape(shape, path, what, locate, where)
+    points = shape_points(shape)
+    if len(set(points)) < 3:
+        return None, [_too_few(what, where)]
+    xs = [p[0] for p in points]
+    ys = [p[1] for p in points]
+    size = max(max(xs) - min(xs), max(ys) - min(ys), 1e-300)
+    if _collinear(points, size):
+        return None, [_collinear_problem(what, where)]
+    checked = CheckedShape(points=points, polygon=None, path=path)
+    if plain_geometry.certainly_simple(points) and abs(
+        plain_geometry.shoelace_area(points)
+    ) > 2 * AREA_TOLERANCE * size * size:
+        return checked, []  # what shapely would say: valid, with an area well above zero
+    polygon = shapely_polygon(checked)
+    if not polygon.is_valid:
+        from shapely.validation import explain_validity
+
+        reason = explain_validity(polygon)
+        return None, [_not_simple(what, reason, _at_crossing(shape, path, reason, locate, where))]
+    if abs(polygon.area) <= AREA_TOLERANCE * size * size:
+        return None, [_zero_area(what, where)]
+    return checked, []
+
+
+def _at_crossing(
+    shape: Any, path: Path, reason: str, locate: Locate, where: dict[str, Any]
+) -> dict[str, Any]:
+    """``where`` moved to the edge ``explain_validity`` names: in a boundary of a million
+    vertices, "line 3" is useless."""
     array, written = _vertices(shape)
+    vertex = _crossing_vertex(array, reason)
+    if vertex is None:
+        return where
+    at = (*path, int(written[vertex]))
+    line, col = locate(at)
+    return {**where, "line": line, "col": col, "path": json_path(at)}
+
+
+def _check_long_shape(
+    shape: Any, path: Path, what: str, locate: Locate, where: dict[str, Any]
+) -> tuple[CheckedShape | None, list[Diagnostic]]:
+    """:func:`check_shape` of a long point list, with array operations only."""
+    import shapely
+    from shapely.validation import explain_validity
+
+    array, _ = _vertices(shape)
     if not _three_distinct(array):
-        return None, [
-            error(
-                "G002",
-                f"{what}: a polygon needs at least 3 distinct points",
-                hint="list the corners as [[x, y], ...]",
-                **where,
-            )
-        ]
+        return None, [_too_few(what, where)]
     polygon = shapely.polygons(array)  # linear, unlike a list
     minx, miny, maxx, maxy = polygon.bounds
     size = max(maxx - minx, maxy - miny, 1e-300)
-    if _collinear(array, size):
-        return None, [
-            error(
-                "G003",
-                f"{what}: the polygon has zero area",
-                hint="its points are collinear; give a proper polygon",
-                **where,
-            )
-        ]
+    if _collinear_array(array, size):
+        return None, [_collinear_problem(what, where)]
     if not polygon.is_valid:
         reason = explain_validity(polygon)
-        vertex = _crossing_vertex(array, reason)
-        if vertex is not None:
-            # Point at the edge itself: in a boundary of a million vertices, "line 3" is useless.
-            at = (*path, int(written[vertex]))
-            line, col = locate(at)
-            where = {**where, "line": line, "col": col, "path": json_path(at)}
-        return None, [
-            error(
-                "G004",
-                f"{what}: the polygon is self-intersecting or not simple ({reason})",
-                hint="edges must not cross or touch; list the corners in order around the shape",
-                **where,
-            )
-        ]
+        return None, [_not_simple(what, reason, _at_crossing(shape, path, reason, locate, where))]
     if abs(polygon.area) <= AREA_TOLERANCE * size * size:
-        return None, [
-            error(
-                "G003",
-                f"{what}: the polygon has zero area",
-                hint="give a polygon with a positive area",
-                **where,
-            )
-        ]
+        return None, [_zero_area(what, where)]
     points = tuple(map(tuple, array.tolist()))
     return CheckedShape(points=points, polygon=polygon, path=path), []
+
+
+def _too_few(what: str, where: dict[str, Any]) -> Diagnostic:
+    return error(
+        "G002",
+        f"{what}: a polygon needs at least 3 distinct points",
+        hint="list the corners as [[x, y], ...]",
+        **where,
+    )
+
+
+def _collinear_problem(what: str, where: dict[str, Any]) -> Diagnostic:
+    return error(
+        "G003",
+        f"{what}: the polygon has zero area",
+        hint="its points are collinear; give a proper polygon",
+        **where,
+    )
+
+
+def _zero_area(what: str, where: dict[str, Any]) -> Diagnostic:
+    return error(
+        "G003",
+        f"{what}: the polygon has zero area",
+        hint="give a polygon with a positive area",
+        **where,
+    )
+
+
+def _not_simple(what: str, reason: str, where: dict[str, Any]) -> Diagnostic:
+    return error(
+        "G004",
+        f"{what}: the polygon is self-intersecting or not simple ({reason})",
+        hint="edges must not cross or touch; list the corners in order around the shape",
+        **where,
+    )
 
 
 def check_layout(
@@ -200,17 +292,45 @@ def check_layout(
         line, col = locate(path)
         return error(code, message, hint=hint, file=file, line=line, col=col, path=json_path(path))
 
+    rect = plain_geometry.axis_rectangle(boundary.points) if boundary is not None else None
+    if rect is not None and not holes:
+        # A rectangular workspace without holes: containment in a closed convex shape is
+        # exactly "every vertex inside", decided by comparisons alone (what shapely answers)
+        for name, region in regions.items():
+            if not plain_geometry.inside_rectangle(region.points, rect):
+                problems.append(
+                    at(
+                        region.path,
+                        "G007",
+                        f"region {name!r} extends outside the workspace boundary",
+                        "regions must lie inside the boundary; clip the region",
+                    )
+                )
+        if start is not None and not plain_geometry.inside_rectangle([start], rect):
+            problems.append(
+                at(
+                    start_path,
+                    "G009",
+                    f"the start point ({start[0]:g}, "
+                    f"{start[1]:g}) is outside the workspace boundary",
+                    "the robot must start in the free workspace",
+                )
+            )
+        return problems
+    import shapely
+    from shapely.geometry import Point as ShapelyPoint
+
     # Near-linear on large inputs: the boundary is prepared once (an indexed edge set, so each
     # containment test is logarithmic in its vertices), and overlap tests run only on pairs a
     # spatial index reports as candidates, never on all pairs.
-    hole_union = shapely.union_all([h.polygon for h in holes]) if holes else None
+    hole_union = shapely.union_all([shapely_polygon(h) for h in holes]) if holes else None
     if hole_union is not None:
         shapely.prepare(hole_union)
     if boundary is not None:
-        outer = boundary.polygon
+        outer = shapely_polygon(boundary)
         shapely.prepare(outer)
         for index, hole in enumerate(holes):
-            if not outer.covers(hole.polygon):
+            if not outer.covers(shapely_polygon(hole)):
                 problems.append(
                     at(
                         hole.path,
@@ -220,7 +340,7 @@ def check_layout(
                     )
                 )
         for name, region in regions.items():
-            if not outer.covers(region.polygon):
+            if not outer.covers(shapely_polygon(region)):
                 problems.append(
                     at(
                         region.path,
@@ -232,10 +352,10 @@ def check_layout(
     # overlapping or touching holes are merged later, with a note (tlmpc.mission.holes)
     if hole_union is not None:
         for name, region in regions.items():
-            if not hole_union.intersects(region.polygon):
+            if not hole_union.intersects(shapely_polygon(region)):
                 continue
-            free = region.polygon.difference(hole_union)
-            if free.area <= AREA_TOLERANCE * region.polygon.area:
+            free = shapely_polygon(region).difference(hole_union)
+            if free.area <= AREA_TOLERANCE * shapely_polygon(region).area:
                 problems.append(
                     at(
                         region.path,
@@ -247,7 +367,7 @@ def check_layout(
                 )
     if start is not None:
         point = ShapelyPoint(start)
-        if boundary is not None and not boundary.polygon.covers(point):
+        if boundary is not None and not shapely_polygon(boundary).covers(point):
             problems.append(
                 at(
                     start_path,

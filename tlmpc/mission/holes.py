@@ -247,10 +247,17 @@ def workspace_notes(mission: Mission, text: str | None = None) -> tuple[Mission,
     ``text`` is the mission file's YAML (read from ``mission.source`` when not given); it only
     serves to put each diagnostic on the line of the hole or boundary it is about.
     """
+    from tlmpc.mission.plain_geometry import axis_rectangle
     from tlmpc.mission.yamlpos import load_positioned
 
     file = mission.source
     holes = mission.workspace.holes
+    rect = axis_rectangle(mission.workspace.boundary)
+    if not holes and rect is not None:
+        width, height = rect[2] - rect[0], rect[3] - rect[1]
+        if min(width, height) > 2 * NARROW_FRACTION * max(width, height):
+            # nothing to merge, and the only passages of a rectangle are its width and height
+            return mission, []
     merged = merge_holes(holes)
     boundary = mission.workspace.boundary
     passages, complete = passage_search(boundary, merged.holes)

@@ -12,21 +12,21 @@ import re
 from collections.abc import Mapping
 from itertools import chain
 from pathlib import Path as FilePath
-from typing import Any
-
-import jsonschema
-import numpy as np
-from jsonschema.exceptions import ValidationError, best_match
+from typing import TYPE_CHECKING, Any
 
 from tlmpc.artifacts import load_schema
 from tlmpc.errors import Diagnostic, InvalidInputError, UsageError, best_first, error
 from tlmpc.ltl.ast import Formula, Or, Prop, conjoin
-from tlmpc.ltl.parser import KEYWORDS, parse_ltl
+from tlmpc.ltl.keywords import KEYWORDS
 from tlmpc.ltl.transform import substitute
 from tlmpc.mission.geometry import CheckedShape, check_layout, check_shape
 from tlmpc.mission.model import Component, Mission, Options, Polygon, Region, Robot, Workspace
 from tlmpc.mission.yamlpos import Path, PositionedDocument, json_path, load_positioned
+from tlmpc.schema_check import is_valid
 from tlmpc.tasks.compiler import compile_phrases
+
+if TYPE_CHECKING:
+    from jsonschema.exceptions import ValidationError
 
 #: Files larger than this are refused while reading, before parsing (Example 8, a thousand
 #: rooms, is 52 KB; a 10^6-vertex boundary 24 to 45 MB, depending on the digits written).
@@ -64,7 +64,7 @@ def _plain_shape(value: Any) -> bool:
     coordinates = list(chain.from_iterable(value))
     if not set(map(type, coordinates)) <= {int, float}:
         return False
-    return bool(np.abs(np.asarray(coordinates, dtype=float)).max() <= 1e9)
+    return all(abs(c) <= 1e9 for c in coordinates)  # NaN is no coordinate either
 
 
 _STAND_IN = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]
@@ -84,7 +84,6 @@ def _small_component(component: Any, path: Path, bad: list[Path]) -> Any:
 
 
 def _schema_diagnostics(doc: PositionedDocument, file: str) -> list[Diagnostic]:
-    validator = jsonschema.Draft202012Validator(load_schema("mission"))
     data = doc.data
     regions = data.get("regions") if isinstance(data, dict) else None
     if (
@@ -121,6 +120,11 @@ def _schema_diagnostics(doc: PositionedDocument, file: str) -> list[Diagnostic]:
             ]
         data = {**data, "workspace": small}
     problems = [p for path in bad for p in _point_problem(path, doc, file)]
+    if not problems and is_valid(data, "mission"):
+        return []  # jsonschema (a tenth of a second to import) is needed only to word problems
+    import jsonschema
+
+    validator = jsonschema.Draft202012Validator(load_schema("mission"))
     for err in validator.iter_errors(data):
         problems.extend(_describe(err, doc, file))
     return problems
@@ -152,6 +156,8 @@ def _point_problem(path: Path, doc: PositionedDocument, file: str) -> list[Diagn
         point = point[part]
     definitions: Any = load_schema("mission")["$defs"]
     schema = {"$ref": "#/$defs/point", "$defs": definitions}
+    import jsonschema
+
     alone = jsonschema.Draft202012Validator(schema)
     return [d for err in alone.iter_errors(point) for d in _describe(err, doc, file, path)]
 
@@ -199,6 +205,8 @@ def _describe(
                     path=json_path(path),
                 )
             ]
+        from jsonschema.exceptions import best_match
+
         deepest = best_match(err.context)
         if deepest is not None and not isinstance(err.instance, list | dict):
             deepest = err
@@ -312,6 +320,8 @@ def _check_task(
             )
         )
     if isinstance(ltl, str) and ltl.strip():
+        from tlmpc.ltl.parser import parse_ltl  # lark: only for missions with `ltl`
+
         line, col = _ltl_position(doc, ("ltl",))
         try:
             parts.append(parse_ltl(ltl, file=file, line=line, col=col))

@@ -6,7 +6,6 @@ Computed on demand (only when no plan exists), so loading a mission pays nothing
 from __future__ import annotations
 
 from tlmpc.ltl.ast import And, Formula, Or, Prop
-from tlmpc.ltl.parser import parse_ltl
 from tlmpc.ltl.printer import to_text
 from tlmpc.ltl.transform import substitute
 from tlmpc.mission.model import Mission, TaskPart
@@ -33,6 +32,8 @@ def task_parts(mission: Mission) -> tuple[TaskPart, ...]:
         )
         parts.append(TaskPart(text=phrase, formula=substitute(formula, expand), line=line, col=col))
     if mission.ltl and mission.ltl.strip():
+        from tlmpc.ltl.parser import parse_ltl  # lark: only for missions with `ltl`
+
         index = len(mission.task)
         line, col = positions[index] if index < len(positions) else (1, 1)
         whole = parse_ltl(mission.ltl, file=mission.source, line=line, col=col)

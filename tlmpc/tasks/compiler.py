@@ -11,11 +11,7 @@ from __future__ import annotations
 import difflib
 import functools
 from collections.abc import Mapping, Sequence
-from importlib import resources
-from typing import Any
-
-from lark import Lark, Token, Tree
-from lark.exceptions import LarkError
+from typing import TYPE_CHECKING, Any
 
 from tlmpc.errors import Diagnostic, InvalidInputError, error
 from tlmpc.ltl.ast import (
@@ -31,6 +27,10 @@ from tlmpc.ltl.ast import (
     conjoin,
     disjoin,
 )
+from tlmpc.tasks.phrases import Node, Word, parse_plain
+
+if TYPE_CHECKING:
+    from lark import Lark
 
 #: The phrase forms, as shown to users when a phrase is not understood.
 KNOWN_PHRASES = (
@@ -58,8 +58,52 @@ _LEADING_WORDS = ("visit", "avoid", "never", "patrol", "stay", "eventually", "al
 
 @functools.cache
 def _parser() -> Lark:
+    from importlib import resources
+
+    from lark import Lark
+
     grammar = (resources.files("tlmpc.tasks") / "tasks.lark").read_text(encoding="utf-8")
     return Lark(grammar, parser="earley", ambiguity="resolve", propagate_positions=True)
+
+
+def _from_lark(tree: Any) -> Node:
+    """Lark's tree as the reader's :class:`Node` (names keep their line and column)."""
+    from lark import Token
+
+    children: list[Node | Word] = []
+    for child in tree.children:
+        if isinstance(child, Token):
+            children.append(Word(str(child), child.line or 1, child.column or 1))
+        else:
+            children.append(_from_lark(child))
+    return Node(str(tree.data), tuple(children))
+
+
+class PhraseSyntaxError(Exception):
+    """The phrase is not in the language; ``column`` (1-based) is where the parser stopped."""
+
+    def __init__(self, column: int) -> None:
+        super().__init__(column)
+        self.column = column
+
+
+@functools.lru_cache(maxsize=4096)  # trees are immutable; a check compiles each phrase thrice
+def parse_tree(phrase: str) -> Node:
+    """The parse tree of one phrase (rule ``start``); :class:`PhraseSyntaxError` when none.
+
+    Plain phrases are read by :func:`tlmpc.tasks.phrases.parse_plain`; the rest (and every
+    error) by the Earley parser of ``tasks.lark``, so the language and its messages are the
+    grammar's.
+    """
+    plain = parse_plain(phrase)
+    if plain is not None:
+        return plain
+    from lark.exceptions import LarkError
+
+    try:
+        return _from_lark(_parser().parse(phrase))
+    except LarkError as exc:
+        raise PhraseSyntaxError(int(getattr(exc, "column", 1) or 1)) from None
 
 
 class _Lowering:
@@ -76,21 +120,21 @@ class _Lowering:
         #: each avoidance's scope in words, for ``tlmpc check --explain``
         self.scopes: list[str] = []
 
-    def _where(self, token: Token) -> tuple[int, int]:
+    def _where(self, token: Word) -> tuple[int, int]:
         if (token.line or 1) > 1:  # a phrase spread over several lines (a YAML block scalar)
             return self.line + (token.line or 1) - 1, token.column or 1
         return self.line, self.col + (token.column or 1) - 1
 
-    def name(self, tree: Tree[Any]) -> Prop:
+    def name(self, tree: Node) -> Prop:
         token = tree.children[0]
-        assert isinstance(token, Token)
+        assert isinstance(token, Word)
         line, col = self._where(token)
         return Prop(str(token), span=Span(line, col, line, col + len(token)))
 
-    def names(self, tree: Tree[Any]) -> list[Prop]:
-        return [self.name(child) for child in tree.children if isinstance(child, Tree)]
+    def names(self, tree: Node) -> list[Prop]:
+        return [self.name(child) for child in tree.children if isinstance(child, Node)]
 
-    def group(self, tree: Tree[Any]) -> list[Formula]:
+    def group(self, tree: Node) -> list[Formula]:
         prop = self.name(tree)
         members = self.groups.get(prop.name)
         if members is None:
@@ -110,9 +154,9 @@ class _Lowering:
             return [prop]
         return [Prop(m, span=prop.span) for m in members]
 
-    def lower(self, tree: Tree[Any]) -> Formula:
+    def lower(self, tree: Node) -> Formula:
         kind = tree.data
-        children = [c for c in tree.children if isinstance(c, Tree)]
+        children = [c for c in tree.children if isinstance(c, Node)]
         if kind == "visit_set":
             return conjoin([Eventually(p) for p in self.names(children[0])])
         if kind == "visit_all":
@@ -142,23 +186,23 @@ class _Lowering:
             return Globally(Implies(self.name(children[0]), Eventually(self.name(children[1]))))
         raise ValueError(f"unknown phrase kind {kind}")  # pragma: no cover - grammar is closed
 
-    def _avoided_names(self, avoiding: Tree[Any]) -> list[Prop]:
-        names_tree = next(c for c in avoiding.children if isinstance(c, Tree))
+    def _avoided_names(self, avoiding: Node) -> list[Prop]:
+        names_tree = next(c for c in avoiding.children if isinstance(c, Node))
         return self.names(names_tree)
 
     def _members(self, name: str) -> set[str]:
         """The regions a name stands for (a group stands for its members)."""
         return set(self.groups.get(name, (name,)))
 
-    def _step(self, step: Tree[Any]) -> list[Prop]:
-        inner = next(c for c in step.children if isinstance(c, Tree))
+    def _step(self, step: Node) -> list[Prop]:
+        inner = next(c for c in step.children if isinstance(c, Node))
         if step.data == "all_step":
             return [p for p in self.group(inner) if isinstance(p, Prop)]
         if step.data == "return_step":
             return [self.name(inner)]
         return self.names(inner)
 
-    def _sequence(self, children: list[Tree[Any]]) -> Formula:
+    def _sequence(self, children: list[Node]) -> Formula:
         """Steps S1 then S2 ... then Sn, each a set visited in any order after the previous set.
 
         ``Φ_k = ⋀_{s ∈ S_k} F(s & Φ_{k+1})``: each region of a step is visited after every
@@ -297,9 +341,9 @@ def _compile(
             )
         )
     try:
-        tree = _parser().parse(phrase)
-    except LarkError as exc:
-        at = int(getattr(exc, "column", 1) or 1) - 1
+        tree = parse_tree(phrase)
+    except PhraseSyntaxError as exc:
+        at = exc.column - 1
         raise InvalidInputError(_unknown_phrase(phrase, file, line, col, max(at, 0))) from None
     lowering = _Lowering(groups or {}, file, line, col)
     formula = lowering.lower(tree.children[0])  # type: ignore[arg-type]

@@ -17,7 +17,6 @@ import numpy.typing as npt
 
 from tlmpc.errors import UsageError, error
 from tlmpc.ltl.ast import Formula
-from tlmpc.ltl.parser import parse_ltl
 from tlmpc.verify.model import Ending
 from tlmpc.verify.samples import check_samples
 
@@ -92,6 +91,7 @@ def _formula(text: Any, names: set[str], file: str | None) -> Formula:
     if not isinstance(text, str):
         raise _fail("V006", "the trace has no `ltl` task", file)
     from tlmpc.errors import InvalidInputError
+    from tlmpc.ltl.parser import parse_ltl  # lark: only when a formula is read as text
 
     try:
         formula = parse_ltl(text, file=file)
