@@ -157,6 +157,13 @@ class _Compiler:
         if key == "not":
             inner = self.compile(value)
             return lambda v: not inner(v)
+        if key == "if":
+            condition = self.compile(value)
+            then = self.compile(schema.get("then", True))
+            otherwise = self.compile(schema.get("else", True))
+            return lambda v: then(v) if condition(v) else otherwise(v)
+        if key in ("then", "else"):
+            return lambda v: True  # applied by "if"; alone they mean nothing
         raise _Unsupported(key)
 
 

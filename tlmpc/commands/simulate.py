@@ -127,16 +127,17 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         _write(args.output, result.trace)
     document = _report(args, result, verdict, bound, declared)
     reporter = Reporter.for_args(args, out, err)
-    if bound > declared:
-        reporter.note(
-            f"note: the controllers guarantee the task for |w| <= {declared:g} "
-            "(robot.disturbance); above it the executor recovers where it can"
-        )
     if result.progress.status in ("no_plan", "violated"):
         code = EXIT_NEGATIVE
     else:
         code = OUTCOME_EXIT[verdict.outcome]
-    return reporter.finish(code, document, _text(document))
+    reporter.finish(code, document, _text(document))
+    if bound > declared:  # after the result, which it qualifies
+        reporter.note(
+            f"note: the controllers guarantee the task for |w| <= {declared:g} "
+            "(robot.disturbance); above it the executor recovers where it can"
+        )
+    return code
 
 
 def _write(path: Path, document: Any) -> None:
