@@ -80,6 +80,24 @@ def test_check_imports_no_heavy_packages() -> None:
     assert completed.stdout.strip() == "0 []"
 
 
+def test_check_of_a_plain_mission_imports_no_geometry_or_schema_library() -> None:
+    """Example 1 (a rectangle, small polygons, a point robot, task phrases only): the pure
+    Python checks answer; shapely, numpy, jsonschema and lark stay unloaded."""
+    example1 = str(ROOT / "specs" / "example1.yaml")
+    script = (
+        "import sys, io\n"
+        "from tlmpc.cli import main\n"
+        f"code = main(['check', {example1!r}], io.StringIO(), io.StringIO())\n"
+        "heavy = sorted(m for m in sys.modules if m.split('.')[0] in "
+        "('numpy', 'shapely', 'jsonschema', 'lark'))\n"
+        "print(code, heavy)\n"
+    )
+    completed = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, check=True
+    )
+    assert completed.stdout.strip() == "0 []"
+
+
 def test_console_entry_point_runs() -> None:
     completed = subprocess.run(
         [sys.executable, "-m", "tlmpc", "check", SPECS[0]],

@@ -50,13 +50,16 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             if mission is not None and not diagnostics:
                 diagnostics = _contradictions(path, mission)
                 if not diagnostics:
-                    from tlmpc.mission.cspace import body_diagnostics
+                    from tlmpc.mission.body import body_radius
                     from tlmpc.mission.holes import workspace_notes
 
                     merged, notices = workspace_notes(mission)
-                    body = body_diagnostics(merged)
-                    diagnostics = [d for d in body if d.severity == "error"]
-                    notices += [d for d in body if d.severity != "error"]
+                    if body_radius(mission.robot) > 0.0:  # shapely only for a body
+                        from tlmpc.mission.cspace import body_diagnostics
+
+                        body = body_diagnostics(merged)
+                        diagnostics = [d for d in body if d.severity == "error"]
+                        notices += [d for d in body if d.severity != "error"]
             if diagnostics:
                 invalid += 1
             else:
