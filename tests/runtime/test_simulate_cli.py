@@ -123,3 +123,19 @@ def test_a_unicycle_simulation_exits_0(tmp_path: Path) -> None:
     code, out_text, err = run("simulate", str(out), "--heading", "1.5", "--cycles", "1")
     assert code == 0, out_text + err
     assert ": satisfied:" in out_text
+
+
+def test_the_simulated_trace_describes_the_mission_as_the_compiled_one_does(
+    tmp_path: Path,
+) -> None:
+    """Everything a trace takes from the mission (workspace pieces, the body's radius, the
+    convention...) is the compiled trace's, so the verifier judges both on the same terms."""
+    out = _compile(tmp_path, "patrol", radius=0.05)
+    trace = tmp_path / "simulated.json"
+    code, _, err = run("simulate", str(out), "--cycles", "1", "-o", str(trace))
+    assert code == 0, err
+    simulated = json.loads(trace.read_text())
+    compiled = json.loads((out / "trace.json").read_text())
+    assert simulated["radius"] == 0.05
+    for key in ("ltl", "regions", "workspace", "boundary", "radius"):
+        assert simulated[key] == compiled[key], key

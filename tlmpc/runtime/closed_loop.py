@@ -180,23 +180,10 @@ def _trace_document(
     speed: float,
 ) -> dict[str, Any]:
     """``trace.json`` of the reference point (``max_speed`` bounds its speed: u plus w)."""
-    from tlmpc.ltl.printer import to_text
-
-    mission = executor.mission
-
-    def poly(points: tuple[tuple[float, float], ...]) -> list[list[float]]:
-        return [[x, y] for x, y in points]
+    from tlmpc.simulate.exact import trace_header
 
     return {
-        "format": "tlmpc.trace/1",
-        "ltl": to_text(mission.formula),
-        "regions": {r.name: poly(r.polygon) for r in mission.regions},
-        "workspace": {
-            "boundary": poly(mission.workspace.boundary),
-            "holes": [poly(h) for h in mission.workspace.holes],
-        },
-        "boundary": mission.options.boundary,
-        "max_speed": speed,
+        **trace_header(executor.mission, speed),
         "points": [list(sample) for sample in samples],
         "loop_start": loop_start,
         "end": end,

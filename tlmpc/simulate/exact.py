@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import NoReturn
+from typing import Any, NoReturn
 
 import numpy as np
 
@@ -360,8 +360,9 @@ def simulate(abstraction: Abstraction, controllers: Controllers, mission: Missio
     )
 
 
-def trace_to_json(trace: Trace, mission: Mission) -> dict[str, object]:
-    """``trace.json`` (``tlmpc.trace/1``): self-contained, so it verifies on its own."""
+def trace_header(mission: Mission, max_speed: float) -> dict[str, Any]:
+    """What ``trace.json`` takes from the mission (all but the samples), so that a trace
+    verifies on its own: task, regions, every workspace piece, convention, speed, body."""
     from tlmpc.ltl.printer import to_text
     from tlmpc.mission.body import body_radius
 
@@ -374,8 +375,15 @@ def trace_to_json(trace: Trace, mission: Mission) -> dict[str, object]:
         "regions": {r.name: poly(r.polygon) for r in mission.regions},
         "workspace": mission.workspace.to_json(),
         "boundary": mission.options.boundary,
-        "max_speed": mission.robot.max_speed,
+        "max_speed": max_speed,
         **({"radius": radius} if (radius := body_radius(mission.robot)) > 0.0 else {}),
+    }
+
+
+def trace_to_json(trace: Trace, mission: Mission) -> dict[str, object]:
+    """``trace.json`` (``tlmpc.trace/1``): self-contained, so it verifies on its own."""
+    return {
+        **trace_header(mission, mission.robot.max_speed),
         "points": np.column_stack([trace.times, trace.points]).tolist(),
         "loop_start": trace.loop_start,
         # A plan's run is infinite: the trace either loops or ends in a stay.
