@@ -71,7 +71,8 @@ _STAND_IN = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]
 
 
 def _small_component(component: Any, path: Path, bad: list[Path]) -> Any:
-    """A workspace component with its shapes replaced by small stand-ins (see ``_small``)."""
+    """The workspace, or one of its components, with its boundary and holes replaced by small
+    stand-ins (see ``_small``)."""
     if not isinstance(component, dict):
         return component
     small = dict(component)
@@ -104,14 +105,7 @@ def _schema_diagnostics(doc: PositionedDocument, file: str) -> list[Diagnostic]:
     if isinstance(workspace, dict):
         # A boundary or hole with 10^5 vertices: the schema would descend into every point
         # (a minute); a plain shape has the schema's shape, so validate a small stand-in.
-        small = dict(workspace)
-        if "boundary" in small:
-            small["boundary"] = _small(small["boundary"], ("workspace", "boundary"), bad)
-        holes = small.get("holes")
-        if isinstance(holes, list):
-            small["holes"] = [
-                _small(h, ("workspace", "holes", i), bad) for i, h in enumerate(holes)
-            ]
+        small = _small_component(workspace, ("workspace",), bad)
         components = small.get("components")
         if isinstance(components, list):
             small["components"] = [
