@@ -26,7 +26,7 @@ def controllers_to_json(controllers: Controllers) -> dict[str, Any]:
                 "triangle": c.triangle,
                 "exit_edge": c.exit_edge,
                 "next_triangle": c.next_triangle,
-                "stay": c.exit_edge is None,
+                "stay": c.is_stay,
                 "vertices": c.vertices.tolist(),
                 "vertex_velocities": c.velocities.tolist(),
                 "K": c.gain.tolist(),
@@ -34,6 +34,7 @@ def controllers_to_json(controllers: Controllers) -> dict[str, Any]:
                 "exit_speed": c.exit_speed,
                 "exit_time_bound": None if math.isinf(c.exit_time_bound) else c.exit_time_bound,
                 "target": list(c.target) if c.target is not None else None,
+                **({"kind": c.kind} if c.kind != "affine" else {}),
             }
             for c in controllers.steps
         ],
@@ -73,6 +74,7 @@ def controllers_from_json(document: Mapping[str, Any]) -> Controllers:
                     math.inf if s["exit_time_bound"] is None else float(s["exit_time_bound"])
                 ),
                 target=None if s["target"] is None else _point(s["target"]),
+                kind=s.get("kind", "affine"),
             )
             for s in document["steps"]
         ),

@@ -17,6 +17,13 @@ class StepController:
     converges to ``target``).  ``exit_speed`` is the guaranteed speed across the exit edge
     (for a stay: the guaranteed inward speed on every edge); ``exit_time_bound`` bounds the
     time to leave from any point of the closed triangle.
+
+    ``kind`` is ``"affine"`` for the fields above and ``"vertex"`` for a vertex passage: the
+    pursuit law u(x) = max_speed (v - x) / |v - x| toward the corner ``target`` = v, which
+    every point of the triangle reaches along a straight segment in at most
+    ``exit_time_bound``; the robot then goes on in ``next_triangle`` from v (see
+    docs/control.md).  A vertex step has no exit edge; ``gain`` and ``offset`` are zero and
+    ``velocities`` hold the pursuit velocities at the corners (zero at v itself).
     """
 
     step: int
@@ -30,6 +37,17 @@ class StepController:
     exit_speed: float
     exit_time_bound: float
     target: tuple[float, float] | None = None
+    kind: str = "affine"
+
+    @property
+    def is_stay(self) -> bool:
+        """True for the stay field that converges inside its triangle."""
+        return self.exit_edge is None and self.kind == "affine"
+
+    @property
+    def is_vertex(self) -> bool:
+        """True for a vertex passage (pursuit of the corner ``target``)."""
+        return self.kind == "vertex"
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -48,12 +48,18 @@ class _Step:
     next_triangle: int | None
     geometry: TriangleGeometry
     runs: list[int] = field(default_factory=list)  # run id per local vertex
+    through: int | None = None  # a vertex passage: the mesh vertex pursued (no program)
 
 
 def plan_steps(abstraction: Abstraction, witness: Witness) -> tuple[list[_Step], int | None]:
-    """The (triangle, exit edge) steps of the lasso, and the first step of a moving cycle."""
+    """The (triangle, exit edge) steps of the lasso, and the first step of a moving cycle.
+
+    A vertex passage is a step of its own (``through`` set, no exit edge); the step after it
+    starts at that vertex and must leave through the edge opposite it (or stay).
+    """
     path = [*witness.prefix, *witness.cycle]
     stay = witness.is_stay
+    passages = dict(witness.passages)
     steps: list[_Step] = []
     for index, tri in enumerate(path):
         if stay and index == len(path) - 1:
@@ -62,6 +68,20 @@ def plan_steps(abstraction: Abstraction, witness: Witness) -> tuple[list[_Step],
             nxt = path[index + 1]
         else:
             nxt = witness.cycle[0]
+        geometry = triangle_geometry(abstraction.corners(tri))
+        if index in passages and nxt is not None:
+            vertex = passages[index]
+            if vertex not in abstraction.triangles[tri] or vertex not in abstraction.triangles[nxt]:
+                raise InvalidInputError(
+                    error(
+                        "C040",
+                        f"plan step {index}: the passage vertex {vertex} is not a corner of "
+                        f"both triangles {tri} and {nxt}",
+                        hint="the witness does not belong to this abstraction",
+                    )
+                )
+            steps.append(_Step(tri, None, nxt, geometry, through=vertex))
+            continue
         exit_edge = None
         if nxt is not None:
             matches = np.flatnonzero(abstraction.neighbors[tri] == nxt)
@@ -86,7 +106,23 @@ def plan_steps(abstraction: Abstraction, witness: Witness) -> tuple[list[_Step],
                         hint="an affine field cannot leave a triangle through its entry edge",
                     )
                 )
-        geometry = triangle_geometry(abstraction.corners(tri))
+            arrivals = [passages.get(index - 1)] if index > 0 else []
+            if not stay and index == len(witness.prefix):
+                arrivals.append(passages.get(len(path) - 1))  # later laps
+            for arrived in arrivals:
+                if arrived is None:
+                    continue
+                corners = abstraction.triangles[tri].tolist()
+                if arrived not in corners or exit_edge != corners.index(arrived):
+                    raise InvalidInputError(
+                        error(
+                            "C040",
+                            f"plan step {index} starts at vertex {arrived} of triangle {tri} "
+                            "and does not leave through the edge opposite it",
+                            hint="after a vertex passage only the edge opposite the vertex "
+                            "can be left; the witness does not belong to this abstraction",
+                        )
+                    )
         steps.append(_Step(tri, exit_edge, nxt, geometry))
     loop_start = None if stay else len(witness.prefix)
     return steps, loop_start
@@ -163,6 +199,9 @@ def _assign_runs(
     jumps: list[VelocityJump] = []
     previous: dict[int, int] = {}  # global vertex -> run id at the previous step
     for index, step in enumerate(steps):
+        if step.through is not None:
+            previous = {}  # the pursuit law between: no velocity to share across it
+            continue
         vertices = abstraction.triangles[step.triangle].tolist()
         current: dict[int, int] = {}
         for local, vertex in enumerate(vertices):
@@ -183,7 +222,7 @@ def _assign_runs(
             current[vertex] = run
             step.runs.append(run)
         previous = current
-    if loop_start is not None:
+    if loop_start is not None and steps[loop_start].through is None:
         first = steps[loop_start]
         first_vertices = abstraction.triangles[first.triangle].tolist()
         for local, vertex in enumerate(first_vertices):
@@ -403,6 +442,8 @@ def _check_rejectable(
         )
     problems = []
     for index, step in enumerate(steps):
+        if step.through is not None:
+            continue  # the pursuit law rejects any disturbance below max_speed (C033)
         corners = abstraction.triangles[step.triangle].tolist()
         for local in range(3):
             normals = [a for a, _ in _normals(step, local)]
@@ -426,6 +467,39 @@ def _check_rejectable(
         raise InvalidInputError(problems[:10])
 
 
+def pursuit_controller(
+    index: int, step: _Step, vertex: FloatArray, max_speed: float, disturbance: float = 0.0
+) -> StepController:
+    """The vertex passage of ``step``: pursue the corner ``vertex`` at ``max_speed``.
+
+    Every point x of the (convex) triangle moves straight to the corner and arrives after
+    |v - x| / max_speed, or |v - x| / (max_speed - disturbance) under a disturbance below
+    max_speed (the component along the pursuit direction is at least max_speed - d).
+    """
+    corners = step.geometry.vertices
+    offsets = vertex[None, :] - corners
+    distances = np.linalg.norm(offsets, axis=1)
+    velocities = np.zeros_like(corners)
+    moving = distances > 0.0
+    velocities[moving] = max_speed * offsets[moving] / distances[moving, None]
+    velocities.setflags(write=False)
+    closing = max_speed - disturbance
+    return StepController(
+        step=index,
+        triangle=step.triangle,
+        exit_edge=None,
+        next_triangle=step.next_triangle,
+        vertices=corners,
+        velocities=velocities,
+        gain=np.zeros((2, 2)),
+        offset=np.zeros(2),
+        exit_speed=closing,
+        exit_time_bound=float(distances.max()) / closing,
+        target=(float(vertex[0]), float(vertex[1])),
+        kind="vertex",
+    )
+
+
 def synthesize(
     abstraction: Abstraction, witness: Witness, robot: Robot, *, source: str | None = None
 ) -> Controllers:
@@ -446,12 +520,21 @@ def synthesize(
         else 0.0
     )
     _, jumps = _assign_runs(abstraction, steps, loop_start, push=push, max_speed=robot.max_speed)
-    program, column = vertex_program(steps, robot.max_speed, robot.disturbance)
+    affine = [step for step in steps if step.through is None]
+    program, column = vertex_program(affine, robot.max_speed, robot.disturbance)
     built = time.perf_counter()
     velocities, _ = solve_vertex_program(program)
     solved = time.perf_counter()
     controllers = []
     for index, step in enumerate(steps):
+        if step.through is not None:
+            controllers.append(
+                pursuit_controller(
+                    index, step, abstraction.vertices[step.through], robot.max_speed,
+                    robot.disturbance,
+                )
+            )
+            continue
         w = np.array([velocities[column[r]] for r in step.runs])
         geometry = step.geometry
         target = None
@@ -493,6 +576,8 @@ def synthesize(
             )
         )
     for controller in controllers:
+        if controller.is_vertex:
+            continue  # the pursuit law's guarantees hold by construction (docs/control.md)
         problem = _violated_condition(controller, robot.max_speed, robot.disturbance)
         if problem is not None:
             raise SolverError(

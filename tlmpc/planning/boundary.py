@@ -84,8 +84,11 @@ def closed_letters(
 
     The triangles' letters, the start point's, and the crossing letters of adjacent label
     pairs; also ``L + POINT`` for every triangle letter ``L``, the letter of an edge inside
-    one labelled area (refinement for U-turns makes new such edges).
+    one labelled area (refinement for U-turns makes new such edges), and the letters of the
+    mesh vertices where labels meet (read by vertex passages).
     """
+    from tlmpc.planning.passages import vertex_point_letters
+
     letters = dict.fromkeys(abstraction.letters)
     letters[tuple(sorted({*start_point_label(abstraction, start_point), POINT}))] = None
     for letter in abstraction.letters:
@@ -101,6 +104,8 @@ def closed_letters(
             letters[
                 crossing_letter(abstraction.letters[key // count], abstraction.letters[key % count])
             ] = None
+    for letter in vertex_point_letters(abstraction).values():
+        letters.setdefault(letter, None)
     return tuple(letters)
 
 

@@ -69,42 +69,83 @@ def plan_complete(
     ``parts`` gives the task's parts for that explanation (called only then).
     """
 
-    def attempt(mesh: Abstraction, bounces: bool) -> Witness:
-        return plan(
-            mesh,
-            automaton,
-            formula=formula,
-            options=options,
-            start_point=start_point,
-            bounces=bounces,
-        )
-
     try:
-        return abstraction, attempt(abstraction, False)
+        return abstraction, _attempt(abstraction, automaton, formula, options, start_point)
     except NoPlanError as first:
         no_bounce_failure = first
+    try:
+        return _refined(abstraction, automaton, formula, options, start_point, passages=False)
+    except NoPlanError:
+        pass
+    # The one place vertex passages come in: no plan exists along edges alone.
+    try:
+        return abstraction, _attempt(
+            abstraction, automaton, formula, options, start_point, passages=True
+        )
+    except NoPlanError:
+        pass
+    try:
+        return _refined(abstraction, automaton, formula, options, start_point, passages=True)
+    except NoPlanError:
+        raise NoPlanError(
+            explain_infeasible(
+                abstraction,
+                automaton,
+                formula=formula,
+                options=options,
+                start_point=start_point,
+                parts=parts(),
+                file=file,
+                fallback=no_bounce_failure.diagnostics,
+            )
+        ) from None
+
+
+def _attempt(
+    mesh: Abstraction,
+    automaton: Automaton,
+    formula: Formula,
+    options: Options,
+    start_point: tuple[float, float],
+    *,
+    bounces: bool = False,
+    passages: bool = False,
+) -> Witness:
+    return plan(
+        mesh,
+        automaton,
+        formula=formula,
+        options=options,
+        start_point=start_point,
+        bounces=bounces,
+        passages=passages,
+    )
+
+
+def _refined(
+    abstraction: Abstraction,
+    automaton: Automaton,
+    formula: Formula,
+    options: Options,
+    start_point: tuple[float, float],
+    *,
+    passages: bool,
+) -> tuple[Abstraction, Witness]:
+    """A no-bounce witness on a mesh refined where a bouncing lasso turns around; raises
+    :class:`NoPlanError` when no bouncing lasso exists on ``abstraction``."""
     mesh = abstraction
     for _ in range(MAX_ROUNDS):
         try:
-            bouncing = attempt(mesh, True)
+            bouncing = _attempt(
+                mesh, automaton, formula, options, start_point, bounces=True, passages=passages
+            )
         except NoPlanError:
             if mesh is abstraction:
-                raise NoPlanError(
-                    explain_infeasible(
-                        abstraction,
-                        automaton,
-                        formula=formula,
-                        options=options,
-                        start_point=start_point,
-                        parts=parts(),
-                        file=file,
-                        fallback=no_bounce_failure.diagnostics,
-                    )
-                ) from None
+                raise
             break
         mesh = split_triangles(mesh, bounce_triangles(bouncing, mesh, start_point), start_point)
         try:
-            witness = attempt(mesh, False)
+            witness = _attempt(mesh, automaton, formula, options, start_point, passages=passages)
         except NoPlanError:
             continue
         return mesh, witness

@@ -28,6 +28,7 @@ def witness_to_json(witness: Witness, abstraction: Abstraction | None = None) ->
         "metric": witness.metric,
         "beta": witness.beta,
         "stats": dict(witness.stats),
+        **({"passages": [list(p) for p in witness.passages]} if witness.passages else {}),
     }
 
 
@@ -45,4 +46,5 @@ def witness_from_json(document: Mapping[str, Any]) -> Witness:
         prefix_cost=float(document["prefix_cost"]),
         cycle_cost=float(document["cycle_cost"]),
         stats=dict(document.get("stats", {})),
+        passages=tuple((int(i), int(v)) for i, v in document.get("passages", ())),
     )

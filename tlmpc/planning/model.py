@@ -5,6 +5,10 @@ triangle unless the start triangle opens the cycle (then ``prefix`` is empty).  
 triangles are distinct and adjacent, the last of ``cycle`` is adjacent to its first, and no
 plan bounces (``path[i-1] != path[i+1]``, across the wrap too).  A cycle of one triangle is
 a *stay*: the robot converges to a point inside it.
+
+A *vertex passage* ``(i, v)`` replaces the edge between ``path[i]`` and the next triangle
+(``cycle[0]`` after the last one): the robot runs to mesh vertex ``v``, a corner of both, and
+goes on from there (see :mod:`tlmpc.planning.passages`).  Such a pair shares ``v``, not an edge.
 """
 
 from __future__ import annotations
@@ -29,6 +33,7 @@ class Witness:
     prefix_cost: float
     cycle_cost: float
     stats: Mapping[str, Any] = field(default_factory=dict)
+    passages: tuple[tuple[int, int], ...] = ()  # (index into prefix + cycle, mesh vertex)
 
     @property
     def is_stay(self) -> bool:

@@ -30,6 +30,7 @@ from tlmpc.mission.model import Options
 from tlmpc.planning.boundary import start_cells, start_point_label
 from tlmpc.planning.explain import explain_no_plan, invariant_mask
 from tlmpc.planning.model import Witness
+from tlmpc.planning.passages import PassageCells, add_vertex_passages
 from tlmpc.planning.product import SLOTS, START_SLOT, Product, build_product
 
 #: At most this many cycle candidates are closed with a Dijkstra search; past it the
@@ -45,20 +46,27 @@ def _path(predecessors: IntArray, target: int) -> list[int]:
     return path
 
 
-def _collapse(nodes: list[int], nq: int) -> tuple[list[int], list[int]]:
-    """Triangles of a product path with stutter steps merged, and the automaton state after
-    reading each triangle (the last one of its stutter group)."""
+def _collapse(
+    nodes: list[int], nq: int, cells: PassageCells | None = None
+) -> tuple[list[int], list[int], dict[int, int]]:
+    """Triangles of a product path with stutter steps merged, the automaton state after
+    reading each triangle (the last one of its stutter group), and the vertex passages
+    (index of the triangle left through a vertex -> that vertex)."""
     triangles: list[int] = []
     states: list[int] = []
+    through: dict[int, int] = {}
     for node in nodes:
-        tri = (node // nq) // SLOTS
+        tri = (node // nq) // SLOTS if cells is None else cells.triangle_of(node, nq)
         q = node % nq
         if triangles and triangles[-1] == tri:
             states[-1] = q
         else:
+            vertex = None if cells is None else cells.vertex_of(node, nq)
+            if vertex is not None and triangles:
+                through[len(triangles) - 1] = vertex
             triangles.append(tri)
             states.append(q)
-    return triangles, states
+    return triangles, states, through
 
 
 def _path_cost(product: Product, nodes: list[int]) -> float:
@@ -75,6 +83,7 @@ def plan(
     start_point: tuple[float, float] | None = None,
     bounces: bool = False,
     resume: frozenset[int] | None = None,
+    passages: bool = False,
 ) -> Witness:
     """A minimum-cost accepting lasso (raises :class:`NoPlanError` with an explanation).
 
@@ -82,6 +91,8 @@ def plan(
     controllers cannot realise on this mesh; :mod:`tlmpc.planning.complete` refines those).
     ``resume`` re-plans a run under way: the robot is in the start triangle and has already
     read its label, the (degeneralized) automaton being in any of these states.
+    ``passages=True`` also lets the lasso pass through mesh vertices where labels meet
+    (:mod:`tlmpc.planning.passages`).
     """
     started = time.perf_counter()
     allowed = invariant_mask(abstraction, formula)
@@ -102,6 +113,18 @@ def plan(
         start_label=start_label,
         bounces=bounces,
     )
+    cells: PassageCells | None = None
+    if passages:
+        product, cells = add_vertex_passages(
+            product,
+            abstraction,
+            working,
+            allowed=allowed,
+            starts=starts,
+            start_point=start_point,
+            metric=options.cost,
+            convention=options.boundary,
+        )
 
     def why() -> NoPlanError:
         return NoPlanError(
@@ -152,7 +175,7 @@ def plan(
         raise why()
     reached = int(np.isfinite(dist).sum())
     return _witness(
-        abstraction, product, best, options, started, searches, exhausted, working, reached
+        abstraction, product, best, options, started, searches, exhausted, working, reached, cells
     )
 
 
@@ -205,20 +228,27 @@ def _witness(
     exhausted: bool,
     automaton: Automaton,
     reached: int,
+    cells: PassageCells | None = None,
 ) -> Witness:
     _, prefix_nodes, cycle_nodes = best
     nq = product.num_automaton_states
     anchor = cycle_nodes[0]
     # prefix_nodes ends at the anchor; the cycle starts at the anchor's triangle.
-    prefix_tris, prefix_states = _collapse(prefix_nodes, nq)
-    cycle_tris, cycle_states = _collapse(cycle_nodes, nq)
-    anchor_tri = (anchor // nq) // SLOTS
+    prefix_tris, prefix_states, prefix_through = _collapse(prefix_nodes, nq, cells)
+    cycle_tris, cycle_states, cycle_through = _collapse(cycle_nodes, nq, cells)
+    anchor_tri = (anchor // nq) // SLOTS if cells is None else cells.triangle_of(anchor, nq)
     # Drop the anchor's own triangle from the prefix: it opens the cycle.
     if prefix_tris and prefix_tris[-1] == anchor_tri:
         prefix_tris, prefix_states = prefix_tris[:-1], prefix_states[:-1]
     # A moving cycle whose last triangle equals its first (stutter at the anchor) is merged.
     if len(cycle_tris) > 1 and cycle_tris[-1] == cycle_tris[0]:
         cycle_tris, cycle_states = cycle_tris[:-1], cycle_states[:-1]
+    # Vertex passages by index into prefix + cycle (the last cycle index: into cycle[0]).
+    through = {i: v for i, v in prefix_through.items() if i < len(prefix_tris)}
+    through.update({len(prefix_tris) + i: v for i, v in cycle_through.items()})
+    wrap = None if cells is None or len(cycle_nodes) == 1 else cells.vertex_of(anchor, nq)
+    if wrap is not None:
+        through[len(prefix_tris) + len(cycle_tris) - 1] = wrap
     prefix_cost = _path_cost(product, prefix_nodes)
     cycle_cost = 0.0 if len(cycle_nodes) == 1 else _path_cost(product, [*cycle_nodes, anchor])
     stats: dict[str, Any] = {
@@ -242,4 +272,5 @@ def _witness(
         prefix_cost=prefix_cost,
         cycle_cost=cycle_cost,
         stats=stats,
+        passages=tuple(sorted(through.items())),
     )

@@ -304,6 +304,18 @@ def _stay_step(
     return times, points
 
 
+def pursuit_step(
+    controller: StepController, x0: FloatArray, max_speed: float
+) -> tuple[list[float], list[FloatArray]]:
+    """A vertex passage, exactly: the pursuit law moves straight to the corner at
+    ``max_speed``, arriving after |v - x0| / max_speed; the last sample is the corner itself
+    (exactly its coordinates, so the verifier reads the point's label there)."""
+    assert controller.target is not None
+    target = np.asarray(controller.target, dtype=np.float64)
+    distance = float(np.linalg.norm(target - x0))
+    return [distance / max_speed], [target]
+
+
 def simulate(abstraction: Abstraction, controllers: Controllers, mission: Mission) -> Trace:
     """The trajectory from ``mission.robot.start`` under ``controllers``."""
     del abstraction  # the controllers carry their triangles' geometry
@@ -325,7 +337,9 @@ def simulate(abstraction: Abstraction, controllers: Controllers, mission: Missio
         controller = steps[index]
         if loop_start_step is not None and index == loop_start_step and position == len(steps):
             loop_index = len(points) - 1  # the crossing into the second lap
-        if controller.exit_edge is None:
+        if controller.is_vertex:
+            rel_times, rel_points = pursuit_step(controller, x, controllers.max_speed)
+        elif controller.exit_edge is None:
             rel_times, rel_points = _stay_step(controller, x, controllers.max_speed)
         else:
             rel_times, rel_points = _exit_step(controller, x)
@@ -337,7 +351,7 @@ def simulate(abstraction: Abstraction, controllers: Controllers, mission: Missio
                 continue
             times.append(now + t)
             points.append(point)
-            is_crossing = controller.exit_edge is not None and offset == len(rel_times) - 1
+            is_crossing = not controller.is_stay and offset == len(rel_times) - 1
             step_of.append(index)
             triangle_of.append(
                 controller.next_triangle
