@@ -17,9 +17,9 @@ from hypothesis import strategies as st
 
 from tlmpc.abstraction import build_abstraction
 from tlmpc.abstraction.resolution import subgrid_problems
-from tlmpc.abstraction.triangulate import grid_size
 from tlmpc.errors import InvalidInputError
 from tlmpc.mission import load_mission_text
+from tlmpc.mission.grid import grid_size
 from tlmpc.mission.model import Mission
 
 BASE = """version: 1

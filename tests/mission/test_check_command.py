@@ -106,3 +106,68 @@ def test_console_entry_point_runs() -> None:
         check=False,
     )
     assert completed.returncode == 0, completed.stderr
+
+
+SUBGRID = """version: 1
+name: grid
+workspace:
+  boundary: {rect: [0, 0, 10, 10]}
+regions:
+  goal: {rect: [8, 1, 9, 9]}
+  wall: [[5, 0], [5.000000003, 0], [5.000000003, 10], [5, 10]]
+  left: [[2, 2], [3, 2], [3, 3], [2, 3]]
+  close: [[3.0000000003, 2], [4, 2], [4, 3], [3.0000000003, 3]]
+robot: {start: [1, 5], max_speed: 1.0}
+ltl: "F goal"
+"""
+
+
+def test_check_reports_the_subgrid_features_compile_refuses(tmp_path: Path) -> None:
+    """G030 (a strip thinner than the grid) and G031 (a gap below it): check gives exactly
+    the diagnostics compile gives, at the same lines (compile's are the oracle here, and
+    the strip's line is known: the geometry makes these two features sub-grid)."""
+    mission = tmp_path / "m.yaml"
+    mission.write_text(SUBGRID)
+    code, out, _ = run("--json", str(mission))
+    assert code == 1
+    checked = json.loads(out)["result"]["files"][0]["diagnostics"]
+    out_dir = tmp_path / "out"
+    compiled_code, compiled_out, _ = run_main("compile", str(mission), "-o", str(out_dir))
+    del compiled_out
+    assert compiled_code == 1
+    assert not out_dir.exists()
+    from tlmpc.abstraction import build_abstraction
+    from tlmpc.errors import InvalidInputError
+    from tlmpc.mission import load_mission_text
+
+    try:
+        build_abstraction(load_mission_text(SUBGRID, str(mission)))
+    except InvalidInputError as refused:
+        expected = [d.to_json() for d in refused.diagnostics]
+    else:  # pragma: no cover - the oracle must refuse
+        raise AssertionError("compile accepted sub-grid features")
+    assert checked == expected
+    codes = sorted(d["code"] for d in checked)
+    assert codes == ["G030", "G031"]
+    wall = next(d for d in checked if d["code"] == "G030")
+    assert wall["line"] == 7 and "'wall'" in wall["message"]
+    assert all(d["hint"] for d in checked)
+
+
+def test_check_of_an_off_grid_mission_without_subgrid_features_passes(tmp_path: Path) -> None:
+    """Coordinates off the grid but features wide enough: the shapely check runs, finds
+    nothing, and the mission is valid."""
+    mission = tmp_path / "m.yaml"
+    mission.write_text(
+        SUBGRID.replace("5.000000003", "5.3")
+        .replace("3.0000000003", "3.3")
+        .replace("[8, 1, 9, 9]", "[8.00000000001, 1, 9, 9]")
+    )
+    code, _, err = run(str(mission))
+    assert code == 0, err
+
+
+def run_main(*argv: str) -> tuple[int, str, str]:
+    out, err = io.StringIO(), io.StringIO()
+    code = main(list(argv), out, err)
+    return code, out.getvalue(), err.getvalue()

@@ -8,7 +8,6 @@ chain of constraint segments, each triangle lies wholly inside or wholly outside
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
@@ -20,6 +19,7 @@ from shapely.geometry import Polygon as ShapelyPolygon
 
 from tlmpc.errors import InvalidInputError, error
 from tlmpc.mission.model import Mission
+from tlmpc.mission.resolution import grid_size
 
 if TYPE_CHECKING:
     from tlmpc.abstraction.layout import PlanningLayout
@@ -31,21 +31,6 @@ IntArray = npt.NDArray[np.int64]
 #: vertex (a cap, far above what well-shaped inputs need, so refinement always terminates).
 MIN_STEINER = 20_000
 STEINER_PER_VERTEX = 50
-
-#: Snapping grid, relative to the workspace's extent: closer features are merged.
-GRID = 1e-9
-
-
-def grid_size(mission: Mission) -> float:
-    """The snapping grid: a power of ten near a billionth of the workspace's extent.
-
-    A power of ten keeps decimal coordinates (the ones users write) exactly where they are.
-    """
-    minx, miny, maxx, maxy = shapely.total_bounds(
-        [ShapelyPolygon(piece.boundary) for piece in mission.workspace.pieces]
-    ).tolist()
-    extent = max(maxx - minx, maxy - miny)
-    return float(10.0 ** math.floor(math.log10(extent * GRID)))
 
 
 def _snapped(points: Sequence[tuple[float, float]], grid: float) -> Any:

@@ -60,6 +60,8 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
                         body = body_diagnostics(merged)
                         diagnostics = [d for d in body if d.severity == "error"]
                         notices += [d for d in body if d.severity != "error"]
+                    if not diagnostics:
+                        diagnostics = _subgrid(merged)
             if diagnostics:
                 invalid += 1
             else:
@@ -85,6 +87,19 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             summary += f", {unreadable} unreadable"
         report.note(summary)
     return code
+
+
+def _subgrid(mission: Any) -> list[Any]:
+    """What compile refuses before triangulating (G030/G031): features snapping would
+    reshape.  A pure-Python look first: when every coordinate is on the grid (decimals, the
+    usual case) nothing moves and numpy and shapely stay unloaded."""
+    from tlmpc.mission.grid import features_on_grid
+
+    if features_on_grid(mission):
+        return []
+    from tlmpc.mission.resolution import subgrid_problems
+
+    return list(subgrid_problems(mission))
 
 
 def _scopes(mission: Any) -> list[str]:

@@ -530,7 +530,10 @@ def synthesize(
         if step.through is not None:
             controllers.append(
                 pursuit_controller(
-                    index, step, abstraction.vertices[step.through], robot.max_speed,
+                    index,
+                    step,
+                    abstraction.vertices[step.through],
+                    robot.max_speed,
                     robot.disturbance,
                 )
             )

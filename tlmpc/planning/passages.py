@@ -30,7 +30,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from scipy.sparse import csr_matrix
 
-from tlmpc.abstraction.model import Abstraction, IntArray
+from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
 from tlmpc.automata.guards import successor_table
 from tlmpc.automata.model import Automaton
 from tlmpc.planning.boundary import POINT, StartCell, crossing_letter
@@ -145,10 +145,11 @@ def add_vertex_passages(
     start_blocked = {cell.triangle: set(cell.blocked) for cell in starts}
     start = np.asarray(start_point, dtype=np.float64)
 
-    def midpoint(t: int, edge: int) -> np.ndarray:  # type: ignore[type-arg]
+    def midpoint(t: int, edge: int) -> FloatArray:
         a = vertices[corners_of[t, (edge + 1) % 3]]
         b = vertices[corners_of[t, (edge + 2) % 3]]
-        return (a + b) / 2.0
+        middle: FloatArray = (a + b) / 2.0
+        return middle
 
     # Moves as (source node without q, target node without q, letters read, weight).
     moves: list[tuple[int, int, tuple[int, ...], float]] = []
@@ -167,9 +168,7 @@ def add_vertex_passages(
             if t1 in start_blocked:
                 through_v = {(k1 + 1) % 3, (k1 + 2) % 3}
                 if not (through_v & start_blocked[t1]):
-                    sources.append(
-                        (t1 * SLOTS + START_SLOT, float(np.linalg.norm(point - start)))
-                    )
+                    sources.append((t1 * SLOTS + START_SLOT, float(np.linalg.norm(point - start))))
             for source, length in sources:
                 weight = 1.0 if metric == "hops" else length + STUTTER_COST
                 moves.append((source, arrival, reads_at_vertex, weight))
@@ -226,11 +225,11 @@ def add_vertex_passages(
                 acc.append(accepting)
     old = product.graph.tocoo()
     old_acc = product.accepting.tocoo()
-    sources = np.concatenate([old.row.astype(np.int64), np.asarray(src, dtype=np.int64)])
+    all_sources = np.concatenate([old.row.astype(np.int64), np.asarray(src, dtype=np.int64)])
     targets = np.concatenate([old.col.astype(np.int64), np.asarray(dst, dtype=np.int64)])
     weights = np.concatenate([old.data, np.asarray(wgt, dtype=np.float64)])
     marked = np.asarray(acc, dtype=bool)
-    graph = csr_matrix((weights, (sources, targets)), shape=(size, size))
+    graph = csr_matrix((weights, (all_sources, targets)), shape=(size, size))
     graph.sum_duplicates()
     graph.sort_indices()
     new_src = np.asarray(src, dtype=np.int64)[marked]
