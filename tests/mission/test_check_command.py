@@ -150,7 +150,8 @@ def test_check_reports_the_subgrid_features_compile_refuses(tmp_path: Path) -> N
     codes = sorted(d["code"] for d in checked)
     assert codes == ["G030", "G031"]
     wall = next(d for d in checked if d["code"] == "G030")
-    assert wall["line"] == 7 and "'wall'" in wall["message"]
+    assert wall["line"] == 7
+    assert "'wall'" in wall["message"]
     assert all(d["hint"] for d in checked)
 
 
