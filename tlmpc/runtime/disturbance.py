@@ -54,6 +54,12 @@ def adversarial_direction(executor: Executor, point: FloatArray) -> FloatArray:
     if executor.progress.status in ("no_plan", "violated"):
         return np.zeros(2)
     controller = executor.controller
+    if controller.is_vertex and controller.target is not None:
+        # A vertex passage: straight against the pursuit, which slows the arrival most.
+        away = point - np.asarray(controller.target, dtype=np.float64)
+        length = float(np.hypot(away[0], away[1]))
+        unit: FloatArray = away / length if length > 0.0 else np.zeros(2)
+        return unit
     normals = executor.locator.normals[controller.triangle]
     distances = executor.locator.offsets[controller.triangle] - normals @ point  # to each facet
     exit_edge = controller.exit_edge

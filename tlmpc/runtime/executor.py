@@ -15,6 +15,11 @@ step).  Each :meth:`Executor.command` call
    the new plan's fields;
 4. returns the current step's field at the reference point (for a unicycle, turned into
    forward and angular speed by feedback linearisation).
+
+A vertex passage step runs the pursuit law toward its corner v, slowed near v so that a
+command held for as long as the last sample period lands on v rather than past it; the step
+ends (the robot is at v, in the next step's triangle) when the robot is within
+:data:`ARRIVAL` of v relative to the triangle's size, or its last move went past v.
 """
 
 from __future__ import annotations
@@ -41,6 +46,9 @@ from tlmpc.runtime.unicycle import reference_point, unicycle_command
 
 if TYPE_CHECKING:
     from tlmpc.api import Compiled
+
+#: A vertex passage has arrived within this fraction of its triangle's diameter of the corner.
+ARRIVAL = 1e-6
 
 
 @dataclass(frozen=True, slots=True)
@@ -118,6 +126,7 @@ class Executor:
         self._point: FloatArray | None = None
         self._status: Status = "following"
         self._time = 0.0
+        self._period = 0.0  # time between the last two commands (a vertex passage lands)
         self._laps = 0
         self._replans = 0
         self._reentries = 0
@@ -201,6 +210,8 @@ class Executor:
         if self._status in ("no_plan", "violated"):
             return np.zeros(2)
         controller = self.controller
+        if controller.is_vertex:
+            return self._pursuit(controller, point)
         u: FloatArray = controller.gain @ point + controller.offset
         speed = float(np.hypot(u[0], u[1]))
         limit = self.mission.robot.max_speed
@@ -223,6 +234,7 @@ class Executor:
                 )
             )
         point = self.reference_point(pose)
+        self._period = max(float(t) - self._time, 0.0) if self._point is not None else 0.0
         self._time = float(t)
         self.observe(point)
         u = self.velocity(point)
@@ -237,6 +249,15 @@ class Executor:
             return
         previous, self._point = self._point, point
         if self._status in ("no_plan", "violated"):
+            return
+        controller = self.controller
+        if (
+            controller.is_vertex
+            and self._status == "following"
+            and controller.next_triangle is not None
+            and self._at_corner(controller, previous, point)
+        ):
+            self._enter(controller.next_triangle, point)
             return
         entered: list[int] | None = None
         if self._triangle is not None and self._status != "outside":
@@ -254,6 +275,33 @@ class Executor:
                 return
 
     # --- internals -----------------------------------------------------------------------
+
+    def _pursuit(self, controller: StepController, point: FloatArray) -> FloatArray:
+        """The pursuit law toward the corner, at max_speed or slower where one more held
+        command of the last period would carry the robot past it."""
+        assert controller.target is not None
+        towards = np.asarray(controller.target, dtype=np.float64) - point
+        distance = float(np.hypot(towards[0], towards[1]))
+        if distance == 0.0:
+            return np.zeros(2)
+        speed = self.mission.robot.max_speed
+        if self._period > 0.0:
+            speed = min(speed, distance / self._period)
+        u: FloatArray = towards * (speed / distance)
+        return u
+
+    @staticmethod
+    def _at_corner(controller: StepController, previous: FloatArray, point: FloatArray) -> bool:
+        """True when a vertex passage has reached its corner (see the module doc)."""
+        assert controller.target is not None
+        corner = np.asarray(controller.target, dtype=np.float64)
+        size = max(
+            float(np.linalg.norm(controller.vertices[i] - controller.vertices[(i + 1) % 3]))
+            for i in range(3)
+        )
+        if float(np.linalg.norm(point - corner)) <= ARRIVAL * size:
+            return True
+        return float((corner - previous) @ (corner - point)) < 0.0
 
     def _check_plan_states(self) -> None:
         """The witness's automaton states must be a run over its own labels (else R022)."""
@@ -345,15 +393,23 @@ class Executor:
             # A triangle crossed on the way to ``point``: the plan starts in it, and the
             # planner's start triangles are those holding its start point.
             point = abstraction.corners(triangle).mean(axis=0)
-        try:
-            witness = plan(
+
+        def resume(passages: bool) -> Witness:
+            return plan(
                 abstraction,
                 self.automaton,
                 formula=self.mission.formula,
                 options=self.mission.options,
                 start_point=(float(point[0]), float(point[1])),
                 resume=self._states,
+                passages=passages,
             )
+
+        try:
+            try:
+                witness = resume(False)
+            except NoPlanError:
+                witness = resume(True)  # as compile does: through a corner only when needed
             controllers = synthesize(abstraction, witness, self.mission.robot)
         except (NoPlanError, SolverError, InvalidInputError):
             self._stop("no_plan", triangle)
