@@ -228,3 +228,48 @@ def test_a_compiled_trace_faster_than_max_speed_fails_the_self_check(
     with pytest.raises(SelfCheckError) as caught:
         compile_mission(mission("F(a & F b)", (5, 5)), until="verify")
     assert "faster than max_speed" in caught.value.diagnostics[0].message
+
+
+# --- corner contacts: regions that touch at a single point --------------------------------
+
+CORNER_REGIONS = {
+    "a": [[2, 2], [5, 2], [5, 5], [2, 5]],
+    "b": [[5, 5], [8, 5], [8, 8], [5, 8]],
+}
+CORNER = (5.0, 5.0)
+
+CORNER_CASES = [
+    # (task, start, convention): each needs the robot at the corner point (5, 5)
+    ("F(a & b)", (1, 1), "closed"),  # only the corner point is in both closures
+    ("F(a & b) & G F !a", (3, 3), "closed"),
+    ("G(a | b) & F b", (3, 3), "right"),  # from a into b without leaving a | b
+    ("G(a | b) & F b", (3, 3), "closed"),
+    ("a & G(a | b) & G F b & G F (a & !b)", (3, 3), "right"),  # back and forth through it
+]
+
+
+@pytest.mark.parametrize(("ltl", "start", "boundary"), CORNER_CASES)
+def test_corner_contacts_are_planned_through_the_point(
+    ltl: str, start: tuple[float, float], boundary: str
+) -> None:
+    """A plan exists (a trajectory through the corner satisfies the task: the elementary
+    facts below) and its trace passes the independent check, sample at the corner included."""
+    document = mission(ltl, start, boundary=boundary, regions=CORNER_REGIONS)
+    a, b = (shapely.Polygon(CORNER_REGIONS[n]) for n in ("a", "b"))
+    touching = shapely.intersection(a, b)
+    assert touching.geom_type == "Point"  # they meet at the corner only ...
+    assert (touching.x, touching.y) == CORNER
+    artifacts = checked(document)
+    assert artifacts is not None, ltl
+    points = [tuple(p[1:]) for p in artifacts["trace.json"]["points"]]
+    assert CORNER in points  # ... and the robot passes exactly through it
+    kinds = [s.get("kind", "affine") for s in artifacts["controllers.json"]["steps"]]
+    assert "vertex" in kinds
+
+
+def test_corner_contact_under_right_reads_the_next_label() -> None:
+    """Under the right-continuous convention the corner instant is in the piece entered, so
+    "a and b at once" stays impossible although a trajectory passes the corner."""
+    document = mission("F(a & b)", (1, 1), regions=CORNER_REGIONS)
+    assert not face_oracle(document)
+    assert compiled(document) is None

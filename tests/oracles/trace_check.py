@@ -5,6 +5,9 @@ Shares no code with tlmpc's control, simulation or verifier:
 * vertex conditions in exact rational arithmetic (outward normals left unnormalised, so no
   square roots): every vertex velocity pushes strictly out through the exit facet and strictly
   into the two other facets, and its squared speed is within the bound;
+* a vertex passage step (pursuit of a corner): the corner is exactly one of the triangle's
+  vertices, the step's samples run straight to it at exactly max_speed and its last sample is
+  the corner itself, and the next step leaves through the edge opposite the corner (or stays);
 * the flow of each step's affine field by scipy's matrix exponential against the samples;
 * the speed between consecutive samples;
 * the task, on the piece word of the piecewise-linear trajectory cut at every region boundary
@@ -24,6 +27,23 @@ from lasso_ltl import holds
 from scipy.linalg import expm
 
 from tlmpc.ltl.parser import parse_ltl
+
+
+def check_pursuit(step: dict[str, Any], following: dict[str, Any], max_speed: float) -> None:
+    """A vertex passage: its corner is one of its triangle's vertices and of the next step's
+    triangle, whose field leaves through the edge opposite that corner (or stays)."""
+    target = [Fraction(c) for c in step["target"]]
+    corners = [[Fraction(c) for c in v] for v in step["vertices"]]
+    assert target in corners, step["step"]
+    assert step["exit_edge"] is None
+    assert not step["stay"]
+    following_corners = [[Fraction(c) for c in v] for v in following["vertices"]]
+    assert target in following_corners, (step["step"], "the next triangle lacks the corner")
+    if not following["stay"]:
+        assert following["exit_edge"] == following_corners.index(target), step["step"]
+    # Every corner reaches the target within the stated bound at max_speed.
+    farthest = max(float(np.hypot(*(np.asarray(v) - step["target"]))) for v in step["vertices"])
+    assert step["exit_time_bound"] >= farthest / max_speed * (1 - 1e-12)
 
 
 def check_vertex_conditions(step: dict[str, Any], max_speed: float) -> None:
@@ -47,7 +67,9 @@ def check_vertex_conditions(step: dict[str, Any], max_speed: float) -> None:
                 assert across < 0, (step["step"], facet, vertex)
 
 
-def check_flow(trace: dict[str, Any], steps: list[dict[str, Any]], size: float) -> None:
+def check_flow(
+    trace: dict[str, Any], steps: list[dict[str, Any]], size: float, max_speed: float = 1.0
+) -> None:
     """Each exit step's samples lie on the exact flow from the previous crossing."""
     points = np.asarray(trace["points"])
     step_of = trace["steps"]
@@ -56,7 +78,20 @@ def check_flow(trace: dict[str, Any], steps: list[dict[str, Any]], size: float) 
         if k < len(points) and step_of[k] == step_of[start]:
             continue
         step = steps[step_of[start]]
-        if step["exit_edge"] is not None:
+        if step.get("kind") == "vertex":
+            # Straight to the corner at exactly max_speed, the last sample on the corner.
+            entry = points[start - 1] if start else points[0]
+            corner = np.asarray(step["target"])
+            heading = corner - entry[1:]
+            distance = float(np.linalg.norm(heading))
+            assert points[k - 1][1] == corner[0]
+            assert points[k - 1][2] == corner[1]
+            for t, x, y in points[start:k]:
+                travelled = (t - entry[0]) * max_speed
+                assert travelled <= distance * (1 + 1e-9) + 1e-12 * size
+                expected = entry[1:] + heading * (travelled / distance if distance else 0.0)
+                assert np.linalg.norm(expected - [x, y]) <= 1e-9 * size
+        elif step["exit_edge"] is not None:
             gain, offset = np.asarray(step["K"]), np.asarray(step["g"])
             center = np.asarray(step["vertices"]).mean(axis=0)
             field = np.zeros((3, 3))
@@ -152,9 +187,14 @@ def task_holds(trace: dict[str, Any]) -> bool:
 def check_output(artifacts: dict[str, Any], max_speed: float, size: float) -> None:
     """Every independent check on a compiled output (a dict of artifact documents)."""
     controllers = artifacts["controllers.json"]
-    for step in controllers["steps"]:
-        check_vertex_conditions(step, max_speed)
+    steps = controllers["steps"]
+    for index, step in enumerate(steps):
+        if step.get("kind") == "vertex":
+            following = index + 1 if index + 1 < len(steps) else controllers["loop_start"]
+            check_pursuit(step, steps[following], max_speed)
+        else:
+            check_vertex_conditions(step, max_speed)
     trace = artifacts["trace.json"]
     check_speed(trace, max_speed, size)
-    check_flow(trace, controllers["steps"], size)
+    check_flow(trace, steps, size, max_speed)
     assert task_holds(trace), trace["ltl"]

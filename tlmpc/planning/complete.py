@@ -23,6 +23,7 @@ from tlmpc.mission.model import Options, TaskPart
 from tlmpc.planning.boundary import start_cells
 from tlmpc.planning.explain import explain_infeasible
 from tlmpc.planning.model import Witness
+from tlmpc.planning.passages import passage_turns
 from tlmpc.planning.plan import plan
 
 #: Rounds of refinement before giving up (one always suffices; see the module docstring).
@@ -143,7 +144,10 @@ def _refined(
             if mesh is abstraction:
                 raise
             break
-        mesh = split_triangles(mesh, bounce_triangles(bouncing, mesh, start_point), start_point)
+        turns = bounce_triangles(bouncing, mesh, start_point)
+        if passages:
+            turns = sorted({*turns, *passage_turns(mesh, bouncing)})
+        mesh = split_triangles(mesh, turns, start_point)
         try:
             witness = _attempt(mesh, automaton, formula, options, start_point, passages=passages)
         except NoPlanError:

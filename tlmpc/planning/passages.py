@@ -34,6 +34,7 @@ from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
 from tlmpc.automata.guards import successor_table
 from tlmpc.automata.model import Automaton
 from tlmpc.planning.boundary import POINT, StartCell, crossing_letter
+from tlmpc.planning.model import Witness
 from tlmpc.planning.product import SLOTS, START_SLOT, STUTTER_COST, BoolArray, Product
 
 Letter = tuple[str, ...]
@@ -96,8 +97,14 @@ def add_vertex_passages(
     start_point: tuple[float, float],
     metric: str,
     convention: str,
+    bounces: bool = False,
 ) -> tuple[Product, PassageCells]:
-    """``product`` with vertex passages (see the module doc) and its arrival cells."""
+    """``product`` with vertex passages (see the module doc) and its arrival cells.
+
+    With ``bounces`` (the search for U-turns), a passage may also start from a triangle
+    entered through an edge that holds the vertex, and an arrival may leave through such an
+    edge: :func:`passage_turns` names those triangles, which refinement splits.
+    """
     nq = automaton.num_states
     m = abstraction.num_triangles
     base = m * SLOTS * nq
@@ -164,25 +171,29 @@ def add_vertex_passages(
         for t1, k1 in around[v]:
             if t1 == t2:
                 continue
-            sources = [((t1 * SLOTS + k1), float(np.linalg.norm(point - midpoint(t1, k1))))]
+            entries = (k1, (k1 + 1) % 3, (k1 + 2) % 3) if bounces else (k1,)
+            sources = [
+                (t1 * SLOTS + e, float(np.linalg.norm(point - midpoint(t1, e))))
+                for e in entries
+                if abstraction.neighbors[t1, e] >= 0
+            ]
             if t1 in start_blocked:
                 through_v = {(k1 + 1) % 3, (k1 + 2) % 3}
-                if not (through_v & start_blocked[t1]):
+                if bounces or not (through_v & start_blocked[t1]):
                     sources.append((t1 * SLOTS + START_SLOT, float(np.linalg.norm(point - start))))
             for source, length in sources:
                 weight = 1.0 if metric == "hops" else length + STUTTER_COST
                 moves.append((source, arrival, reads_at_vertex, weight))
-        # Out of the cell: through the edge opposite v only.
-        n = int(abstraction.neighbors[t2, k2])
-        if n >= 0 and allowed[n]:
+        # Out of the cell: through the edge opposite v only (any edge, with bounces).
+        for exit_edge in (k2, (k2 + 1) % 3, (k2 + 2) % 3) if bounces else (k2,):
+            n = int(abstraction.neighbors[t2, exit_edge])
+            if n < 0 or not allowed[n]:
+                continue
             slot = int(np.flatnonzero(abstraction.neighbors[n] == t2)[0])
             entered = letter_id(abstraction.labels(n))
-            reads = (
-                (letter_id(crossing_letter(abstraction.labels(t2), abstraction.labels(n))), entered)
-                if closed
-                else (entered,)
-            )
-            length = float(np.linalg.norm(midpoint(t2, k2) - point))
+            crossing = crossing_letter(abstraction.labels(t2), abstraction.labels(n))
+            reads = (letter_id(crossing), entered) if closed else (entered,)
+            length = float(np.linalg.norm(midpoint(t2, exit_edge) - point))
             weight = 1.0 if metric == "hops" else length + STUTTER_COST
             moves.append((arrival, n * SLOTS + slot, reads, weight))
         stays.append((arrival, own))
@@ -252,3 +263,35 @@ def add_vertex_passages(
         product, graph=graph, accepting=accepting, stutter_accepting=stutter, num_nodes=size
     )
     return extended, cells_info
+
+
+def passage_turns(abstraction: Abstraction, witness: Witness) -> list[int]:
+    """Triangles where a vertex passage needs a turn the fields cannot make: entered through
+    an edge that holds the passage's vertex before running to it (the run would slide along
+    that edge), or left through such an edge right after arriving at it.  Splitting them into
+    fans (as for U-turns) gives the room to turn."""
+    path = [*witness.prefix, *witness.cycle]
+    loop = None if witness.is_stay else len(witness.prefix)
+
+    def following(i: int) -> int | None:
+        return i + 1 if i + 1 < len(path) else loop
+
+    def previous(i: int) -> list[int]:
+        found = [i - 1] if i > 0 else []
+        if loop is not None and i == loop:
+            found.append(len(path) - 1)
+        return found
+
+    turns: set[int] = set()
+    for i, vertex in witness.passages:
+        here = path[i]
+        for j in previous(i):
+            if vertex in abstraction.triangles[path[j]]:
+                turns.add(here)
+        arrival = following(i)
+        if arrival is None:
+            continue
+        after = following(arrival)
+        if after is not None and after != arrival and vertex in abstraction.triangles[path[after]]:
+            turns.add(path[arrival])
+    return sorted(turns)

@@ -124,6 +124,7 @@ def plan(
             start_point=start_point,
             metric=options.cost,
             convention=options.boundary,
+            bounces=bounces,
         )
 
     def why() -> NoPlanError:
