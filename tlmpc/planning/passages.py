@@ -62,7 +62,9 @@ class PassageCells:
 
 
 def contact_vertices(abstraction: Abstraction) -> IntArray:
-    """Mesh vertices where the triangles around carry at least two different labels."""
+    """Mesh vertices where the triangles around carry at least two different labels, and
+    *pinches*: vertices of the mesh's outline whose triangles form two or more fans that
+    share no edge (free space touching itself at a point between obstacles)."""
     count = abstraction.vertices.shape[0]
     corner_vertex = abstraction.triangles.reshape(-1)
     corner_letter = np.repeat(abstraction.letter_of, 3)
@@ -70,7 +72,44 @@ def contact_vertices(abstraction: Abstraction) -> IntArray:
     high = np.full(count, -1, dtype=np.int64)
     np.minimum.at(low, corner_vertex, corner_letter)
     np.maximum.at(high, corner_vertex, corner_letter)
-    return np.flatnonzero((high >= 0) & (low != high)).astype(np.int64)
+    found = set(np.flatnonzero((high >= 0) & (low != high)).tolist())
+    # Pinches lie on the outline: an endpoint of an edge without a neighbour.
+    t, i = np.nonzero(abstraction.neighbors < 0)
+    outline = np.unique(
+        np.concatenate(
+            [abstraction.triangles[t, (i + 1) % 3], abstraction.triangles[t, (i + 2) % 3]]
+        )
+    )
+    candidates = np.setdiff1d(outline, np.fromiter(found, dtype=np.int64, count=len(found)))
+    if len(candidates):
+        holder = np.isin(abstraction.triangles, candidates)
+        around: dict[int, list[int]] = {}
+        for tri, local in zip(*np.nonzero(holder), strict=True):
+            around.setdefault(int(abstraction.triangles[tri, local]), []).append(int(tri))
+        for v, triangles in around.items():
+            if _fans(abstraction, triangles) > 1:
+                found.add(v)
+    return np.asarray(sorted(found), dtype=np.int64)
+
+
+def _fans(abstraction: Abstraction, triangles: list[int]) -> int:
+    """How many edge-connected groups ``triangles`` (all around one vertex) form."""
+    members = set(triangles)
+    seen: set[int] = set()
+    groups = 0
+    for first in triangles:
+        if first in seen:
+            continue
+        groups += 1
+        stack = [first]
+        seen.add(first)
+        while stack:
+            current = stack.pop()
+            for n in abstraction.neighbors[current].tolist():
+                if n in members and n not in seen:
+                    seen.add(n)
+                    stack.append(n)
+    return groups
 
 
 def vertex_point_letters(abstraction: Abstraction) -> dict[int, Letter]:
@@ -169,8 +208,8 @@ def add_vertex_passages(
         # Into the cell: from every other triangle around v, entered opposite v or started
         # off both of its edges through v.
         for t1, k1 in around[v]:
-            if t1 == t2:
-                continue
+            if t1 == t2 and not bounces:
+                continue  # back into the same triangle: a U-turn at v (refinement splits it)
             entries = (k1, (k1 + 1) % 3, (k1 + 2) % 3) if bounces else (k1,)
             sources = [
                 (t1 * SLOTS + e, float(np.linalg.norm(point - midpoint(t1, e))))
@@ -285,6 +324,9 @@ def passage_turns(abstraction: Abstraction, witness: Witness) -> list[int]:
     turns: set[int] = set()
     for i, vertex in witness.passages:
         here = path[i]
+        back = following(i)
+        if back is not None and path[back] == here:
+            turns.add(here)  # to the vertex and back into the same triangle
         for j in previous(i):
             if vertex in abstraction.triangles[path[j]]:
                 turns.add(here)

@@ -55,13 +55,18 @@ def _collapse(
     triangles: list[int] = []
     states: list[int] = []
     through: dict[int, int] = {}
+    previous = -1
     for node in nodes:
         tri = (node // nq) // SLOTS if cells is None else cells.triangle_of(node, nq)
         q = node % nq
-        if triangles and triangles[-1] == tri:
+        vertex = None if cells is None else cells.vertex_of(node, nq)
+        # A passage back into the same triangle (a U-turn at a vertex, only while searching
+        # with bounces) is a step of its own, not a stutter.
+        entered = vertex is not None and node // nq != previous // nq
+        previous = node
+        if triangles and triangles[-1] == tri and not entered:
             states[-1] = q
         else:
-            vertex = None if cells is None else cells.vertex_of(node, nq)
             if vertex is not None and triangles:
                 through[len(triangles) - 1] = vertex
             triangles.append(tri)
