@@ -1,0 +1,167 @@
+"""Point contacts: tlmpc plans exactly when some trajectory in the plane satisfies the task,
+under both conventions, also when that trajectory must pass a single point where regions
+(or faces) touch only at a corner.
+
+The oracle is tests/oracles/face_graph.py (shapely faces and point contacts, Spot's automaton;
+under the closed convention the instant graph of its module doc).  Maps are rectangles on a
+small integer grid, so corners touch often; starts are at half-integer points, inside a face.
+Every plan's trace also passes the independent check of tests/oracles/trace_check.py.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import pytest
+import shapely
+from face_graph import face_graph, satisfiable_closed, satisfiable_on
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from strategies import formulas
+from trace_check import check_output
+
+from tlmpc.api import compile as compile_mission
+from tlmpc.errors import NoPlanError, TlmpcError
+from tlmpc.ltl.ast import Formula
+from tlmpc.ltl.parser import parse_ltl
+from tlmpc.ltl.printer import to_spin, to_text
+
+SIZE = 6
+BOUNDARY = [(0.0, 0.0), (float(SIZE), 0.0), (float(SIZE), float(SIZE)), (0.0, float(SIZE))]
+
+
+def rect(x0: int, y0: int, x1: int, y1: int) -> list[tuple[float, float]]:
+    return [
+        (float(x0), float(y0)),
+        (float(x1), float(y0)),
+        (float(x1), float(y1)),
+        (float(x0), float(y1)),
+    ]
+
+
+@st.composite
+def rectangles(draw: st.DrawFn) -> list[tuple[float, float]]:
+    x0 = draw(st.integers(1, SIZE - 2))
+    y0 = draw(st.integers(1, SIZE - 2))
+    x1 = draw(st.integers(x0 + 1, SIZE - 1))
+    y1 = draw(st.integers(y0 + 1, SIZE - 1))
+    return rect(x0, y0, x1, y1)
+
+
+def document(
+    regions: dict[str, list[tuple[float, float]]],
+    start: tuple[float, float],
+    task: Formula,
+    boundary: str,
+) -> dict[str, Any]:
+    return {
+        "version": 1,
+        "name": "contacts",
+        "workspace": {"boundary": [list(p) for p in BOUNDARY]},
+        "regions": {n: [list(p) for p in r] for n, r in regions.items()},
+        "robot": {"start": list(start), "max_speed": 1.0},
+        "ltl": to_text(task),
+        "options": {"boundary": boundary},
+    }
+
+
+def oracle(
+    regions: dict[str, list[tuple[float, float]]],
+    start: tuple[float, float],
+    task: Formula,
+    boundary: str,
+) -> bool:
+    graph = face_graph(BOUNDARY, [], regions, start)
+    if boundary == "closed":
+        return satisfiable_closed(graph, task)
+    return satisfiable_on(graph, to_spin(task))
+
+
+def tlmpc_plans(mission: dict[str, Any]) -> bool:
+    failure: TlmpcError | None = None
+    try:
+        result = compile_mission(mission, until="verify")
+    except TlmpcError as exc:
+        failure = exc
+    if failure is not None:
+        assert isinstance(failure, NoPlanError), [d.format() for d in failure.diagnostics]
+        return False
+    check_output(dict(result.artifacts), 1.0, float(SIZE))
+    return True
+
+
+def agree(
+    regions: dict[str, list[tuple[float, float]]],
+    start: tuple[float, float],
+    task: Formula,
+    boundary: str,
+) -> bool:
+    expected = oracle(regions, start, task, boundary)
+    found = tlmpc_plans(document(regions, start, task, boundary))
+    assert found == expected, (to_text(task), boundary, regions, start)
+    return found
+
+
+@settings(
+    deadline=None,
+    max_examples=max(8, settings().max_examples // 4),
+    suppress_health_check=[HealthCheck.too_slow],
+)
+@given(
+    a=rectangles(),
+    b=rectangles(),
+    c=rectangles(),
+    start=st.tuples(st.integers(0, SIZE - 1), st.integers(0, SIZE - 1)),
+    task=formulas(("a", "b", "c"), max_leaves=5),
+    boundary=st.sampled_from(["right", "closed"]),
+)
+def test_plans_exactly_when_a_trajectory_exists(
+    a: list[tuple[float, float]],
+    b: list[tuple[float, float]],
+    c: list[tuple[float, float]],
+    start: tuple[int, int],
+    task: Formula,
+    boundary: str,
+) -> None:
+    regions = {"a": a, "b": b, "c": c}
+    agree(regions, (start[0] + 0.5, start[1] + 0.5), task, boundary)
+
+
+CORNERS = {
+    "a": rect(1, 1, 3, 3),
+    "b": rect(3, 3, 5, 5),
+    "c": rect(3, 1, 5, 2),
+}
+
+HELD_OUT = [
+    # (task, start, convention, a trajectory exists)
+    ("F(a & b)", (0.5, 0.5), "closed", True),  # only at the corner (3, 3)
+    ("F(a & b)", (0.5, 0.5), "right", False),
+    ("G(a | b) & F b", (1.5, 1.5), "right", True),
+    ("G(a | b) & F b", (1.5, 1.5), "closed", True),
+    ("G(a | b) & G F b & G F !b", (1.5, 1.5), "right", True),
+    ("G !(a & b) & F(a & F b)", (0.5, 0.5), "closed", True),  # around, not through the corner
+    ("G(a | b) & F c", (1.5, 1.5), "right", False),
+    ("G !b & F(a & c)", (0.5, 0.5), "closed", True),  # a and c share an edge
+]
+
+
+@pytest.mark.parametrize(("ltl", "start", "boundary", "exists"), HELD_OUT)
+def test_held_out_corner_missions(
+    ltl: str, start: tuple[float, float], boundary: str, exists: bool
+) -> None:
+    a, b = shapely.Polygon(CORNERS["a"]), shapely.Polygon(CORNERS["b"])
+    assert shapely.intersection(a, b).geom_type == "Point"
+    assert agree(CORNERS, start, parse_ltl(ltl), boundary) is exists
+
+
+def test_the_oracle_sees_a_pinch_of_the_free_space() -> None:
+    """Two holes touching the boundary and each other at points split nothing: the faces on
+    either side touch at the pinch, and a plan passes through it."""
+    holes = [rect(0, 3, 3, 4), rect(3, 2, 6, 3)]  # meet at (3, 3); each on one wall
+    regions = {"goal": rect(5, 5, 6, 6)}
+    graph = face_graph(BOUNDARY, holes, regions, (0.5, 0.5))
+    assert satisfiable_on(graph, "F goal")
+    mission = document(regions, (0.5, 0.5), parse_ltl("F goal"), "right")
+    mission["workspace"]["holes"] = [[list(p) for p in h] for h in holes]
+    assert tlmpc_plans(mission)
