@@ -323,3 +323,12 @@ def _cross_check(directory: Path, documents: dict[str, dict[str, Any]]) -> None:
                 raise _tampered(
                     directory / "witness.json", f"witness.json: {key} names a missing triangle"
                 )
+        length = len(witness["prefix"]) + len(witness["cycle"])
+        passages = witness.get("passages", [])
+        if not all(
+            0 <= index < length and 0 <= vertex < len(abstraction["vertices"])
+            for index, vertex in passages
+        ):
+            raise _tampered(
+                directory / "witness.json", "witness.json: a passage names a missing step or vertex"
+            )

@@ -30,6 +30,9 @@ class Plan:
     formula: str
     #: further pieces of free space (workspace components): outer ring and holes
     components: tuple[tuple[Ring, tuple[Ring, ...]], ...] = ()
+    #: samples every export keeps: the corners of vertex passages (the plan needs the robot
+    #: exactly there; a thinned path would cut the corner)
+    pinned: tuple[int, ...] = ()
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -80,6 +83,7 @@ def read_plan(directory: Path) -> Plan:
             ),
             regions={str(k): _ring(v) for k, v in mission["regions"].items()},
             formula=str(mission.get("formula", "")),
+            pinned=_passage_corners(directory, trace, samples),
         )
     except (KeyError, TypeError, ValueError, IndexError) as exc:
         raise _fail(
@@ -90,8 +94,32 @@ def read_plan(directory: Path) -> Plan:
     return plan
 
 
+def _passage_corners(directory: Path, trace: Any, samples: FloatArray) -> tuple[int, ...]:
+    """Indices of the samples at the corner of a vertex passage (from controllers.json, when
+    the folder has it: the samples of a vertex step whose position is its corner)."""
+    from tlmpc.artifacts import read_json
+
+    if not (directory / "controllers.json").is_file():
+        return ()
+    steps = read_json(directory / "controllers.json", "tlmpc.controllers/")["steps"]
+    corners = {
+        int(s["step"]): (float(s["target"][0]), float(s["target"][1]))
+        for s in steps
+        if s.get("kind") == "vertex"
+    }
+    if not corners:
+        return ()
+    step_of = trace.get("steps") or []
+    return tuple(
+        index
+        for index, step in enumerate(step_of)
+        if step in corners and (samples[index, 1], samples[index, 2]) == corners[step]
+    )
+
+
 def waypoints(plan: Plan, spacing: float = 0.0) -> tuple[list[Waypoint], int | None]:
-    """Samples at least ``spacing`` apart (the first, the last and the loop start always kept).
+    """Samples at least ``spacing`` apart (the first, the last, the loop start and the corners
+    of vertex passages always kept).
 
     Returns the waypoints and the index of the loop start among them (``None`` when the plan
     does not loop).  Each heading points to the next waypoint (the last keeps its predecessor's,
@@ -101,7 +129,7 @@ def waypoints(plan: Plan, spacing: float = 0.0) -> tuple[list[Waypoint], int | N
     count = len(samples)
     keep: list[int] = []
     for index in range(count):
-        forced = index in (0, count - 1) or index == plan.loop_start
+        forced = index in (0, count - 1) or index == plan.loop_start or index in plan.pinned
         if forced or not keep:
             keep.append(index)
             continue
