@@ -15,14 +15,14 @@ from typing import Any
 import pytest
 import shapely
 from face_graph import face_graph, satisfiable_closed, satisfiable_on
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 from strategies import formulas
 from trace_check import check_output
 
 from tlmpc.api import compile as compile_mission
 from tlmpc.errors import NoPlanError, TlmpcError
-from tlmpc.ltl.ast import Formula
+from tlmpc.ltl.ast import Formula, Not, Prop, Release, Until
 from tlmpc.ltl.parser import parse_ltl
 from tlmpc.ltl.printer import to_spin, to_text
 
@@ -165,3 +165,64 @@ def test_the_oracle_sees_a_pinch_of_the_free_space() -> None:
     mission = document(regions, (0.5, 0.5), parse_ltl("F goal"), "right")
     mission["workspace"]["holes"] = [[list(p) for p in h] for h in holes]
     assert tlmpc_plans(mission)
+
+
+@st.composite
+def point_open_lassos(draw: st.DrawFn) -> tuple[list[frozenset[str]], list[bool], int]:
+    """Words point, open, point, ..., ending in an open piece whose loop starts at a point,
+    or ending in a point that holds forever (a stay)."""
+    letters = st.frozensets(st.sampled_from(("a", "b")))
+    pieces = draw(st.integers(1, 4))
+    word = [draw(letters) for _ in range(2 * pieces)]
+    is_point = [index % 2 == 0 for index in range(2 * pieces)]
+    if draw(st.booleans()):
+        word.append(draw(letters))
+        is_point.append(True)
+        return word, is_point, len(word) - 1
+    loop = 2 * draw(st.integers(0, pieces - 1))
+    return word, is_point, loop
+
+
+def _spot_letter(letter: frozenset[str], just_after: bool) -> str:
+    literals = [p if p in letter else f"!{p}" for p in ("a", "b")]
+    literals.append("J" if just_after else "!J")
+    return " & ".join(literals)
+
+
+A_THEN_B = ([frozenset({"a"}), frozenset({"b"}), frozenset()], [True, False, True], 2)
+
+
+@settings(deadline=None, max_examples=max(40, settings().max_examples))
+@given(task=formulas(("a", "b"), max_leaves=4), lasso=point_open_lassos())
+@example(task=Until(Prop("a"), Prop("b")), lasso=A_THEN_B)  # a only at the point: false
+@example(task=Release(Not(Prop("a")), Not(Prop("b"))), lasso=A_THEN_B)  # its dual: true
+def test_the_closed_oracles_rewrite_is_the_continuous_definition(
+    task: Formula, lasso: tuple[list[frozenset[str]], list[bool], int]
+) -> None:
+    """The face-graph oracle's closed rewrite, decided by Spot on the instant word, agrees
+    with the continuous-time definition (tests/oracles/continuous_ltl.py) on random lassos."""
+    import warnings
+
+    from continuous_ltl import closed_holds
+    from face_graph import closed_rewrite
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        import spot
+
+    word, is_point, loop = lasso
+    instants: list[str] = []
+    start_of: list[int] = []
+    for letter, point in zip(word, is_point, strict=True):
+        start_of.append(len(instants))
+        if point:
+            instants.append(_spot_letter(letter, False))
+        else:
+            instants += [_spot_letter(letter, True), _spot_letter(letter, False)]
+    cut = start_of[loop]
+    text = "; ".join([*instants[:cut], "cycle{" + "; ".join(instants[cut:]) + "}"])
+    automaton = spot.translate(closed_rewrite(task))
+    accepted = bool(
+        automaton.intersects(spot.parse_word(text, automaton.get_dict()).as_automaton())
+    )
+    assert accepted == closed_holds(task, word, is_point, loop, 0), (to_text(task), lasso)
