@@ -218,7 +218,9 @@ def add_vertex_passages(
             ]
             if t1 in start_blocked:
                 through_v = {(k1 + 1) % 3, (k1 + 2) % 3}
-                if bounces or not (through_v & start_blocked[t1]):
+                # A start on an edge through v would slide along it (even while searching
+                # with bounces: refinement does not see the start's edges).
+                if not (through_v & start_blocked[t1]):
                     sources.append((t1 * SLOTS + START_SLOT, float(np.linalg.norm(point - start))))
             for source, length in sources:
                 weight = 1.0 if metric == "hops" else length + STUTTER_COST
