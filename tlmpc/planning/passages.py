@@ -142,42 +142,48 @@ def add_vertex_passages(
 
     With ``bounces`` (the search for U-turns), a passage may also start from a triangle
     entered through an edge that holds the vertex, and an arrival may leave through such an
-    edge: :func:`passage_turns` names those triangles, which refinement splits.
+    edge: :func:`passage_turns` names those triangles, which refinement splits.  Built with
+    numpy over all corners at once, as the product is.
     """
     nq = automaton.num_states
     m = abstraction.num_triangles
     base = m * SLOTS * nq
     closed = convention == "closed"
+    triangles = abstraction.triangles
+    vertices = abstraction.vertices
+    neighbors = abstraction.neighbors
     contacts = contact_vertices(abstraction)
-    point_letters = vertex_point_letters(abstraction) if closed else {}
-    around: dict[int, list[tuple[int, int]]] = {int(v): [] for v in contacts.tolist()}
-    touching = np.flatnonzero(np.isin(abstraction.triangles, contacts).any(axis=1) & allowed)
-    for t in touching.tolist():
-        for k, v in enumerate(abstraction.triangles[t].tolist()):
-            if v in around:
-                around[v].append((t, k))
-    cell_triangle: list[int] = []
-    cell_vertex: list[int] = []
-    cell_local: list[int] = []
-    cell_index: dict[tuple[int, int], int] = {}
-    for v, cells in around.items():
-        if len(cells) < 2:
-            continue
-        for t, k in cells:
-            cell_index[(t, v)] = len(cell_triangle)
-            cell_triangle.append(t)
-            cell_vertex.append(v)
-            cell_local.append(k)
-    cells_info = PassageCells(
-        base=base,
-        triangle=np.asarray(cell_triangle, dtype=np.int64),
-        vertex=np.asarray(cell_vertex, dtype=np.int64),
-    )
-    if not cell_triangle:
+    # Cells: the corners (t, k) of allowed triangles at contact vertices, grouped by vertex.
+    at_contact = np.isin(triangles, contacts) & allowed[:, None]
+    cell_t, cell_k = np.nonzero(at_contact)
+    cell_v = triangles[cell_t, cell_k]
+    order = np.argsort(cell_v, kind="stable")
+    cell_t, cell_k, cell_v = cell_t[order], cell_k[order], cell_v[order]
+    _, group_start, group_size = np.unique(cell_v, return_index=True, return_counts=True)
+    keep = np.repeat(group_size >= 2, group_size)
+    cell_t, cell_k, cell_v = cell_t[keep], cell_k[keep], cell_v[keep]
+    _, group_start, group_size = np.unique(cell_v, return_index=True, return_counts=True)
+    cells_info = PassageCells(base=base, triangle=cell_t.astype(np.int64), vertex=cell_v)
+    count = len(cell_t)
+    if count == 0:
         return product, cells_info
+    arrival_off = base + np.arange(count, dtype=np.int64) * nq
 
-    letters: list[Letter] = []
-    letter_ids: dict[Letter, int] = {}
+    def midpoints(t: IntArray, edge: IntArray) -> FloatArray:
+        a = vertices[triangles[t, (edge + 1) % 3]]
+        b = vertices[triangles[t, (edge + 2) % 3]]
+        middle: FloatArray = (a + b) / 2.0
+        return middle
+
+    def weights(lengths: FloatArray) -> FloatArray:
+        if metric == "hops":
+            return np.ones(len(lengths))
+        result: FloatArray = lengths + STUTTER_COST
+        return result
+
+    # Letters read, as ids into a local table: the triangles' letters first.
+    letters: list[Letter] = list(abstraction.letters)
+    letter_ids: dict[Letter, int] = {letter: i for i, letter in enumerate(letters)}
 
     def letter_id(letter: Letter) -> int:
         if letter not in letter_ids:
@@ -185,61 +191,93 @@ def add_vertex_passages(
             letters.append(letter)
         return letter_ids[letter]
 
-    full = (1 << automaton.num_acc) - 1
-    vertices = abstraction.vertices
-    corners_of = abstraction.triangles
-    start_blocked = {cell.triangle: set(cell.blocked) for cell in starts}
-    start = np.asarray(start_point, dtype=np.float64)
+    # --- into a cell: every pair (source corner, target cell) around one vertex -----------
+    per_cell_group = np.repeat(np.arange(len(group_size)), group_size)
+    sizes = group_size[per_cell_group]
+    source = np.repeat(np.arange(count), sizes)  # source corner index
+    within = np.arange(len(source)) - np.repeat(np.cumsum(sizes) - sizes, sizes)
+    target = group_start[per_cell_group][source] + within  # target cell index
+    if not bounces:
+        distinct = cell_t[source] != cell_t[target]
+        source, target = source[distinct], target[distinct]
+    src_t, src_k = cell_t[source], cell_k[source]
+    entries = [src_k, (src_k + 1) % 3, (src_k + 2) % 3] if bounces else [src_k]
+    move_src: list[IntArray] = []
+    move_dst: list[IntArray] = []
+    move_len: list[FloatArray] = []
+    move_first: list[IntArray] = []  # the letter read first (-1: none)
+    move_second: list[IntArray] = []
+    corner_point = vertices[cell_v[source]]
+    if closed:
+        point_ids = {
+            v: letter_id(letter) for v, letter in vertex_point_letters(abstraction).items()
+        }
+        at_vertex = np.array([point_ids[v] for v in cell_v.tolist()], dtype=np.int64)
+    else:
+        at_vertex = np.full(count, -1, dtype=np.int64)
+    entered_letter = abstraction.letter_of[cell_t[target]]
+    for entry in entries:
+        valid = neighbors[src_t, entry] >= 0
+        move_src.append((src_t[valid] * SLOTS + entry[valid]) * nq)
+        move_dst.append(arrival_off[target[valid]])
+        move_len.append(
+            np.linalg.norm(corner_point[valid] - midpoints(src_t[valid], entry[valid]), axis=1)
+        )
+        move_first.append(at_vertex[target[valid]])
+        move_second.append(entered_letter[valid])
+    # From the start, off both edges of its triangle through the vertex (a start on such an
+    # edge would slide along it, even while searching with bounces: refinement does not see
+    # the start's edges).
+    start_ok = np.zeros(len(source), dtype=bool)
+    for cell in starts:
+        blocked = np.zeros(3, dtype=bool)
+        blocked[list(cell.blocked)] = True
+        mine = src_t == cell.triangle
+        through_blocked = blocked[(src_k + 1) % 3] | blocked[(src_k + 2) % 3]
+        start_ok |= mine & ~through_blocked
+    start_xy = np.asarray(start_point, dtype=np.float64)
+    move_src.append((src_t[start_ok] * SLOTS + START_SLOT) * nq)
+    move_dst.append(arrival_off[target[start_ok]])
+    move_len.append(np.linalg.norm(corner_point[start_ok] - start_xy[None, :], axis=1))
+    move_first.append(at_vertex[target[start_ok]])
+    move_second.append(entered_letter[start_ok])
 
-    def midpoint(t: int, edge: int) -> FloatArray:
-        a = vertices[corners_of[t, (edge + 1) % 3]]
-        b = vertices[corners_of[t, (edge + 2) % 3]]
-        middle: FloatArray = (a + b) / 2.0
-        return middle
+    # --- out of a cell: through the edge opposite the vertex (any edge, with bounces) -----
+    cells = np.arange(count)
+    exits = [cell_k, (cell_k + 1) % 3, (cell_k + 2) % 3] if bounces else [cell_k]
+    for exit_edge in exits:
+        n = neighbors[cell_t, exit_edge]
+        valid = n >= 0
+        valid[valid] &= allowed[n[valid]]
+        t2, e2, n2 = cell_t[valid], exit_edge[valid], n[valid]
+        back = neighbors[n2]
+        slot = np.where(back[:, 0] == t2, 0, np.where(back[:, 1] == t2, 1, 2)).astype(np.int64)
+        move_src.append(arrival_off[cells[valid]])
+        move_dst.append((n2 * SLOTS + slot) * nq)
+        move_len.append(np.linalg.norm(midpoints(t2, e2) - vertices[cell_v[valid]], axis=1))
+        if closed:
+            pairs = np.stack([abstraction.letter_of[t2], abstraction.letter_of[n2]], axis=1)
+            unique_pairs, inverse = np.unique(pairs, axis=0, return_inverse=True)
+            crossing = np.array(
+                [
+                    letter_id(crossing_letter(letters[int(x)], letters[int(y)]))
+                    for x, y in unique_pairs.tolist()
+                ],
+                dtype=np.int64,
+            )
+            move_first.append(crossing[inverse.reshape(-1)])
+        else:
+            move_first.append(np.full(len(t2), -1, dtype=np.int64))
+        move_second.append(abstraction.letter_of[n2])
 
-    # Moves as (source node without q, target node without q, letters read, weight).
-    moves: list[tuple[int, int, tuple[int, ...], float]] = []
-    stays: list[tuple[int, int]] = []  # (arrival node without q, letter of its triangle)
-    for c, (t2, v, k2) in enumerate(zip(cell_triangle, cell_vertex, cell_local, strict=True)):
-        arrival = base + c * nq
-        point = vertices[v]
-        own = letter_id(abstraction.labels(t2))
-        reads_at_vertex = (letter_id(point_letters[v]), own) if closed else (own,)
-        # Into the cell: from every other triangle around v, entered opposite v or started
-        # off both of its edges through v.
-        for t1, k1 in around[v]:
-            if t1 == t2 and not bounces:
-                continue  # back into the same triangle: a U-turn at v (refinement splits it)
-            entries = (k1, (k1 + 1) % 3, (k1 + 2) % 3) if bounces else (k1,)
-            sources = [
-                (t1 * SLOTS + e, float(np.linalg.norm(point - midpoint(t1, e))))
-                for e in entries
-                if abstraction.neighbors[t1, e] >= 0
-            ]
-            if t1 in start_blocked:
-                through_v = {(k1 + 1) % 3, (k1 + 2) % 3}
-                # A start on an edge through v would slide along it (even while searching
-                # with bounces: refinement does not see the start's edges).
-                if not (through_v & start_blocked[t1]):
-                    sources.append((t1 * SLOTS + START_SLOT, float(np.linalg.norm(point - start))))
-            for source, length in sources:
-                weight = 1.0 if metric == "hops" else length + STUTTER_COST
-                moves.append((source, arrival, reads_at_vertex, weight))
-        # Out of the cell: through the edge opposite v only (any edge, with bounces).
-        for exit_edge in (k2, (k2 + 1) % 3, (k2 + 2) % 3) if bounces else (k2,):
-            n = int(abstraction.neighbors[t2, exit_edge])
-            if n < 0 or not allowed[n]:
-                continue
-            slot = int(np.flatnonzero(abstraction.neighbors[n] == t2)[0])
-            entered = letter_id(abstraction.labels(n))
-            crossing = crossing_letter(abstraction.labels(t2), abstraction.labels(n))
-            reads = (letter_id(crossing), entered) if closed else (entered,)
-            length = float(np.linalg.norm(midpoint(t2, exit_edge) - point))
-            weight = 1.0 if metric == "hops" else length + STUTTER_COST
-            moves.append((arrival, n * SLOTS + slot, reads, weight))
-        stays.append((arrival, own))
+    src_off = np.concatenate(move_src)
+    dst_off = np.concatenate(move_dst)
+    weight = weights(np.concatenate(move_len))
+    first = np.concatenate(move_first)
+    second = np.concatenate(move_second)
 
     table = successor_table(automaton, letters)
+    full = (1 << automaton.num_acc) - 1
 
     def read(q: int, word: tuple[int, ...]) -> dict[int, bool]:
         frontier: dict[int, int] = {q: 0}
@@ -251,53 +289,66 @@ def add_vertex_passages(
             frontier = following
         return {state: mask == full for state, mask in frontier.items()}
 
-    src: list[int] = []
-    dst: list[int] = []
-    wgt: list[float] = []
-    acc: list[bool] = []
-    for source, target, word, weight in moves:
+    sources: list[IntArray] = []
+    targets: list[IntArray] = []
+    costs: list[FloatArray] = []
+    marks: list[BoolArray] = []
+    kinds, kind_of = np.unique(np.stack([first, second], axis=1), axis=0, return_inverse=True)
+    kind_of = kind_of.reshape(-1)
+    for index, (x, y) in enumerate(kinds.tolist()):
+        moves = np.flatnonzero(kind_of == index)
+        word = (x, y) if x >= 0 else (y,)
         for q in range(nq):
             for q_next, accepting in read(q, word).items():
-                src.append(source * nq + q if source < base else source + q)
-                dst.append(target * nq + q_next if target < base else target + q_next)
-                wgt.append(weight)
-                acc.append(accepting)
-    size = base + len(cell_triangle) * nq
+                sources.append(src_off[moves] + q)
+                targets.append(dst_off[moves] + q_next)
+                costs.append(weight[moves])
+                marks.append(np.full(len(moves), accepting))
+    # Stutter in a cell: reading its triangle's letter again.
+    size = base + count * nq
     stutter = np.zeros(size, dtype=bool)
     stutter[: product.num_nodes] = product.stutter_accepting
-    for arrival, own in stays:
+    own = abstraction.letter_of[cell_t]
+    for letter in np.unique(own).tolist():
+        stays = np.flatnonzero(own == letter)
         for q in range(nq):
-            for q_next, accepting in read(q, (own,)).items():
+            for q_next, accepting in read(q, (letter,)).items():
                 if q_next == q:
-                    stutter[arrival + q] |= accepting
+                    if accepting:
+                        stutter[arrival_off[stays] + q] = True
                     continue
-                src.append(arrival + q)
-                dst.append(arrival + q_next)
-                wgt.append(STUTTER_COST)
-                acc.append(accepting)
+                sources.append(arrival_off[stays] + q)
+                targets.append(arrival_off[stays] + q_next)
+                costs.append(np.full(len(stays), STUTTER_COST))
+                marks.append(np.full(len(stays), accepting))
+
     old = product.graph.tocoo()
     old_acc = product.accepting.tocoo()
-    all_sources = np.concatenate([old.row.astype(np.int64), np.asarray(src, dtype=np.int64)])
-    targets = np.concatenate([old.col.astype(np.int64), np.asarray(dst, dtype=np.int64)])
-    weights = np.concatenate([old.data, np.asarray(wgt, dtype=np.float64)])
-    marked = np.asarray(acc, dtype=bool)
-    graph = csr_matrix((weights, (all_sources, targets)), shape=(size, size))
-    graph.sum_duplicates()
-    graph.sort_indices()
-    new_src = np.asarray(src, dtype=np.int64)[marked]
-    new_dst = np.asarray(dst, dtype=np.int64)[marked]
-    accepting = csr_matrix(
+    new_src = np.concatenate(sources) if sources else np.zeros(0, dtype=np.int64)
+    new_dst = np.concatenate(targets) if targets else np.zeros(0, dtype=np.int64)
+    new_cost = np.concatenate(costs) if costs else np.zeros(0)
+    new_mark = np.concatenate(marks) if marks else np.zeros(0, dtype=bool)
+    graph = csr_matrix(
         (
-            np.ones(len(old_acc.row) + len(new_src)),
+            np.concatenate([old.data, new_cost]),
             (
-                np.concatenate([old_acc.row.astype(np.int64), new_src]),
-                np.concatenate([old_acc.col.astype(np.int64), new_dst]),
+                np.concatenate([old.row.astype(np.int64), new_src]),
+                np.concatenate([old.col.astype(np.int64), new_dst]),
             ),
         ),
         shape=(size, size),
     )
-    accepting.data[:] = 1.0
-    accepting.sum_duplicates()
+    graph.sort_indices()
+    accepting = csr_matrix(
+        (
+            np.ones(len(old_acc.row) + int(new_mark.sum())),
+            (
+                np.concatenate([old_acc.row.astype(np.int64), new_src[new_mark]]),
+                np.concatenate([old_acc.col.astype(np.int64), new_dst[new_mark]]),
+            ),
+        ),
+        shape=(size, size),
+    )
     accepting.data[:] = 1.0
     accepting.sort_indices()
     extended = replace(
