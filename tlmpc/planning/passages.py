@@ -117,13 +117,24 @@ def vertex_point_letters(abstraction: Abstraction) -> dict[int, Letter]:
     around it (regions are unions of triangles, so these are exactly the regions whose
     closure holds the vertex), with :data:`POINT`."""
     contacts = contact_vertices(abstraction)
-    names: dict[int, set[str]] = {v: set() for v in contacts.tolist()}
-    touching = np.flatnonzero(np.isin(abstraction.triangles, contacts).any(axis=1))
-    for t in touching.tolist():
-        for v in abstraction.triangles[t].tolist():
-            if v in names:
-                names[v].update(abstraction.labels(t))
-    return {v: tuple(sorted({*found, POINT})) for v, found in names.items()}
+    holder = np.isin(abstraction.triangles, contacts)
+    t, k = np.nonzero(holder)
+    count = len(abstraction.letters)
+    pairs = np.unique(abstraction.triangles[t, k] * count + abstraction.letter_of[t])
+    owners, letter_ids = (pairs // count).tolist(), (pairs % count).tolist()
+    combos: dict[tuple[int, ...], Letter] = {}
+    found: dict[int, Letter] = {}
+    start = 0
+    for index in range(1, len(owners) + 1):
+        if index < len(owners) and owners[index] == owners[start]:
+            continue
+        combo = tuple(letter_ids[start:index])
+        if combo not in combos:
+            names = {n for i in combo for n in abstraction.letters[i]}
+            combos[combo] = tuple(sorted({*names, POINT}))
+        found[owners[start]] = combos[combo]
+        start = index
+    return found
 
 
 def add_vertex_passages(
@@ -256,12 +267,13 @@ def add_vertex_passages(
         move_dst.append((n2 * SLOTS + slot) * nq)
         move_len.append(np.linalg.norm(midpoints(t2, e2) - vertices[cell_v[valid]], axis=1))
         if closed:
-            pairs = np.stack([abstraction.letter_of[t2], abstraction.letter_of[n2]], axis=1)
-            unique_pairs, inverse = np.unique(pairs, axis=0, return_inverse=True)
+            stride = len(abstraction.letters)
+            pairs = abstraction.letter_of[t2] * stride + abstraction.letter_of[n2]
+            unique_pairs, inverse = np.unique(pairs, return_inverse=True)
             crossing = np.array(
                 [
-                    letter_id(crossing_letter(letters[int(x)], letters[int(y)]))
-                    for x, y in unique_pairs.tolist()
+                    letter_id(crossing_letter(letters[key // stride], letters[key % stride]))
+                    for key in unique_pairs.tolist()
                 ],
                 dtype=np.int64,
             )
@@ -278,13 +290,22 @@ def add_vertex_passages(
 
     table = successor_table(automaton, letters)
     full = (1 << automaton.num_acc) - 1
+    # Letters with one projection on the automaton's propositions share one row (the table
+    # caches it): moves are grouped by those classes, not by letters (maps have many).
+    rows: list[list[tuple[tuple[int, int], ...]]] = []
+    row_index: dict[int, int] = {}
+    letter_class = np.empty(len(letters), dtype=np.int64)
+    for index, row in enumerate(table):
+        letter_class[index] = row_index.setdefault(id(row), len(rows))
+        if letter_class[index] == len(rows):
+            rows.append(row)
 
     def read(q: int, word: tuple[int, ...]) -> dict[int, bool]:
         frontier: dict[int, int] = {q: 0}
-        for letter in word:
+        for cls in word:
             following: dict[int, int] = {}
             for state, mask in frontier.items():
-                for q_next, mark in table[letter][state]:
+                for q_next, mark in rows[cls][state]:
                     following[q_next] = following.get(q_next, 0) | mask | mark
             frontier = following
         return {state: mask == full for state, mask in frontier.items()}
@@ -293,10 +314,14 @@ def add_vertex_passages(
     targets: list[IntArray] = []
     costs: list[FloatArray] = []
     marks: list[BoolArray] = []
-    kinds, kind_of = np.unique(np.stack([first, second], axis=1), axis=0, return_inverse=True)
+    classes = len(rows) + 1
+    first_class = np.where(first >= 0, letter_class[np.maximum(first, 0)], -1)
+    key = (first_class + 1) * classes + letter_class[second]
+    kinds, kind_of = np.unique(key, return_inverse=True)
     kind_of = kind_of.reshape(-1)
-    for index, (x, y) in enumerate(kinds.tolist()):
+    for index, kind in enumerate(kinds.tolist()):
         moves = np.flatnonzero(kind_of == index)
+        x, y = kind // classes - 1, kind % classes
         word = (x, y) if x >= 0 else (y,)
         for q in range(nq):
             for q_next, accepting in read(q, word).items():
@@ -308,11 +333,11 @@ def add_vertex_passages(
     size = base + count * nq
     stutter = np.zeros(size, dtype=bool)
     stutter[: product.num_nodes] = product.stutter_accepting
-    own = abstraction.letter_of[cell_t]
-    for letter in np.unique(own).tolist():
-        stays = np.flatnonzero(own == letter)
+    own = letter_class[abstraction.letter_of[cell_t]]
+    for cls in np.unique(own).tolist():
+        stays = np.flatnonzero(own == cls)
         for q in range(nq):
-            for q_next, accepting in read(q, (letter,)).items():
+            for q_next, accepting in read(q, (cls,)).items():
                 if q_next == q:
                     if accepting:
                         stutter[arrival_off[stays] + q] = True
