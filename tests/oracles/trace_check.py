@@ -86,6 +86,13 @@ def check_flow(
             distance = float(np.linalg.norm(heading))
             assert points[k - 1][1] == corner[0]
             assert points[k - 1][2] == corner[1]
+            # The run to the corner goes through the triangle's interior, not along an edge
+            # (there the plan would count a label the robot never has): exactly, in rationals.
+            middle = [
+                (Fraction(float(a)) + Fraction(float(b))) / 2
+                for a, b in zip(entry[1:], corner, strict=True)
+            ]
+            assert _strictly_inside(step["vertices"], middle), step["step"]
             for t, x, y in points[start:k]:
                 travelled = (t - entry[0]) * max_speed
                 assert travelled <= distance * (1 + 1e-9) + 1e-12 * size
@@ -102,6 +109,15 @@ def check_flow(
                 expected = (expm((t - t0) * field) @ [*(first - center), 1.0])[:2] + center
                 assert np.linalg.norm(expected - [x, y]) <= 1e-6 * size
         start = k
+
+
+def _strictly_inside(vertices: list[list[float]], point: list[Fraction]) -> bool:
+    corners = [(Fraction(x), Fraction(y)) for x, y in vertices]
+    sides = []
+    for i in range(3):
+        (ax, ay), (bx, by) = corners[i], corners[(i + 1) % 3]
+        sides.append((bx - ax) * (point[1] - ay) - (by - ay) * (point[0] - ax))
+    return all(side > 0 for side in sides) or all(side < 0 for side in sides)
 
 
 def check_speed(trace: dict[str, Any], max_speed: float, size: float) -> None:
