@@ -151,3 +151,19 @@ def test_a_tampered_passage_is_refused(tmp_path: Path) -> None:
     with pytest.raises(UsageError) as caught:
         read_output(out, ("abstraction.json", "witness.json"))
     assert "passage" in caught.value.diagnostics[0].message
+
+
+def test_the_verifier_reads_the_corner_instant() -> None:
+    """Under closed, F(a & b) holds on the compiled trace only at the corner sample: the
+    verifier accepts it, and rejects the same trace with that sample moved off the corner
+    by a hair (into a alone) — the corner instant's label is what satisfies the task."""
+    from tlmpc.verify import verify_document
+
+    output = artifacts(mission("F(a & b)", (1, 1), boundary="closed"))
+    trace = output["trace.json"]
+    assert verify_document(dict(trace)).satisfied
+    index = [tuple(p[1:]) for p in trace["points"]].index(CORNER)
+    moved = json.loads(json.dumps(trace))
+    moved["points"][index][1:] = [CORNER[0] - 1e-6, CORNER[1] - 1e-6]
+    assert shapely.Polygon(B).distance(shapely.Point(moved["points"][index][1:])) > 0
+    assert not verify_document(moved).satisfied
