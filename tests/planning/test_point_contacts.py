@@ -10,18 +10,20 @@ Every plan's trace also passes the independent check of tests/oracles/trace_chec
 
 from __future__ import annotations
 
+import json
 from typing import Any
 
 import pytest
 import shapely
 from face_graph import face_graph, satisfiable_closed, satisfiable_on
-from hypothesis import HealthCheck, example, given, settings
+from face_maps import FaceMap, face_maps
+from hypothesis import HealthCheck, assume, example, given, reject, settings
 from hypothesis import strategies as st
 from strategies import formulas
 from trace_check import check_output
 
 from tlmpc.api import compile as compile_mission
-from tlmpc.errors import NoPlanError, TlmpcError
+from tlmpc.errors import InvalidInputError, NoPlanError, TlmpcError
 from tlmpc.ltl.ast import Formula, Not, Prop, Release, Until
 from tlmpc.ltl.parser import parse_ltl
 from tlmpc.ltl.printer import to_spin, to_text
@@ -259,3 +261,27 @@ def test_the_closed_oracles_rewrite_is_the_continuous_definition(
         automaton.intersects(spot.parse_word(text, automaton.get_dict()).as_automaton())
     )
     assert accepted == closed_holds(task, word, is_point, loop, 0), (to_text(task), lasso)
+
+
+@settings(
+    deadline=None,
+    max_examples=max(4, settings().max_examples // 16),
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much],
+)
+@given(generated=face_maps())
+def test_closed_convention_on_corridor_maps(generated: FaceMap) -> None:
+    """The completeness property's maps (corridors, dead ends, bays, pockets, holes) under the
+    closed convention: tlmpc plans exactly when the instant-graph oracle finds a run."""
+    point = shapely.Point(generated.start)
+    free = shapely.Polygon(generated.boundary, generated.holes)
+    lines = [free.boundary, *(shapely.Polygon(p).boundary for p in generated.regions.values())]
+    assume(free.contains(point) and all(line.distance(point) > 1e-4 for line in lines))
+    mission = json.loads(generated.yaml())
+    mission["options"] = {"boundary": "closed"}
+    try:
+        compile_mission(mission, until="abstraction")
+    except InvalidInputError:
+        reject()  # a layout the mission checks refuse
+    found = tlmpc_plans(mission)
+    graph = face_graph(generated.boundary, generated.holes, generated.regions, generated.start)
+    assert found == satisfiable_closed(graph, parse_ltl(generated.ltl)), generated
