@@ -99,12 +99,9 @@ json_values = st.recursive(
     | st.sampled_from([0.0, 1.0, -1.0, 1e9, 1e10, 2.5, 0, 1, 2, 4, 1e-12])
     | st.text(max_size=4)
     | st.sampled_from(["F", "true", "a", "p1", "hops", "length", "closed", "2x", "_a", ""]),
-    lambda inner: (
-        st.lists(inner, max_size=5)
-        | st.dictionaries(
-            st.sampled_from(["rect", "start", "x", "a", "boundary"]), inner, max_size=3
-        )
-    ),
+    lambda inner: st.lists(inner, max_size=5)
+    | st.dictionaries(st.sampled_from(["rect", "start", "x", "a", "boundary"]), inner,
+                      max_size=3),
     max_leaves=12,
 )
 
@@ -169,10 +166,8 @@ def test_json_equality_keeps_true_apart_from_one() -> None:
     assert not _equal(math.nan, 0)
 
 
-@pytest.mark.parametrize(
-    ("value", "valid"),
-    [(2, True), (2.0, True), (2.5, False), (True, False), (-1, False), ("2", False)],
-)
+@pytest.mark.parametrize(("value", "valid"), [(2, True), (2.0, True), (2.5, False), (True, False),
+                                               (-1, False), ("2", False)])
 def test_integer_items_as_jsonschema_reads_them(value: Any, valid: bool) -> None:
     witness = copy.deepcopy(_artifacts()["witness.json"])
     witness["cycle"] = [value]

@@ -98,4 +98,6 @@ def best_push(normals: list[FloatArray], max_speed: float) -> float:
             length = float(np.linalg.norm(bisector))
             if length > 1e-12:
                 directions.append(bisector / length)
-    return max(min(float(np.asarray(a) @ u) for a in normals) * max_speed for u in directions)
+    return max(
+        min(float(np.asarray(a) @ u) for a in normals) * max_speed for u in directions
+    )
