@@ -133,6 +133,36 @@ def test_an_undisturbed_run_follows_the_plan_without_recovering() -> None:
     assert verify_document(run.trace).satisfied
 
 
+@pytest.mark.parametrize(
+    ("b", "ltl", "crossings"),
+    [
+        ([2, 1, 3, 2], "F (a & b)", "across"),  # b shares a's right edge: met on the edge
+        ([2, 2, 3, 3], "F (a & b)", "corner"),  # b touches a's corner only: a vertex passage
+        ([2, 1, 3, 2], "F a & F b & G !(a & b)", "around"),  # never on the shared edge
+    ],
+)
+def test_the_executor_runs_closed_convention_plans(b: list[int], ltl: str, crossings: str) -> None:
+    """Under the closed convention every handover instant is read with its own letter (the
+    plan's states are a run over them), so the executor follows the compiled plan without
+    re-planning, and the verifier, under the same convention, accepts the run."""
+    mission = {
+        "version": 1,
+        "name": f"closed-{crossings}",
+        "workspace": {"boundary": {"rect": [0, 0, 4, 4]}},
+        "regions": {"a": {"rect": [1, 1, 2, 2]}, "b": {"rect": b}},
+        "robot": {"start": [0.5, 0.5], "max_speed": 1.0},
+        "ltl": ltl,
+        "options": {"boundary": "closed"},
+    }
+    executor = tlmpc.executor(tlmpc.compile(mission))
+    run = run_closed_loop(executor, lambda t, p, e: np.zeros(2), bound=0.0)
+    assert run.completed
+    assert run.progress.status == "following"
+    assert run.recoveries == ()
+    verdict = verify_document(run.trace)
+    assert verdict.satisfied
+
+
 def test_a_push_past_the_goal_replans_from_the_tracked_automaton_state() -> None:
     """Pushed from the start onto the plan after ``a`` without having visited ``a``: the
     plan's step there assumes ``a`` was seen, so re-entering would skip ``a``.  The executor

@@ -38,6 +38,7 @@ from tlmpc.automata.model import Automaton
 from tlmpc.control.model import Controllers, StepController
 from tlmpc.errors import InvalidInputError, NoPlanError, SolverError, UsageError, error
 from tlmpc.mission.model import Mission
+from tlmpc.planning.boundary import POINT, crossing_letter, start_point_label
 from tlmpc.planning.model import Witness
 from tlmpc.runtime.locate import Locator
 from tlmpc.runtime.model import Phase, Progress, Recovery, RecoveryKind, Status
@@ -118,6 +119,7 @@ class Executor:
         self.automaton = automaton  # as compiled: re-planning degeneralizes it as planning did
         self.locator = Locator.of(abstraction)
         self.tracker = TaskTracker(working_automaton(automaton), abstraction.letters)
+        self._closed = mission.options.boundary == "closed"
         self.plan = RunPlan.of(witness, controllers)
         self._check_plan_states()
         self._step = 0
@@ -257,7 +259,7 @@ class Executor:
             and controller.next_triangle is not None
             and self._at_corner(controller, previous, point)
         ):
-            self._enter(controller.next_triangle, point)
+            self._enter(controller.next_triangle, point, controller.target)
             return
         entered: list[int] | None = None
         if self._triangle is not None and self._status != "outside":
@@ -305,12 +307,14 @@ class Executor:
 
     def _check_plan_states(self) -> None:
         """The witness's automaton states must be a run over its own labels (else R022)."""
-        letters = self.abstraction.letter_of
         steps, states = self.plan.steps, self.plan.states
-        seen = self.tracker.initial(int(letters[steps[0].triangle]))
+        start = self.mission.robot.start
+        seen = self._initial_states(steps[0].triangle, np.array(start, dtype=np.float64))
         for index, (controller, state) in enumerate(zip(steps, states, strict=True)):
             if index > 0:
-                seen = self.tracker.read(seen, int(letters[controller.triangle]))
+                previous = steps[index - 1]
+                corner = previous.target if previous.is_vertex else None
+                seen = self._read_entry(seen, previous.triangle, controller.triangle, corner)
             if state not in seen:
                 raise UsageError(
                     error(
@@ -322,6 +326,36 @@ class Executor:
                 )
             seen = frozenset({state})
 
+    def _initial_states(self, triangle: int, point: FloatArray) -> frozenset[int]:
+        """The automaton states after the start: under the closed convention the start
+        point's own letter first, then the start triangle's label."""
+        states = frozenset({self.tracker.automaton.initial})
+        if self._closed:
+            where = (float(point[0]), float(point[1]))
+            states = self.tracker.read_point(
+                states, (*start_point_label(self.abstraction, where), POINT)
+            )
+        return self.tracker.read(states, int(self.abstraction.letter_of[triangle]))
+
+    def _read_entry(
+        self,
+        states: frozenset[int],
+        before: int | None,
+        triangle: int,
+        corner: tuple[float, float] | None = None,
+    ) -> frozenset[int]:
+        """The automaton states after moving into ``triangle``: under the closed convention
+        the handover instant's letter first (the crossed edge's, or the corner's for a
+        vertex passage), as the planner reads it."""
+        if self._closed:
+            if corner is not None:
+                instant = (*start_point_label(self.abstraction, corner), POINT)
+            else:
+                left = self.abstraction.labels(before) if before is not None else ()
+                instant = crossing_letter(left, self.abstraction.labels(triangle))
+            states = self.tracker.read_point(states, instant)
+        return self.tracker.read(states, int(self.abstraction.letter_of[triangle]))
+
     def _start(self, point: FloatArray) -> None:
         self._point = point
         first = self.plan.steps[0].triangle
@@ -331,8 +365,7 @@ class Executor:
             self._status = "outside"
             return
         self._triangle = triangle
-        letter = int(self.abstraction.letter_of[triangle])
-        self._states = self.tracker.initial(letter)
+        self._states = self._initial_states(triangle, point)
         for name in self.abstraction.labels(triangle):
             self._visits[name] = self._visits.get(name, 0) + 1
         if triangle == self.plan.steps[0].triangle and self.plan.states[0] in self._states:
@@ -340,15 +373,16 @@ class Executor:
         else:
             self._recover(triangle, point)
 
-    def _enter(self, triangle: int, point: FloatArray) -> None:
-        before = (
-            set(self.abstraction.labels(self._triangle)) if self._triangle is not None else set()
-        )
+    def _enter(
+        self, triangle: int, point: FloatArray, corner: tuple[float, float] | None = None
+    ) -> None:
+        previous = self._triangle
+        before = set(self.abstraction.labels(previous)) if previous is not None else set()
         self._triangle = triangle
         for name in self.abstraction.labels(triangle):
             if name not in before:
                 self._visits[name] = self._visits.get(name, 0) + 1
-        self._states = self.tracker.read(self._states, int(self.abstraction.letter_of[triangle]))
+        self._states = self._read_entry(self._states, previous, triangle, corner)
         if not self._states:
             self._stop("violated", triangle)
             return

@@ -8,7 +8,10 @@ the whole run accepted.  An empty set means the history already violates the tas
 
 The robot spends a positive time in every triangle it enters, so the label of a triangle is
 read once or more (stuttering): the set after entering is closed under re-reading its letter,
-which is also what the planner's stutter steps do.
+which is also what the planner's stutter steps do.  Under the closed convention the automaton
+(built over the rewritten task, see :mod:`tlmpc.planning.boundary`) also reads, exactly once,
+the letter of each point instant: the start point, every edge crossing and every corner a
+vertex passage goes through (:meth:`TaskTracker.read_point`).
 """
 
 from __future__ import annotations
@@ -36,10 +39,25 @@ class TaskTracker:
         self._next: list[list[frozenset[int]]] = [
             [frozenset(dst for dst, _ in row) for row in per_letter] for per_letter in table
         ]
+        self._point_next: dict[tuple[str, ...], list[frozenset[int]]] = {}
 
     def initial(self, letter: int) -> frozenset[int]:
         """The states after reading the start triangle's ``letter``."""
         return self.read(frozenset({self.automaton.initial}), letter)
+
+    def read_point(self, states: frozenset[int], letter: Sequence[str]) -> frozenset[int]:
+        """The states after one point instant labelled ``letter`` (a label set, read once:
+        a point has no duration to stutter over)."""
+        key = tuple(sorted(letter))
+        row = self._point_next.get(key)
+        if row is None:
+            (per_letter,) = successor_table(self.automaton, [key])
+            row = [frozenset(dst for dst, _ in edges) for edges in per_letter]
+            self._point_next[key] = row
+        found: set[int] = set()
+        for state in states:
+            found |= row[state]
+        return frozenset(found)
 
     def read(self, states: frozenset[int], letter: int) -> frozenset[int]:
         """The states after entering a triangle labelled ``letter`` (read once or more)."""
