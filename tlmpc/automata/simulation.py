@@ -124,11 +124,59 @@ def _with_edges(automaton: Automaton, edges: Sequence[Edge]) -> Automaton:
     return dataclasses.replace(automaton, edges=tuple(edges))
 
 
+def transpose(automaton: Automaton) -> Automaton:
+    """Every edge reversed (same guard and marks): the reverse simulation of an automaton is
+    the direct simulation of its transpose, with the initial state told apart."""
+    edges = tuple(Edge(src=e.dst, dst=e.src, guard=e.guard, marks=e.marks) for e in automaton.edges)
+    return _with_edges(automaton, edges)
+
+
+def cosimulation(automaton: Automaton, alphabet: Alphabet, deadline: float) -> list[list[bool]]:
+    """``cosim[p][q]``: ``q`` reverse-simulates ``p`` (Spot's ``cosimulation``).
+
+    The largest relation where ``p`` initial implies ``q`` initial and every edge
+    ``p' --a/M--> p`` is matched by an edge ``q' --a/M'--> q`` with ``M ⊆ M'`` and ``q'``
+    reverse-simulating ``p'``: every run prefix reaching ``p`` is matched, position by
+    position and with at least its marks, by a prefix reaching ``q``.  König's lemma turns
+    infinitely many such replacements into one run, so merging reverse-simulation-equivalent
+    states and dropping reverse little brothers (:func:`prune_reverse`) keep the language."""
+    return simulation(transpose(automaton), alphabet, deadline, initial=automaton.initial)
+
+
+def quotient_reverse(automaton: Automaton, cosim: list[list[bool]]) -> Automaton:
+    """Merge states that reverse-simulate each other: edges into a merged state go to its
+    representative, and the representative gets the edges out of every merged state."""
+    n = automaton.num_states
+    representative = list(range(n))
+    for p in range(n):
+        for q in range(p):
+            if representative[q] == q and cosim[p][q] and cosim[q][p]:
+                representative[p] = q
+                break
+    if all(representative[p] == p for p in range(n)):
+        return automaton
+    edges = tuple(
+        Edge(src=representative[e.src], dst=representative[e.dst], guard=e.guard, marks=e.marks)
+        for e in automaton.edges
+    )
+    return dataclasses.replace(automaton, edges=edges, initial=representative[automaton.initial])
+
+
+def prune_reverse(
+    automaton: Automaton, alphabet: Alphabet, cosim: list[list[bool]], deadline: float
+) -> Automaton:
+    """Drop the cubes of an edge into ``p`` whose every letter also enters ``p`` from a
+    strictly better source (reverse little brothers) with at least its marks."""
+    return transpose(prune(transpose(automaton), alphabet, cosim, deadline))
+
+
 def simulation(
     automaton: Automaton,
     alphabet: Alphabet,
     deadline: float,
     component: Sequence[int] | None = None,
+    *,
+    initial: int | None = None,
 ) -> list[list[bool]]:
     """``sim[p][q]``: ``q`` directly simulates ``p`` (largest relation).
 
@@ -155,6 +203,9 @@ def simulation(
         for letters, _marks, _dst in out[state]:
             enabled[state] |= letters
     sim = [[(enabled[p] & ~enabled[q]) == 0 for q in range(n)] for p in range(n)]
+    if initial is not None:
+        # Only the initial state matches the empty prefix that reaches the initial state.
+        sim[initial] = [q == initial for q in range(n)]
     changed = True
     while changed:
         changed = False

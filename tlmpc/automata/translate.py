@@ -249,16 +249,9 @@ def _explore(
 
 
 def _is_empty(formula: Formula) -> bool:
-    """No word satisfies ``formula`` (its trimmed automaton has no edge)."""
-    translated = _translate(
-        formula,
-        letters=None,
-        simplify=True,
-        budget=CONTAINMENT_BUDGET,
-        containment=False,
-        check_wdba=False,
-    )
-    return not translated.edges
+    """No word satisfies ``formula`` (its raw automaton, trimmed, has no edge: emptiness
+    needs no reduction of the automaton)."""
+    return _is_empty_term(rewrite(from_ast(nnf(formula))))
 
 
 def _is_empty_term(root: Node) -> bool:
