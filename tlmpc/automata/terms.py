@@ -210,6 +210,12 @@ def _pure_universality(f: Node) -> bool:
             assert_never(f)
 
 
+def _suspendable(f: Node) -> bool:
+    """Both a pure eventuality and a pure universality (``G F a``, ``F G a``): true at one
+    position iff true at every position."""
+    return _pure_eventuality(f) and _pure_universality(f)
+
+
 def make_f(a: Node) -> Node:
     """F a, simplified: F true = true, F false = false, F(eventuality) = itself,
     F(a U b) = F b, F(a M b) = F(a & b), F(a | F b) = F(a | b)."""
@@ -241,6 +247,13 @@ def make_g(a: Node) -> Node:
             return make_g(make_or([left, right]))
         case Conj(args=args) if any(isinstance(x, Always) for x in args):
             return make_g(make_and(x.arg if isinstance(x, Always) else x for x in args))
+        case Disj(args=args) if any(_suspendable(x) for x in args):
+            # G(a | s) = G a | s for s both a pure eventuality and a pure universality (its
+            # truth is the same at every position; Babiak et al.'s suspension).
+            return make_or(
+                [make_g(make_or(x for x in args if not _suspendable(x)))]
+                + [x for x in args if _suspendable(x)]
+            )
         case Finally(arg=Conj(args=args)) if any(_pure_eventuality(x) for x in args):
             eventual = [x for x in args if _pure_eventuality(x)]
             rest = [x for x in args if not _pure_eventuality(x)]
