@@ -226,6 +226,9 @@ def make_f(a: Node) -> Node:
             return make_f(right)
         case Binary(kind="M", left=left, right=right):
             return make_f(make_and([left, right]))
+        case Binary(kind="W", left=left, right=right):
+            # F(a W b) = F(b | G a) (Spot's rule): no choice between two F's.
+            return make_f(make_or([right, make_g(left)]))
         case Disj(args=args) if any(isinstance(x, Finally) for x in args):
             return make_f(make_or(x.arg if isinstance(x, Finally) else x for x in args))
     return Finally("F", a)
@@ -247,6 +250,13 @@ def make_g(a: Node) -> Node:
             return make_g(make_or([left, right]))
         case Conj(args=args) if any(isinstance(x, Always) for x in args):
             return make_g(make_and(x.arg if isinstance(x, Always) else x for x in args))
+        case Disj(args=args) if sum(isinstance(x, Always) for x in args) == 1 and all(
+            (isinstance(x, Always) and is_eventuality_free(x.arg)) or _pure_eventuality(x)
+            for x in args
+        ):
+            # G(G a | e) = G(a W e) = G(a | e) for a pure eventuality e (for an eventuality-
+            # free a: G a then costs no acceptance set, G(a | e) costs none more).
+            return make_g(make_or(x.arg if isinstance(x, Always) else x for x in args))
         case Disj(args=args) if any(_suspendable(x) for x in args):
             # G(a | s) = G a | s for s both a pure eventuality and a pure universality (its
             # truth is the same at every position; Babiak et al.'s suspension).
@@ -288,7 +298,8 @@ def make_binary(kind: BinaryKind, a: Node, b: Node) -> Node:
             return make_g(a)
         if _pure_universality(a):
             return make_or([a, b])
-        if _pure_eventuality(b):  # a W e = (a U e) | G a = e | G a
+        if _pure_eventuality(b) and not _suspendable(b):  # a W e = (a U e) | G a = e | G a
+            # (Not for a suspendable e: the state of a W e then loops on a, accepting.)
             return make_or([b, make_g(a)])
     elif kind == "M":
         if b == FALSE or a == FALSE:
