@@ -202,31 +202,84 @@ def simulation(
     for state in range(n):
         for letters, _marks, _dst in out[state]:
             enabled[state] |= letters
-    sim = [[(enabled[p] & ~enabled[q]) == 0 for q in range(n)] for p in range(n)]
+    # simulators[p]: bitmask of the states still believed to simulate p.
+    simulators = [0] * n
+    for p in range(n):
+        for q in range(n):
+            if (enabled[p] & ~enabled[q]) == 0:
+                simulators[p] |= 1 << q
     if initial is not None:
         # Only the initial state matches the empty prefix that reaches the initial state.
-        sim[initial] = [q == initial for q in range(n)]
+        simulators[initial] = 1 << initial
+    # Letters every edge treats alike (the atoms of the algebra of the edges' letter sets):
+    # a state matches an edge on every letter iff it does on one letter of every atom.
+    atoms = [alphabet.full]
+    for letters in {
+        letters for edges in (out, answers) for row in edges for letters, _m, _d in row
+    }:
+        _check(deadline)
+        split = []
+        for atom in atoms:
+            inside = atom & letters
+            if inside and inside != atom:
+                split += [inside, atom & ~letters]
+            else:
+                split.append(atom)
+        atoms = split
+    atom_ids = {
+        letters: [i for i, atom in enumerate(atoms) if atom & letters]
+        for letters in {letters for row in out for letters, _m, _d in row}
+    }
+    needed_marks = {marks for row in out for _l, marks, _d in row}
+    # pre[(atom, marks)][d]: bitmask of the states with an edge to d on that atom carrying at
+    # least those marks.
+    pre: dict[tuple[int, int], list[int]] = {}
+    for q in range(n):
+        for letters, other_marks, target in answers[q]:
+            for index, atom in enumerate(atoms):
+                if not atom & letters:
+                    continue
+                for marks in needed_marks:
+                    if marks & ~other_marks == 0:
+                        row = pre.get((index, marks))
+                        if row is None:
+                            row = pre[(index, marks)] = [0] * n
+                        row[target] |= 1 << q
     changed = True
     while changed:
         changed = False
         _check(deadline)
+        # Predecessors (on an atom, with marks) of the simulators of a target, this sweep.
+        memo: dict[tuple[int, int, int], int] = {}
         for p in range(n):
-            _check(deadline)
-            row = sim[p]
-            for q in range(n):
-                if p == q or not row[q]:
-                    continue
-                for letters, marks, target in out[p]:
-                    covered = 0
-                    target_row = sim[target]
-                    for other_letters, other_marks, other_target in answers[q]:
-                        if marks & ~other_marks == 0 and target_row[other_target]:
-                            covered |= other_letters
-                    if letters & ~covered:
-                        row[q] = False
-                        changed = True
+            current = simulators[p]
+            if current == 1 << p:
+                continue
+            for letters, marks, target in out[p]:
+                good = simulators[target]
+                for index in atom_ids[letters]:
+                    key = (index, marks, target)
+                    matched = memo.get(key)
+                    if matched is None:
+                        matched = 0
+                        row = pre.get((index, marks))
+                        if row is not None:
+                            rest = good
+                            while rest:
+                                low = rest & -rest
+                                matched |= row[low.bit_length() - 1]
+                                rest ^= low
+                        memo[key] = matched
+                    current &= matched | (1 << p)
+                    if current == 1 << p:
                         break
-    return sim
+                if current == 1 << p:
+                    break
+            if current != simulators[p]:
+                simulators[p] = current
+                changed = True
+                _check(deadline)
+    return [[q == p or bool(simulators[p] >> q & 1) for q in range(n)] for p in range(n)]
 
 
 def quotient(automaton: Automaton, sim: list[list[bool]]) -> Automaton:

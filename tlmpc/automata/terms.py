@@ -96,6 +96,17 @@ def make_and(parts: Iterable[Node]) -> Node:
         inner = make_and(part.arg.arg for part in persistent if isinstance(part.arg, Always))
         flat.add(Finally("F", Always("G", inner)))
     suspendable = [part for part in flat if _pure_eventuality(part) and _pure_universality(part)]
+    # F a & s = s when s ⇒ F a (G F a & F a = G F a): dropped before the suspension below
+    # would fold s into F a.
+    flat.difference_update(
+        [
+            part
+            for part in flat
+            if isinstance(part, Finally)
+            and part not in suspendable
+            and any(implies(s, part) for s in suspendable)
+        ]
+    )
     eventual = sorted(
         (part for part in flat if isinstance(part, Finally) and part not in suspendable),
         key=repr,

@@ -20,6 +20,7 @@ from tlmpc.automata.model import Automaton, Edge
 from tlmpc.automata.nnf import FALSE, Node
 from tlmpc.automata.rewrite import MAX_SEMANTIC_APS, rewrite
 from tlmpc.automata.simplify import postprocess, strongly_connected
+from tlmpc.automata.simulation import OutOfTime
 from tlmpc.automata.terms import (
     Expansion,
     cube_allowed,
@@ -149,7 +150,10 @@ def _translate(
     budget: float | None,
     containment: bool,
     check_wdba: bool = True,
+    explore_deadline: float | None = None,
 ) -> Automaton:
+    """:func:`translate`; with ``explore_deadline``, :class:`OutOfTime` is raised when the raw
+    automaton is not built by then (for the optional checks that need one)."""
     started = time.process_time()
     deadline = None if budget is None else started + budget
     original = formula
@@ -175,7 +179,9 @@ def _translate(
     initial = simplify_state(frozenset([root])) if root != FALSE else None
     previous_letters = restrict_letters(letter_sets)
     try:
-        automaton = _explore(initial, events, letter_sets, formula_text(original), aps)
+        automaton = _explore(
+            initial, events, letter_sets, formula_text(original), aps, explore_deadline
+        )
     finally:
         restrict_letters(previous_letters)
     if simplify:
@@ -183,16 +189,27 @@ def _translate(
         if check_wdba:
 
             def verify(reduced: Automaton, candidate: Automaton) -> bool:
-                # The negation's automaton, itself without this check (no recursion).
-                negation = _translate(
-                    Not(original),
-                    letters=None if letter_sets is None else [sorted(x) for x in letter_sets],
-                    simplify=True,
-                    budget=WDBA_CHECK_BUDGET,
-                    containment=False,
-                    check_wdba=False,
-                )
+                # The negation's automaton, itself without this check (no recursion), built
+                # within the check's own budget and the translation's deadline: past them
+                # the candidate is simply not proved equivalent.
                 limit = time.process_time() + WDBA_CHECK_BUDGET
+                if deadline is not None:
+                    limit = min(limit, deadline)
+                try:
+                    negation = _translate(
+                        Not(original),
+                        letters=None if letter_sets is None else [sorted(x) for x in letter_sets],
+                        simplify=True,
+                        budget=WDBA_CHECK_BUDGET,
+                        containment=False,
+                        check_wdba=False,
+                        explore_deadline=limit,
+                    )
+                except OutOfTime:
+                    return False
+                limit = time.process_time() + WDBA_CHECK_BUDGET
+                if deadline is not None:
+                    limit = min(limit, deadline)
                 return equivalent_to_deterministic(reduced, candidate, negation, letter_sets, limit)
 
         automaton = postprocess(
@@ -211,8 +228,10 @@ def _explore(
     letter_sets: list[frozenset[str]] | None,
     text: str,
     aps: tuple[str, ...],
+    deadline: float | None = None,
 ) -> Automaton:
-    """The raw TGBA: states reached from ``initial`` by the expansion terms letters allow."""
+    """The raw TGBA: states reached from ``initial`` by the expansion terms letters allow
+    (:class:`OutOfTime` past ``deadline``, when given)."""
     event_index = {e: i for i, e in enumerate(events)}
     states: dict[State, int] = {}
     names: list[str] = []
@@ -222,6 +241,8 @@ def _explore(
         names.append(_state_name(initial))
         queue = [initial]
         while queue:
+            if deadline is not None and time.process_time() > deadline:
+                raise OutOfTime
             state = queue.pop()
             source = states[state]
             terms: list[tuple[Cube, State, frozenset[int]]] = []
