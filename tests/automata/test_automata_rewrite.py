@@ -87,6 +87,12 @@ RULES = [
     ("F b & (a U b)", "a U b"),
     ("G a & F !a", "false"),
     ("F a | G !a", "true"),
+    # Suspension (Babiak et al.), Spot's F(a W b) rule, and G over a W e.
+    ("G(a | G F b)", "G a | G F b"),
+    ("G(a | F G b)", "G a | F G b"),
+    ("F(a W b)", "F(b | G a)"),
+    ("G(G a | F b)", "G(a | F b)"),
+    ("F a & G F a", "G F a"),
 ]
 
 
