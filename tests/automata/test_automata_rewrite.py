@@ -93,6 +93,7 @@ RULES = [
     ("F(a W b)", "F(b | G a)"),
     ("G(G a | F b)", "G(a | F b)"),
     ("F a & G F a", "G F a"),
+    ("(!a & !b) W F G !a", "F G !a"),
 ]
 
 

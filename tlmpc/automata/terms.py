@@ -221,6 +221,11 @@ def _pure_universality(f: Node) -> bool:
             assert_never(f)
 
 
+def is_pure_eventuality(f: Node) -> bool:
+    """``F f == f`` (Etessami–Holzmann's pure eventualities)."""
+    return _pure_eventuality(f)
+
+
 def _suspendable(f: Node) -> bool:
     """Both a pure eventuality and a pure universality (``G F a``, ``F G a``): true at one
     position iff true at every position."""
