@@ -94,6 +94,7 @@ RULES = [
     ("G(G a | F b)", "G(a | F b)"),
     ("F a & G F a", "G F a"),
     ("(!a & !b) W F G !a", "F G !a"),
+    ("a W G F b", "a W G F b"),  # G a does not imply G F b: the W stays
 ]
 
 
