@@ -95,6 +95,8 @@ RULES = [
     ("F a & G F a", "G F a"),
     ("(!a & !b) W F G !a", "F G !a"),
     ("a W G F b", "a W G F b"),  # G a does not imply G F b: the W stays
+    ("G a | (a U G b)", "a W G b"),
+    ("F a & (a R F b)", "a M F b"),
 ]
 
 

@@ -81,6 +81,21 @@ def make_and(parts: Iterable[Node]) -> Node:
     for part in flat:
         if isinstance(part, Pos) and neg(part.name) in flat:
             return FALSE
+    strong = [
+        part
+        for part in flat
+        if isinstance(part, Binary) and part.kind == "R" and Finally("F", part.left) in flat
+    ]
+    if strong:
+        # F a & (a R b) = a M b (the dual rule).
+        flat.difference_update(strong)
+        flat.difference_update(
+            Finally("F", part.left) for part in strong if isinstance(part, Binary)
+        )
+        flat.update(
+            make_binary("M", part.left, part.right) for part in strong if isinstance(part, Binary)
+        )
+        return make_and(flat)
     always = [part for part in flat if isinstance(part, Always)]
     if len(always) > 1:
         # G a & G b = G(a & b): one obligation instead of many (fifty `avoid` phrases would
@@ -141,6 +156,19 @@ def make_or(parts: Iterable[Node]) -> Node:
     for part in flat:
         if isinstance(part, Pos) and neg(part.name) in flat:
             return TRUE
+    weak = [
+        part
+        for part in flat
+        if isinstance(part, Binary) and part.kind == "U" and Always("G", part.left) in flat
+    ]
+    if weak:
+        # G a | (a U b) = a W b (Spot's rule): one state instead of a choice.
+        flat.difference_update(weak)
+        flat.difference_update(Always("G", part.left) for part in weak if isinstance(part, Binary))
+        flat.update(
+            make_binary("W", part.left, part.right) for part in weak if isinstance(part, Binary)
+        )
+        return make_or(flat)
     recurrent = [
         part for part in flat if isinstance(part, Always) and isinstance(part.arg, Finally)
     ]
