@@ -174,8 +174,9 @@ def run_spot(
     Both sides are transition-based generalized Büchi automata over the full alphabet (every
     valuation of the propositions): tlmpc's ``translate(f)`` against Spot's
     ``translate(f, "TGBA", "Small", "High")``; equivalence by ``spot.are_equivalent`` on
-    tlmpc's HOA.  ``held-out`` continues the random stream: formulas never used while tuning
-    the translator.
+    tlmpc's HOA.  ``held-out`` continues the random stream (formulas not tuned on; its few
+    larger-than-Spot formulas were looked at once); ``random 2-5 APs`` (with ``large``) is
+    the larger seeded set of :data:`LARGE_BATCHES`.
     """
     import spot
 
