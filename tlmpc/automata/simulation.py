@@ -1,4 +1,5 @@
-"""Direct-simulation reduction of a TGBA (Spot's ``simul``; Somenzi–Bloem "little brothers").
+"""Direct- and reverse-simulation reduction of a TGBA (Spot's ``simulation`` and
+``cosimulation``; Somenzi–Bloem "little brothers").
 
 State ``q`` directly simulates ``p`` when every edge ``p --a/M--> p'`` is matched, for the same
 letter ``a``, by an edge ``q --a/M'--> q'`` with ``M ⊆ M'`` and ``q'`` simulating ``p'``.  The
@@ -9,6 +10,14 @@ Two language-preserving reductions follow (Etessami–Wilke–Schuller; Clemente
 * **quotient** by simulation equivalence (states simulating each other are merged);
 * **pruning**: a cube of an edge is dropped when, for each of its letters, another edge of the
   same source goes to a strictly better target with at least its marks.
+
+The reverse simulation is the direct simulation of the transposed automaton in which only the
+initial state reverse-simulates the initial state (:func:`cosimulation`); its quotient merges
+states with the same pasts and its pruning drops edges into a state that a strictly better
+source also provides (:func:`quotient_reverse`, :func:`prune_reverse`).
+
+The relation is computed on bitsets: the letters are split into the atoms of the edges' letter
+sets, and the states matching an edge on an atom come from precomputed predecessor masks.
 
 Edges that lie on no cycle are taken at most once by a run, so their marks do not matter; they
 are given every mark first ("saturation"), which lets them dominate and be dominated more often.
