@@ -87,6 +87,16 @@ RULES = [
     ("F b & (a U b)", "a U b"),
     ("G a & F !a", "false"),
     ("F a | G !a", "true"),
+    # Suspension (Babiak et al.), Spot's F(a W b) rule, and G over a W e.
+    ("G(a | G F b)", "G a | G F b"),
+    ("G(a | F G b)", "G a | F G b"),
+    ("F(a W b)", "F(b | G a)"),
+    ("G(G a | F b)", "G(a | F b)"),
+    ("F a & G F a", "G F a"),
+    ("(!a & !b) W F G !a", "F G !a"),
+    ("a W G F b", "a W G F b"),  # G a does not imply G F b: the W stays
+    ("G a | (a U G b)", "a W G b"),
+    ("F a & (a R F b)", "a M F b"),
 ]
 
 

@@ -73,7 +73,7 @@ def test_equivalent_to_spot(family: str, text: str) -> None:
         assert spot.are_equivalent(_spot_of(degeneralize(ours)), theirs), (family, text)
 
 
-@pytest.mark.parametrize("family", ["robotics", "eh"])
+@pytest.mark.parametrize("family", ["robotics", "eh", "sb", "dac"])
 def test_no_more_states_than_spot(family: str) -> None:
     """On these families tlmpc matches Spot formula by formula (a regression guard)."""
     larger = []

@@ -56,6 +56,7 @@ from tlmpc.automata.nnf import (
 )
 from tlmpc.automata.terms import (
     implies,
+    is_pure_eventuality,
     make_and,
     make_binary,
     make_f,
@@ -204,6 +205,9 @@ class _Rewriter:
             if self.implies(negate(a), b):
                 return make_f(b) if kind == "U" else TRUE
             if isinstance(b, Binary) and b.kind == kind and self.implies(a, b.left):
+                return b
+            if kind == "W" and is_pure_eventuality(b) and self.implies(make_g(a), b):
+                # a W b = (a U b) | G a = a U b when G a ⇒ b, and a U e = e.
                 return b
         else:  # R, M
             if self.implies(b, a):

@@ -371,6 +371,10 @@ def reduce_by_simulation(
     try:
         for saturated in (False, True):
             current = _simulation_round(current, alphabet, deadline, saturated=saturated)
+        for saturated in (False, True):
+            current = _simulation_round(
+                current, alphabet, deadline, saturated=saturated, reverse=True
+            )
         stripped = simulation.strip_transient(
             current, sccs(current.num_states, current.edges, current.initial)
         )
@@ -386,12 +390,29 @@ def reduce_by_simulation(
 
 
 def _simulation_round(
-    automaton: Automaton, alphabet: simulation.Alphabet, deadline: float, *, saturated: bool
+    automaton: Automaton,
+    alphabet: simulation.Alphabet,
+    deadline: float,
+    *,
+    saturated: bool,
+    reverse: bool = False,
 ) -> Automaton:
     """One quotient-and-prune pass.  Edges between SCCs carry no marks after trimming; with
     ``saturated`` they carry every mark instead (both are the same language, since a run takes
     such an edge once): the bare marks let those edges be dominated, every mark lets them
-    dominate, and each finds reductions the other misses."""
+    dominate, and each finds reductions the other misses.  With ``reverse``, by reverse
+    simulation (states with the same pasts) instead of direct simulation."""
+    relate: Callable[[Automaton, simulation.Alphabet, float], list[list[bool]]]
+    merge: Callable[[Automaton, list[list[bool]]], Automaton]
+    drop: Callable[[Automaton, simulation.Alphabet, list[list[bool]], float], Automaton]
+    if reverse:
+        relate = simulation.cosimulation
+        merge = simulation.quotient_reverse
+        drop = simulation.prune_reverse
+    else:
+        relate = simulation.simulation
+        merge = simulation.quotient
+        drop = simulation.prune
 
     def prepared(current: Automaton) -> Automaton:
         component = sccs(current.num_states, current.edges, current.initial)
@@ -400,13 +421,14 @@ def _simulation_round(
         return simulation.strip_transient(current, component)
 
     current = prepared(automaton)
-    relation = simulation.simulation(current, alphabet, deadline)
-    merged = simulation.quotient(current, relation)
+    relation = relate(current, alphabet, deadline)
+    merged = merge(current, relation)
     if merged is not current:
-        keep = {e.src for e in merged.edges} | {merged.initial}
+        merged = merge_parallel_automaton(merged)
+        keep = {e.src for e in merged.edges} | {e.dst for e in merged.edges} | {merged.initial}
         current = prepared(_renumber(merged, merged.edges, keep))
-        relation = simulation.simulation(current, alphabet, deadline)
-    return simulation.prune(current, alphabet, relation, deadline)
+        relation = relate(current, alphabet, deadline)
+    return drop(current, alphabet, relation, deadline)
 
 
 def postprocess(

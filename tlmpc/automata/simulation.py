@@ -1,4 +1,5 @@
-"""Direct-simulation reduction of a TGBA (Spot's ``simul``; Somenzi–Bloem "little brothers").
+"""Direct- and reverse-simulation reduction of a TGBA (Spot's ``simulation`` and
+``cosimulation``; Somenzi–Bloem "little brothers").
 
 State ``q`` directly simulates ``p`` when every edge ``p --a/M--> p'`` is matched, for the same
 letter ``a``, by an edge ``q --a/M'--> q'`` with ``M ⊆ M'`` and ``q'`` simulating ``p'``.  The
@@ -9,6 +10,14 @@ Two language-preserving reductions follow (Etessami–Wilke–Schuller; Clemente
 * **quotient** by simulation equivalence (states simulating each other are merged);
 * **pruning**: a cube of an edge is dropped when, for each of its letters, another edge of the
   same source goes to a strictly better target with at least its marks.
+
+The reverse simulation is the direct simulation of the transposed automaton in which only the
+initial state reverse-simulates the initial state (:func:`cosimulation`); its quotient merges
+states with the same pasts and its pruning drops edges into a state that a strictly better
+source also provides (:func:`quotient_reverse`, :func:`prune_reverse`).
+
+The relation is computed on bitsets: the letters are split into the atoms of the edges' letter
+sets, and the states matching an edge on an atom come from precomputed predecessor masks.
 
 Edges that lie on no cycle are taken at most once by a run, so their marks do not matter; they
 are given every mark first ("saturation"), which lets them dominate and be dominated more often.
@@ -124,11 +133,59 @@ def _with_edges(automaton: Automaton, edges: Sequence[Edge]) -> Automaton:
     return dataclasses.replace(automaton, edges=tuple(edges))
 
 
+def transpose(automaton: Automaton) -> Automaton:
+    """Every edge reversed (same guard and marks): the reverse simulation of an automaton is
+    the direct simulation of its transpose, with the initial state told apart."""
+    edges = tuple(Edge(src=e.dst, dst=e.src, guard=e.guard, marks=e.marks) for e in automaton.edges)
+    return _with_edges(automaton, edges)
+
+
+def cosimulation(automaton: Automaton, alphabet: Alphabet, deadline: float) -> list[list[bool]]:
+    """``cosim[p][q]``: ``q`` reverse-simulates ``p`` (Spot's ``cosimulation``).
+
+    The largest relation where ``p`` initial implies ``q`` initial and every edge
+    ``p' --a/M--> p`` is matched by an edge ``q' --a/M'--> q`` with ``M ⊆ M'`` and ``q'``
+    reverse-simulating ``p'``: every run prefix reaching ``p`` is matched, position by
+    position and with at least its marks, by a prefix reaching ``q``.  König's lemma turns
+    infinitely many such replacements into one run, so merging reverse-simulation-equivalent
+    states and dropping reverse little brothers (:func:`prune_reverse`) keep the language."""
+    return simulation(transpose(automaton), alphabet, deadline, initial=automaton.initial)
+
+
+def quotient_reverse(automaton: Automaton, cosim: list[list[bool]]) -> Automaton:
+    """Merge states that reverse-simulate each other: edges into a merged state go to its
+    representative, and the representative gets the edges out of every merged state."""
+    n = automaton.num_states
+    representative = list(range(n))
+    for p in range(n):
+        for q in range(p):
+            if representative[q] == q and cosim[p][q] and cosim[q][p]:
+                representative[p] = q
+                break
+    if all(representative[p] == p for p in range(n)):
+        return automaton
+    edges = tuple(
+        Edge(src=representative[e.src], dst=representative[e.dst], guard=e.guard, marks=e.marks)
+        for e in automaton.edges
+    )
+    return dataclasses.replace(automaton, edges=edges, initial=representative[automaton.initial])
+
+
+def prune_reverse(
+    automaton: Automaton, alphabet: Alphabet, cosim: list[list[bool]], deadline: float
+) -> Automaton:
+    """Drop the cubes of an edge into ``p`` whose every letter also enters ``p`` from a
+    strictly better source (reverse little brothers) with at least its marks."""
+    return transpose(prune(transpose(automaton), alphabet, cosim, deadline))
+
+
 def simulation(
     automaton: Automaton,
     alphabet: Alphabet,
     deadline: float,
     component: Sequence[int] | None = None,
+    *,
+    initial: int | None = None,
 ) -> list[list[bool]]:
     """``sim[p][q]``: ``q`` directly simulates ``p`` (largest relation).
 
@@ -154,28 +211,84 @@ def simulation(
     for state in range(n):
         for letters, _marks, _dst in out[state]:
             enabled[state] |= letters
-    sim = [[(enabled[p] & ~enabled[q]) == 0 for q in range(n)] for p in range(n)]
+    # simulators[p]: bitmask of the states still believed to simulate p.
+    simulators = [0] * n
+    for p in range(n):
+        for q in range(n):
+            if (enabled[p] & ~enabled[q]) == 0:
+                simulators[p] |= 1 << q
+    if initial is not None:
+        # Only the initial state matches the empty prefix that reaches the initial state.
+        simulators[initial] = 1 << initial
+    # Letters every edge treats alike (the atoms of the algebra of the edges' letter sets):
+    # a state matches an edge on every letter iff it does on one letter of every atom.
+    atoms = [alphabet.full]
+    for letters in {
+        letters for edges in (out, answers) for row in edges for letters, _m, _d in row
+    }:
+        _check(deadline)
+        split = []
+        for atom in atoms:
+            inside = atom & letters
+            if inside and inside != atom:
+                split += [inside, atom & ~letters]
+            else:
+                split.append(atom)
+        atoms = split
+    atom_ids = {
+        letters: [i for i, atom in enumerate(atoms) if atom & letters]
+        for letters in {letters for row in out for letters, _m, _d in row}
+    }
+    needed_marks = {marks for row in out for _l, marks, _d in row}
+    # pre[(atom, marks)][d]: bitmask of the states with an edge to d on that atom carrying at
+    # least those marks.
+    pre: dict[tuple[int, int], list[int]] = {}
+    for q in range(n):
+        for letters, other_marks, target in answers[q]:
+            for index, atom in enumerate(atoms):
+                if not atom & letters:
+                    continue
+                for marks in needed_marks:
+                    if marks & ~other_marks == 0:
+                        row = pre.get((index, marks))
+                        if row is None:
+                            row = pre[(index, marks)] = [0] * n
+                        row[target] |= 1 << q
     changed = True
     while changed:
         changed = False
         _check(deadline)
+        # Predecessors (on an atom, with marks) of the simulators of a target, this sweep.
+        memo: dict[tuple[int, int, int], int] = {}
         for p in range(n):
-            _check(deadline)
-            row = sim[p]
-            for q in range(n):
-                if p == q or not row[q]:
-                    continue
-                for letters, marks, target in out[p]:
-                    covered = 0
-                    target_row = sim[target]
-                    for other_letters, other_marks, other_target in answers[q]:
-                        if marks & ~other_marks == 0 and target_row[other_target]:
-                            covered |= other_letters
-                    if letters & ~covered:
-                        row[q] = False
-                        changed = True
+            current = simulators[p]
+            if current == 1 << p:
+                continue
+            for letters, marks, target in out[p]:
+                good = simulators[target]
+                for index in atom_ids[letters]:
+                    key = (index, marks, target)
+                    matched = memo.get(key)
+                    if matched is None:
+                        matched = 0
+                        row = pre.get((index, marks))
+                        if row is not None:
+                            rest = good
+                            while rest:
+                                low = rest & -rest
+                                matched |= row[low.bit_length() - 1]
+                                rest ^= low
+                        memo[key] = matched
+                    current &= matched | (1 << p)
+                    if current == 1 << p:
                         break
-    return sim
+                if current == 1 << p:
+                    break
+            if current != simulators[p]:
+                simulators[p] = current
+                changed = True
+                _check(deadline)
+    return [[q == p or bool(simulators[p] >> q & 1) for q in range(n)] for p in range(n)]
 
 
 def quotient(automaton: Automaton, sim: list[list[bool]]) -> Automaton:

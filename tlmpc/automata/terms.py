@@ -81,6 +81,21 @@ def make_and(parts: Iterable[Node]) -> Node:
     for part in flat:
         if isinstance(part, Pos) and neg(part.name) in flat:
             return FALSE
+    strong = [
+        part
+        for part in flat
+        if isinstance(part, Binary) and part.kind == "R" and Finally("F", part.left) in flat
+    ]
+    if strong:
+        # F a & (a R b) = a M b (the dual rule).
+        flat.difference_update(strong)
+        flat.difference_update(
+            Finally("F", part.left) for part in strong if isinstance(part, Binary)
+        )
+        flat.update(
+            make_binary("M", part.left, part.right) for part in strong if isinstance(part, Binary)
+        )
+        return make_and(flat)
     always = [part for part in flat if isinstance(part, Always)]
     if len(always) > 1:
         # G a & G b = G(a & b): one obligation instead of many (fifty `avoid` phrases would
@@ -96,6 +111,17 @@ def make_and(parts: Iterable[Node]) -> Node:
         inner = make_and(part.arg.arg for part in persistent if isinstance(part.arg, Always))
         flat.add(Finally("F", Always("G", inner)))
     suspendable = [part for part in flat if _pure_eventuality(part) and _pure_universality(part)]
+    # F a & s = s when s ⇒ F a (G F a & F a = G F a): dropped before the suspension below
+    # would fold s into F a.
+    flat.difference_update(
+        [
+            part
+            for part in flat
+            if isinstance(part, Finally)
+            and part not in suspendable
+            and any(implies(s, part) for s in suspendable)
+        ]
+    )
     eventual = sorted(
         (part for part in flat if isinstance(part, Finally) and part not in suspendable),
         key=repr,
@@ -130,6 +156,19 @@ def make_or(parts: Iterable[Node]) -> Node:
     for part in flat:
         if isinstance(part, Pos) and neg(part.name) in flat:
             return TRUE
+    weak = [
+        part
+        for part in flat
+        if isinstance(part, Binary) and part.kind == "U" and Always("G", part.left) in flat
+    ]
+    if weak:
+        # G a | (a U b) = a W b (Spot's rule): one state instead of a choice.
+        flat.difference_update(weak)
+        flat.difference_update(Always("G", part.left) for part in weak if isinstance(part, Binary))
+        flat.update(
+            make_binary("W", part.left, part.right) for part in weak if isinstance(part, Binary)
+        )
+        return make_or(flat)
     recurrent = [
         part for part in flat if isinstance(part, Always) and isinstance(part.arg, Finally)
     ]
@@ -210,6 +249,17 @@ def _pure_universality(f: Node) -> bool:
             assert_never(f)
 
 
+def is_pure_eventuality(f: Node) -> bool:
+    """``F f == f`` (Etessami–Holzmann's pure eventualities)."""
+    return _pure_eventuality(f)
+
+
+def _suspendable(f: Node) -> bool:
+    """Both a pure eventuality and a pure universality (``G F a``, ``F G a``): true at one
+    position iff true at every position."""
+    return _pure_eventuality(f) and _pure_universality(f)
+
+
 def make_f(a: Node) -> Node:
     """F a, simplified: F true = true, F false = false, F(eventuality) = itself,
     F(a U b) = F b, F(a M b) = F(a & b), F(a | F b) = F(a | b)."""
@@ -220,6 +270,9 @@ def make_f(a: Node) -> Node:
             return make_f(right)
         case Binary(kind="M", left=left, right=right):
             return make_f(make_and([left, right]))
+        case Binary(kind="W", left=left, right=right):
+            # F(a W b) = F(b | G a) (Spot's rule): no choice between two F's.
+            return make_f(make_or([right, make_g(left)]))
         case Disj(args=args) if any(isinstance(x, Finally) for x in args):
             return make_f(make_or(x.arg if isinstance(x, Finally) else x for x in args))
     return Finally("F", a)
@@ -241,6 +294,20 @@ def make_g(a: Node) -> Node:
             return make_g(make_or([left, right]))
         case Conj(args=args) if any(isinstance(x, Always) for x in args):
             return make_g(make_and(x.arg if isinstance(x, Always) else x for x in args))
+        case Disj(args=args) if sum(isinstance(x, Always) for x in args) == 1 and all(
+            (isinstance(x, Always) and is_eventuality_free(x.arg)) or _pure_eventuality(x)
+            for x in args
+        ):
+            # G(G a | e) = G(a W e) = G(a | e) for a pure eventuality e (for an eventuality-
+            # free a: G a then costs no acceptance set, G(a | e) costs none more).
+            return make_g(make_or(x.arg if isinstance(x, Always) else x for x in args))
+        case Disj(args=args) if any(_suspendable(x) for x in args):
+            # G(a | s) = G a | s for s both a pure eventuality and a pure universality (its
+            # truth is the same at every position; Babiak et al.'s suspension).
+            return make_or(
+                [make_g(make_or(x for x in args if not _suspendable(x)))]
+                + [x for x in args if _suspendable(x)]
+            )
         case Finally(arg=Conj(args=args)) if any(_pure_eventuality(x) for x in args):
             eventual = [x for x in args if _pure_eventuality(x)]
             rest = [x for x in args if not _pure_eventuality(x)]
@@ -275,7 +342,8 @@ def make_binary(kind: BinaryKind, a: Node, b: Node) -> Node:
             return make_g(a)
         if _pure_universality(a):
             return make_or([a, b])
-        if _pure_eventuality(b):  # a W e = (a U e) | G a = e | G a
+        if _pure_eventuality(b) and not _suspendable(b):  # a W e = (a U e) | G a = e | G a
+            # (Not for a suspendable e: the state of a W e then loops on a, accepting.)
             return make_or([b, make_g(a)])
     elif kind == "M":
         if b == FALSE or a == FALSE:

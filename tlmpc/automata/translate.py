@@ -19,14 +19,14 @@ from tlmpc.automata.emptiness import equivalent_to_deterministic
 from tlmpc.automata.model import Automaton, Edge
 from tlmpc.automata.nnf import FALSE, Node
 from tlmpc.automata.rewrite import MAX_SEMANTIC_APS, rewrite
-from tlmpc.automata.simplify import postprocess, trim
+from tlmpc.automata.simplify import postprocess, strongly_connected
+from tlmpc.automata.simulation import OutOfTime
 from tlmpc.automata.terms import (
     Expansion,
     cube_allowed,
     eventualities,
     expand,
     from_ast,
-    props,
     restrict_letters,
     simplify_state,
     to_text,
@@ -40,6 +40,9 @@ from tlmpc.ltl.transform import nnf
 DEFAULT_BUDGET = 0.5
 #: At most this long for the language-containment simplification of the formula.
 CONTAINMENT_BUDGET = 0.2
+
+#: Emptiness checks of the rewriting give up (answer "not shown empty") past this many states.
+MAX_EMPTINESS_STATES = 400
 
 #: At most this long for each equivalence check of a WDBA-minimized automaton (a formula that
 #: is not a syntactic obligation may still have one; the check decides).
@@ -147,20 +150,25 @@ def _translate(
     budget: float | None,
     containment: bool,
     check_wdba: bool = True,
+    explore_deadline: float | None = None,
 ) -> Automaton:
+    """:func:`translate`; with ``explore_deadline``, :class:`OutOfTime` is raised when the raw
+    automaton is not built by then (for the optional checks that need one)."""
     started = time.process_time()
     deadline = None if budget is None else started + budget
     original = formula
     if simplify and containment:
         # Half the budget at most for the containment checks (each one a small translation).
         share = CONTAINMENT_BUDGET if budget is None else min(CONTAINMENT_BUDGET, budget / 2)
-        formula = simplify_by_containment(nnf(formula), _is_empty, started + share)
+        limit = started + share
+        formula = simplify_by_containment(nnf(formula), lambda f: _is_empty(f, limit), limit)
     aps = tuple(sorted(original.props()))
     semantic = simplify and containment and len(aps) <= MAX_SEMANTIC_APS
+    rewrite_deadline = time.process_time() + (CONTAINMENT_BUDGET if budget is None else budget / 4)
     root = rewrite(
         from_ast(formula),
-        _is_empty_term if semantic else None,
-        time.process_time() + (CONTAINMENT_BUDGET if budget is None else budget / 4),
+        (lambda f: _is_empty_term(f, rewrite_deadline)) if semantic else None,
+        rewrite_deadline,
     )
     letter_sets = (
         None
@@ -171,7 +179,9 @@ def _translate(
     initial = simplify_state(frozenset([root])) if root != FALSE else None
     previous_letters = restrict_letters(letter_sets)
     try:
-        automaton = _explore(initial, events, letter_sets, formula_text(original), aps)
+        automaton = _explore(
+            initial, events, letter_sets, formula_text(original), aps, explore_deadline
+        )
     finally:
         restrict_letters(previous_letters)
     if simplify:
@@ -179,16 +189,27 @@ def _translate(
         if check_wdba:
 
             def verify(reduced: Automaton, candidate: Automaton) -> bool:
-                # The negation's automaton, itself without this check (no recursion).
-                negation = _translate(
-                    Not(original),
-                    letters=None if letter_sets is None else [sorted(x) for x in letter_sets],
-                    simplify=True,
-                    budget=WDBA_CHECK_BUDGET,
-                    containment=False,
-                    check_wdba=False,
-                )
+                # The negation's automaton, itself without this check (no recursion), built
+                # within the check's own budget and the translation's deadline: past them
+                # the candidate is simply not proved equivalent.
                 limit = time.process_time() + WDBA_CHECK_BUDGET
+                if deadline is not None:
+                    limit = min(limit, deadline)
+                try:
+                    negation = _translate(
+                        Not(original),
+                        letters=None if letter_sets is None else [sorted(x) for x in letter_sets],
+                        simplify=True,
+                        budget=WDBA_CHECK_BUDGET,
+                        containment=False,
+                        check_wdba=False,
+                        explore_deadline=limit,
+                    )
+                except OutOfTime:
+                    return False
+                limit = time.process_time() + WDBA_CHECK_BUDGET
+                if deadline is not None:
+                    limit = min(limit, deadline)
                 return equivalent_to_deterministic(reduced, candidate, negation, letter_sets, limit)
 
         automaton = postprocess(
@@ -207,8 +228,10 @@ def _explore(
     letter_sets: list[frozenset[str]] | None,
     text: str,
     aps: tuple[str, ...],
+    deadline: float | None = None,
 ) -> Automaton:
-    """The raw TGBA: states reached from ``initial`` by the expansion terms letters allow."""
+    """The raw TGBA: states reached from ``initial`` by the expansion terms letters allow
+    (:class:`OutOfTime` past ``deadline``, when given)."""
     event_index = {e: i for i, e in enumerate(events)}
     states: dict[State, int] = {}
     names: list[str] = []
@@ -218,6 +241,8 @@ def _explore(
         names.append(_state_name(initial))
         queue = [initial]
         while queue:
+            if deadline is not None and time.process_time() > deadline:
+                raise OutOfTime
             state = queue.pop()
             source = states[state]
             terms: list[tuple[Cube, State, frozenset[int]]] = []
@@ -248,31 +273,61 @@ def _explore(
     )
 
 
-def _is_empty(formula: Formula) -> bool:
-    """No word satisfies ``formula`` (its trimmed automaton has no edge)."""
-    translated = _translate(
-        formula,
-        letters=None,
-        simplify=True,
-        budget=CONTAINMENT_BUDGET,
-        containment=False,
-        check_wdba=False,
-    )
-    return not translated.edges
+def _is_empty(formula: Formula, deadline: float = float("inf")) -> bool:
+    """No word satisfies ``formula`` (see :func:`_is_empty_term`)."""
+    return _is_empty_term(rewrite(from_ast(nnf(formula))), deadline)
 
 
-def _is_empty_term(root: Node) -> bool:
-    """No word satisfies the internal formula ``root`` (its raw automaton, trimmed, has no
-    edge).  Over every letter: the caller's letter restriction is set aside meanwhile."""
+def _is_empty_term(root: Node, deadline: float = float("inf")) -> bool:
+    """No word satisfies the internal formula ``root``: no SCC of its raw automaton carries
+    every acceptance set on its inner edges.  Over every letter (the caller's letter
+    restriction is set aside meanwhile).  Only the graph is built (no guards, no reduction);
+    past :data:`MAX_EMPTINESS_STATES` states or ``deadline`` the answer is False ("not
+    shown empty"), which only leaves a rewriting unapplied."""
     if root == FALSE:
         return True
-    aps = tuple(sorted(props(root)))
+    initial = simplify_state(frozenset([root]))
+    if initial is None:
+        return True
+    events = eventualities(root)
+    event_index = {e: i for i, e in enumerate(events)}
+    every = (1 << len(events)) - 1
     previous = restrict_letters(None)
     try:
-        raw = _explore(simplify_state(frozenset([root])), eventualities(root), None, "", aps)
+        states: dict[State, int] = {initial: 0}
+        queue = [initial]
+        graph: list[tuple[int, int, int]] = []
+        while queue:
+            if len(states) > MAX_EMPTINESS_STATES or time.process_time() > deadline:
+                return False
+            state = queue.pop()
+            source = states[state]
+            terms: list[tuple[Cube, State, frozenset[int]]] = []
+            for pos, neg, nxt, promises in _state_terms(state):
+                target = simplify_state(nxt)
+                if target is None:
+                    continue
+                marks = frozenset(i for e, i in event_index.items() if e not in promises)
+                terms.append(((pos, neg), target, marks))
+            for _cube, target, marks in _dominated(terms, len(events)):
+                if target not in states:
+                    states[target] = len(states)
+                    queue.append(target)
+                bits = 0
+                for mark in marks:
+                    bits |= 1 << mark
+                graph.append((source, states[target], bits))
     finally:
         restrict_letters(previous)
-    return not trim(raw).edges
+    succ: list[list[int]] = [[] for _ in range(len(states))]
+    for src, dst, _bits in graph:
+        succ[src].append(dst)
+    component = strongly_connected(succ, [0])
+    seen: dict[int, int] = {}
+    for src, dst, bits in graph:
+        if component[src] == component[dst]:
+            seen[component[src]] = seen.get(component[src], 0) | bits
+    return not any(bits == every for bits in seen.values())
 
 
 def _state_terms(state: State) -> list[Expansion]:
