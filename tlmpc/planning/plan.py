@@ -90,7 +90,9 @@ def plan(
         x, y = abstraction.corners(abstraction.start).mean(axis=0).tolist()
         start_point = (float(x), float(y))
     starts = start_cells(abstraction, start_point)
-    start_label = start_point_label(abstraction, start_point)
+    # Only the closed convention reads the start point's own letter.
+    closed = options.boundary == "closed"
+    start_label = start_point_label(abstraction, start_point) if closed else ()
     product = build_product(
         abstraction,
         working,
@@ -111,7 +113,7 @@ def plan(
                 formula,
                 allowed,
                 starts=starts,
-                start_label=start_label if options.boundary == "closed" else None,
+                start_label=start_label if closed else None,
             )
         )
 
