@@ -5,10 +5,13 @@ degeneralized first, so every search below handles one set (see docs/planning.md
 optimality statement).  Two kinds of cycles are considered:
 
 * a *stay*: the robot converges inside one triangle whose stutter loop is accepting (cost 0);
-* a *moving cycle* through an accepting product edge ``u -> v``: one Dijkstra from the
-  initial nodes gives every prefix cost d0(u); candidates are taken in increasing order of the
-  lower bound d0(u) + beta * w(u, v), each closed by a Dijkstra from v back to u, and the
-  search stops when the bound reaches the best lasso found.
+* a *moving cycle* through an accepting product edge ``u -> v``: one shortest-path search
+  from the initial nodes gives every prefix cost d0(u); candidates are taken in increasing
+  order of the lower bound d0(u) + beta * w(u, v), each closed by a search from v back to u,
+  and the search stops when the bound reaches the best lasso found.
+
+The searches are :func:`tlmpc.planning.search.shortest_paths` (its tie-break among equal
+paths is stated there).
 """
 
 from __future__ import annotations
@@ -19,7 +22,6 @@ import time
 from typing import Any
 
 import numpy as np
-from scipy.sparse.csgraph import connected_components, dijkstra
 
 from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
 from tlmpc.automata.degeneralize import degeneralize
@@ -31,8 +33,9 @@ from tlmpc.planning.boundary import start_cells, start_point_label
 from tlmpc.planning.explain import explain_no_plan, invariant_mask
 from tlmpc.planning.model import Witness
 from tlmpc.planning.product import SLOTS, START_SLOT, Product, build_product
+from tlmpc.planning.search import shortest_paths, strongly_connected
 
-#: At most this many cycle candidates are closed with a Dijkstra search; past it the
+#: At most this many cycle candidates are closed with a shortest-path search; past it the
 #: witness is the best found and records ``optimal: false``.
 MAX_CYCLE_SEARCHES = 40
 
@@ -63,7 +66,7 @@ def _collapse(nodes: list[int], nq: int) -> tuple[list[int], list[int]]:
 
 def _path_cost(product: Product, nodes: list[int]) -> float:
     graph = product.graph
-    return float(sum(graph[a, b] for a, b in itertools.pairwise(nodes)))
+    return float(sum(graph.weight(a, b) for a, b in itertools.pairwise(nodes)))
 
 
 def plan(
@@ -125,9 +128,9 @@ def plan(
         product = dataclasses.replace(product, initial=initial)
     if len(product.initial) == 0 or not working.edges:
         raise why()
-    dist, pred, _ = dijkstra(
-        product.graph, indices=product.initial, min_only=True, return_predecessors=True
-    )
+    # A stay ends the search early: no lasso costs less than its prefix (see module doc).
+    stays = product.stutter_accepting if product.stutter_accepting.any() else None
+    dist, pred = shortest_paths(product.graph, product.initial, goals=stays)
     best: tuple[float, list[int], list[int]] | None = None  # cost, prefix nodes, cycle nodes
     # Stays: an accepting stutter loop.
     stay_nodes = np.flatnonzero(product.stutter_accepting & np.isfinite(dist))
@@ -135,19 +138,20 @@ def plan(
         goal = int(stay_nodes[np.argmin(dist[stay_nodes])])
         best = (float(dist[goal]), _path(pred, goal), [goal])
     # Moving cycles through accepting edges.
-    acc = product.accepting.tocoo()
-    us, vs = acc.row.astype(np.int64), acc.col.astype(np.int64)
-    reachable = np.isfinite(dist[us])
-    us, vs = us[reachable], vs[reachable]
-    best, searches, exhausted = _close_cycles(product, dist, pred, us, vs, best, options.beta)
+    graph = product.graph
+    marked = np.flatnonzero(product.accepting)
+    marked = marked[np.isfinite(dist[graph.sources[marked]])]
+    # In (u, v) order: equal bounds are closed in that order (a stable sort below).
+    marked = marked[np.lexsort((graph.targets[marked], graph.sources[marked]))]
+    best, searches, exhausted = _close_cycles(product, dist, pred, marked, best, options.beta)
     if best is None and not exhausted:
         # The cap stopped the search before any cycle closed.  Only edges inside one strongly
         # connected component close; keeping those, the first search succeeds, so the cap
         # never hides the existence of a lasso (computed only here: it costs a graph pass).
-        _, scc = connected_components(product.graph, directed=True, connection="strong")
-        closable = scc[us] == scc[vs]
+        scc = strongly_connected(graph)
+        closable = scc[graph.sources[marked]] == scc[graph.targets[marked]]
         best, more, exhausted = _close_cycles(
-            product, dist, pred, us[closable], vs[closable], None, options.beta
+            product, dist, pred, marked[closable], None, options.beta
         )
         searches += more
     if best is None:
@@ -162,20 +166,22 @@ def _close_cycles(
     product: Product,
     dist: FloatArray,
     pred: IntArray,
-    us: IntArray,
-    vs: IntArray,
+    marked: IntArray,
     best: tuple[float, list[int], list[int]] | None,
     beta: float,
 ) -> tuple[tuple[float, list[int], list[int]] | None, int, bool]:
-    """Close accepting edges ``u -> v`` in order of their lower bound (see the module doc).
+    """Close the accepting edges ``u -> v`` (indices ``marked`` of the product's edges) in
+    order of their lower bound (see the module doc).
 
     Returns the best lasso (or the incumbent ``best``), the searches made, and whether the
     candidates were exhausted (False when :data:`MAX_CYCLE_SEARCHES` cut the search).
     """
     searches = 0
-    if not len(us):
+    if not len(marked):
         return best, searches, True
-    edge_w = np.asarray(product.graph[us, vs]).ravel()
+    us = product.graph.sources[marked]
+    vs = product.graph.targets[marked]
+    edge_w = product.graph.weights[marked]
     bound = dist[us] + beta * edge_w
     order = np.argsort(bound, kind="stable")
     for index in order.tolist():
@@ -187,7 +193,7 @@ def _close_cycles(
             return best, searches, False
         searches += 1
         limit = np.inf if best is None else (best[0] - bound[index]) / max(beta, 1e-12)
-        back, back_pred = dijkstra(product.graph, indices=v, return_predecessors=True, limit=limit)
+        back, back_pred = shortest_paths(product.graph, np.array([v], dtype=np.int64), limit=limit)
         if not np.isfinite(back[u]):
             continue
         total = float(dist[u] + beta * (edge_w[index] + back[u]))

@@ -20,16 +20,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import numpy.typing as npt
-from scipy.sparse import csr_matrix
 
 from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
 from tlmpc.automata.guards import successor_table
 from tlmpc.automata.model import Automaton
 from tlmpc.planning.boundary import POINT, StartCell, crossing_letter, start_cells
+from tlmpc.planning.search import Graph
 
 SLOTS = 4  # three edges, and "no entry edge yet" for the start
 START_SLOT = 3
-#: Weight of a stutter step: Dijkstra on scipy ignores zero weights, and stutter is free.
+#: Weight of a stutter step: the searches need positive weights, and stutter is free.
 STUTTER_COST = 1e-9
 
 BoolArray = npt.NDArray[np.bool_]
@@ -37,10 +37,10 @@ BoolArray = npt.NDArray[np.bool_]
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Product:
-    """The product graph as CSR plus what the witness extraction needs."""
+    """The product graph plus what the witness extraction needs."""
 
-    graph: csr_matrix = field(compare=False)  # weights
-    accepting: csr_matrix = field(compare=False)  # 1 where the edge carries the mark
+    graph: Graph = field(compare=False)  # weights
+    accepting: BoolArray = field(compare=False)  # per edge of ``graph``: carries the mark
     stutter_accepting: BoolArray = field(compare=False)  # node whose stutter loop accepts
     initial: IntArray = field(compare=False)
     num_automaton_states: int
@@ -218,12 +218,9 @@ def build_product(
         src = dst = np.zeros(0, dtype=np.int64)
         wgt = np.zeros(0)
         acc = np.zeros(0, dtype=bool)
-    graph = csr_matrix((wgt, (src, dst)), shape=(size, size))
-    graph.sort_indices()  # canonical order: the searches break ties as they always did
-    accepting_graph = csr_matrix(
-        (np.ones(int(acc.sum())), (src[acc], dst[acc])), shape=(size, size)
-    )
-    accepting_graph.sort_indices()
+    graph, position = Graph.from_edges(src, dst, wgt, size)
+    accepting_edges = np.empty(len(acc), dtype=bool)
+    accepting_edges[position] = acc
     # Initial nodes: each start triangle after reading (the start point's letter, under the
     # closed convention, then) its own label.
     first = [automaton.initial]
@@ -240,7 +237,7 @@ def build_product(
     initial = np.array(sorted(initial_nodes), dtype=np.int64)
     return Product(
         graph=graph,
-        accepting=accepting_graph,
+        accepting=accepting_edges,
         stutter_accepting=stutter_accepting,
         initial=initial,
         num_automaton_states=nq,

@@ -1,0 +1,220 @@
+"""Shortest paths on the product graph, with numpy alone (no graph library to import).
+
+The graph is a CSR arrangement of its edges (:class:`Graph`).  :func:`shortest_paths` is a
+label-correcting search processed in distance buckets (delta-stepping): each round relaxes,
+all at once, every edge out of the queued nodes whose tentative distance lies in the lowest
+bucket.  The distances it returns are those of Dijkstra's algorithm bit for bit: both are the
+unique solution of ``d(v) = min over edges u -> v of fl(d(u) + w)`` with ``d = 0`` at the
+sources, since every weight is positive and floating-point addition is monotone (a second
+solution would differ first at some node, whose minimising edge comes from a node where
+both agree).
+
+**Tie-break.**  Among the edges ``u -> v`` that attain ``d(v)``, the predecessor of ``v`` is
+the one with the smallest ``d(u)``, then the smallest node index ``u``.  A Dijkstra search
+that keeps the first predecessor attaining the minimum (as scipy's does) agrees with this
+wherever those smallest ``d(u)`` are unique; it orders equal ``d(u)`` by its heap instead.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+FloatArray = npt.NDArray[np.float64]
+IntArray = npt.NDArray[np.int64]
+BoolArray = npt.NDArray[np.bool_]
+
+#: Bucket width as a multiple of the mean edge weight: wide enough to relax many nodes per
+#: round, narrow enough that few are relaxed again.
+BUCKET_WIDTH = 1.0
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Graph:
+    """A weighted directed graph with its edges grouped by source (CSR).
+
+    ``indptr[u]:indptr[u + 1]`` are the edges out of ``u``; ``sources``, ``targets`` and
+    ``weights`` give each edge's ends and weight (all weights positive).
+    """
+
+    indptr: IntArray
+    sources: IntArray
+    targets: IntArray
+    weights: FloatArray
+    num_nodes: int
+
+    @property
+    def nnz(self) -> int:
+        """Number of edges."""
+        return len(self.targets)
+
+    @staticmethod
+    def from_edges(
+        sources: IntArray, targets: IntArray, weights: FloatArray, num_nodes: int
+    ) -> tuple[Graph, IntArray]:
+        """The graph of these edges, and where each input edge went (its edge index)."""
+        order = np.argsort(sources, kind="stable")
+        counts = np.bincount(sources, minlength=num_nodes)
+        indptr = np.zeros(num_nodes + 1, dtype=np.int64)
+        np.cumsum(counts, out=indptr[1:])
+        position = np.empty(len(order), dtype=np.int64)
+        position[order] = np.arange(len(order), dtype=np.int64)
+        graph = Graph(
+            indptr=indptr,
+            sources=sources[order],
+            targets=targets[order],
+            weights=weights[order],
+            num_nodes=num_nodes,
+        )
+        return graph, position
+
+    def weight(self, source: int, target: int) -> float:
+        """The weight of the edge ``source -> target`` (KeyError when there is none)."""
+        lo, hi = int(self.indptr[source]), int(self.indptr[source + 1])
+        hits = np.flatnonzero(self.targets[lo:hi] == target)
+        if not len(hits):
+            raise KeyError((source, target))
+        return float(self.weights[lo + int(hits[0])])
+
+
+def _out_edges(graph: Graph, nodes: IntArray) -> IntArray:
+    """Indices of every edge out of ``nodes``."""
+    starts = graph.indptr[nodes]
+    counts = graph.indptr[nodes + 1] - starts
+    total = int(counts.sum())
+    if total == 0:
+        return np.zeros(0, dtype=np.int64)
+    # Edge k of the run of node j is starts[j] + k: one arange shifted per run.
+    shift = np.repeat(starts - (np.cumsum(counts) - counts), counts)
+    return shift + np.arange(total, dtype=np.int64)
+
+
+def shortest_paths(
+    graph: Graph,
+    sources: IntArray,
+    *,
+    limit: float = np.inf,
+    goals: BoolArray | None = None,
+) -> tuple[FloatArray, IntArray]:
+    """Distances from the nearest of ``sources`` and predecessors (-1 at sources and at
+    unreached nodes), over paths of length at most ``limit`` (farther nodes stay at inf).
+
+    With ``goals``, the search ends once the nearest goal node is known: every node up to
+    that goal's distance is exact (ties included), every farther one is left at inf.
+    See the module doc for the tie-break among equal predecessors.
+    """
+    n = graph.num_nodes
+    dist = np.full(n, np.inf)
+    pred = np.full(n, -1, dtype=np.int64)
+    via = np.full(n, np.inf)  # d(pred[v]): the tie-break's first key
+    queued = np.zeros(n, dtype=bool)
+    frontier = np.unique(np.asarray(sources, dtype=np.int64))
+    dist[frontier] = 0.0
+    queued[frontier] = True
+    nearest_goal = np.inf
+    if goals is not None and len(frontier) and goals[frontier].any():
+        nearest_goal = 0.0
+    width = BUCKET_WIDTH * float(graph.weights.mean()) if graph.nnz else 1.0
+    while len(frontier):
+        current = dist[frontier]
+        lowest = float(current.min())
+        if lowest > nearest_goal:
+            break  # every node at most nearest_goal away is final
+        take = current <= lowest + width
+        active, frontier = frontier[take], frontier[~take]
+        queued[active] = False
+        edges = _out_edges(graph, active)
+        if not len(edges):
+            continue
+        u = graph.sources[edges]
+        v = graph.targets[edges]
+        du = dist[u]
+        d = du + graph.weights[edges]
+        # Only offers that can still win (or tie) at v, within the limit.
+        keep = (d <= dist[v]) & (d <= limit)
+        if not keep.all():
+            u, v, du, d = u[keep], v[keep], du[keep], d[keep]
+        if not len(v):
+            continue
+        # The best offer per target: smallest (d, d(u), u).
+        order = np.lexsort((u, du, d, v))
+        v, d, du, u = v[order], d[order], du[order], u[order]
+        first = np.ones(len(v), dtype=bool)
+        first[1:] = v[1:] != v[:-1]
+        v, d, du, u = v[first], d[first], du[first], u[first]
+        old = dist[v]
+        shorter = d < old
+        better = shorter | ((d == old) & ((du < via[v]) | ((du == via[v]) & (u < pred[v]))))
+        v, d, du, u = v[better], d[better], du[better], u[better]
+        dist[v] = d
+        via[v] = du
+        pred[v] = u
+        improved = v[shorter[better]]
+        if goals is not None and len(improved):
+            hit = goals[improved]
+            if hit.any():
+                nearest_goal = min(nearest_goal, float(d[shorter[better]][hit].min()))
+        fresh = improved[~queued[improved]]
+        queued[fresh] = True
+        frontier = np.concatenate([frontier, fresh])
+    if len(frontier):
+        # Stopped at the nearest goal: what lies beyond is not final.
+        beyond = dist > nearest_goal
+        dist[beyond] = np.inf
+        pred[beyond] = -1
+    return dist, pred
+
+
+def strongly_connected(graph: Graph) -> IntArray:
+    """A strongly connected component label per node (Tarjan's algorithm, iterative).
+
+    Planning needs it only when the cycle-search cap was hit before any cycle closed.
+    """
+    n = graph.num_nodes
+    indptr = graph.indptr.tolist()
+    targets = graph.targets.tolist()
+    index = [-1] * n
+    low = [0] * n
+    on_stack = [False] * n
+    label = [-1] * n
+    stack: list[int] = []
+    counter = 0
+    components = 0
+    for root in range(n):
+        if index[root] >= 0:
+            continue
+        # Each frame: a node and the position of its next edge to look at.
+        frames = [(root, indptr[root])]
+        index[root] = low[root] = counter
+        counter += 1
+        stack.append(root)
+        on_stack[root] = True
+        while frames:
+            node, edge = frames[-1]
+            if edge < indptr[node + 1]:
+                frames[-1] = (node, edge + 1)
+                nxt = targets[edge]
+                if index[nxt] < 0:
+                    index[nxt] = low[nxt] = counter
+                    counter += 1
+                    stack.append(nxt)
+                    on_stack[nxt] = True
+                    frames.append((nxt, indptr[nxt]))
+                elif on_stack[nxt]:
+                    low[node] = min(low[node], index[nxt])
+                continue
+            frames.pop()
+            if frames:
+                parent = frames[-1][0]
+                low[parent] = min(low[parent], low[node])
+            if low[node] == index[node]:
+                while True:
+                    member = stack.pop()
+                    on_stack[member] = False
+                    label[member] = components
+                    if member == node:
+                        break
+                components += 1
+    return np.array(label, dtype=np.int64)
