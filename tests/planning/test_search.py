@@ -236,7 +236,7 @@ def test_plan_is_the_former_scipy_planners(
             return None
 
     ours = run()
-    plan_module = sys.modules["tlmpc.planning.plan"]
+    plan_module: Any = sys.modules["tlmpc.planning.plan"]
     original = plan_module.shortest_paths
     plan_module.shortest_paths = former
     try:
