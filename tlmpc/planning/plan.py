@@ -193,7 +193,11 @@ def _close_cycles(
             return best, searches, False
         searches += 1
         limit = np.inf if best is None else (best[0] - bound[index]) / max(beta, 1e-12)
-        back, back_pred = shortest_paths(product.graph, np.array([v], dtype=np.int64), limit=limit)
+        target = np.zeros(product.graph.num_nodes, dtype=bool)
+        target[u] = True  # only the way back to u matters: end the search there
+        back, back_pred = shortest_paths(
+            product.graph, np.array([v], dtype=np.int64), limit=limit, goals=target
+        )
         if not np.isfinite(back[u]):
             continue
         total = float(dist[u] + beta * (edge_w[index] + back[u]))
