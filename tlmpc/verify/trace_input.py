@@ -64,6 +64,29 @@ def _polygon(value: Any, what: str, file: str | None) -> FloatArray:
     return array
 
 
+def _polygons(named: Mapping[str, Any], file: str | None) -> dict[str, FloatArray]:
+    """``_polygon`` of every region, converted in one array when all are well formed (a map
+    of many regions would spend most of its reading here); any doubt: one by one, for the
+    precise error."""
+    values = list(named.values())
+    try:
+        lengths = [len(v) for v in values]
+        flat = np.array([p for v in values for p in v], dtype=np.float64)
+        fine = (
+            all(isinstance(v, list) for v in values)
+            and flat.ndim == 2
+            and flat.shape[1] == 2
+            and min(lengths, default=3) >= 3
+            and bool(np.isfinite(flat).all())
+        )
+    except (TypeError, ValueError):
+        fine = False
+    if not fine:
+        return {str(k): _polygon(v, f"region {k!r}", file) for k, v in named.items()}
+    pieces = np.split(flat, np.cumsum(lengths)[:-1]) if values else []
+    return {str(k): piece for k, piece in zip(named, pieces, strict=True)}
+
+
 def _samples(rows: Any, file: str | None, lines: list[int] | None = None) -> FloatArray:
     try:
         array = np.asarray(rows, dtype=np.float64)
@@ -123,7 +146,7 @@ def from_document(
     regions_doc = document.get("regions")
     if not isinstance(regions_doc, dict):
         raise _fail("V004", "the trace has no `regions`", file)
-    regions = {str(k): _polygon(v, f"region {k!r}", file) for k, v in regions_doc.items()}
+    regions = _polygons(regions_doc, file)
     samples = _samples(document.get("points"), file)
     loop = document.get("loop_start")
     if loop is not None and (
