@@ -133,7 +133,9 @@ def build_product(
             np.asarray(start_point, dtype=np.float64)[None, :],
             mids[t, np.minimum(s, 2)],
         )
-        weight = np.linalg.norm(mids[t, i] - origin, axis=1) + STUTTER_COST
+        step = mids[t, i] - origin
+        # sqrt(dx² + dy²) exactly as numpy's norm computes it, without its temporaries.
+        weight = np.sqrt(step[:, 0] * step[:, 0] + step[:, 1] * step[:, 1]) + STUTTER_COST
     move_src = t * SLOTS + s
     move_dst = n * SLOTS + slot
     # A move's kind: the class of the entered triangle's letter, and under the closed
@@ -214,13 +216,18 @@ def build_product(
         dst = np.concatenate(targets)
         wgt = np.concatenate(weights)
         acc = np.concatenate(accept)
+        # The pieces are copied: free them before the graph makes its sorted copies.
+        sources.clear()
+        targets.clear()
+        weights.clear()
+        accept.clear()
     else:
         src = dst = np.zeros(0, dtype=np.int64)
         wgt = np.zeros(0)
         acc = np.zeros(0, dtype=bool)
-    graph, position = Graph.from_edges(src, dst, wgt, size)
-    accepting_edges = np.empty(len(acc), dtype=bool)
-    accepting_edges[position] = acc
+    graph, order = Graph.from_edges(src, dst, wgt, size)
+    del src, dst, wgt  # the graph holds its own, sorted copies
+    accepting_edges = acc[order]
     # Initial nodes: each start triangle after reading (the start point's letter, under the
     # closed convention, then) its own label.
     first = [automaton.initial]

@@ -54,13 +54,11 @@ class Graph:
     def from_edges(
         sources: IntArray, targets: IntArray, weights: FloatArray, num_nodes: int
     ) -> tuple[Graph, IntArray]:
-        """The graph of these edges, and where each input edge went (its edge index)."""
+        """The graph of these edges, and the order that took the input edges to it (edge k
+        of the graph is input edge ``order[k]``; edges of one source keep their input order)."""
         order = np.argsort(sources, kind="stable")
-        counts = np.bincount(sources, minlength=num_nodes)
         indptr = np.zeros(num_nodes + 1, dtype=np.int64)
-        np.cumsum(counts, out=indptr[1:])
-        position = np.empty(len(order), dtype=np.int64)
-        position[order] = np.arange(len(order), dtype=np.int64)
+        np.cumsum(np.bincount(sources, minlength=num_nodes), out=indptr[1:])
         graph = Graph(
             indptr=indptr,
             sources=sources[order],
@@ -68,7 +66,7 @@ class Graph:
             weights=weights[order],
             num_nodes=num_nodes,
         )
-        return graph, position
+        return graph, order
 
     def weight(self, source: int, target: int) -> float:
         """The weight of the edge ``source -> target`` (KeyError when there is none)."""
