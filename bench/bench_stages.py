@@ -93,12 +93,13 @@ def _environment(tree: Path) -> dict[str, str]:
 
 
 def _run(tree: Path, program: str, *args: str) -> dict[str, Any]:
+    # Not from ROOT: ``-c`` puts the working directory first on sys.path.
     done = subprocess.run(
         [sys.executable, "-c", program, *args],
         capture_output=True,
         text=True,
         env=_environment(tree),
-        cwd=ROOT,
+        cwd=tempfile.gettempdir(),
         check=False,
     )
     if done.returncode != 0:
