@@ -27,7 +27,7 @@ from tlmpc.automata import translate
 from tlmpc.errors import InvalidInputError, NoPlanError
 from tlmpc.mission import load_mission_text
 from tlmpc.planning.plan import plan
-from tlmpc.planning.search import Graph, shortest_paths, strongly_connected
+from tlmpc.planning.search import Graph, closing_searches, shortest_paths, strongly_connected
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
@@ -95,6 +95,8 @@ def _graph(edges: list[tuple[int, int, float]], n: int) -> Graph:
 DIAMOND = _graph([(0, 1, 0.5), (0, 2, 0.5), (1, 3, 0.25), (2, 3, 0.25)], 4)
 # A goal found while a nearer node is still to be searched from.
 BEHIND = _graph([(0, 1, 0.25), (1, 2, 0.25), (0, 3, 0.5)], 4)
+# The target is first offered by a long edge, then by a shorter way through a farther node.
+SHORTCUT = _graph([(0, 3, 1.0), (0, 1, 0.75), (1, 3, 0.1)], 4)
 ZERO = np.array([0], dtype=np.int64)
 
 
@@ -148,6 +150,37 @@ def _check_goal_stop(graph: Graph, sources: IntArray, goals: npt.NDArray[np.bool
     assert np.array_equal(stopped_pred[kept], full_pred[kept])
     assert np.isinf(stopped[~kept]).all()
     assert (stopped_pred[~kept] == -1).all()
+
+
+@given(graphs(), st.data())
+@example((DIAMOND, ZERO), None)
+@example((SHORTCUT, ZERO), None)
+def test_batched_closing_searches_are_single_searches(
+    case: tuple[Graph, IntArray], data: st.DataObject | None
+) -> None:
+    graph, _ = case
+    n = graph.num_nodes
+    if data is None:  # from the source to the sink and back, with and without a limit
+        starts, targets, limits = [0, 3, 0], [3, 0, 3], [np.inf, np.inf, 0.5]
+    else:
+        size = data.draw(st.integers(1, 5))
+        nodes = st.lists(st.integers(0, n - 1), min_size=size, max_size=size)
+        starts, targets = data.draw(nodes), data.draw(nodes)
+        limits = data.draw(
+            st.lists(st.sampled_from([np.inf, 0.3, 1.0]), min_size=size, max_size=size)
+        )
+    distances, paths = closing_searches(
+        graph, np.array(starts), np.array(targets), np.array(limits)
+    )
+    for k, (start, target, limit) in enumerate(zip(starts, targets, limits, strict=True)):
+        goal = np.zeros(n, dtype=bool)
+        goal[target] = True
+        dist, pred = shortest_paths(graph, np.array([start]), limit=limit, goals=goal)
+        assert distances[k] == dist[target] or (np.isinf(distances[k]) and np.isinf(dist[target]))
+        path = [target] if np.isfinite(dist[target]) else []
+        while path and pred[path[-1]] >= 0:
+            path.append(int(pred[path[-1]]))
+        assert paths[k] == path[::-1]
 
 
 @given(graphs())
@@ -223,6 +256,20 @@ def test_plan_is_the_former_scipy_planners(
         tied.append(not np.array_equal(pred, own_pred))
         return dist, pred
 
+    def former_closing(
+        graph: Graph, starts: IntArray, targets: IntArray, limits: FloatArray
+    ) -> tuple[FloatArray, list[list[int]]]:
+        # One scipy search per candidate, as the former planner closed them.
+        distances, paths = [], []
+        for start, target, limit in zip(starts, targets, limits, strict=True):
+            dist, pred = former(graph, np.array([start]), limit=float(limit))
+            distances.append(dist[target])
+            path = [int(target)] if np.isfinite(dist[target]) else []
+            while path and pred[path[-1]] >= 0:
+                path.append(int(pred[path[-1]]))
+            paths.append(path[::-1])
+        return np.array(distances), paths
+
     def run() -> Any:
         try:
             return plan(
@@ -237,12 +284,12 @@ def test_plan_is_the_former_scipy_planners(
 
     ours = run()
     plan_module: Any = sys.modules["tlmpc.planning.plan"]
-    original = plan_module.shortest_paths
-    plan_module.shortest_paths = former
+    originals = plan_module.shortest_paths, plan_module.closing_searches
+    plan_module.shortest_paths, plan_module.closing_searches = former, former_closing
     try:
         theirs = run()
     finally:
-        plan_module.shortest_paths = original
+        plan_module.shortest_paths, plan_module.closing_searches = originals
     assert (ours is None) == (theirs is None)
     if ours is None:
         event("no plan")

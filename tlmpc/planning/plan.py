@@ -33,11 +33,13 @@ from tlmpc.planning.boundary import start_cells, start_point_label
 from tlmpc.planning.explain import explain_no_plan, invariant_mask
 from tlmpc.planning.model import Witness
 from tlmpc.planning.product import SLOTS, START_SLOT, Product, build_product
-from tlmpc.planning.search import shortest_paths, strongly_connected
+from tlmpc.planning.search import closing_searches, shortest_paths, strongly_connected
 
 #: At most this many cycle candidates are closed with a shortest-path search; past it the
 #: witness is the best found and records ``optimal: false``.
 MAX_CYCLE_SEARCHES = 40
+#: Closing searches run together up to this many product nodes in all (their arrays).
+BATCH_NODES = 4_000_000
 
 
 def _path(predecessors: IntArray, target: int) -> list[int]:
@@ -179,30 +181,47 @@ def _close_cycles(
     searches = 0
     if not len(marked):
         return best, searches, True
-    us = product.graph.sources[marked]
-    vs = product.graph.targets[marked]
-    edge_w = product.graph.weights[marked]
+    graph = product.graph
+    us = graph.sources[marked]
+    vs = graph.targets[marked]
+    edge_w = graph.weights[marked]
     bound = dist[us] + beta * edge_w
-    order = np.argsort(bound, kind="stable")
-    for index in order.tolist():
+    order = np.argsort(bound, kind="stable").tolist()
+    # The closing searches run several at a time (they share the search's rounds), each with
+    # the limit the incumbent allows when the batch starts; the candidates are then taken in
+    # order exactly as one search at a time would take them (a distance beyond the limit the
+    # incumbent allows by then counts as unreached, as that search would have left it).
+    batch = max(1, min(MAX_CYCLE_SEARCHES, BATCH_NODES // max(graph.num_nodes, 1)))
+    closed: dict[int, tuple[float, list[int]]] = {}
+    for position, index in enumerate(order):
         if best is not None and bound[index] >= best[0]:
             break
-        v = int(vs[index])
-        u = int(us[index])
         if searches >= MAX_CYCLE_SEARCHES:
             return best, searches, False
+        if index not in closed:
+            chosen: list[int] = []
+            for ahead in order[position:]:
+                if len(chosen) == min(batch, MAX_CYCLE_SEARCHES - searches):
+                    break
+                if best is not None and bound[ahead] >= best[0]:
+                    break
+                chosen.append(ahead)
+            limits = np.array(
+                [
+                    np.inf if best is None else (best[0] - bound[k]) / max(beta, 1e-12)
+                    for k in chosen
+                ]
+            )
+            distances, paths = closing_searches(graph, vs[chosen], us[chosen], limits)
+            closed = {k: (float(distances[j]), paths[j]) for j, k in enumerate(chosen)}
         searches += 1
         limit = np.inf if best is None else (best[0] - bound[index]) / max(beta, 1e-12)
-        target = np.zeros(product.graph.num_nodes, dtype=bool)
-        target[u] = True  # only the way back to u matters: end the search there
-        back, back_pred = shortest_paths(
-            product.graph, np.array([v], dtype=np.int64), limit=limit, goals=target
-        )
-        if not np.isfinite(back[u]):
-            continue
-        total = float(dist[u] + beta * (edge_w[index] + back[u]))
+        back, back_path = closed[index]  # back_path: v, ..., u
+        if not (np.isfinite(back) and back <= limit):
+            continue  # unreached, or farther than a search from here on would look
+        u = int(us[index])
+        total = float(dist[u] + beta * (edge_w[index] + back))
         if best is None or total < best[0] - 1e-12:
-            back_path = _path(back_pred, u)  # v, ..., u
             best = (total, _path(pred, u), [u, *back_path[:-1]])
     return best, searches, True
 

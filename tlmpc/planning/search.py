@@ -89,6 +89,28 @@ def _out_edges(graph: Graph, nodes: IntArray) -> IntArray:
     return shift + np.arange(total, dtype=np.int64)
 
 
+def _best_offers(
+    v: IntArray, d: FloatArray, du: FloatArray, u: IntArray
+) -> tuple[IntArray, FloatArray, FloatArray, IntArray]:
+    """One offer per target ``v``: the smallest (d, d(u), u) among its offers."""
+    order = np.argsort(v, kind="stable")
+    v, d, du, u = v[order], d[order], du[order], u[order]
+    same = v[1:] == v[:-1]
+    if not same.any():
+        return v, d, du, u
+    # Targets with several offers: order just those lexicographically, keep each first.
+    shared = np.zeros(len(v), dtype=bool)
+    shared[1:] |= same
+    shared[:-1] |= same
+    rivals = np.flatnonzero(shared)
+    rivals = rivals[np.lexsort((u[rivals], du[rivals], d[rivals], v[rivals]))]
+    head = np.ones(len(rivals), dtype=bool)
+    head[1:] = v[rivals[1:]] != v[rivals[:-1]]
+    keep = ~shared
+    keep[rivals[head]] = True
+    return v[keep], d[keep], du[keep], u[keep]
+
+
 def shortest_paths(
     graph: Graph,
     sources: IntArray,
@@ -136,12 +158,7 @@ def shortest_paths(
             u, v, du, d = u[keep], v[keep], du[keep], d[keep]
         if not len(v):
             continue
-        # The best offer per target: smallest (d, d(u), u).
-        order = np.lexsort((u, du, d, v))
-        v, d, du, u = v[order], d[order], du[order], u[order]
-        first = np.ones(len(v), dtype=bool)
-        first[1:] = v[1:] != v[:-1]
-        v, d, du, u = v[first], d[first], du[first], u[first]
+        v, d, du, u = _best_offers(v, d, du, u)
         old = dist[v]
         shorter = d < old
         better = shorter | ((d == old) & ((du < via[v]) | ((du == via[v]) & (u < pred[v]))))
@@ -216,3 +233,88 @@ def strongly_connected(graph: Graph) -> IntArray:
                         break
                 components += 1
     return np.array(label, dtype=np.int64)
+
+
+def closing_searches(
+    graph: Graph, starts: IntArray, targets: IntArray, limits: FloatArray
+) -> tuple[FloatArray, list[list[int]]]:
+    """Several searches at once: from ``starts[k]`` to ``targets[k]`` within ``limits[k]``.
+
+    Returns each target's distance (inf when farther than its limit) and the path to it
+    (empty when unreached), exactly what :func:`shortest_paths` from ``starts[k]`` with the
+    goal ``targets[k]`` and that limit gives: the searches share the rounds (a round costs
+    about the same for one search as for ten), each in its own copy of the node numbers.
+    """
+    n = graph.num_nodes
+    count = len(starts)
+    total = n * count
+    dist = np.full(total, np.inf)
+    pred = np.full(total, -1, dtype=np.int64)
+    via = np.full(total, np.inf)
+    queued = np.zeros(total, dtype=bool)
+    base = np.arange(count, dtype=np.int64) * n
+    goal = base + np.asarray(targets, dtype=np.int64)
+    limit = np.asarray(limits, dtype=np.float64)
+    nearest = np.full(count, np.inf)  # per search: the distance of its target, once known
+    frontier = base + np.asarray(starts, dtype=np.int64)
+    dist[frontier] = 0.0
+    queued[frontier] = True
+    nearest[goal == frontier] = 0.0
+    is_goal = np.zeros(total, dtype=bool)
+    is_goal[goal] = True
+    width = BUCKET_WIDTH * float(graph.weights.mean()) if graph.nnz else 1.0
+    while len(frontier):
+        current = dist[frontier]
+        # A search whose target is known needs nothing beyond it.
+        alive = current <= nearest[frontier // n]
+        if not alive.all():
+            queued[frontier[~alive]] = False
+            frontier, current = frontier[alive], current[alive]
+            if not len(frontier):
+                break
+        take = current <= float(current.min()) + width
+        active, frontier = frontier[take], frontier[~take]
+        queued[active] = False
+        local = active % n
+        offset = active - local
+        edges = _out_edges(graph, local)
+        if not len(edges):
+            continue
+        counts = graph.indptr[local + 1] - graph.indptr[local]
+        u = np.repeat(active, counts)
+        v = graph.targets[edges] + np.repeat(offset, counts)
+        du = dist[u]
+        d = du + graph.weights[edges]
+        keep = (d <= dist[v]) & (d <= limit[v // n])
+        if not keep.all():
+            u, v, du, d = u[keep], v[keep], du[keep], d[keep]
+        if not len(v):
+            continue
+        v, d, du, u = _best_offers(v, d, du, u)
+        old = dist[v]
+        shorter = d < old
+        better = shorter | ((d == old) & ((du < via[v]) | ((du == via[v]) & (u < pred[v]))))
+        v, d, du, u = v[better], d[better], du[better], u[better]
+        dist[v] = d
+        via[v] = du
+        pred[v] = u
+        improved = v[shorter[better]]
+        reached = improved[is_goal[improved]]
+        if len(reached):
+            searches = reached // n
+            nearest[searches] = np.minimum(nearest[searches], dist[reached])
+        fresh = improved[~queued[improved]]
+        queued[fresh] = True
+        frontier = np.concatenate([frontier, fresh])
+    distances = dist[goal]
+    paths: list[list[int]] = []
+    for k in range(count):
+        if not np.isfinite(distances[k]):
+            paths.append([])
+            continue
+        path = [int(goal[k])]
+        while pred[path[-1]] >= 0:
+            path.append(int(pred[path[-1]]))
+        path.reverse()
+        paths.append([node - int(base[k]) for node in path])
+    return distances, paths
