@@ -5,9 +5,10 @@ label-correcting search processed in distance buckets (delta-stepping): each rou
 all at once, every edge out of the queued nodes whose tentative distance lies in the lowest
 bucket.  The distances it returns are those of Dijkstra's algorithm bit for bit: both are the
 unique solution of ``d(v) = min over edges u -> v of fl(d(u) + w)`` with ``d = 0`` at the
-sources, since every weight is positive and floating-point addition is monotone (a second
-solution would differ first at some node, whose minimising edge comes from a node where
-both agree).
+sources, since floating-point addition is monotone and every weight is positive and large
+enough not to vanish in the sum (the smallest, 1e-9, would only at distances beyond 1e7):
+a second solution would differ first at some node, whose minimising edge comes from a node
+where both agree.  :func:`closing_searches` runs several such searches at once.
 
 **Tie-break.**  Among the edges ``u -> v`` that attain ``d(v)``, the predecessor of ``v`` is
 the one with the smallest ``d(u)``, then the smallest node index ``u``.  A Dijkstra search
