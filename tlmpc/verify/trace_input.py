@@ -6,6 +6,7 @@ traces) and shared error types are used.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -83,7 +84,9 @@ def _polygons(named: Mapping[str, Any], file: str | None) -> dict[str, FloatArra
         fine = False
     if not fine:
         return {str(k): _polygon(v, f"region {k!r}", file) for k, v in named.items()}
-    pieces = np.split(flat, np.cumsum(lengths)[:-1]) if values else []
+    # Plain slices (np.split costs microseconds per piece).
+    bounds = [0, *itertools.accumulate(lengths)]
+    pieces = [flat[a:b] for a, b in itertools.pairwise(bounds)]
     return {str(k): piece for k, piece in zip(named, pieces, strict=True)}
 
 
