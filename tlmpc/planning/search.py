@@ -112,6 +112,36 @@ def _best_offers(
     return v[keep], d[keep], du[keep], u[keep]
 
 
+def _take_offers(
+    dist: FloatArray,
+    via: FloatArray,
+    pred: IntArray,
+    v: IntArray,
+    d: FloatArray,
+    du: FloatArray,
+    u: IntArray,
+) -> IntArray:
+    """Record the offers (one per target) that beat what ``v`` has: a shorter distance, or
+    the same one from a nearer node, or from an equally near one of smaller index.  Returns
+    the targets whose distance got shorter (they must be searched from again)."""
+    old = dist[v]
+    shorter = d < old
+    better = shorter | ((d == old) & ((du < via[v]) | ((du == via[v]) & (u < pred[v]))))
+    v = v[better]
+    dist[v] = d[better]
+    via[v] = du[better]
+    pred[v] = u[better]
+    improved: IntArray = v[shorter[better]]
+    return improved
+
+
+def _enqueue(frontier: IntArray, improved: IntArray, queued: BoolArray) -> IntArray:
+    """The frontier with the improved nodes not already in it."""
+    fresh = improved[~queued[improved]]
+    queued[fresh] = True
+    return np.concatenate([frontier, fresh])
+
+
 def shortest_paths(
     graph: Graph,
     sources: IntArray,
@@ -160,21 +190,12 @@ def shortest_paths(
         if not len(v):
             continue
         v, d, du, u = _best_offers(v, d, du, u)
-        old = dist[v]
-        shorter = d < old
-        better = shorter | ((d == old) & ((du < via[v]) | ((du == via[v]) & (u < pred[v]))))
-        v, d, du, u = v[better], d[better], du[better], u[better]
-        dist[v] = d
-        via[v] = du
-        pred[v] = u
-        improved = v[shorter[better]]
+        improved = _take_offers(dist, via, pred, v, d, du, u)
         if goals is not None and len(improved):
             hit = goals[improved]
             if hit.any():
-                nearest_goal = min(nearest_goal, float(d[shorter[better]][hit].min()))
-        fresh = improved[~queued[improved]]
-        queued[fresh] = True
-        frontier = np.concatenate([frontier, fresh])
+                nearest_goal = min(nearest_goal, float(dist[improved[hit]].min()))
+        frontier = _enqueue(frontier, improved, queued)
     if len(frontier):
         # Stopped at the nearest goal: what lies beyond is not final.
         beyond = dist > nearest_goal
@@ -292,21 +313,12 @@ def closing_searches(
         if not len(v):
             continue
         v, d, du, u = _best_offers(v, d, du, u)
-        old = dist[v]
-        shorter = d < old
-        better = shorter | ((d == old) & ((du < via[v]) | ((du == via[v]) & (u < pred[v]))))
-        v, d, du, u = v[better], d[better], du[better], u[better]
-        dist[v] = d
-        via[v] = du
-        pred[v] = u
-        improved = v[shorter[better]]
+        improved = _take_offers(dist, via, pred, v, d, du, u)
         reached = improved[is_goal[improved]]
         if len(reached):
             searches = reached // n
             nearest[searches] = np.minimum(nearest[searches], dist[reached])
-        fresh = improved[~queued[improved]]
-        queued[fresh] = True
-        frontier = np.concatenate([frontier, fresh])
+        frontier = _enqueue(frontier, improved, queued)
     distances = dist[goal]
     paths: list[list[int]] = []
     for k in range(count):
