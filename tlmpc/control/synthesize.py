@@ -19,10 +19,8 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
-import scipy.sparse as sp
 
 from tlmpc.abstraction.model import Abstraction, FloatArray
 from tlmpc.control.geometry import (
@@ -33,6 +31,7 @@ from tlmpc.control.geometry import (
     triangle_geometry,
 )
 from tlmpc.control.model import Controllers, StepController, VelocityJump
+from tlmpc.control.sparse import CscMatrix, Triplets, stacked_csc
 from tlmpc.errors import InvalidInputError, SolverError, error
 from tlmpc.mission.model import Robot
 from tlmpc.planning.model import Witness
@@ -249,8 +248,8 @@ class VertexProgram:
     targets), |w_r| <= max_speed, and s_k >= f.
     """
 
-    inequality: sp.csr_matrix
-    equality: sp.csr_matrix | None
+    inequality: Triplets
+    equality: Triplets | None
     runs: int
     steps: int
     max_speed: float
@@ -288,48 +287,70 @@ def vertex_program(
                     eq_vals.append(weights[local])
                 eq_row += 1
     size = 2 * count + n_steps
-    inequality = sp.csr_matrix((vals, (rows, cols)), shape=(row, size))
-    equality = (
-        sp.csr_matrix((eq_vals, (eq_rows, eq_cols)), shape=(eq_row, size)) if eq_row else None
-    )
+    inequality = Triplets.build(rows, cols, vals, (row, size))
+    equality = Triplets.build(eq_rows, eq_cols, eq_vals, (eq_row, size)) if eq_row else None
     program = VertexProgram(inequality, equality, count, n_steps, max_speed, disturbance)
     return program, column
 
 
-def solve_vertex_program(program: VertexProgram) -> tuple[FloatArray, FloatArray]:
-    """Velocities per run (R, 2) and guaranteed speeds per step (N,), by Clarabel.
+@dataclass(frozen=True, slots=True)
+class ConicForm:
+    """Clarabel's form of a vertex program: min costs·x subject to
+    constraints @ x + s = offsets, s in the cones (kind, dimension) in row order."""
 
-    Clarabel's form is min q·x subject to A x + s = b with s in a product of cones; here
-    x = (z, f), and the cones are: zero (stay targets), non-negative (the facet rows and
-    s_k - f), and one three-dimensional second-order cone (max_speed, w_r) per run.
+    constraints: CscMatrix
+    costs: FloatArray
+    offsets: FloatArray
+    cones: tuple[tuple[str, int], ...]
+
+
+def conic_form(program: VertexProgram) -> ConicForm:
+    """The program in Clarabel's form; x = (z, f).
+
+    The cones are: zero (stay targets), non-negative (the facet rows and s_k - f), and one
+    three-dimensional second-order cone (max_speed, w_r) per run.
     """
-    import clarabel
-
     count, n_steps = program.runs, program.steps
     size = 2 * count + n_steps
-    floor_column = sp.csr_matrix(([1.0] * n_steps, (range(n_steps), [0] * n_steps)), (n_steps, 1))
-    speeds = sp.hstack([sp.csr_matrix((n_steps, 2 * count)), -sp.identity(n_steps)])
-    blocks: list[sp.spmatrix] = []
+    blocks: list[tuple[int, Triplets]] = []
     offsets: list[FloatArray] = []
-    cones: list[Any] = []
+    cones: list[tuple[str, int]] = []
+    row = 0
     if program.equality is not None:
-        blocks.append(sp.hstack([program.equality, sp.csr_matrix((program.equality.shape[0], 1))]))
+        blocks.append((row, program.equality))
+        row += program.equality.shape[0]
         offsets.append(np.zeros(program.equality.shape[0]))
-        cones.append(clarabel.ZeroConeT(program.equality.shape[0]))
-    inequality_rows = program.inequality.shape[0]
-    blocks.append(sp.hstack([-program.inequality, sp.csr_matrix((inequality_rows, 1))]))
-    blocks.append(sp.hstack([speeds, floor_column]))
+        cones.append(("zero", program.equality.shape[0]))
+    inequality = program.inequality
+    negated = Triplets(inequality.rows, inequality.cols, -inequality.values, inequality.shape)
+    blocks.append((row, negated))
+    inequality_rows = inequality.shape[0]
+    row += inequality_rows
+    # s_k - f >= 0: -1 at s_k, +1 at f (column size).
+    steps = np.arange(n_steps, dtype=np.int64)
+    speeds = Triplets.build(
+        np.repeat(steps, 2),
+        np.stack([2 * count + steps, np.full(n_steps, size)], axis=1),
+        np.tile([-1.0, 1.0], n_steps),
+        (n_steps, size + 1),
+    )
+    blocks.append((row, speeds))
+    row += n_steps
     # Robust rows: a·w >= c·s + disturbance, i.e. a·(w + δ) >= c·s for every |δ| <= it.
     spare = program.disturbance / program.max_speed
     offsets.append(np.concatenate([np.full(inequality_rows, -spare), np.zeros(n_steps)]))
-    cones.append(clarabel.NonnegativeConeT(inequality_rows + n_steps))
+    cones.append(("nonnegative", inequality_rows + n_steps))
     # (max_speed, w_r) in the cone: rows (0; -e_2r; -e_2r+1), offsets (max_speed; 0; 0).
-    soc_rows = np.arange(3 * count).reshape(count, 3)[:, 1:].ravel()
+    soc_rows = np.arange(3 * count, dtype=np.int64).reshape(count, 3)[:, 1:].ravel()
     blocks.append(
-        sp.csr_matrix(
-            (-np.ones(2 * count), (soc_rows, np.arange(2 * count))), shape=(3 * count, size + 1)
+        (
+            row,
+            Triplets.build(
+                soc_rows, np.arange(2 * count), -np.ones(2 * count), (3 * count, size + 1)
+            ),
         )
     )
+    row += 3 * count
     cone_offsets = np.zeros(3 * count)
     # Solved at unit speed and scaled back below: the solver's absolute tolerances (1e-8) are
     # then relative to max_speed, whatever its magnitude (at 1e-9 m/s they would swamp it).
@@ -338,18 +359,40 @@ def solve_vertex_program(program: VertexProgram) -> tuple[FloatArray, FloatArray
     # solve inside a disc smaller than the solver's tolerance instead.
     cone_offsets[::3] = 1.0 if program.disturbance == 0.0 else 1.0 - 1e-7
     offsets.append(cone_offsets)
-    cones += [clarabel.SecondOrderConeT(3)] * count
-    constraints = sp.vstack(blocks, format="csc")
+    cones += [("second-order", 3)] * count
     costs = np.zeros(size + 1)
     costs[2 * count : size] = -0.1 / n_steps
     costs[size] = -1.0
+    return ConicForm(
+        constraints=stacked_csc(blocks, (row, size + 1)),
+        costs=costs,
+        offsets=np.concatenate(offsets),
+        cones=tuple(cones),
+    )
+
+
+def solve_vertex_program(program: VertexProgram) -> tuple[FloatArray, FloatArray]:
+    """Velocities per run (R, 2) and guaranteed speeds per step (N,), by Clarabel
+    (the program in :func:`conic_form`)."""
+    import clarabel
+
+    count, n_steps = program.runs, program.steps
+    size = 2 * count + n_steps
+    form = conic_form(program)
+    kinds = {
+        "zero": clarabel.ZeroConeT,
+        "nonnegative": clarabel.NonnegativeConeT,
+        "second-order": clarabel.SecondOrderConeT,
+    }
+    cones = [kinds[kind](dim) for kind, dim in form.cones]
     settings = clarabel.DefaultSettings()
     settings.verbose = False
+    empty = np.zeros(0, dtype=np.int64)
     solver = clarabel.DefaultSolver(
-        sp.csc_matrix((size + 1, size + 1)),
-        costs,
-        constraints,
-        np.concatenate(offsets),
+        CscMatrix(np.zeros(0), empty, np.zeros(size + 2, dtype=np.int64), (size + 1, size + 1)),
+        form.costs,
+        form.constraints,
+        form.offsets,
         cones,
         settings,
     )

@@ -58,16 +58,23 @@ def start_point_label(abstraction: Abstraction, point: tuple[float, float]) -> t
     by its rule (within 1e-12 of the largest of the point's and the regions' coordinates)."""
     if not abstraction.regions:
         return ()
-    extent = max(
-        float(np.abs(np.asarray(p, dtype=np.float64)).max()) for p in abstraction.regions.values()
-    )
+    names = list(abstraction.regions)
+    corners = [np.asarray(abstraction.regions[name], dtype=np.float64) for name in names]
+    low = np.array([c.min(axis=0) for c in corners])
+    high = np.array([c.max(axis=0) for c in corners])
+    extent = float(np.maximum(np.abs(low), np.abs(high)).max())
     reach = 1e-12 * max(abs(float(point[0])), abs(float(point[1])), extent)
+    # Only regions whose bounding box comes within reach can: a cheap filter before shapely
+    # (twice the reach, which is far above the rounding of these sums).
+    where = np.asarray(point, dtype=np.float64)
+    slack = 2.0 * reach
+    near = np.flatnonzero(((low - slack <= where) & (where <= high + slack)).all(axis=1))
     probe = shapely.Point(point)
     return tuple(
         sorted(
-            name
-            for name, polygon in abstraction.regions.items()
-            if shapely.dwithin(shapely.Polygon(polygon), probe, reach)
+            names[k]
+            for k in near.tolist()
+            if shapely.dwithin(shapely.Polygon(corners[k]), probe, reach)
         )
     )
 

@@ -8,8 +8,6 @@ from typing import Any
 
 import numpy as np
 import numpy.typing as npt
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import breadth_first_order
 
 from tlmpc.abstraction.model import Abstraction
 from tlmpc.automata.guards import holds
@@ -56,15 +54,18 @@ def _reachable(
     abstraction: Abstraction, allowed: BoolArray, sources: Sequence[int] | None = None
 ) -> BoolArray:
     m = abstraction.num_triangles
-    rows = np.repeat(np.arange(m), 3)
-    cols = abstraction.neighbors.reshape(-1)
-    keep = (cols >= 0) & allowed[rows] & allowed[np.maximum(cols, 0)]
-    graph = coo_matrix((np.ones(int(keep.sum())), (rows[keep], cols[keep])), shape=(m, m))
+    neighbors = abstraction.neighbors
     seen = np.zeros(m, dtype=bool)
-    csr = graph.tocsr()
-    for source in [abstraction.start] if sources is None else sources:
-        if allowed[source] and not seen[source]:
-            seen[breadth_first_order(csr, source, return_predecessors=False)] = True
+    start = np.array([abstraction.start] if sources is None else list(sources), dtype=np.int64)
+    frontier = np.unique(start[allowed[start]]) if len(start) else start
+    seen[frontier] = True
+    # Breadth-first, one layer of triangles per round, through edges between allowed ones.
+    while len(frontier):
+        ahead = neighbors[frontier].reshape(-1)
+        ahead = ahead[ahead >= 0]
+        ahead = np.unique(ahead[allowed[ahead] & ~seen[ahead]])
+        seen[ahead] = True
+        frontier = ahead
     return seen
 
 

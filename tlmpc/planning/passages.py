@@ -28,7 +28,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-from scipy.sparse import csr_matrix
 
 from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
 from tlmpc.automata.guards import successor_table
@@ -36,6 +35,7 @@ from tlmpc.automata.model import Automaton
 from tlmpc.planning.boundary import POINT, StartCell, crossing_letter
 from tlmpc.planning.model import Witness
 from tlmpc.planning.product import SLOTS, START_SLOT, STUTTER_COST, BoolArray, Product
+from tlmpc.planning.search import Graph
 
 Letter = tuple[str, ...]
 
@@ -347,37 +347,21 @@ def add_vertex_passages(
                 costs.append(np.full(len(stays), STUTTER_COST))
                 marks.append(np.full(len(stays), accepting))
 
-    old = product.graph.tocoo()
-    old_acc = product.accepting.tocoo()
+    old = product.graph
     new_src = np.concatenate(sources) if sources else np.zeros(0, dtype=np.int64)
     new_dst = np.concatenate(targets) if targets else np.zeros(0, dtype=np.int64)
     new_cost = np.concatenate(costs) if costs else np.zeros(0)
     new_mark = np.concatenate(marks) if marks else np.zeros(0, dtype=bool)
-    graph = csr_matrix(
-        (
-            np.concatenate([old.data, new_cost]),
-            (
-                np.concatenate([old.row.astype(np.int64), new_src]),
-                np.concatenate([old.col.astype(np.int64), new_dst]),
-            ),
-        ),
-        shape=(size, size),
+    # Stable by source: every node's ordinary edges keep their order, passages come after.
+    graph, order = Graph.from_edges(
+        np.concatenate([old.sources, new_src]),
+        np.concatenate([old.targets, new_dst]),
+        np.concatenate([old.weights, new_cost]),
+        size,
     )
-    graph.sort_indices()
-    accepting = csr_matrix(
-        (
-            np.ones(len(old_acc.row) + int(new_mark.sum())),
-            (
-                np.concatenate([old_acc.row.astype(np.int64), new_src[new_mark]]),
-                np.concatenate([old_acc.col.astype(np.int64), new_dst[new_mark]]),
-            ),
-        ),
-        shape=(size, size),
-    )
-    accepting.data[:] = 1.0
-    accepting.sort_indices()
+    accepting_edges = np.concatenate([product.accepting, new_mark])[order]
     extended = replace(
-        product, graph=graph, accepting=accepting, stutter_accepting=stutter, num_nodes=size
+        product, graph=graph, accepting=accepting_edges, stutter_accepting=stutter, num_nodes=size
     )
     return extended, cells_info
 

@@ -5,10 +5,13 @@ degeneralized first, so every search below handles one set (see docs/planning.md
 optimality statement).  Two kinds of cycles are considered:
 
 * a *stay*: the robot converges inside one triangle whose stutter loop is accepting (cost 0);
-* a *moving cycle* through an accepting product edge ``u -> v``: one Dijkstra from the
-  initial nodes gives every prefix cost d0(u); candidates are taken in increasing order of the
-  lower bound d0(u) + beta * w(u, v), each closed by a Dijkstra from v back to u, and the
-  search stops when the bound reaches the best lasso found.
+* a *moving cycle* through an accepting product edge ``u -> v``: one shortest-path search
+  from the initial nodes gives every prefix cost d0(u); candidates are taken in increasing
+  order of the lower bound d0(u) + beta * w(u, v), each closed by a search from v back to u,
+  and the search stops when the bound reaches the best lasso found.
+
+The searches are :func:`tlmpc.planning.search.shortest_paths` (its tie-break among equal
+paths is stated there).
 """
 
 from __future__ import annotations
@@ -19,7 +22,6 @@ import time
 from typing import Any
 
 import numpy as np
-from scipy.sparse.csgraph import connected_components, dijkstra
 
 from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
 from tlmpc.automata.degeneralize import degeneralize
@@ -32,10 +34,13 @@ from tlmpc.planning.explain import explain_no_plan, invariant_mask
 from tlmpc.planning.model import Witness
 from tlmpc.planning.passages import PassageCells, add_vertex_passages
 from tlmpc.planning.product import SLOTS, START_SLOT, Product, build_product
+from tlmpc.planning.search import closing_searches, shortest_paths, strongly_connected
 
-#: At most this many cycle candidates are closed with a Dijkstra search; past it the
+#: At most this many cycle candidates are closed with a shortest-path search; past it the
 #: witness is the best found and records ``optimal: false``.
 MAX_CYCLE_SEARCHES = 40
+#: Closing searches run together up to this many product nodes in all (their arrays).
+BATCH_NODES = 4_000_000
 
 
 def _path(predecessors: IntArray, target: int) -> list[int]:
@@ -76,7 +81,7 @@ def _collapse(
 
 def _path_cost(product: Product, nodes: list[int]) -> float:
     graph = product.graph
-    return float(sum(graph[a, b] for a, b in itertools.pairwise(nodes)))
+    return float(sum(graph.weight(a, b) for a, b in itertools.pairwise(nodes)))
 
 
 def plan(
@@ -106,7 +111,9 @@ def plan(
         x, y = abstraction.corners(abstraction.start).mean(axis=0).tolist()
         start_point = (float(x), float(y))
     starts = start_cells(abstraction, start_point)
-    start_label = start_point_label(abstraction, start_point)
+    # Only the closed convention reads the start point's own letter.
+    closed = options.boundary == "closed"
+    start_label = start_point_label(abstraction, start_point) if closed else ()
     product = build_product(
         abstraction,
         working,
@@ -140,7 +147,7 @@ def plan(
                 formula,
                 allowed,
                 starts=starts,
-                start_label=start_label if options.boundary == "closed" else None,
+                start_label=start_label if closed else None,
             )
         )
 
@@ -152,9 +159,9 @@ def plan(
         product = dataclasses.replace(product, initial=initial)
     if len(product.initial) == 0 or not working.edges:
         raise why()
-    dist, pred, _ = dijkstra(
-        product.graph, indices=product.initial, min_only=True, return_predecessors=True
-    )
+    # A stay ends the search early: no lasso costs less than its prefix (see module doc).
+    stays = product.stutter_accepting if product.stutter_accepting.any() else None
+    dist, pred = shortest_paths(product.graph, product.initial, goals=stays)
     best: tuple[float, list[int], list[int]] | None = None  # cost, prefix nodes, cycle nodes
     # Stays: an accepting stutter loop.
     stay_nodes = np.flatnonzero(product.stutter_accepting & np.isfinite(dist))
@@ -162,19 +169,20 @@ def plan(
         goal = int(stay_nodes[np.argmin(dist[stay_nodes])])
         best = (float(dist[goal]), _path(pred, goal), [goal])
     # Moving cycles through accepting edges.
-    acc = product.accepting.tocoo()
-    us, vs = acc.row.astype(np.int64), acc.col.astype(np.int64)
-    reachable = np.isfinite(dist[us])
-    us, vs = us[reachable], vs[reachable]
-    best, searches, exhausted = _close_cycles(product, dist, pred, us, vs, best, options.beta)
+    graph = product.graph
+    marked = np.flatnonzero(product.accepting)
+    marked = marked[np.isfinite(dist[graph.sources[marked]])]
+    # In (u, v) order: equal bounds are closed in that order (a stable sort below).
+    marked = marked[np.lexsort((graph.targets[marked], graph.sources[marked]))]
+    best, searches, exhausted = _close_cycles(product, dist, pred, marked, best, options.beta)
     if best is None and not exhausted:
         # The cap stopped the search before any cycle closed.  Only edges inside one strongly
         # connected component close; keeping those, the first search succeeds, so the cap
         # never hides the existence of a lasso (computed only here: it costs a graph pass).
-        _, scc = connected_components(product.graph, directed=True, connection="strong")
-        closable = scc[us] == scc[vs]
+        scc = strongly_connected(graph)
+        closable = scc[graph.sources[marked]] == scc[graph.targets[marked]]
         best, more, exhausted = _close_cycles(
-            product, dist, pred, us[closable], vs[closable], None, options.beta
+            product, dist, pred, marked[closable], None, options.beta
         )
         searches += more
     if best is None:
@@ -189,37 +197,60 @@ def _close_cycles(
     product: Product,
     dist: FloatArray,
     pred: IntArray,
-    us: IntArray,
-    vs: IntArray,
+    marked: IntArray,
     best: tuple[float, list[int], list[int]] | None,
     beta: float,
 ) -> tuple[tuple[float, list[int], list[int]] | None, int, bool]:
-    """Close accepting edges ``u -> v`` in order of their lower bound (see the module doc).
+    """Close the accepting edges ``u -> v`` (indices ``marked`` of the product's edges) in
+    order of their lower bound (see the module doc).
 
     Returns the best lasso (or the incumbent ``best``), the searches made, and whether the
     candidates were exhausted (False when :data:`MAX_CYCLE_SEARCHES` cut the search).
     """
     searches = 0
-    if not len(us):
+    if not len(marked):
         return best, searches, True
-    edge_w = np.asarray(product.graph[us, vs]).ravel()
+    graph = product.graph
+    us = graph.sources[marked]
+    vs = graph.targets[marked]
+    edge_w = graph.weights[marked]
     bound = dist[us] + beta * edge_w
-    order = np.argsort(bound, kind="stable")
-    for index in order.tolist():
+    order = np.argsort(bound, kind="stable").tolist()
+    # The closing searches run several at a time (they share the search's rounds), each with
+    # the limit the incumbent allows when the batch starts; the candidates are then taken in
+    # order exactly as one search at a time would take them (a distance beyond the limit the
+    # incumbent allows by then counts as unreached, as that search would have left it).
+    batch = max(1, min(MAX_CYCLE_SEARCHES, BATCH_NODES // max(graph.num_nodes, 1)))
+    closed: dict[int, tuple[float, list[int]]] = {}
+    for position, index in enumerate(order):
         if best is not None and bound[index] >= best[0]:
             break
-        v = int(vs[index])
-        u = int(us[index])
         if searches >= MAX_CYCLE_SEARCHES:
             return best, searches, False
+        if index not in closed:
+            chosen: list[int] = []
+            for ahead in order[position:]:
+                if len(chosen) == min(batch, MAX_CYCLE_SEARCHES - searches):
+                    break
+                if best is not None and bound[ahead] >= best[0]:
+                    break
+                chosen.append(ahead)
+            limits = np.array(
+                [
+                    np.inf if best is None else (best[0] - bound[k]) / max(beta, 1e-12)
+                    for k in chosen
+                ]
+            )
+            distances, paths = closing_searches(graph, vs[chosen], us[chosen], limits)
+            closed = {k: (float(distances[j]), paths[j]) for j, k in enumerate(chosen)}
         searches += 1
         limit = np.inf if best is None else (best[0] - bound[index]) / max(beta, 1e-12)
-        back, back_pred = dijkstra(product.graph, indices=v, return_predecessors=True, limit=limit)
-        if not np.isfinite(back[u]):
-            continue
-        total = float(dist[u] + beta * (edge_w[index] + back[u]))
+        back, back_path = closed[index]  # back_path: v, ..., u
+        if not (np.isfinite(back) and back <= limit):
+            continue  # unreached, or farther than a search from here on would look
+        u = int(us[index])
+        total = float(dist[u] + beta * (edge_w[index] + back))
         if best is None or total < best[0] - 1e-12:
-            back_path = _path(back_pred, u)  # v, ..., u
             best = (total, _path(pred, u), [u, *back_path[:-1]])
     return best, searches, True
 

@@ -20,16 +20,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import numpy.typing as npt
-from scipy.sparse import csr_matrix
 
 from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
 from tlmpc.automata.guards import successor_table
 from tlmpc.automata.model import Automaton
 from tlmpc.planning.boundary import POINT, StartCell, crossing_letter, start_cells
+from tlmpc.planning.search import Graph
 
 SLOTS = 4  # three edges, and "no entry edge yet" for the start
 START_SLOT = 3
-#: Weight of a stutter step: Dijkstra on scipy ignores zero weights, and stutter is free.
+#: Weight of a stutter step: the searches need positive weights, and stutter is free.
 STUTTER_COST = 1e-9
 
 BoolArray = npt.NDArray[np.bool_]
@@ -37,10 +37,10 @@ BoolArray = npt.NDArray[np.bool_]
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Product:
-    """The product graph as CSR plus what the witness extraction needs."""
+    """The product graph plus what the witness extraction needs."""
 
-    graph: csr_matrix = field(compare=False)  # weights
-    accepting: csr_matrix = field(compare=False)  # 1 where the edge carries the mark
+    graph: Graph = field(compare=False)  # weights
+    accepting: BoolArray = field(compare=False)  # per edge of ``graph``: carries the mark
     stutter_accepting: BoolArray = field(compare=False)  # node whose stutter loop accepts
     initial: IntArray = field(compare=False)
     num_automaton_states: int
@@ -133,7 +133,9 @@ def build_product(
             np.asarray(start_point, dtype=np.float64)[None, :],
             mids[t, np.minimum(s, 2)],
         )
-        weight = np.linalg.norm(mids[t, i] - origin, axis=1) + STUTTER_COST
+        step = mids[t, i] - origin
+        # sqrt(dx² + dy²) exactly as numpy's norm computes it, without its temporaries.
+        weight = np.sqrt(step[:, 0] * step[:, 0] + step[:, 1] * step[:, 1]) + STUTTER_COST
     move_src = t * SLOTS + s
     move_dst = n * SLOTS + slot
     # A move's kind: the class of the entered triangle's letter, and under the closed
@@ -214,16 +216,18 @@ def build_product(
         dst = np.concatenate(targets)
         wgt = np.concatenate(weights)
         acc = np.concatenate(accept)
+        # The pieces are copied: free them before the graph makes its sorted copies.
+        sources.clear()
+        targets.clear()
+        weights.clear()
+        accept.clear()
     else:
         src = dst = np.zeros(0, dtype=np.int64)
         wgt = np.zeros(0)
         acc = np.zeros(0, dtype=bool)
-    graph = csr_matrix((wgt, (src, dst)), shape=(size, size))
-    graph.sort_indices()  # canonical order: the searches break ties as they always did
-    accepting_graph = csr_matrix(
-        (np.ones(int(acc.sum())), (src[acc], dst[acc])), shape=(size, size)
-    )
-    accepting_graph.sort_indices()
+    graph, order = Graph.from_edges(src, dst, wgt, size)
+    del src, dst, wgt  # the graph holds its own, sorted copies
+    accepting_edges = acc[order]
     # Initial nodes: each start triangle after reading (the start point's letter, under the
     # closed convention, then) its own label.
     first = [automaton.initial]
@@ -240,7 +244,7 @@ def build_product(
     initial = np.array(sorted(initial_nodes), dtype=np.int64)
     return Product(
         graph=graph,
-        accepting=accepting_graph,
+        accepting=accepting_edges,
         stutter_accepting=stutter_accepting,
         initial=initial,
         num_automaton_states=nq,

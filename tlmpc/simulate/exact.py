@@ -205,29 +205,26 @@ def _exit_step(controller: StepController, x0: FloatArray) -> tuple[list[float],
         powers.append(step @ powers[-1])
     stack = np.stack(powers)  # step^1 .. step^GRID_CHUNK: a chunk of grid points at once
     state = np.array([y0[0], y0[1], 1.0])
-    inside: list[FloatArray] = []  # grid states before the crossing, in chunks
-    bracket = None
     # The other two facets, watched too: a field that leaves by an unplanned facet is a bug the
     # simulation must report, not hide by snapping the crossing onto the planned edge.
     others = [j for j in range(3) if j != controller.exit_edge]
     other_normals = geometry.normals[others]
     other_offsets = geometry.offsets[others] - other_normals @ center
     slack = WRONG_FACET_TOLERANCE * float(geometry.heights.max())
-    for first in range(0, GRID_POINTS, GRID_CHUNK):
+    # All grid states, chunk after chunk from the last state of the one before, then one check
+    # of them all (states past the crossing are computed and not used).
+    chunks = []
+    for _ in range(0, GRID_POINTS, GRID_CHUNK):
         states = stack @ state
-        hits = np.flatnonzero(states[:, :2] @ normal - offset >= 0.0)
-        beyond = (states[:, :2] @ other_normals.T - other_offsets).max(axis=1)
-        outside = np.flatnonzero(beyond > slack)
-        if outside.size and (not hits.size or outside[0] < hits[0]):
-            _wrong_exit(controller, others, states[int(outside[0]), :2] + center)
-        if hits.size:
-            k = int(hits[0])
-            inside.append(states[:k])
-            bracket = (first + k) * dt, state if k == 0 else states[k - 1]
-            break
-        inside.append(states)
+        chunks.append(states)
         state = states[-1]
-    if bracket is None:
+    grid_states = np.concatenate(chunks)
+    hits = np.flatnonzero(grid_states[:, :2] @ normal - offset >= 0.0)
+    beyond = (grid_states[:, :2] @ other_normals.T - other_offsets).max(axis=1)
+    outside = np.flatnonzero(beyond > slack)
+    if outside.size and (not hits.size or outside[0] < hits[0]):
+        _wrong_exit(controller, others, grid_states[int(outside[0]), :2] + center)
+    if not hits.size:
         raise SolverError(
             error(
                 "C010",
@@ -236,6 +233,10 @@ def _exit_step(controller: StepController, x0: FloatArray) -> tuple[list[float],
                 hint="please report this mission",
             )
         )
+    k = int(hits[0])
+    start = np.array([y0[0], y0[1], 1.0])
+    inside = [grid_states[:k]]  # grid states before the crossing
+    bracket = (k * dt, start if k == 0 else grid_states[k - 1])
     lower, before = bracket
     point, height = _local_flow(matrix, before, dt, normal, offset)
     if height(0.0) >= 0.0:

@@ -1,0 +1,333 @@
+"""Shortest paths on the product graph, with numpy alone (no graph library to import).
+
+The graph is a CSR arrangement of its edges (:class:`Graph`).  :func:`shortest_paths` is a
+label-correcting search processed in distance buckets (delta-stepping): each round relaxes,
+all at once, every edge out of the queued nodes whose tentative distance lies in the lowest
+bucket.  The distances it returns are those of Dijkstra's algorithm bit for bit: both are the
+unique solution of ``d(v) = min over edges u -> v of fl(d(u) + w)`` with ``d = 0`` at the
+sources, since floating-point addition is monotone and every weight is positive and large
+enough not to vanish in the sum (the smallest, 1e-9, would only at distances beyond 1e7):
+a second solution would differ first at some node, whose minimising edge comes from a node
+where both agree.  :func:`closing_searches` runs several such searches at once.
+
+**Tie-break.**  Among the edges ``u -> v`` that attain ``d(v)``, the predecessor of ``v`` is
+the one with the smallest ``d(u)``, then the smallest node index ``u``.  A Dijkstra search
+that keeps the first predecessor attaining the minimum (as scipy's does) agrees with this
+wherever those smallest ``d(u)`` are unique; it orders equal ``d(u)`` by its heap instead.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+FloatArray = npt.NDArray[np.float64]
+IntArray = npt.NDArray[np.int64]
+BoolArray = npt.NDArray[np.bool_]
+
+#: Bucket width as a multiple of the mean edge weight: wide enough to relax many nodes per
+#: round, narrow enough that few are relaxed again.
+BUCKET_WIDTH = 1.0
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Graph:
+    """A weighted directed graph with its edges grouped by source (CSR).
+
+    ``indptr[u]:indptr[u + 1]`` are the edges out of ``u``; ``sources``, ``targets`` and
+    ``weights`` give each edge's ends and weight (all weights positive).
+    """
+
+    indptr: IntArray
+    sources: IntArray
+    targets: IntArray
+    weights: FloatArray
+    num_nodes: int
+
+    @property
+    def nnz(self) -> int:
+        """Number of edges."""
+        return len(self.targets)
+
+    @staticmethod
+    def from_edges(
+        sources: IntArray, targets: IntArray, weights: FloatArray, num_nodes: int
+    ) -> tuple[Graph, IntArray]:
+        """The graph of these edges, and the order that took the input edges to it (edge k
+        of the graph is input edge ``order[k]``; edges of one source keep their input order)."""
+        order = np.argsort(sources, kind="stable")
+        indptr = np.zeros(num_nodes + 1, dtype=np.int64)
+        np.cumsum(np.bincount(sources, minlength=num_nodes), out=indptr[1:])
+        graph = Graph(
+            indptr=indptr,
+            sources=sources[order],
+            targets=targets[order],
+            weights=weights[order],
+            num_nodes=num_nodes,
+        )
+        return graph, order
+
+    def weight(self, source: int, target: int) -> float:
+        """The weight of the edge ``source -> target`` (KeyError when there is none)."""
+        lo, hi = int(self.indptr[source]), int(self.indptr[source + 1])
+        hits = np.flatnonzero(self.targets[lo:hi] == target)
+        if not len(hits):
+            raise KeyError((source, target))
+        return float(self.weights[lo + int(hits[0])])
+
+
+def _out_edges(graph: Graph, nodes: IntArray) -> IntArray:
+    """Indices of every edge out of ``nodes``."""
+    starts = graph.indptr[nodes]
+    counts = graph.indptr[nodes + 1] - starts
+    total = int(counts.sum())
+    if total == 0:
+        return np.zeros(0, dtype=np.int64)
+    # Edge k of the run of node j is starts[j] + k: one arange shifted per run.
+    shift = np.repeat(starts - (np.cumsum(counts) - counts), counts)
+    return shift + np.arange(total, dtype=np.int64)
+
+
+def _best_offers(
+    v: IntArray, d: FloatArray, du: FloatArray, u: IntArray
+) -> tuple[IntArray, FloatArray, FloatArray, IntArray]:
+    """One offer per target ``v``: the smallest (d, d(u), u) among its offers."""
+    order = np.argsort(v, kind="stable")
+    v, d, du, u = v[order], d[order], du[order], u[order]
+    same = v[1:] == v[:-1]
+    if not same.any():
+        return v, d, du, u
+    # Targets with several offers: order just those lexicographically, keep each first.
+    shared = np.zeros(len(v), dtype=bool)
+    shared[1:] |= same
+    shared[:-1] |= same
+    rivals = np.flatnonzero(shared)
+    rivals = rivals[np.lexsort((u[rivals], du[rivals], d[rivals], v[rivals]))]
+    head = np.ones(len(rivals), dtype=bool)
+    head[1:] = v[rivals[1:]] != v[rivals[:-1]]
+    keep = ~shared
+    keep[rivals[head]] = True
+    return v[keep], d[keep], du[keep], u[keep]
+
+
+def _take_offers(
+    dist: FloatArray,
+    via: FloatArray,
+    pred: IntArray,
+    v: IntArray,
+    d: FloatArray,
+    du: FloatArray,
+    u: IntArray,
+) -> IntArray:
+    """Record the offers (one per target) that beat what ``v`` has: a shorter distance, or
+    the same one from a nearer node, or from an equally near one of smaller index.  Returns
+    the targets whose distance got shorter (they must be searched from again)."""
+    old = dist[v]
+    shorter = d < old
+    better = shorter | ((d == old) & ((du < via[v]) | ((du == via[v]) & (u < pred[v]))))
+    v = v[better]
+    dist[v] = d[better]
+    via[v] = du[better]
+    pred[v] = u[better]
+    improved: IntArray = v[shorter[better]]
+    return improved
+
+
+def _enqueue(frontier: IntArray, improved: IntArray, queued: BoolArray) -> IntArray:
+    """The frontier with the improved nodes not already in it."""
+    fresh = improved[~queued[improved]]
+    queued[fresh] = True
+    return np.concatenate([frontier, fresh])
+
+
+def shortest_paths(
+    graph: Graph,
+    sources: IntArray,
+    *,
+    limit: float = np.inf,
+    goals: BoolArray | None = None,
+) -> tuple[FloatArray, IntArray]:
+    """Distances from the nearest of ``sources`` and predecessors (-1 at sources and at
+    unreached nodes), over paths of length at most ``limit`` (farther nodes stay at inf).
+
+    With ``goals``, the search ends once the nearest goal node is known: every node up to
+    that goal's distance is exact (ties included), every farther one is left at inf.
+    See the module doc for the tie-break among equal predecessors.
+    """
+    n = graph.num_nodes
+    dist = np.full(n, np.inf)
+    pred = np.full(n, -1, dtype=np.int64)
+    via = np.full(n, np.inf)  # d(pred[v]): the tie-break's first key
+    queued = np.zeros(n, dtype=bool)
+    frontier = np.unique(np.asarray(sources, dtype=np.int64))
+    dist[frontier] = 0.0
+    queued[frontier] = True
+    nearest_goal = np.inf
+    if goals is not None and len(frontier) and goals[frontier].any():
+        nearest_goal = 0.0
+    width = BUCKET_WIDTH * float(graph.weights.mean()) if graph.nnz else 1.0
+    while len(frontier):
+        current = dist[frontier]
+        lowest = float(current.min())
+        if lowest > nearest_goal:
+            break  # every node at most nearest_goal away is final
+        take = current <= lowest + width
+        active, frontier = frontier[take], frontier[~take]
+        queued[active] = False
+        edges = _out_edges(graph, active)
+        if not len(edges):
+            continue
+        u = graph.sources[edges]
+        v = graph.targets[edges]
+        du = dist[u]
+        d = du + graph.weights[edges]
+        # Only offers that can still win (or tie) at v, within the limit.
+        keep = (d <= dist[v]) & (d <= limit)
+        if not keep.all():
+            u, v, du, d = u[keep], v[keep], du[keep], d[keep]
+        if not len(v):
+            continue
+        v, d, du, u = _best_offers(v, d, du, u)
+        improved = _take_offers(dist, via, pred, v, d, du, u)
+        if goals is not None and len(improved):
+            hit = goals[improved]
+            if hit.any():
+                nearest_goal = min(nearest_goal, float(dist[improved[hit]].min()))
+        frontier = _enqueue(frontier, improved, queued)
+    if len(frontier):
+        # Stopped at the nearest goal: what lies beyond is not final.
+        beyond = dist > nearest_goal
+        dist[beyond] = np.inf
+        pred[beyond] = -1
+    return dist, pred
+
+
+def strongly_connected(graph: Graph) -> IntArray:
+    """A strongly connected component label per node (Tarjan's algorithm, iterative).
+
+    Planning needs it only when the cycle-search cap was hit before any cycle closed.
+    """
+    n = graph.num_nodes
+    indptr = graph.indptr.tolist()
+    targets = graph.targets.tolist()
+    index = [-1] * n
+    low = [0] * n
+    on_stack = [False] * n
+    label = [-1] * n
+    stack: list[int] = []
+    counter = 0
+    components = 0
+    for root in range(n):
+        if index[root] >= 0:
+            continue
+        # Each frame: a node and the position of its next edge to look at.
+        frames = [(root, indptr[root])]
+        index[root] = low[root] = counter
+        counter += 1
+        stack.append(root)
+        on_stack[root] = True
+        while frames:
+            node, edge = frames[-1]
+            if edge < indptr[node + 1]:
+                frames[-1] = (node, edge + 1)
+                nxt = targets[edge]
+                if index[nxt] < 0:
+                    index[nxt] = low[nxt] = counter
+                    counter += 1
+                    stack.append(nxt)
+                    on_stack[nxt] = True
+                    frames.append((nxt, indptr[nxt]))
+                elif on_stack[nxt]:
+                    low[node] = min(low[node], index[nxt])
+                continue
+            frames.pop()
+            if frames:
+                parent = frames[-1][0]
+                low[parent] = min(low[parent], low[node])
+            if low[node] == index[node]:
+                while True:
+                    member = stack.pop()
+                    on_stack[member] = False
+                    label[member] = components
+                    if member == node:
+                        break
+                components += 1
+    return np.array(label, dtype=np.int64)
+
+
+def closing_searches(
+    graph: Graph, starts: IntArray, targets: IntArray, limits: FloatArray
+) -> tuple[FloatArray, list[list[int]]]:
+    """Several searches at once: from ``starts[k]`` to ``targets[k]`` within ``limits[k]``.
+
+    Returns each target's distance (inf when farther than its limit) and the path to it
+    (empty when unreached), exactly what :func:`shortest_paths` from ``starts[k]`` with the
+    goal ``targets[k]`` and that limit gives: the searches share the rounds (a round costs
+    about the same for one search as for ten), each in its own copy of the node numbers.
+    """
+    n = graph.num_nodes
+    count = len(starts)
+    total = n * count
+    dist = np.full(total, np.inf)
+    pred = np.full(total, -1, dtype=np.int64)
+    via = np.full(total, np.inf)
+    queued = np.zeros(total, dtype=bool)
+    base = np.arange(count, dtype=np.int64) * n
+    goal = base + np.asarray(targets, dtype=np.int64)
+    limit = np.asarray(limits, dtype=np.float64)
+    nearest = np.full(count, np.inf)  # per search: the distance of its target, once known
+    frontier = base + np.asarray(starts, dtype=np.int64)
+    dist[frontier] = 0.0
+    queued[frontier] = True
+    nearest[goal == frontier] = 0.0
+    is_goal = np.zeros(total, dtype=bool)
+    is_goal[goal] = True
+    width = BUCKET_WIDTH * float(graph.weights.mean()) if graph.nnz else 1.0
+    while len(frontier):
+        current = dist[frontier]
+        # A search whose target is known needs nothing beyond it.
+        alive = current <= nearest[frontier // n]
+        if not alive.all():
+            queued[frontier[~alive]] = False
+            frontier, current = frontier[alive], current[alive]
+            if not len(frontier):
+                break
+        take = current <= float(current.min()) + width
+        active, frontier = frontier[take], frontier[~take]
+        queued[active] = False
+        local = active % n
+        offset = active - local
+        edges = _out_edges(graph, local)
+        if not len(edges):
+            continue
+        counts = graph.indptr[local + 1] - graph.indptr[local]
+        u = np.repeat(active, counts)
+        v = graph.targets[edges] + np.repeat(offset, counts)
+        du = dist[u]
+        d = du + graph.weights[edges]
+        keep = (d <= dist[v]) & (d <= limit[v // n])
+        if not keep.all():
+            u, v, du, d = u[keep], v[keep], du[keep], d[keep]
+        if not len(v):
+            continue
+        v, d, du, u = _best_offers(v, d, du, u)
+        improved = _take_offers(dist, via, pred, v, d, du, u)
+        reached = improved[is_goal[improved]]
+        if len(reached):
+            searches = reached // n
+            nearest[searches] = np.minimum(nearest[searches], dist[reached])
+        frontier = _enqueue(frontier, improved, queued)
+    distances = dist[goal]
+    paths: list[list[int]] = []
+    for k in range(count):
+        if not np.isfinite(distances[k]):
+            paths.append([])
+            continue
+        path = [int(goal[k])]
+        while pred[path[-1]] >= 0:
+            path.append(int(pred[path[-1]]))
+        path.reverse()
+        paths.append([node - int(base[k]) for node in path])
+    return distances, paths
