@@ -7,8 +7,6 @@ from typing import Any
 
 import numpy as np
 import shapely
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
 
 from tlmpc.abstraction.layout import PlanningLayout
 from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
@@ -72,15 +70,36 @@ def _labels(
 
 
 def _components(neighbors: IntArray) -> IntArray:
+    """Connected components of the triangle adjacency, numbered by their lowest triangle.
+
+    That numbering is the one of a search started from each unlabelled triangle in index
+    order (scipy's ``connected_components``), computed with numpy alone so that the stage
+    does not import scipy (a fifth of a cold compile).  Union-find by hooking: every root
+    points to the smallest root it shares an edge with, then paths are halved until every
+    triangle points to its root; each round merges at least one pair of roots, so the loop
+    ends, and on meshes it takes a handful of rounds.
+    """
     count = len(neighbors)
-    rows = np.repeat(np.arange(count), 3)
-    cols = neighbors.reshape(-1)
-    keep = cols >= 0
-    graph = coo_matrix(
-        (np.ones(int(keep.sum()), dtype=np.int8), (rows[keep], cols[keep])), shape=(count, count)
-    )
-    _, labels = connected_components(graph, directed=False)
-    return np.asarray(labels, dtype=np.int64)
+    first = np.repeat(np.arange(count, dtype=np.int64), neighbors.shape[1] if count else 0)
+    second = neighbors.reshape(-1).astype(np.int64, copy=False)
+    keep = second >= 0  # -1: no neighbour across that side
+    first, second = first[keep], second[keep]
+    root = np.arange(count, dtype=np.int64)  # invariant: root[t] <= t
+    while len(first):
+        a, b = root[first], root[second]
+        apart = a != b
+        if not apart.any():
+            break
+        first, second, a, b = first[apart], second[apart], a[apart], b[apart]
+        np.minimum.at(root, np.maximum(a, b), np.minimum(a, b))
+        while True:
+            jumped = root[root]
+            if np.array_equal(jumped, root):
+                break
+            root = jumped
+    # The root of a component is its lowest triangle: number components in that order.
+    _, labels = np.unique(root, return_inverse=True)
+    return np.asarray(labels, dtype=np.int64).reshape(-1)
 
 
 def build_abstraction(mission: Mission, layout: PlanningLayout | None = None) -> Abstraction:
