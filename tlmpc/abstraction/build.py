@@ -47,26 +47,37 @@ def locate_in(vertices: FloatArray, triangles: IntArray, point: tuple[float, flo
 def _labels(
     mission: Mission, vertices: FloatArray, triangles: IntArray, shapes: list[Any]
 ) -> tuple[IntArray, tuple[tuple[str, ...], ...]]:
+    """Each triangle's letter (the set of regions holding its centroid) and the letters,
+    ordered by size, then by names."""
     centroids = vertices[triangles].mean(axis=1)
     names = [r.name for r in mission.regions]
     tree = shapely.STRtree(shapes)
     hits = tree.query(shapely.points(centroids), predicate="within")
-    order = np.lexsort((hits[1], hits[0]))
-    tri_of, region_of = hits[0][order], hits[1][order]
-    letters: dict[tuple[str, ...], int] = {(): 0}
-    letter_of = np.zeros(len(triangles), dtype=np.int64)
-    if len(tri_of):
-        boundaries = np.flatnonzero(np.diff(tri_of)) + 1
-        starts = np.concatenate([[0], boundaries])
-        ends = np.concatenate([boundaries, [len(tri_of)]])
-        for start, end in zip(starts.tolist(), ends.tolist(), strict=True):
-            key = tuple(sorted(names[i] for i in region_of[start:end].tolist()))
-            letter_of[tri_of[start]] = letters.setdefault(key, len(letters))
-    ordered = sorted(letters, key=lambda k: (len(k), k))
-    remap = np.array([0] * len(letters), dtype=np.int64)
-    for new_index, key in enumerate(ordered):
-        remap[letters[key]] = new_index
-    return remap[letter_of], tuple(ordered)
+    tri_of, region_of = hits[0], hits[1]
+    # Most triangles lie in at most one region: their letters come from numpy, only the
+    # triangles in several regions (overlaps) are keyed one by one.
+    count = np.bincount(tri_of, minlength=len(triangles))
+    alone = count[tri_of] == 1
+    single_region = np.zeros(len(triangles), dtype=np.int64)
+    single_region[tri_of[alone]] = region_of[alone]
+    single = np.flatnonzero(count == 1)
+    used, single_key = np.unique(single_region[single], return_inverse=True)
+    keys: set[tuple[str, ...]] = {()}
+    keys.update((names[r],) for r in used.tolist())
+    several: dict[int, list[str]] = {}
+    for t, r in zip(tri_of[~alone].tolist(), region_of[~alone].tolist(), strict=True):
+        several.setdefault(t, []).append(names[r])
+    several_keys = {t: tuple(sorted(found)) for t, found in several.items()}
+    keys.update(several_keys.values())
+    ordered = sorted(keys, key=lambda k: (len(k), k))
+    index = {key: k for k, key in enumerate(ordered)}
+    letter_of = np.zeros(len(triangles), dtype=np.int64)  # index 0: the empty letter
+    letter_of[single] = np.array([index[(names[r],)] for r in used.tolist()], dtype=np.int64)[
+        single_key.reshape(-1)
+    ]
+    for t, key in several_keys.items():
+        letter_of[t] = index[key]
+    return letter_of, tuple(ordered)
 
 
 def _components(neighbors: IntArray) -> IntArray:
