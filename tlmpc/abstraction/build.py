@@ -62,14 +62,15 @@ def _labels(
     single_region[tri_of[alone]] = region_of[alone]
     single = np.flatnonzero(count == 1)
     used, single_key = np.unique(single_region[single], return_inverse=True)
-    keys: set[tuple[str, ...]] = {()}
-    keys.update((names[r],) for r in used.tolist())
     several: dict[int, list[str]] = {}
     for t, r in zip(tri_of[~alone].tolist(), region_of[~alone].tolist(), strict=True):
         several.setdefault(t, []).append(names[r])
     several_keys = {t: tuple(sorted(found)) for t, found in several.items()}
-    keys.update(several_keys.values())
-    ordered = sorted(keys, key=lambda k: (len(k), k))
+    # Ordered by size, then by names: the empty letter, the single regions by name, then
+    # the overlaps (sorting plain names is cheaper than sorting keyed tuples).
+    single_names = sorted({names[r] for r in used.tolist()})
+    ordered = [(), *((name,) for name in single_names)]
+    ordered += sorted(set(several_keys.values()), key=lambda k: (len(k), k))
     index = {key: k for k, key in enumerate(ordered)}
     letter_of = np.zeros(len(triangles), dtype=np.int64)  # index 0: the empty letter
     letter_of[single] = np.array([index[(names[r],)] for r in used.tolist()], dtype=np.int64)[
@@ -165,14 +166,24 @@ def build_abstraction(mission: Mission, layout: PlanningLayout | None = None) ->
 
 
 def _min_angle(corners: FloatArray) -> FloatArray:
-    def angle(p: FloatArray, q: FloatArray, r: FloatArray) -> FloatArray:
-        u, v = q - p, r - p
-        cos = (u * v).sum(axis=1) / (np.linalg.norm(u, axis=1) * np.linalg.norm(v, axis=1))
-        degrees: FloatArray = np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
-        return degrees
+    """Each triangle's smallest angle in degrees.
 
+    arccos is decreasing, so the smallest angle is the arccos of the largest cosine: one
+    arccos per triangle instead of three, and each side's length computed once (a side's
+    length does not depend on its direction), which gives the same floats.
+    """
     a, b, c = corners[:, 0], corners[:, 1], corners[:, 2]
-    return np.minimum(np.minimum(angle(a, b, c), angle(b, c, a)), angle(c, a, b))
+    ab, bc, ca = b - a, c - b, a - c
+    length_ab = np.linalg.norm(ab, axis=1)
+    length_bc = np.linalg.norm(bc, axis=1)
+    length_ca = np.linalg.norm(ca, axis=1)
+    # the angle at a is between b - a and c - a (= -ca), and so on around the triangle
+    cos_a = (ab * -ca).sum(axis=1) / (length_ab * length_ca)
+    cos_b = (bc * -ab).sum(axis=1) / (length_bc * length_ab)
+    cos_c = (ca * -bc).sum(axis=1) / (length_ca * length_bc)
+    largest = np.maximum(np.maximum(cos_a, cos_b), cos_c)
+    degrees: FloatArray = np.degrees(np.arccos(np.clip(largest, -1.0, 1.0)))
+    return degrees
 
 
 def abstraction_diagnostics(abstraction: Abstraction, mission: Mission) -> list[Diagnostic]:

@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 import shapely
 
-from tlmpc.abstraction.triangulate import grid_size
+from tlmpc.abstraction.triangulate import grid_size, polygon_coordinates
 from tlmpc.errors import Diagnostic, InvalidInputError, error
 from tlmpc.mission.model import Mission, Polygon
 
@@ -34,8 +34,7 @@ def _off_grid(polygons: Sequence[Polygon], grid: float) -> list[int]:
     """Indices of the polygons with a vertex off the grid (vectorised over all of them)."""
     if not polygons:
         return []
-    coords = np.concatenate([np.asarray(p, dtype=np.float64).reshape(-1, 2) for p in polygons])
-    owner = np.repeat(np.arange(len(polygons)), [len(p) for p in polygons])
+    coords, owner = polygon_coordinates(polygons)
     scaled = coords / grid
     off = np.abs(scaled - np.round(scaled)).max(axis=1) > 1e-6
     moved = np.zeros(len(polygons), dtype=bool)

@@ -83,11 +83,12 @@ _FAST_FLOAT = re.compile(r"[-+]?[0-9]{1,15}\.[0-9]{0,17}")
 class _Frame:
     """An open mapping or sequence while the event stream is read."""
 
-    __slots__ = ("anchor", "container", "key", "path", "seen", "size")
+    __slots__ = ("anchor", "container", "key", "path", "seen", "shallow", "size")
 
     def __init__(self, container: Any, path: Path, anchor: str | None) -> None:
         self.container = container
         self.path = path
+        self.shallow = len(path) < MAX_DEPTH  # an item's path is within the depth limit
         self.anchor = anchor
         self.key: Any = _NO_KEY  # a mapping's pending key (text) or a bad-key marker
         self.seen: dict[str, tuple[int, int]] = {}
@@ -179,26 +180,45 @@ class _Converter:
         stack: list[_Frame] = []
         documents = 0
         values = self.doc.values
+        # The loop runs once per YAML value (a million on large maps): names bound locally.
+        scalar_event = yaml.ScalarEvent
+        ends = (yaml.MappingEndEvent, yaml.SequenceEndEvent)
+        fast_float = _FAST_FLOAT.fullmatch
+        fast_int = _FAST_INT.fullmatch
         for event in events:
-            if type(event) is yaml.ScalarEvent and stack:  # fast path: a number in a list
+            kind = type(event)
+            if kind in ends and stack:  # as below, without the checks before it
+                frame = stack.pop()
+                if frame.anchor is not None:
+                    self.anchors[frame.anchor] = (frame.container, frame.size)
+                if stack:
+                    stack[-1].size += frame.size
+                continue
+            if kind is scalar_event and stack:
                 frame = stack[-1]
                 items = frame.container
+                if type(items) is dict and frame.key is _NO_KEY:  # a key: as below, directly
+                    self._key(frame, event)
+                    continue
+                # fast path: a number in a list
                 if (
                     type(items) is list
                     and not event.style
                     and event.tag is None
                     and event.anchor is None
-                    and len(frame.path) < MAX_DEPTH
+                    and frame.shallow
                     and self.count < MAX_NODES
                 ):
+                    text = event.value
                     number: float | int | None = None
-                    if _FAST_FLOAT.fullmatch(event.value):
-                        number = float(event.value)
-                    elif _FAST_INT.fullmatch(event.value):
-                        number = int(event.value)
+                    if fast_float(text):
+                        number = float(text)
+                    elif fast_int(text):
+                        number = int(text)
                     if number is not None:
                         self.count += 1
-                        values[(*frame.path, len(items))] = _mark(event)
+                        mark = event.start_mark
+                        values[(*frame.path, len(items))] = (mark.line + 1, mark.column + 1)
                         items.append(number)
                         frame.size += 1
                         continue
@@ -405,7 +425,13 @@ def _ends_on_line(converter: _Converter, mark: Any) -> bool:
 def _convert(converter: _Converter, text: str) -> bool | yaml.YAMLError | None:
     """Whether ``text`` held a document; None when a limit stopped reading; or the error."""
     try:
-        return converter.convert(yaml.parse(text, Loader=_LOADER))
+        # The loader's events without yaml.parse's generator around them (a tenth of the
+        # reading time); get_event gives None after the stream's end.
+        loader = _LOADER(text)
+        try:
+            return converter.convert(iter(loader.get_event, None))
+        finally:
+            loader.dispose()
     except _TooBig:
         return None
     except yaml.YAMLError as exc:
