@@ -188,11 +188,12 @@ def _min_angle(corners: FloatArray) -> FloatArray:
 
 def abstraction_diagnostics(abstraction: Abstraction, mission: Mission) -> list[Diagnostic]:
     """Warnings: regions that got no triangle, regions unreachable from the start."""
-    used = set(np.unique(abstraction.letter_of).tolist())
+    # Which letters occur (anywhere, and in the start's component): counts, not a sort.
+    letters = len(abstraction.letters)
+    used = set(np.flatnonzero(np.bincount(abstraction.letter_of, minlength=letters)).tolist())
     start_component = abstraction.component[abstraction.start]
-    reachable = set(
-        np.unique(abstraction.letter_of[abstraction.component == start_component]).tolist()
-    )
+    near_start = abstraction.letter_of[abstraction.component == start_component]
+    reachable = set(np.flatnonzero(np.bincount(near_start, minlength=letters)).tolist())
     present: set[str] = set()
     near: set[str] = set()
     for index, letter in enumerate(abstraction.letters):
