@@ -11,7 +11,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from shapely.geometry import MultiPolygon, Point, Polygon
 
-from tlmpc.abstraction.build import _components, _labels
+from tlmpc.abstraction.build import _components, _labels, _min_angle
 from tlmpc.abstraction.triangulate import _polygons, _rings, _rings_of_all, _unique_rows
 from tlmpc.ltl.ast import TRUE
 from tlmpc.mission.model import Mission, Region, Robot, Workspace
@@ -136,3 +136,27 @@ def test_labels_equal_a_per_triangle_shapely_test(shapes: list[Polygon], seed: i
     ]
     assert letters == tuple(sorted({(), *want}, key=lambda k: (len(k), k)))
     assert [letters[i] for i in letter_of.tolist()] == want
+
+
+def _reference_min_angle(corners: npt.NDArray[np.float64]) -> list[float]:
+    """Each triangle's smallest angle, corner by corner with the law of cosines' terms."""
+    out = []
+    for triangle in corners.tolist():
+        angles = []
+        for k in range(3):
+            p, q, r = triangle[k], triangle[(k + 1) % 3], triangle[(k + 2) % 3]
+            u = (q[0] - p[0], q[1] - p[1])
+            v = (r[0] - p[0], r[1] - p[1])
+            cos = (u[0] * v[0] + u[1] * v[1]) / (np.hypot(*u) * np.hypot(*v))
+            angles.append(float(np.degrees(np.arccos(min(1.0, max(-1.0, cos))))))
+        out.append(min(angles))
+    return out
+
+
+@given(st.integers(0, 2**32 - 1))
+def test_min_angle_is_the_smallest_corner_angle(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    corners = rng.random((40, 3, 2)) * 10.0
+    got = _min_angle(corners).tolist()
+    want = _reference_min_angle(corners)
+    assert np.allclose(got, want, rtol=1e-9, atol=1e-9)
