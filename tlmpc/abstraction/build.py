@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import time
+from itertools import chain
 from typing import Any
 
 import numpy as np
@@ -68,12 +69,15 @@ def _labels(
     several_keys = {t: tuple(sorted(found)) for t, found in several.items()}
     # Ordered by size, then by names: the empty letter, the single regions by name, then
     # the overlaps (sorting plain names is cheaper than sorting keyed tuples).
-    single_names = sorted({names[r] for r in used.tolist()})
+    used_names = [names[r] for r in used.tolist()]
+    single_names = sorted(set(used_names))
     ordered = [(), *((name,) for name in single_names)]
     ordered += sorted(set(several_keys.values()), key=lambda k: (len(k), k))
+    # A single region's letter index: 1 + its name's rank among the single names.
+    rank = {name: k for k, name in enumerate(single_names, start=1)}
     index = {key: k for k, key in enumerate(ordered)}
     letter_of = np.zeros(len(triangles), dtype=np.int64)  # index 0: the empty letter
-    letter_of[single] = np.array([index[(names[r],)] for r in used.tolist()], dtype=np.int64)[
+    letter_of[single] = np.array([rank[name] for name in used_names], dtype=np.int64)[
         single_key.reshape(-1)
     ]
     for t, key in several_keys.items():
@@ -190,17 +194,12 @@ def abstraction_diagnostics(abstraction: Abstraction, mission: Mission) -> list[
     """Warnings: regions that got no triangle, regions unreachable from the start."""
     # Which letters occur (anywhere, and in the start's component): counts, not a sort.
     letters = len(abstraction.letters)
-    used = set(np.flatnonzero(np.bincount(abstraction.letter_of, minlength=letters)).tolist())
+    used = np.flatnonzero(np.bincount(abstraction.letter_of, minlength=letters)).tolist()
     start_component = abstraction.component[abstraction.start]
     near_start = abstraction.letter_of[abstraction.component == start_component]
-    reachable = set(np.flatnonzero(np.bincount(near_start, minlength=letters)).tolist())
-    present: set[str] = set()
-    near: set[str] = set()
-    for index, letter in enumerate(abstraction.letters):
-        if index in used:
-            present.update(letter)
-        if index in reachable:
-            near.update(letter)
+    reachable = np.flatnonzero(np.bincount(near_start, minlength=letters)).tolist()
+    present = set(chain.from_iterable(map(abstraction.letters.__getitem__, used)))
+    near = set(chain.from_iterable(map(abstraction.letters.__getitem__, reachable)))
     problems = []
     for region in mission.regions:
         if region.name not in present:

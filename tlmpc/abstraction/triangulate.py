@@ -61,7 +61,7 @@ def polygon_coordinates(
     One conversion of the chained points (an array per polygon costs several times more on
     maps of a hundred thousand rooms).
     """
-    lengths = [len(p) for p in polygons]
+    lengths = list(map(len, polygons))
     coords = np.array(list(chain.from_iterable(polygons)), dtype=np.float64).reshape(-1, 2)
     owner = np.repeat(np.arange(len(polygons), dtype=np.int64), lengths)
     return coords, owner
