@@ -202,6 +202,7 @@ class _Converter:
         values = self.doc.values
         # The loop runs once per YAML value (a million on large maps): names bound locally.
         scalar_event = yaml.ScalarEvent
+        mapping_start, sequence_start = yaml.MappingStartEvent, yaml.SequenceStartEvent
         ends = (yaml.MappingEndEvent, yaml.SequenceEndEvent)
         fast_float = _FAST_FLOAT.fullmatch
         fast_int = _FAST_INT.fullmatch
@@ -217,6 +218,28 @@ class _Converter:
                 if stack:
                     stack[-1].size += frame.size
                 continue
+            if (kind is mapping_start or kind is sequence_start) and stack:
+                # A container as a list item or as the value of a named key: as below.
+                frame = stack[-1]
+                holder = frame.container
+                if type(holder) is list:
+                    path: Path | None = (*frame.path, len(holder))
+                elif type(holder) is dict and type(frame.key) is str:
+                    path = (*frame.path, frame.key)
+                else:
+                    path = None
+                if path is not None and len(path) <= MAX_DEPTH and self.count < MAX_NODES:
+                    self.count += 1
+                    mark = event.start_mark
+                    values[path] = (mark.line + 1, mark.column + 1)
+                    opened: Any = {} if kind is mapping_start else []
+                    if type(holder) is list:
+                        holder.append(opened)
+                    else:
+                        holder[frame.key] = opened
+                        frame.key = _NO_KEY
+                    stack.append(_Frame(opened, path, event.anchor))
+                    continue
             if kind is scalar_event and stack:
                 frame = stack[-1]
                 items = frame.container
