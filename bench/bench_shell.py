@@ -12,7 +12,8 @@ the machine's load hits every column alike):
 3. The import breakdown of a cold compile (``python -X importtime``), by top-level package.
 4. Each stage of Example 8 and the peak memory.
 5. The scaling curve on grid maps (10k, 100k, 300k, 1M triangles) with fitted growth
-   exponents of time and peak memory (least squares on log-log).
+   exponents of time and peak memory (least squares on log-log), for the baseline tree too;
+   a refused compile (e.g. the planner's product budget at 1M) is shown with its diagnostic.
 
 CPU seconds are printed beside wall seconds: on a shared machine they move less.
 """
