@@ -244,7 +244,15 @@ class _Converter:
                 frame = stack[-1]
                 items = frame.container
                 if type(items) is dict and frame.key is _NO_KEY:  # a key: as below, directly
-                    self._key(frame, event)
+                    key = str(event.value)
+                    if key in frame.seen or (self.lists and STEM in key):
+                        self._key(frame, event)  # a duplicate, or a placeholder as a key
+                    else:  # what _key does with a new plain key
+                        mark = event.start_mark
+                        position = (mark.line + 1, mark.column + 1)
+                        frame.seen[key] = position
+                        self.doc.keys[(*frame.path, key)] = position
+                        frame.key = key
                     continue
                 # fast path: a number in a list
                 if (
