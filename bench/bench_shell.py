@@ -12,7 +12,8 @@ the machine's load hits every column alike):
 3. The import breakdown of a cold compile (``python -X importtime``), by top-level package.
 4. Each stage of Example 8 and the peak memory.
 5. The scaling curve on grid maps (10k, 100k, 300k, 1M triangles) with fitted growth
-   exponents of time and peak memory (least squares on log-log).
+   exponents of time and peak memory (least squares on log-log), for the baseline tree too;
+   a refused compile (e.g. the planner's product budget at 1M) is shown with its diagnostic.
 
 CPU seconds are printed beside wall seconds: on a shared machine they move less.
 """
@@ -190,6 +191,73 @@ def _fit(xs: list[float], ys: list[float]) -> float:
     return sum((a - mx) * (b - my) for a, b in zip(lx, ly, strict=True)) / denominator
 
 
+STAGE_COLUMNS = ("load", "abstraction", "plan", "control", "simulate", "verify", "plot")
+
+
+def _stage_seconds(run: dict[str, Any], name: str) -> float:
+    return next((s["seconds"] for s in run["summary"]["stages"] if s["name"] == name), math.nan)
+
+
+def _scaling(
+    grids: list[str], trees: dict[str, Path], scratch: Path, repeats: int
+) -> dict[str, list[tuple[int, float, float, float]]]:
+    """The scaling table: every tree on every grid, interleaved round by round."""
+    print("\n## Scaling on grid maps (fresh interpreter per run, median)\n")
+    print(
+        "| grid | tree | triangles | product nodes | wall s | CPU s | peak MB | "
+        + " | ".join(STAGE_COLUMNS)
+        + " |"
+    )
+    print("|---|---|---:|---:|---:|---:|---:|" + "---:|" * len(STAGE_COLUMNS))
+    points: dict[str, list[tuple[int, float, float, float]]] = {name: [] for name in trees}
+    for label in grids:
+        n = SCALING[label]
+        mission = write_mission(grid_of_rooms(n), scratch)
+        columns: dict[str, Callable[[], Any]] = {
+            name: functools.partial(
+                _run,
+                tree,
+                ["compile", str(mission), "-o", str(scratch / f"g{n}-{name}"), "-q", "--force"],
+                scratch,
+            )
+            for name, tree in trees.items()
+        }
+        print(f"grid {label} ...", file=sys.stderr, flush=True)
+        results = _interleaved(repeats if n <= 200 else 1, columns)
+        for name, runs in results.items():
+            wall = _median([r["wall_seconds"] for r in runs])
+            cpu = _median([r["cpu_seconds"] for r in runs])
+            peak = max(r["peak_rss_mb"] for r in runs)
+            if any(r["summary"] is None for r in runs):
+                # A refusal (e.g. the planner's product budget) or a failure: say which.
+                failed = next(r for r in runs if r["summary"] is None)
+                first = failed["stderr"].strip().splitlines()[:1]
+                print(
+                    f"| {label} | {name} | - | - | {wall:.2f} | {cpu:.2f} | {peak:.0f} | "
+                    f"exit {failed['exit']}: {first[0] if first else ''} |"
+                )
+                continue
+            stage = {s["name"]: s for s in runs[-1]["summary"]["stages"]}
+            triangles = stage["abstraction"]["sizes"]["triangles"]
+            points[name].append((triangles, wall, cpu, peak))
+            cells = [f"{_median([_stage_seconds(r, c) for r in runs]):.2f}" for c in STAGE_COLUMNS]
+            nodes = stage["plan"]["sizes"].get("product nodes", "?")
+            print(
+                f"| {label} | {name} | {triangles:,} | {nodes:,} | {wall:.2f} | {cpu:.2f} | "
+                f"{peak:.0f} | " + " | ".join(cells) + " |"
+            )
+    for name, curve in points.items():
+        if len(curve) >= 2:
+            xs = [float(p[0]) for p in curve]
+            print(
+                f"\nGrowth exponents of {name} (time ~ triangles^k, least squares on log-log): "
+                f"wall {_fit(xs, [p[1] for p in curve]):.2f}, "
+                f"CPU {_fit(xs, [p[2] for p in curve]):.2f}, "
+                f"peak memory {_fit(xs, [p[3] for p in curve]):.2f}"
+            )
+    return points
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python bench/bench_shell.py", description=__doc__)
     parser.add_argument("--rounds", type=int, default=5, help="rounds of the side-by-side runs")
@@ -317,67 +385,7 @@ def main(argv: list[str] | None = None) -> int:
         # --- scaling ----------------------------------------------------------------------
         grids = [s for s in args.scaling.split(",") if s]
         if grids:
-            print("\n## Scaling on grid maps (fresh interpreter per run, median)\n")
-            print(
-                "| grid | triangles | product nodes | wall s | CPU s | peak MB | "
-                + "load | abstraction | plan | control | simulate | verify | plot |"
-            )
-            print("|---|---:|---:|---:|---:|---:|" + "---:|" * 7)
-            points = []
-            for label in grids:
-                n = SCALING[label]
-                document = grid_of_rooms(n)
-                mission = write_mission(document, scratch)
-                runs = []
-                repeats = args.scaling_rounds if n <= 200 else 1
-                for _ in range(repeats):
-                    print(f"grid {label} ...", file=sys.stderr, flush=True)
-                    runs.append(
-                        _run(
-                            ROOT,
-                            [
-                                "compile",
-                                str(mission),
-                                "-o",
-                                str(scratch / f"g{n}"),
-                                "-q",
-                                "--force",
-                            ],
-                            scratch,
-                        )
-                    )
-                summary = runs[-1]["summary"]
-                stage = {s["name"]: s for s in summary["stages"]}
-                wall = _median([r["wall_seconds"] for r in runs])
-                cpu = _median([r["cpu_seconds"] for r in runs])
-                peak = max(r["peak_rss_mb"] for r in runs)
-                triangles = stage["abstraction"]["sizes"]["triangles"]
-                points.append((triangles, wall, cpu, peak))
-                stage_cells = [
-                    f"{_median([next(s['seconds'] for s in r['summary']['stages'] if s['name'] == name) for r in runs]):.2f}"  # noqa: E501
-                    for name in (
-                        "load",
-                        "abstraction",
-                        "plan",
-                        "control",
-                        "simulate",
-                        "verify",
-                        "plot",
-                    )
-                ]
-                print(
-                    f"| {label} | {triangles:,} | {stage['plan']['sizes'].get('product nodes', '?'):,} | "  # noqa: E501
-                    f"{wall:.2f} | {cpu:.2f} | {peak:.0f} | " + " | ".join(stage_cells) + " |"
-                )
-            report["scaling"] = points
-            if len(points) >= 2:
-                xs = [p[0] for p in points]
-                print(
-                    "\nGrowth exponents (time ~ triangles^k, least squares on log-log): "
-                    f"wall {_fit(xs, [p[1] for p in points]):.2f}, "
-                    f"CPU {_fit(xs, [p[2] for p in points]):.2f}, "
-                    f"peak memory {_fit(xs, [p[3] for p in points]):.2f}"
-                )
+            report["scaling"] = _scaling(grids, trees, scratch, args.scaling_rounds)
     if args.json is not None:
         args.json.write_text(json.dumps(report, indent=2, default=str) + "\n", encoding="utf-8")
     return 0

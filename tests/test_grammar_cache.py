@@ -1,4 +1,7 @@
-"""The LTL parser is built once and reused from the per-user cache; a bad cache is harmless."""
+"""The LTL parser is built once and reused from the per-user cache; a bad cache is harmless.
+
+(The lark parser itself: plain formulas are read without it, see tests/ltl/test_ltl_reader.py.)
+"""
 
 from __future__ import annotations
 
@@ -10,7 +13,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 
 _PROGRAM = (
-    "from tlmpc.ltl.parser import parse_ltl\n"
+    "from tlmpc.ltl.lark_parser import parse_ltl\n"
     "from tlmpc.ltl.printer import to_text\n"
     "print(to_text(parse_ltl('G (a -> F b) & !c U d')))\n"
 )

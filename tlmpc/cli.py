@@ -18,7 +18,6 @@ import os
 import signal
 import sys
 import threading
-import traceback
 import typing
 from collections.abc import Sequence
 from types import ModuleType
@@ -238,6 +237,8 @@ def _main(argv: Sequence[str] | None, out: TextIO, err: TextIO) -> int:
         err.write(
             "tlmpc: internal error (exit 3). Please report it with the input that caused it:\n"
         )
+        import traceback  # only for a bug's report: not imported on every start
+
         err.write(traceback.format_exc())
         reporter.diagnose(
             [

@@ -24,8 +24,6 @@ Safety rules, each of which guards a way user data was once lost:
 from __future__ import annotations
 
 import contextlib
-import ctypes
-import ctypes.util
 import errno
 import os
 import shutil
@@ -323,11 +321,20 @@ _AT_FDCWD = -100
 
 def _exchange(a: Path, b: Path) -> bool:
     """Swap two paths atomically (Linux ``renameat2``); False when the system cannot."""
+    import ctypes  # here, not at the top: only a recompile over an earlier output needs it
+
     try:
-        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
-        renameat2 = libc.renameat2
+        # The interpreter's own symbols include the C library's; searching for libc by name
+        # (ctypes.util.find_library) would run ldconfig in a subprocess first.
+        renameat2 = ctypes.CDLL(None, use_errno=True).renameat2
     except (OSError, AttributeError):
-        return False
+        try:
+            import ctypes.util
+
+            libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
+            renameat2 = libc.renameat2
+        except (OSError, AttributeError):
+            return False
     renameat2.argtypes = [
         ctypes.c_int,
         ctypes.c_char_p,

@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from html import escape
+from itertools import chain
 from typing import TYPE_CHECKING
 
 from tlmpc.plot_scene import Path, Point, Region, Scene, viridis
@@ -82,6 +83,29 @@ def _label_position(canvas: _Canvas, region: Region) -> tuple[float, float, str]
 
 def _polygon_path(canvas: _Canvas, polygon: Sequence[Point]) -> str:
     return "M" + "L".join(canvas.xy(p) for p in polygon) + "Z"
+
+
+#: From this many polygons on, their paths are formatted in one pass over a numpy array.
+_BATCH_FROM = 64
+
+
+def _polygon_paths(canvas: _Canvas, polygons: Sequence[Sequence[Point]]) -> list[str]:
+    """:func:`_polygon_path` of each polygon, the same text.
+
+    Many polygons (maps with thousands of rooms) are mapped to pixels with numpy, by the
+    same float operations as :meth:`_Canvas.xy`, and written with one ``%``-format (``%.1f``
+    formats as ``:.1f`` does).
+    """
+    if len(polygons) < _BATCH_FROM:
+        return [_polygon_path(canvas, polygon) for polygon in polygons]
+    import numpy as np
+
+    coords = np.array(list(chain.from_iterable(polygons)), dtype=np.float64).reshape(-1, 2)
+    pixels = np.empty_like(coords)
+    pixels[:, 0] = canvas.left + (coords[:, 0] - canvas.x0) * canvas.scale
+    pixels[:, 1] = canvas.top + (canvas.y1 - coords[:, 1]) * canvas.scale
+    template = "\n".join("M" + "L".join(["%.1f %.1f"] * len(p)) + "Z" for p in polygons)
+    return (template % tuple(pixels.ravel().tolist())).split("\n")
 
 
 def _polyline(canvas: _Canvas, points: Sequence[Point]) -> str:
@@ -275,10 +299,11 @@ def render_svg(scene: Scene) -> bytes:
                 d = "".join(_polygon_path(canvas, ring) for ring in rings)
                 parts.append(f'<path d="{d}" fill="{colour}" stroke="#000" stroke-width="1.2"/>')
     by_colour: dict[tuple[str, bool], list[str]] = {}
-    for region in scene.regions:
+    region_paths = _polygon_paths(canvas, [region.polygon for region in scene.regions])
+    for region, path in zip(scene.regions, region_paths, strict=True):
         emphasised = scene.emphasise_task_regions and region.named_by_task
         key = ("#1f1f1f" if emphasised else region.colour, emphasised)
-        by_colour.setdefault(key, []).append(_polygon_path(canvas, region.polygon))
+        by_colour.setdefault(key, []).append(path)
     for (colour, emphasised), paths in sorted(by_colour.items()):
         opacity = "0.8" if emphasised else "0.3"
         parts.append(

@@ -356,3 +356,23 @@ def test_the_bulk_budget_sends_huge_lists_the_ordinary_way(
     assert doc is not None
     assert doc.bulk == {}
     assert doc.data == yaml.safe_load(text)
+
+
+def test_a_short_list_where_a_run_starts_is_not_cut_out() -> None:
+    # The run of number characters starts after the word in the first point; the list the
+    # JSON decoder reads there is that one short point.  Cut out, its placeholder (longer
+    # than the point) moved every later column of the line (found by the property above).
+    points = [[f"{k}.5", f"{-k}.25"] for k in range(400)]
+    points[0][1] = '"far"'
+    rows = [
+        ", ".join(f"[{x}, {y}]" for x, y in points[i : i + 7]) for i in range(0, len(points), 7)
+    ]
+    text = "a: [" + ",\n   ".join(rows) + "]\nb: 1\n"
+    fast_doc, fast_problems = _fast(text)
+    slow_doc, slow_problems = _ordinary(text)
+    assert fast_problems == slow_problems
+    assert fast_doc is not None
+    assert slow_doc is not None
+    for index in range(12):
+        path = ("a", index, 0)
+        assert fast_doc.value_at(path) == slow_doc.value_at(path), path

@@ -3,12 +3,11 @@
 from __future__ import annotations
 
 import time
+from itertools import chain
 from typing import Any
 
 import numpy as np
 import shapely
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
 
 from tlmpc.abstraction.layout import PlanningLayout
 from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
@@ -49,38 +48,74 @@ def locate_in(vertices: FloatArray, triangles: IntArray, point: tuple[float, flo
 def _labels(
     mission: Mission, vertices: FloatArray, triangles: IntArray, shapes: list[Any]
 ) -> tuple[IntArray, tuple[tuple[str, ...], ...]]:
+    """Each triangle's letter (the set of regions holding its centroid) and the letters,
+    ordered by size, then by names."""
     centroids = vertices[triangles].mean(axis=1)
     names = [r.name for r in mission.regions]
     tree = shapely.STRtree(shapes)
     hits = tree.query(shapely.points(centroids), predicate="within")
-    order = np.lexsort((hits[1], hits[0]))
-    tri_of, region_of = hits[0][order], hits[1][order]
-    letters: dict[tuple[str, ...], int] = {(): 0}
-    letter_of = np.zeros(len(triangles), dtype=np.int64)
-    if len(tri_of):
-        boundaries = np.flatnonzero(np.diff(tri_of)) + 1
-        starts = np.concatenate([[0], boundaries])
-        ends = np.concatenate([boundaries, [len(tri_of)]])
-        for start, end in zip(starts.tolist(), ends.tolist(), strict=True):
-            key = tuple(sorted(names[i] for i in region_of[start:end].tolist()))
-            letter_of[tri_of[start]] = letters.setdefault(key, len(letters))
-    ordered = sorted(letters, key=lambda k: (len(k), k))
-    remap = np.array([0] * len(letters), dtype=np.int64)
-    for new_index, key in enumerate(ordered):
-        remap[letters[key]] = new_index
-    return remap[letter_of], tuple(ordered)
+    tri_of, region_of = hits[0], hits[1]
+    # Most triangles lie in at most one region: their letters come from numpy, only the
+    # triangles in several regions (overlaps) are keyed one by one.
+    count = np.bincount(tri_of, minlength=len(triangles))
+    alone = count[tri_of] == 1
+    single_region = np.zeros(len(triangles), dtype=np.int64)
+    single_region[tri_of[alone]] = region_of[alone]
+    single = np.flatnonzero(count == 1)
+    used, single_key = np.unique(single_region[single], return_inverse=True)
+    several: dict[int, list[str]] = {}
+    for t, r in zip(tri_of[~alone].tolist(), region_of[~alone].tolist(), strict=True):
+        several.setdefault(t, []).append(names[r])
+    several_keys = {t: tuple(sorted(found)) for t, found in several.items()}
+    # Ordered by size, then by names: the empty letter, the single regions by name, then
+    # the overlaps (sorting plain names is cheaper than sorting keyed tuples).
+    used_names = [names[r] for r in used.tolist()]
+    single_names = sorted(set(used_names))
+    ordered = [(), *((name,) for name in single_names)]
+    ordered += sorted(set(several_keys.values()), key=lambda k: (len(k), k))
+    # A single region's letter index: 1 + its name's rank among the single names.
+    rank = {name: k for k, name in enumerate(single_names, start=1)}
+    index = {key: k for k, key in enumerate(ordered)}
+    letter_of = np.zeros(len(triangles), dtype=np.int64)  # index 0: the empty letter
+    letter_of[single] = np.array([rank[name] for name in used_names], dtype=np.int64)[
+        single_key.reshape(-1)
+    ]
+    for t, key in several_keys.items():
+        letter_of[t] = index[key]
+    return letter_of, tuple(ordered)
 
 
 def _components(neighbors: IntArray) -> IntArray:
+    """Connected components of the triangle adjacency, numbered by their lowest triangle.
+
+    That numbering is the one of a search started from each unlabelled triangle in index
+    order (scipy's ``connected_components``), computed with numpy alone so that the stage
+    does not import scipy (a fifth of a cold compile).  Union-find by hooking: every root
+    points to the smallest root it shares an edge with, then paths are halved until every
+    triangle points to its root; each round merges at least one pair of roots, so the loop
+    ends, and on meshes it takes a handful of rounds.
+    """
     count = len(neighbors)
-    rows = np.repeat(np.arange(count), 3)
-    cols = neighbors.reshape(-1)
-    keep = cols >= 0
-    graph = coo_matrix(
-        (np.ones(int(keep.sum()), dtype=np.int8), (rows[keep], cols[keep])), shape=(count, count)
-    )
-    _, labels = connected_components(graph, directed=False)
-    return np.asarray(labels, dtype=np.int64)
+    first = np.repeat(np.arange(count, dtype=np.int64), neighbors.shape[1] if count else 0)
+    second = neighbors.reshape(-1).astype(np.int64, copy=False)
+    keep = second >= 0  # -1: no neighbour across that side
+    first, second = first[keep], second[keep]
+    root = np.arange(count, dtype=np.int64)  # invariant: root[t] <= t
+    while len(first):
+        a, b = root[first], root[second]
+        apart = a != b
+        if not apart.any():
+            break
+        first, second, a, b = first[apart], second[apart], a[apart], b[apart]
+        np.minimum.at(root, np.maximum(a, b), np.minimum(a, b))
+        while True:
+            jumped = root[root]
+            if np.array_equal(jumped, root):
+                break
+            root = jumped
+    # The root of a component is its lowest triangle: number components in that order.
+    _, labels = np.unique(root, return_inverse=True)
+    return np.asarray(labels, dtype=np.int64).reshape(-1)
 
 
 def build_abstraction(mission: Mission, layout: PlanningLayout | None = None) -> Abstraction:
@@ -135,30 +170,36 @@ def build_abstraction(mission: Mission, layout: PlanningLayout | None = None) ->
 
 
 def _min_angle(corners: FloatArray) -> FloatArray:
-    def angle(p: FloatArray, q: FloatArray, r: FloatArray) -> FloatArray:
-        u, v = q - p, r - p
-        cos = (u * v).sum(axis=1) / (np.linalg.norm(u, axis=1) * np.linalg.norm(v, axis=1))
-        degrees: FloatArray = np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
-        return degrees
+    """Each triangle's smallest angle in degrees.
 
+    arccos is decreasing, so the smallest angle is the arccos of the largest cosine: one
+    arccos per triangle instead of three, and each side's length computed once (a side's
+    length does not depend on its direction), which gives the same floats.
+    """
     a, b, c = corners[:, 0], corners[:, 1], corners[:, 2]
-    return np.minimum(np.minimum(angle(a, b, c), angle(b, c, a)), angle(c, a, b))
+    ab, bc, ca = b - a, c - b, a - c
+    length_ab = np.linalg.norm(ab, axis=1)
+    length_bc = np.linalg.norm(bc, axis=1)
+    length_ca = np.linalg.norm(ca, axis=1)
+    # the angle at a is between b - a and c - a (= -ca), and so on around the triangle
+    cos_a = (ab * -ca).sum(axis=1) / (length_ab * length_ca)
+    cos_b = (bc * -ab).sum(axis=1) / (length_bc * length_ab)
+    cos_c = (ca * -bc).sum(axis=1) / (length_ca * length_bc)
+    largest = np.maximum(np.maximum(cos_a, cos_b), cos_c)
+    degrees: FloatArray = np.degrees(np.arccos(np.clip(largest, -1.0, 1.0)))
+    return degrees
 
 
 def abstraction_diagnostics(abstraction: Abstraction, mission: Mission) -> list[Diagnostic]:
     """Warnings: regions that got no triangle, regions unreachable from the start."""
-    used = set(np.unique(abstraction.letter_of).tolist())
+    # Which letters occur (anywhere, and in the start's component): counts, not a sort.
+    letters = len(abstraction.letters)
+    used = np.flatnonzero(np.bincount(abstraction.letter_of, minlength=letters)).tolist()
     start_component = abstraction.component[abstraction.start]
-    reachable = set(
-        np.unique(abstraction.letter_of[abstraction.component == start_component]).tolist()
-    )
-    present: set[str] = set()
-    near: set[str] = set()
-    for index, letter in enumerate(abstraction.letters):
-        if index in used:
-            present.update(letter)
-        if index in reachable:
-            near.update(letter)
+    near_start = abstraction.letter_of[abstraction.component == start_component]
+    reachable = np.flatnonzero(np.bincount(near_start, minlength=letters)).tolist()
+    present = set(chain.from_iterable(map(abstraction.letters.__getitem__, used)))
+    near = set(chain.from_iterable(map(abstraction.letters.__getitem__, reachable)))
     problems = []
     for region in mission.regions:
         if region.name not in present:

@@ -20,12 +20,12 @@ def abstraction_to_json(abstraction: Abstraction) -> dict[str, Any]:
         "vertices": abstraction.vertices.tolist(),
         "triangles": abstraction.triangles.tolist(),
         "neighbors": abstraction.neighbors.tolist(),
-        "labels": [letters[i] for i in abstraction.letter_of.tolist()],
+        "labels": list(map(letters.__getitem__, abstraction.letter_of.tolist())),
         "letters": letters,
         "letter_of": abstraction.letter_of.tolist(),
         "start": abstraction.start,
         "components": abstraction.component.tolist(),
-        "regions": {name: [list(p) for p in poly] for name, poly in abstraction.regions.items()},
+        "regions": {name: list(map(list, poly)) for name, poly in abstraction.regions.items()},
         "stats": dict(abstraction.stats),
     }
 

@@ -59,10 +59,15 @@ def cells_in(
 ) -> tuple[StartCell, ...]:
     """:func:`start_cells` on raw arrays."""
     corners = vertices[triangles]
-    low, high = corners.min(axis=1), corners.max(axis=1)
     x, y = float(point[0]), float(point[1])
+    # Bounding boxes column by column (a reduction over an axis of three is several times
+    # slower on a million triangles).
+    xs, ys = corners[:, :, 0], corners[:, :, 1]
     candidates = np.flatnonzero(
-        (low[:, 0] <= x) & (x <= high[:, 0]) & (low[:, 1] <= y) & (y <= high[:, 1])
+        (np.minimum(np.minimum(xs[:, 0], xs[:, 1]), xs[:, 2]) <= x)
+        & (x <= np.maximum(np.maximum(xs[:, 0], xs[:, 1]), xs[:, 2]))
+        & (np.minimum(np.minimum(ys[:, 0], ys[:, 1]), ys[:, 2]) <= y)
+        & (y <= np.maximum(np.maximum(ys[:, 0], ys[:, 1]), ys[:, 2]))
     )
     p = (Fraction(x), Fraction(y))
     cells: list[StartCell] = []

@@ -179,7 +179,10 @@ def cut_out(text: str) -> tuple[str, dict[str, BulkList]]:
             value, end = _decode(text, start)
         except (ValueError, RecursionError):
             continue
-        if not isinstance(value, list):
+        if not isinstance(value, list) or end - start < MIN_CHARS:
+            # A short list where a run starts (its first item of a list that holds a word,
+            # say) stays with the YAML reader: a placeholder longer than a list on one line
+            # would move everything after it on that line.
             continue
         span = text[start:end]
         numbers: str | None = span

@@ -530,7 +530,7 @@ def _load(text: str, file: str, stem: str) -> tuple[Mission | None, list[Diagnos
 
 
 def _load_data(text: str, file: str, stem: str) -> tuple[Mission | None, list[Diagnostic]]:
-    doc, problems = load_positioned(text, file)
+    doc, problems = load_positioned(text, file, lazy=True)
     if doc is None:
         return None, problems
     if problems:  # non-finite numbers, duplicate keys: the schema would mislead after these

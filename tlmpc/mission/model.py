@@ -67,7 +67,7 @@ class Workspace:
         only when there are any)."""
 
         def poly(p: Polygon) -> list[list[float]]:
-            return [[x, y] for x, y in p]
+            return list(map(list, p))
 
         document: dict[str, Any] = {
             "boundary": poly(self.boundary),
@@ -178,7 +178,7 @@ class Mission:
         from tlmpc.ltl.printer import to_text
 
         def poly(p: Polygon) -> list[list[float]]:
-            return [[x, y] for x, y in p]
+            return list(map(list, p))
 
         return {
             "format": "tlmpc.mission/1",

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -42,15 +42,30 @@ class PositionedDocument:
     block: dict[Path, bool] = field(default_factory=dict)
     #: Long number lists read in bulk: positions inside them are found on demand.
     bulk: dict[Path, BulkList] = field(default_factory=dict)
+    #: Lists whose plain numbers were read without their positions (``lazy`` reading) ...
+    unplaced: set[Path] = field(default_factory=set)
+    #: ... and how to read the whole document again with every position, when one is asked.
+    reread: Callable[[], PositionedDocument | None] | None = None
 
     def value_at(self, path: Path) -> tuple[int, int]:
         """Position of the value at ``path``, or of its deepest known ancestor."""
         for cut in range(len(path), -1, -1):
             prefix = path[:cut]
+            if cut < len(path) and prefix in self.unplaced and self.reread is not None:
+                self._place_all()
+                return self.value_at(path)
             if prefix in self.values:
                 inside = self.bulk[prefix].locate(path[cut:]) if prefix in self.bulk else None
                 return inside or self.values[prefix]
         return (1, 1)
+
+    def _place_all(self) -> None:
+        """Take every position from a reading that records them all (diagnostics only)."""
+        full = self.reread() if self.reread is not None else None
+        self.reread = None
+        self.unplaced = set()
+        if full is not None:
+            self.values, self.keys, self.bulk = full.values, full.keys, full.bulk
 
     def key_at(self, path: Path) -> tuple[int, int]:
         """Position of the key of the entry at ``path`` (its value's when not a mapping entry)."""
@@ -83,11 +98,13 @@ _FAST_FLOAT = re.compile(r"[-+]?[0-9]{1,15}\.[0-9]{0,17}")
 class _Frame:
     """An open mapping or sequence while the event stream is read."""
 
-    __slots__ = ("anchor", "container", "key", "path", "seen", "size")
+    __slots__ = ("anchor", "container", "key", "path", "seen", "shallow", "size", "unplaced")
 
     def __init__(self, container: Any, path: Path, anchor: str | None) -> None:
         self.container = container
         self.path = path
+        self.shallow = len(path) < MAX_DEPTH  # an item's path is within the depth limit
+        self.unplaced = False  # a number in it was read without recording its position
         self.anchor = anchor
         self.key: Any = _NO_KEY  # a mapping's pending key (text) or a bad-key marker
         self.seen: dict[str, tuple[int, int]] = {}
@@ -112,8 +129,12 @@ class _Converter:
     additions.  Aliased data is shared, never copied; positions inside it are the alias's.
     """
 
-    def __init__(self, file: str, lists: dict[str, BulkList] | None = None) -> None:
+    def __init__(
+        self, file: str, lists: dict[str, BulkList] | None = None, *, lazy: bool = False
+    ) -> None:
         self.file = file
+        #: Record no position for plain numbers in lists (see PositionedDocument.reread).
+        self.lazy = lazy
         #: Lists cut out of the text (see tlmpc.mission.bulk) by placeholder, until met.
         self.lists = dict(lists or {})
         #: A placeholder was met where a whole list could not be: read the original text.
@@ -179,26 +200,82 @@ class _Converter:
         stack: list[_Frame] = []
         documents = 0
         values = self.doc.values
+        # The loop runs once per YAML value (a million on large maps): names bound locally.
+        scalar_event = yaml.ScalarEvent
+        mapping_start, sequence_start = yaml.MappingStartEvent, yaml.SequenceStartEvent
+        ends = (yaml.MappingEndEvent, yaml.SequenceEndEvent)
+        fast_float = _FAST_FLOAT.fullmatch
+        fast_int = _FAST_INT.fullmatch
+        lazy = self.lazy
         for event in events:
-            if type(event) is yaml.ScalarEvent and stack:  # fast path: a number in a list
+            kind = type(event)
+            if kind in ends and stack:  # as below, without the checks before it
+                frame = stack.pop()
+                if frame.unplaced:
+                    self.doc.unplaced.add(frame.path)
+                if frame.anchor is not None:
+                    self.anchors[frame.anchor] = (frame.container, frame.size)
+                if stack:
+                    stack[-1].size += frame.size
+                continue
+            if (kind is mapping_start or kind is sequence_start) and stack:
+                # A container as a list item or as the value of a named key: as below.
+                frame = stack[-1]
+                holder = frame.container
+                if type(holder) is list:
+                    path: Path | None = (*frame.path, len(holder))
+                elif type(holder) is dict and type(frame.key) is str:
+                    path = (*frame.path, frame.key)
+                else:
+                    path = None
+                if path is not None and len(path) <= MAX_DEPTH and self.count < MAX_NODES:
+                    self.count += 1
+                    mark = event.start_mark
+                    values[path] = (mark.line + 1, mark.column + 1)
+                    opened: Any = {} if kind is mapping_start else []
+                    if type(holder) is list:
+                        holder.append(opened)
+                    else:
+                        holder[frame.key] = opened
+                        frame.key = _NO_KEY
+                    stack.append(_Frame(opened, path, event.anchor))
+                    continue
+            if kind is scalar_event and stack:
                 frame = stack[-1]
                 items = frame.container
+                if type(items) is dict and frame.key is _NO_KEY:  # a key: as below, directly
+                    key = str(event.value)
+                    if key in frame.seen or (self.lists and STEM in key):
+                        self._key(frame, event)  # a duplicate, or a placeholder as a key
+                    else:  # what _key does with a new plain key
+                        mark = event.start_mark
+                        position = (mark.line + 1, mark.column + 1)
+                        frame.seen[key] = position
+                        self.doc.keys[(*frame.path, key)] = position
+                        frame.key = key
+                    continue
+                # fast path: a number in a list
                 if (
                     type(items) is list
                     and not event.style
                     and event.tag is None
                     and event.anchor is None
-                    and len(frame.path) < MAX_DEPTH
+                    and frame.shallow
                     and self.count < MAX_NODES
                 ):
+                    text = event.value
                     number: float | int | None = None
-                    if _FAST_FLOAT.fullmatch(event.value):
-                        number = float(event.value)
-                    elif _FAST_INT.fullmatch(event.value):
-                        number = int(event.value)
+                    if fast_float(text):
+                        number = float(text)
+                    elif fast_int(text):
+                        number = int(text)
                     if number is not None:
                         self.count += 1
-                        values[(*frame.path, len(items))] = _mark(event)
+                        if lazy:
+                            frame.unplaced = True
+                        else:
+                            mark = event.start_mark
+                            values[(*frame.path, len(items))] = (mark.line + 1, mark.column + 1)
                         items.append(number)
                         frame.size += 1
                         continue
@@ -214,6 +291,8 @@ class _Converter:
                 continue
             if isinstance(event, (yaml.MappingEndEvent, yaml.SequenceEndEvent)):
                 frame = stack.pop()
+                if frame.unplaced:
+                    self.doc.unplaced.add(frame.path)
                 if frame.anchor is not None:
                     self.anchors[frame.anchor] = (frame.container, frame.size)
                 if stack:
@@ -361,11 +440,26 @@ def _as_yaml_float(text: str) -> str:
     return f"{mantissa}e{exponent}"
 
 
-def load_positioned(text: str, file: str) -> tuple[PositionedDocument | None, list[Diagnostic]]:
-    """Parse YAML ``text``; return the data with positions, or None and the diagnostics."""
+def load_positioned(
+    text: str, file: str, *, lazy: bool = False
+) -> tuple[PositionedDocument | None, list[Diagnostic]]:
+    """Parse YAML ``text``; return the data with positions, or None and the diagnostics.
+
+    ``lazy``: the plain numbers of lists get no position while reading (a tenth of the time
+    on large maps); the first question about one reads the text again with every position.
+    """
+    doc, problems = _load_positioned(text, file, lazy)
+    if doc is not None and doc.unplaced:
+        doc.reread = lambda: _load_positioned(text, file, False)[0]
+    return doc, problems
+
+
+def _load_positioned(
+    text: str, file: str, lazy: bool
+) -> tuple[PositionedDocument | None, list[Diagnostic]]:
     cut, lists = cut_out(text)
     if lists:
-        converter = _Converter(file, lists)
+        converter = _Converter(file, lists, lazy=lazy)
         outcome = _convert(converter, cut)
         # The answer stands when every placeholder met was a whole list in a value's place:
         # the text up to where reading stopped then means the same as the original.
@@ -380,7 +474,7 @@ def load_positioned(text: str, file: str) -> tuple[PositionedDocument | None, li
                     return _result(converter, outcome, file)
             elif outcome is None or not converter.lists:  # a limit stopped it, or all met
                 return _result(converter, outcome, file)
-    converter = _Converter(file)
+    converter = _Converter(file, lazy=lazy)
     return _result(converter, _convert(converter, text), file)
 
 
@@ -405,7 +499,13 @@ def _ends_on_line(converter: _Converter, mark: Any) -> bool:
 def _convert(converter: _Converter, text: str) -> bool | yaml.YAMLError | None:
     """Whether ``text`` held a document; None when a limit stopped reading; or the error."""
     try:
-        return converter.convert(yaml.parse(text, Loader=_LOADER))
+        # The loader's events without yaml.parse's generator around them (a tenth of the
+        # reading time); get_event gives None after the stream's end.
+        loader = _LOADER(text)
+        try:
+            return converter.convert(iter(loader.get_event, None))
+        finally:
+            loader.dispose()
     except _TooBig:
         return None
     except yaml.YAMLError as exc:

@@ -1,0 +1,427 @@
+"""Parse LTL text with lark into the AST of :mod:`tlmpc.ltl.ast`, keeping source positions.
+
+The reference parser and the one that words every syntax error; :mod:`tlmpc.ltl.parser`
+tries a lark-free reader first (see :mod:`tlmpc.ltl.reader`).
+
+``parse_ltl(text, file=..., line=..., col=...)`` takes the position where ``text`` starts in
+its file (an LTL string inside a YAML mission), so every diagnostic and every node's span
+points into the user's file.  Problems raise :class:`~tlmpc.errors.InvalidInputError` with
+L-coded diagnostics; no input, however malformed, produces a traceback.
+"""
+
+from __future__ import annotations
+
+import functools
+from collections.abc import Callable
+from importlib import resources
+from typing import Any
+
+from lark import Lark, Token, Transformer, Tree, v_args
+from lark.exceptions import (
+    LarkError,
+    UnexpectedCharacters,
+    UnexpectedEOF,
+    UnexpectedToken,
+    VisitError,
+)
+
+from tlmpc.errors import Diagnostic, InvalidInputError, error
+from tlmpc.grammar_cache import lalr_parser
+from tlmpc.ltl.ast import (
+    And,
+    Const,
+    Equiv,
+    Eventually,
+    Formula,
+    Globally,
+    Implies,
+    Not,
+    Or,
+    Prop,
+    Release,
+    Span,
+    StrongRelease,
+    Until,
+    WeakUntil,
+)
+from tlmpc.ltl.keywords import KEYWORDS  # re-exported: words that cannot name a region
+
+#: Nesting deeper than this is refused (L005) instead of exhausting the Python stack.
+MAX_DEPTH = 400
+
+_NEXT_HINT = (
+    "Next (X) has no meaning in continuous time: a robot has no 'next instant'. tlmpc keeps "
+    "formulas stutter-invariant, which is what makes the discrete plan sound for the "
+    "continuous robot; say what must happen eventually (F) or until something (U) instead"
+)
+
+_BINARY_TEMPORAL: dict[str, Callable[..., Formula]] = {
+    "U": Until,
+    "R": Release,
+    "V": Release,
+    "W": WeakUntil,
+    "M": StrongRelease,
+}
+
+
+@functools.cache
+def _parser() -> Lark:
+    grammar = (resources.files("tlmpc.ltl") / "ltl.lark").read_text(encoding="utf-8")
+    parser: Lark = lalr_parser(grammar, propagate_positions=True, maybe_placeholders=False)
+    return parser
+
+
+class _Positions:
+    """Shifts lark's 1-based positions (relative to the text) into the user's file."""
+
+    def __init__(self, line: int, col: int) -> None:
+        self.line = line
+        self.col = col
+
+    def at(self, line: int, col: int) -> tuple[int, int]:
+        if line == 1:
+            return self.line, self.col + col - 1
+        return self.line + line - 1, col
+
+    def span(self, line: int, col: int, end_line: int, end_col: int) -> Span:
+        start = self.at(line, col)
+        end = self.at(end_line, end_col)
+        return Span(start[0], start[1], end[0], end[1])
+
+
+def _token_span(pos: _Positions, token: Token) -> Span:
+    return pos.span(
+        token.line or 1,
+        token.column or 1,
+        token.end_line or token.line or 1,
+        token.end_column or (token.column or 1) + len(token),
+    )
+
+
+def unquote(token: str) -> str:
+    """The name inside a quoted proposition: ``\\n`` is a newline, ``\\x`` is ``x``."""
+    body = token[1:-1]
+    if "\\" not in body:
+        return body
+    out = []
+    chars = iter(body)
+    for char in chars:
+        if char == "\\":
+            escaped = next(chars, "")
+            out.append("\n" if escaped == "n" else escaped)
+        else:
+            out.append(char)
+    return "".join(out)
+
+
+class _ToAst(Transformer[Token, Formula]):
+    def __init__(self, pos: _Positions, file: str | None) -> None:
+        super().__init__()
+        self.pos = pos
+        self.file = file
+        #: Operator keywords used as bare proposition names (L030), reported after the walk.
+        self.keyword_names: list[Diagnostic] = []
+
+    def _span(self, meta: Any) -> Span | None:
+        if getattr(meta, "empty", True):
+            return None
+        return self.pos.span(meta.line, meta.column, meta.end_line, meta.end_column)
+
+    @v_args(meta=True)
+    def true_const(self, meta: Any, children: list[Token]) -> Formula:
+        return Const(True, span=_token_span(self.pos, children[0]))
+
+    @v_args(meta=True)
+    def false_const(self, meta: Any, children: list[Token]) -> Formula:
+        return Const(False, span=_token_span(self.pos, children[0]))
+
+    @v_args(meta=True)
+    def prop(self, meta: Any, children: list[Token]) -> Formula:
+        name = str(children[0])
+        span = _token_span(self.pos, children[0])
+        if name in KEYWORDS:
+            # The contextual lexer reads `U` as a name where no operator can stand (`U U U`).
+            self.keyword_names.append(
+                error(
+                    "L030",
+                    f"{name!r} is an operator of the language, not a proposition name",
+                    hint=f'write "{name}" in double quotes to name a region {name}',
+                    file=self.file,
+                    line=span.line,
+                    col=span.col,
+                )
+            )
+        return Prop(name, span=span)
+
+    @v_args(meta=True)
+    def quoted_prop(self, meta: Any, children: list[Token]) -> Formula:
+        return Prop(unquote(str(children[0])), span=_token_span(self.pos, children[0]))
+
+    @v_args(meta=True)
+    def not_op(self, meta: Any, children: list[Any]) -> Formula:
+        return Not(children[1], span=self._span(meta))
+
+    @v_args(meta=True)
+    def unary_op(self, meta: Any, children: list[Any]) -> Formula:
+        operators, operand = str(children[0]), children[1]
+        if operators == "<>":
+            operators = "F"
+        elif operators == "[]":
+            operators = "G"
+        result: Formula = operand
+        for symbol in reversed(operators):
+            # X/N were rejected before the transformation; only F and G reach here.
+            result = (
+                Eventually(result, span=self._span(meta))
+                if symbol == "F"
+                else Globally(result, span=self._span(meta))
+            )
+        return result
+
+    @v_args(meta=True)
+    def temporal_op(self, meta: Any, children: list[Any]) -> Formula:
+        left, op, right = children
+        return _BINARY_TEMPORAL[str(op)](left, right, span=self._span(meta))
+
+    @v_args(meta=True)
+    def and_op(self, meta: Any, children: list[Any]) -> Formula:
+        return And(tuple(c for c in children if not isinstance(c, Token)), span=self._span(meta))
+
+    @v_args(meta=True)
+    def or_op(self, meta: Any, children: list[Any]) -> Formula:
+        return Or(tuple(c for c in children if not isinstance(c, Token)), span=self._span(meta))
+
+    @v_args(meta=True)
+    def implies_op(self, meta: Any, children: list[Any]) -> Formula:
+        return Implies(children[0], children[2], span=self._span(meta))
+
+    @v_args(meta=True)
+    def equiv_op(self, meta: Any, children: list[Any]) -> Formula:
+        return Equiv(children[0], children[2], span=self._span(meta))
+
+
+_EXPECTED_NAMES = {
+    "NAME": "a region name",
+    "STRING": "a quoted name",
+    "TRUE": "true",
+    "FALSE": "false",
+    "LPAR": "'('",
+    "RPAR": "')'",
+    "NOT": "'!'",
+    "UNARY_CHAIN": "F or G",
+    "EVENTUALLY": "'<>'",
+    "ALWAYS": "'[]'",
+    "AND": "'&'",
+    "OR": "'|'",
+    "IMPLIES": "'->'",
+    "EQUIV": "'<->'",
+    "BINTEMP": "U, R, W or M",
+    "$END": "the end of the formula",
+}
+
+
+_OPERAND_STARTS = frozenset(
+    {"NAME", "STRING", "TRUE", "FALSE", "LPAR", "NOT", "UNARY_CHAIN", "EVENTUALLY", "ALWAYS"}
+)
+_OPERAND = "an operand (a region name, true, false, '(' or one of ! F G [] <>)"
+
+
+def _describe_expected(expected: set[str] | frozenset[str], open_parens: int = 1) -> str:
+    expected = set(expected)
+    if open_parens <= 0:
+        # LALR merges lookaheads, so ')' shows up even where no '(' is open.
+        expected.discard("RPAR")
+    parts: list[str] = []
+    if expected & _OPERAND_STARTS:
+        parts.append(_OPERAND)
+        expected -= _OPERAND_STARTS
+    if expected & {"AND", "OR", "IMPLIES", "EQUIV", "BINTEMP"} == {
+        "AND",
+        "OR",
+        "IMPLIES",
+        "EQUIV",
+        "BINTEMP",
+    }:
+        parts.append("a binary operator (& | -> <-> U R W M)")
+        expected -= {"AND", "OR", "IMPLIES", "EQUIV", "BINTEMP"}
+    parts.extend(sorted(_EXPECTED_NAMES.get(e, e) for e in expected))
+    if not parts:
+        return "something else"
+    return ", ".join(parts[:-1]) + (" or " if len(parts) > 1 else "") + parts[-1]
+
+
+def _open_parens(text: str, end: int) -> int:
+    return text[:end].count("(") - text[:end].count(")")
+
+
+def _tree_depth(tree: Tree[Token]) -> int:
+    deepest = 0
+    stack: list[tuple[Tree[Token], int]] = [(tree, 1)]
+    while stack:
+        node, depth = stack.pop()
+        deepest = max(deepest, depth)
+        # `FGFG a` is one token but as many AST levels as letters.
+        step = sum(
+            len(c) for c in node.children if isinstance(c, Token) and c.type == "UNARY_CHAIN"
+        )
+        stack.extend((c, depth + max(step, 1)) for c in node.children if isinstance(c, Tree))
+    return deepest
+
+
+def _max_depth(text: str) -> int:
+    depth = deepest = 0
+    for char in text:
+        if char == "(":
+            depth += 1
+            deepest = max(deepest, depth)
+        elif char == ")":
+            depth -= 1
+    return deepest
+
+
+def _syntax_diagnostic(exc: LarkError, text: str, file: str | None, pos: _Positions) -> Diagnostic:
+    if isinstance(exc, UnexpectedCharacters):
+        line, col = pos.at(exc.line, exc.column)
+        index = exc.pos_in_stream if exc.pos_in_stream is not None else -1
+        char = text[index] if 0 <= index < len(text) else "?"
+        return error(
+            "L001",
+            f"unexpected character {char!r} in LTL formula",
+            hint="operators are ! & | -> <-> U R W M F G (or [] <> && || ~); "
+            "names are letters, digits and _",
+            file=file,
+            line=line,
+            col=col,
+        )
+    if isinstance(exc, UnexpectedToken):
+        token = exc.token
+        if token.type == "$END":
+            line, col = pos.at(*_end_position(text))
+            return error(
+                "L002",
+                "the LTL formula ends too early",
+                hint=f"expected {_describe_expected(exc.expected, _open_parens(text, len(text)))}",
+                file=file,
+                line=line,
+                col=col,
+            )
+        line, col = pos.at(token.line or 1, token.column or 1)
+        return error(
+            "L003",
+            f"unexpected {str(token)!r} in LTL formula",
+            hint="expected "
+            + _describe_expected(exc.expected, _open_parens(text, token.start_pos or 0))
+            + " here",
+            file=file,
+            line=line,
+            col=col,
+        )
+    if isinstance(exc, UnexpectedEOF):
+        line, col = pos.at(*_end_position(text))
+        return error(
+            "L002",
+            "the LTL formula ends too early",
+            hint="complete the formula (an operand or a closing ')' is missing)",
+            file=file,
+            line=line,
+            col=col,
+        )
+    return error("L003", f"cannot parse LTL formula: {exc}", file=file, line=pos.line, col=pos.col)
+
+
+def _end_position(text: str) -> tuple[int, int]:
+    lines = text.split("\n")
+    return len(lines), len(lines[-1]) + 1
+
+
+def _next_operators(tokens: list[Token], pos: _Positions, file: str | None) -> list[Diagnostic]:
+    found = []
+    for token in tokens:
+        if token.type == "UNARY_CHAIN" and ("X" in token or "N" in token):
+            line, col = pos.at(
+                token.line or 1, (token.column or 1) + str(token).find("X" if "X" in token else "N")
+            )
+            found.append(
+                error(
+                    "L004",
+                    "the Next operator (X) is not allowed",
+                    hint=_NEXT_HINT,
+                    file=file,
+                    line=line,
+                    col=col,
+                )
+            )
+    return found
+
+
+def parse_ltl(text: str, *, file: str | None = None, line: int = 1, col: int = 1) -> Formula:
+    """Parse ``text`` (LTL without Next) into an AST.
+
+    Args:
+        text: the formula.
+        file: the file name to put in diagnostics.
+        line: the 1-based line where ``text`` starts in ``file``.
+        col: the 1-based column where ``text`` starts in ``file``.
+
+    Raises:
+        InvalidInputError: with L-coded diagnostics (syntax errors, Next, nesting too deep).
+    """
+    pos = _Positions(line, col)
+    if not isinstance(text, str):
+        raise InvalidInputError(
+            error("L003", "an LTL formula must be a string", file=file, line=line, col=col)
+        )
+    if not text.strip():
+        raise InvalidInputError(
+            error(
+                "L002",
+                "the LTL formula is empty",
+                hint="write a formula such as `F goal`",
+                file=file,
+                line=line,
+                col=col,
+            )
+        )
+    if _max_depth(text) > MAX_DEPTH:
+        raise InvalidInputError(
+            error(
+                "L005",
+                f"the LTL formula is nested more than {MAX_DEPTH} levels deep",
+                hint="split the task into several phrases or conjuncts",
+                file=file,
+                line=line,
+                col=col,
+            )
+        )
+    parser = _parser()
+    try:
+        tokens = list(parser.lex(text))
+    except LarkError as exc:
+        raise InvalidInputError(_syntax_diagnostic(exc, text, file, pos)) from None
+    next_diagnostics = _next_operators(tokens, pos, file)
+    if next_diagnostics:
+        raise InvalidInputError(next_diagnostics)
+    try:
+        tree = parser.parse(text)
+    except LarkError as exc:
+        raise InvalidInputError(_syntax_diagnostic(exc, text, file, pos)) from None
+    too_deep = error(
+        "L005",
+        f"the LTL formula is nested more than {MAX_DEPTH} levels deep",
+        hint="split the task into several phrases or conjuncts",
+        file=file,
+        line=line,
+        col=col,
+    )
+    if _tree_depth(tree) > MAX_DEPTH:
+        raise InvalidInputError(too_deep)
+    transformer = _ToAst(pos, file)
+    try:
+        formula = transformer.transform(tree)
+    except (RecursionError, VisitError):
+        raise InvalidInputError(too_deep) from None
+    if transformer.keyword_names:
+        raise InvalidInputError(transformer.keyword_names)
+    if not isinstance(formula, Formula):  # pragma: no cover - the grammar always yields one
+        raise InvalidInputError(error("L003", "cannot parse LTL formula", file=file))
+    return formula
