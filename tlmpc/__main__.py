@@ -1,5 +1,5 @@
 """``python -m tlmpc``."""
 
-from tlmpc.cli import main
+from tlmpc.cli import run
 
-raise SystemExit(main())
+run()

@@ -141,6 +141,23 @@ def _on_sigterm(number: int, frame: object) -> None:
     raise _Terminated
 
 
+def run() -> typing.NoReturn:
+    """The ``tlmpc`` command: :func:`main` on the process's arguments, then exit with its code.
+
+    After Ctrl-C or SIGTERM (exit 130 or 143) the process ends at once, its streams flushed:
+    everything tlmpc wrote or staged has been cleaned up by then, and a normal interpreter
+    shutdown can still turn an interrupt it saw into death by SIGINT, losing the documented
+    exit code.
+    """
+    code = main()
+    if code in (EXIT_INTERRUPTED, EXIT_TERMINATED):
+        for stream in (sys.stdout, sys.stderr):
+            with contextlib.suppress(Exception):
+                stream.flush()
+        os._exit(code)
+    raise SystemExit(code)
+
+
 def main(
     argv: Sequence[str] | None = None,
     out: TextIO | None = None,
