@@ -72,7 +72,6 @@ def _run_locked(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     )
     from tlmpc.pipeline import StageReport, collector_paused, compile_mission
     from tlmpc.report import Reporter
-    from tlmpc.startup import lean_numpy_listing
 
     reporter = Reporter.for_args(args, out, err)
     destination: Path = args.out
@@ -91,7 +90,7 @@ def _run_locked(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
 
     # One pause for compiling and writing: re-enabling in between would trigger a full
     # collection over everything the compilation still holds.
-    with collector_paused(), lean_numpy_listing():
+    with collector_paused():
         result = compile_mission(
             args.mission,
             until=args.until,
