@@ -55,3 +55,20 @@ def test_a_bad_region_is_named(bad: object, message: str) -> None:
         from_document(_document({"a": good, "b": bad, "c": good}))
     assert caught.value.diagnostics[0].code == "V004"
     assert caught.value.diagnostics[0].message == message
+
+
+@pytest.mark.parametrize(("end", "outcome"), [("stay", "satisfied"), ("open", "inconclusive")])
+def test_a_last_point_on_a_region_boundary(end: str, outcome: str) -> None:
+    """Right convention: a robot that stays forever at a point of ``a``'s boundary is in
+    ``a`` (its label is where it rests, the closure); a log that just ends there may go on
+    into ``a`` or away from it, so ``F a`` is neither satisfied nor violated yet."""
+    from tlmpc.verify import verify_document
+
+    document = {
+        "format": "tlmpc.trace/1",
+        "ltl": "F a",
+        "regions": {"a": [[1.0, -1.0], [2.0, -1.0], [2.0, 1.0], [1.0, 1.0]]},
+        "points": [[0.0, 0.0, 0.0], [1.0, 1.0, 0.0]],
+        "end": end,
+    }
+    assert verify_document(document).outcome == outcome
