@@ -97,6 +97,20 @@ RULES = [
     ("a W G F b", "a W G F b"),  # G a does not imply G F b: the W stays
     ("G a | (a U G b)", "a W G b"),
     ("F a & (a R F b)", "a M F b"),
+    # Eventualities under G F, absorbed F disjuncts and G conjuncts, until/release over G/F.
+    ("G F(a R F b)", "G F b"),
+    ("F(a | G F a)", "F a"),
+    ("G(a & F G a)", "G a"),
+    ("G F((b R c) | G F c)", "G F c"),
+    ("(a & b) U G a", "G a"),
+    ("(a & b) W G a", "G a"),
+    ("G a U !a", "!a"),
+    ("G a W !a", "!a | G a"),
+    ("F b U b", "F b"),
+    ("a R F(a & b)", "F(a & b)"),
+    ("a M F(a & b)", "F(a & b)"),
+    ("F a R !a", "!a"),
+    ("F a M !a", "!a & F a"),
 ]
 
 

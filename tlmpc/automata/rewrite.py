@@ -147,9 +147,9 @@ class _Rewriter:
             case Disj(args=args):
                 result = self.junction(False, [self.run(a) for a in args])
             case Finally(arg=arg):
-                result = make_f(self.run(arg))
+                result = self.under_f(make_f(self.run(arg)))
             case Always(arg=arg):
-                result = make_g(self.run(arg))
+                result = self.under_g(make_g(self.run(arg)))
             case Binary(kind=kind, left=left, right=right):
                 result = self.binary(kind, self.run(left), self.run(right))
             case _:
@@ -162,6 +162,58 @@ class _Rewriter:
                 result = TRUE
         self.memo[f] = result
         return result
+
+    def under_f(self, f: Node) -> Node:
+        # F(a | b) = F b when F a ⇒ F b (F(p | G F p) = F p).
+        if isinstance(f, Finally) and isinstance(f.arg, Disj):
+            kept = self.absorbed(list(f.arg.args), make_f, make_or)
+            if kept is not None:
+                return make_f(kept)
+        return f
+
+    def under_g(self, f: Node) -> Node:
+        # G(a & b) = G b when G b ⇒ G a (the dual), and inside G F, G F(a | b) = G F b when
+        # G F a ⇒ G F b (G F((p1 R p0) | G F p0) = G F p0).
+        if isinstance(f, Always) and isinstance(f.arg, Conj):
+            kept = self.absorbed(list(f.arg.args), make_g, make_and, weaker_drops=True)
+            if kept is not None:
+                return make_g(kept)
+        if isinstance(f, Always) and isinstance(f.arg, Finally) and isinstance(f.arg.arg, Disj):
+            kept = self.absorbed(
+                list(f.arg.arg.args), lambda d: make_g(make_f(d)), make_or
+            )
+            if kept is not None:
+                return make_g(make_f(kept))
+        return f
+
+    def absorbed(
+        self,
+        items: list[Node],
+        wrap: Callable[[Node], Node],
+        join: Callable[[list[Node]], Node],
+        *,
+        weaker_drops: bool = False,
+    ) -> Node | None:
+        """``join`` of ``items`` without those made redundant under ``wrap`` by another
+        remaining one (a disjunct whose wrapped form implies another's; with
+        ``weaker_drops``, a conjunct whose wrapped form another's implies), or None."""
+        if len(items) > MAX_OPERANDS:
+            return None
+        small = len(items) <= MAX_SEMANTIC_OPERANDS
+        wrapped = {item: wrap(item) for item in items}
+        kept = list(items)
+        for item in items:
+            if any(
+                other is not item
+                and (
+                    self.implies(wrapped[other], wrapped[item], small=small)
+                    if weaker_drops
+                    else self.implies(wrapped[item], wrapped[other], small=small)
+                )
+                for other in kept
+            ):
+                kept.remove(item)
+        return None if len(kept) == len(items) else join(kept)
 
     def junction(self, conjunction: bool, args: list[Node]) -> Node:
         built = make_and(args) if conjunction else make_or(args)
@@ -206,6 +258,15 @@ class _Rewriter:
                 return make_f(b) if kind == "U" else TRUE
             if isinstance(b, Binary) and b.kind == kind and self.implies(a, b.left):
                 return b
+            if isinstance(b, Always) and self.implies(a, b.arg):
+                # a U G c = a W G c = G c when a ⇒ c: the positions before G c have c too.
+                return b
+            if isinstance(a, Always) and self.implies(a.arg, negate(b)):
+                # G d U b = b when d ⇒ ¬b: b cannot come after a position of G d.
+                return b if kind == "U" else make_or([b, a])
+            if kind == "U" and self.implies(make_f(b), a):
+                # a U b = F b when F b ⇒ a: F b holds at every position before the first b.
+                return make_f(b)
             if kind == "W" and is_pure_eventuality(b) and self.implies(make_g(a), b):
                 # a W b = (a U b) | G a = a U b when G a ⇒ b, and a U e = e.
                 return b
@@ -216,4 +277,11 @@ class _Rewriter:
                 return make_g(b) if kind == "R" else FALSE
             if isinstance(b, Binary) and b.kind == kind and self.implies(b.left, a):
                 return b
+            if isinstance(b, Finally) and self.implies(b.arg, a):
+                # a R F c = a M F c = F c when c ⇒ a: the first c releases (the duals of
+                # the a U G c rule).
+                return b
+            if isinstance(a, Finally) and self.implies(negate(a.arg), b):
+                # F c R b = b when ¬c ⇒ b: F c releases at once, or G ¬c gives G b.
+                return b if kind == "R" else make_and([b, a])
         return make_binary(kind, a, b)
