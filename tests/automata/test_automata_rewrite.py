@@ -111,6 +111,11 @@ RULES = [
     ("a M F(a & b)", "F(a & b)"),
     ("F a R !a", "!a"),
     ("F a M !a", "!a & F a"),
+    ("a U (a & b)", "b M a"),
+    ("a W (a & b)", "b R a"),
+    ("a R (a | b)", "b W a"),
+    ("a M (a | b)", "b U a"),
+    ("F a W G F b", "G F a | G F b"),
 ]
 
 

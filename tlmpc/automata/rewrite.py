@@ -264,6 +264,10 @@ class _Rewriter:
             if isinstance(a, Always) and self.implies(a.arg, negate(b)):
                 # G d U b = b when d ⇒ ¬b: b cannot come after a position of G d.
                 return b if kind == "U" else make_or([b, a])
+            if isinstance(b, Conj) and a in b.args:
+                # a U (a & b) = b M a and a W (a & b) = b R a (Spot's rules).
+                rest = make_and([x for x in b.args if x != a])
+                return make_binary("M" if kind == "U" else "R", rest, a)
             if kind == "U" and self.implies(make_f(b), a):
                 # a U b = F b when F b ⇒ a: F b holds at every position before the first b.
                 return make_f(b)
@@ -277,6 +281,10 @@ class _Rewriter:
                 return make_g(b) if kind == "R" else FALSE
             if isinstance(b, Binary) and b.kind == kind and self.implies(b.left, a):
                 return b
+            if isinstance(b, Disj) and a in b.args:
+                # a R (a | b) = b W a and a M (a | b) = b U a (the duals).
+                rest = make_or([x for x in b.args if x != a])
+                return make_binary("W" if kind == "R" else "U", rest, a)
             if isinstance(b, Finally) and self.implies(b.arg, a):
                 # a R F c = a M F c = F c when c ⇒ a: the first c releases (the duals of
                 # the a U G c rule).

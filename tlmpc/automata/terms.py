@@ -346,8 +346,9 @@ def make_binary(kind: BinaryKind, a: Node, b: Node) -> Node:
             return make_g(a)
         if _pure_universality(a):
             return make_or([a, b])
-        if _pure_eventuality(b) and not _suspendable(b):  # a W e = (a U e) | G a = e | G a
-            # (Not for a suspendable e: the state of a W e then loops on a, accepting.)
+        if _pure_eventuality(b) and (not _suspendable(b) or _suspendable(make_g(a))):
+            # a W e = (a U e) | G a = e | G a (not for a suspendable e: the state of a W e
+            # then loops on a, accepting; unless G a is suspendable too, as for a = F c).
             return make_or([b, make_g(a)])
     elif kind == "M":
         if b == FALSE or a == FALSE:
