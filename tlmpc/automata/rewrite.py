@@ -179,9 +179,7 @@ class _Rewriter:
             if kept is not None:
                 return make_g(kept)
         if isinstance(f, Always) and isinstance(f.arg, Finally) and isinstance(f.arg.arg, Disj):
-            kept = self.absorbed(
-                list(f.arg.arg.args), lambda d: make_g(make_f(d)), make_or
-            )
+            kept = self.absorbed(list(f.arg.arg.args), lambda d: make_g(make_f(d)), make_or)
             if kept is not None:
                 return make_g(make_f(kept))
         return f
@@ -261,9 +259,10 @@ class _Rewriter:
             if isinstance(b, Always) and self.implies(a, b.arg):
                 # a U G c = a W G c = G c when a ⇒ c: the positions before G c have c too.
                 return b
-            if isinstance(a, Always) and self.implies(a.arg, negate(b)):
-                # G d U b = b when d ⇒ ¬b: b cannot come after a position of G d.
-                return b if kind == "U" else make_or([b, a])
+            if kind == "U" and isinstance(a, Always) and self.implies(a.arg, negate(b)):
+                # G d U b = b when d ⇒ ¬b: b cannot come after a position of G d (G d W b
+                # is G d | b already).
+                return b
             if isinstance(b, Conj) and a in b.args:
                 # a U (a & b) = b M a and a W (a & b) = b R a (Spot's rules).
                 rest = make_and([x for x in b.args if x != a])
@@ -289,7 +288,8 @@ class _Rewriter:
                 # a R F c = a M F c = F c when c ⇒ a: the first c releases (the duals of
                 # the a U G c rule).
                 return b
-            if isinstance(a, Finally) and self.implies(negate(a.arg), b):
-                # F c R b = b when ¬c ⇒ b: F c releases at once, or G ¬c gives G b.
-                return b if kind == "R" else make_and([b, a])
+            if kind == "R" and isinstance(a, Finally) and self.implies(negate(a.arg), b):
+                # F c R b = b when ¬c ⇒ b: F c releases at once, or G ¬c gives G b (F c M b
+                # is F c & b already).
+                return b
         return make_binary(kind, a, b)
