@@ -120,6 +120,7 @@ RULES = [
     ("a R (a | b)", "b W a"),
     ("a M (a | b)", "b U a"),
     ("F a W G F b", "G F a | G F b"),
+    ("G F(a R (b U a))", "G F a"),
 ]
 
 
@@ -141,6 +142,8 @@ NEAR_MISSES = [
     "a R (b | c)",
     "a W G F b",
     "G a W F b",
+    "G F((a & b) R a)",
+    "G F(a R (b & F a))",
 ]
 
 
@@ -166,6 +169,7 @@ SPOT_SIZED = [
     "FG(Fp2 U !(0 R (!(p2 M 1) U p2)))",
     "p0 R (!p3 & G((p1 M 1) U ((p0 R Fp0) U p0)))",
     "(p1 U (p1 & !p2)) W ((Gp1 | G(p0 -> p2)) M p2)",
+    "0 R F(p1 R (p2 U p1))",
     "F(((p0 & F!p0) M (p2 | p4)) <-> (p4 | (!p3 -> Fp4))) W (Gp0 M 1)",
 ]
 

@@ -178,6 +178,17 @@ class _Rewriter:
             kept = self.absorbed(list(f.arg.args), make_g, make_and, weaker_drops=True)
             if kept is not None:
                 return make_g(kept)
+        if (
+            isinstance(f, Always)
+            and isinstance(f.arg, Finally)
+            and isinstance(f.arg.arg, Binary)
+            and f.arg.arg.kind == "R"
+            and self.implies(f.arg.arg.left, f.arg.arg.right)
+            and self.implies(f.arg.arg.right, make_f(f.arg.arg.left))
+        ):
+            # G F(a R b) = G F a when a ⇒ b and b ⇒ F a: a R b holds wherever a does, and
+            # a R b implies b, hence F a.
+            return make_g(make_f(f.arg.arg.left))
         if isinstance(f, Always) and isinstance(f.arg, Finally) and isinstance(f.arg.arg, Disj):
             kept = self.absorbed(list(f.arg.arg.args), lambda d: make_g(make_f(d)), make_or)
             if kept is not None:
