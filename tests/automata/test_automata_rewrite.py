@@ -121,6 +121,9 @@ RULES = [
     ("a M (a | b)", "b U a"),
     ("F a W G F b", "G F a | G F b"),
     ("G F(a R (b U a))", "G F a"),
+    ("F a | G(a | b)", "F a | G b"),
+    ("G a & F(!a & b | c)", "G a & F c"),
+    ("F(a | b) | (a U c)", "F(a | b) | c"),
 ]
 
 
@@ -144,6 +147,10 @@ NEAR_MISSES = [
     "G a W F b",
     "G F((a & b) R a)",
     "G F(a R (b & F a))",
+    "F a | (b & a)",
+    "F(a & b) | G(a | c)",
+    "G(a | b) & F(!a & c)",
+    "a | G(!a | b)",
 ]
 
 
@@ -170,6 +177,7 @@ SPOT_SIZED = [
     "p0 R (!p3 & G((p1 M 1) U ((p0 R Fp0) U p0)))",
     "(p1 U (p1 & !p2)) W ((Gp1 | G(p0 -> p2)) M p2)",
     "0 R F(p1 R (p2 U p1))",
+    "(p2 | p3) & (p0 | (!(p1 <-> Fp3) W Fp1))",
     "F(((p0 & F!p0) M (p2 | p4)) <-> (p4 | (!p3 -> Fp4))) W (Gp0 M 1)",
 ]
 

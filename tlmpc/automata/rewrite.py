@@ -26,6 +26,12 @@ node                becomes               when
 ``a M (b M c)``     ``b M c``             b ⇒ a
 ==================  ====================  ======================
 
+Beside them: ``G F(a R b) = G F a`` (a ⇒ b, b ⇒ F a), ``F(a | b) = F b`` (F a ⇒ F b),
+``G(a & b) = G b`` (G b ⇒ G a), ``G F(a | b) = G F b`` (G F a ⇒ G F b), ``a U G c = G c``
+(a ⇒ c), ``G d U b = b`` (d ⇒ ¬b), ``a U b = F b`` (F b ⇒ a), ``a R F c = F c`` (c ⇒ a),
+``F c R b = b`` (¬c ⇒ b), Spot's ``a U (a & b) = b M a`` (and duals), and the literal
+assumptions ``x | F ℓ = x[ℓ := false] | F ℓ``, ``x & G ℓ = x[ℓ := true] & G ℓ``.
+
 Why they hold: for ``a U b`` with a ⇒ b, wherever ``a`` holds so does ``b``, so the until is
 fulfilled at once or never needed ``a``; with ¬a ⇒ b every position before the first ``b`` has
 ``a``.  The ``R``/``M`` rules are the duals (``¬(a U b) = ¬a R ¬b``, ``¬(a W b) = ¬a M ¬b``).
@@ -232,6 +238,9 @@ class _Rewriter:
         if len(built.args) > MAX_OPERANDS:
             return built
         items = list(built.args)
+        substituted = _assume_literals(items, conjunction)
+        if substituted != items:
+            return self.junction(conjunction, substituted)
         small = len(items) <= MAX_SEMANTIC_OPERANDS
         for index, item in enumerate(items):
             for other in items[index + 1 :]:
@@ -304,3 +313,51 @@ class _Rewriter:
                 # is F c & b already).
                 return b
         return make_binary(kind, a, b)
+
+
+def _assumed(item: Node, conjunction: bool) -> list[Node]:
+    """The literals ``item`` makes true everywhere (``G ℓ``, ``G(ℓ1 & …)``: conjunction) or
+    false everywhere unless it holds (``F ℓ``, ``F(ℓ1 | …)``: disjunction)."""
+    if conjunction and isinstance(item, Always):
+        parts = item.arg.args if isinstance(item.arg, Conj) else (item.arg,)
+        return [p for p in parts if isinstance(p, Pos | Neg)]
+    if not conjunction and isinstance(item, Finally):
+        parts = item.arg.args if isinstance(item.arg, Disj) else (item.arg,)
+        return [negate(p) for p in parts if isinstance(p, Pos | Neg)]
+    return []
+
+
+def _assume_literals(items: list[Node], conjunction: bool) -> list[Node]:
+    """``x & G ℓ = x[ℓ := true] & G ℓ`` and ``x | F ℓ = x[ℓ := false] | F ℓ``: where the
+    sibling does not already decide the junction, ℓ has that value at every position."""
+    out = list(items)
+    for index, item in enumerate(items):
+        truths = _assumed(item, conjunction)
+        if not truths:
+            continue
+        values: dict[Node, Node] = {}
+        for literal in truths:
+            values[literal] = TRUE
+            values[negate(literal)] = FALSE
+        out = [x if i == index else _substitute(x, values) for i, x in enumerate(out)]
+    return out
+
+
+def _substitute(f: Node, values: dict[Node, Node]) -> Node:
+    match f:
+        case Top() | Bottom():
+            return f
+        case Pos() | Neg():
+            return values.get(f, f)
+        case Conj(args=args):
+            return make_and([_substitute(a, values) for a in args])
+        case Disj(args=args):
+            return make_or([_substitute(a, values) for a in args])
+        case Finally(arg=arg):
+            return make_f(_substitute(arg, values))
+        case Always(arg=arg):
+            return make_g(_substitute(arg, values))
+        case Binary(kind=kind, left=left, right=right):
+            return make_binary(kind, _substitute(left, values), _substitute(right, values))
+        case _:
+            assert_never(f)
