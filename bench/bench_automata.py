@@ -103,6 +103,9 @@ BEFORE = {
     "held-out": (500, 2406, 1903, 171, 0.41),
     # Before the reverse simulation and the suspension rules (max: CPU seconds).
     "random 2-5 APs": (2854, 10391, 10110, 151, 0.865),
+    # Before the F/G absorption, until/release over G/F and literal-assumption rules.
+    "fresh 2-5 APs": (1145, 4026, 4000, 37, 0.372),
+    "fresh held-out 2-5 APs": (1145, 3989, 4006, 28, 0.501),
 }
 
 
@@ -135,6 +138,20 @@ LARGE_BATCHES = (
     (5, 350, 108, 30),
 )
 
+#: Two more seeded sets of the same kind, drawn with other seeds (9201-9207 and 9301-9307):
+#: the first was the tuning set of the round that added the F/G absorption, until/release over
+#: G/F and literal-assumption rules; the second was measured before and after that round only.
+FRESH_BATCHES = (
+    (2, 200, 9201, 12),
+    (3, 200, 9202, 18),
+    (3, 150, 9203, 26),
+    (4, 200, 9204, 16),
+    (4, 150, 9205, 24),
+    (5, 200, 9206, 20),
+    (5, 100, 9207, 28),
+)
+HELD_OUT_BATCHES = tuple((aps, n, seed + 100, size) for aps, n, seed, size in FRESH_BATCHES)
+
 _GENERATE = (
     "import sys, spot\n"
     "aps, count, seed, size = map(int, sys.argv[1:5])\n"
@@ -144,11 +161,11 @@ _GENERATE = (
 )
 
 
-def large_random_set() -> list[str]:
-    """The larger seeded set (one process per batch: Spot 2.13's ``randltl`` fails on a
-    second call in one process)."""
+def large_random_set(batches: tuple[tuple[int, int, int, int], ...] = LARGE_BATCHES) -> list[str]:
+    """A seeded set (one process per batch: Spot 2.13's ``randltl`` fails on a second call
+    in one process)."""
     texts: list[str] = []
-    for batch in LARGE_BATCHES:
+    for batch in batches:
         done = subprocess.run(
             [sys.executable, "-c", _GENERATE, *map(str, batch)],
             capture_output=True,
@@ -176,7 +193,8 @@ def run_spot(
     ``translate(f, "TGBA", "Small", "High")``; equivalence by ``spot.are_equivalent`` on
     tlmpc's HOA.  ``held-out`` continues the random stream (formulas not tuned on; its few
     larger-than-Spot formulas were looked at once); ``random 2-5 APs`` (with ``large``) is
-    the larger seeded set of :data:`LARGE_BATCHES`.
+    the larger seeded set of :data:`LARGE_BATCHES`, ``fresh 2-5 APs`` and ``fresh held-out
+    2-5 APs`` those of :data:`FRESH_BATCHES` and :data:`HELD_OUT_BATCHES`.
     """
     import spot
 
@@ -188,6 +206,8 @@ def run_spot(
     groups = families.families(random_count=random_count, random_seed=0, held_out=held_out)
     if large:
         groups["random 2-5 APs"] = large_random_set()
+        groups["fresh 2-5 APs"] = large_random_set(FRESH_BATCHES)
+        groups["fresh held-out 2-5 APs"] = large_random_set(HELD_OUT_BATCHES)
     rows = []
     for family, texts in groups.items():
         ours_total = theirs_total = larger = wrong = 0

@@ -281,8 +281,8 @@ def make_f(a: Node) -> Node:
 def make_g(a: Node) -> Node:
     """G a, simplified: G true = true, G(universality) = itself (conjunctions of G merge in
     :func:`make_and`), G(a R b) = G b, G(a W b) = G(a | b), G(a & G b) = G(a & b), and
-    G F(a & e) = G F a & G e for a pure eventuality e (which holds everywhere as soon as it
-    holds infinitely often)."""
+    G F(a & e) = G F a & G e and G F(a R e) = G e for a pure eventuality e (which holds
+    everywhere as soon as it holds infinitely often)."""
     if a in (TRUE, FALSE) or _pure_universality(a):
         return a
     match a:
@@ -308,6 +308,10 @@ def make_g(a: Node) -> Node:
                 [make_g(make_or(x for x in args if not _suspendable(x)))]
                 + [x for x in args if _suspendable(x)]
             )
+        case Finally(arg=Binary(kind="R", right=right)) if _pure_eventuality(right):
+            # G F(a R e) = G e for a pure eventuality e: a R e implies e, and e infinitely
+            # often is e everywhere, where a R e holds too.
+            return make_g(right)
         case Finally(arg=Conj(args=args)) if any(_pure_eventuality(x) for x in args):
             eventual = [x for x in args if _pure_eventuality(x)]
             rest = [x for x in args if not _pure_eventuality(x)]
@@ -342,8 +346,9 @@ def make_binary(kind: BinaryKind, a: Node, b: Node) -> Node:
             return make_g(a)
         if _pure_universality(a):
             return make_or([a, b])
-        if _pure_eventuality(b) and not _suspendable(b):  # a W e = (a U e) | G a = e | G a
-            # (Not for a suspendable e: the state of a W e then loops on a, accepting.)
+        if _pure_eventuality(b) and (not _suspendable(b) or _suspendable(make_g(a))):
+            # a W e = (a U e) | G a = e | G a (not for a suspendable e: the state of a W e
+            # then loops on a, accepting; unless G a is suspendable too, as for a = F c).
             return make_or([b, make_g(a)])
     elif kind == "M":
         if b == FALSE or a == FALSE:

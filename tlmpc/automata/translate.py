@@ -164,7 +164,7 @@ def _translate(
         formula = simplify_by_containment(nnf(formula), lambda f: _is_empty(f, limit), limit)
     aps = tuple(sorted(original.props()))
     semantic = simplify and containment and len(aps) <= MAX_SEMANTIC_APS
-    rewrite_deadline = time.process_time() + (CONTAINMENT_BUDGET if budget is None else budget / 4)
+    rewrite_deadline = time.process_time() + (CONTAINMENT_BUDGET if budget is None else budget / 5)
     root = rewrite(
         from_ast(formula),
         (lambda f: _is_empty_term(f, rewrite_deadline)) if semantic else None,
