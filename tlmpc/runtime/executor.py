@@ -38,7 +38,7 @@ from tlmpc.automata.model import Automaton
 from tlmpc.control.model import Controllers, StepController
 from tlmpc.errors import InvalidInputError, NoPlanError, SolverError, UsageError, error
 from tlmpc.mission.model import Mission
-from tlmpc.planning.boundary import POINT, crossing_letter, start_point_label
+from tlmpc.planning.boundary import crossing_letter, start_point_label
 from tlmpc.planning.model import Witness
 from tlmpc.runtime.locate import Locator
 from tlmpc.runtime.model import Phase, Progress, Recovery, RecoveryKind, Status
@@ -331,11 +331,14 @@ class Executor:
         point's own letter first, then the start triangle's label."""
         states = frozenset({self.tracker.automaton.initial})
         if self._closed:
-            where = (float(point[0]), float(point[1]))
-            states = self.tracker.read_point(
-                states, (*start_point_label(self.abstraction, where), POINT)
-            )
+            states = self.tracker.read_point(states, self._point_letter(point))
         return self.tracker.read(states, int(self.abstraction.letter_of[triangle]))
+
+    def _point_letter(self, point: Sequence[float] | FloatArray) -> tuple[str, ...]:
+        """The closed convention's letter of the robot at ``point`` (the start, or a passage
+        corner): every region whose closure holds it, as the planner reads it."""
+        where = (float(point[0]), float(point[1]))
+        return crossing_letter(start_point_label(self.abstraction, where), ())
 
     def _read_entry(
         self,
@@ -349,7 +352,7 @@ class Executor:
         vertex passage), as the planner reads it."""
         if self._closed:
             if corner is not None:
-                instant = (*start_point_label(self.abstraction, corner), POINT)
+                instant = self._point_letter(corner)
             else:
                 left = self.abstraction.labels(before) if before is not None else ()
                 instant = crossing_letter(left, self.abstraction.labels(triangle))
