@@ -209,7 +209,7 @@ class _Converter:
         lazy = self.lazy
         for event in events:
             kind = type(event)
-            if kind in ends and stack:  # as below, without the checks before it
+            if kind in ends:  # the parser balances them: a container is open
                 frame = stack.pop()
                 if frame.unplaced:
                     self.doc.unplaced.add(frame.path)
@@ -288,15 +288,6 @@ class _Converter:
             if isinstance(
                 event, (yaml.StreamStartEvent, yaml.StreamEndEvent, yaml.DocumentEndEvent)
             ):
-                continue
-            if isinstance(event, (yaml.MappingEndEvent, yaml.SequenceEndEvent)):
-                frame = stack.pop()
-                if frame.unplaced:
-                    self.doc.unplaced.add(frame.path)
-                if frame.anchor is not None:
-                    self.anchors[frame.anchor] = (frame.container, frame.size)
-                if stack:
-                    stack[-1].size += frame.size
                 continue
             parent = stack[-1] if stack else None
             path = self._child_path(parent)
