@@ -5,6 +5,9 @@ Facet ``i`` is the edge opposite vertex ``i`` (the same convention as ``neighbor
 
 from __future__ import annotations
 
+import itertools
+import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -37,15 +40,47 @@ class TriangleGeometry:
 
 
 def triangle_geometry(vertices: FloatArray) -> TriangleGeometry:
-    """Geometry of a counter-clockwise triangle."""
+    """Geometry of a counter-clockwise triangle.
+
+    Computed on Python floats: a plan's steps call this thousands of times and numpy's
+    per-call overhead on 2-vectors was most of the control stage.  The operations are the
+    ones numpy performs (a 2-vector's norm is sqrt(x·x) and a dot of two is a0 b0 + a1 b1,
+    in that order), so the values are bit for bit those of the array code (tests compare).
+    """
     v = np.asarray(vertices, dtype=np.float64)
+    corners = v.tolist()
+    normals: list[list[float]] = []
+    offsets: list[float] = []
+    heights: list[float] = []
+    for i in range(3):
+        ax, ay = corners[(i + 1) % 3]
+        bx, by = corners[(i + 2) % 3]
+        # outward for a counter-clockwise triangle: (edge_y, -edge_x)
+        nx, ny = by - ay, -(bx - ax)
+        length = math.sqrt(nx * nx + ny * ny)
+        if not 0.0 < length < math.inf:
+            return _triangle_geometry_arrays(v)  # degenerate: numpy's nan/inf semantics
+        nx, ny = nx / length, ny / length
+        offset = nx * ax + ny * ay
+        px, py = corners[i]
+        normals.append([nx, ny])
+        offsets.append(offset)
+        heights.append(offset - (nx * px + ny * py))
+    return TriangleGeometry(
+        vertices=v, normals=np.array(normals), offsets=np.array(offsets), heights=np.array(heights)
+    )
+
+
+def _triangle_geometry_arrays(v: FloatArray) -> TriangleGeometry:
+    """:func:`triangle_geometry` on numpy arrays, for a degenerate edge: nan/inf (with
+    numpy's warning) as numpy divides, where Python floats would raise."""
     normals = np.empty((3, 2))
     offsets = np.empty(3)
     heights = np.empty(3)
     for i in range(3):
         a, b = v[(i + 1) % 3], v[(i + 2) % 3]
         edge = b - a
-        normal = np.array([edge[1], -edge[0]])  # outward for a counter-clockwise triangle
+        normal = np.array([edge[1], -edge[0]])
         normal /= np.linalg.norm(normal)
         normals[i] = normal
         offsets[i] = normal @ a
@@ -58,30 +93,40 @@ def affine_law(vertices: FloatArray, velocities: FloatArray) -> tuple[FloatArray
 
     Solved in the triangle's own frame (centred, unit size): in map coordinates the system
     mixes the triangle's size with its distance from the origin and loses digits far out.
+    The frame is computed on Python floats with numpy's operations in numpy's order (the
+    mean sums the rows first to last), so the system is bit for bit the array code's.
     """
-    center = vertices.mean(axis=0)
-    size = float(np.abs(vertices - center).max())
-    local = (vertices - center) / size
-    system = np.hstack([local, np.ones((3, 1))])
+    (x0, y0), (x1, y1), (x2, y2) = np.asarray(vertices, dtype=np.float64).tolist()
+    cx, cy = (x0 + x1 + x2) / 3, (y0 + y1 + y2) / 3
+    dx0, dy0, dx1, dy1, dx2, dy2 = x0 - cx, y0 - cy, x1 - cx, y1 - cy, x2 - cx, y2 - cy
+    size = max(abs(dx0), abs(dy0), abs(dx1), abs(dy1), abs(dx2), abs(dy2))
+    system = np.array(
+        [
+            [dx0 / size, dy0 / size, 1.0],
+            [dx1 / size, dy1 / size, 1.0],
+            [dx2 / size, dy2 / size, 1.0],
+        ]
+    )
     solution = np.asarray(np.linalg.solve(system, velocities), dtype=np.float64)
     gain: FloatArray = np.ascontiguousarray(solution[:2].T / size)
-    offset: FloatArray = solution[2] - gain @ center
+    offset: FloatArray = solution[2] - gain @ np.array([cx, cy])
     return gain, offset
 
 
-def half_plane_feasible(normals: list[FloatArray]) -> bool:
+def half_plane_feasible(normals: Sequence[Sequence[float]]) -> bool:
     """True when some w has a·w > 0 for every a in ``normals`` (cones intersect).
 
     The normals must fit in an open half-plane: their directions span less than 180°.
     """
     if len(normals) <= 1:
         return True
-    angles = np.sort(np.array([np.arctan2(a[1], a[0]) for a in normals]))
-    gaps = np.diff(np.concatenate([angles, [angles[0] + 2 * np.pi]]))
-    return bool(gaps.max() > np.pi + 1e-9)
+    angles = sorted(math.atan2(a[1], a[0]) for a in normals)
+    angles.append(angles[0] + 2 * math.pi)
+    widest = max(after - before for before, after in itertools.pairwise(angles))
+    return widest > math.pi + 1e-9
 
 
-def best_push(normals: list[FloatArray], max_speed: float) -> float:
+def best_push(normals: Sequence[Sequence[float]], max_speed: float) -> float:
     """max over |w| <= max_speed of min_k a_k·w, for unit normals a_k (exact, in the plane).
 
     The largest speed a vertex velocity can guarantee along every normal at once: a disturbance
@@ -98,6 +143,4 @@ def best_push(normals: list[FloatArray], max_speed: float) -> float:
             length = float(np.linalg.norm(bisector))
             if length > 1e-12:
                 directions.append(bisector / length)
-    return max(
-        min(float(np.asarray(a) @ u) for a in normals) * max_speed for u in directions
-    )
+    return max(min(float(np.asarray(a) @ u) for a in normals) * max_speed for u in directions)

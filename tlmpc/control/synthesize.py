@@ -17,6 +17,7 @@ with cvxpy and compare the optima).
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, field
 
@@ -36,6 +37,9 @@ from tlmpc.errors import InvalidInputError, SolverError, error
 from tlmpc.mission.model import Robot
 from tlmpc.planning.model import Witness
 
+#: A unit normal as Python floats.
+Vector = tuple[float, float]
+
 #: Invariance margin: non-exit facets are pushed inward at least MARGIN times the exit speed.
 MARGIN = 0.3
 
@@ -48,6 +52,7 @@ class _Step:
     geometry: TriangleGeometry
     runs: list[int] = field(default_factory=list)  # run id per local vertex
     through: int | None = None  # a vertex passage: the mesh vertex pursued (no program)
+    rows: list[list[tuple[Vector, float]]] | None = None  # _normals per local vertex, once
 
 
 def plan_steps(abstraction: Abstraction, witness: Witness) -> tuple[list[_Step], int | None]:
@@ -127,19 +132,29 @@ def plan_steps(abstraction: Abstraction, witness: Witness) -> tuple[list[_Step],
     return steps, loop_start
 
 
-def _normals(step: _Step, local: int) -> list[tuple[FloatArray, float]]:
-    """(a, c) pairs meaning a·w >= c·s for the velocity at local vertex ``local``."""
-    geometry = step.geometry
-    rows: list[tuple[FloatArray, float]] = []
-    for facet in range(3):
-        if facet == local:
-            continue  # the vertex is not on the facet opposite it
-        if facet == step.exit_edge:
-            continue
-        rows.append((-geometry.normals[facet], MARGIN))
-    if step.exit_edge is not None:
-        rows.append((geometry.normals[step.exit_edge], 1.0))
-    return rows
+def _normals(step: _Step, local: int) -> list[tuple[Vector, float]]:
+    """(a, c) pairs meaning a·w >= c·s for the velocity at local vertex ``local``.
+
+    Computed once per step on Python floats (the runs and the program each ask for every
+    vertex; numpy's per-call overhead on 2-vectors dominated).
+    """
+    if step.rows is None:
+        normals = step.geometry.normals.tolist()
+        step.rows = []
+        for vertex in range(3):
+            rows: list[tuple[Vector, float]] = []
+            for facet in range(3):
+                if facet == vertex:
+                    continue  # the vertex is not on the facet opposite it
+                if facet == step.exit_edge:
+                    continue
+                nx, ny = normals[facet]
+                rows.append(((-nx, -ny), MARGIN))
+            if step.exit_edge is not None:
+                nx, ny = normals[step.exit_edge]
+                rows.append(((nx, ny), 1.0))
+            step.rows.append(rows)
+    return step.rows[local]
 
 
 class _Runs:
@@ -147,17 +162,17 @@ class _Runs:
 
     def __init__(self, push: float = 0.0, max_speed: float = 1.0) -> None:
         self.parent: list[int] = []
-        self.normals: list[list[FloatArray]] = []
+        self.normals: list[list[Vector]] = []
         # With a disturbance, one velocity must push at least ``push`` along every normal it
         # collects, not merely be positive along each.
         self.push, self.max_speed = push, max_speed
 
-    def compatible(self, normals: list[FloatArray]) -> bool:
+    def compatible(self, normals: list[Vector]) -> bool:
         if self.push <= 0.0:
             return half_plane_feasible(normals)
         return best_push(normals, self.max_speed) > self.push
 
-    def new(self, normals: list[FloatArray]) -> int:
+    def new(self, normals: list[Vector]) -> int:
         self.parent.append(len(self.parent))
         self.normals.append(list(normals))
         return len(self.parent) - 1
@@ -168,7 +183,7 @@ class _Runs:
             run = self.parent[run]
         return run
 
-    def try_extend(self, run: int, normals: list[FloatArray]) -> bool:
+    def try_extend(self, run: int, normals: list[Vector]) -> bool:
         root = self.find(run)
         if self.compatible(self.normals[root] + normals):
             self.normals[root].extend(normals)
@@ -429,22 +444,28 @@ def _violated_condition(
     triangle: speed bound, exit across the planned facet, invariance of the two others; for a
     stay, inward on every facet, equilibrium at its target and a Hurwitz gain."""
     geometry = triangle_geometry(controller.vertices)
-    w = controller.velocities
+    # Python floats, numpy's operations in numpy's order (|w| = sqrt(wx wx + wy wy), a dot
+    # of two is ax bx + ay by): the array code's values, without its per-call cost.
+    w = controller.velocities.tolist()
+    normals = geometry.normals.tolist()
     floor = disturbance + RECHECK_TOLERANCE * max_speed
-    fastest = float(np.linalg.norm(w, axis=1).max())
+    fastest = max(math.sqrt(wx * wx + wy * wy) for wx, wy in w)
     if fastest > max_speed * (1.0 + RECHECK_TOLERANCE):
         return f"a vertex speed {fastest:.6g} exceeds max_speed {max_speed:.6g}"
     for i in range(3):
+        wx, wy = w[i]
         for facet in range(3):
             if facet == i:
                 continue
-            across = float(geometry.normals[facet] @ w[i])
+            nx, ny = normals[facet]
+            across = nx * wx + ny * wy
             if facet == controller.exit_edge and across <= floor:
                 return f"vertex {i} does not move across the exit facet (speed {across:.3g})"
             if facet != controller.exit_edge and -across <= floor:
                 return f"vertex {i} is not pushed inside facet {facet} (inward {-across:.3g})"
     if controller.exit_edge is not None:
-        if float(geometry.normals[controller.exit_edge] @ w[controller.exit_edge]) <= floor:
+        (nx, ny), (wx, wy) = normals[controller.exit_edge], w[controller.exit_edge]
+        if nx * wx + ny * wy <= floor:
             return "the vertex opposite the exit does not move toward it"
         return None
     assert controller.target is not None
