@@ -79,6 +79,22 @@ def _taylor_degree(radius: float, cap: int) -> int:
     return degree
 
 
+#: The identity of the augmented matrices (only read: every use makes a new array).
+_IDENTITY_3 = np.eye(3)
+
+
+def _column_norm(matrix: FloatArray) -> float:
+    """The 1-norm (largest column sum of |a_ij|) of a square matrix: the value of
+    ``np.abs(matrix).sum(axis=0).max()``, summed as numpy sums (rows first to last) on
+    Python floats, without numpy's per-call cost on a 3 x 3 matrix."""
+    rows = matrix.tolist()
+    sums = [abs(a) for a in rows[0]]
+    for row in rows[1:]:
+        sums = [total + abs(a) for total, a in zip(sums, row, strict=True)]
+    largest = max(sums)
+    return math.nan if math.isnan(sum(sums)) else largest  # numpy's max propagates nan
+
+
 def expm_small(matrix: FloatArray) -> FloatArray:
     """exp(A) of a small matrix by scaling and squaring with a Taylor polynomial (Horner form).
 
@@ -87,12 +103,12 @@ def expm_small(matrix: FloatArray) -> FloatArray:
     rounding to about 1e-11 relative for the gains that occur here (checked against scipy's
     ``expm`` in the tests), and it is many times faster than a general call.
     """
-    norm = float(np.abs(matrix).sum(axis=0).max())
+    norm = _column_norm(matrix)
     squarings = max(0, math.ceil(math.log2(norm)) + 1) if norm > 0.5 else 0
     scale = 0.5**squarings
     scaled = matrix * scale
     degree = _taylor_degree(norm * scale, 18)
-    identity = np.eye(matrix.shape[0])
+    identity = _IDENTITY_3 if matrix.shape == (3, 3) else np.eye(matrix.shape[0])
     result = identity + scaled / degree
     for k in range(degree - 1, 0, -1):
         result = identity + (scaled @ result) / k
@@ -146,7 +162,7 @@ def _local_flow(
     coefficients M^k base / k!, so the exit height is a scalar polynomial: a root search costs
     a few Horner steps per evaluation instead of a matrix exponential.
     """
-    radius = float(np.abs(matrix).sum(axis=0).max()) * reach
+    radius = _column_norm(matrix) * reach
     if radius > SERIES_RADIUS:
 
         def far_point(s: float) -> FloatArray:
@@ -183,13 +199,19 @@ def _exit_step(controller: StepController, x0: FloatArray) -> tuple[list[float],
     assert controller.exit_edge is not None
     geometry = triangle_geometry(controller.vertices)
     normal = geometry.normals[controller.exit_edge]
-    scale = float(np.abs(geometry.vertices).max()) + float(geometry.heights.max())
+    # Per-step bookkeeping on Python floats (numpy's operations in numpy's order: the mean
+    # sums the rows first to last): an exit step is a few dozen tiny array operations, and
+    # their per-call cost was most of the stage.
+    corners = geometry.vertices.tolist()
+    tallest = max(geometry.heights.tolist())
+    scale = max(abs(c) for corner in corners for c in corner) + tallest
     if geometry.offsets[controller.exit_edge] - normal @ x0 <= 1e-12 * scale:
         return [0.0], [x0]  # already on the exit edge (to rounding): the crossing is now
     # Coordinates relative to the triangle: y = x - center obeys y' = K y + v(center), whose
     # augmented matrix has the size of the field, not of the map's coordinates (far from the
     # origin the global offset g would dominate it and scaling and squaring would lose digits).
-    center = geometry.vertices.mean(axis=0)
+    (x1, y1), (x2, y2), (x3, y3) = corners
+    center = np.array([(x1 + x2 + x3) / 3, (y1 + y2 + y3) / 3])
     matrix = _augmented(controller.gain, controller.gain @ center + controller.offset)
     offset = float(geometry.offsets[controller.exit_edge] - normal @ center)
     y0 = x0 - center
@@ -200,17 +222,17 @@ def _exit_step(controller: StepController, x0: FloatArray) -> tuple[list[float],
     # grid step, then matrix-vector products).
     dt = horizon * 1.02 / GRID_POINTS
     step = expm_small(dt * matrix)
-    powers = [step]
-    for _ in range(GRID_CHUNK - 1):
-        powers.append(step @ powers[-1])
-    stack = np.stack(powers)  # step^1 .. step^GRID_CHUNK: a chunk of grid points at once
+    stack = np.empty((GRID_CHUNK, 3, 3))  # step^1 .. step^GRID_CHUNK: a chunk of grid points
+    stack[0] = step
+    for power in range(1, GRID_CHUNK):
+        np.matmul(step, stack[power - 1], out=stack[power])
     state = np.array([y0[0], y0[1], 1.0])
     # The other two facets, watched too: a field that leaves by an unplanned facet is a bug the
     # simulation must report, not hide by snapping the crossing onto the planned edge.
     others = [j for j in range(3) if j != controller.exit_edge]
     other_normals = geometry.normals[others]
     other_offsets = geometry.offsets[others] - other_normals @ center
-    slack = WRONG_FACET_TOLERANCE * float(geometry.heights.max())
+    slack = WRONG_FACET_TOLERANCE * tallest
     # All grid states, chunk after chunk from the last state of the one before, then one check
     # of them all (states past the crossing are computed and not used).
     chunks = []
@@ -219,12 +241,15 @@ def _exit_step(controller: StepController, x0: FloatArray) -> tuple[list[float],
         chunks.append(states)
         state = states[-1]
     grid_states = np.concatenate(chunks)
-    hits = np.flatnonzero(grid_states[:, :2] @ normal - offset >= 0.0)
-    beyond = (grid_states[:, :2] @ other_normals.T - other_offsets).max(axis=1)
-    outside = np.flatnonzero(beyond > slack)
-    if outside.size and (not hits.size or outside[0] < hits[0]):
-        _wrong_exit(controller, others, grid_states[int(outside[0]), :2] + center)
-    if not hits.size:
+    # The first grid state on or past the exit edge, and the first beyond another facet
+    # (argmax of a boolean array: its first True, or 0 when there is none).
+    reached = grid_states[:, :2] @ normal - offset >= 0.0
+    k = int(reached.argmax())
+    beyond = (grid_states[:, :2] @ other_normals.T - other_offsets).max(axis=1) > slack
+    first_outside = int(beyond.argmax())
+    if beyond[first_outside] and (not reached[k] or first_outside < k):
+        _wrong_exit(controller, others, grid_states[first_outside, :2] + center)
+    if not reached[k]:
         raise SolverError(
             error(
                 "C010",
@@ -233,7 +258,6 @@ def _exit_step(controller: StepController, x0: FloatArray) -> tuple[list[float],
                 hint="please report this mission",
             )
         )
-    k = int(hits[0])
     start = np.array([y0[0], y0[1], 1.0])
     inside = [grid_states[:k]]  # grid states before the crossing
     bracket = (k * dt, start if k == 0 else grid_states[k - 1])
@@ -252,16 +276,16 @@ def _exit_step(controller: StepController, x0: FloatArray) -> tuple[list[float],
     # Samples: the grid points nearest to evenly spaced times (exact states, no extra work).
     grid = np.concatenate(inside)
     wanted = np.rint(np.arange(1, SAMPLES_PER_STEP) * (crossing / SAMPLES_PER_STEP) / dt)
-    indices = np.unique(wanted[(wanted >= 1) & (wanted <= len(grid))].astype(np.int64))
-    times = [float(j * dt) for j in indices.tolist()]
-    points = [grid[j - 1, :2] + center for j in indices.tolist()]
+    indices = sorted({int(j) for j in wanted.tolist() if 1 <= j <= len(grid)})
+    times = [float(j * dt) for j in indices]
+    points = [grid[j - 1, :2] + center for j in indices]
     # Snap onto the exit edge (the root is exact to ~1e-14; this removes the residue).
     a = geometry.vertices[(controller.exit_edge + 1) % 3]
     b = geometry.vertices[(controller.exit_edge + 2) % 3]
     along = float((end - a) @ (b - a) / ((b - a) @ (b - a)))
     if not -WRONG_FACET_TOLERANCE <= along <= 1.0 + WRONG_FACET_TOLERANCE:
         _wrong_exit(controller, others, end)
-    end = a + float(np.clip(along, 0.0, 1.0)) * (b - a)
+    end = a + min(max(along, 0.0), 1.0) * (b - a)
     return [*times, float(crossing)], [*points, end]
 
 
