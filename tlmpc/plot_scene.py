@@ -122,10 +122,13 @@ class Scene:
     #: further pieces of free space (workspace components): outer boundaries, and their holes
     components: tuple[Polygon, ...] = ()
     component_holes: tuple[Polygon, ...] = ()
+    #: the points of every polygon in ``regions``, in order, as rows ``x, y`` (when the scene
+    #: converted them in one array anyway: the SVG writer then need not convert them again)
+    region_points: FloatArray | None = field(default=None, compare=False)
 
 
 def _polygon(points: Sequence[Sequence[float]]) -> Polygon:
-    return tuple((float(p[0]), float(p[1])) for p in points)
+    return tuple([(float(p[0]), float(p[1])) for p in points])
 
 
 def _label_point(polygon: Polygon) -> Point:
@@ -195,6 +198,40 @@ def _mesh(
     return np.concatenate([vertices[first], vertices[second]], axis=1), 0
 
 
+#: From this many regions on, their points are converted and boxed in one numpy pass.
+_BATCH_FROM = 64
+
+
+def _region_polygons(
+    listed: Sequence[Sequence[Sequence[float]]], view: Sequence[float]
+) -> tuple[list[Polygon], list[bool], FloatArray | None]:
+    """:func:`_polygon` of each region, whether its bounding box meets ``view``, and all
+    their points as rows ``x, y`` when they were gathered in one array (else None).
+
+    With many regions (maps with thousands of rooms) the boxes come from one array and
+    ``minimum/maximum.reduceat``: the same floats and the same comparisons as :func:`_bbox`
+    and :func:`_inside_view` one by one (the extremes of finite floats do not depend on the
+    order).  A non-finite coordinate or an empty ring takes the one-by-one path.
+    """
+    polygons = [_polygon(points) for points in listed]
+    lengths = [len(polygon) for polygon in polygons]
+    if len(polygons) < _BATCH_FROM or min(lengths) == 0:
+        return polygons, [_inside_view(_bbox(polygon), view) for polygon in polygons], None
+    import numpy as np
+
+    chain = itertools.chain.from_iterable
+    flat = np.fromiter(chain(chain(polygons)), dtype=np.float64, count=2 * sum(lengths))
+    flat = flat.reshape(-1, 2)
+    if not np.isfinite(flat).all():
+        return polygons, [_inside_view(_bbox(polygon), view) for polygon in polygons], None
+    starts = np.cumsum([0, *lengths[:-1]])
+    low = np.minimum.reduceat(flat, starts, axis=0)
+    high = np.maximum.reduceat(flat, starts, axis=0)
+    x0, y0, x1, y1 = view
+    outside = (high[:, 0] < x0) | (low[:, 0] > x1) | (high[:, 1] < y0) | (low[:, 1] > y1)
+    return polygons, (~outside).tolist(), flat
+
+
 def _centroids(abstraction: Mapping[str, Any], triangles: Sequence[int]) -> tuple[Point, ...]:
     vertices = abstraction["vertices"]
     tris = abstraction["triangles"]
@@ -215,12 +252,11 @@ def arc_length_path(samples: Sequence[Sequence[float]]) -> Path | None:
     """
     if not samples:
         return None
-    points = tuple((float(s[1]), float(s[2])) for s in samples)
-    cumulative = [0.0]
-    for (ax, ay), (bx, by) in itertools.pairwise(points):
-        cumulative.append(cumulative[-1] + math.hypot(bx - ax, by - ay))
+    points = tuple([(float(s[1]), float(s[2])) for s in samples])
+    steps = [math.hypot(bx - ax, by - ay) for (ax, ay), (bx, by) in itertools.pairwise(points)]
+    cumulative = list(itertools.accumulate(steps, initial=0.0))  # summed first to last
     total = cumulative[-1]
-    fractions = tuple(c / total if total > 0 else 0.0 for c in cumulative)
+    fractions = tuple([c / total for c in cumulative] if total > 0 else [0.0] * len(cumulative))
     return Path(points=points, fractions=fractions, length=total)
 
 
@@ -273,9 +309,12 @@ def build_scene(
 
     named = _task_propositions(mission)
     many = len(mission["regions"]) > MAX_REGION_NAMES
+    ordered = sorted(mission["regions"].items())
+    polygons, in_view, flat = _region_polygons([points for _, points in ordered], view)
     regions = []
-    for index, (name, points) in enumerate(sorted(mission["regions"].items())):
-        polygon = _polygon(points)
+    for index, ((name, _), polygon) in enumerate(zip(ordered, polygons, strict=True)):
+        if not in_view[index]:
+            continue  # not drawn; its colour still counts (colours follow the sorted names)
         labelled = not many or name in named
         regions.append(
             Region(
@@ -287,11 +326,14 @@ def build_scene(
                 label_at=_label_point(polygon) if labelled else polygon[0],
             )
         )
-    visible_regions = tuple(r for r in regions if _inside_view(_bbox(r.polygon), view))
+    visible_regions = tuple(regions)
+    # Every region drawn: the converted points are the drawn ones, in order.
+    region_points = flat if len(visible_regions) == len(ordered) else None
     regions_omitted = 0
     if len(visible_regions) > MAX_DRAWN_REGIONS:
         regions_omitted = sum(1 for r in visible_regions if not r.named_by_task)
         visible_regions = tuple(r for r in visible_regions if r.named_by_task)
+        region_points = None
 
     abstraction = artifacts.get("abstraction.json")
     if abstraction is not None:
@@ -335,4 +377,5 @@ def build_scene(
         violations=_violations(verdict),
         components=components,
         component_holes=component_holes,
+        region_points=region_points,
     )

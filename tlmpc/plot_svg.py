@@ -89,22 +89,31 @@ def _polygon_path(canvas: _Canvas, polygon: Sequence[Point]) -> str:
 _BATCH_FROM = 64
 
 
-def _polygon_paths(canvas: _Canvas, polygons: Sequence[Sequence[Point]]) -> list[str]:
+def _polygon_paths(
+    canvas: _Canvas, polygons: Sequence[Sequence[Point]], points: FloatArray | None = None
+) -> list[str]:
     """:func:`_polygon_path` of each polygon, the same text.
 
     Many polygons (maps with thousands of rooms) are mapped to pixels with numpy, by the
     same float operations as :meth:`_Canvas.xy`, and written with one ``%``-format (``%.1f``
-    formats as ``:.1f`` does).
+    formats as ``:.1f`` does).  ``points``, when given, holds the polygons' points in order
+    as rows ``x, y`` (the scene's own array: no second conversion).
     """
     if len(polygons) < _BATCH_FROM:
         return [_polygon_path(canvas, polygon) for polygon in polygons]
     import numpy as np
 
-    coords = np.array(list(chain.from_iterable(polygons)), dtype=np.float64).reshape(-1, 2)
-    pixels = np.empty_like(coords)
-    pixels[:, 0] = canvas.left + (coords[:, 0] - canvas.x0) * canvas.scale
-    pixels[:, 1] = canvas.top + (canvas.y1 - coords[:, 1]) * canvas.scale
-    template = "\n".join("M" + "L".join(["%.1f %.1f"] * len(p)) + "Z" for p in polygons)
+    if points is None:
+        points = np.array(list(chain.from_iterable(polygons)), dtype=np.float64).reshape(-1, 2)
+    pixels = np.empty_like(points)
+    pixels[:, 0] = canvas.left + (points[:, 0] - canvas.x0) * canvas.scale
+    pixels[:, 1] = canvas.top + (canvas.y1 - points[:, 1]) * canvas.scale
+    # One template per ring length (most maps repeat a few: rooms are rectangles).
+    templates: dict[int, str] = {}
+    for polygon in polygons:
+        if len(polygon) not in templates:
+            templates[len(polygon)] = "M" + "L".join(["%.1f %.1f"] * len(polygon)) + "Z"
+    template = "\n".join([templates[len(polygon)] for polygon in polygons])
     return (template % tuple(pixels.ravel().tolist())).split("\n")
 
 
@@ -299,7 +308,9 @@ def render_svg(scene: Scene) -> bytes:
                 d = "".join(_polygon_path(canvas, ring) for ring in rings)
                 parts.append(f'<path d="{d}" fill="{colour}" stroke="#000" stroke-width="1.2"/>')
     by_colour: dict[tuple[str, bool], list[str]] = {}
-    region_paths = _polygon_paths(canvas, [region.polygon for region in scene.regions])
+    region_paths = _polygon_paths(
+        canvas, [region.polygon for region in scene.regions], scene.region_points
+    )
     for region, path in zip(scene.regions, region_paths, strict=True):
         emphasised = scene.emphasise_task_regions and region.named_by_task
         key = ("#1f1f1f" if emphasised else region.colour, emphasised)
