@@ -235,12 +235,11 @@ def _exit_step(controller: StepController, x0: FloatArray) -> tuple[list[float],
     slack = WRONG_FACET_TOLERANCE * tallest
     # All grid states, chunk after chunk from the last state of the one before, then one check
     # of them all (states past the crossing are computed and not used).
-    chunks = []
-    for _ in range(0, GRID_POINTS, GRID_CHUNK):
-        states = stack @ state
-        chunks.append(states)
-        state = states[-1]
-    grid_states = np.concatenate(chunks)
+    grid_states = np.empty((GRID_POINTS, 3))
+    for first in range(0, GRID_POINTS, GRID_CHUNK):
+        chunk = grid_states[first : first + GRID_CHUNK]
+        np.matmul(stack, state, out=chunk)
+        state = chunk[-1]
     # The first grid state on or past the exit edge, and the first beyond another facet
     # (argmax of a boolean array: its first True, or 0 when there is none).
     reached = grid_states[:, :2] @ normal - offset >= 0.0
@@ -278,15 +277,19 @@ def _exit_step(controller: StepController, x0: FloatArray) -> tuple[list[float],
     wanted = np.rint(np.arange(1, SAMPLES_PER_STEP) * (crossing / SAMPLES_PER_STEP) / dt)
     indices = sorted({int(j) for j in wanted.tolist() if 1 <= j <= len(grid)})
     times = [float(j * dt) for j in indices]
-    points = [grid[j - 1, :2] + center for j in indices]
+    points = list(grid[[j - 1 for j in indices], :2] + center)
     # Snap onto the exit edge (the root is exact to ~1e-14; this removes the residue).
-    a = geometry.vertices[(controller.exit_edge + 1) % 3]
-    b = geometry.vertices[(controller.exit_edge + 2) % 3]
-    along = float((end - a) @ (b - a) / ((b - a) @ (b - a)))
+    # (On Python floats: a dot of two is ax bx + ay by, as numpy computes it.)
+    ax, ay = corners[(controller.exit_edge + 1) % 3]
+    bx, by = corners[(controller.exit_edge + 2) % 3]
+    ex, ey = end.tolist()
+    dx, dy = bx - ax, by - ay
+    squared = dx * dx + dy * dy
+    along = ((ex - ax) * dx + (ey - ay) * dy) / squared if squared > 0.0 else math.nan
     if not -WRONG_FACET_TOLERANCE <= along <= 1.0 + WRONG_FACET_TOLERANCE:
         _wrong_exit(controller, others, end)
-    end = a + min(max(along, 0.0), 1.0) * (b - a)
-    return [*times, float(crossing)], [*points, end]
+    along = min(max(along, 0.0), 1.0)
+    return [*times, float(crossing)], [*points, np.array([ax + along * dx, ay + along * dy])]
 
 
 def _wrong_exit(controller: StepController, facets: list[int], where: FloatArray) -> NoReturn:
@@ -406,7 +409,7 @@ def trace_header(mission: Mission, max_speed: float) -> dict[str, Any]:
     from tlmpc.mission.body import body_radius
 
     def poly(points: tuple[tuple[float, float], ...]) -> list[list[float]]:
-        return [[x, y] for x, y in points]
+        return list(map(list, points))  # thousands of regions: no per-point Python frame
 
     return {
         "format": "tlmpc.trace/1",
