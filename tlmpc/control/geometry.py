@@ -14,6 +14,9 @@ import numpy as np
 
 from tlmpc.abstraction.model import FloatArray
 
+#: A plane vector: a numpy array or a pair of floats.
+VectorLike = Sequence[float] | FloatArray
+
 
 @dataclass(frozen=True, slots=True)
 class TriangleGeometry:
@@ -113,7 +116,7 @@ def affine_law(vertices: FloatArray, velocities: FloatArray) -> tuple[FloatArray
     return gain, offset
 
 
-def half_plane_feasible(normals: Sequence[Sequence[float]]) -> bool:
+def half_plane_feasible(normals: Sequence[VectorLike]) -> bool:
     """True when some w has a·w > 0 for every a in ``normals`` (cones intersect).
 
     The normals must fit in an open half-plane: their directions span less than 180°.
@@ -126,7 +129,7 @@ def half_plane_feasible(normals: Sequence[Sequence[float]]) -> bool:
     return widest > math.pi + 1e-9
 
 
-def best_push(normals: Sequence[Sequence[float]], max_speed: float) -> float:
+def best_push(normals: Sequence[VectorLike], max_speed: float) -> float:
     """max over |w| <= max_speed of min_k a_k·w, for unit normals a_k (exact, in the plane).
 
     The largest speed a vertex velocity can guarantee along every normal at once: a disturbance

@@ -1,0 +1,141 @@
+"""The per-step arithmetic done on Python floats gives numpy's values bit for bit.
+
+The controllers and the exact simulation compute triangle geometry, affine frames, 1-norms and
+angle gaps on Python floats (numpy's per-call cost on 2-vectors dominated those stages).  Each
+is compared here with its definition written with numpy arrays, the way the stages computed
+them before, on triangles of every size and distance from the origin: equal arrays, not close
+ones, so the artifacts stay byte for byte the same.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from hypothesis import example, given
+from hypothesis import strategies as st
+
+from tlmpc.abstraction.model import FloatArray
+from tlmpc.control.geometry import affine_law, half_plane_feasible, triangle_geometry
+from tlmpc.simulate.exact import _column_norm
+
+MAGNITUDE = st.floats(-12, 12)  # decimal exponents of sizes and offsets
+
+
+@st.composite
+def triangles(draw: st.DrawFn) -> FloatArray:
+    """A counter-clockwise triangle of any size, anywhere (not degenerate)."""
+    exponent = draw(MAGNITUDE)
+    size = 10.0**exponent
+    # at most a million sizes from the origin: farther, rounding flattens the triangle
+    shift = 10.0 ** draw(st.floats(exponent - 6, exponent + 6)) * np.array(
+        [draw(st.floats(-1, 1)), draw(st.floats(-1, 1))]
+    )
+    corners = np.array(
+        [[draw(st.floats(-1, 1)), draw(st.floats(-1, 1))] for _ in range(3)], dtype=np.float64
+    )
+    first, second = corners[1] - corners[0], corners[2] - corners[0]
+    area = first[0] * second[1] - first[1] * second[0]
+    if abs(area) < 1e-3:
+        corners = np.array([[0.0, 0.0], [1.0, 0.0], [0.25, 0.75]])
+    elif area < 0:
+        corners = corners[::-1].copy()
+    return np.asarray(corners * size + shift, dtype=np.float64)
+
+
+def geometry_by_arrays(v: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Normals, offsets and heights with numpy arrays, as the definition reads."""
+    normals, offsets, heights = np.empty((3, 2)), np.empty(3), np.empty(3)
+    for i in range(3):
+        a, b = v[(i + 1) % 3], v[(i + 2) % 3]
+        edge = b - a
+        normal = np.array([edge[1], -edge[0]])
+        normal /= np.linalg.norm(normal)
+        normals[i], offsets[i] = normal, normal @ a
+        heights[i] = offsets[i] - normal @ v[i]
+    return normals, offsets, heights
+
+
+def affine_law_by_arrays(v: FloatArray, w: FloatArray) -> tuple[FloatArray, FloatArray]:
+    center = v.mean(axis=0)
+    size = float(np.abs(v - center).max())
+    system = np.hstack([(v - center) / size, np.ones((3, 1))])
+    solution = np.linalg.solve(system, w)
+    gain = np.ascontiguousarray(solution[:2].T / size)
+    return gain, solution[2] - gain @ center
+
+
+def half_plane_by_arrays(normals: list[FloatArray]) -> bool:
+    if len(normals) <= 1:
+        return True
+    angles = np.sort(np.array([np.arctan2(a[1], a[0]) for a in normals]))
+    gaps = np.diff(np.concatenate([angles, [angles[0] + 2 * np.pi]]))
+    return bool(gaps.max() > np.pi + 1e-9)
+
+
+@given(triangles())
+@example(np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]))
+@example(np.array([[1e6, 1e6], [1e6 + 1e-3, 1e6], [1e6, 1e6 + 1e-3]]))
+def test_triangle_geometry_is_the_array_definition(v: FloatArray) -> None:
+    geometry = triangle_geometry(v)
+    normals, offsets, heights = geometry_by_arrays(v)
+    assert np.array_equal(geometry.normals, normals)
+    assert np.array_equal(geometry.offsets, offsets)
+    assert np.array_equal(geometry.heights, heights)
+    # and the definition itself: unit outward normals, each facet on its line, positive heights
+    assert np.allclose(np.linalg.norm(geometry.normals, axis=1), 1.0)
+    assert np.all(geometry.heights > 0)
+
+
+def test_a_degenerate_edge_gives_numpy_nan_not_an_exception() -> None:
+    v = np.array([[0.0, 0.0], [0.0, 0.0], [1.0, 1.0]])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        geometry = triangle_geometry(v)
+    assert np.isnan(geometry.normals[2]).all()
+
+
+@given(triangles(), st.lists(st.floats(-10, 10), min_size=6, max_size=6))
+def test_affine_law_is_the_array_definition(v: FloatArray, speeds: list[float]) -> None:
+    w = np.array(speeds, dtype=np.float64).reshape(3, 2)
+    gain, offset = affine_law(v, w)
+    expected_gain, expected_offset = affine_law_by_arrays(v, w)
+    assert np.array_equal(gain, expected_gain)
+    assert np.array_equal(offset, expected_offset)
+
+
+@given(st.lists(st.floats(-math.pi, math.pi), max_size=6))
+def test_half_plane_test_is_the_array_definition(angles: list[float]) -> None:
+    normals = [np.array([math.cos(a), math.sin(a)]) for a in angles]
+    assert half_plane_feasible(normals) == half_plane_by_arrays(normals)
+    as_floats: list[tuple[float, float]] = [(float(n[0]), float(n[1])) for n in normals]
+    assert half_plane_feasible(as_floats) == half_plane_by_arrays(normals)
+
+
+def test_half_plane_test_on_known_fans() -> None:
+    def unit(degrees: float) -> FloatArray:
+        return np.array([math.cos(math.radians(degrees)), math.sin(math.radians(degrees))])
+
+    assert half_plane_feasible([unit(0), unit(90), unit(170)])
+    assert not half_plane_feasible([unit(0), unit(90), unit(190)])
+    assert not half_plane_feasible([unit(-100), unit(0), unit(100)])  # wraps around 180°
+
+
+@given(
+    st.integers(2, 4).flatmap(
+        lambda n: st.lists(
+            st.floats(-1e6, 1e6, allow_nan=False, allow_subnormal=False),
+            min_size=n * n,
+            max_size=n * n,
+        )
+    )
+)
+def test_column_norm_is_numpys(entries: list[float]) -> None:
+    n = math.isqrt(len(entries))
+    matrix = np.array(entries, dtype=np.float64).reshape(n, n)
+    assert _column_norm(matrix) == float(np.abs(matrix).sum(axis=0).max())
+
+
+def test_column_norm_propagates_nan_as_numpy_does() -> None:
+    matrix = np.array([[1.0, np.nan, 0.0], [2.0, 3.0, 0.0], [0.0, 0.0, 5.0]])
+    assert math.isnan(_column_norm(matrix))
+    assert math.isnan(float(np.abs(matrix).sum(axis=0).max()))
