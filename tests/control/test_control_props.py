@@ -493,6 +493,47 @@ def test_a_field_leaving_by_an_unplanned_facet_is_reported(
     assert caught.value.diagnostics[0].code in {"C031", "C010"}
 
 
+@pytest.mark.parametrize("scale", [1.0, 1e-3, 1e4])
+def test_a_dip_across_another_facet_before_the_exit_is_reported(scale: float) -> None:
+    """An outward spiral that dips below the bottom edge, comes back in and then leaves
+    through the planned hypotenuse: the first exit was the wrong one (C031), even though the
+    later crossing lies on the planned edge and would snap cleanly."""
+    from tlmpc.errors import SolverError
+
+    v = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]) * scale
+    center = np.array([0.45, 0.4]) * scale
+    gain = np.array([[0.1, -1.0], [1.0, 0.1]])  # x' = K (x - center): turn, slowly grow
+    angle = math.radians(-120.0)
+    x0 = center + 0.39 * scale * np.array([math.cos(angle), math.sin(angle)])
+    controller = StepController(
+        step=0,
+        triangle=0,
+        exit_edge=0,  # the hypotenuse, opposite vertex 0
+        next_triangle=1,
+        vertices=v,
+        velocities=(v - center) @ gain.T,
+        gain=gain,
+        offset=-gain @ center,
+        exit_speed=0.3 * scale,  # a horizon long enough for the spiral to reach the exit
+        exit_time_bound=10.0,
+    )
+    # the definition, by a fine RK45 integration: below y = 0 first, then across x + y = 1
+    # inside the edge's span
+    run = solve_ivp(
+        lambda _, x: gain @ (x - center), (0.0, 1.6), x0, max_step=1e-3, rtol=1e-10, atol=1e-12
+    )
+    bottom = np.flatnonzero(run.y[1] < -1e-3 * scale)
+    across = np.flatnonzero(run.y[0] + run.y[1] > scale)
+    assert bottom.size
+    assert across.size
+    assert bottom[-1] < across[0]
+    assert 0 < run.y[0][across[0]] < scale  # back in, then out within the edge's span
+    assert run.y[1][across[0]] > 0
+    with pytest.raises(SolverError) as caught:
+        _exit_step(controller, x0)
+    assert caught.value.diagnostics[0].code == "C031"
+
+
 @settings(deadline=None, max_examples=30)
 @given(triangles(), st.integers(0, 2))
 def test_the_recheck_finds_every_broken_vertex_condition(v: np.ndarray, exit_edge: int) -> None:

@@ -64,6 +64,7 @@ def plan_steps(abstraction: Abstraction, witness: Witness) -> tuple[list[_Step],
     path = [*witness.prefix, *witness.cycle]
     stay = witness.is_stay
     passages = dict(witness.passages)
+    neighbors = abstraction.neighbors
     steps: list[_Step] = []
     for index, tri in enumerate(path):
         if stay and index == len(path) - 1:
@@ -88,7 +89,7 @@ def plan_steps(abstraction: Abstraction, witness: Witness) -> tuple[list[_Step],
             continue
         exit_edge = None
         if nxt is not None:
-            matches = np.flatnonzero(abstraction.neighbors[tri] == nxt)
+            matches = [edge for edge, other in enumerate(neighbors[tri].tolist()) if other == nxt]
             if len(matches) != 1:
                 raise InvalidInputError(
                     error(
@@ -602,7 +603,7 @@ def synthesize(
                 )
             )
             continue
-        w = np.array([velocities[column[r]] for r in step.runs])
+        w = velocities[[column[r] for r in step.runs]]
         geometry = step.geometry
         target = None
         if step.exit_edge is None:
@@ -624,7 +625,8 @@ def synthesize(
             target = (float(equilibrium[0]), float(equilibrium[1]))
         else:
             gain, offset = affine_law(geometry.vertices, w)
-            delta = float(min(geometry.normals[step.exit_edge] @ w[i] for i in range(3)))
+            nx, ny = geometry.normals[step.exit_edge].tolist()
+            delta = min(nx * wx + ny * wy for wx, wy in w.tolist())  # numpy's 2-vector dot
             speed = delta
             bound = float(geometry.heights[step.exit_edge] / delta) if delta > 0 else float("inf")
         controllers.append(
