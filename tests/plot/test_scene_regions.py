@@ -11,7 +11,7 @@ from __future__ import annotations
 import dataclasses
 from typing import Any
 
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from tlmpc.plot_scene import _BATCH_FROM, REGION_COLOURS, build_scene
@@ -40,11 +40,19 @@ def _meets(ring: list[tuple[float, float]], view: tuple[float, float, float, flo
     return min(xs) <= x1 and max(xs) >= x0 and min(ys) <= y1 and max(ys) >= y0
 
 
+#: Rooms left of, right of, below, above and inside the window (0, 0)-(10, 10), and one on it.
+_AROUND = [
+    [(-20.0 + dx, 2.0 + dy), (-15.0 + dx, 2.0 + dy), (-15.0 + dx, 6.0 + dy)]
+    for dx, dy in [(0.0, 0.0), (40.0, 0.0), (17.0, -20.0), (17.0, 20.0), (19.0, 0.0), (25.0, 0.0)]
+]
+
+
 @settings(max_examples=max(10, settings().max_examples // 5), deadline=None)
 @given(
     st.lists(RING, min_size=_BATCH_FROM, max_size=2 * _BATCH_FROM),
     st.one_of(st.none(), VIEW),
 )
+@example(_AROUND * (_BATCH_FROM // len(_AROUND) + 1), (0.0, 0.0, 10.0, 10.0))
 def test_batched_regions_are_the_one_by_one_definition(
     rings: list[list[tuple[float, float]]], window: tuple[float, float, float, float] | None
 ) -> None:
