@@ -65,7 +65,7 @@ def main(argv: list[str] | None = None) -> int:
         workloads = {"example8": ROOT / "specs" / "example8.yaml"}
         for name in [g for g in args.grids.split(",") if g]:
             workloads[f"grid {name}"] = _write_grid(GRIDS[name], Path(tmp))
-        print("| workload | tree | scene CPU s | plan.svg (scene + SVG) CPU s | bytes | same bytes |")
+        print("| workload | tree | scene CPU s | scene + SVG CPU s | bytes | same bytes |")
         print("|---|---|---:|---:|---:|---|")
         for workload, path in workloads.items():
             out = Path(tmp) / workload.replace(" ", "-")
