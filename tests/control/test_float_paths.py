@@ -16,7 +16,12 @@ from hypothesis import example, given
 from hypothesis import strategies as st
 
 from tlmpc.abstraction.model import FloatArray
-from tlmpc.control.geometry import affine_law, half_plane_feasible, triangle_geometry
+from tlmpc.control.geometry import (
+    affine_law,
+    half_plane_feasible,
+    largest_of,
+    triangle_geometry,
+)
 from tlmpc.simulate.exact import _column_norm
 
 MAGNITUDE = st.floats(-12, 12)  # decimal exponents of sizes and offsets
@@ -139,3 +144,29 @@ def test_column_norm_propagates_nan_as_numpy_does() -> None:
     matrix = np.array([[1.0, np.nan, 0.0], [2.0, 3.0, 0.0], [0.0, 0.0, 5.0]])
     assert math.isnan(_column_norm(matrix))
     assert math.isnan(float(np.abs(matrix).sum(axis=0).max()))
+
+
+@given(
+    st.lists(
+        st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.just(math.nan)),
+        min_size=1,
+        max_size=6,
+    )
+)
+def test_largest_of_is_numpys_max(values: list[float]) -> None:
+    expected = float(np.max(np.array(values)))
+    got = largest_of(values)
+    assert got == expected or (math.isnan(got) and math.isnan(expected))
+
+
+def test_non_finite_inputs_take_numpys_path() -> None:
+    point = np.array([[1.0, 1.0], [1.0, 1.0], [1.0, 1.0]])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        gain, offset = affine_law(point, np.ones((3, 2)))
+        expected_gain, expected_offset = affine_law_by_arrays(point, np.ones((3, 2)))
+    assert np.array_equal(gain, expected_gain, equal_nan=True)
+    assert np.array_equal(offset, expected_offset, equal_nan=True)
+    normals = [np.array([math.nan, 0.0]), np.array([1.0, 0.0])]
+    assert half_plane_feasible(normals) is False
+    with np.errstate(invalid="ignore"):
+        assert half_plane_by_arrays(normals) is False

@@ -103,6 +103,8 @@ def affine_law(vertices: FloatArray, velocities: FloatArray) -> tuple[FloatArray
     cx, cy = (x0 + x1 + x2) / 3, (y0 + y1 + y2) / 3
     dx0, dy0, dx1, dy1, dx2, dy2 = x0 - cx, y0 - cy, x1 - cx, y1 - cy, x2 - cx, y2 - cy
     size = max(abs(dx0), abs(dy0), abs(dx1), abs(dy1), abs(dx2), abs(dy2))
+    if not (math.isfinite(cx) and math.isfinite(cy) and 0.0 < size < math.inf):
+        return _affine_law_arrays(np.asarray(vertices, dtype=np.float64), velocities)
     system = np.array(
         [
             [dx0 / size, dy0 / size, 1.0],
@@ -116,6 +118,29 @@ def affine_law(vertices: FloatArray, velocities: FloatArray) -> tuple[FloatArray
     return gain, offset
 
 
+def _affine_law_arrays(
+    vertices: FloatArray, velocities: FloatArray
+) -> tuple[FloatArray, FloatArray]:
+    """:func:`affine_law` on numpy arrays, for a point-like or non-finite triangle: numpy's
+    nan/inf (with its warning) where Python floats would raise or differ."""
+    center = vertices.mean(axis=0)
+    size = float(np.abs(vertices - center).max())
+    local = (vertices - center) / size
+    system = np.hstack([local, np.ones((3, 1))])
+    solution = np.asarray(np.linalg.solve(system, velocities), dtype=np.float64)
+    gain: FloatArray = np.ascontiguousarray(solution[:2].T / size)
+    offset: FloatArray = solution[2] - gain @ center
+    return gain, offset
+
+
+def largest_of(values: list[float]) -> float:
+    """``max(values)`` as numpy's ``max`` gives it: nan when any value is nan (Python's
+    ``max`` answers according to where the nan stands)."""
+    if any(value != value for value in values):
+        return math.nan
+    return max(values)
+
+
 def half_plane_feasible(normals: Sequence[VectorLike]) -> bool:
     """True when some w has a·w > 0 for every a in ``normals`` (cones intersect).
 
@@ -124,6 +149,8 @@ def half_plane_feasible(normals: Sequence[VectorLike]) -> bool:
     if len(normals) <= 1:
         return True
     angles = sorted(math.atan2(a[1], a[0]) for a in normals)
+    if any(angle != angle for angle in angles):
+        return False  # a nan direction: numpy's largest gap is nan, never wide enough
     angles.append(angles[0] + 2 * math.pi)
     widest = max(after - before for before, after in itertools.pairwise(angles))
     return widest > math.pi + 1e-9

@@ -29,6 +29,7 @@ from tlmpc.control.geometry import (
     affine_law,
     best_push,
     half_plane_feasible,
+    largest_of,
     triangle_geometry,
 )
 from tlmpc.control.model import Controllers, StepController, VelocityJump
@@ -450,7 +451,7 @@ def _violated_condition(
     w = controller.velocities.tolist()
     normals = geometry.normals.tolist()
     floor = disturbance + RECHECK_TOLERANCE * max_speed
-    fastest = max(math.sqrt(wx * wx + wy * wy) for wx, wy in w)
+    fastest = largest_of([math.sqrt(wx * wx + wy * wy) for wx, wy in w])
     if fastest > max_speed * (1.0 + RECHECK_TOLERANCE):
         return f"a vertex speed {fastest:.6g} exceeds max_speed {max_speed:.6g}"
     for i in range(3):

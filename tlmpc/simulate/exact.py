@@ -22,7 +22,7 @@ from typing import Any, NoReturn
 import numpy as np
 
 from tlmpc.abstraction.model import Abstraction, FloatArray
-from tlmpc.control.geometry import triangle_geometry
+from tlmpc.control.geometry import largest_of, triangle_geometry
 from tlmpc.control.model import Controllers, StepController
 from tlmpc.errors import SolverError, error
 from tlmpc.mission.model import Mission
@@ -91,8 +91,7 @@ def _column_norm(matrix: FloatArray) -> float:
     sums = [abs(a) for a in rows[0]]
     for row in rows[1:]:
         sums = [total + abs(a) for total, a in zip(sums, row, strict=True)]
-    largest = max(sums)
-    return math.nan if math.isnan(sum(sums)) else largest  # numpy's max propagates nan
+    return largest_of(sums)
 
 
 def expm_small(matrix: FloatArray) -> FloatArray:
@@ -203,8 +202,8 @@ def _exit_step(controller: StepController, x0: FloatArray) -> tuple[list[float],
     # sums the rows first to last): an exit step is a few dozen tiny array operations, and
     # their per-call cost was most of the stage.
     corners = geometry.vertices.tolist()
-    tallest = max(geometry.heights.tolist())
-    scale = max(abs(c) for corner in corners for c in corner) + tallest
+    tallest = largest_of(geometry.heights.tolist())
+    scale = largest_of([abs(c) for corner in corners for c in corner]) + tallest
     if geometry.offsets[controller.exit_edge] - normal @ x0 <= 1e-12 * scale:
         return [0.0], [x0]  # already on the exit edge (to rounding): the crossing is now
     # Coordinates relative to the triangle: y = x - center obeys y' = K y + v(center), whose
