@@ -38,6 +38,7 @@ MissionSource = str | os.PathLike[str] | Mapping[str, Any]
 """A mission: a path to a YAML file, YAML text, or the mission as a dict."""
 
 
+
 def _mission_text(mission: MissionSource) -> tuple[str | None, Path]:
     """(YAML text or None when ``mission`` is a file, the path diagnostics will name)."""
     if isinstance(mission, Mapping):
@@ -210,13 +211,17 @@ def verify_trace(
     if isinstance(trace, Compiled):
         document = trace.artifacts.get("trace.json")
         if document is None:
-            raise UsageError(error("U073", "this compilation stopped before the simulate stage"))
+            raise UsageError(
+                error("U073", "this compilation stopped before the simulate stage")
+            )
         return check_trace(from_document(document, convention=boundary))
     if isinstance(trace, Mapping):
         return check_trace(from_document(trace, convention=boundary))
     path = Path(trace)
     if path.suffix.lower() == ".csv":
-        return check_trace(from_csv(path, Path(mission) if mission is not None else None, boundary))
+        return check_trace(
+            from_csv(path, Path(mission) if mission is not None else None, boundary)
+        )
     from tlmpc.artifacts import read_json
 
     return check_trace(from_document(read_json(path), file=str(path), convention=boundary))

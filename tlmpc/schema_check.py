@@ -17,7 +17,8 @@ from typing import Any
 
 #: Keywords that never change whether an instance is valid.
 _ANNOTATIONS = frozenset(
-    {"$id", "$schema", "$comment", "$defs", "title", "description", "default", "examples", "format"}
+    {"$id", "$schema", "$comment", "$defs", "title", "description", "default", "examples",
+     "format"}
 )
 
 Check = Callable[[Any], bool]
@@ -130,16 +131,16 @@ class _Compiler:
             return lambda v: not isinstance(v, list) or all(item(x) for x in v)
         if key == "properties":
             props = {name: self.compile(sub) for name, sub in value.items()}
-            return lambda v: (
-                not isinstance(v, dict) or all(props[k](x) for k, x in v.items() if k in props)
+            return lambda v: not isinstance(v, dict) or all(
+                props[k](x) for k, x in v.items() if k in props
             )
         if key == "additionalProperties":
             if "patternProperties" in schema:
                 raise _Unsupported(key)
             known = frozenset(schema.get("properties", {}))
             extra = self.compile(value)
-            return lambda v: (
-                not isinstance(v, dict) or all(extra(x) for k, x in v.items() if k not in known)
+            return lambda v: not isinstance(v, dict) or all(
+                extra(x) for k, x in v.items() if k not in known
             )
         if key == "propertyNames":
             name_check = self.compile(value)

@@ -176,10 +176,9 @@ def check_shape(
     if _collinear(points, size):
         return None, [_collinear_problem(what, where)]
     checked = CheckedShape(points=points, polygon=None, path=path)
-    if (
-        plain_geometry.certainly_simple(points)
-        and abs(plain_geometry.shoelace_area(points)) > 2 * AREA_TOLERANCE * size * size
-    ):
+    if plain_geometry.certainly_simple(points) and abs(
+        plain_geometry.shoelace_area(points)
+    ) > 2 * AREA_TOLERANCE * size * size:
         return checked, []  # what shapely would say: valid, with an area well above zero
     polygon = shapely_polygon(checked)
     if not polygon.is_valid:

@@ -171,10 +171,8 @@ def find_contradiction(
         message = f"the task is a contradiction: {first.text!r} cannot hold together with " + (
             ", ".join(_describe(p) for p in others)
         )
-        hint = (
-            "together they mean "
-            + to_text(conjoin([formulas[i] for i in core]))
-            + (", which no behaviour satisfies; drop or change one of them")
+        hint = "together they mean " + to_text(conjoin([formulas[i] for i in core])) + (
+            ", which no behaviour satisfies; drop or change one of them"
         )
     code = "L020" if first.kind == "ltl" and not others else "T011"
     return error(code, message, hint=hint, file=file, line=first.line, col=first.col)
