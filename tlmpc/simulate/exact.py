@@ -79,8 +79,9 @@ def _taylor_degree(radius: float, cap: int) -> int:
     return degree
 
 
-#: The identity of the augmented matrices (only read: every use makes a new array).
+#: The identity of the augmented matrices (read only: every use makes a new array).
 _IDENTITY_3 = np.eye(3)
+_IDENTITY_3.setflags(write=False)
 
 
 def _column_norm(matrix: FloatArray) -> float:
