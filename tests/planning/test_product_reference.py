@@ -56,7 +56,8 @@ def _map(index: int) -> Abstraction:
 
 
 def guards() -> st.SearchStrategy[Formula]:
-    leaves = st.sampled_from([TRUE, FALSE, *(Prop(p) for p in (*APS, POINT))])
+    names: list[Formula] = [Prop(p) for p in (*APS, POINT)]
+    leaves: st.SearchStrategy[Formula] = st.sampled_from([TRUE, FALSE, *names])
     return st.recursive(
         leaves,
         lambda inner: st.one_of(
@@ -219,7 +220,7 @@ def _start_points(abstraction: Abstraction) -> st.SearchStrategy[tuple[float, fl
     inside = [tuple(map(float, c.mean(axis=0))) for c in corners]
     on_edge = [tuple(map(float, (c[0] + c[1]) / 2.0)) for c in corners]
     vertex = [tuple(map(float, c[0])) for c in corners]
-    return st.sampled_from([*inside, *on_edge, *vertex])  # type: ignore[arg-type]
+    return st.sampled_from([*inside, *on_edge, *vertex])
 
 
 @settings(max_examples=max(20, settings().max_examples // 2))
