@@ -27,6 +27,8 @@ FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
 BoolArray = npt.NDArray[np.bool_]
 
+#: Larger than any node index: a predecessor not chosen yet (searches return -1 instead).
+NO_NODE = np.iinfo(np.int64).max
 #: Bucket width as a multiple of the mean edge weight: wide enough to relax many nodes per
 #: round, narrow enough that few are relaxed again.
 BUCKET_WIDTH = 1.0
@@ -90,29 +92,7 @@ def _out_edges(graph: Graph, nodes: IntArray) -> IntArray:
     return shift + np.arange(total, dtype=np.int64)
 
 
-def _best_offers(
-    v: IntArray, d: FloatArray, du: FloatArray, u: IntArray
-) -> tuple[IntArray, FloatArray, FloatArray, IntArray]:
-    """One offer per target ``v``: the smallest (d, d(u), u) among its offers."""
-    order = np.argsort(v, kind="stable")
-    v, d, du, u = v[order], d[order], du[order], u[order]
-    same = v[1:] == v[:-1]
-    if not same.any():
-        return v, d, du, u
-    # Targets with several offers: order just those lexicographically, keep each first.
-    shared = np.zeros(len(v), dtype=bool)
-    shared[1:] |= same
-    shared[:-1] |= same
-    rivals = np.flatnonzero(shared)
-    rivals = rivals[np.lexsort((u[rivals], du[rivals], d[rivals], v[rivals]))]
-    head = np.ones(len(rivals), dtype=bool)
-    head[1:] = v[rivals[1:]] != v[rivals[:-1]]
-    keep = ~shared
-    keep[rivals[head]] = True
-    return v[keep], d[keep], du[keep], u[keep]
-
-
-def _take_offers(
+def _relax(
     dist: FloatArray,
     via: FloatArray,
     pred: IntArray,
@@ -121,17 +101,31 @@ def _take_offers(
     du: FloatArray,
     u: IntArray,
 ) -> IntArray:
-    """Record the offers (one per target) that beat what ``v`` has: a shorter distance, or
-    the same one from a nearer node, or from an equally near one of smaller index.  Returns
-    the targets whose distance got shorter (they must be searched from again)."""
+    """Take the offers ``u -> v`` (distance ``d`` through ``u``, itself at ``du``): each node
+    keeps the smallest (distance, d(predecessor), predecessor) among what it had and its
+    offers, by three scatter-minimums, one key after the other.  Returns the nodes whose
+    distance got shorter, each once (they must be searched from again).  The pairs
+    ``(u, v)`` must be distinct."""
     old = dist[v]
-    shorter = d < old
-    better = shorter | ((d == old) & ((du < via[v]) | ((du == via[v]) & (u < pred[v]))))
-    v = v[better]
-    dist[v] = d[better]
-    via[v] = du[better]
-    pred[v] = u[better]
-    improved: IntArray = v[shorter[better]]
+    np.minimum.at(dist, v, d)
+    best = dist[v]
+    win = d == best  # offers that attain the node's (new) distance
+    if not win.all():
+        v, du, u, old, best = v[win], du[win], u[win], old[win], best[win]
+    shorter = best < old
+    # A shorter distance voids the former predecessor's rank.
+    via[v[shorter]] = np.inf
+    former = via[v]
+    np.minimum.at(via, v, du)
+    nearest = via[v]
+    # A nearer predecessor replaces the former one; among equally near ones, the smallest.
+    pred[v[nearest < former]] = NO_NODE
+    tie = du == nearest
+    np.minimum.at(pred, v[tie], u[tie])
+    # The one offer per node that won: its predecessor is the node's (pairs are distinct).
+    won = shorter & tie
+    won[won] = u[won] == pred[v[won]]
+    improved: IntArray = v[won]
     return improved
 
 
@@ -183,14 +177,10 @@ def shortest_paths(
         v = graph.targets[edges]
         du = dist[u]
         d = du + graph.weights[edges]
-        # Only offers that can still win (or tie) at v, within the limit.
-        keep = (d <= dist[v]) & (d <= limit)
-        if not keep.all():
+        if limit < np.inf:
+            keep = d <= limit
             u, v, du, d = u[keep], v[keep], du[keep], d[keep]
-        if not len(v):
-            continue
-        v, d, du, u = _best_offers(v, d, du, u)
-        improved = _take_offers(dist, via, pred, v, d, du, u)
+        improved = _relax(dist, via, pred, v, d, du, u)
         if goals is not None and len(improved):
             hit = goals[improved]
             if hit.any():
@@ -307,13 +297,10 @@ def closing_searches(
         v = graph.targets[edges] + np.repeat(offset, counts)
         du = dist[u]
         d = du + graph.weights[edges]
-        keep = (d <= dist[v]) & (d <= limit[v // n])
+        keep = d <= limit[v // n]
         if not keep.all():
             u, v, du, d = u[keep], v[keep], du[keep], d[keep]
-        if not len(v):
-            continue
-        v, d, du, u = _best_offers(v, d, du, u)
-        improved = _take_offers(dist, via, pred, v, d, du, u)
+        improved = _relax(dist, via, pred, v, d, du, u)
         reached = improved[is_goal[improved]]
         if len(reached):
             searches = reached // n
