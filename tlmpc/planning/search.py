@@ -18,6 +18,7 @@ wherever those smallest ``d(u)`` are unique; it orders equal ``d(u)`` by its hea
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -78,6 +79,19 @@ class Graph:
         if not len(hits):
             raise KeyError((source, target))
         return float(self.weights[lo + int(hits[0])])
+
+    def path_weights(self, nodes: Sequence[int]) -> list[float]:
+        """The weights of the edges ``nodes[k] -> nodes[k + 1]`` along a path, each as
+        :meth:`weight` gives it (KeyError when one is missing), looked up all at once."""
+        path = np.asarray(nodes, dtype=np.int64)
+        tails, heads = path[:-1], path[1:]
+        edges = _out_edges(self, tails)
+        counts = self.indptr[tails + 1] - self.indptr[tails]
+        found = edges[self.targets[edges] == np.repeat(heads, counts)]
+        if len(found) != len(tails):  # a missing edge, or parallel ones: one at a time
+            return [self.weight(int(a), int(b)) for a, b in zip(tails, heads, strict=True)]
+        weights: list[float] = self.weights[found].tolist()
+        return weights
 
 
 def _out_edges(graph: Graph, nodes: IntArray) -> IntArray:
