@@ -124,9 +124,9 @@ def _relax(
     np.minimum.at(dist, v, d)
     best = dist[v]
     win = d == best  # offers that attain the node's (new) distance
-    if not win.all():
-        v, du, u, old, best = v[win], du[win], u[win], old[win], best[win]
     shorter = best < old
+    if not win.all():
+        v, du, u, shorter = v[win], du[win], u[win], shorter[win]
     # A shorter distance voids the former predecessor's rank.
     via[v[shorter]] = np.inf
     former = via[v]
@@ -176,6 +176,7 @@ def shortest_paths(
     if goals is not None and len(frontier) and goals[frontier].any():
         nearest_goal = 0.0
     width = BUCKET_WIDTH * float(graph.weights.mean()) if graph.nnz else 1.0
+    indptr, targets, weights = graph.indptr, graph.targets, graph.weights
     while len(frontier):
         current = dist[frontier]
         lowest = float(current.min())
@@ -184,13 +185,19 @@ def shortest_paths(
         take = current <= lowest + width
         active, frontier = frontier[take], frontier[~take]
         queued[active] = False
-        edges = _out_edges(graph, active)
-        if not len(edges):
+        starts = indptr[active]
+        counts = indptr[active + 1] - starts
+        ends = np.cumsum(counts)
+        total = int(ends[-1])
+        if not total:
             continue
-        u = graph.sources[edges]
-        v = graph.targets[edges]
-        du = dist[u]
-        d = du + graph.weights[edges]
+        # As in _out_edges; each edge's tail and its distance, repeated along its run, are
+        # read from the active nodes rather than gathered per edge.
+        edges = np.repeat(starts - ends + counts, counts) + np.arange(total)
+        u = np.repeat(active, counts)
+        du = np.repeat(current[take], counts)
+        v = targets[edges]
+        d = du + weights[edges]
         if limit < np.inf:
             keep = d <= limit
             u, v, du, d = u[keep], v[keep], du[keep], d[keep]
