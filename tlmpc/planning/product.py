@@ -123,9 +123,10 @@ def build_product(
             class_rows.append(row)
         return class_index[key]
 
-    for row in table:
-        class_of(row)
-    letter_class = np.array([class_index[id(row)] for row in table], dtype=np.int64)
+    letter_class = np.array(
+        [class_index.setdefault(id(row), len(class_index)) for row in table], dtype=np.int64
+    )
+    class_rows.extend({id(row): row for row in table}.values())  # in order of first occurrence
     tri_class = letter_class[abstraction.letter_of]
     if starts is None:
         starts = start_cells(abstraction, start_point)
