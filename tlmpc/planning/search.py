@@ -309,14 +309,17 @@ def closing_searches(
         active, frontier = frontier[take], frontier[~take]
         queued[active] = False
         local = active % n
-        offset = active - local
-        edges = _out_edges(graph, local)
-        if not len(edges):
+        starts = graph.indptr[local]
+        counts = graph.indptr[local + 1] - starts
+        ends = np.cumsum(counts)
+        total = int(ends[-1])
+        if not total:
             continue
-        counts = graph.indptr[local + 1] - graph.indptr[local]
+        # As in shortest_paths, in each search's own copy of the node numbers.
+        edges = np.repeat(starts - ends + counts, counts) + np.arange(total)
         u = np.repeat(active, counts)
-        v = graph.targets[edges] + np.repeat(offset, counts)
-        du = dist[u]
+        v = graph.targets[edges] + np.repeat(active - local, counts)
+        du = np.repeat(current[take], counts)
         d = du + graph.weights[edges]
         keep = d <= limit[v // n]
         if not keep.all():
