@@ -10,6 +10,7 @@ very same lasso whenever scipy's predecessors had no such tie.
 
 from __future__ import annotations
 
+import itertools
 import json
 import sys
 from typing import Any
@@ -181,6 +182,33 @@ def test_batched_closing_searches_are_single_searches(
         while path and pred[path[-1]] >= 0:
             path.append(int(pred[path[-1]]))
         assert paths[k] == path[::-1]
+
+
+@given(graphs(), st.data())
+def test_path_weights_are_the_edges_weights(
+    case: tuple[Graph, IntArray], data: st.DataObject
+) -> None:
+    graph, _ = case
+    edges = {
+        (int(u), int(v)): float(w)
+        for u, v, w in zip(graph.sources, graph.targets, graph.weights, strict=True)
+    }
+    walk: list[int] = [data.draw(st.integers(0, graph.num_nodes - 1))]
+    for _ in range(data.draw(st.integers(0, 8))):
+        # Mostly along an edge; now and then to any node (an edge that may not exist).
+        ahead = [v for (u, v) in edges if u == walk[-1]]
+        if ahead and data.draw(st.integers(0, 9)) > 0:
+            walk.append(data.draw(st.sampled_from(ahead)))
+        else:
+            walk.append(data.draw(st.integers(0, graph.num_nodes - 1)))
+    pairs = list(itertools.pairwise(walk))
+    if all(pair in edges for pair in pairs):
+        event("a path")
+        assert graph.path_weights(walk) == [edges[pair] for pair in pairs]
+    else:
+        event("a missing edge")
+        with pytest.raises(KeyError):
+            graph.path_weights(walk)
 
 
 @given(graphs())

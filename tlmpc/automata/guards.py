@@ -53,8 +53,11 @@ def successor_table(
     projections: dict[frozenset[str], list[list[tuple[int, int]]]] = {}
     table: list[list[tuple[tuple[int, int], ...]]] = []
     cache: dict[frozenset[str], list[tuple[tuple[int, int], ...]]] = {}
+    empty: frozenset[str] = frozenset()
     for letter in letters:
-        key = frozenset(p for p in letter if p in aps)
+        # Most letters of a large map name no proposition of the task: one set operation.
+        common = aps.intersection(letter)
+        key = frozenset(common) if common else empty
         row = cache.get(key)
         if row is None:
             per_state: list[list[tuple[int, int]]] = [[] for _ in range(automaton.num_states)]

@@ -18,6 +18,7 @@ wherever those smallest ``d(u)`` are unique; it orders equal ``d(u)`` by its hea
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -27,6 +28,8 @@ FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
 BoolArray = npt.NDArray[np.bool_]
 
+#: Larger than any node index: a predecessor not chosen yet (searches return -1 instead).
+NO_NODE = np.iinfo(np.int64).max
 #: Bucket width as a multiple of the mean edge weight: wide enough to relax many nodes per
 #: round, narrow enough that few are relaxed again.
 BUCKET_WIDTH = 1.0
@@ -77,6 +80,19 @@ class Graph:
             raise KeyError((source, target))
         return float(self.weights[lo + int(hits[0])])
 
+    def path_weights(self, nodes: Sequence[int]) -> list[float]:
+        """The weights of the edges ``nodes[k] -> nodes[k + 1]`` along a path, each as
+        :meth:`weight` gives it (KeyError when one is missing), looked up all at once."""
+        path = np.asarray(nodes, dtype=np.int64)
+        tails, heads = path[:-1], path[1:]
+        edges = _out_edges(self, tails)
+        counts = self.indptr[tails + 1] - self.indptr[tails]
+        found = edges[self.targets[edges] == np.repeat(heads, counts)]
+        if len(found) != len(tails):  # a missing edge, or parallel ones: one at a time
+            return [self.weight(int(a), int(b)) for a, b in zip(tails, heads, strict=True)]
+        weights: list[float] = self.weights[found].tolist()
+        return weights
+
 
 def _out_edges(graph: Graph, nodes: IntArray) -> IntArray:
     """Indices of every edge out of ``nodes``."""
@@ -90,29 +106,7 @@ def _out_edges(graph: Graph, nodes: IntArray) -> IntArray:
     return shift + np.arange(total, dtype=np.int64)
 
 
-def _best_offers(
-    v: IntArray, d: FloatArray, du: FloatArray, u: IntArray
-) -> tuple[IntArray, FloatArray, FloatArray, IntArray]:
-    """One offer per target ``v``: the smallest (d, d(u), u) among its offers."""
-    order = np.argsort(v, kind="stable")
-    v, d, du, u = v[order], d[order], du[order], u[order]
-    same = v[1:] == v[:-1]
-    if not same.any():
-        return v, d, du, u
-    # Targets with several offers: order just those lexicographically, keep each first.
-    shared = np.zeros(len(v), dtype=bool)
-    shared[1:] |= same
-    shared[:-1] |= same
-    rivals = np.flatnonzero(shared)
-    rivals = rivals[np.lexsort((u[rivals], du[rivals], d[rivals], v[rivals]))]
-    head = np.ones(len(rivals), dtype=bool)
-    head[1:] = v[rivals[1:]] != v[rivals[:-1]]
-    keep = ~shared
-    keep[rivals[head]] = True
-    return v[keep], d[keep], du[keep], u[keep]
-
-
-def _take_offers(
+def _relax(
     dist: FloatArray,
     via: FloatArray,
     pred: IntArray,
@@ -121,17 +115,31 @@ def _take_offers(
     du: FloatArray,
     u: IntArray,
 ) -> IntArray:
-    """Record the offers (one per target) that beat what ``v`` has: a shorter distance, or
-    the same one from a nearer node, or from an equally near one of smaller index.  Returns
-    the targets whose distance got shorter (they must be searched from again)."""
+    """Take the offers ``u -> v`` (distance ``d`` through ``u``, itself at ``du``): each node
+    keeps the smallest (distance, d(predecessor), predecessor) among what it had and its
+    offers, by three scatter-minimums, one key after the other.  Returns the nodes whose
+    distance got shorter, each once (they must be searched from again).  The pairs
+    ``(u, v)`` must be distinct."""
     old = dist[v]
-    shorter = d < old
-    better = shorter | ((d == old) & ((du < via[v]) | ((du == via[v]) & (u < pred[v]))))
-    v = v[better]
-    dist[v] = d[better]
-    via[v] = du[better]
-    pred[v] = u[better]
-    improved: IntArray = v[shorter[better]]
+    np.minimum.at(dist, v, d)
+    best = dist[v]
+    win = d == best  # offers that attain the node's (new) distance
+    shorter = best < old
+    if not win.all():
+        v, du, u, shorter = v[win], du[win], u[win], shorter[win]
+    # A shorter distance voids the former predecessor's rank.
+    via[v[shorter]] = np.inf
+    former = via[v]
+    np.minimum.at(via, v, du)
+    nearest = via[v]
+    # A nearer predecessor replaces the former one; among equally near ones, the smallest.
+    pred[v[nearest < former]] = NO_NODE
+    tie = du == nearest
+    np.minimum.at(pred, v[tie], u[tie])
+    # The one offer per node that won: its predecessor is the node's (pairs are distinct).
+    won = shorter & tie
+    won[won] = u[won] == pred[v[won]]
+    improved: IntArray = v[won]
     return improved
 
 
@@ -168,6 +176,7 @@ def shortest_paths(
     if goals is not None and len(frontier) and goals[frontier].any():
         nearest_goal = 0.0
     width = BUCKET_WIDTH * float(graph.weights.mean()) if graph.nnz else 1.0
+    indptr, targets, weights = graph.indptr, graph.targets, graph.weights
     while len(frontier):
         current = dist[frontier]
         lowest = float(current.min())
@@ -176,21 +185,23 @@ def shortest_paths(
         take = current <= lowest + width
         active, frontier = frontier[take], frontier[~take]
         queued[active] = False
-        edges = _out_edges(graph, active)
-        if not len(edges):
+        starts = indptr[active]
+        counts = indptr[active + 1] - starts
+        ends = np.cumsum(counts)
+        total = int(ends[-1])
+        if not total:
             continue
-        u = graph.sources[edges]
-        v = graph.targets[edges]
-        du = dist[u]
-        d = du + graph.weights[edges]
-        # Only offers that can still win (or tie) at v, within the limit.
-        keep = (d <= dist[v]) & (d <= limit)
-        if not keep.all():
+        # As in _out_edges; each edge's tail and its distance, repeated along its run, are
+        # read from the active nodes rather than gathered per edge.
+        edges = np.repeat(starts - ends + counts, counts) + np.arange(total)
+        u = np.repeat(active, counts)
+        du = np.repeat(current[take], counts)
+        v = targets[edges]
+        d = du + weights[edges]
+        if limit < np.inf:
+            keep = d <= limit
             u, v, du, d = u[keep], v[keep], du[keep], d[keep]
-        if not len(v):
-            continue
-        v, d, du, u = _best_offers(v, d, du, u)
-        improved = _take_offers(dist, via, pred, v, d, du, u)
+        improved = _relax(dist, via, pred, v, d, du, u)
         if goals is not None and len(improved):
             hit = goals[improved]
             if hit.any():
@@ -298,22 +309,22 @@ def closing_searches(
         active, frontier = frontier[take], frontier[~take]
         queued[active] = False
         local = active % n
-        offset = active - local
-        edges = _out_edges(graph, local)
-        if not len(edges):
+        starts = graph.indptr[local]
+        counts = graph.indptr[local + 1] - starts
+        ends = np.cumsum(counts)
+        total = int(ends[-1])
+        if not total:
             continue
-        counts = graph.indptr[local + 1] - graph.indptr[local]
+        # As in shortest_paths, in each search's own copy of the node numbers.
+        edges = np.repeat(starts - ends + counts, counts) + np.arange(total)
         u = np.repeat(active, counts)
-        v = graph.targets[edges] + np.repeat(offset, counts)
-        du = dist[u]
+        v = graph.targets[edges] + np.repeat(active - local, counts)
+        du = np.repeat(current[take], counts)
         d = du + graph.weights[edges]
-        keep = (d <= dist[v]) & (d <= limit[v // n])
+        keep = d <= limit[v // n]
         if not keep.all():
             u, v, du, d = u[keep], v[keep], du[keep], d[keep]
-        if not len(v):
-            continue
-        v, d, du, u = _best_offers(v, d, du, u)
-        improved = _take_offers(dist, via, pred, v, d, du, u)
+        improved = _relax(dist, via, pred, v, d, du, u)
         reached = improved[is_goal[improved]]
         if len(reached):
             searches = reached // n
