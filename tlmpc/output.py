@@ -34,7 +34,7 @@ from collections.abc import Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
-from tlmpc.artifacts import ARTIFACT_SCHEMAS, dumps
+from tlmpc.artifacts import ARTIFACT_SCHEMAS, dumps, dumps_all
 from tlmpc.errors import UsageError, error
 
 #: The marker file every output directory holds; its first line starts with MARKER_FORMAT.
@@ -308,9 +308,16 @@ def staging_directory(out: Path) -> Iterator[Path]:
 
 def write_artifacts(staging: Path, artifacts: Mapping[str, Any]) -> None:
     """Write each artifact (JSON document, text or bytes) into ``staging``."""
+    texts = dumps_all(
+        {
+            name: content
+            for name, content in artifacts.items()
+            if not isinstance(content, str | bytes)
+        }
+    )
     for name, content in artifacts.items():
         try:
-            _write(staging / name, content)
+            _write(staging / name, texts.get(name, content))
         except OSError as exc:
             raise io_error(exc, staging / name, "write") from None
 

@@ -146,6 +146,14 @@ def check_shape(
     shape: Any, path: Path, what: str, file: str, locate: Locate
 ) -> tuple[CheckedShape | None, list[Diagnostic]]:
     """Validate one shape; return it when usable, with the problems found."""
+    if isinstance(shape, dict):
+        x0, y0, x1, y1 = map(float, shape["rect"])
+        size = max(x1 - x0, y1 - y0)
+        if x0 < x1 and y0 < y1 and (x1 - x0) * (y1 - y0) > AREA_TOLERANCE * size * size:
+            # A proper rect is simple, valid and not collinear: skip the general checks and
+            # the position (a map of 10^4 rooms is mostly rects).
+            corners: Polygon = ((x0, y0), (x1, y0), (x1, y1), (x0, y1))  # as shape_points
+            return CheckedShape(points=corners, polygon=None, path=path), []
     line, col = locate(path)
     where: dict[str, Any] = {"file": file, "line": line, "col": col, "path": json_path(path)}
     if isinstance(shape, dict):
@@ -160,11 +168,6 @@ def check_shape(
                     **where,
                 )
             ]
-        size = max(x1 - x0, y1 - y0)
-        if (x1 - x0) * (y1 - y0) > AREA_TOLERANCE * size * size:
-            # A proper rect is simple, valid and not collinear: skip the general checks
-            # (Example 8's 1,156 rect regions cost a third of the load stage).
-            return CheckedShape(points=shape_points(shape), polygon=None, path=path), []
     elif len(shape) > ARRAY_ABOVE:
         return _check_long_shape(shape, path, what, locate, where)
     points = shape_points(shape)
@@ -176,9 +179,10 @@ def check_shape(
     if _collinear(points, size):
         return None, [_collinear_problem(what, where)]
     checked = CheckedShape(points=points, polygon=None, path=path)
-    if plain_geometry.certainly_simple(points) and abs(
-        plain_geometry.shoelace_area(points)
-    ) > 2 * AREA_TOLERANCE * size * size:
+    if (
+        plain_geometry.certainly_simple(points)
+        and abs(plain_geometry.shoelace_area(points)) > 2 * AREA_TOLERANCE * size * size
+    ):
         return checked, []  # what shapely would say: valid, with an area well above zero
     polygon = shapely_polygon(checked)
     if not polygon.is_valid:
