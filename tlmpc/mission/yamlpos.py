@@ -209,15 +209,6 @@ class _Converter:
         lazy = self.lazy
         for event in events:
             kind = type(event)
-            if kind in ends:  # the parser balances them: a container is open
-                frame = stack.pop()
-                if frame.unplaced:
-                    self.doc.unplaced.add(frame.path)
-                if frame.anchor is not None:
-                    self.anchors[frame.anchor] = (frame.container, frame.size)
-                if stack:
-                    stack[-1].size += frame.size
-                continue
             if (kind is mapping_start or kind is sequence_start) and stack:
                 # A container as a list item or as the value of a named key: as below.
                 frame = stack[-1]
@@ -238,8 +229,48 @@ class _Converter:
                     else:
                         holder[frame.key] = opened
                         frame.key = _NO_KEY
-                    stack.append(_Frame(opened, path, event.anchor))
-                    continue
+                    frame = _Frame(opened, path, event.anchor)
+                    stack.append(frame)
+                    if kind is mapping_start or not frame.shallow:
+                        continue
+                    # A list: its plain numbers are read right here, as the number branch
+                    # below would read them one event at a time; the event after them (the
+                    # list's end, mostly) falls through to the branches below.
+                    room = MAX_NODES - self.count
+                    for event in events:  # the same stream, read on
+                        if (
+                            type(event) is not scalar_event
+                            or event.style
+                            or event.tag is not None
+                            or event.anchor is not None
+                            or not room
+                        ):
+                            break
+                        text = event.value
+                        if fast_float(text):
+                            opened.append(float(text))
+                        elif fast_int(text):
+                            opened.append(int(text))
+                        else:
+                            break
+                        room -= 1
+                        if not lazy:
+                            values[(*path, len(opened) - 1)] = _mark(event)
+                    read = len(opened)
+                    if read:
+                        self.count += read
+                        frame.size += read
+                        frame.unplaced = lazy
+                    kind = type(event)
+            if kind in ends:  # the parser balances them: a container is open
+                frame = stack.pop()
+                if frame.unplaced:
+                    self.doc.unplaced.add(frame.path)
+                if frame.anchor is not None:
+                    self.anchors[frame.anchor] = (frame.container, frame.size)
+                if stack:
+                    stack[-1].size += frame.size
+                continue
             if kind is scalar_event and stack:
                 frame = stack[-1]
                 items = frame.container
