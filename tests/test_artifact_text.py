@@ -11,6 +11,7 @@ import json
 import math
 from typing import Any
 
+import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
@@ -126,3 +127,13 @@ def test_shared_value_with_a_non_finite_number_is_written_as_text() -> None:
     texts = dumps_all({"a.json": {"regions": regions}, "b.json": {"regions": regions, "n": 1}})
     assert texts["a.json"] == _reference({"regions": regions})
     assert '"r5":[5.0,"inf"]' in texts["b.json"]
+
+
+def test_a_document_holding_itself_fails_as_it_always_did() -> None:
+    loop: list[Any] = [1.5] * 100
+    loop.append(loop)
+    for document in ({"a": loop}, {"a": loop, "b": math.nan}, loop):
+        with pytest.raises(RecursionError):
+            dumps(document)
+        with pytest.raises(RecursionError):
+            dumps_all({"a.json": document, "b.json": {"a": loop}})

@@ -108,7 +108,12 @@ def dumps_all(documents: Mapping[str, Any]) -> dict[str, str]:
 #: Top-level values with fewer items than this are encoded again rather than looked up.
 _SHARED_FROM = 64
 
-_COMPACT = json.JSONEncoder(sort_keys=True, separators=(",", ":"), allow_nan=False)
+#: Without the encoder's bookkeeping of open containers (a fifth of the time on meshes): a
+#: document holding itself fails all the same, with RecursionError, as it did with the
+#: bookkeeping (its ValueError sent the document to ``_finite``, which recursed forever).
+_COMPACT = json.JSONEncoder(
+    sort_keys=True, separators=(",", ":"), allow_nan=False, check_circular=False
+)
 
 
 class SharedTexts:
