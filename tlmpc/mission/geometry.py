@@ -154,8 +154,12 @@ def check_shape(
             # the position (a map of 10^4 rooms is mostly rects).
             corners: Polygon = ((x0, y0), (x1, y0), (x1, y1), (x0, y1))  # as shape_points
             return CheckedShape(points=corners, polygon=None, path=path), []
-    line, col = locate(path)
-    where: dict[str, Any] = {"file": file, "line": line, "col": col, "path": json_path(path)}
+
+    def where() -> dict[str, Any]:
+        # Only a problem asks where the shape is (a lazily read file is read again for it).
+        line, col = locate(path)
+        return {"file": file, "line": line, "col": col, "path": json_path(path)}
+
     if isinstance(shape, dict):
         x0, y0, x1, y1 = (float(v) for v in shape["rect"])
         if not (x0 < x1 and y0 < y1):
@@ -165,19 +169,19 @@ def check_shape(
                     f"{what}: rect needs xmin < xmax and ymin < ymax, got "
                     f"[{x0:g}, {y0:g}, {x1:g}, {y1:g}]",
                     hint="write {rect: [xmin, ymin, xmax, ymax]}",
-                    **where,
+                    **where(),
                 )
             ]
     elif len(shape) > ARRAY_ABOVE:
         return _check_long_shape(shape, path, what, locate, where)
     points = shape_points(shape)
     if len(set(points)) < 3:
-        return None, [_too_few(what, where)]
+        return None, [_too_few(what, where())]
     xs = [p[0] for p in points]
     ys = [p[1] for p in points]
     size = max(max(xs) - min(xs), max(ys) - min(ys), 1e-300)
     if _collinear(points, size):
-        return None, [_collinear_problem(what, where)]
+        return None, [_collinear_problem(what, where())]
     checked = CheckedShape(points=points, polygon=None, path=path)
     if (
         plain_geometry.certainly_simple(points)
@@ -189,9 +193,10 @@ def check_shape(
         from shapely.validation import explain_validity
 
         reason = explain_validity(polygon)
-        return None, [_not_simple(what, reason, _at_crossing(shape, path, reason, locate, where))]
+        at = _at_crossing(shape, path, reason, locate, where())
+        return None, [_not_simple(what, reason, at)]
     if abs(polygon.area) <= AREA_TOLERANCE * size * size:
-        return None, [_zero_area(what, where)]
+        return None, [_zero_area(what, where())]
     return checked, []
 
 
@@ -210,7 +215,7 @@ def _at_crossing(
 
 
 def _check_long_shape(
-    shape: Any, path: Path, what: str, locate: Locate, where: dict[str, Any]
+    shape: Any, path: Path, what: str, locate: Locate, where: Callable[[], dict[str, Any]]
 ) -> tuple[CheckedShape | None, list[Diagnostic]]:
     """:func:`check_shape` of a long point list, with array operations only."""
     import shapely
@@ -218,17 +223,18 @@ def _check_long_shape(
 
     array, _ = _vertices(shape)
     if not _three_distinct(array):
-        return None, [_too_few(what, where)]
+        return None, [_too_few(what, where())]
     polygon = shapely.polygons(array)  # linear, unlike a list
     minx, miny, maxx, maxy = polygon.bounds
     size = max(maxx - minx, maxy - miny, 1e-300)
     if _collinear_array(array, size):
-        return None, [_collinear_problem(what, where)]
+        return None, [_collinear_problem(what, where())]
     if not polygon.is_valid:
         reason = explain_validity(polygon)
-        return None, [_not_simple(what, reason, _at_crossing(shape, path, reason, locate, where))]
+        at = _at_crossing(shape, path, reason, locate, where())
+        return None, [_not_simple(what, reason, at)]
     if abs(polygon.area) <= AREA_TOLERANCE * size * size:
-        return None, [_zero_area(what, where)]
+        return None, [_zero_area(what, where())]
     points = tuple(map(tuple, array.tolist()))
     return CheckedShape(points=points, polygon=polygon, path=path), []
 

@@ -42,7 +42,8 @@ class PositionedDocument:
     block: dict[Path, bool] = field(default_factory=dict)
     #: Long number lists read in bulk: positions inside them are found on demand.
     bulk: dict[Path, BulkList] = field(default_factory=dict)
-    #: Lists whose plain numbers were read without their positions (``lazy`` reading) ...
+    #: Containers whose plain numbers, keys or containers were read without their positions
+    #: (``lazy`` reading: only what the top-level mapping holds is placed) ...
     unplaced: set[Path] = field(default_factory=set)
     #: ... and how to read the whole document again with every position, when one is asked.
     reread: Callable[[], PositionedDocument | None] | None = None
@@ -69,6 +70,12 @@ class PositionedDocument:
 
     def key_at(self, path: Path) -> tuple[int, int]:
         """Position of the key of the entry at ``path`` (its value's when not a mapping entry)."""
+        if (
+            path not in self.keys
+            and self.reread is not None
+            and any(path[:cut] in self.unplaced for cut in range(len(path)))
+        ):
+            self._place_all()
         return self.keys.get(path) or self.value_at(path)
 
 
@@ -107,7 +114,7 @@ class _Frame:
         self.unplaced = False  # a number in it was read without recording its position
         self.anchor = anchor
         self.key: Any = _NO_KEY  # a mapping's pending key (text) or a bad-key marker
-        self.seen: dict[str, tuple[int, int]] = {}
+        self.seen: dict[str, tuple[int, int] | None] = {}  # None: read without a position
         self.size = 1  # nodes in this subtree, aliases expanded
 
 
@@ -117,6 +124,10 @@ _BAD_KEY = object()
 
 class _TooBig(Exception):
     """Stop reading: the problem that stopped it is recorded."""
+
+
+class _PlaceEverything(Exception):
+    """Stop a lazy reading: a diagnostic needs a position it did not record; read again."""
 
 
 class _Converter:
@@ -221,8 +232,11 @@ class _Converter:
                     path = None
                 if path is not None and len(path) <= MAX_DEPTH and self.count < MAX_NODES:
                     self.count += 1
-                    mark = event.start_mark
-                    values[path] = (mark.line + 1, mark.column + 1)
+                    if lazy and len(path) > 1:
+                        frame.unplaced = True  # a container below the top level: no position
+                    else:
+                        mark = event.start_mark
+                        values[path] = (mark.line + 1, mark.column + 1)
                     opened: Any = {} if kind is mapping_start else []
                     if type(holder) is list:
                         holder.append(opened)
@@ -278,6 +292,10 @@ class _Converter:
                     key = str(event.value)
                     if key in frame.seen or (self.lists and STEM in key):
                         self._key(frame, event)  # a duplicate, or a placeholder as a key
+                    elif lazy and frame.path:  # below the top level: no position (see _key)
+                        frame.seen[key] = None
+                        frame.unplaced = True
+                        frame.key = key
                     else:  # what _key does with a new plain key
                         mark = event.start_mark
                         position = (mark.line + 1, mark.column + 1)
@@ -403,6 +421,8 @@ class _Converter:
             self.mismatch = True
         if key in parent.seen:
             first = parent.seen[key]
+            if first is None:  # read lazily: the hint needs where it was first given
+                raise _PlaceEverything
             self.problem(
                 "Y002",
                 f"duplicate key {key!r}",
@@ -477,6 +497,15 @@ def load_positioned(
 
 
 def _load_positioned(
+    text: str, file: str, lazy: bool
+) -> tuple[PositionedDocument | None, list[Diagnostic]]:
+    try:
+        return _read_positioned(text, file, lazy)
+    except _PlaceEverything:
+        return _read_positioned(text, file, False)
+
+
+def _read_positioned(
     text: str, file: str, lazy: bool
 ) -> tuple[PositionedDocument | None, list[Diagnostic]]:
     cut, lists = cut_out(text)
