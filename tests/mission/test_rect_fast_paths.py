@@ -18,7 +18,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from tlmpc.artifacts import load_schema
-from tlmpc.mission.geometry import check_shape
+from tlmpc.mission.geometry import CheckedShape, check_layout, check_shape
 from tlmpc.mission.load import _plain_shape
 
 _EDGES = st.sampled_from(
@@ -110,3 +110,37 @@ def test_a_sliver_rect_has_zero_area() -> None:
     rect, found = check_shape({"rect": [0, 0, 1, 1e-13]}, ("regions", "a"), "a", "f", _no_position)
     assert rect is None
     assert [(p.code, p.line, p.col) for p in found] == [("G003", 7, 3)]
+
+
+_EDGE_XS = st.sampled_from([-0.5, 0.0, 1e-300, 3.0, 9.999999999999998, 10.0, 10.5])
+_EDGE_YS = st.sampled_from([-1e-300, 0.0, 3.0, 5.999999999999999, 6.0, 6.5])
+
+
+@given(
+    st.lists(
+        st.lists(st.tuples(_EDGE_XS, _EDGE_YS), min_size=3, max_size=5),
+        max_size=6,
+    ),
+    st.tuples(_EDGE_XS, _EDGE_YS),
+)
+def test_regions_outside_a_rectangular_workspace_are_the_ones_with_a_vertex_outside(
+    regions: list[list[tuple[float, float]]], start: tuple[float, float]
+) -> None:
+    boundary = CheckedShape(
+        points=((0.0, 0.0), (10.0, 0.0), (10.0, 6.0), (0.0, 6.0)), polygon=None, path=("b",)
+    )
+    shapes = {
+        f"r{i}": CheckedShape(points=tuple(points), polygon=None, path=("regions", f"r{i}"))
+        for i, points in enumerate(regions)
+    }
+    found = check_layout(boundary, [], shapes, start, ("start",), "f", _no_position)
+    outside = [
+        name
+        for name, shape in shapes.items()
+        if any(not (0 <= x <= 10 and 0 <= y <= 6) for x, y in shape.points)
+    ]
+    assert [p.code for p in found if p.code == "G007"] == ["G007"] * len(outside)
+    assert [p.message.split("'")[1] for p in found if p.code == "G007"] == outside
+    assert any(p.code == "G009" for p in found) == (
+        not (0 <= start[0] <= 10 and 0 <= start[1] <= 6)
+    )

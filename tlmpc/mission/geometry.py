@@ -10,6 +10,7 @@ from __future__ import annotations
 import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from itertools import chain
 from typing import TYPE_CHECKING, Any
 
 from tlmpc.errors import Diagnostic, error
@@ -305,8 +306,18 @@ def check_layout(
     rect = plain_geometry.axis_rectangle(boundary.points) if boundary is not None else None
     if rect is not None and not holes:
         # A rectangular workspace without holes: containment in a closed convex shape is
-        # exactly "every vertex inside", decided by comparisons alone (what shapely answers)
-        for name, region in regions.items():
+        # exactly "every vertex inside", decided by comparisons alone (what shapely answers);
+        # first for all regions at once, at C speed (a map of 10^4 rooms), then one by one
+        # only when some vertex is outside
+        coordinates = list(
+            chain.from_iterable(chain.from_iterable(r.points for r in regions.values()))
+        )
+        xs, ys = coordinates[0::2], coordinates[1::2]
+        everything_inside = not coordinates or (
+            rect[0] <= min(xs) and max(xs) <= rect[2] and rect[1] <= min(ys) and max(ys) <= rect[3]
+        )
+        one_by_one = () if everything_inside else regions.items()
+        for name, region in one_by_one:
             if not plain_geometry.inside_rectangle(region.points, rect):
                 problems.append(
                     at(
