@@ -13,7 +13,7 @@ import marshal
 import math
 import re
 from collections import Counter
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -94,14 +94,7 @@ def dumps_all(documents: Mapping[str, Any]) -> dict[str, str]:
     """:func:`dumps` of each document, a large value that several documents hold under the
     same top-level key (the regions of ``mission.json``, ``abstraction.json`` and
     ``trace.json``) encoded once."""
-    names = Counter(
-        key
-        for document in documents.values()
-        if type(document) is dict
-        for key, value in document.items()
-        if type(value) in (dict, list) and len(value) >= _SHARED_FROM
-    )
-    shared = SharedTexts({key for key, count in names.items() if count > 1})
+    shared = SharedTexts.among(documents.values())
     return {name: dumps(document, shared) for name, document in documents.items()}
 
 
@@ -129,6 +122,18 @@ class SharedTexts:
         self.keys = keys
         self.texts: dict[tuple[str, bytes], str] = {}
 
+    @classmethod
+    def among(cls, documents: Iterable[Any]) -> SharedTexts:
+        """For the large values that several of ``documents`` hold under the same key."""
+        names = Counter(
+            key
+            for document in documents
+            if type(document) is dict
+            for key, value in document.items()
+            if type(value) in (dict, list) and len(value) >= _SHARED_FROM
+        )
+        return cls({key for key, count in names.items() if count > 1})
+
     def text(self, key: str, value: Any) -> str:
         """The compact JSON text of ``value``, held at ``key`` of a document."""
         if key not in self.keys or type(value) not in (dict, list):
@@ -145,11 +150,12 @@ class SharedTexts:
 
 def _compact(document: Any, shared: SharedTexts | None) -> str:
     """What ``json.dumps(document, sort_keys=True, separators=(",", ":"), allow_nan=False)``
-    returns, with the top-level values of a dict of text keys taken from ``shared``."""
-    if shared is None or type(document) is not dict or set(map(type, document)) - {str}:
+    returns, with the top-level values of a dict holding a shared key taken from ``shared``."""
+    if shared is None or type(document) is not dict or shared.keys.isdisjoint(document):
         return _COMPACT.encode(document)
-    # The encoder sorts the items of a dict of text keys by key and writes each value
-    # independently of its surroundings: the same text, piece by piece.
+    # The encoder sorts the items of a dict by key and writes each value independently of
+    # its surroundings: the same text, piece by piece.  (The document has a text key, the
+    # shared one: a key of another type beside it fails to sort here as in the encoder.)
     return (
         "{"
         + ",".join(

@@ -34,7 +34,7 @@ from collections.abc import Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
-from tlmpc.artifacts import ARTIFACT_SCHEMAS, dumps, dumps_all
+from tlmpc.artifacts import ARTIFACT_SCHEMAS, SharedTexts, dumps
 from tlmpc.errors import UsageError, error
 
 #: The marker file every output directory holds; its first line starts with MARKER_FORMAT.
@@ -276,13 +276,13 @@ def clean_stale(out: Path) -> list[str]:
     return done
 
 
-def _write(path: Path, content: Any) -> None:
+def _write(path: Path, content: Any, shared: SharedTexts | None = None) -> None:
     if isinstance(content, bytes):
         path.write_bytes(content)
     elif isinstance(content, str):
         path.write_text(content, encoding="utf-8")
     else:
-        path.write_text(dumps(content), encoding="utf-8")
+        path.write_text(dumps(content, shared), encoding="utf-8")
 
 
 @contextlib.contextmanager
@@ -308,16 +308,12 @@ def staging_directory(out: Path) -> Iterator[Path]:
 
 def write_artifacts(staging: Path, artifacts: Mapping[str, Any]) -> None:
     """Write each artifact (JSON document, text or bytes) into ``staging``."""
-    texts = dumps_all(
-        {
-            name: content
-            for name, content in artifacts.items()
-            if not isinstance(content, str | bytes)
-        }
-    )
+    # A large value several documents hold (the regions) is encoded once; each text is
+    # written as soon as it is made, so that only one is held at a time.
+    shared = SharedTexts.among(artifacts.values())
     for name, content in artifacts.items():
         try:
-            _write(staging / name, texts.get(name, content))
+            _write(staging / name, content, shared)
         except OSError as exc:
             raise io_error(exc, staging / name, "write") from None
 
