@@ -276,13 +276,13 @@ def clean_stale(out: Path) -> list[str]:
     return done
 
 
-def _write(path: Path, content: Any, shared: SharedTexts | None = None) -> None:
+def _write(path: Path, content: Any) -> None:
     if isinstance(content, bytes):
         path.write_bytes(content)
     elif isinstance(content, str):
         path.write_text(content, encoding="utf-8")
     else:
-        path.write_text(dumps(content, shared), encoding="utf-8")
+        path.write_text(dumps(content), encoding="utf-8")
 
 
 @contextlib.contextmanager
@@ -312,8 +312,10 @@ def write_artifacts(staging: Path, artifacts: Mapping[str, Any]) -> None:
     # written as soon as it is made, so that only one is held at a time.
     shared = SharedTexts.among(artifacts.values())
     for name, content in artifacts.items():
+        if not isinstance(content, str | bytes):
+            content = dumps(content, shared)
         try:
-            _write(staging / name, content, shared)
+            _write(staging / name, content)
         except OSError as exc:
             raise io_error(exc, staging / name, "write") from None
 
