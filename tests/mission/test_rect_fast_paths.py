@@ -144,3 +144,13 @@ def test_regions_outside_a_rectangular_workspace_are_the_ones_with_a_vertex_outs
     assert any(p.code == "G009" for p in found) == (
         not (0 <= start[0] <= 10 and 0 <= start[1] <= 6)
     )
+
+
+def test_a_region_above_a_wide_workspace_is_outside() -> None:
+    # x within the workspace's height, y within its width: only the right axes tell.
+    boundary = CheckedShape(
+        points=((0.0, 0.0), (10.0, 0.0), (10.0, 6.0), (0.0, 6.0)), polygon=None, path=("b",)
+    )
+    high = CheckedShape(points=((0.0, 3.0), (3.0, 3.0), (3.0, 6.5)), polygon=None, path=("r",))
+    found = check_layout(boundary, [], {"high": high}, (1.0, 1.0), ("s",), "f", _no_position)
+    assert [p.code for p in found] == ["G007"]
