@@ -9,8 +9,11 @@ from __future__ import annotations
 
 import functools
 import json
+import marshal
 import math
 import re
+from collections import Counter
+from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -71,16 +74,93 @@ def _finite(value: Any) -> Any:
 INDENT_BELOW = 20_000
 
 
-def dumps(document: Any) -> str:
-    """Canonical JSON text of ``document``: sorted keys, non-finite floats as strings."""
+def dumps(document: Any, shared: SharedTexts | None = None) -> str:
+    """Canonical JSON text of ``document``: sorted keys, non-finite floats as strings.
+
+    ``shared``: texts of large top-level values already encoded for another document of the
+    same write (see :func:`dumps_all`).
+    """
     try:
-        text = json.dumps(document, sort_keys=True, separators=(",", ":"), allow_nan=False)
+        text = _compact(document, shared)
     except ValueError:  # a non-finite float somewhere: JSON has none
         document = _finite(document)
         text = json.dumps(document, sort_keys=True, separators=(",", ":"), allow_nan=False)
     if len(text) < INDENT_BELOW:
         text = json.dumps(document, indent=2, sort_keys=True, allow_nan=False)
     return text + "\n"
+
+
+def dumps_all(documents: Mapping[str, Any]) -> dict[str, str]:
+    """:func:`dumps` of each document, a large value that several documents hold under the
+    same top-level key (the regions of ``mission.json``, ``abstraction.json`` and
+    ``trace.json``) encoded once."""
+    shared = SharedTexts.among(documents.values())
+    return {name: dumps(document, shared) for name, document in documents.items()}
+
+
+#: Top-level values with fewer items than this are encoded again rather than looked up.
+_SHARED_FROM = 64
+
+#: Without the encoder's bookkeeping of open containers (a fifth of the time on meshes): a
+#: document holding itself fails all the same, with RecursionError, as it did with the
+#: bookkeeping (its ValueError sent the document to ``_finite``, which recursed forever).
+_COMPACT = json.JSONEncoder(
+    sort_keys=True, separators=(",", ":"), allow_nan=False, check_circular=False
+)
+
+
+class SharedTexts:
+    """Compact texts of top-level values by key, for the values that several documents hold.
+
+    A value is looked up by its ``marshal`` bytes, which tell every type apart (``1``,
+    ``1.0`` and ``True``; ``0.0`` and ``-0.0``) and fix the order of every dict and list:
+    equal bytes, equal data, the same JSON text.  A value ``marshal`` refuses (a subclass,
+    say) is simply encoded again.
+    """
+
+    def __init__(self, keys: set[str]) -> None:
+        self.keys = keys
+        self.texts: dict[tuple[str, bytes], str] = {}
+
+    @classmethod
+    def among(cls, documents: Iterable[Any]) -> SharedTexts:
+        """For the large values that several of ``documents`` hold under the same key."""
+        names = Counter(
+            key
+            for document in documents
+            if type(document) is dict
+            for key, value in document.items()
+            if type(value) in (dict, list) and len(value) >= _SHARED_FROM
+        )
+        return cls({key for key, count in names.items() if count > 1})
+
+    def text(self, key: str, value: Any) -> str:
+        """The compact JSON text of ``value``, held at ``key`` of a document."""
+        if key not in self.keys or type(value) not in (dict, list):
+            return _COMPACT.encode(value)
+        try:
+            fingerprint = (key, marshal.dumps(value))
+        except ValueError:
+            return _COMPACT.encode(value)
+        text = self.texts.get(fingerprint)
+        if text is None:
+            text = self.texts[fingerprint] = _COMPACT.encode(value)
+        return text
+
+
+def _compact(document: Any, shared: SharedTexts | None) -> str:
+    """What ``json.dumps(document, sort_keys=True, separators=(",", ":"), allow_nan=False)``
+    returns, with the top-level values of a dict holding a shared key taken from ``shared``."""
+    if shared is None or type(document) is not dict or shared.keys.isdisjoint(document):
+        return _COMPACT.encode(document)
+    # The encoder sorts the items of a dict by key and writes each value independently of
+    # its surroundings: the same text, piece by piece.  (The document has a text key, the
+    # shared one: a key of another type beside it fails to sort here as in the encoder.)
+    pieces = ["{"]
+    for key in sorted(document):  # one join: the texts of a mesh are megabytes, copied once
+        pieces += (_COMPACT.encode(key), ":", shared.text(key, document[key]), ",")
+    pieces[-1] = "}"
+    return "".join(pieces)
 
 
 def json_text(document: Any) -> str:

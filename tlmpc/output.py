@@ -34,7 +34,7 @@ from collections.abc import Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
-from tlmpc.artifacts import ARTIFACT_SCHEMAS, dumps
+from tlmpc.artifacts import ARTIFACT_SCHEMAS, SharedTexts, dumps
 from tlmpc.errors import UsageError, error
 
 #: The marker file every output directory holds; its first line starts with MARKER_FORMAT.
@@ -308,7 +308,12 @@ def staging_directory(out: Path) -> Iterator[Path]:
 
 def write_artifacts(staging: Path, artifacts: Mapping[str, Any]) -> None:
     """Write each artifact (JSON document, text or bytes) into ``staging``."""
+    # A large value several documents hold (the regions) is encoded once; each text is
+    # written as soon as it is made, so that only one is held at a time.
+    shared = SharedTexts.among(artifacts.values())
     for name, content in artifacts.items():
+        if not isinstance(content, str | bytes):
+            content = dumps(content, shared)
         try:
             _write(staging / name, content)
         except OSError as exc:

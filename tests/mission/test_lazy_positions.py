@@ -64,3 +64,72 @@ def test_lazy_positions_on_drawn_lists(rows: list[list[str]], flow: bool) -> Non
             for i, row in enumerate(rows)
         )
     _agree("version: 1\nlists:\n" + body)
+
+
+KEY = st.sampled_from(["a", "b", "rect", "c"])  # few names: repeated keys are common
+
+
+@st.composite
+def _block(draw: st.DrawFn, indent: int = 0, depth: int = 0) -> str:
+    """A block mapping of drawn keys (repeats included) holding numbers, flow lists, flow
+    mappings and, a few levels down, block mappings and block lists."""
+    pad = " " * indent
+    lines = []
+    for _ in range(draw(st.integers(1, 3))):
+        key = draw(KEY)
+        kind = draw(st.integers(0, 4 if depth < 3 else 2))
+        if kind == 0:
+            lines.append(f"{pad}{key}: {draw(NUMBER)}\n")
+        elif kind == 1:
+            lines.append(f"{pad}{key}: [{', '.join(draw(st.lists(NUMBER, max_size=3)))}]\n")
+        elif kind == 2:
+            pairs = [f"{k}: {v}" for k, v in draw(st.lists(st.tuples(KEY, NUMBER), max_size=3))]
+            lines.append(f"{pad}{key}: {{{', '.join(pairs)}}}\n")
+        elif kind == 3:
+            lines.append(f"{pad}{key}:\n" + draw(_block(indent + 2, depth + 1)))
+        else:
+            items = draw(st.lists(NUMBER, min_size=1, max_size=3))
+            lines.append(f"{pad}{key}:\n" + "".join(f"{pad}- {v}\n" for v in items))
+    return "".join(lines)
+
+
+@given(_block())
+def test_lazy_positions_of_keys_and_containers_at_every_depth(text: str) -> None:
+    _agree(text)
+    _agree("version: 1\nregions:\n" + "".join(f"  {line}\n" for line in text.splitlines()))
+
+
+def test_a_valid_mission_is_read_once(monkeypatch: pytest.MonkeyPatch) -> None:
+    # Lazy reading pays only when nothing asks for a position it skipped: a valid mission
+    # (rect and polygon regions, a task, holes) is checked without reading it again.
+    from tlmpc.mission.load import load_mission_text
+    from tlmpc.mission.yamlpos import PositionedDocument
+
+    def refuse(self: PositionedDocument) -> None:
+        raise AssertionError("read again")
+
+    monkeypatch.setattr(PositionedDocument, "_place_all", refuse)
+    for file in sorted((ROOT / "specs").glob("*.yaml")):
+        load_mission_text(file.read_text(encoding="utf-8"), str(file))
+
+
+def test_a_repeated_key_below_the_top_level_is_placed_as_the_full_reading_places_it() -> None:
+    text = "version: 1\nregions:\n  a: {rect: [0, 0, 1, 1]}\n  b: 1\n  a: 2\n"
+    _, problems = load_positioned(text, "m.yaml", lazy=True)
+    assert [p.code for p in problems] == ["Y002"]
+    assert [p.format() for p in problems] == [
+        p.format() for p in load_positioned(text, "m.yaml")[1]
+    ]
+    assert "line 3" in (problems[0].hint or "")
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        "version: 1\nregions:\n  p: [[0, 0], [2, 0], {x: 1}, [2, 2]]\n",
+        "version: 1\nregions:\n  p:\n  - - 0\n    - 0\n  - - 2\n    - 0\n  - [2, 2]\n",
+        "regions:\n- - [1, 2]\n  - [3, 4]\n- {a: [5]}\n",
+    ],
+)
+def test_lazy_positions_of_lists_of_containers(text: str) -> None:
+    _agree(text)

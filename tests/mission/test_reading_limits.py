@@ -53,6 +53,24 @@ def test_alias_bomb_stops_early() -> None:
     assert f"{MAX_NODES:,}" in problems[0].message
 
 
+@pytest.mark.parametrize("lazy", [False, True])
+@pytest.mark.parametrize("flow", [False, True])
+def test_the_value_limit_counts_every_number_of_a_list(
+    monkeypatch: pytest.MonkeyPatch, lazy: bool, flow: bool
+) -> None:
+    # The document's values: its mapping, the list, then n numbers (keys are not values).
+    monkeypatch.setattr("tlmpc.mission.yamlpos.MAX_NODES", 50)
+    for n, expected in ((48, []), (49, ["Y003"])):
+        numbers = [str(i) if i % 2 else f"{i}.5" for i in range(n)]
+        if flow:
+            text = f"xs: [{', '.join(numbers)}]\n"
+        else:
+            text = "xs:\n" + "".join(f"- {v}\n" for v in numbers)
+        doc, problems = load_positioned(text, "x", lazy=lazy)
+        assert [d.code for d in problems] == expected, n
+        assert (doc is None) == bool(expected)
+
+
 def test_aliases_expand_to_shared_data_with_positions() -> None:
     doc, problems = load_positioned("a: &p [1, 2]\nb: *p\n", "x")
     assert problems == []

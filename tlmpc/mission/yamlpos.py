@@ -42,7 +42,8 @@ class PositionedDocument:
     block: dict[Path, bool] = field(default_factory=dict)
     #: Long number lists read in bulk: positions inside them are found on demand.
     bulk: dict[Path, BulkList] = field(default_factory=dict)
-    #: Lists whose plain numbers were read without their positions (``lazy`` reading) ...
+    #: Containers whose plain numbers, keys or containers were read without their positions
+    #: (``lazy`` reading: only what the top-level mapping holds is placed) ...
     unplaced: set[Path] = field(default_factory=set)
     #: ... and how to read the whole document again with every position, when one is asked.
     reread: Callable[[], PositionedDocument | None] | None = None
@@ -69,6 +70,12 @@ class PositionedDocument:
 
     def key_at(self, path: Path) -> tuple[int, int]:
         """Position of the key of the entry at ``path`` (its value's when not a mapping entry)."""
+        if (
+            path not in self.keys
+            and self.reread is not None
+            and any(path[:cut] in self.unplaced for cut in range(len(path)))
+        ):
+            self._place_all()
         return self.keys.get(path) or self.value_at(path)
 
 
@@ -107,7 +114,7 @@ class _Frame:
         self.unplaced = False  # a number in it was read without recording its position
         self.anchor = anchor
         self.key: Any = _NO_KEY  # a mapping's pending key (text) or a bad-key marker
-        self.seen: dict[str, tuple[int, int]] = {}
+        self.seen: dict[str, tuple[int, int] | None] = {}  # None: read without a position
         self.size = 1  # nodes in this subtree, aliases expanded
 
 
@@ -117,6 +124,10 @@ _BAD_KEY = object()
 
 class _TooBig(Exception):
     """Stop reading: the problem that stopped it is recorded."""
+
+
+class _PlaceEverything(Exception):
+    """Stop a lazy reading: a diagnostic needs a position it did not record; read again."""
 
 
 class _Converter:
@@ -209,15 +220,6 @@ class _Converter:
         lazy = self.lazy
         for event in events:
             kind = type(event)
-            if kind in ends:  # the parser balances them: a container is open
-                frame = stack.pop()
-                if frame.unplaced:
-                    self.doc.unplaced.add(frame.path)
-                if frame.anchor is not None:
-                    self.anchors[frame.anchor] = (frame.container, frame.size)
-                if stack:
-                    stack[-1].size += frame.size
-                continue
             if (kind is mapping_start or kind is sequence_start) and stack:
                 # A container as a list item or as the value of a named key: as below.
                 frame = stack[-1]
@@ -230,16 +232,59 @@ class _Converter:
                     path = None
                 if path is not None and len(path) <= MAX_DEPTH and self.count < MAX_NODES:
                     self.count += 1
-                    mark = event.start_mark
-                    values[path] = (mark.line + 1, mark.column + 1)
+                    if lazy and len(path) > 1:
+                        frame.unplaced = True  # a container below the top level: no position
+                    else:
+                        mark = event.start_mark
+                        values[path] = (mark.line + 1, mark.column + 1)
                     opened: Any = {} if kind is mapping_start else []
                     if type(holder) is list:
                         holder.append(opened)
                     else:
                         holder[frame.key] = opened
                         frame.key = _NO_KEY
-                    stack.append(_Frame(opened, path, event.anchor))
-                    continue
+                    frame = _Frame(opened, path, event.anchor)
+                    stack.append(frame)
+                    if kind is mapping_start or not frame.shallow:
+                        continue
+                    # A list: its plain numbers are read right here, as the number branch
+                    # below would read them one event at a time; the event after them (the
+                    # list's end, mostly) falls through to the branches below.
+                    room = MAX_NODES - self.count
+                    for event in events:  # the same stream, read on
+                        if (
+                            type(event) is not scalar_event
+                            or event.style
+                            or event.tag is not None
+                            or event.anchor is not None
+                            or not room
+                        ):
+                            break
+                        text = event.value
+                        if fast_float(text):
+                            opened.append(float(text))
+                        elif fast_int(text):
+                            opened.append(int(text))
+                        else:
+                            break
+                        room -= 1
+                        if not lazy:
+                            values[(*path, len(opened) - 1)] = _mark(event)
+                    read = len(opened)
+                    if read:
+                        self.count += read
+                        frame.size += read
+                        frame.unplaced = lazy
+                    kind = type(event)
+            if kind in ends:  # the parser balances them: a container is open
+                frame = stack.pop()
+                if frame.unplaced:
+                    self.doc.unplaced.add(frame.path)
+                if frame.anchor is not None:
+                    self.anchors[frame.anchor] = (frame.container, frame.size)
+                if stack:
+                    stack[-1].size += frame.size
+                continue
             if kind is scalar_event and stack:
                 frame = stack[-1]
                 items = frame.container
@@ -247,6 +292,10 @@ class _Converter:
                     key = str(event.value)
                     if key in frame.seen or (self.lists and STEM in key):
                         self._key(frame, event)  # a duplicate, or a placeholder as a key
+                    elif lazy and frame.path:  # below the top level: no position (see _key)
+                        frame.seen[key] = None
+                        frame.unplaced = True
+                        frame.key = key
                     else:  # what _key does with a new plain key
                         mark = event.start_mark
                         position = (mark.line + 1, mark.column + 1)
@@ -372,6 +421,8 @@ class _Converter:
             self.mismatch = True
         if key in parent.seen:
             first = parent.seen[key]
+            if first is None:  # read lazily: the hint needs where it was first given
+                raise _PlaceEverything
             self.problem(
                 "Y002",
                 f"duplicate key {key!r}",
@@ -446,6 +497,15 @@ def load_positioned(
 
 
 def _load_positioned(
+    text: str, file: str, lazy: bool
+) -> tuple[PositionedDocument | None, list[Diagnostic]]:
+    try:
+        return _read_positioned(text, file, lazy)
+    except _PlaceEverything:
+        return _read_positioned(text, file, False)
+
+
+def _read_positioned(
     text: str, file: str, lazy: bool
 ) -> tuple[PositionedDocument | None, list[Diagnostic]]:
     cut, lists = cut_out(text)
