@@ -394,14 +394,15 @@ def _simulation_round(
     alphabet: simulation.Alphabet,
     deadline: float,
     *,
-    saturated: bool,
+    saturated: bool | None,
     reverse: bool = False,
 ) -> Automaton:
     """One quotient-and-prune pass.  Edges between SCCs carry no marks after trimming; with
     ``saturated`` they carry every mark instead (both are the same language, since a run takes
     such an edge once): the bare marks let those edges be dominated, every mark lets them
     dominate, and each finds reductions the other misses.  With ``reverse``, by reverse
-    simulation (states with the same pasts) instead of direct simulation."""
+    simulation (states with the same pasts) instead of direct simulation.  With ``saturated``
+    None, the edges between SCCs keep the marks they have (see :func:`_simulated_as_built`)."""
     relate: Callable[[Automaton, simulation.Alphabet, float], list[list[bool]]]
     merge: Callable[[Automaton, list[list[bool]]], Automaton]
     drop: Callable[[Automaton, simulation.Alphabet, list[list[bool]], float], Automaton]
@@ -415,6 +416,8 @@ def _simulation_round(
         drop = simulation.prune
 
     def prepared(current: Automaton) -> Automaton:
+        if saturated is None:
+            return current
         component = sccs(current.num_states, current.edges, current.initial)
         if saturated:
             return simulation.saturate(current, component)
@@ -432,6 +435,83 @@ def _simulation_round(
 
 
 def postprocess(
+    automaton: Automaton,
+    letters: Sequence[frozenset[str]] | None,
+    deadline: float | None = None,
+    *,
+    obligation: bool = False,
+    verify: Callable[[Automaton, Automaton], bool] | None = None,
+) -> Automaton:
+    """The smallest of the reductions of :func:`reduce_automaton` started from ``automaton``
+    and, while ``deadline`` allows, from two other starting points (:data:`STARTS`).
+
+    Simulation-based reduction is a local search: which states end up merged depends on the
+    order of the steps and on the marks of the edges between SCCs (which do not change the
+    language, but do change which states simulate which).  Each start is a correct automaton
+    of the same language, so the smallest result is too."""
+    best = reduce_automaton(automaton, letters, deadline, obligation=obligation, verify=verify)
+    for start in STARTS:
+        if best.num_states <= 1 or (deadline is not None and time.process_time() > deadline):
+            break
+        limit = deadline if deadline is not None else float("inf")
+        candidate = reduce_automaton(
+            start(automaton, letters, limit),
+            letters,
+            deadline,
+            obligation=obligation,
+            verify=verify,
+        )
+        if (candidate.num_states, len(candidate.edges)) < (best.num_states, len(best.edges)):
+            best = candidate
+    return best
+
+
+def _simulated_as_built(
+    automaton: Automaton, letters: Sequence[frozenset[str]] | None, deadline: float
+) -> Automaton:
+    """Direct, reverse and direct simulation before anything else: the edges between SCCs
+    keep the marks the construction gave them (postponed eventualities), which trimming
+    drops; under them some states simulate others that neither bare nor saturated marks
+    relate (Spot reduces its raw automaton the same way)."""
+    if letters is None and len(automaton.aps) > simulation.MAX_APS:
+        return automaton
+    alphabet = simulation.Alphabet(automaton.aps, letters)
+    current = merge_parallel_automaton(automaton)
+    try:
+        for reverse in (False, True, False):
+            current = _simulation_round(
+                current, alphabet, deadline, saturated=None, reverse=reverse
+            )
+            current = merge_parallel_automaton(current)
+    except simulation.OutOfTime:
+        pass
+    return current
+
+
+def _trimmed_and_simulated(
+    automaton: Automaton, letters: Sequence[frozenset[str]] | None, deadline: float
+) -> Automaton:
+    """Simulation to a fixpoint on the trimmed automaton, before the state merging and the
+    reduction of acceptance sets (which may join states that simulation would have reduced
+    differently)."""
+    current = trim(merge_parallel_automaton(automaton))
+    for _ in range(4):
+        before = (current.num_states, len(current.edges), current.num_acc)
+        current = reduce_by_simulation(current, letters, deadline)
+        current = trim(merge_parallel_automaton(current))
+        if (current.num_states, len(current.edges), current.num_acc) == before:
+            break
+    return current
+
+
+#: Other starting points of :func:`postprocess`.
+STARTS: tuple[Callable[[Automaton, Sequence[frozenset[str]] | None, float], Automaton], ...] = (
+    _simulated_as_built,
+    _trimmed_and_simulated,
+)
+
+
+def reduce_automaton(
     automaton: Automaton,
     letters: Sequence[frozenset[str]] | None,
     deadline: float | None = None,
