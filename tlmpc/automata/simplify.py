@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import functools
 import time
 from collections import defaultdict
 from collections.abc import Callable, Iterable, Sequence
@@ -132,8 +133,9 @@ def strongly_connected(succ: Sequence[Sequence[int]], roots: Iterable[int]) -> l
     return component
 
 
-def trim(automaton: Automaton) -> Automaton:
-    """Keep the states that can reach an accepting cycle; drop marks on acyclic edges."""
+def trim(automaton: Automaton, *, keep_transient_marks: bool = False) -> Automaton:
+    """Keep the states that can reach an accepting cycle; drop marks on acyclic edges
+    (unless ``keep_transient_marks``)."""
     edges = automaton.edges
     component = sccs(automaton.num_states, edges, automaton.initial)
     all_marks = frozenset(range(automaton.num_acc))
@@ -161,7 +163,9 @@ def trim(automaton: Automaton) -> Automaton:
             src=e.src,
             dst=e.dst,
             guard=e.guard,
-            marks=e.marks if component[e.src] == component[e.dst] else frozenset(),
+            marks=e.marks
+            if keep_transient_marks or component[e.src] == component[e.dst]
+            else frozenset(),
         )
         for e in edges
         if e.src in useful and e.dst in useful
@@ -227,14 +231,16 @@ def _renumber(automaton: Automaton, edges: Sequence[Edge], keep: set[int]) -> Au
     )
 
 
-def _reduce_marks(automaton: Automaton) -> Automaton:
+def _reduce_marks(automaton: Automaton, *, keep_transient_marks: bool = False) -> Automaton:
     """Keep marks only inside accepting SCCs, then drop or merge redundant acceptance sets.
 
     A run is accepted iff it ends in an accepting SCC and sees every set there, so marks
     elsewhere are useless.  A set carried by every edge of every accepting SCC is then
     implied by staying in one; it is dropped, except that one set must survive whenever some
     cycle lies outside the accepting SCCs (with no sets left every cycle would accept).
-    Sets carried by the same edges are merged.
+    Sets carried by the same edges are merged.  With ``keep_transient_marks``, edges
+    between SCCs that enter an accepting SCC keep their marks (renumbered like the others;
+    a run takes them once, so any marks will do there, and these are the construction's).
     """
     k = automaton.num_acc
     if k == 0:
@@ -250,7 +256,8 @@ def _reduce_marks(automaton: Automaton) -> Automaton:
     accepting = {c for c in cyclic if internal[c] >= everything}
     stripped = [
         e.marks
-        if component[e.src] == component[e.dst] and component[e.src] in accepting
+        if (component[e.src] == component[e.dst] and component[e.src] in accepting)
+        or (keep_transient_marks and component[e.dst] in accepting)
         else frozenset()
         for e in automaton.edges
     ]
@@ -467,16 +474,23 @@ def postprocess(
 
 
 def _simulated_as_built(
-    automaton: Automaton, letters: Sequence[frozenset[str]] | None, deadline: float
+    automaton: Automaton,
+    letters: Sequence[frozenset[str]] | None,
+    deadline: float,
+    *,
+    reduce_sets: bool = False,
 ) -> Automaton:
     """Direct, reverse and direct simulation before anything else: the edges between SCCs
     keep the marks the construction gave them (postponed eventualities), which trimming
     drops; under them some states simulate others that neither bare nor saturated marks
-    relate (Spot reduces its raw automaton the same way)."""
+    relate (Spot reduces its raw automaton the same way).  With ``reduce_sets``, after
+    trimming and reducing the acceptance sets, transient marks kept."""
     if letters is None and len(automaton.aps) > simulation.MAX_APS:
         return automaton
     alphabet = simulation.Alphabet(automaton.aps, letters)
     current = merge_parallel_automaton(automaton)
+    if reduce_sets:
+        current = _reduce_marks(trim(current, keep_transient_marks=True), keep_transient_marks=True)
     try:
         for reverse in (False, True, False):
             current = _simulation_round(
@@ -507,6 +521,7 @@ def _trimmed_and_simulated(
 #: Other starting points of :func:`postprocess`.
 STARTS: tuple[Callable[[Automaton, Sequence[frozenset[str]] | None, float], Automaton], ...] = (
     _simulated_as_built,
+    functools.partial(_simulated_as_built, reduce_sets=True),
     _trimmed_and_simulated,
 )
 
