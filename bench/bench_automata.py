@@ -216,7 +216,7 @@ def run_spot(
         groups["last held-out 2-5 APs"] = large_random_set(LAST_HELD_OUT_BATCHES)
     rows = []
     for family, texts in groups.items():
-        ours_total = theirs_total = larger = wrong = 0
+        ours_total = theirs_total = larger = wrong = unchecked = 0
         slowest = spot_slowest = busiest = 0.0
         for text in texts:
             formula = parse_ltl(families.to_tlmpc(spot.formula(text)))
@@ -232,7 +232,11 @@ def run_spot(
             ours_total += ours.num_states
             theirs_total += theirs.num_states()
             larger += ours.num_states > theirs.num_states()
-            wrong += not spot.are_equivalent(spot.automaton(to_hoa(ours)), theirs)
+            try:
+                wrong += not spot.are_equivalent(spot.automaton(to_hoa(ours)), theirs)
+            except RuntimeError:
+                # Spot's build handles at most 32 acceptance sets.
+                unchecked += 1
         rows.append(
             {
                 "family": family,
@@ -245,6 +249,7 @@ def run_spot(
                 "max CPU s": round(busiest, 3),
                 "Spot max s": round(spot_slowest, 3),
                 "not equivalent": wrong,
+                "not checked (Spot's 32-set limit)": unchecked,
             }
         )
     return rows
@@ -261,11 +266,13 @@ def _spot_markdown(rows: list[dict[str, Any]]) -> str:
         old_states = f" ({before[1]})" if before else ""
         old_larger = f" ({before[3]})" if before else ""
         old_time = f" ({before[4]})" if before else ""
+        unchecked = r["not checked (Spot's 32-set limit)"]
+        beyond = f" ({unchecked} beyond Spot's 32 sets)" if unchecked else ""
         lines.append(
             f"| {r['family']} | {r['formulas']} | {r['tlmpc states']}{old_states} | "
             f"{r['Spot states']} | {r['larger than Spot']}{old_larger} | {r['larger %']} | "
             f"{r['max s']}{old_time} | {r['max CPU s']} | {r['Spot max s']} | "
-            f"{r['not equivalent']} |"
+            f"{r['not equivalent']}{beyond} |"
         )
     return "\n".join(lines)
 

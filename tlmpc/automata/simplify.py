@@ -274,6 +274,9 @@ def _reduce_marks(automaton: Automaton, *, keep_transient_marks: bool = False) -
             continue
         seen.add(carriers)
         keep.append(mark)
+    keep = _drop_implied_sets(
+        keep, [component[automaton.edges[i].src] for i in inside], [stripped[i] for i in inside]
+    )
     if not keep and (cyclic - accepting):
         keep = [0]
     new_index = {old: new for new, old in enumerate(keep)}
@@ -298,6 +301,34 @@ def _reduce_marks(automaton: Automaton, *, keep_transient_marks: bool = False) -
         formula=automaton.formula,
         state_based=automaton.state_based,
     )
+
+
+def _drop_implied_sets(
+    keep: list[int], components: Sequence[int], marks: Sequence[frozenset[int]]
+) -> list[int]:
+    """The sets of ``keep`` without those implied by another kept set in every accepting SCC.
+
+    ``components[i]`` and ``marks[i]`` describe the i-th edge inside an accepting SCC.  When,
+    in each accepting SCC, some other kept set is only carried by edges that carry ``b``, a
+    cycle there that sees that set infinitely often sees ``b`` too, and one that misses ``b``
+    misses that set: dropping ``b`` changes no cycle's verdict (Spot's ``scc_filter`` does
+    the same).  A dropped set keeps a witness among the kept sets: a witness dropped later has
+    a witness of its own, whose carriers are fewer still."""
+    if len(keep) < 2:
+        return keep
+    carriers: dict[tuple[int, int], set[int]] = defaultdict(set)
+    for i, (component, edge_marks) in enumerate(zip(components, marks, strict=True)):
+        for mark in edge_marks:
+            carriers[(component, mark)].add(i)
+    groups = set(components)
+    kept = list(keep)
+    for mark in keep:
+        others = [m for m in kept if m != mark]
+        if others and all(
+            any(carriers[(c, other)] <= carriers[(c, mark)] for other in others) for c in groups
+        ):
+            kept.remove(mark)
+    return kept
 
 
 def _merge_states(automaton: Automaton, letters: Sequence[frozenset[str]] | None) -> Automaton:
