@@ -481,7 +481,7 @@ def postprocess(
     verify: Callable[[Automaton, Automaton], bool] | None = None,
 ) -> Automaton:
     """The smallest of the reductions of :func:`reduce_automaton` started from ``automaton``
-    and, while ``deadline`` allows, from two other starting points (:data:`STARTS`).
+    and, while ``deadline`` allows, from the other starting points of :data:`STARTS`.
 
     Simulation-based reduction is a local search: which states end up merged depends on the
     order of the steps and on the marks of the edges between SCCs (which do not change the
@@ -514,8 +514,12 @@ def _simulated_as_built(
     """Direct, reverse and direct simulation before anything else: the edges between SCCs
     keep the marks the construction gave them (postponed eventualities), which trimming
     drops; under them some states simulate others that neither bare nor saturated marks
-    relate (Spot reduces its raw automaton the same way).  With ``reduce_sets``, after
-    trimming and reducing the acceptance sets, transient marks kept."""
+    relate.  With ``reduce_sets``, first trimmed and with its acceptance sets reduced, the
+    edges entering an accepting SCC keeping their marks (Spot's order: ``scc_filter``, then
+    ``simulation``).  The relation is a direct simulation of the automaton with exactly
+    these marks (which has the same language: a run takes an edge between SCCs once), so
+    the quotient and the pruning are sound even where merging closes a cycle through such
+    an edge."""
     if letters is None and len(automaton.aps) > simulation.MAX_APS:
         return automaton
     alphabet = simulation.Alphabet(automaton.aps, letters)
