@@ -472,6 +472,10 @@ def _simulation_round(
     return drop(current, alphabet, relation, deadline)
 
 
+#: CPU seconds the other starting points of :func:`postprocess` always get under a share.
+START_FLOOR = 0.05
+
+
 def postprocess(
     automaton: Automaton,
     letters: Sequence[frozenset[str]] | None,
@@ -488,13 +492,17 @@ def postprocess(
     order of the steps and on the marks of the edges between SCCs (which do not change the
     language, but do change which states simulate which).  Each start is a correct automaton
     of the same language, so the smallest result is too.  With ``start_share``, the other
-    starts together get at most that multiple of the first reduction's CPU time, and skip
-    the WDBA step (a planner's translation: a few states seldom pay for a slower compile)."""
+    starts together get at most that multiple of the first reduction's CPU time (but at least
+    :data:`START_FLOOR`), and skip the WDBA step (a planner's translation: a few states
+    seldom pay for a slower compile)."""
     started = time.process_time()
     best = reduce_automaton(automaton, letters, deadline, obligation=obligation, verify=verify)
     limit = deadline if deadline is not None else float("inf")
     if start_share is not None:
-        limit = min(limit, time.process_time() + start_share * (time.process_time() - started))
+        # Never less than START_FLOOR: small automata (most missions) then always get every
+        # start, so their result does not depend on the machine's speed.
+        share = max(start_share * (time.process_time() - started), START_FLOOR)
+        limit = min(limit, time.process_time() + share)
     for start in STARTS:
         if best.num_states <= 1 or time.process_time() > limit:
             break
