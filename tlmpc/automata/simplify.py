@@ -503,8 +503,11 @@ def postprocess(
         # start, so their result does not depend on the machine's speed.
         share = max(start_share * (time.process_time() - started), START_FLOOR)
         limit = min(limit, time.process_time() + share)
+    first = time.process_time() - started
     for start in STARTS:
-        if best.num_states <= 1 or time.process_time() > limit:
+        # A start costs about what the first reduction did: none begins that cannot end
+        # before the limit (so the limit is not overrun by the steps that do not check it).
+        if best.num_states <= 1 or time.process_time() + first > limit:
             break
         candidate = reduce_automaton(
             start(automaton, letters, limit),
