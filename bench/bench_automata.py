@@ -90,22 +90,22 @@ def run(
     return rows
 
 
-#: Before the simulation/rewriting work (first measured on this machine, same families and
-#: seeds; the held-out row before the bare-mark simulation, the rewriting rules and the checked
-#: WDBA minimization): family -> (formulas, tlmpc states, Spot states, formulas larger than
-#: Spot, max s).
+#: Before the round that added the letter-wise pruning, the several starts of the
+#: post-processing and the wider pure classes (the previous round's published table; for the
+#: two sets new in this round, measured on the previous round's code, with max CPU seconds):
+#: family -> (formulas, tlmpc states, Spot states, formulas larger than Spot, max s).
 BEFORE = {
-    "dac": (60, 219, 200, 12, 1.206),
-    "eh": (12, 43, 37, 2, 0.002),
-    "sb": (38, 169, 112, 18, 0.005),
-    "robotics": (52, 404, 378, 4, 5.585),
-    "random": (200, 1002, 731, 81, 0.081),
-    "held-out": (500, 2406, 1903, 171, 0.41),
-    # Before the reverse simulation and the suspension rules (max: CPU seconds).
-    "random 2-5 APs": (2854, 10391, 10110, 151, 0.865),
-    # Before the F/G absorption, until/release over G/F and literal-assumption rules.
-    "fresh 2-5 APs": (1145, 4026, 4000, 37, 0.372),
-    "fresh held-out 2-5 APs": (1145, 3989, 4006, 28, 0.501),
+    "dac": (60, 200, 200, 0, 0.051),
+    "eh": (12, 37, 37, 0, 0.025),
+    "sb": (38, 112, 112, 0, 0.052),
+    "robotics": (52, 378, 378, 0, 1.07),
+    "random": (200, 724, 731, 1, 0.32),
+    "held-out": (500, 1876, 1903, 11, 0.51),
+    "random 2-5 APs": (2854, 10034, 10110, 93, 1.29),
+    "fresh 2-5 APs": (1145, 3968, 4000, 25, 0.98),
+    "fresh held-out 2-5 APs": (1145, 3977, 4006, 23, 0.69),
+    "tuning 2-5 APs": (1155, 4206, 4140, 47, 0.566),
+    "last held-out 2-5 APs": (1140, 4181, 4207, 26, 0.573),
 }
 
 
@@ -151,6 +151,11 @@ FRESH_BATCHES = (
     (5, 100, 9207, 28),
 )
 HELD_OUT_BATCHES = tuple((aps, n, seed + 100, size) for aps, n, seed, size in FRESH_BATCHES)
+#: Two more of the same kind (seeds 9501-9507 and 9601-9607) for the round that added the
+#: letter-wise pruning, the several starts of the post-processing and the wider pure classes:
+#: the first was its tuning set, the second was only measured before and after it.
+TUNING_BATCHES = tuple((aps, n, seed + 300, size) for aps, n, seed, size in FRESH_BATCHES)
+LAST_HELD_OUT_BATCHES = tuple((aps, n, seed + 400, size) for aps, n, seed, size in FRESH_BATCHES)
 
 _GENERATE = (
     "import sys, spot\n"
@@ -208,9 +213,11 @@ def run_spot(
         groups["random 2-5 APs"] = large_random_set()
         groups["fresh 2-5 APs"] = large_random_set(FRESH_BATCHES)
         groups["fresh held-out 2-5 APs"] = large_random_set(HELD_OUT_BATCHES)
+        groups["tuning 2-5 APs"] = large_random_set(TUNING_BATCHES)
+        groups["last held-out 2-5 APs"] = large_random_set(LAST_HELD_OUT_BATCHES)
     rows = []
     for family, texts in groups.items():
-        ours_total = theirs_total = larger = wrong = 0
+        ours_total = theirs_total = larger = wrong = unchecked = 0
         slowest = spot_slowest = busiest = 0.0
         for text in texts:
             formula = parse_ltl(families.to_tlmpc(spot.formula(text)))
@@ -226,7 +233,11 @@ def run_spot(
             ours_total += ours.num_states
             theirs_total += theirs.num_states()
             larger += ours.num_states > theirs.num_states()
-            wrong += not spot.are_equivalent(spot.automaton(to_hoa(ours)), theirs)
+            try:
+                wrong += not spot.are_equivalent(spot.automaton(to_hoa(ours)), theirs)
+            except RuntimeError:
+                # Spot's build handles at most 32 acceptance sets.
+                unchecked += 1
         rows.append(
             {
                 "family": family,
@@ -239,6 +250,7 @@ def run_spot(
                 "max CPU s": round(busiest, 3),
                 "Spot max s": round(spot_slowest, 3),
                 "not equivalent": wrong,
+                "not checked (Spot's 32-set limit)": unchecked,
             }
         )
     return rows
@@ -255,11 +267,13 @@ def _spot_markdown(rows: list[dict[str, Any]]) -> str:
         old_states = f" ({before[1]})" if before else ""
         old_larger = f" ({before[3]})" if before else ""
         old_time = f" ({before[4]})" if before else ""
+        unchecked = r["not checked (Spot's 32-set limit)"]
+        beyond = f" ({unchecked} beyond Spot's 32 sets)" if unchecked else ""
         lines.append(
             f"| {r['family']} | {r['formulas']} | {r['tlmpc states']}{old_states} | "
             f"{r['Spot states']} | {r['larger than Spot']}{old_larger} | {r['larger %']} | "
             f"{r['max s']}{old_time} | {r['max CPU s']} | {r['Spot max s']} | "
-            f"{r['not equivalent']} |"
+            f"{r['not equivalent']}{beyond} |"
         )
     return "\n".join(lines)
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import functools
 import time
 from collections import defaultdict
 from collections.abc import Callable, Iterable, Sequence
@@ -132,8 +133,9 @@ def strongly_connected(succ: Sequence[Sequence[int]], roots: Iterable[int]) -> l
     return component
 
 
-def trim(automaton: Automaton) -> Automaton:
-    """Keep the states that can reach an accepting cycle; drop marks on acyclic edges."""
+def trim(automaton: Automaton, *, keep_transient_marks: bool = False) -> Automaton:
+    """Keep the states that can reach an accepting cycle; drop marks on acyclic edges
+    (unless ``keep_transient_marks``)."""
     edges = automaton.edges
     component = sccs(automaton.num_states, edges, automaton.initial)
     all_marks = frozenset(range(automaton.num_acc))
@@ -161,7 +163,9 @@ def trim(automaton: Automaton) -> Automaton:
             src=e.src,
             dst=e.dst,
             guard=e.guard,
-            marks=e.marks if component[e.src] == component[e.dst] else frozenset(),
+            marks=e.marks
+            if keep_transient_marks or component[e.src] == component[e.dst]
+            else frozenset(),
         )
         for e in edges
         if e.src in useful and e.dst in useful
@@ -227,14 +231,16 @@ def _renumber(automaton: Automaton, edges: Sequence[Edge], keep: set[int]) -> Au
     )
 
 
-def _reduce_marks(automaton: Automaton) -> Automaton:
+def _reduce_marks(automaton: Automaton, *, keep_transient_marks: bool = False) -> Automaton:
     """Keep marks only inside accepting SCCs, then drop or merge redundant acceptance sets.
 
     A run is accepted iff it ends in an accepting SCC and sees every set there, so marks
     elsewhere are useless.  A set carried by every edge of every accepting SCC is then
     implied by staying in one; it is dropped, except that one set must survive whenever some
     cycle lies outside the accepting SCCs (with no sets left every cycle would accept).
-    Sets carried by the same edges are merged.
+    Sets carried by the same edges are merged.  With ``keep_transient_marks``, edges
+    between SCCs that enter an accepting SCC keep their marks (renumbered like the others;
+    a run takes them once, so any marks will do there, and these are the construction's).
     """
     k = automaton.num_acc
     if k == 0:
@@ -250,7 +256,8 @@ def _reduce_marks(automaton: Automaton) -> Automaton:
     accepting = {c for c in cyclic if internal[c] >= everything}
     stripped = [
         e.marks
-        if component[e.src] == component[e.dst] and component[e.src] in accepting
+        if (component[e.src] == component[e.dst] and component[e.src] in accepting)
+        or (keep_transient_marks and component[e.dst] in accepting)
         else frozenset()
         for e in automaton.edges
     ]
@@ -267,6 +274,9 @@ def _reduce_marks(automaton: Automaton) -> Automaton:
             continue
         seen.add(carriers)
         keep.append(mark)
+    keep = _drop_implied_sets(
+        keep, [component[automaton.edges[i].src] for i in inside], [stripped[i] for i in inside]
+    )
     if not keep and (cyclic - accepting):
         keep = [0]
     new_index = {old: new for new, old in enumerate(keep)}
@@ -291,6 +301,34 @@ def _reduce_marks(automaton: Automaton) -> Automaton:
         formula=automaton.formula,
         state_based=automaton.state_based,
     )
+
+
+def _drop_implied_sets(
+    keep: list[int], components: Sequence[int], marks: Sequence[frozenset[int]]
+) -> list[int]:
+    """The sets of ``keep`` without those implied by another kept set in every accepting SCC.
+
+    ``components[i]`` and ``marks[i]`` describe the i-th edge inside an accepting SCC.  When,
+    in each accepting SCC, some other kept set is only carried by edges that carry ``b``, a
+    cycle there that sees that set infinitely often sees ``b`` too, and one that misses ``b``
+    misses that set: dropping ``b`` changes no cycle's verdict (Spot's ``scc_filter`` does
+    the same).  A dropped set keeps a witness among the kept sets: a witness dropped later has
+    a witness of its own, whose carriers are fewer still."""
+    if len(keep) < 2:
+        return keep
+    carriers: dict[tuple[int, int], set[int]] = defaultdict(set)
+    for i, (component, edge_marks) in enumerate(zip(components, marks, strict=True)):
+        for mark in edge_marks:
+            carriers[(component, mark)].add(i)
+    groups = set(components)
+    kept = list(keep)
+    for mark in keep:
+        others = [m for m in kept if m != mark]
+        if others and all(
+            any(carriers[(c, other)] <= carriers[(c, mark)] for other in others) for c in groups
+        ):
+            kept.remove(mark)
+    return kept
 
 
 def _merge_states(automaton: Automaton, letters: Sequence[frozenset[str]] | None) -> Automaton:
@@ -394,14 +432,15 @@ def _simulation_round(
     alphabet: simulation.Alphabet,
     deadline: float,
     *,
-    saturated: bool,
+    saturated: bool | None,
     reverse: bool = False,
 ) -> Automaton:
     """One quotient-and-prune pass.  Edges between SCCs carry no marks after trimming; with
     ``saturated`` they carry every mark instead (both are the same language, since a run takes
     such an edge once): the bare marks let those edges be dominated, every mark lets them
     dominate, and each finds reductions the other misses.  With ``reverse``, by reverse
-    simulation (states with the same pasts) instead of direct simulation."""
+    simulation (states with the same pasts) instead of direct simulation.  With ``saturated``
+    None, the edges between SCCs keep the marks they have (see :func:`_simulated_as_built`)."""
     relate: Callable[[Automaton, simulation.Alphabet, float], list[list[bool]]]
     merge: Callable[[Automaton, list[list[bool]]], Automaton]
     drop: Callable[[Automaton, simulation.Alphabet, list[list[bool]], float], Automaton]
@@ -415,6 +454,8 @@ def _simulation_round(
         drop = simulation.prune
 
     def prepared(current: Automaton) -> Automaton:
+        if saturated is None:
+            return current
         component = sccs(current.num_states, current.edges, current.initial)
         if saturated:
             return simulation.saturate(current, component)
@@ -431,7 +472,113 @@ def _simulation_round(
     return drop(current, alphabet, relation, deadline)
 
 
+#: CPU seconds the other starting points of :func:`postprocess` always get under a share.
+START_FLOOR = 0.05
+
+
 def postprocess(
+    automaton: Automaton,
+    letters: Sequence[frozenset[str]] | None,
+    deadline: float | None = None,
+    *,
+    obligation: bool = False,
+    verify: Callable[[Automaton, Automaton], bool] | None = None,
+    start_share: float | None = None,
+) -> Automaton:
+    """The smallest of the reductions of :func:`reduce_automaton` started from ``automaton``
+    and, while ``deadline`` allows, from the other starting points of :data:`STARTS`.
+
+    Simulation-based reduction is a local search: which states end up merged depends on the
+    order of the steps and on the marks of the edges between SCCs (which do not change the
+    language, but do change which states simulate which).  Each start is a correct automaton
+    of the same language, so the smallest result is too.  With ``start_share``, the other
+    starts together get at most that multiple of the first reduction's CPU time (but at least
+    :data:`START_FLOOR`), and skip the WDBA step (a planner's translation: a few states
+    seldom pay for a slower compile)."""
+    started = time.process_time()
+    best = reduce_automaton(automaton, letters, deadline, obligation=obligation, verify=verify)
+    limit = deadline if deadline is not None else float("inf")
+    if start_share is not None:
+        # Never less than START_FLOOR: small automata (most missions) then always get every
+        # start, so their result does not depend on the machine's speed.
+        share = max(start_share * (time.process_time() - started), START_FLOOR)
+        limit = min(limit, time.process_time() + share)
+    first = time.process_time() - started
+    for start in STARTS:
+        # A start costs about what the first reduction did: none begins that cannot end
+        # before the limit (so the limit is not overrun by the steps that do not check it).
+        if best.num_states <= 1 or time.process_time() + first > limit:
+            break
+        candidate = reduce_automaton(
+            start(automaton, letters, limit),
+            letters,
+            limit,
+            obligation=obligation and start_share is None,
+            verify=verify if start_share is None else None,
+        )
+        if (candidate.num_states, len(candidate.edges)) < (best.num_states, len(best.edges)):
+            best = candidate
+    return best
+
+
+def _simulated_as_built(
+    automaton: Automaton,
+    letters: Sequence[frozenset[str]] | None,
+    deadline: float,
+    *,
+    reduce_sets: bool = False,
+) -> Automaton:
+    """Direct, reverse and direct simulation before anything else: the edges between SCCs
+    keep the marks the construction gave them (postponed eventualities), which trimming
+    drops; under them some states simulate others that neither bare nor saturated marks
+    relate.  With ``reduce_sets``, first trimmed and with its acceptance sets reduced, the
+    edges entering an accepting SCC keeping their marks (Spot's order: ``scc_filter``, then
+    ``simulation``).  The relation is a direct simulation of the automaton with exactly
+    these marks (which has the same language: a run takes an edge between SCCs once), so
+    the quotient and the pruning are sound even where merging closes a cycle through such
+    an edge."""
+    if letters is None and len(automaton.aps) > simulation.MAX_APS:
+        return automaton
+    alphabet = simulation.Alphabet(automaton.aps, letters)
+    current = merge_parallel_automaton(automaton)
+    if reduce_sets:
+        current = _reduce_marks(trim(current, keep_transient_marks=True), keep_transient_marks=True)
+    try:
+        for reverse in (False, True, False):
+            current = _simulation_round(
+                current, alphabet, deadline, saturated=None, reverse=reverse
+            )
+            current = merge_parallel_automaton(current)
+    except simulation.OutOfTime:
+        pass
+    return current
+
+
+def _trimmed_and_simulated(
+    automaton: Automaton, letters: Sequence[frozenset[str]] | None, deadline: float
+) -> Automaton:
+    """Simulation to a fixpoint on the trimmed automaton, before the state merging and the
+    reduction of acceptance sets (which may join states that simulation would have reduced
+    differently)."""
+    current = trim(merge_parallel_automaton(automaton))
+    for _ in range(4):
+        before = (current.num_states, len(current.edges), current.num_acc)
+        current = reduce_by_simulation(current, letters, deadline)
+        current = trim(merge_parallel_automaton(current))
+        if (current.num_states, len(current.edges), current.num_acc) == before:
+            break
+    return current
+
+
+#: Other starting points of :func:`postprocess`.
+STARTS: tuple[Callable[[Automaton, Sequence[frozenset[str]] | None, float], Automaton], ...] = (
+    _simulated_as_built,
+    functools.partial(_simulated_as_built, reduce_sets=True),
+    _trimmed_and_simulated,
+)
+
+
+def reduce_automaton(
     automaton: Automaton,
     letters: Sequence[frozenset[str]] | None,
     deadline: float | None = None,

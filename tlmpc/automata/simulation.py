@@ -33,6 +33,7 @@ import time
 from collections import defaultdict
 from collections.abc import Sequence
 
+from tlmpc.automata.cover import cover_formula
 from tlmpc.automata.model import Automaton, Edge
 from tlmpc.ltl.ast import And, Const, Formula, Not, Or, Prop, disjoin
 
@@ -45,6 +46,13 @@ class Alphabet:
 
     def __init__(self, aps: Sequence[str], letters: Sequence[frozenset[str]] | None) -> None:
         self.literal: dict[str, int] = {}
+        self.aps = tuple(aps)
+        # The valuation (numbered as in :mod:`tlmpc.automata.cover`) of each explicit letter.
+        self.valuations: tuple[int, ...] | None = None
+        if letters is not None and len(aps) <= MAX_APS:
+            self.valuations = tuple(
+                sum(1 << i for i, ap in enumerate(aps) if ap in letter) for letter in letters
+            )
         if letters is None:
             n = len(aps)
             size = 1 << n
@@ -88,6 +96,23 @@ class Alphabet:
             raise ValueError(f"guards are propositional, got {guard!r}")
         self._cache[guard] = result
         return result
+
+    def guard(self, mask: int) -> Formula | None:
+        """A guard enabled by exactly the letters of ``mask`` (None over explicit letters of
+        more than :data:`MAX_APS` propositions)."""
+        if self.valuations is None:
+            if len(self.aps) > MAX_APS:
+                return None
+            return cover_formula(self.aps, mask, mask)
+        lower = 0
+        for index, valuation in enumerate(self.valuations):
+            if mask >> index & 1:
+                lower |= 1 << valuation
+        others = (1 << (1 << len(self.aps))) - 1
+        for valuation in self.valuations:
+            others &= ~(1 << valuation)
+        # Valuations that are no letter may go either way (no run reads them).
+        return cover_formula(self.aps, lower, lower | others)
 
 
 class OutOfTime(Exception):
@@ -330,7 +355,7 @@ def prune(
     for src, edges in out.items():
         facts = [(alphabet.mask(e.guard), _bits(e.marks), e.dst) for e in edges]
         _check(deadline)
-        for e, (_letters, marks, target) in zip(edges, facts, strict=True):
+        for e, (letters, marks, target) in zip(edges, facts, strict=True):
             if len(facts) > 64:
                 _check(deadline)
             better = 0
@@ -344,12 +369,22 @@ def prune(
             if better == 0:
                 kept.append(e)
                 continue
-            cubes = e.guard.args if isinstance(e.guard, Or) else (e.guard,)
-            remaining = [c for c in cubes if alphabet.mask(c) & ~better]
-            if len(remaining) == len(cubes):
+            left = letters & ~better
+            if left == letters:
                 kept.append(e)
-            elif remaining:
-                kept.append(Edge(src=src, dst=e.dst, guard=disjoin(remaining), marks=e.marks))
+                continue
+            if not left:
+                continue
+            # Only the letters without a better alternative stay on the edge.
+            guard = alphabet.guard(left)
+            if guard is None:  # whole cubes only
+                cubes = e.guard.args if isinstance(e.guard, Or) else (e.guard,)
+                remaining = [c for c in cubes if alphabet.mask(c) & ~better]
+                if len(remaining) == len(cubes):
+                    kept.append(e)
+                    continue
+                guard = disjoin(remaining)
+            kept.append(Edge(src=src, dst=e.dst, guard=guard, marks=e.marks))
     return _with_edges(automaton, kept)
 
 

@@ -212,13 +212,17 @@ def is_eventuality_free(f: Node) -> bool:
 
 
 def _pure_eventuality(f: Node) -> bool:
-    """Formulas e with F e == e (Etessami–Holzmann): F x, x U (F...), GF..., ..."""
+    """Formulas e with F e == e (Etessami–Holzmann): F x, x U (F...), GF..., ...
+
+    Also ``x R e`` and ``e1 W e2`` (as Spot): a pure eventuality true at some position is
+    true at every earlier one, so ``G e`` or ``e U (x & e)`` at a position, and ``G e1`` or
+    ``e2`` at a position, carry over to every earlier position."""
     match f:
         case Finally():
             return True
-        case Binary(kind="U", right=right):
+        case Binary(kind="U" | "R", right=right):
             return _pure_eventuality(right)
-        case Binary(kind="M", left=left, right=right):
+        case Binary(kind="M" | "W", left=left, right=right):
             return _pure_eventuality(left) and _pure_eventuality(right)
         case Always(arg=arg):
             return _pure_eventuality(arg)
@@ -231,13 +235,14 @@ def _pure_eventuality(f: Node) -> bool:
 
 
 def _pure_universality(f: Node) -> bool:
-    """Formulas u with G u == u: G x, x R (G...), FG..., ..."""
+    """Formulas u with G u == u: G x, x R (G...), FG..., ...; also ``x U u`` and
+    ``u1 M u2`` (the duals of the extra pure eventualities)."""
     match f:
         case Always():
             return True
-        case Binary(kind="R", right=right):
+        case Binary(kind="R" | "U", right=right):
             return _pure_universality(right)
-        case Binary(kind="W", left=left, right=right):
+        case Binary(kind="W" | "M", left=left, right=right):
             return _pure_universality(left) and _pure_universality(right)
         case Finally(arg=arg):
             return _pure_universality(arg)

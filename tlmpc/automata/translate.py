@@ -38,6 +38,9 @@ from tlmpc.ltl.transform import nnf
 
 #: Seconds of optional reduction work per translation (see :func:`translate`).
 DEFAULT_BUDGET = 0.5
+#: Over a map's letters (the planner's translation), the post-processing's other starting
+#: points together get at most this multiple of the first reduction's time.
+PLANNER_START_SHARE = 0.5
 #: At most this long for the language-containment simplification of the formula.
 CONTAINMENT_BUDGET = 0.2
 
@@ -213,7 +216,12 @@ def _translate(
                 return equivalent_to_deterministic(reduced, candidate, negation, letter_sets, limit)
 
         automaton = postprocess(
-            automaton, letter_sets, deadline, obligation=is_obligation(root), verify=verify
+            automaton,
+            letter_sets,
+            deadline,
+            obligation=is_obligation(root),
+            verify=verify,
+            start_share=None if letter_sets is None else PLANNER_START_SHARE,
         )
     if letter_sets is not None:
         automaton = dataclasses.replace(
