@@ -1,6 +1,6 @@
 """The artifact writer's text is what ``json.dumps`` writes, document by document.
 
-``dumps_all`` encodes a large value held by several documents under the same key once; the
+``artifact_texts`` encodes a large value held by several documents under the same key once; the
 oracle is the plain definition: each document encoded on its own by the standard library
 (compact with sorted keys, indented when short, non-finite floats as strings).
 """
@@ -15,7 +15,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from tlmpc.artifacts import INDENT_BELOW, _finite, dumps, dumps_all
+from tlmpc.artifacts import INDENT_BELOW, _finite, artifact_texts, dumps
 
 
 def _reference(document: Any) -> str:
@@ -108,7 +108,7 @@ def _retyped(value: Any) -> Any:
 
 @given(_documents())
 def test_each_text_is_the_documents_own_encoding(documents: dict[str, Any]) -> None:
-    texts = dumps_all(documents)
+    texts = dict(artifact_texts(documents))
     assert texts == {name: _reference(document) for name, document in documents.items()}
     assert all(dumps(document) == texts[name] for name, document in documents.items())
 
@@ -117,14 +117,16 @@ def test_equal_in_python_but_not_in_json_is_encoded_apart() -> None:
     one = {f"r{i}": [[1, 0.0], [True, 2]] for i in range(2000)}
     other = {f"r{i}": [[1.0, -0.0], [1, 2.0]] for i in range(2000)}
     assert one == other
-    texts = dumps_all({"a.json": {"regions": one}, "b.json": {"regions": other}})
+    texts = dict(artifact_texts({"a.json": {"regions": one}, "b.json": {"regions": other}}))
     assert '"r0":[[1,0.0],[true,2]]' in texts["a.json"]
     assert '"r0":[[1.0,-0.0],[1,2.0]]' in texts["b.json"]
 
 
 def test_shared_value_with_a_non_finite_number_is_written_as_text() -> None:
     regions = {f"r{i}": [float(i), math.inf] for i in range(2000)}
-    texts = dumps_all({"a.json": {"regions": regions}, "b.json": {"regions": regions, "n": 1}})
+    texts = dict(
+        artifact_texts({"a.json": {"regions": regions}, "b.json": {"regions": regions, "n": 1}})
+    )
     assert texts["a.json"] == _reference({"regions": regions})
     assert '"r5":[5.0,"inf"]' in texts["b.json"]
 
@@ -136,4 +138,4 @@ def test_a_document_holding_itself_fails_as_it_always_did() -> None:
         with pytest.raises(RecursionError):
             dumps(document)
         with pytest.raises(RecursionError):
-            dumps_all({"a.json": document, "b.json": {"a": loop}})
+            dict(artifact_texts({"a.json": document, "b.json": {"a": loop}}))

@@ -13,7 +13,7 @@ import marshal
 import math
 import re
 from collections import Counter
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -78,7 +78,7 @@ def dumps(document: Any, shared: SharedTexts | None = None) -> str:
     """Canonical JSON text of ``document``: sorted keys, non-finite floats as strings.
 
     ``shared``: texts of large top-level values already encoded for another document of the
-    same write (see :func:`dumps_all`).
+    same write (see :func:`artifact_texts`).
     """
     try:
         text = _compact(document, shared)
@@ -90,12 +90,14 @@ def dumps(document: Any, shared: SharedTexts | None = None) -> str:
     return text + "\n"
 
 
-def dumps_all(documents: Mapping[str, Any]) -> dict[str, str]:
-    """:func:`dumps` of each document, a large value that several documents hold under the
-    same top-level key (the regions of ``mission.json``, ``abstraction.json`` and
-    ``trace.json``) encoded once."""
-    shared = SharedTexts.among(documents.values())
-    return {name: dumps(document, shared) for name, document in documents.items()}
+def artifact_texts(artifacts: Mapping[str, Any]) -> Iterator[tuple[str, str | bytes]]:
+    """``(name, text)`` of each artifact, one at a time: texts and bytes as they are, JSON
+    documents by :func:`dumps`, a large value that several documents hold under the same
+    top-level key (the regions of ``mission.json``, ``abstraction.json`` and ``trace.json``)
+    encoded once."""
+    shared = SharedTexts.among(artifacts.values())
+    for name, content in artifacts.items():
+        yield name, content if isinstance(content, str | bytes) else dumps(content, shared)
 
 
 #: Top-level values with fewer items than this are encoded again rather than looked up.

@@ -34,7 +34,7 @@ from collections.abc import Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
-from tlmpc.artifacts import ARTIFACT_SCHEMAS, SharedTexts, dumps
+from tlmpc.artifacts import ARTIFACT_SCHEMAS, artifact_texts, dumps
 from tlmpc.errors import UsageError, error
 
 #: The marker file every output directory holds; its first line starts with MARKER_FORMAT.
@@ -310,10 +310,7 @@ def write_artifacts(staging: Path, artifacts: Mapping[str, Any]) -> None:
     """Write each artifact (JSON document, text or bytes) into ``staging``."""
     # A large value several documents hold (the regions) is encoded once; each text is
     # written as soon as it is made, so that only one is held at a time.
-    shared = SharedTexts.among(artifacts.values())
-    for name, content in artifacts.items():
-        if not isinstance(content, str | bytes):
-            content = dumps(content, shared)
+    for name, content in artifact_texts(artifacts):
         try:
             _write(staging / name, content)
         except OSError as exc:
