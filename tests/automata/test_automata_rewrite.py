@@ -127,6 +127,10 @@ RULES = [
     ("F a | G(a | b)", "F a | G b"),
     ("G a & F(!a & b | c)", "G a & F c"),
     ("F(a | b) | (a U c)", "F(a | b) | c"),
+    # A literal decides its own occurrences at the present position in its siblings.
+    ("a & (F b | !a)", "a & F b"),
+    ("!a | (a & G b)", "!a | G b"),
+    ("a & (b | (!a & c))", "a & b"),
 ]
 
 
@@ -154,6 +158,9 @@ NEAR_MISSES = [
     "F(a & b) | G(a | c)",
     "G(a | b) & F(!a & c)",
     "a | G(!a | b)",
+    "a & F(b | !a)",
+    "!a | (b U (a & c))",
+    "a & G(b | !a)",
 ]
 
 
@@ -182,6 +189,7 @@ SPOT_SIZED = [
     "0 R F(p1 R (p2 U p1))",
     "(p2 | p3) & (p0 | (!(p1 <-> Fp3) W Fp1))",
     "F(((p0 & F!p0) M (p2 | p4)) <-> (p4 | (!p3 -> Fp4))) W (Gp0 M 1)",
+    "FG(F((p0 <-> (p0 & Gp1)) -> !p0) M 1)",
 ]
 
 

@@ -238,7 +238,7 @@ class _Rewriter:
         if len(built.args) > MAX_OPERANDS:
             return built
         items = list(built.args)
-        substituted = _assume_literals(items, conjunction)
+        substituted = _assume_present_literals(_assume_literals(items, conjunction), conjunction)
         if substituted != items:
             return self.junction(conjunction, substituted)
         small = len(items) <= MAX_SEMANTIC_OPERANDS
@@ -341,6 +341,34 @@ def _assume_literals(items: list[Node], conjunction: bool) -> list[Node]:
             values[negate(literal)] = FALSE
         out = [x if i == index else _substitute(x, values) for i, x in enumerate(out)]
     return out
+
+
+def _assume_present_literals(items: list[Node], conjunction: bool) -> list[Node]:
+    """``ℓ & x = ℓ & x[ℓ := true]`` and ``ℓ | x = ℓ | x[ℓ := false]`` for the occurrences of
+    the literal ℓ in x outside every temporal operator: those are read at the present
+    position only, where the sibling ℓ decides them (``p & (F q | !p) = p & F q``)."""
+    out = list(items)
+    for index, item in enumerate(items):
+        if not isinstance(item, Pos | Neg):
+            continue
+        values: dict[Node, Node] = {
+            item: TRUE if conjunction else FALSE,
+            negate(item): FALSE if conjunction else TRUE,
+        }
+        out = [x if i == index else _substitute_present(x, values) for i, x in enumerate(out)]
+    return out
+
+
+def _substitute_present(f: Node, values: dict[Node, Node]) -> Node:
+    match f:
+        case Pos() | Neg():
+            return values.get(f, f)
+        case Conj(args=args):
+            return make_and([_substitute_present(a, values) for a in args])
+        case Disj(args=args):
+            return make_or([_substitute_present(a, values) for a in args])
+        case _:
+            return f
 
 
 def _substitute(f: Node, values: dict[Node, Node]) -> Node:
