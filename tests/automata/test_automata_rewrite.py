@@ -131,6 +131,12 @@ RULES = [
     ("a & (F b | !a)", "a & F b"),
     ("!a | (a & G b)", "!a | G b"),
     ("a & (b | (!a & c))", "a & b"),
+    # The other halves of a U b = (a W b) & F b and a R b = (a M b) | G b.
+    ("F b & (a W b)", "a U b"),
+    ("G b | (a M b)", "a R b"),
+    # A pure universality under F G leaves the G (Spot's form).
+    ("F G(a | G b)", "F(G a | G b)"),
+    ("F G(a | (b U G c))", "F(G a | (b U G c))"),
 ]
 
 
@@ -161,6 +167,10 @@ NEAR_MISSES = [
     "a & F(b | !a)",
     "!a | (b U (a & c))",
     "a & G(b | !a)",
+    "F a & (a W b)",
+    "G a | (a M b)",
+    "G(a | G b)",
+    "F G(a | F b)",
 ]
 
 
@@ -190,6 +200,9 @@ SPOT_SIZED = [
     "(p2 | p3) & (p0 | (!(p1 <-> Fp3) W Fp1))",
     "F(((p0 & F!p0) M (p2 | p4)) <-> (p4 | (!p3 -> Fp4))) W (Gp0 M 1)",
     "FG(F((p0 <-> (p0 & Gp1)) -> !p0) M 1)",
+    "Fp0 U ((Gp1 W (Gp0 M p1)) M !G(p2 & p3))",
+    "!GF(Gp2 <-> FGp0)",
+    "F(!(p3 -> ((p3 | p4) M (0 R p3))) <-> !(p4 M GF(p1 M (p1 & Fp0))))",
 ]
 
 

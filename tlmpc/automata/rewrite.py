@@ -63,6 +63,7 @@ from tlmpc.automata.nnf import (
 from tlmpc.automata.terms import (
     implies,
     is_pure_eventuality,
+    is_pure_universality,
     make_and,
     make_binary,
     make_f,
@@ -175,6 +176,18 @@ class _Rewriter:
             kept = self.absorbed(list(f.arg.args), make_f, make_or)
             if kept is not None:
                 return make_f(kept)
+        if (
+            isinstance(f, Finally)
+            and isinstance(f.arg, Always)
+            and isinstance(f.arg.arg, Disj)
+            and any(is_pure_universality(x) for x in f.arg.arg.args)
+        ):
+            # F G(a | u) = F(G a | u) for a pure universality u (Spot's form): from some
+            # position on, either u holds somewhere, and then from there on, or a holds at
+            # every position.
+            args = f.arg.arg.args
+            rest = make_or([x for x in args if not is_pure_universality(x)])
+            return make_f(make_or([make_g(rest), *(x for x in args if is_pure_universality(x))]))
         return f
 
     def under_g(self, f: Node) -> Node:
