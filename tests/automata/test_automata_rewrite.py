@@ -131,6 +131,8 @@ RULES = [
     ("a & (F b | !a)", "a & F b"),
     ("!a | (a & G b)", "!a | G b"),
     ("a & (b | (!a & c))", "a & b"),
+    ("a & (b | (a & F c))", "a & (b | F c)"),
+    ("a | (b & (a | G c))", "a | (b & G c)"),
     # The other halves of a U b = (a W b) & F b and a R b = (a M b) | G b.
     ("F b & (a W b)", "a U b"),
     ("G b | (a M b)", "a R b"),
