@@ -139,6 +139,8 @@ RULES = [
     # A pure universality under F G leaves the G (Spot's form).
     ("F G(a | G b)", "F(G a | G b)"),
     ("F G(a | (b U G c))", "F(G a | (b U G c))"),
+    ("F(a | G(b | G c))", "F(a | G b | G c)"),
+    ("F(a | G(b | G(c | G d)))", "F(a | G b | G c | G d)"),
 ]
 
 
@@ -173,6 +175,7 @@ NEAR_MISSES = [
     "G a | (a M b)",
     "G(a | G b)",
     "F G(a | F b)",
+    "G(a | G b) | F c",
 ]
 
 
@@ -205,6 +208,7 @@ SPOT_SIZED = [
     "Fp0 U ((Gp1 W (Gp0 M p1)) M !G(p2 & p3))",
     "!GF(Gp2 <-> FGp0)",
     "F(!(p3 -> ((p3 | p4) M (0 R p3))) <-> !(p4 M GF(p1 M (p1 & Fp0))))",
+    "(Fp1 U FG((p2 <-> p3) | G(p0 W Gp2))) R ((p0 -> p2) <-> Gp0)",
 ]
 
 

@@ -176,18 +176,15 @@ class _Rewriter:
             kept = self.absorbed(list(f.arg.args), make_f, make_or)
             if kept is not None:
                 return make_f(kept)
-        if (
-            isinstance(f, Finally)
-            and isinstance(f.arg, Always)
-            and isinstance(f.arg.arg, Disj)
-            and any(is_pure_universality(x) for x in f.arg.arg.args)
-        ):
+        if isinstance(f, Finally):
             # F G(a | u) = F(G a | u) for a pure universality u (Spot's form): from some
             # position on, either u holds somewhere, and then from there on, or a holds at
-            # every position.
-            args = f.arg.arg.args
-            rest = make_or([x for x in args if not is_pure_universality(x)])
-            return make_f(make_or([make_g(rest), *(x for x in args if is_pure_universality(x))]))
+            # every position.  F distributes over |, so also for a disjunct G(a | u).
+            parts = f.arg.args if isinstance(f.arg, Disj) else (f.arg,)
+            split = [_split_universal(x) for x in parts]
+            if split != list(parts):
+                # Again: a u split off may be a G(a | u) itself (each round removes a G).
+                return self.under_f(make_f(make_or(split)))
         return f
 
     def under_g(self, f: Node) -> Node:
@@ -326,6 +323,18 @@ class _Rewriter:
                 # is F c & b already).
                 return b
         return make_binary(kind, a, b)
+
+
+def _split_universal(f: Node) -> Node:
+    """``G(a | u)`` as ``G a | u`` for the pure universalities u among its disjuncts (equal
+    under F only), else ``f``."""
+    if not isinstance(f, Always) or not isinstance(f.arg, Disj):
+        return f
+    args = f.arg.args
+    universal = [x for x in args if is_pure_universality(x)]
+    if not universal:
+        return f
+    return make_or([make_g(make_or([x for x in args if x not in universal])), *universal])
 
 
 def _assumed(item: Node, conjunction: bool) -> list[Node]:
