@@ -30,7 +30,11 @@ Beside them: ``G F(a R b) = G F a`` (a ⇒ b, b ⇒ F a), ``F(a | b) = F b`` (F 
 ``G(a & b) = G b`` (G b ⇒ G a), ``G F(a | b) = G F b`` (G F a ⇒ G F b), ``a U G c = G c``
 (a ⇒ c), ``G d U b = b`` (d ⇒ ¬b), ``a U b = F b`` (F b ⇒ a), ``a R F c = F c`` (c ⇒ a),
 ``F c R b = b`` (¬c ⇒ b), Spot's ``a U (a & b) = b M a`` (and duals), and the literal
-assumptions ``x | F ℓ = x[ℓ := false] | F ℓ``, ``x & G ℓ = x[ℓ := true] & G ℓ``.
+assumptions ``x | F ℓ = x[ℓ := false] | F ℓ``, ``x & G ℓ = x[ℓ := true] & G ℓ``, the present
+literals ``ℓ & x = ℓ & x[ℓ := true]`` and ``ℓ | x = ℓ | x[ℓ := false]`` (outside the temporal
+operators of x), and ``F G(a | u) = F(G a | u)`` for a pure universality u (also for a
+disjunct under F).  :func:`tlmpc.automata.terms.make_and` and ``make_or`` add
+``F b & (a W b) = a U b`` and ``G b | (a M b) = a R b``.
 
 Why they hold: for ``a U b`` with a ⇒ b, wherever ``a`` holds so does ``b``, so the until is
 fulfilled at once or never needed ``a``; with ¬a ⇒ b every position before the first ``b`` has
