@@ -141,6 +141,8 @@ RULES = [
     ("F G(a | (b U G c))", "F(G a | (b U G c))"),
     ("F(a | G(b | G c))", "F(a | G b | G c)"),
     ("F(a | G(b | G(c | G d)))", "F(a | G b | G c | G d)"),
+    ("F G(a | (F b & F c))", "F(G a | G(F b & F c))"),
+    ("F G(a | (b U F c))", "F(G a | G F c)"),
 ]
 
 
@@ -176,6 +178,8 @@ NEAR_MISSES = [
     "G(a | G b)",
     "F G(a | F b)",
     "G(a | G b) | F c",
+    "G(a | (F b & F c))",
+    "F G(a | (b U c))",
 ]
 
 
@@ -209,6 +213,7 @@ SPOT_SIZED = [
     "!GF(Gp2 <-> FGp0)",
     "F(!(p3 -> ((p3 | p4) M (0 R p3))) <-> !(p4 M GF(p1 M (p1 & Fp0))))",
     "(Fp1 U FG((p2 <-> p3) | G(p0 W Gp2))) R ((p0 -> p2) <-> Gp0)",
+    "FG!(Gp2 <-> !Gp1)",
 ]
 
 

@@ -174,21 +174,22 @@ class _Rewriter:
         self.memo[f] = result
         return result
 
-    def under_f(self, f: Node) -> Node:
+    def under_f(self, f: Node, rounds: int = 8) -> Node:
         # F(a | b) = F b when F a ⇒ F b (F(p | G F p) = F p).
         if isinstance(f, Finally) and isinstance(f.arg, Disj):
             kept = self.absorbed(list(f.arg.args), make_f, make_or)
             if kept is not None:
                 return make_f(kept)
-        if isinstance(f, Finally):
+        if isinstance(f, Finally) and rounds > 0:
             # F G(a | u) = F(G a | u) for a pure universality u (Spot's form): from some
             # position on, either u holds somewhere, and then from there on, or a holds at
-            # every position.  F distributes over |, so also for a disjunct G(a | u).
+            # every position; likewise F G(a | e) = F(G a | G e) for a pure eventuality e.
+            # F distributes over |, so also for a disjunct G(a | u) or G(a | e).
             parts = f.arg.args if isinstance(f.arg, Disj) else (f.arg,)
             split = [_split_universal(x) for x in parts]
             if split != list(parts):
                 # Again: a u split off may be a G(a | u) itself (each round removes a G).
-                return self.under_f(make_f(make_or(split)))
+                return self.under_f(make_f(make_or(split)), rounds - 1)
         return f
 
     def under_g(self, f: Node) -> Node:
@@ -330,15 +331,19 @@ class _Rewriter:
 
 
 def _split_universal(f: Node) -> Node:
-    """``G(a | u)`` as ``G a | u`` for the pure universalities u among its disjuncts (equal
-    under F only), else ``f``."""
+    """``G(a | u)`` as ``G a | u`` for the pure universalities u among its disjuncts and
+    ``G(a | e)`` as ``G a | G e`` for the pure eventualities e (equal under F only: e true
+    infinitely often is e everywhere, as e at a position makes it true at every earlier
+    one), else ``f``."""
     if not isinstance(f, Always) or not isinstance(f.arg, Disj):
         return f
     args = f.arg.args
     universal = [x for x in args if is_pure_universality(x)]
-    if not universal:
+    eventual = [x for x in args if is_pure_eventuality(x) and x not in universal]
+    if not universal and not eventual:
         return f
-    return make_or([make_g(make_or([x for x in args if x not in universal])), *universal])
+    rest = [x for x in args if x not in universal and x not in eventual]
+    return make_or([make_g(make_or(rest)), *universal, *(make_g(e) for e in eventual)])
 
 
 def _assumed(item: Node, conjunction: bool) -> list[Node]:
