@@ -96,6 +96,21 @@ def make_and(parts: Iterable[Node]) -> Node:
             make_binary("M", part.left, part.right) for part in strong if isinstance(part, Binary)
         )
         return make_and(flat)
+    until = [
+        part
+        for part in flat
+        if isinstance(part, Binary) and part.kind == "W" and Finally("F", part.right) in flat
+    ]
+    if until:
+        # F b & (a W b) = a U b (a U b = (a W b) & F b).
+        flat.difference_update(until)
+        flat.difference_update(
+            Finally("F", part.right) for part in until if isinstance(part, Binary)
+        )
+        flat.update(
+            make_binary("U", part.left, part.right) for part in until if isinstance(part, Binary)
+        )
+        return make_and(flat)
     always = [part for part in flat if isinstance(part, Always)]
     if len(always) > 1:
         # G a & G b = G(a & b): one obligation instead of many (fifty `avoid` phrases would
@@ -167,6 +182,21 @@ def make_or(parts: Iterable[Node]) -> Node:
         flat.difference_update(Always("G", part.left) for part in weak if isinstance(part, Binary))
         flat.update(
             make_binary("W", part.left, part.right) for part in weak if isinstance(part, Binary)
+        )
+        return make_or(flat)
+    release = [
+        part
+        for part in flat
+        if isinstance(part, Binary) and part.kind == "M" and Always("G", part.right) in flat
+    ]
+    if release:
+        # G b | (a M b) = a R b (the dual: a R b = (a M b) | G b).
+        flat.difference_update(release)
+        flat.difference_update(
+            Always("G", part.right) for part in release if isinstance(part, Binary)
+        )
+        flat.update(
+            make_binary("R", part.left, part.right) for part in release if isinstance(part, Binary)
         )
         return make_or(flat)
     recurrent = [
@@ -257,6 +287,11 @@ def _pure_universality(f: Node) -> bool:
 def is_pure_eventuality(f: Node) -> bool:
     """``F f == f`` (Etessami–Holzmann's pure eventualities)."""
     return _pure_eventuality(f)
+
+
+def is_pure_universality(f: Node) -> bool:
+    """``G f == f`` (the duals of the pure eventualities)."""
+    return _pure_universality(f)
 
 
 def _suspendable(f: Node) -> bool:
