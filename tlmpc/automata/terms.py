@@ -13,7 +13,7 @@ step.
 from __future__ import annotations
 
 import functools
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from typing import NamedTuple, assert_never
 
 from tlmpc.automata.nnf import (
@@ -81,35 +81,10 @@ def make_and(parts: Iterable[Node]) -> Node:
     for part in flat:
         if isinstance(part, Pos) and neg(part.name) in flat:
             return FALSE
-    strong = [
-        part
-        for part in flat
-        if isinstance(part, Binary) and part.kind == "R" and Finally("F", part.left) in flat
-    ]
-    if strong:
-        # F a & (a R b) = a M b (the dual rule).
-        flat.difference_update(strong)
-        flat.difference_update(
-            Finally("F", part.left) for part in strong if isinstance(part, Binary)
-        )
-        flat.update(
-            make_binary("M", part.left, part.right) for part in strong if isinstance(part, Binary)
-        )
-        return make_and(flat)
-    until = [
-        part
-        for part in flat
-        if isinstance(part, Binary) and part.kind == "W" and Finally("F", part.right) in flat
-    ]
-    if until:
-        # F b & (a W b) = a U b (a U b = (a W b) & F b).
-        flat.difference_update(until)
-        flat.difference_update(
-            Finally("F", part.right) for part in until if isinstance(part, Binary)
-        )
-        flat.update(
-            make_binary("U", part.left, part.right) for part in until if isinstance(part, Binary)
-        )
+    # F a & (a R b) = a M b; F b & (a W b) = a U b (a U b = (a W b) & F b).
+    if _fuse(flat, "R", "M", lambda b: Finally("F", b.left)) or _fuse(
+        flat, "W", "U", lambda b: Finally("F", b.right)
+    ):
         return make_and(flat)
     always = [part for part in flat if isinstance(part, Always)]
     if len(always) > 1:
@@ -155,6 +130,26 @@ def make_and(parts: Iterable[Node]) -> Node:
     return Conj("&", _sorted(flat))
 
 
+def _fuse(
+    flat: set[Node], kind: BinaryKind, fused: BinaryKind, partner: Callable[[Binary], Node]
+) -> bool:
+    """Replace each ``kind`` operand whose ``partner`` formula is also in ``flat`` (a set of
+    conjuncts or of disjuncts) and that partner by the ``fused`` operator; True when any was."""
+    found = [
+        part
+        for part in flat
+        if isinstance(part, Binary) and part.kind == kind and partner(part) in flat
+    ]
+    if not found:
+        return False
+    flat.difference_update(found)
+    flat.difference_update(partner(part) for part in found if isinstance(part, Binary))
+    flat.update(
+        make_binary(fused, part.left, part.right) for part in found if isinstance(part, Binary)
+    )
+    return True
+
+
 def make_or(parts: Iterable[Node]) -> Node:
     """Flattened, sorted, deduplicated disjunction with constant folding."""
     flat: set[Node] = set()
@@ -171,33 +166,11 @@ def make_or(parts: Iterable[Node]) -> Node:
     for part in flat:
         if isinstance(part, Pos) and neg(part.name) in flat:
             return TRUE
-    weak = [
-        part
-        for part in flat
-        if isinstance(part, Binary) and part.kind == "U" and Always("G", part.left) in flat
-    ]
-    if weak:
-        # G a | (a U b) = a W b (Spot's rule): one state instead of a choice.
-        flat.difference_update(weak)
-        flat.difference_update(Always("G", part.left) for part in weak if isinstance(part, Binary))
-        flat.update(
-            make_binary("W", part.left, part.right) for part in weak if isinstance(part, Binary)
-        )
-        return make_or(flat)
-    release = [
-        part
-        for part in flat
-        if isinstance(part, Binary) and part.kind == "M" and Always("G", part.right) in flat
-    ]
-    if release:
-        # G b | (a M b) = a R b (the dual: a R b = (a M b) | G b).
-        flat.difference_update(release)
-        flat.difference_update(
-            Always("G", part.right) for part in release if isinstance(part, Binary)
-        )
-        flat.update(
-            make_binary("R", part.left, part.right) for part in release if isinstance(part, Binary)
-        )
+    # G a | (a U b) = a W b (Spot's rule: one state instead of a choice); the dual
+    # G b | (a M b) = a R b (a R b = (a M b) | G b).
+    if _fuse(flat, "U", "W", lambda b: Always("G", b.left)) or _fuse(
+        flat, "M", "R", lambda b: Always("G", b.right)
+    ):
         return make_or(flat)
     recurrent = [
         part for part in flat if isinstance(part, Always) and isinstance(part.arg, Finally)
