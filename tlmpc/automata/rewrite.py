@@ -30,11 +30,7 @@ Beside them: ``G F(a R b) = G F a`` (a ⇒ b, b ⇒ F a), ``F(a | b) = F b`` (F 
 ``G(a & b) = G b`` (G b ⇒ G a), ``G F(a | b) = G F b`` (G F a ⇒ G F b), ``a U G c = G c``
 (a ⇒ c), ``G d U b = b`` (d ⇒ ¬b), ``a U b = F b`` (F b ⇒ a), ``a R F c = F c`` (c ⇒ a),
 ``F c R b = b`` (¬c ⇒ b), Spot's ``a U (a & b) = b M a`` (and duals), and the literal
-assumptions ``x | F ℓ = x[ℓ := false] | F ℓ``, ``x & G ℓ = x[ℓ := true] & G ℓ``, the present
-literals ``ℓ & x = ℓ & x[ℓ := true]`` and ``ℓ | x = ℓ | x[ℓ := false]`` (outside the temporal
-operators of x), and ``F G(a | u) = F(G a | u)`` for a pure universality u (also for a
-disjunct under F).  :func:`tlmpc.automata.terms.make_and` and ``make_or`` add
-``F b & (a W b) = a U b`` and ``G b | (a M b) = a R b``.
+assumptions ``x | F ℓ = x[ℓ := false] | F ℓ``, ``x & G ℓ = x[ℓ := true] & G ℓ``.
 
 Why they hold: for ``a U b`` with a ⇒ b, wherever ``a`` holds so does ``b``, so the until is
 fulfilled at once or never needed ``a``; with ¬a ⇒ b every position before the first ``b`` has
@@ -67,7 +63,6 @@ from tlmpc.automata.nnf import (
 from tlmpc.automata.terms import (
     implies,
     is_pure_eventuality,
-    is_pure_universality,
     make_and,
     make_binary,
     make_f,
@@ -174,22 +169,12 @@ class _Rewriter:
         self.memo[f] = result
         return result
 
-    def under_f(self, f: Node, rounds: int = 8) -> Node:
+    def under_f(self, f: Node) -> Node:
         # F(a | b) = F b when F a ⇒ F b (F(p | G F p) = F p).
         if isinstance(f, Finally) and isinstance(f.arg, Disj):
             kept = self.absorbed(list(f.arg.args), make_f, make_or)
             if kept is not None:
                 return make_f(kept)
-        if isinstance(f, Finally) and rounds > 0:
-            # F G(a | u) = F(G a | u) for a pure universality u (Spot's form): from some
-            # position on, either u holds somewhere, and then from there on, or a holds at
-            # every position; likewise F G(a | e) = F(G a | G e) for a pure eventuality e.
-            # F distributes over |, so also for a disjunct G(a | u) or G(a | e).
-            parts = f.arg.args if isinstance(f.arg, Disj) else (f.arg,)
-            split = [_split_universal(x) for x in parts]
-            if split != list(parts):
-                # Again: a u split off may be a G(a | u) itself (each round removes a G).
-                return self.under_f(make_f(make_or(split)), rounds - 1)
         return f
 
     def under_g(self, f: Node) -> Node:
@@ -253,7 +238,7 @@ class _Rewriter:
         if len(built.args) > MAX_OPERANDS:
             return built
         items = list(built.args)
-        substituted = _assume_present_literals(_assume_literals(items, conjunction), conjunction)
+        substituted = _assume_literals(items, conjunction)
         if substituted != items:
             return self.junction(conjunction, substituted)
         small = len(items) <= MAX_SEMANTIC_OPERANDS
@@ -330,22 +315,6 @@ class _Rewriter:
         return make_binary(kind, a, b)
 
 
-def _split_universal(f: Node) -> Node:
-    """``G(a | u)`` as ``G a | u`` for the pure universalities u among its disjuncts and
-    ``G(a | e)`` as ``G a | G e`` for the pure eventualities e (equal under F only: e true
-    infinitely often is e everywhere, as e at a position makes it true at every earlier
-    one), else ``f``."""
-    if not isinstance(f, Always) or not isinstance(f.arg, Disj):
-        return f
-    args = f.arg.args
-    universal = [x for x in args if is_pure_universality(x)]
-    eventual = [x for x in args if is_pure_eventuality(x) and x not in universal]
-    if not universal and not eventual:
-        return f
-    rest = [x for x in args if x not in universal and x not in eventual]
-    return make_or([make_g(make_or(rest)), *universal, *(make_g(e) for e in eventual)])
-
-
 def _assumed(item: Node, conjunction: bool) -> list[Node]:
     """The literals ``item`` makes true everywhere (``G ℓ``, ``G(ℓ1 & …)``: conjunction) or
     false everywhere unless it holds (``F ℓ``, ``F(ℓ1 | …)``: disjunction)."""
@@ -372,34 +341,6 @@ def _assume_literals(items: list[Node], conjunction: bool) -> list[Node]:
             values[negate(literal)] = FALSE
         out = [x if i == index else _substitute(x, values) for i, x in enumerate(out)]
     return out
-
-
-def _assume_present_literals(items: list[Node], conjunction: bool) -> list[Node]:
-    """``ℓ & x = ℓ & x[ℓ := true]`` and ``ℓ | x = ℓ | x[ℓ := false]`` for the occurrences of
-    the literal ℓ in x outside every temporal operator: those are read at the present
-    position only, where the sibling ℓ decides them (``p & (F q | !p) = p & F q``)."""
-    out = list(items)
-    for index, item in enumerate(items):
-        if not isinstance(item, Pos | Neg):
-            continue
-        values: dict[Node, Node] = {
-            item: TRUE if conjunction else FALSE,
-            negate(item): FALSE if conjunction else TRUE,
-        }
-        out = [x if i == index else _substitute_present(x, values) for i, x in enumerate(out)]
-    return out
-
-
-def _substitute_present(f: Node, values: dict[Node, Node]) -> Node:
-    match f:
-        case Pos() | Neg():
-            return values.get(f, f)
-        case Conj(args=args):
-            return make_and([_substitute_present(a, values) for a in args])
-        case Disj(args=args):
-            return make_or([_substitute_present(a, values) for a in args])
-        case _:
-            return f
 
 
 def _substitute(f: Node, values: dict[Node, Node]) -> Node:

@@ -13,7 +13,7 @@ step.
 from __future__ import annotations
 
 import functools
-from collections.abc import Callable, Iterable
+from collections.abc import Iterable
 from typing import NamedTuple, assert_never
 
 from tlmpc.automata.nnf import (
@@ -81,10 +81,20 @@ def make_and(parts: Iterable[Node]) -> Node:
     for part in flat:
         if isinstance(part, Pos) and neg(part.name) in flat:
             return FALSE
-    # F a & (a R b) = a M b; F b & (a W b) = a U b (a U b = (a W b) & F b).
-    if _fuse(flat, "R", "M", lambda b: Finally("F", b.left)) or _fuse(
-        flat, "W", "U", lambda b: Finally("F", b.right)
-    ):
+    strong = [
+        part
+        for part in flat
+        if isinstance(part, Binary) and part.kind == "R" and Finally("F", part.left) in flat
+    ]
+    if strong:
+        # F a & (a R b) = a M b (the dual rule).
+        flat.difference_update(strong)
+        flat.difference_update(
+            Finally("F", part.left) for part in strong if isinstance(part, Binary)
+        )
+        flat.update(
+            make_binary("M", part.left, part.right) for part in strong if isinstance(part, Binary)
+        )
         return make_and(flat)
     always = [part for part in flat if isinstance(part, Always)]
     if len(always) > 1:
@@ -130,26 +140,6 @@ def make_and(parts: Iterable[Node]) -> Node:
     return Conj("&", _sorted(flat))
 
 
-def _fuse(
-    flat: set[Node], kind: BinaryKind, fused: BinaryKind, partner: Callable[[Binary], Node]
-) -> bool:
-    """Replace each ``kind`` operand whose ``partner`` formula is also in ``flat`` (a set of
-    conjuncts or of disjuncts) and that partner by the ``fused`` operator; True when any was."""
-    found = [
-        part
-        for part in flat
-        if isinstance(part, Binary) and part.kind == kind and partner(part) in flat
-    ]
-    if not found:
-        return False
-    flat.difference_update(found)
-    flat.difference_update(partner(part) for part in found if isinstance(part, Binary))
-    flat.update(
-        make_binary(fused, part.left, part.right) for part in found if isinstance(part, Binary)
-    )
-    return True
-
-
 def make_or(parts: Iterable[Node]) -> Node:
     """Flattened, sorted, deduplicated disjunction with constant folding."""
     flat: set[Node] = set()
@@ -166,11 +156,18 @@ def make_or(parts: Iterable[Node]) -> Node:
     for part in flat:
         if isinstance(part, Pos) and neg(part.name) in flat:
             return TRUE
-    # G a | (a U b) = a W b (Spot's rule: one state instead of a choice); the dual
-    # G b | (a M b) = a R b (a R b = (a M b) | G b).
-    if _fuse(flat, "U", "W", lambda b: Always("G", b.left)) or _fuse(
-        flat, "M", "R", lambda b: Always("G", b.right)
-    ):
+    weak = [
+        part
+        for part in flat
+        if isinstance(part, Binary) and part.kind == "U" and Always("G", part.left) in flat
+    ]
+    if weak:
+        # G a | (a U b) = a W b (Spot's rule): one state instead of a choice.
+        flat.difference_update(weak)
+        flat.difference_update(Always("G", part.left) for part in weak if isinstance(part, Binary))
+        flat.update(
+            make_binary("W", part.left, part.right) for part in weak if isinstance(part, Binary)
+        )
         return make_or(flat)
     recurrent = [
         part for part in flat if isinstance(part, Always) and isinstance(part.arg, Finally)
@@ -260,11 +257,6 @@ def _pure_universality(f: Node) -> bool:
 def is_pure_eventuality(f: Node) -> bool:
     """``F f == f`` (Etessami–Holzmann's pure eventualities)."""
     return _pure_eventuality(f)
-
-
-def is_pure_universality(f: Node) -> bool:
-    """``G f == f`` (the duals of the pure eventualities)."""
-    return _pure_universality(f)
 
 
 def _suspendable(f: Node) -> bool:
