@@ -11,7 +11,6 @@ digests of the trees must agree: the same artifacts, byte for byte).
 
 from __future__ import annotations
 
-import argparse
 import statistics
 import sys
 import tempfile
@@ -20,7 +19,7 @@ from typing import Any
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from bench.bench_stages import GRIDS, ROOT, _run, _write_grid
+from bench.bench_stages import _run, comparison_parser, trees_of, workloads_of
 
 #: Run in a fresh interpreter: every stage but the figure, then the writing, timed.
 WRITE_PROGRAM = """
@@ -50,18 +49,10 @@ print(json.dumps({"cpu": cpu, "bytes": size, "digest": digest.hexdigest()[:16]})
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python bench/bench_artifacts.py", description=__doc__)
-    parser.add_argument("--baseline", type=Path, help="another tlmpc source tree to compare")
-    parser.add_argument("--grids", default="100k", help="of: " + ", ".join(GRIDS))
-    parser.add_argument("--rounds", type=int, default=5)
-    args = parser.parse_args(argv)
-    trees = {"tlmpc": ROOT}
-    if args.baseline is not None:
-        trees["baseline"] = args.baseline.resolve()
+    args = comparison_parser("bench_artifacts.py", __doc__, rounds=5).parse_args(argv)
+    trees = trees_of(args)
     with tempfile.TemporaryDirectory(prefix="tlmpc-write-") as tmp:
-        workloads = {"example8": ROOT / "specs" / "example8.yaml"}
-        for name in [g for g in args.grids.split(",") if g]:
-            workloads[f"grid {name}"] = _write_grid(GRIDS[name], Path(tmp))
+        workloads = workloads_of(args.grids, Path(tmp))
         print("| workload | tree | write CPU s (median) | artifacts MB | digest (timings masked) |")
         print("|---|---|---:|---:|---|")
         for workload, path in workloads.items():

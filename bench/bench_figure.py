@@ -11,7 +11,6 @@ pauses it.
 
 from __future__ import annotations
 
-import argparse
 import statistics
 import subprocess
 import sys
@@ -21,7 +20,7 @@ from typing import Any
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from bench.bench_stages import GRIDS, ROOT, _environment, _run, _write_grid
+from bench.bench_stages import ROOT, _environment, _run, comparison_parser, trees_of, workloads_of
 
 #: Run in a fresh interpreter: read the artifacts, then draw the picture ``rounds`` times.
 FIGURE_PROGRAM = """
@@ -53,18 +52,10 @@ sys.exit(main(["compile", sys.argv[1], "-o", sys.argv[2], "-q", "--until", "veri
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python bench/bench_figure.py", description=__doc__)
-    parser.add_argument("--baseline", type=Path, help="another tlmpc source tree to compare")
-    parser.add_argument("--grids", default="100k", help="of: " + ", ".join(GRIDS))
-    parser.add_argument("--rounds", type=int, default=5)
-    args = parser.parse_args(argv)
-    trees = {"tlmpc": ROOT}
-    if args.baseline is not None:
-        trees["baseline"] = args.baseline.resolve()
+    args = comparison_parser("bench_figure.py", __doc__, rounds=5).parse_args(argv)
+    trees = trees_of(args)
     with tempfile.TemporaryDirectory(prefix="tlmpc-figure-") as tmp:
-        workloads = {"example8": ROOT / "specs" / "example8.yaml"}
-        for name in [g for g in args.grids.split(",") if g]:
-            workloads[f"grid {name}"] = _write_grid(GRIDS[name], Path(tmp))
+        workloads = workloads_of(args.grids, Path(tmp))
         print("| workload | tree | scene CPU s | scene + SVG CPU s | bytes | same bytes |")
         print("|---|---|---:|---:|---:|---|")
         for workload, path in workloads.items():

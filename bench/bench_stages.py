@@ -126,16 +126,36 @@ def _median(values: list[float]) -> float:
     return statistics.median(values)
 
 
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python bench/bench_stages.py", description=__doc__)
+def comparison_parser(script: str, description: str | None, rounds: int) -> argparse.ArgumentParser:
+    """The flags every before/after bench shares: ``--baseline``, ``--grids``, ``--rounds``."""
+    parser = argparse.ArgumentParser(prog=f"python bench/{script}", description=description)
     parser.add_argument("--baseline", type=Path, help="another tlmpc source tree to compare")
     parser.add_argument("--grids", default="100k", help="of: " + ", ".join(GRIDS))
-    parser.add_argument("--rounds", type=int, default=3)
-    parser.add_argument("--tasks", action="store_true", help="planning-only rows on Example 8")
-    args = parser.parse_args(argv)
+    parser.add_argument("--rounds", type=int, default=rounds)
+    return parser
+
+
+def trees_of(args: argparse.Namespace) -> dict[str, Path]:
+    """This tree, and the ``--baseline`` tree when given, by column name."""
     trees = {"tlmpc": ROOT}
     if args.baseline is not None:
         trees["baseline"] = args.baseline.resolve()
+    return trees
+
+
+def workloads_of(grids: str, directory: Path) -> dict[str, Path]:
+    """Example 8 and the grid missions named by ``grids`` (written into ``directory``)."""
+    workloads = {"example8": ROOT / "specs" / "example8.yaml"}
+    for name in [g for g in grids.split(",") if g]:
+        workloads[f"grid {name}"] = _write_grid(GRIDS[name], directory)
+    return workloads
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = comparison_parser("bench_stages.py", __doc__, rounds=3)
+    parser.add_argument("--tasks", action="store_true", help="planning-only rows on Example 8")
+    args = parser.parse_args(argv)
+    trees = trees_of(args)
     for tree in trees.values():
         subprocess.run(
             [sys.executable, "-m", "compileall", "-q", str(tree / "tlmpc")],
@@ -144,9 +164,7 @@ def main(argv: list[str] | None = None) -> int:
             check=True,
         )
     with tempfile.TemporaryDirectory(prefix="tlmpc-stages-") as tmp:
-        workloads = {"example8": ROOT / "specs" / "example8.yaml"}
-        for name in [g for g in args.grids.split(",") if g]:
-            workloads[f"grid {name}"] = _write_grid(GRIDS[name], Path(tmp))
+        workloads = workloads_of(args.grids, Path(tmp))
         header = " | ".join(STAGE_NAMES)
         print(f"| workload | tree | {header} | total CPU s | peak MB | plan |")
         print("|---|---|" + "---:|" * (len(STAGE_NAMES) + 2) + "---|")
