@@ -26,8 +26,8 @@ WRITE_PROGRAM = """
 import gc, hashlib, json, re, sys, tempfile, time
 from pathlib import Path
 gc.disable()
-from tlmpc.output import write_artifacts
-from tlmpc.pipeline import STAGES, Compilation, run_stages
+from tlmpc.io.outdir import write_artifacts
+from tlmpc.pipeline.stages import STAGES, Compilation, run_stages
 compilation = Compilation(source=Path(sys.argv[1]), text=None, figures=())
 for stage in STAGES:
     if stage.name != "plot":

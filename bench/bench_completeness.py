@@ -36,8 +36,8 @@ task: [visit tip then base]
 CHILD = """\
 import json, sys, time
 sys.path.insert(0, sys.argv[1])
-from tlmpc.errors import TlmpcError
-from tlmpc.pipeline import ABSTRACTION, compile_mission
+from tlmpc.base.errors import TlmpcError
+from tlmpc.pipeline.stages import ABSTRACTION, compile_mission
 compile_mission(sys.argv[2], until="verify")  # warm the imports and caches
 rows = {}
 for path in sys.argv[2:]:

@@ -29,8 +29,8 @@ from pathlib import Path
 gc.disable()
 directory, rounds = Path(sys.argv[1]), int(sys.argv[2])
 documents = {p.name: json.loads(p.read_text()) for p in directory.glob("*.json")}
-from tlmpc.plot import render_svg
-from tlmpc.plot_scene import build_scene
+from tlmpc.render.plot import render_svg
+from tlmpc.render.scene import build_scene
 render_svg(documents)  # imports and first-call caches: not the stage's work
 scene, svg = [], []
 for _ in range(rounds):

@@ -153,8 +153,7 @@ def map_rows(data: Path, radius: float, work: Path) -> list[dict[str, Any]]:
                 "verdict": "satisfied" if verdict.get("satisfied") else "VIOLATED/none",
                 "area / free cells (r=0)": f"{ratio_all:.2f}%",
                 "main piece / robot's free piece (r=0)": f"{ratio_piece:.2f}%",
-                "further pieces (r=0 / r)": f"{len(imported.components)} / "
-                f"{len(draft.components)}",
+                "further pieces (r=0 / r)": f"{len(imported.components)} / {len(draft.components)}",
                 "triangles": triangles,
             }
         )

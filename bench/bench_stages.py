@@ -35,7 +35,7 @@ import gc, json, resource, sys, time
 from pathlib import Path
 gc.disable()
 started = time.process_time()
-from tlmpc.pipeline import STAGES, Compilation, run_stages
+from tlmpc.pipeline.stages import STAGES, Compilation, run_stages
 compilation = Compilation(source=Path(sys.argv[1]), text=None, figures=())
 cpu = {}
 plan = {}

@@ -26,8 +26,14 @@ from dataclasses import dataclass
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-PAGES = ("README.md", "docs/quickstart.md", "docs/task-phrases.md", "docs/verify.md",
-         "docs/errors.md", "docs/cli.md")
+PAGES = (
+    "README.md",
+    "docs/quickstart.md",
+    "docs/task-phrases.md",
+    "docs/verify.md",
+    "docs/errors.md",
+    "docs/cli.md",
+)
 
 _BLOCK = re.compile(r"```console\n(.*?)```", re.DOTALL)
 _SETUP = re.compile(r"<!-- setup: (.*?) -->")

@@ -15,7 +15,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from tlmpc.artifacts import INDENT_BELOW, _finite, artifact_texts, dumps
+from tlmpc.io.artifacts import INDENT_BELOW, _finite, artifact_texts, dumps
 
 
 def _reference(document: Any) -> str:

@@ -6,7 +6,7 @@ import io
 
 import pytest
 
-from tlmpc import __version__
+from tlmpc.base.version import __version__
 from tlmpc.cli import COMMAND_MODULES, _command, main
 
 

@@ -18,7 +18,7 @@ from typing import Any
 import pytest
 
 from tlmpc.cli import COMMAND_MODULES, _command, build_parser, main
-from tlmpc.report import EXIT_CODES, cli_output_errors
+from tlmpc.io.report import EXIT_CODES, cli_output_errors
 
 ROOT = Path(__file__).resolve().parent.parent
 SPECS = ROOT / "specs"
@@ -264,8 +264,8 @@ def test_infinite_robustness_is_a_string_in_the_envelope(compiled: Path, tmp_pat
 def test_a_run_prints_one_document_even_if_it_finishes_twice() -> None:
     # A command that finished and then failed (say, a late I/O error) must not print a second
     # envelope after the first one.
-    from tlmpc.errors import UsageError, error
-    from tlmpc.report import Reporter
+    from tlmpc.base.errors import UsageError, error
+    from tlmpc.io.report import Reporter
 
     out, err = io.StringIO(), io.StringIO()
     reporter = Reporter(command="verify", json=True, out=out, err=err)

@@ -14,9 +14,9 @@ from pathlib import Path
 import pytest
 
 from tlmpc import cli
-from tlmpc.artifacts import json_text
+from tlmpc.base.errors import error, printable
 from tlmpc.cli import main
-from tlmpc.errors import error, printable
+from tlmpc.io.artifacts import json_text
 
 ROOT = Path(__file__).resolve().parents[1]
 ENV = {**os.environ, "PYTHONPATH": str(ROOT)}

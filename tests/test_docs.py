@@ -116,8 +116,10 @@ def test_the_examples_table_is_what_compile_gives(row: dict[str, str], tmp_path:
 
     out = tmp_path / "out"
     spec = ROOT / "specs" / f"{row['name']}.yaml"
-    assert main(["compile", str(spec), "-o", str(out), "-q"], out=io.StringIO(),
-                err=io.StringIO()) == 0
+    assert (
+        main(["compile", str(spec), "-o", str(out), "-q"], out=io.StringIO(), err=io.StringIO())
+        == 0
+    )
     summary = json.loads((out / "summary.json").read_text())
     sizes = {stage["name"]: stage["sizes"] for stage in summary["stages"]}
     if "…" not in row["ltl"]:

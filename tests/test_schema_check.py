@@ -18,8 +18,7 @@ import yaml
 from hypothesis import given
 from hypothesis import strategies as st
 
-from tlmpc.artifacts import load_schema
-from tlmpc.schema_check import is_valid
+from tlmpc.io.schema_check import is_valid, load_schema
 
 ROOT = Path(__file__).resolve().parents[1]
 ARTIFACT_SCHEMAS = {
@@ -99,9 +98,12 @@ json_values = st.recursive(
     | st.sampled_from([0.0, 1.0, -1.0, 1e9, 1e10, 2.5, 0, 1, 2, 4, 1e-12])
     | st.text(max_size=4)
     | st.sampled_from(["F", "true", "a", "p1", "hops", "length", "closed", "2x", "_a", ""]),
-    lambda inner: st.lists(inner, max_size=5)
-    | st.dictionaries(st.sampled_from(["rect", "start", "x", "a", "boundary"]), inner,
-                      max_size=3),
+    lambda inner: (
+        st.lists(inner, max_size=5)
+        | st.dictionaries(
+            st.sampled_from(["rect", "start", "x", "a", "boundary"]), inner, max_size=3
+        )
+    ),
     max_leaves=12,
 )
 
@@ -157,7 +159,7 @@ def test_agrees_on_mutated_artifacts(data: st.DataObject) -> None:
 
 
 def test_json_equality_keeps_true_apart_from_one() -> None:
-    from tlmpc.schema_check import _equal
+    from tlmpc.io.schema_check import _equal
 
     assert not _equal(True, 1)
     assert not _equal(0, False)
@@ -166,8 +168,10 @@ def test_json_equality_keeps_true_apart_from_one() -> None:
     assert not _equal(math.nan, 0)
 
 
-@pytest.mark.parametrize(("value", "valid"), [(2, True), (2.0, True), (2.5, False), (True, False),
-                                               (-1, False), ("2", False)])
+@pytest.mark.parametrize(
+    ("value", "valid"),
+    [(2, True), (2.0, True), (2.5, False), (True, False), (-1, False), ("2", False)],
+)
 def test_integer_items_as_jsonschema_reads_them(value: Any, valid: bool) -> None:
     witness = copy.deepcopy(_artifacts()["witness.json"])
     witness["cycle"] = [value]

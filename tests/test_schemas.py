@@ -8,7 +8,7 @@ from pathlib import Path
 import jsonschema
 import pytest
 
-from tlmpc.artifacts import load_schema, schema_dir
+from tlmpc.io.schema_check import load_schema, schema_dir
 
 ROOT = Path(__file__).resolve().parent.parent
 SCHEMAS = sorted((ROOT / "schemas").glob("*.schema.json"))

@@ -15,9 +15,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-__version__ = "0.1.0"
-
-from tlmpc.errors import (
+from tlmpc.base.errors import (
     Diagnostic,
     InvalidInputError,
     NoPlanError,
@@ -25,6 +23,7 @@ from tlmpc.errors import (
     TlmpcError,
     UsageError,
 )
+from tlmpc.base.version import __version__
 
 if TYPE_CHECKING:
     from tlmpc.api import (

@@ -10,7 +10,7 @@ Everything here is also what the command line does, minus the printing::
     verdict = tlmpc.verify_trace(result)                          # re-check the trajectory
     automaton = tlmpc.translate("G F a & G F b")
 
-Failures raise :class:`~tlmpc.errors.TlmpcError` subclasses carrying the same diagnostics the
+Failures raise :class:`~tlmpc.base.errors.TlmpcError` subclasses carrying the same diagnostics the
 command line prints (``error.diagnostics``); ``error.exit_code`` is the CLI's exit code.
 Results render in Jupyter (``_repr_svg_`` / ``_repr_html_``).
 
@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from tlmpc.errors import Diagnostic, UsageError, error
+from tlmpc.base.errors import Diagnostic, UsageError, error
 
 if TYPE_CHECKING:
     from tlmpc.automata.model import Automaton
@@ -36,7 +36,6 @@ if TYPE_CHECKING:
 
 MissionSource = str | os.PathLike[str] | Mapping[str, Any]
 """A mission: a path to a YAML file, YAML text, or the mission as a dict."""
-
 
 
 def _mission_text(mission: MissionSource) -> tuple[str | None, Path]:
@@ -89,7 +88,7 @@ class Compiled:
 
     def write(self, out: str | os.PathLike[str], *, force: bool = False) -> Path:
         """Write every artifact (and the figure, when drawn) into ``out`` atomically."""
-        from tlmpc.output import check_destination, commit, staging_directory, write_artifacts
+        from tlmpc.io.outdir import check_destination, commit, staging_directory, write_artifacts
 
         destination = Path(out)
         check_destination(destination, force=force)
@@ -103,7 +102,7 @@ class Compiled:
         if "svg" not in self._figure:
             drawn = self.artifacts.get("plan.svg")
             if not isinstance(drawn, bytes):
-                from tlmpc.plot import render_svg
+                from tlmpc.render.plot import render_svg
 
                 drawn = render_svg(self.artifacts)
             self._figure["svg"] = drawn.decode("utf-8")
@@ -141,15 +140,15 @@ def compile(
     """Compile ``mission`` through every stage (or up to the stage ``until``).
 
     ``mission`` is a path to a YAML file, YAML text, or a dict with the same keys as the
-    YAML format.  Raises :class:`~tlmpc.errors.TlmpcError` (with diagnostics) when the mission
+    YAML format.  Raises :class:`~tlmpc.base.errors.TlmpcError` (with diagnostics) when the mission
     is invalid, has no plan, or a stage fails.  Nothing is written: call
     :meth:`Compiled.write`.
     """
-    from tlmpc.pipeline import compile_mission
+    from tlmpc.pipeline.stages import compile_mission
 
     text, source = _mission_text(mission)
     if until is not None:
-        from tlmpc.pipeline import stage_names
+        from tlmpc.pipeline.stages import stage_names
 
         if until not in stage_names():
             raise UsageError(
@@ -169,9 +168,9 @@ def read_output(directory: str | os.PathLike[str]) -> Compiled:
     """Read the artifacts of an output directory written by ``tlmpc compile``.
 
     Each JSON artifact is checked against its schema; raises
-    :class:`~tlmpc.errors.UsageError` when the directory holds no tlmpc output.
+    :class:`~tlmpc.base.errors.UsageError` when the directory holds no tlmpc output.
     """
-    from tlmpc.artifacts import ARTIFACT_SCHEMAS, read_artifact
+    from tlmpc.io.artifacts import ARTIFACT_SCHEMAS, read_artifact
 
     root = Path(directory)
     artifacts: dict[str, Any] = {}
@@ -211,18 +210,14 @@ def verify_trace(
     if isinstance(trace, Compiled):
         document = trace.artifacts.get("trace.json")
         if document is None:
-            raise UsageError(
-                error("U073", "this compilation stopped before the simulate stage")
-            )
+            raise UsageError(error("U073", "this compilation stopped before the simulate stage"))
         return check_trace(from_document(document, convention=boundary))
     if isinstance(trace, Mapping):
         return check_trace(from_document(trace, convention=boundary))
     path = Path(trace)
     if path.suffix.lower() == ".csv":
-        return check_trace(
-            from_csv(path, Path(mission) if mission is not None else None, boundary)
-        )
-    from tlmpc.artifacts import read_json
+        return check_trace(from_csv(path, Path(mission) if mission is not None else None, boundary))
+    from tlmpc.io.artifacts import read_json
 
     return check_trace(from_document(read_json(path), file=str(path), convention=boundary))
 
@@ -230,7 +225,7 @@ def verify_trace(
 def translate(formula: str) -> Automaton:
     """Translate a Next-free LTL formula into a transition-based generalized Büchi automaton.
 
-    Raises :class:`~tlmpc.errors.InvalidInputError` with located diagnostics for bad syntax.
+    Raises :class:`~tlmpc.base.errors.InvalidInputError` with located diagnostics for bad syntax.
     """
     from tlmpc.automata import translate as translate_formula
     from tlmpc.ltl import parse_ltl

@@ -23,9 +23,9 @@ from collections.abc import Sequence
 from types import ModuleType
 from typing import Any, TextIO
 
-from tlmpc import __version__
-from tlmpc.errors import EXIT_INTERNAL, EXIT_USAGE, TlmpcError, error, printable
-from tlmpc.report import EXIT_INTERRUPTED, EXIT_TERMINATED, Reporter, exit_code_epilog
+from tlmpc.base.errors import EXIT_INTERNAL, EXIT_USAGE, TlmpcError, error, printable
+from tlmpc.base.version import __version__
+from tlmpc.io.report import EXIT_INTERRUPTED, EXIT_TERMINATED, Reporter, exit_code_epilog
 
 #: Subcommand modules, in the order ``--help`` lists them.
 COMMAND_MODULES = (

@@ -20,8 +20,8 @@ from tlmpc.abstraction import (
 )
 from tlmpc.abstraction.model import Abstraction
 from tlmpc.abstraction.resolution import subgrid_problems
-from tlmpc.artifacts import validation_errors
-from tlmpc.errors import InvalidInputError
+from tlmpc.base.errors import InvalidInputError
+from tlmpc.io.schema_check import validation_errors
 from tlmpc.ltl.ast import TRUE
 from tlmpc.mission import load_mission
 from tlmpc.mission.model import Mission, Options, Region, Robot, Workspace

@@ -63,9 +63,7 @@ def test_components_of_a_shuffled_path_and_islands() -> None:
 
 
 @given(
-    st.lists(
-        st.tuples(st.integers(-(2**40), 2**40), st.integers(-3, 3)), min_size=0, max_size=60
-    ),
+    st.lists(st.tuples(st.integers(-(2**40), 2**40), st.integers(-3, 3)), min_size=0, max_size=60),
     st.booleans(),
 )
 def test_unique_rows_equal_numpy_unique(pairs: list[tuple[int, int]], huge: bool) -> None:
@@ -129,9 +127,7 @@ def test_labels_equal_a_per_triangle_shapely_test(shapes: list[Polygon], seed: i
     letter_of, letters = _labels(mission, vertices, triangles, list(shapes))
     centroids = vertices[triangles].mean(axis=1)
     want = [
-        tuple(
-            sorted(n for n, shape in zip(names, shapes, strict=True) if Point(c).within(shape))
-        )
+        tuple(sorted(n for n, shape in zip(names, shapes, strict=True) if Point(c).within(shape)))
         for c in centroids.tolist()
     ]
     assert letters == tuple(sorted({(), *want}, key=lambda k: (len(k), k)))

@@ -17,7 +17,7 @@ from hypothesis import strategies as st
 
 from tlmpc.abstraction import build_abstraction
 from tlmpc.abstraction.resolution import subgrid_problems
-from tlmpc.errors import InvalidInputError
+from tlmpc.base.errors import InvalidInputError
 from tlmpc.mission import load_mission_text
 from tlmpc.mission.grid import grid_size
 from tlmpc.mission.model import Mission

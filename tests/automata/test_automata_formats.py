@@ -12,7 +12,6 @@ import pytest
 from hypothesis import given, settings
 from test_automata_props import formulas
 
-from tlmpc.artifacts import validation_errors
 from tlmpc.automata import (
     Automaton,
     automaton_from_json,
@@ -25,8 +24,9 @@ from tlmpc.automata import (
     to_hoa,
     translate,
 )
+from tlmpc.base.errors import InvalidInputError
 from tlmpc.commands import automaton as command
-from tlmpc.errors import InvalidInputError
+from tlmpc.io.schema_check import validation_errors
 from tlmpc.ltl import parse_ltl
 from tlmpc.ltl.ast import Formula
 

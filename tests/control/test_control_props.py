@@ -18,7 +18,7 @@ from scipy.integrate import solve_ivp
 from scipy.linalg import expm
 
 from tlmpc.abstraction.model import Abstraction
-from tlmpc.artifacts import validation_errors
+from tlmpc.base.errors import InvalidInputError
 from tlmpc.control import controllers_to_json, synthesize
 from tlmpc.control.geometry import triangle_geometry
 from tlmpc.control.model import StepController
@@ -30,9 +30,9 @@ from tlmpc.control.synthesize import (
     solve_vertex_program,
     vertex_program,
 )
-from tlmpc.errors import InvalidInputError
+from tlmpc.io.schema_check import validation_errors
 from tlmpc.mission.model import Robot
-from tlmpc.pipeline import ABSTRACTION, CONTROLLERS, MISSION, WITNESS
+from tlmpc.pipeline.stages import ABSTRACTION, CONTROLLERS, MISSION, WITNESS
 from tlmpc.planning.model import Witness
 from tlmpc.simulate.exact import (
     _exit_step,
@@ -244,7 +244,7 @@ def test_a_bounce_is_rejected() -> None:
 def test_continuity_and_jumps_on_a_real_plan(specs_dir: object) -> None:
     from pathlib import Path
 
-    from tlmpc.pipeline import compile_mission
+    from tlmpc.pipeline.stages import compile_mission
 
     result = compile_mission(Path(str(specs_dir)) / "patrol.yaml", until="control")
     controllers = result.compilation.get(CONTROLLERS)
@@ -273,7 +273,7 @@ def test_lasso_without_prefix_loops_from_the_second_lap(specs_dir: object) -> No
     import dataclasses
     from pathlib import Path
 
-    from tlmpc.pipeline import compile_mission
+    from tlmpc.pipeline.stages import compile_mission
     from tlmpc.simulate import simulate, trace_to_json
     from tlmpc.verify import verify_document
 
@@ -326,7 +326,7 @@ def _cvxpy_optimum(program: VertexProgram) -> float:
 def test_clarabel_conic_form_matches_cvxpy(specs_dir: object, spec: str, max_speed: float) -> None:
     from pathlib import Path
 
-    from tlmpc.pipeline import compile_mission
+    from tlmpc.pipeline.stages import compile_mission
 
     result = compile_mission(Path(str(specs_dir)) / f"{spec}.yaml", until="plan")
     abstraction, witness = result.compilation.get(ABSTRACTION), result.compilation.get(WITNESS)
@@ -423,7 +423,7 @@ def test_solved_fields_meet_the_stated_vertex_conditions(specs_dir: object, spec
     """Re-check every step after solving: exit at the reported speed, invariance, speed bound."""
     from pathlib import Path
 
-    from tlmpc.pipeline import compile_mission
+    from tlmpc.pipeline.stages import compile_mission
 
     result = compile_mission(Path(str(specs_dir)) / spec, until="control")
     controllers = result.compilation.get(CONTROLLERS)
@@ -479,7 +479,7 @@ def test_a_field_leaving_by_an_unplanned_facet_is_reported(
     v: np.ndarray, exit_edge: int, shift: int, data: st.DataObject
 ) -> None:
     """The simulator never snaps a wrong exit onto the planned edge."""
-    from tlmpc.errors import SolverError
+    from tlmpc.base.errors import SolverError
 
     controller = _exit_controller(v, exit_edge, 1.0)
     wrong = dataclasses.replace(controller, exit_edge=(exit_edge + shift) % 3)
@@ -498,7 +498,7 @@ def test_a_dip_across_another_facet_before_the_exit_is_reported(scale: float) ->
     """An outward spiral that dips below the bottom edge, comes back in and then leaves
     through the planned hypotenuse: the first exit was the wrong one (C031), even though the
     later crossing lies on the planned edge and would snap cleanly."""
-    from tlmpc.errors import SolverError
+    from tlmpc.base.errors import SolverError
 
     v = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]) * scale
     center = np.array([0.45, 0.4]) * scale
@@ -600,7 +600,7 @@ def test_conic_form_is_the_scipy_assembly(specs_dir: object, spec: str) -> None:
     included), as from the scipy.sparse blocks it was built with before."""
     from pathlib import Path
 
-    from tlmpc.pipeline import compile_mission
+    from tlmpc.pipeline.stages import compile_mission
 
     result = compile_mission(Path(str(specs_dir)) / f"{spec}.yaml", until="plan")
     abstraction, witness = result.compilation.get(ABSTRACTION), result.compilation.get(WITNESS)

@@ -22,7 +22,7 @@ from trace_check import check_output
 
 from tlmpc.abstraction import build_abstraction
 from tlmpc.api import compile as compile_mission
-from tlmpc.errors import NoPlanError, TlmpcError
+from tlmpc.base.errors import NoPlanError, TlmpcError
 from tlmpc.ltl.parser import parse_ltl
 from tlmpc.ltl.printer import to_spin
 from tlmpc.mission import load_mission_text
@@ -216,7 +216,7 @@ def test_a_compiled_trace_faster_than_max_speed_fails_the_self_check(
     import dataclasses
 
     import tlmpc.simulate
-    from tlmpc.pipeline import SelfCheckError
+    from tlmpc.pipeline.stages import SelfCheckError
 
     honest = tlmpc.simulate.simulate
 

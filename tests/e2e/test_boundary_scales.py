@@ -23,7 +23,7 @@ from trace_check import check_output
 
 from tlmpc.abstraction import build_abstraction
 from tlmpc.api import compile as compile_mission
-from tlmpc.errors import NoPlanError
+from tlmpc.base.errors import NoPlanError
 from tlmpc.ltl.parser import parse_ltl
 from tlmpc.ltl.printer import to_spin
 from tlmpc.mission import load_mission_text

@@ -11,8 +11,8 @@ from xml.etree import ElementTree
 
 import pytest
 
-from tlmpc.artifacts import validation_errors
 from tlmpc.cli import main
+from tlmpc.io.schema_check import validation_errors
 
 ROOT = Path(__file__).resolve().parents[2]
 SPECS = sorted((ROOT / "specs").glob("*.yaml"))

@@ -22,10 +22,10 @@ from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 from strategies import TEMPLATES, missions_with_template
 
-from tlmpc.errors import NoPlanError
+from tlmpc.base.errors import NoPlanError
 from tlmpc.ltl import nnf, parse_ltl
 from tlmpc.ltl.ast import And, Eventually, Formula, Globally, Or, Prop
-from tlmpc.pipeline import TRACE, compile_mission
+from tlmpc.pipeline.stages import TRACE, compile_mission
 from tlmpc.verify import verdict_to_json, verify_document
 
 

@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from tlmpc.errors import UsageError
-from tlmpc.output import (
+from tlmpc.base.errors import UsageError
+from tlmpc.io.outdir import (
     MARKER,
     check_destination,
     commit,
@@ -34,7 +34,7 @@ def test_new_directory_receives_all_artifacts(tmp_path: Path) -> None:
 def test_failure_inside_staging_leaves_previous_output_untouched(tmp_path: Path) -> None:
     out = tmp_path / "out"
     out.mkdir()
-    (out / MARKER).write_text("tlmpc.output/1\n")
+    (out / MARKER).write_text("tlmpc.io.outdir/1\n")
     (out / "summary.json").write_text('{"format": "tlmpc.summary/1"}')
     (out / "trace.json").write_text("old")
     before = _snapshot(out)
@@ -53,7 +53,7 @@ def test_failure_inside_staging_leaves_previous_output_untouched(tmp_path: Path)
 def test_previous_output_is_replaced_whole(tmp_path: Path) -> None:
     out = tmp_path / "out"
     out.mkdir()
-    (out / MARKER).write_text("tlmpc.output/1\n")
+    (out / MARKER).write_text("tlmpc.io.outdir/1\n")
     (out / "summary.json").write_text('{"format": "tlmpc.summary/1"}')
     (out / "controllers.json").write_text("stale")
     with staging_directory(out) as staging:

@@ -11,10 +11,10 @@ from pathlib import Path
 
 import pytest
 
-from tlmpc import output
+from tlmpc.base.errors import UsageError
 from tlmpc.cli import main
-from tlmpc.errors import UsageError
-from tlmpc.output import (
+from tlmpc.io import outdir as output
+from tlmpc.io.outdir import (
     MARKER,
     check_destination,
     commit,
@@ -69,7 +69,7 @@ def test_compiling_a_mission_inside_out_is_refused(tmp_path: Path) -> None:
         assert "error[U01" in err or "error[U031]" in err
         assert mission.read_bytes() == SPEC.read_bytes()
     # Even a marked output is not swapped away while it holds the source.
-    (project / MARKER).write_text("tlmpc.output/1\n")
+    (project / MARKER).write_text("tlmpc.io.outdir/1\n")
     source = project / "src.yaml"
     source.write_bytes(SPEC.read_bytes())
     code, _, err = run_cli("compile", str(source), "-o", str(project), "-q", "--until", "load")
@@ -120,7 +120,7 @@ def test_stale_folders_of_killed_runs_are_cleaned_or_restored(tmp_path: Path) ->
     assert compile_to(out)[0] == 0
     stale = tmp_path / ".out.tlmpc-new-killed"
     stale.mkdir()
-    (stale / MARKER).write_text("tlmpc.output/1\n")
+    (stale / MARKER).write_text("tlmpc.io.outdir/1\n")
     foreign = tmp_path / ".out.tlmpc-new-notours"
     foreign.mkdir()
     (foreign / "data.txt").write_text("mine")
@@ -146,7 +146,7 @@ def test_stale_folders_of_killed_runs_are_cleaned_or_restored(tmp_path: Path) ->
 
 def _previous_output(out: Path) -> dict[str, bytes | str]:
     out.mkdir()
-    (out / MARKER).write_text("tlmpc.output/1\n")
+    (out / MARKER).write_text("tlmpc.io.outdir/1\n")
     (out / "summary.json").write_text("old")
     return snapshot(out)
 

@@ -10,8 +10,8 @@ from typing import Any
 
 import pytest
 
-from tlmpc.output import write_artifacts
-from tlmpc.pipeline import STAGES, compile_mission, run_stage_from_artifacts
+from tlmpc.io.outdir import write_artifacts
+from tlmpc.pipeline.stages import STAGES, compile_mission, run_stage_from_artifacts
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -35,9 +35,11 @@ def test_every_stage_reproduces_its_artifacts_from_its_inputs(tmp_path: Path, sp
         alone = run_stage_from_artifacts(stage.name, tmp_path)
         assert alone.artifacts, stage.name
         for name, document in alone.artifacts.items():
-            expected = json.loads(json.dumps(whole.artifacts[name])) if name.endswith(
-                ".json"
-            ) else whole.artifacts[name]
+            expected = (
+                json.loads(json.dumps(whole.artifacts[name]))
+                if name.endswith(".json")
+                else whole.artifacts[name]
+            )
             got = json.loads(json.dumps(document)) if name.endswith(".json") else document
             assert _without_timings(got) == _without_timings(expected), (stage.name, name)
 

@@ -19,7 +19,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from tlmpc.cli import main
-from tlmpc.output import KNOWN_ARTIFACTS, MARKER
+from tlmpc.io.outdir import KNOWN_ARTIFACTS, MARKER
 
 ROOT = Path(__file__).resolve().parents[2]
 SPECS = sorted((ROOT / "specs").glob("*.yaml"))
@@ -222,7 +222,7 @@ def test_output_folders_never_lose_user_files(
             elif kind == "link":
                 path.symlink_to(outside)
             elif kind == "marker" or name == MARKER:
-                path.write_text("tlmpc.output/1\n" if kind == "marker" else "mine")
+                path.write_text("tlmpc.io.outdir/1\n" if kind == "marker" else "mine")
             else:
                 path.write_text(f"user {name}")
     before = _snapshot(out) if out.is_dir() and not out.is_symlink() else None
@@ -230,7 +230,7 @@ def test_output_folders_never_lose_user_files(
         out.is_dir()
         and not out.is_symlink()
         and (out / MARKER).is_file()
-        and ((out / MARKER).read_text().startswith("tlmpc.output/"))
+        and ((out / MARKER).read_text().startswith("tlmpc.io.outdir/"))
     )
     spec = str(ROOT / "specs" / "example1.yaml")
     argv = [

@@ -18,8 +18,8 @@ from hypothesis import strategies as st
 from robot_data import require_shared
 from scipy.spatial.transform import Rotation, Slerp
 
+from tlmpc.base.errors import UsageError
 from tlmpc.cli import main
-from tlmpc.errors import UsageError
 from tlmpc.importers.frames import TransformCollector
 from tlmpc.importers.logs import read_log
 

@@ -12,8 +12,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 from robot_data import require_shared, write_bag
 
+from tlmpc.base.errors import UsageError
 from tlmpc.cli import main
-from tlmpc.errors import UsageError
 from tlmpc.importers.logs import read_log
 
 POSE_TYPES = (

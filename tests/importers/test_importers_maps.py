@@ -15,8 +15,8 @@ from hypothesis.extra.numpy import arrays
 from robot_data import components, image_from_free, nav2_cell, require_shared, write_map
 from shapely.geometry import Point, Polygon, box
 
+from tlmpc.base.errors import UsageError
 from tlmpc.cli import main
-from tlmpc.errors import UsageError
 from tlmpc.importers.maps import ImportedMap, ImportSettings, import_map
 from tlmpc.importers.occupancy import cell_values, read_map
 from tlmpc.mission.load import check_file, load_mission

@@ -8,7 +8,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 from strategies import formulas
 
-from tlmpc.errors import InvalidInputError
+from tlmpc.base.errors import InvalidInputError
 from tlmpc.ltl import parse_ltl, to_text
 from tlmpc.ltl.ast import Eventually, Formula, Globally, Prop, Until
 

@@ -7,7 +7,7 @@ from hypothesis import given
 from lasso_ltl import holds
 from strategies import formulas, lassos
 
-from tlmpc.errors import InvalidInputError
+from tlmpc.base.errors import InvalidInputError
 from tlmpc.ltl import is_cosafe, is_safety, nnf, parse_ltl, to_spin, to_text
 from tlmpc.ltl.ast import (
     And,

@@ -10,7 +10,7 @@ from pathlib import Path
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from tlmpc.errors import InvalidInputError
+from tlmpc.base.errors import InvalidInputError
 from tlmpc.ltl.ast import Formula
 from tlmpc.ltl.lark_parser import parse_ltl as parse_with_lark
 from tlmpc.ltl.reader import read_plain_ltl
@@ -25,8 +25,12 @@ def shape(formula: Formula) -> Shape:
     out: Shape = []
     for node in formula.walk():
         out.append(
-            (type(node).__name__, getattr(node, "name", None), getattr(node, "value", None),
-             node.span)
+            (
+                type(node).__name__,
+                getattr(node, "name", None),
+                getattr(node, "value", None),
+                node.span,
+            )
         )
     return out
 
@@ -39,9 +43,7 @@ def lark_or_none(text: str, line: int, col: int) -> Formula | None:
 
 
 SPACE = st.sampled_from(["", " ", "  ", "\n", " \n  ", "\t"])
-NAMES = st.sampled_from(
-    ["a", "b", "r31_13", "Fa", "Ga", "U2", "true_x", "trueish", "_x", "room1"]
-)
+NAMES = st.sampled_from(["a", "b", "r31_13", "Fa", "Ga", "U2", "true_x", "trueish", "_x", "room1"])
 
 
 @st.composite
@@ -81,9 +83,47 @@ def test_reader_equals_lark_on_well_formed_formulas(text: str, line: int, col: i
 
 
 TOKENS = st.sampled_from(
-    ["a", "b", "U", "R", "F", "G", "X", "N", "V", "W", "M", "FX", "true", "false", "1",
-     "0", "12", "(", ")", "!", "~", "&", "|", "->", "<->", "<>", "[]", "&&", "||", '"q"',
-     "<", "-", "/", "\\", "#", " ", "\n", "é", "x1"]
+    [
+        "a",
+        "b",
+        "U",
+        "R",
+        "F",
+        "G",
+        "X",
+        "N",
+        "V",
+        "W",
+        "M",
+        "FX",
+        "true",
+        "false",
+        "1",
+        "0",
+        "12",
+        "(",
+        ")",
+        "!",
+        "~",
+        "&",
+        "|",
+        "->",
+        "<->",
+        "<>",
+        "[]",
+        "&&",
+        "||",
+        '"q"',
+        "<",
+        "-",
+        "/",
+        "\\",
+        "#",
+        " ",
+        "\n",
+        "é",
+        "x1",
+    ]
 )
 
 

@@ -327,7 +327,7 @@ def test_an_endless_stream_is_cut_at_the_limit() -> None:
     script = (
         "import re, sys; from tlmpc.mission import load\n"
         "load.MAX_BYTES = 32 << 20\n"
-        "from tlmpc.errors import UsageError\n"
+        "from tlmpc.base.errors import UsageError\n"
         "try:\n    load.inspect_file('/dev/zero')\n"
         "except UsageError as exc:\n    print(exc.diagnostics[0].code)\n"
         "status = open('/proc/self/status').read()\n"

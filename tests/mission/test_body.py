@@ -21,7 +21,7 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 import tlmpc
-from tlmpc.errors import InvalidInputError, NoPlanError, TlmpcError
+from tlmpc.base.errors import InvalidInputError, NoPlanError, TlmpcError
 from tlmpc.mission.body import body_radius
 from tlmpc.mission.load import check_text
 from tlmpc.mission.model import Robot

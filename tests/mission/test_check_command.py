@@ -137,7 +137,7 @@ def test_check_reports_the_subgrid_features_compile_refuses(tmp_path: Path) -> N
     assert compiled_code == 1
     assert not out_dir.exists()
     from tlmpc.abstraction import build_abstraction
-    from tlmpc.errors import InvalidInputError
+    from tlmpc.base.errors import InvalidInputError
     from tlmpc.mission import load_mission_text
 
     try:

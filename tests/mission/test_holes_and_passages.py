@@ -11,10 +11,10 @@ from hypothesis import given
 from hypothesis import strategies as st
 from shapely import Polygon, union_all
 
+from tlmpc.base.progress import heartbeat
 from tlmpc.cli import main
 from tlmpc.mission import load_mission_text
 from tlmpc.mission.holes import merge_holes, narrow_passages, workspace_notes
-from tlmpc.progress import heartbeat
 
 ROOT = Path(__file__).resolve().parents[2]
 

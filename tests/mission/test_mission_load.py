@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from tlmpc.errors import InvalidInputError, UsageError
+from tlmpc.base.errors import InvalidInputError, UsageError
 from tlmpc.ltl import parse_ltl
 from tlmpc.mission import check_text, load_mission, load_mission_text
 

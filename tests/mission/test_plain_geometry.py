@@ -62,9 +62,11 @@ def test_shoelace_area_is_shapelys(ring: list[tuple[float, float]]) -> None:
     if len(set(ring_points)) < 3:
         return
     area = plain_geometry.shoelace_area(ring_points)
-    assert abs(area - ShapelyPolygon(ring_points).area * (1 if area >= 0 else -1)) <= 1e-12 + (
-        1e-12 * abs(area)
-    ) or not ShapelyPolygon(ring_points).is_valid
+    assert (
+        abs(area - ShapelyPolygon(ring_points).area * (1 if area >= 0 else -1))
+        <= 1e-12 + (1e-12 * abs(area))
+        or not ShapelyPolygon(ring_points).is_valid
+    )
 
 
 @given(st.lists(points, min_size=4, max_size=4), st.lists(points, min_size=1, max_size=6))
@@ -112,7 +114,8 @@ def test_check_shape_reports_as_with_shapely_alone(ring: list[tuple[float, float
     points,
 )
 def test_check_layout_reports_as_with_shapely_alone(
-    box: tuple[float, float, float, float], shapes: list[list[tuple[float, float]]],
+    box: tuple[float, float, float, float],
+    shapes: list[list[tuple[float, float]]],
     start: tuple[float, float],
 ) -> None:
     x0, x1 = sorted((box[0], box[2]))

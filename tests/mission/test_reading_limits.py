@@ -10,7 +10,7 @@ import yaml
 from hypothesis import given
 from hypothesis import strategies as st
 
-from tlmpc.errors import UsageError
+from tlmpc.base.errors import UsageError
 from tlmpc.mission import load
 from tlmpc.mission.geometry import check_layout, check_shape, shapely_polygon
 from tlmpc.mission.load import check_text, inspect_file

@@ -17,7 +17,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from tlmpc.artifacts import load_schema
+from tlmpc.io.schema_check import load_schema
 from tlmpc.mission.geometry import CheckedShape, check_layout, check_shape
 from tlmpc.mission.load import _plain_shape
 

@@ -21,9 +21,9 @@ from shapely.geometry import Point, Polygon, shape
 
 from tlmpc.abstraction import build_abstraction
 from tlmpc.api import compile as compile_mission
-from tlmpc.artifacts import validation_errors
+from tlmpc.base.errors import NoPlanError
 from tlmpc.cli import main
-from tlmpc.errors import NoPlanError
+from tlmpc.io.schema_check import validation_errors
 from tlmpc.ltl.ast import TRUE
 from tlmpc.mission.io import mission_from_json
 from tlmpc.mission.load import check_text, load_mission_text

@@ -18,9 +18,9 @@ from face_maps import FaceMap, face_maps
 from hypothesis import HealthCheck, assume, event, given, settings
 from shapely.geometry import Point, Polygon
 
-from tlmpc.errors import InvalidInputError, NoPlanError
+from tlmpc.base.errors import InvalidInputError, NoPlanError
 from tlmpc.ltl.parser import parse_ltl
-from tlmpc.pipeline import compile_mission
+from tlmpc.pipeline.stages import compile_mission
 from tlmpc.planning.complete import bounce_triangles
 from tlmpc.planning.explain import _positive_props
 from tlmpc.planning.model import Witness

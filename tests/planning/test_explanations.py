@@ -7,8 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from tlmpc.errors import Diagnostic, NoPlanError
-from tlmpc.pipeline import compile_mission
+from tlmpc.base.errors import Diagnostic, NoPlanError
+from tlmpc.pipeline.stages import compile_mission
 
 MAP = """\
 version: 1

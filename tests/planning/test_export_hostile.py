@@ -21,8 +21,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from tlmpc.abstraction import abstraction_from_json
+from tlmpc.base.errors import UsageError
 from tlmpc.cli import main
-from tlmpc.errors import UsageError
 from tlmpc.ltl import parse_ltl
 from tlmpc.planning.export import comment_text, to_dot_graph, to_promela, to_smv
 

@@ -18,7 +18,7 @@ from hypothesis import strategies as st
 from tlmpc.abstraction import build_abstraction
 from tlmpc.automata import translate
 from tlmpc.automata.degeneralize import degeneralize
-from tlmpc.errors import InvalidInputError, NoPlanError
+from tlmpc.base.errors import InvalidInputError, NoPlanError
 from tlmpc.mission import load_mission_text
 from tlmpc.planning.complete import plan_complete
 

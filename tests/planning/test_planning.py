@@ -18,9 +18,9 @@ from starts import start_triangles
 from strategies import CO_SAFE_TEMPLATES, missions_with_template
 
 from tlmpc.abstraction import build_abstraction
-from tlmpc.artifacts import validation_errors
 from tlmpc.automata import translate
-from tlmpc.errors import NoPlanError
+from tlmpc.base.errors import NoPlanError
+from tlmpc.io.schema_check import validation_errors
 from tlmpc.mission import load_mission_text
 from tlmpc.mission.model import Mission, Options
 from tlmpc.planning import plan, witness_from_json, witness_to_json

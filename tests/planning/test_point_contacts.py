@@ -23,7 +23,7 @@ from strategies import formulas
 from trace_check import check_output
 
 from tlmpc.api import compile as compile_mission
-from tlmpc.errors import InvalidInputError, NoPlanError, TlmpcError
+from tlmpc.base.errors import InvalidInputError, NoPlanError, TlmpcError
 from tlmpc.ltl.ast import Formula, Not, Prop, Release, Until
 from tlmpc.ltl.parser import parse_ltl
 from tlmpc.ltl.printer import to_spin, to_text

@@ -25,7 +25,7 @@ from scipy.sparse.csgraph import dijkstra
 
 from tlmpc.abstraction import build_abstraction
 from tlmpc.automata import translate
-from tlmpc.errors import InvalidInputError, NoPlanError
+from tlmpc.base.errors import InvalidInputError, NoPlanError
 from tlmpc.mission import load_mission_text
 from tlmpc.planning.plan import plan
 from tlmpc.planning.search import Graph, closing_searches, shortest_paths, strongly_connected

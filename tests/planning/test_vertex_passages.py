@@ -20,10 +20,10 @@ import yaml
 from trace_check import check_output
 
 from tlmpc.api import compile as compile_mission
-from tlmpc.artifacts import validation_errors
 from tlmpc.cli import main
 from tlmpc.control.geometry import triangle_geometry
 from tlmpc.control.synthesize import _Step, pursuit_controller
+from tlmpc.io.schema_check import validation_errors
 from tlmpc.planning.io import witness_from_json, witness_to_json
 from tlmpc.runtime import Executor, run_closed_loop
 from tlmpc.runtime.disturbance import random_disturbance
@@ -145,11 +145,11 @@ def test_a_tampered_passage_is_refused(tmp_path: Path) -> None:
     witness = json.loads((out / "witness.json").read_text())
     witness["passages"] = [[0, 10**6]]
     (out / "witness.json").write_text(json.dumps(witness))
-    from tlmpc.artifacts import read_output
-    from tlmpc.errors import UsageError
+    from tlmpc.base.errors import UsageError
+    from tlmpc.io.artifacts import read_artifacts
 
     with pytest.raises(UsageError) as caught:
-        read_output(out, ("abstraction.json", "witness.json"))
+        read_artifacts(out, ("abstraction.json", "witness.json"))
     assert "passage" in caught.value.diagnostics[0].message
 
 

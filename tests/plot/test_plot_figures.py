@@ -11,8 +11,8 @@ import numpy as np
 from hypothesis import given
 from hypothesis import strategies as st
 
-from tlmpc.plot import render_svg
-from tlmpc.plot_scene import MAX_MESH_TRIANGLES, arc_length_path, build_scene, viridis
+from tlmpc.render.plot import render_svg
+from tlmpc.render.scene import MAX_MESH_TRIANGLES, arc_length_path, build_scene, viridis
 
 SVG = "{http://www.w3.org/2000/svg}"
 

@@ -14,8 +14,8 @@ from typing import Any
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
-from tlmpc.plot_scene import _BATCH_FROM, REGION_COLOURS, build_scene
-from tlmpc.plot_svg import render_svg
+from tlmpc.render.scene import _BATCH_FROM, REGION_COLOURS, build_scene
+from tlmpc.render.svg import render_svg
 
 COORDINATE = st.floats(-50.0, 50.0, allow_nan=False).map(lambda v: round(v, 3))
 RING = st.lists(st.tuples(COORDINATE, COORDINATE), min_size=3, max_size=6)

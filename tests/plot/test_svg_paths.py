@@ -5,7 +5,7 @@ from __future__ import annotations
 from hypothesis import given
 from hypothesis import strategies as st
 
-from tlmpc.plot_svg import _BATCH_FROM, _Canvas, _polygon_path, _polygon_paths
+from tlmpc.render.svg import _BATCH_FROM, _Canvas, _polygon_path, _polygon_paths
 
 COORDINATE = st.floats(-1e4, 1e4, allow_nan=False, allow_infinity=False)
 POLYGON = st.lists(st.tuples(COORDINATE, COORDINATE), min_size=0, max_size=6)

@@ -124,8 +124,9 @@ def test_the_check_stays_light(tmp_path: Path) -> None:
         "('scipy', 'cvxpy', 'triangle', 'matplotlib', 'clarabel'))\n"
         "print(code, heavy)\n"
     )
-    result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
-                            check=True)
+    result = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, check=True
+    )
     assert result.stdout.strip() == "1 []"
 
 

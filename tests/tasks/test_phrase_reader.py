@@ -24,15 +24,82 @@ from tlmpc.tasks.phrases import KEYWORDS, Node, Word, parse_plain
 
 ROOT = Path(__file__).resolve().parents[2]
 
-PLAIN_NAMES = ["a", "b", "p1", "r_2", "kitchen", "Hall", "_x", "gate7", "area", "rooms", "go",
-               "one", "come", "of", "back", "F", "true"]
-TRICKY_NAMES = ["visitor", "tox", "andy", "allx", "anyway", "inbox", "attic", "thenx",
-                "finally_", "avoid_x", "stayed", "returned", "whilex", "office", "background",
-                "often2", "never_", "patrolman", "alwaysx", "untilx", "eventuallyx", "Visit2"]
-KEYWORD_WORDS = ["visit", "go to", "reach", "then", "and", "finally", "avoid", "avoiding",
-                 "never", "until", "patrol", "stay", "remain", "in", "at", "always",
-                 "eventually", "whenever", "return to", "come back to", "to", "while",
-                 "all", "any", "one of", "infinitely", "often", ",", ".", "area", "room"]
+PLAIN_NAMES = [
+    "a",
+    "b",
+    "p1",
+    "r_2",
+    "kitchen",
+    "Hall",
+    "_x",
+    "gate7",
+    "area",
+    "rooms",
+    "go",
+    "one",
+    "come",
+    "of",
+    "back",
+    "F",
+    "true",
+]
+TRICKY_NAMES = [
+    "visitor",
+    "tox",
+    "andy",
+    "allx",
+    "anyway",
+    "inbox",
+    "attic",
+    "thenx",
+    "finally_",
+    "avoid_x",
+    "stayed",
+    "returned",
+    "whilex",
+    "office",
+    "background",
+    "often2",
+    "never_",
+    "patrolman",
+    "alwaysx",
+    "untilx",
+    "eventuallyx",
+    "Visit2",
+]
+KEYWORD_WORDS = [
+    "visit",
+    "go to",
+    "reach",
+    "then",
+    "and",
+    "finally",
+    "avoid",
+    "avoiding",
+    "never",
+    "until",
+    "patrol",
+    "stay",
+    "remain",
+    "in",
+    "at",
+    "always",
+    "eventually",
+    "whenever",
+    "return to",
+    "come back to",
+    "to",
+    "while",
+    "all",
+    "any",
+    "one of",
+    "infinitely",
+    "often",
+    ",",
+    ".",
+    "area",
+    "room",
+]
 
 
 def _shape(tree: Node | Word) -> Any:
@@ -75,8 +142,20 @@ def name_lists(draw: st.DrawFn) -> str:
 @st.composite
 def phrases(draw: st.DrawFn) -> str:
     visit = draw(st.sampled_from(["visit", "Visit", "go to", "reach", "go  to", "VISIT"]))
-    then = draw(st.sampled_from([" then ", ", then ", " and then ", ", and, finally, ",
-                                 " then, finally ", " finally ", ",then ", " andthen "]))
+    then = draw(
+        st.sampled_from(
+            [
+                " then ",
+                ", then ",
+                " and then ",
+                ", and, finally, ",
+                " then, finally ",
+                " finally ",
+                ",then ",
+                " andthen ",
+            ]
+        )
+    )
     avoiding = draw(st.sampled_from(["", " while avoiding ", ", while avoiding "]))
     kind = draw(st.integers(0, 11))
     if kind == 0:
@@ -89,8 +168,9 @@ def phrases(draw: st.DrawFn) -> str:
         if avoiding:
             text += avoiding + draw(name_lists())
     elif kind == 1:
-        text = f"{visit} all {draw(names)}" + (then + draw(name_lists()) if draw(st.booleans())
-                                                else "")
+        text = f"{visit} all {draw(names)}" + (
+            then + draw(name_lists()) if draw(st.booleans()) else ""
+        )
     elif kind == 2:
         text = f"{visit} {draw(st.sampled_from(['any', 'one of', 'one  of']))} {draw(names)}"
     elif kind == 3:
@@ -103,8 +183,17 @@ def phrases(draw: st.DrawFn) -> str:
     elif kind == 6:
         text = f"patrol {draw(name_lists())}"
     elif kind == 7:
-        text = draw(st.sampled_from(["stay in ", "eventually stay at ", "remain in ",
-                                     "always stay in ", "always remain at "])) + draw(names)
+        text = draw(
+            st.sampled_from(
+                [
+                    "stay in ",
+                    "eventually stay at ",
+                    "remain in ",
+                    "always stay in ",
+                    "always remain at ",
+                ]
+            )
+        ) + draw(names)
     elif kind == 8:
         text = f"whenever {draw(names)}{draw(st.sampled_from([',', '', ' ,']))} "
         text += f"{visit} {draw(names)}"
@@ -121,8 +210,10 @@ def test_reader_agrees_with_earley_on_grammar_phrases(phrase: str) -> None:
     _agree(phrase)
 
 
-@given(st.lists(st.sampled_from(KEYWORD_WORDS + PLAIN_NAMES + TRICKY_NAMES), min_size=1,
-                max_size=9), spaces)
+@given(
+    st.lists(st.sampled_from(KEYWORD_WORDS + PLAIN_NAMES + TRICKY_NAMES), min_size=1, max_size=9),
+    spaces,
+)
 def test_reader_agrees_with_earley_on_token_soup(words: list[str], space: str) -> None:
     _agree(space.join(words))
 
@@ -168,8 +259,18 @@ def test_shipped_phrases_agree_and_most_are_plain() -> None:
     assert plain >= 0.9 * len(found)
 
 
-@pytest.mark.parametrize("phrase", ["visitor", "visit a then visitb", "avoidx", "visit allx",
-                                    "visit a, andy", "go tox", "visit a then return tox"])
+@pytest.mark.parametrize(
+    "phrase",
+    [
+        "visitor",
+        "visit a then visitb",
+        "avoidx",
+        "visit allx",
+        "visit a, andy",
+        "go tox",
+        "visit a then return tox",
+    ],
+)
 def test_names_the_lexer_could_split_go_to_earley(phrase: str) -> None:
     assert parse_plain(phrase) is None
 

@@ -13,7 +13,7 @@ from ci_oracles import import_oracle
 from hypothesis import given
 from hypothesis import strategies as st
 
-from tlmpc.errors import InvalidInputError
+from tlmpc.base.errors import InvalidInputError
 from tlmpc.ltl import to_text
 from tlmpc.tasks import avoid_scopes, compile_phrase
 

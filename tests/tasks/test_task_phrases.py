@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from tlmpc.errors import InvalidInputError
+from tlmpc.base.errors import InvalidInputError
 from tlmpc.ltl import parse_ltl, to_text
 from tlmpc.tasks import compile_phrase, compile_phrases
 

@@ -6,7 +6,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from tlmpc.errors import InvalidInputError
+from tlmpc.base.errors import InvalidInputError
 from tlmpc.ltl import parse_ltl, to_text
 from tlmpc.ltl.ast import Prop
 from tlmpc.tasks import compile_phrase, compile_phrases

@@ -11,7 +11,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from tlmpc.errors import UsageError
+from tlmpc.base.errors import UsageError
 from tlmpc.verify.trace_input import from_document
 
 coordinate = st.floats(-1e6, 1e6, allow_nan=False)

@@ -177,7 +177,7 @@ def test_all_sample_problems_at_once(tmp_path: Path) -> None:
     "spec", ["example1", "example6", "example7", "example8", "patrol", "reach-avoid"]
 )
 def test_compiled_traces_are_satisfied_and_certified(spec: str, tmp_path: Path) -> None:
-    from tlmpc.pipeline import TRACE, compile_mission
+    from tlmpc.pipeline.stages import TRACE, compile_mission
 
     result = compile_mission(ROOT / "specs" / f"{spec}.yaml", until="simulate")
     document = result.compilation.get(TRACE)

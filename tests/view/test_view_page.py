@@ -60,6 +60,4 @@ def test_view_usage(tmp_path: Path) -> None:
     assert main(["view"], out=io.StringIO(), err=err) == 2
     assert "give either OUT" in err.getvalue()
     assert main(["view", str(tmp_path)], out=io.StringIO(), err=io.StringIO()) == 2
-    assert main(
-        ["view", "--log", "x.csv"], out=io.StringIO(), err=io.StringIO()
-    ) == 2
+    assert main(["view", "--log", "x.csv"], out=io.StringIO(), err=io.StringIO()) == 2

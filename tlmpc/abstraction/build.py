@@ -14,7 +14,7 @@ from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
 from tlmpc.abstraction.resolution import refuse_subgrid_features
 from tlmpc.abstraction.starts import cells_in
 from tlmpc.abstraction.triangulate import triangulate
-from tlmpc.errors import Diagnostic, InvalidInputError, error
+from tlmpc.base.errors import Diagnostic, InvalidInputError, error
 from tlmpc.mission.model import Mission
 
 

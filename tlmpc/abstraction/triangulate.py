@@ -18,7 +18,7 @@ import shapely
 import triangle
 from shapely.geometry import Polygon as ShapelyPolygon
 
-from tlmpc.errors import InvalidInputError, error
+from tlmpc.base.errors import InvalidInputError, error
 from tlmpc.mission.model import Mission
 from tlmpc.mission.resolution import grid_size
 

@@ -11,9 +11,9 @@ import functools
 import re
 from typing import TYPE_CHECKING, Any
 
-from tlmpc import __version__
 from tlmpc.automata.model import Automaton, Edge
-from tlmpc.errors import InvalidInputError, error
+from tlmpc.base.errors import InvalidInputError, error
+from tlmpc.base.version import __version__
 from tlmpc.ltl.ast import TRUE, And, Const, Formula, Not, Or, Prop, conjoin, disjoin
 from tlmpc.ltl.printer import to_text
 

@@ -6,7 +6,7 @@ import argparse
 import time
 from typing import TextIO
 
-from tlmpc.artifacts import json_text
+from tlmpc.io.artifacts import json_text
 
 NAME = "automaton"
 HELP = "translate an LTL formula to a generalized Büchi automaton (HOA, DOT or JSON)"
@@ -36,9 +36,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Translate and print."""
     from tlmpc.automata import automaton_to_json, degeneralize, to_dot, to_hoa, translate
-    from tlmpc.errors import EXIT_OK
+    from tlmpc.base.errors import EXIT_OK
+    from tlmpc.io.report import Reporter
     from tlmpc.ltl import parse_ltl
-    from tlmpc.report import Reporter
 
     formula = parse_ltl(args.formula, file="<formula>")
     started = time.perf_counter()

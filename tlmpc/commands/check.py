@@ -29,10 +29,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Check every file; report all problems of all files."""
-    from tlmpc.errors import EXIT_NEGATIVE, EXIT_OK, EXIT_USAGE, UsageError
+    from tlmpc.base.errors import EXIT_NEGATIVE, EXIT_OK, EXIT_USAGE, UsageError
+    from tlmpc.io.report import Reporter
     from tlmpc.ltl.printer import to_text
     from tlmpc.mission.load import inspect_file
-    from tlmpc.report import Reporter
 
     report = Reporter.for_args(args, out, err)
     results: list[dict[str, Any]] = []

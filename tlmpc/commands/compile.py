@@ -19,7 +19,7 @@ failed run leaves OUT untouched."""
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Register the command's flags."""
-    from tlmpc.pipeline import stage_names
+    from tlmpc.pipeline.stages import stage_names
 
     parser.add_argument("mission", type=Path, help="mission file (YAML)")
     parser.add_argument(
@@ -53,15 +53,15 @@ def _format_sizes(sizes: dict[str, object]) -> str:
 
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Compile ``args.mission`` into ``args.out``."""
-    from tlmpc.output import output_lock
+    from tlmpc.io.outdir import output_lock
 
     with output_lock(args.out):
         return _run_locked(args, out, err)
 
 
 def _run_locked(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
-    from tlmpc.errors import EXIT_OK
-    from tlmpc.output import (
+    from tlmpc.base.errors import EXIT_OK
+    from tlmpc.io.outdir import (
         KNOWN_ARTIFACTS,
         check_destination,
         clean_stale,
@@ -70,8 +70,8 @@ def _run_locked(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         staging_directory,
         write_artifacts,
     )
-    from tlmpc.pipeline import StageReport, collector_paused, compile_mission
-    from tlmpc.report import Reporter
+    from tlmpc.io.report import Reporter
+    from tlmpc.pipeline.stages import StageReport, collector_paused, compile_mission
 
     reporter = Reporter.for_args(args, out, err)
     destination: Path = args.out

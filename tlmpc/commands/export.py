@@ -30,10 +30,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Read the artifacts and print (or write) the model."""
     from tlmpc.abstraction import abstraction_from_json
-    from tlmpc.artifacts import read_output
-    from tlmpc.errors import EXIT_OK, UsageError, error
+    from tlmpc.base.errors import EXIT_OK, UsageError, error
+    from tlmpc.io.artifacts import read_artifacts
+    from tlmpc.io.outdir import replace_file
     from tlmpc.ltl import parse_ltl
-    from tlmpc.output import replace_file
     from tlmpc.planning.export import to_dot_graph, to_promela, to_smv
 
     directory: Path = args.out
@@ -56,7 +56,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
                     file=str(directory),
                 )
             )
-    documents = read_output(directory, ("mission.json", "abstraction.json"))
+    documents = read_artifacts(directory, ("mission.json", "abstraction.json"))
     abstraction = abstraction_from_json(documents["abstraction.json"])
     mission = documents["mission.json"]
     formula = parse_ltl(mission["formula"])
@@ -67,7 +67,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         text = to_smv(abstraction, formula, title, bounce=args.bounce)
     else:
         text = to_dot_graph(abstraction, title)
-    from tlmpc.report import Reporter
+    from tlmpc.io.report import Reporter
 
     reporter = Reporter.for_args(args, out, err)
     if args.output is None:

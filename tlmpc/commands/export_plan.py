@@ -39,10 +39,10 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Read the plan and write the chosen format."""
     import math
 
-    from tlmpc.errors import EXIT_OK, UsageError, error
+    from tlmpc.base.errors import EXIT_OK, UsageError, error
     from tlmpc.exports.formats import geojson, path_mcap, waypoints_csv, waypoints_yaml
     from tlmpc.exports.plan import read_plan, waypoints
-    from tlmpc.output import replace_file
+    from tlmpc.io.outdir import replace_file
 
     if not math.isfinite(args.spacing) or args.spacing < 0:
         raise UsageError(
@@ -72,7 +72,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         data = geojson(plan, points, loop).encode("utf-8")
     else:
         data = path_mcap(plan, points, args.topic, args.frame_id)
-    from tlmpc.report import Reporter
+    from tlmpc.io.report import Reporter
 
     reporter = Reporter.for_args(args, out, err)
     if args.output is None:

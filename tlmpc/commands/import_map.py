@@ -57,11 +57,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Import the map and write the mission."""
-    from tlmpc.errors import EXIT_OK
+    from tlmpc.base.errors import EXIT_OK
     from tlmpc.importers.maps import ImportSettings, import_map
     from tlmpc.importers.mission import mission_document, mission_yaml
-    from tlmpc.output import replace_file
-    from tlmpc.report import Reporter
+    from tlmpc.io.outdir import replace_file
+    from tlmpc.io.report import Reporter
 
     settings = ImportSettings(
         radius=args.radius,
@@ -96,7 +96,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
 
 
 def _rects(values: list[list[str]]) -> dict[str, tuple[float, float, float, float]]:
-    from tlmpc.errors import UsageError, error
+    from tlmpc.base.errors import UsageError, error
 
     rects: dict[str, tuple[float, float, float, float]] = {}
     for name, *numbers in values:

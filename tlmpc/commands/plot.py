@@ -7,7 +7,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any, TextIO
 
-from tlmpc.errors import UsageError, error
+from tlmpc.base.errors import UsageError, error
 
 NAME = "plot"
 HELP = "draw plan.svg (or plan.png) from a compile output, optionally with a log over the map"
@@ -74,7 +74,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def _log_samples(path: Path) -> tuple[list[list[float]], dict[str, Any] | None]:
     """The log's ``[t, x, y]`` rows, and its document when it is a trace.json."""
-    from tlmpc.artifacts import read_json
+    from tlmpc.io.artifacts import read_json
 
     if path.suffix.lower() == ".csv":
         from tlmpc.verify.trace_input import read_csv
@@ -114,10 +114,10 @@ def _verify_log(
 
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Read the artifacts of ``args.out`` and write the picture(s) next to them."""
-    from tlmpc.artifacts import read_json, read_output
-    from tlmpc.errors import EXIT_OK
-    from tlmpc.output import replace_file
-    from tlmpc.report import Reporter
+    from tlmpc.base.errors import EXIT_OK
+    from tlmpc.io.artifacts import read_artifacts, read_json
+    from tlmpc.io.outdir import replace_file
+    from tlmpc.io.report import Reporter
 
     directory: Path = args.out
     if not (directory / "mission.json").is_file():
@@ -129,7 +129,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
                 file=str(directory),
             )
         )
-    artifacts: dict[str, Any] = read_output(directory, tuple(_INPUTS))
+    artifacts: dict[str, Any] = read_artifacts(directory, tuple(_INPUTS))
     log: list[list[float]] | None = None
     verdict: dict[str, Any] | None = None
     if args.verdict is not None:
@@ -141,13 +141,13 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     stem = "log" if log is not None else "plan"
     written = []
     if args.format in ("svg", "both"):
-        from tlmpc.plot import render_svg
+        from tlmpc.render.plot import render_svg
 
         svg = render_svg(artifacts, zoom=args.zoom, log=log, verdict=verdict)
         replace_file(directory / f"{stem}.svg", svg)
         written.append(f"{stem}.svg")
     if args.format in ("png", "both"):
-        from tlmpc.plot import render_png
+        from tlmpc.render.plot import render_png
 
         png = render_png(artifacts, zoom=args.zoom, log=log, verdict=verdict)
         replace_file(directory / f"{stem}.png", png)

@@ -15,8 +15,8 @@ import tempfile
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TextIO
 
-from tlmpc.artifacts import dumps
-from tlmpc.errors import UsageError, error
+from tlmpc.base.errors import UsageError, error
+from tlmpc.io.artifacts import dumps
 
 if TYPE_CHECKING:
     from tlmpc.runtime import ClosedLoopRun
@@ -76,8 +76,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Simulate, verify and report."""
-    from tlmpc.errors import EXIT_NEGATIVE
-    from tlmpc.report import OUTCOME_EXIT, Reporter
+    from tlmpc.base.errors import EXIT_NEGATIVE
+    from tlmpc.io.report import OUTCOME_EXIT, Reporter
     from tlmpc.runtime import Executor, make_disturbance, run_closed_loop
     from tlmpc.verify import verify_document
 

@@ -18,7 +18,7 @@ failed run leaves DIR as it was.  For example, after editing controllers.json by
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Register the command's flags."""
-    from tlmpc.pipeline import STAGES
+    from tlmpc.pipeline.stages import STAGES
 
     names = [stage.name for stage in STAGES if stage.requires]
     parser.add_argument("name", choices=names, metavar="NAME", help="one of: %(choices)s")
@@ -30,7 +30,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _bytes(content: Any) -> bytes:
-    from tlmpc.artifacts import dumps
+    from tlmpc.io.artifacts import dumps
 
     if isinstance(content, bytes):
         return content
@@ -41,10 +41,10 @@ def _bytes(content: Any) -> bytes:
 
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Run the stage and write what it produced."""
-    from tlmpc.errors import EXIT_OK, UsageError, error
-    from tlmpc.output import replace_file
-    from tlmpc.pipeline import run_stage_from_artifacts
-    from tlmpc.report import Reporter
+    from tlmpc.base.errors import EXIT_OK, UsageError, error
+    from tlmpc.io.outdir import replace_file
+    from tlmpc.io.report import Reporter
+    from tlmpc.pipeline.stages import run_stage_from_artifacts
 
     target: Path = args.out if args.out is not None else args.directory
     if not target.is_dir():

@@ -75,9 +75,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Verify and report."""
-    from tlmpc.artifacts import read_json
     from tlmpc.importers.logs import is_log, parse_columns, parse_transform
-    from tlmpc.report import OUTCOME_EXIT, Reporter
+    from tlmpc.io.artifacts import read_json
+    from tlmpc.io.report import OUTCOME_EXIT, Reporter
     from tlmpc.verify import (
         declare_ending,
         from_csv,

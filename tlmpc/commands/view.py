@@ -36,9 +36,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Build the scene, render it and write the page atomically."""
-    from tlmpc.errors import EXIT_OK, UsageError, error
-    from tlmpc.output import replace_file
-    from tlmpc.report import Reporter
+    from tlmpc.base.errors import EXIT_OK, UsageError, error
+    from tlmpc.io.outdir import replace_file
+    from tlmpc.io.report import Reporter
     from tlmpc.view import render_html, scene_from_log, scene_from_output
 
     if (args.out is None) == (args.log is None) or (args.log is not None) != (

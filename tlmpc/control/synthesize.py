@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tlmpc.abstraction.model import Abstraction, FloatArray
+from tlmpc.base.errors import InvalidInputError, SolverError, error
 from tlmpc.control.geometry import (
     TriangleGeometry,
     affine_law,
@@ -34,7 +35,6 @@ from tlmpc.control.geometry import (
 )
 from tlmpc.control.model import Controllers, StepController, VelocityJump
 from tlmpc.control.sparse import CscMatrix, Triplets, stacked_csc
-from tlmpc.errors import InvalidInputError, SolverError, error
 from tlmpc.mission.model import Robot
 from tlmpc.planning.model import Witness
 

@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from tlmpc.errors import UsageError, error
+from tlmpc.base.errors import UsageError, error
 
 FloatArray = npt.NDArray[np.float64]
 Point = tuple[float, float]
@@ -55,7 +55,7 @@ def _ring(value: Any) -> Ring:
 
 def read_plan(directory: Path) -> Plan:
     """Read ``trace.json`` and ``mission.json`` of a ``tlmpc compile`` output directory."""
-    from tlmpc.artifacts import read_json
+    from tlmpc.io.artifacts import read_json
 
     for name in ("trace.json", "mission.json"):
         if not (directory / name).is_file():
@@ -97,7 +97,7 @@ def read_plan(directory: Path) -> Plan:
 def _passage_corners(directory: Path, trace: Any, samples: FloatArray) -> tuple[int, ...]:
     """Indices of the samples at the corner of a vertex passage (from controllers.json, when
     the folder has it: the samples of a vertex step whose position is its corner)."""
-    from tlmpc.artifacts import read_json
+    from tlmpc.io.artifacts import read_json
 
     if not (directory / "controllers.json").is_file():
         return ()

@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from tlmpc.errors import UsageError, error
+from tlmpc.base.errors import UsageError, error
 
 FloatArray = npt.NDArray[np.float64]
 

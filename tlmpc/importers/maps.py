@@ -30,7 +30,7 @@ from shapely.geometry import Point as ShapelyPoint
 from shapely.geometry.base import BaseGeometry
 from shapely.ops import split
 
-from tlmpc.errors import UsageError, error
+from tlmpc.base.errors import UsageError, error
 from tlmpc.importers.occupancy import FREE, OCCUPIED, OccupancyGrid, read_map
 from tlmpc.importers.polygonize import (
     cells_to_geometry,

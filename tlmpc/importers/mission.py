@@ -12,7 +12,7 @@ import yaml
 from shapely.geometry import Polygon, box
 from shapely.ops import polylabel
 
-from tlmpc.errors import UsageError, error
+from tlmpc.base.errors import UsageError, error
 from tlmpc.importers.maps import ImportedMap, Point, Ring
 from tlmpc.importers.polygonize import polygons
 

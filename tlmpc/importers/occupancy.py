@@ -26,7 +26,7 @@ import numpy as np
 import numpy.typing as npt
 import yaml
 
-from tlmpc.errors import UsageError, error
+from tlmpc.base.errors import UsageError, error
 
 MODES = ("trinary", "scale", "raw")
 UNKNOWN = -1

@@ -5,7 +5,7 @@ tries a lark-free reader first (see :mod:`tlmpc.ltl.reader`).
 
 ``parse_ltl(text, file=..., line=..., col=...)`` takes the position where ``text`` starts in
 its file (an LTL string inside a YAML mission), so every diagnostic and every node's span
-points into the user's file.  Problems raise :class:`~tlmpc.errors.InvalidInputError` with
+points into the user's file.  Problems raise :class:`~tlmpc.base.errors.InvalidInputError` with
 L-coded diagnostics; no input, however malformed, produces a traceback.
 """
 
@@ -25,8 +25,7 @@ from lark.exceptions import (
     VisitError,
 )
 
-from tlmpc.errors import Diagnostic, InvalidInputError, error
-from tlmpc.grammar_cache import lalr_parser
+from tlmpc.base.errors import Diagnostic, InvalidInputError, error
 from tlmpc.ltl.ast import (
     And,
     Const,
@@ -44,6 +43,7 @@ from tlmpc.ltl.ast import (
     Until,
     WeakUntil,
 )
+from tlmpc.ltl.grammar_cache import lalr_parser
 from tlmpc.ltl.keywords import KEYWORDS  # re-exported: words that cannot name a region
 
 #: Nesting deeper than this is refused (L005) instead of exhausting the Python stack.

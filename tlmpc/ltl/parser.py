@@ -2,7 +2,7 @@
 
 ``parse_ltl(text, file=..., line=..., col=...)`` takes the position where ``text`` starts in
 its file (an LTL string inside a YAML mission), so every diagnostic and every node's span
-points into the user's file.  Problems raise :class:`~tlmpc.errors.InvalidInputError` with
+points into the user's file.  Problems raise :class:`~tlmpc.base.errors.InvalidInputError` with
 L-coded diagnostics; no input, however malformed, produces a traceback.
 
 Plain formulas are read without lark (:mod:`tlmpc.ltl.reader`, the same AST and spans);

@@ -14,7 +14,7 @@ import numpy as np
 import shapely
 from shapely.geometry import Point as ShapelyPoint
 
-from tlmpc.errors import Diagnostic, error
+from tlmpc.base.errors import Diagnostic, error
 from tlmpc.mission.geometry import AREA_TOLERANCE, CheckedShape, shapely_polygon
 from tlmpc.mission.yamlpos import Path, json_path
 

@@ -23,7 +23,7 @@ from typing import Any
 
 import shapely
 
-from tlmpc.errors import Diagnostic, error
+from tlmpc.base.errors import Diagnostic, error
 from tlmpc.mission.body import ARC_SEGMENTS, body_radius, conservative_offset, obstacle_offset
 from tlmpc.mission.model import Mission, Point, Polygon
 

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from itertools import chain
 from typing import TYPE_CHECKING, Any
 
-from tlmpc.errors import Diagnostic, error
+from tlmpc.base.errors import Diagnostic, error
 from tlmpc.mission import plain_geometry
 from tlmpc.mission.model import Polygon
 from tlmpc.mission.yamlpos import Path, json_path

@@ -19,7 +19,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from tlmpc.errors import Diagnostic
+from tlmpc.base.errors import Diagnostic
 from tlmpc.mission.geometry import AREA_TOLERANCE
 from tlmpc.mission.model import Mission, Point, Polygon
 

@@ -14,15 +14,14 @@ from itertools import chain
 from pathlib import Path as FilePath
 from typing import TYPE_CHECKING, Any
 
-from tlmpc.artifacts import load_schema
-from tlmpc.errors import Diagnostic, InvalidInputError, UsageError, best_first, error
+from tlmpc.base.errors import Diagnostic, InvalidInputError, UsageError, best_first, error
+from tlmpc.io.schema_check import is_valid, load_schema
 from tlmpc.ltl.ast import Formula, Or, Prop, conjoin
 from tlmpc.ltl.keywords import KEYWORDS
 from tlmpc.ltl.transform import substitute
 from tlmpc.mission.geometry import CheckedShape, check_layout, check_shape
 from tlmpc.mission.model import Component, Mission, Options, Polygon, Region, Robot, Workspace
 from tlmpc.mission.yamlpos import Path, PositionedDocument, json_path, load_positioned
-from tlmpc.schema_check import is_valid
 from tlmpc.tasks.compiler import compile_phrases
 
 if TYPE_CHECKING:

@@ -12,7 +12,7 @@ from typing import Any
 
 from shapely.geometry import Polygon as ShapelyPolygon
 
-from tlmpc.errors import Diagnostic, TlmpcError, error
+from tlmpc.base.errors import Diagnostic, TlmpcError, error
 from tlmpc.mission.geometry import CheckedShape, check_shape
 from tlmpc.mission.yamlpos import PositionedDocument
 

@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 import shapely
 
-from tlmpc.errors import Diagnostic, InvalidInputError, error
+from tlmpc.base.errors import Diagnostic, InvalidInputError, error
 from tlmpc.mission.grid import GRID, ON_GRID, grid_size
 from tlmpc.mission.model import Mission, Polygon
 

@@ -16,7 +16,7 @@ from typing import Any
 
 import yaml
 
-from tlmpc.errors import Diagnostic, error
+from tlmpc.base.errors import Diagnostic, error
 from tlmpc.mission.bulk import STEM, BulkList, cut_out
 
 Path = tuple[str | int, ...]

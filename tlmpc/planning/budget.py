@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 from tlmpc.abstraction.model import Abstraction
 from tlmpc.automata.model import Automaton
-from tlmpc.errors import UsageError, error
+from tlmpc.base.errors import UsageError, error
 
 #: Upper bounds the planner accepts.  The edge estimate is loose (on grid maps the built
 #: product has a fifth of it): a million-triangle grid with a 4-state automaton is estimated

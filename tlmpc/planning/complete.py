@@ -17,7 +17,7 @@ from collections.abc import Callable, Sequence
 from tlmpc.abstraction.model import Abstraction
 from tlmpc.abstraction.refine import split_triangles
 from tlmpc.automata.model import Automaton
-from tlmpc.errors import NoPlanError, TlmpcError, error
+from tlmpc.base.errors import NoPlanError, TlmpcError, error
 from tlmpc.ltl.ast import Formula
 from tlmpc.mission.model import Options, TaskPart
 from tlmpc.planning.boundary import start_cells

@@ -12,7 +12,7 @@ import numpy.typing as npt
 from tlmpc.abstraction.model import Abstraction
 from tlmpc.automata.guards import holds
 from tlmpc.automata.model import Automaton
-from tlmpc.errors import Diagnostic, NoPlanError, error
+from tlmpc.base.errors import Diagnostic, NoPlanError, error
 from tlmpc.ltl.ast import And, Formula, Globally, Not, Prop, conjoin, is_propositional
 from tlmpc.ltl.printer import to_text
 from tlmpc.ltl.transform import nnf

@@ -12,7 +12,7 @@ from __future__ import annotations
 import re
 
 from tlmpc.abstraction.model import Abstraction
-from tlmpc.errors import UsageError, error
+from tlmpc.base.errors import UsageError, error
 from tlmpc.ltl.ast import TRUE, Formula, Prop
 from tlmpc.ltl.printer import to_spin
 from tlmpc.ltl.transform import nnf, substitute

@@ -25,7 +25,7 @@ import numpy as np
 from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
 from tlmpc.automata.degeneralize import degeneralize
 from tlmpc.automata.model import Automaton
-from tlmpc.errors import NoPlanError
+from tlmpc.base.errors import NoPlanError
 from tlmpc.ltl.ast import Formula
 from tlmpc.mission.model import Options
 from tlmpc.planning.boundary import start_cells, start_point_label

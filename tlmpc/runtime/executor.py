@@ -27,16 +27,17 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from pathlib import Path
+from typing import Any, Protocol
 
 import numpy as np
 
 from tlmpc.abstraction.model import Abstraction, FloatArray
 from tlmpc.automata.model import Automaton
+from tlmpc.base.errors import InvalidInputError, NoPlanError, SolverError, UsageError, error
 from tlmpc.control.model import Controllers, StepController
-from tlmpc.errors import InvalidInputError, NoPlanError, SolverError, UsageError, error
 from tlmpc.mission.model import Mission
 from tlmpc.planning.boundary import crossing_letter, start_point_label
 from tlmpc.planning.model import Witness
@@ -45,8 +46,16 @@ from tlmpc.runtime.model import Phase, Progress, Recovery, RecoveryKind, Status
 from tlmpc.runtime.tracker import TaskTracker, working_automaton
 from tlmpc.runtime.unicycle import reference_point, unicycle_command
 
-if TYPE_CHECKING:
-    from tlmpc.api import Compiled
+
+class CompiledOutput(Protocol):
+    """What the executor needs of an in-memory compilation (``tlmpc.Compiled`` is one)."""
+
+    @property
+    def artifacts(self) -> Mapping[str, Any]: ...
+
+    @property
+    def source(self) -> str: ...
+
 
 #: A vertex passage has arrived within this fraction of its triangle's diameter of the corner.
 ARRIVAL = 1e-6
@@ -136,29 +145,38 @@ class Executor:
         self._events: list[Recovery] = []
 
     @classmethod
-    def from_output(cls, output: Compiled | str | os.PathLike[str]) -> Executor:
+    def from_output(cls, output: CompiledOutput | str | os.PathLike[str]) -> Executor:
         """The executor of a compiled output folder (or an in-memory compilation)."""
         from tlmpc.abstraction.io import abstraction_from_json
-        from tlmpc.api import Compiled, read_output
         from tlmpc.automata.io import automaton_from_json
         from tlmpc.control.io import controllers_from_json
+        from tlmpc.io.artifacts import read_artifacts
         from tlmpc.mission.io import mission_from_json
         from tlmpc.planning.io import witness_from_json
 
-        compiled = output if isinstance(output, Compiled) else read_output(output)
-        needed = ("mission.json", "abstraction.json", "automaton.json", "witness.json")
-        missing = [name for name in (*needed, "controllers.json") if name not in compiled.artifacts]
+        needed = (
+            "mission.json",
+            "abstraction.json",
+            "automaton.json",
+            "witness.json",
+            "controllers.json",
+        )
+        if isinstance(output, str | os.PathLike):
+            source = str(output)
+            artifacts: Mapping[str, Any] = read_artifacts(Path(output), needed)
+        else:
+            source, artifacts = output.source, output.artifacts
+        missing = [name for name in needed if name not in artifacts]
         if missing:
             raise UsageError(
                 error(
                     "R020",
-                    f"{compiled.source} has no {', '.join(missing)}: the executor needs a "
+                    f"{source} has no {', '.join(missing)}: the executor needs a "
                     "compilation through the control stage",
-                    file=compiled.source,
+                    file=source,
                     hint="compile the mission without --until (or up to the control stage)",
                 )
             )
-        artifacts = compiled.artifacts
         return cls(
             mission=mission_from_json(artifacts["mission.json"]),
             abstraction=abstraction_from_json(artifacts["abstraction.json"]),

@@ -22,9 +22,9 @@ from typing import Any, NoReturn
 import numpy as np
 
 from tlmpc.abstraction.model import Abstraction, FloatArray
+from tlmpc.base.errors import SolverError, error
 from tlmpc.control.geometry import largest_of, triangle_geometry
 from tlmpc.control.model import Controllers, StepController
-from tlmpc.errors import SolverError, error
 from tlmpc.mission.model import Mission
 
 #: Samples per step (besides the crossings): grid points near SAMPLES_PER_STEP - 1 evenly

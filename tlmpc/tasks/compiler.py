@@ -13,7 +13,7 @@ import functools
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
-from tlmpc.errors import Diagnostic, InvalidInputError, error
+from tlmpc.base.errors import Diagnostic, InvalidInputError, error
 from tlmpc.ltl.ast import (
     And,
     Eventually,
@@ -249,11 +249,7 @@ class _Lowering:
         self._scope(always, "always (the phrase never visits {it})")
         if last_leg:
             before = steps[-2] if len(steps) > 1 else []
-            start = (
-                "after the last visit, from " + _listing(before)
-                if before
-                else "from the start"
-            )
+            start = "after the last visit, from " + _listing(before) if before else "from the start"
             self._scope(
                 last_leg,
                 f"on the last leg only, {start} until {_listing(steps[-1])} "
@@ -314,9 +310,7 @@ def compile_phrase(
     return _compile(phrase, groups=groups, file=file, line=line, col=col)[0]
 
 
-def avoid_scopes(
-    phrase: str, *, groups: Mapping[str, Sequence[str]] | None = None
-) -> list[str]:
+def avoid_scopes(phrase: str, *, groups: Mapping[str, Sequence[str]] | None = None) -> list[str]:
     """Each avoidance in ``phrase`` with its scope in words (``avoid c: always``)."""
     return _compile(phrase, groups=groups, file=None, line=1, col=1)[1]
 

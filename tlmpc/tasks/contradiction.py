@@ -17,7 +17,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 from tlmpc.automata.translate import translate
-from tlmpc.errors import Diagnostic, error
+from tlmpc.base.errors import Diagnostic, error
 from tlmpc.ltl.ast import And, Const, Formula, Not, Or, Prop, conjoin
 from tlmpc.ltl.printer import to_text
 from tlmpc.ltl.transform import substitute
@@ -171,8 +171,10 @@ def find_contradiction(
         message = f"the task is a contradiction: {first.text!r} cannot hold together with " + (
             ", ".join(_describe(p) for p in others)
         )
-        hint = "together they mean " + to_text(conjoin([formulas[i] for i in core])) + (
-            ", which no behaviour satisfies; drop or change one of them"
+        hint = (
+            "together they mean "
+            + to_text(conjoin([formulas[i] for i in core]))
+            + (", which no behaviour satisfies; drop or change one of them")
         )
     code = "L020" if first.kind == "ltl" and not others else "T011"
     return error(code, message, hint=hint, file=file, line=first.line, col=first.col)

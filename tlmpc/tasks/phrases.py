@@ -42,9 +42,30 @@ class Node:
 #: Words the grammar's NAME terminal refuses (``tasks.lark``), lower case.
 KEYWORDS = frozenset(
     {
-        "visit", "then", "and", "avoid", "avoiding", "never", "until", "patrol", "stay",
-        "remain", "in", "at", "always", "eventually", "whenever", "return", "to", "while",
-        "all", "any", "infinitely", "often", "finally", "reach",
+        "visit",
+        "then",
+        "and",
+        "avoid",
+        "avoiding",
+        "never",
+        "until",
+        "patrol",
+        "stay",
+        "remain",
+        "in",
+        "at",
+        "always",
+        "eventually",
+        "whenever",
+        "return",
+        "to",
+        "while",
+        "all",
+        "any",
+        "infinitely",
+        "often",
+        "finally",
+        "reach",
     }
 )
 #: A name starting with one of these could be split by the Earley parser's dynamic lexer

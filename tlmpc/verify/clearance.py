@@ -22,7 +22,7 @@ import numpy as np
 import shapely
 from shapely.ops import polylabel
 
-from tlmpc.errors import Diagnostic
+from tlmpc.base.errors import Diagnostic
 from tlmpc.ltl.polarity import polarities
 from tlmpc.verify.trace_input import TraceInput
 

@@ -6,7 +6,7 @@ import dataclasses
 
 import numpy as np
 
-from tlmpc.errors import UsageError, error
+from tlmpc.base.errors import UsageError, error
 from tlmpc.verify.trace_input import TraceInput
 
 

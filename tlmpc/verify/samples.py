@@ -14,7 +14,7 @@ from collections.abc import Sequence
 import numpy as np
 import numpy.typing as npt
 
-from tlmpc.errors import Diagnostic, UsageError, error
+from tlmpc.base.errors import Diagnostic, UsageError, error
 
 FloatArray = npt.NDArray[np.float64]
 

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from tlmpc.errors import UsageError, error
+from tlmpc.base.errors import UsageError, error
 from tlmpc.ltl.ast import Formula
 from tlmpc.verify.model import Ending
 from tlmpc.verify.samples import check_samples
@@ -116,7 +116,7 @@ def _certifying_speed(speed: Any) -> float | None:
 def _formula(text: Any, names: set[str], file: str | None) -> Formula:
     if not isinstance(text, str):
         raise _fail("V006", "the trace has no `ltl` task", file)
-    from tlmpc.errors import InvalidInputError
+    from tlmpc.base.errors import InvalidInputError
     from tlmpc.ltl.parser import parse_ltl  # lark: only when a formula is read as text
 
     try:
@@ -300,7 +300,7 @@ def from_csv(
         raise _fail(
             "V010", "a CSV trace needs --mission MISSION.yaml for its regions and task", str(path)
         )
-    from tlmpc.errors import InvalidInputError
+    from tlmpc.base.errors import InvalidInputError
     from tlmpc.importers.logs import CSV_SUFFIXES, read_log
     from tlmpc.ltl.printer import to_text
     from tlmpc.mission.body import body_radius

@@ -12,7 +12,7 @@ import math
 from pathlib import Path
 from typing import Any
 
-from tlmpc.errors import UsageError, error
+from tlmpc.base.errors import UsageError, error
 
 
 def _points(value: Any) -> list[list[float]]:
@@ -95,7 +95,7 @@ def _scene(
 
 def scene_from_output(directory: Path) -> dict[str, Any]:
     """The scene of a ``tlmpc compile`` output directory (mesh, trajectory, verdict)."""
-    from tlmpc.artifacts import read_json
+    from tlmpc.io.artifacts import read_json
 
     if not (directory / "mission.json").is_file():
         raise UsageError(
@@ -139,7 +139,7 @@ def scene_from_output(directory: Path) -> dict[str, Any]:
 
 def scene_from_log(log: Path, mission_path: Path) -> dict[str, Any]:
     """The scene of a robot's log (CSV ``t,x,y`` or ``trace.json``) verified against a mission."""
-    from tlmpc.artifacts import read_json
+    from tlmpc.io.artifacts import read_json
     from tlmpc.ltl.printer import to_text
     from tlmpc.mission.load import load_mission
     from tlmpc.verify import from_csv, from_document, verdict_to_json, verify_trace

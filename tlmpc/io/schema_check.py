@@ -1,4 +1,7 @@
-"""A small yes/no JSON Schema (draft 2020-12) checker for the keywords tlmpc's schemas use.
+"""The JSON Schemas: where they live, loading them, and checking documents against them.
+
+A small yes/no JSON Schema (draft 2020-12) checker for the keywords tlmpc's schemas use
+runs first.
 
 jsonschema stays the validator that words every problem; importing it (with ``referencing``
 and ``attrs``) costs a tenth of a second on every start, which is most of a ``tlmpc check``
@@ -11,14 +14,15 @@ suite compares both on the shipped missions, every artifact and random mutations
 from __future__ import annotations
 
 import functools
+import json
 import re
 from collections.abc import Callable, Mapping
+from pathlib import Path
 from typing import Any
 
 #: Keywords that never change whether an instance is valid.
 _ANNOTATIONS = frozenset(
-    {"$id", "$schema", "$comment", "$defs", "title", "description", "default", "examples",
-     "format"}
+    {"$id", "$schema", "$comment", "$defs", "title", "description", "default", "examples", "format"}
 )
 
 Check = Callable[[Any], bool]
@@ -131,16 +135,16 @@ class _Compiler:
             return lambda v: not isinstance(v, list) or all(item(x) for x in v)
         if key == "properties":
             props = {name: self.compile(sub) for name, sub in value.items()}
-            return lambda v: not isinstance(v, dict) or all(
-                props[k](x) for k, x in v.items() if k in props
+            return lambda v: (
+                not isinstance(v, dict) or all(props[k](x) for k, x in v.items() if k in props)
             )
         if key == "additionalProperties":
             if "patternProperties" in schema:
                 raise _Unsupported(key)
             known = frozenset(schema.get("properties", {}))
             extra = self.compile(value)
-            return lambda v: not isinstance(v, dict) or all(
-                extra(x) for k, x in v.items() if k not in known
+            return lambda v: (
+                not isinstance(v, dict) or all(extra(x) for k, x in v.items() if k not in known)
             )
         if key == "propertyNames":
             name_check = self.compile(value)
@@ -169,8 +173,6 @@ class _Compiler:
 
 @functools.cache
 def _checker(name: str) -> Check | None:
-    from tlmpc.artifacts import load_schema
-
     schema = load_schema(name)
     try:
         return _Compiler(schema).compile(schema)
@@ -187,3 +189,39 @@ def is_valid(document: Any, name: str) -> bool | None:
         return check(document)
     except (TypeError, ValueError, RecursionError):
         return None  # an instance jsonschema itself must judge (and word)
+
+
+def schema_dir() -> Path:
+    """The folder holding the JSON Schemas (packaged copy first, then the source tree)."""
+    package = Path(__file__).resolve().parent.parent  # tlmpc/
+    for folder in (package / "schemas", package.parent / "schemas"):  # installed, source tree
+        if folder.is_dir():
+            return folder
+    from importlib import resources  # not at the top: it imports tempfile, shutil, random
+
+    packaged = resources.files("tlmpc") / "schemas"
+    if packaged.is_dir():
+        return Path(str(packaged))
+    return package.parent / "schemas"
+
+
+@functools.cache
+def load_schema(name: str) -> dict[str, Any]:
+    """The schema ``schemas/<name>.schema.json`` (e.g. ``"mission"``, ``"abstraction"``)."""
+    path = schema_dir() / f"{name}.schema.json"
+    with path.open(encoding="utf-8") as handle:
+        schema: dict[str, Any] = json.load(handle)
+    return schema
+
+
+def validation_errors(document: Any, name: str) -> list[str]:
+    """Messages for every way ``document`` violates schema ``name`` (empty when valid)."""
+    if is_valid(document, name):
+        return []  # jsonschema is imported only to word the problems
+    import jsonschema
+
+    validator = jsonschema.Draft202012Validator(load_schema(name))
+    return [
+        f"{err.json_path}: {err.message}"
+        for err in sorted(validator.iter_errors(document), key=lambda e: list(e.path))
+    ]

@@ -1,4 +1,4 @@
-"""``plan.svg`` written directly from a :class:`~tlmpc.plot_scene.Scene` (no plotting library).
+"""``plan.svg`` written directly from a :class:`~tlmpc.render.scene.Scene` (no plotting library).
 
 The picture a compile always writes, so it must be cheap: a few string joins, no font
 machinery.  Coordinates are mapped to pixels here, which gives every stroke a width on the
@@ -15,10 +15,10 @@ from html import escape
 from itertools import chain
 from typing import TYPE_CHECKING
 
-from tlmpc.plot_scene import Path, Point, Region, Scene, viridis
+from tlmpc.render.scene import Path, Point, Region, Scene, viridis
 
 if TYPE_CHECKING:
-    from tlmpc.plot_scene import FloatArray
+    from tlmpc.render.scene import FloatArray
 
 _MAX_WIDTH = 900.0  # pixels for the map's width ...
 _MAX_HEIGHT = 700.0  # ... and height; the map keeps its aspect ratio within both

@@ -23,7 +23,7 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any, TextIO
 
-from tlmpc.errors import (
+from tlmpc.base.errors import (
     EXIT_INCONCLUSIVE,
     EXIT_INTERNAL,
     EXIT_NEGATIVE,
@@ -132,8 +132,8 @@ class Reporter:
 
     def envelope(self, exit_code: int, result: Mapping[str, Any] | None) -> str:
         """The ``--json`` document, as text."""
-        from tlmpc import __version__
-        from tlmpc.artifacts import json_text
+        from tlmpc.base.version import __version__
+        from tlmpc.io.artifacts import json_text
 
         document = {
             "format": CLI_FORMAT,
@@ -154,7 +154,7 @@ def cli_output_errors(document: Any) -> list[str]:
     import jsonschema
     from referencing import Registry, Resource
 
-    from tlmpc.artifacts import load_schema, schema_dir
+    from tlmpc.io.schema_check import load_schema, schema_dir
 
     resources = []
     for path in sorted(schema_dir().glob("*.schema.json")):

@@ -1,6 +1,6 @@
 """Figures of a compiled mission, drawn from its artifacts alone (headless, reproducible).
 
-Both pictures draw the same :class:`~tlmpc.plot_scene.Scene`: the workspace, holes, regions
+Both pictures draw the same :class:`~tlmpc.render.scene.Scene`: the workspace, holes, regions
 with their names, the triangulation, the discrete plan, the simulated trajectory coloured by
 distance travelled, the start, and optionally a recorded log and its violations.
 
@@ -18,7 +18,7 @@ import itertools
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-from tlmpc.plot_scene import Scene, build_scene, viridis
+from tlmpc.render.scene import Scene, build_scene, viridis
 
 View = tuple[float, float, float, float]
 
@@ -30,8 +30,8 @@ def render_svg(
     log: Sequence[Sequence[float]] | None = None,
     verdict: Mapping[str, Any] | None = None,
 ) -> bytes:
-    """``plan.svg`` of a compile output's artifacts (see :func:`~tlmpc.plot_scene.build_scene`)."""
-    from tlmpc.plot_svg import render_svg as draw
+    """``plan.svg`` of a compile output's artifacts (see :func:`.scene.build_scene`)."""
+    from tlmpc.render.svg import render_svg as draw
 
     return draw(build_scene(artifacts, zoom=zoom, log=log, verdict=verdict))
 

@@ -18,15 +18,15 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
-from tlmpc import __version__
-from tlmpc.errors import NoPlanError, TlmpcError, error
-from tlmpc.progress import heartbeat
+from tlmpc.base.errors import NoPlanError, TlmpcError, error
+from tlmpc.base.progress import heartbeat
+from tlmpc.base.version import __version__
 
 if TYPE_CHECKING:
     from tlmpc.abstraction.model import Abstraction
     from tlmpc.automata.model import Automaton
+    from tlmpc.base.errors import Diagnostic
     from tlmpc.control.model import Controllers
-    from tlmpc.errors import Diagnostic
     from tlmpc.mission.model import Mission
     from tlmpc.planning.model import Witness
     from tlmpc.verify.clearance import Clearance
@@ -185,7 +185,7 @@ def _load(c: Compilation) -> StageResult:
 
 def _body_notes(mission: Mission, text: str | None) -> list[Diagnostic]:
     """R001 (raised) and the R002-R004 warnings of a robot with a body."""
-    from tlmpc.errors import InvalidInputError
+    from tlmpc.base.errors import InvalidInputError
     from tlmpc.mission.cspace import body_diagnostics
 
     found = body_diagnostics(mission, text)
@@ -327,7 +327,7 @@ def _without_margin(
     from tlmpc.abstraction import build_abstraction
     from tlmpc.abstraction.layout import planning_layout
     from tlmpc.automata import translate
-    from tlmpc.errors import Diagnostic as Note
+    from tlmpc.base.errors import Diagnostic as Note
     from tlmpc.mission.body import requested_margin
 
     margin = requested_margin(mission)
@@ -441,7 +441,7 @@ def _plot(c: Compilation) -> StageResult:
     # Drawn from the artifacts themselves (the same code as `tlmpc plot`), so the picture
     # always shows what was written.
     # plan.svg is written directly (cheap); plan.png needs matplotlib, so only on request.
-    from tlmpc.plot import render_png, render_svg
+    from tlmpc.render.plot import render_png, render_svg
 
     pictures: dict[str, bytes] = {}
     if "svg" in c.figures:
@@ -644,7 +644,7 @@ def compile_mission(
 
     With ``text``, the mission is that YAML text and ``source`` only names it in diagnostics.
     ``figures`` names the pictures the plot stage draws (``"svg"``, ``"png"``).  Raises the
-    stage's :class:`~tlmpc.errors.TlmpcError` when one fails; nothing is written here (the
+    stage's :class:`~tlmpc.base.errors.TlmpcError` when one fails; nothing is written here (the
     CLI writes the returned artifacts atomically).
     """
     compilation = Compilation(source=Path(source), text=text, figures=figures)
@@ -665,7 +665,7 @@ def compilation_from_artifacts(directory: Path, needed: Sequence[Product[Any]]) 
     Every artifact is checked against its schema first; a missing or invalid one is a
     diagnostic naming the file.
     """
-    from tlmpc.artifacts import read_artifact
+    from tlmpc.io.artifacts import read_artifact
 
     products: dict[Product[Any], Any] = {}
     documents: dict[str, Any] = {}

@@ -3,7 +3,7 @@
 A :class:`Scene` is plain data in world coordinates: the map, its holes, the regions with
 their names, the mesh's edges, the discrete plan, the simulated trajectory (or a recorded
 log) with its arc-length colouring, the start and any violations.  The SVG writer
-(:mod:`tlmpc.plot_svg`) and the matplotlib renderer (:mod:`tlmpc.plot`) only draw it, so
+(:mod:`tlmpc.render.svg`) and the matplotlib renderer (:mod:`tlmpc.render.plot`) only draw it, so
 both pictures always agree.  Building a scene imports numpy (for the mesh), never a
 plotting library.
 """

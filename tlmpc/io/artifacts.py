@@ -7,7 +7,6 @@ keys and a trailing newline; small documents indented, large ones (meshes, trace
 
 from __future__ import annotations
 
-import functools
 import json
 import marshal
 import math
@@ -17,45 +16,8 @@ from collections.abc import Iterable, Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
-from tlmpc.errors import UsageError, error
-
-
-def schema_dir() -> Path:
-    """The folder holding the JSON Schemas (packaged copy first, then the source tree)."""
-    package = Path(__file__).resolve().parent
-    for folder in (package / "schemas", package.parent / "schemas"):  # installed, source tree
-        if folder.is_dir():
-            return folder
-    from importlib import resources  # not at the top: it imports tempfile, shutil, random
-
-    packaged = resources.files("tlmpc") / "schemas"
-    if packaged.is_dir():
-        return Path(str(packaged))
-    return Path(__file__).resolve().parent.parent / "schemas"
-
-
-@functools.cache
-def load_schema(name: str) -> dict[str, Any]:
-    """The schema ``schemas/<name>.schema.json`` (e.g. ``"mission"``, ``"abstraction"``)."""
-    path = schema_dir() / f"{name}.schema.json"
-    with path.open(encoding="utf-8") as handle:
-        schema: dict[str, Any] = json.load(handle)
-    return schema
-
-
-def validation_errors(document: Any, name: str) -> list[str]:
-    """Messages for every way ``document`` violates schema ``name`` (empty when valid)."""
-    from tlmpc.schema_check import is_valid
-
-    if is_valid(document, name):
-        return []  # jsonschema is imported only to word the problems
-    import jsonschema
-
-    validator = jsonschema.Draft202012Validator(load_schema(name))
-    return [
-        f"{err.json_path}: {err.message}"
-        for err in sorted(validator.iter_errors(document), key=lambda e: list(e.path))
-    ]
+from tlmpc.base.errors import UsageError, error
+from tlmpc.io.schema_check import validation_errors
 
 
 def _finite(value: Any) -> Any:
@@ -279,7 +241,7 @@ def _tampered(path: Path, message: str, code: str = "U042") -> UsageError:
     )
 
 
-def read_output(directory: Path, names: tuple[str, ...]) -> dict[str, dict[str, Any]]:
+def read_artifacts(directory: Path, names: tuple[str, ...]) -> dict[str, dict[str, Any]]:
     """The artifacts ``names`` that exist in the output ``directory``, each checked against
     its schema (U041) and against each other (U042: indices in range, the task's regions
     defined), so ``plot`` and ``export`` never work on a tampered or mixed-up output."""
@@ -338,7 +300,7 @@ def _indices(values: Any, bound: int, low: int = 0) -> bool:
 
 
 def _cross_check(directory: Path, documents: dict[str, dict[str, Any]]) -> None:
-    from tlmpc.errors import TlmpcError
+    from tlmpc.base.errors import TlmpcError
     from tlmpc.ltl.parser import parse_ltl
 
     identifier = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")

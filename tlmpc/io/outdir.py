@@ -34,12 +34,12 @@ from collections.abc import Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
-from tlmpc.artifacts import ARTIFACT_SCHEMAS, artifact_texts, dumps
-from tlmpc.errors import UsageError, error
+from tlmpc.base.errors import UsageError, error
+from tlmpc.io.artifacts import ARTIFACT_SCHEMAS, artifact_texts, dumps
 
 #: The marker file every output directory holds; its first line starts with MARKER_FORMAT.
 MARKER = ".tlmpc-output"
-MARKER_FORMAT = "tlmpc.output/"
+MARKER_FORMAT = "tlmpc.io.outdir/"
 _MARKER_TEXT = MARKER_FORMAT + "1\n"
 
 #: Every file name ``tlmpc compile`` may write (used by ``--force`` and documentation only).

@@ -1,0 +1,1 @@
+"""The compiler's stage list and its driver (``stages``): what ``tlmpc compile`` walks."""

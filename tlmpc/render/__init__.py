@@ -1,0 +1,1 @@
+"""Figures: one scene model (``scene``) drawn as SVG (``svg``) or, through matplotlib, PNG."""
