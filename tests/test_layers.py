@@ -56,9 +56,7 @@ KNOWN_MODULE_CYCLES: frozenset[frozenset[str]] = frozenset(
                 "tlmpc.mission.geometry",
             }
         ),
-        frozenset(
-            {"tlmpc.planning.boundary", "tlmpc.planning.passages", "tlmpc.planning.product"}
-        ),
+        frozenset({"tlmpc.planning.boundary", "tlmpc.planning.passages", "tlmpc.planning.product"}),
         frozenset({"tlmpc.planning.explain", "tlmpc.planning.plan"}),
         frozenset({"tlmpc.automata.simplify", "tlmpc.automata.wdba"}),
     }
