@@ -156,6 +156,16 @@ def _run_one(args: argparse.Namespace, path: Path, out: TextIO, err: TextIO) -> 
         verify_trace,
     )
 
+    report = Reporter.for_args(args, out, err)
+    if is_log(path) and _too_large_for_memory(path):
+        verdict = _streamed(args, path)
+        report.note(
+            f"{path}: streamed ({verdict.stats['samples']:,} samples, "
+            f"{verdict.stats['kept_samples']:,} kept); robustness and certificate are the kept "
+            "samples'"
+        )
+        text = _text(path, verdict)
+        return report.finish(OUTCOME_EXIT[verdict.outcome], verdict_to_json(verdict), text)
     if is_log(path):
         trace = from_csv(
             path,
@@ -171,9 +181,35 @@ def _run_one(args: argparse.Namespace, path: Path, out: TextIO, err: TextIO) -> 
         trace = from_document(document, file=str(path), convention=args.boundary)
     trace = declare_ending(trace, assume_stay=args.assume_stay, loop_from=args.loop_from)
     verdict = verify_trace(trace)
-    report = Reporter.for_args(args, out, err)
     text = _text(path, verdict)
     return report.finish(OUTCOME_EXIT[verdict.outcome], verdict_to_json(verdict), text)
+
+
+def _too_large_for_memory(path: Path) -> bool:
+    from tlmpc.importers.logs import CSV_SUFFIXES
+    from tlmpc.verify.trace_input import is_large_csv
+
+    return path.suffix.lower() in CSV_SUFFIXES and path.is_file() and is_large_csv(path)
+
+
+def _streamed(args: argparse.Namespace, path: Path) -> Verdict:
+    """A CSV log too large to hold whole, verified in constant memory (docs/verify.md)."""
+    from tlmpc.fleet.stream import verify_log
+    from tlmpc.importers.logs import parse_columns, parse_transform
+    from tlmpc.verify.trace_input import mission_document
+
+    streamed = verify_log(
+        path,
+        mission_document(path, args.mission),
+        convention=args.boundary,
+        topic=args.topic,
+        columns=parse_columns(args.columns) if args.columns else None,
+        transform=parse_transform(args.transform) if args.transform else None,
+        frame=args.frame,
+        assume_stay=args.assume_stay,
+        loop_from=args.loop_from,
+    )
+    return streamed.verdict
 
 
 def _text(path: Path, verdict: Verdict) -> str:

@@ -36,7 +36,6 @@ from typing import Any
 
 import numpy as np
 import numpy.typing as npt
-import shapely
 
 from tlmpc.base.errors import Diagnostic, UsageError
 from tlmpc.verify import Verdict, declare_ending, from_document, verify_trace
@@ -77,12 +76,29 @@ def _rings(document: Mapping[str, Any]) -> tuple[list[FloatArray], list[FloatArr
     return regions, free
 
 
-def _lines(rings: Sequence[FloatArray]) -> shapely.Geometry | None:
-    if not rings:
-        return None
-    geometry = shapely.MultiLineString([np.vstack([r, r[:1]]) for r in rings])
-    shapely.prepare(geometry)
-    return geometry
+@dataclass(frozen=True, slots=True)
+class _Edges:
+    """The straight edges of some closed rings, for point-to-boundary distances."""
+
+    starts: FloatArray
+    vectors: FloatArray
+    squares: FloatArray
+
+    @classmethod
+    def of(cls, rings: Sequence[FloatArray]) -> _Edges | None:
+        if not rings:
+            return None
+        starts = np.vstack(rings)
+        vectors = np.vstack([np.roll(r, -1, axis=0) - r for r in rings])
+        squares = np.maximum(np.einsum("ij,ij->i", vectors, vectors), 1e-300)
+        return cls(starts, vectors, squares)
+
+    def distance(self, x: float, y: float) -> float:
+        """The least distance from ``(x, y)`` to an edge."""
+        dx, dy = x - self.starts[:, 0], y - self.starts[:, 1]
+        along = np.clip((dx * self.vectors[:, 0] + dy * self.vectors[:, 1]) / self.squares, 0, 1)
+        gap_x, gap_y = dx - along * self.vectors[:, 0], dy - along * self.vectors[:, 1]
+        return float(np.sqrt(np.min(gap_x * gap_x + gap_y * gap_y)))
 
 
 class Reducer:
@@ -90,8 +106,8 @@ class Reducer:
 
     def __init__(self, document: Mapping[str, Any], *, pin_time: float | None = None) -> None:
         regions, free = _rings(document)
-        self.regions = _lines(regions)
-        self.free = _lines(free)
+        self.regions = _Edges.of(regions)
+        self.free = _Edges.of(free)
         self.radius = float(document.get("radius") or 0.0)
         extent = max((float(np.abs(r).max()) for r in (*regions, *free)), default=1.0)
         self.margin = MARGIN * max(1.0, extent)
@@ -105,12 +121,12 @@ class Reducer:
 
     def clearance(self, point: FloatArray) -> float:
         """The radius of the open disc around ``point`` that touches no boundary."""
-        where = shapely.Point(float(point[1]), float(point[2]))
+        x, y = float(point[1]), float(point[2])
         reach = math.inf
         if self.regions is not None:
-            reach = float(shapely.distance(self.regions, where))
+            reach = self.regions.distance(x, y)
         if self.free is not None:
-            reach = min(reach, float(shapely.distance(self.free, where)) - self.radius)
+            reach = min(reach, self.free.distance(x, y) - self.radius)
         return reach - self.margin
 
     def _keep(self, sample: FloatArray) -> None:

@@ -244,8 +244,8 @@ MAX_CSV_ROWS = 2_000_000
 MAX_CSV_LINE = 4096
 
 
-def check_csv_file(path: Path) -> None:
-    """Refuse (U038) a CSV trace too large to verify, reading it in chunks (never whole)."""
+def _csv_extent(path: Path) -> tuple[int, int, int]:
+    """Bytes, rows and longest line of a CSV file, read in chunks until a limit is passed."""
     rows = 0
     longest = 0
     current = 0
@@ -266,6 +266,19 @@ def check_csv_file(path: Path) -> None:
                     break
     except OSError as exc:
         raise _fail("U001", f"cannot read {path}: {exc.strerror or exc}", str(path)) from None
+    return size, rows, longest
+
+
+def is_large_csv(path: Path) -> bool:
+    """Whether the whole-log reader refuses the CSV for its size alone (U038): a log to
+    stream instead."""
+    size, rows, longest = _csv_extent(path)
+    return (size > MAX_CSV_BYTES or rows > MAX_CSV_ROWS) and longest <= MAX_CSV_LINE
+
+
+def check_csv_file(path: Path) -> None:
+    """Refuse (U038) a CSV trace too large to verify, reading it in chunks (never whole)."""
+    size, rows, longest = _csv_extent(path)
     if size > MAX_CSV_BYTES or rows > MAX_CSV_ROWS:
         raise _fail(
             "U038",
