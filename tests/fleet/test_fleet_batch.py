@@ -208,3 +208,27 @@ def test_no_logs_and_missing_distributed(tmp_path: Path, monkeypatch: pytest.Mon
     assert code == 2
     assert "F001" in err
     assert "tlmpc[fleet]" in err
+
+
+def test_the_json_envelope_of_a_batch_is_valid(
+    fleet: tuple[Path, Path, list[Planted]], tmp_path: Path
+) -> None:
+    from tlmpc.io.report import cli_output_errors
+
+    folder, mapping, _ = fleet
+    code, out, err = run_cli(
+        "verify",
+        str(folder / "logs"),
+        "--mission",
+        str(mapping),
+        "--jobs",
+        "1",
+        "--json",
+        "--cache",
+        str(tmp_path / "c"),
+    )
+    assert code == 1
+    document = json.loads(out)
+    assert cli_output_errors(document) == []
+    assert len(document["result"]["logs"]) == LOGS
+    assert err.count("\n") >= LOGS  # the per-log lines go to stderr with --json

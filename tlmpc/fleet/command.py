@@ -80,11 +80,7 @@ def run_batch(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     try:
         for record in [*failed, *run(jobs, workers=workers, client=client)]:
             records.append(record)
-            if report.json:
-                report.note(line(record))
-            else:
-                out.write(line(record) + "\n")
-                out.flush()
+            report.stream(line(record))
     finally:
         if client is not None:
             client.close()

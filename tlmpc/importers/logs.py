@@ -394,6 +394,32 @@ def apply_transform(
     return _apply(samples, transform)
 
 
+class CsvLines:
+    """A CSV log read one line at a time (a live log): the same header rules, columns and
+    numbers as :func:`read_csv_log`."""
+
+    def __init__(self, file: str, columns: Sequence[str] | None = None) -> None:
+        self.file = file
+        self.columns = columns
+        self.separator: str | None = None
+        self.indices: tuple[int, int, int] | None = None
+
+    def parse(self, raw: str, number: int) -> tuple[float, float, float] | None:
+        """The sample on line ``number``; None for a blank, comment or header line."""
+        stripped = raw.strip()
+        if not stripped or stripped.startswith("#"):
+            return None
+        if self.indices is None:
+            self.separator = next((s for s in _SEPARATORS if s in stripped), None)
+            header, self.indices = _layout(
+                _split(stripped, self.separator), self.columns, self.file, number
+            )
+            if header:
+                return None
+        t, x, y = _row(_split(stripped, self.separator), self.indices, self.file, number)
+        return t, x, y
+
+
 # --- ROS bags ---------------------------------------------------------------------------------
 
 
