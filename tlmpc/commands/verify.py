@@ -34,8 +34,8 @@ each conjunct's own verdict and progress, every violation (when and where), the 
 and whether the verdict is certified for the real robot between samples.
 
 Several logs, or folders of logs, are a batch: verified in parallel (--jobs, --dask), one
-line per log as it finishes, a summary table, --results as JSON lines or Parquet, and a content
-cache so unchanged logs are not verified again; see
+line per log as it finishes, a summary table, --results as JSON lines or Parquet, a content
+cache so unchanged logs are not verified again, and --report for a fleet page; see
 docs/verify.md ("Many logs")."""
 
 
@@ -108,6 +108,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="write a record per log: JSON lines, or Parquet for FILE.parquet (needs pyarrow)",
     )
     batch.add_argument(
+        "--report",
+        type=Path,
+        metavar="FILE",
+        help="write the fleet report (one HTML page; each log's view in FILE's .views folder)",
+    )
+    batch.add_argument(
+        "--group",
+        metavar="REGEX",
+        help="report: groups `robot` and `day` found in each log's path (default: the first "
+        "folder under the batch's common folder is the robot, a YYYY-MM-DD in the path the day)",
+    )
+    batch.add_argument(
         "--cache",
         type=Path,
         metavar="DIR",
@@ -118,7 +130,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
 
 
-BATCH_FLAGS = ("jobs", "dask", "results", "cache")
+BATCH_FLAGS = ("jobs", "dask", "results", "report", "group", "cache")
 
 
 def _is_batch(args: argparse.Namespace) -> bool:

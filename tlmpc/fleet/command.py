@@ -52,6 +52,10 @@ def run_batch(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             )
         )
     workers = _workers(args)
+    if args.report is not None:
+        from tlmpc.fleet.report import group_pattern
+
+        group_pattern(args.group)  # a bad --group fails before any log is verified
     if args.mission is None:
         raise UsageError(
             error(
@@ -89,6 +93,10 @@ def run_batch(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     numbers = summary(rows, wall)
     if args.results is not None:
         write_results(args.results, rows)
+    if args.report is not None:
+        from tlmpc.fleet.report import write_report
+
+        write_report(args.report, rows, jobs, group=args.group)
     code = batch_exit(rows)
     text = "summary:\n" + summary_table(numbers)
     from tlmpc.fleet.job import finite

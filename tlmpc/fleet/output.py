@@ -98,7 +98,7 @@ def summary_table(numbers: Mapping[str, Any]) -> str:
     return "".join(f"  {name:<{width}}  {value:>10}\n" for name, value in rows)
 
 
-def _atomic(path: Path, write: Callable[[Path], None]) -> None:
+def write_atomically(path: Path, write: Callable[[Path], None]) -> None:
     """Write through a temporary file in the same folder, renamed into place."""
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -138,7 +138,7 @@ def write_results(path: Path, rows: Sequence[Mapping[str, Any]]) -> None:
                 )
             ) from None
         table = pa.Table.from_pylist([dict(_parquet_row(r)) for r in rows], schema=_schema(pa))
-        _atomic(path, lambda temporary: pq.write_table(table, temporary))
+        write_atomically(path, lambda temporary: pq.write_table(table, temporary))
         return
 
     def write(temporary: Path) -> None:
@@ -146,7 +146,7 @@ def write_results(path: Path, rows: Sequence[Mapping[str, Any]]) -> None:
             for row in rows:
                 stream.write(json.dumps(finite(dict(row)), sort_keys=False) + "\n")
 
-    _atomic(path, write)
+    write_atomically(path, write)
 
 
 def _parquet_row(row: Mapping[str, Any]) -> dict[str, Any]:
