@@ -130,6 +130,20 @@ def test_a_second_run_reads_everything_from_the_cache(
     summary = json.loads(out)["result"]["summary"]
     assert summary["verified"] == 1
     assert summary["cached"] == LOGS - 1
+    # A mission that means something else is verified again for its logs; a comment is not.
+    avoid = folder / "avoid.yaml"
+    original = avoid.read_text(encoding="utf-8")
+    avoid.write_text("# reviewed\n" + original, encoding="utf-8")
+    code, out, _ = run_cli(*base, "--jobs", "1", "--json")
+    assert json.loads(out)["result"]["summary"]["verified"] == 0
+    avoid.write_text(original.replace("12.0, 7.0]", "12.0, 7.5]"), encoding="utf-8")
+    try:
+        code, out, _ = run_cli(*base, "--jobs", "1", "--json")
+    finally:
+        avoid.write_text(original, encoding="utf-8")
+    assert json.loads(out)["result"]["summary"]["verified"] == sum(
+        1 for p in planted if p.task == "avoid"
+    )
 
 
 def test_parquet_results_hold_the_same_rows(
@@ -232,3 +246,59 @@ def test_the_json_envelope_of_a_batch_is_valid(
     assert cli_output_errors(document) == []
     assert len(document["result"]["logs"]) == LOGS
     assert err.count("\n") >= LOGS  # the per-log lines go to stderr with --json
+
+
+@pytest.mark.slow
+def test_a_held_out_fleet_of_three_hundred_logs(tmp_path: Path) -> None:
+    planted = generate(tmp_path / "logs", 300, seed=11)
+    mapping = write_missions(tmp_path)
+    results = tmp_path / "r.jsonl"
+    code, _, _ = run_cli(
+        "verify",
+        str(tmp_path / "logs"),
+        "--mission",
+        str(mapping),
+        "--jobs",
+        "2",
+        "--cache",
+        str(tmp_path / "cache"),
+        "--results",
+        str(results),
+    )
+    assert code == 1
+    check_against_oracle(records(results), planted)
+    code, out, _ = run_cli(
+        "verify",
+        str(tmp_path / "logs"),
+        "--mission",
+        str(mapping),
+        "--jobs",
+        "2",
+        "--cache",
+        str(tmp_path / "cache"),
+        "--json",
+    )
+    assert json.loads(out)["result"]["summary"]["verified"] == 0
+
+
+def test_first_violation_is_the_earliest(tmp_path: Path) -> None:
+    """The shipped log enters the hazard at 18.89 s, again at 32.32 s, and a hole at 33.96 s
+    (the verifier lists the hole first)."""
+    root = Path(__file__).resolve().parents[2]
+    results = tmp_path / "r.jsonl"
+    code, _, _ = run_cli(
+        "verify",
+        str(root / "specs" / "logs" / "hazard-crossing.csv"),
+        "--mission",
+        str(root / "specs" / "reach-avoid.yaml"),
+        "--no-cache",
+        "--results",
+        str(results),
+    )
+    assert code == 1
+    (row,) = records(results)
+    assert row["violations"][0]["conjunct"] == "workspace"
+    first = row["first_violation"]
+    assert first["conjunct"] == "G !hazard"
+    assert first["t"] == pytest.approx(18.0 + 8.0 / 9.0)
+    assert (first["x"], first["y"]) == (8.0, 2.0)
