@@ -250,34 +250,35 @@ def test_the_json_envelope_of_a_batch_is_valid(
 
 @pytest.mark.slow
 def test_a_held_out_fleet_of_three_hundred_logs(tmp_path: Path) -> None:
+    from distributed import Client, LocalCluster
+
     planted = generate(tmp_path / "logs", 300, seed=11)
     mapping = write_missions(tmp_path)
-    results = tmp_path / "r.jsonl"
-    code, _, _ = run_cli(
-        "verify",
-        str(tmp_path / "logs"),
-        "--mission",
-        str(mapping),
-        "--jobs",
-        "2",
-        "--cache",
-        str(tmp_path / "cache"),
-        "--results",
-        str(results),
-    )
-    assert code == 1
-    check_against_oracle(records(results), planted)
-    code, out, _ = run_cli(
-        "verify",
-        str(tmp_path / "logs"),
-        "--mission",
-        str(mapping),
-        "--jobs",
-        "2",
-        "--cache",
-        str(tmp_path / "cache"),
-        "--json",
-    )
+    base = ["verify", str(tmp_path / "logs"), "--mission", str(mapping)]
+    rows = []
+    for flags in (["--jobs", "1"], ["--jobs", "2"]):
+        results = tmp_path / f"r{flags[1]}.jsonl"
+        code, _, _ = run_cli(*base, *flags, "--no-cache", "--results", str(results))
+        assert code == 1
+        rows.append(records(results))
+    with (
+        LocalCluster(
+            n_workers=1,
+            processes=False,
+            threads_per_worker=2,
+            dashboard_address=None,
+            protocol="tcp://",
+        ) as cluster,
+        Client(cluster),
+    ):
+        results = tmp_path / "dask.jsonl"
+        flags = ["--dask", cluster.scheduler_address, "--cache", str(tmp_path / "cache")]
+        code, _, _ = run_cli(*base, *flags, "--results", str(results))
+        assert code == 1
+        rows.append(records(results))
+    check_against_oracle(rows[0], planted)
+    assert comparable(rows[0]) == comparable(rows[1]) == comparable(rows[2])
+    code, out, _ = run_cli(*base, "--jobs", "2", "--cache", str(tmp_path / "cache"), "--json")
     assert json.loads(out)["result"]["summary"]["verified"] == 0
 
 
