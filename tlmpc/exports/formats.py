@@ -10,6 +10,7 @@ from typing import Any
 import yaml
 
 from tlmpc.exports.plan import Plan, Ring, Waypoint
+from tlmpc.io.outputs import csv_cell
 
 
 def _quaternion(yaw: float) -> dict[str, float]:
@@ -41,9 +42,12 @@ def waypoints_yaml(
 
 
 def waypoints_csv(plan: Plan, points: list[Waypoint], loop: int | None) -> str:
-    """``t,x,y,yaw`` rows; comment lines give the mission and the loop start (row index)."""
+    """``t,x,y,yaw`` rows; comment lines give the mission and the loop start (row index).
+
+    The mission's name is one neutralised CSV cell: a name with newlines, separators or a
+    leading ``=`` can add neither a row nor a formula."""
     out = io.StringIO()
-    out.write(f"# tlmpc.waypoints/1 mission {plan.name}\n")
+    out.write(f"# tlmpc.waypoints/1 mission {csv_cell(plan.name)}\n")
     out.write(f"# loop_start: {'none' if loop is None else loop}\n")
     out.write("t,x,y,yaw\n")
     for w in points:
@@ -128,7 +132,10 @@ def geojson(plan: Plan, points: list[Waypoint], loop: int | None) -> str:
             "geometry": {"type": "MultiPoint", "coordinates": [[w.x, w.y] for w in points]},
         }
     )
-    return json.dumps({"type": "FeatureCollection", "features": features}, indent=1) + "\n"
+    # strict JSON: a non-finite number (only an edited output has one) is refused, not
+    # written as the NaN no GeoJSON reader accepts
+    document = {"type": "FeatureCollection", "features": features}
+    return json.dumps(document, indent=1, allow_nan=False) + "\n"
 
 
 PATH_TYPE = "nav_msgs/msg/Path"
