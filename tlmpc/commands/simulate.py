@@ -103,6 +103,11 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             raise UsageError(error("U081", f"--cycles must be a whole number, not {args.cycles!r}"))
         cycles = int(cycles_value)
     dt = _positive(args.dt, "--dt", "U082") if args.dt is not None else None
+    if args.output is not None:
+        from tlmpc.io.outputs import refuse_input_as_output
+        from tlmpc.runtime.executor import EXECUTOR_ARTIFACTS
+
+        refuse_input_as_output(args.output, [args.out / name for name in EXECUTOR_ARTIFACTS])
     executor = Executor.from_output(args.out)
     declared = executor.mission.robot.disturbance
     if args.disturbance is None:
