@@ -94,8 +94,11 @@ class _OutputLost(Exception):
         self.cause = cause
 
 
-class _Terminated(Exception):
-    """SIGTERM arrived: unwind like Ctrl-C so temporary folders are removed."""
+class _Terminated(BaseException):
+    """SIGTERM arrived: unwind like Ctrl-C so temporary folders are removed.
+
+    A :class:`BaseException`, like :class:`KeyboardInterrupt`, so that no ``except
+    Exception`` on the way (a bag reader's, a library's) takes it for an error of its own."""
 
 
 class TerminalText(io.TextIOBase):

@@ -126,9 +126,10 @@ def waypoints(plan: Plan, spacing: float = 0.0) -> tuple[list[Waypoint], int | N
     """
     samples = plan.samples
     count = len(samples)
+    pinned = set(plan.pinned)
     keep: list[int] = []
     for index in range(count):
-        forced = index in (0, count - 1) or index == plan.loop_start or index in plan.pinned
+        forced = index in (0, count - 1) or index == plan.loop_start or index in pinned
         if forced or not keep:
             keep.append(index)
             continue
