@@ -219,7 +219,9 @@ def verify_trace(
         return check_trace(from_csv(path, Path(mission) if mission is not None else None, boundary))
     from tlmpc.io.artifacts import read_json
 
-    return check_trace(from_document(read_json(path), file=str(path), convention=boundary))
+    return check_trace(
+        from_document(read_json(path, finite=False), file=str(path), convention=boundary)
+    )
 
 
 def translate(formula: str) -> Automaton:

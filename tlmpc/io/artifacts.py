@@ -159,10 +159,14 @@ def _has_non_finite(document: Any) -> bool:
     return False
 
 
-def read_json(path: Path, expected_format: str | None = None) -> dict[str, Any]:
+def read_json(
+    path: Path, expected_format: str | None = None, *, finite: bool = True
+) -> dict[str, Any]:
     """Read an artifact, checking its ``format`` prefix (e.g. ``"tlmpc.trace/"``).
 
-    Raises :class:`UsageError` (exit 2) for unreadable files, bad JSON or another format.
+    Raises :class:`UsageError` (exit 2) for unreadable files, bad JSON or another format, and
+    (``finite``) for ``NaN``/``Infinity``, which tlmpc never writes; a user's trace is read
+    with ``finite=False`` so that the verifier reports a non-finite sample where it is.
     """
     from tlmpc.io.inputs import read_text
 
@@ -171,8 +175,8 @@ def read_json(path: Path, expected_format: str | None = None) -> dict[str, Any]:
         path, limit=MAX_ARTIFACT_BYTES, code="U001", too_large_code="U040", what="artifact"
     )
     try:
-        document = json.loads(text, parse_constant=_no_constant)
-        if _HUGE_EXPONENT.search(text) and _has_non_finite(document):
+        document = json.loads(text, parse_constant=_no_constant if finite else None)
+        if finite and _HUGE_EXPONENT.search(text) and _has_non_finite(document):
             raise ValueError("a number too large for a float (it reads as infinity)")
     except RecursionError:
         raise UsageError(

@@ -152,7 +152,7 @@ def scene_from_log(log: Path, mission_path: Path) -> dict[str, Any]:
     if log.suffix.lower() == ".csv":
         trace = from_csv(log, mission_path, None)
     else:
-        trace = from_document(read_json(log), file=str(log), convention=None)
+        trace = from_document(read_json(log, finite=False), file=str(log), convention=None)
     verdict = verdict_to_json(verify_trace(trace))
     samples = [
         [float(t), float(x), float(y)]
