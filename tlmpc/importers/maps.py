@@ -46,6 +46,9 @@ Ring = tuple[Point, ...]
 #: Default speck threshold, in cells: obstacle specks and region pieces smaller are dropped.
 DEFAULT_MIN_CELLS = 4.0
 
+#: Free pieces a map may have (each becomes a workspace component the planner meshes).
+MAX_PIECES = 2_000
+
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class ImportSettings:
@@ -122,6 +125,15 @@ def _free_pieces(
     if chosen is None:
         chosen = max(pieces, key=lambda p: p.area)
     others = [p for p in pieces if p is not chosen and p.area >= min_cells]
+    if len(others) >= MAX_PIECES:
+        raise _fail(
+            "M019",
+            f"the map has {len(others) + 1:,} separate free pieces of at least the minimum "
+            f"area, more than {MAX_PIECES:,} (a noise or dither pattern?)",
+            grid.source,
+            hint="clean the map, or raise the minimum area (--min-area, workspace.min_area) "
+            "so that specks are dropped",
+        )
     others.sort(key=lambda p: (-p.area, p.bounds))
     return chosen, others
 
