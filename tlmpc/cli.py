@@ -19,6 +19,7 @@ import signal
 import sys
 import threading
 import typing
+import warnings
 from collections.abc import Sequence
 from types import ModuleType
 from typing import Any, TextIO
@@ -225,7 +226,11 @@ def _main(argv: Sequence[str] | None, out: TextIO, err: TextIO) -> int:
     err.write(usage.getvalue())
     reporter = Reporter.for_args(args, out, err)
     try:
-        result: int = args._run(args, out, err)
+        with warnings.catch_warnings():
+            # Floating-point overflow on extreme inputs is numpy's and shapely's business: the
+            # inputs are checked and refused with diagnostics, never with a screen of warnings.
+            warnings.filterwarnings("ignore", category=RuntimeWarning)
+            result: int = args._run(args, out, err)
         return result
     except TlmpcError as exc:
         return reporter.fail(exc)
