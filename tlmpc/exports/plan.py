@@ -58,7 +58,7 @@ def read_plan(directory: Path) -> Plan:
     from tlmpc.io.artifacts import read_artifacts
 
     for name in ("trace.json", "mission.json"):
-        if not (directory / name).is_file():
+        if not (directory / name).exists():
             raise _fail(
                 "M080",
                 f"{directory} has no {name}",

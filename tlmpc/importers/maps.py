@@ -272,7 +272,7 @@ def _check_settings(settings: ImportSettings, file: str) -> None:
                 hint="--radius, --tolerance and --min-area are lengths and areas in map units",
             )
     if settings.start is not None and not all(math.isfinite(v) for v in settings.start):
-        raise _fail("M017", f"the start must be finite, got {settings.start}", file)
+        raise _fail("M018", f"the start must be finite, got {settings.start}", file)
 
 
 def import_map(
