@@ -13,8 +13,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from conftest import MAP_YAML, write_map
-from hostile_harness import run_hostile
+from hostile_harness import (  # noqa: F401 (fixtures, found by their names)
+    MAP_YAML,
+    compiled_fixture,
+    compiled_once_fixture,
+    room_map_fixture,
+    run_hostile,
+    work_fixture,
+    write_map,
+)
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 

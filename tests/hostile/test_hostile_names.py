@@ -14,7 +14,14 @@ import xml.etree.ElementTree as ElementTree
 from pathlib import Path
 
 import yaml
-from hostile_harness import FORBIDDEN, run_hostile
+from hostile_harness import (  # noqa: F401 (fixtures, found by their names)
+    FORBIDDEN,
+    compiled_fixture,
+    compiled_once_fixture,
+    room_map_fixture,
+    run_hostile,
+    work_fixture,
+)
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 

@@ -7,7 +7,13 @@ import os
 from pathlib import Path
 
 import pytest
-from hostile_harness import run_hostile
+from hostile_harness import (  # noqa: F401 (fixtures, found by their names)
+    compiled_fixture,
+    compiled_once_fixture,
+    room_map_fixture,
+    run_hostile,
+    work_fixture,
+)
 
 ROOT = Path(__file__).resolve().parents[2]
 
