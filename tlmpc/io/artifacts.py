@@ -421,6 +421,16 @@ def _cross_check_results(
             _indices([s["triangle"], s["next_triangle"] or 0], triangles) for s in steps
         ):
             raise _tampered(path, "controllers.json: a step names a missing triangle")
+        # the steps are one path: each leaves into the triangle of the next (the last into
+        # the loop's first, unless it is a final stay)
+        successor = [*(s["triangle"] for s in steps[1:]), None]
+        if loop is not None:
+            successor[-1] = steps[loop]["triangle"]
+        if any(
+            s["next_triangle"] is not None and s["next_triangle"] != after
+            for s, after in zip(steps, successor, strict=True)
+        ) or (loop is None and not steps[-1]["stay"]):
+            raise _tampered(path, "controllers.json: the steps do not follow one another")
         witness = documents.get("witness.json")
         if witness is not None and len(steps) != len(witness["prefix"]) + len(witness["cycle"]):
             raise _tampered(
