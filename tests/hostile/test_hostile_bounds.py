@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import signal
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -150,7 +151,7 @@ wrong_values = st.one_of(
 
 @given(value=wrong_values)
 def test_wrong_typed_api_arguments_are_usage_errors(value: Any) -> None:
-    calls = [
+    calls: list[Callable[[], object]] = [
         lambda: tlmpc.compile(value),
         lambda: tlmpc.check(value),
         lambda: tlmpc.translate(value),
