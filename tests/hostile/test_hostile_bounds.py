@@ -164,3 +164,19 @@ def test_wrong_typed_api_arguments_are_usage_errors(value: Any) -> None:
             call()
         assert caught.value.diagnostics[0].code == "U075"
         assert caught.value.exit_code == 2
+
+
+@pytest.mark.parametrize(("number", "code"), [(signal.SIGTERM, 143), (signal.SIGINT, 130)])
+def test_a_signal_disguised_by_c_code_still_ends_the_run(
+    monkeypatch: pytest.MonkeyPatch, number: signal.Signals, code: int
+) -> None:
+    # numpy's C import turns an exception raised by a signal handler into an ImportError
+    def disguised(*args: object) -> int:
+        try:
+            signal.raise_signal(number)
+        except BaseException as exc:
+            raise ImportError("numpy._core.multiarray failed to import") from exc
+        return 0
+
+    monkeypatch.setattr("tlmpc.commands.automaton.run", disguised)
+    assert tlmpc.cli.main(["automaton", "G a"]) == code
