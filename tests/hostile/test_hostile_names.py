@@ -26,6 +26,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from tlmpc.base.errors import error
+from tlmpc.io.outputs import plain_name
 
 HOSTILE_CHARS = [
     "\n",
@@ -97,9 +98,12 @@ def test_waypoints_csv_has_exactly_its_rows(compiled: Path, work: Path, name: st
     for row in rows[1:]:
         assert len(row) == 4
         [float(cell) for cell in row]  # numbers only: no injected cell
-    # the comment, read as CSV, is one cell or a neutralised one: no cell a spreadsheet runs
-    for cell in next(csv.reader(io.StringIO(comments[0]))):
-        assert not cell.lstrip().startswith(("=", "+", "@")) or cell.startswith("'"), cell
+    # the comment, read as CSV: its first cell, and the name as one neutralised cell
+    cells = next(csv.reader(io.StringIO(comments[0])))
+    assert cells[0] == "# tlmpc.waypoints/1 mission"
+    assert len(cells) == 2
+    shown = plain_name(name)
+    assert cells[1] == ("'" + shown if shown.startswith(("=", "+", "-", "@", "\t")) else shown)
 
 
 @FEW

@@ -65,10 +65,11 @@ def _yaml_float(value: float) -> str:
 def waypoints_csv(plan: Plan, points: list[Waypoint], loop: int | None) -> str:
     """``t,x,y,yaw`` rows; comment lines give the mission and the loop start (row index).
 
-    The mission's name is one neutralised CSV cell: a name with newlines, separators or a
-    leading ``=`` can add neither a row nor a formula."""
+    The mission's name is the second cell of the first comment line, one neutralised CSV cell
+    (a name's separators, quotes or newlines inside the text of the first cell would start new
+    cells there, where quoting does not work): it adds neither a row nor a formula."""
     out = io.StringIO()
-    out.write(f"# tlmpc.waypoints/1 mission {csv_cell(plan.name)}\n")
+    out.write(f"# tlmpc.waypoints/1 mission,{csv_cell(plan.name)}\n")
     out.write(f"# loop_start: {'none' if loop is None else loop}\n")
     out.write("t,x,y,yaw\n")
     for w in points:
