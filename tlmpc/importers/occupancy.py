@@ -96,7 +96,17 @@ def _number(meta: dict[str, Any], key: str, file: str, default: float | None = N
             hint="a map_server map needs image, resolution, origin, occupied_thresh, free_thresh",
         )
     if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise _fail("M004", f"`{key}` is not a finite number: {brief(value)}", file)
+        hint = None
+        if isinstance(value, str):
+            try:
+                float(value)
+                hint = (
+                    "YAML 1.1 reads this as text: write it with a decimal point and a signed "
+                    "exponent, e.g. 1.0e-3"
+                )
+            except ValueError:
+                pass
+        raise _fail("M004", f"`{key}` is not a finite number: {brief(value)}", file, hint=hint)
     return float(value)
 
 
