@@ -189,7 +189,7 @@ def _run_one(args: argparse.Namespace, path: Path, out: TextIO, err: TextIO) -> 
             frame=args.frame,
         )
     else:
-        document = read_json(path)
+        document = read_json(path, finite=False)
         trace = from_document(document, file=str(path), convention=args.boundary)
     trace = declare_ending(trace, assume_stay=args.assume_stay, loop_from=args.loop_from)
     verdict = verify_trace(trace)

@@ -665,7 +665,7 @@ def compilation_from_artifacts(directory: Path, needed: Sequence[Product[Any]]) 
     Every artifact is checked against its schema first; a missing or invalid one is a
     diagnostic naming the file.
     """
-    from tlmpc.io.artifacts import read_artifact
+    from tlmpc.io.artifacts import cross_check, read_artifact
 
     products: dict[Product[Any], Any] = {}
     documents: dict[str, Any] = {}
@@ -680,9 +680,11 @@ def compilation_from_artifacts(directory: Path, needed: Sequence[Product[Any]]) 
                     hint="run the earlier stages first (tlmpc compile --until ...)",
                 )
             )
-        document = read_artifact(path, product.schema)
-        products[product] = product.read(document)
-        documents[product.artifact] = document
+        documents[product.artifact] = read_artifact(path, product.schema)
+    # before any is used: the artifacts must agree (indices in range, one mission)
+    cross_check(directory, documents)
+    for product in needed:
+        products[product] = product.read(documents[product.artifact])
     source = Path(str(documents.get("mission.json", {}).get("source") or directory))
     return Compilation(source=source, products=products, documents=documents)
 
