@@ -4,15 +4,16 @@ robustness that agrees with the verdict, and the certificate for the real robot.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 import shapely
 
-from tlmpc.ltl.ast import And, Formula
+from tlmpc.ltl.ast import And, Formula, bounded_operators
 from tlmpc.ltl.printer import to_text
-from tlmpc.verify.evaluate import UNKNOWN, IntervalEvaluator, Value, truth_atoms
+from tlmpc.verify.evaluate import Value, truth_atoms
 from tlmpc.verify.model import (
     Certificate,
     ConjunctReport,
@@ -23,12 +24,8 @@ from tlmpc.verify.model import (
 )
 from tlmpc.verify.pieces import Pieces, build_pieces, merge_pieces, region_membership
 from tlmpc.verify.progress import Timeline, conjunct_reports
-from tlmpc.verify.robustness import (
-    evaluate_with_ending,
-    piece_atoms,
-    tube_atoms,
-    tube_radii,
-)
+from tlmpc.verify.robustness import piece_atoms, tube_atoms, tube_radii
+from tlmpc.verify.semantics import PieceEnding, Semantics, Timing
 from tlmpc.verify.trace_input import TraceInput
 
 FloatArray = npt.NDArray[np.float64]
@@ -70,34 +67,64 @@ def _last_point_unknown(
     return unknown
 
 
-class _Truth:
-    """Three-valued truth on the pieces, with the unknown future after an open log."""
+def _piece_ending(trace: TraceInput, pieces: Pieces) -> PieceEnding:
+    if trace.ending == "open":
+        return "open"
+    if pieces.loop_start is not None:
+        return pieces.loop_start
+    return "stay"
 
-    def __init__(
-        self, trace: TraceInput, pieces: Pieces, names: list[str], unknown: BoolArray | None
-    ) -> None:
-        size = len(pieces.is_point)
-        self.size = size
-        is_point = pieces.is_point if trace.convention == "closed" else None
-        atoms = truth_atoms(pieces.labels, names, unknown)
-        if trace.ending == "open":
 
-            def padded(name: str) -> Value:
-                lo, hi = atoms(name)
-                return np.append(lo, UNKNOWN[0]), np.append(hi, UNKNOWN[1])
+def _sample_cells(
+    trace: TraceInput, atoms: Callable[[str], Value]
+) -> tuple[Callable[[str], Value], int, PieceEnding, Timing]:
+    """The samples as a dense-time signal: sample i holds from the middle of the gap before
+    it to the middle of the gap after it; at a middle instant either neighbour's bounds hold,
+    so their hull is taken.  A loop's last sample is the wrap back to its first."""
+    times = trace.times
+    n = len(times)
+    middles = (times[:-1] + times[1:]) / 2.0
+    loop = trace.loop_start if trace.ending == "loop" else None
+    # instants: T_0, the middles, T_last; a loop's first sample's time is an instant too (the
+    # loop returns to it), and its last sample is no instant (the wrap).
+    instants = [float(times[0])]
+    owners: list[tuple[int, int]] = [(0, 0)]  # the samples whose hull holds at the instant
+    stretch: list[int] = []  # the sample of the open stretch after each instant
+    loop_instant = 0
+    for i in range(1, n):
+        stretch.append(i - 1)
+        instants.append(float(middles[i - 1]))
+        owners.append((i - 1, i))
+        if loop is not None and i == loop:
+            stretch.append(i)
+            instants.append(float(times[i]))
+            owners.append((i, i))
+            loop_instant = len(instants) - 1
+    stretch.append(n - 1)
+    if loop is None:
+        instants.append(float(times[-1]))
+        owners.append((n - 1, n - 1))
+    first = np.array([o[0] for o in owners])
+    second = np.array([o[1] for o in owners])
+    stretch_of = np.array(stretch)
+    size = len(instants) + len(stretch)
+    starts = np.empty(size)
+    starts[0::2] = instants
+    starts[1::2] = np.asarray(instants)[: len(stretch)]
 
-            points = None if is_point is None else np.append(is_point, False)
-            self.evaluator = IntervalEvaluator(padded, size + 1, size, points)
-        else:
-            loop = pieces.loop_start if pieces.loop_start is not None else size - 1
-            self.evaluator = IntervalEvaluator(atoms, size, loop, is_point)
+    def cells(name: str) -> Value:
+        lo, hi = atoms(name)
+        out_lo, out_hi = np.empty(size), np.empty(size)
+        out_lo[0::2] = np.minimum(lo[first], lo[second])
+        out_hi[0::2] = np.maximum(hi[first], hi[second])
+        out_lo[1::2], out_hi[1::2] = lo[stretch_of], hi[stretch_of]
+        return out_lo, out_hi
 
-    def __call__(self, formula: Formula) -> Value:
-        return self.evaluator(formula)
-
-    def outcome(self, formula: Formula) -> Outcome:
-        lo, hi = self.evaluator(formula)
-        return _outcome(float(lo[0]), float(hi[0]))
+    if loop is not None:
+        ending: PieceEnding = 2 * loop_instant
+    else:
+        ending = "stay" if trace.ending == "stay" else "open"
+    return cells, size, ending, Timing(starts, float(times[-1]))
 
 
 def _free_space(trace: TraceInput) -> shapely.Geometry | None:
@@ -251,11 +278,19 @@ def certify(trace: TraceInput, regions: dict[str, FloatArray], outcome: Outcome)
     bound = float(radii.max())
     if outcome == "inconclusive":
         return refuse("an inconclusive verdict has nothing to certify", bound)
-    loop = {"loop": trace.loop_start, "stay": len(times) - 1, "open": None}[trace.ending]
-    lo, hi = evaluate_with_ending(
-        trace.formula, tube_atoms(regions, points, radii), len(times), loop
-    )
-    margin = float(lo[0]) if outcome == "satisfied" else -float(hi[0])
+    atoms = tube_atoms(regions, points, radii)
+    if bounded_operators(trace.formula):
+        cells, size, ending, timing = _sample_cells(trace, atoms)
+        tube = Semantics(cells, size, ending, timing=timing)
+    else:
+        samples: PieceEnding = "open"
+        if trace.ending == "loop":
+            samples = trace.loop_start or 0
+        elif trace.ending == "stay":
+            samples = len(times) - 1
+        tube = Semantics(atoms, len(times), samples)
+    lo, hi = tube.at_start(trace.formula)
+    margin = lo if outcome == "satisfied" else -hi
     certified = margin > 0
     if certified:
         reason = (
@@ -289,11 +324,20 @@ def verify_trace(trace: TraceInput) -> Verdict:
     loop_start = trace.loop_start if trace.ending == "loop" else None
     pieces = build_pieces(trace.times, trace.points, loop_start, regions, trace.convention)
     unknown = _last_point_unknown(trace, pieces, regions)
-    truth = _Truth(trace, pieces, names, unknown)
-    task_outcome = truth.outcome(trace.formula)
-    conjuncts = _conjuncts(trace.formula)
-    outcomes = [truth.outcome(c) for c in conjuncts]
     size = len(pieces.is_point)
+    ending = _piece_ending(trace, pieces)
+    is_point = pieces.is_point if trace.convention == "closed" else None
+    timing = Timing(pieces.times, float(trace.times[-1]))
+    truth = Semantics(
+        truth_atoms(pieces.labels, names, unknown),
+        size,
+        ending,
+        is_point=is_point,
+        timing=timing,
+    )
+    task_outcome = _outcome(*truth.at_start(trace.formula))
+    conjuncts = _conjuncts(trace.formula)
+    outcomes = [_outcome(*truth.at_start(c)) for c in conjuncts]
     ends = np.append(pieces.times[1:], pieces.times[-1])
     if loop_start is not None and size:
         ends[-1] = trace.times[-1]
@@ -308,20 +352,15 @@ def verify_trace(trace: TraceInput) -> Verdict:
     excursions, workspace_rho = workspace_violations(trace)
     outcome: Outcome = "violated" if excursions else task_outcome
     # Robustness on the same pieces and recursion as the truth: the signs agree.
-    is_point = pieces.is_point if trace.convention == "closed" else None
-    loop = (
-        None
-        if trace.ending == "open"
-        else (pieces.loop_start if pieces.loop_start is not None else size - 1)
-    )
-    lo, hi = evaluate_with_ending(
-        trace.formula,
+    space = Semantics(
         piece_atoms(regions, pieces.positions, pieces.labels, unknown),
         size,
-        loop,
-        is_point,
+        ending,
+        is_point=is_point,
+        timing=timing,
     )
-    rho = float(lo[0]) if lo[0] > 0 else float(hi[0]) if hi[0] < 0 else 0.0
+    lo, hi = space.at_start(trace.formula)
+    rho = lo if lo > 0 else hi if hi < 0 else 0.0
     if excursions and workspace_rho is not None:
         rho = min(rho, workspace_rho)
     certificate = certify(trace, regions, task_outcome)
