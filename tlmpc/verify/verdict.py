@@ -3,6 +3,7 @@ robustness that agrees with the verdict, and the certificate for the real robot.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable
 from typing import Any
@@ -11,7 +12,7 @@ import numpy as np
 import numpy.typing as npt
 import shapely
 
-from tlmpc.ltl.ast import And, Formula, bounded_operators
+from tlmpc.ltl.ast import And, Formula, Globally, bounded_operators
 from tlmpc.ltl.printer import to_text
 from tlmpc.verify.evaluate import Value, truth_atoms
 from tlmpc.verify.model import (
@@ -23,9 +24,10 @@ from tlmpc.verify.model import (
     Violation,
 )
 from tlmpc.verify.pieces import Pieces, build_pieces, merge_pieces, region_membership
-from tlmpc.verify.progress import Timeline, conjunct_reports
+from tlmpc.verify.progress import Timeline, conjunct_reports, runs, timed_progress
 from tlmpc.verify.robustness import piece_atoms, tube_atoms, tube_radii
 from tlmpc.verify.semantics import PieceEnding, Semantics, Timing
+from tlmpc.verify.time_robustness import horizon, time_robustness
 from tlmpc.verify.trace_input import TraceInput
 
 FloatArray = npt.NDArray[np.float64]
@@ -125,6 +127,97 @@ def _sample_cells(
     else:
         ending = "stay" if trace.ending == "stay" else "open"
     return cells, size, ending, Timing(starts, float(times[-1]))
+
+
+def _with_time_robustness(
+    report: ConjunctReport,
+    conjunct: Formula,
+    outcome_of: Callable[[Formula], Outcome],
+    truth: Semantics,
+    line: Timeline,
+    duration: float,
+) -> ConjunctReport:
+    """``report`` with the conjunct's time robustness and, for a bounded one, its progress."""
+    if not bounded_operators(conjunct):
+        return report
+    slack = time_robustness(conjunct, report.outcome, outcome_of, horizon(conjunct, duration))
+    first_broken = None
+    if isinstance(conjunct, Globally):
+        broken = np.flatnonzero(truth(conjunct.arg)[1][: line.size] < 0)
+        if len(broken):
+            first_broken = float(line.starts[int(broken[0])])
+    progress = timed_progress(conjunct, report.outcome, slack, first_broken)
+    return dataclasses.replace(
+        report, time_robustness=slack, progress=progress if progress else report.progress
+    )
+
+
+def _timed_violations(
+    conjuncts: list[Formula],
+    reports: list[ConjunctReport],
+    found: list[Violation],
+    truth: Semantics,
+    trace: TraceInput,
+) -> list[Violation]:
+    """The violations of conjuncts with time bounds, in dense time: for ``G x``, each maximal
+    stretch of instants where ``x`` fails (exact ends); for the others, their progress."""
+    timed = {
+        to_text(c): (c, r)
+        for c, r in zip(conjuncts, reports, strict=True)
+        if bounded_operators(c) and r.outcome == "violated"
+    }
+    if not timed:
+        return found
+    kept = [v for v in found if v.conjunct not in timed]
+    for text, (conjunct, report) in timed.items():
+        if not isinstance(conjunct, Globally):
+            kept.append(
+                Counterexample(
+                    conjunct=text, time=None, position=None, message=f"`{text}`: {report.progress}"
+                )
+            )
+            continue
+        signal = truth.dense().signal(conjunct.arg)
+        stretches = _failing_stretches(signal.times, signal.hi, truth.dense().domain.end)
+        for start, end in stretches[:MAX_STRETCHES]:
+            x = float(np.interp(start, trace.times, trace.points[:, 0]))
+            y = float(np.interp(start, trace.times, trace.points[:, 1]))
+            when = (
+                f"at t={start:.4g} s" if end == start else f"from t={start:.4g} s to t={end:.4g} s"
+            )
+            kept.append(
+                Counterexample(
+                    conjunct=text,
+                    time=start,
+                    position=(x, y),
+                    message=f"`{to_text(conjunct.arg)}` fails {when}, starting at "
+                    f"({x:.4g}, {y:.4g}), while `{text}` must hold",
+                )
+            )
+    return kept
+
+
+#: At most this many failing stretches are listed per conjunct.
+MAX_STRETCHES = 20
+
+
+def _failing_stretches(
+    times: FloatArray, hi: FloatArray, domain_end: float
+) -> list[tuple[float, float]]:
+    """Maximal stretches ``[start, end]`` of a signal's positions where ``hi < 0`` (the last
+    open position, a tail, is left out: it is not part of the trace)."""
+    bad = hi[: 2 * len(times) - 1] < 0
+    stretches: list[tuple[float, float]] = []
+    for first, last in runs(bad):
+        start = float(times[first // 2])
+        # an instant ends where it is; an open stretch at the next instant
+        end = (
+            float(times[last // 2])
+            if last % 2 == 0
+            else float(times[last // 2 + 1] if last // 2 + 1 < len(times) else domain_end)
+        )
+        stretches.append((start, end))
+    return stretches
 
 
 def _free_space(trace: TraceInput) -> shapely.Geometry | None:
@@ -349,6 +442,19 @@ def verify_trace(trace: TraceInput) -> Verdict:
         names=names,
     )
     reports, violations = conjunct_reports(conjuncts, outcomes, truth, line)
+
+    def outcome_of(formula: Formula) -> Outcome:
+        return _outcome(*truth.at_start(formula))
+
+    duration = float(trace.times[-1] - trace.times[0])
+    reports = [
+        _with_time_robustness(report, conjunct, outcome_of, truth, line, duration)
+        for report, conjunct in zip(reports, conjuncts, strict=True)
+    ]
+    violations = _timed_violations(conjuncts, reports, violations, truth, trace)
+    task_slack = time_robustness(
+        trace.formula, task_outcome, outcome_of, horizon(trace.formula, duration)
+    )
     excursions, workspace_rho = workspace_violations(trace)
     outcome: Outcome = "violated" if excursions else task_outcome
     # Robustness on the same pieces and recursion as the truth: the signs agree.
@@ -381,6 +487,7 @@ def verify_trace(trace: TraceInput) -> Verdict:
         convention=trace.convention,
         ending=trace.ending,
         robustness=rho,
+        time_robustness=task_slack,
         certificate=certificate,
         pieces=len(merged.is_point),
         conjuncts=tuple(reports),
@@ -414,6 +521,7 @@ def _report(report: ConjunctReport) -> dict[str, Any]:
         "visits": report.visits,
         "last_visit": report.last_visit,
         "longest_gap": report.longest_gap,
+        "time_robustness": _number(report.time_robustness),
     }
 
 
@@ -428,6 +536,7 @@ def verdict_to_json(verdict: Verdict) -> dict[str, Any]:
         "boundary": verdict.convention,
         "ending": verdict.ending,
         "robustness": _number(verdict.robustness),
+        "time_robustness": _number(verdict.time_robustness),
         "certificate": {
             "certified": certificate.certified,
             "bound": certificate.bound,
