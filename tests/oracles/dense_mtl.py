@@ -143,9 +143,7 @@ def _evaluate(
     def negate(value: tuple[list[bool], int]) -> tuple[list[bool], int]:
         return [not v for v in value[0]], value[1]
 
-    def combine(
-        parts: list[tuple[list[bool], int]], op: str
-    ) -> tuple[list[bool], int]:
+    def combine(parts: list[tuple[list[bool], int]], op: str) -> tuple[list[bool], int]:
         limit = min(p[1] for p in parts)
         rows = list(zip(*(p[0] for p in parts), strict=True))
         if op == "and":

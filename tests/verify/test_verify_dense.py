@@ -144,13 +144,17 @@ def _check(formula: Formula, trace: TickTrace) -> None:
 
 @settings(deadline=None)
 @given(bounded_formulas(), tick_traces(loop=False))
-def test_bounded_operators_on_stays_match_the_definition(formula: Formula, trace: TickTrace) -> None:
+def test_bounded_operators_on_stays_match_the_definition(
+    formula: Formula, trace: TickTrace
+) -> None:
     _check(formula, trace)
 
 
 @settings(deadline=None)
 @given(bounded_formulas(), tick_traces(loop=True))
-def test_bounded_operators_on_loops_match_the_definition(formula: Formula, trace: TickTrace) -> None:
+def test_bounded_operators_on_loops_match_the_definition(
+    formula: Formula, trace: TickTrace
+) -> None:
     _check(formula, trace)
 
 
