@@ -41,7 +41,7 @@ from tlmpc.ltl.ast import (
 from tlmpc.ltl.parser import parse_ltl
 from tlmpc.ltl.printer import to_text
 from tlmpc.verify.evaluate import truth_atoms
-from tlmpc.verify.semantics import Semantics, Timing, three_valued
+from tlmpc.verify.semantics import PieceEnding, Semantics, Timing, three_valued
 
 PROPS = ("a", "b")
 QUANTUM = 0.25
@@ -98,14 +98,14 @@ def _labels(word: tuple[frozenset[str], ...]) -> npt.NDArray[np.bool_]:
     )
 
 
-def ours(formula: Formula, trace: TickTrace, ending: str | None = None) -> Semantics:
+def ours(formula: Formula, trace: TickTrace, ending: PieceEnding | None = None) -> Semantics:
     """The verifier's evaluator on ``trace`` (``ending`` overrides: ``open``)."""
     starts = np.repeat(np.asarray(trace.breaks, dtype=np.float64) * TICK, 2)
     size = len(trace.letters)
     starts = starts[:size]
     is_point = np.zeros(size, dtype=bool)
     is_point[0::2] = True
-    chosen: int | str
+    chosen: PieceEnding
     if ending is not None:
         chosen = ending
     elif trace.loop is None:
