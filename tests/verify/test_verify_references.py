@@ -102,7 +102,8 @@ def _rtamt_at_start(formula: Formula, trace: TickTrace) -> float:
         # the letter of the stretch after each instant (right-continuous), and the last's own
         values = [trace.letters[2 * i + 1] for i in range(len(trace.breaks) - 1)]
         values.append(trace.letters[-1])
-        samples = [[t * TICK, 1.0 if p in v else -1.0] for t, v in zip(trace.breaks, values, strict=True)]
+        pairs = zip(trace.breaks, values, strict=True)
+        samples = [[t * TICK, 1.0 if p in v else -1.0] for t, v in pairs]
         signals.append([p, samples])
     result = spec.evaluate(*signals)
     return float(result[0][1])
