@@ -7,6 +7,7 @@ inconclusive, 2 when the trace cannot be read.
 from __future__ import annotations
 
 import argparse
+import math
 from pathlib import Path
 from typing import TYPE_CHECKING, TextIO
 
@@ -124,9 +125,13 @@ def _text(path: Path, verdict: Verdict) -> str:
     for violation in verdict.violations:
         lines.append(f"  violation: {violation.message}")
     lines.append(f"  robustness: {verdict.robustness:.6g}")
-    if verdict.time_robustness is not None:
+    slack = verdict.time_robustness
+    if slack is not None and math.isinf(slack):
+        decided = "holds" if slack > 0 else "fails"
+        lines.append(f"  time robustness: {slack:g} (the task {decided} at any time bound)")
+    elif slack is not None:
         lines.append(
-            f"  time robustness: {verdict.time_robustness:.6g} s "
+            f"  time robustness: {slack:.6g} s "
             "(how much tighter the time bounds could be; < 0: how much looser they must be)"
         )
     certificate = verdict.certificate

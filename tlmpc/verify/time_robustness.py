@@ -156,4 +156,7 @@ def time_robustness(
             low = middle
         else:
             high = middle
-    return low if outcome == "satisfied" else -high
+    # The edge is known to reach / 2**STEPS; twelve significant digits say no more than that
+    # (and print -0.5 rather than -0.49999999999999983).
+    found = low if outcome == "satisfied" else -high
+    return float(f"{found:.12g}")
