@@ -11,6 +11,7 @@ from __future__ import annotations
 import io
 import json
 import math
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -26,7 +27,7 @@ RUN = [[0, 0, 5], [20, 20, 5]]  # x = t for 20 s
 BACK_AND_FORTH = [[0, 0, 5], [20, 20, 5], [40, 0, 5]]  # a at [4, 6] and [34, 36] of 40 s
 
 
-def document(points: list[list[float]], ltl: str, **extra: Any) -> dict[str, Any]:
+def document(points: Sequence[Sequence[float]], ltl: str, **extra: Any) -> dict[str, Any]:
     """A trace document over ``a`` and ``b`` in a 20 x 10 workspace."""
     base = {
         "format": "tlmpc.trace/1",
