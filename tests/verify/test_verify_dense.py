@@ -11,32 +11,16 @@ violated must hold for every continuation drawn.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import numpy.typing as npt
 import pytest
 from dense_mtl import TickTrace, dense_values
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from strategies import bounded_formulas
 
 from tlmpc.ltl.ast import (
-    FALSE,
-    TRUE,
-    And,
-    BoundedEventually,
-    BoundedGlobally,
-    BoundedUntil,
-    Eventually,
     Formula,
-    Globally,
-    Implies,
-    Interval,
-    Not,
-    Or,
-    Prop,
-    Release,
-    Until,
 )
 from tlmpc.ltl.parser import parse_ltl
 from tlmpc.ltl.printer import to_text
@@ -48,31 +32,6 @@ QUANTUM = 0.25
 TICK = QUANTUM / 2
 
 letters = st.frozensets(st.sampled_from(PROPS))
-lows = st.sampled_from([0.0, 0.25, 0.5, 1.0])
-widths = st.sampled_from([0.0, 0.25, 0.5, 1.0, 2.0, math.inf])
-intervals = st.builds(lambda low, width: Interval(low, low + width), lows, widths)
-
-
-def bounded_formulas(max_leaves: int = 6) -> st.SearchStrategy[Formula]:
-    """Random formulas over ``a``, ``b`` with bounded and untimed operators."""
-    leaves = st.one_of(st.sampled_from([Prop(p) for p in PROPS]), st.sampled_from([TRUE, FALSE]))
-
-    def extend(inner: st.SearchStrategy[Formula]) -> st.SearchStrategy[Formula]:
-        return st.one_of(
-            st.builds(BoundedEventually, inner, intervals),
-            st.builds(BoundedGlobally, inner, intervals),
-            st.builds(BoundedUntil, inner, inner, intervals),
-            st.builds(Not, inner),
-            st.builds(lambda a, b: And((a, b)), inner, inner),
-            st.builds(lambda a, b: Or((a, b)), inner, inner),
-            st.builds(Implies, inner, inner),
-            st.builds(Eventually, inner),
-            st.builds(Globally, inner),
-            st.builds(Until, inner, inner),
-            st.builds(Release, inner, inner),
-        )
-
-    return st.recursive(leaves, extend, max_leaves=max_leaves)
 
 
 @st.composite

@@ -180,6 +180,9 @@ class Interval:
     high: float
 
     def __post_init__(self) -> None:
+        # seconds are floats, however given (Interval(0, 5) equals Interval(0.0, 5.0) anyway)
+        object.__setattr__(self, "low", float(self.low))
+        object.__setattr__(self, "high", float(self.high))
         if not (0.0 <= self.low <= self.high) or self.low == float("inf"):
             raise ValueError(f"not an interval of seconds: [{self.low}, {self.high}]")
 
