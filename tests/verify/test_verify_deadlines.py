@@ -9,6 +9,7 @@ boundary conventions.
 from __future__ import annotations
 
 import io
+import itertools
 import json
 import math
 from collections.abc import Sequence
@@ -16,6 +17,8 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from tlmpc.cli import main
 from tlmpc.io.schema_check import validation_errors
@@ -192,3 +195,48 @@ def test_compile_refuses_time_bounds_at_the_operator(tmp_path: Path) -> None:
     code, out, err = run("automaton", "G F[0,5] a")
     assert code == 1
     assert "<formula>:1:3: error[L045]" in out + err
+
+
+@st.composite
+def sparse_runs(draw: st.DrawFn) -> tuple[list[list[float]], list[list[float]]]:
+    """Samples of a run along y = 5 at speed <= 1, and a motion through them that detours."""
+    x = draw(st.floats(0.5, 3))
+    samples = [[0.0, x, 5.0]]
+    for step in range(1, draw(st.integers(3, 12))):
+        x = min(19.5, max(0.5, x + draw(st.sampled_from([-0.75, 0.0, 0.5, 1.0]))))
+        samples.append([float(step), x, 5.0])
+    motion = [samples[0]]
+    for before, after in itertools.pairwise(samples):
+        budget = after[0] - before[0]  # at speed 1
+        room = (budget - abs(after[1] - before[1])) / 2
+        detour = draw(st.floats(-1, 1)) * room
+        turn = (before[1] + after[1]) / 2 + detour
+        first = abs(turn - before[1])
+        total = first + abs(after[1] - turn)
+        share = 0.5 if total == 0 else first / total
+        motion.append([before[0] + share * budget, turn, 5.0])
+        motion.append(after)
+    return samples, motion
+
+
+@settings(deadline=None, max_examples=60)
+@given(sparse_runs(), st.sampled_from(["F[0,4] a", "G[0,3] !a", "G F[0,4] (a | b)", "F G[0,1] a"]))
+def test_certified_verdicts_hold_for_every_motion(
+    runs: tuple[list[list[float]], list[list[float]]], ltl: str
+) -> None:
+    samples, motion = runs
+    verdict = verify_document(document(samples, ltl, max_speed=1.0))
+    if not verdict.certified:
+        return
+    for convention in ("right", "closed"):
+        other = verify_document(document(motion, ltl, max_speed=1.0), boundary=convention)
+        assert other.outcome == verdict.outcome, (ltl, samples, motion)
+
+
+def test_dense_samples_certify_a_deadline() -> None:
+    samples = [[t / 2, t / 2, 5.0] for t in range(41)]
+    verdict = verify_document(document(samples, "F[0,5] a", max_speed=1.0))
+    assert verdict.outcome == "satisfied"
+    assert verdict.certified
+    assert verdict.certificate.margin is not None
+    assert math.isclose(verdict.certificate.margin, 0.75, abs_tol=1e-9)
