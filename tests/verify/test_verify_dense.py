@@ -17,11 +17,9 @@ import pytest
 from dense_mtl import TickTrace, dense_values
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from strategies import bounded_formulas
+from strategies import bounded_formulas, intervals
 
-from tlmpc.ltl.ast import (
-    Formula,
-)
+from tlmpc.ltl.ast import BoundedUntil, Formula, Interval, Not, Or, Prop
 from tlmpc.ltl.parser import parse_ltl
 from tlmpc.ltl.printer import to_text
 from tlmpc.verify.evaluate import truth_atoms
@@ -182,3 +180,16 @@ def test_loop_deadline_over_the_wrap() -> None:
     trace = _trace("-@0 - a@8 a a@16 -", loop=0, end=24)
     assert ours(parse_ltl("G F[0,2] a"), trace).at_start(parse_ltl("G F[0,2] a"))[0] > 0
     assert ours(parse_ltl("G F[0,1.875] a"), trace).at_start(parse_ltl("G F[0,1.875] a"))[1] < 0
+
+
+literals = st.sampled_from(
+    [Prop("a"), Prop("b"), Not(Prop("a")), Not(Prop("b")), Or((Prop("a"), Prop("b")))]
+)
+
+
+@given(literals, literals, intervals, tick_traces())
+def test_bounded_until_on_literals(
+    left: Formula, right: Formula, interval: Interval, trace: TickTrace
+) -> None:
+    # single bounded untils, where the window's ends meet the instants of change most often
+    _check(BoundedUntil(left, right, interval), trace)
