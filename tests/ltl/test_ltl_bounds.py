@@ -108,3 +108,19 @@ def test_bounds_are_in_neither_planner_class() -> None:
     assert not is_cosafe(parse_ltl("F[0,5] a"))
     assert not is_safety(parse_ltl("G[0,5] a"))
     assert nnf(parse_ltl("!(a U[0,1] b)")) == Not(BoundedUntil(a, b, Interval(0, 1)))
+
+
+@pytest.mark.parametrize(
+    ("text", "normal"),
+    [
+        ("!F[0,1] a", "G[0,1] !a"),
+        ("!G[0,1] a", "F[0,1] !a"),
+        ("F[0,1] a -> b", "G[0,1] !a | b"),
+        ("!G[1,2] (a & F[0,1] b)", "F[1,2] (!a | G[0,1] !b)"),
+    ],
+)
+def test_nnf_dualises_the_bounds(text: str, normal: str) -> None:
+    formula = parse_ltl(text)
+    assert nnf(formula) == parse_ltl(normal)
+    trace = TickTrace((0, 2, 6), tuple(frozenset(s) for s in ("a", "", "b", "ab", "")))
+    assert dense_values(nnf(formula), trace, 0.25) == dense_values(formula, trace, 0.25)

@@ -240,3 +240,14 @@ def test_dense_samples_certify_a_deadline() -> None:
     assert verdict.certified
     assert verdict.certificate.margin is not None
     assert math.isclose(verdict.certificate.margin, 0.75, abs_tol=1e-9)
+
+
+def test_a_sample_on_the_boundary_is_not_certified() -> None:
+    # the straight line touches a at t = 2 only; a motion at speed 1 through the same samples
+    # runs on to x = 4.2 and back, inside a for 0.4 s
+    samples = [[0.0, 3.0, 5.0], [1.0, 3.0, 5.0], [2.0, 4.0, 5.0], [3.0, 3.4, 5.0]]
+    verdict = verify_document(document(samples, "G[0,3] !a", max_speed=1.0))
+    assert verdict.outcome == "satisfied"
+    assert not verdict.certified
+    motion = [*samples[:3], [2.2, 4.2, 5.0], samples[3]]
+    assert verify_document(document(motion, "G[0,3] !a", max_speed=1.0)).outcome == "violated"

@@ -80,9 +80,10 @@ def _piece_ending(trace: TraceInput, pieces: Pieces) -> PieceEnding:
 def _sample_cells(
     trace: TraceInput, atoms: Callable[[str], Value]
 ) -> tuple[Callable[[str], Value], int, PieceEnding, Timing]:
-    """The samples as a dense-time signal: sample i holds from the middle of the gap before
-    it to the middle of the gap after it; at a middle instant either neighbour's bounds hold,
-    so their hull is taken.  A loop's last sample is the wrap back to its first."""
+    """The samples as a dense-time signal: sample i's bounds hold from the middle of the gap
+    before it to the middle of the gap after it; at a middle instant both neighbours' bounds
+    hold (the robot is within each one's radius then), so their intersection is taken.  A
+    loop's last sample is the wrap back to its first."""
     times = trace.times
     n = len(times)
     middles = (times[:-1] + times[1:]) / 2.0
@@ -90,7 +91,7 @@ def _sample_cells(
     # instants: T_0, the middles, T_last; a loop's first sample's time is an instant too (the
     # loop returns to it), and its last sample is no instant (the wrap).
     instants = [float(times[0])]
-    owners: list[tuple[int, int]] = [(0, 0)]  # the samples whose hull holds at the instant
+    owners: list[tuple[int, int]] = [(0, 0)]  # the samples whose bounds hold at the instant
     stretch: list[int] = []  # the sample of the open stretch after each instant
     loop_instant = 0
     for i in range(1, n):
@@ -117,8 +118,8 @@ def _sample_cells(
     def cells(name: str) -> Value:
         lo, hi = atoms(name)
         out_lo, out_hi = np.empty(size), np.empty(size)
-        out_lo[0::2] = np.minimum(lo[first], lo[second])
-        out_hi[0::2] = np.maximum(hi[first], hi[second])
+        out_lo[0::2] = np.maximum(lo[first], lo[second])
+        out_hi[0::2] = np.minimum(hi[first], hi[second])
         out_lo[1::2], out_hi[1::2] = lo[stretch_of], hi[stretch_of]
         return out_lo, out_hi
 
