@@ -50,8 +50,9 @@ from tlmpc.ltl.ast import (
     bounded_operators,
 )
 
-#: Bisection steps: the search range is halved this many times.
-STEPS = 60
+#: Bisection steps: the search range (the trace's duration and the bounds) is halved this many
+#: times, to about a millionth of a millionth of it.
+STEPS = 40
 
 
 class BothPolarities(ValueError):
@@ -156,7 +157,7 @@ def time_robustness(
             low = middle
         else:
             high = middle
-    # The edge is known to reach / 2**STEPS; twelve significant digits say no more than that
-    # (and print -0.5 rather than -0.49999999999999983).
+    # The edge is known to reach / 2**STEPS; ten significant digits say no more than that (and
+    # print -0.5 rather than -0.49999999999999983).
     found = low if outcome == "satisfied" else -high
-    return float(f"{found:.12g}")
+    return float(f"{found:.10g}")

@@ -453,9 +453,12 @@ def verify_trace(trace: TraceInput) -> Verdict:
         for report, conjunct in zip(reports, conjuncts, strict=True)
     ]
     violations = _timed_violations(conjuncts, reports, violations, truth, trace)
-    task_slack = time_robustness(
-        trace.formula, task_outcome, outcome_of, horizon(trace.formula, duration)
-    )
+    if len(reports) == 1:
+        task_slack = reports[0].time_robustness  # the task is its one conjunct
+    else:
+        task_slack = time_robustness(
+            trace.formula, task_outcome, outcome_of, horizon(trace.formula, duration)
+        )
     excursions, workspace_rho = workspace_violations(trace)
     outcome: Outcome = "violated" if excursions else task_outcome
     # Robustness on the same pieces and recursion as the truth: the signs agree.
