@@ -188,6 +188,8 @@ class DenseSemantics:
         """A signal on the trace's own pieces (plus the tail after a stay or an open log)."""
         if self.ending == "open":
             lo, hi = np.append(lo, UNKNOWN[0]), np.append(hi, UNKNOWN[1])
+        elif self.ending == "stay" and lo is hi:  # two-valued: one array for both ends
+            lo = hi = np.append(lo, lo[-1])
         elif self.ending == "stay":
             lo, hi = np.append(lo, lo[-1]), np.append(hi, hi[-1])
         return Signal(self.base_times, np.asarray(lo, np.float64), np.asarray(hi, np.float64))
@@ -216,6 +218,9 @@ class DenseSemantics:
         positions = np.empty(2 * len(times), dtype=np.int64)
         positions[0::2] = point
         positions[1::2] = stretch
+        if signal.lo is signal.hi:
+            both = signal.lo[positions]
+            return both, both
         return signal.lo[positions], signal.hi[positions]
 
     def _common(self, signals: list[Signal]) -> tuple[FloatArray, list[Value]]:
@@ -309,7 +314,10 @@ class DenseSemantics:
         starts = np.concatenate([starts, np.tile(starts[first:], copies) + shifts])
         ends = np.concatenate([ends, np.tile(ends[first:], copies) + shifts])
         lo = np.concatenate([signal.lo, np.tile(signal.lo[first:], copies)])
-        hi = np.concatenate([signal.hi, np.tile(signal.hi[first:], copies)])
+        if signal.lo is signal.hi:
+            hi = lo
+        else:
+            hi = np.concatenate([signal.hi, np.tile(signal.hi[first:], copies)])
         is_point = np.concatenate([is_point, np.tile(is_point[first:], copies)])
         return starts, ends, lo, hi, is_point
 
@@ -355,7 +363,7 @@ class DenseSemantics:
         first = np.searchsorted(left_key, queries, side="left").astype(np.int64)
         last = (np.searchsorted(right_key, queries, side="right") - 1).astype(np.int64)
         out_lo = _range_reduce(lo, first, last, use_max)
-        out_hi = _range_reduce(hi, first, last, use_max)
+        out_hi = out_lo if signal.lo is signal.hi else _range_reduce(hi, first, last, use_max)
         if domain.loop_time is None:
             # On the tail the window lies wholly in it: its constant value.
             out_lo[-1], out_hi[-1] = signal.lo[-1], signal.hi[-1]

@@ -111,6 +111,24 @@ def tighten(formula: Formula, amount: float, positive: bool = True) -> Formula:
             assert_never(formula)
 
 
+def reach(formula: Formula) -> float:
+    """How far past t the value of ``formula`` at t looks: the largest sum of bounds along a
+    path of nested operators (``inf`` with an unbounded temporal operator or bound)."""
+    match formula:
+        case Const() | Prop():
+            return 0.0
+        case Not() | And() | Or() | Implies() | Equiv():
+            return max(reach(c) for c in formula.children())
+        case BoundedEventually(_, interval) | BoundedGlobally(_, interval):
+            return interval.high + max(reach(c) for c in formula.children())
+        case BoundedUntil(_, _, interval):
+            return interval.high + max(reach(c) for c in formula.children())
+        case Eventually() | Globally() | Until() | Release() | WeakUntil() | StrongRelease():
+            return math.inf
+        case _:
+            assert_never(formula)
+
+
 def horizon(formula: Formula, duration: float) -> float:
     """How far a search for the time robustness must look: the trace's duration plus every
     finite bound."""

@@ -27,7 +27,7 @@ from tlmpc.verify.pieces import Pieces, build_pieces, merge_pieces, region_membe
 from tlmpc.verify.progress import Timeline, conjunct_reports, runs, timed_progress
 from tlmpc.verify.robustness import piece_atoms, tube_atoms, tube_radii
 from tlmpc.verify.semantics import PieceEnding, Semantics, Timing
-from tlmpc.verify.time_robustness import horizon, time_robustness
+from tlmpc.verify.time_robustness import horizon, reach, time_robustness
 from tlmpc.verify.trace_input import TraceInput
 
 FloatArray = npt.NDArray[np.float64]
@@ -128,6 +128,29 @@ def _sample_cells(
     else:
         ending = "stay" if trace.ending == "stay" else "open"
     return cells, size, ending, Timing(starts, float(times[-1]))
+
+
+def _prefix_end(starts: FloatArray, span: float) -> int | None:
+    """How many pieces cover ``[T_0, T_0 + span]`` and end on an instant after it (None: the
+    trace is not longer than that)."""
+    if not math.isfinite(span):
+        return None
+    index = int(np.searchsorted(starts, starts[0] + span, side="right"))
+    if index % 2:  # the instant that ends the open piece holding T_0 + span
+        index += 1
+    if index >= len(starts):
+        return None
+    return index + 1
+
+
+def _prefix_atoms(atoms: Callable[[str], Value], cut: int) -> Callable[[str], Value]:
+    def prefix(name: str) -> Value:
+        lo, hi = atoms(name)
+        if lo is hi:
+            return lo[:cut], lo[:cut]
+        return lo[:cut], hi[:cut]
+
+    return prefix
 
 
 def _with_time_robustness(
@@ -444,8 +467,24 @@ def verify_trace(trace: TraceInput) -> Verdict:
     )
     reports, violations = conjunct_reports(conjuncts, outcomes, truth, line)
 
+    atoms = truth_atoms(pieces.labels, names, unknown)
+    prefixes: dict[int, Semantics] = {}
+
     def outcome_of(formula: Formula) -> Outcome:
-        return _outcome(*truth.at_start(formula))
+        # A formula whose operators all have finite bounds is decided at t=0 by the trace up
+        # to its reach: the searches for time robustness evaluate only that prefix.
+        cut = _prefix_end(pieces.times, reach(formula))
+        if cut is None:
+            return _outcome(*truth.at_start(formula))
+        if cut not in prefixes:
+            prefixes[cut] = Semantics(
+                _prefix_atoms(atoms, cut),
+                cut,
+                "open",
+                is_point=None if is_point is None else is_point[:cut],
+                timing=Timing(pieces.times[:cut], float(pieces.times[cut - 1])),
+            )
+        return _outcome(*prefixes[cut].at_start(formula))
 
     duration = float(trace.times[-1] - trace.times[0])
     reports = [
