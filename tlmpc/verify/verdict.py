@@ -135,10 +135,10 @@ def _prefix_end(starts: FloatArray, span: float) -> int | None:
     trace is not longer than that)."""
     if not math.isfinite(span):
         return None
+    # pieces come in pairs (an instant and the stretch after it, with one start): an even count
+    # ends on a stretch, closed by the instant at ``index``; an odd one is the whole trace
     index = int(np.searchsorted(starts, starts[0] + span, side="right"))
-    if index % 2:  # the instant that ends the open piece holding T_0 + span
-        index += 1
-    if index >= len(starts):
+    if index % 2 or index >= len(starts):
         return None
     return index + 1
 
@@ -147,7 +147,8 @@ def _prefix_atoms(atoms: Callable[[str], Value], cut: int) -> Callable[[str], Va
     def prefix(name: str) -> Value:
         lo, hi = atoms(name)
         if lo is hi:
-            return lo[:cut], lo[:cut]
+            both = lo[:cut]
+            return both, both
         return lo[:cut], hi[:cut]
 
     return prefix
