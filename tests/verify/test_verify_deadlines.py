@@ -214,7 +214,9 @@ def sparse_runs(draw: st.DrawFn) -> tuple[list[list[float]], list[list[float]]]:
         first = abs(turn - before[1])
         total = first + abs(after[1] - turn)
         share = 0.5 if total == 0 else first / total
-        motion.append([before[0] + share * budget, turn, 5.0])
+        when = before[0] + share * budget
+        if before[0] < when < after[0]:  # a turn on a sample is no detour (and no new time)
+            motion.append([when, turn, 5.0])
         motion.append(after)
     return samples, motion
 
