@@ -202,9 +202,12 @@ def _abstraction(c: Compilation) -> StageResult:
         build_abstraction,
     )
     from tlmpc.abstraction.layout import planning_layout
+    from tlmpc.ltl.bounds import refuse_bounds
     from tlmpc.mission.body import requested_margin
 
     mission = c.get(MISSION)
+    # Refused before the triangulation's work: the planner cannot honour a time bound.
+    refuse_bounds(mission.formula, file=mission.source, purpose="planning")
     # A body or a margin: the configuration space, goal cores and grown avoided regions are
     # triangulated (the body's own diagnostics came with the load stage).
     layout = planning_layout(mission, requested_margin(mission))
@@ -223,9 +226,11 @@ def _abstraction(c: Compilation) -> StageResult:
 
 def _automaton(c: Compilation) -> StageResult:
     from tlmpc.automata import automaton_to_json, to_hoa, translate
+    from tlmpc.ltl.bounds import refuse_bounds
     from tlmpc.planning.boundary import task_formula, task_letters
 
     mission = c.get(MISSION)
+    refuse_bounds(mission.formula, file=mission.source, purpose="planning")
     abstraction = c.get(ABSTRACTION)
     # Under the closed convention the planner reads boundary instants too (their letters and
     # a rewritten task; see tlmpc/planning/boundary.py).
