@@ -76,6 +76,12 @@ def _scene(
         {"boundary": _points(c["boundary"]), "holes": [_points(h) for h in c.get("holes", [])]}
         for c in workspace.get("components", [])
     ]
+    from tlmpc.render.scene import named_regions
+
+    labels = [
+        {"name": name, "at": [x, y], "task": task}
+        for name, (x, y), task in named_regions(regions, formula)
+    ]
     scene: dict[str, Any] = _finite(
         {
             "format": "tlmpc.view/1",
@@ -83,6 +89,7 @@ def _scene(
             "formula": formula,
             "workspace": {"boundary": boundary, "holes": holes, "components": components},
             "regions": {name: _points(poly) for name, poly in regions.items()},
+            "labels": labels,
             "mesh": mesh,
             "trajectory": samples,
             "loop_start": loop_start,
