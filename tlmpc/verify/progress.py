@@ -165,7 +165,7 @@ def _progress(
     match conjunct:
         case Globally(Eventually(goal)):
             count, last, gap = _visits(line, held(goal))
-            if count:
+            if last is not None:  # visited at least once
                 progress = (
                     f"visited {_times(count)}, last at {at(last, line.origin)}, "
                     f"longest gap {gap:.4g} s"
