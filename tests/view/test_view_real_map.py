@@ -147,3 +147,39 @@ def test_names_on_a_real_map_are_readable_and_do_not_cover_it(
     browser.evaluate("document.getElementById('map').dispatchEvent(new MouseEvent('dblclick'))")
     assert [label["name"] for label in _labels(browser)] == [label["name"] for label in before]
     assert browser.errors == []
+
+
+def test_the_real_jackal_log_plays_in_times_from_its_start(
+    browser: Browser, tmp_path: Path
+) -> None:
+    # The Jackal's odometry (ROS 1 bag, 61.18 s stamped from 47.584 s on the robot's clock),
+    # against a mission drawn in its odom frame: the slider and every time on the page count
+    # from the log's start.
+    bag = require_shared("bags/jackal_odometry.bag")
+    mission = tmp_path / "m.yaml"
+    mission.write_text(
+        "version: 1\nworkspace:\n  boundary: {rect: [-12, -5, 6, 25]}\nregions:\n"
+        "  goal: {rect: [-10, 20, -8, 23]}\n  pond: {rect: [-2, 8, 1, 12]}\n"
+        "robot: {start: [0, 0], max_speed: 2.5}\ntask: [visit goal, avoid pond]\n"
+    )
+    page = tmp_path / "jackal.html"
+    quiet = {"out": io.StringIO(), "err": io.StringIO()}
+    assert (
+        main(["view", "--log", str(bag), "--mission", str(mission), "-o", str(page)], **quiet) == 0
+    )
+    browser.errors.clear()
+    browser.open(page)
+    assert browser.errors == []
+    assert browser.evaluate("document.getElementById('duration').textContent") == "61.18"
+    assert browser.evaluate("document.getElementById('time').textContent") == "0.00"
+    browser.evaluate(
+        "(() => { const s = document.getElementById('scrub'); s.value = 500;"
+        " s.dispatchEvent(new Event('input')); })()"
+    )
+    assert browser.evaluate("document.getElementById('time').textContent") == "30.59"
+    text = browser.evaluate("document.getElementById('verdict').textContent")
+    assert "done at t=56.54 s (stamp 104.125)" in text
+    assert "t=1e+02" not in text
+    assert "t=104" not in text
+    # the names are readable on this map too
+    _check_what_is_seen(browser)
