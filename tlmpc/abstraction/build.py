@@ -191,7 +191,8 @@ def _min_angle(corners: FloatArray) -> FloatArray:
 
 
 def abstraction_diagnostics(abstraction: Abstraction, mission: Mission) -> list[Diagnostic]:
-    """Warnings: regions that got no triangle, regions unreachable from the start."""
+    """Warnings: regions that got no triangle, regions unreachable from the start, a mesh far
+    larger than the layout suggests."""
     # Which letters occur (anywhere, and in the start's component): counts, not a sort.
     letters = len(abstraction.letters)
     used = np.flatnonzero(np.bincount(abstraction.letter_of, minlength=letters)).tolist()
@@ -223,6 +224,9 @@ def abstraction_diagnostics(abstraction: Abstraction, mission: Mission) -> list[
                     hint="open a passage or move the start",
                 )
             )
+    blowup = mesh_size_diagnostic(abstraction, mission)
+    if blowup is not None:
+        problems.append(blowup)
     return problems
 
 
@@ -249,3 +253,59 @@ def _separation(mission: Mission, polygon: tuple[tuple[float, float], ...]) -> s
             + ") cannot reach"
         )
     return "holes separate it from the robot"
+
+
+#: A mesh more than this many times the layout's corners is suspicious: clean maps and the
+#: shipped missions give 2 to 5 triangles per corner of the workspace and regions.
+MESH_BLOWUP_FACTOR = 20
+#: ... and never below this many triangles (a small mission may refine freely).
+MESH_BLOWUP_MIN = 2000
+
+
+def _ring_area(ring: tuple[tuple[float, float], ...]) -> float:
+    return abs(
+        sum(x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in zip(ring, ring[1:] + ring[:1], strict=True))
+        / 2.0
+    )
+
+
+def mesh_size_diagnostic(abstraction: Abstraction, mission: Mission) -> Diagnostic | None:
+    """A warning (A012) when the mesh is far larger than the region layout suggests.
+
+    The layout suggests about as many triangles as the workspace's and regions' corners (or
+    the free area over ``max_area`` when that bound asks for more); far more means some
+    feature much smaller than the rest forces the quality mesh to refine around it — most
+    often a region corner or edge a hair (not exactly) on a wall.  The message names the
+    shortest mesh edge and where it is, which is where that feature lies.
+    """
+    rings = [p.boundary for p in mission.workspace.pieces]
+    rings += [h for p in mission.workspace.pieces for h in p.holes]
+    corners = sum(len(ring) for ring in rings) + sum(len(r.polygon) for r in mission.regions)
+    expected = float(corners)
+    if mission.options.max_area:
+        area = sum(_ring_area(p.boundary) for p in mission.workspace.pieces) - sum(
+            _ring_area(h) for p in mission.workspace.pieces for h in p.holes
+        )
+        expected = max(expected, area / mission.options.max_area)
+    count = abstraction.num_triangles
+    if count <= max(MESH_BLOWUP_MIN, MESH_BLOWUP_FACTOR * expected):
+        return None
+    corners_xy = abstraction.vertices[abstraction.triangles]  # (n, 3, 2)
+    sides = corners_xy[:, [1, 2, 0]] - corners_xy
+    lengths = np.hypot(sides[..., 0], sides[..., 1])
+    triangle, side = np.unravel_index(int(np.argmin(lengths)), lengths.shape)
+    a = corners_xy[triangle, side]
+    b = corners_xy[triangle, (side + 1) % 3]
+    x, y = ((a + b) / 2).tolist()
+    shortest = float(lengths[triangle, side])
+    return Diagnostic(
+        code="A012",
+        severity="warning",
+        file=mission.source,
+        message=f"the mesh has {count:,} triangles, {count / expected:.0f} times what the "
+        f"{corners:,} corners of the workspace and regions suggest: a feature as small as "
+        f"{shortest:.2g} near ({x:.6g}, {y:.6g}) forces the refinement",
+        hint="a region's corner or edge almost, but not exactly, on a wall or another "
+        "region's edge leaves a sliver the mesh must fill: put it exactly on the edge "
+        "(the same coordinates) or clearly away from it",
+    )

@@ -47,6 +47,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--max-speed", type=float, default=1.0, help="robot max speed")
     parser.add_argument("--name", help="mission name (default: the map's file name)")
     parser.add_argument(
+        "-q", "--quiet", action="store_true", help="no progress lines while a long import runs"
+    )
+    parser.add_argument(
         "--region",
         action="append",
         nargs=5,
@@ -69,7 +72,13 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         min_area=args.min_area,
         start=tuple(args.start) if args.start else None,
     )
-    imported = import_map(args.map, settings, keepout=args.keepout, speed=args.speed)
+    import contextlib
+    import sys
+
+    from tlmpc.base.progress import heartbeat
+
+    with contextlib.nullcontext() if args.quiet else heartbeat("import-map", sys.stderr):
+        imported = import_map(args.map, settings, keepout=args.keepout, speed=args.speed)
     document = mission_document(
         imported,
         name=args.name or args.map.stem,
