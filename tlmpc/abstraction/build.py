@@ -202,32 +202,94 @@ def abstraction_diagnostics(abstraction: Abstraction, mission: Mission) -> list[
     present = set(chain.from_iterable(map(abstraction.letters.__getitem__, used)))
     near = set(chain.from_iterable(map(abstraction.letters.__getitem__, reachable)))
     problems = []
-    for region in mission.regions:
-        if region.name not in present:
-            problems.append(
-                Diagnostic(
-                    code="A010",
-                    severity="warning",
-                    file=mission.source,
-                    message=f"region {region.name!r} got no triangle",
-                    hint="it lies outside the boundary or in holes, or is too thin to triangulate",
-                )
+    missing = [r for r in mission.regions if r.name not in present]
+    unreachable = [r for r in mission.regions if r.name in present and r.name not in near]
+    if len(missing) == 1:
+        problems.append(
+            Diagnostic(
+                code="A010",
+                severity="warning",
+                file=mission.source,
+                message=f"region {missing[0].name!r} got no triangle",
+                hint="it lies outside the boundary or in holes, or is too thin to triangulate",
             )
-        elif region.name not in near:
-            problems.append(
-                Diagnostic(
-                    code="A011",
-                    severity="warning",
-                    file=mission.source,
-                    message=f"region {region.name!r} is not reachable from "
-                    "the start: " + _separation(mission, region.polygon),
-                    hint="open a passage or move the start",
-                )
+        )
+    elif missing:
+        problems.append(
+            Diagnostic(
+                code="A010",
+                severity="warning",
+                file=mission.source,
+                message=f"{len(missing)} regions got no triangle: "
+                + _names([r.name for r in missing]),
+                hint="they lie outside the boundary or in holes, or are too thin to triangulate",
             )
+        )
+    if len(unreachable) == 1:
+        problems.append(
+            Diagnostic(
+                code="A011",
+                severity="warning",
+                file=mission.source,
+                message=f"region {unreachable[0].name!r} is not reachable from "
+                "the start: " + _separation(mission, unreachable[0].polygon),
+                hint="open a passage or move the start",
+            )
+        )
+    elif unreachable:
+        # One warning for all (a map with pockets inside its racks has dozens): each name with
+        # the piece it lies in.
+        places = [_piece_of(mission, r.polygon) for r in unreachable]
+        listed = _names(
+            [
+                f"{r.name} ({place})" if place else r.name
+                for r, place in zip(unreachable, places, strict=True)
+            ]
+        )
+        why = (
+            "each lies in a separate piece of free space (a workspace component) that the "
+            "robot cannot reach"
+            if all(places)
+            else "holes or separate pieces of free space keep the robot from them"
+        )
+        problems.append(
+            Diagnostic(
+                code="A011",
+                severity="warning",
+                file=mission.source,
+                message=f"{len(unreachable)} regions are not reachable from the start: "
+                f"{listed}; {why}",
+                hint="open a passage or move the start",
+            )
+        )
     blowup = mesh_size_diagnostic(abstraction, mission)
     if blowup is not None:
         problems.append(blowup)
     return problems
+
+
+def _names(names: list[str], shown: int = 12) -> str:
+    """``a, b, c`` — the first ``shown`` of ``names`` and how many more."""
+    if len(names) <= shown:
+        return ", ".join(names)
+    return ", ".join(names[:shown]) + f" and {len(names) - shown} more"
+
+
+def _piece_of(mission: Mission, polygon: tuple[tuple[float, float], ...]) -> str | None:
+    """``workspace component K`` when the region lies in a piece the robot is not in."""
+    if not mission.workspace.components:
+        return None
+    from shapely.geometry import Point as ShapelyPoint
+    from shapely.geometry import Polygon as ShapelyPolygon
+
+    shape = ShapelyPolygon(polygon)
+    start = ShapelyPoint(mission.robot.start)
+    pieces = [ShapelyPolygon(p.boundary, p.holes) for p in mission.workspace.pieces]
+    inside = [k for k, piece in enumerate(pieces) if piece.intersection(shape).area > 0]
+    robot = next((k for k, piece in enumerate(pieces) if piece.covers(start)), None)
+    if not inside or robot in inside:
+        return None
+    return ", ".join("the main piece" if k == 0 else f"workspace component {k - 1}" for k in inside)
 
 
 def _separation(mission: Mission, polygon: tuple[tuple[float, float], ...]) -> str:

@@ -142,27 +142,8 @@ def mission_document(
     regions: dict[str, Any] = {n: _points(r) for n, r in imported.regions.items()}
     boundary, holes, clipped = _clip_rects(imported, rects or {})
     regions.update(clipped)
-    if not regions:
-        raise UsageError(
-            error(
-                "M016",
-                "the mission would have no regions",
-                hint="give --keepout or --speed masks, or --region NAME XMIN YMIN XMAX YMAX",
-                file=imported.source,
-            )
-        )
     phrases = list(task or [])
-    if not phrases and not ltl:
-        if "keepout" not in imported.groups:
-            raise UsageError(
-                error(
-                    "M016",
-                    "the mission would have no task",
-                    hint="give --task PHRASE or --ltl FORMULA (without a keepout mask there "
-                    "is no default task)",
-                    file=imported.source,
-                )
-            )
+    if not phrases and not ltl and "keepout" in imported.groups:
         phrases = ["avoid keepout"]
     document: dict[str, Any] = {
         "version": 1,
@@ -181,8 +162,9 @@ def mission_document(
                 else {}
             ),
         },
-        "regions": regions,
     }
+    if regions:
+        document["regions"] = regions
     if imported.groups:
         document["groups"] = {g: list(m) for g, m in imported.groups.items()}
     document["robot"] = {
@@ -196,12 +178,28 @@ def mission_document(
     return document
 
 
+def unfinished(document: Mapping[str, Any]) -> list[str]:
+    """What a mission still lacks before it can be checked: ``regions``, ``task``."""
+    missing = [] if "regions" in document else ["regions"]
+    if "task" not in document and "ltl" not in document:
+        missing.append("task")
+    return missing
+
+
 def mission_yaml(document: Mapping[str, Any]) -> str:
-    """The mission as YAML, points in flow style (``[x, y]``), floats exact (repr)."""
+    """The mission as YAML, points in flow style (``[x, y]``), floats exact (repr); a mission
+    still without regions or a task says what to add."""
     header = (
         "# written by `tlmpc import-map`: the workspace is the free space of an occupancy-grid\n"
         "# map (configuration space when a radius was given); see docs/robot-data.md\n"
     )
+    missing = unfinished(document)
+    if missing:
+        header += (
+            f"# still to add: {' and '.join(missing)} (docs/mission-format.md), e.g.\n"
+            "#   regions:\n#     dock: {rect: [XMIN, YMIN, XMAX, YMAX]}\n"
+            "#   task: [visit dock]\n# then run `tlmpc check` on this file\n"
+        )
     return header + yaml.safe_dump(
         dict(document), sort_keys=False, default_flow_style=None, width=100
     )
