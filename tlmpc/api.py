@@ -51,7 +51,7 @@ def _mission_text(mission: MissionSource) -> tuple[str | None, Path]:
     return None, Path(mission)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class Compiled:
     """A compiled mission: its artifacts (parsed JSON documents, HOA text) and summary.
 
@@ -63,6 +63,25 @@ class Compiled:
     source: str = "<mission>"
     warnings: tuple[Diagnostic, ...] = ()
     _figure: dict[str, str] = field(default_factory=dict, repr=False, compare=False)
+
+    def __repr__(self) -> str:
+        """One line: the source, the mesh, the plan and the verdict — not every artifact."""
+        summary = self.summary
+        parts = [f"source={self.source!r}"]
+        for stage in summary.get("stages", []):
+            if stage.get("name") == "abstraction" and "triangles" in stage.get("sizes", {}):
+                parts.append(f"triangles={stage['sizes']['triangles']}")
+        plan = summary.get("plan")
+        if plan:
+            parts.append(f"plan=({plan.get('prefix_length')} + {plan.get('cycle_length')} steps)")
+        verdict = summary.get("verdict")
+        if verdict:
+            parts.append(f"satisfied={verdict.get('satisfied')}")
+            parts.append(f"robustness={verdict.get('robustness', float('nan')):.4g}")
+        parts.append(f"artifacts={len(self.artifacts)}")
+        if self.warnings:
+            parts.append(f"warnings={len(self.warnings)}")
+        return f"Compiled({', '.join(parts)})"
 
     @property
     def summary(self) -> Mapping[str, Any]:
