@@ -41,6 +41,7 @@ COMMAND_MODULES = (
     "export_plan",
     "simulate",
     "new",
+    "completion",
 )
 
 EPILOG = exit_code_epilog()
