@@ -9,6 +9,7 @@ from typing import Any
 
 import yaml
 
+from tlmpc.exports.georeference import Georeference, to_lon_lat
 from tlmpc.exports.plan import Plan, Ring, Waypoint
 
 
@@ -78,10 +79,17 @@ def _workspace_geometry(plan: Plan) -> dict[str, Any]:
     }
 
 
-def geojson(plan: Plan, points: list[Waypoint], loop: int | None) -> str:
-    """A FeatureCollection in the map frame (metres): workspace, regions, trajectory, waypoints.
+def geojson(
+    plan: Plan,
+    points: list[Waypoint],
+    loop: int | None,
+    georeference: Georeference | None = None,
+) -> str:
+    """A FeatureCollection: workspace, regions, trajectory, waypoints.
 
-    Rings follow RFC 7946's right-hand rule (outer counter-clockwise, holes clockwise).
+    Coordinates are the map frame's metres, or with ``georeference`` WGS 84 longitude and
+    latitude (RFC 7946 proper).  Rings follow RFC 7946's right-hand rule (outer
+    counter-clockwise, holes clockwise; a yaw or a mirror-free georeference keeps the turn).
     """
     features: list[dict[str, Any]] = [
         {
@@ -128,7 +136,29 @@ def geojson(plan: Plan, points: list[Waypoint], loop: int | None) -> str:
             "geometry": {"type": "MultiPoint", "coordinates": [[w.x, w.y] for w in points]},
         }
     )
-    return json.dumps({"type": "FeatureCollection", "features": features}, indent=1) + "\n"
+    collection: dict[str, Any] = {"type": "FeatureCollection", "features": features}
+    if georeference is not None:
+        _georeferenced(collection, georeference)
+    return json.dumps(collection, indent=1) + "\n"
+
+
+def _georeferenced(collection: dict[str, Any], reference: Georeference) -> None:
+    """Every coordinate pair of ``collection`` mapped to ``[longitude, latitude]``."""
+
+    def convert(value: Any) -> Any:
+        if (
+            isinstance(value, list)
+            and len(value) == 2
+            and all(isinstance(v, float | int) for v in value)
+        ):
+            return list(to_lon_lat(reference, float(value[0]), float(value[1])))
+        if isinstance(value, list):
+            return [convert(v) for v in value]
+        return value
+
+    for feature in collection["features"]:
+        geometry = feature["geometry"]
+        geometry["coordinates"] = convert(geometry["coordinates"])
 
 
 PATH_TYPE = "nav_msgs/msg/Path"
