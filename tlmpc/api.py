@@ -219,11 +219,12 @@ def verify_trace(
     """Verify a trajectory against its task under continuous-time semantics.
 
     ``trace`` is a :class:`Compiled` result, a ``trace.json`` document (dict), or a path to a
-    ``trace.json`` or a CSV log (then ``mission`` names the mission file whose task and regions
+    ``trace.json`` or a robot log — CSV, ROS 1 ``.bag``, ROS 2 bag directory, ``.mcap`` — read
+    as ``tlmpc verify`` reads it (then ``mission`` names the mission file whose task and regions
     apply).  ``boundary`` overrides the labelling convention (``"right"`` or ``"closed"``).
     The verifier shares no code with the planner.
     """
-    from tlmpc.verify import from_csv, from_document
+    from tlmpc.verify import from_document, read_trace
     from tlmpc.verify import verify_trace as check_trace
 
     if isinstance(trace, Compiled):
@@ -234,11 +235,7 @@ def verify_trace(
     if isinstance(trace, Mapping):
         return check_trace(from_document(trace, convention=boundary))
     path = Path(trace)
-    if path.suffix.lower() == ".csv":
-        return check_trace(from_csv(path, Path(mission) if mission is not None else None, boundary))
-    from tlmpc.io.artifacts import read_json
-
-    return check_trace(from_document(read_json(path), file=str(path), convention=boundary))
+    return check_trace(read_trace(path, Path(mission) if mission is not None else None, boundary))
 
 
 def translate(formula: str) -> Automaton:
