@@ -19,6 +19,7 @@ PACKAGE = ROOT / "tlmpc"
 #: The layers, lowest first.  A new subpackage goes where its imports put it.
 LAYERS = (
     "base",
+    "templates",
     "ltl",
     "io",
     "importers",

@@ -85,7 +85,7 @@ def _mission_text(mission: MissionSource, function: str) -> tuple[str | None, Pa
     return None, Path(mission)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class Compiled:
     """A compiled mission: its artifacts (parsed JSON documents, HOA text) and summary.
 
@@ -97,6 +97,25 @@ class Compiled:
     source: str = "<mission>"
     warnings: tuple[Diagnostic, ...] = ()
     _figure: dict[str, str] = field(default_factory=dict, repr=False, compare=False)
+
+    def __repr__(self) -> str:
+        """One line: the source, the mesh, the plan and the verdict — not every artifact."""
+        summary = self.summary
+        parts = [f"source={self.source!r}"]
+        for stage in summary.get("stages", []):
+            if stage.get("name") == "abstraction" and "triangles" in stage.get("sizes", {}):
+                parts.append(f"triangles={stage['sizes']['triangles']}")
+        plan = summary.get("plan")
+        if plan:
+            parts.append(f"plan=({plan.get('prefix_length')} + {plan.get('cycle_length')} steps)")
+        verdict = summary.get("verdict")
+        if verdict:
+            parts.append(f"satisfied={verdict.get('satisfied')}")
+            parts.append(f"robustness={verdict.get('robustness', float('nan')):.4g}")
+        parts.append(f"artifacts={len(self.artifacts)}")
+        if self.warnings:
+            parts.append(f"warnings={len(self.warnings)}")
+        return f"Compiled({', '.join(parts)})"
 
     @property
     def summary(self) -> Mapping[str, Any]:
@@ -238,11 +257,12 @@ def verify_trace(
     """Verify a trajectory against its task under continuous-time semantics.
 
     ``trace`` is a :class:`Compiled` result, a ``trace.json`` document (dict), or a path to a
-    ``trace.json`` or a CSV log (then ``mission`` names the mission file whose task and regions
+    ``trace.json`` or a robot log — CSV, ROS 1 ``.bag``, ROS 2 bag directory, ``.mcap`` — read
+    as ``tlmpc verify`` reads it (then ``mission`` names the mission file whose task and regions
     apply).  ``boundary`` overrides the labelling convention (``"right"`` or ``"closed"``).
     The verifier shares no code with the planner.
     """
-    from tlmpc.verify import from_csv, from_document
+    from tlmpc.verify import from_document, read_trace
     from tlmpc.verify import verify_trace as check_trace
 
     _expect(
@@ -263,13 +283,7 @@ def verify_trace(
     if isinstance(trace, Mapping):
         return check_trace(from_document(trace, convention=boundary))
     path = Path(trace)
-    if path.suffix.lower() == ".csv":
-        return check_trace(from_csv(path, Path(mission) if mission is not None else None, boundary))
-    from tlmpc.io.artifacts import read_json
-
-    return check_trace(
-        from_document(read_json(path, finite=False), file=str(path), convention=boundary)
-    )
+    return check_trace(read_trace(path, Path(mission) if mission is not None else None, boundary))
 
 
 def translate(formula: str) -> Automaton:

@@ -42,6 +42,8 @@ COMMAND_MODULES = (
     "import_map",
     "export_plan",
     "simulate",
+    "new",
+    "completion",
 )
 
 EPILOG = exit_code_epilog()
@@ -83,7 +85,9 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
         )
         if only is None or only == module.NAME:
             module.add_arguments(command_parser)
-        command_parser.set_defaults(_run=module.run)
+        # `_full_parser`: every command's flags (for `tlmpc completion`, which commands cannot
+        # import from here: the command line sits above them)
+        command_parser.set_defaults(_run=module.run, _full_parser=build_parser)
     return parser
 
 

@@ -33,6 +33,20 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--frame-id", default="map", help="frame of the poses (default: map)")
     parser.add_argument("--topic", default="/plan", help="path-mcap: the topic (default: /plan)")
+    parser.add_argument(
+        "--georeference",
+        metavar="LAT,LON[,YAW]",
+        type=_georeference,
+        help="geojson: the map origin's WGS 84 latitude and longitude and the angle from east "
+        "to the map's x axis (degrees, counter-clockwise): coordinates become longitude, "
+        "latitude (RFC 7946) instead of the map's metres",
+    )
+
+
+def _georeference(text: str) -> object:
+    from tlmpc.exports.georeference import parse_georeference
+
+    return parse_georeference(text)
 
 
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
@@ -73,6 +87,14 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
                 file=str(args.output),
             )
         )
+    if args.georeference is not None and args.format != "geojson":
+        raise UsageError(
+            error(
+                "M086",
+                f"--georeference applies to geojson, not to {args.format}",
+                hint="the other formats are in the map frame, as a navigation stack expects",
+            )
+        )
     if args.format == "path-mcap" and args.output is None:
         raise UsageError(
             error("M083", "path-mcap is binary: give -o FILE.mcap", hint="-o plan.mcap")
@@ -86,7 +108,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         data = waypoints_csv(plan, points, loop).encode("utf-8")
     elif args.format == "geojson":
         try:
-            data = geojson(plan, points, loop).encode("utf-8")
+            data = geojson(plan, points, loop, args.georeference).encode("utf-8")
         except ValueError:  # a non-finite number, which JSON cannot hold
             raise UsageError(
                 error(

@@ -13,6 +13,8 @@ import math
 from pathlib import Path
 from typing import TYPE_CHECKING, TextIO
 
+from tlmpc.commands.log_flags import add_log_flags, log_options
+
 if TYPE_CHECKING:
     from tlmpc.verify.model import Verdict
 
@@ -71,25 +73,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="the part of the log from time T to its end repeats forever (two-valued verdict)",
     )
     parser.add_argument("--json", action="store_true", help="print the verdict as JSON")
-    parser.add_argument(
-        "--topic", help="bags: the pose topic (needed when several topics carry poses)"
-    )
-    parser.add_argument(
-        "--columns",
-        metavar="TIME,X,Y",
-        help="CSV logs: the time and position columns, by name or 1-based number",
-    )
-    parser.add_argument(
-        "--transform",
-        metavar="X,Y,YAW",
-        help="logs: map the log's frame into the mission's (p = R(YAW) p_log + (X, Y))",
-    )
-    parser.add_argument(
-        "--frame",
-        metavar="FRAME",
-        help="bags: express the poses in FRAME (e.g. map) through the bag's /tf and /tf_static "
-        "(default: the poses' own frame)",
-    )
+    add_log_flags(parser)
     batch = parser.add_argument_group("many logs")
     batch.add_argument(
         "--jobs",
@@ -158,16 +142,9 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
 
 
 def _run_one(args: argparse.Namespace, path: Path, out: TextIO, err: TextIO) -> int:
-    from tlmpc.importers.logs import is_log, parse_columns, parse_transform
-    from tlmpc.io.artifacts import read_json
+    from tlmpc.importers.logs import is_log
     from tlmpc.io.report import OUTCOME_EXIT, Reporter
-    from tlmpc.verify import (
-        declare_ending,
-        from_csv,
-        from_document,
-        verdict_to_json,
-        verify_trace,
-    )
+    from tlmpc.verify import declare_ending, read_trace, verdict_to_json, verify_trace
 
     report = Reporter.for_args(args, out, err)
     if is_log(path) and _too_large_for_memory(path):
@@ -179,19 +156,7 @@ def _run_one(args: argparse.Namespace, path: Path, out: TextIO, err: TextIO) -> 
         )
         text = _text(path, verdict)
         return report.finish(OUTCOME_EXIT[verdict.outcome], verdict_to_json(verdict), text)
-    if is_log(path):
-        trace = from_csv(
-            path,
-            args.mission,
-            args.boundary,
-            topic=args.topic,
-            columns=parse_columns(args.columns) if args.columns else None,
-            transform=parse_transform(args.transform) if args.transform else None,
-            frame=args.frame,
-        )
-    else:
-        document = read_json(path, finite=False)
-        trace = from_document(document, file=str(path), convention=args.boundary)
+    trace = read_trace(path, args.mission, args.boundary, log_options(args))
     trace = declare_ending(trace, assume_stay=args.assume_stay, loop_from=args.loop_from)
     verdict = verify_trace(trace)
     text = _text(path, verdict)

@@ -9,6 +9,7 @@ from typing import Any
 
 import yaml
 
+from tlmpc.exports.georeference import Georeference, to_lon_lat
 from tlmpc.exports.plan import Plan, Ring, Waypoint
 from tlmpc.io.outputs import csv_cell
 
@@ -104,10 +105,17 @@ def _workspace_geometry(plan: Plan) -> dict[str, Any]:
     }
 
 
-def geojson(plan: Plan, points: list[Waypoint], loop: int | None) -> str:
-    """A FeatureCollection in the map frame (metres): workspace, regions, trajectory, waypoints.
+def geojson(
+    plan: Plan,
+    points: list[Waypoint],
+    loop: int | None,
+    georeference: Georeference | None = None,
+) -> str:
+    """A FeatureCollection: workspace, regions, trajectory, waypoints.
 
-    Rings follow RFC 7946's right-hand rule (outer counter-clockwise, holes clockwise).
+    Coordinates are the map frame's metres, or with ``georeference`` WGS 84 longitude and
+    latitude (RFC 7946 proper).  Rings follow RFC 7946's right-hand rule (outer
+    counter-clockwise, holes clockwise; a yaw or a mirror-free georeference keeps the turn).
     """
     features: list[dict[str, Any]] = [
         {
@@ -154,10 +162,31 @@ def geojson(plan: Plan, points: list[Waypoint], loop: int | None) -> str:
             "geometry": {"type": "MultiPoint", "coordinates": [[w.x, w.y] for w in points]},
         }
     )
+    collection: dict[str, Any] = {"type": "FeatureCollection", "features": features}
+    if georeference is not None:
+        _georeferenced(collection, georeference)
     # strict JSON: a non-finite number (only an edited output has one) is refused, not
     # written as the NaN no GeoJSON reader accepts
-    document = {"type": "FeatureCollection", "features": features}
-    return json.dumps(document, indent=1, allow_nan=False) + "\n"
+    return json.dumps(collection, indent=1, allow_nan=False) + "\n"
+
+
+def _georeferenced(collection: dict[str, Any], reference: Georeference) -> None:
+    """Every coordinate pair of ``collection`` mapped to ``[longitude, latitude]``."""
+
+    def convert(value: Any) -> Any:
+        if (
+            isinstance(value, list)
+            and len(value) == 2
+            and all(isinstance(v, float | int) for v in value)
+        ):
+            return list(to_lon_lat(reference, float(value[0]), float(value[1])))
+        if isinstance(value, list):
+            return [convert(v) for v in value]
+        return value
+
+    for feature in collection["features"]:
+        geometry = feature["geometry"]
+        geometry["coordinates"] = convert(geometry["coordinates"])
 
 
 PATH_TYPE = "nav_msgs/msg/Path"

@@ -156,6 +156,79 @@ def _faces(linework: BaseGeometry) -> list[Polygon]:
     return polygons(shapely.polygonize(lines))
 
 
+def _simplified(noded: BaseGeometry, tolerance: float, rounds: int = 8) -> BaseGeometry:
+    """The chains of ``noded`` simplified within ``tolerance``, with the exact course put
+    back wherever the simplification pinched the free space.
+
+    Douglas-Peucker with topology preserved keeps chains from crossing, not from nearly
+    touching: a wall a cell away from a pillar (or from its own other side, across an inlet)
+    can end up a ten-thousandth of a cell away, a passage narrower than anything in the map
+    (G021) and needles in the mesh.  A kept vertex closer than half the tolerance to a
+    simplified segment it is not next to marks a pinch; that segment and the two at the
+    vertex get back every exact vertex between their ends (a kept vertex is an exact one), and
+    the check runs again.  Elsewhere the simplification stands.
+    """
+    simple = noded.simplify(tolerance, preserve_topology=True)
+    exact_parts = [np.asarray(g.coords) for g in getattr(noded, "geoms", [noded])]
+    simple_parts = [np.asarray(g.coords) for g in getattr(simple, "geoms", [simple])]
+    if len(exact_parts) != len(simple_parts):
+        return simple
+    kept: list[list[int]] = []
+    for exact, part in zip(exact_parts, simple_parts, strict=True):
+        where: dict[tuple[float, float], int] = {}
+        for index, (x, y) in enumerate(exact.tolist()):
+            where.setdefault((x, y), index)
+        indices = [where.get((x, y), -1) for x, y in part.tolist()]
+        if indices and len(part) > 1 and part[0].tolist() == part[-1].tolist():
+            indices[-1] = len(exact) - 1  # a closed chain ends where it starts
+        if -1 in indices or indices != sorted(indices):
+            return simple  # not a subset of the exact vertices in order: leave it be
+        kept.append(indices)
+    limit = 0.75 * tolerance
+    for _ in range(rounds):
+        segments = [
+            (chain, k) for chain, indices in enumerate(kept) for k in range(len(indices) - 1)
+        ]
+        if not segments:
+            break
+        starts = np.array([exact_parts[c][kept[c][k]] for c, k in segments])
+        ends = np.array([exact_parts[c][kept[c][k + 1]] for c, k in segments])
+        lines = shapely.linestrings(np.stack([starts, ends], axis=1))
+        tree = shapely.STRtree(lines)
+        vertices = [(c, k) for c, indices in enumerate(kept) for k in range(len(indices))]
+        points = shapely.points(np.array([exact_parts[c][kept[c][k]] for c, k in vertices]))
+        near_point, near_line = tree.query(points, predicate="dwithin", distance=limit)
+        widen: set[tuple[int, int]] = set()
+        for v, sgm in zip(near_point.tolist(), near_line.tolist(), strict=True):
+            chain, k = vertices[v]
+            other, j = segments[sgm]
+            if other == chain and k in (j, j + 1):
+                continue  # the vertex's own segment
+            point = exact_parts[chain][kept[chain][k]]
+            if any((exact_parts[other][kept[other][e]] == point).all() for e in (j, j + 1)):
+                continue  # a junction: the chains meet there
+            if exact_parts[other][kept[other][j] : kept[other][j + 1] + 1].shape[0] <= 2:
+                continue  # an exact segment already: the gap is the map's own
+            widen.add((other, j))
+            for e in (k - 1, k):
+                if 0 <= e < len(kept[chain]) - 1:
+                    widen.add((chain, e))
+        if not widen:
+            break
+        for chain in {c for c, _ in widen}:
+            indices = kept[chain]
+            grown: list[int] = []
+            for e in range(len(indices) - 1):
+                grown.append(indices[e])
+                if (chain, e) in widen:
+                    grown.extend(range(indices[e] + 1, indices[e + 1]))
+            grown.append(indices[-1])
+            kept[chain] = grown
+    return shapely.MultiLineString(
+        [exact[indices] for exact, indices in zip(exact_parts, kept, strict=True)]
+    )
+
+
 def _coverage(
     workspace: BaseGeometry, labels: npt.NDArray[np.int64], tolerance: float
 ) -> tuple[list[Polygon], dict[int, list[BaseGeometry]]]:
@@ -195,7 +268,7 @@ def _coverage(
             exact_labels.append(None)  # the inside of a hole
     faces, face_labels = exact, exact_labels
     if tolerance > 0:
-        simple = _faces(noded.simplify(tolerance, preserve_topology=True))
+        simple = _faces(_simplified(noded, tolerance))
         tree = shapely.STRtree(exact)
         matched: list[int | None] = []
         for face in simple:

@@ -324,17 +324,23 @@ def _check_task(
             parts.append(parse_ltl(ltl, file=file, line=line, col=col))
         except InvalidInputError as exc:
             problems.extend(exc.diagnostics)
+    from tlmpc.ltl.fused import fused_operators
+
     known = sorted(names | set(groups))
     for part in parts:
         for node in part.walk():
             if isinstance(node, Prop) and node.name not in names and node.name not in groups:
                 close = difflib.get_close_matches(node.name, known, n=1, cutoff=0.5)
+                fused = fused_operators(node.name, known)
                 span = node.span
                 problems.append(
                     error(
                         "L010",
                         f"unknown region {node.name!r}",
-                        hint=(f"did you mean {close[0]!r}? " if close else "")
+                        hint=f"did you mean `{fused}`? operators are words of their own: "
+                        f"`{node.name}` is one proposition named {node.name!r}"
+                        if fused
+                        else (f"did you mean {close[0]!r}? " if close else "")
                         + "regions and groups are declared under `regions:` and `groups:`",
                         file=file,
                         line=span.line if span else None,

@@ -201,6 +201,7 @@ def _abstraction(c: Compilation) -> StageResult:
         abstraction_to_json,
         build_abstraction,
     )
+    from tlmpc.abstraction.build import mesh_size_diagnostic
     from tlmpc.abstraction.layout import planning_layout
     from tlmpc.ltl.bounds import refuse_bounds
     from tlmpc.mission.body import requested_margin
@@ -220,7 +221,9 @@ def _abstraction(c: Compilation) -> StageResult:
             "vertices": int(abstraction.vertices.shape[0]),
             "letters": len(abstraction.letters),
         },
-        warnings=tuple(abstraction_diagnostics(abstraction, mission)) if layout is None else (),
+        warnings=tuple(abstraction_diagnostics(abstraction, mission))
+        if layout is None
+        else tuple(d for d in [mesh_size_diagnostic(abstraction, mission)] if d is not None),
     )
 
 

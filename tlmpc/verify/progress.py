@@ -22,6 +22,7 @@ from tlmpc.ltl.ast import (
     Until,
 )
 from tlmpc.ltl.printer import to_text
+from tlmpc.verify.clock import at
 from tlmpc.verify.evaluate import Value
 from tlmpc.verify.model import ConjunctReport, Outcome, Violation
 
@@ -38,6 +39,7 @@ class Timeline:
     positions: FloatArray
     labels: BoolArray
     names: list[str]
+    origin: float = 0.0  # the time of the log's first sample: times are reported from it
 
     @property
     def size(self) -> int:
@@ -94,7 +96,7 @@ def _globally_violations(
         time, position = _at(line, first)
         if isinstance(inner, Eventually):
             message = (
-                f"`{to_text(inner.arg)}` never holds again after t={time:.4g} s "
+                f"`{to_text(inner.arg)}` never holds again after {at(time, line.origin)} "
                 f"(from {_place(position)}), so `{text}` fails"
             )
             found.append(Violation(conjunct=text, time=time, position=position, message=message))
@@ -106,11 +108,12 @@ def _globally_violations(
             if isinstance(n, Not) and isinstance(n.arg, Prop) and n.arg.name in inside
         ]
         if forbidden:
-            message = f"entered {forbidden[0]} at t={time:.4g} s at {_place(position)}"
+            message = f"entered {forbidden[0]} at {at(time, line.origin)} at {_place(position)}"
         else:
             where = ", ".join(inside) if inside else "free space"
             message = (
-                f"`{to_text(inner)}` stops holding at t={time:.4g} s at {_place(position)} "
+                f"`{to_text(inner)}` stops holding at {at(time, line.origin)} at "
+                f"{_place(position)} "
                 f"(in {where})"
             )
         duration = float(line.ends[last]) - time
@@ -143,7 +146,7 @@ def _other_violation(
                     conjunct=text,
                     time=time,
                     position=position,
-                    message=f"`{to_text(left)}` stops holding at t={time:.4g} s at "
+                    message=f"`{to_text(left)}` stops holding at {at(time, line.origin)} at "
                     f"{_place(position)} before `{to_text(right)}` holds",
                 )
             if right_never.all():
@@ -174,9 +177,10 @@ def _progress(
     match conjunct:
         case Globally(Eventually(goal)):
             count, last, gap = _visits(line, held(goal))
-            if count:
+            if last is not None:  # visited at least once
                 progress = (
-                    f"visited {_times(count)}, last at t={last:.4g} s, longest gap {gap:.4g} s"
+                    f"visited {_times(count)}, last at {at(last, line.origin)}, "
+                    f"longest gap {gap:.4g} s"
                 )
             else:
                 progress = f"never visited in {gap:.4g} s"
@@ -192,7 +196,7 @@ def _progress(
             found = runs(held(arg))
             if found:
                 time = float(line.starts[found[0][0]])
-                progress = f"done at t={time:.4g} s"
+                progress = f"done at {at(time, line.origin)}"
             else:
                 progress = "pending" if outcome == "inconclusive" else "never done"
             return ConjunctReport(
@@ -202,14 +206,15 @@ def _progress(
             broken = runs(value(arg)[1][:size] < 0)
             if broken:
                 time = float(line.starts[broken[0][0]])
-                progress = f"broken {_times(len(broken))}, first at t={time:.4g} s"
+                progress = f"broken {_times(len(broken))}, first at {at(time, line.origin)}"
             else:
                 progress = "held so far" if outcome == "inconclusive" else "held throughout"
             return ConjunctReport(conjunct=text, outcome=outcome, progress=progress)
         case Until(_, right):
             found = runs(held(right))
             if found and outcome == "satisfied":
-                progress = f"`{to_text(right)}` reached at t={line.starts[found[0][0]]:.4g} s"
+                reached = float(line.starts[found[0][0]])
+                progress = f"`{to_text(right)}` reached at {at(reached, line.origin)}"
             else:
                 progress = words[outcome]
             return ConjunctReport(conjunct=text, outcome=outcome, progress=progress)

@@ -11,7 +11,7 @@ import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import numpy.typing as npt
@@ -20,6 +20,9 @@ from tlmpc.base.errors import UsageError, error
 from tlmpc.ltl.ast import Formula
 from tlmpc.verify.model import Ending
 from tlmpc.verify.samples import check_samples
+
+if TYPE_CHECKING:
+    from tlmpc.mission.model import Mission
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -296,6 +299,55 @@ def check_csv_file(path: Path) -> None:
         )
 
 
+@dataclass(frozen=True, slots=True)
+class LogOptions:
+    """How to read a robot log (the flags every command that takes a log shares)."""
+
+    topic: str | None = None  # bags: the pose topic
+    columns: Sequence[str] | None = None  # CSV: the time and position columns
+    transform: tuple[float, float, float] | None = None  # x, y, yaw into the mission's frame
+    frame: str | None = None  # bags: express the poses in this frame through the bag's tf
+
+
+def read_trace(
+    path: Path,
+    mission: Path | Mission | None,
+    convention: str | None = None,
+    options: LogOptions = LogOptions(),
+) -> TraceInput:
+    """The one way a command reads a trajectory: a ``trace.json`` (self-contained), or a robot
+    log — CSV, ROS 1 ``.bag``, ROS 2 bag directory (sqlite3 or MCAP), ``.mcap`` — checked
+    against ``mission`` (a mission file, or a mission already loaded) for its regions and task.
+    ``tlmpc verify``, ``tlmpc plot --log`` and ``tlmpc view --log`` all read through here, so
+    they take the same formats."""
+    from tlmpc.importers.logs import is_log
+
+    if is_log(path):
+        if mission is None:
+            raise _fail(
+                "V010",
+                "a robot log needs --mission MISSION.yaml for its regions and task",
+                str(path),
+            )
+        if isinstance(mission, Path):
+            mission = _load_mission(mission)
+        return _log_trace(path, mission, convention, options)
+    from tlmpc.io.artifacts import read_json
+
+    # non-finite numbers are read, so that the verifier reports the sample where it is
+    return from_document(read_json(path, finite=False), file=str(path), convention=convention)
+
+
+def _load_mission(mission_path: Path) -> Mission:
+    from tlmpc.base.errors import InvalidInputError
+    from tlmpc.mission.load import load_mission
+
+    try:
+        return load_mission(mission_path)
+    except InvalidInputError as exc:
+        raise UsageError(exc.diagnostics) from None
+
+
 def mission_document(path: Path, mission_path: Path | None) -> dict[str, Any]:
     """A ``tlmpc.trace/1`` document without samples: the task, regions, workspace, convention,
     ``max_speed`` and body radius that ``mission_path`` gives the log at ``path``."""
@@ -303,15 +355,13 @@ def mission_document(path: Path, mission_path: Path | None) -> dict[str, Any]:
         raise _fail(
             "V010", "a CSV trace needs --mission MISSION.yaml for its regions and task", str(path)
         )
-    from tlmpc.base.errors import InvalidInputError
+    return _mission_fields(_load_mission(mission_path))
+
+
+def _mission_fields(mission: Mission) -> dict[str, Any]:
     from tlmpc.ltl.printer import to_text
     from tlmpc.mission.body import body_radius
-    from tlmpc.mission.load import load_mission
 
-    try:
-        mission = load_mission(mission_path)
-    except InvalidInputError as exc:
-        raise UsageError(exc.diagnostics) from None
     return {
         "format": "tlmpc.trace/1",
         "ltl": to_text(mission.formula),
@@ -323,6 +373,27 @@ def mission_document(path: Path, mission_path: Path | None) -> dict[str, Any]:
         "points": [],
         "loop_start": None,
     }
+
+
+def _log_trace(
+    path: Path, mission: Mission, convention: str | None, options: LogOptions
+) -> TraceInput:
+    """A log's samples with the mission's regions, task, workspace, speed and body."""
+    from tlmpc.importers.logs import CSV_SUFFIXES, read_log
+
+    if path.suffix.lower() in CSV_SUFFIXES and path.is_file():
+        check_csv_file(path)  # bounded before parsing
+    log = read_log(
+        path,
+        topic=options.topic,
+        columns=options.columns,
+        transform=options.transform,
+        frame=options.frame,
+    )
+    samples = _samples(log.samples, str(path), list(log.lines) or None)
+    document = _mission_fields(mission)
+    document["points"] = samples.tolist()
+    return from_document(document, file=str(path), convention=convention)
 
 
 def from_csv(
@@ -338,12 +409,9 @@ def from_csv(
     """A logged trajectory (CSV or ROS bag) checked against a mission file's regions and task.
 
     ``frame`` (bags): the poses are expressed in that frame through the bag's tf."""
-    from tlmpc.importers.logs import CSV_SUFFIXES, read_log
-
-    document = mission_document(path, mission_path)
-    if path.suffix.lower() in CSV_SUFFIXES and path.is_file():
-        check_csv_file(path)  # bounded before parsing
-    log = read_log(path, topic=topic, columns=columns, transform=transform, frame=frame)
-    samples = _samples(log.samples, str(path), list(log.lines) or None)
-    document["points"] = samples.tolist()
-    return from_document(document, file=str(path), convention=convention)
+    if mission_path is None:
+        raise _fail(
+            "V010", "a CSV trace needs --mission MISSION.yaml for its regions and task", str(path)
+        )
+    options = LogOptions(topic=topic, columns=columns, transform=transform, frame=frame)
+    return _log_trace(path, _load_mission(mission_path), convention, options)

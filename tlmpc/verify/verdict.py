@@ -14,6 +14,7 @@ import shapely
 
 from tlmpc.ltl.ast import And, Formula, Globally, bounded_operators
 from tlmpc.ltl.printer import to_text
+from tlmpc.verify.clock import at
 from tlmpc.verify.evaluate import Value, truth_atoms
 from tlmpc.verify.model import (
     Certificate,
@@ -288,7 +289,7 @@ def _body_contacts(trace: TraceInput, distances: FloatArray) -> list[Violation]:
             time=time,
             position=(x, y),
             message=f"the robot's body (radius {trace.radius:g}) touches an obstacle near "
-            f"t={time:.4g} s at ({x:.4g}, {y:.4g}): the path passes "
+            f"{at(time, float(trace.times[0]))} at ({x:.4g}, {y:.4g}): the path passes "
             f"{float(distances[index]):.4g} from it",
         )
     ]
@@ -357,7 +358,8 @@ def workspace_violations(trace: TraceInput) -> tuple[list[Violation], float | No
                 conjunct="workspace",
                 time=time,
                 position=(x, y),
-                message=f"the trajectory {where} at t={time:.4g} s at ({x:.4g}, {y:.4g})",
+                message=f"the trajectory {where} at {at(time, float(trace.times[0]))} at "
+                f"({x:.4g}, {y:.4g})",
             )
         )
     return found, -depth
@@ -387,9 +389,11 @@ def certify(trace: TraceInput, regions: dict[str, FloatArray], outcome: Outcome)
         return refuse("no max_speed is known, so nothing bounds the motion between samples")
     if observed > speed * (1 + SPEED_SLACK):
         index = int(np.argmax(speeds))
+        origin = float(times[0])
+        begin, end = at(float(times[index]), origin), at(float(times[index + 1]), origin)
         return refuse(
-            f"the log moves at {observed:.4g} m/s between t={times[index]:.4g} s and "
-            f"t={times[index + 1]:.4g} s, faster than max_speed {speed:.4g}: the "
+            f"the log moves at {observed:.4g} m/s between {begin} and {end}, "
+            f"faster than max_speed {speed:.4g}: the "
             "certificate's assumption does not hold"
         )
     radii = tube_radii(times, speed)
@@ -465,6 +469,7 @@ def verify_trace(trace: TraceInput) -> Verdict:
         positions=pieces.positions,
         labels=pieces.labels,
         names=names,
+        origin=float(trace.times[0]),
     )
     reports, violations = conjunct_reports(conjuncts, outcomes, truth, line)
 
@@ -536,7 +541,12 @@ def verify_trace(trace: TraceInput) -> Verdict:
         pieces=len(merged.is_point),
         conjuncts=tuple(reports),
         violations=tuple(excursions + violations),
-        stats={"samples": len(trace.times), "raw_pieces": size},
+        stats={
+            "samples": len(trace.times),
+            "raw_pieces": size,
+            "start_time": float(trace.times[0]),
+            "duration": float(trace.times[-1] - trace.times[0]),
+        },
     )
 
 
