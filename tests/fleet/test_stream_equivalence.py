@@ -103,7 +103,8 @@ def test_streamed_equals_whole(
     base = document(ltl, convention, radius)
     path = tmp_path / "log.csv"
     write_csv(path, samples)
-    loop_from = float(samples[len(samples) // 2, 0]) if ending == "loop" else None
+    middle = float(samples[len(samples) // 2, 0] - samples[0, 0])  # from the log's start
+    loop_from = middle if ending == "loop" else None
     stay = ending == "stay"
     refused: list[str] = []
     try:

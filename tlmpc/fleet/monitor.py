@@ -83,6 +83,7 @@ class Monitor:
         self.workspace = self.trace.boundary_polygon is not None
         self.last: FloatArray | None = None  # the last kept sample, pieces progressed to it
         self.previous_time: float | None = None
+        self.origin: float | None = None
         self.verdicts: dict[str, str] = {}
         self.excursion: Change | None = None
         self.pending: list[Change] = []
@@ -105,6 +106,8 @@ class Monitor:
                     line=line,
                 )
             )
+        if self.previous_time is None:
+            self.origin = t  # times in messages count from the first pose
         self.previous_time = t
         self.samples += 1
         before = len(self.reducer.kept)
@@ -191,6 +194,7 @@ class Monitor:
             regions={},
             ending="open",
             loop_start=None,
+            origin=self.origin,
         )
         found = [v for v in verify_trace(piece).violations if v.conjunct == "workspace"]
         if found:

@@ -111,8 +111,10 @@ class Reducer:
         self.radius = float(document.get("radius") or 0.0)
         extent = max((float(np.abs(r).max()) for r in (*regions, *free)), default=1.0)
         self.margin = MARGIN * max(1.0, extent)
-        #: the first sample at or after this time is kept (the start of a declared loop)
+        #: the first sample at or after this many seconds from the first one is kept (the start
+        #: of a declared loop; counted from the log's start, as ``declare_ending`` counts)
         self.pin_time = pin_time
+        self.origin = 0.0  # the first sample's time
         self.kept: list[FloatArray] = []
         self.anchor: FloatArray | None = None  # (t, x, y) of the current anchor, kept
         self.reach = 0.0  # the anchor's disc radius
@@ -130,7 +132,7 @@ class Reducer:
         return reach - self.margin
 
     def _keep(self, sample: FloatArray) -> None:
-        if self.pin_time is not None and sample[0] >= self.pin_time:
+        if self.pin_time is not None and sample[0] - self.origin >= self.pin_time:
             self.pin_time = None
         self.kept.append(sample)
         self.anchor = sample
@@ -141,6 +143,7 @@ class Reducer:
         """The next samples ``(t, x, y)`` of the stream, in time order."""
         start = 0
         if self.anchor is None and len(samples):
+            self.origin = float(samples[0][0])
             self._keep(samples[0].copy())
             start = 1
         self.count += len(samples)
@@ -153,7 +156,7 @@ class Reducer:
             offsets = np.hypot(block[:, 1] - self.anchor[1], block[:, 2] - self.anchor[2])
             out = ~(offsets < self.reach)
             if self.pin_time is not None:
-                out |= block[:, 0] >= self.pin_time
+                out |= block[:, 0] - self.origin >= self.pin_time
             if not out.any():
                 self.pending = samples[stop - 1].copy()
                 index = stop

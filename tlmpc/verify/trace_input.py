@@ -48,6 +48,14 @@ class TraceInput:
     source: str | None = None
     #: The robot's body radius: the body must stay off obstacles, not just the point.
     radius: float = 0.0
+    #: When the log started, if before ``times[0]`` (a stretch of a longer log, as the live
+    #: monitor checks): messages give times from here.
+    origin: float | None = None
+
+    @property
+    def start(self) -> float:
+        """The time messages count from: the log's first sample."""
+        return float(self.times[0]) if self.origin is None else self.origin
 
 
 def _fail(

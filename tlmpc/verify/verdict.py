@@ -289,7 +289,7 @@ def _body_contacts(trace: TraceInput, distances: FloatArray) -> list[Violation]:
             time=time,
             position=(x, y),
             message=f"the robot's body (radius {trace.radius:g}) touches an obstacle near "
-            f"{at(time, float(trace.times[0]))} at ({x:.4g}, {y:.4g}): the path passes "
+            f"{at(time, trace.start)} at ({x:.4g}, {y:.4g}): the path passes "
             f"{float(distances[index]):.4g} from it",
         )
     ]
@@ -358,8 +358,7 @@ def workspace_violations(trace: TraceInput) -> tuple[list[Violation], float | No
                 conjunct="workspace",
                 time=time,
                 position=(x, y),
-                message=f"the trajectory {where} at {at(time, float(trace.times[0]))} at "
-                f"({x:.4g}, {y:.4g})",
+                message=f"the trajectory {where} at {at(time, trace.start)} at ({x:.4g}, {y:.4g})",
             )
         )
     return found, -depth
@@ -469,7 +468,7 @@ def verify_trace(trace: TraceInput) -> Verdict:
         positions=pieces.positions,
         labels=pieces.labels,
         names=names,
-        origin=float(trace.times[0]),
+        origin=trace.start,
     )
     reports, violations = conjunct_reports(conjuncts, outcomes, truth, line)
 
