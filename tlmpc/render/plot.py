@@ -18,6 +18,7 @@ import itertools
 from collections.abc import Mapping, Sequence
 from typing import Any
 
+from tlmpc.base.extras import require
 from tlmpc.render.scene import Scene, build_scene, viridis
 
 View = tuple[float, float, float, float]
@@ -45,6 +46,7 @@ def render_png(
 ) -> bytes:
     """``plan.png`` of the same scene, drawn with matplotlib (reproducible byte for byte)."""
     scene = build_scene(artifacts, zoom=zoom, log=log, verdict=verdict)
+    require("matplotlib.backends.backend_agg", "drawing a PNG figure")
     import matplotlib
 
     matplotlib.use("Agg", force=False)
