@@ -177,7 +177,7 @@ def spin_and_ours(
     abstraction = build_abstraction(m)
     model = tmp_path / "model.pml"
     model.write_text(to_promela(abstraction, m.formula, bounce=bounce))
-    trail = spin.run_spin(model, shortest=True, timeout=120, max_depth=100_000)
+    trail = spin.run_spin(model, shortest=True, max_depth=100_000)
     automaton = translate(m.formula, letters=abstraction.letters)
     try:
         witness = plan(
