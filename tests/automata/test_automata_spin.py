@@ -134,6 +134,7 @@ def test_claim_parser_sanity() -> None:
 SMALL = [(r[0], r[2]) for r in FAST if len(parse_ltl(r[2]).props()) <= 5]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("name", "text"), SMALL)
 def test_same_language_as_spin(name: str, text: str) -> None:
     formula = parse_ltl(text)

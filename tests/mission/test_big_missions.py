@@ -113,6 +113,7 @@ _PLACES = [
 ]
 
 
+@pytest.mark.slow
 @settings(deadline=None)
 @given(
     place=st.sampled_from(_PLACES),
