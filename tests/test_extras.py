@@ -79,6 +79,21 @@ def test_png_without_matplotlib_names_the_png_extra(
     assert not (compiled / "plan.png").exists()
 
 
+def test_compile_png_without_matplotlib_stops_before_compiling(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    hide(monkeypatch, "matplotlib")
+    stages: list[str] = []
+    monkeypatch.setattr(
+        "tlmpc.pipeline.stages.compile_mission", lambda *a, **k: stages.append("ran")
+    )
+    code, _, err = run_cli("compile", str(EXAMPLE), "-o", str(tmp_path / "out"), "--png")
+    assert_names_extra(code, err, "png")
+    assert "--png" in err
+    assert stages == []
+    assert not (tmp_path / "out").exists()
+
+
 def test_a_bag_without_rosbags_names_the_ros_extra(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
