@@ -102,6 +102,7 @@ def test_a_bag_without_rosbags_names_the_ros_extra(
     bag.write_bytes(b"\x89MCAP0\r\n")
     code, _, err = run_cli("verify", str(bag), "--mission", str(EXAMPLE))
     assert_names_extra(code, err, "ros")
+    assert err.startswith(f"{bag}: error[U060]")
 
 
 @pytest.mark.parametrize("package", EXTRAS["ros"])

@@ -20,11 +20,11 @@ EXTRAS: dict[str, tuple[str, ...]] = {
 }
 
 
-def require(module: str, purpose: str) -> ModuleType:
+def require(module: str, purpose: str, file: str | None = None) -> ModuleType:
     """Import ``module`` (``"rosbags.highlevel"``) for ``purpose`` (``"reading a ROS bag"``).
 
-    Raises :class:`UsageError` (U060, exit 2) naming the extra that provides it when the
-    package is not installed.
+    Raises :class:`UsageError` (U060, exit 2, at ``file`` when the command was reading one)
+    naming the extra that provides it when the package is not installed.
     """
     package = module.partition(".")[0]
     extra = next((name for name, packages in EXTRAS.items() if package in packages), None)
@@ -40,5 +40,6 @@ def require(module: str, purpose: str) -> ModuleType:
                 "U060",
                 f"{purpose} needs the optional package {package!r}, which is not installed",
                 hint=f"install tlmpc with the {extra!r} extra: pip install 'tlmpc[{extra}]'",
+                file=file,
             )
         ) from None
