@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import assume, example, given, settings
+from hypothesis import HealthCheck, assume, example, given, settings
 from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
 from scipy.linalg import expm
@@ -474,7 +474,13 @@ def test_exit_speed_is_the_best_the_vertex_conditions_allow(
     assert step.exit_speed >= float(best) * (1 - 1e-5)
 
 
-@settings(deadline=None, max_examples=30)
+@settings(
+    deadline=None,
+    max_examples=30,
+    # thin triangles and boundary points are filtered out; older hypothesis releases count
+    # that against the strategy
+    suppress_health_check=[HealthCheck.filter_too_much],
+)
 @given(triangles(), st.integers(0, 2), st.integers(1, 2), st.data())
 def test_a_field_leaving_by_an_unplanned_facet_is_reported(
     v: np.ndarray, exit_edge: int, shift: int, data: st.DataObject
