@@ -32,6 +32,7 @@ COMMAND_MODULES = (
     "compile",
     "check",
     "verify",
+    "monitor",
     "automaton",
     "export",
     "plot",

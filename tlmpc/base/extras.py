@@ -17,6 +17,7 @@ from tlmpc.base.errors import UsageError, error
 EXTRAS: dict[str, tuple[str, ...]] = {
     "ros": ("rosbags", "mcap"),
     "png": ("matplotlib",),
+    "fleet": ("distributed", "pyarrow"),  # fleet verification names it itself (F001, F006)
 }
 
 

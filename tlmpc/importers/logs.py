@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -207,6 +207,53 @@ def parse_columns(text: str) -> tuple[str, str, str]:
     return parts[0], parts[1], parts[2]
 
 
+def _layout(
+    cells: list[str], columns: Sequence[str] | None, file: str, number: int
+) -> tuple[bool, tuple[int, int, int]]:
+    """Whether the first data line is a header, and the columns of t, x, y."""
+    header = not all(_is_number(c) for c in cells if c)
+    if header:
+        if columns is not None:
+            chosen = tuple(_pick(cells, c, file, number) for c in columns)
+            return True, (chosen[0], chosen[1], chosen[2])
+        return True, _guess(cells, file, number)
+    if columns is not None:
+        if not all(c.isdigit() for c in columns):
+            raise _fail(
+                "M052",
+                "the log has no header line, so --columns must give column numbers",
+                file,
+                hint="for example --columns 1,2,3",
+                line=number,
+            )
+        chosen = tuple(_pick(cells, c, file, number) for c in columns)
+        return False, (chosen[0], chosen[1], chosen[2])
+    if len(cells) != 3:
+        raise _fail(
+            "M052",
+            f"no header line and {len(cells)} columns: cannot tell which are t, x, y",
+            file,
+            hint="add a header line naming t (or time), x, y, or pass --columns",
+            line=number,
+        )
+    return False, (0, 1, 2)
+
+
+def _row(cells: list[str], indices: tuple[int, int, int], file: str, number: int) -> list[float]:
+    if len(cells) <= max(indices):
+        raise _fail(
+            "M053",
+            f"row has {len(cells)} columns, expected at least {max(indices) + 1}",
+            file,
+            line=number,
+        )
+    try:
+        return [float(cells[i]) for i in indices]
+    except ValueError:
+        bad = next(cells[i] for i in indices if not _is_number(cells[i]))
+        raise _fail("M053", f"not a number: {bad!r}", file, line=number) from None
+
+
 def read_csv_log(path: Path, columns: Sequence[str] | None = None) -> Log:
     """A CSV/TSV/whitespace log; see the module docstring for the accepted forms."""
     file = str(path)
@@ -228,51 +275,150 @@ def read_csv_log(path: Path, columns: Sequence[str] | None = None) -> Log:
         cells = _split(stripped, separator)
         if first:
             first = False
-            header = not all(_is_number(c) for c in cells if c)
+            header, indices = _layout(cells, columns, file, number)
             if header:
-                if columns is not None:
-                    chosen = tuple(_pick(cells, c, file, number) for c in columns)
-                    indices = (chosen[0], chosen[1], chosen[2])
-                else:
-                    indices = _guess(cells, file, number)
                 continue
-            if columns is not None:
-                if not all(c.isdigit() for c in columns):
-                    raise _fail(
-                        "M052",
-                        "the log has no header line, so --columns must give column numbers",
-                        file,
-                        hint="for example --columns 1,2,3",
-                        line=number,
-                    )
-                chosen = tuple(_pick(cells, c, file, number) for c in columns)
-                indices = (chosen[0], chosen[1], chosen[2])
-            elif len(cells) != 3:
-                raise _fail(
-                    "M052",
-                    f"no header line and {len(cells)} columns: cannot tell which are t, x, y",
-                    file,
-                    hint="add a header line naming t (or time), x, y, or pass --columns",
-                    line=number,
-                )
-            else:
-                indices = (0, 1, 2)
         assert indices is not None
-        if len(cells) <= max(indices):
-            raise _fail(
-                "M053",
-                f"row has {len(cells)} columns, expected at least {max(indices) + 1}",
-                file,
-                line=number,
-            )
-        try:
-            rows.append([float(cells[i]) for i in indices])
-        except ValueError:
-            bad = next(cells[i] for i in indices if not _is_number(cells[i]))
-            raise _fail("M053", f"not a number: {bad!r}", file, line=number) from None
+        rows.append(_row(cells, indices, file, number))
         lines.append(number)
     samples = np.asarray(rows, dtype=np.float64).reshape(-1, 3)
     return Log(samples=samples, lines=tuple(lines), source=file)
+
+
+#: Characters read at a time by :func:`iter_csv_chunks`.
+BLOCK_CHARS = 1 << 22
+
+
+def _fast_rows(
+    lines: list[str], separator: str | None, indices: tuple[int, int, int]
+) -> FloatArray | None:
+    """The rows of plain lines at C speed (numpy's reader, whose numbers are Python's
+    ``float`` of the same text); None when any line needs the line-by-line parser's care
+    (a quoted cell, a short row, a blank line, a number only ``float`` reads)."""
+    try:
+        rows = np.loadtxt(
+            lines,
+            delimiter=separator,
+            usecols=indices,
+            ndmin=2,
+            comments=None,
+            dtype=np.float64,
+        )
+    except ValueError:
+        return None
+    return rows if len(rows) == len(lines) else None
+
+
+def iter_csv_chunks(
+    path: Path, columns: Sequence[str] | None = None, block_chars: int = BLOCK_CHARS
+) -> Iterator[Log]:
+    """The samples of a CSV log, a block of text at a time, never the whole file.
+
+    Accepts exactly what :func:`read_csv_log` accepts and gives the same samples and line
+    numbers, in order; a problem is raised when its block is reached.
+    """
+    file = str(path)
+    separator: str | None = None
+    indices: tuple[int, int, int] | None = None
+    number = 0  # lines before the current block
+    carry = ""
+    try:
+        with open(path, encoding="utf-8-sig") as stream:
+            while True:
+                text = stream.read(block_chars)
+                end = text.rfind("\n") + 1 if text else len(carry)
+                if text and end == 0:
+                    carry += text
+                    continue
+                block, carry = carry + text[:end], text[end:] if text else ""
+                if not block:
+                    break
+                # splitlines, as read_csv_log splits the whole text (form feeds, ...); the
+                # block ends after a line break, so its lines are the file's lines.
+                lines = block.splitlines()
+                first_number = number + 1
+                number += len(lines)
+                if indices is None:
+                    for offset, raw in enumerate(lines):
+                        stripped = raw.strip()
+                        if not stripped or stripped.startswith("#"):
+                            continue
+                        separator = next((s for s in _SEPARATORS if s in stripped), None)
+                        header, indices = _layout(
+                            _split(stripped, separator), columns, file, first_number + offset
+                        )
+                        skip = offset + 1 if header else offset
+                        lines, first_number = lines[skip:], first_number + skip
+                        break
+                    else:
+                        continue
+                chunk = _chunk(lines, first_number, separator, indices, file, "#" not in block)
+                if len(chunk.samples):
+                    yield chunk
+    except (OSError, UnicodeDecodeError) as exc:
+        raise _fail("M050", f"cannot read {file}: {exc}", file) from None
+
+
+def _chunk(
+    lines: list[str],
+    first_number: int,
+    separator: str | None,
+    indices: tuple[int, int, int],
+    file: str,
+    plain: bool,
+) -> Log:
+    """The samples of consecutive lines (the first is line ``first_number``); ``plain``: no
+    line is a comment (blank lines make the widths differ, which the fast parser refuses)."""
+    numbers = range(first_number, first_number + len(lines))
+    samples = _fast_rows(lines, separator, indices) if plain and lines else None
+    if samples is not None:
+        return Log(samples=samples, lines=tuple(numbers), source=file)
+    rows: list[list[float]] = []
+    kept: list[int] = []
+    for raw, number in zip(lines, numbers, strict=True):
+        stripped = raw.strip()
+        if not stripped or stripped.startswith("#"):
+            continue
+        rows.append(_row(_split(stripped, separator), indices, file, number))
+        kept.append(number)
+    return Log(
+        samples=np.asarray(rows, dtype=np.float64).reshape(-1, 3),
+        lines=tuple(kept),
+        source=file,
+    )
+
+
+def apply_transform(
+    samples: FloatArray, transform: tuple[float, float, float] | None
+) -> FloatArray:
+    """``samples`` moved by the rigid ``(x, y, yaw)`` (see :func:`read_log`)."""
+    return _apply(samples, transform)
+
+
+class CsvLines:
+    """A CSV log read one line at a time (a live log): the same header rules, columns and
+    numbers as :func:`read_csv_log`."""
+
+    def __init__(self, file: str, columns: Sequence[str] | None = None) -> None:
+        self.file = file
+        self.columns = columns
+        self.separator: str | None = None
+        self.indices: tuple[int, int, int] | None = None
+
+    def parse(self, raw: str, number: int) -> tuple[float, float, float] | None:
+        """The sample on line ``number``; None for a blank, comment or header line."""
+        stripped = raw.strip()
+        if not stripped or stripped.startswith("#"):
+            return None
+        if self.indices is None:
+            self.separator = next((s for s in _SEPARATORS if s in stripped), None)
+            header, self.indices = _layout(
+                _split(stripped, self.separator), self.columns, self.file, number
+            )
+            if header:
+                return None
+        t, x, y = _row(_split(stripped, self.separator), self.indices, self.file, number)
+        return t, x, y
 
 
 # --- ROS bags ---------------------------------------------------------------------------------

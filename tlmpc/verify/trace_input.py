@@ -244,8 +244,8 @@ MAX_CSV_ROWS = 2_000_000
 MAX_CSV_LINE = 4096
 
 
-def check_csv_file(path: Path) -> None:
-    """Refuse (U038) a CSV trace too large to verify, reading it in chunks (never whole)."""
+def _csv_extent(path: Path) -> tuple[int, int, int]:
+    """Bytes, rows and longest line of a CSV file, read in chunks until a limit is passed."""
     rows = 0
     longest = 0
     current = 0
@@ -266,6 +266,19 @@ def check_csv_file(path: Path) -> None:
                     break
     except OSError as exc:
         raise _fail("U001", f"cannot read {path}: {exc.strerror or exc}", str(path)) from None
+    return size, rows, longest
+
+
+def is_large_csv(path: Path) -> bool:
+    """Whether the whole-log reader refuses the CSV for its size alone (U038): a log to
+    stream instead."""
+    size, rows, longest = _csv_extent(path)
+    return (size > MAX_CSV_BYTES or rows > MAX_CSV_ROWS) and longest <= MAX_CSV_LINE
+
+
+def check_csv_file(path: Path) -> None:
+    """Refuse (U038) a CSV trace too large to verify, reading it in chunks (never whole)."""
+    size, rows, longest = _csv_extent(path)
     if size > MAX_CSV_BYTES or rows > MAX_CSV_ROWS:
         raise _fail(
             "U038",
@@ -283,6 +296,35 @@ def check_csv_file(path: Path) -> None:
         )
 
 
+def mission_document(path: Path, mission_path: Path | None) -> dict[str, Any]:
+    """A ``tlmpc.trace/1`` document without samples: the task, regions, workspace, convention,
+    ``max_speed`` and body radius that ``mission_path`` gives the log at ``path``."""
+    if mission_path is None:
+        raise _fail(
+            "V010", "a CSV trace needs --mission MISSION.yaml for its regions and task", str(path)
+        )
+    from tlmpc.base.errors import InvalidInputError
+    from tlmpc.ltl.printer import to_text
+    from tlmpc.mission.body import body_radius
+    from tlmpc.mission.load import load_mission
+
+    try:
+        mission = load_mission(mission_path)
+    except InvalidInputError as exc:
+        raise UsageError(exc.diagnostics) from None
+    return {
+        "format": "tlmpc.trace/1",
+        "ltl": to_text(mission.formula),
+        "regions": {r.name: [list(p) for p in r.polygon] for r in mission.regions},
+        "workspace": mission.workspace.to_json(),
+        "boundary": mission.options.boundary,
+        "max_speed": mission.robot.max_speed,
+        "radius": body_radius(mission.robot),
+        "points": [],
+        "loop_start": None,
+    }
+
+
 def from_csv(
     path: Path,
     mission_path: Path | None,
@@ -296,33 +338,12 @@ def from_csv(
     """A logged trajectory (CSV or ROS bag) checked against a mission file's regions and task.
 
     ``frame`` (bags): the poses are expressed in that frame through the bag's tf."""
-    if mission_path is None:
-        raise _fail(
-            "V010", "a CSV trace needs --mission MISSION.yaml for its regions and task", str(path)
-        )
-    from tlmpc.base.errors import InvalidInputError
     from tlmpc.importers.logs import CSV_SUFFIXES, read_log
-    from tlmpc.ltl.printer import to_text
-    from tlmpc.mission.body import body_radius
-    from tlmpc.mission.load import load_mission
 
-    try:
-        mission = load_mission(mission_path)
-    except InvalidInputError as exc:
-        raise UsageError(exc.diagnostics) from None
+    document = mission_document(path, mission_path)
     if path.suffix.lower() in CSV_SUFFIXES and path.is_file():
         check_csv_file(path)  # bounded before parsing
     log = read_log(path, topic=topic, columns=columns, transform=transform, frame=frame)
     samples = _samples(log.samples, str(path), list(log.lines) or None)
-    document = {
-        "format": "tlmpc.trace/1",
-        "ltl": to_text(mission.formula),
-        "regions": {r.name: [list(p) for p in r.polygon] for r in mission.regions},
-        "workspace": mission.workspace.to_json(),
-        "boundary": mission.options.boundary,
-        "max_speed": mission.robot.max_speed,
-        "radius": body_radius(mission.robot),
-        "points": samples.tolist(),
-        "loop_start": None,
-    }
+    document["points"] = samples.tolist()
     return from_document(document, file=str(path), convention=convention)
