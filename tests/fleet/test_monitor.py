@@ -27,7 +27,8 @@ from tlmpc.ltl.ast import Prop, Until
 from tlmpc.ltl.parser import parse_ltl
 from tlmpc.ltl.printer import to_text
 from tlmpc.verify import verify_document
-from tlmpc.verify.evaluate import open_truth
+from tlmpc.verify.evaluate import truth_atoms
+from tlmpc.verify.semantics import evaluate, three_valued
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -92,7 +93,10 @@ def test_progression_is_the_evaluator_on_words(
     labels = np.array([[n in letter for n in names] for letter in word], dtype=bool)
     for closed in (False, True):
         is_point = np.array(points[: len(word)]) if closed else None
-        expected = int(open_truth(formula, labels, names, is_point)[0])
+        evaluated = evaluate(
+            formula, truth_atoms(labels, names), labels.shape[0], "open", is_point=is_point
+        )
+        expected = int(three_valued(evaluated)[0])
         pieces = [
             Piece(letter, point_rule=closed and bool(points[k])) for k, letter in enumerate(word)
         ]
@@ -179,3 +183,12 @@ def test_bad_poses_exit_2(tmp_path: Path) -> None:
 def test_parse_ltl_residue_of_every_operator() -> None:
     formula = parse_ltl("(a W b) & (a M b) & (a R b) & (a <-> b) & (a -> F b)")
     assert value(residue(formula), []) == 0
+
+
+def test_a_time_bound_is_refused_with_f010(tmp_path: Path) -> None:
+    mission = tmp_path / "timed.yaml"
+    text = (ROOT / "specs" / "reach-avoid.yaml").read_text(encoding="utf-8")
+    mission.write_text(text.replace("- avoid hazard", "- visit dock within 60 s"), encoding="utf-8")
+    code, _, err = run_cli("monitor", "--mission", str(mission), stdin="t,x,y\n0,1,1\n")
+    assert code == 2
+    assert "F010" in err

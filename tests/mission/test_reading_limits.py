@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import os
 from pathlib import Path
 
 import pytest
@@ -158,13 +159,28 @@ def test_second_document_and_undefined_alias_are_y001() -> None:
     assert codes("a: *nowhere\n") == ["Y001"]
 
 
-def test_endless_file_is_refused_while_reading(monkeypatch: pytest.MonkeyPatch) -> None:
+def test_a_huge_file_is_refused_while_reading(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
     # (the memory bound is measured in a child process in test_big_missions)
     monkeypatch.setattr(load, "MAX_BYTES", 8 << 20)
+    huge = tmp_path / "huge.yaml"
+    with huge.open("wb") as stream:
+        stream.truncate(1 << 30)  # sparse: a gigabyte long, no disk used
     with pytest.raises(UsageError) as caught:
-        inspect_file(Path("/dev/zero"))
+        inspect_file(huge)
     assert caught.value.diagnostics[0].code == "U004"
     assert "8 MiB" in caught.value.diagnostics[0].message
+
+
+def test_devices_and_fifos_are_refused_at_once(tmp_path: Path) -> None:
+    fifo = tmp_path / "mission.yaml"
+    os.mkfifo(fifo)  # no writer: opening it for reading the usual way would block forever
+    for path in (Path("/dev/zero"), fifo, tmp_path):
+        with pytest.raises(UsageError) as caught:
+            inspect_file(path)
+        assert caught.value.diagnostics[0].code == "U001"
+        assert "not a regular file" in caught.value.diagnostics[0].message
 
 
 def test_a_file_of_exactly_the_limit_is_read(

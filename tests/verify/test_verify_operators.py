@@ -46,12 +46,41 @@ from tlmpc.ltl.ast import (
     WeakUntil,
 )
 from tlmpc.ltl.printer import to_text
-from tlmpc.verify.evaluate import lasso_truth, open_truth
+from tlmpc.verify.evaluate import truth_atoms
+from tlmpc.verify.semantics import evaluate, three_valued
 
 PROPS = ("a", "b")
 Word = list[frozenset[str]]
 letters = st.frozensets(st.sampled_from(PROPS))
 ALL_LETTERS = [frozenset(s) for n in range(3) for s in itertools.combinations(PROPS, n)]
+
+
+def lasso_truth(
+    formula: Formula,
+    labels: npt.NDArray[np.bool_],
+    names: list[str],
+    loop_start: int,
+    is_point: npt.NDArray[np.bool_] | None = None,
+) -> npt.NDArray[np.bool_]:
+    """Two-valued truth at every piece of a lasso, by the verifier's own evaluator."""
+    lo, _ = evaluate(
+        formula, truth_atoms(labels, names), labels.shape[0], loop_start, is_point=is_point
+    )
+    truth: npt.NDArray[np.bool_] = lo > 0
+    return truth
+
+
+def open_truth(
+    formula: Formula,
+    labels: npt.NDArray[np.bool_],
+    names: list[str],
+    is_point: npt.NDArray[np.bool_] | None = None,
+) -> npt.NDArray[np.int8]:
+    """Three-valued truth at every piece of a log that goes on, by the verifier's evaluator."""
+    value = evaluate(
+        formula, truth_atoms(labels, names), labels.shape[0], "open", is_point=is_point
+    )
+    return three_valued(value)
 
 
 def _labels(word: Word) -> npt.NDArray[np.bool_]:

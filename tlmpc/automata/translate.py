@@ -33,6 +33,7 @@ from tlmpc.automata.terms import (
 )
 from tlmpc.automata.wdba import is_obligation
 from tlmpc.ltl.ast import Formula, Not, Prop, conjoin
+from tlmpc.ltl.bounds import refuse_bounds
 from tlmpc.ltl.printer import to_text as formula_text
 from tlmpc.ltl.transform import nnf
 
@@ -140,6 +141,7 @@ def translate(
             and the automaton reduced so far, which is always correct, is returned; None = no
             limit.
     """
+    refuse_bounds(formula, purpose="the automaton translation")
     return _translate(
         formula, letters=letters, simplify=simplify, budget=budget, containment=containment
     )

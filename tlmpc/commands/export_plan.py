@@ -43,10 +43,26 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     from tlmpc.exports.formats import geojson, path_mcap, waypoints_csv, waypoints_yaml
     from tlmpc.exports.plan import read_plan, waypoints
     from tlmpc.io.outdir import replace_file
+    from tlmpc.io.outputs import has_unsafe_chars, plain_name, refuse_input_as_output
 
     if not math.isfinite(args.spacing) or args.spacing < 0:
         raise UsageError(
             error("M082", f"--spacing must be a non-negative number, got {args.spacing:g}")
+        )
+    for flag, value in (("--frame-id", args.frame_id), ("--topic", args.topic)):
+        if not value or has_unsafe_chars(value):
+            raise UsageError(
+                error(
+                    "M084",
+                    f"{flag} {plain_name(value)!r} is empty or holds control, newline or "
+                    "direction characters",
+                    hint=f"give a plain {flag} such as "
+                    + ("map" if flag == "--frame-id" else "/plan"),
+                )
+            )
+    if args.output is not None:
+        refuse_input_as_output(
+            args.output, [args.out / n for n in ("trace.json", "mission.json", "controllers.json")]
         )
     if args.output is not None and not args.output.parent.is_dir():
         raise UsageError(
@@ -69,7 +85,17 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     elif args.format == "waypoints-csv":
         data = waypoints_csv(plan, points, loop).encode("utf-8")
     elif args.format == "geojson":
-        data = geojson(plan, points, loop).encode("utf-8")
+        try:
+            data = geojson(plan, points, loop).encode("utf-8")
+        except ValueError:  # a non-finite number, which JSON cannot hold
+            raise UsageError(
+                error(
+                    "M081",
+                    f"the plan in {args.out} holds a number that is not finite",
+                    hint="this output was edited or damaged; compile the mission again",
+                    file=str(args.out),
+                )
+            ) from None
     else:
         data = path_mcap(plan, points, args.topic, args.frame_id)
     from tlmpc.io.report import Reporter

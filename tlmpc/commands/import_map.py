@@ -79,6 +79,10 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         max_speed=args.max_speed,
         rects=_rects(args.region or []),
     )
+    if args.output is not None:
+        from tlmpc.io.outputs import refuse_input_as_output
+
+        refuse_input_as_output(args.output, [Path(name) for name in imported.inputs])
     text = mission_yaml(document)
     ratio = imported.workspace_area / imported.free_cells_area if imported.free_cells_area else 0
     summary = (

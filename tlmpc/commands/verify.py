@@ -9,6 +9,7 @@ line per log as it finishes, a summary, and one exit code for the batch (see
 from __future__ import annotations
 
 import argparse
+import math
 from pathlib import Path
 from typing import TYPE_CHECKING, TextIO
 
@@ -189,7 +190,7 @@ def _run_one(args: argparse.Namespace, path: Path, out: TextIO, err: TextIO) -> 
             frame=args.frame,
         )
     else:
-        document = read_json(path)
+        document = read_json(path, finite=False)
         trace = from_document(document, file=str(path), convention=args.boundary)
     trace = declare_ending(trace, assume_stay=args.assume_stay, loop_from=args.loop_from)
     verdict = verify_trace(trace)
@@ -234,12 +235,22 @@ def _text(path: Path, verdict: Verdict) -> str:
     }[verdict.ending]
     lines.append(f"{path}: {status[verdict.outcome]}: {verdict.formula}")
     lines.append(f"  boundary convention: {verdict.convention}; {ending}; {verdict.pieces} pieces")
-    if len(verdict.conjuncts) > 1 or verdict.ending == "open":
+    timed = any(r.time_robustness is not None for r in verdict.conjuncts)
+    if len(verdict.conjuncts) > 1 or verdict.ending == "open" or timed:
         for report in verdict.conjuncts:
             lines.append(f"  {report.conjunct}: {report.outcome}: {report.progress}")
     for violation in verdict.violations:
         lines.append(f"  violation: {violation.message}")
     lines.append(f"  robustness: {verdict.robustness:.6g}")
+    slack = verdict.time_robustness
+    if slack is not None and math.isinf(slack):
+        decided = "holds" if slack > 0 else "fails"
+        lines.append(f"  time robustness: {slack:g} (the task {decided} at any time bound)")
+    elif slack is not None:
+        lines.append(
+            f"  time robustness: {slack:.6g} s "
+            "(how much tighter the time bounds could be; < 0: how much looser they must be)"
+        )
     certificate = verdict.certificate
     word = "certified" if certificate.certified else "not certified"
     lines.append(f"  {word}: {certificate.reason}")

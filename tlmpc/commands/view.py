@@ -37,7 +37,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Build the scene, render it and write the page atomically."""
     from tlmpc.base.errors import EXIT_OK, UsageError, error
+    from tlmpc.io.artifacts import ARTIFACT_SCHEMAS
     from tlmpc.io.outdir import replace_file
+    from tlmpc.io.outputs import refuse_input_as_output
     from tlmpc.io.report import Reporter
     from tlmpc.view import render_html, scene_from_log, scene_from_output
 
@@ -52,11 +54,16 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             )
         )
     if args.log is not None:
-        scene = scene_from_log(args.log, args.mission)
         target = args.output or args.log.with_suffix(".html")
+        inputs = [args.log, args.mission]
+    else:
+        target = args.output or args.out / "view.html"
+        inputs = [args.out / name for name in ARTIFACT_SCHEMAS]
+    refuse_input_as_output(target, inputs)
+    if args.log is not None:
+        scene = scene_from_log(args.log, args.mission)
     else:
         scene = scene_from_output(args.out)
-        target = args.output or args.out / "view.html"
     page = render_html(scene)
     if not target.parent.is_dir():
         raise UsageError(

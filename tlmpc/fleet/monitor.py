@@ -31,7 +31,7 @@ import shapely
 from tlmpc.base.errors import UsageError, error
 from tlmpc.fleet.progression import Piece, Residue, progress, residue, value
 from tlmpc.fleet.stream import Reducer
-from tlmpc.ltl.ast import And, Formula
+from tlmpc.ltl.ast import And, Formula, bounded_operators
 from tlmpc.ltl.printer import to_text
 from tlmpc.verify import TraceInput, from_document, verify_trace
 from tlmpc.verify.pieces import boundary_membership, build_pieces, region_membership
@@ -60,6 +60,16 @@ class Monitor:
         )
         self.convention = self.trace.convention
         formula = self.trace.formula
+        bounded = bounded_operators(formula)
+        if bounded:
+            raise UsageError(
+                error(
+                    "F010",
+                    f"the live monitor does not decide time bounds yet ({bounded[0]})",
+                    hint="verify the log when it ends: tlmpc verify LOG --mission MISSION "
+                    "decides time bounds exactly",
+                )
+            )
         self.conjuncts: list[Formula] = (
             list(formula.args) if isinstance(formula, And) else [formula]
         )

@@ -11,7 +11,8 @@
   ``geometry_msgs/PoseStamped`` or ``geometry_msgs/PoseWithCovarianceStamped`` messages on
   ``topic`` (needed only when several topics carry poses), stamped with the message header
   (the log time when the header stamp is zero).  Samples are sorted by time; a repeated
-  stamp keeps its first sample.
+  stamp is kept, for the verifier to refuse (V020) as in a CSV log.  At most
+  :data:`MAX_LOG_SAMPLES` samples are read (M066).
 
 An optional rigid ``transform`` ``(x, y, yaw)`` maps the log's frame into the mission's
 (e.g. ``odom`` into ``map``): ``p_mission = R(yaw) p_log + (x, y)``.  For bags, ``frame``
@@ -46,6 +47,11 @@ POSE_TYPES = {
     "geometry_msgs/msg/PoseWithCovarianceStamped": "pose.pose",
 }
 TIME_NAMES = ("t", "time", "timestamp", "stamp")
+
+#: The most samples a log may have (the verifier's limit for CSV traces), and the most bytes
+#: a CSV log may have; a bag's messages on the chosen topics count as they are read.
+MAX_LOG_SAMPLES = 2_000_000
+MAX_CSV_BYTES = 256 * 1024 * 1024
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -256,11 +262,10 @@ def _row(cells: list[str], indices: tuple[int, int, int], file: str, number: int
 
 def read_csv_log(path: Path, columns: Sequence[str] | None = None) -> Log:
     """A CSV/TSV/whitespace log; see the module docstring for the accepted forms."""
+    from tlmpc.io.inputs import read_text
+
     file = str(path)
-    try:
-        text = path.read_text(encoding="utf-8-sig")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise _fail("M050", f"cannot read {file}: {exc}", file) from None
+    text = read_text(path, limit=MAX_CSV_BYTES, code="M050", what="log", encoding="utf-8-sig")
     separator: str | None = None
     indices: tuple[int, int, int] | None = None
     rows: list[list[float]] = []
@@ -281,6 +286,14 @@ def read_csv_log(path: Path, columns: Sequence[str] | None = None) -> Log:
         assert indices is not None
         rows.append(_row(cells, indices, file, number))
         lines.append(number)
+        if len(rows) > MAX_LOG_SAMPLES:
+            raise _fail(
+                "M066",
+                f"the log has more than {MAX_LOG_SAMPLES:,} samples",
+                file,
+                hint="verify a shorter stretch of the log, or thin it out",
+                line=number,
+            )
     samples = np.asarray(rows, dtype=np.float64).reshape(-1, 3)
     return Log(samples=samples, lines=tuple(lines), source=file)
 
@@ -446,6 +459,7 @@ def read_bag(path: Path, topic: str | None = None, frame: str | None = None) -> 
     from rosbags.typesys import Stores, get_typestore
 
     file = str(path)
+    _check_bag_path(path, file)
     try:
         reader = AnyReader([_bag_paths(path)], default_typestore=get_typestore(Stores.ROS2_HUMBLE))
         reader.open()
@@ -499,6 +513,9 @@ def read_bag(path: Path, topic: str | None = None, frame: str | None = None) -> 
                 )
             chosen = [c for c in poses if c.topic == topics[0]]
             topic = topics[0]
+        declared = sum(int(c.msgcount) for c in chosen)
+        if declared > MAX_LOG_SAMPLES:
+            raise _too_many(file)
         rows: list[tuple[int, float, float]] = []
         frames: list[tuple[int, float, float, float, str]] = []
         try:
@@ -511,6 +528,8 @@ def read_bag(path: Path, topic: str | None = None, frame: str | None = None) -> 
                 nanoseconds = int(stamp.sec) * 1_000_000_000 + int(stamp.nanosec)
                 when = nanoseconds if nanoseconds else int(log_time)
                 rows.append((when, float(pose.position.x), float(pose.position.y)))
+                if len(rows) > MAX_LOG_SAMPLES:  # a bag whose index understates its messages
+                    raise _too_many(file)
                 if frame is not None:
                     frames.append(
                         (
@@ -532,6 +551,35 @@ def read_bag(path: Path, topic: str | None = None, frame: str | None = None) -> 
     finally:
         reader.close()
     return Log(samples=_sorted_samples(rows), source=file, topic=topic)
+
+
+def _too_many(file: str) -> UsageError:
+    return _fail(
+        "M066",
+        f"the bag's pose topic has more than {MAX_LOG_SAMPLES:,} messages",
+        file,
+        hint="verify a shorter stretch of the recording (e.g. `ros2 bag convert` or "
+        "`rosbag filter` by time)",
+    )
+
+
+def _check_bag_path(path: Path, file: str) -> None:
+    """A bag is a regular file or a ROS 2 bag directory: never a device or a FIFO, which
+    would be read without end or block."""
+    import os
+    import stat
+
+    try:
+        mode = os.stat(path).st_mode
+    except OSError as exc:
+        raise _fail("M050", f"cannot read {file}: {exc.strerror or exc}", file) from None
+    if not (stat.S_ISREG(mode) or stat.S_ISDIR(mode)):
+        raise _fail(
+            "M060",
+            f"{file} is not a regular file or a bag directory",
+            file,
+            hint="tlmpc reads only regular files (no devices, pipes or sockets)",
+        )
 
 
 def _in_frame(
@@ -583,14 +631,13 @@ def _in_frame(
 
 
 def _sorted_samples(rows: list[tuple[int, float, float]]) -> FloatArray:
-    """Sorted by integer nanoseconds (exact), first of a repeated stamp kept, then seconds."""
+    """Sorted by integer nanoseconds (exact, stable), then seconds.
+
+    Repeated stamps are kept: the verifier refuses them (V020) as it does in a CSV log, since
+    two poses at one instant are not a trajectory and keeping one would hide the other."""
     rows.sort(key=lambda r: r[0])
-    kept: list[tuple[int, float, float]] = []
-    for row in rows:
-        if not kept or row[0] != kept[-1][0]:
-            kept.append(row)
-    samples = np.empty((len(kept), 3), dtype=np.float64)
-    for i, (ns, x, y) in enumerate(kept):
+    samples = np.empty((len(rows), 3), dtype=np.float64)
+    for i, (ns, x, y) in enumerate(rows):
         samples[i] = (ns / 1e9, x, y)
     return samples
 

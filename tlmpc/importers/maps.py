@@ -46,6 +46,9 @@ Ring = tuple[Point, ...]
 #: Default speck threshold, in cells: obstacle specks and region pieces smaller are dropped.
 DEFAULT_MIN_CELLS = 4.0
 
+#: Free pieces a map may have (each becomes a workspace component the planner meshes).
+MAX_PIECES = 2_000
+
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class ImportSettings:
@@ -73,6 +76,8 @@ class ImportedMap:
     tolerance: float
     source: str
     speckles_dropped: int = 0
+    #: every file read: the map YAML, its image, and those of the masks
+    inputs: tuple[str, ...] = ()
 
 
 def _ring(polygon_ring: Any) -> Ring:
@@ -120,6 +125,15 @@ def _free_pieces(
     if chosen is None:
         chosen = max(pieces, key=lambda p: p.area)
     others = [p for p in pieces if p is not chosen and p.area >= min_cells]
+    if len(others) >= MAX_PIECES:
+        raise _fail(
+            "M019",
+            f"the map has {len(others) + 1:,} separate free pieces of at least the minimum "
+            f"area, more than {MAX_PIECES:,} (a noise or dither pattern?)",
+            grid.source,
+            hint="clean the map, or raise the minimum area (--min-area, workspace.min_area) "
+            "so that specks are dropped",
+        )
     others.sort(key=lambda p: (-p.area, p.bounds))
     return chosen, others
 
@@ -241,6 +255,26 @@ def _exact_free(
     ]
 
 
+def _check_settings(settings: ImportSettings, file: str) -> None:
+    """Refuse (M012) a radius, tolerance or minimum area that is negative or not a finite
+    number: NaN compares false with everything, so a NaN minimum area would silently drop
+    every obstacle, and an infinite radius erodes nothing well-defined."""
+    for what, value in (
+        ("radius", settings.radius),
+        ("tolerance", settings.tolerance),
+        ("minimum area", settings.min_area),
+    ):
+        if value is not None and not (math.isfinite(value) and value >= 0):
+            raise _fail(
+                "M012",
+                f"the {what} must be a finite number >= 0, got {value:g}",
+                file,
+                hint="--radius, --tolerance and --min-area are lengths and areas in map units",
+            )
+    if settings.start is not None and not all(math.isfinite(v) for v in settings.start):
+        raise _fail("M018", f"the start must be finite, got {settings.start}", file)
+
+
 def import_map(
     map_path: Path,
     settings: ImportSettings = ImportSettings(),
@@ -249,17 +283,12 @@ def import_map(
     speed: Path | None = None,
 ) -> ImportedMap:
     """Read a map (and masks) and build the workspace and regions."""
+    _check_settings(settings, str(map_path))
     grid = read_map(map_path)
-    if settings.radius < 0:
-        raise _fail(
-            "M012", f"the radius must not be negative, got {settings.radius:g}", str(map_path)
-        )
     tolerance = grid.resolution if settings.tolerance is None else settings.tolerance
     min_area = (
         DEFAULT_MIN_CELLS * grid.cell_area() if settings.min_area is None else settings.min_area
     )
-    if tolerance < 0 or min_area < 0:
-        raise _fail("M012", "tolerance and min_area must not be negative", str(map_path))
     cell_area = grid.cell_area()
     exact_main, exact_others = _exact_free(grid, settings, min_area / cell_area)
     mask_grids: list[tuple[str, Path, OccupancyGrid]] = []
@@ -267,11 +296,16 @@ def import_map(
         if path is None:
             continue
         mask = read_map(path)
-        if mask.shape != grid.shape or mask.resolution != grid.resolution:
+        if (
+            mask.shape != grid.shape
+            or mask.resolution != grid.resolution
+            or mask.origin != grid.origin
+        ):
             raise _fail(
                 "M013",
-                f"the mask is {mask.shape[1]}x{mask.shape[0]} cells at {mask.resolution:g}, "
-                f"the map {grid.shape[1]}x{grid.shape[0]} at {grid.resolution:g}",
+                f"the mask is {mask.shape[1]}x{mask.shape[0]} cells at {mask.resolution:g} "
+                f"from origin {list(mask.origin)}, the map {grid.shape[1]}x{grid.shape[0]} "
+                f"at {grid.resolution:g} from {list(grid.origin)}",
                 str(path),
                 hint="a mask must have the map's size, resolution and origin",
             )
@@ -343,4 +377,7 @@ def import_map(
         tolerance=tolerance,
         source=str(map_path),
         speckles_dropped=dropped,
+        inputs=tuple(
+            name for g in (grid, *(m for _, _, m in mask_grids)) for name in (g.source, g.image)
+        ),
     )

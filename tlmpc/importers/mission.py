@@ -24,6 +24,12 @@ def _points(ring: Ring) -> list[list[float]]:
     return [[x, y] for x, y in ring]
 
 
+def _free_workspace(imported: ImportedMap) -> Any:
+    pieces = [Polygon(imported.boundary, imported.holes)]
+    pieces += [Polygon(outer, inner) for outer, inner in imported.components]
+    return shapely.union_all(pieces)
+
+
 def default_start(imported: ImportedMap) -> Point:
     """The free point farthest from obstacles and keepout regions (pole of inaccessibility)."""
     free: Any = Polygon(imported.boundary, imported.holes)
@@ -77,7 +83,32 @@ def mission_document(
     max_speed: float = 1.0,
     rects: Mapping[str, tuple[float, float, float, float]] | None = None,
 ) -> dict[str, Any]:
-    """A ``version: 1`` mission with the imported workspace, regions and groups."""
+    """A ``version: 1`` mission with the imported workspace, regions and groups.
+
+    Refuses (M018) what ``tlmpc check`` would reject in the written mission: a start that is
+    not a finite point of the free workspace, a speed that is not a positive finite number."""
+    if not (math.isfinite(max_speed) and max_speed > 0):
+        raise UsageError(
+            error(
+                "M018",
+                f"--max-speed must be a positive finite number, got {max_speed:g}",
+                hint="the robot's speed bound in map units per second, e.g. --max-speed 0.5",
+            )
+        )
+    if start is not None:
+        free = _free_workspace(imported)
+        if not all(math.isfinite(v) for v in start) or not free.covers(
+            shapely.Point(start[0], start[1])
+        ):
+            raise UsageError(
+                error(
+                    "M018",
+                    f"--start {start[0]:g} {start[1]:g} is not a point of the free workspace",
+                    hint="choose a free point of the map, or leave --start out for the point "
+                    "farthest from obstacles",
+                    file=imported.source,
+                )
+            )
     regions: dict[str, Any] = {n: _points(r) for n, r in imported.regions.items()}
     for region, rect in (rects or {}).items():
         regions[region] = _clip_rect(imported, region, rect)

@@ -7,6 +7,10 @@ parsed from different places compare equal when they mean the same tree.
 
 There is deliberately no ``Next`` node: Next has no meaning in continuous time.
 
+The time-bounded operators ``F[a,b]``, ``G[a,b]`` and ``U[a,b]`` (metric temporal logic over
+continuous time, bounds in seconds) are nodes of their own, so that code written for the
+untimed operators cannot mistake one for its unbounded namesake and drop the bound.
+
 ``Formula`` is a closed union of the node classes, not a base class: code that takes a formula
 apart does it with ``match`` and ends in ``case _: assert_never(formula)``, so mypy rejects a
 ``match`` that forgets a node kind (a test checks that it does).
@@ -167,6 +171,60 @@ class Globally(Node):
         return (self.arg,)
 
 
+@dataclass(frozen=True, slots=True)
+class Interval:
+    """A closed interval of seconds ``[low, high]``: ``0 <= low <= high``, ``high`` may be
+    ``inf`` (the parser refuses anything else)."""
+
+    low: float
+    high: float
+
+    def __post_init__(self) -> None:
+        # seconds are floats, however given (Interval(0, 5) equals Interval(0.0, 5.0) anyway)
+        object.__setattr__(self, "low", float(self.low))
+        object.__setattr__(self, "high", float(self.high))
+        if not (0.0 <= self.low <= self.high) or self.low == float("inf"):
+            raise ValueError(f"not an interval of seconds: [{self.low}, {self.high}]")
+
+
+@dataclass(frozen=True, slots=True)
+class BoundedEventually(Node):
+    """``F[a,b] arg``: ``arg`` holds at some instant of ``[t + a, t + b]``."""
+
+    arg: Formula
+    interval: Interval
+    span: Span | None = field(default=None, compare=False, repr=False)
+
+    def children(self) -> tuple[Formula, ...]:
+        return (self.arg,)
+
+
+@dataclass(frozen=True, slots=True)
+class BoundedGlobally(Node):
+    """``G[a,b] arg``: ``arg`` holds at every instant of ``[t + a, t + b]``."""
+
+    arg: Formula
+    interval: Interval
+    span: Span | None = field(default=None, compare=False, repr=False)
+
+    def children(self) -> tuple[Formula, ...]:
+        return (self.arg,)
+
+
+@dataclass(frozen=True, slots=True)
+class BoundedUntil(Node):
+    """``left U[a,b] right``: ``right`` at some ``s`` in ``[t + a, t + b]``, ``left`` on
+    ``[t, s)``."""
+
+    left: Formula
+    right: Formula
+    interval: Interval
+    span: Span | None = field(default=None, compare=False, repr=False)
+
+    def children(self) -> tuple[Formula, ...]:
+        return (self.left, self.right)
+
+
 Formula: TypeAlias = (
     Const
     | Prop
@@ -181,6 +239,9 @@ Formula: TypeAlias = (
     | StrongRelease
     | Eventually
     | Globally
+    | BoundedEventually
+    | BoundedGlobally
+    | BoundedUntil
 )
 """An LTL formula: one of the node classes above (a closed union)."""
 
@@ -189,12 +250,15 @@ FALSE = Const(False)
 
 BINARY_TEMPORAL = (Until, Release, WeakUntil, StrongRelease)
 UNARY_TEMPORAL = (Eventually, Globally)
+BOUNDED = (BoundedEventually, BoundedGlobally, BoundedUntil)
 
 
 def is_temporal(node: Formula) -> bool:
     """True for a temporal operator node (``U R W M F G``), False for the others."""
     match node:
         case Until() | Release() | WeakUntil() | StrongRelease() | Eventually() | Globally():
+            return True
+        case BoundedEventually() | BoundedGlobally() | BoundedUntil():
             return True
         case Const() | Prop() | Not() | And() | Or() | Implies() | Equiv():
             return False
@@ -205,6 +269,11 @@ def is_temporal(node: Formula) -> bool:
 def is_propositional(formula: Formula) -> bool:
     """True when the formula has no temporal operator."""
     return not any(is_temporal(n) for n in formula.walk())
+
+
+def bounded_operators(formula: Formula) -> list[Formula]:
+    """The time-bounded operators of ``formula`` (``F[a,b]``, ``G[a,b]``, ``U[a,b]``), pre-order."""
+    return [n for n in formula.walk() if isinstance(n, BOUNDED)]
 
 
 def conjoin(parts: list[Formula] | tuple[Formula, ...]) -> Formula:

@@ -13,12 +13,16 @@ from typing import assert_never
 
 from tlmpc.ltl.ast import (
     And,
+    BoundedEventually,
+    BoundedGlobally,
+    BoundedUntil,
     Const,
     Equiv,
     Eventually,
     Formula,
     Globally,
     Implies,
+    Interval,
     Not,
     Or,
     Prop,
@@ -50,6 +54,20 @@ def proposition_text(name: str) -> str:
     return f'"{escaped}"'
 
 
+def seconds_text(value: float) -> str:
+    """A bound in seconds as the parser reads it back exactly: ``5``, ``0.25``, ``inf``."""
+    if value == float("inf"):
+        return "inf"
+    if value.is_integer() and abs(value) < 1e15:
+        return str(int(value))
+    return repr(value)
+
+
+def interval_text(interval: Interval) -> str:
+    """``[a,b]``."""
+    return f"[{seconds_text(interval.low)},{seconds_text(interval.high)}]"
+
+
 def _level(formula: Formula) -> int:
     match formula:
         case Implies() | Equiv():
@@ -58,9 +76,9 @@ def _level(formula: Formula) -> int:
             return _OR
         case And():
             return _AND
-        case Until() | Release() | WeakUntil() | StrongRelease():
+        case Until() | Release() | WeakUntil() | StrongRelease() | BoundedUntil():
             return _BINTEMP
-        case Not() | Eventually() | Globally():
+        case Not() | Eventually() | Globally() | BoundedEventually() | BoundedGlobally():
             return _UNARY
         case Const() | Prop():
             return _ATOM
@@ -112,6 +130,12 @@ def _print(formula: Formula) -> str:
         ):
             symbol = _TEMPORAL_SYMBOL[type(formula)]
             return f"{_operand(left, _BINTEMP + 1)} {symbol} {_operand(right, _BINTEMP)}"
+        case BoundedEventually(arg, interval) | BoundedGlobally(arg, interval):
+            symbol = "F" if isinstance(formula, BoundedEventually) else "G"
+            return f"{symbol}{interval_text(interval)} {_operand(arg, _UNARY)}"
+        case BoundedUntil(left, right, interval):
+            left_text = _operand(left, _BINTEMP + 1)
+            return f"{left_text} U{interval_text(interval)} {_operand(right, _BINTEMP)}"
         case _:
             assert_never(formula)
 
@@ -151,5 +175,7 @@ def to_spin(formula: Formula) -> str:
         case StrongRelease(left, right):
             a, b = to_spin(left), to_spin(right)
             return f"(({b}) U (({a}) && ({b})))"
+        case BoundedEventually() | BoundedGlobally() | BoundedUntil():
+            raise ValueError(f"SPIN has no time bounds: {_print(formula)} cannot be written for it")
         case _:
             assert_never(formula)

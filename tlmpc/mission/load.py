@@ -14,7 +14,7 @@ from itertools import chain
 from pathlib import Path as FilePath
 from typing import TYPE_CHECKING, Any
 
-from tlmpc.base.errors import Diagnostic, InvalidInputError, UsageError, best_first, error
+from tlmpc.base.errors import Diagnostic, InvalidInputError, best_first, error
 from tlmpc.io.schema_check import is_valid, load_schema
 from tlmpc.ltl.ast import Formula, Or, Prop, conjoin
 from tlmpc.ltl.keywords import KEYWORDS
@@ -30,9 +30,6 @@ if TYPE_CHECKING:
 #: Files larger than this are refused while reading, before parsing (Example 8, a thousand
 #: rooms, is 52 KB; a 10^6-vertex boundary 24 to 45 MB, depending on the digits written).
 MAX_BYTES = 256 * 1024 * 1024
-#: Read in pieces of this size, so an endless stream stops at the limit, not at its end.
-_CHUNK = 4 * 1024 * 1024
-
 
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 
@@ -625,33 +622,13 @@ def _load_data(text: str, file: str, stem: str) -> tuple[Mission | None, list[Di
 
 
 def _read(path: str | FilePath) -> str:
+    from tlmpc.io.inputs import read_bytes
+
     file = str(path)
-    try:
-        with open(path, "rb") as stream:  # a bounded read: never read() whole
-            raw = bytearray()
-            while len(raw) <= MAX_BYTES:
-                piece = stream.read(min(_CHUNK, MAX_BYTES + 1 - len(raw)))
-                if not piece:
-                    break
-                raw += piece
-    except OSError as exc:
-        raise UsageError(
-            error(
-                "U001",
-                f"cannot read {file}: {exc.strerror or exc}",
-                hint="check the path",
-                file=file,
-            )
-        ) from None
-    if len(raw) > MAX_BYTES:
-        raise UsageError(
-            error(
-                "U004",
-                f"{file} is larger than {MAX_BYTES // 2**20} MiB",
-                hint="a mission is a small text file; is this the right file?",
-                file=file,
-            )
-        )
+    # a bounded read of a regular file: `check /dev/zero` or a FIFO is refused at once
+    raw = read_bytes(
+        FilePath(path), limit=MAX_BYTES, code="U001", too_large_code="U004", what="mission file"
+    )
     try:
         return raw.decode("utf-8")
     except UnicodeDecodeError as exc:

@@ -202,9 +202,12 @@ def _abstraction(c: Compilation) -> StageResult:
         build_abstraction,
     )
     from tlmpc.abstraction.layout import planning_layout
+    from tlmpc.ltl.bounds import refuse_bounds
     from tlmpc.mission.body import requested_margin
 
     mission = c.get(MISSION)
+    # Refused before the triangulation's work: the planner cannot honour a time bound.
+    refuse_bounds(mission.formula, file=mission.source, purpose="planning")
     # A body or a margin: the configuration space, goal cores and grown avoided regions are
     # triangulated (the body's own diagnostics came with the load stage).
     layout = planning_layout(mission, requested_margin(mission))
@@ -223,9 +226,11 @@ def _abstraction(c: Compilation) -> StageResult:
 
 def _automaton(c: Compilation) -> StageResult:
     from tlmpc.automata import automaton_to_json, to_hoa, translate
+    from tlmpc.ltl.bounds import refuse_bounds
     from tlmpc.planning.boundary import task_formula, task_letters
 
     mission = c.get(MISSION)
+    refuse_bounds(mission.formula, file=mission.source, purpose="planning")
     abstraction = c.get(ABSTRACTION)
     # Under the closed convention the planner reads boundary instants too (their letters and
     # a rewritten task; see tlmpc/planning/boundary.py).
@@ -665,7 +670,7 @@ def compilation_from_artifacts(directory: Path, needed: Sequence[Product[Any]]) 
     Every artifact is checked against its schema first; a missing or invalid one is a
     diagnostic naming the file.
     """
-    from tlmpc.io.artifacts import read_artifact
+    from tlmpc.io.artifacts import cross_check, read_artifact
 
     products: dict[Product[Any], Any] = {}
     documents: dict[str, Any] = {}
@@ -680,9 +685,11 @@ def compilation_from_artifacts(directory: Path, needed: Sequence[Product[Any]]) 
                     hint="run the earlier stages first (tlmpc compile --until ...)",
                 )
             )
-        document = read_artifact(path, product.schema)
-        products[product] = product.read(document)
-        documents[product.artifact] = document
+        documents[product.artifact] = read_artifact(path, product.schema)
+    # before any is used: the artifacts must agree (indices in range, one mission)
+    cross_check(directory, documents)
+    for product in needed:
+        products[product] = product.read(documents[product.artifact])
     source = Path(str(documents.get("mission.json", {}).get("source") or directory))
     return Compilation(source=source, products=products, documents=documents)
 

@@ -11,10 +11,11 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from html import escape
+from html import escape as _html_escape
 from itertools import chain
 from typing import TYPE_CHECKING
 
+from tlmpc.base.errors import printable
 from tlmpc.render.scene import Path, Point, Region, Scene, viridis
 
 if TYPE_CHECKING:
@@ -28,6 +29,12 @@ _TITLE = 26.0
 _LEGEND_WIDTH = 230.0
 _COLOUR_STEPS = 48  # the trajectory is drawn in this many colours along its length
 _MIN_STEP_PX = 0.4  # consecutive samples closer than this on screen are merged
+
+
+def escape(text: str) -> str:
+    """Text for an SVG element: XML-escaped, with control characters (which XML 1.0 does not
+    allow at all), newlines and direction controls as visible escapes."""
+    return _html_escape(printable(text, keep=""))
 
 
 def _fmt(value: float) -> str:

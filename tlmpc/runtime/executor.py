@@ -106,6 +106,16 @@ class RunPlan:
         return 2 * len(self.steps) + start - target
 
 
+#: The artifacts of an output folder the executor is built from.
+EXECUTOR_ARTIFACTS = (
+    "mission.json",
+    "abstraction.json",
+    "automaton.json",
+    "witness.json",
+    "controllers.json",
+)
+
+
 class Executor:
     """Pose → velocity for a compiled mission, with plan tracking and recovery.
 
@@ -154,13 +164,7 @@ class Executor:
         from tlmpc.mission.io import mission_from_json
         from tlmpc.planning.io import witness_from_json
 
-        needed = (
-            "mission.json",
-            "abstraction.json",
-            "automaton.json",
-            "witness.json",
-            "controllers.json",
-        )
+        needed = EXECUTOR_ARTIFACTS
         if isinstance(output, str | os.PathLike):
             source = str(output)
             artifacts: Mapping[str, Any] = read_artifacts(Path(output), needed)

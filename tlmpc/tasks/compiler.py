@@ -10,16 +10,20 @@ from __future__ import annotations
 
 import difflib
 import functools
+import re
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
 from tlmpc.base.errors import Diagnostic, InvalidInputError, error
 from tlmpc.ltl.ast import (
     And,
+    BoundedEventually,
+    BoundedGlobally,
     Eventually,
     Formula,
     Globally,
     Implies,
+    Interval,
     Not,
     Prop,
     Span,
@@ -52,8 +56,23 @@ KNOWN_PHRASES = (
     "eventually stay in A",
     "always stay in A",
     "whenever A, visit B",
+    "visit A within T s",
+    "visit A at least every T s",
+    "stay in A for at least T s",
+    "never stay in A longer than T s",
+    "after A, visit B within T s",
 )
-_LEADING_WORDS = ("visit", "avoid", "never", "patrol", "stay", "eventually", "always", "whenever")
+_LEADING_WORDS = (
+    "visit",
+    "avoid",
+    "never",
+    "patrol",
+    "stay",
+    "eventually",
+    "always",
+    "whenever",
+    "after",
+)
 
 
 @functools.cache
@@ -184,7 +203,25 @@ class _Lowering:
             return Globally(self.name(children[0]))
         if kind == "whenever":
             return Globally(Implies(self.name(children[0]), Eventually(self.name(children[1]))))
+        if kind in _TIMED:
+            return self._timed(kind, children, _duration(tree))
         raise ValueError(f"unknown phrase kind {kind}")  # pragma: no cover - grammar is closed
+
+    def _timed(self, kind: str, children: list[Node], seconds: float) -> Formula:
+        window = Interval(0.0, seconds)
+        if kind == "visit_within":
+            return conjoin([BoundedEventually(p, window) for p in self.names(children[0])])
+        if kind == "visit_every":
+            return conjoin(
+                [Globally(BoundedEventually(p, window)) for p in self.names(children[0])]
+            )
+        if kind == "stay_for":
+            return Eventually(BoundedGlobally(self.name(children[0]), window))
+        if kind == "stay_at_most":
+            place = self.name(children[0])
+            return Globally(Implies(place, BoundedEventually(Not(place), window)))
+        trigger, goal = self.name(children[0]), self.name(children[1])
+        return Globally(Implies(trigger, BoundedEventually(goal, window)))
 
     def _avoided_names(self, avoiding: Node) -> list[Prop]:
         names_tree = next(c for c in avoiding.children if isinstance(c, Node))
@@ -275,6 +312,21 @@ class _Lowering:
         if props:
             it = "it" if len(props) == 1 else "them"
             self.scopes.append(f"avoid {_listing(props)}: " + scope.replace("{it}", it))
+
+
+#: The time-bounded phrase kinds (their last token is the duration).
+_TIMED = frozenset({"visit_within", "visit_every", "stay_for", "stay_at_most", "after_within"})
+
+_DURATION = re.compile(r"([0-9]+(?:\.[0-9]+)?)\s*([A-Za-z]+)")
+_UNITS = {"s": 1.0, "sec": 1.0, "secs": 1.0, "second": 1.0, "seconds": 1.0}
+_UNITS.update({"min": 60.0, "mins": 60.0, "minute": 60.0, "minutes": 60.0})
+
+
+def _duration(tree: Node) -> float:
+    """The seconds of a timed phrase's duration token (``30 s``, ``1.5 minutes``)."""
+    found = _DURATION.fullmatch(str(tree.children[-1]))
+    assert found is not None  # the grammar's DURATION
+    return float(found.group(1)) * _UNITS[found.group(2).lower()]
 
 
 def _listing(props: Sequence[Prop]) -> str:

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 from tlmpc.automata.translate import translate
 from tlmpc.base.errors import Diagnostic, error
-from tlmpc.ltl.ast import And, Const, Formula, Not, Or, Prop, conjoin
+from tlmpc.ltl.ast import And, Const, Formula, Not, Or, Prop, bounded_operators, conjoin
 from tlmpc.ltl.printer import to_text
 from tlmpc.ltl.transform import substitute
 
@@ -129,11 +129,13 @@ def _independent_groups(formulas: Sequence[Formula]) -> list[list[Formula]]:
 def contradictory(formulas: Sequence[Formula]) -> bool:
     """Whether the conjunction of ``formulas`` is certainly unsatisfiable.
 
-    False also when a group of dependent conjuncts is too large to check.
+    False also when a group of dependent conjuncts is too large to check, or has a time bound.
     """
     for group in _independent_groups(formulas):
         if sum(_temporal_size(f) for f in group) > MAX_TEMPORAL_OPERATORS:
             continue
+        if any(bounded_operators(f) for f in group):
+            continue  # the automaton check does not take time bounds
         if not is_satisfiable(conjoin(group)):
             return True
     return False

@@ -39,6 +39,8 @@ class ConjunctReport:
     visits: int | None = None
     last_visit: float | None = None
     longest_gap: float | None = None
+    #: By how many seconds its time bounds held (> 0) or failed (< 0); None without bounds.
+    time_robustness: float | None = None
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -71,6 +73,9 @@ class Verdict:
     ending: Ending
     robustness: float
     certificate: Certificate
+    #: By how many seconds the task's time bounds held (> 0) or failed (< 0), None without
+    #: bounds or for an inconclusive verdict (see tlmpc.verify.time_robustness).
+    time_robustness: float | None = None
     pieces: int
     conjuncts: tuple[ConjunctReport, ...] = ()
     violations: tuple[Violation, ...] = ()

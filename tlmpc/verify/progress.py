@@ -2,13 +2,25 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
 
-from tlmpc.ltl.ast import Eventually, Formula, Globally, Not, Prop, Until
+from tlmpc.ltl.ast import (
+    BoundedEventually,
+    BoundedGlobally,
+    Eventually,
+    Formula,
+    Globally,
+    Implies,
+    Not,
+    Or,
+    Prop,
+    Until,
+)
 from tlmpc.ltl.printer import to_text
 from tlmpc.verify.evaluate import Value
 from tlmpc.verify.model import ConjunctReport, Outcome, Violation
@@ -226,3 +238,76 @@ def conjunct_reports(
                 continue
         violations.append(_other_violation(conjunct, value, line))
     return reports, violations
+
+
+def _seconds(value: float) -> str:
+    return f"{value:.4g} s"
+
+
+def _response(inner: Formula) -> tuple[Formula, Formula, float] | None:
+    """``(trigger, goal, T)`` of ``trigger -> F[0,T] goal`` (or ``!trigger | F[0,T] goal``)."""
+    match inner:
+        case Implies(trigger, BoundedEventually(goal, interval)) if interval.low == 0:
+            return trigger, goal, interval.high
+        case Or((Not(trigger), BoundedEventually(goal, interval))) if interval.low == 0:
+            return trigger, goal, interval.high
+        case _:
+            return None
+
+
+def timed_progress(
+    conjunct: Formula, outcome: Outcome, slack: float | None, first_broken: float | None
+) -> str | None:
+    """Progress of a conjunct with time bounds, from its time robustness ``slack``.
+
+    None when the conjunct has no time bound or no time robustness.
+    """
+    if outcome == "inconclusive":
+        if isinstance(conjunct, BoundedEventually):
+            return f"pending: deadline t={conjunct.interval.high:.4g} s"
+        return "pending" if first_broken is None else f"pending (broken at t={first_broken:.4g} s)"
+    if slack is None:
+        return None
+    at = f" at t={first_broken:.4g} s" if first_broken is not None else ""
+    if math.isinf(slack):
+        return "holds at any bound" if slack > 0 else "fails at any bound"
+    match conjunct:
+        case BoundedEventually(_, interval) if math.isfinite(interval.high):
+            deadline = interval.high
+            if slack >= 0:
+                return (
+                    f"done at t={deadline - slack:.4g} s, {_seconds(slack)} before the "
+                    f"deadline t={deadline:.4g} s"
+                )
+            return f"deadline t={deadline:.4g} s missed by {_seconds(-slack)}"
+        case Globally(BoundedEventually(goal, interval)) if interval.low == 0:
+            gap = interval.high - slack
+            return (
+                f"longest time without `{to_text(goal)}` {_seconds(gap)} "
+                f"(bound {interval.high:.4g} s)"
+            )
+        case Eventually(BoundedGlobally(goal, interval)) if interval.low == 0:
+            stay = interval.high + slack
+            return (
+                f"longest stay in `{to_text(goal)}` {_seconds(stay)} "
+                f"(at least {interval.high:.4g} s)"
+            )
+        case Globally(inner) if _response(inner) is not None:
+            found = _response(inner)
+            assert found is not None
+            trigger, goal, bound = found
+            if isinstance(goal, Not) and goal.arg == trigger:
+                return (
+                    f"longest stay in `{to_text(trigger)}` {_seconds(bound - slack)} "
+                    f"(at most {bound:.4g} s)"
+                )
+            if slack >= 0:
+                return (
+                    f"longest wait for `{to_text(goal)}` after `{to_text(trigger)}` "
+                    f"{_seconds(bound - slack)} (within {bound:.4g} s)"
+                )
+            return f"deadline missed by {_seconds(-slack)}{at}"
+        case _:
+            if slack >= 0:
+                return f"holds with {_seconds(slack)} to spare"
+            return f"fails by {_seconds(-slack)}{at}"

@@ -95,7 +95,7 @@ def _scene(
 
 def scene_from_output(directory: Path) -> dict[str, Any]:
     """The scene of a ``tlmpc compile`` output directory (mesh, trajectory, verdict)."""
-    from tlmpc.io.artifacts import read_json
+    from tlmpc.io.artifacts import read_artifacts
 
     if not (directory / "mission.json").is_file():
         raise UsageError(
@@ -107,10 +107,14 @@ def scene_from_output(directory: Path) -> dict[str, Any]:
                 file=str(directory),
             )
         )
-    mission = read_json(directory / "mission.json", "tlmpc.mission/")
+    # each checked against its schema (finite numbers) and against the others
+    documents = read_artifacts(
+        directory, ("mission.json", "abstraction.json", "trace.json", "verdict.json")
+    )
+    mission = documents["mission.json"]
     mesh = None
-    if (directory / "abstraction.json").is_file():
-        abstraction = read_json(directory / "abstraction.json", "tlmpc.abstraction/")
+    if "abstraction.json" in documents:
+        abstraction = documents["abstraction.json"]
         mesh = {
             "vertices": _points(abstraction["vertices"]),
             "triangles": [list(map(int, t)) for t in abstraction["triangles"]],
@@ -118,13 +122,13 @@ def scene_from_output(directory: Path) -> dict[str, Any]:
         }
     samples: list[list[float]] = []
     loop_start = None
-    if (directory / "trace.json").is_file():
-        trace = read_json(directory / "trace.json", "tlmpc.trace/")
+    if "trace.json" in documents:
+        trace = documents["trace.json"]
         samples = [[float(t), float(x), float(y)] for t, x, y in trace["points"]]
         loop_start = trace.get("loop_start")
     verdict = None
-    if (directory / "verdict.json").is_file():
-        verdict = read_json(directory / "verdict.json", "tlmpc.verdict/")
+    if "verdict.json" in documents:
+        verdict = documents["verdict.json"]
     return _scene(
         title=str(mission.get("name") or directory.name),
         workspace=mission["workspace"],
@@ -148,7 +152,7 @@ def scene_from_log(log: Path, mission_path: Path) -> dict[str, Any]:
     if log.suffix.lower() == ".csv":
         trace = from_csv(log, mission_path, None)
     else:
-        trace = from_document(read_json(log), file=str(log), convention=None)
+        trace = from_document(read_json(log, finite=False), file=str(log), convention=None)
     verdict = verdict_to_json(verify_trace(trace))
     samples = [
         [float(t), float(x), float(y)]
