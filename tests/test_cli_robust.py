@@ -39,7 +39,7 @@ def test_full_stdout_is_a_u_code_not_a_traceback() -> None:
         process = tlmpc(
             "check", "--json", "specs/example1.yaml", stdout=full, stderr=subprocess.PIPE
         )
-        _, err = process.communicate(timeout=60)
+        _, err = process.communicate()
     assert process.returncode == 2
     assert b"error[U035]" in err
     assert b"Traceback" not in err
@@ -50,7 +50,7 @@ def test_closed_pipe_exits_quietly() -> None:
     os.close(read)  # like `| head -1` that has already exited
     process = tlmpc("check", "--json", "specs/example1.yaml", stdout=write, stderr=subprocess.PIPE)
     os.close(write)
-    _, err = process.communicate(timeout=60)
+    _, err = process.communicate()
     assert process.returncode == 2
     assert b"Traceback" not in err
     assert b"Exception ignored" not in err
@@ -69,7 +69,7 @@ def test_sigterm_during_compile_leaves_no_temporary_folder(tmp_path: Path) -> No
     assert process.stderr is not None
     process.stderr.readline()  # the first progress line: compiling has started
     process.send_signal(signal.SIGTERM)
-    _, err = process.communicate(timeout=120)
+    _, err = process.communicate()
     assert process.returncode in (0, 143), err
     assert b"Traceback" not in err
     leftovers = [p.name for p in tmp_path.iterdir() if p.name != "out"]
@@ -101,7 +101,7 @@ def test_sigint_to_a_running_compile_is_130(tmp_path: Path) -> None:
     assert process.stderr is not None
     process.stderr.readline()  # started: Python's handlers are installed
     process.send_signal(signal.SIGINT)
-    _, err = process.communicate(timeout=120)
+    _, err = process.communicate()
     assert process.returncode in (0, 130), err
     assert b"Traceback" not in err
     assert [p.name for p in tmp_path.iterdir() if p.name != "out"] == []

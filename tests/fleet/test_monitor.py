@@ -106,6 +106,7 @@ def test_progression_is_the_evaluator_on_words(
         assert value(r, pieces[-1:]) == expected
 
 
+@pytest.mark.slow
 def test_memory_does_not_grow_with_the_log() -> None:
     base = document("G F a & G F d & G !c & (!d U a)", "right", 0.0)
     monitor = Monitor(base)

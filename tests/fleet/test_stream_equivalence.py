@@ -80,7 +80,9 @@ def write_csv(path: Path, samples: np.ndarray) -> None:
 
 @pytest.mark.slow
 @settings(
-    max_examples=150, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+    max_examples=max(40, settings().max_examples * 3 // 4),  # 150 in CI
+    deadline=None,
+    suppress_health_check=[HealthCheck.function_scoped_fixture],
 )
 @given(
     samples=walks(),

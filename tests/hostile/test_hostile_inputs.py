@@ -53,19 +53,16 @@ def fifo(work: Path) -> Path:
 
 
 def _guarded(*argv: str, cwd: Path) -> subprocess.CompletedProcess[str]:
-    """``tlmpc ARGV`` in a child, so a regression (a read that blocks) fails the test instead
-    of hanging the suite; the bound is a guard, not a measurement."""
-    try:
-        return subprocess.run(
-            [sys.executable, "-m", "tlmpc", *argv],
-            cwd=cwd,
-            capture_output=True,
-            text=True,
-            timeout=120,
-            env={**os.environ, "PYTHONPATH": str(ROOT)},
-        )
-    except subprocess.TimeoutExpired:
-        pytest.fail(f"tlmpc {' '.join(argv)} did not answer: it read or waited without bound")
+    """``tlmpc ARGV`` in a child, so a regression (a read that blocks) cannot take the test
+    process with it.  No clock of ours decides a verdict: such a regression hangs this child,
+    and the CI job's own limit stops it."""
+    return subprocess.run(
+        [sys.executable, "-m", "tlmpc", *argv],
+        cwd=cwd,
+        capture_output=True,
+        text=True,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+    )
 
 
 @pytest.mark.parametrize("special", ["/dev/zero", "FIFO"])

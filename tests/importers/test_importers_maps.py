@@ -179,6 +179,7 @@ def test_small_free_pieces_are_specks(tmp_path: Path) -> None:
     assert len(simplified.components) == 2
 
 
+@pytest.mark.slow
 @given(free=grids, tolerance=st.sampled_from([0.5, 1.0, 2.0]))
 def test_simplified_boundary_stays_within_the_tolerance(
     tmp_path_factory: pytest.TempPathFactory, free: np.ndarray, tolerance: float
@@ -601,6 +602,7 @@ def test_real_depot_mission_form_compiles_and_verifies(tmp_path: Path) -> None:
     assert "trace verifies" in err + out
 
 
+@pytest.mark.slow
 @example(
     pillars=[(2, 2), (1, 3), (6, 4), (3, 5)],
     corner=(7, 3),

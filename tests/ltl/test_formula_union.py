@@ -95,6 +95,7 @@ def _mypy(tmp_path: Path, source: str) -> subprocess.CompletedProcess[str]:
     )
 
 
+@pytest.mark.slow
 def test_mypy_rejects_a_match_that_forgets_a_node_kind(tmp_path: Path) -> None:
     pytest.importorskip("mypy")
     complete = _mypy(tmp_path, _MATCH_TEMPLATE.format(extra=" | StrongRelease()"))

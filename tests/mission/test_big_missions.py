@@ -114,6 +114,7 @@ _PLACES = [
 ]
 
 
+@pytest.mark.slow
 @settings(deadline=None)
 @given(
     place=st.sampled_from(_PLACES),

@@ -34,11 +34,35 @@ def test_the_valid_mission_is_valid() -> None:
     assert codes(VALID) == []
 
 
-@pytest.mark.parametrize("depth", [MAX_DEPTH + 1, 30_000, 200_000])
+#: PyYAML's parsers: libyaml's (when built with it; 0.2.6 and later refuse 1,000 levels while
+#: scanning ahead) and the pure-Python one.  The limits are ours on either.
+LOADERS = [yaml.SafeLoader] + ([yaml.CSafeLoader] if yaml.__with_libyaml__ else [])
+
+
+@pytest.fixture(params=LOADERS, ids=lambda loader: loader.__name__)
+def loader(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> type:
+    monkeypatch.setattr("tlmpc.mission.yamlpos._LOADER", request.param)
+    return request.param  # type: ignore[no-any-return]
+
+
+@pytest.mark.usefixtures("loader")
+@pytest.mark.parametrize("depth", [MAX_DEPTH + 1, 999, 1_001, 30_000, 200_000])
 def test_deep_flow_nesting_is_y003_not_a_crash(depth: int) -> None:
     assert codes("a: " + "[" * depth + "]" * depth + "\n") == ["Y003"]
+    assert codes("a: " + "{a: " * depth + "1" + "}" * depth + "\n") == ["Y003"]
+    problems = check_text("b: 1\nc:\n  - " + "[" * depth + "\n", "m.yaml")
+    assert [(d.code, d.line) for d in problems] == [("Y003", 3)]
 
 
+@pytest.mark.usefixtures("loader")
+def test_nesting_within_the_limit_then_a_syntax_error_is_y001() -> None:
+    depth = MAX_DEPTH - 1
+    problems = check_text("a: " + "[" * depth + "]" * depth + "\nb: [1, 2\nc: 3\n", "m.yaml")
+    assert [d.code for d in problems] == ["Y001"]
+    assert codes("a: [1, 2]]\n") == ["Y001"]
+
+
+@pytest.mark.usefixtures("loader")
 def test_deep_block_nesting_is_y003() -> None:
     text = "".join(" " * i + f"k{i}:\n" for i in range(MAX_DEPTH + 5))
     assert codes(text) == ["Y003"]

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
@@ -12,6 +13,7 @@ COORDINATE = st.floats(-1e4, 1e4, allow_nan=False, allow_infinity=False)
 POLYGON = st.lists(st.tuples(COORDINATE, COORDINATE), min_size=0, max_size=6)
 
 
+@pytest.mark.slow
 @given(
     st.lists(POLYGON, min_size=_BATCH_FROM, max_size=3 * _BATCH_FROM),
     st.tuples(COORDINATE, COORDINATE, st.floats(1e-3, 1e4), st.floats(1e-3, 1e4)),

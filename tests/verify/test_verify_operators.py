@@ -22,6 +22,7 @@ import itertools
 
 import numpy as np
 import numpy.typing as npt
+import pytest
 from continuous_ltl import closed_holds
 from hypothesis import given
 from hypothesis import strategies as st
@@ -286,6 +287,7 @@ def _continuations(length: int, closed: bool) -> list[tuple[Word, list[bool], in
 CONTINUATIONS = [c for n in (1, 2, 3, 4) for c in _continuations(n, closed=True)]
 
 
+@pytest.mark.slow
 @given(formulas(PROPS, max_leaves=4), st.lists(letters, min_size=1, max_size=3))
 def test_open_verdict_is_sound_on_closed_pieces_by_brute_force(
     formula: Formula, start: Word

@@ -80,6 +80,10 @@ def _run_locked(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
 
     reporter = Reporter.for_args(args, out, err)
     destination: Path = args.out
+    if args.png:  # before any stage runs: a missing extra is known at once
+        from tlmpc.base.extras import require
+
+        require("matplotlib.backends.backend_agg", "drawing a PNG figure (--png)")
     check_destination(destination, force=args.force)
     refuse_overwriting(destination, sorted(KNOWN_ARTIFACTS), args.mission)
     for note in clean_stale(destination):

@@ -9,6 +9,7 @@ from typing import Any
 
 import yaml
 
+from tlmpc.base.extras import require
 from tlmpc.exports.georeference import Georeference, to_lon_lat
 from tlmpc.exports.plan import Plan, Ring, Waypoint
 from tlmpc.io.outputs import csv_cell
@@ -202,6 +203,8 @@ def path_mcap(
 
     Pose stamps are the plan's times; the message's log time is the first of them.
     """
+    require("mcap.writer", "writing a nav_msgs/Path MCAP file")
+    require("rosbags.typesys", "writing a nav_msgs/Path MCAP file")
     from mcap.writer import Writer
     from rosbags.typesys import Stores, get_typestore
 

@@ -35,6 +35,7 @@ import numpy as np
 import numpy.typing as npt
 
 from tlmpc.base.errors import UsageError, error
+from tlmpc.base.extras import require
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -453,6 +454,7 @@ def read_bag(path: Path, topic: str | None = None, frame: str | None = None) -> 
     With ``frame``, each pose is expressed in that frame through the bag's ``/tf`` and
     ``/tf_static`` at its stamp (see :mod:`tlmpc.importers.frames`).
     """
+    require("rosbags.highlevel", "reading a ROS bag or MCAP log", file=str(path))
     from rosbags.highlevel import AnyReader
     from rosbags.typesys import Stores, get_typestore
 

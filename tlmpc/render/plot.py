@@ -19,6 +19,7 @@ import itertools
 from collections.abc import Iterator, Mapping, Sequence
 from typing import Any
 
+from tlmpc.base.extras import require
 from tlmpc.render.layout import (
     FONT_PX,
     LABEL_HALO,
@@ -60,6 +61,7 @@ def render_png(
 ) -> bytes:
     """``plan.png`` of the same scene, drawn with matplotlib (reproducible byte for byte)."""
     scene = build_scene(artifacts, zoom=zoom, log=log, verdict=verdict)
+    require("matplotlib.backends.backend_agg", "drawing a PNG figure")
     with png_style():
         figure = figure_of(scene)
         png = io.BytesIO()
