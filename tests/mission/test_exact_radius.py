@@ -63,7 +63,8 @@ def test_a_doorway_narrower_than_the_body_is_named_with_both_widths() -> None:
         tlmpc.compile(mission)
     r002 = [d for d in failure.value.diagnostics if d.code == "R002"]
     assert len(r002) == 1
-    assert "0.98 wide" in r002[0].message and "the 1 the robot's body needs" in r002[0].message
+    assert "0.98 wide" in r002[0].message
+    assert "the 1 the robot's body needs" in r002[0].message
 
 
 def test_a_doorway_wider_than_the_body_is_no_r002() -> None:
@@ -91,3 +92,60 @@ def test_a_start_a_hair_closer_than_the_radius_is_r001() -> None:
     with pytest.raises(TlmpcError) as failure:
         tlmpc.compile(_door(0.5, 2.0, (0.5 - 1e-6, 3.0)))
     assert [d.code for d in failure.value.diagnostics] == ["R001"]
+
+
+def _obstacle_course() -> Any:
+    """A room with a square hole, a triangular hole and a notch in the wall."""
+    room = shapely.Polygon([(0, 0), (10, 0), (10, 10), (6, 10), (5, 8), (4, 10), (0, 10)])
+    holes = [shapely.box(2, 2, 4, 4), shapely.Polygon([(6, 2), (8, 2.5), (7, 5)])]
+    return room.difference(shapely.union_all(holes))
+
+
+def test_the_exact_reach_holds_every_disc_around_an_obstacle() -> None:
+    """Points just inside the radius of every obstacle vertex and edge are in the reach."""
+    from tlmpc.mission.cspace import obstacle_reach
+
+    free = _obstacle_course()
+    radius = 0.7
+    reach = obstacle_reach(free, radius)
+    walls = free.boundary
+    angles = np.linspace(0.0, 2.0 * math.pi, 720, endpoint=False)
+    for x, y in shapely.get_coordinates(walls):
+        ring = np.stack(
+            [x + 0.999999 * radius * np.cos(angles), y + 0.999999 * radius * np.sin(angles)], axis=1
+        )
+        inside = shapely.covers(free, shapely.points(ring))
+        assert shapely.covers(reach, shapely.points(ring[inside])).all(), (x, y)
+
+
+@pytest.mark.parametrize("through", [None, (2.0 - 0.7 * 0.6, 2.0 - 0.7 * 0.8)])
+def test_erosion_keeps_the_radius_and_loses_little(through: tuple[float, float] | None) -> None:
+    """Exact segment distances: at least the radius everywhere, and every point 1.002 r from
+    the obstacles kept (0.12 % beyond the radius at corners is all the construction may
+    lose); a point exactly the radius from a corner stays in when passed as ``through``."""
+    from tlmpc.mission.cspace import erode
+
+    free = _obstacle_course()
+    radius = 0.7
+    eroded = erode(free, radius, through=through)
+    walls = free.boundary
+    edges = [
+        shapely.LineString(pair)
+        for ring in shapely.get_parts(eroded.boundary)
+        for pair in itertools.pairwise(shapely.get_coordinates(ring))
+    ]
+    assert float(np.min(shapely.distance(walls, edges))) >= radius * (1 - 1e-12)
+    samples = shapely.points(np.random.default_rng(3).uniform(0, 10, size=(20000, 2)))
+    far = shapely.covers(free, samples) & (shapely.distance(walls, samples) >= 1.002 * radius)
+    assert shapely.covers(eroded, samples[far]).all()
+    if through is not None:
+        assert eroded.distance(shapely.Point(through)) <= 1e-12
+
+
+def test_the_proof_rejects_a_shape_too_close() -> None:
+    from tlmpc.mission.cspace import keeps_distance
+
+    free = _obstacle_course()
+    assert keeps_distance(free.buffer(-0.7 * 1.0001, quad_segs=64), free, 0.7)
+    assert not keeps_distance(free.buffer(-0.7 * 0.999, quad_segs=64), free, 0.7)
+    assert not keeps_distance(free.buffer(-0.7, quad_segs=2), free, 0.7)  # chords inside
