@@ -44,7 +44,7 @@ def _clearance(trace: dict[str, Any]) -> float:
     walls = [shapely.Polygon(trace["workspace"]["boundary"]).exterior]
     walls += [shapely.Polygon(h) for h in trace["workspace"]["holes"]]
     segments = [shapely.LineString([a, b]) for a, b in itertools.pairwise(points)]
-    return min(w.distance(s) for w in walls for s in segments)
+    return min(float(w.distance(s)) for w in walls for s in segments)
 
 
 @pytest.mark.parametrize("spare", [0.02, 1e-3])
