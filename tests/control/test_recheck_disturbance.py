@@ -75,3 +75,46 @@ def test_fields_solved_for_a_disturbance_pass_its_recheck() -> None:
         if step.exit_edge is not None:
             assert _robust_margin(step) > 0.1 * controllers.max_speed
         assert _violated_condition(step, controllers.max_speed, 0.1) is None
+
+
+def _exit_time(step: Any, push: float) -> float | None:
+    """RK45: when the step's field plus a steady push of ``push`` straight back against the
+    exit facet carries the vertex opposite the exit across it (None if it does not)."""
+    from scipy.integrate import solve_ivp
+
+    vertices = np.asarray(step.vertices, dtype=float)
+    normal = _normals(vertices)[step.exit_edge]
+    level = float(normal @ vertices[(step.exit_edge + 1) % 3])
+    gain, offset = np.asarray(step.gain), np.asarray(step.offset)
+
+    def field(t: float, x: np.ndarray[Any, Any]) -> np.ndarray[Any, Any]:
+        result: np.ndarray[Any, Any] = gain @ x + offset - push * normal
+        return result
+
+    def crossing(t: float, x: np.ndarray[Any, Any]) -> float:
+        return float(normal @ x - level)
+
+    crossing.terminal = True  # type: ignore[attr-defined]
+    start = vertices[step.exit_edge]  # the vertex opposite the exit: the farthest from it
+    horizon = 2.0 * step.exit_time_bound
+    run = solve_ivp(field, (0.0, horizon), start, events=crossing, rtol=1e-10, atol=1e-12)
+    return float(run.t_events[0][0]) if run.t_events[0].size else None
+
+
+def test_the_exit_time_bound_holds_under_the_worst_steady_push() -> None:
+    """From the vertex farthest from the exit facet, pushed straight back against it at the
+    declared bound, the field still leaves before ``exit_time_bound`` (RK45, own geometry);
+    the bound is the height over the exit speed less the disturbance."""
+    disturbance = 0.1
+    controllers = _controllers(disturbance)
+    for step in controllers.steps:
+        if step.exit_edge is None or step.kind == "vertex":
+            continue
+        crossed = _exit_time(step, disturbance)
+        assert crossed is not None, step.step
+        assert crossed <= step.exit_time_bound * (1 + 1e-9), step.step
+        vertices = np.asarray(step.vertices, dtype=float)
+        normal = _normals(vertices)[step.exit_edge]
+        height = float(normal @ (vertices[(step.exit_edge + 1) % 3] - vertices[step.exit_edge]))
+        speed = min(float(normal @ w) for w in np.asarray(step.velocities))
+        assert step.exit_time_bound == pytest.approx(height / (speed - disturbance), rel=1e-9)

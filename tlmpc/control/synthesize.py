@@ -674,7 +674,11 @@ def synthesize(
             nx, ny = geometry.normals[step.exit_edge].tolist()
             delta = min(nx * wx + ny * wy for wx, wy in w.tolist())  # numpy's 2-vector dot
             speed = delta
-            bound = float(geometry.heights[step.exit_edge] / delta) if delta > 0 else float("inf")
+            # under a disturbance |w| <= d the state still crosses at delta - d or faster
+            closing = delta - robot.disturbance
+            bound = (
+                float(geometry.heights[step.exit_edge] / closing) if closing > 0 else float("inf")
+            )
         controllers.append(
             StepController(
                 step=index,
