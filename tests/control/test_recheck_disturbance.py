@@ -118,3 +118,36 @@ def test_the_exit_time_bound_holds_under_the_worst_steady_push() -> None:
         height = float(normal @ (vertices[(step.exit_edge + 1) % 3] - vertices[step.exit_edge]))
         speed = min(float(normal @ w) for w in np.asarray(step.velocities))
         assert step.exit_time_bound == pytest.approx(height / (speed - disturbance), rel=1e-9)
+
+
+def test_the_stored_gains_keep_the_speed_to_their_rounding_far_from_the_origin() -> None:
+    """At 1e8 from the origin: vertex velocities within max_speed (1e-9), K x + g within it
+    plus the documented rounding, and the field in the triangle's frame within 1e-9."""
+    mission = yaml.safe_load((ROOT / "specs" / "example1.yaml").read_text())
+    offset = 1e8
+
+    def moved(ring: Any) -> Any:
+        return [[x + offset, y + offset] for x, y in ring]
+
+    box = mission["workspace"]["boundary"]["rect"]
+    mission["workspace"]["boundary"]["rect"] = [c + offset for c in box]
+    for name, shape in mission["regions"].items():
+        if isinstance(shape, dict):
+            mission["regions"][name] = {"rect": [c + offset for c in shape["rect"]]}
+        else:
+            mission["regions"][name] = moved(shape)
+    mission["robot"]["start"] = [c + offset for c in mission["robot"]["start"]]
+    controllers = tlmpc.compile(mission, until="control").artifacts["controllers.json"]
+    speed = controllers["max_speed"]
+    eps = float(np.finfo(float).eps)
+    for step in controllers["steps"]:
+        gain, g = np.asarray(step["K"]), np.asarray(step["g"])
+        vertices = np.asarray(step["vertices"])
+        velocities = np.asarray(step["vertex_velocities"])
+        assert np.linalg.norm(velocities, axis=1).max() <= speed * (1 + 1e-9)
+        for x, w in zip(vertices, velocities, strict=True):
+            rounding = 4 * eps * (np.abs(gain).sum() * np.abs(x).max() + np.abs(g).max())
+            assert np.linalg.norm(gain @ x + g) <= speed * (1 + 1e-9) + rounding
+            local = velocities[0] + gain @ (x - vertices[0])
+            assert np.linalg.norm(local) <= speed * (1 + 1e-9)
+            assert np.allclose(local, w, atol=1e-9 * speed)
