@@ -120,8 +120,8 @@ def test_the_exact_reach_holds_every_disc_around_an_obstacle() -> None:
 
 @pytest.mark.parametrize("through", [None, (2.0 - 0.7 * 0.6, 2.0 - 0.7 * 0.8)])
 def test_erosion_keeps_the_radius_and_loses_little(through: tuple[float, float] | None) -> None:
-    """Exact segment distances: at least the radius everywhere, and every point 1.002 r from
-    the obstacles kept (0.12 % beyond the radius at corners is all the construction may
+    """Exact segment distances: at least the radius everywhere, and every point 1.005 r from
+    the obstacles kept (0.48 % beyond the radius at corners is all the construction may
     lose); a point exactly the radius from a corner stays in when passed as ``through``."""
     from tlmpc.mission.cspace import erode
 
@@ -136,7 +136,7 @@ def test_erosion_keeps_the_radius_and_loses_little(through: tuple[float, float] 
     ]
     assert float(np.min(shapely.distance(walls, edges))) >= radius * (1 - 1e-12)
     samples = shapely.points(np.random.default_rng(3).uniform(0, 10, size=(20000, 2)))
-    far = shapely.covers(free, samples) & (shapely.distance(walls, samples) >= 1.002 * radius)
+    far = shapely.covers(free, samples) & (shapely.distance(walls, samples) >= 1.005 * radius)
     assert shapely.covers(eroded, samples[far]).all()
     if through is not None:
         assert eroded.distance(shapely.Point(through)) <= 1e-12

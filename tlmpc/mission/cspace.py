@@ -51,13 +51,13 @@ def workspace_free_space(mission: Mission) -> Any:
 
 #: The polygon standing in for a disc's arc around an obstacle corner has a side tangent to
 #: the circle at least every this many radians: it lies outside the circle (so it keeps the
-#: whole disc off the corner) and at most ``1 / cos(ARC_STEP / 2) - 1`` (0.12 %) of the
+#: whole disc off the corner) and at most ``1 / cos(ARC_STEP / 2) - 1`` (0.48 %) of the
 #: distance beyond it.
-ARC_STEP = 2.0 * math.pi / 64
+ARC_STEP = 2.0 * math.pi / 32
 
 #: Chords per quarter circle of the round buffer in :func:`erode` (its radius is enlarged so
-#: that the chords, not the vertices, lie at the distance: 0.12 % more at corners).
-QUAD_SEGS = 16
+#: that the chords, not the vertices, lie at the distance: 0.48 % more at corners).
+QUAD_SEGS = 8
 
 
 def erode(free: Any, distance: float, *, slack: float = 0.0, through: Point | None = None) -> Any:
@@ -69,12 +69,12 @@ def erode(free: Any, distance: float, *, slack: float = 0.0, through: Point | No
     as the intersection of two buffers of ``free``'s boundary that each hold every point
     within the distance of it: a mitred one at exactly the distance (exact along walls; a
     mitre, or a bevel twice the distance out, lies outside the circle at a corner) and a
-    round one whose chords, not vertices, lie at the distance (0.12 % beyond it at corners).
+    round one whose chords, not vertices, lie at the distance (0.48 % beyond it at corners).
     The result is then *proved*: the exact distance from each of its boundary segments to
     the boundary of ``free`` must be at least the distance.  Where GEOS's simplification
     broke that, the exact construction replaces it (each edge's rectangle and each obstacle
     corner's sector bounded by tangent sides; slower on large maps).  So the result keeps
-    the distance exactly along walls, within 0.12 % of it at obstacle corners, and never
+    the distance exactly along walls, within 0.48 % of it at obstacle corners, and never
     less; points at exactly the distance from a wall stay in it.
 
     ``slack`` is an absolute allowance added to the distance (the snapping grid, so that a
