@@ -196,8 +196,8 @@ def abstraction_diagnostics(abstraction: Abstraction, mission: Mission) -> list[
     # Which letters occur (anywhere, and in the start's component): counts, not a sort.
     letters = len(abstraction.letters)
     used = np.flatnonzero(np.bincount(abstraction.letter_of, minlength=letters)).tolist()
-    start_component = abstraction.component[abstraction.start]
-    near_start = abstraction.letter_of[abstraction.component == start_component]
+    joined = _touching_components(abstraction)
+    near_start = abstraction.letter_of[joined == joined[abstraction.start]]
     reachable = np.flatnonzero(np.bincount(near_start, minlength=letters)).tolist()
     present = set(chain.from_iterable(map(abstraction.letters.__getitem__, used)))
     near = set(chain.from_iterable(map(abstraction.letters.__getitem__, reachable)))
@@ -290,6 +290,33 @@ def _piece_of(mission: Mission, polygon: tuple[tuple[float, float], ...]) -> str
     if not inside or robot in inside:
         return None
     return ", ".join("the main piece" if k == 0 else f"workspace component {k - 1}" for k in inside)
+
+
+def _touching_components(abstraction: Abstraction) -> Any:
+    """Each triangle's component, with components that share a mesh vertex merged: pieces
+    of free space that touch at a point are connected through it (a plan may pass through
+    the point, see docs/planning.md), so a region beyond such a point is reachable."""
+    component = np.asarray(abstraction.component, dtype=np.int64)
+    count = int(component.max()) + 1 if len(component) else 0
+    parent = list(range(count))
+
+    def root(c: int) -> int:
+        while parent[c] != c:
+            parent[c] = parent[parent[c]]
+            c = parent[c]
+        return c
+
+    # the components around each vertex: one row per (vertex, component) pair
+    pairs = np.unique(
+        np.stack([abstraction.triangles.ravel(), np.repeat(component, 3)], axis=1), axis=0
+    )
+    shared = np.flatnonzero(pairs[1:, 0] == pairs[:-1, 0])
+    for k in shared.tolist():
+        a, b = root(int(pairs[k, 1])), root(int(pairs[k + 1, 1]))
+        if a != b:
+            parent[max(a, b)] = min(a, b)
+    roots = np.array([root(c) for c in range(count)], dtype=np.int64)
+    return roots[component]
 
 
 def _separation(mission: Mission, polygon: tuple[tuple[float, float], ...]) -> str:

@@ -6,7 +6,8 @@
 * The workspace's main piece is the free piece containing ``start`` (else the largest); its
   outer ring is the boundary, its inner rings the holes.  Every other free piece of at least
   ``min_area`` becomes a further workspace component; holes and pieces smaller than
-  ``min_area`` are specks (holes filled, pieces dropped).
+  ``min_area`` are specks (holes filled, pieces dropped), except that with
+  ``keep_obstacles`` (a robot with a body) every hole is kept, however small.
 * Rings are simplified within ``tolerance`` (default: one cell), never moving the boundary by
   more than that.
 * A keepout mask's occupied cells (value 100) and a speed mask's limited cells (values 1..100)
@@ -58,6 +59,9 @@ class ImportSettings:
     tolerance: float | None = None  # default: one cell
     min_area: float | None = None  # default: DEFAULT_MIN_CELLS cells
     start: Point | None = None
+    #: Keep every obstacle however small (``min_area`` then drops only free specks): a robot
+    #: with a body can hit an obstacle of a few cells, so none may vanish from its map.
+    keep_obstacles: bool = False
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -323,9 +327,8 @@ def _exact_free(
     grid: OccupancyGrid, settings: ImportSettings, min_area_cells: float
 ) -> tuple[Polygon, list[Polygon]]:
     main, others = _free_pieces(grid, settings.radius, settings.start, min_area_cells)
-    return drop_small_holes(main, min_area_cells), [
-        drop_small_holes(p, min_area_cells) for p in others
-    ]
+    holes = 0.0 if settings.keep_obstacles else min_area_cells
+    return drop_small_holes(main, holes), [drop_small_holes(p, holes) for p in others]
 
 
 def _check_settings(settings: ImportSettings, file: str) -> None:
@@ -391,7 +394,8 @@ def import_map(
     main = max(simplified, key=lambda p: (p.intersection(exact_main).area, p.area))
     others = [p for p in simplified if p is not main and p.area >= min_area / cell_area]
     others.sort(key=lambda p: (-p.area, p.bounds))
-    kept_cells = [drop_small_holes(p, min_area / cell_area) for p in (main, *others)]
+    hole_cells = 0.0 if settings.keep_obstacles else min_area / cell_area
+    kept_cells = [drop_small_holes(p, hole_cells) for p in (main, *others)]
     dropped = sum(
         len(a.interiors) - len(b.interiors)
         for a, b in zip((main, *others), kept_cells, strict=True)

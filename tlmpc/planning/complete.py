@@ -63,31 +63,43 @@ def plan_complete(
     start_point: tuple[float, float],
     parts: Callable[[], Sequence[TaskPart]] = tuple,
     file: str | None = None,
+    resume: frozenset[int] | None = None,
+    explain: bool = True,
 ) -> tuple[Abstraction, Witness]:
     """A witness on ``abstraction`` or on a locally refined copy of it (returned with it).
 
     Raises :class:`NoPlanError` only when no trajectory in the plane satisfies the task;
-    ``parts`` gives the task's parts for that explanation (called only then).
+    ``parts`` gives the task's parts for that explanation (called only then, and only with
+    ``explain``: a run re-planning under way needs no explanation).  ``resume`` re-plans a
+    run under way (see :func:`tlmpc.planning.plan.plan`).
     """
 
     try:
-        return abstraction, _attempt(abstraction, automaton, formula, options, start_point)
+        return abstraction, _attempt(
+            abstraction, automaton, formula, options, start_point, resume=resume
+        )
     except NoPlanError as first:
         no_bounce_failure = first
     try:
-        return _refined(abstraction, automaton, formula, options, start_point, passages=False)
+        return _refined(
+            abstraction, automaton, formula, options, start_point, passages=False, resume=resume
+        )
     except NoPlanError:
         pass
     # The one place vertex passages come in: no plan exists along edges alone.
     try:
         return abstraction, _attempt(
-            abstraction, automaton, formula, options, start_point, passages=True
+            abstraction, automaton, formula, options, start_point, passages=True, resume=resume
         )
     except NoPlanError:
         pass
     try:
-        return _refined(abstraction, automaton, formula, options, start_point, passages=True)
+        return _refined(
+            abstraction, automaton, formula, options, start_point, passages=True, resume=resume
+        )
     except NoPlanError:
+        if not explain:
+            raise no_bounce_failure from None
         raise NoPlanError(
             explain_infeasible(
                 abstraction,
@@ -111,6 +123,7 @@ def _attempt(
     *,
     bounces: bool = False,
     passages: bool = False,
+    resume: frozenset[int] | None = None,
 ) -> Witness:
     return plan(
         mesh,
@@ -120,6 +133,7 @@ def _attempt(
         start_point=start_point,
         bounces=bounces,
         passages=passages,
+        resume=resume,
     )
 
 
@@ -131,6 +145,7 @@ def _refined(
     start_point: tuple[float, float],
     *,
     passages: bool,
+    resume: frozenset[int] | None = None,
 ) -> tuple[Abstraction, Witness]:
     """A no-bounce witness on a mesh refined where a bouncing lasso turns around; raises
     :class:`NoPlanError` when no bouncing lasso exists on ``abstraction``."""
@@ -138,7 +153,14 @@ def _refined(
     for _ in range(MAX_ROUNDS):
         try:
             bouncing = _attempt(
-                mesh, automaton, formula, options, start_point, bounces=True, passages=passages
+                mesh,
+                automaton,
+                formula,
+                options,
+                start_point,
+                bounces=True,
+                passages=passages,
+                resume=resume,
             )
         except NoPlanError:
             if mesh is abstraction:
@@ -149,7 +171,9 @@ def _refined(
             turns = sorted({*turns, *passage_turns(mesh, bouncing)})
         mesh = split_triangles(mesh, turns, start_point)
         try:
-            witness = _attempt(mesh, automaton, formula, options, start_point, passages=passages)
+            witness = _attempt(
+                mesh, automaton, formula, options, start_point, passages=passages, resume=resume
+            )
         except NoPlanError:
             continue
         return mesh, witness

@@ -247,17 +247,9 @@ def _failing_stretches(
 
 
 def _free_space(trace: TraceInput) -> shapely.Geometry | None:
-    if trace.boundary_polygon is None:
-        return None
-    pieces = [(trace.boundary_polygon, trace.holes), *trace.components]
-    free_pieces = []
-    for boundary, holes in pieces:
-        free = shapely.Polygon(boundary)
-        if holes:
-            free = free.difference(shapely.union_all([shapely.Polygon(h) for h in holes]))
-        free_pieces.append(free)
-    free = free_pieces[0] if len(free_pieces) == 1 else shapely.union_all(free_pieces)
-    shapely.prepare(free)
+    from tlmpc.verify.clearance import free_space
+
+    free: shapely.Geometry | None = free_space(trace)
     return free
 
 
