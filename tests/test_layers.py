@@ -58,7 +58,6 @@ KNOWN_MODULE_CYCLES: frozenset[frozenset[str]] = frozenset(
         ),
         frozenset({"tlmpc.planning.boundary", "tlmpc.planning.passages", "tlmpc.planning.product"}),
         frozenset({"tlmpc.planning.explain", "tlmpc.planning.plan"}),
-        frozenset({"tlmpc.automata.simplify", "tlmpc.automata.wdba"}),
     }
 )
 

@@ -22,6 +22,7 @@ from collections.abc import Sequence
 
 from tlmpc.automata.model import Automaton
 from tlmpc.automata.simulation import Alphabet, OutOfTime
+from tlmpc.base.graphs import csr, strong_components
 
 #: Products with more nodes are not searched (the inclusion is then not established).
 MAX_PRODUCT = 20_000
@@ -100,9 +101,7 @@ def has_accepting_cycle(
         succ.append(row)
     # Only edges without a forbidden mark may lie on the cycle.
     allowed = [[t for t, marks in row if marks & forbidden == 0] for row in succ]
-    from tlmpc.automata.simplify import strongly_connected  # simplify imports wdba
-
-    component = strongly_connected(allowed, range(len(nodes)))
+    component = strong_components(*csr(allowed))
     collected: dict[int, int] = {}
     for source, row in enumerate(succ):
         for target, marks in row:

@@ -6,11 +6,12 @@ import dataclasses
 import functools
 import time
 from collections import defaultdict
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Sequence
 
 from tlmpc.automata import simulation, wdba
 from tlmpc.automata.guards import holds
 from tlmpc.automata.model import Automaton, Edge
+from tlmpc.base.graphs import csr, strong_components
 from tlmpc.ltl.ast import TRUE, And, Formula, Not, Or, Prop, conjoin, disjoin
 
 #: Guards with more cubes than this are left unabsorbed (the check is quadratic).
@@ -77,60 +78,12 @@ def _absorb(guards: list[Formula]) -> list[Formula]:
 
 
 def sccs(num_states: int, edges: Sequence[Edge], initial: int) -> list[int]:
-    """SCC id of every state reachable from ``initial`` (-1 for unreachable); iterative Tarjan."""
+    """SCC id of every state reachable from ``initial`` (-1 for unreachable), in Tarjan's
+    order (see :func:`tlmpc.base.graphs.strong_components`)."""
     succ: list[list[int]] = [[] for _ in range(num_states)]
     for edge in edges:
         succ[edge.src].append(edge.dst)
-    return strongly_connected(succ, [initial])
-
-
-def strongly_connected(succ: Sequence[Sequence[int]], roots: Iterable[int]) -> list[int]:
-    """SCC id of every state reachable from ``roots`` (-1 for the others), in Tarjan's order
-    (a component's id is smaller than those of the components that reach it).  Iterative, so
-    long chains cannot exhaust the interpreter's stack."""
-    num_states = len(succ)
-    index = [-1] * num_states
-    low = [0] * num_states
-    on_stack = [False] * num_states
-    component = [-1] * num_states
-    stack: list[int] = []
-    counter = 0
-    count = 0
-    for root in roots:
-        if index[root] != -1:
-            continue
-        work: list[tuple[int, int]] = [(root, 0)]
-        while work:
-            node, child = work.pop()
-            if child == 0:
-                index[node] = low[node] = counter
-                counter += 1
-                stack.append(node)
-                on_stack[node] = True
-            recursed = False
-            for position in range(child, len(succ[node])):
-                target = succ[node][position]
-                if index[target] == -1:
-                    work.append((node, position + 1))
-                    work.append((target, 0))
-                    recursed = True
-                    break
-                if on_stack[target]:
-                    low[node] = min(low[node], index[target])
-            if recursed:
-                continue
-            if low[node] == index[node]:
-                while True:
-                    member = stack.pop()
-                    on_stack[member] = False
-                    component[member] = count
-                    if member == node:
-                        break
-                count += 1
-            if work:
-                parent = work[-1][0]
-                low[parent] = min(low[parent], low[node])
-    return component
+    return strong_components(*csr(succ), [initial])
 
 
 def trim(automaton: Automaton, *, keep_transient_marks: bool = False) -> Automaton:

@@ -19,7 +19,7 @@ from tlmpc.automata.emptiness import equivalent_to_deterministic
 from tlmpc.automata.model import Automaton, Edge
 from tlmpc.automata.nnf import FALSE, Node
 from tlmpc.automata.rewrite import MAX_SEMANTIC_APS, rewrite
-from tlmpc.automata.simplify import postprocess, strongly_connected
+from tlmpc.automata.simplify import postprocess
 from tlmpc.automata.simulation import OutOfTime
 from tlmpc.automata.terms import (
     Expansion,
@@ -32,6 +32,7 @@ from tlmpc.automata.terms import (
     to_text,
 )
 from tlmpc.automata.wdba import is_obligation
+from tlmpc.base.graphs import csr, strong_components
 from tlmpc.ltl.ast import Formula, Not, Prop, conjoin
 from tlmpc.ltl.printer import to_text as formula_text
 from tlmpc.ltl.transform import nnf
@@ -330,7 +331,7 @@ def _is_empty_term(root: Node, deadline: float = float("inf")) -> bool:
     succ: list[list[int]] = [[] for _ in range(len(states))]
     for src, dst, _bits in graph:
         succ[src].append(dst)
-    component = strongly_connected(succ, [0])
+    component = strong_components(*csr(succ), [0])
     seen: dict[int, int] = {}
     for src, dst, bits in graph:
         if component[src] == component[dst]:

@@ -24,6 +24,7 @@ from typing import assert_never
 from tlmpc.automata.model import Automaton, Edge
 from tlmpc.automata.nnf import Always, Binary, Bottom, Conj, Disj, Finally, Neg, Node, Pos, Top
 from tlmpc.automata.simulation import Alphabet, OutOfTime
+from tlmpc.base.graphs import csr, strong_components
 from tlmpc.ltl.ast import FALSE, Formula, Not, Prop, conjoin, disjoin
 
 #: Subset construction is abandoned past this many subsets (the input is kept).
@@ -185,9 +186,7 @@ def _minimize(
 
 def _sccs(delta: list[list[int]]) -> list[int]:
     """SCC number of every state (a negative entry of ``delta`` is a missing transition)."""
-    from tlmpc.automata.simplify import strongly_connected  # simplify imports this module
-
-    return strongly_connected([[t for t in row if t >= 0] for row in delta], range(len(delta)))
+    return strong_components(*csr([[t for t in row if t >= 0] for row in delta]))
 
 
 def _bfs_tree(delta: list[list[int]]) -> list[tuple[int, int]]:
