@@ -26,9 +26,9 @@ from scipy.sparse.csgraph import dijkstra
 from tlmpc.abstraction import build_abstraction
 from tlmpc.automata import translate
 from tlmpc.base.errors import InvalidInputError, NoPlanError
+from tlmpc.base.graphs import strong_components
 from tlmpc.mission import load_mission_text
 from tlmpc.planning.plan import plan
-from tlmpc.base.graphs import strong_components
 from tlmpc.planning.search import Graph, closing_searches, shortest_paths
 
 FloatArray = npt.NDArray[np.float64]

@@ -17,11 +17,11 @@ edges carry every required mark and none of the forbidden ones.
 
 from __future__ import annotations
 
-import time
 from collections.abc import Sequence
 
+from tlmpc.automata import work
 from tlmpc.automata.model import Automaton
-from tlmpc.automata.simulation import Alphabet, OutOfTime
+from tlmpc.automata.simulation import Alphabet
 from tlmpc.base.graphs import csr, strong_components
 
 #: Products with more nodes are not searched (the inclusion is then not established).
@@ -85,7 +85,7 @@ def has_accepting_cycle(
     nodes = [(left_initial, right_initial)]
     succ: list[list[tuple[int, int]]] = []
     for p, q in nodes:
-        if len(nodes) > MAX_PRODUCT or time.process_time() > deadline:
+        if len(nodes) > MAX_PRODUCT or work.over(deadline, 1 + len(left[p]) * len(right[q])):
             return None
         row: list[tuple[int, int]] = []
         for letters, bits, p2 in left[p]:
@@ -158,5 +158,5 @@ def equivalent_to_deterministic(
             deadline=deadline,
         )
         return extra is False
-    except OutOfTime:
+    except work.OutOfBudget:
         return False
