@@ -17,9 +17,11 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
+from tlmpc.base.content import ContentEquality
 
-@dataclass(frozen=True, slots=True, kw_only=True)
-class Witness:
+
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
+class Witness(ContentEquality):
     """A minimum-cost accepting lasso (see docs/planning.md for the optimality statement)."""
 
     prefix: tuple[int, ...]

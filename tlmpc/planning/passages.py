@@ -25,13 +25,14 @@ Plans use passages only when no plan exists without them (see
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
 from tlmpc.automata.guards import successor_table
 from tlmpc.automata.model import Automaton
+from tlmpc.base.content import ContentEquality
 from tlmpc.planning.boundary import POINT, StartCell, crossing_letter
 from tlmpc.planning.model import Witness
 from tlmpc.planning.product import SLOTS, START_SLOT, STUTTER_COST, BoolArray, Product
@@ -40,13 +41,13 @@ from tlmpc.planning.search import Graph
 Letter = tuple[str, ...]
 
 
-@dataclass(frozen=True, slots=True)
-class PassageCells:
+@dataclass(frozen=True, slots=True, eq=False)
+class PassageCells(ContentEquality):
     """The arrival cells appended to a product: node ``base + c * Q + q`` is cell ``c``."""
 
     base: int
-    triangle: IntArray = field(compare=False)  # (P,) the triangle entered at the vertex
-    vertex: IntArray = field(compare=False)  # (P,) the mesh vertex passed through
+    triangle: IntArray  # (P,) the triangle entered at the vertex
+    vertex: IntArray  # (P,) the mesh vertex passed through
 
     def triangle_of(self, node: int, num_states: int) -> int:
         """The triangle of any product node (ordinary or arrival)."""

@@ -24,6 +24,8 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from tlmpc.base.content import ContentEquality
+
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
 BoolArray = npt.NDArray[np.bool_]
@@ -35,8 +37,8 @@ NO_NODE = np.iinfo(np.int64).max
 BUCKET_WIDTH = 1.0
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
-class Graph:
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
+class Graph(ContentEquality):
     """A weighted directed graph with its edges grouped by source (CSR).
 
     ``indptr[u]:indptr[u + 1]`` are the edges out of ``u``; ``sources``, ``targets`` and
