@@ -48,9 +48,14 @@ def _timed(value: Any, seconds: float) -> Any:
 
 def test_two_compilations_give_equal_results(twice: tuple[Compilation, Compilation]) -> None:
     first, second = twice
-    for product in (ABSTRACTION, WITNESS, CONTROLLERS):
-        assert first.get(product) == second.get(product)
-        assert hash(first.get(product)) == hash(second.get(product))
+    pairs: list[tuple[object, object]] = [
+        (first.get(ABSTRACTION), second.get(ABSTRACTION)),
+        (first.get(WITNESS), second.get(WITNESS)),
+        (first.get(CONTROLLERS), second.get(CONTROLLERS)),
+    ]
+    for one, other in pairs:
+        assert one == other
+        assert hash(one) == hash(other)
 
 
 def test_timings_do_not_count(twice: tuple[Compilation, Compilation]) -> None:
@@ -72,7 +77,7 @@ def test_geometry_counts(twice: tuple[Compilation, Compilation]) -> None:
     relabelled = abstraction.letter_of.copy()
     relabelled[0] = (relabelled[0] + 1) % len(abstraction.letters)
     assert dataclasses.replace(abstraction, letter_of=relabelled) != abstraction
-    narrower = abstraction.triangles.astype(np.int32)
+    narrower: Any = abstraction.triangles.astype(np.int32)  # same values, another dtype
     assert dataclasses.replace(abstraction, triangles=narrower) != abstraction
     controllers: Controllers = twice[0].get(CONTROLLERS)
     step = controllers.steps[0]
@@ -115,11 +120,11 @@ def test_arrays_by_shape_dtype_and_value() -> None:
 
 def test_artifacts_read_back_to_equal_results() -> None:
     result = compile_mission(SPEC, until="control")
-    readers = {
-        ABSTRACTION: abstraction_from_json,
-        WITNESS: witness_from_json,
-        CONTROLLERS: controllers_from_json,
-    }
-    for product, read in readers.items():
-        document = json.loads(json.dumps(result.artifacts[product.artifact]))
-        assert read(document) == result.compilation.get(product), product.artifact
+    compilation = result.compilation
+
+    def document(name: str) -> Any:
+        return json.loads(json.dumps(result.artifacts[name]))
+
+    assert abstraction_from_json(document("abstraction.json")) == compilation.get(ABSTRACTION)
+    assert witness_from_json(document("witness.json")) == compilation.get(WITNESS)
+    assert controllers_from_json(document("controllers.json")) == compilation.get(CONTROLLERS)
