@@ -19,6 +19,10 @@ from typing import Any, Literal
 
 from tlmpc.base.content import ContentEquality
 
+#: The proposition true exactly at point instants (crossings and the start) in the closed
+#: convention's word.  Region names are identifiers, so no region can be called this.
+POINT = "@point"
+
 
 @dataclass(frozen=True, slots=True, kw_only=True, eq=False)
 class Witness(ContentEquality):
