@@ -13,7 +13,6 @@
 
 from __future__ import annotations
 
-import math
 import warnings
 
 import pytest
@@ -38,11 +37,6 @@ with warnings.catch_warnings():
     spot = pytest.importorskip("spot")
     from spot_families import to_tlmpc
 
-#: The automata stages' CPU-time deadline, lifted: a test's answer must not depend on the
-#: machine's speed or load.
-NO_DEADLINE = math.inf
-
-
 PROPS = ("a", "b", "c")
 letters = st.frozensets(st.sampled_from(PROPS))
 words = st.tuples(st.lists(letters, max_size=4), st.lists(letters, min_size=1, max_size=4))
@@ -50,7 +44,7 @@ words = st.tuples(st.lists(letters, max_size=4), st.lists(letters, min_size=1, m
 
 def rewritten(formula: Formula, *, semantic: bool) -> Formula:
     oracle = _is_empty_term if semantic else None
-    return to_formula(rewrite(from_ast(formula), oracle, NO_DEADLINE))
+    return to_formula(rewrite(from_ast(formula), oracle, float("inf")))
 
 
 @given(formulas(PROPS, max_leaves=10), st.lists(words, min_size=1, max_size=8), st.booleans())
@@ -234,7 +228,7 @@ def test_wdba_replaces_a_non_obligation_when_equivalent() -> None:
 
 
 def test_wdba_equivalence_check() -> None:
-    deadline = NO_DEADLINE
+    deadline = float("inf")
     recurrence = parse_ltl("G F a")
     tgba = translate(recurrence)  # one state, deterministic, one set
     negation = translate(Not(recurrence))
@@ -285,5 +279,5 @@ def test_transient_state_never_replaced_by_a_state_that_reaches_it() -> None:
     word: tuple[list[frozenset[str]], list[frozenset[str]]] = ([], [frozenset({"a"}), frozenset()])
     assert accepts(automaton, *word)
     component = sccs(automaton.num_states, automaton.edges, automaton.initial)
-    merged = merge_transient(automaton, Alphabet(("a",), None), component, NO_DEADLINE)
+    merged = merge_transient(automaton, Alphabet(("a",), None), component, float("inf"))
     assert accepts(merged, *word)

@@ -13,8 +13,9 @@ from hypothesis import strategies as st
 
 from tlmpc.base.errors import UsageError
 from tlmpc.mission import load
-from tlmpc.mission.geometry import check_layout, check_shape, shapely_polygon
+from tlmpc.mission.geometry import check_layout, check_shape
 from tlmpc.mission.load import check_text, inspect_file
+from tlmpc.mission.shapes import shapely_polygon
 from tlmpc.mission.yamlpos import MAX_DEPTH, MAX_NODES, load_positioned
 
 VALID = """\

@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
+from tlmpc.base.content import ContentEquality
 from tlmpc.base.errors import UsageError, error
 
 FloatArray = npt.NDArray[np.float64]
@@ -17,11 +18,11 @@ Point = tuple[float, float]
 Ring = tuple[Point, ...]
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
-class Plan:
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
+class Plan(ContentEquality):
     """Samples ``[t, x, y]`` of the planned trajectory; ``loop_start`` begins the repeated cycle."""
 
-    samples: FloatArray = field(compare=False)
+    samples: FloatArray
     loop_start: int | None
     name: str
     boundary: Ring

@@ -19,8 +19,9 @@ from tlmpc.io.schema_check import is_valid, load_schema
 from tlmpc.ltl.ast import Formula, Or, Prop, conjoin
 from tlmpc.ltl.keywords import KEYWORDS
 from tlmpc.ltl.transform import substitute
-from tlmpc.mission.geometry import CheckedShape, check_layout, check_shape
+from tlmpc.mission.geometry import check_layout, check_shape
 from tlmpc.mission.model import Component, Mission, Options, Polygon, Region, Robot, Workspace
+from tlmpc.mission.shapes import CheckedShape
 from tlmpc.mission.yamlpos import Path, PositionedDocument, json_path, load_positioned
 from tlmpc.tasks.compiler import compile_phrases
 

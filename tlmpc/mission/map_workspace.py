@@ -13,7 +13,8 @@ from typing import Any
 from shapely.geometry import Polygon as ShapelyPolygon
 
 from tlmpc.base.errors import Diagnostic, TlmpcError, error
-from tlmpc.mission.geometry import CheckedShape, check_shape
+from tlmpc.mission.geometry import check_shape
+from tlmpc.mission.shapes import CheckedShape
 from tlmpc.mission.yamlpos import PositionedDocument
 
 

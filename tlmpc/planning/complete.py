@@ -20,7 +20,7 @@ from tlmpc.automata.model import Automaton
 from tlmpc.base.errors import NoPlanError, TlmpcError, error
 from tlmpc.ltl.ast import Formula
 from tlmpc.mission.model import Options, TaskPart
-from tlmpc.planning.boundary import start_cells
+from tlmpc.planning.boundary import start_cells, task_formula, task_letters
 from tlmpc.planning.explain import explain_infeasible
 from tlmpc.planning.model import Witness
 from tlmpc.planning.passages import passage_turns
@@ -110,8 +110,35 @@ def plan_complete(
                 parts=parts(),
                 file=file,
                 fallback=no_bounce_failure.diagnostics,
+                feasible=_feasibility(abstraction, options, start_point),
             )
         ) from None
+
+
+def _feasibility(
+    abstraction: Abstraction, options: Options, start_point: tuple[float, float]
+) -> Callable[[Formula], bool]:
+    """Whether the planner (U-turns allowed) finds a plan for a task formula on this map."""
+    from tlmpc.automata.translate import translate
+
+    convention = options.boundary
+    letters = task_letters(abstraction, convention, start_point)
+
+    def feasible(formula: Formula) -> bool:
+        try:
+            plan(
+                abstraction,
+                translate(task_formula(formula, convention), letters=letters),
+                formula=formula,
+                options=options,
+                start_point=start_point,
+                bounces=True,
+            )
+        except NoPlanError:
+            return False
+        return True
+
+    return feasible
 
 
 def _attempt(

@@ -6,6 +6,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
+from tlmpc.base.content import ContentEquality
+
 #: ``satisfied``: every continuation satisfies the task (for a lasso or a stay: the trace does);
 #: ``violated``: no continuation can; ``inconclusive``: some may and some may not.
 Outcome = Literal["satisfied", "violated", "inconclusive"]
@@ -63,8 +65,8 @@ class Certificate:
     reason: str
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
-class Verdict:
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
+class Verdict(ContentEquality):
     """The verifier's answer for one trace."""
 
     outcome: Outcome
