@@ -27,7 +27,15 @@ TIMING_FIELDS = {
     "tlmpc/control/synthesize.py": "the controllers' prepare and solve seconds",
     "tlmpc/base/progress.py": "the elapsed time on the progress line",
     "tlmpc/commands/automaton.py": "the seconds of `tlmpc automaton --stats`",
+    "tlmpc/fleet/job.py": "each log's verification seconds in the batch results",
+    "tlmpc/fleet/command.py": "the batch's total seconds in its summary",
+    "tlmpc/commands/monitor.py": "`monitor --follow --idle N`: the user's own wall-clock limit",
 }
+
+#: The one place a clock reading is compared: following a growing log, the monitor stops after
+#: the number of seconds without a new line the user asked for (a live tool's own time, which
+#: decides when it stops reading, never a verdict).
+COMPARED = {"tlmpc/commands/monitor.py": "the --idle limit"}
 
 
 def _imported_clocks(tree: ast.AST) -> set[str]:
@@ -103,7 +111,10 @@ def test_wall_clocks_only_for_the_timing_fields() -> None:
 
 def test_no_clock_reading_is_compared() -> None:
     found = [
-        f"{name}:{line}" for name, tree in _sources().items() for line in _compared_clocks(tree)
+        f"{name}:{line}"
+        for name, tree in _sources().items()
+        if name not in COMPARED
+        for line in _compared_clocks(tree)
     ]
     assert found == []
 
