@@ -66,6 +66,16 @@ KEYWORDS = frozenset(
         "often",
         "finally",
         "reach",
+        "if",
+        "you",
+        "sense",
+        "see",
+        "when",
+        "there",
+        "unless",
+        "enter",
+        "do",
+        "of",
     }
 )
 #: A name starting with one of these could be split by the Earley parser's dynamic lexer
