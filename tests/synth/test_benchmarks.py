@@ -36,6 +36,17 @@ PUBLISHED: list[tuple[str, InitMode, bool]] = [
     (f"{GR1C}/trivial_mustblock.spc", "forall_env_exists_sys", True),
     (f"{GR1C}/trivial_un.spc", "forall_env_exists_sys", False),
     (f"{GR1C}/trivial_partwin.spc", "all_init", False),
+    (f"{SLUGS}/networks.slugsin", "forall_env_exists_sys", True),
+    (f"{SLUGS}/optimisticRecoveryTest.slugsin", "forall_env_exists_sys", True),
+    (f"{SLUGS}/semantics_diference.slugsin", "forall_env_exists_sys", True),
+    (f"{SLUGS}/simple_safety_example.slugsin", "forall_env_exists_sys", True),
+    (f"{SLUGS}/firefighting.slugsin", "forall_env_exists_sys", True),
+    (f"{SLUGS}/baby_network.slugsin", "forall_env_exists_sys", False),
+    (
+        f"{SLUGS}/example_outermost_fixed_point_unrealizability.slugsin",
+        "forall_env_exists_sys",
+        False,
+    ),
 ]
 
 

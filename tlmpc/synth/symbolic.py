@@ -176,7 +176,7 @@ class Encoding:
             else:
                 result = bdd.false
                 for u in operands:
-                    result ^= u
+                    result = bdd.apply("xor", result, u)
             return result
         assert isinstance(node, Binary)
         left, right = memo[id(node.left)], memo[id(node.right)]
