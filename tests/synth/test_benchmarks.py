@@ -1,0 +1,63 @@
+"""Every external GR(1) benchmark with a published answer gets that answer.
+
+The suites live in ``$TLMPC_SHARED_BENCHMARKS/gr1``, else ``<repo>/../shared/benchmarks/gr1``
+(their README lists the published answers and where they come from); the tests skip cleanly
+where the folder is absent.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+from tlmpc.synth.readers import read_spec
+from tlmpc.synth.solver import Game, solve
+from tlmpc.synth.spec import InitMode
+
+ROOT = Path(__file__).resolve().parents[2]
+SUITES = (
+    Path(os.environ.get("TLMPC_SHARED_BENCHMARKS") or ROOT.parent / "shared" / "benchmarks") / "gr1"
+)
+
+GR1C = "gr1c/tests/specs"
+SLUGS = "slugs/examples"
+GRID = "syntcomp-robot-grid/non_parametric"
+
+#: (file, initial-state quantification, published answer), from each suite's upstream tests
+PUBLISHED: list[tuple[str, InitMode, bool]] = [
+    (f"{GR1C}/gridworld_bool.spc", "forall_env_exists_sys", True),
+    (f"{GR1C}/gridworld_env.spc", "forall_env_exists_sys", True),
+    (f"{GR1C}/arbiter4.spc", "forall_env_exists_sys", True),
+    (f"{GR1C}/trivial_2var.spc", "forall_env_exists_sys", True),
+    (f"{GR1C}/free_counter.spc", "forall_env_exists_sys", True),
+    (f"{GR1C}/empty.spc", "forall_env_exists_sys", True),
+    (f"{GR1C}/trivial_mustblock.spc", "forall_env_exists_sys", True),
+    (f"{GR1C}/trivial_un.spc", "forall_env_exists_sys", False),
+    (f"{GR1C}/trivial_partwin.spc", "all_init", False),
+    (f"{SLUGS}/networks.slugsin", "forall_env_exists_sys", True),
+    (f"{SLUGS}/optimisticRecoveryTest.slugsin", "forall_env_exists_sys", True),
+    (f"{SLUGS}/semantics_diference.slugsin", "forall_env_exists_sys", True),
+    (f"{SLUGS}/simple_safety_example.slugsin", "forall_env_exists_sys", True),
+    (f"{SLUGS}/firefighting.slugsin", "forall_env_exists_sys", True),
+    (f"{SLUGS}/baby_network.slugsin", "forall_env_exists_sys", False),
+    (
+        f"{SLUGS}/example_outermost_fixed_point_unrealizability.slugsin",
+        "forall_env_exists_sys",
+        False,
+    ),
+]
+
+
+def _suite_file(relative: str) -> Path:
+    path = SUITES / relative
+    if not path.is_file():
+        pytest.skip(f"the benchmark suite is absent ({path})")
+    return path
+
+
+@pytest.mark.parametrize(("relative", "mode", "answer"), PUBLISHED, ids=lambda v: str(v))
+def test_published_answer(relative: str, mode: InitMode, answer: bool) -> None:
+    spec = read_spec(str(_suite_file(relative)), init_mode=mode)
+    assert solve(Game.build(spec)).realizable is answer

@@ -1,0 +1,183 @@
+"""The GR(1) game solver: the three-nested fixpoint on BDDs.
+
+The winning region of the system is (Bloem, Jobstmann, Piterman, Pnueli, Sa'ar, "Synthesis of
+Reactive(1) designs", JCSS 2012; Piterman, Pnueli, Sa'ar, VMCAI 2006)::
+
+    Z = nu Z. /\\_j mu Y. \\/_i nu X. cpre( (J^s_j /\\ Z') \\/ Y' \\/ (~J^e_i /\\ X') )
+
+with the controllable predecessor ``cpre(T) = forall x'. exists y'. (rho_e -> rho_s /\\ T)``:
+whatever the environment does next within its safety assumption, the system has an answer
+within its own safety guarantee that takes a transition in ``T``.  Goals may mention the next
+step (slugs allows it), so they are read on transitions; a goal over the current state is the
+special case.  The relational products use CUDD's ``and_exists`` / ``or_forall``.
+
+Besides the winning region, the last pass of the outer fixpoint leaves, for each system goal,
+the ordered list of transition sets that make a positional strategy per goal (the rank of the
+middle fixpoint and the index of the environment goal being waited for, lowest first); the
+Mealy machine in :mod:`tlmpc.synth.strategy` is built from them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from dd import cudd
+
+from tlmpc.synth.spec import GameSpec, InitMode
+from tlmpc.synth.symbolic import Encoding, Function
+
+
+@dataclass
+class Game:
+    """The symbolic game of a specification: the encoding and the conjoined parts."""
+
+    spec: GameSpec
+    enc: Encoding
+    env_init: Function
+    sys_init: Function
+    env_safety: Function
+    sys_safety: Function
+    env_goals: list[Function]
+    sys_goals: list[Function]
+
+    @classmethod
+    def build(cls, spec: GameSpec, enc: Encoding | None = None) -> Game:
+        """Translate ``spec`` (reusing ``enc``'s BDDs of parts when given)."""
+        if enc is None:
+            enc = Encoding(spec)
+        else:
+            enc.spec = spec
+        bdd = enc.bdd
+        env_goals = [enc.part(p) for p in spec.select("env", "liveness")] or [bdd.true]
+        sys_goals = [enc.part(p) for p in spec.select("sys", "liveness")] or [bdd.true]
+        return cls(
+            spec=spec,
+            enc=enc,
+            env_init=enc.conjoin(spec.select("env", "init")) & enc.domain("env", False),
+            sys_init=enc.conjoin(spec.select("sys", "init")) & enc.domain("sys", False),
+            env_safety=enc.conjoin(spec.select("env", "safety")) & enc.domain("env", True),
+            sys_safety=enc.conjoin(spec.select("sys", "safety")) & enc.domain("sys", True),
+            env_goals=env_goals,
+            sys_goals=sys_goals,
+        )
+
+
+@dataclass
+class Solution:
+    """The outcome of :func:`solve`."""
+
+    game: Game
+    winning: Function
+    realizable: bool
+    #: per system goal, the transition sets (over current, next inputs, next outputs) in the
+    #: order of the middle and inner fixpoints, lowest rank first
+    layers: list[list[Function]] = field(default_factory=list)
+    #: how many times ``cpre`` was applied (the solver's work, machine-independent)
+    cpre_count: int = 0
+
+
+class _Cpre:
+    """``cpre`` with the quantified variable sets and the environment's safety prepared."""
+
+    def __init__(self, game: Game) -> None:
+        enc = game.enc
+        self.bdd = enc.bdd
+        self.next_inputs = enc.names("env", True)
+        self.next_outputs = enc.names("sys", True)
+        self.not_env = ~game.env_safety
+        self.sys_safety = game.sys_safety
+        # slugs lets the environment's safety mention next outputs; then the quantifiers cannot
+        # be split around it
+        self.mixed = bool(set(enc.bdd.support(game.env_safety)) & self.next_outputs)
+        self.count = 0
+
+    def moves(self, target: Function) -> Function:
+        """``exists y'. rho_s /\\ target`` (over current and next inputs)."""
+        return cudd.and_exists(self.sys_safety, target, self.next_outputs)
+
+    def of_moves(self, moves: Function) -> Function:
+        """``forall x'. (rho_e -> moves)``, ``moves`` from :meth:`moves`."""
+        self.count += 1
+        return cudd.or_forall(self.not_env, moves, self.next_inputs)
+
+    def __call__(self, target: Function) -> Function:
+        if self.mixed:
+            self.count += 1
+            inner = self.not_env | (self.sys_safety & target)
+            return self.bdd.forall(self.next_inputs, self.bdd.exist(self.next_outputs, inner))
+        return self.of_moves(self.moves(target))
+
+
+def solve(game: Game, *, keep_layers: bool = True) -> Solution:
+    """Solve the game: the system's winning region and realizability under the spec's
+    initial-state quantification."""
+    enc = game.enc
+    bdd = enc.bdd
+    cpre = _Cpre(game)
+    not_env_goals = [~g for g in game.env_goals]
+    z = bdd.true
+    layers: list[list[Function]] = []
+    while True:
+        layers = [[] for _ in game.sys_goals]
+        new_z = bdd.true
+        for j, goal in enumerate(game.sys_goals):
+            reach_goal = goal & enc.prime(z)
+            y = bdd.false
+            while True:
+                live = reach_goal | enc.prime(y)
+                live_moves = None if cpre.mixed else cpre.moves(live)
+                new_y = y
+                for i, not_goal in enumerate(not_env_goals):
+                    del i
+                    x = bdd.true
+                    while True:
+                        paths = live | (enc.prime(x) & not_goal)
+                        if live_moves is not None:
+                            moves = live_moves | cpre.moves(enc.prime(x) & not_goal)
+                            new_x = cpre.of_moves(moves)
+                        else:
+                            new_x = cpre(paths)
+                        if new_x == x:
+                            break
+                        x = new_x
+                    new_y |= x
+                    if keep_layers:
+                        layers[j].append(paths)
+                if new_y == y:
+                    break
+                y = new_y
+            new_z &= y
+            if new_z == bdd.false:
+                break
+        if new_z == z:
+            break
+        z = new_z
+    return Solution(
+        game=game,
+        winning=z,
+        realizable=initially_winning(game, z, game.spec.init_mode),
+        layers=layers,
+        cpre_count=cpre.count,
+    )
+
+
+def initially_winning(game: Game, winning: Function, mode: InitMode) -> bool:
+    """Whether the initial condition is met from ``winning`` under ``mode``."""
+    enc = game.enc
+    bdd = enc.bdd
+    inputs = enc.names("env", False)
+    outputs = enc.names("sys", False)
+    domain = enc.domain(None, False)
+    if mode == "forall_env_exists_sys":
+        answer = bdd.exist(outputs, winning & game.sys_init & domain)
+        result = bdd.forall(inputs, ~game.env_init | answer)
+    elif mode == "all_init":
+        result = bdd.forall(inputs | outputs, ~(game.env_init & game.sys_init & domain) | winning)
+    else:  # gr1c's ONE_SIDE_INIT
+        has_sys = bool(game.spec.select("sys", "init"))
+        has_env = bool(game.spec.select("env", "init"))
+        if has_sys and not has_env:
+            result = bdd.exist(inputs | outputs, game.sys_init & domain & winning)
+        else:
+            result = bdd.forall(inputs | outputs, ~(game.env_init & domain) | winning)
+    return bool(result == bdd.true)
