@@ -182,7 +182,7 @@ class Encoding:
         left, right = memo[id(node.left)], memo[id(node.right)]
         if node.op == "->":
             return ~left | right
-        return ~(left ^ right)
+        return bdd.apply("equiv", left, right)
 
     def part(self, part: Part) -> Function:
         """The BDD of one part (cached)."""

@@ -1,0 +1,82 @@
+"""Solve a reactive mission: its GR(1) game, realizability, and a core when it is not.
+
+The core is the smallest set of task parts (deletion-minimal) that no robot strategy can
+meet under all of the mission's assumptions: every one of them is needed for the conflict.
+Assumptions stay in the game while the core is sought (taking one away only makes the robot's
+task harder, so none would ever be needed).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from tlmpc.abstraction.model import Abstraction
+from tlmpc.base.errors import InvalidInputError
+from tlmpc.mission.model import Mission, TaskPart
+from tlmpc.reactive.faces import Faces, faces_of
+from tlmpc.reactive.fragment import Owner, reading
+from tlmpc.reactive.game import MissionGame, build_game
+from tlmpc.synth.solver import Game, Solution, solve
+from tlmpc.synth.symbolic import Encoding
+
+
+def mission_parts(mission: Mission) -> list[tuple[TaskPart, Owner]]:
+    """Every assumption (the environment's) and every task part (the robot's), in file order."""
+    from tlmpc.mission.parts import task_parts
+
+    assert mission.reactive is not None
+    env: list[tuple[TaskPart, Owner]] = [(p, "env") for p in mission.reactive.assumptions]
+    return env + [(p, "sys") for p in task_parts(mission)]
+
+
+def mission_game(mission: Mission, abstraction: Abstraction) -> MissionGame:
+    """The game of ``mission`` on the faces of ``abstraction`` (Q102 for a part outside GR(1))."""
+    pieces, problems = reading(mission_parts(mission), mission.source)
+    if problems:
+        raise InvalidInputError(problems)
+    faces: Faces = faces_of(abstraction)
+    start_face = int(faces.face_of[abstraction.start])
+    return build_game(mission, faces, start_face, pieces)
+
+
+@dataclass(frozen=True)
+class Synthesis:
+    """The outcome: the solved game; ``core`` (task parts) when unrealizable."""
+
+    game: MissionGame
+    solution: Solution
+    core: tuple[TaskPart, ...] | None
+
+    @property
+    def realizable(self) -> bool:
+        """Whether a robot strategy wins from the start."""
+        return self.solution.realizable
+
+
+def synthesize(mission: Mission, abstraction: Abstraction) -> Synthesis:
+    """Solve the mission's game; find a core when it is unrealizable."""
+    game = mission_game(mission, abstraction)
+    encoding = Encoding(game.spec)
+    solution = solve(Game.build(game.spec, encoding))
+    core = None if solution.realizable else _core(game, encoding)
+    return Synthesis(game=game, solution=solution, core=core)
+
+
+def _core(game: MissionGame, encoding: Encoding) -> tuple[TaskPart, ...]:
+    """Drop one task part at a time while the rest is still unrealizable."""
+    spec = game.spec
+    kept: dict[int, TaskPart] = {}
+    for part in spec.parts:
+        source = game.sources.get(id(part))
+        if source is not None and part.owner == "sys":
+            kept.setdefault(id(source), source)
+    for dropped in list(kept):
+        trial = {key: source for key, source in kept.items() if key != dropped}
+        parts = tuple(
+            p
+            for p in spec.parts
+            if p.owner == "env" or id(game.sources.get(id(p))) in trial or id(p) not in game.sources
+        )
+        if not solve(Game.build(spec.with_parts(parts), encoding), keep_layers=False).realizable:
+            kept = trial
+    return tuple(kept.values())
