@@ -212,7 +212,7 @@ def _not_gr1(formula: Formula, part: TaskPart, file: str | None) -> Diagnostic:
     why = (
         "'eventually always' (F G) asks the robot to settle without saying when"
         if persistence
-        else "tlmpc finds no deterministic automaton for it, and a GR(1) game tracks only deterministic ones"
+        else "tlmpc finds no deterministic automaton for it, and a game tracks only those"
     )
     return error(
         "Q102",

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import Literal
 
 from tlmpc.automata.model import Automaton
 from tlmpc.ltl.ast import And, Const, Equiv, Formula, Implies, Not, Or, Prop
@@ -103,10 +104,10 @@ class _Letters:
         if isinstance(formula, Not):
             return SpecNot(self.formula(formula.arg, primed))
         if isinstance(formula, And | Or):
-            op = "and" if isinstance(formula, And) else "or"
-            return Nary(op, tuple(self.formula(arg, primed) for arg in formula.args))
+            args = tuple(self.formula(arg, primed) for arg in formula.args)
+            return Nary("and", args) if isinstance(formula, And) else Nary("or", args)
         if isinstance(formula, Implies | Equiv):
-            op = "->" if isinstance(formula, Implies) else "<->"
+            op: Literal["->", "<->"] = "->" if isinstance(formula, Implies) else "<->"
             return Binary(
                 op, self.formula(formula.left, primed), self.formula(formula.right, primed)
             )
@@ -257,7 +258,7 @@ def _monitor_parts(
         )
         for e in automaton.edges
     ]
-    goals = [
+    goals: list[Expr] = [
         Nary(
             "or",
             tuple(steps[k] for k, e in enumerate(automaton.edges) if mark in e.marks)
@@ -265,6 +266,6 @@ def _monitor_parts(
         )
         for mark in range(automaton.num_acc)
     ]
-    init = Nary("or", tuple(first)) if first else SpecConst(False)
-    step = Nary("or", tuple(steps)) if steps else SpecConst(False)
+    init: Expr = Nary("or", tuple(first)) if first else SpecConst(False)
+    step: Expr = Nary("or", tuple(steps)) if steps else SpecConst(False)
     return init, step, goals

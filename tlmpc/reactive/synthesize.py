@@ -14,19 +14,11 @@ from tlmpc.abstraction.model import Abstraction
 from tlmpc.base.errors import InvalidInputError
 from tlmpc.mission.model import Mission, TaskPart
 from tlmpc.reactive.faces import Faces, faces_of
-from tlmpc.reactive.fragment import Owner, reading
+from tlmpc.reactive.fragment import reading
 from tlmpc.reactive.game import MissionGame, build_game
+from tlmpc.reactive.parts import mission_parts
 from tlmpc.synth.solver import Game, Solution, solve
 from tlmpc.synth.symbolic import Encoding
-
-
-def mission_parts(mission: Mission) -> list[tuple[TaskPart, Owner]]:
-    """Every assumption (the environment's) and every task part (the robot's), in file order."""
-    from tlmpc.mission.parts import task_parts
-
-    assert mission.reactive is not None
-    env: list[tuple[TaskPart, Owner]] = [(p, "env") for p in mission.reactive.assumptions]
-    return env + [(p, "sys") for p in task_parts(mission)]
 
 
 def mission_game(mission: Mission, abstraction: Abstraction) -> MissionGame:

@@ -235,7 +235,7 @@ class _Lowering:
             sensed = self._condition(children[1])
             return conjoin(
                 [
-                    Globally(Implies(And((sensed, Not(p))), WeakUntil(Not(p), Not(sensed))))
+                    Globally(Implies(conjoin([sensed, Not(p)]), WeakUntil(Not(p), Not(sensed))))
                     for p in places
                 ]
             )
@@ -254,7 +254,7 @@ class _Lowering:
         return And(
             (
                 Globally(Implies(sensed, Eventually(Or((Not(sensed), place))))),
-                Globally(Implies(And((sensed, place)), WeakUntil(place, Not(sensed)))),
+                Globally(Implies(conjoin([sensed, place]), WeakUntil(place, Not(sensed)))),
             )
         )
 
