@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from tlmpc.abstraction.model import Abstraction
-from tlmpc.base.errors import InvalidInputError
+from tlmpc.base.errors import Diagnostic, InvalidInputError, error
 from tlmpc.mission.model import Mission, TaskPart
 from tlmpc.reactive.faces import Faces, faces_of
 from tlmpc.reactive.fragment import reading
@@ -22,8 +22,19 @@ from tlmpc.synth.symbolic import Encoding
 
 
 def mission_game(mission: Mission, abstraction: Abstraction) -> MissionGame:
-    """The game of ``mission`` on the faces of ``abstraction`` (Q102 for a part outside GR(1))."""
+    """The game of ``mission`` on the faces of ``abstraction`` (Q102 for a part outside GR(1),
+    Q103 under the closed convention)."""
     pieces, problems = reading(mission_parts(mission), mission.source)
+    if mission.options.boundary == "closed":
+        problems.append(
+            error(
+                "Q103",
+                "a reactive mission is read with the right-continuous convention",
+                hint="leave options.boundary out (or set it to right): the game's steps are "
+                "the run's events, each letter held for a positive time",
+                file=mission.source,
+            )
+        )
     if problems:
         raise InvalidInputError(problems)
     faces: Faces = faces_of(abstraction)
@@ -52,6 +63,37 @@ def synthesize(mission: Mission, abstraction: Abstraction) -> Synthesis:
     solution = solve(Game.build(game.spec, encoding))
     core = None if solution.realizable else _core(game, encoding)
     return Synthesis(game=game, solution=solution, core=core)
+
+
+def unrealizable(synthesis: Synthesis, mission: Mission) -> list[Diagnostic]:
+    """Q110 at the core's first part, and a note at each further part of the core."""
+    core = synthesis.core or ()
+    names = "; ".join(part.text for part in core) or "the robot's motion alone"
+    first = core[0] if core else None
+    found = [
+        error(
+            "Q110",
+            f"no robot strategy meets the task under the assumptions: {names} cannot all hold "
+            "whatever the environment does",
+            hint="each of these parts is needed for the conflict: weaken one of them, or add "
+            "an assumption that rules out the environment's winning moves",
+            file=mission.source,
+            line=first.line if first else None,
+            col=first.col if first else None,
+        )
+    ]
+    found += [
+        Diagnostic(
+            code="Q110",
+            message=f"part of the conflict: {part.text}",
+            file=mission.source,
+            line=part.line,
+            col=part.col,
+            severity="note",
+        )
+        for part in core[1:]
+    ]
+    return found
 
 
 def _core(game: MissionGame, encoding: Encoding) -> tuple[TaskPart, ...]:
