@@ -117,19 +117,24 @@ def solve(game: Game, *, keep_layers: bool = True) -> Solution:
     not_env_goals = [~g for g in game.env_goals]
     z = bdd.true
     layers: list[list[Function]] = []
+    # The X of each (goal, rank, assumption) from the previous pass of Z: Z only shrinks, so
+    # every X does too and the old value is a sound start for the new greatest fixpoint
+    # (fixpoint recycling), which saves most of the inner iterations.
+    previous: dict[tuple[int, int, int], Function] = {}
     while True:
         layers = [[] for _ in game.sys_goals]
         new_z = bdd.true
+        current: dict[tuple[int, int, int], Function] = {}
         for j, goal in enumerate(game.sys_goals):
             reach_goal = goal & enc.prime(z)
             y = bdd.false
+            rank = 0
             while True:
                 live = reach_goal | enc.prime(y)
                 live_moves = None if cpre.mixed else cpre.moves(live)
                 new_y = y
                 for i, not_goal in enumerate(not_env_goals):
-                    del i
-                    x = bdd.true
+                    x = previous.get((j, rank, i), bdd.true)
                     while True:
                         paths = live | (enc.prime(x) & not_goal)
                         if live_moves is not None:
@@ -140,18 +145,21 @@ def solve(game: Game, *, keep_layers: bool = True) -> Solution:
                         if new_x == x:
                             break
                         x = new_x
+                    current[(j, rank, i)] = x
                     new_y |= x
                     if keep_layers:
                         layers[j].append(paths)
                 if new_y == y:
                     break
                 y = new_y
+                rank += 1
             new_z &= y
             if new_z == bdd.false:
                 break
         if new_z == z:
             break
         z = new_z
+        previous = current
     return Solution(
         game=game,
         winning=z,
