@@ -7,16 +7,27 @@ strategy wins by an explicit-state check.
 * gr1py (an enumerative GR(1) solver that reads gr1c's format) solves the same ``.spc`` text
   under gr1c's default initial condition.
 
+Unrealizable games get a counterstrategy checked the same way, and a core that Spot finds
+unrealizable, each of whose parts Spot finds necessary.
+
 Formulas are printed fully parenthesised so that no two tools' precedence rules can differ.
 """
 
 from __future__ import annotations
 
 import pytest
-from game_oracle import check_strategy, holds, valuations
+from game_oracle import (
+    check_counterstrategy,
+    check_strategy,
+    holds,
+    strict_ltl_of,
+    valuations,
+)
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from tlmpc.synth.core import minimal_core
+from tlmpc.synth.counter import extract_counterstrategy
 from tlmpc.synth.readers.gr1c import parse_gr1c
 from tlmpc.synth.solver import Game, solve
 from tlmpc.synth.spec import GameSpec
@@ -144,3 +155,13 @@ def test_agrees_with_spot_and_gr1py(game: dict[str, list[Tree]]) -> None:
         assert solution.realizable == bool(gr1py_solve.check_realizable(tsys, exprtab)), text
     if solution.realizable:
         check_strategy(spec, extract(solution))
+    else:
+        check_counterstrategy(spec, extract_counterstrategy(solution))
+        core = minimal_core(spec)
+        assumptions = tuple(p for p in spec.parts if p.owner == "env")
+        assert not spot_realizable(strict_ltl_of(spec.with_parts(assumptions + core.parts)))
+        for dropped in core.parts:
+            rest = tuple(p for p in core.parts if p is not dropped)
+            assert spot_realizable(strict_ltl_of(spec.with_parts(assumptions + rest))), (
+                f"the core is not minimal: {dropped.text} can go"
+            )
