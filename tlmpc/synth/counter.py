@@ -137,9 +137,7 @@ def extract_counterstrategy(solution: Solution, *, max_nodes: int = MAX_NODES) -
         r = rank(values)
         bits = _assignment(enc, values, False)
         if restrict(enc, bits, layers.v[r][goal]) != bdd.true:
-            goal = next(
-                j for j, v in enumerate(layers.v[r]) if restrict(enc, bits, v) == bdd.true
-            )
+            goal = next(j for j, v in enumerate(layers.v[r]) if restrict(enc, bits, v) == bdd.true)
             env_goal = 0
         key = (_key(values), goal, env_goal)
         found = index.get(key)

@@ -193,8 +193,7 @@ def _variable_json(variable: Variable) -> dict[str, Any]:
 def to_json(machine: MealyMachine) -> dict[str, Any]:
     """The ``strategy.json`` document (schemas/strategy.schema.json)."""
     return {
-        "format": "tlmpc-strategy",
-        "version": 1,
+        "format": "tlmpc.strategy/1",
         "source": {"file": machine.source_file, "format": machine.source_format},
         "initial_quantification": machine.init_mode,
         "inputs": [_variable_json(v) for v in machine.inputs],

@@ -21,7 +21,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-from tlmpc.errors import InvalidInputError
+from tlmpc.errors import UsageError
 from tlmpc.synth.readers.source import Source
 from tlmpc.synth.spec import (
     Atom,
@@ -299,7 +299,7 @@ class _Lowering:
         self.source = source
         self.variables = variables
 
-    def fail(self, node: Node, message: str, hint: str) -> InvalidInputError:
+    def fail(self, node: Node, message: str, hint: str) -> UsageError:
         return self.source.fail("Q044", message, node.start, hint)
 
     def boolean(self, node: Node, owner: Owner, kind: str, primed: bool = False) -> Expr:
