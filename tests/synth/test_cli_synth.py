@@ -49,7 +49,7 @@ def write(tmp_path: Path, name: str, text: str) -> Path:
 def test_realizable_writes_a_strategy_that_follows_the_schema(tmp_path: Path) -> None:
     spec = write(tmp_path, "copy.spc", REALIZABLE)
     target = tmp_path / "strategy.json"
-    code, out, err = run("synth", str(spec), "-o", str(target))
+    code, out, _err = run("synth", str(spec), "-o", str(target))
     assert (code, out) == (0, "realizable\n")
     document = json.loads(target.read_text())
     jsonschema.validate(document, load_schema("strategy"))
@@ -70,7 +70,8 @@ def test_dot_output(tmp_path: Path) -> None:
     code, _, err = run("synth", str(spec), "-o", str(target), "--format", "dot")
     assert code == 0
     text = target.read_text()
-    assert text.startswith("digraph strategy {") and "start -> n0;" in text
+    assert text.startswith("digraph strategy {")
+    assert "start -> n0;" in text
     assert f"wrote {target}" in err
 
 
@@ -83,7 +84,8 @@ def test_unrealizable_explains_with_a_located_core(tmp_path: Path) -> None:
     assert f"{spec}:5:13: sys safety: (x' -> !y')" in out
     assert f"{spec}:7:15: sys liveness: (y & x)" in out
     assert "(True)" not in out.split("counterstrategy")[0]
-    assert "counterstrategy (" in out and "first inputs: x" in out
+    assert "counterstrategy (" in out
+    assert "first inputs: x" in out
 
 
 def test_unrealizable_json_carries_core_and_counterstrategy(tmp_path: Path) -> None:
@@ -107,7 +109,9 @@ def test_all_init_changes_the_answer(tmp_path: Path) -> None:
         "ENV: x;\nSYS: y;\nSYSTRANS: [](!y');\nSYSGOAL: []<> !y;\nSYSINIT: True;\n",
     )
     assert run("synth", str(spec))[0] == 0
-    spec2 = write(tmp_path, "stuck.spc", "ENV: x;\nSYS: y;\nSYSTRANS: [](y -> y') & [](x -> !y');\n")
+    spec2 = write(
+        tmp_path, "stuck.spc", "ENV: x;\nSYS: y;\nSYSTRANS: [](y -> y') & [](x -> !y');\n"
+    )
     assert run("synth", str(spec2))[0] == 0
     assert run("synth", str(spec2), "--all-init", "--no-explain")[0] == 1
 
