@@ -22,7 +22,15 @@ from dd import cudd
 
 from tlmpc.errors import UsageError, error
 from tlmpc.synth.solver import Game, Solution
-from tlmpc.synth.strategy import Value, _assignment, _key, restrict
+from tlmpc.synth.strategy import (
+    Value,
+    _assignment,
+    _key,
+    all_assignments,
+    ordered_bits,
+    restrict,
+    smallest,
+)
 from tlmpc.synth.symbolic import Function
 
 #: the largest counterstrategy written explicitly (nodes)
@@ -114,9 +122,7 @@ def extract_counterstrategy(solution: Solution, *, max_nodes: int = MAX_NODES) -
     enc = game.enc
     bdd = enc.bdd
     layers = _environment_layers(game)
-    inputs = enc.names("env", False)
     outputs = enc.names("sys", False)
-    next_inputs = enc.names("env", True)
     next_outputs = enc.names("sys", True)
     domain = enc.domain(None, False)
     losing = ~solution.winning & domain
@@ -167,11 +173,11 @@ def extract_counterstrategy(solution: Solution, *, max_nodes: int = MAX_NODES) -
     if mode == "forall_env_exists_sys":
         # an initial input from which every allowed initial output loses
         bad = env_start & bdd.forall(outputs, ~sys_start | losing)
-        x = bdd.pick(bdd.exist(outputs, bad), care_vars=inputs)
+        x = smallest(enc, bdd.exist(outputs, bad), ordered_bits(enc, "env", False))
         assert x is not None, "unrealizable, yet every initial input has a winning answer"
         initial_inputs = enc.decode(x, "env", False)
         answers = restrict(enc, x, sys_start)
-        for y in bdd.pick_iter(answers, care_vars=outputs):
+        for y in all_assignments(enc, answers, ordered_bits(enc, "sys", False)):
             starts.append(enc.decode({**x, **y}, None, False))
     else:
         if mode == "all_init":
@@ -180,7 +186,7 @@ def extract_counterstrategy(solution: Solution, *, max_nodes: int = MAX_NODES) -
             start = env_start & losing
         else:  # one side, system's: every start the system may pick loses
             start = sys_start & env_start & domain
-        for s in bdd.pick_iter(start, care_vars=inputs | outputs):
+        for s in all_assignments(enc, start, ordered_bits(enc, None, False)):
             starts.append(enc.decode(s, None, False))
             if mode != "one_side" or game.spec.select("env", "init"):
                 break
@@ -207,13 +213,17 @@ def extract_counterstrategy(solution: Solution, *, max_nodes: int = MAX_NODES) -
             & (game.env_goals[env_goal] | lower)
         )
         good = game.env_safety & cudd.or_forall(not_sys, target, next_outputs)
-        x = bdd.pick(restrict(enc, bits, bdd.exist(next_outputs, good)), care_vars=next_inputs)
+        x = smallest(
+            enc,
+            restrict(enc, bits, bdd.exist(next_outputs, good)),
+            ordered_bits(enc, "env", True),
+        )
         assert x is not None, "a losing state without a winning environment move"
         moves[current] = enc.decode(x, "env", True)
         allowed = restrict(enc, {**bits, **x}, game.sys_safety & enc.domain("sys", True))
         targets: list[int] = []
         done = restrict(enc, {**bits, **x}, game.env_goals[env_goal])
-        for y in bdd.pick_iter(allowed, care_vars=next_outputs):
+        for y in all_assignments(enc, allowed, ordered_bits(enc, "sys", True)):
             reached = restrict(enc, y, done) == bdd.true
             next_env_goal = (env_goal + 1) % len(game.env_goals) if reached else env_goal
             targets.append(node(enc.decode({**x, **y}, None, True), goal, next_env_goal))

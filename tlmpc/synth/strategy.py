@@ -84,6 +84,38 @@ def restrict(enc: Encoding, assignment: dict[str, bool], u: Function) -> Functio
     return enc.bdd.let(assignment, u) if assignment else u
 
 
+def smallest(enc: Encoding, u: Function, bits: list[str]) -> dict[str, bool] | None:
+    """The assignment of ``bits`` (in the given order, False before True) that comes first
+    lexicographically among those satisfying ``u``; None when ``u`` is false.  Unlike
+    ``pick``, the choice does not depend on the BDD's current variable order (CUDD reorders
+    dynamically), so the same input always gives the same strategy."""
+    bdd = enc.bdd
+    if u == bdd.false:
+        return None
+    chosen: dict[str, bool] = {}
+    for bit in bits:
+        low = bdd.let({bit: False}, u)
+        if low != bdd.false:
+            chosen[bit], u = False, low
+        else:
+            chosen[bit], u = True, bdd.let({bit: True}, u)
+    return chosen
+
+
+def ordered_bits(enc: Encoding, owner: str | None, primed: bool) -> list[str]:
+    """Bit names of one player's variables in declaration order."""
+    table = enc.next_bits if primed else enc.bits
+    return [b for v in enc.spec.variables if owner in (None, v.owner) for b in table[v.name]]
+
+
+def all_assignments(enc: Encoding, u: Function, bits: list[str]) -> list[dict[str, bool]]:
+    """Every assignment of ``bits`` satisfying ``u``, in a fixed (variable-order-free) order."""
+    found = list(enc.bdd.pick_iter(u, care_vars=set(bits))) if bits else []
+    if not bits and u != enc.bdd.false:
+        found = [{}]
+    return sorted(found, key=lambda a: tuple(a[b] for b in bits))
+
+
 def _key(values: dict[str, Value]) -> tuple[Value, ...]:
     return tuple(values[k] for k in sorted(values))
 
@@ -93,25 +125,26 @@ def initial_states(solution: Solution) -> list[dict[str, Value]]:
     game = solution.game
     enc = game.enc
     bdd = enc.bdd
-    inputs = enc.names("env", False)
     outputs = enc.names("sys", False)
     env_start = game.env_init & enc.domain("env", False)
     sys_start = game.sys_init & enc.domain("sys", False)
     mode = game.spec.init_mode
     states: list[dict[str, Value]] = []
+    input_bits = ordered_bits(enc, "env", False)
+    output_bits = ordered_bits(enc, "sys", False)
     if mode == "forall_env_exists_sys":
-        for x in bdd.pick_iter(bdd.exist(outputs, env_start), care_vars=inputs):
+        for x in all_assignments(enc, bdd.exist(outputs, env_start), input_bits):
             answer = restrict(enc, x, sys_start & solution.winning)
-            y = bdd.pick(answer, care_vars=outputs)
+            y = smallest(enc, answer, output_bits)
             assert y is not None, "realizable, yet an initial input has no winning answer"
             states.append(enc.decode({**x, **y}, None, False))
     elif mode == "one_side" and not game.spec.select("env", "init"):
-        start = bdd.pick(sys_start & env_start & solution.winning, care_vars=inputs | outputs)
+        start = smallest(enc, sys_start & env_start & solution.winning, input_bits + output_bits)
         assert start is not None
         states.append(enc.decode(start, None, False))
     else:
         both = env_start & sys_start if mode == "all_init" else env_start & enc.domain(None, False)
-        for s in bdd.pick_iter(both, care_vars=inputs | outputs):
+        for s in all_assignments(enc, both, input_bits + output_bits):
             states.append(enc.decode(s, None, False))
     return sorted(states, key=_key)
 
@@ -122,8 +155,8 @@ def extract(solution: Solution, *, max_nodes: int = MAX_NODES) -> MealyMachine:
     enc = game.enc
     bdd = enc.bdd
     strategies = goal_strategies(solution)
-    next_inputs = enc.names("env", True)
-    next_outputs = enc.names("sys", True)
+    next_inputs = ordered_bits(enc, "env", True)
+    next_outputs = ordered_bits(enc, "sys", True)
     goals_done = [g & enc.prime(solution.winning) for g in game.sys_goals]
     env_moves_all = game.env_safety & enc.domain("env", True)
     index: dict[tuple[tuple[Value, ...], int], int] = {}
@@ -160,9 +193,9 @@ def extract(solution: Solution, *, max_nodes: int = MAX_NODES) -> MealyMachine:
         strategy = restrict(enc, current, strategies[goal])
         env_moves = restrict(enc, current, env_moves_all)
         done = restrict(enc, current, goals_done[goal])
-        for x in bdd.pick_iter(env_moves, care_vars=next_inputs):
+        for x in all_assignments(enc, env_moves, next_inputs):
             answers = restrict(enc, x, strategy)
-            y = bdd.pick(answers, care_vars=next_outputs)
+            y = smallest(enc, answers, next_outputs)
             if y is None:
                 raise AssertionError("a winning state has no strategy move for an input")
             move = {**x, **y}
