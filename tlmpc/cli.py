@@ -40,6 +40,7 @@ COMMAND_MODULES = (
     "import_map",
     "export_plan",
     "simulate",
+    "synth",
 )
 
 EPILOG = exit_code_epilog()

@@ -117,41 +117,64 @@ def solve(game: Game, *, keep_layers: bool = True) -> Solution:
     not_env_goals = [~g for g in game.env_goals]
     z = bdd.true
     layers: list[list[Function]] = []
+    # The X of each (goal, rank, assumption) from the previous pass of Z: Z only shrinks, so
+    # every X does too and the old value is a sound start for the new greatest fixpoint
+    # (fixpoint recycling), which saves most of the inner iterations.
+    previous: dict[tuple[int, int, int], Function] = {}
+    next_bits = enc.names(None, True)
+    # A goal over the current state only commutes with the quantifiers over next values:
+    # exists y'. rho_s /\ (J /\ T) = J /\ exists y'. rho_s /\ T, which keeps the relational
+    # products small and shares exists y'. rho_s /\ Z' among all system goals.
+    sys_on_state = [not (set(bdd.support(g)) & next_bits) for g in game.sys_goals]
+    env_on_state = [not (set(bdd.support(g)) & next_bits) for g in game.env_goals]
     while True:
         layers = [[] for _ in game.sys_goals]
         new_z = bdd.true
+        current: dict[tuple[int, int, int], Function] = {}
+        z_next = enc.prime(z)
+        to_z = None if cpre.mixed else cpre.moves(z_next)
         for j, goal in enumerate(game.sys_goals):
-            reach_goal = goal & enc.prime(z)
+            reach_goal = goal & z_next
+            reach_moves = None
+            if to_z is not None:
+                reach_moves = goal & to_z if sys_on_state[j] else cpre.moves(reach_goal)
             y = bdd.false
+            rank = 0
             while True:
-                live = reach_goal | enc.prime(y)
-                live_moves = None if cpre.mixed else cpre.moves(live)
+                y_next = enc.prime(y)
+                live = reach_goal | y_next
+                live_moves = None
+                if reach_moves is not None:
+                    live_moves = reach_moves | cpre.moves(y_next)
                 new_y = y
                 for i, not_goal in enumerate(not_env_goals):
-                    del i
-                    x = bdd.true
+                    x = previous.get((j, rank, i), bdd.true)
                     while True:
-                        paths = live | (enc.prime(x) & not_goal)
-                        if live_moves is not None:
-                            moves = live_moves | cpre.moves(enc.prime(x) & not_goal)
-                            new_x = cpre.of_moves(moves)
+                        x_next = enc.prime(x)
+                        if live_moves is None:
+                            new_x = cpre(live | (x_next & not_goal))
+                        elif env_on_state[i]:
+                            new_x = cpre.of_moves(live_moves | (not_goal & cpre.moves(x_next)))
                         else:
-                            new_x = cpre(paths)
+                            new_x = cpre.of_moves(live_moves | cpre.moves(x_next & not_goal))
                         if new_x == x:
                             break
                         x = new_x
+                    current[(j, rank, i)] = x
                     new_y |= x
                     if keep_layers:
-                        layers[j].append(paths)
+                        layers[j].append(live | (x_next & not_goal))
                 if new_y == y:
                     break
                 y = new_y
+                rank += 1
             new_z &= y
             if new_z == bdd.false:
                 break
         if new_z == z:
             break
         z = new_z
+        previous = current
     return Solution(
         game=game,
         winning=z,

@@ -59,6 +59,9 @@ class Encoding:
     bdd: Any = field(default_factory=cudd.BDD)
     bits: dict[str, list[str]] = field(default_factory=dict)
     next_bits: dict[str, list[str]] = field(default_factory=dict)
+    #: keep each bit's current and next copy adjacent under CUDD's dynamic reordering (sifting,
+    #: on by default); free sifting measured faster on the robot-grid benchmarks
+    group_pairs: bool = False
 
     def __post_init__(self) -> None:
         for index, variable in enumerate(self.spec.variables):
@@ -67,6 +70,9 @@ class Encoding:
             self.next_bits[variable.name] = [f"v{index}b{k}n" for k in range(width)]
             for k in range(width):
                 self.bdd.declare(self.bits[variable.name][k], self.next_bits[variable.name][k])
+                if self.group_pairs:
+                    # sifting then moves each current/next pair as one block
+                    self.bdd.group({self.bits[variable.name][k]: 2})
         self.to_next = {
             b: n
             for v in self.spec.variables
@@ -199,11 +205,20 @@ class Encoding:
         return result
 
     def prime(self, u: Function) -> Function:
-        """``u`` over the next copy (``u`` mentions current bits only)."""
+        """``u`` over the next copy (``u`` mentions current bits only).
+
+        CUDD's variable swap (a permutation) is several times faster than the substitution
+        behind ``let``, which dominates the fixpoint's time otherwise."""
+        swap = getattr(self.bdd, "_swap", None)
+        if swap is not None:
+            return swap(u, self.to_next)
         return self.bdd.let(self.to_next, u)
 
     def unprime(self, u: Function) -> Function:
         """``u`` over the current copy (``u`` mentions next bits only)."""
+        swap = getattr(self.bdd, "_swap", None)
+        if swap is not None:
+            return swap(u, self.to_next)
         return self.bdd.let(self.to_current, u)
 
     # --- decoding ---------------------------------------------------------------------------

@@ -5,7 +5,7 @@ from __future__ import annotations
 import bisect
 from dataclasses import dataclass
 
-from tlmpc.errors import InvalidInputError, error
+from tlmpc.errors import UsageError, error
 from tlmpc.synth.spec import Location
 
 
@@ -29,10 +29,11 @@ class Source:
         line = bisect.bisect_right(starts, offset) - 1
         return Location(self.file, line + 1, offset - starts[line] + 1)
 
-    def fail(self, code: str, message: str, offset: int, hint: str) -> InvalidInputError:
-        """An error at ``offset`` (to raise)."""
+    def fail(self, code: str, message: str, offset: int, hint: str) -> UsageError:
+        """An error at ``offset`` (to raise): a specification that cannot be read means that
+        synthesis could not run (exit 2), never an answer."""
         where = self.location(offset)
-        return InvalidInputError(
+        return UsageError(
             error(code, message, hint=hint, file=self.file, line=where.line, col=where.col)
         )
 
