@@ -27,6 +27,7 @@ LAYERS = (
     "synth",
     "mission",
     "abstraction",
+    "reactive",
     "planning",
     "control",
     "simulate",

@@ -12,6 +12,7 @@ from __future__ import annotations
 from collections import deque
 
 import pytest
+from game_oracle import check_counterstrategy, check_strategy
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -22,17 +23,17 @@ from tlmpc.ltl.ast import Formula, Prop, disjoin
 from tlmpc.ltl.transform import substitute
 from tlmpc.mission import load_mission_text
 from tlmpc.mission.model import Mission
-from tlmpc.reactive.synthesize import synthesize
+from tlmpc.reactive.synthesize import Synthesis, synthesize
+from tlmpc.synth.solver import Game, solve
 
 spot = pytest.importorskip("spot")
 
 CORRIDOR = """\
 version: 1
-workspace: {{boundary: {{rect: [0, 0, 5, 2]}}}}
+workspace: {{boundary: {{rect: [0, 0, 3, 2]}}}}
 regions:
   r0: {{rect: [0, 0, 1, 2]}}
   r1: {{rect: [2, 0, 3, 2]}}
-  r2: {{rect: [4, 0, 5, 2]}}
 sensors: {{s: null, t: null}}
 actions: {{beep: null}}
 {assumptions}robot: {{start: [1.5, 1]}}
@@ -42,16 +43,16 @@ task:
 """
 
 TASKS = [
-    "if you sense s then visit r2",
+    "if you sense s then visit r1",
     "visit r0 infinitely often unless t",
-    "visit r2 infinitely often",
+    "visit r1 infinitely often",
     "never enter r1 while s",
     "when s, go to r0 and stay there while s",
-    "when t, go to r2 and stay there while t",
-    "avoid r2",
+    "when t, go to r1 and stay there while t",
+    "avoid r1",
     "if you sense t then do beep",
-    "visit r1 then r2",
-    "avoid r2 until r1",
+    "visit r0 then r1",
+    "avoid r1 until r0",
 ]
 ASSUMPTIONS = ["G F !s", "!s", "G F s", "G(s -> !t)", "G F !t", "!t"]
 
@@ -148,17 +149,20 @@ def _mission(task: list[str], assumptions: list[str]) -> Mission:
 def test_realizability_agrees_with_spot(task: list[str], assumptions: list[str]) -> None:
     mission = _mission(task, assumptions)
     abstraction = build_abstraction(mission)
-    assert synthesize(mission, abstraction).realizable == _spot_realizable(mission, abstraction)
+    found = synthesize(mission, abstraction)
+    assert found.realizable == _spot_realizable(mission, abstraction)
+    _check_explicitly(found)
 
 
 @pytest.mark.parametrize(
     ("task", "assumptions", "realizable"),
     [
-        (["if you sense s then visit r2", "visit r0 infinitely often"], [], True),
+        (["if you sense s then visit r1", "visit r0 infinitely often"], [], True),
         (["when s, go to r1 and stay there while s", "never enter r1 while s"], ["G F s"], False),
         (["when s, go to r1 and stay there while s", "never enter r1 while s"], ["!s"], False),
-        (["never enter r1 while s", "visit r2 infinitely often"], [], False),
-        (["never enter r1 while s", "visit r2 infinitely often"], ["G F !s"], True),
+        (["never enter r1 while s", "visit r1 infinitely often"], [], False),
+        (["never enter r1 while s", "visit r1 infinitely often"], ["G F !s"], False),
+        (["never enter r1 while s", "visit r1 infinitely often unless s"], [], True),
     ],
 )
 def test_known_answers(task: list[str], assumptions: list[str], realizable: bool) -> None:
@@ -169,3 +173,31 @@ def test_known_answers(task: list[str], assumptions: list[str], realizable: bool
     if not realizable:
         assert found.core is not None
         assert {p.text for p in found.core} <= set(task)
+    _check_explicitly(found)
+
+
+def _check_explicitly(found: Synthesis) -> None:
+    """The strategy wins, or the counterstrategy defeats the robot, by explicit enumeration
+    of the game's definition; a core is unrealizable and each of its parts needed."""
+    spec = found.game.spec
+    if found.strategy is not None:
+        check_strategy(spec, found.strategy)
+        return
+    assert found.counter is not None
+    check_counterstrategy(spec, found.counter)
+    assert found.core is not None
+    core_sources = {id(p) for p in found.core}
+
+    def keeping(sources: set[int]) -> bool:
+        parts = tuple(
+            p
+            for p in spec.parts
+            if p.owner == "env"
+            or id(p) not in found.game.sources
+            or id(found.game.sources[id(p)]) in sources
+        )
+        return solve(Game.build(spec.with_parts(parts))).realizable
+
+    assert not keeping(core_sources)
+    for part in found.core:
+        assert keeping(core_sources - {id(part)})

@@ -8,8 +8,8 @@ from pathlib import Path
 
 import jsonschema
 import pytest
-
 from tlmpc.artifacts import load_schema
+
 from tlmpc.cli import main
 
 REALIZABLE = """\

@@ -63,7 +63,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _fail_flag(args: argparse.Namespace, fmt: str, flag: str) -> None:
-    from tlmpc.errors import UsageError, error
+    from tlmpc.base.errors import UsageError, error
 
     raise UsageError(
         error(
@@ -78,7 +78,7 @@ def _fail_flag(args: argparse.Namespace, fmt: str, flag: str) -> None:
 
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Read, solve, explain, write."""
-    from tlmpc.errors import EXIT_NEGATIVE, EXIT_OK, UsageError, error
+    from tlmpc.base.errors import EXIT_NEGATIVE, EXIT_OK, UsageError, error
     from tlmpc.report import Reporter
     from tlmpc.synth.readers import format_of, read_spec
     from tlmpc.synth.solver import Game, solve

@@ -211,6 +211,7 @@ ARTIFACT_SCHEMAS = {
     "trace.json": ("tlmpc.trace/", "trace"),
     "verdict.json": ("tlmpc.verdict/", "verdict"),
     "summary.json": ("tlmpc.summary/", "summary"),
+    "strategy.json": ("tlmpc.strategy/", "strategy"),
 }
 
 

@@ -452,19 +452,21 @@ def _verify(c: Compilation) -> StageResult:
 
 
 def _synthesize(c: Compilation) -> StageResult:
-    from tlmpc.reactive.synthesize import synthesize, unrealizable
+    from tlmpc.reactive.synthesize import strategy_to_json, synthesize, unrealizable
 
     mission = c.get(MISSION)
     synthesis = synthesize(mission, c.get(ABSTRACTION))
-    if not synthesis.realizable:
+    if synthesis.strategy is None:
         raise NoPlanError(unrealizable(synthesis, mission))
     game = synthesis.game
     return StageResult(
+        artifacts={"strategy.json": strategy_to_json(synthesis)},
         sizes={
             "faces": game.faces.count,
             "variables": len(game.spec.variables),
             "parts": len(game.spec.parts),
             "fixpoint steps": synthesis.solution.cpre_count,
+            "strategy nodes": len(synthesis.strategy.states),
         },
         summary={"reactive": {"realizable": True, "faces": game.faces.count}},
     )

@@ -9,15 +9,21 @@ task harder, so none would ever be needed).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 from tlmpc.abstraction.model import Abstraction
 from tlmpc.base.errors import Diagnostic, InvalidInputError, error
 from tlmpc.mission.model import Mission, TaskPart
+from tlmpc.reactive.explain import counter_play
 from tlmpc.reactive.faces import Faces, faces_of
 from tlmpc.reactive.fragment import reading
 from tlmpc.reactive.game import MissionGame, build_game
 from tlmpc.reactive.parts import mission_parts
+from tlmpc.synth.core import minimal_core
+from tlmpc.synth.counter import CounterStrategy, extract_counterstrategy
 from tlmpc.synth.solver import Game, Solution, solve
+from tlmpc.synth.spec import Part
+from tlmpc.synth.strategy import MealyMachine, extract, to_json
 from tlmpc.synth.symbolic import Encoding
 
 
@@ -44,11 +50,14 @@ def mission_game(mission: Mission, abstraction: Abstraction) -> MissionGame:
 
 @dataclass(frozen=True)
 class Synthesis:
-    """The outcome: the solved game; ``core`` (task parts) when unrealizable."""
+    """The outcome: the solved game; the strategy when realizable, else a core (task parts)
+    and the environment's counterstrategy."""
 
     game: MissionGame
     solution: Solution
-    core: tuple[TaskPart, ...] | None
+    strategy: MealyMachine | None = None
+    core: tuple[TaskPart, ...] | None = None
+    counter: CounterStrategy | None = None
 
     @property
     def realizable(self) -> bool:
@@ -56,13 +65,42 @@ class Synthesis:
         return self.solution.realizable
 
 
-def synthesize(mission: Mission, abstraction: Abstraction) -> Synthesis:
-    """Solve the mission's game; find a core when it is unrealizable."""
+def synthesize(mission: Mission, abstraction: Abstraction, *, explain: bool = True) -> Synthesis:
+    """Solve the mission's game: its strategy, or (with ``explain``) a core and a
+    counterstrategy."""
     game = mission_game(mission, abstraction)
     encoding = Encoding(game.spec)
     solution = solve(Game.build(game.spec, encoding))
-    core = None if solution.realizable else _core(game, encoding)
-    return Synthesis(game=game, solution=solution, core=core)
+    if solution.realizable:
+        return Synthesis(game=game, solution=solution, strategy=extract(solution))
+    if not explain:
+        return Synthesis(game=game, solution=solution)
+    counter = extract_counterstrategy(solution)
+    core = minimal_core(game.spec, encoding, group=lambda part: _source_key(game, part))
+    parts: dict[int, TaskPart] = {}
+    for part in core.parts:
+        source = game.sources[id(part)]
+        parts.setdefault(id(source), source)
+    return Synthesis(game=game, solution=solution, core=tuple(parts.values()), counter=counter)
+
+
+def strategy_to_json(synthesis: Synthesis) -> dict[str, Any]:
+    """``strategy.json`` of a reactive mission: the Mealy machine and the faces it moves on."""
+    assert synthesis.strategy is not None
+    faces = synthesis.game.faces
+    document = to_json(synthesis.strategy)
+    document["faces"] = {
+        "labels": [list(letter) for letter in faces.letters],
+        "adjacent": [list(a) for a in faces.adjacent],
+        "face_of": faces.face_of.tolist(),
+    }
+    return document
+
+
+def _source_key(game: MissionGame, part: Part) -> int | None:
+    """The task part a game part comes from (None: a rule of the motion, never dropped)."""
+    source = game.sources.get(id(part))
+    return None if source is None else id(source)
 
 
 def unrealizable(synthesis: Synthesis, mission: Mission) -> list[Diagnostic]:
@@ -70,13 +108,15 @@ def unrealizable(synthesis: Synthesis, mission: Mission) -> list[Diagnostic]:
     core = synthesis.core or ()
     names = "; ".join(part.text for part in core) or "the robot's motion alone"
     first = core[0] if core else None
+    play = counter_play(synthesis) if synthesis.counter is not None else []
     found = [
         error(
             "Q110",
             f"no robot strategy meets the task under the assumptions: {names} cannot all hold "
             "whatever the environment does",
             hint="each of these parts is needed for the conflict: weaken one of them, or add "
-            "an assumption that rules out the environment's winning moves",
+            "an assumption that rules out the environment's winning moves (the notes Q111 show "
+            "how the environment wins)",
             file=mission.source,
             line=first.line if first else None,
             col=first.col if first else None,
@@ -93,24 +133,13 @@ def unrealizable(synthesis: Synthesis, mission: Mission) -> list[Diagnostic]:
         )
         for part in core[1:]
     ]
-    return found
-
-
-def _core(game: MissionGame, encoding: Encoding) -> tuple[TaskPart, ...]:
-    """Drop one task part at a time while the rest is still unrealizable."""
-    spec = game.spec
-    kept: dict[int, TaskPart] = {}
-    for part in spec.parts:
-        source = game.sources.get(id(part))
-        if source is not None and part.owner == "sys":
-            kept.setdefault(id(source), source)
-    for dropped in list(kept):
-        trial = {key: source for key, source in kept.items() if key != dropped}
-        parts = tuple(
-            p
-            for p in spec.parts
-            if p.owner == "env" or id(game.sources.get(id(p))) in trial or id(p) not in game.sources
+    found += [
+        Diagnostic(
+            code="Q111",
+            message=f"the environment wins: {line}",
+            file=mission.source,
+            severity="note",
         )
-        if not solve(Game.build(spec.with_parts(parts), encoding), keep_layers=False).realizable:
-            kept = trial
-    return tuple(kept.values())
+        for line in play
+    ]
+    return found

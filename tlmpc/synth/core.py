@@ -9,6 +9,7 @@ therefore never needed in, nor removable from, the explanation.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Hashable
 from dataclasses import dataclass
 
 from tlmpc.synth.solver import Game, solve
@@ -24,17 +25,34 @@ class Core:
     solves: int
 
 
-def minimal_core(spec: GameSpec, enc: Encoding | None = None) -> Core:
-    """A minimal core of an unrealizable ``spec`` (raises ValueError if it is realizable)."""
+def minimal_core(
+    spec: GameSpec,
+    enc: Encoding | None = None,
+    *,
+    group: Callable[[Part], Hashable | None] | None = None,
+) -> Core:
+    """A minimal core of an unrealizable ``spec`` (raises ValueError if it is realizable).
+
+    With ``group``, the guarantees that share a key are dropped together (the game parts one
+    phrase of a mission became), and a guarantee whose key is None is never dropped (a rule
+    of the robot's motion); the core then lists the kept groups' parts.
+    """
     enc = enc or Encoding(spec)
+    key = group or id
     assumptions = tuple(p for p in spec.parts if p.owner == "env")
-    kept = [p for p in spec.parts if p.owner == "sys"]
+    fixed = tuple(p for p in spec.parts if p.owner == "sys" and key(p) is None)
+    members: dict[Hashable, list[Part]] = {}
+    for part in spec.parts:
+        if part.owner == "sys" and key(part) is not None:
+            members.setdefault(key(part), []).append(part)
+    kept = list(members)
     solves = 0
 
-    def unrealizable(guarantees: list[Part]) -> bool:
+    def unrealizable(groups: list[Hashable]) -> bool:
         nonlocal solves
         solves += 1
-        trial = spec.with_parts(assumptions + tuple(guarantees))
+        guarantees = tuple(p for g in groups for p in members[g])
+        trial = spec.with_parts(assumptions + fixed + guarantees)
         return not solve(Game.build(trial, enc), keep_layers=False).realizable
 
     if not unrealizable(kept):
@@ -52,4 +70,4 @@ def minimal_core(spec: GameSpec, enc: Encoding | None = None) -> Core:
             break
         chunk = max(1, chunk // 2)
     enc.spec = spec
-    return Core(parts=tuple(kept), solves=solves)
+    return Core(parts=tuple(p for g in kept for p in members[g]), solves=solves)

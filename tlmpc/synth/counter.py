@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 
 from dd import cudd
 
-from tlmpc.errors import UsageError, error
+from tlmpc.base.errors import UsageError, error
 from tlmpc.synth.solver import Game, Solution
 from tlmpc.synth.strategy import (
     Value,

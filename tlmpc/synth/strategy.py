@@ -15,7 +15,7 @@ from collections import deque
 from dataclasses import dataclass
 from typing import Any
 
-from tlmpc.errors import UsageError, error
+from tlmpc.base.errors import UsageError, error
 from tlmpc.synth.solver import Solution
 from tlmpc.synth.spec import Variable
 from tlmpc.synth.symbolic import Encoding, Function

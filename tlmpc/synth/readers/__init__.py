@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from tlmpc.errors import UsageError, error
+from tlmpc.base.errors import UsageError, error
 from tlmpc.synth.spec import GameSpec, InitMode
 
 #: file suffix -> format name

@@ -5,7 +5,7 @@ from __future__ import annotations
 import bisect
 from dataclasses import dataclass
 
-from tlmpc.errors import UsageError, error
+from tlmpc.base.errors import UsageError, error
 from tlmpc.synth.spec import Location
 
 

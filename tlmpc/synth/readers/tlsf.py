@@ -21,7 +21,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-from tlmpc.errors import UsageError
+from tlmpc.base.errors import UsageError
 from tlmpc.synth.readers.source import Source
 from tlmpc.synth.spec import (
     Atom,
