@@ -8,7 +8,7 @@ from pathlib import Path
 
 import jsonschema
 import pytest
-from tlmpc.artifacts import load_schema
+from tlmpc.io.schema_check import load_schema
 
 from tlmpc.cli import main
 

@@ -79,7 +79,7 @@ def _fail_flag(args: argparse.Namespace, fmt: str, flag: str) -> None:
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Read, solve, explain, write."""
     from tlmpc.base.errors import EXIT_NEGATIVE, EXIT_OK, UsageError, error
-    from tlmpc.report import Reporter
+    from tlmpc.io.report import Reporter
     from tlmpc.synth.readers import format_of, read_spec
     from tlmpc.synth.solver import Game, solve
 
@@ -119,8 +119,8 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     }
     if solution.realizable:
         if args.output is not None:
-            from tlmpc.artifacts import json_text as document_text
-            from tlmpc.output import replace_file
+            from tlmpc.io.artifacts import json_text as document_text
+            from tlmpc.io.outdir import replace_file
             from tlmpc.synth.strategy import extract, to_dot, to_json
 
             machine = extract(solution)
