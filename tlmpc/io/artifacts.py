@@ -356,7 +356,9 @@ def _cross_check(directory: Path, documents: dict[str, dict[str, Any]]) -> None:
             raise _tampered(path, f"mission.json has an unreadable formula: {exc}") from None
         names = set(mission["regions"]) if isinstance(mission["regions"], dict) else set()
         known = names if regions is None else regions
-        unknown = sorted(formula.props() - known)
+        reactive = mission.get("reactive") or {}
+        signals = {*reactive.get("sensors", {}), *reactive.get("actions", [])}
+        unknown = sorted(formula.props() - known - signals)
         if unknown:
             raise _tampered(
                 path, f"the formula names regions the output does not have: {', '.join(unknown)}"

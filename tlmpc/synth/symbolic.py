@@ -112,6 +112,11 @@ class Encoding:
             return self.bdd.true
         return result
 
+    def _in_range(self, variable: Variable, primed: bool) -> Function:
+        assert variable.low is not None
+        assert variable.high is not None
+        return self._less_equal(variable, variable.high - variable.low, primed)
+
     def value_cube(self, variable: Variable, value: int | bool, primed: bool) -> Function:
         """The BDD of ``variable == value``."""
         bits = (self.next_bits if primed else self.bits)[variable.name]
@@ -161,6 +166,10 @@ class Encoding:
             variable = self.spec.variable(node.name)
             assert variable.low is not None
             assert variable.high is not None
+            if node.op in ("=", "!="):  # one cube, not a loop over the range (faces: thousands)
+                inside = variable.low <= node.value <= variable.high
+                cube = self.value_cube(variable, node.value, node.primed) if inside else bdd.false
+                return cube if node.op == "=" else ~cube & self._in_range(variable, node.primed)
             test = _COMPARE[node.op]
             result = bdd.false
             for value in range(variable.low, variable.high + 1):
