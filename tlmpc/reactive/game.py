@@ -177,18 +177,14 @@ def build_game(
         "env", "init", "start", Nary("and", (Compare(FACE, "=", start_face), SpecNot(Atom(MOVED))))
     )
     stays = _equal(FACE, FACE, True, False, count)
-    motion(
-        "env", "safety", "destination", Nary("or", (stays, _equal(FACE, GOAL, True, False, count)))
-    )
+    destination = Nary("or", (stays, _equal(FACE, GOAL, True, False, count)))
+    motion("env", "safety", "destination", destination)
     if sensors_still:
-        motion("env", "safety", "one_event", Nary("or", (stays, Nary("and", sensors_still))))
+        one_event = Nary("or", (stays, Nary("and", sensors_still)))
+        motion("env", "safety", "one_event", one_event)
     motion("env", "safety", "moved", Binary("<->", Atom(MOVED, True), SpecNot(stays)))
-    motion(
-        "env",
-        "liveness",
-        "arrival",
-        Nary("or", (Atom(MOVED), _equal(FACE, GOAL, False, False, count))),
-    )
+    arrival = Nary("or", (Atom(MOVED), _equal(FACE, GOAL, False, False, count)))
+    motion("env", "liveness", "arrival", arrival)
     motion("sys", "init", "heading", _heading(faces, count, primed=False))
     motion("sys", "safety", "heading", _heading(faces, count, primed=True))
     monitor_of = {id(piece): name for name, _, piece in monitors}
