@@ -8,12 +8,12 @@ Players and variables (docs/semantics.md, "Reactive missions"):
 * the **robot** owns ``goal`` (the face it is heading for: its own face to stay, or a
   neighbouring one), its actions, and the memory of the task's monitors.
 
-One step of the game is one event of the continuous run: a sensor changes, or the robot
-crosses into the face it is heading for; the robot then answers (a new goal, actions set at
-once).  The motion's rules are parts of the game like the user's, so a core can name them:
+One step of the game is one event of the continuous run: sensors change, or the robot
+crosses into the face it is heading for, or both at one instant; the robot then answers (a new
+goal, actions set at once).  The motion's rules are parts of the game like the user's, so a
+core can name them:
 
 * ``face' = face | face' = goal`` — the robot moves only where it is heading;
-* ``face' = face | sensors' = sensors`` — two events never happen at one instant;
 * ``moved' <-> face' != face``;
 * the robot heads for its own face or a neighbour (``goal' in adjacent(face') + face'``);
 * fairness: ``G F(moved | face = goal)`` — heading for a neighbour, the robot gets there.
@@ -57,7 +57,6 @@ MOVED = "moved"
 MOTION_TEXTS = {
     "start": "the robot starts in the face of its start point",
     "destination": "the robot moves only into the face it is heading for",
-    "one_event": "a sensor change and a crossing never happen at the same instant",
     "moved": "`moved` records that the last step crossed into another face",
     "heading": "the robot heads for its own face or a neighbouring one",
     "arrival": "heading for a neighbouring face, the robot gets there",
@@ -172,16 +171,12 @@ def build_game(
         sources[id(part)] = piece.part
         parts.append(part)
 
-    sensors_still = tuple(Binary("<->", Atom(s, True), Atom(s)) for s in sensors)
     motion(
         "env", "init", "start", Nary("and", (Compare(FACE, "=", start_face), SpecNot(Atom(MOVED))))
     )
     stays = _equal(FACE, FACE, True, False, count)
     destination = Nary("or", (stays, _equal(FACE, GOAL, True, False, count)))
     motion("env", "safety", "destination", destination)
-    if sensors_still:
-        one_event = Nary("or", (stays, Nary("and", sensors_still)))
-        motion("env", "safety", "one_event", one_event)
     motion("env", "safety", "moved", Binary("<->", Atom(MOVED, True), SpecNot(stays)))
     arrival = Nary("or", (Atom(MOVED), _equal(FACE, GOAL, False, False, count)))
     motion("env", "liveness", "arrival", arrival)
