@@ -55,6 +55,11 @@ PUBLISHED: list[tuple[str, InitMode, bool]] = [
 ]
 
 
+#: SYNTCOMP's robot-grid family: every gr_*.tlsf is realizable (upstream README); seconds to
+#: minutes each, hence slow
+ROBOT_GRID = [f"{GRID}/gr_{n}.tlsf" for n in (1, 2, 3, 4)]
+
+
 def _suite_file(relative: str) -> Path:
     path = SUITES / relative
     if not path.is_file():
@@ -66,6 +71,13 @@ def _suite_file(relative: str) -> Path:
 def test_published_answer(relative: str, mode: InitMode, answer: bool) -> None:
     spec = read_spec(str(_suite_file(relative)), init_mode=mode)
     assert solve(Game.build(spec)).realizable is answer
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("relative", ROBOT_GRID)
+def test_robot_grid_is_realizable(relative: str) -> None:
+    spec = read_spec(str(_suite_file(relative)))
+    assert solve(Game.build(spec), keep_layers=False).realizable
 
 
 SMALL_REALIZABLE = [r for r, _, answer in PUBLISHED if answer and "gridworld_bool" not in r]
