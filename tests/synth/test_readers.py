@@ -100,3 +100,15 @@ def test_tlsf_strict_safety_ends_when_the_environment_breaks_its_own() -> None:
         _tlsf("Mealy,Strict", "INITIALLY { !r; }\nPRESET { !g; }\nASSERT { X g <-> r; !g; }")
     )
     assert not solve(Game.build(unguarded)).realizable
+
+
+def test_gr1c_one_side_init() -> None:
+    """gr1c's ONE_SIDE_INIT: a SYSINIT alone needs one winning state; an ENVINIT alone needs
+    every state it allows to win (y is frozen, and only y = True wins)."""
+    frozen = "ENV: x;\nSYS: y;\nSYSTRANS: [](y' <-> y);\nSYSGOAL: []<> y;\n"
+    sys_side = parse_gr1c(frozen + "SYSINIT: x & y;\n", init_mode="one_side")
+    assert solve(Game.build(sys_side)).realizable
+    env_side = parse_gr1c(frozen + "ENVINIT: x | y;\n", init_mode="one_side")
+    assert not solve(Game.build(env_side)).realizable
+    env_side_ok = parse_gr1c(frozen + "ENVINIT: y;\n", init_mode="one_side")
+    assert solve(Game.build(env_side_ok)).realizable
