@@ -127,17 +127,21 @@ def solve(game: Game, *, keep_layers: bool = True) -> Solution:
     # products small and shares exists y'. rho_s /\ Z' among all system goals.
     sys_on_state = [not (set(bdd.support(g)) & next_bits) for g in game.sys_goals]
     env_on_state = [not (set(bdd.support(g)) & next_bits) for g in game.env_goals]
+    # Gauss-Seidel order: each goal's Y shrinks Z at once, and the goals after it in the same
+    # pass already use the smaller Z (any Z above the fixpoint is a sound start); a pass in
+    # which no goal shrinks Z ends the outer fixpoint, and its layers are the strategy's.
     while True:
         layers = [[] for _ in game.sys_goals]
-        new_z = bdd.true
+        changed = False
         current: dict[tuple[int, int, int], Function] = {}
-        z_next = enc.prime(z)
-        to_z = None if cpre.mixed else cpre.moves(z_next)
         for j, goal in enumerate(game.sys_goals):
+            z_next = enc.prime(z)
             reach_goal = goal & z_next
             reach_moves = None
-            if to_z is not None:
-                reach_moves = goal & to_z if sys_on_state[j] else cpre.moves(reach_goal)
+            if not cpre.mixed:
+                reach_moves = (
+                    goal & cpre.moves(z_next) if sys_on_state[j] else cpre.moves(reach_goal)
+                )
             y = bdd.false
             rank = 0
             while True:
@@ -168,12 +172,14 @@ def solve(game: Game, *, keep_layers: bool = True) -> Solution:
                     break
                 y = new_y
                 rank += 1
-            new_z &= y
-            if new_z == bdd.false:
+            shrunk = z & y
+            if shrunk != z:
+                z = shrunk
+                changed = True
+            if z == bdd.false:
                 break
-        if new_z == z:
+        if not changed or z == bdd.false:
             break
-        z = new_z
         previous = current
     return Solution(
         game=game,

@@ -5,8 +5,9 @@ environment move, the moves of the lowest (rank, assumption) layer that has any 
 Bloem et al.'s construction); taking a transition that fulfils goal ``j`` switches the memory to
 goal ``j + 1``.  The machine is built from the initial states by breadth-first search over the
 environment's moves, so only reachable nodes are kept, and a (state, goal) pair met again is
-the same node.  A node's state holds every variable's value; the transition into a node reads
-the environment's inputs and answers with the system's outputs of that node's state.
+the same node; then nodes that behave alike are merged.  A node's state holds every variable's
+value; the transition into a node reads the environment's inputs and answers with the system's
+outputs of that node's state.
 """
 
 from __future__ import annotations
@@ -149,8 +150,11 @@ def initial_states(solution: Solution) -> list[dict[str, Value]]:
     return sorted(states, key=_key)
 
 
-def extract(solution: Solution, *, max_nodes: int = MAX_NODES) -> MealyMachine:
-    """The explicit Mealy machine of a realizable game's winning strategy."""
+def extract(
+    solution: Solution, *, max_nodes: int = MAX_NODES, minimal: bool = True
+) -> MealyMachine:
+    """The explicit Mealy machine of a realizable game's winning strategy (with ``minimal``,
+    nodes that behave alike merged: :func:`minimize`)."""
     game = solution.game
     enc = game.enc
     bdd = enc.bdd
@@ -203,7 +207,7 @@ def extract(solution: Solution, *, max_nodes: int = MAX_NODES) -> MealyMachine:
             next_goal = (goal + 1) % len(game.sys_goals) if reached else goal
             target = node(enc.decode(move, None, True), next_goal)
             transitions.append((source, target))
-    return MealyMachine(
+    machine = MealyMachine(
         inputs=game.spec.owned("env"),
         outputs=game.spec.owned("sys"),
         goals=len(game.sys_goals),
@@ -214,6 +218,54 @@ def extract(solution: Solution, *, max_nodes: int = MAX_NODES) -> MealyMachine:
         transitions=tuple(transitions),
         source_file=game.spec.file,
         source_format=game.spec.source_format,
+    )
+    return minimize(machine) if minimal else machine
+
+
+def minimize(machine: MealyMachine) -> MealyMachine:
+    """Merge nodes that behave alike: the same state, and for every input the same answer into
+    merged nodes again (partition refinement, as for a Mealy machine).  The answers the machine
+    gives to every input sequence are unchanged, so it wins exactly where it did; a merged
+    node keeps the goal of its first member."""
+    count = len(machine.states)
+    successors: list[list[int]] = [[] for _ in range(count)]
+    for source, target in machine.transitions:
+        successors[source].append(target)
+    keys = [_key(state) for state in machine.states]
+    classes: dict[tuple[object, ...], int] = {}
+    block = [classes.setdefault((keys[n],), len(classes)) for n in range(count)]
+    while True:
+        signatures: dict[tuple[object, ...], int] = {}
+        refined = [
+            signatures.setdefault(
+                (block[n], tuple(sorted({block[t] for t in successors[n]}))), len(signatures)
+            )
+            for n in range(count)
+        ]
+        if len(signatures) == len(set(block)):
+            break
+        block = refined
+    # number the blocks by their first node, so the result is as deterministic as the input
+    first: dict[int, int] = {}
+    for n in range(count):
+        first.setdefault(block[n], len(first))
+    members = [0] * len(first)
+    for n in range(count - 1, -1, -1):
+        members[first[block[n]]] = n
+    new = [first[block[n]] for n in range(count)]
+    transitions = sorted({(new[s], new[t]) for s, t in machine.transitions})
+    initial = tuple(dict.fromkeys(new[i] for i in machine.initial))
+    return MealyMachine(
+        inputs=machine.inputs,
+        outputs=machine.outputs,
+        goals=machine.goals,
+        init_mode=machine.init_mode,
+        states=tuple(machine.states[m] for m in members),
+        node_goals=tuple(machine.node_goals[m] for m in members),
+        initial=initial,
+        transitions=tuple(transitions),
+        source_file=machine.source_file,
+        source_format=machine.source_format,
     )
 
 
@@ -272,4 +324,4 @@ def to_dot(machine: MealyMachine) -> str:
     return "\n".join(lines) + "\n"
 
 
-__all__ = ["MealyMachine", "extract", "goal_strategies", "to_dot", "to_json"]
+__all__ = ["MealyMachine", "extract", "goal_strategies", "minimize", "to_dot", "to_json"]

@@ -216,8 +216,8 @@ class Encoding:
     def prime(self, u: Function) -> Function:
         """``u`` over the next copy (``u`` mentions current bits only).
 
-        CUDD's variable swap (a permutation) is several times faster than the substitution
-        behind ``let``, which dominates the fixpoint's time otherwise."""
+        Renaming is a permutation, so CUDD's variable swap does it; ``dd`` exposes that only as
+        the private ``_swap`` (``let`` is the general substitution), hence the fallback."""
         swap = getattr(self.bdd, "_swap", None)
         if swap is not None:
             return swap(u, self.to_next)

@@ -84,13 +84,11 @@ def tokenize(source: Source) -> list[Token]:
     while offset < len(text):
         match = _TOKEN.match(text, offset)
         if match is None:
-            raise source.fail(
-                "Q040",
-                f"unexpected character {text[offset]!r}",
-                offset,
-                "basic TLSF uses identifiers, ! && || -> <-> X G F U W R, parentheses, "
-                "braces, ';' and // or /* */ comments",
-            )
+            # kept as a token: the parser says where it stops making sense (a parametric
+            # GLOBAL section is refused as such before its '=' is reached)
+            tokens.append(Token("other", text[offset], offset, offset + 1))
+            offset += 1
+            continue
         kind = match.lastgroup or ""
         if kind not in ("space", "comment"):
             word = match.group()
@@ -169,6 +167,14 @@ class _Parser:
                     "(syfco -f basic spec.tlsf)",
                 )
             return Node("ap", (), token.start, name=token.text)
+        if token.kind == "other":
+            raise self.source.fail(
+                "Q040",
+                f"unexpected character {token.text!r}",
+                token.start,
+                "basic TLSF uses identifiers, ! && || -> <-> X G F U W R, parentheses, "
+                "braces, ';' and // or /* */ comments",
+            )
         raise self.source.fail(
             "Q041",
             f"expected a formula, found {self.shown(token)}",
