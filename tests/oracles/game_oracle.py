@@ -12,7 +12,7 @@ from __future__ import annotations
 import itertools
 from collections.abc import Iterator, Mapping
 
-from tlmpc.automata.simplify import strongly_connected
+from tlmpc.base.graphs import csr, strong_components
 from tlmpc.synth.counter import CounterStrategy
 from tlmpc.synth.spec import (
     Atom,
@@ -129,7 +129,7 @@ def check_strategy(spec: GameSpec, machine: MealyMachine) -> None:
         succ: list[list[int]] = [[] for _ in states]
         for src, dst in kept:
             succ[src].append(dst)
-        component = strongly_connected(succ, range(len(states)))
+        component = strong_components(*csr(succ))
         inner: dict[int, list[tuple[int, int]]] = {}
         for src, dst in kept:
             if component[src] == component[dst] and component[src] != -1:
@@ -182,7 +182,7 @@ def check_counterstrategy(spec: GameSpec, counter: CounterStrategy) -> None:
         succ: list[list[int]] = [[] for _ in states]
         for src, dst in kept:
             succ[src].append(dst)
-        component = strongly_connected(succ, range(len(states)))
+        component = strong_components(*csr(succ))
         inner: dict[int, list[tuple[int, int]]] = {}
         for src, dst in kept:
             if component[src] == component[dst] and component[src] != -1:
