@@ -185,13 +185,13 @@ def run_spot(
     *,
     random_count: int = 200,
     held_out: int = 500,
-    budget: float | None = None,
+    budget: int | None = None,
     large: bool = True,
 ) -> list[dict[str, Any]]:
     """Per family: formulas, total states (tlmpc, Spot), formulas larger than Spot, the
-    largest tlmpc translation time (wall clock, and CPU time of the process: the translator's
-    budget counts the latter, so other load on the machine does not change the automata), and
-    formulas not equivalent (must be 0).
+    largest tlmpc translation time (wall clock, and CPU time of the process; the translator's
+    budget counts work units, not time, so neither changes the automata), and formulas not
+    equivalent (must be 0).
 
     Both sides are transition-based generalized Büchi automata over the full alphabet (every
     valuation of the propositions): tlmpc's ``translate(f)`` against Spot's

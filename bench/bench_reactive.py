@@ -3,9 +3,9 @@
 A warehouse floor (40 m x 20 m, shelves as holes, seven named places) meshed ever finer
 (``options.max_area``, or small pillars as holes) from 2k to 44k triangles, with 1 to 6
 sensors; each sensor ``s_k`` adds "if you sense s_k then visit place_k" and the assumption
-"G F !s_k", beside a patrol of two places and "never enter aisle while s_1".  A grid of rooms shows what does grow:
-the number of regions (faces).  CPU seconds of this process, the median of ``--rounds`` runs
-(fresh mission objects, the BDD manager new each time).
+"G F !s_k", beside a patrol of two places and "never enter aisle while s_1".  A grid of rooms
+shows what does grow: the number of regions (faces).  CPU seconds of this process, the median
+of ``--rounds`` runs (fresh mission objects, the BDD manager new each time).
 
     python bench/bench_reactive.py [--rounds 3] [--quick]
 """

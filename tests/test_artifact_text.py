@@ -106,6 +106,7 @@ def _retyped(value: Any) -> Any:
     return value
 
 
+@pytest.mark.slow
 @given(_documents())
 def test_each_text_is_the_documents_own_encoding(documents: dict[str, Any]) -> None:
     texts = dict(artifact_texts(documents))

@@ -142,6 +142,7 @@ def _mutate(document: Any, data: st.DataObject) -> Any:
     return document
 
 
+@pytest.mark.slow
 @given(st.data())
 def test_agrees_on_mutated_missions(data: st.DataObject) -> None:
     mission = data.draw(st.sampled_from(_missions(20_000)))
@@ -150,6 +151,7 @@ def test_agrees_on_mutated_missions(data: st.DataObject) -> None:
     assert verdict is None or verdict == _oracle(mutated, "mission")
 
 
+@pytest.mark.slow
 @given(st.data())
 def test_agrees_on_mutated_artifacts(data: st.DataObject) -> None:
     file, schema = data.draw(st.sampled_from(sorted(ARTIFACT_SCHEMAS.items())))

@@ -38,20 +38,54 @@ MissionSource = str | os.PathLike[str] | Mapping[str, Any]
 """A mission: a path to a YAML file, YAML text, or the mission as a dict."""
 
 
-def _mission_text(mission: MissionSource) -> tuple[str | None, Path]:
+def _expect(value: Any, kinds: tuple[type, ...], what: str, function: str) -> None:
+    """Refuse (U075) an argument of the wrong type with a diagnostic, not a bare TypeError
+    from deep inside a stage."""
+    if isinstance(value, kinds) and not isinstance(value, bool):
+        return
+    from tlmpc.io.outputs import plain_name
+
+    raise UsageError(
+        error(
+            "U075",
+            f"tlmpc.{function}: {what}, not {type(value).__name__} {plain_name(repr(value)[:60])}",
+            hint=f"see help(tlmpc.{function})",
+        )
+    )
+
+
+_PATH = (str, os.PathLike)
+
+
+def _mission_text(mission: MissionSource, function: str) -> tuple[str | None, Path]:
     """(YAML text or None when ``mission`` is a file, the path diagnostics will name)."""
+    _expect(mission, (*_PATH, Mapping), "the mission must be a path, YAML text or a dict", function)
     if isinstance(mission, Mapping):
         import yaml
 
-        return yaml.safe_dump(dict(mission), sort_keys=False), Path("<mission>")
+        try:
+            return yaml.safe_dump(dict(mission), sort_keys=False), Path("<mission>")
+        except (yaml.YAMLError, TypeError, ValueError, RecursionError) as exc:
+            raise UsageError(
+                error(
+                    "U075",
+                    f"tlmpc.{function}: the mission dict holds a value YAML cannot write: "
+                    f"{str(exc)[:80]}",
+                    hint="use plain dicts, lists, strings and numbers",
+                )
+            ) from None
     if isinstance(mission, os.PathLike):
         return None, Path(mission)
+    if "\x00" in mission:
+        raise UsageError(
+            error("U075", f"tlmpc.{function}: the mission text or path holds a NUL character")
+        )
     if "\n" in mission or (":" in mission and not Path(mission).exists()):
         return mission, Path("<mission>")
     return None, Path(mission)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class Compiled:
     """A compiled mission: its artifacts (parsed JSON documents, HOA text) and summary.
 
@@ -63,6 +97,25 @@ class Compiled:
     source: str = "<mission>"
     warnings: tuple[Diagnostic, ...] = ()
     _figure: dict[str, str] = field(default_factory=dict, repr=False, compare=False)
+
+    def __repr__(self) -> str:
+        """One line: the source, the mesh, the plan and the verdict — not every artifact."""
+        summary = self.summary
+        parts = [f"source={self.source!r}"]
+        for stage in summary.get("stages", []):
+            if stage.get("name") == "abstraction" and "triangles" in stage.get("sizes", {}):
+                parts.append(f"triangles={stage['sizes']['triangles']}")
+        plan = summary.get("plan")
+        if plan:
+            parts.append(f"plan=({plan.get('prefix_length')} + {plan.get('cycle_length')} steps)")
+        verdict = summary.get("verdict")
+        if verdict:
+            parts.append(f"satisfied={verdict.get('satisfied')}")
+            parts.append(f"robustness={verdict.get('robustness', float('nan')):.4g}")
+        parts.append(f"artifacts={len(self.artifacts)}")
+        if self.warnings:
+            parts.append(f"warnings={len(self.warnings)}")
+        return f"Compiled({', '.join(parts)})"
 
     @property
     def summary(self) -> Mapping[str, Any]:
@@ -90,6 +143,7 @@ class Compiled:
         """Write every artifact (and the figure, when drawn) into ``out`` atomically."""
         from tlmpc.io.outdir import check_destination, commit, staging_directory, write_artifacts
 
+        _expect(out, _PATH, "out must be a path", "Compiled.write")
         destination = Path(out)
         check_destination(destination, force=force)
         with staging_directory(destination) as staging:
@@ -146,8 +200,9 @@ def compile(
     """
     from tlmpc.pipeline.stages import compile_mission
 
-    text, source = _mission_text(mission)
+    text, source = _mission_text(mission, "compile")
     if until is not None:
+        _expect(until, (str,), "until must be a stage name", "compile")
         from tlmpc.pipeline.stages import stage_names
 
         if until not in stage_names():
@@ -170,8 +225,9 @@ def read_output(directory: str | os.PathLike[str]) -> Compiled:
     Each JSON artifact is checked against its schema; raises
     :class:`~tlmpc.base.errors.UsageError` when the directory holds no tlmpc output.
     """
-    from tlmpc.io.artifacts import ARTIFACT_SCHEMAS, read_artifact
+    from tlmpc.io.artifacts import ARTIFACT_SCHEMAS, cross_check, read_artifact
 
+    _expect(directory, _PATH, "directory must be a path", "read_output")
     root = Path(directory)
     artifacts: dict[str, Any] = {}
     for name, (_, schema) in ARTIFACT_SCHEMAS.items():
@@ -188,6 +244,7 @@ def read_output(directory: str | os.PathLike[str]) -> Compiled:
                 hint="pass the directory given to `tlmpc compile -o`",
             )
         )
+    cross_check(root, {k: v for k, v in artifacts.items() if isinstance(v, dict)})
     return Compiled(artifacts=artifacts, source=str(root))
 
 
@@ -200,13 +257,24 @@ def verify_trace(
     """Verify a trajectory against its task under continuous-time semantics.
 
     ``trace`` is a :class:`Compiled` result, a ``trace.json`` document (dict), or a path to a
-    ``trace.json`` or a CSV log (then ``mission`` names the mission file whose task and regions
+    ``trace.json`` or a robot log — CSV, ROS 1 ``.bag``, ROS 2 bag directory, ``.mcap`` — read
+    as ``tlmpc verify`` reads it (then ``mission`` names the mission file whose task and regions
     apply).  ``boundary`` overrides the labelling convention (``"right"`` or ``"closed"``).
     The verifier shares no code with the planner.
     """
-    from tlmpc.verify import from_csv, from_document
+    from tlmpc.verify import from_document, read_trace
     from tlmpc.verify import verify_trace as check_trace
 
+    _expect(
+        trace,
+        (Compiled, Mapping, *_PATH),
+        "trace must be a Compiled result, a trace.json dict or a path",
+        "verify_trace",
+    )
+    if mission is not None:
+        _expect(mission, _PATH, "mission must be a path", "verify_trace")
+    if boundary is not None:
+        _expect(boundary, (str,), "boundary must be 'right' or 'closed'", "verify_trace")
     if isinstance(trace, Compiled):
         document = trace.artifacts.get("trace.json")
         if document is None:
@@ -215,11 +283,7 @@ def verify_trace(
     if isinstance(trace, Mapping):
         return check_trace(from_document(trace, convention=boundary))
     path = Path(trace)
-    if path.suffix.lower() == ".csv":
-        return check_trace(from_csv(path, Path(mission) if mission is not None else None, boundary))
-    from tlmpc.io.artifacts import read_json
-
-    return check_trace(from_document(read_json(path), file=str(path), convention=boundary))
+    return check_trace(read_trace(path, Path(mission) if mission is not None else None, boundary))
 
 
 def translate(formula: str) -> Automaton:
@@ -230,6 +294,7 @@ def translate(formula: str) -> Automaton:
     from tlmpc.automata import translate as translate_formula
     from tlmpc.ltl import parse_ltl
 
+    _expect(formula, (str,), "the formula must be a string", "translate")
     return translate_formula(parse_ltl(formula))
 
 
@@ -237,7 +302,7 @@ def check(mission: MissionSource) -> list[Diagnostic]:
     """Every problem of ``mission`` (schema, geometry, task), best first; empty when valid."""
     from tlmpc.mission.load import check_file, check_text
 
-    text, source = _mission_text(mission)
+    text, source = _mission_text(mission, "check")
     if text is None:
         return check_file(source)
     return check_text(text, str(source))
@@ -252,4 +317,5 @@ def executor(output: Compiled | str | os.PathLike[str]) -> Executor:
     """
     from tlmpc.runtime import Executor
 
+    _expect(output, (Compiled, *_PATH), "output must be a Compiled result or a path", "executor")
     return Executor.from_output(output)

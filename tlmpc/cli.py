@@ -19,6 +19,7 @@ import signal
 import sys
 import threading
 import typing
+import warnings
 from collections.abc import Sequence
 from types import ModuleType
 from typing import Any, TextIO
@@ -32,6 +33,7 @@ COMMAND_MODULES = (
     "compile",
     "check",
     "verify",
+    "monitor",
     "automaton",
     "export",
     "plot",
@@ -41,6 +43,8 @@ COMMAND_MODULES = (
     "export_plan",
     "simulate",
     "synth",
+    "new",
+    "completion",
 )
 
 EPILOG = exit_code_epilog()
@@ -82,7 +86,9 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
         )
         if only is None or only == module.NAME:
             module.add_arguments(command_parser)
-        command_parser.set_defaults(_run=module.run)
+        # `_full_parser`: every command's flags (for `tlmpc completion`, which commands cannot
+        # import from here: the command line sits above them)
+        command_parser.set_defaults(_run=module.run, _full_parser=build_parser)
     return parser
 
 
@@ -95,8 +101,11 @@ class _OutputLost(Exception):
         self.cause = cause
 
 
-class _Terminated(Exception):
-    """SIGTERM arrived: unwind like Ctrl-C so temporary folders are removed."""
+class _Terminated(BaseException):
+    """SIGTERM arrived: unwind like Ctrl-C so temporary folders are removed.
+
+    A :class:`BaseException`, like :class:`KeyboardInterrupt`, so that no ``except
+    Exception`` on the way (a bag reader's, a library's) takes it for an error of its own."""
 
 
 class TerminalText(io.TextIOBase):
@@ -138,8 +147,27 @@ def _silence(stream: TextIO) -> None:
         os.close(devnull)
 
 
+#: The signals received during the current run (SIGINT, SIGTERM), in order.
+_RECEIVED: list[int] = []
+
+
 def _on_sigterm(number: int, frame: object) -> None:
+    _RECEIVED.append(number)
     raise _Terminated
+
+
+def _on_sigint(number: int, frame: object) -> None:
+    _RECEIVED.append(number)
+    raise KeyboardInterrupt
+
+
+def _signalled() -> BaseException | None:
+    """The exception of the first signal this run received, if any: an exception raised by a
+    signal handler inside C code (an extension module being imported, say) may reach us as
+    another exception, an ImportError wrapping it; it is still the signal's doing."""
+    if not _RECEIVED:
+        return None
+    return _Terminated() if _RECEIVED[0] == signal.SIGTERM else KeyboardInterrupt()
 
 
 def run() -> typing.NoReturn:
@@ -175,8 +203,12 @@ def main(
     safe_out = typing.cast(TextIO, TerminalText(raw_out, "standard output"))
     safe_err = typing.cast(TextIO, TerminalText(raw_err, "standard error"))
     previous: Any = None
+    previous_int: Any = None
+    _RECEIVED.clear()
     if threading.current_thread() is threading.main_thread():
         previous = signal.signal(signal.SIGTERM, _on_sigterm)
+        if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+            previous_int = signal.signal(signal.SIGINT, _on_sigint)
     try:
         code = _main(argv, safe_out, safe_err)
         safe_out.flush()
@@ -205,6 +237,8 @@ def main(
     finally:
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
+        if previous_int is not None:
+            signal.signal(signal.SIGINT, previous_int)
 
 
 def _main(argv: Sequence[str] | None, out: TextIO, err: TextIO) -> int:
@@ -223,35 +257,44 @@ def _main(argv: Sequence[str] | None, out: TextIO, err: TextIO) -> int:
     err.write(usage.getvalue())
     reporter = Reporter.for_args(args, out, err)
     try:
-        result: int = args._run(args, out, err)
+        with warnings.catch_warnings():
+            # Floating-point overflow on extreme inputs is numpy's and shapely's business: the
+            # inputs are checked and refused with diagnostics, never with a screen of warnings.
+            warnings.filterwarnings("ignore", category=RuntimeWarning)
+            result: int = args._run(args, out, err)
         return result
     except TlmpcError as exc:
         return reporter.fail(exc)
     except (KeyboardInterrupt, _Terminated, _OutputLost):
         raise
-    except RecursionError:  # a pathological input nested beyond what a stage handles
-        reporter.diagnose(
-            [
-                error(
-                    "U036",
-                    "the input is nested too deeply to process",
-                    hint="flatten the input (no real mission or trace nests this deep)",
-                )
-            ]
-        )
-        return reporter.finish(EXIT_USAGE)
-    except MemoryError:
-        reporter.diagnose(
-            [
-                error(
-                    "U037",
-                    "the input needs more memory than this machine has",
-                    hint="make the input smaller (fewer regions, a coarser mesh, a shorter trace)",
-                )
-            ]
-        )
-        return reporter.finish(EXIT_USAGE)
-    except Exception as exc:  # a bug: say so, never a bare traceback without context
+    except Exception as exc:
+        signalled = _signalled()
+        if signalled is not None:  # the signal's exception, disguised on its way up
+            raise signalled from exc
+        if isinstance(exc, RecursionError):  # an input nested beyond what a stage handles
+            reporter.diagnose(
+                [
+                    error(
+                        "U036",
+                        "the input is nested too deeply to process",
+                        hint="flatten the input (no real mission or trace nests this deep)",
+                    )
+                ]
+            )
+            return reporter.finish(EXIT_USAGE)
+        if isinstance(exc, MemoryError):
+            reporter.diagnose(
+                [
+                    error(
+                        "U037",
+                        "the input needs more memory than this machine has",
+                        hint="make the input smaller (fewer regions, a coarser mesh, a shorter "
+                        "trace)",
+                    )
+                ]
+            )
+            return reporter.finish(EXIT_USAGE)
+        # a bug: say so, never a bare traceback without context
         err.write(
             "tlmpc: internal error (exit 3). Please report it with the input that caused it:\n"
         )

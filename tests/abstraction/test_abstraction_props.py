@@ -204,6 +204,24 @@ def test_unreachable_region_is_reported() -> None:
     assert a.stats["components"] == 2
 
 
+@given(st.integers(2, 30))
+@settings(max_examples=6, deadline=None)
+def test_many_unreachable_regions_are_one_warning(count: int) -> None:
+    # a wall of holes; behind it, `count` regions in a row: one A011 naming each of them
+    regions = {f"r{k}": rect(4 + 0.1 * k, 1, 4.05 + 0.1 * k, 2) for k in range(count)}
+    mission = mission_of(rect(0, 0, 8, 4), [rect(2, 0, 3, 4)], regions, (0.5, 0.5))
+    warnings = abstraction_diagnostics(build_abstraction(mission), mission)
+    assert [w.code for w in warnings] == ["A011"]
+    message = warnings[0].message
+    assert message.startswith(f"{count} regions are not reachable from the start: ")
+    shown = [f"r{k}" for k in range(count)][:12]
+    assert all(
+        f"{name}," in message or f"{name} " in message or f"{name};" in message for name in shown
+    )
+    if count > 12:
+        assert f"and {count - 12} more" in message
+
+
 def test_artifact_round_trip_and_schema() -> None:
     a = build_abstraction(load_mission(ROOT / "specs" / "example6.yaml"))
     document = abstraction_to_json(a)

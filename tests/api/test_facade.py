@@ -125,3 +125,16 @@ def test_read_output_rejects_an_artifact_that_fails_its_schema(tmp_path: Path) -
         tlmpc.read_output(out)
     assert caught.value.diagnostics[0].code == "U071"
     assert caught.value.diagnostics[0].file == str(out / "witness.json")
+
+
+def test_the_repr_of_a_compiled_mission_is_one_short_line() -> None:
+    compiled = tlmpc.compile(ROOT / "specs" / "example1.yaml")
+    text = repr(compiled)
+    summary = compiled.summary
+    triangles = next(s for s in summary["stages"] if s["name"] == "abstraction")["sizes"]
+    assert "\n" not in text
+    assert len(text) < 200  # not every artifact
+    assert text.startswith("Compiled(source=")
+    assert f"triangles={triangles['triangles']}" in text
+    assert f"satisfied={summary['verdict']['satisfied']}" in text
+    assert f"artifacts={len(compiled.artifacts)}" in text

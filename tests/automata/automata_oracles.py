@@ -10,6 +10,9 @@ from collections.abc import Callable, Sequence
 
 from tlmpc.ltl.ast import (
     And,
+    BoundedEventually,
+    BoundedGlobally,
+    BoundedUntil,
     Const,
     Equiv,
     Eventually,
@@ -66,6 +69,8 @@ def evaluate(formula: Formula, prefix: Sequence[Letter], loop: Sequence[Letter])
         if isinstance(f, Globally):
             a = ev(f.arg)
             return fix(lambda i, v: a[i] and v[succ[i]], True)
+        if isinstance(f, BoundedEventually | BoundedGlobally | BoundedUntil):
+            raise ValueError(f"a word without times has no time bounds: {f}")
         left, right = ev(f.left), ev(f.right)
         if isinstance(f, Implies):
             return [not x or y for x, y in zip(left, right, strict=True)]

@@ -12,8 +12,6 @@
 
 from __future__ import annotations
 
-import time
-
 from automata_oracles import accepts
 from hypothesis import given
 from hypothesis import strategies as st
@@ -159,7 +157,7 @@ def test_each_reduction_keeps_the_language(
 def test_iterated_reduction_keeps_the_language(
     automaton: Automaton, samples: list[tuple[list[frozenset[str]], ...]]
 ) -> None:
-    reduced = reduce_by_simulation(automaton, None, time.process_time() + 10.0)
+    reduced = reduce_by_simulation(automaton, None, float("inf"))
     _same_language(automaton, reduced, samples)
 
 

@@ -13,7 +13,6 @@
 
 from __future__ import annotations
 
-import time
 import warnings
 
 import pytest
@@ -45,7 +44,7 @@ words = st.tuples(st.lists(letters, max_size=4), st.lists(letters, min_size=1, m
 
 def rewritten(formula: Formula, *, semantic: bool) -> Formula:
     oracle = _is_empty_term if semantic else None
-    return to_formula(rewrite(from_ast(formula), oracle, time.process_time() + 10.0))
+    return to_formula(rewrite(from_ast(formula), oracle, float("inf")))
 
 
 @given(formulas(PROPS, max_leaves=10), st.lists(words, min_size=1, max_size=8), st.booleans())
@@ -229,7 +228,7 @@ def test_wdba_replaces_a_non_obligation_when_equivalent() -> None:
 
 
 def test_wdba_equivalence_check() -> None:
-    deadline = time.process_time() + 10.0
+    deadline = float("inf")
     recurrence = parse_ltl("G F a")
     tgba = translate(recurrence)  # one state, deterministic, one set
     negation = translate(Not(recurrence))
@@ -280,5 +279,5 @@ def test_transient_state_never_replaced_by_a_state_that_reaches_it() -> None:
     word: tuple[list[frozenset[str]], list[frozenset[str]]] = ([], [frozenset({"a"}), frozenset()])
     assert accepts(automaton, *word)
     component = sccs(automaton.num_states, automaton.edges, automaton.initial)
-    merged = merge_transient(automaton, Alphabet(("a",), None), component, time.process_time() + 10)
+    merged = merge_transient(automaton, Alphabet(("a",), None), component, float("inf"))
     assert accepts(merged, *word)

@@ -73,6 +73,7 @@ def test_equivalent_to_spot(family: str, text: str) -> None:
         assert spot.are_equivalent(_spot_of(degeneralize(ours)), theirs), (family, text)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("family", ["robotics", "eh", "sb", "dac"])
 def test_no_more_states_than_spot(family: str) -> None:
     """On these families tlmpc matches Spot formula by formula (a regression guard)."""
@@ -102,6 +103,7 @@ def _letters_constraint(letters: list[frozenset[str]], aps: list[str]) -> Any:
     return spot.formula("G(" + (" | ".join(cubes) or "0") + ")")
 
 
+@pytest.mark.slow
 @given(
     formulas(("a", "b", "c")),
     st.lists(st.frozensets(st.sampled_from(["a", "b", "c"])), min_size=1, max_size=5),

@@ -15,6 +15,7 @@ import sys
 import warnings
 from typing import Any
 
+import pytest
 from ci_oracles import import_oracle
 
 from tlmpc.automata import to_hoa, translate
@@ -56,6 +57,7 @@ def _ours(text: str) -> Any:
     return translate(parse_ltl(to_tlmpc(spot.formula(text))), budget=None)
 
 
+@pytest.mark.slow
 def test_random_set_no_larger_than_spot_but_a_few() -> None:
     texts = _random_set()
     assert len(texts) > 200

@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import assume, example, given, settings
+from hypothesis import HealthCheck, assume, example, given, settings
 from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
 from scipy.linalg import expm
@@ -115,7 +115,8 @@ def _exit_controller(v: np.ndarray, exit_edge: int, speed: float) -> StepControl
     return synthesize(abstraction, witness, Robot(start=(0.0, 0.0), max_speed=speed)).steps[0]
 
 
-@settings(deadline=None, max_examples=60)
+@pytest.mark.slow
+@settings(deadline=None, max_examples=max(15, settings().max_examples * 3 // 10))  # 60 in CI
 @given(triangles(), st.integers(0, 2), st.floats(0.2, 3.0), st.data())
 def test_every_state_leaves_through_the_planned_edge(
     v: np.ndarray, exit_edge: int, speed: float, data: st.DataObject
@@ -473,7 +474,13 @@ def test_exit_speed_is_the_best_the_vertex_conditions_allow(
     assert step.exit_speed >= float(best) * (1 - 1e-5)
 
 
-@settings(deadline=None, max_examples=30)
+@settings(
+    deadline=None,
+    max_examples=30,
+    # thin triangles and boundary points are filtered out; older hypothesis releases count
+    # that against the strategy
+    suppress_health_check=[HealthCheck.filter_too_much],
+)
 @given(triangles(), st.integers(0, 2), st.integers(1, 2), st.data())
 def test_a_field_leaving_by_an_unplanned_facet_is_reported(
     v: np.ndarray, exit_edge: int, shift: int, data: st.DataObject

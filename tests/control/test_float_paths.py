@@ -1,10 +1,16 @@
-"""The per-step arithmetic done on Python floats gives numpy's values bit for bit.
+"""The per-step arithmetic done on Python floats against its definition on numpy arrays.
 
 The controllers and the exact simulation compute triangle geometry, affine frames, 1-norms and
 angle gaps on Python floats (numpy's per-call cost on 2-vectors dominated those stages).  Each
 is compared here with its definition written with numpy arrays, the way the stages computed
-them before, on triangles of every size and distance from the origin: equal arrays, not close
-ones, so the artifacts stay byte for byte the same.
+them before, on triangles of every size and distance from the origin.
+
+Where both sides run the same numpy operation on the same inputs (the affine frame's solve, the
+column sums) the arrays are equal.  A 2-vector's norm and dot product are IEEE operations in a
+fixed order on Python floats, so the stages give the same bytes on every machine; numpy hands
+them to BLAS, whose kernels fuse multiply and add on some processors (AVX-512, FMA), so there
+the definition itself differs in the last bit.  Those are compared at a stated tolerance: a few
+units in the last place of the terms summed.
 """
 
 from __future__ import annotations
@@ -12,7 +18,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from hypothesis import example, given
+from hypothesis import assume, example, given
 from hypothesis import strategies as st
 
 from tlmpc.abstraction.model import FloatArray
@@ -25,6 +31,9 @@ from tlmpc.control.geometry import (
 from tlmpc.simulate.exact import _column_norm
 
 MAGNITUDE = st.floats(-12, 12)  # decimal exponents of sizes and offsets
+EPS = float(np.finfo(np.float64).eps)
+#: Units in the last place allowed between the Python-float path and numpy's BLAS path.
+ULPS = 8
 
 
 @st.composite
@@ -84,9 +93,13 @@ def half_plane_by_arrays(normals: list[FloatArray]) -> bool:
 def test_triangle_geometry_is_the_array_definition(v: FloatArray) -> None:
     geometry = triangle_geometry(v)
     normals, offsets, heights = geometry_by_arrays(v)
-    assert np.array_equal(geometry.normals, normals)
-    assert np.array_equal(geometry.offsets, offsets)
-    assert np.array_equal(geometry.heights, heights)
+    # Each value is a short sum of products: rounded (with or without fused multiply-adds)
+    # within a few ulps of the largest term, here bounded by ULPS units of the coordinates'
+    # magnitude.  Unit normals: of 1.
+    reach = np.abs(v).max() + float(np.abs(v[:, None, :] - v[None, :, :]).max())
+    assert np.abs(geometry.normals - normals).max() <= ULPS * EPS
+    assert np.abs(geometry.offsets - offsets).max() <= ULPS * EPS * reach
+    assert np.abs(geometry.heights - heights).max() <= ULPS * EPS * reach
     # and the definition itself: unit outward normals, each facet on its line, positive heights
     assert np.allclose(np.linalg.norm(geometry.normals, axis=1), 1.0)
     assert np.all(geometry.heights > 0)
@@ -111,6 +124,11 @@ def test_affine_law_is_the_array_definition(v: FloatArray, speeds: list[float]) 
 @given(st.lists(st.floats(-math.pi, math.pi), max_size=6))
 def test_half_plane_test_is_the_array_definition(angles: list[float]) -> None:
     normals = [np.array([math.cos(a), math.sin(a)]) for a in angles]
+    # numpy's arctan2 may be a vectorised kernel a few ulps from math.atan2: a widest gap
+    # within rounding of the threshold can go either way, and is not a disagreement.
+    directions = sorted(math.atan2(n[1], n[0]) for n in normals)
+    gaps = [b - a for a, b in zip(directions, directions[1:] + directions[:1], strict=True)]
+    assume(all(abs((gap % (2 * math.pi)) - (math.pi + 1e-9)) > 1e-12 for gap in gaps))
     assert half_plane_feasible(normals) == half_plane_by_arrays(normals)
     as_floats: list[tuple[float, float]] = [(float(n[0]), float(n[1])) for n in normals]
     assert half_plane_feasible(as_floats) == half_plane_by_arrays(normals)

@@ -195,6 +195,7 @@ MESH_POINTS = _mesh_points(mission("F a", (1.3, 0.7)))
 TASKS = ["F(a & F b)", "b & F a", "G !a & F b", "F a & G !b", "!a U b", "G F a & G F b"]
 
 
+@pytest.mark.slow
 @settings(
     deadline=None,
     max_examples=max(6, settings().max_examples // 8),

@@ -14,6 +14,7 @@ import re
 import string
 from pathlib import Path
 
+import pytest
 import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -94,6 +95,7 @@ def _mutate(text: str, data: st.DataObject) -> str:
     return text
 
 
+@pytest.mark.slow
 @FUZZ
 @given(st.data())
 def test_mutated_missions_get_clean_answers(tmp_path: Path, data: st.DataObject) -> None:
@@ -124,6 +126,7 @@ KEYS = st.sampled_from(
 )
 
 
+@pytest.mark.slow
 @FUZZ
 @given(st.dictionaries(KEYS, VALUES, max_size=9), st.booleans())
 def test_random_mission_documents_get_clean_answers(
@@ -146,6 +149,7 @@ SAMPLES = st.lists(
 )
 
 
+@pytest.mark.slow
 @FUZZ
 @given(
     st.fixed_dictionaries(

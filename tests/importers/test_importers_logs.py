@@ -15,6 +15,7 @@ from robot_data import require_shared, write_bag
 from tlmpc.base.errors import UsageError
 from tlmpc.cli import main
 from tlmpc.importers.logs import read_log
+from tlmpc.verify.samples import check_samples
 
 POSE_TYPES = (
     "nav_msgs/msg/Odometry",
@@ -183,9 +184,10 @@ def test_a_bare_mcap_file_and_a_db3_file_read_like_their_bags(tmp_path: Path) ->
 
 
 @pytest.mark.parametrize("kind", KINDS)
-def test_stamps_are_sorted_and_repeats_dropped(tmp_path: Path, kind: str) -> None:
+def test_stamps_are_sorted_and_repeats_refused_like_csv(tmp_path: Path, kind: str) -> None:
     # Received in this order (log times increase) but stamped out of order, one stamp twice.
-    rows = [ROWS[2], ROWS[0], ROWS[1], (ROWS[1][0], 9.0, 9.0)]
+    repeat = (ROWS[1][0], 9.0, 9.0)
+    rows = [ROWS[2], ROWS[0], ROWS[1], repeat]
     received = [5_000_000_000 + i for i in range(len(rows))]
     path = write_bag(
         bag_path(tmp_path, kind),
@@ -193,7 +195,17 @@ def test_stamps_are_sorted_and_repeats_dropped(tmp_path: Path, kind: str) -> Non
         {"/odom": (POSE_TYPES[0], rows)},
         log_times={"/odom": received},
     )
-    assert np.array_equal(read_log(path).samples, expected(ROWS[:3]))
+    samples = read_log(path).samples
+    # sorted by stamp, the repeat kept after its twin (arrival order): neither is hidden
+    assert np.array_equal(samples, expected([ROWS[0], ROWS[1], repeat, ROWS[2]]))
+    # ... and refused as the same rows in a CSV are
+    csv = tmp_path / "log.csv"
+    in_order = [ROWS[0], ROWS[1], repeat, ROWS[2]]
+    csv.write_text("t,x,y\n" + "".join(f"{r[0] / 1e9!r},{r[1]!r},{r[2]!r}\n" for r in in_order))
+    for log in (samples, read_log(csv).samples):
+        with pytest.raises(UsageError) as caught:
+            check_samples(log[:, 0], log[:, 1], log[:, 2], file="log")
+        assert [d.code for d in caught.value.diagnostics] == ["V020"]
 
 
 def test_transform_maps_the_log_frame(tmp_path: Path) -> None:

@@ -179,6 +179,7 @@ def test_small_free_pieces_are_specks(tmp_path: Path) -> None:
     assert len(simplified.components) == 2
 
 
+@pytest.mark.slow
 @given(free=grids, tolerance=st.sampled_from([0.5, 1.0, 2.0]))
 def test_simplified_boundary_stays_within_the_tolerance(
     tmp_path_factory: pytest.TempPathFactory, free: np.ndarray, tolerance: float
@@ -467,7 +468,6 @@ def test_import_map_writes_a_mission_that_check_accepts(tmp_path: Path) -> None:
         ("bad_thresholds", "M004"),
         ("all_occupied", "M010"),
         ("mask_size", "M013"),
-        ("no_task", "M016"),
     ],
 )
 def test_bad_maps_get_diagnostics_not_tracebacks(tmp_path: Path, setup: str, code: str) -> None:
@@ -492,8 +492,6 @@ def test_bad_maps_get_diagnostics_not_tracebacks(tmp_path: Path, setup: str, cod
     elif setup == "mask_size":
         mask = write_map(tmp_path, "k", np.zeros((4, 4), dtype=np.uint8), resolution=0.1)
         extra += ["--keepout", str(mask)]
-    elif setup == "no_task":
-        extra = ["--region", "g", "0.1", "0.1", "0.3", "0.3"]
     result, _, err = run("import-map", str(path), *extra)
     assert result == 2, err
     assert f"error[{code}]" in err
@@ -604,6 +602,7 @@ def test_real_depot_mission_form_compiles_and_verifies(tmp_path: Path) -> None:
     assert "trace verifies" in err + out
 
 
+@pytest.mark.slow
 @example(
     pillars=[(2, 2), (1, 3), (6, 4), (3, 5)],
     corner=(7, 3),
@@ -663,3 +662,47 @@ def test_default_start_avoids_keepout(tmp_path: Path) -> None:
     start = Point(default_start(imported))
     assert Polygon(imported.boundary).covers(start)
     assert not box(6, 6, 14, 14).covers(start)
+
+
+def test_import_then_edit(tmp_path: Path) -> None:
+    # no regions and no task: the mission is written with what is still to add
+    free = np.ones((20, 20), dtype=bool)
+    path = write_map(tmp_path, "m", image_from_free(free), resolution=0.1)
+    out = tmp_path / "mission.yaml"
+    code, _, err = run("import-map", str(path), "-o", str(out))
+    assert code == 0, err
+    assert "no regions and no task yet" in err
+    text = out.read_text()
+    assert "# still to add: regions and task" in text
+    assert check_file(out) != []  # not a mission yet
+    out.write_text(text + "regions:\n  dock: {rect: [0.5, 0.5, 1, 1]}\ntask: [visit dock]\n")
+    assert check_file(out) == []
+    # regions but no task (and no keepout mask to avoid): also written, the task to add
+    code, _, err = run(
+        "import-map", str(path), "--region", "g", "0.1", "0.1", "0.3", "0.3", "-o", str(out)
+    )
+    assert code == 0, err
+    assert "# still to add: task" in out.read_text()
+
+
+@pytest.mark.parametrize(
+    ("flags", "where"),
+    [
+        (["--task", "visit goal", "--task", "visit dockk"], "--task 'visit dockk':1:7:"),
+        (["--ltl", "F goal & G !pond"], "--ltl 'F goal & G !pond':1:"),
+    ],
+)
+def test_a_task_naming_an_unknown_region_fails_at_the_flag(
+    tmp_path: Path, flags: list[str], where: str
+) -> None:
+    free = np.ones((20, 20), dtype=bool)
+    path = write_map(tmp_path, "m", image_from_free(free), resolution=0.1)
+    out = tmp_path / "mission.yaml"
+    code, _, err = run(
+        "import-map", str(path), "--region", "goal", "0.1", "0.1", "0.3", "0.3",
+        *flags, "-o", str(out),
+    )  # fmt: skip
+    assert code == 1, err
+    assert err.startswith(where), err
+    assert "error[L010]: unknown region" in err
+    assert not out.exists()

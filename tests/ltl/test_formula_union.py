@@ -50,8 +50,8 @@ _MATCH_TEMPLATE = """
 from typing import assert_never
 
 from tlmpc.ltl.ast import (
-    And, Const, Equiv, Eventually, Formula, Globally, Implies, Not, Or, Prop, Release,
-    StrongRelease, Until, WeakUntil,
+    And, BoundedEventually, BoundedGlobally, BoundedUntil, Const, Equiv, Eventually, Formula,
+    Globally, Implies, Not, Or, Prop, Release, StrongRelease, Until, WeakUntil,
 )
 
 
@@ -63,6 +63,8 @@ def kind(formula: Formula) -> str:
             return "boolean"
         case Eventually() | Globally() | Until() | Release() | WeakUntil(){extra}:
             return "temporal"
+        case BoundedEventually() | BoundedGlobally() | BoundedUntil():
+            return "bounded"
         case _:
             assert_never(formula)
 """
@@ -93,6 +95,7 @@ def _mypy(tmp_path: Path, source: str) -> subprocess.CompletedProcess[str]:
     )
 
 
+@pytest.mark.slow
 def test_mypy_rejects_a_match_that_forgets_a_node_kind(tmp_path: Path) -> None:
     pytest.importorskip("mypy")
     complete = _mypy(tmp_path, _MATCH_TEMPLATE.format(extra=" | StrongRelease()"))

@@ -17,6 +17,7 @@ from tlmpc.ltl.ast import Eventually, Formula, Globally, Prop, Until
 NAMES = st.lists(st.text(max_size=6), min_size=1, max_size=4, unique=True)
 
 
+@pytest.mark.slow
 @given(NAMES.flatmap(lambda names: formulas(tuple(names), max_leaves=8)))
 def test_print_then_parse_is_the_identity_for_any_names(formula: Formula) -> None:
     assert parse_ltl(to_text(formula)) == formula

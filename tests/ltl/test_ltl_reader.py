@@ -7,6 +7,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -70,7 +71,8 @@ def formulas(draw: st.DrawFn, depth: int = 0) -> str:
     return leaf
 
 
-@settings(max_examples=400)
+@pytest.mark.slow
+@settings(max_examples=2 * settings().max_examples)  # 400 in CI
 @given(formulas(), st.integers(1, 5), st.integers(1, 9))
 def test_reader_equals_lark_on_well_formed_formulas(text: str, line: int, col: int) -> None:
     fast = read_plain_ltl(text, line, col)

@@ -21,9 +21,10 @@ import yaml
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from tlmpc.base.errors import UsageError
 from tlmpc.mission import bulk, yamlpos
 from tlmpc.mission.holes import narrow_passages, passage_search
-from tlmpc.mission.load import check_text
+from tlmpc.mission.load import check_text, inspect_file
 from tlmpc.mission.yamlpos import PositionedDocument, load_positioned
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -113,6 +114,7 @@ _PLACES = [
 ]
 
 
+@pytest.mark.slow
 @settings(deadline=None)
 @given(
     place=st.sampled_from(_PLACES),
@@ -321,14 +323,25 @@ def test_the_passage_search_stops_at_its_budget() -> None:
 # --- the read limit is checked while reading ---------------------------------------------------
 
 
-def test_an_endless_stream_is_cut_at_the_limit() -> None:
+def test_a_device_is_refused_at_once() -> None:
+    with pytest.raises(UsageError) as caught:
+        inspect_file("/dev/zero")
+    assert caught.value.diagnostics[0].code == "U001"
+    assert "device" in caught.value.diagnostics[0].message
+
+
+def test_a_huge_file_is_cut_at_the_limit(tmp_path: Path) -> None:
+    # a sparse file: 64 MiB long, no disk used; read up to the limit and no further
+    huge = tmp_path / "huge.yaml"
+    with huge.open("wb") as stream:
+        stream.truncate(64 << 20)
     # VmHWM is the peak of this process image alone; ru_maxrss would also count the pytest
     # worker the child was forked from
     script = (
         "import re, sys; from tlmpc.mission import load\n"
         "load.MAX_BYTES = 32 << 20\n"
         "from tlmpc.base.errors import UsageError\n"
-        "try:\n    load.inspect_file('/dev/zero')\n"
+        f"try:\n    load.inspect_file({str(huge)!r})\n"
         "except UsageError as exc:\n    print(exc.diagnostics[0].code)\n"
         "status = open('/proc/self/status').read()\n"
         "print(re.search(r'VmHWM:\\s*(\\d+) kB', status).group(1))\n"

@@ -240,6 +240,7 @@ def _rooms(draw: st.DrawFn) -> tuple[Mission, float]:
     )
 
 
+@pytest.mark.slow
 @given(_rooms(), st.integers(0, 10**6))
 def test_body_never_meets_an_obstacle(case: tuple[Mission, float], seed: int) -> None:
     mission, radius = case
@@ -316,6 +317,7 @@ def _obstacles(draw: st.DrawFn) -> tuple[list[list[tuple[float, float]]], float]
     return holes, draw(st.floats(0.02, 0.8))
 
 
+@pytest.mark.slow
 @given(_obstacles())
 def test_every_triangle_keeps_the_radius_from_every_obstacle(
     case: tuple[list[list[tuple[float, float]]], float],
@@ -352,7 +354,8 @@ def test_every_triangle_keeps_the_radius_from_every_obstacle(
     assert shapely.union_all(triangles).buffer(1e-9).covers(free.buffer(-1.05 * radius))
 
 
-@settings(max_examples=30)  # a compile per example
+@pytest.mark.slow
+@settings(max_examples=max(8, settings().max_examples * 3 // 20))  # a compile per example
 @given(
     st.floats(2.0, 7.0),  # x of the wall
     st.floats(0.5, 0.9),  # thickness of the wall
@@ -440,7 +443,8 @@ def test_check_reports_the_body_diagnostics(tmp_path: Path) -> None:
 
 
 @settings(  # a compile per example; many random layouts have no deep way to the goal
-    max_examples=40, suppress_health_check=[HealthCheck.filter_too_much, HealthCheck.too_slow]
+    max_examples=max(10, settings().max_examples // 5),
+    suppress_health_check=[HealthCheck.filter_too_much, HealthCheck.too_slow],
 )
 @given(_rooms(), st.floats(0.05, 0.5), st.integers(0, 10**6))
 def test_margin_is_kept_where_the_geometry_allows(

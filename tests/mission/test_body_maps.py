@@ -18,13 +18,10 @@ import pytest
 import shapely
 import yaml
 from robot_data import require_shared
-from scipy import ndimage
 
 import tlmpc
 from tlmpc.importers.maps import ImportSettings, import_map
 
-#: The importer's default speck size (min_area), in cells.
-SPECK_CELLS = 4
 MARGIN = 0.1
 
 
@@ -57,11 +54,8 @@ def _obstacle_cells(map_yaml: Path) -> Any:
     image = _pgm(map_yaml.parent / meta["image"])
     shade = image.astype(float) / 255.0
     occupancy = shade if meta.get("negate", 0) else 1.0 - shade
+    # every non-free cell: a robot with a body keeps even the specks (a body can hit them)
     free = occupancy < float(meta["free_thresh"])
-    # specks: obstacle pieces under 4 cells are sensor noise the importer fills (min_area)
-    pieces, count = ndimage.label(~free, structure=np.ones((3, 3), dtype=bool))
-    sizes = np.bincount(pieces.ravel(), minlength=count + 1)
-    free |= (sizes[pieces] < SPECK_CELLS) & (pieces > 0)
     padded = np.pad(free, 1, constant_values=False)
     near_free = np.zeros_like(free)
     for dr in (-1, 0, 1):

@@ -7,6 +7,7 @@ import json
 import threading
 from pathlib import Path
 
+import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 from shapely import Polygon, union_all
@@ -166,11 +167,30 @@ def test_heartbeat_on_a_terminal() -> None:
     assert text.endswith("\r\033[K")
 
 
-def test_no_heartbeat_into_a_pipe() -> None:
+def test_no_heartbeat_for_a_short_stage() -> None:
     stream = io.StringIO()
-    with heartbeat("meshing", stream, first=0.0, every=0.01):
+    with heartbeat("meshing", stream, first=60.0):
         pass
     assert stream.getvalue() == ""
+
+
+def test_a_heartbeat_into_a_pipe_writes_whole_lines() -> None:
+    # not a terminal (a CI log, a file): lines, not a status line rewritten in place
+    stream = io.StringIO()
+    seen = threading.Event()
+
+    class Watch(io.StringIO):
+        def write(self, text: str) -> int:
+            if "running for" in text:
+                seen.set()
+            return stream.write(text)
+
+    with heartbeat("meshing", Watch(), first=0.0):
+        assert seen.wait(60)
+    lines = stream.getvalue().splitlines(keepends=True)
+    assert lines[0].startswith("… meshing: running for ")
+    assert lines[-1].startswith("… meshing: done in ")
+    assert all(line.endswith("\n") and "\r" not in line for line in lines)
 
 
 def test_a_narrow_gap_between_holes_is_reported_at_the_hole(tmp_path: Path) -> None:
@@ -180,3 +200,19 @@ def test_a_narrow_gap_between_holes_is_reported_at_the_hole(tmp_path: Path) -> N
     err = io.StringIO()
     assert main(["check", str(path)], out=io.StringIO(), err=err) == 0
     assert f"{path}:7: warning[G021]: a passage only 1e-05 wide at (5, " in err.getvalue()
+
+
+def test_compile_reports_long_stages_into_a_pipe_unless_quiet(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import tlmpc.base.progress as progress
+
+    monkeypatch.setattr(progress, "FIRST", 0.0)  # every stage counts as long
+    mission = Path(__file__).resolve().parents[2] / "specs" / "example1.yaml"
+    out = tmp_path / "out"
+    assert main(["compile", str(mission), "-o", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert "… abstraction: running for" in err or "… abstraction: done in" in err
+    assert "\r" not in err  # not a terminal: whole lines
+    assert main(["compile", str(mission), "-o", str(out), "-q"]) == 0
+    assert "…" not in capsys.readouterr().err

@@ -111,6 +111,7 @@ def test_random_bytes_never_crash(data: bytes) -> None:
         assert diagnostic.code[0] in "YSGLT"
 
 
+@pytest.mark.slow
 @settings(deadline=None)
 @given(
     st.dictionaries(

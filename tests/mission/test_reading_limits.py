@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import os
 from pathlib import Path
 
 import pytest
@@ -12,8 +13,9 @@ from hypothesis import strategies as st
 
 from tlmpc.base.errors import UsageError
 from tlmpc.mission import load
-from tlmpc.mission.geometry import check_layout, check_shape, shapely_polygon
+from tlmpc.mission.geometry import check_layout, check_shape
 from tlmpc.mission.load import check_text, inspect_file
+from tlmpc.mission.shapes import shapely_polygon
 from tlmpc.mission.yamlpos import MAX_DEPTH, MAX_NODES, load_positioned
 
 VALID = """\
@@ -33,11 +35,35 @@ def test_the_valid_mission_is_valid() -> None:
     assert codes(VALID) == []
 
 
-@pytest.mark.parametrize("depth", [MAX_DEPTH + 1, 30_000, 200_000])
+#: PyYAML's parsers: libyaml's (when built with it; 0.2.6 and later refuse 1,000 levels while
+#: scanning ahead) and the pure-Python one.  The limits are ours on either.
+LOADERS = [yaml.SafeLoader] + ([yaml.CSafeLoader] if yaml.__with_libyaml__ else [])
+
+
+@pytest.fixture(params=LOADERS, ids=lambda loader: loader.__name__)
+def loader(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> type:
+    monkeypatch.setattr("tlmpc.mission.yamlpos._LOADER", request.param)
+    return request.param  # type: ignore[no-any-return]
+
+
+@pytest.mark.usefixtures("loader")
+@pytest.mark.parametrize("depth", [MAX_DEPTH + 1, 999, 1_001, 30_000, 200_000])
 def test_deep_flow_nesting_is_y003_not_a_crash(depth: int) -> None:
     assert codes("a: " + "[" * depth + "]" * depth + "\n") == ["Y003"]
+    assert codes("a: " + "{a: " * depth + "1" + "}" * depth + "\n") == ["Y003"]
+    problems = check_text("b: 1\nc:\n  - " + "[" * depth + "\n", "m.yaml")
+    assert [(d.code, d.line) for d in problems] == [("Y003", 3)]
 
 
+@pytest.mark.usefixtures("loader")
+def test_nesting_within_the_limit_then_a_syntax_error_is_y001() -> None:
+    depth = MAX_DEPTH - 1
+    problems = check_text("a: " + "[" * depth + "]" * depth + "\nb: [1, 2\nc: 3\n", "m.yaml")
+    assert [d.code for d in problems] == ["Y001"]
+    assert codes("a: [1, 2]]\n") == ["Y001"]
+
+
+@pytest.mark.usefixtures("loader")
 def test_deep_block_nesting_is_y003() -> None:
     text = "".join(" " * i + f"k{i}:\n" for i in range(MAX_DEPTH + 5))
     assert codes(text) == ["Y003"]
@@ -134,13 +160,28 @@ def test_second_document_and_undefined_alias_are_y001() -> None:
     assert codes("a: *nowhere\n") == ["Y001"]
 
 
-def test_endless_file_is_refused_while_reading(monkeypatch: pytest.MonkeyPatch) -> None:
+def test_a_huge_file_is_refused_while_reading(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
     # (the memory bound is measured in a child process in test_big_missions)
     monkeypatch.setattr(load, "MAX_BYTES", 8 << 20)
+    huge = tmp_path / "huge.yaml"
+    with huge.open("wb") as stream:
+        stream.truncate(1 << 30)  # sparse: a gigabyte long, no disk used
     with pytest.raises(UsageError) as caught:
-        inspect_file(Path("/dev/zero"))
+        inspect_file(huge)
     assert caught.value.diagnostics[0].code == "U004"
     assert "8 MiB" in caught.value.diagnostics[0].message
+
+
+def test_devices_and_fifos_are_refused_at_once(tmp_path: Path) -> None:
+    fifo = tmp_path / "mission.yaml"
+    os.mkfifo(fifo)  # no writer: opening it for reading the usual way would block forever
+    for path in (Path("/dev/zero"), fifo, tmp_path):
+        with pytest.raises(UsageError) as caught:
+            inspect_file(path)
+        assert caught.value.diagnostics[0].code == "U001"
+        assert "not a regular file" in caught.value.diagnostics[0].message
 
 
 def test_a_file_of_exactly_the_limit_is_read(

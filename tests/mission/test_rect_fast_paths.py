@@ -18,8 +18,9 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from tlmpc.io.schema_check import load_schema
-from tlmpc.mission.geometry import CheckedShape, check_layout, check_shape
+from tlmpc.mission.geometry import check_layout, check_shape
 from tlmpc.mission.load import _plain_shape
+from tlmpc.mission.shapes import CheckedShape
 
 _EDGES = st.sampled_from(
     [0, 1, -1, 0.0, -0.0, 1e9, -1e9, 10**9, -(10**9), 10**9 + 1, 1e9 + 1e-6, True, False]

@@ -2,7 +2,7 @@
 lacks them, but never in CI (the ``CI`` environment variable set), where a missing oracle fails
 the test: a CI run must not pass by silently skipping the checks that give its tests teeth.
 
-SPIN time-outs are failures everywhere (``spin_runner.SpinError``), never skips.
+SPIN failures (``spin_runner.SpinError``) are failures everywhere, never skips.
 """
 
 from __future__ import annotations

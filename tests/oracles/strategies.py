@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 from hypothesis import strategies as st
@@ -10,11 +11,15 @@ from tlmpc.ltl.ast import (
     FALSE,
     TRUE,
     And,
+    BoundedEventually,
+    BoundedGlobally,
+    BoundedUntil,
     Equiv,
     Eventually,
     Formula,
     Globally,
     Implies,
+    Interval,
     Not,
     Or,
     Prop,
@@ -134,3 +139,33 @@ def missions_with_template(
 def missions() -> st.SearchStrategy[dict[str, Any]]:
     """Random mission documents (see :func:`missions_with_template`)."""
     return missions_with_template().map(lambda pair: pair[0])
+
+
+lows = st.sampled_from([0.0, 0.25, 0.5, 1.0])
+widths = st.sampled_from([0.0, 0.25, 0.5, 1.0, 2.0, math.inf])
+intervals = st.builds(lambda low, width: Interval(low, low + width), lows, widths)
+
+
+def bounded_formulas(
+    props: tuple[str, ...] = ("a", "b"), max_leaves: int = 6
+) -> st.SearchStrategy[Formula]:
+    """Random formulas over ``props`` with time bounds (multiples of a quarter second) and
+    the untimed operators."""
+    leaves = st.one_of(st.sampled_from([Prop(p) for p in props]), st.sampled_from([TRUE, FALSE]))
+
+    def extend(inner: st.SearchStrategy[Formula]) -> st.SearchStrategy[Formula]:
+        return st.one_of(
+            st.builds(BoundedEventually, inner, intervals),
+            st.builds(BoundedGlobally, inner, intervals),
+            st.builds(BoundedUntil, inner, inner, intervals),
+            st.builds(Not, inner),
+            st.builds(lambda a, b: And((a, b)), inner, inner),
+            st.builds(lambda a, b: Or((a, b)), inner, inner),
+            st.builds(Implies, inner, inner),
+            st.builds(Eventually, inner),
+            st.builds(Globally, inner),
+            st.builds(Until, inner, inner),
+            st.builds(Release, inner, inner),
+        )
+
+    return st.recursive(leaves, extend, max_leaves=max_leaves)

@@ -71,6 +71,7 @@ def _agree(mission: FaceMap, tmp: Path, record: Callable[[str], None] = lambda _
     return found
 
 
+@pytest.mark.slow
 @settings(
     max_examples=max(10, settings().max_examples // 4),
     suppress_health_check=[

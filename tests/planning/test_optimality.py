@@ -98,10 +98,12 @@ rects = st.tuples(st.integers(0, 8), st.integers(0, 6), st.integers(1, 3), st.in
     st.lists(rects, min_size=3, max_size=3),
     st.booleans(),
     st.sampled_from(["length", "hops"]),
-    st.sampled_from([0.5, 1.0, 3.0]),
+    st.floats(0.05, 20.0, allow_nan=False),  # the whole range: beta weighs every cycle edge
 )
 # Adjacent regions and a heavy cycle weight: the first cycle closed is not the cheapest.
 @example("patrol a, b", [(0, 0, 1, 2), (1, 0, 1, 2), (0, 0, 1, 1)], False, "hops", 3.0)
+# A light cycle weight: the closing edge must be weighed by beta like the rest of the cycle.
+@example("patrol a, b", [(0, 0, 2, 2), (1, 1, 1, 1), (0, 0, 1, 1)], False, "length", 0.125)
 def test_witness_cost_is_the_brute_force_minimum(
     task: str, regions: list[tuple[int, int, int, int]], hole: bool, cost: str, beta: float
 ) -> None:

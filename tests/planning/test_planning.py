@@ -177,7 +177,7 @@ def spin_and_ours(
     abstraction = build_abstraction(m)
     model = tmp_path / "model.pml"
     model.write_text(to_promela(abstraction, m.formula, bounce=bounce))
-    trail = spin.run_spin(model, shortest=True, timeout=120, max_depth=100_000)
+    trail = spin.run_spin(model, shortest=True, max_depth=100_000)
     automaton = translate(m.formula, letters=abstraction.letters)
     try:
         witness = plan(
@@ -198,6 +198,7 @@ def check_spin_trail(abstraction: Any, trail: spin.SpinTrail, *, bounce: bool) -
     return bounces
 
 
+@pytest.mark.slow
 @needs_spin
 @pytest.mark.parametrize(
     ("task", "holes", "start", "co_safe"),  # co_safe None: no plan
@@ -266,8 +267,12 @@ def test_example8_plan_is_found(specs_dir: Path) -> None:
     assert isinstance(m.options, Options)
 
 
+@pytest.mark.slow
 @needs_spin
-@settings(max_examples=8, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(
+    max_examples=max(2, settings().max_examples // 25),  # 8 in CI: a SPIN run per example
+    suppress_health_check=[HealthCheck.function_scoped_fixture],
+)
 @given(drawn=missions_with_template())
 def test_spin_agrees_on_random_missions(
     drawn: tuple[dict[str, Any], str], tmp_path_factory: pytest.TempPathFactory

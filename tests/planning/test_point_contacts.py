@@ -141,6 +141,7 @@ def corner_maps(draw: st.DrawFn) -> tuple[dict[str, list[tuple[float, float]]], 
     return regions, start
 
 
+@pytest.mark.slow
 @settings(
     deadline=None,
     max_examples=max(8, settings().max_examples // 4),
@@ -263,6 +264,7 @@ def test_the_closed_oracles_rewrite_is_the_continuous_definition(
     assert accepted == closed_holds(task, word, is_point, loop, 0), (to_text(task), lasso)
 
 
+@pytest.mark.slow
 @settings(
     deadline=None,
     max_examples=max(4, settings().max_examples // 16),

@@ -152,6 +152,7 @@ def test_runs_pushed_above_the_bound_recover_and_still_satisfy_the_task() -> Non
     assert recovered > 0, "pushes this strong must throw the robot off its plan"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", SHIPPED)
 def test_a_unicycle_satisfies_the_shipped_spec(name: str) -> None:
     compiled = _compiled(name, model="unicycle", offset=0.1)
@@ -160,6 +161,7 @@ def test_a_unicycle_satisfies_the_shipped_spec(name: str) -> None:
         _check_satisfied(run)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("model", ["random", "adversarial"])
 def test_a_disturbed_unicycle_satisfies_its_task(model: str) -> None:
     compiled = _compiled("patrol", model="unicycle", offset=0.1, disturbance=0.1)

@@ -8,9 +8,9 @@ from pathlib import Path
 
 import jsonschema
 import pytest
-from tlmpc.io.schema_check import load_schema
 
 from tlmpc.cli import main
+from tlmpc.io.schema_check import load_schema
 
 REALIZABLE = """\
 # the system copies the request one step later and must grant infinitely often

@@ -148,6 +148,7 @@ def _chains(steps: list[list[str]], last_leg: str | None) -> str:
     return " & ".join(parts)
 
 
+@pytest.mark.slow
 @given(sequences())
 def test_sequences_never_weaken_a_visible_avoidance(
     case: tuple[str, list[list[str]], list[str], bool],
@@ -162,6 +163,7 @@ def test_sequences_never_weaken_a_visible_avoidance(
     assert not mine.translate().is_empty(), phrase
 
 
+@pytest.mark.slow
 @given(sequences())
 def test_sequences_are_every_chain_in_order(
     case: tuple[str, list[list[str]], list[str], bool],

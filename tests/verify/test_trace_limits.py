@@ -79,12 +79,13 @@ def test_csv_limits_are_checked_before_parsing(tmp_path: Path) -> None:
     code, _, err = run_cli("verify", str(wide), "--mission", mission)
     assert code == 2
     assert "error[U038]" in err
+    # A log past the whole-log limits is streamed in constant memory instead of refused.
     long = tmp_path / "long.csv"
     with long.open("w") as stream:
-        stream.write("0,1,1\n" * (MAX_CSV_ROWS + 1))
+        stream.writelines(f"{k},1,1\n" for k in range(MAX_CSV_ROWS + 1))
     code, _, err = run_cli("verify", str(long), "--mission", mission)
-    assert code == 2
-    assert "error[U038]" in err
+    assert code in (0, 1, 4), err
+    assert f"streamed ({MAX_CSV_ROWS + 1:,} samples, 2 kept)" in err
     ok = tmp_path / "ok.csv"
     ok.write_text("t,x,y\n0,1.5,1.5\n1,1.6,1.6\n")
     code, _, err = run_cli("verify", str(ok), "--mission", mission)

@@ -27,6 +27,7 @@ def _document(regions: dict[str, Any]) -> dict[str, Any]:
     }
 
 
+@pytest.mark.slow
 @given(st.dictionaries(st.from_regex(r"[a-z][a-z0-9_]{0,5}", fullmatch=True), polygon))
 def test_regions_are_their_points(regions: dict[str, list[list[float]]]) -> None:
     read = from_document(_document(regions)).regions

@@ -13,7 +13,8 @@ from hypothesis import strategies as st
 from lasso_ltl import holds
 
 from tlmpc.ltl.ast import And, Eventually, Formula, Globally, Not, Or, Prop, Until
-from tlmpc.verify.evaluate import lasso_truth
+from tlmpc.verify.evaluate import truth_atoms
+from tlmpc.verify.semantics import evaluate
 
 PROPS = ("a", "b", "c")
 leaves = st.sampled_from([Prop(p) for p in PROPS])
@@ -52,7 +53,8 @@ def _mtl_text(f: Formula) -> str:
 
 def _ours(formula: Formula, word: list[frozenset[str]], loop: int) -> bool:
     labels = np.array([[p in letter for p in PROPS] for letter in word], dtype=bool)
-    return bool(lasso_truth(formula, labels, list(PROPS), loop)[0])
+    lo, _ = evaluate(formula, truth_atoms(labels, list(PROPS)), labels.shape[0], loop)
+    return bool(lo[0] > 0)
 
 
 @settings(deadline=None)

@@ -67,17 +67,18 @@ class Browser:
     def _connect(self) -> Any:
         import websocket
 
+        # No time limits: the browser either writes its port or exits (a hang is the CI job's
+        # to stop, never a verdict that depends on the machine's load).
         port_file = Path(self.profile.name) / "DevToolsActivePort"
-        deadline = time.monotonic() + 60
         while not port_file.exists() or not port_file.read_text().strip():
-            if time.monotonic() > deadline or self.process.poll() is not None:
+            if self.process.poll() is not None:
                 raise RuntimeError("chromium did not start")
             time.sleep(0.05)
         port = port_file.read_text().split()[0]
-        with urllib.request.urlopen(f"http://127.0.0.1:{port}/json/list", timeout=30) as reply:
+        with urllib.request.urlopen(f"http://127.0.0.1:{port}/json/list") as reply:
             targets = json.load(reply)
         page = next(t for t in targets if t.get("type") == "page")
-        return websocket.create_connection(page["webSocketDebuggerUrl"], timeout=60)
+        return websocket.create_connection(page["webSocketDebuggerUrl"])
 
     def _event(self, message: dict[str, Any]) -> None:
         method = message.get("method")
@@ -130,12 +131,8 @@ class Browser:
             self._socket.close()
         finally:
             group = self.process.pid  # the session this browser leads: only its own helpers
-            self.process.terminate()
-            try:
-                self.process.wait(timeout=20)
-            except subprocess.TimeoutExpired:
-                self.process.kill()
-                self.process.wait()
+            self.process.kill()  # its profile is a throw-away folder: nothing to save
+            self.process.wait()
             with contextlib.suppress(ProcessLookupError):
                 os.killpg(group, signal.SIGKILL)
             shutil.rmtree(self.profile.name, ignore_errors=True)

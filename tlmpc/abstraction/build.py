@@ -191,39 +191,132 @@ def _min_angle(corners: FloatArray) -> FloatArray:
 
 
 def abstraction_diagnostics(abstraction: Abstraction, mission: Mission) -> list[Diagnostic]:
-    """Warnings: regions that got no triangle, regions unreachable from the start."""
+    """Warnings: regions that got no triangle, regions unreachable from the start, a mesh far
+    larger than the layout suggests."""
     # Which letters occur (anywhere, and in the start's component): counts, not a sort.
     letters = len(abstraction.letters)
     used = np.flatnonzero(np.bincount(abstraction.letter_of, minlength=letters)).tolist()
-    start_component = abstraction.component[abstraction.start]
-    near_start = abstraction.letter_of[abstraction.component == start_component]
+    joined = _touching_components(abstraction)
+    near_start = abstraction.letter_of[joined == joined[abstraction.start]]
     reachable = np.flatnonzero(np.bincount(near_start, minlength=letters)).tolist()
     present = set(chain.from_iterable(map(abstraction.letters.__getitem__, used)))
     near = set(chain.from_iterable(map(abstraction.letters.__getitem__, reachable)))
     problems = []
-    for region in mission.regions:
-        if region.name not in present:
-            problems.append(
-                Diagnostic(
-                    code="A010",
-                    severity="warning",
-                    file=mission.source,
-                    message=f"region {region.name!r} got no triangle",
-                    hint="it lies outside the boundary or in holes, or is too thin to triangulate",
-                )
+    missing = [r for r in mission.regions if r.name not in present]
+    unreachable = [r for r in mission.regions if r.name in present and r.name not in near]
+    if len(missing) == 1:
+        problems.append(
+            Diagnostic(
+                code="A010",
+                severity="warning",
+                file=mission.source,
+                message=f"region {missing[0].name!r} got no triangle",
+                hint="it lies outside the boundary or in holes, or is too thin to triangulate",
             )
-        elif region.name not in near:
-            problems.append(
-                Diagnostic(
-                    code="A011",
-                    severity="warning",
-                    file=mission.source,
-                    message=f"region {region.name!r} is not reachable from "
-                    "the start: " + _separation(mission, region.polygon),
-                    hint="open a passage or move the start",
-                )
+        )
+    elif missing:
+        problems.append(
+            Diagnostic(
+                code="A010",
+                severity="warning",
+                file=mission.source,
+                message=f"{len(missing)} regions got no triangle: "
+                + _names([r.name for r in missing]),
+                hint="they lie outside the boundary or in holes, or are too thin to triangulate",
             )
+        )
+    if len(unreachable) == 1:
+        problems.append(
+            Diagnostic(
+                code="A011",
+                severity="warning",
+                file=mission.source,
+                message=f"region {unreachable[0].name!r} is not reachable from "
+                "the start: " + _separation(mission, unreachable[0].polygon),
+                hint="open a passage or move the start",
+            )
+        )
+    elif unreachable:
+        # One warning for all (a map with pockets inside its racks has dozens): each name with
+        # the piece it lies in.
+        places = [_piece_of(mission, r.polygon) for r in unreachable]
+        listed = _names(
+            [
+                f"{r.name} ({place})" if place else r.name
+                for r, place in zip(unreachable, places, strict=True)
+            ]
+        )
+        why = (
+            "each lies in a separate piece of free space (a workspace component) that the "
+            "robot cannot reach"
+            if all(places)
+            else "holes or separate pieces of free space keep the robot from them"
+        )
+        problems.append(
+            Diagnostic(
+                code="A011",
+                severity="warning",
+                file=mission.source,
+                message=f"{len(unreachable)} regions are not reachable from the start: "
+                f"{listed}; {why}",
+                hint="open a passage or move the start",
+            )
+        )
+    blowup = mesh_size_diagnostic(abstraction, mission)
+    if blowup is not None:
+        problems.append(blowup)
     return problems
+
+
+def _names(names: list[str], shown: int = 12) -> str:
+    """``a, b, c`` — the first ``shown`` of ``names`` and how many more."""
+    if len(names) <= shown:
+        return ", ".join(names)
+    return ", ".join(names[:shown]) + f" and {len(names) - shown} more"
+
+
+def _piece_of(mission: Mission, polygon: tuple[tuple[float, float], ...]) -> str | None:
+    """``workspace component K`` when the region lies in a piece the robot is not in."""
+    if not mission.workspace.components:
+        return None
+    from shapely.geometry import Point as ShapelyPoint
+    from shapely.geometry import Polygon as ShapelyPolygon
+
+    shape = ShapelyPolygon(polygon)
+    start = ShapelyPoint(mission.robot.start)
+    pieces = [ShapelyPolygon(p.boundary, p.holes) for p in mission.workspace.pieces]
+    inside = [k for k, piece in enumerate(pieces) if piece.intersection(shape).area > 0]
+    robot = next((k for k, piece in enumerate(pieces) if piece.covers(start)), None)
+    if not inside or robot in inside:
+        return None
+    return ", ".join("the main piece" if k == 0 else f"workspace component {k - 1}" for k in inside)
+
+
+def _touching_components(abstraction: Abstraction) -> Any:
+    """Each triangle's component, with components that share a mesh vertex merged: pieces
+    of free space that touch at a point are connected through it (a plan may pass through
+    the point, see docs/planning.md), so a region beyond such a point is reachable."""
+    component = np.asarray(abstraction.component, dtype=np.int64)
+    count = int(component.max()) + 1 if len(component) else 0
+    parent = list(range(count))
+
+    def root(c: int) -> int:
+        while parent[c] != c:
+            parent[c] = parent[parent[c]]
+            c = parent[c]
+        return c
+
+    # the components around each vertex: one row per (vertex, component) pair
+    pairs = np.unique(
+        np.stack([abstraction.triangles.ravel(), np.repeat(component, 3)], axis=1), axis=0
+    )
+    shared = np.flatnonzero(pairs[1:, 0] == pairs[:-1, 0])
+    for k in shared.tolist():
+        a, b = root(int(pairs[k, 1])), root(int(pairs[k + 1, 1]))
+        if a != b:
+            parent[max(a, b)] = min(a, b)
+    roots = np.array([root(c) for c in range(count)], dtype=np.int64)
+    return roots[component]
 
 
 def _separation(mission: Mission, polygon: tuple[tuple[float, float], ...]) -> str:
@@ -249,3 +342,59 @@ def _separation(mission: Mission, polygon: tuple[tuple[float, float], ...]) -> s
             + ") cannot reach"
         )
     return "holes separate it from the robot"
+
+
+#: A mesh more than this many times the layout's corners is suspicious: clean maps and the
+#: shipped missions give 2 to 5 triangles per corner of the workspace and regions.
+MESH_BLOWUP_FACTOR = 20
+#: ... and never below this many triangles (a small mission may refine freely).
+MESH_BLOWUP_MIN = 2000
+
+
+def _ring_area(ring: tuple[tuple[float, float], ...]) -> float:
+    return abs(
+        sum(x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in zip(ring, ring[1:] + ring[:1], strict=True))
+        / 2.0
+    )
+
+
+def mesh_size_diagnostic(abstraction: Abstraction, mission: Mission) -> Diagnostic | None:
+    """A warning (A012) when the mesh is far larger than the region layout suggests.
+
+    The layout suggests about as many triangles as the workspace's and regions' corners (or
+    the free area over ``max_area`` when that bound asks for more); far more means some
+    feature much smaller than the rest forces the quality mesh to refine around it — most
+    often a region corner or edge a hair (not exactly) on a wall.  The message names the
+    shortest mesh edge and where it is, which is where that feature lies.
+    """
+    rings = [p.boundary for p in mission.workspace.pieces]
+    rings += [h for p in mission.workspace.pieces for h in p.holes]
+    corners = sum(len(ring) for ring in rings) + sum(len(r.polygon) for r in mission.regions)
+    expected = float(corners)
+    if mission.options.max_area:
+        area = sum(_ring_area(p.boundary) for p in mission.workspace.pieces) - sum(
+            _ring_area(h) for p in mission.workspace.pieces for h in p.holes
+        )
+        expected = max(expected, area / mission.options.max_area)
+    count = abstraction.num_triangles
+    if count <= max(MESH_BLOWUP_MIN, MESH_BLOWUP_FACTOR * expected):
+        return None
+    corners_xy = abstraction.vertices[abstraction.triangles]  # (n, 3, 2)
+    sides = corners_xy[:, [1, 2, 0]] - corners_xy
+    lengths = np.hypot(sides[..., 0], sides[..., 1])
+    triangle, side = np.unravel_index(int(np.argmin(lengths)), lengths.shape)
+    a = corners_xy[triangle, side]
+    b = corners_xy[triangle, (side + 1) % 3]
+    x, y = ((a + b) / 2).tolist()
+    shortest = float(lengths[triangle, side])
+    return Diagnostic(
+        code="A012",
+        severity="warning",
+        file=mission.source,
+        message=f"the mesh has {count:,} triangles, {count / expected:.0f} times what the "
+        f"{corners:,} corners of the workspace and regions suggest: a feature as small as "
+        f"{shortest:.2g} near ({x:.6g}, {y:.6g}) forces the refinement",
+        hint="a region's corner or edge almost, but not exactly, on a wall or another "
+        "region's edge leaves a sliver the mesh must fill: put it exactly on the edge "
+        "(the same coordinates) or clearly away from it",
+    )

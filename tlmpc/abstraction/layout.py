@@ -1,9 +1,10 @@
 """The geometry the planner triangulates for a robot with a body and a margin.
 
-* **Free space**: the configuration space (free space eroded by the body radius) and, with a
-  margin m, eroded by m more; when the robot starts closer than that to a wall, the plain
-  configuration space is kept in a disc around the start (twice its way out, plus m), so it can
-  still leave the wall.
+* **Free space**: the configuration space (free space eroded by the body radius, exactly, plus
+  two steps of the snapping grid) and, with a margin m, eroded by m more; when the robot starts
+  closer than that to a wall (in the margin band, or exactly the radius away), the
+  configuration space without the grid's step is kept in a disc around the start (twice its
+  way out, plus m), so it can still leave the wall.
 * **Regions** keep their names, and the labels are the reference point's, but the shapes that
   label the triangles change with the task (its negation normal form):
 
@@ -30,11 +31,19 @@ import shapely
 from tlmpc.ltl.polarity import polarities
 from tlmpc.mission.body import ARC_SEGMENTS, conservative_offset, obstacle_offset
 from tlmpc.mission.cspace import erode, workspace_free_space
+from tlmpc.mission.grid import grid_size
 from tlmpc.mission.model import Mission
 
 #: A robot that starts in a margin band may use the band within this many times the distance
 #: out of it (the straight way out may be blocked; a wider disc leaves room to turn).
 ESCAPE = 2.0
+
+#: The erosion's allowance for snapping, in grid steps (see :func:`planning_layout`).
+SNAP_SLACK = 2.0
+
+#: ... and, however near the band's edge it starts, within this many grid steps of the start
+#: (a smaller patch would be a sliver of the grid's size in the mesh).
+START_ROOM = 1e3
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -68,18 +77,25 @@ def planning_layout(mission: Mission, margin: float) -> PlanningLayout | None:
     if radius <= 0.0 and margin <= 0.0:
         return None
     raw = workspace_free_space(mission)
-    cspace = erode(raw, radius)
-    free = cspace
+    # two steps of the snapping grid more: the free space is snapped, and then noded with the
+    # regions' rings, each moving a vertex by up to a step's half diagonal
+    grid = grid_size(mission)
+    free = erode(raw, radius + max(margin, 0.0), slack=SNAP_SLACK * grid)
     start = shapely.Point(mission.robot.start)
-    if margin > 0.0:
-        # the band is closed, except on the robot's way out of it when it starts there
-        free = erode(raw, radius + margin)
-        if not free.covers(start):
-            way_out = free.distance(start) if not free.is_empty else 0.0
-            near_start = start.buffer(
-                ESCAPE * way_out + conservative_offset(margin), quad_segs=ARC_SEGMENTS
-            )
-            free = shapely.make_valid(shapely.union(free, cspace.intersection(near_start)))
+    if not free.covers(start):
+        # The robot starts in the margin band, or exactly the radius from a wall (legal:
+        # R001 measures exactly): it may use the configuration space without the grid's
+        # slack in a disc around the start, twice its way out plus the margin, so that it
+        # can leave the band or the wall.
+        way_out = free.distance(start) if not free.is_empty else 0.0
+        reach = ESCAPE * way_out + conservative_offset(margin) + START_ROOM * grid
+        near_start = start.buffer(reach, quad_segs=ARC_SEGMENTS)
+        # only the obstacles near the start matter there: erode a window around it
+        x, y = mission.robot.start
+        half = reach + 2.0 * radius
+        window = raw.intersection(shapely.box(x - half, y - half, x + half, y + half))
+        exact = erode(window, radius, through=mission.robot.start)
+        free = shapely.make_valid(shapely.union(free, exact.intersection(near_start)))
     signs = polarities(mission.formula) if margin > 0.0 else {}
     shapes: list[Any] = []
     for region in mission.regions:

@@ -18,27 +18,28 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from tlmpc.base.content import ContentEquality
 from tlmpc.mission.model import Polygon
 
 IntArray = npt.NDArray[np.int64]
 FloatArray = npt.NDArray[np.float64]
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
-class Abstraction:
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
+class Abstraction(ContentEquality):
     """Triangles as states, shared edges as transitions, label sets as observations.
 
     ``triangles[t]`` holds vertex indices counter-clockwise; ``neighbors[t, i]`` is the
     triangle across the edge opposite vertex ``i`` (``-1`` at the boundary or a hole).
     """
 
-    vertices: FloatArray = field(compare=False)  # (n, 2)
-    triangles: IntArray = field(compare=False)  # (m, 3), counter-clockwise
-    neighbors: IntArray = field(compare=False)  # (m, 3), -1 for none
-    letter_of: IntArray = field(compare=False)  # (m,), index into letters
+    vertices: FloatArray  # (n, 2)
+    triangles: IntArray  # (m, 3), counter-clockwise
+    neighbors: IntArray  # (m, 3), -1 for none
+    letter_of: IntArray  # (m,), index into letters
     letters: tuple[tuple[str, ...], ...]
     start: int
-    component: IntArray = field(compare=False)  # (m,), connected component id
+    component: IntArray  # (m,), connected component id
     regions: Mapping[str, Polygon]
     stats: Mapping[str, Any] = field(default_factory=dict)
 

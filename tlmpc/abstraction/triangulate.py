@@ -100,8 +100,9 @@ def free_space(mission: Mission, grid: float) -> Any:
 
 
 def _snapped_free(free: Any, grid: float, mission: Mission) -> Any:
-    """A layout's free space on the grid (snapping moves a vertex by half a grid step, far
-    less than the slack :func:`~tlmpc.mission.body.conservative_offset` leaves)."""
+    """A layout's free space on the grid (snapping, and noding with the regions' rings, move
+    a vertex by at most a grid step's half diagonal each, less than the two grid steps the
+    layout's erosion adds)."""
     snapped = shapely.set_precision(free, grid)
     if snapped.is_empty:
         raise InvalidInputError(

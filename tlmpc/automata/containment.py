@@ -5,14 +5,15 @@ checks, the rules of its "High" level), decided with tlmpc's own translator.
 it has no edges.  Bottom-up, in every conjunction a conjunct implied by the others is dropped
 (``a & b = a`` when ``a ⊆ b``), in every disjunction a disjunct implied by the others is dropped,
 and a node equivalent to ``false`` / ``true`` becomes that constant.  Only small nodes over few
-propositions are checked, under a deadline; past it the formula is left as it is.
+propositions are checked, within a work budget (:mod:`tlmpc.automata.work`: the emptiness checks
+charge it); past it the formula is left as it is.
 """
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable
 
+from tlmpc.automata import work
 from tlmpc.ltl.ast import FALSE, TRUE, And, Formula, Not, Or, conjoin, disjoin
 
 #: Nodes with more operands, or formulas over more propositions, are not checked.
@@ -30,7 +31,7 @@ def simplify_by_containment(
 
 
 def _walk(formula: Formula, empty: Callable[[Formula], bool], deadline: float) -> Formula:
-    if not isinstance(formula, And | Or) or time.process_time() > deadline:
+    if not isinstance(formula, And | Or) or work.over(deadline):
         return formula
     args = [_walk(a, empty, deadline) for a in formula.args]
     if len(args) > MAX_OPERANDS:
@@ -39,7 +40,7 @@ def _walk(formula: Formula, empty: Callable[[Formula], bool], deadline: float) -
     kept = list(args)
     index = 0
     while index < len(kept) and len(kept) > 1:
-        if time.process_time() > deadline:
+        if work.over(deadline):
             break
         candidate = kept[index]
         others = kept[:index] + kept[index + 1 :]
@@ -54,6 +55,6 @@ def _walk(formula: Formula, empty: Callable[[Formula], bool], deadline: float) -
         else:
             index += 1
     result = conjoin(kept) if conjunction else disjoin(kept)
-    if time.process_time() <= deadline and empty(result if conjunction else Not(result)):
+    if not work.over(deadline) and empty(result if conjunction else Not(result)):
         return FALSE if conjunction else TRUE
     return result

@@ -17,11 +17,12 @@ edges carry every required mark and none of the forbidden ones.
 
 from __future__ import annotations
 
-import time
 from collections.abc import Sequence
 
+from tlmpc.automata import work
 from tlmpc.automata.model import Automaton
-from tlmpc.automata.simulation import Alphabet, OutOfTime
+from tlmpc.automata.simulation import Alphabet
+from tlmpc.base.graphs import csr, strong_components
 
 #: Products with more nodes are not searched (the inclusion is then not established).
 MAX_PRODUCT = 20_000
@@ -84,7 +85,7 @@ def has_accepting_cycle(
     nodes = [(left_initial, right_initial)]
     succ: list[list[tuple[int, int]]] = []
     for p, q in nodes:
-        if len(nodes) > MAX_PRODUCT or time.process_time() > deadline:
+        if len(nodes) > MAX_PRODUCT or work.over(deadline, 1 + len(left[p]) * len(right[q])):
             return None
         row: list[tuple[int, int]] = []
         for letters, bits, p2 in left[p]:
@@ -100,9 +101,7 @@ def has_accepting_cycle(
         succ.append(row)
     # Only edges without a forbidden mark may lie on the cycle.
     allowed = [[t for t, marks in row if marks & forbidden == 0] for row in succ]
-    from tlmpc.automata.simplify import strongly_connected  # simplify imports wdba
-
-    component = strongly_connected(allowed, range(len(nodes)))
+    component = strong_components(*csr(allowed))
     collected: dict[int, int] = {}
     for source, row in enumerate(succ):
         for target, marks in row:
@@ -159,5 +158,5 @@ def equivalent_to_deterministic(
             deadline=deadline,
         )
         return extra is False
-    except OutOfTime:
+    except work.OutOfBudget:
         return False

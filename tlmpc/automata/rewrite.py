@@ -39,10 +39,10 @@ fulfilled at once or never needed ``a``; with ¬a ⇒ b every position before th
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable
 from typing import assert_never
 
+from tlmpc.automata import work
 from tlmpc.automata.nnf import (
     FALSE,
     TRUE,
@@ -111,9 +111,10 @@ def rewrite(f: Node, empty: Callable[[Node], bool] | None = None, deadline: floa
 
     With ``empty`` (a language-emptiness oracle), an implication the syntactic check misses is
     also decided semantically (``a ⇒ b`` iff ``a & !b`` is empty), and a temporal node whose
-    language is empty (or universal) becomes ``false`` (``true``); only until ``deadline`` (a
-    ``time.process_time`` value), on formulas over at most :data:`MAX_SEMANTIC_APS`
-    propositions and nodes of at most :data:`MAX_SEMANTIC_OPERANDS` operands."""
+    language is empty (or universal) becomes ``false`` (``true``); only until the work
+    count (:mod:`tlmpc.automata.work`) passes ``deadline``, on formulas over at most
+    :data:`MAX_SEMANTIC_APS` propositions and nodes of at most :data:`MAX_SEMANTIC_OPERANDS`
+    operands."""
     return _Rewriter(empty, deadline).run(f)
 
 
@@ -125,7 +126,7 @@ class _Rewriter:
         self.semantic_memo: dict[tuple[Node, Node], bool] = {}
 
     def semantic(self) -> bool:
-        return self.empty is not None and time.process_time() < self.deadline
+        return self.empty is not None and not work.over(self.deadline)
 
     def implies(self, f: Node, g: Node, *, small: bool = True) -> bool:
         if implies(f, g):

@@ -4,13 +4,13 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-import time
 from collections import defaultdict
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Sequence
 
-from tlmpc.automata import simulation, wdba
+from tlmpc.automata import simulation, wdba, work
 from tlmpc.automata.guards import holds
 from tlmpc.automata.model import Automaton, Edge
+from tlmpc.base.graphs import csr, strong_components
 from tlmpc.ltl.ast import TRUE, And, Formula, Not, Or, Prop, conjoin, disjoin
 
 #: Guards with more cubes than this are left unabsorbed (the check is quadratic).
@@ -77,60 +77,12 @@ def _absorb(guards: list[Formula]) -> list[Formula]:
 
 
 def sccs(num_states: int, edges: Sequence[Edge], initial: int) -> list[int]:
-    """SCC id of every state reachable from ``initial`` (-1 for unreachable); iterative Tarjan."""
+    """SCC id of every state reachable from ``initial`` (-1 for unreachable), in Tarjan's
+    order (see :func:`tlmpc.base.graphs.strong_components`)."""
     succ: list[list[int]] = [[] for _ in range(num_states)]
     for edge in edges:
         succ[edge.src].append(edge.dst)
-    return strongly_connected(succ, [initial])
-
-
-def strongly_connected(succ: Sequence[Sequence[int]], roots: Iterable[int]) -> list[int]:
-    """SCC id of every state reachable from ``roots`` (-1 for the others), in Tarjan's order
-    (a component's id is smaller than those of the components that reach it).  Iterative, so
-    long chains cannot exhaust the interpreter's stack."""
-    num_states = len(succ)
-    index = [-1] * num_states
-    low = [0] * num_states
-    on_stack = [False] * num_states
-    component = [-1] * num_states
-    stack: list[int] = []
-    counter = 0
-    count = 0
-    for root in roots:
-        if index[root] != -1:
-            continue
-        work: list[tuple[int, int]] = [(root, 0)]
-        while work:
-            node, child = work.pop()
-            if child == 0:
-                index[node] = low[node] = counter
-                counter += 1
-                stack.append(node)
-                on_stack[node] = True
-            recursed = False
-            for position in range(child, len(succ[node])):
-                target = succ[node][position]
-                if index[target] == -1:
-                    work.append((node, position + 1))
-                    work.append((target, 0))
-                    recursed = True
-                    break
-                if on_stack[target]:
-                    low[node] = min(low[node], index[target])
-            if recursed:
-                continue
-            if low[node] == index[node]:
-                while True:
-                    member = stack.pop()
-                    on_stack[member] = False
-                    component[member] = count
-                    if member == node:
-                        break
-                count += 1
-            if work:
-                parent = work[-1][0]
-                low[parent] = min(low[parent], low[node])
-    return component
+    return strong_components(*csr(succ), [initial])
 
 
 def trim(automaton: Automaton, *, keep_transient_marks: bool = False) -> Automaton:
@@ -422,7 +374,7 @@ def reduce_by_simulation(
             sccs(stripped.num_states, stripped.edges, stripped.initial),
             deadline,
         )
-    except simulation.OutOfTime:
+    except work.OutOfBudget:
         pass
     return current
 
@@ -472,8 +424,8 @@ def _simulation_round(
     return drop(current, alphabet, relation, deadline)
 
 
-#: CPU seconds the other starting points of :func:`postprocess` always get under a share.
-START_FLOOR = 0.05
+#: Work units the other starting points of :func:`postprocess` always get under a share.
+START_FLOOR = 200_000
 
 
 def postprocess(
@@ -492,22 +444,22 @@ def postprocess(
     order of the steps and on the marks of the edges between SCCs (which do not change the
     language, but do change which states simulate which).  Each start is a correct automaton
     of the same language, so the smallest result is too.  With ``start_share``, the other
-    starts together get at most that multiple of the first reduction's CPU time (but at least
+    starts together get at most that multiple of the first reduction's work (but at least
     :data:`START_FLOOR`), and skip the WDBA step (a planner's translation: a few states
     seldom pay for a slower compile)."""
-    started = time.process_time()
+    started = work.spent()
     best = reduce_automaton(automaton, letters, deadline, obligation=obligation, verify=verify)
     limit = deadline if deadline is not None else float("inf")
     if start_share is not None:
         # Never less than START_FLOOR: small automata (most missions) then always get every
         # start, so their result does not depend on the machine's speed.
-        share = max(start_share * (time.process_time() - started), START_FLOOR)
-        limit = min(limit, time.process_time() + share)
-    first = time.process_time() - started
+        share = max(start_share * (work.spent() - started), START_FLOOR)
+        limit = min(limit, work.spent() + share)
+    first = work.spent() - started
     for start in STARTS:
         # A start costs about what the first reduction did: none begins that cannot end
         # before the limit (so the limit is not overrun by the steps that do not check it).
-        if best.num_states <= 1 or time.process_time() + first > limit:
+        if best.num_states <= 1 or work.spent() + first > limit:
             break
         candidate = reduce_automaton(
             start(automaton, letters, limit),
@@ -549,7 +501,7 @@ def _simulated_as_built(
                 current, alphabet, deadline, saturated=None, reverse=reverse
             )
             current = merge_parallel_automaton(current)
-    except simulation.OutOfTime:
+    except work.OutOfBudget:
         pass
     return current
 
@@ -587,7 +539,8 @@ def reduce_automaton(
     verify: Callable[[Automaton, Automaton], bool] | None = None,
 ) -> Automaton:
     """Trim, prune SCCs, reduce acceptance sets and merge equivalent states (to a fixpoint),
-    then reduce by direct simulation while ``deadline`` (a ``time.process_time`` value) allows.
+    then reduce by direct simulation while the work count (:mod:`tlmpc.automata.work`) is under
+    ``deadline``.
 
     Then the minimized weak deterministic automaton replaces the result: for a syntactic
     ``obligation`` when it is not larger, otherwise when it has fewer states and
@@ -610,7 +563,7 @@ def reduce_automaton(
         if (current.num_states, len(current.edges), current.num_acc) == before:
             break
     for _ in range(4):
-        if deadline is not None and time.process_time() > deadline:
+        if deadline is not None and work.over(deadline):
             break
         before = (current.num_states, len(current.edges), current.num_acc)
         current = reduce_by_simulation(
@@ -623,13 +576,13 @@ def reduce_automaton(
         if (current.num_states, len(current.edges), current.num_acc) == before:
             break
     worth_trying = obligation or (verify is not None and current.num_states > 1)
-    if worth_trying and (deadline is None or time.process_time() < deadline):
+    if worth_trying and (deadline is None or not work.over(deadline)):
         candidate = wdba.minimize_obligation(
             current, letters, deadline if deadline is not None else float("inf")
         )
         if candidate is not None:
             candidate = _merge_states(_reduce_marks(trim(candidate)), letters)
-            if deadline is None or time.process_time() < deadline:
+            if deadline is None or not work.over(deadline):
                 # States on no cycle were told apart from the rest by the minimization's
                 # acceptance flag, which does not matter for them: simulation merges them.
                 reduced = reduce_by_simulation(

@@ -22,17 +22,17 @@ sets, and the states matching an edge on an atom come from precomputed predecess
 Edges that lie on no cycle are taken at most once by a run, so their marks do not matter; they
 are given every mark first ("saturation"), which lets them dominate and be dominated more often.
 
-Every step checks a deadline; when it passes, the automaton reduced so far (always correct) is
-returned.
+Every step charges its work to a budget (:mod:`tlmpc.automata.work`, about one unit per edge
+visited); when it runs out, the automaton reduced so far (always correct) is returned.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import time
 from collections import defaultdict
 from collections.abc import Sequence
 
+from tlmpc.automata import work
 from tlmpc.automata.cover import cover_formula
 from tlmpc.automata.model import Automaton, Edge
 from tlmpc.ltl.ast import And, Const, Formula, Not, Or, Prop, disjoin
@@ -113,15 +113,6 @@ class Alphabet:
             others &= ~(1 << valuation)
         # Valuations that are no letter may go either way (no run reads them).
         return cover_formula(self.aps, lower, lower | others)
-
-
-class OutOfTime(Exception):
-    """The reduction's deadline passed."""
-
-
-def _check(deadline: float) -> None:
-    if time.process_time() > deadline:
-        raise OutOfTime
 
 
 def _bits(marks: frozenset[int]) -> int:
@@ -222,6 +213,7 @@ def simulation(
     n = automaton.num_states
     out: list[list[tuple[int, int, int]]] = [[] for _ in range(n)]
     every = (1 << automaton.num_acc) - 1
+    work.charge(deadline, n + len(automaton.edges))
     for e in automaton.edges:
         out[e.src].append((alphabet.mask(e.guard), _bits(e.marks), e.dst))
     answers = out
@@ -251,7 +243,7 @@ def simulation(
     for letters in {
         letters for edges in (out, answers) for row in edges for letters, _m, _d in row
     }:
-        _check(deadline)
+        work.charge(deadline, len(atoms))
         split = []
         for atom in atoms:
             inside = atom & letters
@@ -269,6 +261,7 @@ def simulation(
     # least those marks.
     pre: dict[tuple[int, int], list[int]] = {}
     for q in range(n):
+        work.charge(deadline, len(answers[q]) * len(atoms) * len(needed_marks))
         for letters, other_marks, target in answers[q]:
             for index, atom in enumerate(atoms):
                 if not atom & letters:
@@ -282,13 +275,14 @@ def simulation(
     changed = True
     while changed:
         changed = False
-        _check(deadline)
+        work.charge(deadline)
         # Predecessors (on an atom, with marks) of the simulators of a target, this sweep.
         memo: dict[tuple[int, int, int], int] = {}
         for p in range(n):
             current = simulators[p]
             if current == 1 << p:
                 continue
+            work.charge(deadline, 1 + len(out[p]))
             for letters, marks, target in out[p]:
                 good = simulators[target]
                 for index in atom_ids[letters]:
@@ -312,7 +306,6 @@ def simulation(
             if current != simulators[p]:
                 simulators[p] = current
                 changed = True
-                _check(deadline)
     return [[q == p or bool(simulators[p] >> q & 1) for q in range(n)] for p in range(n)]
 
 
@@ -354,10 +347,8 @@ def prune(
     kept: list[Edge] = []
     for src, edges in out.items():
         facts = [(alphabet.mask(e.guard), _bits(e.marks), e.dst) for e in edges]
-        _check(deadline)
         for e, (letters, marks, target) in zip(edges, facts, strict=True):
-            if len(facts) > 64:
-                _check(deadline)
+            work.charge(deadline, len(facts))
             better = 0
             for other_letters, other_marks, other_target in facts:
                 if marks & ~other_marks or not sim[target][other_target]:
@@ -415,9 +406,10 @@ def merge_transient(
         for q in range(n):
             if q == p or q in removed or not (relation[p][q] and relation[q][p]):
                 continue
+            work.charge(deadline, n)  # the search of _reaches
             if _reaches(succ, q, p):
                 continue
-            _check(deadline)
+            work.charge(deadline, len(edges))
             edges = [
                 e if e.dst != p else Edge(src=e.src, dst=q, guard=e.guard, marks=e.marks)
                 for e in edges

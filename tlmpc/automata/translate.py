@@ -11,16 +11,15 @@ are dropped, and states with the same outgoing behaviour are merged.  See docs/a
 from __future__ import annotations
 
 import dataclasses
-import time
 from collections.abc import Iterable, Sequence
 
+from tlmpc.automata import work
 from tlmpc.automata.containment import simplify_by_containment
 from tlmpc.automata.emptiness import equivalent_to_deterministic
 from tlmpc.automata.model import Automaton, Edge
 from tlmpc.automata.nnf import FALSE, Node
 from tlmpc.automata.rewrite import MAX_SEMANTIC_APS, rewrite
-from tlmpc.automata.simplify import postprocess, strongly_connected
-from tlmpc.automata.simulation import OutOfTime
+from tlmpc.automata.simplify import postprocess
 from tlmpc.automata.terms import (
     Expansion,
     cube_allowed,
@@ -32,24 +31,29 @@ from tlmpc.automata.terms import (
     to_text,
 )
 from tlmpc.automata.wdba import is_obligation
+from tlmpc.automata.work import OutOfBudget
+from tlmpc.base.graphs import csr, strong_components
 from tlmpc.ltl.ast import Formula, Not, Prop, conjoin
+from tlmpc.ltl.bounds import refuse_bounds
 from tlmpc.ltl.printer import to_text as formula_text
 from tlmpc.ltl.transform import nnf
 
-#: Seconds of optional reduction work per translation (see :func:`translate`).
-DEFAULT_BUDGET = 0.5
+#: Work units (:mod:`tlmpc.automata.work`) of optional reduction work per translation (see
+#: :func:`translate`).  The budgets were seconds of CPU time once; a unit is about a fourth of a
+#: microsecond of it (measured over Spot's random formulas), so this was half a second.
+DEFAULT_BUDGET = 2_000_000
 #: Over a map's letters (the planner's translation), the post-processing's other starting
-#: points together get at most this multiple of the first reduction's time.
+#: points together get at most this multiple of the first reduction's work.
 PLANNER_START_SHARE = 0.5
-#: At most this long for the language-containment simplification of the formula.
-CONTAINMENT_BUDGET = 0.2
+#: At most this much work for the language-containment simplification of the formula.
+CONTAINMENT_BUDGET = 800_000
 
 #: Emptiness checks of the rewriting give up (answer "not shown empty") past this many states.
 MAX_EMPTINESS_STATES = 400
 
-#: At most this long for each equivalence check of a WDBA-minimized automaton (a formula that
-#: is not a syntactic obligation may still have one; the check decides).
-WDBA_CHECK_BUDGET = 0.1
+#: At most this much work for each equivalence check of a WDBA-minimized automaton (a formula
+#: that is not a syntactic obligation may still have one; the check decides).
+WDBA_CHECK_BUDGET = 400_000
 
 #: Above this many expansion terms in one state, dominated terms are left to the simulation.
 MAX_DOMINATION_TERMS = 600
@@ -124,7 +128,7 @@ def translate(
     *,
     letters: Sequence[Sequence[str]] | None = None,
     simplify: bool = True,
-    budget: float | None = DEFAULT_BUDGET,
+    budget: int | None = DEFAULT_BUDGET,
     containment: bool = True,
 ) -> Automaton:
     """Translate ``formula`` (no X) into a TGBA.
@@ -135,11 +139,13 @@ def translate(
             true at once; all others false).  Edges no letter enables are dropped and states are
             merged with respect to these letters only.
         simplify: run the post-processing (trim, SCC pruning, merging).
-        budget: seconds of CPU time (of this process, so that other load on the machine
-            does not change the result) after which the optional reductions (simulation) stop
-            and the automaton reduced so far, which is always correct, is returned; None = no
-            limit.
+        budget: work units (:mod:`tlmpc.automata.work`: counted operations, never time, so
+            that the result is the same on any machine under any load) after which the
+            optional reductions (simulation) stop and the automaton reduced so far, which is
+            always correct, is returned; None = no limit.
+        containment: simplify the formula by language containment first.
     """
+    refuse_bounds(formula, purpose="the automaton translation")
     return _translate(
         formula, letters=letters, simplify=simplify, budget=budget, containment=containment
     )
@@ -155,9 +161,9 @@ def _translate(
     check_wdba: bool = True,
     explore_deadline: float | None = None,
 ) -> Automaton:
-    """:func:`translate`; with ``explore_deadline``, :class:`OutOfTime` is raised when the raw
-    automaton is not built by then (for the optional checks that need one)."""
-    started = time.process_time()
+    """:func:`translate`; with ``explore_deadline`` (a work count), :class:`OutOfBudget` is
+    raised when the raw automaton is not built by then (for the optional checks that need one)."""
+    started = work.spent()
     deadline = None if budget is None else started + budget
     original = formula
     if simplify and containment:
@@ -167,7 +173,7 @@ def _translate(
         formula = simplify_by_containment(nnf(formula), lambda f: _is_empty(f, limit), limit)
     aps = tuple(sorted(original.props()))
     semantic = simplify and containment and len(aps) <= MAX_SEMANTIC_APS
-    rewrite_deadline = time.process_time() + (CONTAINMENT_BUDGET if budget is None else budget / 5)
+    rewrite_deadline = work.spent() + (CONTAINMENT_BUDGET if budget is None else budget / 5)
     root = rewrite(
         from_ast(formula),
         (lambda f: _is_empty_term(f, rewrite_deadline)) if semantic else None,
@@ -195,7 +201,7 @@ def _translate(
                 # The negation's automaton, itself without this check (no recursion), built
                 # within the check's own budget and the translation's deadline: past them
                 # the candidate is simply not proved equivalent.
-                limit = time.process_time() + WDBA_CHECK_BUDGET
+                limit: float = work.spent() + WDBA_CHECK_BUDGET
                 if deadline is not None:
                     limit = min(limit, deadline)
                 try:
@@ -208,9 +214,9 @@ def _translate(
                         check_wdba=False,
                         explore_deadline=limit,
                     )
-                except OutOfTime:
+                except OutOfBudget:
                     return False
-                limit = time.process_time() + WDBA_CHECK_BUDGET
+                limit = work.spent() + WDBA_CHECK_BUDGET
                 if deadline is not None:
                     limit = min(limit, deadline)
                 return equivalent_to_deterministic(reduced, candidate, negation, letter_sets, limit)
@@ -239,7 +245,8 @@ def _explore(
     deadline: float | None = None,
 ) -> Automaton:
     """The raw TGBA: states reached from ``initial`` by the expansion terms letters allow
-    (:class:`OutOfTime` past ``deadline``, when given)."""
+    (:class:`~tlmpc.automata.work.OutOfBudget` once the work count passes ``deadline``, when
+    given)."""
     event_index = {e: i for i, e in enumerate(events)}
     states: dict[State, int] = {}
     names: list[str] = []
@@ -249,12 +256,13 @@ def _explore(
         names.append(_state_name(initial))
         queue = [initial]
         while queue:
-            if deadline is not None and time.process_time() > deadline:
-                raise OutOfTime
             state = queue.pop()
             source = states[state]
+            expansion = _state_terms(state)
+            if deadline is not None:
+                work.charge(deadline, 1 + len(expansion))
             terms: list[tuple[Cube, State, frozenset[int]]] = []
-            for pos, neg, nxt, promises in _state_terms(state):
+            for pos, neg, nxt, promises in expansion:
                 target = simplify_state(nxt)
                 if target is None or not _letter_ok((pos, neg), letter_sets):
                     continue
@@ -306,12 +314,15 @@ def _is_empty_term(root: Node, deadline: float = float("inf")) -> bool:
         queue = [initial]
         graph: list[tuple[int, int, int]] = []
         while queue:
-            if len(states) > MAX_EMPTINESS_STATES or time.process_time() > deadline:
+            if len(states) > MAX_EMPTINESS_STATES:
                 return False
             state = queue.pop()
             source = states[state]
+            expansion = _state_terms(state)
+            if work.over(deadline, 1 + len(expansion)):
+                return False
             terms: list[tuple[Cube, State, frozenset[int]]] = []
-            for pos, neg, nxt, promises in _state_terms(state):
+            for pos, neg, nxt, promises in expansion:
                 target = simplify_state(nxt)
                 if target is None:
                     continue
@@ -330,7 +341,7 @@ def _is_empty_term(root: Node, deadline: float = float("inf")) -> bool:
     succ: list[list[int]] = [[] for _ in range(len(states))]
     for src, dst, _bits in graph:
         succ[src].append(dst)
-    component = strongly_connected(succ, [0])
+    component = strong_components(*csr(succ), [0])
     seen: dict[int, int] = {}
     for src, dst, bits in graph:
         if component[src] == component[dst]:
@@ -365,21 +376,28 @@ def _merge_adjacent(terms: list[Expansion]) -> list[Expansion]:
         return terms
     out: list[Expansion] = []
     for (nxt, prom), cubes in groups.items():
+        # In a canonical order (the cubes by their sorted literals, a cube's names sorted),
+        # not the sets' own: that order follows the string hashes, which differ from one
+        # process to the next, and which cubes merge first decides the result.
         changed = len(cubes) > 1
         while changed:
             changed = False
-            for pos, neg in list(cubes):
+            for pos, neg in sorted(cubes, key=_cube_key):
                 if (pos, neg) not in cubes:
                     continue
-                for name in pos:
+                for name in sorted(pos):
                     flipped = (pos - {name}, neg | {name})
                     if flipped in cubes:
                         cubes -= {(pos, neg), flipped}
                         cubes.add((pos - {name}, neg))
                         changed = True
                         break
-        out.extend(Expansion(pos, neg, nxt, prom) for pos, neg in cubes)
+        out.extend(Expansion(pos, neg, nxt, prom) for pos, neg in sorted(cubes, key=_cube_key))
     return out
+
+
+def _cube_key(cube: Cube) -> tuple[list[str], list[str]]:
+    return sorted(cube[0]), sorted(cube[1])
 
 
 def _undominated_partial(terms: list[Expansion]) -> list[Expansion]:

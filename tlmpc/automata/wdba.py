@@ -9,21 +9,22 @@ a DFA whose final states are those of accepting SCCs (for deterministic Büchi a
 with the same finite-word language to the final states accept the same infinite words).
 
 The caller must only pass automata of obligation formulas (:func:`is_obligation` on the
-formula); for other languages the subset construction is not sound.  Every step checks a deadline
-and gives up (None) rather than overrun it.
+formula); for other languages the subset construction is not sound.  Every step charges its work
+(:mod:`tlmpc.automata.work`) and gives up (None) rather than overrun the budget.
 """
 
 from __future__ import annotations
 
 import functools
-import time
 from collections import deque
 from collections.abc import Sequence
 from typing import assert_never
 
+from tlmpc.automata import work
 from tlmpc.automata.model import Automaton, Edge
 from tlmpc.automata.nnf import Always, Binary, Bottom, Conj, Disj, Finally, Neg, Node, Pos, Top
-from tlmpc.automata.simulation import Alphabet, OutOfTime
+from tlmpc.automata.simulation import Alphabet
+from tlmpc.base.graphs import csr, strong_components
 from tlmpc.ltl.ast import FALSE, Formula, Not, Prop, conjoin, disjoin
 
 #: Subset construction is abandoned past this many subsets (the input is kept).
@@ -75,11 +76,6 @@ def is_obligation(f: Node) -> bool:
     return False
 
 
-def _check(deadline: float) -> None:
-    if time.process_time() > deadline:
-        raise OutOfTime
-
-
 def minimize_obligation(
     automaton: Automaton,
     letters: Sequence[frozenset[str]] | None,
@@ -92,7 +88,7 @@ def minimize_obligation(
         return None
     try:
         return _minimize(automaton, letters, deadline)
-    except OutOfTime:
+    except work.OutOfBudget:
         return None
 
 
@@ -117,13 +113,13 @@ def _minimize(
                 succ[edge.src][letter].append((edge.dst, marks))
             mask >>= 1
             letter += 1
-    _check(deadline)
+    work.charge(deadline, len(automaton.edges) * size)
     start = frozenset([automaton.initial])
     index = {start: 0}
     subsets = [start]
     delta: list[list[int]] = []
     for subset in subsets:
-        _check(deadline)
+        work.charge(deadline, size * len(subset))
         row = []
         for letter in range(size):
             target = frozenset(d for q in subset for d, _m in succ[q][letter])
@@ -148,8 +144,9 @@ def _minimize(
         cycle = _cycle(delta, component, state)
         if cycle is None:
             continue  # trivial SCC
-        _check(deadline)
         prefix = _path(parent, state)
+        # the lasso's product with the automaton
+        work.charge(deadline, (len(prefix) + len(cycle)) * automaton.num_states)
         accepting_scc[c] = _accepts(succ, automaton.initial, prefix, cycle, everything)
     final = [accepting_scc.get(component[s], False) for s in range(n)]
     block = _moore(delta, final)
@@ -185,9 +182,7 @@ def _minimize(
 
 def _sccs(delta: list[list[int]]) -> list[int]:
     """SCC number of every state (a negative entry of ``delta`` is a missing transition)."""
-    from tlmpc.automata.simplify import strongly_connected  # simplify imports this module
-
-    return strongly_connected([[t for t in row if t >= 0] for row in delta], range(len(delta)))
+    return strong_components(*csr([[t for t in row if t >= 0] for row in delta]))
 
 
 def _bfs_tree(delta: list[list[int]]) -> list[tuple[int, int]]:

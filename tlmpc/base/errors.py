@@ -38,16 +38,35 @@ EXIT_INTERNAL = 3  # a bug or a solver failure
 EXIT_INCONCLUSIVE = 4  # ran fine, no answer yet: a log whose continuation decides (verify)
 
 
+#: Characters that reorder or break the text around them without being seen: Unicode
+#: direction controls (a name ``abc\u202etxt.exe`` shows as ``abcexe.txt``), and the line and
+#: paragraph separators some viewers break lines at.
+_INVISIBLE = frozenset(
+    "\u061c\u200e\u200f\u202a\u202b\u202c\u202d\u202e\u2066\u2067\u2068\u2069\u2028\u2029"
+)
+
+
+def is_unsafe_char(ch: str) -> bool:
+    """Whether ``ch`` is a control character (C0, DEL, C1) or an invisible direction or line
+    control: the characters no exported or printed name may carry as they are."""
+    return "\x00" <= ch < " " or "\x7f" <= ch <= "\x9f" or ch in _INVISIBLE
+
+
 def printable(text: str, keep: str = "\n\t") -> str:
-    """``text`` with control characters (C0 but ``keep``, DEL, C1) as ``\\xNN`` escapes."""
-    if text.isprintable() and not keep:
+    """``text`` with control characters (C0 but ``keep``, DEL, C1) and invisible direction and
+    line controls as ``\\xNN`` / ``\\uNNNN`` escapes.
+
+    The one sanitiser of everything tlmpc prints (diagnostics, hints, status lines) and of
+    names written into exported text: a hostile name can neither forge a line, drive the
+    terminal, nor reorder what is shown."""
+    if text.isprintable():  # no control character at all (newlines and tabs included)
         return text
-    return "".join(
-        ch
-        if ch in keep or not ("\x00" <= ch < " " or "\x7f" <= ch <= "\x9f")
-        else f"\\x{ord(ch):02x}"
-        for ch in text
-    )
+    return "".join(ch if ch in keep or not is_unsafe_char(ch) else _escaped(ch) for ch in text)
+
+
+def _escaped(ch: str) -> str:
+    code = ord(ch)
+    return f"\\x{code:02x}" if code < 0x100 else f"\\u{code:04x}"
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -79,12 +98,12 @@ class Diagnostic:
     def format(self) -> str:
         """The human form: ``FILE:LINE:COL: error[CODE]: message`` and an indented hint.
 
-        Control characters are escaped (newlines too, in the file name and message), so a
-        hostile file name can neither forge a diagnostic line nor drive the terminal."""
+        Control characters are escaped (newlines too, in the file name, message and hint), so
+        a hostile name can neither forge a diagnostic line nor drive the terminal."""
         location = printable(self.location(), keep="")
         text = f"{location}: {self.severity}[{self.code}]: {printable(self.message, keep='')}"
         if self.hint:
-            text += f"\n  hint: {printable(self.hint)}"
+            text += f"\n  hint: {printable(self.hint, keep='')}"
         return text
 
     def to_json(self) -> dict[str, Any]:

@@ -1,9 +1,16 @@
-"""Progress inside long stages: a heartbeat line on a terminal while a stage runs.
+"""Progress inside long stages: a line on standard error while a stage runs long.
 
-The stages themselves stay silent; while one runs longer than a moment, a background thread
-rewrites one status line (``\\r``) on stderr with the stage's name and the time spent, and clears
-it when the stage ends.  Only when stderr is a terminal: logs and pipes get the per-stage
-lines of ``tlmpc compile`` and nothing else.
+The stages themselves stay silent; while one runs longer than :data:`FIRST` seconds, a
+background thread reports it on stderr with the stage's name and the time spent:
+
+* on a terminal, one status line rewritten in place (``\\r``) every :data:`EVERY` seconds and
+  cleared when the stage ends;
+* anywhere else (a pipe, a CI log, a file), whole lines — ``… NAME: running for 2.0 s`` — the
+  first after :data:`FIRST` seconds and then at doubling intervals (2, 4, 8, 16 s ...), so a
+  long job's log shows that it is alive without being flooded, and ``… NAME: done in 9.3 s``
+  when the stage ends.
+
+Commands silence it with ``--quiet`` (they do not start it).
 """
 
 from __future__ import annotations
@@ -14,20 +21,20 @@ import time
 from collections.abc import Iterator
 from typing import TextIO
 
-#: Seconds before the first heartbeat, and between heartbeats.
-FIRST = 1.0
+#: Seconds before the first report, and between rewrites of a terminal's status line.
+FIRST = 2.0
 EVERY = 0.5
 
 
 @contextlib.contextmanager
 def heartbeat(
-    name: str, stream: TextIO, *, first: float = FIRST, every: float = EVERY
+    name: str, stream: TextIO, *, first: float | None = None, every: float = EVERY
 ) -> Iterator[None]:
-    """Show ``… NAME: 3.5 s`` on ``stream`` while the body runs (when it is a terminal)."""
+    """Report on ``stream`` while the body runs longer than ``first`` seconds (default
+    :data:`FIRST`)."""
+    first = FIRST if first is None else first
     isatty = getattr(stream, "isatty", None)
-    if isatty is None or not isatty():
-        yield
-        return
+    terminal = bool(isatty is not None and isatty())
     stop = threading.Event()
     started = time.perf_counter()
     shown = False
@@ -36,11 +43,18 @@ def heartbeat(
         nonlocal shown
         if stop.wait(first):
             return
+        wait = max(first, every)
         while True:
-            stream.write(f"\r… {name}: {time.perf_counter() - started:5.1f} s")
+            spent = time.perf_counter() - started
+            if terminal:
+                stream.write(f"\r… {name}: {spent:5.1f} s")
+            else:
+                stream.write(f"… {name}: running for {spent:.1f} s\n")
             stream.flush()
             shown = True
-            if stop.wait(every):
+            if not terminal:
+                wait *= 2  # 2, 4, 8, 16 s ... apart: alive, not flooding a log
+            if stop.wait(every if terminal else wait):
                 return
 
     thread = threading.Thread(target=beat, name=f"tlmpc-progress-{name}", daemon=True)
@@ -51,5 +65,8 @@ def heartbeat(
         stop.set()
         thread.join()
         if shown:
-            stream.write("\r\033[K")  # clear the status line
+            if terminal:
+                stream.write("\r\033[K")  # clear the status line
+            else:
+                stream.write(f"… {name}: done in {time.perf_counter() - started:.1f} s\n")
             stream.flush()

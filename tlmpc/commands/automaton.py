@@ -39,8 +39,10 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     from tlmpc.base.errors import EXIT_OK
     from tlmpc.io.report import Reporter
     from tlmpc.ltl import parse_ltl
+    from tlmpc.ltl.bounds import refuse_bounds
 
     formula = parse_ltl(args.formula, file="<formula>")
+    refuse_bounds(formula, file="<formula>", purpose="the automaton translation")
     started = time.perf_counter()
     automaton = translate(formula)
     if args.ba:

@@ -44,7 +44,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--json", action="store_true", help="print summary.json on stdout (as the result)"
     )
-    parser.add_argument("-q", "--quiet", action="store_true", help="no progress lines")
+    parser.add_argument(
+        "-q",
+        "--quiet",
+        action="store_true",
+        help="no progress lines (neither per stage nor while a long stage runs)",
+    )
 
 
 def _format_sizes(sizes: dict[str, object]) -> str:
@@ -75,6 +80,10 @@ def _run_locked(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
 
     reporter = Reporter.for_args(args, out, err)
     destination: Path = args.out
+    if args.png:  # before any stage runs: a missing extra is known at once
+        from tlmpc.base.extras import require
+
+        require("matplotlib.backends.backend_agg", "drawing a PNG figure (--png)")
     check_destination(destination, force=args.force)
     refuse_overwriting(destination, sorted(KNOWN_ARTIFACTS), args.mission)
     for note in clean_stale(destination):
@@ -94,7 +103,7 @@ def _run_locked(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         result = compile_mission(
             args.mission,
             until=args.until,
-            progress=progress,
+            progress=None if args.quiet else progress,  # --quiet: no heartbeat either
             figures=("svg", "png") if args.png else ("svg",),
         )
         reporter.diagnose(result.warnings)

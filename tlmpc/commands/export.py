@@ -33,10 +33,15 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     from tlmpc.base.errors import EXIT_OK, UsageError, error
     from tlmpc.io.artifacts import read_artifacts
     from tlmpc.io.outdir import replace_file
+    from tlmpc.io.outputs import refuse_input_as_output
     from tlmpc.ltl import parse_ltl
     from tlmpc.planning.export import to_dot_graph, to_promela, to_smv
 
     directory: Path = args.out
+    if args.output is not None:
+        refuse_input_as_output(
+            args.output, [directory / "abstraction.json", directory / "mission.json"]
+        )
     if args.output is not None and not args.output.parent.is_dir():
         raise UsageError(
             error(

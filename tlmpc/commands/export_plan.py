@@ -33,6 +33,20 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--frame-id", default="map", help="frame of the poses (default: map)")
     parser.add_argument("--topic", default="/plan", help="path-mcap: the topic (default: /plan)")
+    parser.add_argument(
+        "--georeference",
+        metavar="LAT,LON[,YAW]",
+        type=_georeference,
+        help="geojson: the map origin's WGS 84 latitude and longitude and the angle from east "
+        "to the map's x axis (degrees, counter-clockwise): coordinates become longitude, "
+        "latitude (RFC 7946) instead of the map's metres",
+    )
+
+
+def _georeference(text: str) -> object:
+    from tlmpc.exports.georeference import parse_georeference
+
+    return parse_georeference(text)
 
 
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
@@ -43,10 +57,26 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     from tlmpc.exports.formats import geojson, path_mcap, waypoints_csv, waypoints_yaml
     from tlmpc.exports.plan import read_plan, waypoints
     from tlmpc.io.outdir import replace_file
+    from tlmpc.io.outputs import has_unsafe_chars, plain_name, refuse_input_as_output
 
     if not math.isfinite(args.spacing) or args.spacing < 0:
         raise UsageError(
             error("M082", f"--spacing must be a non-negative number, got {args.spacing:g}")
+        )
+    for flag, value in (("--frame-id", args.frame_id), ("--topic", args.topic)):
+        if not value or has_unsafe_chars(value):
+            raise UsageError(
+                error(
+                    "M084",
+                    f"{flag} {plain_name(value)!r} is empty or holds control, newline or "
+                    "direction characters",
+                    hint=f"give a plain {flag} such as "
+                    + ("map" if flag == "--frame-id" else "/plan"),
+                )
+            )
+    if args.output is not None:
+        refuse_input_as_output(
+            args.output, [args.out / n for n in ("trace.json", "mission.json", "controllers.json")]
         )
     if args.output is not None and not args.output.parent.is_dir():
         raise UsageError(
@@ -55,6 +85,14 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
                 f"cannot write {args.output}: {args.output.parent} is not a directory",
                 hint="create the directory first",
                 file=str(args.output),
+            )
+        )
+    if args.georeference is not None and args.format != "geojson":
+        raise UsageError(
+            error(
+                "M086",
+                f"--georeference applies to geojson, not to {args.format}",
+                hint="the other formats are in the map frame, as a navigation stack expects",
             )
         )
     if args.format == "path-mcap" and args.output is None:
@@ -69,7 +107,17 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     elif args.format == "waypoints-csv":
         data = waypoints_csv(plan, points, loop).encode("utf-8")
     elif args.format == "geojson":
-        data = geojson(plan, points, loop).encode("utf-8")
+        try:
+            data = geojson(plan, points, loop, args.georeference).encode("utf-8")
+        except ValueError:  # a non-finite number, which JSON cannot hold
+            raise UsageError(
+                error(
+                    "M081",
+                    f"the plan in {args.out} holds a number that is not finite",
+                    hint="this output was edited or damaged; compile the mission again",
+                    file=str(args.out),
+                )
+            ) from None
     else:
         data = path_mcap(plan, points, args.topic, args.frame_id)
     from tlmpc.io.report import Reporter

@@ -47,6 +47,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--max-speed", type=float, default=1.0, help="robot max speed")
     parser.add_argument("--name", help="mission name (default: the map's file name)")
     parser.add_argument(
+        "-q", "--quiet", action="store_true", help="no progress lines while a long import runs"
+    )
+    parser.add_argument(
         "--region",
         action="append",
         nargs=5,
@@ -59,7 +62,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Import the map and write the mission."""
     from tlmpc.base.errors import EXIT_OK
     from tlmpc.importers.maps import ImportSettings, import_map
-    from tlmpc.importers.mission import mission_document, mission_yaml
+    from tlmpc.importers.mission import mission_document, mission_yaml, unfinished
     from tlmpc.io.outdir import replace_file
     from tlmpc.io.report import Reporter
 
@@ -69,7 +72,13 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         min_area=args.min_area,
         start=tuple(args.start) if args.start else None,
     )
-    imported = import_map(args.map, settings, keepout=args.keepout, speed=args.speed)
+    import contextlib
+    import sys
+
+    from tlmpc.base.progress import heartbeat
+
+    with contextlib.nullcontext() if args.quiet else heartbeat("import-map", sys.stderr):
+        imported = import_map(args.map, settings, keepout=args.keepout, speed=args.speed)
     document = mission_document(
         imported,
         name=args.name or args.map.stem,
@@ -79,7 +88,14 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         max_speed=args.max_speed,
         rects=_rects(args.region or []),
     )
+    if args.output is not None:
+        from tlmpc.io.outputs import refuse_input_as_output
+
+        refuse_input_as_output(args.output, [Path(name) for name in imported.inputs])
     text = mission_yaml(document)
+    missing = unfinished(document)
+    if not missing:
+        _check_task(text, args)
     ratio = imported.workspace_area / imported.free_cells_area if imported.free_cells_area else 0
     summary = (
         f"workspace {imported.workspace_area:.6g} (free cells {imported.free_cells_area:.6g}, "
@@ -92,7 +108,40 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         return reporter.finish(EXIT_OK, text=text)
     replace_file(args.output, text.encode("utf-8"))
     reporter.note(f"wrote {args.output}: {summary}")
+    if missing:
+        reporter.note(
+            f"note: the mission has no {' and no '.join(missing)} yet: add them to "
+            f"{args.output} (see its first lines), then run `tlmpc check {args.output}`"
+        )
     return reporter.finish(EXIT_OK)
+
+
+def _check_task(text: str, args: argparse.Namespace) -> None:
+    """Load the mission about to be written; its errors (an unknown region in a --task, an
+    --ltl that does not parse) are the command's, located at the flag (exit 1, nothing
+    written)."""
+    import dataclasses
+
+    from tlmpc.base.errors import InvalidInputError
+    from tlmpc.mission.load import load_mission_text
+
+    name = str(args.output) if args.output is not None else "<stdout>"
+    try:
+        load_mission_text(text, name)
+    except InvalidInputError as exc:
+        lines = text.splitlines()
+        located = []
+        for problem in exc.diagnostics:
+            if problem.severity != "error":
+                continue
+            row = lines[problem.line - 1] if problem.line and problem.line <= len(lines) else ""
+            flag = _flag_at(row, problem.col, args)
+            if flag is not None:
+                where, start = flag
+                col = (problem.col - start) if problem.col and start >= 0 else None
+                problem = dataclasses.replace(problem, file=where, line=1, col=col)
+            located.append(problem)
+        raise InvalidInputError(located or list(exc.diagnostics)) from None
 
 
 def _rects(values: list[list[str]]) -> dict[str, tuple[float, float, float, float]]:
@@ -108,3 +157,18 @@ def _rects(values: list[list[str]]) -> dict[str, tuple[float, float, float, floa
             ) from None
         rects[name] = (x0, y0, x1, y1)
     return rects
+
+
+def _flag_at(row: str, col: int | None, args: argparse.Namespace) -> tuple[str, int] | None:
+    """The --task or --ltl flag whose text sits at column ``col`` of the mission's ``row``,
+    and where that text starts in the row."""
+    spans = [(f"--task {p!r}", p) for p in args.task or []]
+    if args.ltl:
+        spans.append((f"--ltl {args.ltl!r}", args.ltl))
+    for flag, text in spans:
+        start = row.find(text)
+        while start >= 0:
+            if col is None or start < col <= start + len(text):
+                return flag, start
+            start = row.find(text, start + 1)
+    return None

@@ -5,9 +5,13 @@ from __future__ import annotations
 import argparse
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any, TextIO
+from typing import TYPE_CHECKING, Any, TextIO
 
 from tlmpc.base.errors import UsageError, error
+from tlmpc.commands.log_flags import LOG_FORMATS, add_log_flags, log_options
+
+if TYPE_CHECKING:
+    from tlmpc.verify import TraceInput
 
 NAME = "plot"
 HELP = "draw plan.svg (or plan.png) from a compile output, optionally with a log over the map"
@@ -16,9 +20,11 @@ Re-draw the picture of a compile output directory OUT from its artifacts: the ma
 regions, mesh, plan, trajectory (coloured by distance travelled) and start.  plan.svg is
 written directly; --format png draws plan.png with matplotlib.
 
-With --log FILE (a CSV of t,x,y rows or a trace.json) the log is drawn over the map and its
-violations are marked: from --verdict VERDICT.json when given, otherwise by running the
-verifier on the log against the mission's task.  The pictures are then log.svg / log.png.
+With --log FILE (a trace.json, a CSV of t,x,y rows, a ROS 1 .bag, a ROS 2 bag directory or
+an .mcap file: every format `tlmpc verify` reads, with its --topic, --columns, --transform and
+--frame) the log is drawn over the map and its violations are marked: from --verdict
+VERDICT.json when given, otherwise by running the verifier on the log against the mission of
+the compile output.  The pictures are then log.svg / log.png.
 --zoom x0,y0,x1,y1 draws only that window of the map (narrow doors, dense meshes)."""
 
 _INPUTS = {
@@ -56,9 +62,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         default="svg",
         help="which picture to write (default: svg; png needs matplotlib and is slower)",
     )
-    parser.add_argument(
-        "--log", type=Path, help="a recorded trajectory to draw: CSV t,x,y or trace.json"
-    )
+    parser.add_argument("--log", type=Path, help=f"a recorded trajectory to draw: {LOG_FORMATS}")
     parser.add_argument(
         "--verdict",
         type=Path,
@@ -70,46 +74,22 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--json", action="store_true", help="one JSON document: the files written and the verdict"
     )
+    add_log_flags(parser)
 
 
-def _log_samples(path: Path) -> tuple[list[list[float]], dict[str, Any] | None]:
-    """The log's ``[t, x, y]`` rows, and its document when it is a trace.json."""
-    from tlmpc.io.artifacts import read_json
+def _read_log(
+    args: argparse.Namespace, mission: Mapping[str, Any]
+) -> tuple[list[list[float]], TraceInput]:
+    """The log's ``[t, x, y]`` samples, read as ``tlmpc verify`` reads it, against the
+    compile output's mission."""
+    from tlmpc.mission.io import mission_from_json
+    from tlmpc.verify import read_trace
 
-    if path.suffix.lower() == ".csv":
-        from tlmpc.verify.trace_input import read_csv
-
-        samples, _ = read_csv(path)
-        return samples.tolist(), None
-    document = read_json(path, "tlmpc.trace/")
-    points = document.get("points")
-    if not isinstance(points, list) or not points:
-        raise UsageError(error("V002", "the trace has no samples", file=str(path)))
-    return points, document
-
-
-def _verify_log(
-    samples: list[list[float]],
-    document: Mapping[str, Any] | None,
-    mission: Mapping[str, Any],
-    path: Path,
-) -> dict[str, Any]:
-    """Run the verifier on the log (against the mission of the compile output for a CSV)."""
-    from tlmpc.verify import verdict_to_json, verify_document
-
-    if document is None:
-        options = mission.get("options") or {}
-        document = {
-            "format": "tlmpc.trace/1",
-            "ltl": mission["formula"],
-            "regions": mission["regions"],
-            "workspace": mission["workspace"],
-            "boundary": options.get("boundary"),
-            "max_speed": (mission.get("robot") or {}).get("max_speed"),
-            "points": samples,
-            "loop_start": None,
-        }
-    return verdict_to_json(verify_document(dict(document), file=str(path)))
+    trace = read_trace(args.log, mission_from_json(mission), None, log_options(args))
+    samples = [
+        [t, x, y] for t, (x, y) in zip(trace.times.tolist(), trace.points.tolist(), strict=True)
+    ]
+    return samples, trace
 
 
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
@@ -135,9 +115,11 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     if args.verdict is not None:
         verdict = read_json(args.verdict, "tlmpc.verdict/")
     if args.log is not None:
-        log, document = _log_samples(args.log)
+        from tlmpc.verify import verdict_to_json, verify_trace
+
+        log, trace = _read_log(args, artifacts["mission.json"])
         if verdict is None:
-            verdict = _verify_log(log, document, artifacts["mission.json"], args.log)
+            verdict = verdict_to_json(verify_trace(trace))
     stem = "log" if log is not None else "plan"
     written = []
     if args.format in ("svg", "both"):

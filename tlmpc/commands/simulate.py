@@ -10,8 +10,6 @@ from __future__ import annotations
 import argparse
 import contextlib
 import math
-import os
-import tempfile
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TextIO
 
@@ -55,7 +53,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="D",
         help="bound on the disturbance's norm (default: the mission's robot.disturbance)",
     )
-    parser.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    parser.add_argument(
+        "--seed", type=int, default=0, help="random seed, a whole number >= 0 (default 0)"
+    )
     parser.add_argument(
         "--model-disturbance",
         choices=("random", "adversarial"),
@@ -103,6 +103,19 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             raise UsageError(error("U081", f"--cycles must be a whole number, not {args.cycles!r}"))
         cycles = int(cycles_value)
     dt = _positive(args.dt, "--dt", "U082") if args.dt is not None else None
+    if not 0 <= args.seed < 2**128:
+        raise UsageError(
+            error(
+                "U084",
+                f"--seed must be a whole number from 0 to 2**128 - 1, not {args.seed}",
+                hint="any seed in range gives a reproducible disturbance, e.g. --seed 1",
+            )
+        )
+    if args.output is not None:
+        from tlmpc.io.outputs import refuse_input_as_output
+        from tlmpc.runtime.executor import EXECUTOR_ARTIFACTS
+
+        refuse_input_as_output(args.output, [args.out / name for name in EXECUTOR_ARTIFACTS])
     executor = Executor.from_output(args.out)
     declared = executor.mission.robot.disturbance
     if args.disturbance is None:
@@ -141,27 +154,16 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
 
 
 def _write(path: Path, document: Any) -> None:
-    """Write ``document`` to ``path`` atomically (a temporary file renamed over it)."""
+    """Write ``document`` to ``path`` atomically (the one atomic writer: a temporary file
+    renamed over it, removed whatever stops the write, Ctrl-C included)."""
+    from tlmpc.base.errors import TlmpcError
+    from tlmpc.io.outdir import replace_file
+
     try:
-        if path.is_symlink() or (path.exists() and not path.is_file()):
-            raise UsageError(
-                error(
-                    "U083",
-                    f"{path} exists and is not a regular file; it is never replaced",
-                    hint="choose another -o path",
-                )
-            )
-        handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.")
-        with os.fdopen(handle, "w", encoding="utf-8") as stream:
-            stream.write(dumps(document))
-        os.replace(temporary, path)
-    except OSError as exc:
+        replace_file(path, dumps(document).encode("utf-8"))
+    except TlmpcError as exc:  # the writer's U033/U034, under this command's code
         raise UsageError(
-            error(
-                "U083",
-                f"cannot write {path}: {exc.strerror or exc}",
-                hint="check that the folder exists and is writable",
-            )
+            [error("U083", d.message, hint=d.hint, file=str(path)) for d in exc.diagnostics]
         ) from None
 
 

@@ -26,6 +26,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "-o", "--out", type=Path, help="write the new artifacts here instead (an existing dir)"
     )
+    parser.add_argument(
+        "--force",
+        action="store_true",
+        help="with -o: replace files of the same names in a folder tlmpc did not write",
+    )
     parser.add_argument("--json", action="store_true", help="print the stage report as JSON")
 
 
@@ -42,7 +47,7 @@ def _bytes(content: Any) -> bytes:
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Run the stage and write what it produced."""
     from tlmpc.base.errors import EXIT_OK, UsageError, error
-    from tlmpc.io.outdir import replace_file
+    from tlmpc.io.outdir import MARKER, is_tlmpc_output, replace_file
     from tlmpc.io.report import Reporter
     from tlmpc.pipeline.stages import run_stage_from_artifacts
 
@@ -54,6 +59,18 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     reporter = Reporter.for_args(args, out, err)
     result = run_stage_from_artifacts(args.name, args.directory)
     reporter.diagnose(result.warnings)
+    if args.out is not None and not args.force and not is_tlmpc_output(target):
+        existing = sorted(name for name in result.artifacts if (target / name).exists())
+        if existing:
+            raise UsageError(
+                error(
+                    "U012",
+                    f"{target} is not a tlmpc output (it has no {MARKER} file) and holds "
+                    f"{', '.join(existing)}, which this stage would replace",
+                    hint="choose another -o, or pass --force to replace those files",
+                    file=str(target),
+                )
+            )
     for name, content in result.artifacts.items():
         replace_file(target / name, _bytes(content))
     report = result.reports[0]

@@ -1,20 +1,27 @@
-"""``tlmpc verify TRACE``: re-check a trajectory against its task in continuous time.
+"""``tlmpc verify TRACE...``: re-check trajectories against their task in continuous time.
 
-Exit 0 when the task holds, 1 when it is violated, 4 when a log that may go on is
-inconclusive, 2 when the trace cannot be read.
+One trace: exit 0 when the task holds, 1 when it is violated, 4 when a log that may go on is
+inconclusive, 2 when the trace cannot be read.  Many logs (or a folder, or a batch flag): a
+line per log as it finishes, a summary, and one exit code for the batch (see
+:func:`tlmpc.fleet.batch.batch_exit`).
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 from pathlib import Path
 from typing import TYPE_CHECKING, TextIO
+
+from tlmpc.commands.log_flags import add_log_flags, log_options
 
 if TYPE_CHECKING:
     from tlmpc.verify.model import Verdict
 
 NAME = "verify"
-HELP = "check a trajectory (trace.json, or a CSV/ROS bag log with --mission) against its task"
+HELP = (
+    "check trajectories (trace.json, or CSV/ROS bag logs and folders with --mission) against a task"
+)
 DESCRIPTION = """\
 Check TRACE against its task under the continuous-time semantics of LTL (docs/semantics.md).
 TRACE is a trace.json written by `tlmpc compile` (self-contained), or a robot log whose
@@ -27,13 +34,27 @@ A log that simply ends gets a three-valued verdict: satisfied (no continuation c
 task), violated (none can repair it) or inconclusive; --assume-stay reads it as staying at its
 last point forever, --loop-from T as repeating its part from time T on.  Prints the verdict,
 each conjunct's own verdict and progress, every violation (when and where), the robustness
-and whether the verdict is certified for the real robot between samples."""
+and whether the verdict is certified for the real robot between samples.
+
+Several logs, or folders of logs, are a batch: verified in parallel (--jobs, --dask), one
+line per log as it finishes, a summary table, --results as JSON lines or Parquet, a content
+cache so unchanged logs are not verified again, and --report for a fleet page; see
+docs/verify.md ("Many logs")."""
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Register the command's flags."""
-    parser.add_argument("trace", type=Path, help="trace.json, a CSV log or a ROS bag")
-    parser.add_argument("--mission", type=Path, help="mission file (needed for CSV traces)")
+    parser.add_argument(
+        "trace",
+        type=Path,
+        nargs="+",
+        help="trace.json, a CSV log or a ROS bag; several logs or folders of logs: a batch",
+    )
+    parser.add_argument(
+        "--mission",
+        type=Path,
+        help="mission file (needed for logs), or a tlmpc.fleet-missions/1 mapping file",
+    )
     parser.add_argument(
         "--boundary",
         choices=("right", "closed"),
@@ -52,59 +73,121 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="the part of the log from time T to its end repeats forever (two-valued verdict)",
     )
     parser.add_argument("--json", action="store_true", help="print the verdict as JSON")
-    parser.add_argument(
-        "--topic", help="bags: the pose topic (needed when several topics carry poses)"
+    add_log_flags(parser)
+    batch = parser.add_argument_group("many logs")
+    batch.add_argument(
+        "--jobs",
+        type=int,
+        metavar="N",
+        help="verify N logs at once in local processes (default: all cores)",
     )
-    parser.add_argument(
-        "--columns",
-        metavar="TIME,X,Y",
-        help="CSV logs: the time and position columns, by name or 1-based number",
+    batch.add_argument(
+        "--dask",
+        metavar="ADDRESS",
+        help="verify on the Dask cluster whose scheduler is at ADDRESS (the [fleet] extra)",
     )
-    parser.add_argument(
-        "--transform",
-        metavar="X,Y,YAW",
-        help="logs: map the log's frame into the mission's (p = R(YAW) p_log + (X, Y))",
+    batch.add_argument(
+        "--results",
+        type=Path,
+        metavar="FILE",
+        help="write a record per log: JSON lines, or Parquet for FILE.parquet (needs pyarrow)",
     )
-    parser.add_argument(
-        "--frame",
-        metavar="FRAME",
-        help="bags: express the poses in FRAME (e.g. map) through the bag's /tf and /tf_static "
-        "(default: the poses' own frame)",
+    batch.add_argument(
+        "--report",
+        type=Path,
+        metavar="FILE",
+        help="write the fleet report (one HTML page; each log's view in FILE's .views folder)",
     )
+    batch.add_argument(
+        "--group",
+        metavar="REGEX",
+        help="report: groups `robot` and `day` found in each log's path (default: the first "
+        "folder under the batch's common folder is the robot, a YYYY-MM-DD in the path the day)",
+    )
+    batch.add_argument(
+        "--cache",
+        type=Path,
+        metavar="DIR",
+        help="the verification cache (default: $TLMPC_CACHE_DIR or ~/.cache/tlmpc/verify)",
+    )
+    batch.add_argument(
+        "--no-cache", action="store_true", help="verify every log again, store nothing"
+    )
+
+
+BATCH_FLAGS = ("jobs", "dask", "results", "report", "group", "cache")
+
+
+def _is_batch(args: argparse.Namespace) -> bool:
+    paths: list[Path] = args.trace
+    if len(paths) > 1 or args.no_cache or any(getattr(args, f) is not None for f in BATCH_FLAGS):
+        return True
+    only = paths[0]
+    if only.is_dir() and not (only / "metadata.yaml").is_file():
+        return True
+    if args.mission is not None:
+        from tlmpc.fleet.batch import read_mapping
+
+        return read_mapping(args.mission) is not None
+    return False
 
 
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Verify and report."""
-    from tlmpc.importers.logs import is_log, parse_columns, parse_transform
-    from tlmpc.io.artifacts import read_json
-    from tlmpc.io.report import OUTCOME_EXIT, Reporter
-    from tlmpc.verify import (
-        declare_ending,
-        from_csv,
-        from_document,
-        verdict_to_json,
-        verify_trace,
-    )
+    if _is_batch(args):
+        from tlmpc.fleet.command import run_batch
 
-    path: Path = args.trace
-    if is_log(path):
-        trace = from_csv(
-            path,
-            args.mission,
-            args.boundary,
-            topic=args.topic,
-            columns=parse_columns(args.columns) if args.columns else None,
-            transform=parse_transform(args.transform) if args.transform else None,
-            frame=args.frame,
+        return run_batch(args, out, err)
+    return _run_one(args, args.trace[0], out, err)
+
+
+def _run_one(args: argparse.Namespace, path: Path, out: TextIO, err: TextIO) -> int:
+    from tlmpc.importers.logs import is_log
+    from tlmpc.io.report import OUTCOME_EXIT, Reporter
+    from tlmpc.verify import declare_ending, read_trace, verdict_to_json, verify_trace
+
+    report = Reporter.for_args(args, out, err)
+    if is_log(path) and _too_large_for_memory(path):
+        verdict = _streamed(args, path)
+        report.note(
+            f"{path}: streamed ({verdict.stats['samples']:,} samples, "
+            f"{verdict.stats['kept_samples']:,} kept); robustness and certificate are the kept "
+            "samples'"
         )
-    else:
-        document = read_json(path)
-        trace = from_document(document, file=str(path), convention=args.boundary)
+        text = _text(path, verdict)
+        return report.finish(OUTCOME_EXIT[verdict.outcome], verdict_to_json(verdict), text)
+    trace = read_trace(path, args.mission, args.boundary, log_options(args))
     trace = declare_ending(trace, assume_stay=args.assume_stay, loop_from=args.loop_from)
     verdict = verify_trace(trace)
-    report = Reporter.for_args(args, out, err)
     text = _text(path, verdict)
     return report.finish(OUTCOME_EXIT[verdict.outcome], verdict_to_json(verdict), text)
+
+
+def _too_large_for_memory(path: Path) -> bool:
+    from tlmpc.importers.logs import CSV_SUFFIXES
+    from tlmpc.verify.trace_input import is_large_csv
+
+    return path.suffix.lower() in CSV_SUFFIXES and path.is_file() and is_large_csv(path)
+
+
+def _streamed(args: argparse.Namespace, path: Path) -> Verdict:
+    """A CSV log too large to hold whole, verified in constant memory (docs/verify.md)."""
+    from tlmpc.fleet.stream import verify_log
+    from tlmpc.importers.logs import parse_columns, parse_transform
+    from tlmpc.verify.trace_input import mission_document
+
+    streamed = verify_log(
+        path,
+        mission_document(path, args.mission),
+        convention=args.boundary,
+        topic=args.topic,
+        columns=parse_columns(args.columns) if args.columns else None,
+        transform=parse_transform(args.transform) if args.transform else None,
+        frame=args.frame,
+        assume_stay=args.assume_stay,
+        loop_from=args.loop_from,
+    )
+    return streamed.verdict
 
 
 def _text(path: Path, verdict: Verdict) -> str:
@@ -117,12 +200,22 @@ def _text(path: Path, verdict: Verdict) -> str:
     }[verdict.ending]
     lines.append(f"{path}: {status[verdict.outcome]}: {verdict.formula}")
     lines.append(f"  boundary convention: {verdict.convention}; {ending}; {verdict.pieces} pieces")
-    if len(verdict.conjuncts) > 1 or verdict.ending == "open":
+    timed = any(r.time_robustness is not None for r in verdict.conjuncts)
+    if len(verdict.conjuncts) > 1 or verdict.ending == "open" or timed:
         for report in verdict.conjuncts:
             lines.append(f"  {report.conjunct}: {report.outcome}: {report.progress}")
     for violation in verdict.violations:
         lines.append(f"  violation: {violation.message}")
     lines.append(f"  robustness: {verdict.robustness:.6g}")
+    slack = verdict.time_robustness
+    if slack is not None and math.isinf(slack):
+        decided = "holds" if slack > 0 else "fails"
+        lines.append(f"  time robustness: {slack:g} (the task {decided} at any time bound)")
+    elif slack is not None:
+        lines.append(
+            f"  time robustness: {slack:.6g} s "
+            "(how much tighter the time bounds could be; < 0: how much looser they must be)"
+        )
     certificate = verdict.certificate
     word = "certified" if certificate.certified else "not certified"
     lines.append(f"  {word}: {certificate.reason}")

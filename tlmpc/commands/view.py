@@ -10,20 +10,24 @@ import argparse
 from pathlib import Path
 from typing import TextIO
 
+from tlmpc.commands.log_flags import LOG_FORMATS, add_log_flags, log_options
+
 NAME = "view"
 HELP = "write an interactive HTML view of a compile output or of a verified log"
 DESCRIPTION = """\
 Write one self-contained HTML page (no network needed to open it): the map, the regions, the
 triangulation on demand, the trajectory animated over time (play, pause, scrub), the regions and
 triangle under the pointer, and the counterexample of a failed verification highlighted.
-Either OUT, a directory written by `tlmpc compile`, or --log LOG (a CSV of t,x,y rows or a
-trace.json) with --mission MISSION, verified here."""
+Either OUT, a directory written by `tlmpc compile`, or --log LOG with --mission MISSION,
+verified here: LOG is any log `tlmpc verify` reads (a trace.json, a CSV of t,x,y rows, a ROS 1
+.bag, a ROS 2 bag directory or an .mcap file), with the same --topic, --columns, --transform
+and --frame."""
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Register the command's flags."""
     parser.add_argument("out", type=Path, nargs="?", help="a `tlmpc compile` output directory")
-    parser.add_argument("--log", type=Path, help="a robot log (CSV t,x,y or trace.json)")
+    parser.add_argument("--log", type=Path, help=f"a robot log: {LOG_FORMATS}")
     parser.add_argument("--mission", type=Path, help="the mission file the log is checked against")
     parser.add_argument(
         "-o",
@@ -32,12 +36,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="the HTML file to write (default: OUT/view.html, or LOG with .html)",
     )
     parser.add_argument("--json", action="store_true", help="one JSON document: the page written")
+    add_log_flags(parser)
 
 
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Build the scene, render it and write the page atomically."""
     from tlmpc.base.errors import EXIT_OK, UsageError, error
+    from tlmpc.io.artifacts import ARTIFACT_SCHEMAS
     from tlmpc.io.outdir import replace_file
+    from tlmpc.io.outputs import refuse_input_as_output
     from tlmpc.io.report import Reporter
     from tlmpc.view import render_html, scene_from_log, scene_from_output
 
@@ -52,11 +59,16 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             )
         )
     if args.log is not None:
-        scene = scene_from_log(args.log, args.mission)
-        target = args.output or args.log.with_suffix(".html")
+        target = args.output or _page_beside(args.log)
+        inputs = [args.log, args.mission]
+    else:
+        target = args.output or args.out / "view.html"
+        inputs = [args.out / name for name in ARTIFACT_SCHEMAS]
+    refuse_input_as_output(target, inputs)
+    if args.log is not None:
+        scene = scene_from_log(args.log, args.mission, log_options(args))
     else:
         scene = scene_from_output(args.out)
-        target = args.output or args.out / "view.html"
     page = render_html(scene)
     if not target.parent.is_dir():
         raise UsageError(
@@ -70,3 +82,10 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     replace_file(target, page.encode("utf-8"))
     report = Reporter.for_args(args, out, err)
     return report.finish(EXIT_OK, {"written": [str(target)]}, f"wrote {target}\n")
+
+
+def _page_beside(log: Path) -> Path:
+    """LOG.html next to a log file; for a bag directory, DIR.html beside the directory."""
+    if log.is_dir():
+        return log.parent / f"{log.name}.html"
+    return log.with_suffix(".html")

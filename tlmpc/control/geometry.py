@@ -47,8 +47,10 @@ def triangle_geometry(vertices: FloatArray) -> TriangleGeometry:
 
     Computed on Python floats: a plan's steps call this thousands of times and numpy's
     per-call overhead on 2-vectors was most of the control stage.  The operations are the
-    ones numpy performs (a 2-vector's norm is sqrt(x·x) and a dot of two is a0 b0 + a1 b1,
-    in that order), so the values are bit for bit those of the array code (tests compare).
+    definition's (a 2-vector's norm is sqrt(x·x) and a dot of two is a0 b0 + a1 b1, in that
+    order), each rounded once as IEEE prescribes, so the values are the same on every
+    machine; numpy's BLAS may fuse a multiply and an add where the processor can, so the array
+    code agrees with them to a few units in the last place (tests compare).
     """
     v = np.asarray(vertices, dtype=np.float64)
     corners = v.tolist()

@@ -7,10 +7,11 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from tlmpc.abstraction.model import FloatArray
+from tlmpc.base.content import ContentEquality
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
-class StepController:
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
+class StepController(ContentEquality):
     """The field used while the plan is at ``step``: in ``triangle``, leaving by ``exit_edge``.
 
     ``exit_edge`` is the index of the facet opposite that vertex (None for a stay, which
@@ -30,10 +31,10 @@ class StepController:
     triangle: int
     exit_edge: int | None
     next_triangle: int | None
-    vertices: FloatArray = field(compare=False)  # (3, 2)
-    velocities: FloatArray = field(compare=False)  # (3, 2), at the vertices
-    gain: FloatArray = field(compare=False)  # K (2, 2)
-    offset: FloatArray = field(compare=False)  # g (2,)
+    vertices: FloatArray  # (3, 2)
+    velocities: FloatArray  # (3, 2), at the vertices
+    gain: FloatArray  # K (2, 2)
+    offset: FloatArray  # g (2,)
     exit_speed: float
     exit_time_bound: float
     target: tuple[float, float] | None = None
@@ -60,8 +61,8 @@ class VelocityJump:
     reason: str
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
-class Controllers:
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
+class Controllers(ContentEquality):
     """Every step's controller; ``loop_start`` is the first step of a moving cycle."""
 
     steps: tuple[StepController, ...]

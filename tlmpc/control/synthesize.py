@@ -494,7 +494,9 @@ def _violated_condition(
 def _check_rejectable(
     abstraction: Abstraction, steps: list[_Step], robot: Robot, source: str | None
 ) -> None:
-    """Located errors where no vertex velocity can reject ``robot.disturbance`` (C032/C033)."""
+    """Located errors where no vertex velocity can reject ``robot.disturbance`` (C032/C033),
+    and where the plan passes through a single point, which no law here reaches under a
+    disturbance (C034)."""
     if robot.disturbance >= robot.max_speed:
         raise InvalidInputError(
             error(
@@ -509,7 +511,26 @@ def _check_rejectable(
     problems = []
     for index, step in enumerate(steps):
         if step.through is not None:
-            continue  # the pursuit law rejects any disturbance below max_speed (C033)
+            # The pursuit law closes in on the corner at s - d, but a push across the pursuit
+            # direction turns the robot about the corner at d / r, unboundedly fast as r -> 0:
+            # it leaves the triangle beside the corner before it arrives.
+            x, y = abstraction.vertices[step.through].tolist()
+            problems.append(
+                error(
+                    "C034",
+                    f"plan step {index} (triangle {step.triangle}) passes through the single "
+                    f"point ({x:.6g}, {y:.6g}), which no controller here reaches under a "
+                    f"disturbance: a push of {robot.disturbance:g} across the way to the "
+                    "point turns the robot about it faster the nearer it gets, so it leaves "
+                    "the triangle beside the point",
+                    hint="the task is met only through this point (regions touching at a "
+                    "corner, or a pinch): set robot.disturbance to 0, or let the regions share "
+                    "an edge",
+                    file=source,
+                    path="$.robot.disturbance",
+                )
+            )
+            continue
         corners = abstraction.triangles[step.triangle].tolist()
         for local in range(3):
             normals = [a for a, _ in _normals(step, local)]
@@ -523,14 +544,38 @@ def _check_rejectable(
                         f"({x:.6g}, {y:.6g}) a velocity within max_speed pushes at most "
                         f"{best:.4g} along every facet it must, not more than the "
                         f"disturbance {robot.disturbance:g}",
-                        hint="lower robot.disturbance, raise max_speed, or raise "
-                        "options.min_angle (sharp corners leave little room)",
+                        hint=_angle_hint(robot),
                         file=source,
                         path="$.robot.disturbance",
                     )
                 )
     if problems:
         raise InvalidInputError(problems[:10])
+
+
+#: The largest smallest-angle bound the triangulator meets (degrees; the mission format's
+#: ``options.min_angle`` allows up to 34).
+MAX_MIN_ANGLE = 34.0
+
+
+def _angle_hint(robot: Robot) -> str:
+    """What the mesh can do about a disturbance: a corner of angle a pushed inside both of
+    its facets rejects at most max_speed * sin(a / 2), so ``min_angle`` helps only up to
+    max_speed * sin(MAX_MIN_ANGLE / 2)."""
+    ratio = robot.disturbance / robot.max_speed
+    ceiling = math.sin(math.radians(MAX_MIN_ANGLE) / 2.0)
+    if ratio < ceiling:
+        needed = math.degrees(2.0 * math.asin(ratio))
+        return (
+            f"raise options.min_angle above {needed:.3g} degrees (a corner of angle a rejects "
+            f"at most max_speed * sin(a / 2)), lower robot.disturbance, or raise max_speed"
+        )
+    return (
+        f"no mesh here can reject it: a corner of angle a rejects at most max_speed * "
+        f"sin(a / 2), and options.min_angle is at most {MAX_MIN_ANGLE:g} degrees, so the "
+        f"largest disturbance a mesh supports is {ceiling * robot.max_speed:.4g} "
+        f"({ceiling:.3f} x max_speed); lower robot.disturbance or raise max_speed"
+    )
 
 
 def pursuit_controller(
@@ -629,7 +674,11 @@ def synthesize(
             nx, ny = geometry.normals[step.exit_edge].tolist()
             delta = min(nx * wx + ny * wy for wx, wy in w.tolist())  # numpy's 2-vector dot
             speed = delta
-            bound = float(geometry.heights[step.exit_edge] / delta) if delta > 0 else float("inf")
+            # under a disturbance |w| <= d the state still crosses at delta - d or faster
+            closing = delta - robot.disturbance
+            bound = (
+                float(geometry.heights[step.exit_edge] / closing) if closing > 0 else float("inf")
+            )
         controllers.append(
             StepController(
                 step=index,

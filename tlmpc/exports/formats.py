@@ -9,7 +9,10 @@ from typing import Any
 
 import yaml
 
+from tlmpc.base.extras import require
+from tlmpc.exports.georeference import Georeference, to_lon_lat
 from tlmpc.exports.plan import Plan, Ring, Waypoint
+from tlmpc.io.outputs import csv_cell
 
 
 def _quaternion(yaw: float) -> dict[str, float]:
@@ -19,31 +22,56 @@ def _quaternion(yaw: float) -> dict[str, float]:
 def waypoints_yaml(
     plan: Plan, points: list[Waypoint], loop: int | None, frame_id: str = "map"
 ) -> str:
-    """``tlmpc.waypoints/1``: frame, loop start and poses (yaw and quaternion) with plan times."""
-    document: dict[str, Any] = {
+    """``tlmpc.waypoints/1``: frame, loop start and poses (yaw and quaternion) with plan times.
+
+    The text is what ``yaml.safe_dump(document, sort_keys=False, default_flow_style=None)``
+    writes, but the waypoints (numbers only) are written here line by line: PyYAML's emitter
+    takes half a minute and 2 GB for a trace of a few hundred thousand samples.  The names
+    (the mission's, the frame's) are still quoted and escaped by PyYAML."""
+    header: dict[str, Any] = {
         "format": "tlmpc.waypoints/1",
         "mission": plan.name,
         "task": plan.formula,
         "frame_id": frame_id,
         "loop_start": loop,
-        "waypoints": [
-            {
-                "t": w.t,
-                "x": w.x,
-                "y": w.y,
-                "yaw": w.yaw,
-                "orientation": _quaternion(w.yaw),
-            }
-            for w in points
-        ],
     }
-    return yaml.safe_dump(document, sort_keys=False, default_flow_style=None)
+    if not points:
+        return yaml.safe_dump({**header, "waypoints": []}, sort_keys=False, default_flow_style=None)
+    out = io.StringIO()
+    # block style, as the top level is when it holds the waypoints' list
+    out.write(yaml.safe_dump(header, sort_keys=False, default_flow_style=False))
+    out.write("waypoints:\n")
+    for w in points:
+        q = _quaternion(w.yaw)
+        out.write(
+            f"- t: {_yaml_float(w.t)}\n  x: {_yaml_float(w.x)}\n  y: {_yaml_float(w.y)}\n"
+            f"  yaw: {_yaml_float(w.yaw)}\n  orientation: {{x: {_yaml_float(q['x'])}, "
+            f"y: {_yaml_float(q['y'])}, z: {_yaml_float(q['z'])}, w: {_yaml_float(q['w'])}}}\n"
+        )
+    return out.getvalue()
+
+
+def _yaml_float(value: float) -> str:
+    """A float as PyYAML's SafeRepresenter writes it (``repr``, with ``.0`` before a bare
+    exponent so that YAML 1.1 reads it back as a float)."""
+    if value != value:
+        return ".nan"
+    if value in (math.inf, -math.inf):
+        return ".inf" if value > 0 else "-.inf"
+    text = repr(float(value)).lower()
+    if "." not in text and "e" in text:
+        text = text.replace("e", ".0e", 1)
+    return text
 
 
 def waypoints_csv(plan: Plan, points: list[Waypoint], loop: int | None) -> str:
-    """``t,x,y,yaw`` rows; comment lines give the mission and the loop start (row index)."""
+    """``t,x,y,yaw`` rows; comment lines give the mission and the loop start (row index).
+
+    The mission's name is the second cell of the first comment line, one neutralised CSV cell
+    (a name's separators, quotes or newlines inside the text of the first cell would start new
+    cells there, where quoting does not work): it adds neither a row nor a formula."""
     out = io.StringIO()
-    out.write(f"# tlmpc.waypoints/1 mission {plan.name}\n")
+    out.write(f"# tlmpc.waypoints/1 mission,{csv_cell(plan.name)}\n")
     out.write(f"# loop_start: {'none' if loop is None else loop}\n")
     out.write("t,x,y,yaw\n")
     for w in points:
@@ -78,10 +106,17 @@ def _workspace_geometry(plan: Plan) -> dict[str, Any]:
     }
 
 
-def geojson(plan: Plan, points: list[Waypoint], loop: int | None) -> str:
-    """A FeatureCollection in the map frame (metres): workspace, regions, trajectory, waypoints.
+def geojson(
+    plan: Plan,
+    points: list[Waypoint],
+    loop: int | None,
+    georeference: Georeference | None = None,
+) -> str:
+    """A FeatureCollection: workspace, regions, trajectory, waypoints.
 
-    Rings follow RFC 7946's right-hand rule (outer counter-clockwise, holes clockwise).
+    Coordinates are the map frame's metres, or with ``georeference`` WGS 84 longitude and
+    latitude (RFC 7946 proper).  Rings follow RFC 7946's right-hand rule (outer
+    counter-clockwise, holes clockwise; a yaw or a mirror-free georeference keeps the turn).
     """
     features: list[dict[str, Any]] = [
         {
@@ -128,10 +163,37 @@ def geojson(plan: Plan, points: list[Waypoint], loop: int | None) -> str:
             "geometry": {"type": "MultiPoint", "coordinates": [[w.x, w.y] for w in points]},
         }
     )
-    return json.dumps({"type": "FeatureCollection", "features": features}, indent=1) + "\n"
+    collection: dict[str, Any] = {"type": "FeatureCollection", "features": features}
+    if georeference is not None:
+        _georeferenced(collection, georeference)
+    # strict JSON: a non-finite number (only an edited output has one) is refused, not
+    # written as the NaN no GeoJSON reader accepts
+    return json.dumps(collection, indent=1, allow_nan=False) + "\n"
+
+
+def _georeferenced(collection: dict[str, Any], reference: Georeference) -> None:
+    """Every coordinate pair of ``collection`` mapped to ``[longitude, latitude]``."""
+
+    def convert(value: Any) -> Any:
+        if (
+            isinstance(value, list)
+            and len(value) == 2
+            and all(isinstance(v, float | int) for v in value)
+        ):
+            return list(to_lon_lat(reference, float(value[0]), float(value[1])))
+        if isinstance(value, list):
+            return [convert(v) for v in value]
+        return value
+
+    for feature in collection["features"]:
+        geometry = feature["geometry"]
+        geometry["coordinates"] = convert(geometry["coordinates"])
 
 
 PATH_TYPE = "nav_msgs/msg/Path"
+
+#: A ROS ``builtin_interfaces/Time`` holds whole seconds in an unsigned 32-bit field.
+MAX_STAMP_SECONDS = 2**32
 
 
 def path_mcap(
@@ -141,8 +203,23 @@ def path_mcap(
 
     Pose stamps are the plan's times; the message's log time is the first of them.
     """
+    require("mcap.writer", "writing a nav_msgs/Path MCAP file")
+    require("rosbags.typesys", "writing a nav_msgs/Path MCAP file")
     from mcap.writer import Writer
     from rosbags.typesys import Stores, get_typestore
+
+    from tlmpc.base.errors import UsageError, error
+
+    late = [w.t for w in points if not 0.0 <= w.t < MAX_STAMP_SECONDS]
+    if late:
+        raise UsageError(
+            error(
+                "M085",
+                f"a plan time ({late[0]:g} s) does not fit a ROS time stamp "
+                f"(0 to {MAX_STAMP_SECONDS:,} s)",
+                hint="export this plan as waypoints-yaml, waypoints-csv or geojson",
+            )
+        )
 
     store = get_typestore(Stores.ROS2_HUMBLE)
     types: Any = store.types

@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
+from tlmpc.base.content import ContentEquality
 from tlmpc.base.errors import UsageError, error
 
 FloatArray = npt.NDArray[np.float64]
@@ -17,11 +18,11 @@ Point = tuple[float, float]
 Ring = tuple[Point, ...]
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
-class Plan:
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
+class Plan(ContentEquality):
     """Samples ``[t, x, y]`` of the planned trajectory; ``loop_start`` begins the repeated cycle."""
 
-    samples: FloatArray = field(compare=False)
+    samples: FloatArray
     loop_start: int | None
     name: str
     boundary: Ring
@@ -55,18 +56,19 @@ def _ring(value: Any) -> Ring:
 
 def read_plan(directory: Path) -> Plan:
     """Read ``trace.json`` and ``mission.json`` of a ``tlmpc compile`` output directory."""
-    from tlmpc.io.artifacts import read_json
+    from tlmpc.io.artifacts import read_artifacts
 
     for name in ("trace.json", "mission.json"):
-        if not (directory / name).is_file():
+        if not (directory / name).exists():
             raise _fail(
                 "M080",
                 f"{directory} has no {name}",
                 str(directory),
                 hint="run `tlmpc compile MISSION -o DIR` first and export from DIR",
             )
-    trace = read_json(directory / "trace.json", "tlmpc.trace/")
-    mission = read_json(directory / "mission.json", "tlmpc.mission/")
+    # each checked against its schema (finite numbers) and against the others
+    documents = read_artifacts(directory, ("trace.json", "mission.json", "controllers.json"))
+    trace, mission = documents["trace.json"], documents["mission.json"]
     try:
         samples = np.asarray(trace["points"], dtype=np.float64).reshape(-1, 3)
         loop = trace.get("loop_start")
@@ -83,7 +85,7 @@ def read_plan(directory: Path) -> Plan:
             ),
             regions={str(k): _ring(v) for k, v in mission["regions"].items()},
             formula=str(mission.get("formula", "")),
-            pinned=_passage_corners(directory, trace, samples),
+            pinned=_passage_corners(documents.get("controllers.json"), trace, samples),
         )
     except (KeyError, TypeError, ValueError, IndexError) as exc:
         raise _fail(
@@ -94,14 +96,12 @@ def read_plan(directory: Path) -> Plan:
     return plan
 
 
-def _passage_corners(directory: Path, trace: Any, samples: FloatArray) -> tuple[int, ...]:
+def _passage_corners(controllers: Any, trace: Any, samples: FloatArray) -> tuple[int, ...]:
     """Indices of the samples at the corner of a vertex passage (from controllers.json, when
     the folder has it: the samples of a vertex step whose position is its corner)."""
-    from tlmpc.io.artifacts import read_json
-
-    if not (directory / "controllers.json").is_file():
+    if controllers is None:
         return ()
-    steps = read_json(directory / "controllers.json", "tlmpc.controllers/")["steps"]
+    steps = controllers["steps"]
     corners = {
         int(s["step"]): (float(s["target"][0]), float(s["target"][1]))
         for s in steps
@@ -127,9 +127,10 @@ def waypoints(plan: Plan, spacing: float = 0.0) -> tuple[list[Waypoint], int | N
     """
     samples = plan.samples
     count = len(samples)
+    pinned = set(plan.pinned)
     keep: list[int] = []
     for index in range(count):
-        forced = index in (0, count - 1) or index == plan.loop_start or index in plan.pinned
+        forced = index in (0, count - 1) or index == plan.loop_start or index in pinned
         if forced or not keep:
             keep.append(index)
             continue

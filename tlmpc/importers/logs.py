@@ -11,7 +11,8 @@
   ``geometry_msgs/PoseStamped`` or ``geometry_msgs/PoseWithCovarianceStamped`` messages on
   ``topic`` (needed only when several topics carry poses), stamped with the message header
   (the log time when the header stamp is zero).  Samples are sorted by time; a repeated
-  stamp keeps its first sample.
+  stamp is kept, for the verifier to refuse (V020) as in a CSV log.  At most
+  :data:`MAX_LOG_SAMPLES` samples are read (M066).
 
 An optional rigid ``transform`` ``(x, y, yaw)`` maps the log's frame into the mission's
 (e.g. ``odom`` into ``map``): ``p_mission = R(yaw) p_log + (x, y)``.  For bags, ``frame``
@@ -25,7 +26,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -34,6 +35,7 @@ import numpy as np
 import numpy.typing as npt
 
 from tlmpc.base.errors import UsageError, error
+from tlmpc.base.extras import require
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -45,6 +47,11 @@ POSE_TYPES = {
     "geometry_msgs/msg/PoseWithCovarianceStamped": "pose.pose",
 }
 TIME_NAMES = ("t", "time", "timestamp", "stamp")
+
+#: The most samples a log may have (the verifier's limit for CSV traces), and the most bytes
+#: a CSV log may have; a bag's messages on the chosen topics count as they are read.
+MAX_LOG_SAMPLES = 2_000_000
+MAX_CSV_BYTES = 256 * 1024 * 1024
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -206,13 +213,59 @@ def parse_columns(text: str) -> tuple[str, str, str]:
     return parts[0], parts[1], parts[2]
 
 
+def _layout(
+    cells: list[str], columns: Sequence[str] | None, file: str, number: int
+) -> tuple[bool, tuple[int, int, int]]:
+    """Whether the first data line is a header, and the columns of t, x, y."""
+    header = not all(_is_number(c) for c in cells if c)
+    if header:
+        if columns is not None:
+            chosen = tuple(_pick(cells, c, file, number) for c in columns)
+            return True, (chosen[0], chosen[1], chosen[2])
+        return True, _guess(cells, file, number)
+    if columns is not None:
+        if not all(c.isdigit() for c in columns):
+            raise _fail(
+                "M052",
+                "the log has no header line, so --columns must give column numbers",
+                file,
+                hint="for example --columns 1,2,3",
+                line=number,
+            )
+        chosen = tuple(_pick(cells, c, file, number) for c in columns)
+        return False, (chosen[0], chosen[1], chosen[2])
+    if len(cells) != 3:
+        raise _fail(
+            "M052",
+            f"no header line and {len(cells)} columns: cannot tell which are t, x, y",
+            file,
+            hint="add a header line naming t (or time), x, y, or pass --columns",
+            line=number,
+        )
+    return False, (0, 1, 2)
+
+
+def _row(cells: list[str], indices: tuple[int, int, int], file: str, number: int) -> list[float]:
+    if len(cells) <= max(indices):
+        raise _fail(
+            "M053",
+            f"row has {len(cells)} columns, expected at least {max(indices) + 1}",
+            file,
+            line=number,
+        )
+    try:
+        return [float(cells[i]) for i in indices]
+    except ValueError:
+        bad = next(cells[i] for i in indices if not _is_number(cells[i]))
+        raise _fail("M053", f"not a number: {bad!r}", file, line=number) from None
+
+
 def read_csv_log(path: Path, columns: Sequence[str] | None = None) -> Log:
     """A CSV/TSV/whitespace log; see the module docstring for the accepted forms."""
+    from tlmpc.io.inputs import read_text
+
     file = str(path)
-    try:
-        text = path.read_text(encoding="utf-8-sig")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise _fail("M050", f"cannot read {file}: {exc}", file) from None
+    text = read_text(path, limit=MAX_CSV_BYTES, code="M050", what="log", encoding="utf-8-sig")
     separator: str | None = None
     indices: tuple[int, int, int] | None = None
     rows: list[list[float]] = []
@@ -227,51 +280,158 @@ def read_csv_log(path: Path, columns: Sequence[str] | None = None) -> Log:
         cells = _split(stripped, separator)
         if first:
             first = False
-            header = not all(_is_number(c) for c in cells if c)
+            header, indices = _layout(cells, columns, file, number)
             if header:
-                if columns is not None:
-                    chosen = tuple(_pick(cells, c, file, number) for c in columns)
-                    indices = (chosen[0], chosen[1], chosen[2])
-                else:
-                    indices = _guess(cells, file, number)
                 continue
-            if columns is not None:
-                if not all(c.isdigit() for c in columns):
-                    raise _fail(
-                        "M052",
-                        "the log has no header line, so --columns must give column numbers",
-                        file,
-                        hint="for example --columns 1,2,3",
-                        line=number,
-                    )
-                chosen = tuple(_pick(cells, c, file, number) for c in columns)
-                indices = (chosen[0], chosen[1], chosen[2])
-            elif len(cells) != 3:
-                raise _fail(
-                    "M052",
-                    f"no header line and {len(cells)} columns: cannot tell which are t, x, y",
-                    file,
-                    hint="add a header line naming t (or time), x, y, or pass --columns",
-                    line=number,
-                )
-            else:
-                indices = (0, 1, 2)
         assert indices is not None
-        if len(cells) <= max(indices):
+        rows.append(_row(cells, indices, file, number))
+        lines.append(number)
+        if len(rows) > MAX_LOG_SAMPLES:
             raise _fail(
-                "M053",
-                f"row has {len(cells)} columns, expected at least {max(indices) + 1}",
+                "M066",
+                f"the log has more than {MAX_LOG_SAMPLES:,} samples",
                 file,
+                hint="verify a shorter stretch of the log, or thin it out",
                 line=number,
             )
-        try:
-            rows.append([float(cells[i]) for i in indices])
-        except ValueError:
-            bad = next(cells[i] for i in indices if not _is_number(cells[i]))
-            raise _fail("M053", f"not a number: {bad!r}", file, line=number) from None
-        lines.append(number)
     samples = np.asarray(rows, dtype=np.float64).reshape(-1, 3)
     return Log(samples=samples, lines=tuple(lines), source=file)
+
+
+#: Characters read at a time by :func:`iter_csv_chunks`.
+BLOCK_CHARS = 1 << 22
+
+
+def _fast_rows(
+    lines: list[str], separator: str | None, indices: tuple[int, int, int]
+) -> FloatArray | None:
+    """The rows of plain lines at C speed (numpy's reader, whose numbers are Python's
+    ``float`` of the same text); None when any line needs the line-by-line parser's care
+    (a quoted cell, a short row, a blank line, a number only ``float`` reads)."""
+    try:
+        rows = np.loadtxt(
+            lines,
+            delimiter=separator,
+            usecols=indices,
+            ndmin=2,
+            comments=None,
+            dtype=np.float64,
+        )
+    except ValueError:
+        return None
+    return rows if len(rows) == len(lines) else None
+
+
+def iter_csv_chunks(
+    path: Path, columns: Sequence[str] | None = None, block_chars: int = BLOCK_CHARS
+) -> Iterator[Log]:
+    """The samples of a CSV log, a block of text at a time, never the whole file.
+
+    Accepts exactly what :func:`read_csv_log` accepts and gives the same samples and line
+    numbers, in order; a problem is raised when its block is reached.
+    """
+    file = str(path)
+    separator: str | None = None
+    indices: tuple[int, int, int] | None = None
+    number = 0  # lines before the current block
+    carry = ""
+    try:
+        with open(path, encoding="utf-8-sig") as stream:
+            while True:
+                text = stream.read(block_chars)
+                end = text.rfind("\n") + 1 if text else len(carry)
+                if text and end == 0:
+                    carry += text
+                    continue
+                block, carry = carry + text[:end], text[end:] if text else ""
+                if not block:
+                    break
+                # splitlines, as read_csv_log splits the whole text (form feeds, ...); the
+                # block ends after a line break, so its lines are the file's lines.
+                lines = block.splitlines()
+                first_number = number + 1
+                number += len(lines)
+                if indices is None:
+                    for offset, raw in enumerate(lines):
+                        stripped = raw.strip()
+                        if not stripped or stripped.startswith("#"):
+                            continue
+                        separator = next((s for s in _SEPARATORS if s in stripped), None)
+                        header, indices = _layout(
+                            _split(stripped, separator), columns, file, first_number + offset
+                        )
+                        skip = offset + 1 if header else offset
+                        lines, first_number = lines[skip:], first_number + skip
+                        break
+                    else:
+                        continue
+                chunk = _chunk(lines, first_number, separator, indices, file, "#" not in block)
+                if len(chunk.samples):
+                    yield chunk
+    except (OSError, UnicodeDecodeError) as exc:
+        raise _fail("M050", f"cannot read {file}: {exc}", file) from None
+
+
+def _chunk(
+    lines: list[str],
+    first_number: int,
+    separator: str | None,
+    indices: tuple[int, int, int],
+    file: str,
+    plain: bool,
+) -> Log:
+    """The samples of consecutive lines (the first is line ``first_number``); ``plain``: no
+    line is a comment (blank lines make the widths differ, which the fast parser refuses)."""
+    numbers = range(first_number, first_number + len(lines))
+    samples = _fast_rows(lines, separator, indices) if plain and lines else None
+    if samples is not None:
+        return Log(samples=samples, lines=tuple(numbers), source=file)
+    rows: list[list[float]] = []
+    kept: list[int] = []
+    for raw, number in zip(lines, numbers, strict=True):
+        stripped = raw.strip()
+        if not stripped or stripped.startswith("#"):
+            continue
+        rows.append(_row(_split(stripped, separator), indices, file, number))
+        kept.append(number)
+    return Log(
+        samples=np.asarray(rows, dtype=np.float64).reshape(-1, 3),
+        lines=tuple(kept),
+        source=file,
+    )
+
+
+def apply_transform(
+    samples: FloatArray, transform: tuple[float, float, float] | None
+) -> FloatArray:
+    """``samples`` moved by the rigid ``(x, y, yaw)`` (see :func:`read_log`)."""
+    return _apply(samples, transform)
+
+
+class CsvLines:
+    """A CSV log read one line at a time (a live log): the same header rules, columns and
+    numbers as :func:`read_csv_log`."""
+
+    def __init__(self, file: str, columns: Sequence[str] | None = None) -> None:
+        self.file = file
+        self.columns = columns
+        self.separator: str | None = None
+        self.indices: tuple[int, int, int] | None = None
+
+    def parse(self, raw: str, number: int) -> tuple[float, float, float] | None:
+        """The sample on line ``number``; None for a blank, comment or header line."""
+        stripped = raw.strip()
+        if not stripped or stripped.startswith("#"):
+            return None
+        if self.indices is None:
+            self.separator = next((s for s in _SEPARATORS if s in stripped), None)
+            header, self.indices = _layout(
+                _split(stripped, self.separator), self.columns, self.file, number
+            )
+            if header:
+                return None
+        t, x, y = _row(_split(stripped, self.separator), self.indices, self.file, number)
+        return t, x, y
 
 
 # --- ROS bags ---------------------------------------------------------------------------------
@@ -294,10 +454,12 @@ def read_bag(path: Path, topic: str | None = None, frame: str | None = None) -> 
     With ``frame``, each pose is expressed in that frame through the bag's ``/tf`` and
     ``/tf_static`` at its stamp (see :mod:`tlmpc.importers.frames`).
     """
+    require("rosbags.highlevel", "reading a ROS bag or MCAP log", file=str(path))
     from rosbags.highlevel import AnyReader
     from rosbags.typesys import Stores, get_typestore
 
     file = str(path)
+    _check_bag_path(path, file)
     try:
         reader = AnyReader([_bag_paths(path)], default_typestore=get_typestore(Stores.ROS2_HUMBLE))
         reader.open()
@@ -351,6 +513,9 @@ def read_bag(path: Path, topic: str | None = None, frame: str | None = None) -> 
                 )
             chosen = [c for c in poses if c.topic == topics[0]]
             topic = topics[0]
+        declared = sum(int(c.msgcount) for c in chosen)
+        if declared > MAX_LOG_SAMPLES:
+            raise _too_many(file)
         rows: list[tuple[int, float, float]] = []
         frames: list[tuple[int, float, float, float, str]] = []
         try:
@@ -363,6 +528,8 @@ def read_bag(path: Path, topic: str | None = None, frame: str | None = None) -> 
                 nanoseconds = int(stamp.sec) * 1_000_000_000 + int(stamp.nanosec)
                 when = nanoseconds if nanoseconds else int(log_time)
                 rows.append((when, float(pose.position.x), float(pose.position.y)))
+                if len(rows) > MAX_LOG_SAMPLES:  # a bag whose index understates its messages
+                    raise _too_many(file)
                 if frame is not None:
                     frames.append(
                         (
@@ -384,6 +551,35 @@ def read_bag(path: Path, topic: str | None = None, frame: str | None = None) -> 
     finally:
         reader.close()
     return Log(samples=_sorted_samples(rows), source=file, topic=topic)
+
+
+def _too_many(file: str) -> UsageError:
+    return _fail(
+        "M066",
+        f"the bag's pose topic has more than {MAX_LOG_SAMPLES:,} messages",
+        file,
+        hint="verify a shorter stretch of the recording (e.g. `ros2 bag convert` or "
+        "`rosbag filter` by time)",
+    )
+
+
+def _check_bag_path(path: Path, file: str) -> None:
+    """A bag is a regular file or a ROS 2 bag directory: never a device or a FIFO, which
+    would be read without end or block."""
+    import os
+    import stat
+
+    try:
+        mode = os.stat(path).st_mode
+    except OSError as exc:
+        raise _fail("M050", f"cannot read {file}: {exc.strerror or exc}", file) from None
+    if not (stat.S_ISREG(mode) or stat.S_ISDIR(mode)):
+        raise _fail(
+            "M060",
+            f"{file} is not a regular file or a bag directory",
+            file,
+            hint="tlmpc reads only regular files (no devices, pipes or sockets)",
+        )
 
 
 def _in_frame(
@@ -435,14 +631,13 @@ def _in_frame(
 
 
 def _sorted_samples(rows: list[tuple[int, float, float]]) -> FloatArray:
-    """Sorted by integer nanoseconds (exact), first of a repeated stamp kept, then seconds."""
+    """Sorted by integer nanoseconds (exact, stable), then seconds.
+
+    Repeated stamps are kept: the verifier refuses them (V020) as it does in a CSV log, since
+    two poses at one instant are not a trajectory and keeping one would hide the other."""
     rows.sort(key=lambda r: r[0])
-    kept: list[tuple[int, float, float]] = []
-    for row in rows:
-        if not kept or row[0] != kept[-1][0]:
-            kept.append(row)
-    samples = np.empty((len(kept), 3), dtype=np.float64)
-    for i, (ns, x, y) in enumerate(kept):
+    samples = np.empty((len(rows), 3), dtype=np.float64)
+    for i, (ns, x, y) in enumerate(rows):
         samples[i] = (ns / 1e9, x, y)
     return samples
 

@@ -6,7 +6,8 @@
 * The workspace's main piece is the free piece containing ``start`` (else the largest); its
   outer ring is the boundary, its inner rings the holes.  Every other free piece of at least
   ``min_area`` becomes a further workspace component; holes and pieces smaller than
-  ``min_area`` are specks (holes filled, pieces dropped).
+  ``min_area`` are specks (holes filled, pieces dropped), except that with
+  ``keep_obstacles`` (a robot with a body) every hole is kept, however small.
 * Rings are simplified within ``tolerance`` (default: one cell), never moving the boundary by
   more than that.
 * A keepout mask's occupied cells (value 100) and a speed mask's limited cells (values 1..100)
@@ -46,6 +47,9 @@ Ring = tuple[Point, ...]
 #: Default speck threshold, in cells: obstacle specks and region pieces smaller are dropped.
 DEFAULT_MIN_CELLS = 4.0
 
+#: Free pieces a map may have (each becomes a workspace component the planner meshes).
+MAX_PIECES = 2_000
+
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class ImportSettings:
@@ -55,6 +59,9 @@ class ImportSettings:
     tolerance: float | None = None  # default: one cell
     min_area: float | None = None  # default: DEFAULT_MIN_CELLS cells
     start: Point | None = None
+    #: Keep every obstacle however small (``min_area`` then drops only free specks): a robot
+    #: with a body can hit an obstacle of a few cells, so none may vanish from its map.
+    keep_obstacles: bool = False
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -73,6 +80,8 @@ class ImportedMap:
     tolerance: float
     source: str
     speckles_dropped: int = 0
+    #: every file read: the map YAML, its image, and those of the masks
+    inputs: tuple[str, ...] = ()
 
 
 def _ring(polygon_ring: Any) -> Ring:
@@ -120,6 +129,15 @@ def _free_pieces(
     if chosen is None:
         chosen = max(pieces, key=lambda p: p.area)
     others = [p for p in pieces if p is not chosen and p.area >= min_cells]
+    if len(others) >= MAX_PIECES:
+        raise _fail(
+            "M019",
+            f"the map has {len(others) + 1:,} separate free pieces of at least the minimum "
+            f"area, more than {MAX_PIECES:,} (a noise or dither pattern?)",
+            grid.source,
+            hint="clean the map, or raise the minimum area (--min-area, workspace.min_area) "
+            "so that specks are dropped",
+        )
     others.sort(key=lambda p: (-p.area, p.bounds))
     return chosen, others
 
@@ -140,6 +158,79 @@ def _faces(linework: BaseGeometry) -> list[Polygon]:
     parts = getattr(linework, "geoms", None)
     lines = list(parts) if parts is not None else [linework]
     return polygons(shapely.polygonize(lines))
+
+
+def _simplified(noded: BaseGeometry, tolerance: float, rounds: int = 8) -> BaseGeometry:
+    """The chains of ``noded`` simplified within ``tolerance``, with the exact course put
+    back wherever the simplification pinched the free space.
+
+    Douglas-Peucker with topology preserved keeps chains from crossing, not from nearly
+    touching: a wall a cell away from a pillar (or from its own other side, across an inlet)
+    can end up a ten-thousandth of a cell away, a passage narrower than anything in the map
+    (G021) and needles in the mesh.  A kept vertex closer than half the tolerance to a
+    simplified segment it is not next to marks a pinch; that segment and the two at the
+    vertex get back every exact vertex between their ends (a kept vertex is an exact one), and
+    the check runs again.  Elsewhere the simplification stands.
+    """
+    simple = noded.simplify(tolerance, preserve_topology=True)
+    exact_parts = [np.asarray(g.coords) for g in getattr(noded, "geoms", [noded])]
+    simple_parts = [np.asarray(g.coords) for g in getattr(simple, "geoms", [simple])]
+    if len(exact_parts) != len(simple_parts):
+        return simple
+    kept: list[list[int]] = []
+    for exact, part in zip(exact_parts, simple_parts, strict=True):
+        where: dict[tuple[float, float], int] = {}
+        for index, (x, y) in enumerate(exact.tolist()):
+            where.setdefault((x, y), index)
+        indices = [where.get((x, y), -1) for x, y in part.tolist()]
+        if indices and len(part) > 1 and part[0].tolist() == part[-1].tolist():
+            indices[-1] = len(exact) - 1  # a closed chain ends where it starts
+        if -1 in indices or indices != sorted(indices):
+            return simple  # not a subset of the exact vertices in order: leave it be
+        kept.append(indices)
+    limit = 0.75 * tolerance
+    for _ in range(rounds):
+        segments = [
+            (chain, k) for chain, indices in enumerate(kept) for k in range(len(indices) - 1)
+        ]
+        if not segments:
+            break
+        starts = np.array([exact_parts[c][kept[c][k]] for c, k in segments])
+        ends = np.array([exact_parts[c][kept[c][k + 1]] for c, k in segments])
+        lines = shapely.linestrings(np.stack([starts, ends], axis=1))
+        tree = shapely.STRtree(lines)
+        vertices = [(c, k) for c, indices in enumerate(kept) for k in range(len(indices))]
+        points = shapely.points(np.array([exact_parts[c][kept[c][k]] for c, k in vertices]))
+        near_point, near_line = tree.query(points, predicate="dwithin", distance=limit)
+        widen: set[tuple[int, int]] = set()
+        for v, sgm in zip(near_point.tolist(), near_line.tolist(), strict=True):
+            chain, k = vertices[v]
+            other, j = segments[sgm]
+            if other == chain and k in (j, j + 1):
+                continue  # the vertex's own segment
+            point = exact_parts[chain][kept[chain][k]]
+            if any((exact_parts[other][kept[other][e]] == point).all() for e in (j, j + 1)):
+                continue  # a junction: the chains meet there
+            if exact_parts[other][kept[other][j] : kept[other][j + 1] + 1].shape[0] <= 2:
+                continue  # an exact segment already: the gap is the map's own
+            widen.add((other, j))
+            for e in (k - 1, k):
+                if 0 <= e < len(kept[chain]) - 1:
+                    widen.add((chain, e))
+        if not widen:
+            break
+        for chain in {c for c, _ in widen}:
+            indices = kept[chain]
+            grown: list[int] = []
+            for e in range(len(indices) - 1):
+                grown.append(indices[e])
+                if (chain, e) in widen:
+                    grown.extend(range(indices[e] + 1, indices[e + 1]))
+            grown.append(indices[-1])
+            kept[chain] = grown
+    return shapely.MultiLineString(
+        [exact[indices] for exact, indices in zip(exact_parts, kept, strict=True)]
+    )
 
 
 def _coverage(
@@ -181,7 +272,7 @@ def _coverage(
             exact_labels.append(None)  # the inside of a hole
     faces, face_labels = exact, exact_labels
     if tolerance > 0:
-        simple = _faces(noded.simplify(tolerance, preserve_topology=True))
+        simple = _faces(_simplified(noded, tolerance))
         tree = shapely.STRtree(exact)
         matched: list[int | None] = []
         for face in simple:
@@ -236,9 +327,28 @@ def _exact_free(
     grid: OccupancyGrid, settings: ImportSettings, min_area_cells: float
 ) -> tuple[Polygon, list[Polygon]]:
     main, others = _free_pieces(grid, settings.radius, settings.start, min_area_cells)
-    return drop_small_holes(main, min_area_cells), [
-        drop_small_holes(p, min_area_cells) for p in others
-    ]
+    holes = 0.0 if settings.keep_obstacles else min_area_cells
+    return drop_small_holes(main, holes), [drop_small_holes(p, holes) for p in others]
+
+
+def _check_settings(settings: ImportSettings, file: str) -> None:
+    """Refuse (M012) a radius, tolerance or minimum area that is negative or not a finite
+    number: NaN compares false with everything, so a NaN minimum area would silently drop
+    every obstacle, and an infinite radius erodes nothing well-defined."""
+    for what, value in (
+        ("radius", settings.radius),
+        ("tolerance", settings.tolerance),
+        ("minimum area", settings.min_area),
+    ):
+        if value is not None and not (math.isfinite(value) and value >= 0):
+            raise _fail(
+                "M012",
+                f"the {what} must be a finite number >= 0, got {value:g}",
+                file,
+                hint="--radius, --tolerance and --min-area are lengths and areas in map units",
+            )
+    if settings.start is not None and not all(math.isfinite(v) for v in settings.start):
+        raise _fail("M018", f"the start must be finite, got {settings.start}", file)
 
 
 def import_map(
@@ -249,17 +359,12 @@ def import_map(
     speed: Path | None = None,
 ) -> ImportedMap:
     """Read a map (and masks) and build the workspace and regions."""
+    _check_settings(settings, str(map_path))
     grid = read_map(map_path)
-    if settings.radius < 0:
-        raise _fail(
-            "M012", f"the radius must not be negative, got {settings.radius:g}", str(map_path)
-        )
     tolerance = grid.resolution if settings.tolerance is None else settings.tolerance
     min_area = (
         DEFAULT_MIN_CELLS * grid.cell_area() if settings.min_area is None else settings.min_area
     )
-    if tolerance < 0 or min_area < 0:
-        raise _fail("M012", "tolerance and min_area must not be negative", str(map_path))
     cell_area = grid.cell_area()
     exact_main, exact_others = _exact_free(grid, settings, min_area / cell_area)
     mask_grids: list[tuple[str, Path, OccupancyGrid]] = []
@@ -267,11 +372,16 @@ def import_map(
         if path is None:
             continue
         mask = read_map(path)
-        if mask.shape != grid.shape or mask.resolution != grid.resolution:
+        if (
+            mask.shape != grid.shape
+            or mask.resolution != grid.resolution
+            or mask.origin != grid.origin
+        ):
             raise _fail(
                 "M013",
-                f"the mask is {mask.shape[1]}x{mask.shape[0]} cells at {mask.resolution:g}, "
-                f"the map {grid.shape[1]}x{grid.shape[0]} at {grid.resolution:g}",
+                f"the mask is {mask.shape[1]}x{mask.shape[0]} cells at {mask.resolution:g} "
+                f"from origin {list(mask.origin)}, the map {grid.shape[1]}x{grid.shape[0]} "
+                f"at {grid.resolution:g} from {list(grid.origin)}",
                 str(path),
                 hint="a mask must have the map's size, resolution and origin",
             )
@@ -284,7 +394,8 @@ def import_map(
     main = max(simplified, key=lambda p: (p.intersection(exact_main).area, p.area))
     others = [p for p in simplified if p is not main and p.area >= min_area / cell_area]
     others.sort(key=lambda p: (-p.area, p.bounds))
-    kept_cells = [drop_small_holes(p, min_area / cell_area) for p in (main, *others)]
+    hole_cells = 0.0 if settings.keep_obstacles else min_area / cell_area
+    kept_cells = [drop_small_holes(p, hole_cells) for p in (main, *others)]
     dropped = sum(
         len(a.interiors) - len(b.interiors)
         for a, b in zip((main, *others), kept_cells, strict=True)
@@ -343,4 +454,7 @@ def import_map(
         tolerance=tolerance,
         source=str(map_path),
         speckles_dropped=dropped,
+        inputs=tuple(
+            name for g in (grid, *(m for _, _, m in mask_grids)) for name in (g.source, g.image)
+        ),
     )

@@ -24,6 +24,12 @@ def _points(ring: Ring) -> list[list[float]]:
     return [[x, y] for x, y in ring]
 
 
+def _free_workspace(imported: ImportedMap) -> Any:
+    pieces = [Polygon(imported.boundary, imported.holes)]
+    pieces += [Polygon(outer, inner) for outer, inner in imported.components]
+    return shapely.union_all(pieces)
+
+
 def default_start(imported: ImportedMap) -> Point:
     """The free point farthest from obstacles and keepout regions (pole of inaccessibility)."""
     free: Any = Polygon(imported.boundary, imported.holes)
@@ -36,9 +42,7 @@ def default_start(imported: ImportedMap) -> Point:
     return float(point.x), float(point.y)
 
 
-def _clip_rect(
-    imported: ImportedMap, name: str, rect: tuple[float, float, float, float]
-) -> list[list[float]]:
+def _check_rect(imported: ImportedMap, name: str, rect: tuple[float, float, float, float]) -> None:
     if not _NAME.match(name) or name in _KEYWORDS or name in imported.regions:
         raise UsageError(
             error(
@@ -50,21 +54,84 @@ def _clip_rect(
     x0, y0, x1, y1 = rect
     if not (x0 < x1 and y0 < y1 and all(math.isfinite(v) for v in rect)):
         raise UsageError(error("M017", f"--region {name}: need XMIN < XMAX and YMIN < YMAX"))
-    free = Polygon(imported.boundary, imported.holes)
+
+
+def _nearest_on_segment(p: Point, a: Point, b: Point) -> tuple[float, float]:
+    """The distance from ``p`` to segment ``ab`` and the parameter of the nearest point."""
+    dx, dy = b[0] - a[0], b[1] - a[1]
+    length2 = dx * dx + dy * dy
+    t = 0.0 if length2 == 0 else ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / length2
+    t = min(1.0, max(0.0, t))
+    return math.hypot(a[0] + t * dx - p[0], a[1] + t * dy - p[1]), t
+
+
+def snap_to_rings(
+    point: Point, rings: list[list[Point]], tolerance: float
+) -> tuple[Point, tuple[int, int] | None]:
+    """``point`` moved onto the workspace rings it came from, when it lies within
+    ``tolerance`` of them: onto the nearest ring vertex, else returned as it is together with
+    ``(ring, index)``, the place to insert it into a ring edge (so the ring and the region
+    share it exactly).  Far from every ring: unchanged, ``None``."""
+    best_vertex: Point | None = None
+    best = tolerance
+    for ring in rings:
+        for vertex in ring:
+            distance = math.hypot(vertex[0] - point[0], vertex[1] - point[1])
+            if distance <= best:
+                best, best_vertex = distance, vertex
+    if best_vertex is not None:
+        return best_vertex, None
+    best_edge: tuple[int, int] | None = None
+    best = tolerance
+    for r, ring in enumerate(rings):
+        for i, a in enumerate(ring):
+            distance, t = _nearest_on_segment(point, a, ring[(i + 1) % len(ring)])
+            if distance <= best and 0.0 < t < 1.0:
+                best, best_edge = distance, (r, i + 1)
+    return point, best_edge
+
+
+def _clip_rects(
+    imported: ImportedMap, rects: Mapping[str, tuple[float, float, float, float]]
+) -> tuple[Ring, tuple[Ring, ...], dict[str, list[list[float]]]]:
+    """Each rectangle clipped to the workspace's outer boundary, and the boundary and holes
+    noded with the clipped regions.
+
+    A clipped region's vertices on the boundary are the boundary's own: the boundary
+    vertices it follows are copied exactly, and each point where a rectangle's edge crosses a
+    boundary edge (computed, so a rounding error off that edge) is inserted into the boundary
+    as a vertex that both rings share.  Any vertex within a billionth of the map's size of a
+    workspace ring is snapped onto it this way.  Without this, a region edge a few 1e-11 m
+    beside a wall leaves a sliver between them that the quality mesh refines into tens of
+    thousands of triangles.
+    """
+    rings = [list(imported.boundary), *[list(h) for h in imported.holes]]
     outer = Polygon(imported.boundary)
     minx, miny, maxx, maxy = outer.bounds
-    # A hair inside the boundary (a hundred-billionth of the coordinates' size): above rounding,
-    # so the boundary covers the region exactly, and far below the triangulation's snap grid.
     size = max(abs(minx), abs(miny), abs(maxx), abs(maxy), maxx - minx, maxy - miny)
-    inside = outer.buffer(-1e-11 * size, join_style="mitre")
-    clipped = polygons(box(x0, y0, x1, y1).intersection(inside))
-    usable = [p for p in clipped if p.intersection(free).area > 0]
-    if not usable:
-        raise UsageError(
-            error("M017", f"--region {name} has no free space in the imported workspace")
-        )
-    largest = max(usable, key=lambda p: p.area)
-    return _points(tuple(largest.exterior.coords)[:-1])
+    tolerance = 1e-9 * size
+    regions: dict[str, list[list[float]]] = {}
+    for name, rect in rects.items():
+        _check_rect(imported, name, rect)
+        free = Polygon(rings[0], rings[1:])
+        clipped = polygons(box(*rect).intersection(Polygon(rings[0])))
+        usable = [p for p in clipped if p.intersection(free).area > 0]
+        if not usable:
+            raise UsageError(
+                error("M017", f"--region {name} has no free space in the imported workspace")
+            )
+        largest = max(usable, key=lambda p: p.area)
+        ring: list[Point] = []
+        for x, y in list(largest.exterior.coords)[:-1]:
+            point, insert = snap_to_rings((float(x), float(y)), rings, tolerance)
+            if insert is not None:
+                rings[insert[0]].insert(insert[1], point)
+            if not ring or ring[-1] != point:
+                ring.append(point)
+        if len(ring) > 1 and ring[0] == ring[-1]:
+            ring.pop()
+        regions[name] = [[x, y] for x, y in ring]
+    return tuple(rings[0]), tuple(tuple(h) for h in rings[1:]), regions
 
 
 def mission_document(
@@ -77,38 +144,44 @@ def mission_document(
     max_speed: float = 1.0,
     rects: Mapping[str, tuple[float, float, float, float]] | None = None,
 ) -> dict[str, Any]:
-    """A ``version: 1`` mission with the imported workspace, regions and groups."""
-    regions: dict[str, Any] = {n: _points(r) for n, r in imported.regions.items()}
-    for region, rect in (rects or {}).items():
-        regions[region] = _clip_rect(imported, region, rect)
-    if not regions:
+    """A ``version: 1`` mission with the imported workspace, regions and groups.
+
+    Refuses (M018) what ``tlmpc check`` would reject in the written mission: a start that is
+    not a finite point of the free workspace, a speed that is not a positive finite number."""
+    if not (math.isfinite(max_speed) and max_speed > 0):
         raise UsageError(
             error(
-                "M016",
-                "the mission would have no regions",
-                hint="give --keepout or --speed masks, or --region NAME XMIN YMIN XMAX YMAX",
-                file=imported.source,
+                "M018",
+                f"--max-speed must be a positive finite number, got {max_speed:g}",
+                hint="the robot's speed bound in map units per second, e.g. --max-speed 0.5",
             )
         )
-    phrases = list(task or [])
-    if not phrases and not ltl:
-        if "keepout" not in imported.groups:
+    if start is not None:
+        free = _free_workspace(imported)
+        if not all(math.isfinite(v) for v in start) or not free.covers(
+            shapely.Point(start[0], start[1])
+        ):
             raise UsageError(
                 error(
-                    "M016",
-                    "the mission would have no task",
-                    hint="give --task PHRASE or --ltl FORMULA (without a keepout mask there "
-                    "is no default task)",
+                    "M018",
+                    f"--start {start[0]:g} {start[1]:g} is not a point of the free workspace",
+                    hint="choose a free point of the map, or leave --start out for the point "
+                    "farthest from obstacles",
                     file=imported.source,
                 )
             )
+    regions: dict[str, Any] = {n: _points(r) for n, r in imported.regions.items()}
+    boundary, holes, clipped = _clip_rects(imported, rects or {})
+    regions.update(clipped)
+    phrases = list(task or [])
+    if not phrases and not ltl and "keepout" in imported.groups:
         phrases = ["avoid keepout"]
     document: dict[str, Any] = {
         "version": 1,
         "name": name,
         "workspace": {
-            "boundary": _points(imported.boundary),
-            "holes": [_points(h) for h in imported.holes],
+            "boundary": _points(boundary),
+            "holes": [_points(h) for h in holes],
             **(
                 {
                     "components": [
@@ -120,8 +193,9 @@ def mission_document(
                 else {}
             ),
         },
-        "regions": regions,
     }
+    if regions:
+        document["regions"] = regions
     if imported.groups:
         document["groups"] = {g: list(m) for g, m in imported.groups.items()}
     document["robot"] = {
@@ -135,12 +209,28 @@ def mission_document(
     return document
 
 
+def unfinished(document: Mapping[str, Any]) -> list[str]:
+    """What a mission still lacks before it can be checked: ``regions``, ``task``."""
+    missing = [] if "regions" in document else ["regions"]
+    if "task" not in document and "ltl" not in document:
+        missing.append("task")
+    return missing
+
+
 def mission_yaml(document: Mapping[str, Any]) -> str:
-    """The mission as YAML, points in flow style (``[x, y]``), floats exact (repr)."""
+    """The mission as YAML, points in flow style (``[x, y]``), floats exact (repr); a mission
+    still without regions or a task says what to add."""
     header = (
         "# written by `tlmpc import-map`: the workspace is the free space of an occupancy-grid\n"
         "# map (configuration space when a radius was given); see docs/robot-data.md\n"
     )
+    missing = unfinished(document)
+    if missing:
+        header += (
+            f"# still to add: {' and '.join(missing)} (docs/mission-format.md), e.g.\n"
+            "#   regions:\n#     dock: {rect: [XMIN, YMIN, XMAX, YMAX]}\n"
+            "#   task: [visit dock]\n# then run `tlmpc check` on this file\n"
+        )
     return header + yaml.safe_dump(
         dict(document), sort_keys=False, default_flow_style=None, width=100
     )

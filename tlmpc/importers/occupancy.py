@@ -18,15 +18,16 @@ Pillow is imported only here, and only when a map is read.
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import numpy.typing as npt
-import yaml
 
 from tlmpc.base.errors import UsageError, error
+from tlmpc.io.inputs import brief, load_small_yaml, open_regular, read_text
 
 MODES = ("trinary", "scale", "raw")
 UNKNOWN = -1
@@ -35,6 +36,20 @@ OCCUPIED = 100
 
 #: Maps larger than this many cells are refused (a 16k x 16k grid is already 1 GB of floats).
 MAX_CELLS = 64_000_000
+
+#: A map YAML is a handful of keys; anything larger is not one.
+MAX_MAP_YAML_BYTES = 1024 * 1024
+
+#: The largest image file read (a 64-million-cell 16-bit PGM is 128 MB).
+MAX_IMAGE_BYTES = 512 * 1024 * 1024
+
+#: The smallest and largest cell size accepted: beyond these a cell's square, its area or
+#: the map's extent leaves the range of floating point (1e-300 squared is 0).
+MIN_RESOLUTION = 1e-9
+MAX_RESOLUTION = 1e9
+
+#: Origins farther out than this put the map beyond where a float resolves a cell.
+MAX_COORDINATE = 1e12
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -46,6 +61,8 @@ class OccupancyGrid:
     origin: tuple[float, float, float]
     mode: str
     source: str
+    #: the image file the cells were read from
+    image: str = ""
 
     @property
     def shape(self) -> tuple[int, int]:
@@ -79,21 +96,25 @@ def _number(meta: dict[str, Any], key: str, file: str, default: float | None = N
             hint="a map_server map needs image, resolution, origin, occupied_thresh, free_thresh",
         )
     if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise _fail("M004", f"`{key}` is not a number: {value!r}", file)
+        hint = None
+        if isinstance(value, str):
+            try:
+                float(value)
+                hint = (
+                    "YAML 1.1 reads this as text: write it with a decimal point and a signed "
+                    "exponent, e.g. 1.0e-3"
+                )
+            except ValueError:
+                pass
+        raise _fail("M004", f"`{key}` is not a finite number: {brief(value)}", file, hint=hint)
     return float(value)
 
 
 def read_metadata(path: Path) -> dict[str, Any]:
     """The map YAML, checked: resolution > 0, 0 <= free <= occupied <= 1, a known mode."""
     file = str(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise _fail("M001", f"cannot read map {file}: {exc}", file, hint="check the path") from None
-    try:
-        meta = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        raise _fail("M002", f"the map file is not YAML: {exc}", file) from None
+    text = read_text(path, limit=MAX_MAP_YAML_BYTES, code="M001", what="map")
+    meta = load_small_yaml(text, file, code="M002")
     if not isinstance(meta, dict):
         raise _fail(
             "M002",
@@ -105,23 +126,37 @@ def read_metadata(path: Path) -> dict[str, Any]:
     if not isinstance(image, str) or not image:
         raise _fail("M003", "the map has no `image`", file, hint="image: map.pgm")
     resolution = _number(meta, "resolution", file)
-    if resolution <= 0:
-        raise _fail("M004", f"`resolution` must be positive, got {resolution:g}", file)
+    if not MIN_RESOLUTION <= resolution <= MAX_RESOLUTION:
+        raise _fail(
+            "M004",
+            f"`resolution` must be between {MIN_RESOLUTION:g} and {MAX_RESOLUTION:g} "
+            f"(metres per cell), got {resolution:g}",
+            file,
+            hint="resolution is the size of one cell, e.g. 0.05",
+        )
     origin = meta.get("origin")
     if (
         not isinstance(origin, list)
         or len(origin) != 3
         or not all(
-            isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
+            isinstance(v, int | float)
+            and not isinstance(v, bool)
+            and math.isfinite(v)
+            and abs(v) <= MAX_COORDINATE
             for v in origin
         )
     ):
-        raise _fail("M004", f"`origin` must be [x, y, yaw], got {origin!r}", file)
+        raise _fail(
+            "M004",
+            f"`origin` must be [x, y, yaw] of finite numbers (at most {MAX_COORDINATE:g} "
+            f"in size), got {brief(origin)}",
+            file,
+        )
     occupied = _number(meta, "occupied_thresh", file)
     free = _number(meta, "free_thresh", file)
     negate = meta.get("negate", 0)
     if negate not in (0, 1, True, False):
-        raise _fail("M004", f"`negate` must be 0 or 1, got {negate!r}", file)
+        raise _fail("M004", f"`negate` must be 0 or 1, got {brief(negate)}", file)
     if not 0.0 <= free <= occupied <= 1.0:
         raise _fail(
             "M004",
@@ -131,7 +166,9 @@ def read_metadata(path: Path) -> dict[str, Any]:
         )
     mode = meta.get("mode", "trinary")
     if mode not in MODES:
-        raise _fail("M004", f"unknown map mode {mode!r}", file, hint="use trinary, scale or raw")
+        raise _fail(
+            "M004", f"unknown map mode {brief(mode)}", file, hint="use trinary, scale or raw"
+        )
     return {
         "image": image,
         "resolution": resolution,
@@ -145,23 +182,53 @@ def read_metadata(path: Path) -> dict[str, Any]:
 
 def _pixels(path: Path, file: str) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.bool_] | None]:
     """Shade in [0, 1] per pixel (mean of colour channels) and, if any, opacity per pixel."""
+    import warnings
+
     from PIL import Image, UnidentifiedImageError
 
-    try:
-        with Image.open(path) as image:
-            if image.width * image.height > MAX_CELLS:
-                raise _fail("M006", f"the map image has more than {MAX_CELLS} cells", file)
-            mode = image.mode
-            array = np.asarray(image)
-    except FileNotFoundError:
+    if not path.exists():
         raise _fail(
             "M005",
             f"the map image {path} does not exist",
             file,
             hint="`image` is relative to the map YAML file",
+        )
+    try:
+        with (
+            open_regular(path, code="M006", what="map image") as stream,
+            warnings.catch_warnings(),
+        ):
+            # The size is checked from the header, before any pixel is decoded; Pillow's own
+            # "decompression bomb" check (a warning, then an error) is ours to report.
+            warnings.simplefilter("ignore", Image.DecompressionBombWarning)
+            if os.fstat(stream.fileno()).st_size > MAX_IMAGE_BYTES:
+                raise _fail(
+                    "M006", f"the map image {path} is larger than {MAX_IMAGE_BYTES >> 20} MiB", file
+                )
+            with Image.open(stream) as image:
+                if image.width * image.height > MAX_CELLS:
+                    raise _fail(
+                        "M006",
+                        f"the map image {path} is {image.width}x{image.height} pixels, more "
+                        f"than {MAX_CELLS:,} cells",
+                        file,
+                        hint="crop or downsample the map",
+                    )
+                mode = image.mode
+                array = np.asarray(image)
+    except UsageError as exc:
+        raise UsageError(
+            [error(d.code, d.message, hint=d.hint, file=file) for d in exc.diagnostics]
         ) from None
-    except (OSError, UnidentifiedImageError, ValueError, SyntaxError) as exc:
-        raise _fail("M006", f"cannot read the map image {path}: {exc}", file) from None
+    except Image.DecompressionBombError:
+        raise _fail(
+            "M006",
+            f"the map image {path} declares more than {MAX_CELLS:,} cells",
+            file,
+            hint="crop or downsample the map",
+        ) from None
+    except (OSError, UnidentifiedImageError, ValueError, SyntaxError, MemoryError) as exc:
+        raise _fail("M006", f"cannot read the map image {path}: {brief(str(exc))}", file) from None
     if mode == "1":
         return array.astype(np.float64), None
     if mode in ("I;16", "I;16B", "I;16L", "I"):
@@ -236,4 +303,5 @@ def read_map(path: Path) -> OccupancyGrid:
         origin=meta["origin"],
         mode=meta["mode"],
         source=str(path),
+        image=str(image_path),
     )

@@ -137,30 +137,47 @@ def json_text(document: Any) -> str:
 MAX_ARTIFACT_BYTES = 64 * 1024 * 1024
 
 
-def read_json(path: Path, expected_format: str | None = None) -> dict[str, Any]:
+def _no_constant(name: str) -> Any:
+    raise ValueError(f"{name} is not a JSON number (tlmpc writes non-finite numbers as strings)")
+
+
+#: A number with an exponent of three digits or more may overflow to infinity when read.
+_HUGE_EXPONENT = re.compile(r"[0-9][eE]\+?[0-9]{3}")
+
+
+def _has_non_finite(document: Any) -> bool:
+    stack = [document]
+    while stack:
+        value = stack.pop()
+        if isinstance(value, float):
+            if not math.isfinite(value):
+                return True
+        elif isinstance(value, dict):
+            stack.extend(value.values())
+        elif isinstance(value, list):
+            stack.extend(value)
+    return False
+
+
+def read_json(
+    path: Path, expected_format: str | None = None, *, finite: bool = True
+) -> dict[str, Any]:
     """Read an artifact, checking its ``format`` prefix (e.g. ``"tlmpc.trace/"``).
 
-    Raises :class:`UsageError` (exit 2) for unreadable files, bad JSON or another format.
+    Raises :class:`UsageError` (exit 2) for unreadable files, bad JSON or another format, and
+    (``finite``) for ``NaN``/``Infinity``, which tlmpc never writes; a user's trace is read
+    with ``finite=False`` so that the verifier reports a non-finite sample where it is.
     """
+    from tlmpc.io.inputs import read_text
+
+    # bounded, regular files only: never read() a device, a FIFO or a huge file whole
+    text = read_text(
+        path, limit=MAX_ARTIFACT_BYTES, code="U001", too_large_code="U040", what="artifact"
+    )
     try:
-        with open(path, "rb") as stream:  # bounded: never read() a device or a huge file whole
-            raw = stream.read(MAX_ARTIFACT_BYTES + 1)
-        text = raw.decode("utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise UsageError(
-            error("U001", f"cannot read {path}: {exc}", hint="check the path", file=str(path))
-        ) from None
-    if len(raw) > MAX_ARTIFACT_BYTES:
-        raise UsageError(
-            error(
-                "U040",
-                f"{path} is larger than {MAX_ARTIFACT_BYTES // 2**20} MiB",
-                hint="artifacts are written by `tlmpc compile`; is this the right file?",
-                file=str(path),
-            )
-        )
-    try:
-        document = json.loads(text)
+        document = json.loads(text, parse_constant=_no_constant if finite else None)
+        if finite and _HUGE_EXPONENT.search(text) and _has_non_finite(document):
+            raise ValueError("a number too large for a float (it reads as infinity)")
     except RecursionError:
         raise UsageError(
             error(
@@ -223,12 +240,17 @@ def read_artifact(path: Path, schema: str) -> dict[str, Any]:
         raise UsageError(
             error(
                 "U071",
-                f"{path.name} does not match its schema: {problems[0]}",
+                f"{path.name} does not match its schema: {_cut(problems[0])}",
                 file=str(path),
                 hint="artifacts are written by `tlmpc compile`; was this file edited?",
             )
         )
     return document
+
+
+def _cut(text: str, limit: int = 300) -> str:
+    """A schema message cut short: it may quote a whole (edited, huge) value."""
+    return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
 def _tampered(path: Path, message: str, code: str = "U042") -> UsageError:
@@ -257,10 +279,10 @@ def read_artifacts(directory: Path, names: tuple[str, ...]) -> dict[str, dict[st
         document = read_json(path, fmt)
         problems = validation_errors(_skeleton(path, document), schema)
         if problems:
-            shown = "; ".join(problems[:3]) + (" ..." if len(problems) > 3 else "")
+            shown = "; ".join(map(_cut, problems[:3])) + (" ..." if len(problems) > 3 else "")
             raise _tampered(path, f"{name} does not match its schema: {shown}", "U041")
         documents[name] = document
-    _cross_check(directory, documents)
+    cross_check(directory, documents)
     return documents
 
 
@@ -300,7 +322,10 @@ def _indices(values: Any, bound: int, low: int = 0) -> bool:
     return True
 
 
-def _cross_check(directory: Path, documents: dict[str, dict[str, Any]]) -> None:
+def cross_check(directory: Path, documents: Mapping[str, Mapping[str, Any]]) -> None:
+    """Refuse (U042) artifacts of ``directory`` that contradict each other: indices out of
+    range, a task naming a region the output lacks, a trace or controllers of another
+    mission or abstraction.  ``documents`` have passed their schemas."""
     from tlmpc.base.errors import TlmpcError
     from tlmpc.ltl.parser import parse_ltl
 
@@ -378,4 +403,58 @@ def _cross_check(directory: Path, documents: dict[str, dict[str, Any]]) -> None:
         ):
             raise _tampered(
                 directory / "witness.json", "witness.json: a passage names a missing step or vertex"
+            )
+    _cross_check_results(directory, documents, triangles if abstraction is not None else None)
+
+
+def _cross_check_results(
+    directory: Path, documents: Mapping[str, Mapping[str, Any]], triangles: int | None
+) -> None:
+    """The controllers and the trace against the plan, the mesh and the mission."""
+    controllers = documents.get("controllers.json")
+    if controllers is not None:
+        path = directory / "controllers.json"
+        steps = controllers["steps"]
+        if not all(s["step"] == k for k, s in enumerate(steps)):
+            raise _tampered(path, "controllers.json: the steps are not numbered 0, 1, 2, ...")
+        loop = controllers["loop_start"]
+        if loop is not None and not 0 <= loop < len(steps):
+            raise _tampered(path, "controllers.json: loop_start is not a step")
+        if triangles is not None and not all(
+            _indices([s["triangle"], s["next_triangle"] or 0], triangles) for s in steps
+        ):
+            raise _tampered(path, "controllers.json: a step names a missing triangle")
+        # the steps are one path: each leaves into the triangle of the next (the last into
+        # the loop's first, unless it is a final stay)
+        successor = [*(s["triangle"] for s in steps[1:]), None]
+        if loop is not None:
+            successor[-1] = steps[loop]["triangle"]
+        if any(
+            s["next_triangle"] is not None and s["next_triangle"] != after
+            for s, after in zip(steps, successor, strict=True)
+        ) or (loop is None and not steps[-1]["stay"]):
+            raise _tampered(path, "controllers.json: the steps do not follow one another")
+        witness = documents.get("witness.json")
+        if witness is not None and len(steps) != len(witness["prefix"]) + len(witness["cycle"]):
+            raise _tampered(
+                path, "controllers.json and witness.json have different numbers of steps"
+            )
+    trace = documents.get("trace.json")
+    if trace is not None:
+        path = directory / "trace.json"
+        points = trace["points"]
+        if not all(isinstance(p, list) and len(p) == 3 for p in points):
+            raise _tampered(path, "trace.json: not every point is [t, x, y]")
+        loop = trace["loop_start"]
+        if loop is not None and not (isinstance(loop, int) and 0 <= loop < len(points)):
+            raise _tampered(path, "trace.json: loop_start is not the index of a point")
+        mission = documents.get("mission.json")
+        if (
+            mission is not None
+            and isinstance(mission.get("regions"), dict)
+            and isinstance(trace.get("regions"), dict)
+            and set(trace["regions"]) != set(mission["regions"])
+        ):
+            raise _tampered(
+                path, "trace.json and mission.json name different regions (two missions mixed)"
             )

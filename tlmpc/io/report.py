@@ -108,6 +108,14 @@ class Reporter:
         self.err.write(text + "\n")
         self.err.flush()
 
+    def stream(self, text: str) -> None:
+        """A line of the result printed as soon as it is known (a batch's log that finished,
+        a monitor's verdict that changed): on standard output in text mode; with ``--json``
+        on standard error, since the envelope is all standard output holds."""
+        target = self.err if self.json else self.out
+        target.write(text + "\n")
+        target.flush()
+
     def finish(
         self, exit_code: int, result: Mapping[str, Any] | None = None, text: str = ""
     ) -> int:

@@ -12,6 +12,8 @@ L-coded diagnostics; no input, however malformed, produces a traceback.
 from __future__ import annotations
 
 import functools
+import math
+import re
 from collections.abc import Callable
 from importlib import resources
 from typing import Any
@@ -28,12 +30,16 @@ from lark.exceptions import (
 from tlmpc.base.errors import Diagnostic, InvalidInputError, error
 from tlmpc.ltl.ast import (
     And,
+    BoundedEventually,
+    BoundedGlobally,
+    BoundedUntil,
     Const,
     Equiv,
     Eventually,
     Formula,
     Globally,
     Implies,
+    Interval,
     Not,
     Or,
     Prop,
@@ -62,6 +68,39 @@ _BINARY_TEMPORAL: dict[str, Callable[..., Formula]] = {
     "W": WeakUntil,
     "M": StrongRelease,
 }
+
+
+_NUMBER = re.compile(r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
+_INFINITY = re.compile(r"\+?(?:inf|infinity|∞)", re.IGNORECASE)
+_NOT_A_NUMBER = re.compile(r"[+-]?nan", re.IGNORECASE)
+_INTERVAL_HINT = "write a closed interval of seconds [a,b] with 0 <= a <= b, e.g. F[0,30] dock"
+
+
+def _interval_problem(text: str) -> tuple[str, str, Interval | None]:
+    """``(code, message, interval)``: the interval of ``[a,b]`` text, or why it is none."""
+    body = text[1:-1]
+    parts = body.split(",")
+    if len(parts) != 2:
+        return "L040", f"the time bound {text} needs exactly two bounds [a,b]", None
+    bounds: list[float] = []
+    for part in (p.strip() for p in parts):
+        if _NUMBER.fullmatch(part):
+            bounds.append(float(part))
+        elif _INFINITY.fullmatch(part):
+            bounds.append(math.inf)
+        elif _NOT_A_NUMBER.fullmatch(part):
+            return "L043", f"the time bound {text} is not a number (NaN)", None
+        else:
+            return "L040", f"the time bound {text}: {part!r} is not a number of seconds", None
+    low, high = bounds
+    if low < 0 or high < 0:
+        return "L042", f"the time bound {text} is negative: bounds look into the future", None
+    if math.isinf(low):
+        return "L043", f"the time bound {text} starts at infinity: no instant is in it", None
+    if low > high:
+        low_text, high_text = parts[0].strip(), parts[1].strip()
+        return "L041", f"the time bound {text} is empty: {low_text} > {high_text}", None
+    return "", "", Interval(low, high)
 
 
 @functools.cache
@@ -119,7 +158,8 @@ class _ToAst(Transformer[Token, Formula]):
         super().__init__()
         self.pos = pos
         self.file = file
-        #: Operator keywords used as bare proposition names (L030), reported after the walk.
+        #: Operator keywords used as bare proposition names (L030) and bad time bounds
+        #: (L040-L044), reported after the walk.
         self.keyword_names: list[Diagnostic] = []
 
     def _span(self, meta: Any) -> Span | None:
@@ -178,6 +218,53 @@ class _ToAst(Transformer[Token, Formula]):
             )
         return result
 
+    def _interval(self, token: Token) -> Interval:
+        code, message, interval = _interval_problem(str(token))
+        if interval is not None:
+            return interval
+        span = _token_span(self.pos, token)
+        self.keyword_names.append(
+            error(code, message, hint=_INTERVAL_HINT, file=self.file, line=span.line, col=span.col)
+        )
+        return Interval(0.0, 0.0)  # a placeholder: the parse fails with the diagnostic
+
+    @v_args(meta=True)
+    def bounded_unary_op(self, meta: Any, children: list[Any]) -> Formula:
+        chain, token, operand = str(children[0]), children[1], children[2]
+        interval = self._interval(token)
+        # The bound belongs to the last letter of a chain: `GF[0,10] a` is `G F[0,10] a`.
+        result: Formula = (
+            BoundedEventually(operand, interval, span=self._span(meta))
+            if chain[-1] == "F"
+            else BoundedGlobally(operand, interval, span=self._span(meta))
+        )
+        for symbol in reversed(chain[:-1]):
+            result = (
+                Eventually(result, span=self._span(meta))
+                if symbol == "F"
+                else Globally(result, span=self._span(meta))
+            )
+        return result
+
+    @v_args(meta=True)
+    def bounded_temporal_op(self, meta: Any, children: list[Any]) -> Formula:
+        left, op, token, right = children
+        interval = self._interval(token)
+        if str(op) != "U":
+            span = _token_span(self.pos, op)
+            self.keyword_names.append(
+                error(
+                    "L044",
+                    f"only U takes a time bound, not {op}",
+                    hint="bounded operators are F[a,b], G[a,b] and U[a,b]; write "
+                    "`a R[a,b] b` as `!(!a U[a,b] !b)`",
+                    file=self.file,
+                    line=span.line,
+                    col=span.col,
+                )
+            )
+        return BoundedUntil(left, right, interval, span=self._span(meta))
+
     @v_args(meta=True)
     def temporal_op(self, meta: Any, children: list[Any]) -> Formula:
         left, op, right = children
@@ -216,6 +303,7 @@ _EXPECTED_NAMES = {
     "IMPLIES": "'->'",
     "EQUIV": "'<->'",
     "BINTEMP": "U, R, W or M",
+    "INTERVAL": "a time bound [a,b]",
     "$END": "the end of the formula",
 }
 

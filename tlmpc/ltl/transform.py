@@ -3,6 +3,9 @@
 NNF keeps ``W``/``M``/``R`` as native operators (expanding ``W`` duplicates a subformula)
 and uses the dualities ``!(a U b) = !a R !b``, ``!(a R b) = !a U !b``,
 ``!(a W b) = !a M !b``, ``!(a M b) = !a W !b``, ``!F a = G !a``, ``!G a = F !a``.
+The bounded operators dualise as ``!F[a,b] x = G[a,b] !x`` and ``!G[a,b] x = F[a,b] !x``; a
+negated bounded until has no dual in the language (there is no bounded release), so NNF keeps
+``!(x U[a,b] y)`` with its operands in NNF: the only negation above a non-proposition.
 """
 
 from __future__ import annotations
@@ -14,6 +17,9 @@ from tlmpc.ltl.ast import (
     FALSE,
     TRUE,
     And,
+    BoundedEventually,
+    BoundedGlobally,
+    BoundedUntil,
     Const,
     Equiv,
     Eventually,
@@ -85,6 +91,17 @@ def nnf(formula: Formula, negate: bool = False) -> Formula:
         ):
             build = _DUAL[type(formula)] if negate else _SAME[type(formula)]
             return build(nnf(left, negate), nnf(right, negate))
+        case BoundedEventually(arg, interval):
+            if negate:
+                return BoundedGlobally(nnf(arg, True), interval)
+            return BoundedEventually(nnf(arg), interval)
+        case BoundedGlobally(arg, interval):
+            if negate:
+                return BoundedEventually(nnf(arg, True), interval)
+            return BoundedGlobally(nnf(arg), interval)
+        case BoundedUntil(left, right, interval):
+            until = BoundedUntil(nnf(left), nnf(right), interval)
+            return Not(until) if negate else until
         case _:
             assert_never(formula)
 
@@ -116,12 +133,22 @@ def substitute(formula: Formula, replace: Mapping[str, Formula]) -> Formula:
             | StrongRelease(left, right)
         ):
             return type(f)(substitute(left, replace), substitute(right, replace), span=f.span)
+        case BoundedEventually(arg, interval) | BoundedGlobally(arg, interval):
+            return type(f)(substitute(arg, replace), interval, span=f.span)
+        case BoundedUntil(left, right, interval):
+            return BoundedUntil(
+                substitute(left, replace), substitute(right, replace), interval, span=f.span
+            )
         case _:
             assert_never(f)
 
 
 def _only(formula: Formula, allowed: tuple[type, ...]) -> bool:
+    # A bounded operator is in neither class: the classes are the automaton planner's, which
+    # does not take bounds.
     for node in nnf(formula).walk():
+        if isinstance(node, BoundedEventually | BoundedGlobally | BoundedUntil):
+            return False
         if isinstance(node, Const | Prop | Not | And | Or):
             continue
         if not isinstance(node, allowed):
@@ -189,5 +216,12 @@ def simplify(formula: Formula) -> Formula:
             | StrongRelease(left, right)
         ):
             return type(f)(simplify(left), simplify(right), span=f.span)
+        case BoundedEventually(arg, interval) | BoundedGlobally(arg, interval):
+            arg = simplify(arg)
+            if isinstance(arg, Const):  # the window is never empty
+                return arg
+            return type(f)(arg, interval, span=f.span)
+        case BoundedUntil(left, right, interval):
+            return BoundedUntil(simplify(left), simplify(right), interval, span=f.span)
         case _:
             assert_never(f)

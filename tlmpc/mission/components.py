@@ -15,7 +15,7 @@ import shapely
 from shapely.geometry import Point as ShapelyPoint
 
 from tlmpc.base.errors import Diagnostic, error
-from tlmpc.mission.geometry import AREA_TOLERANCE, CheckedShape, shapely_polygon
+from tlmpc.mission.shapes import AREA_TOLERANCE, CheckedShape, shapely_polygon
 from tlmpc.mission.yamlpos import Path, json_path
 
 Locate = Callable[[Path], tuple[int, int]]

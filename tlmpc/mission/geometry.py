@@ -9,23 +9,16 @@ from __future__ import annotations
 
 import re
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 from itertools import chain
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from tlmpc.base.errors import Diagnostic, error
 from tlmpc.mission import plain_geometry
 from tlmpc.mission.model import Polygon
+from tlmpc.mission.shapes import AREA_TOLERANCE, CheckedShape, shapely_polygon
 from tlmpc.mission.yamlpos import Path, json_path
 
-#: Relative tolerance for "zero area" (relative to the squared size of the shape).
-AREA_TOLERANCE = 1e-12
-
 Locate = Callable[[Path], tuple[int, int]]
-
-if TYPE_CHECKING:
-    from shapely.geometry import Polygon as ShapelyPolygon
-
 
 #: Point lists longer than this are checked with array operations (numpy, shapely); shorter
 #: ones in pure Python first, so that a plain mission's check imports neither.
@@ -120,27 +113,6 @@ def _crossing_vertex(points: Any, reason: str) -> int | None:
     t = np.clip(((x - start[:, 0]) * edge[:, 0] + (y - start[:, 1]) * edge[:, 1]) / squared, 0, 1)
     gap = np.hypot(start[:, 0] + t * edge[:, 0] - x, start[:, 1] + t * edge[:, 1] - y)
     return int(np.argmin(gap))
-
-
-@dataclass(frozen=True, slots=True)
-class CheckedShape:
-    """A shape that passed its own checks, as points and (built on first use) a shapely polygon."""
-
-    points: Polygon
-    polygon: ShapelyPolygon | None
-    path: Path
-
-
-def shapely_polygon(shape: CheckedShape) -> ShapelyPolygon:
-    """The shape's shapely polygon, built once when a check first needs it."""
-    if shape.polygon is None:
-        import numpy as np
-        import shapely
-
-        # shapely.polygons on an array is linear in the vertices, unlike a list of tuples
-        object.__setattr__(shape, "polygon", shapely.polygons(np.asarray(shape.points, float)))
-    assert shape.polygon is not None
-    return shape.polygon
 
 
 def check_shape(

@@ -20,8 +20,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from tlmpc.base.errors import Diagnostic
-from tlmpc.mission.geometry import AREA_TOLERANCE
 from tlmpc.mission.model import Mission, Point, Polygon
+from tlmpc.mission.shapes import AREA_TOLERANCE
 
 #: A passage narrower than this fraction of the workspace's size is reported (G021).
 NARROW_FRACTION = 1e-3

@@ -14,12 +14,12 @@ from itertools import chain
 from pathlib import Path as FilePath
 from typing import TYPE_CHECKING, Any
 
-from tlmpc.base.errors import Diagnostic, InvalidInputError, UsageError, best_first, error
+from tlmpc.base.errors import Diagnostic, InvalidInputError, best_first, error
 from tlmpc.io.schema_check import is_valid, load_schema
 from tlmpc.ltl.ast import Formula, Or, Prop, conjoin
 from tlmpc.ltl.keywords import KEYWORDS
 from tlmpc.ltl.transform import substitute
-from tlmpc.mission.geometry import CheckedShape, check_layout, check_shape
+from tlmpc.mission.geometry import check_layout, check_shape
 from tlmpc.mission.model import (
     Component,
     Mission,
@@ -32,6 +32,7 @@ from tlmpc.mission.model import (
     TaskPart,
     Workspace,
 )
+from tlmpc.mission.shapes import CheckedShape
 from tlmpc.mission.yamlpos import Path, PositionedDocument, json_path, load_positioned
 from tlmpc.tasks.compiler import NameKinds, compile_phrases
 
@@ -41,9 +42,6 @@ if TYPE_CHECKING:
 #: Files larger than this are refused while reading, before parsing (Example 8, a thousand
 #: rooms, is 52 KB; a 10^6-vertex boundary 24 to 45 MB, depending on the digits written).
 MAX_BYTES = 256 * 1024 * 1024
-#: Read in pieces of this size, so an endless stream stops at the limit, not at its end.
-_CHUNK = 4 * 1024 * 1024
-
 
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 
@@ -363,16 +361,22 @@ def _unknown_names(
         if reactive
         else "regions and groups are declared under `regions:` and `groups:`"
     )
+    from tlmpc.ltl.fused import fused_operators
+
     for formula in formulas:
         for node in formula.walk():
             if isinstance(node, Prop) and node.name not in known:
                 close = difflib.get_close_matches(node.name, sorted(known), n=1, cutoff=0.5)
+                fused = fused_operators(node.name, sorted(known))
                 span = node.span
                 problems.append(
                     error(
                         "L010",
                         f"unknown {'name' if reactive else 'region'} {node.name!r}",
-                        hint=(f"did you mean {close[0]!r}? " if close else "") + where,
+                        hint=f"did you mean `{fused}`? operators are words of their own: "
+                        f"`{node.name}` is one proposition named {node.name!r}"
+                        if fused
+                        else (f"did you mean {close[0]!r}? " if close else "") + where,
                         file=file,
                         line=span.line if span else None,
                         col=span.col if span else None,
@@ -735,33 +739,13 @@ def _load_data(text: str, file: str, stem: str) -> tuple[Mission | None, list[Di
 
 
 def _read(path: str | FilePath) -> str:
+    from tlmpc.io.inputs import read_bytes
+
     file = str(path)
-    try:
-        with open(path, "rb") as stream:  # a bounded read: never read() whole
-            raw = bytearray()
-            while len(raw) <= MAX_BYTES:
-                piece = stream.read(min(_CHUNK, MAX_BYTES + 1 - len(raw)))
-                if not piece:
-                    break
-                raw += piece
-    except OSError as exc:
-        raise UsageError(
-            error(
-                "U001",
-                f"cannot read {file}: {exc.strerror or exc}",
-                hint="check the path",
-                file=file,
-            )
-        ) from None
-    if len(raw) > MAX_BYTES:
-        raise UsageError(
-            error(
-                "U004",
-                f"{file} is larger than {MAX_BYTES // 2**20} MiB",
-                hint="a mission is a small text file; is this the right file?",
-                file=file,
-            )
-        )
+    # a bounded read of a regular file: `check /dev/zero` or a FIFO is refused at once
+    raw = read_bytes(
+        FilePath(path), limit=MAX_BYTES, code="U001", too_large_code="U004", what="mission file"
+    )
     try:
         return raw.decode("utf-8")
     except UnicodeDecodeError as exc:

@@ -13,7 +13,8 @@ from typing import Any
 from shapely.geometry import Polygon as ShapelyPolygon
 
 from tlmpc.base.errors import Diagnostic, TlmpcError, error
-from tlmpc.mission.geometry import CheckedShape, check_shape
+from tlmpc.mission.geometry import check_shape
+from tlmpc.mission.shapes import CheckedShape
 from tlmpc.mission.yamlpos import PositionedDocument
 
 
@@ -22,6 +23,15 @@ def _resolve(mission_file: str, value: str) -> FilePath:
     if path.is_absolute():
         return path
     return FilePath(mission_file).parent / path
+
+
+def _has_body(robot: Any) -> bool:
+    """True when the mission's robot (as written) has a body: a radius, an inflation, a
+    footprint, or a unicycle's axle behind its reference point."""
+    if not isinstance(robot, dict):
+        return False
+    sized = any(robot.get(key) for key in ("radius", "inflate", "footprint"))
+    return bool(sized) or robot.get("model") == "unicycle"
 
 
 def map_shapes(
@@ -68,6 +78,8 @@ def map_shapes(
         tolerance=workspace.get("tolerance"),
         min_area=workspace.get("min_area"),
         start=(float(start[0]), float(start[1])),
+        # a body can hit an obstacle of a few cells: none is dropped as a speck
+        keep_obstacles=_has_body(data["robot"]),
     )
     masks = {
         key: _resolve(file, workspace[key]) for key in ("keepout", "speed") if key in workspace

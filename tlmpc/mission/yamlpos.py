@@ -560,7 +560,41 @@ def _convert(converter: _Converter, text: str) -> bool | yaml.YAMLError | None:
     except _TooBig:
         return None
     except yaml.YAMLError as exc:
-        return exc
+        return _limit_before(converter, text, exc)
+
+
+def _limit_before(converter: _Converter, text: str, exc: yaml.YAMLError) -> yaml.YAMLError | None:
+    """``exc``, unless one of our own limits is met in the text before it (then None).
+
+    A parser scans ahead of the events it has handed over (a flow collection may turn out to
+    be a mapping key), and libyaml refuses nesting past its own depth while doing so: 1,000
+    ``[`` on one line fail there before this reader has seen the 65th.  Which limit a mission
+    meets must not depend on the parser's build or version, so the text up to the failure's
+    line is read again with PyYAML's pure-Python parser, which hands over every event as it
+    goes and has no limit of its own; when our reader stops that reading (too deep, too
+    large), that is the answer, else the parser's error stands.
+    """
+    mark = getattr(exc, "problem_mark", None) or getattr(exc, "context_mark", None)
+    if mark is None or _LOADER is yaml.SafeLoader:
+        return exc  # no position to read up to, or already read by the pure-Python parser
+    end = -1
+    for _ in range(mark.line + 1):
+        end = text.find("\n", end + 1)
+        if end < 0:
+            end = len(text)
+            break
+    probe = _Converter(converter.file, converter.lists)
+    loader = yaml.SafeLoader(text[:end])
+    try:
+        probe.convert(iter(loader.get_event, None))
+    except _TooBig:
+        converter.problems.extend(probe.problems)
+        return None
+    except yaml.YAMLError:
+        pass  # the text stops inside a value: the parser's error stands
+    finally:
+        loader.dispose()
+    return exc
 
 
 def _result(

@@ -215,10 +215,14 @@ def _abstraction(c: Compilation) -> StageResult:
         abstraction_to_json,
         build_abstraction,
     )
+    from tlmpc.abstraction.build import mesh_size_diagnostic
     from tlmpc.abstraction.layout import planning_layout
+    from tlmpc.ltl.bounds import refuse_bounds
     from tlmpc.mission.body import requested_margin
 
     mission = c.get(MISSION)
+    # Refused before the triangulation's work: the planner cannot honour a time bound.
+    refuse_bounds(mission.formula, file=mission.source, purpose="planning")
     # A body or a margin: the configuration space, goal cores and grown avoided regions are
     # triangulated (the body's own diagnostics came with the load stage).
     layout = planning_layout(mission, requested_margin(mission))
@@ -231,23 +235,22 @@ def _abstraction(c: Compilation) -> StageResult:
             "vertices": int(abstraction.vertices.shape[0]),
             "letters": len(abstraction.letters),
         },
-        warnings=tuple(abstraction_diagnostics(abstraction, mission)) if layout is None else (),
+        warnings=tuple(abstraction_diagnostics(abstraction, mission))
+        if layout is None
+        else tuple(d for d in [mesh_size_diagnostic(abstraction, mission)] if d is not None),
     )
 
 
 def _automaton(c: Compilation) -> StageResult:
-    from tlmpc.automata import automaton_to_json, to_hoa, translate
-    from tlmpc.planning.boundary import task_formula, task_letters
+    from tlmpc.automata import automaton_to_json, to_hoa
+    from tlmpc.ltl.bounds import refuse_bounds
+    from tlmpc.planning.mission import automaton_for
 
     mission = c.get(MISSION)
-    abstraction = c.get(ABSTRACTION)
+    refuse_bounds(mission.formula, file=mission.source, purpose="planning")
     # Under the closed convention the planner reads boundary instants too (their letters and
     # a rewritten task; see tlmpc/planning/boundary.py).
-    convention = mission.options.boundary
-    automaton = translate(
-        task_formula(mission.formula, convention),
-        letters=task_letters(abstraction, convention, mission.robot.start),
-    )
+    automaton = automaton_for(mission, c.get(ABSTRACTION))
     return StageResult(
         products=provide(AUTOMATON, automaton),
         artifacts={
@@ -265,58 +268,34 @@ def _automaton(c: Compilation) -> StageResult:
 def _plan(c: Compilation) -> StageResult:
     from tlmpc.abstraction import abstraction_to_json
     from tlmpc.automata import automaton_to_json, to_hoa
-    from tlmpc.mission.parts import task_parts
     from tlmpc.planning import witness_to_json
-    from tlmpc.planning.budget import check_product_size
-    from tlmpc.planning.complete import plan_complete
+    from tlmpc.planning.mission import plan_mission
 
-    mission = c.get(MISSION)
     built = c.get(ABSTRACTION)
-    automaton = c.get(AUTOMATON)
-    check_product_size(built, automaton)  # a diagnostic, not an exhausted machine
-
-    def attempt(on: Abstraction, with_automaton: Automaton) -> tuple[Abstraction, Witness]:
-        # The plan may need U-turns: then it comes on a locally refined mesh, which replaces
-        # the built one (and its artifact) for every later stage.
-        return plan_complete(
-            on,
-            with_automaton,
-            formula=mission.formula,
-            options=mission.options,
-            start_point=mission.robot.start,
-            parts=lambda: task_parts(mission),
-            file=mission.source,
-        )
-
-    warnings: list[Diagnostic] = []
+    # The plan may need U-turns (a locally refined mesh) or, when no plan keeps the margin,
+    # the mesh and automaton without it: either replaces the built one (and its artifacts)
+    # for every later stage.
+    planned = plan_mission(c.get(MISSION), built, c.get(AUTOMATON))
+    abstraction, witness = planned.abstraction, planned.witness
     products: dict[Product[Any], Any] = {}
     artifacts: dict[str, Any] = {}
-    try:
-        abstraction, witness = attempt(built, automaton)
-    except NoPlanError as exc:
-        fallback = _without_margin(mission, exc)
-        if fallback is None:
-            raise _with_body_notes(exc, mission) from None
-        built, automaton, note = fallback
-        try:
-            abstraction, witness = attempt(built, automaton)
-        except NoPlanError as again:
-            raise _with_body_notes(again, mission) from None
-        warnings.append(note)
-        products.update(provide(AUTOMATON, automaton))
-        artifacts["automaton.json"] = automaton_to_json(automaton)
-        artifacts["automaton.hoa"] = to_hoa(automaton)
-        artifacts["abstraction.json"] = abstraction_to_json(abstraction)
+    if planned.margin_dropped:
+        products.update(provide(AUTOMATON, planned.automaton))
+        artifacts["automaton.json"] = automaton_to_json(planned.automaton)
+        artifacts["automaton.hoa"] = to_hoa(planned.automaton)
     artifacts["witness.json"] = witness_to_json(witness, abstraction)
     if abstraction is not built:
         artifacts["abstraction.json"] = abstraction_to_json(abstraction)
+    refined = abstraction.stats.get("split_for_u_turns", 0) != built.stats.get(
+        "split_for_u_turns", 0
+    )
     return StageResult(
         products={
             **products,
             **provide(ABSTRACTION, abstraction),
             **provide(WITNESS, witness),
         },
-        warnings=tuple(warnings),
+        warnings=planned.notes,
         artifacts=artifacts,
         sizes={
             "prefix": len(witness.prefix),
@@ -324,51 +303,9 @@ def _plan(c: Compilation) -> StageResult:
             "cost": round(witness.cost, 6),
             "product nodes": witness.stats.get("product_nodes"),
             "reached": witness.stats.get("product_reached"),
-            **(
-                {"triangles after U-turn splits": abstraction.num_triangles}
-                if abstraction is not built
-                else {}
-            ),
+            **({"triangles after U-turn splits": abstraction.num_triangles} if refined else {}),
         },
     )
-
-
-def _without_margin(
-    mission: Mission, failure: NoPlanError
-) -> tuple[Abstraction, Automaton, Diagnostic] | None:
-    """When planning with the margin failed: the abstraction and automaton without it, and
-    the R008 warning; None when no margin was asked (nothing to fall back to)."""
-    from tlmpc.abstraction import build_abstraction
-    from tlmpc.abstraction.layout import planning_layout
-    from tlmpc.automata import translate
-    from tlmpc.base.errors import Diagnostic as Note
-    from tlmpc.mission.body import requested_margin
-
-    margin = requested_margin(mission)
-    if margin <= 0.0:
-        return None
-    abstraction = build_abstraction(mission, planning_layout(mission, 0.0))
-    automaton = translate(mission.formula, letters=abstraction.letters)
-    reason = failure.diagnostics[0].message if failure.diagnostics else "no plan"
-    note = Note(
-        code="R008",
-        severity="warning",
-        message=f"no plan keeps the margin {margin:g} ({reason}); planned without it",
-        hint="the R006/R007 warnings, if any, say where the path comes closer; lower "
-        "options.margin to plan with a smaller one",
-        file=mission.source,
-    )
-    return abstraction, automaton, note
-
-
-def _with_body_notes(failure: NoPlanError, mission: Mission) -> NoPlanError:
-    """The no-plan error with the body's diagnostics (a passage too narrow says why)."""
-    from tlmpc.mission.cspace import body_diagnostics
-
-    extra = [d for d in body_diagnostics(mission) if d.code in ("R002", "R003", "R004")]
-    if not extra:
-        return failure
-    return NoPlanError([*failure.diagnostics, *extra])
 
 
 def _control(c: Compilation) -> StageResult:
@@ -721,7 +658,7 @@ def compilation_from_artifacts(directory: Path, needed: Sequence[Product[Any]]) 
     Every artifact is checked against its schema first; a missing or invalid one is a
     diagnostic naming the file.
     """
-    from tlmpc.io.artifacts import read_artifact
+    from tlmpc.io.artifacts import cross_check, read_artifact
 
     products: dict[Product[Any], Any] = {}
     documents: dict[str, Any] = {}
@@ -736,9 +673,11 @@ def compilation_from_artifacts(directory: Path, needed: Sequence[Product[Any]]) 
                     hint="run the earlier stages first (tlmpc compile --until ...)",
                 )
             )
-        document = read_artifact(path, product.schema)
-        products[product] = product.read(document)
-        documents[product.artifact] = document
+        documents[product.artifact] = read_artifact(path, product.schema)
+    # before any is used: the artifacts must agree (indices in range, one mission)
+    cross_check(directory, documents)
+    for product in needed:
+        products[product] = product.read(documents[product.artifact])
     source = Path(str(documents.get("mission.json", {}).get("source") or directory))
     return Compilation(source=source, products=products, documents=documents)
 

@@ -45,12 +45,10 @@ from tlmpc.ltl.ast import (
     disjoin,
 )
 from tlmpc.ltl.transform import nnf
+from tlmpc.planning.contacts import vertex_point_letters
+from tlmpc.planning.model import POINT
 
 __all__ = ["POINT", "StartCell", "closed_task", "start_cells", "task_formula", "task_letters"]
-
-#: The proposition true exactly at point instants (crossings and the start) in the closed
-#: convention's word.  Region names are identifiers, so no region can be called this.
-POINT = "@point"
 
 
 def start_point_label(abstraction: Abstraction, point: tuple[float, float]) -> tuple[str, ...]:
@@ -94,8 +92,6 @@ def closed_letters(
     one labelled area (refinement for U-turns makes new such edges), and the letters of the
     mesh vertices where labels meet (read by vertex passages).
     """
-    from tlmpc.planning.passages import vertex_point_letters
-
     letters = dict.fromkeys(abstraction.letters)
     letters[tuple(sorted({*start_point_label(abstraction, start_point), POINT}))] = None
     for letter in abstraction.letters:

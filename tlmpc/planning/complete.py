@@ -20,7 +20,7 @@ from tlmpc.automata.model import Automaton
 from tlmpc.base.errors import NoPlanError, TlmpcError, error
 from tlmpc.ltl.ast import Formula
 from tlmpc.mission.model import Options, TaskPart
-from tlmpc.planning.boundary import start_cells
+from tlmpc.planning.boundary import start_cells, task_formula, task_letters
 from tlmpc.planning.explain import explain_infeasible
 from tlmpc.planning.model import Witness
 from tlmpc.planning.passages import passage_turns
@@ -63,31 +63,43 @@ def plan_complete(
     start_point: tuple[float, float],
     parts: Callable[[], Sequence[TaskPart]] = tuple,
     file: str | None = None,
+    resume: frozenset[int] | None = None,
+    explain: bool = True,
 ) -> tuple[Abstraction, Witness]:
     """A witness on ``abstraction`` or on a locally refined copy of it (returned with it).
 
     Raises :class:`NoPlanError` only when no trajectory in the plane satisfies the task;
-    ``parts`` gives the task's parts for that explanation (called only then).
+    ``parts`` gives the task's parts for that explanation (called only then, and only with
+    ``explain``: a run re-planning under way needs no explanation).  ``resume`` re-plans a
+    run under way (see :func:`tlmpc.planning.plan.plan`).
     """
 
     try:
-        return abstraction, _attempt(abstraction, automaton, formula, options, start_point)
+        return abstraction, _attempt(
+            abstraction, automaton, formula, options, start_point, resume=resume
+        )
     except NoPlanError as first:
         no_bounce_failure = first
     try:
-        return _refined(abstraction, automaton, formula, options, start_point, passages=False)
+        return _refined(
+            abstraction, automaton, formula, options, start_point, passages=False, resume=resume
+        )
     except NoPlanError:
         pass
     # The one place vertex passages come in: no plan exists along edges alone.
     try:
         return abstraction, _attempt(
-            abstraction, automaton, formula, options, start_point, passages=True
+            abstraction, automaton, formula, options, start_point, passages=True, resume=resume
         )
     except NoPlanError:
         pass
     try:
-        return _refined(abstraction, automaton, formula, options, start_point, passages=True)
+        return _refined(
+            abstraction, automaton, formula, options, start_point, passages=True, resume=resume
+        )
     except NoPlanError:
+        if not explain:
+            raise no_bounce_failure from None
         raise NoPlanError(
             explain_infeasible(
                 abstraction,
@@ -98,8 +110,35 @@ def plan_complete(
                 parts=parts(),
                 file=file,
                 fallback=no_bounce_failure.diagnostics,
+                feasible=_feasibility(abstraction, options, start_point),
             )
         ) from None
+
+
+def _feasibility(
+    abstraction: Abstraction, options: Options, start_point: tuple[float, float]
+) -> Callable[[Formula], bool]:
+    """Whether the planner (U-turns allowed) finds a plan for a task formula on this map."""
+    from tlmpc.automata.translate import translate
+
+    convention = options.boundary
+    letters = task_letters(abstraction, convention, start_point)
+
+    def feasible(formula: Formula) -> bool:
+        try:
+            plan(
+                abstraction,
+                translate(task_formula(formula, convention), letters=letters),
+                formula=formula,
+                options=options,
+                start_point=start_point,
+                bounces=True,
+            )
+        except NoPlanError:
+            return False
+        return True
+
+    return feasible
 
 
 def _attempt(
@@ -111,6 +150,7 @@ def _attempt(
     *,
     bounces: bool = False,
     passages: bool = False,
+    resume: frozenset[int] | None = None,
 ) -> Witness:
     return plan(
         mesh,
@@ -120,6 +160,7 @@ def _attempt(
         start_point=start_point,
         bounces=bounces,
         passages=passages,
+        resume=resume,
     )
 
 
@@ -131,6 +172,7 @@ def _refined(
     start_point: tuple[float, float],
     *,
     passages: bool,
+    resume: frozenset[int] | None = None,
 ) -> tuple[Abstraction, Witness]:
     """A no-bounce witness on a mesh refined where a bouncing lasso turns around; raises
     :class:`NoPlanError` when no bouncing lasso exists on ``abstraction``."""
@@ -138,7 +180,14 @@ def _refined(
     for _ in range(MAX_ROUNDS):
         try:
             bouncing = _attempt(
-                mesh, automaton, formula, options, start_point, bounces=True, passages=passages
+                mesh,
+                automaton,
+                formula,
+                options,
+                start_point,
+                bounces=True,
+                passages=passages,
+                resume=resume,
             )
         except NoPlanError:
             if mesh is abstraction:
@@ -149,7 +198,9 @@ def _refined(
             turns = sorted({*turns, *passage_turns(mesh, bouncing)})
         mesh = split_triangles(mesh, turns, start_point)
         try:
-            witness = _attempt(mesh, automaton, formula, options, start_point, passages=passages)
+            witness = _attempt(
+                mesh, automaton, formula, options, start_point, passages=passages, resume=resume
+            )
         except NoPlanError:
             continue
         return mesh, witness

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -12,7 +12,7 @@ import numpy.typing as npt
 from tlmpc.abstraction.model import Abstraction
 from tlmpc.automata.guards import holds
 from tlmpc.automata.model import Automaton
-from tlmpc.base.errors import Diagnostic, NoPlanError, error
+from tlmpc.base.errors import Diagnostic, error
 from tlmpc.ltl.ast import And, Formula, Globally, Not, Prop, conjoin, is_propositional
 from tlmpc.ltl.printer import to_text
 from tlmpc.ltl.transform import nnf
@@ -183,42 +183,25 @@ def explain_infeasible(
     parts: Sequence[TaskPart],
     file: str | None,
     fallback: Sequence[Diagnostic],
+    feasible: Callable[[Formula], bool],
 ) -> list[Diagnostic]:
     """Why no trajectory in the plane satisfies the task, blaming the parts that fail.
 
     Called only once planning *with U-turns* failed, which is exact (see docs/planning.md).
     The blamed parts are a minimal set of task parts (phrases, top-level LTL conjuncts) that
     already has no plan on this map: dropping any one of them would make the rest possible.
+    ``feasible(formula)`` tells whether the planner finds a plan for a conjunction of parts
+    (the caller's planner: this module explains, it does not plan).
     """
     if not parts:
         return list(fallback)
-    from tlmpc.automata.translate import translate
-    from tlmpc.planning.boundary import start_cells, task_formula, task_letters
-    from tlmpc.planning.plan import plan
-
-    convention = options.boundary
-    letters = task_letters(abstraction, convention, start_point)
-
-    def feasible(chosen: Sequence[TaskPart]) -> bool:
-        conjunction = conjoin([p.formula for p in chosen])
-        try:
-            plan(
-                abstraction,
-                translate(task_formula(conjunction, convention), letters=letters),
-                formula=conjunction,
-                options=options,
-                start_point=start_point,
-                bounces=True,
-            )
-        except NoPlanError:
-            return False
-        return True
+    from tlmpc.planning.boundary import start_cells
 
     core = list(parts)
     if 1 < len(parts) <= MAX_CORE_PARTS:
         for part in list(parts):
             rest = [p for p in core if p is not part]
-            if rest and not feasible(rest):
+            if rest and not feasible(conjoin([p.formula for p in rest])):
                 core = rest
     blamed = conjoin([p.formula for p in core])
     first = core[0]

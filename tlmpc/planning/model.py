@@ -17,9 +17,15 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
+from tlmpc.base.content import ContentEquality
 
-@dataclass(frozen=True, slots=True, kw_only=True)
-class Witness:
+#: The proposition true exactly at point instants (crossings and the start) in the closed
+#: convention's word.  Region names are identifiers, so no region can be called this.
+POINT = "@point"
+
+
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
+class Witness(ContentEquality):
     """A minimum-cost accepting lasso (see docs/planning.md for the optimality statement)."""
 
     prefix: tuple[int, ...]

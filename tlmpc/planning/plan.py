@@ -26,6 +26,7 @@ from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
 from tlmpc.automata.degeneralize import degeneralize
 from tlmpc.automata.model import Automaton
 from tlmpc.base.errors import NoPlanError
+from tlmpc.base.graphs import strong_components
 from tlmpc.ltl.ast import Formula
 from tlmpc.mission.model import Options
 from tlmpc.planning.boundary import start_cells, start_point_label
@@ -33,7 +34,7 @@ from tlmpc.planning.explain import explain_no_plan, invariant_mask
 from tlmpc.planning.model import Witness
 from tlmpc.planning.passages import PassageCells, add_vertex_passages
 from tlmpc.planning.product import SLOTS, START_SLOT, Product, build_product
-from tlmpc.planning.search import closing_searches, shortest_paths, strongly_connected
+from tlmpc.planning.search import closing_searches, shortest_paths
 
 #: At most this many cycle candidates are closed with a shortest-path search; past it the
 #: witness is the best found and records ``optimal: false``.
@@ -178,7 +179,7 @@ def plan(
         # The cap stopped the search before any cycle closed.  Only edges inside one strongly
         # connected component close; keeping those, the first search succeeds, so the cap
         # never hides the existence of a lasso (computed only here: it costs a graph pass).
-        scc = strongly_connected(graph)
+        scc = np.asarray(strong_components(graph.indptr, graph.targets))
         closable = scc[graph.sources[marked]] == scc[graph.targets[marked]]
         best, more, exhausted = _close_cycles(
             product, dist, pred, marked[closable], None, options.beta

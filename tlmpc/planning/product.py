@@ -16,7 +16,7 @@ entered triangle's; the start reads its point letter before its triangle's.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
@@ -24,6 +24,7 @@ import numpy.typing as npt
 from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
 from tlmpc.automata.guards import successor_table
 from tlmpc.automata.model import Automaton
+from tlmpc.base.content import ContentEquality
 from tlmpc.planning.boundary import POINT, StartCell, crossing_letter, start_cells
 from tlmpc.planning.search import Graph
 
@@ -35,14 +36,14 @@ STUTTER_COST = 1e-9
 BoolArray = npt.NDArray[np.bool_]
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
-class Product:
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
+class Product(ContentEquality):
     """The product graph plus what the witness extraction needs."""
 
-    graph: Graph = field(compare=False)  # weights
-    accepting: BoolArray = field(compare=False)  # per edge of ``graph``: carries the mark
-    stutter_accepting: BoolArray = field(compare=False)  # node whose stutter loop accepts
-    initial: IntArray = field(compare=False)
+    graph: Graph  # weights
+    accepting: BoolArray  # per edge of ``graph``: carries the mark
+    stutter_accepting: BoolArray  # node whose stutter loop accepts
+    initial: IntArray
     num_automaton_states: int
     num_nodes: int
 

@@ -24,6 +24,8 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from tlmpc.base.content import ContentEquality
+
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
 BoolArray = npt.NDArray[np.bool_]
@@ -35,8 +37,8 @@ NO_NODE = np.iinfo(np.int64).max
 BUCKET_WIDTH = 1.0
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
-class Graph:
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
+class Graph(ContentEquality):
     """A weighted directed graph with its edges grouped by source (CSR).
 
     ``indptr[u]:indptr[u + 1]`` are the edges out of ``u``; ``sources``, ``targets`` and
@@ -213,59 +215,6 @@ def shortest_paths(
         dist[beyond] = np.inf
         pred[beyond] = -1
     return dist, pred
-
-
-def strongly_connected(graph: Graph) -> IntArray:
-    """A strongly connected component label per node (Tarjan's algorithm, iterative).
-
-    Planning needs it only when the cycle-search cap was hit before any cycle closed.
-    """
-    n = graph.num_nodes
-    indptr = graph.indptr.tolist()
-    targets = graph.targets.tolist()
-    index = [-1] * n
-    low = [0] * n
-    on_stack = [False] * n
-    label = [-1] * n
-    stack: list[int] = []
-    counter = 0
-    components = 0
-    for root in range(n):
-        if index[root] >= 0:
-            continue
-        # Each frame: a node and the position of its next edge to look at.
-        frames = [(root, indptr[root])]
-        index[root] = low[root] = counter
-        counter += 1
-        stack.append(root)
-        on_stack[root] = True
-        while frames:
-            node, edge = frames[-1]
-            if edge < indptr[node + 1]:
-                frames[-1] = (node, edge + 1)
-                nxt = targets[edge]
-                if index[nxt] < 0:
-                    index[nxt] = low[nxt] = counter
-                    counter += 1
-                    stack.append(nxt)
-                    on_stack[nxt] = True
-                    frames.append((nxt, indptr[nxt]))
-                elif on_stack[nxt]:
-                    low[node] = min(low[node], index[nxt])
-                continue
-            frames.pop()
-            if frames:
-                parent = frames[-1][0]
-                low[parent] = min(low[parent], low[node])
-            if low[node] == index[node]:
-                while True:
-                    member = stack.pop()
-                    on_stack[member] = False
-                    label[member] = components
-                    if member == node:
-                        break
-                components += 1
-    return np.array(label, dtype=np.int64)
 
 
 def closing_searches(

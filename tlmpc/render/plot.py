@@ -13,11 +13,23 @@ The same artifacts always give the same bytes: no timestamps, no software tag.
 
 from __future__ import annotations
 
+import contextlib
 import io
 import itertools
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from typing import Any
 
+from tlmpc.base.extras import require
+from tlmpc.render.layout import (
+    FONT_PX,
+    LABEL_HALO,
+    PAD,
+    SMALL_PX,
+    TITLE_PX,
+    FigureLayout,
+    baseline_offset,
+    layout,
+)
 from tlmpc.render.scene import Scene, build_scene, viridis
 
 View = tuple[float, float, float, float]
@@ -36,6 +48,10 @@ def render_svg(
     return draw(build_scene(artifacts, zoom=zoom, log=log, verdict=verdict))
 
 
+#: Points per figure pixel: the PNG has 100 figure pixels per inch (and 150 dpi).
+_PT = 0.72
+
+
 def render_png(
     artifacts: Mapping[str, Any],
     *,
@@ -45,46 +61,9 @@ def render_png(
 ) -> bytes:
     """``plan.png`` of the same scene, drawn with matplotlib (reproducible byte for byte)."""
     scene = build_scene(artifacts, zoom=zoom, log=log, verdict=verdict)
-    import matplotlib
-
-    matplotlib.use("Agg", force=False)
-    from matplotlib import rc_context
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    x0, y0, x1, y1 = scene.view
-    aspect = (y1 - y0) / max(x1 - x0, 1e-12)
-    map_width = 6.0
-    map_height = min(max(map_width * aspect, 0.6), 7.0)
-    if map_width * aspect > 7.0:
-        map_width = 7.0 / aspect
-    legend_width = 2.6
-    figure_width = map_width + legend_width + 0.9
-    figure_height = max(map_height + 0.9, 2.8)  # room for the legend beside a wide map
-    with rc_context({"path.simplify": False}):
-        figure = Figure(figsize=(figure_width, figure_height), dpi=150)
-        FigureCanvasAgg(figure)
-        axes = figure.add_axes(
-            (
-                0.6 / figure_width,
-                (figure_height - 0.45 - map_height) / figure_height,  # top-aligned
-                map_width / figure_width,
-                map_height / figure_height,
-            )
-        )
-        handles = draw_scene(axes, scene)
-        legend_left = (0.75 + map_width) / figure_width
-        figure.legend(
-            handles=handles,
-            loc="upper left",
-            bbox_to_anchor=(legend_left, 1 - 0.35 / figure_height),
-            fontsize=7,
-            frameon=False,
-        )
-        if scene.trajectory is not None:
-            # Just under the legend (about 0.19 inch per entry at this font size).
-            bar_bottom = max(figure_height - 0.35 - 0.19 * len(handles) - 0.6, 0.35)
-            _colour_scale(figure, scene, legend_left, figure_width, figure_height, bar_bottom)
+    require("matplotlib.backends.backend_agg", "drawing a PNG figure")
+    with png_style():
+        figure = figure_of(scene)
         png = io.BytesIO()
         figure.savefig(
             png, format="png", metadata={"Software": None}, pil_kwargs={"compress_level": 3}
@@ -92,41 +71,219 @@ def render_png(
     return png.getvalue()
 
 
-def _colour_scale(
-    figure: Any,
-    scene: Scene,
-    left: float,
-    figure_width: float,
-    figure_height: float,
-    bottom: float,
-) -> None:
-    """A small horizontal colour bar under the legend: 0 to the path's length."""
-    from matplotlib.colors import LinearSegmentedColormap
+@contextlib.contextmanager
+def png_style() -> Iterator[None]:
+    """Matplotlib settings the PNG is drawn with: no path simplification, and text laid out
+    at the font's own advance widths (hinting would round each glyph to whole pixels and
+    make a name wider than its layout box)."""
+    import matplotlib
 
-    assert scene.trajectory is not None
-    bar = figure.add_axes(
+    matplotlib.use("Agg", force=False)
+    from matplotlib import rc_context
+
+    with rc_context({"path.simplify": False, "text.hinting": "no_hinting"}):
+        yield
+
+
+def figure_of(scene: Scene) -> Any:
+    """The matplotlib figure of ``scene``: its :func:`.layout.layout` at 150 dpi.
+
+    The figure measures the layout's width and height in hundredths of an inch, so one figure
+    pixel is 1.5 device pixels and text sizes convert at 0.72 points per figure pixel: the
+    picture is the SVG's, scaled.  Texts carry a ``gid`` (``title``, ``label``, ``legend``,
+    ``extent``, ``bar``) so a test can find them.
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+    from matplotlib.patheffects import withStroke
+    from matplotlib.transforms import Affine2D
+
+    figure_layout = layout(scene)
+    width, height = figure_layout.width, figure_layout.height
+    figure = Figure(figsize=(width / 100, height / 100), dpi=150)
+    FigureCanvasAgg(figure)
+    pixels = Affine2D().scale(1 / 100, -1 / 100).translate(0, height / 100)
+    transform = pixels + figure.dpi_scale_trans
+    canvas = figure_layout.canvas
+    axes = figure.add_axes(
         (
-            left + 0.05 / figure_width,
-            bottom / figure_height,
-            1.6 / figure_width,
-            0.12 / figure_height,
+            canvas.left / width,
+            1 - (canvas.top + canvas.height) / height,
+            canvas.width / width,
+            canvas.height / height,
         )
     )
-    cmap = LinearSegmentedColormap.from_list("arc", [viridis(i / 10) for i in range(11)])
-    bar.imshow([[i / 255 for i in range(256)]], aspect="auto", cmap=cmap, extent=(0, 1, 0, 1))
-    bar.set_yticks([])
-    bar.set_xticks([0, 1], ["0", f"{scene.trajectory.length:.4g}"], fontsize=7)
-    bar.set_title("trajectory: distance travelled", fontsize=7)
+    draw_scene(axes, scene)
+    axes.set_xlim(scene.view[0], scene.view[2])
+    axes.set_ylim(scene.view[1], scene.view[3])
+    axes.set_aspect("auto")  # the layout's scale is already the same along x and y
+    axes.set_axis_off()
+
+    def text(x: float, y: float, value: str, size: float, gid: str, **style: Any) -> Any:
+        return figure.text(x, y, value, transform=transform, fontsize=size * _PT, gid=gid, **style)
+
+    text(canvas.left, PAD + 12, figure_layout.title, TITLE_PX, "title", va="baseline")
+    halo = [withStroke(linewidth=2 * LABEL_HALO * _PT, foreground="white", alpha=0.85)]
+    for label in figure_layout.labels:
+        text(
+            label.x,
+            label.y + baseline_offset(label.font_px),
+            label.name,
+            label.font_px,
+            "label",
+            ha="center",
+            va="baseline",
+            path_effects=halo,
+            zorder=8,
+        )
+    for number, violation in enumerate(scene.violations, start=1):
+        vx, vy = canvas.pixel(violation.position)
+        text(
+            vx + 8,
+            vy - 6,
+            str(number),
+            FONT_PX,
+            "violation-number",
+            va="baseline",
+            color="#dd0000",
+            path_effects=[withStroke(linewidth=3 * _PT, foreground="white")],
+            zorder=8,
+        )
+    text(
+        canvas.left,
+        figure_layout.extent_y,
+        figure_layout.extent_text,
+        SMALL_PX,
+        "extent",
+        va="baseline",
+        color="#555555",
+    )
+    _legend(figure, transform, scene, figure_layout)
+    return figure
 
 
-def draw_scene(axes: Any, scene: Scene) -> list[Any]:
-    """Draw ``scene`` on matplotlib ``axes``; return the legend's handles."""
-    from matplotlib.collections import LineCollection, PolyCollection
+def _legend(figure: Any, transform: Any, scene: Scene, figure_layout: FigureLayout) -> None:
+    """The layout's legend rows and colour bar, in figure pixels."""
+    from matplotlib.colors import LinearSegmentedColormap
     from matplotlib.lines import Line2D
-    from matplotlib.patches import Patch
+    from matplotlib.patches import Rectangle
+
+    def line(x: float, y: float, colour: str, width: float, style: Any = "-") -> None:
+        figure.add_artist(
+            Line2D(
+                [x, x + 22],
+                [y, y],
+                color=colour,
+                linewidth=width * _PT,
+                linestyle=style,
+                transform=transform,
+            )
+        )
+
+    def box(x: float, y: float, face: str, alpha: float, edge: str, width: float) -> None:
+        figure.add_artist(
+            Rectangle(
+                (x, y - 5),
+                22,
+                10,
+                facecolor=face,
+                alpha=alpha,
+                edgecolor=edge,
+                linewidth=width * _PT,
+                transform=transform,
+            )
+        )
+
+    region_colour = scene.regions[0].colour if scene.regions else "#000000"
+    for row in figure_layout.legend:
+        cy = row.y - 4
+        swatch = True
+        match row.kind:
+            case "hole":
+                box(row.x, cy, "#9a9a9a", 1.0, "black", 1.2)
+            case "region":
+                box(row.x, cy, region_colour, 0.35, region_colour, 1.0)
+            case "task-region":
+                box(row.x, cy, "#1f1f1f", 0.8, "#1f1f1f", 1.0)
+            case "mesh":
+                line(row.x, cy, "#b0b0b0", 0.6)
+            case "plan":
+                line(row.x, cy, "#1f3b73", 1.0)
+            case "cycle":
+                line(row.x, cy, "#c0392b", 1.0, "--")
+            case "log":
+                line(row.x, cy, "#e4007c", 2.0)
+            case "start":
+                figure.add_artist(
+                    Line2D(
+                        [row.x + 11],
+                        [cy],
+                        marker="o",
+                        markersize=8 * _PT,
+                        markerfacecolor="white",
+                        markeredgecolor="black",
+                        markeredgewidth=1.6 * _PT,
+                        linestyle="none",
+                        transform=transform,
+                    )
+                )
+            case "violation":
+                figure.add_artist(
+                    Line2D(
+                        [row.x + 6, row.x + 16, row.x + 11, row.x + 16, row.x + 6],
+                        [cy - 5, cy + 5, cy, cy - 5, cy + 5],
+                        color="#dd0000",
+                        linewidth=2.4 * _PT,
+                        transform=transform,
+                    )
+                )
+            case _:
+                swatch = False
+        figure.text(
+            row.x + 30 if swatch else row.x,
+            row.y,
+            row.text,
+            transform=transform,
+            fontsize=row.font_px * _PT,
+            va="baseline",
+            gid="legend",
+        )
+    bar = figure_layout.colour_bar
+    if bar is not None:
+        width, height = figure_layout.width, figure_layout.height
+        axes = figure.add_axes(
+            (
+                bar.x0 / width,
+                1 - bar.y1 / height,
+                (bar.x1 - bar.x0) / width,
+                (bar.y1 - bar.y0) / height,
+            )
+        )
+        cmap = LinearSegmentedColormap.from_list("arc", [viridis(i / 10) for i in range(11)])
+        axes.imshow([[i / 255 for i in range(256)]], aspect="auto", cmap=cmap, extent=(0, 1, 0, 1))
+        axes.set_axis_off()
+        for x, value, align in (
+            (bar.x0, "0", "left"),
+            (bar.x1, figure_layout.colour_bar_end, "right"),
+        ):
+            figure.text(
+                x,
+                bar.y1 + 12,
+                value,
+                transform=transform,
+                fontsize=FONT_PX * _PT,
+                ha=align,
+                va="baseline",
+                gid="bar",
+            )
+
+
+def draw_scene(axes: Any, scene: Scene) -> None:
+    """Draw ``scene``'s map on matplotlib ``axes`` in world coordinates (line widths and
+    marker sizes as the SVG's, in figure pixels converted to points)."""
+    from matplotlib.collections import LineCollection, PolyCollection
     from matplotlib.patches import Polygon as PolygonPatch
 
-    handles: list[Any] = []
     axes.add_patch(PolygonPatch(scene.boundary, closed=True, facecolor="white", zorder=0))
     if scene.components:
         # Pieces of free space may lie inside holes: paint the holes first, then the pieces
@@ -144,7 +301,7 @@ def draw_scene(axes: Any, scene: Scene) -> list[Any]:
                         list(rings),
                         facecolors=colour,
                         edgecolors="black",
-                        linewidths=0.9,
+                        linewidths=1.2 * _PT,
                         zorder=0.2 + 0.1 * layer,
                     )
                 )
@@ -157,30 +314,33 @@ def draw_scene(axes: Any, scene: Scene) -> list[Any]:
                 facecolors=[r.colour for r in plain],
                 edgecolors=[r.colour for r in plain],
                 alpha=0.30,
-                linewidths=0.6,
+                linewidths=0.8 * _PT,
                 zorder=1,
+                gid="regions",
             )
         )
-        handles.append(Patch(facecolor=plain[0].colour, alpha=0.4, label="region"))
     if emphasised:
         axes.add_collection(
             PolyCollection(
                 [r.polygon for r in emphasised],
                 facecolors="#1f1f1f",
-                edgecolors="black",
+                edgecolors="#1f1f1f",
                 alpha=0.8,
-                linewidths=0.8,
+                linewidths=0.8 * _PT,
                 zorder=1.5,
+                gid="task-regions",
             )
         )
-        handles.append(Patch(facecolor="#1f1f1f", alpha=0.8, label="task region"))
     if len(scene.mesh_edges):
         axes.add_collection(
             LineCollection(
-                list(scene.mesh_edges.reshape(-1, 2, 2)), colors="#b0b0b0", linewidths=0.3, zorder=2
+                list(scene.mesh_edges.reshape(-1, 2, 2)),
+                colors="#b0b0b0",
+                linewidths=0.4 * _PT,
+                zorder=2,
+                gid="mesh",
             )
         )
-        handles.append(Line2D([], [], color="#b0b0b0", linewidth=0.6, label="triangulation"))
     if scene.holes and not scene.components:
         # Line widths are in points: a hole thinner than a pixel still shows as a wall.
         axes.add_collection(
@@ -188,34 +348,31 @@ def draw_scene(axes: Any, scene: Scene) -> list[Any]:
                 list(scene.holes),
                 facecolors="#9a9a9a",
                 edgecolors="black",
-                linewidths=0.9,
+                linewidths=1.2 * _PT,
                 zorder=3,
+                gid="holes",
             )
         )
-    if scene.holes or scene.component_holes:
-        handles.append(Patch(facecolor="#9a9a9a", edgecolor="black", label="obstacle (hole)"))
     axes.add_patch(
-        PolygonPatch(scene.boundary, closed=True, fill=False, edgecolor="black", linewidth=1.2)
+        PolygonPatch(
+            scene.boundary, closed=True, fill=False, edgecolor="black", linewidth=1.5 * _PT
+        )
     )
     if len(scene.plan_prefix) >= 2:
         axes.plot(
             *zip(*scene.plan_prefix, strict=True),
             color="#1f3b73",
-            linewidth=0.8,
+            linewidth=1.0 * _PT,
             alpha=0.7,
             zorder=4,
         )
-        handles.append(Line2D([], [], color="#1f3b73", linewidth=0.8, label="plan (triangles)"))
     if len(scene.plan_cycle) >= 2 and not scene.plan_stays:
         axes.plot(
             *zip(*scene.plan_cycle, strict=True),
             color="#c0392b",
-            linewidth=0.8,
-            linestyle="--",
+            linewidth=1.0 * _PT,
+            linestyle=(0, (4, 3)),
             zorder=4,
-        )
-        handles.append(
-            Line2D([], [], color="#c0392b", linewidth=0.8, linestyle="--", label="plan cycle")
         )
     if scene.trajectory is not None and len(scene.trajectory.points) >= 2:
         points = scene.trajectory.points
@@ -223,20 +380,18 @@ def draw_scene(axes: Any, scene: Scene) -> list[Any]:
         lines = LineCollection(
             list(itertools.pairwise(points)),
             colors=[viridis(0.5 * (a + b)) for a, b in itertools.pairwise(fractions)],
-            linewidths=1.6,
+            linewidths=2.0 * _PT,
             zorder=5,
         )
         axes.add_collection(lines)
-        handles.append(Line2D([], [], color=viridis(0.5), linewidth=1.6, label="trajectory"))
     if scene.log is not None:
         axes.plot(
             *zip(*scene.log.points, strict=True),
             color="#e4007c",
-            linewidth=1.2,
+            linewidth=1.6 * _PT,
             alpha=0.85,
             zorder=5.5,
         )
-        handles.append(Line2D([], [], color="#e4007c", linewidth=1.2, label="recorded log"))
     if scene.start is not None:
         axes.plot(
             [scene.start[0]],
@@ -244,79 +399,20 @@ def draw_scene(axes: Any, scene: Scene) -> list[Any]:
             marker="o",
             markerfacecolor="white",
             markeredgecolor="black",
-            markersize=4,
+            markersize=8 * _PT,
+            markeredgewidth=1.6 * _PT,
             linestyle="none",
             zorder=5.8,
         )
-        handles.append(
-            Line2D(
-                [],
-                [],
-                marker="o",
-                markerfacecolor="white",
-                markeredgecolor="black",
-                markersize=4,
-                linestyle="none",
-                label="start",
-            )
-        )
-    for number, violation in enumerate(scene.violations, start=1):
+    for violation in scene.violations:
         vx, vy = violation.position
-        axes.plot([vx], [vy], marker="x", color="#d00", markersize=8, markeredgewidth=2, zorder=7)
-        axes.annotate(
-            str(number),
-            (vx, vy),
-            xytext=(5, 5),
-            textcoords="offset points",
-            color="#d00",
-            fontsize=8,
+        axes.plot(
+            [vx],
+            [vy],
+            marker="x",
+            color="#dd0000",
+            markersize=12 * _PT,
+            markeredgewidth=2.4 * _PT,
             zorder=7,
+            gid="violation",
         )
-        handles.append(
-            Line2D(
-                [],
-                [],
-                marker="x",
-                color="#d00",
-                linestyle="none",
-                label=f"violation {number}: {violation.message[:60]}",
-            )
-        )
-    x0, y0, x1, y1 = scene.view
-    for region in scene.regions:
-        if region.labelled:
-            xs = [p[0] for p in region.polygon]
-            ys = [p[1] for p in region.polygon]
-            # A region narrower than its name gets the name just above it, not over it.
-            small = max(xs) - min(xs) < 0.012 * len(region.name) * (x1 - x0)
-            axes.text(
-                region.label_at[0],
-                max(ys) if small else region.label_at[1],
-                region.name,
-                ha="center",
-                va="bottom" if small else "center",
-                fontsize=7,
-                zorder=6,
-                bbox={"boxstyle": "round,pad=0.1", "fc": "white", "alpha": 0.6, "lw": 0},
-            )
-    axes.set_xlim(x0, x1)
-    axes.set_ylim(y0, y1)
-    axes.set_aspect("equal")
-    axes.tick_params(labelsize=7)
-    axes.set_title(scene.title, fontsize=9)
-    if scene.regions_omitted:
-        handles.append(
-            Line2D(
-                [], [], linestyle="none", label=f"{scene.regions_omitted:,} other regions not drawn"
-            )
-        )
-    if scene.mesh_omitted:
-        handles.append(
-            Line2D(
-                [],
-                [],
-                linestyle="none",
-                label=f"mesh of {scene.mesh_omitted:,} triangles not drawn",
-            )
-        )
-    return handles

@@ -131,7 +131,35 @@ def _polygon(points: Sequence[Sequence[float]]) -> Polygon:
     return tuple([(float(p[0]), float(p[1])) for p in points])
 
 
-def _label_point(polygon: Polygon) -> Point:
+def _inside(polygon: Polygon, point: Point) -> bool:
+    """Whether ``point`` is inside ``polygon`` (even-odd rule)."""
+    x, y = point
+    hit = False
+    for (ax, ay), (bx, by) in zip(polygon, polygon[-1:] + polygon[:-1], strict=True):
+        if (ay > y) != (by > y) and x < (bx - ax) * (y - ay) / (by - ay) + ax:
+            hit = not hit
+    return hit
+
+
+def label_point(polygon: Polygon) -> Point:
+    """Where a region's name goes: its area centroid when that lies inside it, else the
+    point inside farthest from its edges (an L-shaped or ring-like region's centroid is
+    outside it)."""
+    centre = _centroid(polygon)
+    if len(polygon) < 3 or _inside(polygon, centre):
+        return centre
+    import shapely
+    from shapely.ops import polylabel
+
+    shape = shapely.Polygon(polygon)
+    if not shape.is_valid or shape.area <= 0:
+        return centre
+    x0, y0, x1, y1 = shape.bounds
+    pole = polylabel(shape, tolerance=max(x1 - x0, y1 - y0) / 100)
+    return float(pole.x), float(pole.y)
+
+
+def _centroid(polygon: Polygon) -> Point:
     """The area centroid (the vertex mean for degenerate polygons)."""
     area = cx = cy = 0.0
     for (x0, y0), (x1, y1) in zip(polygon, polygon[1:] + polygon[:1], strict=True):
@@ -145,13 +173,44 @@ def _label_point(polygon: Polygon) -> Point:
     return cx / (3.0 * area), cy / (3.0 * area)
 
 
-def _task_propositions(mission: Mapping[str, Any]) -> frozenset[str]:
-    formula = mission.get("formula")
+def task_propositions(formula: str | None) -> frozenset[str]:
+    """The propositions a task formula (text) names."""
     if not formula:
         return frozenset()
     from tlmpc.ltl.parser import parse_ltl
 
     return parse_ltl(formula).props()
+
+
+def _task_propositions(mission: Mapping[str, Any]) -> frozenset[str]:
+    return task_propositions(mission.get("formula"))
+
+
+def label_priority(name: str, polygon: Polygon, named_by_task: bool) -> tuple[int, float, str]:
+    """The order names are placed in (every renderer): the task's regions first, then the
+    larger ones (by bounding box), then by name."""
+    xs = [p[0] for p in polygon]
+    ys = [p[1] for p in polygon]
+    area = (max(xs) - min(xs)) * (max(ys) - min(ys)) if polygon else 0.0
+    return (0 if named_by_task else 1, -area, name)
+
+
+def named_regions(
+    regions: Mapping[str, Sequence[Sequence[float]]], formula: str | None
+) -> list[tuple[str, Point, bool]]:
+    """The regions whose names are drawn, in placement order, with each name's point and
+    whether the task names it: every region, or beyond :data:`MAX_REGION_NAMES` only the
+    task's."""
+    named = task_propositions(formula)
+    many = len(regions) > MAX_REGION_NAMES
+    chosen = []
+    for name, points in regions.items():
+        if many and name not in named:
+            continue
+        polygon = _polygon(points)
+        chosen.append((label_priority(name, polygon, name in named), name, polygon))
+    chosen.sort()
+    return [(name, label_point(polygon), key[0] == 0) for key, name, polygon in chosen]
 
 
 def _inside_view(box: tuple[float, float, float, float], view: Sequence[float]) -> bool:
@@ -323,7 +382,7 @@ def build_scene(
                 colour=REGION_COLOURS[index % len(REGION_COLOURS)],
                 named_by_task=name in named,
                 labelled=labelled,
-                label_at=_label_point(polygon) if labelled else polygon[0],
+                label_at=label_point(polygon) if labelled else polygon[0],
             )
         )
     visible_regions = tuple(regions)

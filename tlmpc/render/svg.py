@@ -11,59 +11,48 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from html import escape
+from html import escape as _html_escape
 from itertools import chain
 from typing import TYPE_CHECKING
 
-from tlmpc.render.scene import Path, Point, Region, Scene, viridis
+from tlmpc.base.errors import printable
+from tlmpc.render.layout import (
+    FONT_PX,
+    LABEL_HALO,
+    LABEL_PX,
+    PAD,
+    SMALL_PX,
+    TITLE_PX,
+    Canvas,
+    FigureLayout,
+    baseline_offset,
+    layout,
+)
+from tlmpc.render.scene import Path, Point, Scene, viridis
 
 if TYPE_CHECKING:
     from tlmpc.render.scene import FloatArray
 
-_MAX_WIDTH = 900.0  # pixels for the map's width ...
-_MAX_HEIGHT = 700.0  # ... and height; the map keeps its aspect ratio within both
-_MIN_HEIGHT = 40.0  # a very wide corridor still gets a visible strip
-_PAD = 14.0
-_TITLE = 26.0
-_LEGEND_WIDTH = 230.0
 _COLOUR_STEPS = 48  # the trajectory is drawn in this many colours along its length
 _MIN_STEP_PX = 0.4  # consecutive samples closer than this on screen are merged
+
+
+def escape(text: str) -> str:
+    """Text for an SVG element: XML-escaped, with control characters (which XML 1.0 does not
+    allow at all), newlines and direction controls as visible escapes."""
+    return _html_escape(printable(text, keep=""))
 
 
 def _fmt(value: float) -> str:
     return f"{value:.1f}"
 
 
-class _Canvas:
-    """World-to-pixel mapping of the scene's view (y upwards in the world, down on screen)."""
-
-    def __init__(self, view: tuple[float, float, float, float]) -> None:
-        x0, y0, x1, y1 = view
-        width = max(x1 - x0, 1e-12)
-        height = max(y1 - y0, 1e-12)
-        self.scale = min(_MAX_WIDTH / width, _MAX_HEIGHT / height)
-        if height * self.scale < _MIN_HEIGHT:
-            self.scale = min(_MIN_HEIGHT / height, 4.0 * _MAX_WIDTH / width)
-        self.x0 = x0
-        self.y1 = y1
-        self.left = _PAD
-        self.top = _PAD + _TITLE
-        self.width = width * self.scale
-        self.height = height * self.scale
-
-    def xy(self, point: Point) -> str:
-        x = self.left + (point[0] - self.x0) * self.scale
-        y = self.top + (self.y1 - point[1]) * self.scale
-        return f"{x:.1f} {y:.1f}"
-
-    def pixel(self, point: Point) -> tuple[float, float]:
-        return (
-            self.left + (point[0] - self.x0) * self.scale,
-            self.top + (self.y1 - point[1]) * self.scale,
-        )
+def _xy(canvas: Canvas, point: Point) -> str:
+    x, y = canvas.pixel(point)
+    return f"{x:.1f} {y:.1f}"
 
 
-def _segments(canvas: _Canvas, segments: FloatArray) -> str:
+def _segments(canvas: Canvas, segments: FloatArray) -> str:
     """Path data of many line segments (rows ``x0, y0, x1, y1``), formatted in one pass."""
     pixels = segments.copy()
     pixels[:, 0::2] = canvas.left + (pixels[:, 0::2] - canvas.x0) * canvas.scale
@@ -71,18 +60,8 @@ def _segments(canvas: _Canvas, segments: FloatArray) -> str:
     return ("M%.1f %.1fL%.1f %.1f" * len(pixels)) % tuple(pixels.ravel().tolist())
 
 
-def _label_position(canvas: _Canvas, region: Region) -> tuple[float, float, str]:
-    """Where a region's name goes: on it when it fits, else just above it."""
-    x, y = canvas.pixel(region.label_at)
-    xs = [canvas.pixel(p)[0] for p in region.polygon]
-    ys = [canvas.pixel(p)[1] for p in region.polygon]
-    if max(xs) - min(xs) >= 6.2 * len(region.name) and max(ys) - min(ys) >= 12:
-        return x, y, "central"
-    return x, min(ys) - 2.0, "text-after-edge"
-
-
-def _polygon_path(canvas: _Canvas, polygon: Sequence[Point]) -> str:
-    return "M" + "L".join(canvas.xy(p) for p in polygon) + "Z"
+def _polygon_path(canvas: Canvas, polygon: Sequence[Point]) -> str:
+    return "M" + "L".join(_xy(canvas, p) for p in polygon) + "Z"
 
 
 #: From this many polygons on, their paths are formatted in one pass over a numpy array.
@@ -90,12 +69,12 @@ _BATCH_FROM = 64
 
 
 def _polygon_paths(
-    canvas: _Canvas, polygons: Sequence[Sequence[Point]], points: FloatArray | None = None
+    canvas: Canvas, polygons: Sequence[Sequence[Point]], points: FloatArray | None = None
 ) -> list[str]:
     """:func:`_polygon_path` of each polygon, the same text.
 
     Many polygons (maps with thousands of rooms) are mapped to pixels with numpy, by the
-    same float operations as :meth:`_Canvas.xy`, and written with one ``%``-format (``%.1f``
+    same float operations as :func:`_xy`, and written with one ``%``-format (``%.1f``
     formats as ``:.1f`` does).  ``points``, when given, holds the polygons' points in order
     as rows ``x, y`` (the scene's own array: no second conversion).
     """
@@ -117,11 +96,11 @@ def _polygon_paths(
     return (template % tuple(pixels.ravel().tolist())).split("\n")
 
 
-def _polyline(canvas: _Canvas, points: Sequence[Point]) -> str:
-    return "M" + "L".join(canvas.xy(p) for p in points)
+def _polyline(canvas: Canvas, points: Sequence[Point]) -> str:
+    return "M" + "L".join(_xy(canvas, p) for p in points)
 
 
-def _decimated(canvas: _Canvas, path: Path) -> list[tuple[float, float, float]]:
+def _decimated(canvas: Canvas, path: Path) -> list[tuple[float, float, float]]:
     """Pixel points ``(x, y, fraction)``, merging samples closer than a fraction of a pixel."""
     kept: list[tuple[float, float, float]] = []
     for point, fraction in zip(path.points, path.fractions, strict=True):
@@ -135,7 +114,7 @@ def _decimated(canvas: _Canvas, path: Path) -> list[tuple[float, float, float]]:
     return kept
 
 
-def _coloured_path(canvas: _Canvas, path: Path, width: float) -> list[str]:
+def _coloured_path(canvas: Canvas, path: Path, width: float) -> list[str]:
     """The path as polylines of ``_COLOUR_STEPS`` colours by arc length."""
     points = _decimated(canvas, path)
     if len(points) < 2:
@@ -161,135 +140,85 @@ def _run(run: Sequence[tuple[float, float, float]], bucket: int, width: float) -
     return f'<path d="{d}" stroke="{colour}" stroke-width="{width}"/>'
 
 
-def _wrap(text: str, width: int) -> list[str]:
-    lines: list[str] = []
-    current = ""
-    for word in text.split():
-        if current and len(current) + 1 + len(word) > width:
-            lines.append(current)
-            current = word
-        else:
-            current = f"{current} {word}".strip()
-    if current:
-        lines.append(current)
-    return lines[:4]
+_LINE = '<path d="M{x} {cy}H{x2}" stroke="{colour}" stroke-width="{width}"{extra}/>'
+_RECT = (
+    '<rect x="{x}" y="{cy}" width="22" height="10" transform="translate(0,-5)" '
+    'fill="{colour}" fill-opacity="{opacity}" stroke="{stroke}" stroke-width="{width}"/>'
+)
+#: The legend's swatch of each row kind: a template filled with the swatch's place.
+_SWATCHES = {
+    "hole": _RECT.replace("{colour}", "#9a9a9a")
+    .replace("{opacity}", "1")
+    .replace("{stroke}", "#000")
+    .replace("{width}", "1.2"),
+    "mesh": _LINE.replace("{colour}", "#b0b0b0").replace("{width}", "0.6").replace("{extra}", ""),
+    "plan": _LINE.replace("{colour}", "#1f3b73").replace("{width}", "1").replace("{extra}", ""),
+    "cycle": _LINE.replace("{colour}", "#c0392b")
+    .replace("{width}", "1")
+    .replace("{extra}", ' stroke-dasharray="4 3"'),
+    "start": '<circle cx="{cx}" cy="{cy}" r="4" fill="#fff" stroke="#000" stroke-width="1.6"/>',
+    "log": _LINE.replace("{colour}", "#e4007c").replace("{width}", "2").replace("{extra}", ""),
+    "violation": '<path d="M{x} {cy}m6 -5l10 10m0 -10l-10 10" stroke="#d00" stroke-width="2.4" '
+    'fill="none"/>',
+}
 
 
-def _legend(scene: Scene, x: float, y: float) -> tuple[list[str], float]:
-    """Legend entries from the top-left corner ``(x, y)``; returns them and their height."""
+def _legend(scene: Scene, figure: FigureLayout) -> list[str]:
+    """The legend's swatches and texts, and the colour bar, as the layout places them."""
     out: list[str] = []
-    row = y
-
-    def entry(swatch: str, label: str) -> None:
-        nonlocal row
-        out.append(swatch.format(x=_fmt(x), cx=_fmt(x + 11), cy=_fmt(row), x2=_fmt(x + 22)))
-        out.append(f'<text x="{_fmt(x + 30)}" y="{_fmt(row + 4)}">{escape(label)}</text>')
-        row += 18
-
-    line = '<path d="M{x} {cy}H{x2}" stroke="{colour}" stroke-width="{w}"{extra}/>'
-    if scene.holes or scene.component_holes:
-        entry(
-            '<rect x="{x}" y="{cy}" width="22" height="10" transform="translate(0,-5)" '
-            'fill="#9a9a9a" stroke="#000" stroke-width="1.2"/>',
-            "obstacle (hole)",
-        )
-    if scene.regions:
-        colour = "#1f1f1f" if scene.emphasise_task_regions else scene.regions[0].colour
-        label = "task region" if scene.emphasise_task_regions else "region"
-        opacity = "0.8" if scene.emphasise_task_regions else "0.35"
-        entry(
-            '<rect x="{x}" y="{cy}" width="22" height="10" transform="translate(0,-5)" '
-            f'fill="{colour}" fill-opacity="{opacity}" stroke="{colour}"/>',
-            label,
-        )
-    if len(scene.mesh_edges):
-        entry(line.format_map(_Keep(colour="#b0b0b0", w="0.6", extra="")), "triangulation")
-    if len(scene.plan_prefix) >= 2:
-        entry(line.format_map(_Keep(colour="#1f3b73", w="1", extra="")), "plan (triangles)")
-    if len(scene.plan_cycle) >= 2 and not scene.plan_stays:
-        entry(
-            line.format_map(_Keep(colour="#c0392b", w="1", extra=' stroke-dasharray="4 3"')),
-            "plan cycle (repeats)",
-        )
-    if scene.start is not None:
-        entry(
-            '<circle cx="{cx}" cy="{cy}" r="4" fill="#fff" stroke="#000" stroke-width="1.6"/>',
-            "start",
-        )
-    if scene.log is not None:
-        entry(line.format_map(_Keep(colour="#e4007c", w="2", extra="")), "recorded log")
-    for number, violation in enumerate(scene.violations, start=1):
-        entry(_cross_swatch(), f"violation {number}")
-        for text in _wrap(violation.message, 34):
-            out.append(
-                f'<text x="{_fmt(x + 30)}" y="{_fmt(row)}" font-size="9">{escape(text)}</text>'
+    region_colour = scene.regions[0].colour if scene.regions else "#000"
+    for row in figure.legend:
+        swatch = _SWATCHES.get(row.kind)
+        if row.kind in ("region", "task-region"):
+            emphasised = row.kind == "task-region"
+            colour = "#1f1f1f" if emphasised else region_colour
+            swatch = (
+                _RECT.replace("{colour}", colour)
+                .replace("{stroke}", colour)
+                .replace("{opacity}", "0.8" if emphasised else "0.35")
+                .replace("{width}", "1")
             )
-            row += 12
-    if scene.trajectory is not None:
-        row += 4
-        out.append(f'<text x="{_fmt(x)}" y="{_fmt(row)}">trajectory, coloured by</text>')
-        out.append(f'<text x="{_fmt(x)}" y="{_fmt(row + 13)}">distance travelled</text>')
-        row += 22
+        if swatch is not None:
+            out.append(
+                swatch.format(
+                    x=_fmt(row.x), cx=_fmt(row.x + 11), cy=_fmt(row.y - 4), x2=_fmt(row.x + 22)
+                )
+            )
+        x = row.x + 30 if swatch is not None else row.x
+        size = "" if row.font_px == FONT_PX else f' font-size="{row.font_px:g}"'
+        out.append(f'<text x="{_fmt(x)}" y="{_fmt(row.y)}"{size}>{escape(row.text)}</text>')
+    bar = figure.colour_bar
+    if bar is not None:
         stops = "".join(
             f'<stop offset="{_fmt(i / 10)}" stop-color="{viridis(i / 10)}"/>' for i in range(11)
         )
         out.append(
             f'<defs><linearGradient id="arc">{stops}</linearGradient></defs>'
-            f'<rect x="{_fmt(x)}" y="{_fmt(row)}" width="150" height="10" fill="url(#arc)"/>'
+            f'<rect x="{_fmt(bar.x0)}" y="{_fmt(bar.y0)}" width="{_fmt(bar.x1 - bar.x0)}" '
+            f'height="{_fmt(bar.y1 - bar.y0)}" fill="url(#arc)"/>'
         )
-        row += 22
-        out.append(f'<text x="{_fmt(x)}" y="{_fmt(row)}">0</text>')
+        out.append(f'<text x="{_fmt(bar.x0)}" y="{_fmt(bar.y1 + 12)}">0</text>')
         out.append(
-            f'<text x="{_fmt(x + 150)}" y="{_fmt(row)}" text-anchor="end">'
-            f"{scene.trajectory.length:.4g}</text>"
+            f'<text x="{_fmt(bar.x1)}" y="{_fmt(bar.y1 + 12)}" text-anchor="end">'
+            f"{escape(figure.colour_bar_end)}</text>"
         )
-        row += 6
-    if scene.regions_omitted:
-        row += 12
-        out.append(
-            f'<text x="{_fmt(x)}" y="{_fmt(row)}" font-size="9">{scene.regions_omitted:,} '
-            "other regions not drawn</text>"
-        )
-    if scene.mesh_omitted:
-        row += 12
-        out.append(
-            f'<text x="{_fmt(x)}" y="{_fmt(row)}" font-size="9">mesh of '
-            f"{scene.mesh_omitted:,} triangles not drawn</text>"
-        )
-        row += 12
-        out.append(f'<text x="{_fmt(x)}" y="{_fmt(row)}" font-size="9">(zoom in to see it)</text>')
-    return out, row - y
-
-
-class _Keep(dict[str, str]):
-    """``format_map`` helper that leaves the legend's own placeholders in place."""
-
-    def __missing__(self, key: str) -> str:
-        return "{" + key + "}"
-
-
-def _cross_swatch() -> str:
-    return (
-        '<path d="M{x} {cy}m6 -5l10 10m0 -10l-10 10" stroke="#d00" stroke-width="2.4" fill="none"/>'
-    )
+    return out
 
 
 def render_svg(scene: Scene) -> bytes:
     """The SVG document of ``scene`` (UTF-8 bytes, deterministic)."""
-    canvas = _Canvas(scene.view)
-    map_right = canvas.left + canvas.width
-    legend_x = map_right + 18
-    legend, legend_height = _legend(scene, legend_x, canvas.top + 8)
-    width = legend_x + _LEGEND_WIDTH
-    height = max(canvas.top + canvas.height + _PAD, canvas.top + legend_height + 2 * _PAD)
+    figure = layout(scene)
+    canvas = figure.canvas
+    width = figure.width
+    height = figure.height
     parts: list[str] = [
         f'<svg xmlns="http://www.w3.org/2000/svg" width="{_fmt(width)}" '
         f'height="{_fmt(height)}" viewBox="0 0 {_fmt(width)} {_fmt(height)}" '
-        'font-family="DejaVu Sans, Arial, sans-serif" font-size="11">',
+        f'font-family="DejaVu Sans, Arial, sans-serif" font-size="{FONT_PX:g}">',
         f"<title>{escape(scene.title)}</title>",
         '<rect width="100%" height="100%" fill="#fff"/>',
-        f'<text x="{_fmt(canvas.left)}" y="{_fmt(_PAD + 12)}" font-size="14">'
-        f"{escape(scene.title)}</text>",
+        f'<text x="{_fmt(canvas.left)}" y="{_fmt(PAD + 12)}" font-size="{TITLE_PX:g}">'
+        f"{escape(figure.title)}</text>",
         '<defs><clipPath id="view">'
         f'<rect x="{_fmt(canvas.left)}" y="{_fmt(canvas.top)}" width="{_fmt(canvas.width)}" '
         f'height="{_fmt(canvas.height)}"/></clipPath></defs>',
@@ -363,28 +292,23 @@ def render_svg(scene: Scene) -> bytes:
             f'{number}</text><text x="{_fmt(vx + 8)}" y="{_fmt(vy - 6)}" fill="#d00">'
             f"{number}</text>"
         )
-    labels = [r for r in scene.regions if r.labelled]
-    if labels:
+    if figure.labels:
         # A white halo under each name (drawn first: not every renderer knows paint-order).
-        texts = []
-        for region in labels:
-            lx, ly, baseline = _label_position(canvas, region)
-            texts.append(
-                f'<text x="{_fmt(lx)}" y="{_fmt(ly)}" dominant-baseline="{baseline}">'
-                f"{escape(region.name)}</text>"
-            )
-        body = "".join(texts)
+        body = "".join(
+            f'<text x="{_fmt(label.x)}" y="{_fmt(label.y + baseline_offset(label.font_px))}">'
+            f"{escape(label.name)}</text>"
+            for label in figure.labels
+        )
         parts.append(
-            '<g text-anchor="middle" font-size="10">'
-            f'<g stroke="#fff" stroke-width="3" fill="#fff" stroke-opacity="0.85">{body}</g>'
-            f'<g fill="#000">{body}</g></g>'
+            f'<g class="labels" text-anchor="middle" font-size="{LABEL_PX:g}">'
+            f'<g stroke="#fff" stroke-width="{2 * LABEL_HALO:g}" fill="#fff" '
+            f'stroke-opacity="0.85">{body}</g><g fill="#000">{body}</g></g>'
         )
     parts.append("</g>")
-    x0, y0, x1, y1 = scene.view
     parts.append(
-        f'<text x="{_fmt(canvas.left)}" y="{_fmt(canvas.top + canvas.height + 11)}" '
-        f'font-size="9" fill="#555">x {x0:.4g} … {x1:.4g}, y {y0:.4g} … {y1:.4g}</text>'
+        f'<text x="{_fmt(canvas.left)}" y="{_fmt(figure.extent_y)}" '
+        f'font-size="{SMALL_PX:g}" fill="#555">{escape(figure.extent_text)}</text>'
     )
-    parts.extend(legend)
+    parts.extend(_legend(scene, figure))
     parts.append("</svg>\n")
     return "\n".join(parts).encode("utf-8")

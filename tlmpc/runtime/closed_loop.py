@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 
 from tlmpc.abstraction.model import FloatArray
+from tlmpc.base.errors import UsageError, error
 from tlmpc.runtime.disturbance import Disturbance
 from tlmpc.runtime.executor import Executor, RunPlan
 from tlmpc.runtime.model import Progress, Recovery
@@ -34,6 +35,10 @@ from tlmpc.runtime.unicycle import unicycle_flow
 DT_FRACTION = 0.1
 #: A run gives up (``end: open``) after this many times its nominal duration.
 TIME_CAP_FACTOR = 10.0
+
+#: Samples a run may take (the verifier's limit for a log): a unicycle's default dt takes
+#: some 10^5 samples for two laps of a shipped mission; a dt of 1e-9 would take forever.
+MAX_SAMPLES = 2_000_000
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -104,8 +109,21 @@ def run_closed_loop(
     step_time = dt if dt is not None else default_dt(executor.plan, speed)
     if duration is not None:
         horizon = duration
+        expected = duration / step_time
     else:
-        horizon = TIME_CAP_FACTOR * max(_nominal(executor.plan, cycles or 1), step_time)
+        nominal = _nominal(executor.plan, cycles or 1)
+        horizon = TIME_CAP_FACTOR * max(nominal, step_time)
+        expected = nominal / step_time
+    if not expected <= MAX_SAMPLES:
+        raise UsageError(
+            error(
+                "R024",
+                f"the run would take about {expected:.3g} samples at dt {step_time:g} s, "
+                f"more than {MAX_SAMPLES:,}",
+                hint="give a larger --dt (or leave it out for the mesh's own), fewer --cycles "
+                "or a shorter --duration",
+            )
+        )
     pose = initial_pose(executor, heading)
     t = 0.0
     samples: list[tuple[float, float, float]] = []
@@ -140,8 +158,10 @@ def run_closed_loop(
         else:
             stay_since = None
         previous_step = progress.step
-        if t >= horizon:
-            completed = duration is not None
+        # the time cap, or the sample budget: a run that needs more samples than expected
+        # (recoveries, or t + dt == t at a tiny dt) ends there, inconclusive
+        if t >= horizon or len(samples) >= MAX_SAMPLES:
+            completed = duration is not None and t >= horizon
             break
         w = disturbance(t, point, executor)
         if executor.is_unicycle:

@@ -106,6 +106,16 @@ class RunPlan:
         return 2 * len(self.steps) + start - target
 
 
+#: The artifacts of an output folder the executor is built from.
+EXECUTOR_ARTIFACTS = (
+    "mission.json",
+    "abstraction.json",
+    "automaton.json",
+    "witness.json",
+    "controllers.json",
+)
+
+
 class Executor:
     """Pose → velocity for a compiled mission, with plan tracking and recovery.
 
@@ -154,13 +164,7 @@ class Executor:
         from tlmpc.mission.io import mission_from_json
         from tlmpc.planning.io import witness_from_json
 
-        needed = (
-            "mission.json",
-            "abstraction.json",
-            "automaton.json",
-            "witness.json",
-            "controllers.json",
-        )
+        needed = EXECUTOR_ARTIFACTS
         if isinstance(output, str | os.PathLike):
             source = str(output)
             artifacts: Mapping[str, Any] = read_artifacts(Path(output), needed)
@@ -441,36 +445,35 @@ class Executor:
 
     def _replan(self, triangle: int, point: FloatArray) -> None:
         from tlmpc.control import synthesize
-        from tlmpc.planning.plan import plan
+        from tlmpc.planning.mission import plan_mission
 
         abstraction = dataclasses.replace(self.abstraction, start=triangle)
         if not self.locator.contains(triangle, point):
             # A triangle crossed on the way to ``point``: the plan starts in it, and the
             # planner's start triangles are those holding its start point.
             point = abstraction.corners(triangle).mean(axis=0)
-
-        def resume(passages: bool) -> Witness:
-            return plan(
+        try:
+            # Compile's own planning entry, resumed from the tracked automaton states: edges,
+            # U-turn refinement, then vertex passages, on the mesh the run was compiled with.
+            planned = plan_mission(
+                self.mission,
                 abstraction,
                 self.automaton,
-                formula=self.mission.formula,
-                options=self.mission.options,
-                start_point=(float(point[0]), float(point[1])),
                 resume=self._states,
-                passages=passages,
+                start_point=(float(point[0]), float(point[1])),
             )
-
-        try:
-            try:
-                witness = resume(False)
-            except NoPlanError:
-                witness = resume(True)  # as compile does: through a corner only when needed
-            controllers = synthesize(abstraction, witness, self.mission.robot)
+            controllers = synthesize(planned.abstraction, planned.witness, self.mission.robot)
         except (NoPlanError, SolverError, InvalidInputError):
             self._stop("no_plan", triangle)
             return
+        if planned.abstraction is not abstraction:
+            # Refined for a U-turn: a split triangle keeps its number for one of its parts and
+            # the others are appended with its label, so the run's history stays meaningful.
+            refined = planned.abstraction
+            self.abstraction = dataclasses.replace(refined, start=self.abstraction.start)
+            self.locator = Locator.of(self.abstraction)
         self._record("replan", triangle, 0)
-        self.plan = RunPlan.of(witness, controllers)
+        self.plan = RunPlan.of(planned.witness, controllers)
         self._step = 0
         self._laps = 0
         self._replans += 1

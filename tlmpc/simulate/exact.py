@@ -16,12 +16,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any, NoReturn
 
 import numpy as np
 
 from tlmpc.abstraction.model import Abstraction, FloatArray
+from tlmpc.base.content import ContentEquality
 from tlmpc.base.errors import SolverError, error
 from tlmpc.control.geometry import largest_of, triangle_geometry
 from tlmpc.control.model import Controllers, StepController
@@ -42,12 +43,12 @@ WRONG_FACET_TOLERANCE = 1e-9
 STAY_CONTRACTION = 1e-6
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
-class Trace:
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
+class Trace(ContentEquality):
     """Samples ``(t, x, y)``, the plan step and triangle of each, and the loop's start."""
 
-    times: FloatArray = field(compare=False)
-    points: FloatArray = field(compare=False)  # (n, 2)
+    times: FloatArray
+    points: FloatArray  # (n, 2)
     steps: tuple[int, ...]
     triangles: tuple[int, ...]
     loop_start: int | None

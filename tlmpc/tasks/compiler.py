@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import difflib
 import functools
+import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
@@ -17,10 +18,13 @@ from typing import TYPE_CHECKING, Any
 from tlmpc.base.errors import Diagnostic, InvalidInputError, error
 from tlmpc.ltl.ast import (
     And,
+    BoundedEventually,
+    BoundedGlobally,
     Eventually,
     Formula,
     Globally,
     Implies,
+    Interval,
     Not,
     Or,
     Prop,
@@ -62,6 +66,11 @@ KNOWN_PHRASES = (
     "if you sense S then do ACTION",
     "if you sense any of S, T then ...",
     "if you sense all of S, T then ...",
+    "visit A within T s",
+    "visit A at least every T s",
+    "stay in A for at least T s",
+    "never stay in A longer than T s",
+    "after A, visit B within T s",
 )
 _LEADING_WORDS = (
     "visit",
@@ -74,6 +83,7 @@ _LEADING_WORDS = (
     "whenever",
     "if",
     "when",
+    "after",
 )
 
 
@@ -213,7 +223,25 @@ class _Lowering:
             return Globally(Implies(self.name(children[0]), Eventually(self.name(children[1]))))
         if kind in _REACTIVE:
             return self._reactive(kind, children)
+        if kind in _TIMED:
+            return self._timed(kind, children, _duration(tree))
         raise ValueError(f"unknown phrase kind {kind}")  # pragma: no cover - grammar is closed
+
+    def _timed(self, kind: str, children: list[Node], seconds: float) -> Formula:
+        window = Interval(0.0, seconds)
+        if kind == "visit_within":
+            return conjoin([BoundedEventually(p, window) for p in self.names(children[0])])
+        if kind == "visit_every":
+            return conjoin(
+                [Globally(BoundedEventually(p, window)) for p in self.names(children[0])]
+            )
+        if kind == "stay_for":
+            return Eventually(BoundedGlobally(self.name(children[0]), window))
+        if kind == "stay_at_most":
+            place = self.name(children[0])
+            return Globally(Implies(place, BoundedEventually(Not(place), window)))
+        trigger, goal = self.name(children[0]), self.name(children[1])
+        return Globally(Implies(trigger, BoundedEventually(goal, window)))
 
     def _reactive(self, kind: str, children: list[Node]) -> Formula:
         """The reactive phrases (docs/task-phrases.md): each lowers to a conjunction of the
@@ -425,6 +453,21 @@ def _words(tree: Node) -> list[Word]:
     for child in tree.children:
         found.extend([child] if isinstance(child, Word) else _words(child))
     return found
+
+
+#: The time-bounded phrase kinds (their last token is the duration).
+_TIMED = frozenset({"visit_within", "visit_every", "stay_for", "stay_at_most", "after_within"})
+
+_DURATION = re.compile(r"([0-9]+(?:\.[0-9]+)?)\s*([A-Za-z]+)")
+_UNITS = {"s": 1.0, "sec": 1.0, "secs": 1.0, "second": 1.0, "seconds": 1.0}
+_UNITS.update({"min": 60.0, "mins": 60.0, "minute": 60.0, "minutes": 60.0})
+
+
+def _duration(tree: Node) -> float:
+    """The seconds of a timed phrase's duration token (``30 s``, ``1.5 minutes``)."""
+    found = _DURATION.fullmatch(str(tree.children[-1]))
+    assert found is not None  # the grammar's DURATION
+    return float(found.group(1)) * _UNITS[found.group(2).lower()]
 
 
 def _listing(props: Sequence[Prop]) -> str:

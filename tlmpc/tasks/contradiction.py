@@ -18,7 +18,8 @@ from dataclasses import dataclass
 
 from tlmpc.automata.translate import translate
 from tlmpc.base.errors import Diagnostic, error
-from tlmpc.ltl.ast import And, Const, Formula, Not, Or, Prop, conjoin
+from tlmpc.base.graphs import csr, strong_components
+from tlmpc.ltl.ast import And, Const, Formula, Not, Or, Prop, bounded_operators, conjoin
 from tlmpc.ltl.printer import to_text
 from tlmpc.ltl.transform import substitute
 
@@ -45,62 +46,18 @@ def is_satisfiable(formula: Formula) -> bool:
     # the translation's edges carry consistent cubes only (a & !a is never emitted), so every
     # edge is enabled by some letter and emptiness is a graph question
     automaton = translate(formula, simplify=False)
-    successors: dict[int, list[tuple[int, frozenset[int]]]] = {}
+    successors: list[list[int]] = [[] for _ in range(automaton.num_states)]
     for edge in automaton.edges:
-        successors.setdefault(edge.src, []).append((edge.dst, edge.marks))
-    components = _reachable_components(automaton.initial, successors)
+        successors[edge.src].append(edge.dst)
+    component = strong_components(*csr(successors), [automaton.initial])
+    # the marks on the edges inside each reachable component (a component with no inner
+    # edge is on no cycle and gets no entry)
+    inner: dict[int, set[int]] = {}
+    for edge in automaton.edges:
+        if component[edge.src] >= 0 and component[edge.src] == component[edge.dst]:
+            inner.setdefault(component[edge.src], set()).update(edge.marks)
     wanted = frozenset(range(automaton.num_acc))
-    for component in components:
-        marks: set[int] = set()
-        cyclic = False
-        for state in component:
-            for target, edge_marks in successors.get(state, ()):
-                if target in component:
-                    cyclic = True
-                    marks |= edge_marks
-        if cyclic and wanted <= marks:
-            return True
-    return False
-
-
-def _reachable_components(
-    initial: int, successors: Mapping[int, list[tuple[int, frozenset[int]]]]
-) -> list[set[int]]:
-    """Strongly connected components reachable from ``initial`` (iterative Tarjan)."""
-    index: dict[int, int] = {}
-    low: dict[int, int] = {}
-    on_stack: set[int] = set()
-    stack: list[int] = []
-    components: list[set[int]] = []
-    work: list[tuple[int, int]] = [(initial, 0)]
-    while work:
-        node, child = work.pop()
-        if child == 0:
-            index[node] = low[node] = len(index)
-            stack.append(node)
-            on_stack.add(node)
-        targets = successors.get(node, [])
-        if child < len(targets):
-            work.append((node, child + 1))
-            target = targets[child][0]
-            if target not in index:
-                work.append((target, 0))
-            elif target in on_stack:
-                low[node] = min(low[node], index[target])
-            continue
-        if low[node] == index[node]:
-            component: set[int] = set()
-            while True:
-                member = stack.pop()
-                on_stack.discard(member)
-                component.add(member)
-                if member == node:
-                    break
-            components.append(component)
-        if work:
-            parent = work[-1][0]
-            low[parent] = min(low[parent], low[node])
-    return components
+    return any(wanted <= marks for marks in inner.values())
 
 
 def _temporal_size(formula: Formula) -> int:
@@ -129,11 +86,13 @@ def _independent_groups(formulas: Sequence[Formula]) -> list[list[Formula]]:
 def contradictory(formulas: Sequence[Formula]) -> bool:
     """Whether the conjunction of ``formulas`` is certainly unsatisfiable.
 
-    False also when a group of dependent conjuncts is too large to check.
+    False also when a group of dependent conjuncts is too large to check, or has a time bound.
     """
     for group in _independent_groups(formulas):
         if sum(_temporal_size(f) for f in group) > MAX_TEMPORAL_OPERATORS:
             continue
+        if any(bounded_operators(f) for f in group):
+            continue  # the automaton check does not take time bounds
         if not is_satisfiable(conjoin(group)):
             return True
     return False

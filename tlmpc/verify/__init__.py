@@ -10,7 +10,7 @@ from typing import Any
 
 from tlmpc.verify.ending import declare_ending
 from tlmpc.verify.model import ConjunctReport, Counterexample, Verdict, Violation
-from tlmpc.verify.trace_input import TraceInput, from_csv, from_document
+from tlmpc.verify.trace_input import LogOptions, TraceInput, from_csv, from_document, read_trace
 from tlmpc.verify.verdict import verdict_to_json, verify_trace
 
 
@@ -30,12 +30,14 @@ def verify_document(
 __all__ = [
     "ConjunctReport",
     "Counterexample",
+    "LogOptions",
     "TraceInput",
     "Verdict",
     "Violation",
     "declare_ending",
     "from_csv",
     "from_document",
+    "read_trace",
     "verdict_to_json",
     "verify_document",
     "verify_trace",

@@ -87,15 +87,34 @@ def inradius(polygon: Any) -> float:
     return float(polygon.boundary.distance(pole))
 
 
+def free_space(trace: TraceInput) -> Any:
+    """The trace's free space: every workspace piece (boundary minus holes), united; None
+    without a workspace."""
+    if trace.boundary_polygon is None:
+        return None
+    pieces = [(trace.boundary_polygon, trace.holes), *trace.components]
+    free_pieces = []
+    for boundary, holes in pieces:
+        free = shapely.Polygon(boundary)
+        if holes:
+            free = free.difference(shapely.union_all([shapely.Polygon(h) for h in holes]))
+        free_pieces.append(free)
+    free = free_pieces[0] if len(free_pieces) == 1 else shapely.union_all(free_pieces)
+    shapely.prepare(free)
+    return free
+
+
 def measure(trace: TraceInput) -> Clearance:
     """Clearance from obstacles and forbidden regions, and depth into goals, of ``trace``."""
     points = np.asarray(trace.points, dtype=np.float64)
     segments = _segments(points)
     obstacles: float | None = None
     obstacle_position: tuple[float, float] | None = None
-    if trace.boundary_polygon is not None:
-        walls = [shapely.Polygon(trace.boundary_polygon).exterior]
-        walls += [shapely.Polygon(h) for h in trace.holes]
+    free = free_space(trace)
+    if free is not None:
+        # every ring of the free space (all workspace pieces, their holes): a path in a second
+        # piece is measured against that piece's walls, as the verifier measures it
+        walls = list(shapely.get_parts(shapely.boundary(free)))
         tree = shapely.STRtree(walls)
         (index, wall), distance = tree.query_nearest(
             segments, return_distance=True, all_matches=False

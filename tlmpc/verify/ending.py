@@ -13,7 +13,8 @@ from tlmpc.verify.trace_input import TraceInput
 def declare_ending(
     trace: TraceInput, *, assume_stay: bool = False, loop_from: float | None = None
 ) -> TraceInput:
-    """``trace`` read as staying at its last point, or repeating from time ``loop_from`` on.
+    """``trace`` read as staying at its last point, or repeating from ``loop_from`` seconds
+    after its first sample on (times are counted from the log's start, as reported).
 
     Without either, the trace keeps the ending it declares itself (a log: ``open``).
     """
@@ -30,13 +31,13 @@ def declare_ending(
         return dataclasses.replace(trace, ending="stay", loop_start=None)
     if loop_from is None:
         return trace
-    times = trace.times
-    if not np.isfinite(loop_from) or not times[0] <= loop_from < times[-1]:
+    times = trace.times - trace.times[0]
+    if not np.isfinite(loop_from) or not 0.0 <= loop_from < times[-1]:
         raise UsageError(
             error(
                 "V022",
                 f"--loop-from {loop_from:g} is outside the log's time range "
-                f"[{times[0]:g}, {times[-1]:g})",
+                f"[0, {times[-1]:g}) (seconds from its first sample)",
                 hint="give the time at which the repeating part of the log starts",
                 file=trace.source,
             )

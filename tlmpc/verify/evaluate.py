@@ -1,7 +1,7 @@
-"""Direct LTL evaluation on a lasso of positions, with interval values (the verifier's semantics).
-
-One evaluator serves every question the verifier asks.  A value is a pair of arrays
-``(lo, hi)`` over the positions: the formula's value is known to lie in ``[lo, hi]``.
+"""Direct LTL evaluation on a lasso of positions, with interval values: the recursion that
+:mod:`tlmpc.verify.semantics` runs for every question the verifier asks (how a trace's end
+becomes a lasso is decided there, once).  A value is a pair of arrays ``(lo, hi)`` over the
+positions: the formula's value is known to lie in ``[lo, hi]``.
 
 * Two-valued truth: atoms are +1 (in the region) or -1, ``lo == hi``.
 * Three-valued truth (a log that may go on): an unknown atom is ``(-1, +1)``; a value with
@@ -26,6 +26,9 @@ import numpy.typing as npt
 
 from tlmpc.ltl.ast import (
     And,
+    BoundedEventually,
+    BoundedGlobally,
+    BoundedUntil,
     Const,
     Equiv,
     Eventually,
@@ -184,6 +187,11 @@ class IntervalEvaluator:
             case StrongRelease(left, right):
                 right_value = self(right)
                 return self.until(right_value, self.meet([self(left), right_value]))
+            case BoundedEventually() | BoundedGlobally() | BoundedUntil():
+                raise ValueError(
+                    "a time bound needs the pieces' times: evaluate it with "
+                    "tlmpc.verify.semantics.evaluate"
+                )
             case _:
                 assert_never(f)
 
@@ -204,49 +212,3 @@ def truth_atoms(
         return lo, hi
 
     return atom
-
-
-def lasso_truth(
-    formula: Formula,
-    labels: BoolArray,
-    names: list[str],
-    loop_start: int,
-    is_point: BoolArray | None = None,
-) -> BoolArray:
-    """Two-valued truth of ``formula`` at every position of the lasso ``labels``."""
-    evaluator = IntervalEvaluator(truth_atoms(labels, names), labels.shape[0], loop_start, is_point)
-    lo, _ = evaluator(formula)
-    truth: BoolArray = lo > 0
-    return truth
-
-
-def open_truth(
-    formula: Formula,
-    labels: BoolArray,
-    names: list[str],
-    is_point: BoolArray | None = None,
-    unknown: BoolArray | None = None,
-) -> npt.NDArray[np.int8]:
-    """Three-valued truth (+1 true, 0 unknown, -1 false) on a finite word that goes on.
-
-    After the last position comes an unknown future: a sentinel position, looping on itself,
-    where every atom is unknown.  The sentinel stands for every future instant at once, so a
-    value known there is known all along the future: the answer is sound (a prefix called good
-    is good for every continuation, one called bad for none), though conjunctions of
-    obligations that contradict each other in the future (``F a & G !a``) stay unknown.
-    """
-    size = labels.shape[0]
-    padded = np.vstack([labels, np.zeros((1, labels.shape[1]), dtype=bool)])
-    unknown_all = np.zeros_like(padded)
-    if unknown is not None:
-        unknown_all[:size] = unknown
-    unknown_all[size] = True
-    points = None
-    if is_point is not None:
-        points = np.concatenate([is_point, [False]])
-    evaluator = IntervalEvaluator(truth_atoms(padded, names, unknown_all), size + 1, size, points)
-    lo, hi = evaluator(formula)
-    result = np.zeros(size, dtype=np.int8)
-    result[lo[:size] > 0] = 1
-    result[hi[:size] < 0] = -1
-    return result

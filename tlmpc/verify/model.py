@@ -6,6 +6,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
+from tlmpc.base.content import ContentEquality
+
 #: ``satisfied``: every continuation satisfies the task (for a lasso or a stay: the trace does);
 #: ``violated``: no continuation can; ``inconclusive``: some may and some may not.
 Outcome = Literal["satisfied", "violated", "inconclusive"]
@@ -39,6 +41,8 @@ class ConjunctReport:
     visits: int | None = None
     last_visit: float | None = None
     longest_gap: float | None = None
+    #: By how many seconds its time bounds held (> 0) or failed (< 0); None without bounds.
+    time_robustness: float | None = None
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -61,8 +65,8 @@ class Certificate:
     reason: str
 
 
-@dataclass(frozen=True, slots=True, kw_only=True)
-class Verdict:
+@dataclass(frozen=True, slots=True, kw_only=True, eq=False)
+class Verdict(ContentEquality):
     """The verifier's answer for one trace."""
 
     outcome: Outcome
@@ -71,6 +75,9 @@ class Verdict:
     ending: Ending
     robustness: float
     certificate: Certificate
+    #: By how many seconds the task's time bounds held (> 0) or failed (< 0), None without
+    #: bounds or for an inconclusive verdict (see tlmpc.verify.time_robustness).
+    time_robustness: float | None = None
     pieces: int
     conjuncts: tuple[ConjunctReport, ...] = ()
     violations: tuple[Violation, ...] = ()

@@ -2,14 +2,27 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
 
-from tlmpc.ltl.ast import Eventually, Formula, Globally, Not, Prop, Until
+from tlmpc.ltl.ast import (
+    BoundedEventually,
+    BoundedGlobally,
+    Eventually,
+    Formula,
+    Globally,
+    Implies,
+    Not,
+    Or,
+    Prop,
+    Until,
+)
 from tlmpc.ltl.printer import to_text
+from tlmpc.verify.clock import at
 from tlmpc.verify.evaluate import Value
 from tlmpc.verify.model import ConjunctReport, Outcome, Violation
 
@@ -26,6 +39,7 @@ class Timeline:
     positions: FloatArray
     labels: BoolArray
     names: list[str]
+    origin: float = 0.0  # the time of the log's first sample: times are reported from it
 
     @property
     def size(self) -> int:
@@ -82,7 +96,7 @@ def _globally_violations(
         time, position = _at(line, first)
         if isinstance(inner, Eventually):
             message = (
-                f"`{to_text(inner.arg)}` never holds again after t={time:.4g} s "
+                f"`{to_text(inner.arg)}` never holds again after {at(time, line.origin)} "
                 f"(from {_place(position)}), so `{text}` fails"
             )
             found.append(Violation(conjunct=text, time=time, position=position, message=message))
@@ -94,11 +108,12 @@ def _globally_violations(
             if isinstance(n, Not) and isinstance(n.arg, Prop) and n.arg.name in inside
         ]
         if forbidden:
-            message = f"entered {forbidden[0]} at t={time:.4g} s at {_place(position)}"
+            message = f"entered {forbidden[0]} at {at(time, line.origin)} at {_place(position)}"
         else:
             where = ", ".join(inside) if inside else "free space"
             message = (
-                f"`{to_text(inner)}` stops holding at t={time:.4g} s at {_place(position)} "
+                f"`{to_text(inner)}` stops holding at {at(time, line.origin)} at "
+                f"{_place(position)} "
                 f"(in {where})"
             )
         duration = float(line.ends[last]) - time
@@ -131,7 +146,7 @@ def _other_violation(
                     conjunct=text,
                     time=time,
                     position=position,
-                    message=f"`{to_text(left)}` stops holding at t={time:.4g} s at "
+                    message=f"`{to_text(left)}` stops holding at {at(time, line.origin)} at "
                     f"{_place(position)} before `{to_text(right)}` holds",
                 )
             if right_never.all():
@@ -162,9 +177,10 @@ def _progress(
     match conjunct:
         case Globally(Eventually(goal)):
             count, last, gap = _visits(line, held(goal))
-            if count:
+            if last is not None:  # visited at least once
                 progress = (
-                    f"visited {_times(count)}, last at t={last:.4g} s, longest gap {gap:.4g} s"
+                    f"visited {_times(count)}, last at {at(last, line.origin)}, "
+                    f"longest gap {gap:.4g} s"
                 )
             else:
                 progress = f"never visited in {gap:.4g} s"
@@ -180,7 +196,7 @@ def _progress(
             found = runs(held(arg))
             if found:
                 time = float(line.starts[found[0][0]])
-                progress = f"done at t={time:.4g} s"
+                progress = f"done at {at(time, line.origin)}"
             else:
                 progress = "pending" if outcome == "inconclusive" else "never done"
             return ConjunctReport(
@@ -190,14 +206,15 @@ def _progress(
             broken = runs(value(arg)[1][:size] < 0)
             if broken:
                 time = float(line.starts[broken[0][0]])
-                progress = f"broken {_times(len(broken))}, first at t={time:.4g} s"
+                progress = f"broken {_times(len(broken))}, first at {at(time, line.origin)}"
             else:
                 progress = "held so far" if outcome == "inconclusive" else "held throughout"
             return ConjunctReport(conjunct=text, outcome=outcome, progress=progress)
         case Until(_, right):
             found = runs(held(right))
             if found and outcome == "satisfied":
-                progress = f"`{to_text(right)}` reached at t={line.starts[found[0][0]]:.4g} s"
+                reached = float(line.starts[found[0][0]])
+                progress = f"`{to_text(right)}` reached at {at(reached, line.origin)}"
             else:
                 progress = words[outcome]
             return ConjunctReport(conjunct=text, outcome=outcome, progress=progress)
@@ -226,3 +243,76 @@ def conjunct_reports(
                 continue
         violations.append(_other_violation(conjunct, value, line))
     return reports, violations
+
+
+def _seconds(value: float) -> str:
+    return f"{value:.4g} s"
+
+
+def _response(inner: Formula) -> tuple[Formula, Formula, float] | None:
+    """``(trigger, goal, T)`` of ``trigger -> F[0,T] goal`` (or ``!trigger | F[0,T] goal``)."""
+    match inner:
+        case Implies(trigger, BoundedEventually(goal, interval)) if interval.low == 0:
+            return trigger, goal, interval.high
+        case Or((Not(trigger), BoundedEventually(goal, interval))) if interval.low == 0:
+            return trigger, goal, interval.high
+        case _:
+            return None
+
+
+def timed_progress(
+    conjunct: Formula, outcome: Outcome, slack: float | None, first_broken: float | None
+) -> str | None:
+    """Progress of a conjunct with time bounds, from its time robustness ``slack``.
+
+    None when the conjunct has no time bound or no time robustness.
+    """
+    if outcome == "inconclusive":
+        if isinstance(conjunct, BoundedEventually):
+            return f"pending: deadline t={conjunct.interval.high:.4g} s"
+        return "pending" if first_broken is None else f"pending (broken at t={first_broken:.4g} s)"
+    if slack is None:
+        return None
+    at = f" at t={first_broken:.4g} s" if first_broken is not None else ""
+    if math.isinf(slack):
+        return "holds at any bound" if slack > 0 else "fails at any bound"
+    match conjunct:
+        case BoundedEventually(_, interval) if math.isfinite(interval.high):
+            deadline = interval.high
+            if slack >= 0:
+                return (
+                    f"done at t={deadline - slack:.4g} s, {_seconds(slack)} before the "
+                    f"deadline t={deadline:.4g} s"
+                )
+            return f"deadline t={deadline:.4g} s missed by {_seconds(-slack)}"
+        case Globally(BoundedEventually(goal, interval)) if interval.low == 0:
+            gap = interval.high - slack
+            return (
+                f"longest time without `{to_text(goal)}` {_seconds(gap)} "
+                f"(bound {interval.high:.4g} s)"
+            )
+        case Eventually(BoundedGlobally(goal, interval)) if interval.low == 0:
+            stay = interval.high + slack
+            return (
+                f"longest stay in `{to_text(goal)}` {_seconds(stay)} "
+                f"(at least {interval.high:.4g} s)"
+            )
+        case Globally(inner) if _response(inner) is not None:
+            found = _response(inner)
+            assert found is not None
+            trigger, goal, bound = found
+            if isinstance(goal, Not) and goal.arg == trigger:
+                return (
+                    f"longest stay in `{to_text(trigger)}` {_seconds(bound - slack)} "
+                    f"(at most {bound:.4g} s)"
+                )
+            if slack >= 0:
+                return (
+                    f"longest wait for `{to_text(goal)}` after `{to_text(trigger)}` "
+                    f"{_seconds(bound - slack)} (within {bound:.4g} s)"
+                )
+            return f"deadline missed by {_seconds(-slack)}{at}"
+        case _:
+            if slack >= 0:
+                return f"holds with {_seconds(slack)} to spare"
+            return f"fails by {_seconds(-slack)}{at}"

@@ -1,7 +1,7 @@
 """Spatial robustness (Fainekos–Pappas) on the pieces of the trajectory, and the certificate.
 
 Robustness of a proposition at a position is the signed distance to its region's boundary
-(positive inside).  Two evaluations use it, both through :class:`IntervalEvaluator`:
+(positive inside).  Two evaluations use it, both through :mod:`tlmpc.verify.semantics`:
 
 * **The reported robustness** is evaluated on the same pieces as the verdict (every sample and
   every boundary crossing of the piecewise-linear trajectory, and the stretches between them,
@@ -25,8 +25,7 @@ import numpy as np
 import numpy.typing as npt
 import shapely
 
-from tlmpc.ltl.ast import Formula
-from tlmpc.verify.evaluate import UNKNOWN, IntervalEvaluator, Value
+from tlmpc.verify.evaluate import Value
 
 FloatArray = npt.NDArray[np.float64]
 BoolArray = npt.NDArray[np.bool_]
@@ -68,34 +67,6 @@ def signed_distance(
     inside = shapely.contains_xy(shape, points[:, 0], points[:, 1])
     result: FloatArray = np.where(inside, distance, -distance)
     return result
-
-
-def evaluate_with_ending(
-    formula: Formula,
-    atoms: Callable[[str], Value],
-    size: int,
-    loop: int | None,
-    is_point: BoolArray | None = None,
-) -> Value:
-    """Interval value of ``formula`` at position 0.
-
-    ``loop`` is the loop's first position (a stay is a loop on the last position); None means
-    the trace is open: an unknown future (every atom ``(-inf, +inf)``) follows the last position.
-    """
-    if loop is not None:
-        evaluator = IntervalEvaluator(atoms, size, loop, is_point)
-        lo, hi = evaluator(formula)
-        return lo[:1], hi[:1]
-
-    def padded(name: str) -> Value:
-        lo, hi = atoms(name)
-        lo2, hi2 = np.append(lo, UNKNOWN[0]), np.append(hi, UNKNOWN[1])
-        return lo2, hi2
-
-    points = None if is_point is None else np.append(is_point, False)
-    evaluator = IntervalEvaluator(padded, size + 1, size, points)
-    lo, hi = evaluator(formula)
-    return lo[:1], hi[:1]
 
 
 def piece_atoms(

@@ -3,8 +3,8 @@
 Every reader of trajectories (trace.json, CSV, recorded bags) hands its arrays to
 :func:`check_samples` before verification, so every log source gets the same diagnostics:
 no samples (V002), a non-finite value (V003), time going backwards (V005), repeated time
-stamps (V020).  All problems are reported at once (a few of each kind), with the source line of
-each sample when the reader knows it.
+stamps (V020), a time or coordinate beyond 1e12 (V024).  All problems are reported at once
+(a few of each kind), with the source line of each sample when the reader knows it.
 """
 
 from __future__ import annotations
@@ -20,6 +20,10 @@ FloatArray = npt.NDArray[np.float64]
 
 #: At most this many diagnostics of one kind (a broken log can have thousands).
 MAX_PER_KIND = 3
+
+#: Times (seconds) and coordinates (the mission's units, at most 1e9 by its schema) beyond this
+#: are refused (V024): a corrupt sample, whose differences would overflow to infinity.
+MAX_MAGNITUDE = 1e12
 
 
 def _where(index: int, lines: Sequence[int] | None) -> tuple[str, int | None]:
@@ -65,6 +69,22 @@ def sample_diagnostics(
         )
     if len(bad):
         return found  # order checks on NaN times would only repeat the same rows
+    far = np.flatnonzero(np.any(np.abs(values) > MAX_MAGNITUDE, axis=1))
+    for index in far[:MAX_PER_KIND].tolist():
+        what, line = _where(index, lines)
+        found.append(
+            error(
+                "V024",
+                f"{what} has a time or coordinate beyond {MAX_MAGNITUDE:g} "
+                f"({', '.join(f'{v:g}' for v in values[index].tolist())})",
+                hint="a corrupt sample, or times in nanoseconds: times are seconds and "
+                "positions the mission's units",
+                file=file,
+                line=line,
+            )
+        )
+    if len(far):
+        return found  # differences of such values overflow
     steps = np.diff(t)
     for index in (np.flatnonzero(steps < 0)[:MAX_PER_KIND] + 1).tolist():
         what, line = _where(index, lines)

@@ -11,7 +11,7 @@ import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import numpy.typing as npt
@@ -20,6 +20,9 @@ from tlmpc.base.errors import UsageError, error
 from tlmpc.ltl.ast import Formula
 from tlmpc.verify.model import Ending
 from tlmpc.verify.samples import check_samples
+
+if TYPE_CHECKING:
+    from tlmpc.mission.model import Mission
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -45,6 +48,14 @@ class TraceInput:
     source: str | None = None
     #: The robot's body radius: the body must stay off obstacles, not just the point.
     radius: float = 0.0
+    #: When the log started, if before ``times[0]`` (a stretch of a longer log, as the live
+    #: monitor checks): messages give times from here.
+    origin: float | None = None
+
+    @property
+    def start(self) -> float:
+        """The time messages count from: the log's first sample."""
+        return float(self.times[0]) if self.origin is None else self.origin
 
 
 def _fail(
@@ -244,8 +255,8 @@ MAX_CSV_ROWS = 2_000_000
 MAX_CSV_LINE = 4096
 
 
-def check_csv_file(path: Path) -> None:
-    """Refuse (U038) a CSV trace too large to verify, reading it in chunks (never whole)."""
+def _csv_extent(path: Path) -> tuple[int, int, int]:
+    """Bytes, rows and longest line of a CSV file, read in chunks until a limit is passed."""
     rows = 0
     longest = 0
     current = 0
@@ -266,6 +277,19 @@ def check_csv_file(path: Path) -> None:
                     break
     except OSError as exc:
         raise _fail("U001", f"cannot read {path}: {exc.strerror or exc}", str(path)) from None
+    return size, rows, longest
+
+
+def is_large_csv(path: Path) -> bool:
+    """Whether the whole-log reader refuses the CSV for its size alone (U038): a log to
+    stream instead."""
+    size, rows, longest = _csv_extent(path)
+    return (size > MAX_CSV_BYTES or rows > MAX_CSV_ROWS) and longest <= MAX_CSV_LINE
+
+
+def check_csv_file(path: Path) -> None:
+    """Refuse (U038) a CSV trace too large to verify, reading it in chunks (never whole)."""
+    size, rows, longest = _csv_extent(path)
     if size > MAX_CSV_BYTES or rows > MAX_CSV_ROWS:
         raise _fail(
             "U038",
@@ -281,6 +305,103 @@ def check_csv_file(path: Path) -> None:
             str(path),
             hint="a CSV trace has short t,x,y rows; is this the right file?",
         )
+
+
+@dataclass(frozen=True, slots=True)
+class LogOptions:
+    """How to read a robot log (the flags every command that takes a log shares)."""
+
+    topic: str | None = None  # bags: the pose topic
+    columns: Sequence[str] | None = None  # CSV: the time and position columns
+    transform: tuple[float, float, float] | None = None  # x, y, yaw into the mission's frame
+    frame: str | None = None  # bags: express the poses in this frame through the bag's tf
+
+
+def read_trace(
+    path: Path,
+    mission: Path | Mission | None,
+    convention: str | None = None,
+    options: LogOptions = LogOptions(),
+) -> TraceInput:
+    """The one way a command reads a trajectory: a ``trace.json`` (self-contained), or a robot
+    log — CSV, ROS 1 ``.bag``, ROS 2 bag directory (sqlite3 or MCAP), ``.mcap`` — checked
+    against ``mission`` (a mission file, or a mission already loaded) for its regions and task.
+    ``tlmpc verify``, ``tlmpc plot --log`` and ``tlmpc view --log`` all read through here, so
+    they take the same formats."""
+    from tlmpc.importers.logs import is_log
+
+    if is_log(path):
+        if mission is None:
+            raise _fail(
+                "V010",
+                "a robot log needs --mission MISSION.yaml for its regions and task",
+                str(path),
+            )
+        if isinstance(mission, Path):
+            mission = _load_mission(mission)
+        return _log_trace(path, mission, convention, options)
+    from tlmpc.io.artifacts import read_json
+
+    # non-finite numbers are read, so that the verifier reports the sample where it is
+    return from_document(read_json(path, finite=False), file=str(path), convention=convention)
+
+
+def _load_mission(mission_path: Path) -> Mission:
+    from tlmpc.base.errors import InvalidInputError
+    from tlmpc.mission.load import load_mission
+
+    try:
+        return load_mission(mission_path)
+    except InvalidInputError as exc:
+        raise UsageError(exc.diagnostics) from None
+
+
+def mission_document(path: Path, mission_path: Path | None) -> dict[str, Any]:
+    """A ``tlmpc.trace/1`` document without samples: the task, regions, workspace, convention,
+    ``max_speed`` and body radius that ``mission_path`` gives the log at ``path``."""
+    if mission_path is None:
+        raise _fail(
+            "V010", "a CSV trace needs --mission MISSION.yaml for its regions and task", str(path)
+        )
+    return _mission_fields(_load_mission(mission_path))
+
+
+def _mission_fields(mission: Mission) -> dict[str, Any]:
+    from tlmpc.ltl.printer import to_text
+    from tlmpc.mission.body import body_radius
+
+    return {
+        "format": "tlmpc.trace/1",
+        "ltl": to_text(mission.formula),
+        "regions": {r.name: [list(p) for p in r.polygon] for r in mission.regions},
+        "workspace": mission.workspace.to_json(),
+        "boundary": mission.options.boundary,
+        "max_speed": mission.robot.max_speed,
+        "radius": body_radius(mission.robot),
+        "points": [],
+        "loop_start": None,
+    }
+
+
+def _log_trace(
+    path: Path, mission: Mission, convention: str | None, options: LogOptions
+) -> TraceInput:
+    """A log's samples with the mission's regions, task, workspace, speed and body."""
+    from tlmpc.importers.logs import CSV_SUFFIXES, read_log
+
+    if path.suffix.lower() in CSV_SUFFIXES and path.is_file():
+        check_csv_file(path)  # bounded before parsing
+    log = read_log(
+        path,
+        topic=options.topic,
+        columns=options.columns,
+        transform=options.transform,
+        frame=options.frame,
+    )
+    samples = _samples(log.samples, str(path), list(log.lines) or None)
+    document = _mission_fields(mission)
+    document["points"] = samples.tolist()
+    return from_document(document, file=str(path), convention=convention)
 
 
 def from_csv(
@@ -300,29 +421,5 @@ def from_csv(
         raise _fail(
             "V010", "a CSV trace needs --mission MISSION.yaml for its regions and task", str(path)
         )
-    from tlmpc.base.errors import InvalidInputError
-    from tlmpc.importers.logs import CSV_SUFFIXES, read_log
-    from tlmpc.ltl.printer import to_text
-    from tlmpc.mission.body import body_radius
-    from tlmpc.mission.load import load_mission
-
-    try:
-        mission = load_mission(mission_path)
-    except InvalidInputError as exc:
-        raise UsageError(exc.diagnostics) from None
-    if path.suffix.lower() in CSV_SUFFIXES and path.is_file():
-        check_csv_file(path)  # bounded before parsing
-    log = read_log(path, topic=topic, columns=columns, transform=transform, frame=frame)
-    samples = _samples(log.samples, str(path), list(log.lines) or None)
-    document = {
-        "format": "tlmpc.trace/1",
-        "ltl": to_text(mission.formula),
-        "regions": {r.name: [list(p) for p in r.polygon] for r in mission.regions},
-        "workspace": mission.workspace.to_json(),
-        "boundary": mission.options.boundary,
-        "max_speed": mission.robot.max_speed,
-        "radius": body_radius(mission.robot),
-        "points": samples.tolist(),
-        "loop_start": None,
-    }
-    return from_document(document, file=str(path), convention=convention)
+    options = LogOptions(topic=topic, columns=columns, transform=transform, frame=frame)
+    return _log_trace(path, _load_mission(mission_path), convention, options)

@@ -3,16 +3,19 @@ robustness that agrees with the verdict, and the certificate for the real robot.
 
 from __future__ import annotations
 
+import dataclasses
 import math
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 import shapely
 
-from tlmpc.ltl.ast import And, Formula
+from tlmpc.ltl.ast import And, Formula, Globally, bounded_operators
 from tlmpc.ltl.printer import to_text
-from tlmpc.verify.evaluate import UNKNOWN, IntervalEvaluator, Value, truth_atoms
+from tlmpc.verify.clock import at
+from tlmpc.verify.evaluate import Value, truth_atoms
 from tlmpc.verify.model import (
     Certificate,
     ConjunctReport,
@@ -22,13 +25,10 @@ from tlmpc.verify.model import (
     Violation,
 )
 from tlmpc.verify.pieces import Pieces, build_pieces, merge_pieces, region_membership
-from tlmpc.verify.progress import Timeline, conjunct_reports
-from tlmpc.verify.robustness import (
-    evaluate_with_ending,
-    piece_atoms,
-    tube_atoms,
-    tube_radii,
-)
+from tlmpc.verify.progress import Timeline, conjunct_reports, runs, timed_progress
+from tlmpc.verify.robustness import piece_atoms, tube_atoms, tube_radii
+from tlmpc.verify.semantics import PieceEnding, Semantics, Timing
+from tlmpc.verify.time_robustness import horizon, reach, time_robustness
 from tlmpc.verify.trace_input import TraceInput
 
 FloatArray = npt.NDArray[np.float64]
@@ -70,48 +70,186 @@ def _last_point_unknown(
     return unknown
 
 
-class _Truth:
-    """Three-valued truth on the pieces, with the unknown future after an open log."""
+def _piece_ending(trace: TraceInput, pieces: Pieces) -> PieceEnding:
+    if trace.ending == "open":
+        return "open"
+    if pieces.loop_start is not None:
+        return pieces.loop_start
+    return "stay"
 
-    def __init__(
-        self, trace: TraceInput, pieces: Pieces, names: list[str], unknown: BoolArray | None
-    ) -> None:
-        size = len(pieces.is_point)
-        self.size = size
-        is_point = pieces.is_point if trace.convention == "closed" else None
-        atoms = truth_atoms(pieces.labels, names, unknown)
-        if trace.ending == "open":
 
-            def padded(name: str) -> Value:
-                lo, hi = atoms(name)
-                return np.append(lo, UNKNOWN[0]), np.append(hi, UNKNOWN[1])
+def _sample_cells(
+    trace: TraceInput, atoms: Callable[[str], Value]
+) -> tuple[Callable[[str], Value], int, PieceEnding, Timing]:
+    """The samples as a dense-time signal: sample i's bounds hold from the middle of the gap
+    before it to the middle of the gap after it; at a middle instant both neighbours' bounds
+    hold (the robot is within each one's radius then), so their intersection is taken.  A
+    loop's last sample is the wrap back to its first."""
+    times = trace.times
+    n = len(times)
+    middles = (times[:-1] + times[1:]) / 2.0
+    loop = trace.loop_start if trace.ending == "loop" else None
+    # instants: T_0, the middles, T_last; a loop's first sample's time is an instant too (the
+    # loop returns to it), and its last sample is no instant (the wrap).
+    instants = [float(times[0])]
+    owners: list[tuple[int, int]] = [(0, 0)]  # the samples whose bounds hold at the instant
+    stretch: list[int] = []  # the sample of the open stretch after each instant
+    loop_instant = 0
+    for i in range(1, n):
+        stretch.append(i - 1)
+        instants.append(float(middles[i - 1]))
+        owners.append((i - 1, i))
+        if loop is not None and i == loop:
+            stretch.append(i)
+            instants.append(float(times[i]))
+            owners.append((i, i))
+            loop_instant = len(instants) - 1
+    stretch.append(n - 1)
+    if loop is None:
+        instants.append(float(times[-1]))
+        owners.append((n - 1, n - 1))
+    first = np.array([o[0] for o in owners])
+    second = np.array([o[1] for o in owners])
+    stretch_of = np.array(stretch)
+    size = len(instants) + len(stretch)
+    starts = np.empty(size)
+    starts[0::2] = instants
+    starts[1::2] = np.asarray(instants)[: len(stretch)]
 
-            points = None if is_point is None else np.append(is_point, False)
-            self.evaluator = IntervalEvaluator(padded, size + 1, size, points)
-        else:
-            loop = pieces.loop_start if pieces.loop_start is not None else size - 1
-            self.evaluator = IntervalEvaluator(atoms, size, loop, is_point)
+    def cells(name: str) -> Value:
+        lo, hi = atoms(name)
+        out_lo, out_hi = np.empty(size), np.empty(size)
+        out_lo[0::2] = np.maximum(lo[first], lo[second])
+        out_hi[0::2] = np.minimum(hi[first], hi[second])
+        out_lo[1::2], out_hi[1::2] = lo[stretch_of], hi[stretch_of]
+        return out_lo, out_hi
 
-    def __call__(self, formula: Formula) -> Value:
-        return self.evaluator(formula)
+    if loop is not None:
+        ending: PieceEnding = 2 * loop_instant
+    else:
+        ending = "stay" if trace.ending == "stay" else "open"
+    return cells, size, ending, Timing(starts, float(times[-1]))
 
-    def outcome(self, formula: Formula) -> Outcome:
-        lo, hi = self.evaluator(formula)
-        return _outcome(float(lo[0]), float(hi[0]))
+
+def _prefix_end(starts: FloatArray, span: float) -> int | None:
+    """How many pieces cover ``[T_0, T_0 + span]`` and end on an instant after it (None: the
+    trace is not longer than that)."""
+    if not math.isfinite(span):
+        return None
+    # pieces come in pairs (an instant and the stretch after it, with one start): an even count
+    # ends on a stretch, closed by the instant at ``index``; an odd one is the whole trace
+    index = int(np.searchsorted(starts, starts[0] + span, side="right"))
+    if index % 2 or index >= len(starts):
+        return None
+    return index + 1
+
+
+def _prefix_atoms(atoms: Callable[[str], Value], cut: int) -> Callable[[str], Value]:
+    def prefix(name: str) -> Value:
+        lo, hi = atoms(name)
+        if lo is hi:
+            both = lo[:cut]
+            return both, both
+        return lo[:cut], hi[:cut]
+
+    return prefix
+
+
+def _with_time_robustness(
+    report: ConjunctReport,
+    conjunct: Formula,
+    outcome_of: Callable[[Formula], Outcome],
+    truth: Semantics,
+    line: Timeline,
+    duration: float,
+) -> ConjunctReport:
+    """``report`` with the conjunct's time robustness and, for a bounded one, its progress."""
+    if not bounded_operators(conjunct):
+        return report
+    slack = time_robustness(conjunct, report.outcome, outcome_of, horizon(conjunct, duration))
+    first_broken = None
+    if isinstance(conjunct, Globally):
+        broken = np.flatnonzero(truth(conjunct.arg)[1][: line.size] < 0)
+        if len(broken):
+            first_broken = float(line.starts[int(broken[0])])
+    progress = timed_progress(conjunct, report.outcome, slack, first_broken)
+    return dataclasses.replace(
+        report, time_robustness=slack, progress=progress if progress else report.progress
+    )
+
+
+def _timed_violations(
+    conjuncts: list[Formula],
+    reports: list[ConjunctReport],
+    found: list[Violation],
+    truth: Semantics,
+    trace: TraceInput,
+) -> list[Violation]:
+    """The violations of conjuncts with time bounds, in dense time: for ``G x``, each maximal
+    stretch of instants where ``x`` fails (exact ends); for the others, their progress."""
+    timed = {
+        to_text(c): (c, r)
+        for c, r in zip(conjuncts, reports, strict=True)
+        if bounded_operators(c) and r.outcome == "violated"
+    }
+    if not timed:
+        return found
+    kept = [v for v in found if v.conjunct not in timed]
+    for text, (conjunct, report) in timed.items():
+        if not isinstance(conjunct, Globally):
+            kept.append(
+                Counterexample(
+                    conjunct=text, time=None, position=None, message=f"`{text}`: {report.progress}"
+                )
+            )
+            continue
+        signal = truth.dense().signal(conjunct.arg)
+        stretches = _failing_stretches(signal.times, signal.hi, truth.dense().domain.end)
+        for start, end in stretches[:MAX_STRETCHES]:
+            x = float(np.interp(start, trace.times, trace.points[:, 0]))
+            y = float(np.interp(start, trace.times, trace.points[:, 1]))
+            when = (
+                f"at t={start:.4g} s" if end == start else f"from t={start:.4g} s to t={end:.4g} s"
+            )
+            kept.append(
+                Counterexample(
+                    conjunct=text,
+                    time=start,
+                    position=(x, y),
+                    message=f"`{to_text(conjunct.arg)}` fails {when}, starting at "
+                    f"({x:.4g}, {y:.4g}), while `{text}` must hold",
+                )
+            )
+    return kept
+
+
+#: At most this many failing stretches are listed per conjunct.
+MAX_STRETCHES = 20
+
+
+def _failing_stretches(
+    times: FloatArray, hi: FloatArray, domain_end: float
+) -> list[tuple[float, float]]:
+    """Maximal stretches ``[start, end]`` of a signal's positions where ``hi < 0`` (the last
+    open position, a tail, is left out: it is not part of the trace)."""
+    bad = hi[: 2 * len(times) - 1] < 0
+    stretches: list[tuple[float, float]] = []
+    for first, last in runs(bad):
+        start = float(times[first // 2])
+        # an instant ends where it is; an open stretch at the next instant
+        end = (
+            float(times[last // 2])
+            if last % 2 == 0
+            else float(times[last // 2 + 1] if last // 2 + 1 < len(times) else domain_end)
+        )
+        stretches.append((start, end))
+    return stretches
 
 
 def _free_space(trace: TraceInput) -> shapely.Geometry | None:
-    if trace.boundary_polygon is None:
-        return None
-    pieces = [(trace.boundary_polygon, trace.holes), *trace.components]
-    free_pieces = []
-    for boundary, holes in pieces:
-        free = shapely.Polygon(boundary)
-        if holes:
-            free = free.difference(shapely.union_all([shapely.Polygon(h) for h in holes]))
-        free_pieces.append(free)
-    free = free_pieces[0] if len(free_pieces) == 1 else shapely.union_all(free_pieces)
-    shapely.prepare(free)
+    from tlmpc.verify.clearance import free_space
+
+    free: shapely.Geometry | None = free_space(trace)
     return free
 
 
@@ -143,7 +281,7 @@ def _body_contacts(trace: TraceInput, distances: FloatArray) -> list[Violation]:
             time=time,
             position=(x, y),
             message=f"the robot's body (radius {trace.radius:g}) touches an obstacle near "
-            f"t={time:.4g} s at ({x:.4g}, {y:.4g}): the path passes "
+            f"{at(time, trace.start)} at ({x:.4g}, {y:.4g}): the path passes "
             f"{float(distances[index]):.4g} from it",
         )
     ]
@@ -212,7 +350,7 @@ def workspace_violations(trace: TraceInput) -> tuple[list[Violation], float | No
                 conjunct="workspace",
                 time=time,
                 position=(x, y),
-                message=f"the trajectory {where} at t={time:.4g} s at ({x:.4g}, {y:.4g})",
+                message=f"the trajectory {where} at {at(time, trace.start)} at ({x:.4g}, {y:.4g})",
             )
         )
     return found, -depth
@@ -242,20 +380,30 @@ def certify(trace: TraceInput, regions: dict[str, FloatArray], outcome: Outcome)
         return refuse("no max_speed is known, so nothing bounds the motion between samples")
     if observed > speed * (1 + SPEED_SLACK):
         index = int(np.argmax(speeds))
+        origin = float(times[0])
+        begin, end = at(float(times[index]), origin), at(float(times[index + 1]), origin)
         return refuse(
-            f"the log moves at {observed:.4g} m/s between t={times[index]:.4g} s and "
-            f"t={times[index + 1]:.4g} s, faster than max_speed {speed:.4g}: the "
+            f"the log moves at {observed:.4g} m/s between {begin} and {end}, "
+            f"faster than max_speed {speed:.4g}: the "
             "certificate's assumption does not hold"
         )
     radii = tube_radii(times, speed)
     bound = float(radii.max())
     if outcome == "inconclusive":
         return refuse("an inconclusive verdict has nothing to certify", bound)
-    loop = {"loop": trace.loop_start, "stay": len(times) - 1, "open": None}[trace.ending]
-    lo, hi = evaluate_with_ending(
-        trace.formula, tube_atoms(regions, points, radii), len(times), loop
-    )
-    margin = float(lo[0]) if outcome == "satisfied" else -float(hi[0])
+    atoms = tube_atoms(regions, points, radii)
+    if bounded_operators(trace.formula):
+        cells, size, ending, timing = _sample_cells(trace, atoms)
+        tube = Semantics(cells, size, ending, timing=timing)
+    else:
+        samples: PieceEnding = "open"
+        if trace.ending == "loop":
+            samples = trace.loop_start or 0
+        elif trace.ending == "stay":
+            samples = len(times) - 1
+        tube = Semantics(atoms, len(times), samples)
+    lo, hi = tube.at_start(trace.formula)
+    margin = lo if outcome == "satisfied" else -hi
     certified = margin > 0
     if certified:
         reason = (
@@ -289,11 +437,20 @@ def verify_trace(trace: TraceInput) -> Verdict:
     loop_start = trace.loop_start if trace.ending == "loop" else None
     pieces = build_pieces(trace.times, trace.points, loop_start, regions, trace.convention)
     unknown = _last_point_unknown(trace, pieces, regions)
-    truth = _Truth(trace, pieces, names, unknown)
-    task_outcome = truth.outcome(trace.formula)
-    conjuncts = _conjuncts(trace.formula)
-    outcomes = [truth.outcome(c) for c in conjuncts]
     size = len(pieces.is_point)
+    ending = _piece_ending(trace, pieces)
+    is_point = pieces.is_point if trace.convention == "closed" else None
+    timing = Timing(pieces.times, float(trace.times[-1]))
+    truth = Semantics(
+        truth_atoms(pieces.labels, names, unknown),
+        size,
+        ending,
+        is_point=is_point,
+        timing=timing,
+    )
+    task_outcome = _outcome(*truth.at_start(trace.formula))
+    conjuncts = _conjuncts(trace.formula)
+    outcomes = [_outcome(*truth.at_start(c)) for c in conjuncts]
     ends = np.append(pieces.times[1:], pieces.times[-1])
     if loop_start is not None and size:
         ends[-1] = trace.times[-1]
@@ -303,25 +460,53 @@ def verify_trace(trace: TraceInput) -> Verdict:
         positions=pieces.positions,
         labels=pieces.labels,
         names=names,
+        origin=trace.start,
     )
     reports, violations = conjunct_reports(conjuncts, outcomes, truth, line)
+
+    atoms = truth_atoms(pieces.labels, names, unknown)
+    prefixes: dict[int, Semantics] = {}
+
+    def outcome_of(formula: Formula) -> Outcome:
+        # A formula whose operators all have finite bounds is decided at t=0 by the trace up
+        # to its reach: the searches for time robustness evaluate only that prefix.
+        cut = _prefix_end(pieces.times, reach(formula))
+        if cut is None:
+            return _outcome(*truth.at_start(formula))
+        if cut not in prefixes:
+            prefixes[cut] = Semantics(
+                _prefix_atoms(atoms, cut),
+                cut,
+                "open",
+                is_point=None if is_point is None else is_point[:cut],
+                timing=Timing(pieces.times[:cut], float(pieces.times[cut - 1])),
+            )
+        return _outcome(*prefixes[cut].at_start(formula))
+
+    duration = float(trace.times[-1] - trace.times[0])
+    reports = [
+        _with_time_robustness(report, conjunct, outcome_of, truth, line, duration)
+        for report, conjunct in zip(reports, conjuncts, strict=True)
+    ]
+    violations = _timed_violations(conjuncts, reports, violations, truth, trace)
+    if len(reports) == 1:
+        task_slack = reports[0].time_robustness  # the task is its one conjunct
+    else:
+        task_slack = time_robustness(
+            trace.formula, task_outcome, outcome_of, horizon(trace.formula, duration)
+        )
     excursions, workspace_rho = workspace_violations(trace)
     outcome: Outcome = "violated" if excursions else task_outcome
     # Robustness on the same pieces and recursion as the truth: the signs agree.
-    is_point = pieces.is_point if trace.convention == "closed" else None
-    loop = (
-        None
-        if trace.ending == "open"
-        else (pieces.loop_start if pieces.loop_start is not None else size - 1)
-    )
-    lo, hi = evaluate_with_ending(
-        trace.formula,
+    space = Semantics(
         piece_atoms(regions, pieces.positions, pieces.labels, unknown),
         size,
-        loop,
-        is_point,
+        ending,
+        is_point=is_point,
+        timing=timing,
     )
-    rho = float(lo[0]) if lo[0] > 0 else float(hi[0]) if hi[0] < 0 else 0.0
+    lo, hi = space.at_start(trace.formula)
+    rho = lo if lo > 0 else hi if hi < 0 else 0.0
     if excursions and workspace_rho is not None:
         rho = min(rho, workspace_rho)
     certificate = certify(trace, regions, task_outcome)
@@ -342,11 +527,17 @@ def verify_trace(trace: TraceInput) -> Verdict:
         convention=trace.convention,
         ending=trace.ending,
         robustness=rho,
+        time_robustness=task_slack,
         certificate=certificate,
         pieces=len(merged.is_point),
         conjuncts=tuple(reports),
         violations=tuple(excursions + violations),
-        stats={"samples": len(trace.times), "raw_pieces": size},
+        stats={
+            "samples": len(trace.times),
+            "raw_pieces": size,
+            "start_time": float(trace.times[0]),
+            "duration": float(trace.times[-1] - trace.times[0]),
+        },
     )
 
 
@@ -375,6 +566,7 @@ def _report(report: ConjunctReport) -> dict[str, Any]:
         "visits": report.visits,
         "last_visit": report.last_visit,
         "longest_gap": report.longest_gap,
+        "time_robustness": _number(report.time_robustness),
     }
 
 
@@ -389,6 +581,7 @@ def verdict_to_json(verdict: Verdict) -> dict[str, Any]:
         "boundary": verdict.convention,
         "ending": verdict.ending,
         "robustness": _number(verdict.robustness),
+        "time_robustness": _number(verdict.time_robustness),
         "certificate": {
             "certified": certificate.certified,
             "bound": certificate.bound,

@@ -10,9 +10,12 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from tlmpc.base.errors import UsageError, error
+
+if TYPE_CHECKING:
+    from tlmpc.verify import LogOptions
 
 
 def _points(value: Any) -> list[list[float]]:
@@ -76,6 +79,12 @@ def _scene(
         {"boundary": _points(c["boundary"]), "holes": [_points(h) for h in c.get("holes", [])]}
         for c in workspace.get("components", [])
     ]
+    from tlmpc.render.scene import named_regions
+
+    labels = [
+        {"name": name, "at": [x, y], "task": task}
+        for name, (x, y), task in named_regions(regions, formula)
+    ]
     scene: dict[str, Any] = _finite(
         {
             "format": "tlmpc.view/1",
@@ -83,6 +92,7 @@ def _scene(
             "formula": formula,
             "workspace": {"boundary": boundary, "holes": holes, "components": components},
             "regions": {name: _points(poly) for name, poly in regions.items()},
+            "labels": labels,
             "mesh": mesh,
             "trajectory": samples,
             "loop_start": loop_start,
@@ -95,7 +105,7 @@ def _scene(
 
 def scene_from_output(directory: Path) -> dict[str, Any]:
     """The scene of a ``tlmpc compile`` output directory (mesh, trajectory, verdict)."""
-    from tlmpc.io.artifacts import read_json
+    from tlmpc.io.artifacts import read_artifacts
 
     if not (directory / "mission.json").is_file():
         raise UsageError(
@@ -107,10 +117,14 @@ def scene_from_output(directory: Path) -> dict[str, Any]:
                 file=str(directory),
             )
         )
-    mission = read_json(directory / "mission.json", "tlmpc.mission/")
+    # each checked against its schema (finite numbers) and against the others
+    documents = read_artifacts(
+        directory, ("mission.json", "abstraction.json", "trace.json", "verdict.json")
+    )
+    mission = documents["mission.json"]
     mesh = None
-    if (directory / "abstraction.json").is_file():
-        abstraction = read_json(directory / "abstraction.json", "tlmpc.abstraction/")
+    if "abstraction.json" in documents:
+        abstraction = documents["abstraction.json"]
         mesh = {
             "vertices": _points(abstraction["vertices"]),
             "triangles": [list(map(int, t)) for t in abstraction["triangles"]],
@@ -118,13 +132,13 @@ def scene_from_output(directory: Path) -> dict[str, Any]:
         }
     samples: list[list[float]] = []
     loop_start = None
-    if (directory / "trace.json").is_file():
-        trace = read_json(directory / "trace.json", "tlmpc.trace/")
+    if "trace.json" in documents:
+        trace = documents["trace.json"]
         samples = [[float(t), float(x), float(y)] for t, x, y in trace["points"]]
         loop_start = trace.get("loop_start")
     verdict = None
-    if (directory / "verdict.json").is_file():
-        verdict = read_json(directory / "verdict.json", "tlmpc.verdict/")
+    if "verdict.json" in documents:
+        verdict = documents["verdict.json"]
     return _scene(
         title=str(mission.get("name") or directory.name),
         workspace=mission["workspace"],
@@ -137,18 +151,17 @@ def scene_from_output(directory: Path) -> dict[str, Any]:
     )
 
 
-def scene_from_log(log: Path, mission_path: Path) -> dict[str, Any]:
-    """The scene of a robot's log (CSV ``t,x,y`` or ``trace.json``) verified against a mission."""
-    from tlmpc.io.artifacts import read_json
+def scene_from_log(
+    log: Path, mission_path: Path, options: LogOptions | None = None
+) -> dict[str, Any]:
+    """The scene of a robot's log (any format ``tlmpc verify`` reads) verified against a
+    mission."""
     from tlmpc.ltl.printer import to_text
     from tlmpc.mission.load import load_mission
-    from tlmpc.verify import from_csv, from_document, verdict_to_json, verify_trace
+    from tlmpc.verify import LogOptions, read_trace, verdict_to_json, verify_trace
 
     mission = load_mission(mission_path)
-    if log.suffix.lower() == ".csv":
-        trace = from_csv(log, mission_path, None)
-    else:
-        trace = from_document(read_json(log), file=str(log), convention=None)
+    trace = read_trace(log, mission, None, options or LogOptions())
     verdict = verdict_to_json(verify_trace(trace))
     samples = [
         [float(t), float(x), float(y)]

@@ -1,0 +1,91 @@
+"""What no controller here can do under a disturbance is refused, and the hint is true.
+
+* A plan through a single point (regions touching only at a corner) uses the pursuit law; a
+  push across the way to the point turns the robot about it at d / r, so no disturbance is
+  rejected there: C034, located at ``robot.disturbance``, and no plan is claimed robust.
+* C032's hint: a corner of angle a pushed inside both its facets rejects at most
+  max_speed * sin(a / 2) (independent: the largest component of a velocity of norm s along
+  two inward normals 180 - a apart).  Where a larger ``min_angle`` is enough, following the
+  hint compiles; above the largest ``min_angle`` the hint says no mesh can, and why.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+import yaml
+
+import tlmpc
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def _corner_mission(disturbance: float) -> dict[str, Any]:
+    return {
+        "version": 1,
+        "workspace": {"boundary": {"rect": [0, 0, 10, 10]}},
+        "regions": {"a": {"rect": [2, 2, 5, 5]}, "b": {"rect": [5, 5, 8, 8]}},
+        "robot": {"start": [3, 3], "max_speed": 1.0, "disturbance": disturbance},
+        "ltl": "G(a | b) & F b",
+    }
+
+
+def test_a_corner_passage_without_disturbance_plans() -> None:
+    compiled = tlmpc.compile(_corner_mission(0.0))
+    assert compiled.artifacts["witness.json"].get("passages")
+
+
+@pytest.mark.parametrize("disturbance", [1e-6, 0.1])
+def test_a_corner_passage_under_a_disturbance_is_refused_where_it_is(disturbance: float) -> None:
+    with pytest.raises(tlmpc.InvalidInputError) as refused:
+        tlmpc.compile(_corner_mission(disturbance))
+    found = refused.value.diagnostics
+    assert [d.code for d in found] == ["C034"]
+    assert found[0].path == "$.robot.disturbance"
+    assert "(5, 5)" in found[0].message  # the corner the regions share
+
+
+def _largest_push(angle_degrees: float) -> float:
+    """Brute force: the best min over two inward normals of a unit velocity's components."""
+    half = math.radians(angle_degrees) / 2.0
+    normals = np.array([[math.sin(half), -math.cos(half)], [math.sin(half), math.cos(half)]])
+    headings = np.linspace(-math.pi, math.pi, 200_001)
+    velocities = np.stack([np.cos(headings), np.sin(headings)], axis=1)
+    return float((velocities @ normals.T).min(axis=1).max())
+
+
+@pytest.mark.parametrize("angle", [20.0, 34.0, 60.0])
+def test_the_corner_bound_the_hint_states(angle: float) -> None:
+    assert _largest_push(angle) == pytest.approx(math.sin(math.radians(angle) / 2.0), abs=1e-6)
+
+
+def _example1(disturbance: float, min_angle: float | None = None) -> dict[str, Any]:
+    mission = yaml.safe_load((ROOT / "specs" / "example1.yaml").read_text())
+    mission["robot"]["disturbance"] = disturbance
+    if min_angle is not None:
+        mission["options"] = {**(mission.get("options") or {}), "min_angle": min_angle}
+    return dict(mission)
+
+
+def test_following_the_min_angle_hint_compiles() -> None:
+    with pytest.raises(tlmpc.InvalidInputError) as refused:
+        tlmpc.compile(_example1(0.27), until="control")
+    hint = refused.value.diagnostics[0].hint or ""
+    assert refused.value.diagnostics[0].code == "C032"
+    needed = float(hint.split("above ")[1].split(" degrees")[0])
+    assert needed == pytest.approx(math.degrees(2 * math.asin(0.27)), rel=1e-2)
+    tlmpc.compile(_example1(0.27, min_angle=math.ceil(needed)), until="control")
+
+
+def test_above_the_largest_min_angle_the_hint_says_no_mesh_can() -> None:
+    with pytest.raises(tlmpc.InvalidInputError) as refused:
+        tlmpc.compile(_example1(0.3, min_angle=33), until="control")
+    diagnostic = refused.value.diagnostics[0]
+    assert diagnostic.code == "C032"
+    assert "no mesh here can reject it" in (diagnostic.hint or "")
+    ceiling = math.sin(math.radians(34.0) / 2.0)
+    assert f"{ceiling:.4g}" in (diagnostic.hint or "")

@@ -1,0 +1,298 @@
+"""Many logs at once: find them, pair each with its mission, verify them in parallel.
+
+* :func:`discover` expands folders into the logs they hold (CSV files, bag files, ROS 2 bag
+  directories), sorted, so a batch has one order on every machine.
+* :func:`missions_for` pairs every log with a mission: one mission file for all, or a mapping
+  file (``tlmpc.fleet-missions/1``) from log name patterns to missions.
+* :func:`run` verifies the jobs in this process (``jobs=1``), in a local process pool, or on a
+  Dask cluster, and yields each log's record as it finishes.
+* :func:`batch_exit` is the batch's one exit code.
+"""
+
+from __future__ import annotations
+
+import fnmatch
+import os
+from collections.abc import Iterator, Mapping, Sequence
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from tlmpc.base.errors import (
+    EXIT_INCONCLUSIVE,
+    EXIT_INTERNAL,
+    EXIT_NEGATIVE,
+    EXIT_OK,
+    EXIT_USAGE,
+    TlmpcError,
+    UsageError,
+    error,
+)
+from tlmpc.fleet.job import Job, Options, error_fields, run_job
+
+MAPPING_FORMAT = "tlmpc.fleet-missions/1"
+
+
+def _is_bag_dir(path: Path) -> bool:
+    return (path / "metadata.yaml").is_file()
+
+
+def discover(paths: Sequence[Path]) -> list[Path]:
+    """The logs the paths name: a file as it is; a folder (not a bag directory) searched
+    recursively for CSV and bag files and ROS 2 bag directories, sorted by path."""
+    from tlmpc.importers.logs import CSV_SUFFIXES
+
+    found: list[Path] = []
+    for path in paths:
+        if not path.is_dir() or _is_bag_dir(path):
+            found.append(path)
+            continue
+        inside: list[Path] = []
+        for folder, names, files in os.walk(path):
+            here = Path(folder)
+            bags = [n for n in names if _is_bag_dir(here / n)]
+            inside.extend(here / n for n in bags)
+            names[:] = sorted(n for n in names if n not in bags and not n.startswith("."))
+            inside.extend(
+                here / f
+                for f in files
+                if Path(f).suffix.lower() in (*CSV_SUFFIXES, ".bag", ".mcap")
+                and not f.startswith(".")
+            )
+        # (a .db3 file is read through its bag directory, found above)
+        found.extend(sorted(inside, key=lambda p: p.as_posix()))
+    return found
+
+
+@dataclass(frozen=True, slots=True)
+class MissionRule:
+    """Logs whose path (or file name) matches ``pattern`` are checked against ``mission``."""
+
+    pattern: str
+    mission: Path
+
+
+def read_mapping(path: Path) -> list[MissionRule] | None:
+    """The rules of a mapping file, or None when ``path`` is a mission file."""
+    import yaml
+
+    try:
+        document = yaml.safe_load(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, yaml.YAMLError):
+        return None  # the mission loader reports it
+    if not isinstance(document, dict) or document.get("format") != MAPPING_FORMAT:
+        return None
+    rules = document.get("missions")
+    if not isinstance(rules, list) or not all(
+        isinstance(r, dict) and isinstance(r.get("logs"), str) and isinstance(r.get("mission"), str)
+        for r in rules
+    ):
+        raise UsageError(
+            error(
+                "F003",
+                "`missions` must be a list of {logs: PATTERN, mission: FILE}",
+                hint="for example: missions: [{logs: 'husky*/*.csv', mission: patrol.yaml}]",
+                file=str(path),
+            )
+        )
+    return [MissionRule(r["logs"], path.parent / r["mission"]) for r in rules]
+
+
+def match(rules: Sequence[MissionRule], log: Path) -> Path | None:
+    """The mission of the first rule whose pattern matches the log's path or its name."""
+    text = log.as_posix()
+    for rule in rules:
+        if fnmatch.fnmatchcase(text, rule.pattern) or fnmatch.fnmatchcase(log.name, rule.pattern):
+            return rule.mission
+    return None
+
+
+def missions_for(logs: Sequence[Path], mission: Path) -> dict[Path, Path | None]:
+    """Each log's mission file (None: no rule of the mapping file matches it)."""
+    rules = read_mapping(mission)
+    if rules is None:
+        return dict.fromkeys(logs, mission)
+    return {log: match(rules, log) for log in logs}
+
+
+def make_jobs(
+    logs: Sequence[Path],
+    missions: Mapping[Path, Path | None],
+    options: Options,
+    cache: Path | None,
+) -> tuple[list[Job], list[dict[str, Any]]]:
+    """A job per log, each mission read once; logs without a usable mission become error
+    records right away."""
+    from tlmpc.verify.trace_input import mission_document
+
+    documents: dict[Path, dict[str, Any] | TlmpcError] = {}
+    jobs: list[Job] = []
+    failed: list[dict[str, Any]] = []
+    for log in logs:
+        mission = missions[log]
+        if mission is None:
+            failed.append(
+                error_record(
+                    log,
+                    None,
+                    UsageError(
+                        error(
+                            "F004",
+                            "no rule of the mission mapping matches this log",
+                            hint="add a rule whose `logs` pattern matches its path or name",
+                            file=str(log),
+                        )
+                    ),
+                )
+            )
+            continue
+        if mission not in documents:
+            try:
+                documents[mission] = mission_document(log, mission)
+            except TlmpcError as exc:
+                documents[mission] = exc
+        document = documents[mission]
+        if isinstance(document, TlmpcError):
+            failed.append(error_record(log, mission, document))
+            continue
+        jobs.append(
+            Job(
+                log=str(log),
+                mission=str(mission),
+                document=document,
+                options=options,
+                cache=None if cache is None else str(cache),
+            )
+        )
+    return jobs, failed
+
+
+def error_record(log: Path, mission: Path | None, exc: TlmpcError) -> dict[str, Any]:
+    """The record of a log that could not be verified."""
+    return {
+        "log": str(log),
+        "mission": None if mission is None else str(mission),
+        **error_fields(exc),
+        "seconds": 0.0,
+        "cached": False,
+    }
+
+
+def _internal(job: Job, exc: BaseException) -> dict[str, Any]:
+    record = error_record(Path(job.log), Path(job.mission), UsageError([]))
+    record["error"] = {
+        "code": "I000",
+        "message": f"internal error: {type(exc).__name__}: {exc}",
+        "exit_code": EXIT_INTERNAL,
+    }
+    return record
+
+
+def _local(jobs: Sequence[Job]) -> Iterator[dict[str, Any]]:
+    for job in jobs:
+        try:
+            yield run_job(job)
+        except Exception as exc:  # one log's bug must not lose the others' records
+            yield _internal(job, exc)
+
+
+def _pool(jobs: Sequence[Job], workers: int) -> Iterator[dict[str, Any]]:
+    # At most a few jobs in flight per worker: a million logs never sit in memory as futures.
+    limit = 4 * workers
+    queue = iter(jobs)
+    with ProcessPoolExecutor(max_workers=workers) as pool:
+        running: dict[Future[dict[str, Any]], Job] = {}
+        for job in queue:
+            running[pool.submit(run_job, job)] = job
+            if len(running) >= limit:
+                break
+        while running:
+            done, _ = wait(running, return_when=FIRST_COMPLETED)
+            for future in done:
+                job = running.pop(future)
+                exc = future.exception()
+                yield _internal(job, exc) if exc is not None else future.result()
+                following = next(queue, None)
+                if following is not None:
+                    running[pool.submit(run_job, following)] = following
+
+
+def dask_client(address: str) -> Any:
+    """A ``distributed.Client`` connected to ``address`` (F001 without the extra, F002 when
+    the scheduler cannot be reached)."""
+    try:
+        from distributed import Client
+    except ImportError:
+        raise UsageError(
+            error(
+                "F001",
+                "--dask needs the `distributed` package, which is not installed",
+                hint="install the fleet extra: pip install 'tlmpc[fleet]'",
+                file="<command line>",
+            )
+        ) from None
+    try:
+        return Client(address, timeout="10s")
+    except (OSError, TimeoutError, ValueError) as exc:
+        raise UsageError(
+            error(
+                "F002",
+                f"cannot reach the Dask scheduler at {address}: {exc}",
+                hint="start one with `dask scheduler` and workers with `dask worker ADDRESS`",
+                file="<command line>",
+            )
+        ) from None
+
+
+def _dask(jobs: Sequence[Job], client: Any) -> Iterator[dict[str, Any]]:
+    from distributed import as_completed
+
+    futures = {client.submit(run_job, job, pure=False): job for job in jobs}
+    for future in as_completed(futures):
+        job = futures[future]
+        if future.status == "error":
+            yield _internal(job, future.exception())
+        else:
+            yield future.result()
+
+
+def run(jobs: Sequence[Job], *, workers: int = 1, client: Any = None) -> Iterator[dict[str, Any]]:
+    """Each job's record as it finishes: on ``client`` (a ``distributed.Client``) when given,
+    else in this process (``workers`` 1) or a pool of ``workers`` processes."""
+    if client is not None:
+        return _dask(jobs, client)
+    if workers <= 1 or len(jobs) <= 1:
+        return _local(jobs)
+    return _pool(jobs, min(workers, len(jobs)))
+
+
+def batch_exit(records: Sequence[Mapping[str, Any]]) -> int:
+    """3 if a log met an internal error, else 2 if one could not be read, else 1 if one is
+    violated, else 4 if one is inconclusive, else 0."""
+    codes = [
+        (r["error"] or {}).get("exit_code", EXIT_USAGE) if r["verdict"] == "error" else 0
+        for r in records
+    ]
+    verdicts = {r["verdict"] for r in records}
+    if EXIT_INTERNAL in codes:
+        return EXIT_INTERNAL
+    if "error" in verdicts:
+        return EXIT_USAGE
+    if "violated" in verdicts:
+        return EXIT_NEGATIVE
+    if "inconclusive" in verdicts:
+        return EXIT_INCONCLUSIVE
+    return EXIT_OK
+
+
+def no_logs(paths: Sequence[Path]) -> UsageError:
+    """F005: the folders hold no log."""
+    return UsageError(
+        error(
+            "F005",
+            "no logs found in " + ", ".join(str(p) for p in paths),
+            hint="logs are .csv/.tsv/.txt files, .bag/.mcap files or ROS 2 bag directories",
+            file=str(paths[0]) if paths else None,
+        )
+    )

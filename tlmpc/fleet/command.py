@@ -1,0 +1,105 @@
+"""``tlmpc verify`` on many logs: the batch's flags in, lines, summary and files out."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import time
+from typing import Any, TextIO
+
+from tlmpc.base.errors import UsageError, error
+
+
+def _workers(args: argparse.Namespace) -> int:
+    if args.jobs is None:
+        return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else 1
+    if args.jobs < 1:
+        raise UsageError(
+            error(
+                "F008",
+                f"--jobs {args.jobs}: the number of processes must be at least 1",
+                file="<command line>",
+            )
+        )
+    return int(args.jobs)
+
+
+def run_batch(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
+    """Verify every log the arguments name; print a line each, then the summary."""
+    from tlmpc.fleet.batch import (
+        batch_exit,
+        dask_client,
+        discover,
+        make_jobs,
+        missions_for,
+        no_logs,
+        run,
+    )
+    from tlmpc.fleet.cache import default_cache_dir
+    from tlmpc.fleet.job import Options
+    from tlmpc.fleet.output import line, ordered, summary, summary_table, write_results
+    from tlmpc.importers.logs import parse_columns, parse_transform
+    from tlmpc.io.report import Reporter
+
+    report = Reporter.for_args(args, out, err)
+    if args.dask is not None and args.jobs is not None:
+        raise UsageError(
+            error(
+                "F008",
+                "--jobs and --dask both given",
+                hint="--jobs runs local processes; the Dask cluster has its own workers",
+                file="<command line>",
+            )
+        )
+    workers = _workers(args)
+    if args.report is not None:
+        from tlmpc.fleet.report import group_pattern
+
+        group_pattern(args.group)  # a bad --group fails before any log is verified
+    if args.mission is None:
+        raise UsageError(
+            error(
+                "V010",
+                "verifying logs needs --mission (a mission file or a mission mapping)",
+                file="<command line>",
+            )
+        )
+    options = Options(
+        boundary=args.boundary,
+        topic=args.topic,
+        columns=parse_columns(args.columns) if args.columns else None,
+        transform=parse_transform(args.transform) if args.transform else None,
+        frame=args.frame,
+        assume_stay=args.assume_stay,
+        loop_from=args.loop_from,
+    )
+    logs = discover(args.trace)
+    if not logs:
+        raise no_logs(args.trace)
+    cache = None if args.no_cache else (args.cache or default_cache_dir())
+    jobs, failed = make_jobs(logs, missions_for(logs, args.mission), options, cache)
+    client = dask_client(args.dask) if args.dask is not None else None
+    began = time.perf_counter()
+    records: list[dict[str, Any]] = []
+    try:
+        for record in [*failed, *run(jobs, workers=workers, client=client)]:
+            records.append(record)
+            report.stream(line(record))
+    finally:
+        if client is not None:
+            client.close()
+    wall = time.perf_counter() - began
+    rows = ordered(records, [str(log) for log in logs])
+    numbers = summary(rows, wall)
+    if args.results is not None:
+        write_results(args.results, rows)
+    if args.report is not None:
+        from tlmpc.fleet.report import write_report
+
+        write_report(args.report, rows, jobs, group=args.group)
+    code = batch_exit(rows)
+    text = "summary:\n" + summary_table(numbers)
+    from tlmpc.fleet.job import finite
+
+    result = {"format": "tlmpc.fleet/1", "summary": numbers, "logs": finite(rows)}
+    return report.finish(code, result, text)

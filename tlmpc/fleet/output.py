@@ -1,0 +1,192 @@
+"""What a batch prints and writes: a line per log, the summary table, the results files."""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from collections import Counter
+from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
+from typing import Any, TextIO
+
+from tlmpc.base.errors import UsageError, error
+from tlmpc.fleet.job import finite
+
+#: The fields of a results row, in order (JSON lines and Parquet alike).
+FIELDS = (
+    "log",
+    "mission",
+    "verdict",
+    "conjuncts",
+    "first_violation",
+    "robustness",
+    "seconds",
+    "samples",
+    "start",
+    "cached",
+    "formula",
+    "violations",
+    "error",
+)
+
+STATUS = {
+    "satisfied": "satisfied",
+    "violated": "VIOLATED",
+    "inconclusive": "inconclusive",
+    "error": "ERROR",
+}
+
+
+def line(record: Mapping[str, Any]) -> str:
+    """One line about one log: its verdict and, if violated, where it first failed."""
+    text = f"{record['log']}: {STATUS[record['verdict']]}"
+    first = record.get("first_violation")
+    if first is not None:
+        when = "" if first["t"] is None else f" at t={first['t']:.4g} s"
+        where = "" if first["x"] is None else f" at ({first['x']:.4g}, {first['y']:.4g})"
+        text += f": {first['conjunct']}{when}{where}"
+    if record["verdict"] == "error":
+        text += f": {record['error']['message']}"
+    if record.get("cached"):
+        text += " (cached)"
+    return text
+
+
+def ordered(records: Sequence[Mapping[str, Any]], logs: Sequence[str]) -> list[dict[str, Any]]:
+    """The records in the batch's own order (the order logs were named and found)."""
+    rank = {log: index for index, log in enumerate(logs)}
+    rows = sorted(records, key=lambda r: (rank.get(r["log"], len(rank)), r["log"]))
+    return [{name: row.get(name) for name in FIELDS} for row in rows]
+
+
+def summary(records: Sequence[Mapping[str, Any]], wall: float) -> dict[str, Any]:
+    """Counts per verdict, per violated conjunct, and what the run cost."""
+    verdicts = Counter(r["verdict"] for r in records)
+    conjuncts: Counter[str] = Counter()
+    for record in records:
+        for conjunct in record["conjuncts"]:
+            if conjunct["verdict"] == "violated":
+                conjuncts[conjunct["conjunct"]] += 1
+        if any(v["conjunct"] == "workspace" for v in record.get("violations") or []):
+            conjuncts["workspace"] += 1
+    return {
+        "logs": len(records),
+        "verdicts": {k: verdicts.get(k, 0) for k in STATUS},
+        "violated_conjuncts": dict(sorted(conjuncts.items(), key=lambda kv: (-kv[1], kv[0]))),
+        "verified": sum(1 for r in records if not r.get("cached") and r["verdict"] != "error"),
+        "cached": sum(1 for r in records if r.get("cached")),
+        "samples": sum(int(r.get("samples") or 0) for r in records),
+        "seconds": sum(float(r.get("seconds") or 0.0) for r in records if not r.get("cached")),
+        "wall_seconds": wall,
+    }
+
+
+def summary_table(numbers: Mapping[str, Any]) -> str:
+    """The summary as a small text table."""
+    rows = [("logs", str(numbers["logs"]))]
+    rows += [(verdict, str(count)) for verdict, count in numbers["verdicts"].items()]
+    rows += [
+        ("verified now", str(numbers["verified"])),
+        ("from the cache", str(numbers["cached"])),
+        ("samples", f"{numbers['samples']:,}"),
+        ("worker seconds", f"{numbers['seconds']:.2f}"),
+        ("wall seconds", f"{numbers['wall_seconds']:.2f}"),
+    ]
+    rows += [(f"violated: {name}", str(n)) for name, n in numbers["violated_conjuncts"].items()]
+    width = max(len(name) for name, _ in rows)
+    return "".join(f"  {name:<{width}}  {value:>10}\n" for name, value in rows)
+
+
+def write_atomically(path: Path, write: Callable[[Path], None]) -> None:
+    """Write through a temporary file in the same folder, renamed into place."""
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.")
+        os.close(handle)
+    except OSError as exc:
+        raise UsageError(
+            error("F007", f"cannot write {path}: {exc.strerror or exc}", file=str(path))
+        ) from None
+    try:
+        write(Path(temporary))
+        os.replace(temporary, path)
+    except OSError as exc:
+        Path(temporary).unlink(missing_ok=True)
+        raise UsageError(
+            error("F007", f"cannot write {path}: {exc.strerror or exc}", file=str(path))
+        ) from None
+    except BaseException:
+        Path(temporary).unlink(missing_ok=True)
+        raise
+
+
+def write_results(path: Path, rows: Sequence[Mapping[str, Any]]) -> None:
+    """JSON lines, or Parquet when ``path`` ends in ``.parquet`` (needs pyarrow)."""
+    if path.suffix.lower() == ".parquet":
+        try:
+            import pyarrow as pa
+            import pyarrow.parquet as pq
+        except ImportError:
+            raise UsageError(
+                error(
+                    "F006",
+                    "writing Parquet needs the `pyarrow` package, which is not installed",
+                    hint="install the fleet extra (pip install 'tlmpc[fleet]') or write "
+                    "JSON lines (--results FILE.jsonl)",
+                    file=str(path),
+                )
+            ) from None
+        table = pa.Table.from_pylist([dict(_parquet_row(r)) for r in rows], schema=_schema(pa))
+        write_atomically(path, lambda temporary: pq.write_table(table, temporary))
+        return
+
+    def write(temporary: Path) -> None:
+        with open(temporary, "w", encoding="utf-8") as stream:
+            for row in rows:
+                stream.write(json.dumps(finite(dict(row)), sort_keys=False) + "\n")
+
+    write_atomically(path, write)
+
+
+def _parquet_row(row: Mapping[str, Any]) -> dict[str, Any]:
+    out = dict(row)
+    out["error"] = None if row["error"] is None else row["error"]["message"]
+    return out
+
+
+def _schema(pa: Any) -> Any:
+    point = pa.struct(
+        [
+            ("conjunct", pa.string()),
+            ("t", pa.float64()),
+            ("x", pa.float64()),
+            ("y", pa.float64()),
+        ]
+    )
+    return pa.schema(
+        [
+            ("log", pa.string()),
+            ("mission", pa.string()),
+            ("verdict", pa.string()),
+            (
+                "conjuncts",
+                pa.list_(pa.struct([("conjunct", pa.string()), ("verdict", pa.string())])),
+            ),
+            ("first_violation", point),
+            ("robustness", pa.float64()),
+            ("seconds", pa.float64()),
+            ("samples", pa.int64()),
+            ("start", pa.float64()),
+            ("cached", pa.bool_()),
+            ("formula", pa.string()),
+            ("violations", pa.list_(point)),
+            ("error", pa.string()),
+        ]
+    )
+
+
+def print_line(out: TextIO, record: Mapping[str, Any]) -> None:
+    """The record's line, flushed at once (a batch reports each log as it finishes)."""
+    out.write(line(record) + "\n")
+    out.flush()

@@ -1,0 +1,323 @@
+"""Verify a long log in constant memory: read it in chunks, keep only the samples that shape it.
+
+The verifier's answer depends on the trajectory through its *label word* (which regions the
+robot is in, piece by piece; the semantics is stutter-invariant), on where and when the path
+crosses a region's or the free space's boundary, and on its first and last samples.  A sample
+strictly inside a disc around an earlier kept sample (the *anchor*) that touches no such
+boundary changes none of these: the path from the anchor through it stays in the disc, so in
+one cell of the map, and so does the straight shortcut from the anchor to the last sample
+inside the disc.  :class:`Reducer` therefore keeps
+
+* the first and the last sample,
+* every sample where the path leaves the current anchor's disc (and the last one inside it,
+  which becomes the next anchor),
+
+so every segment that meets a boundary is kept as it was logged, with its end samples, and every
+dropped stretch is replaced by a shortcut inside one cell.  The disc's radius is the anchor's
+distance to the nearest boundary of a region the task mentions, or of the free space less the
+body radius, minus a rounding margin.  :func:`verify_log` runs :func:`tlmpc.verify.verify_trace`
+on the kept samples: the verdict, every conjunct's verdict and progress, and every violation
+(times, places, durations) are those of the whole log (a property test compares them).  The
+robustness is the kept trajectory's, and the certificate is the kept samples' (their motions
+include the real one, and the log's own top speed is checked on every sample).
+
+Memory is the current chunk plus the kept samples, which grow with the distance travelled
+over the clearance, not with the sampling rate.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Iterable, Iterator, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from tlmpc.base.errors import Diagnostic, UsageError
+from tlmpc.verify import Verdict, declare_ending, from_document, verify_trace
+from tlmpc.verify.model import Certificate
+from tlmpc.verify.samples import MAX_PER_KIND, sample_diagnostics
+
+FloatArray = npt.NDArray[np.float64]
+
+#: Clearance kept back from every boundary, relative to the map's extent: well above the
+#: closed convention's rounding tolerance, so no dropped sample is labelled by rounding.
+MARGIN = 1e-9
+
+#: Samples per chunk of a bag (read whole by its reader, then streamed like a CSV).
+BAG_CHUNK = 100_000
+
+#: Relative slack on the speed check (the verifier's own).
+SPEED_SLACK = 1e-9
+
+
+def _rings(document: Mapping[str, Any]) -> tuple[list[FloatArray], list[FloatArray]]:
+    """The region outlines the task mentions, and the free space's outlines."""
+    from tlmpc.ltl.parser import parse_ltl
+
+    mentioned = parse_ltl(str(document["ltl"])).props()
+    regions = [
+        np.asarray(ring, dtype=np.float64)
+        for name, ring in document["regions"].items()
+        if name in mentioned
+    ]
+    workspace = document.get("workspace") or {}
+    free: list[FloatArray] = []
+    if workspace.get("boundary"):
+        free.append(np.asarray(workspace["boundary"], dtype=np.float64))
+        free.extend(np.asarray(h, dtype=np.float64) for h in workspace.get("holes") or [])
+        for component in workspace.get("components") or []:
+            free.append(np.asarray(component["boundary"], dtype=np.float64))
+            free.extend(np.asarray(h, dtype=np.float64) for h in component.get("holes") or [])
+    return regions, free
+
+
+@dataclass(frozen=True, slots=True)
+class _Edges:
+    """The straight edges of some closed rings, for point-to-boundary distances."""
+
+    starts: FloatArray
+    vectors: FloatArray
+    squares: FloatArray
+
+    @classmethod
+    def of(cls, rings: Sequence[FloatArray]) -> _Edges | None:
+        if not rings:
+            return None
+        starts = np.vstack(rings)
+        vectors = np.vstack([np.roll(r, -1, axis=0) - r for r in rings])
+        squares = np.maximum(np.einsum("ij,ij->i", vectors, vectors), 1e-300)
+        return cls(starts, vectors, squares)
+
+    def distance(self, x: float, y: float) -> float:
+        """The least distance from ``(x, y)`` to an edge."""
+        dx, dy = x - self.starts[:, 0], y - self.starts[:, 1]
+        along = np.clip((dx * self.vectors[:, 0] + dy * self.vectors[:, 1]) / self.squares, 0, 1)
+        gap_x, gap_y = dx - along * self.vectors[:, 0], dy - along * self.vectors[:, 1]
+        return float(np.sqrt(np.min(gap_x * gap_x + gap_y * gap_y)))
+
+
+class Reducer:
+    """Keeps the samples of a stream that shape its verdict (see the module docstring)."""
+
+    def __init__(self, document: Mapping[str, Any], *, pin_time: float | None = None) -> None:
+        regions, free = _rings(document)
+        self.regions = _Edges.of(regions)
+        self.free = _Edges.of(free)
+        self.radius = float(document.get("radius") or 0.0)
+        extent = max((float(np.abs(r).max()) for r in (*regions, *free)), default=1.0)
+        self.margin = MARGIN * max(1.0, extent)
+        #: the first sample at or after this many seconds from the first one is kept (the start
+        #: of a declared loop; counted from the log's start, as ``declare_ending`` counts)
+        self.pin_time = pin_time
+        self.origin = 0.0  # the first sample's time
+        self.kept: list[FloatArray] = []
+        self.anchor: FloatArray | None = None  # (t, x, y) of the current anchor, kept
+        self.reach = 0.0  # the anchor's disc radius
+        self.pending: FloatArray | None = None  # the last sample seen, inside the disc
+        self.count = 0
+
+    def clearance(self, point: FloatArray) -> float:
+        """The radius of the open disc around ``point`` that touches no boundary."""
+        x, y = float(point[1]), float(point[2])
+        reach = math.inf
+        if self.regions is not None:
+            reach = self.regions.distance(x, y)
+        if self.free is not None:
+            reach = min(reach, self.free.distance(x, y) - self.radius)
+        return reach - self.margin
+
+    def _keep(self, sample: FloatArray) -> None:
+        if self.pin_time is not None and sample[0] - self.origin >= self.pin_time:
+            self.pin_time = None
+        self.kept.append(sample)
+        self.anchor = sample
+        self.reach = self.clearance(sample)
+        self.pending = None
+
+    def feed(self, samples: FloatArray) -> None:
+        """The next samples ``(t, x, y)`` of the stream, in time order."""
+        start = 0
+        if self.anchor is None and len(samples):
+            self.origin = float(samples[0][0])
+            self._keep(samples[0].copy())
+            start = 1
+        self.count += len(samples)
+        index = start
+        window = 64
+        while index < len(samples):
+            assert self.anchor is not None
+            stop = min(len(samples), index + window)
+            block = samples[index:stop]
+            offsets = np.hypot(block[:, 1] - self.anchor[1], block[:, 2] - self.anchor[2])
+            out = ~(offsets < self.reach)
+            if self.pin_time is not None:
+                out |= block[:, 0] - self.origin >= self.pin_time
+            if not out.any():
+                self.pending = samples[stop - 1].copy()
+                index = stop
+                window = min(window * 2, 1 << 16)
+                continue
+            first = index + int(np.argmax(out))
+            if first > index:
+                self.pending = samples[first - 1].copy()
+            window = 64
+            if self.pending is not None:
+                # The last sample inside the disc becomes the anchor; test the leaver again.
+                self._keep(self.pending)
+                index = first
+                continue
+            self._keep(samples[first].copy())
+            index = first + 1
+
+    def finish(self) -> FloatArray:
+        """The kept samples, the last sample of the stream included."""
+        if self.pending is not None:
+            self.kept.append(self.pending)
+            self.pending = None
+        if not self.kept:
+            return np.zeros((0, 3))
+        return np.vstack(self.kept)
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class StreamedVerdict:
+    """A log's verdict from :func:`verify_log`, with what streaming saw of it."""
+
+    verdict: Verdict
+    samples: int
+    kept: int
+    start_time: float
+
+
+def _checked_chunks(
+    chunks: Iterable[tuple[FloatArray, tuple[int, ...]]], file: str
+) -> Iterator[FloatArray]:
+    """The chunks, with the log's sample checks across chunk boundaries; every problem is
+    collected (a few of each kind) and raised at the end."""
+    previous: FloatArray | None = None
+    previous_line: tuple[int, ...] = ()
+    found: list[Diagnostic] = []
+    for samples, lines in chunks:
+        joined = samples if previous is None else np.vstack([previous, samples])
+        joined_lines = lines if previous is None or not lines else previous_line + lines
+        problems = sample_diagnostics(
+            joined[:, 0], joined[:, 1], joined[:, 2], file=file, lines=joined_lines or None
+        )
+        for problem in problems:
+            if sum(d.code == problem.code for d in found) < MAX_PER_KIND:
+                found.append(problem)
+        if len(samples):
+            previous = samples[-1:].copy()
+            previous_line = lines[-1:] if lines else ()
+        if not found:
+            yield samples
+    if previous is None and not found:
+        found = sample_diagnostics(np.zeros(0), np.zeros(0), np.zeros(0), file=file)
+    if found:
+        raise UsageError(found)
+
+
+def _log_chunks(
+    path: Path,
+    *,
+    topic: str | None,
+    columns: Sequence[str] | None,
+    transform: tuple[float, float, float] | None,
+    frame: str | None,
+    block_chars: int,
+) -> Iterator[tuple[FloatArray, tuple[int, ...]]]:
+    from tlmpc.importers.logs import CSV_SUFFIXES, apply_transform, iter_csv_chunks, read_log
+
+    if path.suffix.lower() in CSV_SUFFIXES and path.is_file():
+        if topic is not None or frame is not None:
+            read_log(path, topic=topic, frame=frame)  # raises the reader's own diagnostic
+        for chunk in iter_csv_chunks(path, columns, block_chars):
+            yield apply_transform(chunk.samples, transform), chunk.lines
+        return
+    # A bag is sorted by stamp as a whole: read it, then stream its samples.
+    log = read_log(path, topic=topic, columns=columns, transform=transform, frame=frame)
+    for start in range(0, max(len(log.samples), 1), BAG_CHUNK):
+        yield log.samples[start : start + BAG_CHUNK], ()
+
+
+def verify_log(
+    path: Path,
+    document: Mapping[str, Any],
+    *,
+    convention: str | None = None,
+    topic: str | None = None,
+    columns: Sequence[str] | None = None,
+    transform: tuple[float, float, float] | None = None,
+    frame: str | None = None,
+    assume_stay: bool = False,
+    loop_from: float | None = None,
+    block_chars: int = 1 << 22,
+) -> StreamedVerdict:
+    """Verify the log at ``path`` against ``document`` (a sample-less ``tlmpc.trace/1``, see
+    :func:`tlmpc.verify.trace_input.mission_document`), a CSV log ``block_chars`` characters at
+    a time."""
+    file = str(path)
+    reducer = Reducer(document, pin_time=loop_from)
+    top_speed = 0.0
+    max_gap = 0.0
+    where: tuple[float, float] | None = None
+    last: FloatArray | None = None
+    chunks = _log_chunks(
+        path,
+        topic=topic,
+        columns=columns,
+        transform=transform,
+        frame=frame,
+        block_chars=block_chars,
+    )
+    for samples in _checked_chunks(chunks, file):
+        joined = samples if last is None else np.vstack([last, samples])
+        if len(joined) > 1:
+            max_gap = max(max_gap, float(np.diff(joined[:, 0]).max()))
+            steps = np.hypot(np.diff(joined[:, 1]), np.diff(joined[:, 2])) / np.diff(joined[:, 0])
+            index = int(np.argmax(steps))
+            if steps[index] > top_speed:
+                top_speed = float(steps[index])
+                where = (float(joined[index, 0]), float(joined[index + 1, 0]))
+        if len(samples):
+            last = samples[-1:].copy()
+        reducer.feed(samples)
+    kept = reducer.finish()
+    trace = from_document({**document, "points": kept.tolist()}, file=file, convention=convention)
+    trace = declare_ending(trace, assume_stay=assume_stay, loop_from=loop_from)
+    verdict = verify_trace(trace)
+    verdict = dataclasses.replace(
+        verdict,
+        certificate=_raw_speed(
+            dataclasses.replace(verdict.certificate, max_gap=max_gap), top_speed, where
+        ),
+        stats={**verdict.stats, "samples": reducer.count, "kept_samples": len(kept)},
+    )
+    return StreamedVerdict(
+        verdict=verdict, samples=reducer.count, kept=len(kept), start_time=float(kept[0, 0])
+    )
+
+
+def _raw_speed(
+    certificate: Certificate, observed: float, where: tuple[float, float] | None
+) -> Certificate:
+    """The certificate with the log's own top speed (every sample, not only the kept ones)."""
+    speed = certificate.max_speed
+    if speed is None or where is None or observed <= speed * (1 + SPEED_SLACK):
+        return dataclasses.replace(
+            certificate, observed_speed=max(observed, certificate.observed_speed)
+        )
+    return dataclasses.replace(
+        certificate,
+        certified=False,
+        observed_speed=observed,
+        margin=None,
+        reason=f"the log moves at {observed:.4g} m/s between t={where[0]:.4g} s and "
+        f"t={where[1]:.4g} s, faster than max_speed {speed:.4g}: the certificate's assumption "
+        "does not hold",
+    )

@@ -1,0 +1,245 @@
+"""The input policy every reader follows: regular files only, bounded reads, bounded YAML.
+
+Every file a command reads (a mission, its ``map:`` file and image, a mask, a log, a bag, an
+artifact) goes through here, so a hostile path cannot stall or exhaust the process:
+
+* Only regular files are read (:func:`open_regular`): a device (``/dev/zero``), a FIFO (which
+  would block until a writer comes), a socket or a directory is refused at once.  The file is
+  opened without blocking and checked on the open descriptor, so a path swapped between the
+  check and the read changes nothing.
+* Reads are bounded (:func:`read_bytes`): at most ``limit`` bytes are read, in pieces; a larger
+  file is refused without being read whole.
+* YAML that is not a mission (maps, masks) is read by :func:`load_small_yaml`, which counts the
+  values while parsing, aliases expanded, and the nesting depth, and stops at the limits before
+  anything is built: a few hundred bytes of nested aliases cannot expand to gigabytes.
+* Values echoed in messages go through :func:`brief`, a repr cut to a few dozen characters.
+
+Each refusal is a :class:`~tlmpc.base.errors.UsageError` with the reader's own code, the file
+and a hint.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import reprlib
+import stat
+from collections.abc import Iterator
+from pathlib import Path
+from typing import IO, Any
+
+from tlmpc.base.errors import UsageError, error
+
+#: Pieces in which files are read (a bounded read never asks for more than it may keep).
+CHUNK = 4 * 1024 * 1024
+
+#: Small YAML files (maps, masks) expand to at most this many values, nested this deep.
+MAX_YAML_VALUES = 100_000
+MAX_YAML_DEPTH = 64
+
+#: How much of a value a message may quote.
+_BRIEF = reprlib.Repr()
+_BRIEF.maxstring = 40
+_BRIEF.maxother = 40
+_BRIEF.maxlist = 6
+_BRIEF.maxdict = 6
+_BRIEF.maxlevel = 3
+
+
+def brief(value: Any) -> str:
+    """A short repr of ``value`` for a message (long strings, lists and nests are cut)."""
+    return _BRIEF.repr(value)
+
+
+def _kind(mode: int) -> str:
+    if stat.S_ISDIR(mode):
+        return "a directory"
+    if stat.S_ISCHR(mode) or stat.S_ISBLK(mode):
+        return "a device"
+    if stat.S_ISFIFO(mode):
+        return "a FIFO (named pipe)"
+    if stat.S_ISSOCK(mode):
+        return "a socket"
+    return "not a regular file"
+
+
+def _refuse(code: str, message: str, file: str, hint: str | None) -> UsageError:
+    return UsageError(error(code, message, hint=hint, file=file))
+
+
+@contextlib.contextmanager
+def open_regular(
+    path: Path, *, code: str, what: str = "file", hint: str | None = "check the path"
+) -> Iterator[IO[bytes]]:
+    """``path`` opened for binary reading, refused (``code``) unless it is a regular file.
+
+    The open does not block (a FIFO without a writer would) and the check is made on the
+    open descriptor, not on the path."""
+    file = str(path)
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0)
+    try:
+        fd = os.open(path, flags)
+    except OSError as exc:
+        raise _refuse(
+            code, f"cannot read the {what} {file}: {exc.strerror or exc}", file, hint
+        ) from None
+    try:
+        mode = os.fstat(fd).st_mode
+        if not stat.S_ISREG(mode):
+            raise _refuse(
+                code,
+                f"the {what} {file} is {_kind(mode)}, not a regular file",
+                file,
+                "tlmpc reads only regular files (no devices, pipes or directories)",
+            )
+        if hasattr(os, "set_blocking"):
+            os.set_blocking(fd, True)
+        stream = os.fdopen(fd, "rb")
+    except BaseException:
+        os.close(fd)
+        raise
+    with stream:
+        yield stream
+
+
+def read_bytes(
+    path: Path,
+    *,
+    limit: int,
+    code: str,
+    too_large_code: str | None = None,
+    what: str = "file",
+    hint: str | None = "check the path",
+) -> bytes:
+    """The bytes of the regular file ``path``, read in pieces and refused (``too_large_code``,
+    default ``code``) as soon as more than ``limit`` bytes come."""
+    file = str(path)
+    raw = bytearray()
+    try:
+        with open_regular(path, code=code, what=what, hint=hint) as stream:
+            while len(raw) <= limit:
+                piece = stream.read(min(CHUNK, limit + 1 - len(raw)))
+                if not piece:
+                    break
+                raw += piece
+    except OSError as exc:
+        raise _refuse(
+            code, f"cannot read the {what} {file}: {exc.strerror or exc}", file, hint
+        ) from None
+    if len(raw) > limit:
+        raise _refuse(
+            too_large_code or code,
+            f"the {what} {file} is larger than {_size(limit)}",
+            file,
+            "is this the right file?",
+        )
+    return bytes(raw)
+
+
+def read_text(
+    path: Path,
+    *,
+    limit: int,
+    code: str,
+    too_large_code: str | None = None,
+    what: str = "file",
+    encoding: str = "utf-8",
+) -> str:
+    """:func:`read_bytes` decoded (``code`` when it is not text in ``encoding``)."""
+    raw = read_bytes(path, limit=limit, code=code, too_large_code=too_large_code, what=what)
+    try:
+        return raw.decode(encoding)
+    except UnicodeDecodeError as exc:
+        raise _refuse(
+            code,
+            f"the {what} {path} is not {encoding} text ({exc.reason} at byte {exc.start})",
+            str(path),
+            "save it as UTF-8 text",
+        ) from None
+
+
+def _size(limit: int) -> str:
+    if limit >= 2**20 and limit % 2**20 == 0:
+        return f"{limit // 2**20} MiB"
+    if limit >= 2**10 and limit % 2**10 == 0:
+        return f"{limit // 2**10} KiB"
+    return f"{limit} bytes"
+
+
+class _YamlLimit(Exception):
+    def __init__(self, message: str, line: int | None) -> None:
+        super().__init__(message)
+        self.message = message
+        self.line = line
+
+
+def _check_yaml_events(text: str, max_values: int, max_depth: int) -> None:
+    """Walk the event stream of ``text``, counting values (an alias counts as the whole value
+    it names) and depth; raise :class:`_YamlLimit` at the first limit passed."""
+    import yaml
+
+    sizes: dict[str, int] = {}
+    stack: list[tuple[str | None, int]] = []  # (anchor, count when the collection opened)
+    count = 0
+    for event in yaml.parse(text, Loader=yaml.SafeLoader):
+        line = event.start_mark.line + 1 if event.start_mark is not None else None
+        if isinstance(event, yaml.AliasEvent):
+            count += sizes.get(event.anchor or "", 1)
+        elif isinstance(event, yaml.ScalarEvent):
+            count += 1
+            if event.anchor:
+                sizes[event.anchor] = 1
+        elif isinstance(event, yaml.CollectionStartEvent):
+            count += 1
+            stack.append((event.anchor, count))
+            if len(stack) > max_depth:
+                raise _YamlLimit(f"the YAML is nested more than {max_depth} levels deep", line)
+        elif isinstance(event, yaml.CollectionEndEvent):
+            anchor, opened = stack.pop()
+            if anchor:
+                sizes[anchor] = count - opened + 1
+        if count > max_values:
+            raise _YamlLimit(
+                f"the YAML expands (aliases included) to more than {max_values:,} values", line
+            )
+
+
+def load_small_yaml(
+    text: str,
+    file: str,
+    *,
+    code: str,
+    max_values: int = MAX_YAML_VALUES,
+    max_depth: int = MAX_YAML_DEPTH,
+) -> Any:
+    """The data of a small YAML file (a map, a mask), refused (``code``) when it is not YAML
+    or when it nests or expands past the limits; found while parsing, before any value is
+    built.  The YAML error's text is kept short (it may quote the file)."""
+    import yaml
+
+    try:
+        _check_yaml_events(text, max_values, max_depth)
+        return yaml.safe_load(text)
+    except _YamlLimit as limit:
+        raise UsageError(
+            error(
+                code,
+                limit.message,
+                hint="a map file is a handful of keys; no YAML aliases are needed",
+                file=file,
+                line=limit.line,
+            )
+        ) from None
+    except yaml.MarkedYAMLError as exc:
+        mark = exc.problem_mark or exc.context_mark
+        raise UsageError(
+            error(
+                code,
+                f"not valid YAML: {brief(exc.problem or 'invalid YAML')}",
+                file=file,
+                line=mark.line + 1 if mark is not None else None,
+                col=mark.column + 1 if mark is not None else None,
+            )
+        ) from None
+    except (yaml.YAMLError, RecursionError, ValueError) as exc:
+        raise UsageError(error(code, f"not valid YAML: {brief(str(exc))}", file=file)) from None

@@ -1,0 +1,151 @@
+"""Planning a mission: the one entry that compile and the runtime executor both call.
+
+Only this module knows how the pieces of planning fit together for a mission:
+
+* the **margin**: the mesh is built from the mission's planning layout (configuration space,
+  goal cores, grown avoided regions; :mod:`tlmpc.abstraction.layout`), and when no plan keeps
+  the margin the mission is planned again without it, with the warning R008;
+* the **boundary convention**: the automaton is always :func:`automaton_for` the mission and
+  the mesh, so under ``closed`` every attempt, the fallback included, reads the crossing and
+  start letters and the rewritten task (:mod:`tlmpc.planning.boundary`);
+* **completeness**: U-turn refinement and vertex passages (:func:`plan_complete`);
+* the product-size budget (:func:`check_product_size`).
+
+A re-plan of a run under way (``resume``) keeps the mesh and automaton the run was compiled
+with (the executor's triangles and automaton states refer to them) and so never drops the
+margin; it may still refine the mesh for a U-turn, and then returns the refined one.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+from tlmpc.abstraction.model import Abstraction
+from tlmpc.automata.model import Automaton
+from tlmpc.base.errors import Diagnostic, NoPlanError
+from tlmpc.mission.model import Mission, TaskPart
+from tlmpc.planning.model import Witness
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Planned:
+    """A planned mission: the mesh the witness refers to (refined where the plan turns
+    around, or rebuilt without the margin), the automaton it was planned with, the witness,
+    and warnings (R008 when the margin was dropped)."""
+
+    abstraction: Abstraction
+    automaton: Automaton
+    witness: Witness
+    notes: tuple[Diagnostic, ...] = ()
+    margin_dropped: bool = False
+
+
+def abstraction_for(mission: Mission, margin: float) -> Abstraction:
+    """The triangulated workspace of ``mission`` planned with ``margin`` (and its body)."""
+    from tlmpc.abstraction import build_abstraction
+    from tlmpc.abstraction.layout import planning_layout
+
+    return build_abstraction(mission, planning_layout(mission, margin))
+
+
+def automaton_for(mission: Mission, abstraction: Abstraction) -> Automaton:
+    """The task's automaton over the letters the planner reads on ``abstraction``.
+
+    Under the closed convention: the rewritten task over the mesh's letters plus the
+    crossing and start letters; under the right-continuous one the task over the mesh's.
+    """
+    from tlmpc.automata import translate
+    from tlmpc.planning.boundary import task_formula, task_letters
+
+    convention = mission.options.boundary
+    return translate(
+        task_formula(mission.formula, convention),
+        letters=task_letters(abstraction, convention, mission.robot.start),
+    )
+
+
+def plan_mission(
+    mission: Mission,
+    abstraction: Abstraction,
+    automaton: Automaton,
+    *,
+    parts: Callable[[], Sequence[TaskPart]] | None = None,
+    resume: frozenset[int] | None = None,
+    start_point: tuple[float, float] | None = None,
+) -> Planned:
+    """A plan for ``mission`` on ``abstraction`` (built with the requested margin) and
+    ``automaton`` (:func:`automaton_for` it).
+
+    Raises :class:`NoPlanError` only when no trajectory of the robot satisfies the task: then
+    with the explanation of the plan without margin and the body's passage diagnostics.
+    ``parts`` gives the task's parts for that explanation (default: the mission's).
+    ``resume`` re-plans a run under way from ``abstraction.start`` at ``start_point``, the
+    (degeneralized) automaton being in one of these states; it never drops the margin.
+    """
+    from tlmpc.mission.body import requested_margin
+
+    def attempt(mesh: Abstraction, task: Automaton) -> Planned:
+        from tlmpc.planning.budget import check_product_size
+        from tlmpc.planning.complete import plan_complete
+
+        check_product_size(mesh, task)  # a diagnostic, not an exhausted machine
+        planned_mesh, witness = plan_complete(
+            mesh,
+            task,
+            formula=mission.formula,
+            options=mission.options,
+            start_point=start_point if start_point is not None else mission.robot.start,
+            parts=parts if parts is not None else (lambda: _task_parts(mission)),
+            file=mission.source,
+            resume=resume,
+            explain=resume is None,
+        )
+        return Planned(abstraction=planned_mesh, automaton=task, witness=witness)
+
+    try:
+        return attempt(abstraction, automaton)
+    except NoPlanError as failure:
+        if resume is not None:
+            raise
+        margin = requested_margin(mission)
+        if margin <= 0.0:
+            raise _with_body_notes(failure, mission) from None
+        first = failure
+    plain = abstraction_for(mission, 0.0)
+    try:
+        planned = attempt(plain, automaton_for(mission, plain))
+    except NoPlanError as again:
+        raise _with_body_notes(again, mission) from None
+    reason = first.diagnostics[0].message if first.diagnostics else "no plan"
+    note = Diagnostic(
+        code="R008",
+        severity="warning",
+        message=f"no plan keeps the margin {margin:g} ({reason}); planned without it",
+        hint="the R006/R007 warnings, if any, say where the path comes closer; lower "
+        "options.margin to plan with a smaller one",
+        file=mission.source,
+    )
+    return Planned(
+        abstraction=planned.abstraction,
+        automaton=planned.automaton,
+        witness=planned.witness,
+        notes=(note,),
+        margin_dropped=True,
+    )
+
+
+def _task_parts(mission: Mission) -> Sequence[TaskPart]:
+    from tlmpc.mission.parts import task_parts
+
+    return task_parts(mission)
+
+
+def _with_body_notes(failure: NoPlanError, mission: Mission) -> NoPlanError:
+    """The no-plan error with the body's diagnostics (a passage too narrow says why)."""
+    from tlmpc.mission.cspace import body_diagnostics
+
+    extra = [d for d in body_diagnostics(mission) if d.code in ("R002", "R003", "R004")]
+    if not extra:
+        return failure
+    return NoPlanError([*failure.diagnostics, *extra])

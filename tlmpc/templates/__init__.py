@@ -1,0 +1,1 @@
+"""Mission templates for ``tlmpc new``: small, valid missions to start from."""

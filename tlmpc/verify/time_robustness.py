@@ -1,0 +1,181 @@
+"""Time robustness: by how many seconds a task's time bounds held or failed.
+
+Tightening a formula by ``d`` seconds moves the far end of every finite bound against it:
+where the operator occurs positively, ``F[a,b]`` and ``U[a,b]`` become ``F[a,b-d]`` and
+``U[a,b-d]`` (less time to get there) and ``G[a,b]`` becomes ``G[a,b+d]`` (longer to hold);
+under a negation the other way round.  A window that shrinks past its start is empty (an
+``F`` over it is false, a ``G`` true).  Every operator is monotone in its window, so the
+verdict only gets worse as ``d`` grows.
+
+The **time robustness** of a satisfied formula is the largest ``d >= 0`` for which the
+tightened formula is still satisfied (``inf``: any; its bounds have no say); of a violated
+one, minus the smallest ``d >= 0`` by which loosening it (tightening by ``-d``) stops the
+violation (``-inf``: no loosening does).  Inconclusive verdicts have none.  For the task
+phrases it reads directly: ``visit X within T s`` done at time s has ``T - s``; ``visit X at
+least every T s`` has ``T`` minus the longest gap; ``stay in X for at least T s`` the longest
+stay minus ``T``.
+
+It is found by bisection with the exact evaluator, to :data:`STEPS` halvings of the search
+range (a fixed number of evaluations: the same bytes on any machine).  Formulas where a bound
+sits under ``<->`` (both polarities) have none.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import assert_never
+
+from tlmpc.ltl.ast import (
+    FALSE,
+    TRUE,
+    And,
+    BoundedEventually,
+    BoundedGlobally,
+    BoundedUntil,
+    Const,
+    Equiv,
+    Eventually,
+    Formula,
+    Globally,
+    Implies,
+    Interval,
+    Not,
+    Or,
+    Prop,
+    Release,
+    StrongRelease,
+    Until,
+    WeakUntil,
+    bounded_operators,
+)
+
+#: Bisection steps: the search range (the trace's duration and the bounds) is halved this many
+#: times, to about a millionth of a millionth of it.
+STEPS = 40
+
+
+class BothPolarities(ValueError):
+    """A time bound under ``<->``: tightening it has no direction."""
+
+
+def _shrink(interval: Interval, amount: float) -> Interval | None:
+    """``[a, b - amount]`` (None: empty); infinite ends stay."""
+    if math.isinf(interval.high):
+        return interval
+    high = interval.high - amount
+    if high < interval.low:
+        return None
+    return Interval(interval.low, high)
+
+
+def tighten(formula: Formula, amount: float, positive: bool = True) -> Formula:
+    """``formula`` with every finite bound made ``amount`` seconds harder to meet."""
+
+    def again(f: Formula, sign: bool = positive) -> Formula:
+        return tighten(f, amount, sign)
+
+    match formula:
+        case Const() | Prop():
+            return formula
+        case Not(arg):
+            return Not(again(arg, not positive))
+        case And(args):
+            return And(tuple(again(a) for a in args))
+        case Or(args):
+            return Or(tuple(again(a) for a in args))
+        case Implies(left, right):
+            return Implies(again(left, not positive), again(right))
+        case Equiv(left, right):
+            if bounded_operators(formula):
+                raise BothPolarities(str(formula))
+            return formula
+        case Eventually(arg) | Globally(arg):
+            return type(formula)(again(arg))
+        case Until(left, right) | Release(left, right) | WeakUntil(left, right):
+            return type(formula)(again(left), again(right))
+        case StrongRelease(left, right):
+            return StrongRelease(again(left), again(right))
+        case BoundedEventually(arg, interval):
+            window = _shrink(interval, amount if positive else -amount)
+            return FALSE if window is None else BoundedEventually(again(arg), window)
+        case BoundedUntil(left, right, interval):
+            window = _shrink(interval, amount if positive else -amount)
+            if window is None:
+                return FALSE
+            return BoundedUntil(again(left), again(right), window)
+        case BoundedGlobally(arg, interval):
+            window = _shrink(interval, -amount if positive else amount)
+            return TRUE if window is None else BoundedGlobally(again(arg), window)
+        case _:
+            assert_never(formula)
+
+
+def reach(formula: Formula) -> float:
+    """How far past t the value of ``formula`` at t looks: the largest sum of bounds along a
+    path of nested operators (``inf`` with an unbounded temporal operator or bound)."""
+    match formula:
+        case Const() | Prop():
+            return 0.0
+        case Not() | And() | Or() | Implies() | Equiv():
+            return max(reach(c) for c in formula.children())
+        case BoundedEventually(_, interval) | BoundedGlobally(_, interval):
+            return interval.high + max(reach(c) for c in formula.children())
+        case BoundedUntil(_, _, interval):
+            return interval.high + max(reach(c) for c in formula.children())
+        case Eventually() | Globally() | Until() | Release() | WeakUntil() | StrongRelease():
+            return math.inf
+        case _:
+            assert_never(formula)
+
+
+def horizon(formula: Formula, duration: float) -> float:
+    """How far a search for the time robustness must look: the trace's duration plus every
+    finite bound."""
+    bounds = [
+        n.interval.high
+        for n in bounded_operators(formula)
+        if isinstance(n, BoundedEventually | BoundedGlobally | BoundedUntil)
+        and math.isfinite(n.interval.high)
+    ]
+    return duration + sum(bounds) + 1.0
+
+
+def time_robustness(
+    formula: Formula, outcome: str, outcome_of: Callable[[Formula], str], reach: float
+) -> float | None:
+    """The time robustness of ``formula`` whose verdict is ``outcome``; ``outcome_of`` gives the
+    verdict of a tightened formula; ``reach`` bounds the search (see :func:`horizon`)."""
+    if outcome == "inconclusive" or not bounded_operators(formula):
+        return None
+    try:
+        if outcome == "satisfied":
+
+            def good(amount: float) -> bool:
+                return outcome_of(tighten(formula, amount)) == "satisfied"
+
+            if good(reach):
+                return math.inf
+            low, high = 0.0, reach
+        else:
+
+            def good(amount: float) -> bool:
+                return outcome_of(tighten(formula, -amount)) != "violated"
+
+            if not good(reach):
+                return -math.inf
+            low, high = 0.0, reach
+    except BothPolarities:
+        return None
+    # outcome == satisfied: good(low) holds, good(high) fails; find the edge.
+    # outcome == violated: good(low) fails, good(high) holds.
+    for _ in range(STEPS):
+        middle = (low + high) / 2.0
+        if (outcome == "satisfied") == good(middle):
+            low = middle
+        else:
+            high = middle
+    # The edge is known to reach / 2**STEPS; ten significant digits say no more than that (and
+    # print -0.5 rather than -0.49999999999999983).
+    found = low if outcome == "satisfied" else -high
+    return float(f"{found:.10g}")
