@@ -135,7 +135,30 @@ CASES: dict[str, list[tuple[str, int, Case]]] = {
         ("cut short", 4, lambda c, t: run_json("simulate", str(c), "--duration", "0.5", "--json")),
         ("empty dir", 2, lambda c, t: run_json("simulate", str(t), "--json")),
     ],
+    "synth": [
+        (
+            "realizable",
+            0,
+            lambda c, t: run_json("synth", str(_spc(t, "SYSGOAL: []<> y;")), "--json"),
+        ),
+        (
+            "unrealizable",
+            1,
+            lambda c, t: run_json(
+                "synth", str(_spc(t, "SYSTRANS: [](!y');\nSYSGOAL: []<> y;")), "--json"
+            ),
+        ),
+        ("unreadable", 2, lambda c, t: run_json("synth", str(t / "missing.spc"), "--json")),
+    ],
 }
+
+
+def _spc(tmp_path: Path, body: str) -> Path:
+    """A gr1c specification over one input x and one output y."""
+    path = tmp_path / "spec.spc"
+    path.write_text(f"ENV: x;\nSYS: y;\n{body}\n")
+    return path
+
 
 CASE_IDS = [(command, name) for command, cases in CASES.items() for name, _, _ in cases]
 
@@ -175,6 +198,9 @@ def test_json_output_follows_the_contract(
         assert any(d["severity"] == "error" for d in document["diagnostics"])
     elif command == "simulate":  # a run cut short is still reported in full
         assert document["result"]["outcome"] in ("violated", "inconclusive")
+    elif command == "synth":  # "unrealizable" comes with its core and counterstrategy
+        assert document["result"]["realizable"] is False
+        assert document["result"]["core"]
     else:  # a negative or open answer of verify is still a full verdict
         assert document["result"]["verdict"] in ("violated", "inconclusive")
 

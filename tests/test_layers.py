@@ -28,6 +28,7 @@ LAYERS = (
     "synth",
     "mission",
     "abstraction",
+    "reactive",
     "planning",
     "control",
     "simulate",

@@ -42,6 +42,7 @@ COMMAND_MODULES = (
     "import_map",
     "export_plan",
     "simulate",
+    "synth",
     "new",
     "completion",
 )

@@ -8,10 +8,10 @@ import shapely
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
+from scipy.sparse.csgraph import connected_components as scipy_connected_components
 from shapely.geometry import MultiPolygon, Point, Polygon
 
-from tlmpc.abstraction.build import _components, _labels, _min_angle
+from tlmpc.abstraction.build import _labels, _min_angle, connected_components
 from tlmpc.abstraction.triangulate import _polygons, _rings, _rings_of_all, _unique_rows
 from tlmpc.ltl.ast import TRUE
 from tlmpc.mission.model import Mission, Region, Robot, Workspace
@@ -28,7 +28,7 @@ def scipy_components(neighbors: IntArray) -> IntArray:
     graph = coo_matrix(
         (np.ones(int(keep.sum()), dtype=np.int8), (rows[keep], cols[keep])), shape=(count, count)
     )
-    _, labels = connected_components(graph, directed=False)
+    _, labels = scipy_connected_components(graph, directed=False)
     return np.asarray(labels, dtype=np.int64)
 
 
@@ -43,7 +43,7 @@ def adjacencies(draw: st.DrawFn) -> IntArray:
 
 @given(adjacencies())
 def test_components_equal_scipy(neighbors: IntArray) -> None:
-    assert _components(neighbors).tolist() == scipy_components(neighbors).tolist()
+    assert connected_components(neighbors).tolist() == scipy_components(neighbors).tolist()
 
 
 def test_components_of_a_shuffled_path_and_islands() -> None:
@@ -57,7 +57,7 @@ def test_components_of_a_shuffled_path_and_islands() -> None:
     for chain in (path, other):
         neighbors[chain[:-1], 0] = chain[1:]
         neighbors[chain[1:], 1] = chain[:-1]
-    labels = _components(neighbors)
+    labels = connected_components(neighbors)
     assert labels.tolist() == scipy_components(neighbors).tolist()
     assert int(labels.max()) + 1 == 2 + (count - 4500)
 

@@ -66,6 +66,16 @@ TRICKY_NAMES = [
     "untilx",
     "eventuallyx",
     "Visit2",
+    "dock",
+    "door",
+    "ifx",
+    "youth",
+    "seen",
+    "whence",
+    "therefore",
+    "unlessx",
+    "entrance",
+    "sensed",
 ]
 KEYWORD_WORDS = [
     "visit",
@@ -99,6 +109,14 @@ KEYWORD_WORDS = [
     ".",
     "area",
     "room",
+    "if you sense",
+    "when",
+    "there",
+    "unless",
+    "enter",
+    "do",
+    "any of",
+    "all of",
 ]
 
 

@@ -85,7 +85,7 @@ def _labels(
     return letter_of, tuple(ordered)
 
 
-def _components(neighbors: IntArray) -> IntArray:
+def connected_components(neighbors: IntArray) -> IntArray:
     """Connected components of the triangle adjacency, numbered by their lowest triangle.
 
     That numbering is the one of a search started from each unlabelled triangle in index
@@ -142,7 +142,7 @@ def build_abstraction(mission: Mission, layout: PlanningLayout | None = None) ->
                 file=mission.source,
             )
         )
-    component = _components(neighbors)
+    component = connected_components(neighbors)
     corners = vertices[triangles]
     angles = _min_angle(corners)
     for array in (vertices, triangles, neighbors, letter_of, component):

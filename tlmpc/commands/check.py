@@ -49,6 +49,8 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         else:
             if mission is not None and not diagnostics:
                 diagnostics = _contradictions(path, mission)
+                if not diagnostics and mission.reactive is not None:
+                    diagnostics, entry["gr1"] = _gr1_reading(mission)
                 if not diagnostics:
                     from tlmpc.mission.body import body_radius
                     from tlmpc.mission.holes import workspace_notes
@@ -75,6 +77,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         if entry["ok"] and args.explain:
             explained.append(f"{path}: {entry['ltl']}\n")
             explained.extend(f"  {scope}\n" for scope in entry.get("avoid_scopes", []))
+            explained.extend(f"  {line}\n" for line in entry.get("gr1", []))
     # unreadable wins over invalid: the run could not do its job
     code = EXIT_USAGE if unreadable else (EXIT_NEGATIVE if invalid else EXIT_OK)
     report.finish(code, {"files": results}, "".join(explained))
@@ -100,6 +103,21 @@ def _subgrid(mission: Any) -> list[Any]:
     from tlmpc.mission.resolution import subgrid_problems
 
     return list(subgrid_problems(mission))
+
+
+def _gr1_reading(mission: Any) -> tuple[list[Any], list[str]]:
+    """Q102 for each part of a reactive mission outside GR(1); else each part's GR(1) pieces
+    in words (``assume``: the environment's, ``guarantee``: the robot's)."""
+    from tlmpc.reactive.fragment import reading
+    from tlmpc.reactive.parts import mission_parts
+
+    pieces, problems = reading(mission_parts(mission), mission.source)
+    lines = [
+        f"{'assume' if piece.owner == 'env' else 'guarantee'} [{piece.part.text}]: "
+        + piece.describe()
+        for piece in pieces
+    ]
+    return problems, lines
 
 
 def _scopes(mission: Any) -> list[str]:

@@ -228,6 +228,7 @@ ARTIFACT_SCHEMAS = {
     "trace.json": ("tlmpc.trace/", "trace"),
     "verdict.json": ("tlmpc.verdict/", "verdict"),
     "summary.json": ("tlmpc.summary/", "summary"),
+    "strategy.json": ("tlmpc.strategy/", "strategy"),
 }
 
 
@@ -380,7 +381,9 @@ def cross_check(directory: Path, documents: Mapping[str, Mapping[str, Any]]) -> 
             raise _tampered(path, f"mission.json has an unreadable formula: {exc}") from None
         names = set(mission["regions"]) if isinstance(mission["regions"], dict) else set()
         known = names if regions is None else regions
-        unknown = sorted(formula.props() - known)
+        reactive = mission.get("reactive") or {}
+        signals = {*reactive.get("sensors", {}), *reactive.get("actions", [])}
+        unknown = sorted(formula.props() - known - signals)
         if unknown:
             raise _tampered(
                 path, f"the formula names regions the output does not have: {', '.join(unknown)}"

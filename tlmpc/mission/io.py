@@ -5,7 +5,18 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-from tlmpc.mission.model import Component, Mission, Options, Polygon, Region, Robot, Workspace
+from tlmpc.mission.model import (
+    Component,
+    Mission,
+    Options,
+    Polygon,
+    Reactive,
+    Region,
+    Robot,
+    Sensor,
+    TaskPart,
+    Workspace,
+)
 
 
 def _polygon(points: Sequence[Sequence[float]]) -> Polygon:
@@ -61,4 +72,22 @@ def mission_from_json(document: Mapping[str, Any]) -> Mission:
             margin=options.get("margin"),
         ),
         source=document["source"],
+        reactive=_reactive(document.get("reactive")),
+    )
+
+
+def _reactive(document: Mapping[str, Any] | None) -> Reactive | None:
+    from tlmpc.ltl.parser import parse_ltl
+
+    if document is None:
+        return None
+    return Reactive(
+        sensors=tuple(
+            Sensor(name=name, **binding) for name, binding in document["sensors"].items()
+        ),
+        actions=tuple(document["actions"]),
+        assumptions=tuple(
+            TaskPart(text=part["text"], formula=parse_ltl(part["formula"], file="mission.json"))
+            for part in document["assumptions"]
+        ),
     )

@@ -20,10 +20,21 @@ from tlmpc.ltl.ast import Formula, Or, Prop, conjoin
 from tlmpc.ltl.keywords import KEYWORDS
 from tlmpc.ltl.transform import substitute
 from tlmpc.mission.geometry import check_layout, check_shape
-from tlmpc.mission.model import Component, Mission, Options, Polygon, Region, Robot, Workspace
+from tlmpc.mission.model import (
+    Component,
+    Mission,
+    Options,
+    Polygon,
+    Reactive,
+    Region,
+    Robot,
+    Sensor,
+    TaskPart,
+    Workspace,
+)
 from tlmpc.mission.shapes import CheckedShape
 from tlmpc.mission.yamlpos import Path, PositionedDocument, json_path, load_positioned
-from tlmpc.tasks.compiler import compile_phrases
+from tlmpc.tasks.compiler import NameKinds, compile_phrases
 
 if TYPE_CHECKING:
     from jsonschema.exceptions import ValidationError
@@ -293,6 +304,7 @@ def _check_task(
     file: str,
     names: set[str],
     groups: Mapping[str, list[str]],
+    kinds: NameKinds | None = None,
 ) -> tuple[Formula | None, list[Diagnostic]]:
     problems: list[Diagnostic] = []
     parts: list[Formula] = []
@@ -300,7 +312,9 @@ def _check_task(
     if isinstance(phrases, list) and phrases and all(isinstance(p, str) for p in phrases):
         positions = [_ltl_position(doc, ("task", i)) for i in range(len(phrases))]
         try:
-            parts.append(compile_phrases(phrases, groups=groups, file=file, positions=positions))
+            parts.append(
+                compile_phrases(phrases, groups=groups, file=file, positions=positions, kinds=kinds)
+            )
         except InvalidInputError as exc:
             problems.extend(exc.diagnostics)
     ltl = data.get("ltl")
@@ -325,29 +339,8 @@ def _check_task(
             parts.append(parse_ltl(ltl, file=file, line=line, col=col))
         except InvalidInputError as exc:
             problems.extend(exc.diagnostics)
-    from tlmpc.ltl.fused import fused_operators
-
-    known = sorted(names | set(groups))
-    for part in parts:
-        for node in part.walk():
-            if isinstance(node, Prop) and node.name not in names and node.name not in groups:
-                close = difflib.get_close_matches(node.name, known, n=1, cutoff=0.5)
-                fused = fused_operators(node.name, known)
-                span = node.span
-                problems.append(
-                    error(
-                        "L010",
-                        f"unknown region {node.name!r}",
-                        hint=f"did you mean `{fused}`? operators are words of their own: "
-                        f"`{node.name}` is one proposition named {node.name!r}"
-                        if fused
-                        else (f"did you mean {close[0]!r}? " if close else "")
-                        + "regions and groups are declared under `regions:` and `groups:`",
-                        file=file,
-                        line=span.line if span else None,
-                        col=span.col if span else None,
-                    )
-                )
+    signals = set(kinds.sensors | kinds.actions) if kinds is not None else set()
+    problems.extend(_unknown_names(parts, names | set(groups) | signals, file, bool(signals)))
     if problems or not parts:
         return None, problems
     expand: dict[str, Formula] = {
@@ -355,6 +348,120 @@ def _check_task(
         for g, members in groups.items()
     }
     return substitute(conjoin(parts), expand), []
+
+
+def _unknown_names(
+    formulas: list[Formula], known: set[str], file: str, reactive: bool
+) -> list[Diagnostic]:
+    """L010 for every proposition that names nothing the mission declares."""
+    problems: list[Diagnostic] = []
+    where = (
+        "regions, groups, sensors and actions are declared under `regions:`, `groups:`, "
+        "`sensors:` and `actions:`"
+        if reactive
+        else "regions and groups are declared under `regions:` and `groups:`"
+    )
+    from tlmpc.ltl.fused import fused_operators
+
+    for formula in formulas:
+        for node in formula.walk():
+            if isinstance(node, Prop) and node.name not in known:
+                close = difflib.get_close_matches(node.name, sorted(known), n=1, cutoff=0.5)
+                fused = fused_operators(node.name, sorted(known))
+                span = node.span
+                problems.append(
+                    error(
+                        "L010",
+                        f"unknown {'name' if reactive else 'region'} {node.name!r}",
+                        hint=f"did you mean `{fused}`? operators are words of their own: "
+                        f"`{node.name}` is one proposition named {node.name!r}"
+                        if fused
+                        else (f"did you mean {close[0]!r}? " if close else "") + where,
+                        file=file,
+                        line=span.line if span else None,
+                        col=span.col if span else None,
+                    )
+                )
+    return problems
+
+
+def _reactive(
+    data: Mapping[str, Any],
+    doc: PositionedDocument,
+    file: str,
+    names: set[str],
+    groups: Mapping[str, list[str]],
+) -> tuple[Reactive | None, NameKinds | None, list[Diagnostic]]:
+    """Sensors, actions and assumptions (None, None when the mission has none of them)."""
+    if not any(key in data for key in ("sensors", "actions", "assumptions")):
+        return None, None, []
+    problems: list[Diagnostic] = []
+    sensors = dict(data.get("sensors") or {})
+    actions = dict(data.get("actions") or {})
+    taken: dict[str, str] = dict.fromkeys(names, "region")
+    taken.update(dict.fromkeys(groups, "group"))
+    for key, declared in (("sensors", sensors), ("actions", actions)):
+        for name in declared:
+            if name in taken:
+                line, col = doc.key_at((key, name))
+                problems.append(
+                    error(
+                        "S013",
+                        f"{name!r} is declared as a {key[:-1]} and as a {taken[name]}",
+                        hint="a name means one thing: rename one of them",
+                        file=file,
+                        line=line,
+                        col=col,
+                    )
+                )
+            taken[name] = key[:-1]
+    kinds = NameKinds(
+        regions=frozenset(names),
+        groups=frozenset(groups),
+        sensors=frozenset(sensors),
+        actions=frozenset(actions),
+    )
+    assumptions: list[TaskPart] = []
+    for index, text in enumerate(data.get("assumptions") or ()):
+        from tlmpc.ltl.parser import parse_ltl  # lark: only for missions with assumptions
+
+        line, col = _ltl_position(doc, ("assumptions", index))
+        try:
+            formula = parse_ltl(text, file=file, line=line, col=col)
+        except InvalidInputError as exc:
+            problems.extend(exc.diagnostics)
+            continue
+        problems.extend(_unknown_names([formula], set(taken), file, True))
+        for node in formula.walk():
+            if isinstance(node, Prop) and node.name in actions:
+                span = node.span
+                problems.append(
+                    error(
+                        "Q101",
+                        f"the assumption names the action {node.name!r}",
+                        hint="assumptions say what the environment does (sensors, and where "
+                        "the robot is); what the robot does belongs in the task",
+                        file=file,
+                        line=span.line if span else line,
+                        col=span.col if span else col,
+                    )
+                )
+        expand: dict[str, Formula] = {
+            g: Or(tuple(Prop(m) for m in members)) if len(members) > 1 else Prop(members[0])
+            for g, members in groups.items()
+        }
+        assumptions.append(
+            TaskPart(text=text, formula=substitute(formula, expand), line=line, col=col)
+        )
+    reactive = Reactive(
+        sensors=tuple(
+            Sensor(name=name, **{k: str(v) for k, v in (binding or {}).items()})
+            for name, binding in sensors.items()
+        ),
+        actions=tuple(actions),
+        assumptions=tuple(assumptions),
+    )
+    return reactive, kinds, problems
 
 
 def _task_positions(
@@ -581,7 +688,9 @@ def _load_data(text: str, file: str, stem: str) -> tuple[Mission | None, list[Di
     names = set(regions) | set(data["regions"])
     groups, found = _groups(data, doc, file, names)
     problems.extend(found)
-    formula, found = _check_task(data, doc, file, names, groups)
+    reactive, kinds, found = _reactive(data, doc, file, names, groups)
+    problems.extend(found)
+    formula, found = _check_task(data, doc, file, names, groups, kinds)
     problems.extend(found)
     if problems or boundary is None or formula is None:
         return None, problems
@@ -624,6 +733,7 @@ def _load_data(text: str, file: str, stem: str) -> tuple[Mission | None, list[Di
         ),
         source=file,
         task_positions=_task_positions(data, doc),
+        reactive=reactive,
     )
     return mission, []
 

@@ -141,6 +141,55 @@ class TaskPart:
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
+class Sensor:
+    """An environment proposition the robot reads (reactive missions).
+
+    ``column`` (a CSV log's column) or ``topic`` and ``field`` (a bag's) say where a robot's
+    log carries its value, for ``tlmpc verify``; all None when the log names it alike.
+    """
+
+    name: str
+    column: str | None = None
+    topic: str | None = None
+    field: str | None = None
+
+    def to_json(self) -> dict[str, str]:
+        """The sensor's binding as written in ``mission.json`` (keys with a value only)."""
+        bound = {"column": self.column, "topic": self.topic, "field": self.field}
+        return {key: value for key, value in bound.items() if value is not None}
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class Reactive:
+    """What makes a mission reactive: sensors, actions and the environment's assumptions.
+
+    ``assumptions`` are the user's formulas, one part each, with their positions;
+    ``assumption`` is their conjunction (TRUE when there are none).
+    """
+
+    sensors: tuple[Sensor, ...] = ()
+    actions: tuple[str, ...] = ()
+    assumptions: tuple[TaskPart, ...] = ()
+
+    @property
+    def sensor_names(self) -> tuple[str, ...]:
+        """Sensor names in file order."""
+        return tuple(s.name for s in self.sensors)
+
+    def to_json(self) -> dict[str, Any]:
+        """The ``reactive`` object of ``mission.json``."""
+        from tlmpc.ltl.printer import to_text
+
+        return {
+            "sensors": {s.name: s.to_json() for s in self.sensors},
+            "actions": list(self.actions),
+            "assumptions": [
+                {"text": part.text, "formula": to_text(part.formula)} for part in self.assumptions
+            ],
+        }
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Mission:
     """A validated mission.
 
@@ -160,6 +209,8 @@ class Mission:
     source: str | None = None
     #: (line, col) of each task phrase, then of the ``ltl`` string (see :mod:`.parts`).
     task_positions: tuple[tuple[int, int], ...] = ()
+    #: sensors, actions and assumptions; None for a mission in a world that never changes
+    reactive: Reactive | None = None
 
     @property
     def region_names(self) -> tuple[str, ...]:
@@ -174,13 +225,14 @@ class Mission:
         raise KeyError(name)
 
     def to_json(self) -> dict[str, Any]:
-        """The ``mission.json`` artifact (``tlmpc.mission/1``)."""
+        """The ``mission.json`` artifact (``tlmpc.mission/1``); ``reactive`` only when the
+        mission has sensors, actions or assumptions."""
         from tlmpc.ltl.printer import to_text
 
         def poly(p: Polygon) -> list[list[float]]:
             return list(map(list, p))
 
-        return {
+        document: dict[str, Any] = {
             "format": "tlmpc.mission/1",
             "name": self.name,
             "source": self.source,
@@ -208,3 +260,6 @@ class Mission:
                 "margin": self.options.margin,
             },
         }
+        if self.reactive is not None:
+            document["reactive"] = self.reactive.to_json()
+        return document

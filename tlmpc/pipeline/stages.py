@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
-from tlmpc.base.errors import TlmpcError, error
+from tlmpc.base.errors import NoPlanError, TlmpcError, error
 from tlmpc.base.progress import heartbeat
 from tlmpc.base.version import __version__
 
@@ -154,15 +154,29 @@ def provide(product: Product[T], value: T) -> dict[Product[Any], Any]:
     return {product: value}
 
 
+#: A mission's world: ``static`` (one plan, computed once) or ``reactive`` (sensors: a game).
+World = str
+WORLDS: frozenset[World] = frozenset({"static", "reactive"})
+
+
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Stage:
-    """A named lowering step: reads ``requires``, returns ``provides`` (checked when run)."""
+    """A named lowering step: reads ``requires``, returns ``provides`` (checked when run).
+
+    ``worlds`` are the kinds of mission the stage lowers; the walker skips it for the others.
+    """
 
     name: str
     run: Callable[[Compilation], StageResult]
     requires: tuple[Product[Any], ...] = ()
     provides: tuple[Product[Any], ...] = ()
     aliases: tuple[str, ...] = ()
+    worlds: frozenset[World] = WORLDS
+
+
+def world_of(mission: Mission) -> World:
+    """``reactive`` for a mission with sensors, actions or assumptions, else ``static``."""
+    return "reactive" if mission.reactive is not None else "static"
 
 
 def _load(c: Compilation) -> StageResult:
@@ -374,6 +388,27 @@ def _verify(c: Compilation) -> StageResult:
     )
 
 
+def _synthesize(c: Compilation) -> StageResult:
+    from tlmpc.reactive.synthesize import strategy_to_json, synthesize, unrealizable
+
+    mission = c.get(MISSION)
+    synthesis = synthesize(mission, c.get(ABSTRACTION))
+    if synthesis.strategy is None:
+        raise NoPlanError(unrealizable(synthesis, mission))
+    game = synthesis.game
+    return StageResult(
+        artifacts={"strategy.json": strategy_to_json(synthesis)},
+        sizes={
+            "faces": game.faces.count,
+            "variables": len(game.spec.variables),
+            "parts": len(game.spec.parts),
+            "fixpoint steps": synthesis.solution.cpre_count,
+            "strategy nodes": len(synthesis.strategy.states),
+        },
+        summary={"reactive": {"realizable": True, "faces": game.faces.count}},
+    )
+
+
 def _plot(c: Compilation) -> StageResult:
     # Drawn from the artifacts themselves (the same code as `tlmpc plot`), so the picture
     # always shows what was written.
@@ -397,14 +432,24 @@ class SelfCheckError(TlmpcError):
     exit_code = 3
 
 
+_STATIC: frozenset[World] = frozenset({"static"})
+
 STAGES: tuple[Stage, ...] = (
     Stage(name="load", run=_load, provides=(MISSION,), aliases=("mission",)),
     Stage(name="abstraction", run=_abstraction, requires=(MISSION,), provides=(ABSTRACTION,)),
+    Stage(
+        name="synthesize",
+        run=_synthesize,
+        requires=(MISSION, ABSTRACTION),
+        aliases=("strategy", "game"),
+        worlds=frozenset({"reactive"}),
+    ),
     Stage(
         name="automaton",
         run=_automaton,
         requires=(MISSION, ABSTRACTION),
         provides=(AUTOMATON,),
+        worlds=_STATIC,
     ),
     Stage(
         name="plan",
@@ -412,6 +457,7 @@ STAGES: tuple[Stage, ...] = (
         requires=(MISSION, ABSTRACTION, AUTOMATON),
         provides=(WITNESS, ABSTRACTION),  # the mesh, refined where the plan turns around
         aliases=("witness", "planning"),
+        worlds=_STATIC,
     ),
     Stage(
         name="control",
@@ -419,6 +465,7 @@ STAGES: tuple[Stage, ...] = (
         requires=(MISSION, ABSTRACTION, WITNESS),
         provides=(CONTROLLERS,),
         aliases=("controllers",),
+        worlds=_STATIC,
     ),
     Stage(
         name="simulate",
@@ -426,9 +473,15 @@ STAGES: tuple[Stage, ...] = (
         requires=(MISSION, ABSTRACTION, CONTROLLERS),
         provides=(TRACE,),
         aliases=("trace",),
+        worlds=_STATIC,
     ),
-    Stage(name="verify", run=_verify, requires=(TRACE,), aliases=("verdict",)),
-    Stage(name="plot", run=_plot, requires=(MISSION, ABSTRACTION, WITNESS, TRACE)),
+    Stage(name="verify", run=_verify, requires=(TRACE,), aliases=("verdict",), worlds=_STATIC),
+    Stage(
+        name="plot",
+        run=_plot,
+        requires=(MISSION, ABSTRACTION, WITNESS, TRACE),
+        worlds=_STATIC,
+    ),
 )
 
 
@@ -538,6 +591,9 @@ def run_stages(
     warnings: list[Diagnostic] = []
     extras: dict[str, Any] = {}
     for index, stage in enumerate(stages, start=1):
+        mission = products.get(MISSION)
+        if mission is not None and world_of(mission) not in stage.worlds:
+            continue
         for product in stage.requires:
             compilation.get(product)  # a clear error instead of a failure deep inside
         started = time.perf_counter()

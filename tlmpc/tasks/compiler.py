@@ -12,6 +12,7 @@ import difflib
 import functools
 import re
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from tlmpc.base.errors import Diagnostic, InvalidInputError, error
@@ -25,9 +26,11 @@ from tlmpc.ltl.ast import (
     Implies,
     Interval,
     Not,
+    Or,
     Prop,
     Span,
     Until,
+    WeakUntil,
     conjoin,
     disjoin,
 )
@@ -56,6 +59,13 @@ KNOWN_PHRASES = (
     "eventually stay in A",
     "always stay in A",
     "whenever A, visit B",
+    "if you sense S then visit A",
+    "when S, go to A and stay there while S",
+    "visit A infinitely often unless S",
+    "never enter A while S",
+    "if you sense S then do ACTION",
+    "if you sense any of S, T then ...",
+    "if you sense all of S, T then ...",
     "visit A within T s",
     "visit A at least every T s",
     "stay in A for at least T s",
@@ -71,6 +81,8 @@ _LEADING_WORDS = (
     "eventually",
     "always",
     "whenever",
+    "if",
+    "when",
     "after",
 )
 
@@ -129,9 +141,15 @@ class _Lowering:
     """Lowers one phrase's parse tree to LTL, keeping name positions."""
 
     def __init__(
-        self, groups: Mapping[str, Sequence[str]], file: str | None, line: int, col: int
+        self,
+        groups: Mapping[str, Sequence[str]],
+        file: str | None,
+        line: int,
+        col: int,
+        kinds: NameKinds | None = None,
     ) -> None:
         self.groups = groups
+        self.kinds = kinds
         self.file = file
         self.line = line
         self.col = col
@@ -203,6 +221,8 @@ class _Lowering:
             return Globally(self.name(children[0]))
         if kind == "whenever":
             return Globally(Implies(self.name(children[0]), Eventually(self.name(children[1]))))
+        if kind in _REACTIVE:
+            return self._reactive(kind, children)
         if kind in _TIMED:
             return self._timed(kind, children, _duration(tree))
         raise ValueError(f"unknown phrase kind {kind}")  # pragma: no cover - grammar is closed
@@ -222,6 +242,89 @@ class _Lowering:
             return Globally(Implies(place, BoundedEventually(Not(place), window)))
         trigger, goal = self.name(children[0]), self.name(children[1])
         return Globally(Implies(trigger, BoundedEventually(goal, window)))
+
+    def _reactive(self, kind: str, children: list[Node]) -> Formula:
+        """The reactive phrases (docs/task-phrases.md): each lowers to a conjunction of the
+        GR(1) forms tlmpc synthesises (docs/semantics.md, reactive missions)."""
+        if kind == "sense_visit":
+            sensed = self._condition(children[0])
+            goals = self._expect(self.names(children[1]), "region")
+            return Globally(Implies(sensed, conjoin([Eventually(g) for g in goals])))
+        if kind == "sense_do":
+            sensed = self._condition(children[0])
+            actions = self._expect(self.names(children[1]), "action")
+            return Globally(Implies(sensed, conjoin(list(actions))))
+        if kind == "often_unless":
+            goals = self._expect(self.names(children[0]), "region")
+            excused = self._condition(children[1])
+            return conjoin([Globally(Eventually(Or((g, excused)))) for g in goals])
+        if kind == "never_while":
+            places = self._expect(self.names(children[0]), "region")
+            sensed = self._condition(children[1])
+            return conjoin(
+                [
+                    Globally(Implies(conjoin([sensed, Not(p)]), WeakUntil(Not(p), Not(sensed))))
+                    for p in places
+                ]
+            )
+        # sense_stay: reach the place while the condition lasts, then stay while it lasts
+        sensed = self._condition(children[0])
+        (place,) = self._expect([self.name(children[1])], "region")
+        lasting = self._condition(children[2])
+        if lasting != sensed:
+            self._report(
+                "T021",
+                children[2],
+                "`stay there while` must name the same condition as `when`",
+                "write the condition twice, e.g. `when alarm, go to shelter and stay there "
+                "while alarm`",
+            )
+        return And(
+            (
+                Globally(Implies(sensed, Eventually(Or((Not(sensed), place))))),
+                Globally(Implies(conjoin([sensed, place]), WeakUntil(place, Not(sensed)))),
+            )
+        )
+
+    def _condition(self, tree: Node) -> Formula:
+        """A sensor condition: one sensor, ``any of`` (or) or ``all of`` (and) several."""
+        if tree.data == "condition":
+            (sensor,) = self._expect([self.name(tree.children[0])], "sensor")  # type: ignore[arg-type]
+            return sensor
+        inner = next(c for c in tree.children if isinstance(c, Node))
+        sensors = self._expect(self.names(inner), "sensor")
+        return disjoin(list(sensors)) if tree.data == "any_condition" else conjoin(list(sensors))
+
+    def _expect(self, props: list[Prop], kind: str) -> list[Prop]:
+        """``props``, each reported (T020) when the mission declares it as another kind."""
+        if self.kinds is not None:
+            for prop in props:
+                found = self.kinds.kind_of(prop.name)
+                if (
+                    found is not None
+                    and found != kind
+                    and not (kind == "region" and found == "group")
+                ):
+                    line, col = (prop.span.line, prop.span.col) if prop.span else (1, 1)
+                    self.problems.append(
+                        error(
+                            "T020",
+                            f"{prop.name!r} is a {found}, not a {kind}",
+                            hint=_KIND_HINTS[kind],
+                            file=self.file,
+                            line=line,
+                            col=col,
+                        )
+                    )
+        return props
+
+    def _report(self, code: str, tree: Node, message: str, hint: str) -> None:
+        first = next(
+            (w for w in _words(tree)),
+            None,
+        )
+        line, col = self._where(first) if first is not None else (self.line, self.col)
+        self.problems.append(error(code, message, hint=hint, file=self.file, line=line, col=col))
 
     def _avoided_names(self, avoiding: Node) -> list[Prop]:
         names_tree = next(c for c in avoiding.children if isinstance(c, Node))
@@ -314,6 +417,44 @@ class _Lowering:
             self.scopes.append(f"avoid {_listing(props)}: " + scope.replace("{it}", it))
 
 
+_REACTIVE = frozenset({"sense_visit", "sense_stay", "often_unless", "never_while", "sense_do"})
+_KIND_HINTS = {
+    "sensor": "a condition after `sense`, `when`, `while` or `unless` names sensors, declared "
+    "under `sensors:`",
+    "region": "places to visit, enter or stay in are regions or groups",
+    "action": "`do` names actions, declared under `actions:`",
+}
+
+
+@dataclass(frozen=True, slots=True)
+class NameKinds:
+    """What each name of a mission is: a region, a group, a sensor or an action."""
+
+    regions: frozenset[str] = frozenset()
+    groups: frozenset[str] = frozenset()
+    sensors: frozenset[str] = frozenset()
+    actions: frozenset[str] = frozenset()
+
+    def kind_of(self, name: str) -> str | None:
+        """``"region"``, ``"group"``, ``"sensor"``, ``"action"``, or None when unknown."""
+        for kind, names in (
+            ("region", self.regions),
+            ("group", self.groups),
+            ("sensor", self.sensors),
+            ("action", self.actions),
+        ):
+            if name in names:
+                return kind
+        return None
+
+
+def _words(tree: Node) -> list[Word]:
+    found: list[Word] = []
+    for child in tree.children:
+        found.extend([child] if isinstance(child, Word) else _words(child))
+    return found
+
+
 #: The time-bounded phrase kinds (their last token is the duration).
 _TIMED = frozenset({"visit_within", "visit_every", "stay_for", "stay_at_most", "after_within"})
 
@@ -357,9 +498,13 @@ def compile_phrase(
     file: str | None = None,
     line: int = 1,
     col: int = 1,
+    kinds: NameKinds | None = None,
 ) -> Formula:
-    """Compile one phrase to LTL (raises :class:`InvalidInputError` with T-codes)."""
-    return _compile(phrase, groups=groups, file=file, line=line, col=col)[0]
+    """Compile one phrase to LTL (raises :class:`InvalidInputError` with T-codes).
+
+    With ``kinds`` (the mission's names by kind), a name used as the wrong kind — a region
+    where a sensor belongs, say — is reported (T020)."""
+    return _compile(phrase, groups=groups, file=file, line=line, col=col, kinds=kinds)[0]
 
 
 def avoid_scopes(phrase: str, *, groups: Mapping[str, Sequence[str]] | None = None) -> list[str]:
@@ -374,6 +519,7 @@ def _compile(
     file: str | None,
     line: int,
     col: int,
+    kinds: NameKinds | None = None,
 ) -> tuple[Formula, list[str]]:
     if not isinstance(phrase, str) or not phrase.strip():
         raise InvalidInputError(
@@ -391,7 +537,7 @@ def _compile(
     except PhraseSyntaxError as exc:
         at = exc.column - 1
         raise InvalidInputError(_unknown_phrase(phrase, file, line, col, max(at, 0))) from None
-    lowering = _Lowering(groups or {}, file, line, col)
+    lowering = _Lowering(groups or {}, file, line, col, kinds)
     formula = lowering.lower(tree.children[0])  # type: ignore[arg-type]
     if lowering.problems:
         raise InvalidInputError(lowering.problems)
@@ -404,6 +550,7 @@ def compile_phrases(
     groups: Mapping[str, Sequence[str]] | None = None,
     file: str | None = None,
     positions: Sequence[tuple[int, int]] | None = None,
+    kinds: NameKinds | None = None,
 ) -> Formula:
     """Compile every phrase and conjoin them; report the problems of all phrases at once.
 
@@ -412,13 +559,16 @@ def compile_phrases(
         groups: group name -> member region names (for ``visit all/any GROUP``).
         file: the file name for diagnostics.
         positions: (line, col) where each phrase starts in ``file``.
+        kinds: the mission's names by kind, to report a name used as the wrong kind.
     """
     formulas: list[Formula] = []
     problems: list[Diagnostic] = []
     for index, phrase in enumerate(phrases):
         line, col = positions[index] if positions is not None else (1, 1)
         try:
-            formulas.append(compile_phrase(phrase, groups=groups, file=file, line=line, col=col))
+            formulas.append(
+                compile_phrase(phrase, groups=groups, file=file, line=line, col=col, kinds=kinds)
+            )
         except InvalidInputError as exc:
             problems.extend(exc.diagnostics)
     if problems:

@@ -66,11 +66,28 @@ KEYWORDS = frozenset(
         "often",
         "finally",
         "reach",
+        "if",
+        "you",
+        "sense",
+        "see",
+        "when",
+        "there",
+        "unless",
+        "enter",
+        "do",
+        "of",
     }
 )
+#: Keywords of the reactive phrases only, which this reader never reads (it leaves every
+#: phrase that uses them to the Earley parser).
+REACTIVE_KEYWORDS = frozenset(
+    {"if", "you", "sense", "see", "when", "there", "unless", "enter", "do", "of"}
+)
 #: A name starting with one of these could be split by the Earley parser's dynamic lexer
-#: (``visitor`` = ``visit`` + ``or``): such phrases go to the Earley parser.
-_SPLITTABLE = tuple(sorted(KEYWORDS))
+#: (``visitor`` = ``visit`` + ``or``): such phrases go to the Earley parser.  A reactive
+#: keyword cannot split a name in the phrases read here (the parser expects none of them
+#: where a name stands), so ``dock`` and ``office`` stay plain.
+_SPLITTABLE = tuple(sorted(KEYWORDS - REACTIVE_KEYWORDS))
 #: ``one of`` and ``come back`` are keywords only as a pair, one space apart.
 _PAIR_SECOND = {"one": "of", "come": "back", "go": "to"}
 _NOUNS = frozenset({"area", "areas", "region", "regions", "room", "rooms"})

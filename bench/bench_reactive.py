@@ -1,0 +1,160 @@
+"""Reactive missions: synthesis time and strategy size against workspace size and sensors.
+
+A warehouse floor (40 m x 20 m, shelves as holes, seven named places) meshed ever finer
+(``options.max_area``, or small pillars as holes) from 2k to 44k triangles, with 1 to 6
+sensors; each sensor ``s_k`` adds "if you sense s_k then visit place_k" and the assumption
+"G F !s_k", beside a patrol of two places and "never enter aisle while s_1".  A grid of rooms
+shows what does grow: the number of regions (faces).  CPU seconds of this process, the median
+of ``--rounds`` runs (fresh mission objects, the BDD manager new each time).
+
+    python bench/bench_reactive.py [--rounds 3] [--quick]
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from workloads import grid_of_rooms
+
+from tlmpc.abstraction import build_abstraction
+from tlmpc.mission import load_mission_text
+from tlmpc.reactive.synthesize import synthesize
+
+PLACES = {
+    "dock": [1, 1, 4, 4],
+    "charger": [1, 16, 4, 19],
+    "station_a": [36, 16, 39, 19],
+    "station_b": [36, 1, 39, 4],
+    "packing": [18, 1, 22, 3],
+    "office": [18, 17, 22, 19],
+    "aisle": [12, 8, 28, 12],
+}
+
+
+def warehouse(max_area: float | None, sensors: int, pitch: float | None = None) -> dict[str, Any]:
+    """The warehouse mission with ``sensors`` sensors, meshed with ``max_area``; with
+    ``pitch``, small pillars every ``pitch`` metres away from the places and shelves (a finer
+    mesh whose faces stay the same)."""
+    shelves = [
+        {"rect": [x, y, x + 6, y + 1.5]} for x in (6.0, 14.0, 22.0, 30.0) for y in (5.0, 13.5)
+    ]
+    boxes = [s["rect"] for s in shelves] + list(PLACES.values())
+    pillars = []
+    if pitch is not None:
+        for i in range(1, int(40 / pitch)):
+            for j in range(1, int(20 / pitch)):
+                x, y = i * pitch, j * pitch
+                clear = all(
+                    not (b[0] - 0.3 < x < b[2] + 0.3 and b[1] - 0.3 < y < b[3] + 0.3) for b in boxes
+                )
+                if clear:
+                    pillars.append({"rect": [x - 0.04, y - 0.04, x + 0.04, y + 0.04]})
+    names = [f"s{k + 1}" for k in range(sensors)]
+    goals = ["dock", "charger", "packing", "office", "station_a", "station_b"]
+    task = [
+        "visit station_a, station_b infinitely often",
+        "never enter aisle while s1",
+        *(f"if you sense {s} then visit {goals[k]}" for k, s in enumerate(names)),
+    ]
+    return {
+        "version": 1,
+        "name": f"warehouse-{sensors}",
+        "workspace": {"boundary": {"rect": [0, 0, 40, 20]}, "holes": shelves + pillars},
+        "regions": {name: {"rect": box} for name, box in PLACES.items()},
+        "sensors": dict.fromkeys(names),
+        "assumptions": [f"G F !{s}" for s in names],
+        "robot": {"start": [2.5, 2.5]},
+        "options": {"min_angle": 20, "max_area": max_area},
+        "task": task,
+    }
+
+
+def rooms(n: int, sensors: int) -> dict[str, Any]:
+    """An n x n grid of rooms: n^2 + 1 faces; sensor k sends the robot to a far room."""
+    document = grid_of_rooms(n)
+    names = [f"s{k + 1}" for k in range(sensors)]
+    far = n - 1
+    document["sensors"] = dict.fromkeys(names)
+    document["assumptions"] = [f"G F !{s}" for s in names]
+    document["task"] = [
+        f"visit r{far}_{far}, r0_0 infinitely often",
+        *(f"if you sense {s} then visit r{k % n}_{far}" for k, s in enumerate(names)),
+    ]
+    document.pop("ltl", None)
+    document["options"] = {"min_angle": None}
+    return document
+
+
+def measure(document: dict[str, Any], rounds: int) -> dict[str, Any]:
+    """Median CPU seconds of the abstraction and of synthesis, and the sizes."""
+    text = yaml.safe_dump(document, sort_keys=False)
+    meshing: list[float] = []
+    solving: list[float] = []
+    row: dict[str, Any] = {}
+    for _ in range(rounds):
+        mission = load_mission_text(text, f"{document['name']}.yaml")
+        started = time.process_time()
+        abstraction = build_abstraction(mission)
+        meshed = time.process_time()
+        found = synthesize(mission, abstraction)
+        solved = time.process_time()
+        meshing.append(meshed - started)
+        solving.append(solved - meshed)
+        row = {
+            "triangles": abstraction.num_triangles,
+            "faces": found.game.faces.count,
+            "realizable": found.realizable,
+            "nodes": len(found.strategy.states) if found.strategy else 0,
+            "fixpoint": found.solution.cpre_count,
+        }
+    row["mesh s"] = statistics.median(meshing)
+    row["synthesis s"] = statistics.median(solving)
+    return row
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--quick", action="store_true", help="up to 22k triangles and 4 sensors")
+    args = parser.parse_args()
+    print(
+        "| workload | sensors | triangles | faces | mesh CPU s | synthesis CPU s |"
+        " fixpoint steps | strategy nodes | realizable |"
+    )
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---|")
+
+    def show(name: str, sensors: int, row: dict[str, Any]) -> None:
+        print(
+            f"| {name} | {sensors} | {row['triangles']:,} | {row['faces']} | "
+            f"{row['mesh s']:.3f} | {row['synthesis s']:.3f} | {row['fixpoint']} | "
+            f"{row['nodes']:,} | {row['realizable']} |",
+            flush=True,
+        )
+
+    meshes: list[tuple[str, float | None, float | None]] = [
+        ("warehouse, max_area 0.5", 0.5, None),
+        ("warehouse, pillars every 1 m", None, 1.0),
+        ("warehouse, max_area 0.05", 0.05, None),
+    ]
+    if not args.quick:
+        meshes.append(("warehouse, pillars every 0.35 m", None, 0.35))
+    for name, area, pitch in meshes:
+        show(name, 2, measure(warehouse(area, 2, pitch), args.rounds))
+    for sensors in range(1, 5 if args.quick else 7):
+        show("warehouse, max_area 0.5", sensors, measure(warehouse(0.5, sensors), args.rounds))
+    for n in (4, 8) if args.quick else (4, 8, 12):
+        show(f"{n}x{n} rooms", 2, measure(rooms(n, 2), args.rounds))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

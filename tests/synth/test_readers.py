@@ -1,0 +1,114 @@
+"""The readers follow their source tools' grammars and readings."""
+
+from __future__ import annotations
+
+from tlmpc.synth.readers.gr1c import parse_gr1c
+from tlmpc.synth.readers.slugsin import parse_slugsin
+from tlmpc.synth.readers.tlsf import parse_tlsf
+from tlmpc.synth.solver import Game, solve
+from tlmpc.synth.spec import Atom, Binary, Nary, Not
+
+
+def test_gr1c_and_or_share_a_level_and_group_left() -> None:
+    spec = parse_gr1c("SYS: a b c;\nSYSINIT: a | b & !c -> a <-> b;\n")
+    (part,) = spec.parts
+    formula = part.formula
+    # ((((a | b) & !c) -> a) <-> b)
+    assert isinstance(formula, Binary)
+    assert formula.op == "<->"
+    implication = formula.left
+    assert isinstance(implication, Binary)
+    assert implication.op == "->"
+    conjunction = implication.left
+    assert isinstance(conjunction, Nary)
+    assert conjunction.op == "and"
+    disjunction, negation = conjunction.args
+    assert isinstance(disjunction, Nary)
+    assert disjunction.op == "or"
+    assert isinstance(negation, Not)
+
+
+def test_gr1c_and_box_on_one_line_starts_a_new_goal() -> None:
+    spec = parse_gr1c("ENV: x;\nSYS: y;\nENVGOAL: []<> x & !y\n& []<> x & y;\n")
+    goals = spec.select("env", "liveness")
+    assert [g.text for g in goals] == ["x & !y", "x & y"]
+
+
+def test_slugs_memory_buffers_share_formulas() -> None:
+    spec = parse_slugsin("[INPUT]\na\n[OUTPUT]\nb\n[SYS_TRANS]\n$ 2 ^ a b' & ? 0 ! a\n")
+    (part,) = spec.parts
+    formula = part.formula
+    assert isinstance(formula, Nary)
+    assert formula.op == "and"
+    shared, negated = formula.args
+    assert isinstance(shared, Nary)
+    assert shared.op == "xor"
+    assert shared.args[1] == Atom("b", True)
+    assert isinstance(negated, Not)
+
+
+def _tlsf(semantics: str, body: str) -> str:
+    return (
+        f'INFO {{ TITLE: "t" SEMANTICS: {semantics} TARGET: Mealy }}\nGLOBAL {{}}\n'
+        f"MAIN {{\nINPUTS {{ r; }}\nOUTPUTS {{ g; }}\n{body}\n}}\n"
+    )
+
+
+def test_tlsf_sections_become_parts_of_the_right_player() -> None:
+    spec = parse_tlsf(
+        _tlsf(
+            "Mealy,Strict",
+            "INITIALLY { !r; }\nPRESET { !g; }\nREQUIRE { g -> X !r; }\n"
+            "ASSERT { X g <-> r; }\nASSUME { G F r; }\nGUARANTEE { G F g && G (r -> g); }",
+        )
+    )
+    kinds = [(p.owner, p.kind) for p in spec.parts]
+    assert kinds == [
+        ("env", "init"),
+        ("sys", "init"),
+        ("env", "safety"),
+        ("sys", "safety"),
+        ("env", "liveness"),
+        ("sys", "liveness"),
+        ("sys", "safety"),
+    ]
+    # g follows r one step late, so the first r (allowed while g is low) finds g low and
+    # breaks G (r -> g): unrealizable
+    assert not solve(Game.build(spec)).realizable
+
+
+def test_tlsf_mealy_lets_the_system_see_the_inputs_of_the_step() -> None:
+    # g must equal r in every step: realizable only because the system answers after r (Mealy)
+    mealy = parse_tlsf(_tlsf("Mealy", "GUARANTEE { G (g <-> r); }"))
+    assert solve(Game.build(mealy)).realizable
+    # g must equal the next r: the system would have to predict the input
+    predict = parse_tlsf(_tlsf("Mealy", "GUARANTEE { G (g <-> X r); }"))
+    assert not solve(Game.build(predict)).realizable
+
+
+def test_tlsf_strict_safety_ends_when_the_environment_breaks_its_own() -> None:
+    # the environment promises r stays low; the system must keep g equal to the previous r
+    # and never raise g: only an environment that breaks REQUIRE could force g up
+    spec = parse_tlsf(
+        _tlsf(
+            "Mealy,Strict",
+            "INITIALLY { !r; }\nPRESET { !g; }\nREQUIRE { !X r; }\nASSERT { X g <-> r; !g; }",
+        )
+    )
+    assert solve(Game.build(spec)).realizable
+    unguarded = parse_tlsf(
+        _tlsf("Mealy,Strict", "INITIALLY { !r; }\nPRESET { !g; }\nASSERT { X g <-> r; !g; }")
+    )
+    assert not solve(Game.build(unguarded)).realizable
+
+
+def test_gr1c_one_side_init() -> None:
+    """gr1c's ONE_SIDE_INIT: a SYSINIT alone needs one winning state; an ENVINIT alone needs
+    every state it allows to win (y is frozen, and only y = True wins)."""
+    frozen = "ENV: x;\nSYS: y;\nSYSTRANS: [](y' <-> y);\nSYSGOAL: []<> y;\n"
+    sys_side = parse_gr1c(frozen + "SYSINIT: x & y;\n", init_mode="one_side")
+    assert solve(Game.build(sys_side)).realizable
+    env_side = parse_gr1c(frozen + "ENVINIT: x | y;\n", init_mode="one_side")
+    assert not solve(Game.build(env_side)).realizable
+    env_side_ok = parse_gr1c(frozen + "ENVINIT: y;\n", init_mode="one_side")
+    assert solve(Game.build(env_side_ok)).realizable

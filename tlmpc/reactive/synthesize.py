@@ -1,0 +1,145 @@
+"""Solve a reactive mission: its GR(1) game, realizability, and a core when it is not.
+
+The core is the smallest set of task parts (deletion-minimal) that no robot strategy can
+meet under all of the mission's assumptions: every one of them is needed for the conflict.
+Assumptions stay in the game while the core is sought (taking one away only makes the robot's
+task harder, so none would ever be needed).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from tlmpc.abstraction.model import Abstraction
+from tlmpc.base.errors import Diagnostic, InvalidInputError, error
+from tlmpc.mission.model import Mission, TaskPart
+from tlmpc.reactive.explain import counter_play
+from tlmpc.reactive.faces import Faces, faces_of
+from tlmpc.reactive.fragment import reading
+from tlmpc.reactive.game import MissionGame, build_game
+from tlmpc.reactive.parts import mission_parts
+from tlmpc.synth.core import minimal_core
+from tlmpc.synth.counter import CounterStrategy, extract_counterstrategy
+from tlmpc.synth.solver import Game, Solution, solve
+from tlmpc.synth.spec import Part
+from tlmpc.synth.strategy import MealyMachine, extract, to_json
+from tlmpc.synth.symbolic import Encoding
+
+
+def mission_game(mission: Mission, abstraction: Abstraction) -> MissionGame:
+    """The game of ``mission`` on the faces of ``abstraction`` (Q102 for a part outside GR(1),
+    Q103 under the closed convention)."""
+    pieces, problems = reading(mission_parts(mission), mission.source)
+    if mission.options.boundary == "closed":
+        problems.append(
+            error(
+                "Q103",
+                "a reactive mission is read with the right-continuous convention",
+                hint="leave options.boundary out (or set it to right): the game's steps are "
+                "the run's events, each letter held for a positive time",
+                file=mission.source,
+            )
+        )
+    if problems:
+        raise InvalidInputError(problems)
+    faces: Faces = faces_of(abstraction)
+    start_face = int(faces.face_of[abstraction.start])
+    return build_game(mission, faces, start_face, pieces)
+
+
+@dataclass(frozen=True)
+class Synthesis:
+    """The outcome: the solved game; the strategy when realizable, else a core (task parts)
+    and the environment's counterstrategy."""
+
+    game: MissionGame
+    solution: Solution
+    strategy: MealyMachine | None = None
+    core: tuple[TaskPart, ...] | None = None
+    counter: CounterStrategy | None = None
+
+    @property
+    def realizable(self) -> bool:
+        """Whether a robot strategy wins from the start."""
+        return self.solution.realizable
+
+
+def synthesize(mission: Mission, abstraction: Abstraction, *, explain: bool = True) -> Synthesis:
+    """Solve the mission's game: its strategy, or (with ``explain``) a core and a
+    counterstrategy."""
+    game = mission_game(mission, abstraction)
+    encoding = Encoding(game.spec)
+    solution = solve(Game.build(game.spec, encoding))
+    if solution.realizable:
+        return Synthesis(game=game, solution=solution, strategy=extract(solution))
+    if not explain:
+        return Synthesis(game=game, solution=solution)
+    counter = extract_counterstrategy(solution)
+    core = minimal_core(game.spec, encoding, group=lambda part: _source_key(game, part))
+    parts: dict[int, TaskPart] = {}
+    for part in core.parts:
+        source = game.sources[id(part)]
+        parts.setdefault(id(source), source)
+    return Synthesis(game=game, solution=solution, core=tuple(parts.values()), counter=counter)
+
+
+def strategy_to_json(synthesis: Synthesis) -> dict[str, Any]:
+    """``strategy.json`` of a reactive mission: the Mealy machine and the faces it moves on."""
+    assert synthesis.strategy is not None
+    faces = synthesis.game.faces
+    document = to_json(synthesis.strategy)
+    document["faces"] = {
+        "labels": [list(letter) for letter in faces.letters],
+        "adjacent": [list(a) for a in faces.adjacent],
+        "face_of": faces.face_of.tolist(),
+    }
+    return document
+
+
+def _source_key(game: MissionGame, part: Part) -> int | None:
+    """The task part a game part comes from (None: a rule of the motion, never dropped)."""
+    source = game.sources.get(id(part))
+    return None if source is None else id(source)
+
+
+def unrealizable(synthesis: Synthesis, mission: Mission) -> list[Diagnostic]:
+    """Q110 at the core's first part, and a note at each further part of the core."""
+    core = synthesis.core or ()
+    names = "; ".join(part.text for part in core) or "the robot's motion alone"
+    first = core[0] if core else None
+    play = counter_play(synthesis) if synthesis.counter is not None else []
+    found = [
+        error(
+            "Q110",
+            f"no robot strategy meets the task under the assumptions: {names} cannot all hold "
+            "whatever the environment does",
+            hint="each of these parts is needed for the conflict: weaken one of them, or add "
+            "an assumption that rules out the environment's winning moves (the notes Q111 show "
+            "how the environment wins)",
+            file=mission.source,
+            line=first.line if first else None,
+            col=first.col if first else None,
+        )
+    ]
+    found += [
+        Diagnostic(
+            code="Q110",
+            message=f"part of the conflict: {part.text}",
+            file=mission.source,
+            line=part.line,
+            col=part.col,
+            severity="note",
+        )
+        for part in core[1:]
+    ]
+    found += [
+        Diagnostic(
+            code="Q111",
+            message=f"the environment wins: {line}",
+            file=mission.source,
+            severity="note",
+        )
+        for line in play
+    ]
+    return found

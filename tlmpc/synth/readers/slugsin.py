@@ -1,0 +1,213 @@
+"""slugs' ``.slugsin`` format, read as slugs reads it.
+
+Sections ``[INPUT] [OUTPUT] [ENV_INIT] [SYS_INIT] [ENV_TRANS] [SYS_TRANS] [ENV_LIVENESS]
+[SYS_LIVENESS]``, one variable or one formula per line, ``#`` lines are comments.  Formulas
+are in prefix notation over Boolean variables: ``! & | ^``, constants ``0 1``, ``x'`` for the
+next value, and memory buffers ``$ N f0 ... f(N-1)`` whose value is the last formula, where
+``? i`` inside the buffer recalls formula ``i`` (already read).  As in slugs, ENV_INIT may
+mention inputs only, SYS_INIT current variables, ENV_TRANS no next outputs; liveness lines
+may mention the next step (goals on transitions).  Every line is one part of the game.
+"""
+
+from __future__ import annotations
+
+from tlmpc.synth.readers.source import Source
+from tlmpc.synth.spec import (
+    Atom,
+    Const,
+    Expr,
+    GameSpec,
+    InitMode,
+    Nary,
+    Not,
+    Owner,
+    Part,
+    PartKind,
+    Variable,
+)
+
+_SECTIONS: dict[str, tuple[Owner, str]] = {
+    "[INPUT]": ("env", "vars"),
+    "[OUTPUT]": ("sys", "vars"),
+    "[ENV_INIT]": ("env", "init"),
+    "[SYS_INIT]": ("sys", "init"),
+    "[ENV_TRANS]": ("env", "safety"),
+    "[SYS_TRANS]": ("sys", "safety"),
+    "[ENV_LIVENESS]": ("env", "liveness"),
+    "[SYS_LIVENESS]": ("sys", "liveness"),
+}
+
+
+class _Line:
+    """The tokens of one formula line, with their offsets in the file."""
+
+    def __init__(self, source: Source, start: int, text: str) -> None:
+        self.source = source
+        self.tokens: list[tuple[str, int]] = []
+        offset = 0
+        for word in text.split():
+            offset = text.index(word, offset)
+            self.tokens.append((word, start + offset))
+            offset += len(word)
+        self.pos = 0
+        self.end = start + len(text)
+
+    def next(self, what: str) -> tuple[str, int]:
+        if self.pos == len(self.tokens):
+            raise self.source.fail(
+                "Q030",
+                f"the formula ends early: expected {what}",
+                self.end,
+                "slugsin formulas are prefix: '& a b', '| ! a b', '$ 2 a & ? 0 b'",
+            )
+        token = self.tokens[self.pos]
+        self.pos += 1
+        return token
+
+
+def parse_slugsin(
+    text: str, *, file: str = "<input>", init_mode: InitMode = "forall_env_exists_sys"
+) -> GameSpec:
+    """Read a slugs specification."""
+    source = Source(file, text)
+    variables: dict[str, Variable] = {}
+    parts: list[Part] = []
+    section: tuple[Owner, str] | None = None
+    offset = 0
+    for raw in text.split("\n"):
+        line_start = offset
+        offset += len(raw) + 1
+        stripped = raw.strip()
+        if not stripped or stripped.startswith("#"):
+            continue
+        start = line_start + raw.index(stripped[0])
+        if stripped.startswith("["):
+            if stripped not in _SECTIONS:
+                raise source.fail(
+                    "Q031",
+                    f"unknown section {stripped!r}",
+                    start,
+                    "slugsin sections are [INPUT] [OUTPUT] [ENV_INIT] [SYS_INIT] [ENV_TRANS] "
+                    "[SYS_TRANS] [ENV_LIVENESS] [SYS_LIVENESS]",
+                )
+            section = _SECTIONS[stripped]
+            continue
+        if section is None:
+            raise source.fail(
+                "Q031",
+                "a line before any section",
+                start,
+                "start the file with [INPUT] or [OUTPUT]",
+            )
+        owner, what = section
+        if what == "vars":
+            name = stripped
+            if name in variables or any(ch.isspace() for ch in name) or name.endswith("'"):
+                problem = "is declared twice" if name in variables else "is not a variable name"
+                raise source.fail(
+                    "Q032",
+                    f"{name!r} {problem}",
+                    start,
+                    "one variable per line, each name once, without spaces or a trailing '",
+                )
+            variables[name] = Variable(name, owner)
+            continue
+        kind: PartKind = what  # type: ignore[assignment]
+        line = _Line(source, start, stripped)
+        formula = _formula(line, [], variables, owner, kind)
+        if line.pos != len(line.tokens):
+            word, where = line.tokens[line.pos]
+            raise source.fail(
+                "Q030",
+                f"stray text after the formula: {word!r}",
+                where,
+                "each line of a formula section holds exactly one prefix formula",
+            )
+        parts.append(Part(owner, kind, formula, source.location(start), stripped))
+    return GameSpec(
+        variables=tuple(variables.values()),
+        parts=tuple(parts),
+        init_mode=init_mode,
+        source_format="slugsin",
+        file=file,
+    )
+
+
+def _allowed(variable: Variable, primed: bool, owner: Owner, kind: PartKind) -> str | None:
+    """Why slugs refuses the variable in this section, or None."""
+    if kind == "init" and primed:
+        return "initial conditions cannot mention next values"
+    if kind == "init" and owner == "env" and variable.owner == "sys":
+        return "ENV_INIT may mention inputs only"
+    if kind == "safety" and owner == "env" and primed and variable.owner == "sys":
+        return "ENV_TRANS cannot mention next outputs (the environment moves first)"
+    return None
+
+
+def _formula(
+    line: _Line,
+    memory: list[Expr | None],
+    variables: dict[str, Variable],
+    owner: Owner,
+    kind: PartKind,
+) -> Expr:
+    word, where = line.next("an operator, a variable, 0 or 1")
+    source = line.source
+    if word in ("&", "|", "^"):
+        left = _formula(line, memory, variables, owner, kind)
+        right = _formula(line, memory, variables, owner, kind)
+        return Nary({"&": "and", "|": "or", "^": "xor"}[word], (left, right))  # type: ignore[arg-type]
+    if word == "!":
+        return Not(_formula(line, memory, variables, owner, kind))
+    if word in ("0", "1"):
+        return Const(word == "1")
+    if word in ("$", "?"):
+        count_word, count_where = line.next("a number")
+        if not count_word.isdigit():
+            raise source.fail(
+                "Q033",
+                f"expected a number after {word!r}, found {count_word!r}",
+                count_where,
+                "write '$ N' followed by N formulas, and '? i' to recall formula i",
+            )
+        count = int(count_word)
+        if word == "$":
+            if count == 0:
+                raise source.fail(
+                    "Q033", "an empty memory buffer '$ 0'", where, "a buffer holds N >= 1 formulas"
+                )
+            buffer: list[Expr | None] = [None] * count
+            for index in range(count):
+                buffer[index] = _formula(line, buffer, variables, owner, kind)
+            result = buffer[-1]
+            assert result is not None
+            return result
+        if count >= len(memory) or memory[count] is None:
+            raise source.fail(
+                "Q033",
+                f"'? {count}' recalls a formula that is not stored yet",
+                where,
+                "inside '$ N ...', '? i' may recall only the formulas before it",
+            )
+        recalled = memory[count]
+        assert recalled is not None
+        return recalled
+    primed = word.endswith("'")
+    name = word[:-1] if primed else word
+    if name not in variables:
+        raise source.fail(
+            "Q034",
+            f"the variable {name!r} is not declared",
+            where,
+            "declare it under [INPUT] or [OUTPUT]",
+        )
+    variable = variables[name]
+    reason = _allowed(variable, primed, owner, kind)
+    if reason is not None:
+        raise source.fail(
+            "Q035",
+            f"{word!r} is not allowed here: {reason}",
+            where,
+            "move the constraint to the section that may mention it (see docs/synthesis.md)",
+        )
+    return Atom(name, primed)

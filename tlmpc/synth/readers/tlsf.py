@@ -1,0 +1,530 @@
+"""GR(1)-shaped TLSF (SYNTCOMP's format, basic fragment), read as syfco hands it to GR(1) tools.
+
+A basic TLSF file has ``INFO`` (``SEMANTICS: Mealy`` or ``Mealy,Strict``) and ``MAIN`` with
+``INPUTS``/``OUTPUTS`` and formula sections, each formula ended by ``;`` (sections may repeat).
+Its meaning (TLSF 1.1) is ``INITIALLY -> (PRESET /\\ (ASSERT W ~REQUIRE) /\\ ((G REQUIRE /\\
+ASSUME) -> GUARANTEE))`` under strict semantics.  The GR(1) game reads it as syfco's
+GR(1) translation does (the one SYNTCOMP feeds GR(1) tools with):
+
+* ``INITIALLY``: the environment's initial condition (inputs only);
+* ``PRESET``: the system's initial condition;
+* ``REQUIRE``: environment safety (implicitly under ``G``; ``X`` only over inputs);
+* ``ASSERT``: system safety (implicitly under ``G``; ``X`` over anything);
+* ``ASSUME`` / ``GUARANTEE``: conjunctions of ``G F b`` (liveness) and ``G s`` (safety).
+
+Anything else is outside GR(1) and refused with a diagnostic saying why and how to rewrite it.
+Parametric TLSF (a non-empty ``GLOBAL``) and Moore semantics are refused as well.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+from tlmpc.base.errors import UsageError
+from tlmpc.synth.readers.source import Source
+from tlmpc.synth.spec import (
+    Atom,
+    Binary,
+    Const,
+    Expr,
+    GameSpec,
+    InitMode,
+    Nary,
+    Not,
+    Owner,
+    Part,
+    PartKind,
+    Variable,
+)
+
+_TOKEN = re.compile(
+    r"""
+    (?P<space>\s+)
+  | (?P<comment>//[^\n]*|/\*.*?\*/)
+  | (?P<string>"[^"]*")
+  | (?P<op>&&|\|\||<->|->|[!{}();:,])
+  | (?P<ident>[A-Za-z_][A-Za-z0-9_@']*)
+  | (?P<number>[0-9]+)
+    """,
+    re.VERBOSE | re.DOTALL,
+)
+_WORD_OPS = {"NOT": "!", "AND": "&&", "OR": "||", "IMPLIES": "->", "EQUIV": "<->"}
+_UNARY = {"!", "X", "G", "F"}
+_BINARY_TEMPORAL = {"U", "W", "R"}
+
+
+@dataclass(frozen=True)
+class Token:
+    """One lexeme."""
+
+    kind: str
+    text: str
+    start: int
+    end: int
+
+
+@dataclass(frozen=True, eq=False)
+class Node:
+    """A TLSF formula node: ``op`` is ``ap``, ``const``, ``!``, ``&&``, ``||``, ``->``,
+    ``<->``, ``X``, ``G``, ``F``, ``U``, ``W`` or ``R``."""
+
+    op: str
+    args: tuple[Node, ...]
+    start: int
+    name: str = ""
+    value: bool = False
+
+
+def tokenize(source: Source) -> list[Token]:
+    """TLSF's lexemes (comments and whitespace dropped)."""
+    text = source.text
+    tokens: list[Token] = []
+    offset = 0
+    while offset < len(text):
+        match = _TOKEN.match(text, offset)
+        if match is None:
+            # kept as a token: the parser says where it stops making sense (a parametric
+            # GLOBAL section is refused as such before its '=' is reached)
+            tokens.append(Token("other", text[offset], offset, offset + 1))
+            offset += 1
+            continue
+        kind = match.lastgroup or ""
+        if kind not in ("space", "comment"):
+            word = match.group()
+            if kind == "ident" and word in _WORD_OPS:
+                kind, word = "op", _WORD_OPS[word]
+            tokens.append(Token(kind, word, offset, match.end()))
+        offset = match.end()
+    tokens.append(Token("eof", "", len(text), len(text)))
+    return tokens
+
+
+class _Parser:
+    def __init__(self, source: Source) -> None:
+        self.source = source
+        self.tokens = tokenize(source)
+        self.pos = 0
+
+    @property
+    def token(self) -> Token:
+        return self.tokens[self.pos]
+
+    def advance(self) -> Token:
+        token = self.tokens[self.pos]
+        self.pos += 1
+        return token
+
+    def shown(self, token: Token) -> str:
+        return "the end of the file" if token.kind == "eof" else repr(token.text)
+
+    def expect(self, text: str, hint: str) -> Token:
+        if self.token.text != text or self.token.kind not in ("op", "ident"):
+            raise self.source.fail(
+                "Q041", f"expected {text!r}, found {self.shown(self.token)}", self.token.start, hint
+            )
+        return self.advance()
+
+    # formulas: unary > && > || > (-> <->, right) > W > U > R
+    _LEVELS: tuple[tuple[str, ...], ...] = (("R",), ("U",), ("W",), ("->", "<->"), ("||",), ("&&",))
+
+    def formula(self, level: int = 0) -> Node:
+        if level == len(self._LEVELS):
+            return self.unary()
+        ops = self._LEVELS[level]
+        left = self.formula(level + 1)
+        if self.token.text in ops and self.token.kind in ("op", "ident"):
+            op = self.advance()
+            right_assoc = op.text != "R" and op.text not in ("&&", "||")
+            if right_assoc:
+                right = self.formula(level)
+                return Node(op.text, (left, right), op.start)
+            right = self.formula(level + 1)
+            left = Node(op.text, (left, right), op.start)
+            while self.token.text in ops and self.token.kind in ("op", "ident"):
+                op = self.advance()
+                right = self.formula(level + 1)
+                left = Node(op.text, (left, right), op.start)
+        return left
+
+    def unary(self) -> Node:
+        token = self.advance()
+        if token.text in _UNARY and token.kind in ("op", "ident"):
+            return Node(token.text, (self.unary(),), token.start)
+        if token.text == "(" and token.kind == "op":
+            inner = self.formula()
+            self.expect(")", "close the parenthesis")
+            return inner
+        if token.kind == "ident" and token.text in ("true", "false"):
+            return Node("const", (), token.start, value=token.text == "true")
+        if token.kind == "ident" and token.text not in _BINARY_TEMPORAL:
+            if self.token.text == "[" or self.token.text == "(":
+                raise self.source.fail(
+                    "Q042",
+                    f"{token.text!r} is applied like a function or a bus",
+                    token.start,
+                    "only basic TLSF is read: expand parametric TLSF first "
+                    "(syfco -f basic spec.tlsf)",
+                )
+            return Node("ap", (), token.start, name=token.text)
+        if token.kind == "other":
+            raise self.source.fail(
+                "Q040",
+                f"unexpected character {token.text!r}",
+                token.start,
+                "basic TLSF uses identifiers, ! && || -> <-> X G F U W R, parentheses, "
+                "braces, ';' and // or /* */ comments",
+            )
+        raise self.source.fail(
+            "Q041",
+            f"expected a formula, found {self.shown(token)}",
+            token.start,
+            "a formula is built from signals, true, false, ! && || -> <-> X G F U W R "
+            "and parentheses",
+        )
+
+    # --- the file ------------------------------------------------------------------------
+
+    def parse(self) -> tuple[str, list[tuple[str, Token]], list[tuple[str, Node]]]:
+        semantics = "Mealy"
+        signals: list[tuple[str, Token]] = []
+        formulas: list[tuple[str, Node]] = []
+        while self.token.kind != "eof":
+            head = self.advance()
+            if head.text == "INFO":
+                semantics = self.info()
+            elif head.text == "GLOBAL":
+                self.expect("{", "GLOBAL { ... }")
+                if self.token.text != "}":
+                    raise self.source.fail(
+                        "Q042",
+                        "parametric TLSF (GLOBAL with parameters or definitions)",
+                        head.start,
+                        "only basic TLSF is read: expand it first (syfco -f basic spec.tlsf)",
+                    )
+                self.advance()
+            elif head.text == "MAIN":
+                self.main(signals, formulas)
+            else:
+                raise self.source.fail(
+                    "Q041",
+                    f"expected INFO, GLOBAL or MAIN, found {self.shown(head)}",
+                    head.start,
+                    "a TLSF file is INFO { ... } GLOBAL { ... } MAIN { ... }",
+                )
+        return semantics, signals, formulas
+
+    def info(self) -> str:
+        self.expect("{", "INFO { TITLE: ... SEMANTICS: ... }")
+        semantics = "Mealy"
+        while self.token.text != "}":
+            key = self.advance()
+            if key.kind == "eof":
+                raise self.source.fail("Q041", "INFO is not closed", key.start, "add '}'")
+            if key.text == "SEMANTICS":
+                self.expect(":", "SEMANTICS: Mealy")
+                words = [self.advance()]
+                while self.token.text == ",":
+                    self.advance()
+                    words.append(self.advance())
+                semantics = ",".join(w.text for w in words)
+                if words[0].text != "Mealy":
+                    raise self.source.fail(
+                        "Q043",
+                        f"SEMANTICS {semantics}: only Mealy semantics is read",
+                        words[0].start,
+                        "the system answers the inputs of the same step (Mealy); convert a Moore "
+                        "specification with syfco's -os option",
+                    )
+        self.advance()
+        return semantics
+
+    def main(self, signals: list[tuple[str, Token]], formulas: list[tuple[str, Node]]) -> None:
+        self.expect("{", "MAIN { INPUTS { ... } ... }")
+        while self.token.text != "}":
+            head = self.advance()
+            name = head.text
+            if name in ("INPUTS", "OUTPUTS"):
+                self.expect("{", f"{name} {{ a; b; }}")
+                while self.token.text != "}":
+                    signal = self.advance()
+                    if signal.kind != "ident":
+                        raise self.source.fail(
+                            "Q041",
+                            f"expected a signal name, found {self.shown(signal)}",
+                            signal.start,
+                            f"{name} {{ a; b; }} (basic TLSF has no buses or enums)",
+                        )
+                    self.expect(";", "end each signal with ';'")
+                    signals.append((name, signal))
+                self.advance()
+            elif name in (
+                "INITIALLY",
+                "PRESET",
+                "REQUIRE",
+                "ASSERT",
+                "INVARIANTS",
+                "ASSUME",
+                "ASSUMPTIONS",
+                "GUARANTEE",
+                "GUARANTEES",
+            ):
+                self.expect("{", f"{name} {{ formula; ... }}")
+                while self.token.text != "}":
+                    formula = self.formula()
+                    self.expect(";", "end each formula with ';'")
+                    formulas.append((name, formula))
+                self.advance()
+            else:
+                raise self.source.fail(
+                    "Q041",
+                    f"unknown section {self.shown(head)} in MAIN",
+                    head.start,
+                    "MAIN holds INPUTS OUTPUTS INITIALLY PRESET REQUIRE ASSERT ASSUME GUARANTEE",
+                )
+        self.advance()
+
+
+_SECTION_ROLE: dict[str, tuple[Owner, str]] = {
+    "INITIALLY": ("env", "init"),
+    "PRESET": ("sys", "init"),
+    "REQUIRE": ("env", "safety"),
+    "ASSERT": ("sys", "safety"),
+    "INVARIANTS": ("sys", "safety"),
+    "ASSUME": ("env", "temporal"),
+    "ASSUMPTIONS": ("env", "temporal"),
+    "GUARANTEE": ("sys", "temporal"),
+    "GUARANTEES": ("sys", "temporal"),
+}
+
+
+class _Lowering:
+    """From TLSF formulas to game parts, with GR(1)-shape diagnostics."""
+
+    def __init__(self, source: Source, variables: dict[str, Variable]) -> None:
+        self.source = source
+        self.variables = variables
+
+    def fail(self, node: Node, message: str, hint: str) -> UsageError:
+        return self.source.fail("Q044", message, node.start, hint)
+
+    def boolean(self, node: Node, owner: Owner, kind: str, primed: bool = False) -> Expr:
+        """A Boolean formula, ``X`` allowed once (``kind`` safety), as an IR expression."""
+        op = node.op
+        if op == "const":
+            return Const(node.value)
+        if op == "ap":
+            if node.name not in self.variables:
+                raise self.source.fail(
+                    "Q045",
+                    f"the signal {node.name!r} is not declared",
+                    node.start,
+                    "declare it in INPUTS or OUTPUTS",
+                )
+            variable = self.variables[node.name]
+            if kind == "init" and owner == "env" and variable.owner == "sys":
+                raise self.fail(
+                    node,
+                    f"INITIALLY mentions the output {node.name!r}",
+                    "INITIALLY constrains the first inputs only; put conditions on outputs in "
+                    "PRESET",
+                )
+            if kind == "safety" and owner == "env" and primed and variable.owner == "sys":
+                raise self.fail(
+                    node,
+                    f"REQUIRE mentions the next value of the output {node.name!r}",
+                    "the environment moves first: REQUIRE may apply X to inputs only",
+                )
+            return Atom(node.name, primed)
+        if op == "!":
+            return Not(self.boolean(node.args[0], owner, kind, primed))
+        if op in ("&&", "||"):
+            return Nary(
+                "and" if op == "&&" else "or",
+                tuple(self.boolean(a, owner, kind, primed) for a in node.args),
+            )
+        if op in ("->", "<->"):
+            left, right = (self.boolean(a, owner, kind, primed) for a in node.args)
+            return Binary(op, left, right)  # type: ignore[arg-type]
+        if op == "X":
+            if kind != "safety":
+                raise self.fail(
+                    node,
+                    "X in an initial condition or a goal",
+                    "X belongs in REQUIRE, ASSERT or G safety formulas; an initial condition "
+                    "speaks of the first step only",
+                )
+            if primed:
+                raise self.fail(
+                    node,
+                    "nested X: GR(1) safety relates a step to the next one only",
+                    "add an output that remembers the previous value (ASSERT { X m <-> a; }) and "
+                    "use it in place of the inner X",
+                )
+            return self.boolean(node.args[0], owner, kind, True)
+        raise self.fail(node, *self.why_not_gr1(node))
+
+    @staticmethod
+    def why_not_gr1(node: Node) -> tuple[str, str]:
+        """Why a temporal shape is outside GR(1), and the rewrite to suggest."""
+        op = node.op
+        if op == "F" and node.args[0].op == "G":
+            return (
+                "F G (persistence) is outside GR(1)",
+                "GR(1) goals are G F b; G F b is the nearest goal, or make the persistence an "
+                "assumption-free safety (G b) if it must hold from the start",
+            )
+        if op == "F":
+            return (
+                "a one-time F is outside GR(1)",
+                "write G F b if repeating is acceptable, or latch it in an output: ASSERT { X done "
+                "<-> (done || X b); } GUARANTEE { G F done; }",
+            )
+        if op == "G" and node.args[0].op in ("->", "||"):
+            return (
+                "G with an eventuality inside (a response) is outside GR(1)",
+                "add an output p that stays up while a request waits: ASSERT { X p <-> "
+                "((p || a) && !X b); } GUARANTEE { G F !p; }",
+            )
+        if op in ("U", "W", "R"):
+            return (
+                f"the operator {op} is outside GR(1)",
+                "express it with an auxiliary output that records the obligation, a safety "
+                "formula on it, and a G F goal that discharges it",
+            )
+        return (
+            f"{op} here is outside GR(1)",
+            "GR(1) parts are Boolean initial conditions, G safety with one X, and G F goals",
+        )
+
+    def conjuncts(self, node: Node) -> list[Node]:
+        if node.op == "&&":
+            return [c for a in node.args for c in self.conjuncts(a)]
+        return [node]
+
+    @staticmethod
+    def is_boolean(node: Node, allow_x: bool) -> bool:
+        if node.op in ("ap", "const"):
+            return True
+        if node.op == "X":
+            return allow_x and _Lowering.is_boolean(node.args[0], False)
+        if node.op in ("!", "&&", "||", "->", "<->"):
+            return all(_Lowering.is_boolean(a, allow_x) for a in node.args)
+        return False
+
+    def parts(self, section: str, node: Node) -> list[tuple[Owner, PartKind, Expr, Node]]:
+        owner, role = _SECTION_ROLE[section]
+        if role == "init":
+            return [(owner, "init", self.boolean(node, owner, "init"), node)]
+        if role == "safety":
+            while node.op == "G":
+                node = node.args[0]
+            return [(owner, "safety", self.boolean(node, owner, "safety"), node)]
+        found: list[tuple[Owner, PartKind, Expr, Node]] = []
+        for part in self.conjuncts(node):
+            if part.op == "G" and part.args[0].op == "F":
+                goal = part.args[0].args[0]
+                if not self.is_boolean(goal, allow_x=False):
+                    raise self.fail(goal, *self.why_not_gr1(goal))
+                found.append((owner, "liveness", self.boolean(goal, owner, "liveness"), goal))
+            elif part.op == "G" and self.is_boolean(part.args[0], allow_x=True):
+                inner = part.args[0]
+                found.append((owner, "safety", self.boolean(inner, owner, "safety"), inner))
+            elif part.op == "G":
+                raise self.fail(part, *self.why_not_gr1(part))
+            elif self.is_boolean(part, allow_x=False):
+                where = "INITIALLY" if owner == "env" else "PRESET"
+                raise self.fail(
+                    part,
+                    f"a formula without G in {section}",
+                    f"in {section} it would hold only under the assumptions' implication; write "
+                    f"an initial condition in {where}, or G b for every step",
+                )
+            else:
+                raise self.fail(part, *self.why_not_gr1(part))
+        return found
+
+
+def parse_tlsf(
+    text: str, *, file: str = "<input>", init_mode: InitMode = "forall_env_exists_sys"
+) -> GameSpec:
+    """Read a basic, GR(1)-shaped TLSF specification."""
+    source = Source(file, text)
+    parser = _Parser(source)
+    semantics, signals, formulas = parser.parse()
+    variables: dict[str, Variable] = {}
+    for section, token in signals:
+        if token.text in variables:
+            raise source.fail(
+                "Q046",
+                f"the signal {token.text!r} is declared twice",
+                token.start,
+                "declare each signal once, as an input or an output",
+            )
+        variables[token.text] = Variable(token.text, "env" if section == "INPUTS" else "sys")
+    lowering = _Lowering(source, variables)
+    parts: list[Part] = []
+    for section, node in formulas:
+        for owner, kind, expr, origin in lowering.parts(section, node):
+            end = _end_offset(parser, origin)
+            parts.append(
+                Part(
+                    owner,
+                    kind,
+                    expr,
+                    source.location(_start_offset(origin)),
+                    source.excerpt(_start_offset(origin), end),
+                )
+            )
+    strict = "Strict" in semantics.split(",")
+    has_env_safety = any(p.owner == "env" and p.kind == "safety" for p in parts)
+    has_sys_safety = any(p.owner == "sys" and p.kind == "safety" for p in parts)
+    if not strict and has_env_safety and has_sys_safety:
+        first = next(p for p in parts if p.owner == "env" and p.kind == "safety")
+        raise source.fail(
+            "Q047",
+            "non-strict semantics with safety on both sides: G REQUIRE -> G ASSERT is an "
+            "implication the GR(1) game does not decide",
+            _offset_of(source, first.location.line, first.location.col),
+            "declare SEMANTICS: Mealy,Strict (the system keeps its safety until the environment "
+            "breaks its own), the reading GR(1) tools use",
+        )
+    return GameSpec(
+        variables=tuple(variables.values()),
+        parts=tuple(parts),
+        init_mode=init_mode,
+        source_format="tlsf",
+        file=file,
+    )
+
+
+def _start_offset(node: Node) -> int:
+    return min([node.start, *(_start_offset(a) for a in node.args)])
+
+
+def _end_offset(parser: _Parser, node: Node) -> int:
+    """The end of the last token of ``node`` (the token before the next ';' or '}')."""
+    last = max([node.start, *(_end_start(a) for a in node.args)])
+    index = next(i for i, t in enumerate(parser.tokens) if t.start >= last)
+    depth = 0
+    while index < len(parser.tokens) - 1:
+        token = parser.tokens[index]
+        if token.text == "(":
+            depth += 1
+        elif token.text == ")":
+            if depth == 0:
+                break
+            depth -= 1
+        elif token.text in (";", "}") and depth == 0:
+            break
+        index += 1
+    return parser.tokens[index - 1].end
+
+
+def _end_start(node: Node) -> int:
+    return max([node.start, *(_end_start(a) for a in node.args)])
+
+
+def _offset_of(source: Source, line: int, col: int) -> int:
+    lines = source.text.split("\n")
+    return sum(len(text) + 1 for text in lines[: line - 1]) + col - 1
