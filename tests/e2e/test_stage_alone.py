@@ -11,7 +11,14 @@ from typing import Any
 import pytest
 
 from tlmpc.io.outdir import write_artifacts
-from tlmpc.pipeline.stages import STAGES, compile_mission, run_stage_from_artifacts
+from tlmpc.pipeline.stages import (
+    MISSION,
+    STAGES,
+    MissingProductError,
+    compile_mission,
+    run_stage_from_artifacts,
+    world_of,
+)
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -29,8 +36,9 @@ def _without_timings(document: Any) -> Any:
 def test_every_stage_reproduces_its_artifacts_from_its_inputs(tmp_path: Path, spec: str) -> None:
     whole = compile_mission(ROOT / "specs" / spec, until="verify")
     write_artifacts(tmp_path, whole.artifacts)
+    mission = whole.compilation.get(MISSION)
     for stage in STAGES:
-        if not stage.requires or stage.name == "plot":
+        if not stage.requires or stage.name == "plot" or world_of(mission) not in stage.worlds:
             continue
         alone = run_stage_from_artifacts(stage.name, tmp_path)
         assert alone.artifacts, stage.name
@@ -71,3 +79,11 @@ def test_a_tampered_input_artifact_is_rejected_by_its_schema(tmp_path: Path) -> 
     assert done.returncode == 2
     assert "controllers.json" in done.stderr
     assert "error[U071]" in done.stderr
+
+
+def test_a_stage_of_the_other_world_is_refused(tmp_path: Path) -> None:
+    whole = compile_mission(ROOT / "specs" / "example1.yaml", until="abstraction")
+    write_artifacts(tmp_path, whole.artifacts)
+    with pytest.raises(MissingProductError) as caught:
+        run_stage_from_artifacts("synthesize", tmp_path)
+    assert caught.value.diagnostics[0].code == "U076"

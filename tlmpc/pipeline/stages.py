@@ -590,10 +590,12 @@ def run_stages(
     reports: list[StageReport] = []
     warnings: list[Diagnostic] = []
     extras: dict[str, Any] = {}
-    for index, stage in enumerate(stages, start=1):
+    index = 0
+    for stage in stages:
         mission = products.get(MISSION)
         if mission is not None and world_of(mission) not in stage.worlds:
             continue
+        index += 1
         for product in stage.requires:
             compilation.get(product)  # a clear error instead of a failure deep inside
         started = time.perf_counter()
@@ -615,7 +617,9 @@ def run_stages(
         extras.update(result.summary)
         reports.append(report)
         if progress is not None:
-            progress(index, len(stages), report)
+            world = world_of(products[MISSION]) if MISSION in products else None
+            total = sum(1 for s in stages if world is None or world in s.worlds)
+            progress(index, total, report)
     return CompileResult(
         compilation=compilation,
         artifacts=written,
@@ -688,4 +692,16 @@ def run_stage_from_artifacts(
     """Run the one stage ``name`` on the input artifacts found in ``directory``."""
     stage = stage_named(name)
     compilation = compilation_from_artifacts(directory, stage.requires)
+    mission = compilation.find(MISSION)
+    if mission is not None and world_of(mission) not in stage.worlds:
+        raise MissingProductError(
+            error(
+                "U076",
+                f"the {stage.name} stage does not apply to this mission "
+                f"(a {world_of(mission)} mission)",
+                hint="the synthesize stage lowers reactive missions (with sensors); automaton, "
+                "plan, control, simulate, verify and plot lower the others",
+                file=str(directory / MISSION.artifact),
+            )
+        )
     return run_stages([stage], compilation, progress=progress)

@@ -9,12 +9,8 @@ one; steps that differ only in the task's memory are shown once.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
-from tlmpc.reactive.game import FACE, GOAL, MOVED
-
-if TYPE_CHECKING:
-    from tlmpc.reactive.synthesize import Synthesis
+from tlmpc.reactive.game import FACE, GOAL, MOVED, MissionGame
+from tlmpc.synth.counter import CounterStrategy
 
 #: the longest play shown (steps)
 MAX_STEPS = 12
@@ -25,12 +21,10 @@ def place(letters: tuple[str, ...]) -> str:
     return " & ".join(letters) if letters else "free space"
 
 
-def counter_play(synthesis: Synthesis) -> list[str]:
-    """The lines of one play of the counterstrategy (empty when there is none)."""
-    counter = synthesis.counter
-    if counter is None or not counter.initial:
+def counter_play(counter: CounterStrategy, game: MissionGame) -> list[str]:
+    """The lines of one play of the counterstrategy (empty when it has no start)."""
+    if not counter.initial:
         return []
-    game = synthesis.game
     sensors = [v.name for v in game.spec.owned("env") if v.is_bool and v.name != MOVED]
     letters = game.faces.letters
 

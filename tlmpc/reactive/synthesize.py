@@ -108,7 +108,8 @@ def unrealizable(synthesis: Synthesis, mission: Mission) -> list[Diagnostic]:
     core = synthesis.core or ()
     names = "; ".join(part.text for part in core) or "the robot's motion alone"
     first = core[0] if core else None
-    play = counter_play(synthesis) if synthesis.counter is not None else []
+    counter = synthesis.counter
+    play = counter_play(counter, synthesis.game) if counter is not None else []
     found = [
         error(
             "Q110",
