@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 
 from tlmpc.base.errors import Diagnostic, InvalidInputError, best_first, error
 from tlmpc.io.schema_check import is_valid, load_schema
-from tlmpc.ltl.ast import Formula, Or, Prop, conjoin
+from tlmpc.ltl.ast import Formula, Prop, conjoin
 from tlmpc.ltl.keywords import KEYWORDS
 from tlmpc.ltl.transform import substitute
 from tlmpc.mission.geometry import check_layout, check_shape
@@ -32,6 +32,7 @@ from tlmpc.mission.model import (
     TaskPart,
     Workspace,
 )
+from tlmpc.mission.parts import group_expansion
 from tlmpc.mission.shapes import CheckedShape
 from tlmpc.mission.yamlpos import Path, PositionedDocument, json_path, load_positioned
 from tlmpc.tasks.compiler import NameKinds, compile_phrases
@@ -343,11 +344,7 @@ def _check_task(
     problems.extend(_unknown_names(parts, names | set(groups) | signals, file, bool(signals)))
     if problems or not parts:
         return None, problems
-    expand: dict[str, Formula] = {
-        g: Or(tuple(Prop(m) for m in members)) if len(members) > 1 else Prop(members[0])
-        for g, members in groups.items()
-    }
-    return substitute(conjoin(parts), expand), []
+    return substitute(conjoin(parts), group_expansion(groups)), []
 
 
 def _unknown_names(
@@ -446,12 +443,13 @@ def _reactive(
                         col=span.col if span else col,
                     )
                 )
-        expand: dict[str, Formula] = {
-            g: Or(tuple(Prop(m) for m in members)) if len(members) > 1 else Prop(members[0])
-            for g, members in groups.items()
-        }
         assumptions.append(
-            TaskPart(text=text, formula=substitute(formula, expand), line=line, col=col)
+            TaskPart(
+                text=text,
+                formula=substitute(formula, group_expansion(groups)),
+                line=line,
+                col=col,
+            )
         )
     reactive = Reactive(
         sensors=tuple(

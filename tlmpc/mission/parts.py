@@ -5,11 +5,21 @@ Computed on demand (only when no plan exists), so loading a mission pays nothing
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
+
 from tlmpc.ltl.ast import And, Formula, Or, Prop
 from tlmpc.ltl.printer import to_text
 from tlmpc.ltl.transform import substitute
 from tlmpc.mission.model import Mission, TaskPart
 from tlmpc.tasks.compiler import compile_phrases
+
+
+def group_expansion(groups: Mapping[str, Sequence[str]]) -> dict[str, Formula]:
+    """Each group name as the formula it stands for: "in any of its regions"."""
+    return {
+        g: Or(tuple(Prop(m) for m in members)) if len(members) > 1 else Prop(members[0])
+        for g, members in groups.items()
+    }
 
 
 def task_parts(mission: Mission) -> tuple[TaskPart, ...]:
@@ -18,10 +28,7 @@ def task_parts(mission: Mission) -> tuple[TaskPart, ...]:
     Group names are expanded as in :attr:`Mission.formula`.  The mission loaded, so its task
     compiles and nothing here can fail.
     """
-    expand: dict[str, Formula] = {
-        g: Or(tuple(Prop(m) for m in members)) if len(members) > 1 else Prop(members[0])
-        for g, members in mission.groups.items()
-    }
+    expand = group_expansion(mission.groups)
     groups = {g: list(members) for g, members in mission.groups.items()}
     positions = list(mission.task_positions)
     parts: list[TaskPart] = []

@@ -71,12 +71,6 @@ class MissionGame:
     faces: Faces
     #: each user part of the spec, with the mission part (task or assumption) it comes from
     sources: Mapping[int, TaskPart]
-    #: (variable name, automaton) of every monitor, in the order of the spec's variables
-    monitors: tuple[tuple[str, Automaton], ...]
-
-    def user_parts(self) -> tuple[Part, ...]:
-        """The parts that come from the user's task and assumptions."""
-        return tuple(p for p in self.spec.parts if id(p) in self.sources)
 
 
 class _Letters:
@@ -210,7 +204,6 @@ def build_game(
         spec=spec,
         faces=faces,
         sources=sources,
-        monitors=tuple((name, automaton) for name, automaton, _ in monitors),
     )
 
 

@@ -65,16 +65,13 @@ class Synthesis:
         return self.solution.realizable
 
 
-def synthesize(mission: Mission, abstraction: Abstraction, *, explain: bool = True) -> Synthesis:
-    """Solve the mission's game: its strategy, or (with ``explain``) a core and a
-    counterstrategy."""
+def synthesize(mission: Mission, abstraction: Abstraction) -> Synthesis:
+    """Solve the mission's game: its strategy, or a core and a counterstrategy."""
     game = mission_game(mission, abstraction)
     encoding = Encoding(game.spec)
     solution = solve(Game.build(game.spec, encoding))
     if solution.realizable:
         return Synthesis(game=game, solution=solution, strategy=extract(solution))
-    if not explain:
-        return Synthesis(game=game, solution=solution)
     counter = extract_counterstrategy(solution)
     core = minimal_core(game.spec, encoding, group=lambda part: _source_key(game, part))
     parts: dict[int, TaskPart] = {}
