@@ -33,6 +33,7 @@ from tlmpc.control.geometry import (
     largest_of,
     triangle_geometry,
 )
+from tlmpc.control.follow import follow_channel
 from tlmpc.control.model import Controllers, StepController, VelocityJump
 from tlmpc.control.sparse import CscMatrix, Triplets, stacked_csc
 from tlmpc.mission.model import Robot
@@ -612,12 +613,19 @@ def pursuit_controller(
 
 
 def synthesize(
-    abstraction: Abstraction, witness: Witness, robot: Robot, *, source: str | None = None
+    abstraction: Abstraction,
+    witness: Witness,
+    robot: Robot,
+    *,
+    source: str | None = None,
+    follow: bool = True,
 ) -> Controllers:
     """One affine field per plan step realising ``witness`` under ``robot.max_speed``, robust
     to any additive velocity disturbance up to ``robot.disturbance``.
 
-    ``source`` names the mission file in diagnostics.
+    ``source`` names the mission file in diagnostics.  With ``follow`` (the default) the
+    fields are then re-chosen so that their flow follows the shortest path through the plan's
+    channel (:mod:`tlmpc.control.follow`), under the same constraints.
     """
     started = time.perf_counter()
     steps, loop_start = plan_steps(abstraction, witness)
@@ -634,7 +642,15 @@ def synthesize(
     affine = [step for step in steps if step.through is None]
     program, column = vertex_program(affine, robot.max_speed, robot.disturbance)
     built = time.perf_counter()
-    velocities, _ = solve_vertex_program(program)
+    velocities, speeds = solve_vertex_program(program)
+    following: dict[str, float | str] = {"follow_status": "off"}
+    if follow and affine:
+        followed = follow_channel(
+            abstraction, steps, loop_start, robot.start, conic_form(program), program.runs,
+            column, speeds, robot.max_speed, robot.disturbance,
+        )  # fmt: skip
+        following = {"follow_status": "failed"} if followed is None else followed[1]
+        velocities = velocities if followed is None else followed[0]
     solved = time.perf_counter()
     controllers = []
     for index, step in enumerate(steps):
@@ -729,5 +745,6 @@ def synthesize(
             "prepare_seconds": round(built - started, 6),
             "solve_seconds": round(solved - built, 6),
             "min_exit_speed": min(c.exit_speed for c in controllers),
+            **following,
         },
     )

@@ -1,0 +1,212 @@
+"""The shortest path through a plan's channel of triangles (string pulling), as waypoints.
+
+A plan is a sequence of triangles; consecutive ones share an edge, the *portal* the robot
+crosses (a vertex passage crosses a single point, a portal of zero width).  The shortest path
+from the start through the portals in order is found by the funnel algorithm ("simple stupid
+funnel"): it keeps the apex of the shortest paths found so far and the two sides of the
+funnel of directions that still see every later portal, and makes a side's end the next
+apex when the other side crosses over it.  The path bends only at portal ends.
+
+The triangles are those of the planning layout, which meshes the free space already eroded
+by the body radius and the margin, so the channel, and any path through its portals, keeps
+the body's clearance.
+
+Each portal is first shrunk toward its midpoint by :data:`PORTAL_INSET` of its length at both
+ends: an affine field's vertex conditions push every vertex of a portal across it, so a flow
+line can only cross a portal strictly between its ends, and a little away from them the
+controller has room to follow the path (see docs/control.md).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+#: A point of the plane as Python floats.
+Point = tuple[float, float]
+
+#: Each portal keeps this fraction of its length clear at both ends.
+PORTAL_INSET = 0.1
+
+
+@dataclass(frozen=True, slots=True)
+class Portal:
+    """A crossing: ``left`` and ``right`` ends as seen facing the direction of travel
+    (equal for a vertex passage)."""
+
+    left: Point
+    right: Point
+
+
+@dataclass(frozen=True, slots=True)
+class ChannelStep:
+    """One plan step as the channel sees it: the triangle's counter-clockwise corners, the
+    local index of the vertex opposite the exit edge (None for a stay), and the corner a vertex
+    passage goes through (None otherwise)."""
+
+    corners: tuple[Point, Point, Point]
+    exit_edge: int | None
+    through: Point | None = None
+
+
+@dataclass(frozen=True, slots=True)
+class Guide:
+    """The straight piece of the channel's shortest path inside one step's triangle: from
+    ``entry`` (the start, or where the path crosses the entry portal) to ``exit`` (where it
+    crosses the exit portal; a stay's target)."""
+
+    entry: Point
+    exit: Point
+
+
+def _cross(origin: Point, a: Point, b: Point) -> float:
+    """(a - origin) x (b - origin): positive when b lies left of the ray origin -> a."""
+    return (a[0] - origin[0]) * (b[1] - origin[1]) - (a[1] - origin[1]) * (b[0] - origin[0])
+
+
+def inset(portal: Portal, fraction: float = PORTAL_INSET) -> Portal:
+    """``portal`` shrunk toward its midpoint by ``fraction`` of its length at each end."""
+    (lx, ly), (rx, ry) = portal.left, portal.right
+    dx, dy = rx - lx, ry - ly
+    return Portal(
+        (lx + fraction * dx, ly + fraction * dy), (rx - fraction * dx, ry - fraction * dy)
+    )
+
+
+def exit_portal(step: ChannelStep) -> Portal:
+    """The portal a step leaves by: its exit edge, or the corner of a vertex passage.
+
+    For a counter-clockwise triangle the edge opposite vertex e runs from corner e + 1 to
+    corner e + 2 with the interior on its left, so facing outward corner e + 2 is on the left.
+    """
+    if step.through is not None:
+        return Portal(step.through, step.through)
+    assert step.exit_edge is not None
+    e = step.exit_edge
+    return Portal(step.corners[(e + 2) % 3], step.corners[(e + 1) % 3])
+
+
+def funnel(start: Point, portals: Sequence[Portal], end: Point) -> list[Point]:
+    """The point where the shortest path from ``start`` through ``portals`` (in order) to
+    ``end`` crosses each portal.
+
+    The funnel algorithm: the apex and the two sides are tightened portal by portal; when a
+    side would cross the other, the other side's end is a corner of the path (the next apex)
+    and the scan restarts after it.  The crossings of the straight pieces between corners
+    with the portals they pass are then read off.
+    """
+    gates = [Portal(start, start), *portals, Portal(end, end)]
+    corners: list[tuple[int, Point]] = [(0, start)]  # (gate index, point) of each apex
+    apex, left, right = start, start, start
+    apex_at = left_at = right_at = 0
+    index = 1
+    while index < len(gates):
+        gate = gates[index]
+        # The right side moves inward (left) when the gate's right end is not right of it.
+        if _cross(apex, right, gate.right) >= 0.0:
+            if apex == right or _cross(apex, left, gate.right) < 0.0:
+                right, right_at = gate.right, index
+            else:  # it crosses over the left side: the left end is a corner
+                apex, apex_at = left, left_at
+                corners.append((apex_at, apex))
+                right, right_at = apex, apex_at
+                index = apex_at + 1
+                continue
+        if _cross(apex, left, gate.left) <= 0.0:
+            if apex == left or _cross(apex, right, gate.left) > 0.0:
+                left, left_at = gate.left, index
+            else:
+                apex, apex_at = right, right_at
+                corners.append((apex_at, apex))
+                left, left_at = apex, apex_at
+                index = apex_at + 1
+                continue
+        index += 1
+    if corners[-1][0] != len(gates) - 1:
+        corners.append((len(gates) - 1, end))
+    crossings: list[Point] = []
+    for (a_at, a), (b_at, b) in zip(corners, corners[1:], strict=False):
+        for at in range(a_at + 1, b_at + 1):
+            if at == len(gates) - 1:
+                break
+            crossings.append(b if at == b_at else _meet(a, b, gates[at]))
+    return crossings
+
+
+def _meet(a: Point, b: Point, gate: Portal) -> Point:
+    """Where the segment a -> b crosses ``gate`` (clamped onto it against rounding)."""
+    (lx, ly), (rx, ry) = gate.left, gate.right
+    ex, ey = rx - lx, ry - ly
+    dx, dy = b[0] - a[0], b[1] - a[1]
+    denominator = dx * ey - dy * ex
+    if denominator == 0.0:  # parallel (or a point gate): the gate's nearer end
+        return gate.left
+    u = ((lx - a[0]) * dy - (ly - a[1]) * dx) / denominator
+    u = min(1.0, max(0.0, u))
+    return (lx + u * ex, ly + u * ey)
+
+
+def _incenter(corners: tuple[Point, Point, Point]) -> Point:
+    lengths = []
+    for i in range(3):
+        (ax, ay), (bx, by) = corners[(i + 1) % 3], corners[(i + 2) % 3]
+        lengths.append(((bx - ax) ** 2 + (by - ay) ** 2) ** 0.5)
+    total = sum(lengths)
+    return (
+        sum(w * c[0] for w, c in zip(lengths, corners, strict=True)) / total,
+        sum(w * c[1] for w, c in zip(lengths, corners, strict=True)) / total,
+    )
+
+
+#: A lasso's cycle is pulled over this many laps and the middle lap's path is used: a lap
+#: away from both ends of the string is (to within the portals' width) the periodic path.
+LAPS = 3
+
+
+def channel_guides(
+    steps: Sequence[ChannelStep], loop_start: int | None, start: Point
+) -> list[Guide | None]:
+    """The shortest path's piece in each step (None for a vertex passage, whose pursuit law
+    is fixed).
+
+    A plan that ends by staying is pulled from the start to the stay triangle's incenter (the
+    stay field's target); a lasso over its prefix and :data:`LAPS` laps of its cycle, the
+    prefix's steps taking the first pass and the cycle's steps the middle lap.
+    """
+    count = len(steps)
+    if loop_start is None:
+        order = list(range(count))
+        end_step = steps[-1]
+        moving = order[:-1] if end_step.exit_edge is None else order
+        end = _incenter(end_step.corners) if end_step.exit_edge is None else None
+    else:
+        cycle = list(range(loop_start, count))
+        order = list(range(loop_start)) + cycle * LAPS
+        moving = order
+        end = None
+    portals = [inset(exit_portal(steps[i])) for i in moving]
+    if end is None:
+        last = portals.pop()
+        end = ((last.left[0] + last.right[0]) / 2.0, (last.left[1] + last.right[1]) / 2.0)
+        crossings = [*funnel(start, portals, end), end]
+    else:
+        crossings = funnel(start, portals, end)
+    # The pass each step takes: its first in the prefix, the middle lap in the cycle.
+    chosen: dict[int, int] = {}
+    for position, i in enumerate(moving):
+        lap = 0 if loop_start is None or i < loop_start else (position - loop_start) // len(cycle)
+        if lap == (0 if loop_start is None or i < loop_start else LAPS // 2):
+            chosen[i] = position
+    guides: list[Guide | None] = []
+    for i, step in enumerate(steps):
+        if step.through is not None:
+            guides.append(None)
+            continue
+        if step.exit_edge is None:  # the stay: from the last crossing to its target
+            entry = crossings[len(moving) - 1] if moving else start
+            guides.append(Guide(entry, end))
+            continue
+        position = chosen[i]
+        entry = start if position == 0 else crossings[position - 1]
+        guides.append(Guide(entry, crossings[position]))
+    return guides

@@ -1,0 +1,273 @@
+"""Vertex velocities whose flow follows the channel's shortest path (a second program).
+
+The vertex program (:mod:`tlmpc.control.synthesize`) only asks every state to leave by the
+planned facet; its flow wanders from triangle to triangle.  Here the same constraints are kept
+and the objective changes.  In each step the channel's shortest path is one straight piece
+from an entry point p to an exit point q (:mod:`tlmpc.control.channel`), direction d.  The
+field is affine, so if it is parallel to d at p and at q it is parallel to d all along the
+segment, which is then a flow line: the robot entering at p leaves at q, on the path.  The
+program therefore asks, with a slack t per step,
+
+    |d x f(p)| <= t,  |d x f(q)| <= t            (f(x) = sum_i lambda_i(x) w_i, linear in w)
+
+and maximises the speed along the path minus the misalignment, weighted by each piece's
+length (so time, not triangle count, is what it saves):
+
+    sum_k len_k (d·f(p) + d·f(q)) / 2 - ALIGNMENT * len_k t_k
+
+while every guaranteed exit speed stays at least :data:`KEEP_FLOOR` times the one the vertex
+program reached (its exit-time bounds grow by at most 1 / KEEP_FLOOR).  A stay has one piece,
+from its entry to its target, where the field vanishes: parallel at p suffices.  Where a
+bend, a shared vertex velocity or the margins make exact alignment impossible, the slack
+stays positive and the flow deviates as little as the objective allows; every vertex
+condition, the speed bound and the disturbance rows are the vertex program's own rows,
+and the re-check after solving is the same.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+
+from tlmpc.abstraction.model import Abstraction, FloatArray
+from tlmpc.control.channel import ChannelStep, Guide, Point, channel_guides
+from tlmpc.control.geometry import TriangleGeometry
+from tlmpc.control.sparse import CscMatrix, Triplets, stacked_csc
+
+#: Weight of the misalignment slack against the speed along the path.
+ALIGNMENT = 10.0
+#: Every guaranteed exit speed keeps at least this fraction of the vertex program's floor.
+KEEP_FLOOR = 0.5
+
+
+class ConicLike(Protocol):
+    """A conic form (A, b, cones) as :func:`tlmpc.control.synthesize.conic_form` gives it."""
+
+    @property
+    def constraints(self) -> CscMatrix: ...
+    @property
+    def offsets(self) -> FloatArray: ...
+    @property
+    def cones(self) -> tuple[tuple[str, int], ...]: ...
+
+
+@dataclass(frozen=True, slots=True)
+class FollowStep:
+    """An affine step as this program sees it: its triangle, the program column of each local
+    vertex's velocity run, and its piece of the path."""
+
+    geometry: TriangleGeometry
+    columns: tuple[int, int, int]
+    guide: Guide
+    stay: bool
+
+
+@dataclass(frozen=True, slots=True)
+class FollowResult:
+    """The velocities per run (R, 2) at the program's scale, and how the solve went."""
+
+    velocities: FloatArray
+    status: str
+    misalignment: float  # the largest slack t (unit speed)
+
+
+def _csc_triplets(matrix: CscMatrix) -> Triplets:
+    cols = np.repeat(np.arange(matrix.shape[1], dtype=np.int64), np.diff(matrix.indptr))
+    return Triplets(matrix.indices.astype(np.int64), cols, matrix.data, matrix.shape)
+
+
+def follow_program(
+    constraints: CscMatrix,
+    offsets: FloatArray,
+    cones: Sequence[tuple[str, int]],
+    runs: int,
+    steps: int,
+    floor: float,
+    follow: Sequence[FollowStep],
+) -> tuple[CscMatrix, FloatArray, FloatArray, list[tuple[str, int]]]:
+    """The vertex program's conic form (x = (w, s, f)) extended by one slack per followed step
+    and the rows above; returns (A, costs, b, cones) for x = (w, s, f, t).
+
+    ``floor`` is the floor the vertex program reached (unit speed).
+    """
+    rows_a, cols_a = constraints.shape
+    size = cols_a  # the index of the first slack
+    total = size + len(follow)
+    rows: list[int] = []
+    cols: list[int] = []
+    vals: list[float] = []
+    costs = np.zeros(total)
+    lengths = [
+        float(np.hypot(s.guide.exit[0] - s.guide.entry[0], s.guide.exit[1] - s.guide.entry[1]))
+        for s in follow
+    ]
+    scale = sum(lengths) or 1.0
+    row = 0
+    for k, (step, length) in enumerate(zip(follow, lengths, strict=True)):
+        slack = size + k
+        if length <= 0.0:
+            costs[slack] = 1.0  # nothing to follow: the slack is free and pinned at 0
+            continue
+        dx = (step.guide.exit[0] - step.guide.entry[0]) / length
+        dy = (step.guide.exit[1] - step.guide.entry[1]) / length
+        weight = length / scale
+        points = [step.guide.entry] if step.stay else [step.guide.entry, step.guide.exit]
+        for point in points:
+            lambdas = step.geometry.barycentric(np.asarray(point, dtype=np.float64)).tolist()
+            for sign in (1.0, -1.0):  # t >= sign * (d x f): A x <= 0 with A = (sign * d x, -1)
+                for local, column in enumerate(step.columns):
+                    # d x f = dx f_y - dy f_x
+                    rows += [row, row]
+                    cols += [2 * column, 2 * column + 1]
+                    vals += [sign * -dy * lambdas[local], sign * dx * lambdas[local]]
+                rows.append(row)
+                cols.append(slack)
+                vals.append(-1.0)
+                row += 1
+            for local, column in enumerate(step.columns):  # speed along d: minimise -d·f
+                costs[2 * column] -= weight * dx * lambdas[local] / len(points)
+                costs[2 * column + 1] -= weight * dy * lambdas[local] / len(points)
+        costs[slack] += ALIGNMENT * weight
+    # the floor: f >= KEEP_FLOOR * floor, as -f + s = -KEEP_FLOOR * floor
+    rows.append(row)
+    cols.append(2 * runs + steps)
+    vals.append(-1.0)
+    row += 1
+    # slacks are non-negative: -t + s = 0
+    for k in range(len(follow)):
+        rows.append(row)
+        cols.append(size + k)
+        vals.append(-1.0)
+        row += 1
+    base = _csc_triplets(constraints)
+    widened = Triplets(base.rows, base.cols, base.values, (rows_a, total))
+    extra = Triplets.build(rows, cols, vals, (row, total))
+    matrix = stacked_csc([(0, widened), (rows_a, extra)], (rows_a + row, total))
+    extra_offsets = np.zeros(row)
+    extra_offsets[row - len(follow) - 1] = -KEEP_FLOOR * floor
+    return (
+        matrix,
+        costs,
+        np.concatenate([offsets, extra_offsets]),
+        [*cones, ("nonnegative", row)],
+    )
+
+
+def solve_follow(
+    constraints: CscMatrix,
+    offsets: FloatArray,
+    cones: Sequence[tuple[str, int]],
+    runs: int,
+    steps: int,
+    floor: float,
+    follow: Sequence[FollowStep],
+) -> FollowResult | None:
+    """Solve the following program by Clarabel; None when it does not solve (the vertex
+    program's velocities then stand)."""
+    import clarabel
+
+    matrix, costs, b, all_cones = follow_program(
+        constraints, offsets, cones, runs, steps, floor, follow
+    )
+    kinds = {
+        "zero": clarabel.ZeroConeT,
+        "nonnegative": clarabel.NonnegativeConeT,
+        "second-order": clarabel.SecondOrderConeT,
+    }
+    settings = clarabel.DefaultSettings()
+    settings.verbose = False
+    total = matrix.shape[1]
+    empty = np.zeros(0, dtype=np.int64)
+    solver = clarabel.DefaultSolver(
+        CscMatrix(np.zeros(0), empty, np.zeros(total + 1, dtype=np.int64), (total, total)),
+        costs,
+        matrix,
+        b,
+        [kinds[kind](dim) for kind, dim in all_cones],
+        settings,
+    )
+    solution = solver.solve()
+    status = str(solution.status)
+    if status not in ("Solved", "AlmostSolved"):
+        return None
+    x = np.asarray(solution.x, dtype=np.float64)
+    slacks = x[matrix.shape[1] - len(follow) :]
+    return FollowResult(
+        velocities=x[: 2 * runs].reshape(runs, 2),
+        status=status,
+        misalignment=float(slacks.max()) if len(slacks) else 0.0,
+    )
+
+
+class PlanStep(Protocol):
+    """What :func:`follow_channel` reads of a plan step of the vertex program."""
+
+    triangle: int
+    exit_edge: int | None
+    geometry: TriangleGeometry
+    runs: list[int]
+    through: int | None
+
+
+def follow_channel(
+    abstraction: Abstraction,
+    steps: Sequence[PlanStep],
+    loop_start: int | None,
+    start: tuple[float, float],
+    form: ConicLike,
+    runs: int,
+    column: Mapping[int, int],
+    speeds: FloatArray,
+    max_speed: float,
+    disturbance: float,
+) -> tuple[FloatArray, dict[str, float | str]] | None:
+    """Velocities per run (R, 2, at ``max_speed``) whose flow follows the channel's shortest
+    path, and stats; None when the following program does not solve.
+
+    ``form`` is the vertex program's conic form, ``speeds`` its solution's guaranteed speeds.
+    """
+    channel = [
+        ChannelStep(
+            corners=_corners(step.geometry.vertices),
+            exit_edge=step.exit_edge,
+            through=(
+                None
+                if step.through is None
+                else tuple(abstraction.vertices[step.through].tolist())  # type: ignore[arg-type]
+            ),
+        )
+        for step in steps
+    ]
+    guides = channel_guides(channel, loop_start, start)
+    affine = [(step, guide) for step, guide in zip(steps, guides, strict=True)]
+    follow = [
+        FollowStep(
+            geometry=step.geometry,
+            columns=(column[step.runs[0]], column[step.runs[1]], column[step.runs[2]]),
+            guide=guide,
+            stay=step.exit_edge is None,
+        )
+        for step, guide in affine
+        if step.through is None and guide is not None
+    ]
+    floor = float(speeds.min()) / max_speed if len(speeds) else 0.0
+    result = solve_follow(
+        form.constraints, form.offsets, form.cones, runs, len(speeds), floor, follow
+    )
+    if result is None:
+        return None
+    velocities = result.velocities * max_speed
+    # As for the vertex program: the solver meets |w| <= 1 only to its tolerance; the other
+    # rows are homogeneous without a disturbance, so one common shrink keeps them.
+    largest = float(np.linalg.norm(velocities, axis=1).max()) if runs else 0.0
+    if largest > max_speed and disturbance == 0.0:
+        velocities = velocities * (max_speed / largest * (1.0 - 4 * np.finfo(np.float64).eps))
+    return velocities, {"follow_status": result.status, "misalignment": result.misalignment}
+
+
+def _corners(vertices: FloatArray) -> tuple[Point, Point, Point]:
+    (ax, ay), (bx, by), (cx, cy) = vertices.tolist()
+    return ((ax, ay), (bx, by), (cx, cy))
