@@ -19,6 +19,7 @@ controller has room to follow the path (see docs/control.md).
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -26,7 +27,7 @@ from dataclasses import dataclass
 Point = tuple[float, float]
 
 #: Each portal keeps this fraction of its length clear at both ends.
-PORTAL_INSET = 0.1
+PORTAL_INSET = 0.03
 
 
 @dataclass(frozen=True, slots=True)
@@ -125,7 +126,7 @@ def funnel(start: Point, portals: Sequence[Portal], end: Point) -> list[Point]:
     if corners[-1][0] != len(gates) - 1:
         corners.append((len(gates) - 1, end))
     crossings: list[Point] = []
-    for (a_at, a), (b_at, b) in zip(corners, corners[1:], strict=False):
+    for (a_at, a), (b_at, b) in itertools.pairwise(corners):
         for at in range(a_at + 1, b_at + 1):
             if at == len(gates) - 1:
                 break

@@ -39,6 +39,9 @@ from tlmpc.control.sparse import CscMatrix, Triplets, stacked_csc
 
 #: Weight of the misalignment slack against the speed along the path.
 ALIGNMENT = 10.0
+#: The aligned fields keep at least this fraction of the fastest fields' speed along the path
+#: at every point where the path is followed.
+KEEP_SPEED = 0.9
 #: Every guaranteed exit speed keeps at least this fraction of the vertex program's floor.
 KEEP_FLOOR = 0.5
 
@@ -79,6 +82,42 @@ def _csc_triplets(matrix: CscMatrix) -> Triplets:
     return Triplets(matrix.indices.astype(np.int64), cols, matrix.data, matrix.shape)
 
 
+@dataclass(frozen=True, slots=True)
+class _Point:
+    """A point of the path where the field is asked to run along d: the program columns and
+    coefficients of d·f (``along``) and d x f (``across``), its step, its weight."""
+
+    step: int
+    columns: list[int]
+    along: list[float]
+    across: list[float]
+    weight: float
+
+
+def _path_points(follow: Sequence[FollowStep]) -> list[_Point]:
+    lengths = [
+        float(np.hypot(s.guide.exit[0] - s.guide.entry[0], s.guide.exit[1] - s.guide.entry[1]))
+        for s in follow
+    ]
+    scale = sum(lengths) or 1.0
+    points: list[_Point] = []
+    for k, (step, length) in enumerate(zip(follow, lengths, strict=True)):
+        if length <= 0.0:
+            continue  # nothing to follow
+        dx = (step.guide.exit[0] - step.guide.entry[0]) / length
+        dy = (step.guide.exit[1] - step.guide.entry[1]) / length
+        where = [step.guide.entry] if step.stay else [step.guide.entry, step.guide.exit]
+        for point in where:
+            lambdas = step.geometry.barycentric(np.asarray(point, dtype=np.float64)).tolist()
+            columns, along, across = [], [], []
+            for local, column in enumerate(step.columns):
+                columns += [2 * column, 2 * column + 1]
+                along += [dx * lambdas[local], dy * lambdas[local]]
+                across += [-dy * lambdas[local], dx * lambdas[local]]  # d x f = dx fy - dy fx
+            points.append(_Point(k, columns, along, across, length / scale / len(where)))
+    return points
+
+
 def follow_program(
     constraints: CscMatrix,
     offsets: FloatArray,
@@ -87,91 +126,68 @@ def follow_program(
     steps: int,
     floor: float,
     follow: Sequence[FollowStep],
+    *,
+    alignment: float,
+    speeds: Sequence[float] | None = None,
 ) -> tuple[CscMatrix, FloatArray, FloatArray, list[tuple[str, int]]]:
-    """The vertex program's conic form (x = (w, s, f)) extended by one slack per followed step
-    and the rows above; returns (A, costs, b, cones) for x = (w, s, f, t).
+    """The vertex program's conic form (x = (w, s, f)) extended by one slack t per followed
+    step; returns (A, costs, b, cones) for x = (w, s, f, t).
 
-    ``floor`` is the floor the vertex program reached (unit speed).
+    Minimises ``alignment`` * sum(weight t) - sum(weight d·f) over the path points, with
+    |d x f| <= t there, f >= KEEP_FLOOR * ``floor`` (the vertex program's floor, unit speed)
+    and, given ``speeds`` (one per path point), d·f >= that speed at each.
     """
-    rows_a, cols_a = constraints.shape
-    size = cols_a  # the index of the first slack
+    rows_a, size = constraints.shape
     total = size + len(follow)
+    points = _path_points(follow)
     rows: list[int] = []
     cols: list[int] = []
     vals: list[float] = []
+    bounds: list[float] = []
     costs = np.zeros(total)
-    lengths = [
-        float(np.hypot(s.guide.exit[0] - s.guide.entry[0], s.guide.exit[1] - s.guide.entry[1]))
-        for s in follow
-    ]
-    scale = sum(lengths) or 1.0
-    row = 0
-    for k, (step, length) in enumerate(zip(follow, lengths, strict=True)):
-        slack = size + k
-        if length <= 0.0:
-            costs[slack] = 1.0  # nothing to follow: the slack is free and pinned at 0
-            continue
-        dx = (step.guide.exit[0] - step.guide.entry[0]) / length
-        dy = (step.guide.exit[1] - step.guide.entry[1]) / length
-        weight = length / scale
-        points = [step.guide.entry] if step.stay else [step.guide.entry, step.guide.exit]
-        for point in points:
-            lambdas = step.geometry.barycentric(np.asarray(point, dtype=np.float64)).tolist()
-            for sign in (1.0, -1.0):  # t >= sign * (d x f): A x <= 0 with A = (sign * d x, -1)
-                for local, column in enumerate(step.columns):
-                    # d x f = dx f_y - dy f_x
-                    rows += [row, row]
-                    cols += [2 * column, 2 * column + 1]
-                    vals += [sign * -dy * lambdas[local], sign * dx * lambdas[local]]
-                rows.append(row)
-                cols.append(slack)
-                vals.append(-1.0)
-                row += 1
-            for local, column in enumerate(step.columns):  # speed along d: minimise -d·f
-                costs[2 * column] -= weight * dx * lambdas[local] / len(points)
-                costs[2 * column + 1] -= weight * dy * lambdas[local] / len(points)
-        costs[slack] += ALIGNMENT * weight
-    # the floor: f >= KEEP_FLOOR * floor, as -f + s = -KEEP_FLOOR * floor
-    rows.append(row)
+    for point in points:
+        slack = size + point.step
+        for sign in (1.0, -1.0):  # t >= sign (d x f): A x <= 0 with A = (sign d x, -1)
+            rows += [len(bounds)] * (len(point.columns) + 1)
+            cols += [*point.columns, slack]
+            vals += [sign * c for c in point.across] + [-1.0]
+            bounds.append(0.0)
+        for column, coefficient in zip(point.columns, point.along, strict=True):
+            costs[column] -= point.weight * coefficient
+        costs[slack] += alignment * point.weight
+    if speeds is not None:  # d·f >= speed: -(d·f) + s = -speed
+        for point, speed in zip(points, speeds, strict=True):
+            rows += [len(bounds)] * len(point.columns)
+            cols += point.columns
+            vals += [-c for c in point.along]
+            bounds.append(-speed)
+    rows.append(len(bounds))  # f >= KEEP_FLOOR * floor: -f + s = -KEEP_FLOOR * floor
     cols.append(2 * runs + steps)
     vals.append(-1.0)
-    row += 1
-    # slacks are non-negative: -t + s = 0
-    for k in range(len(follow)):
-        rows.append(row)
+    bounds.append(-KEEP_FLOOR * floor)
+    for k in range(len(follow)):  # t >= 0: -t + s = 0
+        rows.append(len(bounds))
         cols.append(size + k)
         vals.append(-1.0)
-        row += 1
+        bounds.append(0.0)
     base = _csc_triplets(constraints)
     widened = Triplets(base.rows, base.cols, base.values, (rows_a, total))
-    extra = Triplets.build(rows, cols, vals, (row, total))
-    matrix = stacked_csc([(0, widened), (rows_a, extra)], (rows_a + row, total))
-    extra_offsets = np.zeros(row)
-    extra_offsets[row - len(follow) - 1] = -KEEP_FLOOR * floor
+    extra = Triplets.build(rows, cols, vals, (len(bounds), total))
+    matrix = stacked_csc([(0, widened), (rows_a, extra)], (rows_a + len(bounds), total))
     return (
         matrix,
         costs,
-        np.concatenate([offsets, extra_offsets]),
-        [*cones, ("nonnegative", row)],
+        np.concatenate([offsets, np.asarray(bounds)]),
+        [*cones, ("nonnegative", len(bounds))],
     )
 
 
-def solve_follow(
-    constraints: CscMatrix,
-    offsets: FloatArray,
-    cones: Sequence[tuple[str, int]],
-    runs: int,
-    steps: int,
-    floor: float,
-    follow: Sequence[FollowStep],
-) -> FollowResult | None:
-    """Solve the following program by Clarabel; None when it does not solve (the vertex
-    program's velocities then stand)."""
+def _clarabel(
+    matrix: CscMatrix, costs: FloatArray, b: FloatArray, cones: Sequence[tuple[str, int]]
+) -> FloatArray | None:
+    """Clarabel's solution x of min costs·x, A x + s = b, s in the cones; None unless solved."""
     import clarabel
 
-    matrix, costs, b, all_cones = follow_program(
-        constraints, offsets, cones, runs, steps, floor, follow
-    )
     kinds = {
         "zero": clarabel.ZeroConeT,
         "nonnegative": clarabel.NonnegativeConeT,
@@ -186,18 +202,42 @@ def solve_follow(
         costs,
         matrix,
         b,
-        [kinds[kind](dim) for kind, dim in all_cones],
+        [kinds[kind](dim) for kind, dim in cones],
         settings,
     )
     solution = solver.solve()
-    status = str(solution.status)
-    if status not in ("Solved", "AlmostSolved"):
+    if str(solution.status) not in ("Solved", "AlmostSolved"):
         return None
-    x = np.asarray(solution.x, dtype=np.float64)
-    slacks = x[matrix.shape[1] - len(follow) :]
+    return np.asarray(solution.x, dtype=np.float64)
+
+
+def solve_follow(
+    constraints: CscMatrix,
+    offsets: FloatArray,
+    cones: Sequence[tuple[str, int]],
+    runs: int,
+    steps: int,
+    floor: float,
+    follow: Sequence[FollowStep],
+) -> FollowResult | None:
+    """Two solves: the fastest fields along the path (no alignment), then the best aligned
+    ones that keep :data:`KEEP_SPEED` of that speed at every path point.  None when either
+    does not solve (the vertex program's velocities then stand)."""
+    common = (constraints, offsets, cones, runs, steps, floor, follow)
+    fastest = _clarabel(*follow_program(*common, alignment=0.0))
+    if fastest is None:
+        return None
+    points = _path_points(follow)
+    reached = [float(np.dot(fastest[p.columns], p.along)) for p in points]
+    # (a point the fastest fields cross against d keeps its speed to the same fraction)
+    speeds = [v - (1.0 - KEEP_SPEED) * abs(v) for v in reached]
+    x = _clarabel(*follow_program(*common, alignment=ALIGNMENT, speeds=speeds))
+    if x is None:
+        return None
+    slacks = x[constraints.shape[1] :]
     return FollowResult(
         velocities=x[: 2 * runs].reshape(runs, 2),
-        status=status,
+        status="Solved",
         misalignment=float(slacks.max()) if len(slacks) else 0.0,
     )
 
@@ -233,11 +273,7 @@ def follow_channel(
         ChannelStep(
             corners=_corners(step.geometry.vertices),
             exit_edge=step.exit_edge,
-            through=(
-                None
-                if step.through is None
-                else tuple(abstraction.vertices[step.through].tolist())  # type: ignore[arg-type]
-            ),
+            through=None if step.through is None else _point(abstraction.vertices[step.through]),
         )
         for step in steps
     ]
@@ -271,3 +307,8 @@ def follow_channel(
 def _corners(vertices: FloatArray) -> tuple[Point, Point, Point]:
     (ax, ay), (bx, by), (cx, cy) = vertices.tolist()
     return ((ax, ay), (bx, by), (cx, cy))
+
+
+def _point(vertex: FloatArray) -> Point:
+    x, y = vertex.tolist()
+    return (x, y)

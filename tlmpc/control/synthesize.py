@@ -25,6 +25,7 @@ import numpy as np
 
 from tlmpc.abstraction.model import Abstraction, FloatArray
 from tlmpc.base.errors import InvalidInputError, SolverError, error
+from tlmpc.control.follow import follow_channel
 from tlmpc.control.geometry import (
     TriangleGeometry,
     affine_law,
@@ -33,7 +34,6 @@ from tlmpc.control.geometry import (
     largest_of,
     triangle_geometry,
 )
-from tlmpc.control.follow import follow_channel
 from tlmpc.control.model import Controllers, StepController, VelocityJump
 from tlmpc.control.sparse import CscMatrix, Triplets, stacked_csc
 from tlmpc.mission.model import Robot

@@ -1,0 +1,237 @@
+"""Fields that follow the channel's shortest path keep every guarantee and shorten the path.
+
+Oracles: the shortest path inside the union of the plan's triangles by a visibility graph on
+shapely geometry (tests/oracles/shortest_paths.py), the vertex conditions re-derived here from
+the corners alone in exact rational arithmetic, and the independent verifier on the simulated
+trace.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from fractions import Fraction
+from typing import Any, cast
+
+import numpy as np
+import pytest
+import shapely
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from shortest_paths import geodesic
+from strategies import missions
+
+from tlmpc.abstraction.model import Abstraction
+from tlmpc.control import synthesize
+from tlmpc.control.channel import Portal, funnel
+from tlmpc.mission.model import Mission, Robot
+from tlmpc.planning.model import Witness
+from tlmpc.simulate import simulate
+
+
+@st.composite
+def strips(draw: st.DrawFn) -> tuple[list[tuple[float, float]], list[tuple[float, float]]]:
+    """A winding corridor: left and right boundary points, 3 to 12 columns, random width,
+    heading and jitter (a strip of 2 (n - 1) triangles)."""
+    n = draw(st.integers(3, 12))
+    heading = draw(st.floats(-1.2, 1.2))
+    left, right = [], []
+    x = y = 0.0
+    for _ in range(n):
+        width = draw(st.floats(0.4, 2.0))
+        heading += draw(st.floats(-0.5, 0.5))
+        step = draw(st.floats(0.5, 1.5))
+        x, y = x + step * math.cos(heading), y + step * math.sin(heading)
+        nx, ny = -math.sin(heading), math.cos(heading)
+        shift = draw(st.floats(-0.3, 0.3))
+        left.append((x + (width / 2 + shift) * nx, y + (width / 2 + shift) * ny))
+        right.append((x - (width / 2 - shift) * nx, y - (width / 2 - shift) * ny))
+    return left, right
+
+
+def _ccw(a: Any, b: Any, c: Any) -> float:
+    return float((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))
+
+
+def strip_plan(
+    left: list[tuple[float, float]], right: list[tuple[float, float]]
+) -> tuple[Abstraction, Witness, list[list[int]]] | None:
+    """The strip's triangles in travel order as an abstraction and a plan that ends by
+    staying in the last one; None when a triangle is folded or too thin."""
+    n = len(left)
+    vertices = [*left, *right]
+    triangles: list[list[int]] = []
+    for i in range(n - 1):
+        for tri in ([n + i, n + i + 1, i], [i, n + i + 1, i + 1]):
+            a, b, c = (vertices[k] for k in tri)
+            area = _ccw(a, b, c)
+            if area <= 0:
+                return None
+            sides = [math.dist(a, b), math.dist(b, c), math.dist(c, a)]
+            if area / max(sides) ** 2 < 0.05:
+                return None  # a needle: the vertex program's margins need a mesh of quality
+            triangles.append(tri)
+    polygon = shapely.Polygon([*right, *reversed(left)])
+    if not polygon.is_valid:
+        return None
+    m = len(triangles)
+    neighbors = np.full((m, 3), -1, dtype=np.int64)
+    for t, tri in enumerate(triangles):
+        for e in range(3):
+            edge = {tri[(e + 1) % 3], tri[(e + 2) % 3]}
+            for u, other in enumerate(triangles):
+                if u != t and edge <= set(other):
+                    neighbors[t, e] = u
+    abstraction = Abstraction(
+        vertices=np.asarray(vertices, dtype=np.float64),
+        triangles=np.asarray(triangles, dtype=np.int64),
+        neighbors=neighbors,
+        letter_of=np.zeros(m, dtype=np.int64),
+        letters=((),),
+        start=0,
+        component=np.zeros(m, dtype=np.int64),
+        regions={},
+    )
+    witness = Witness(
+        prefix=tuple(range(m - 1)),
+        cycle=(m - 1,),
+        prefix_states=(0,) * (m - 1),
+        cycle_states=(0,),
+        word=((),) * m,
+        cost=0.0,
+        metric="length",
+        beta=1.0,
+        prefix_cost=0.0,
+        cycle_cost=0.0,
+    )
+    return abstraction, witness, triangles
+
+
+def test_funnel_is_the_shortest_path_in_the_channel() -> None:
+    """Through a bend the funnel's corners are the portal ends the path wraps around."""
+    # an L: portals across the corridor, the inner corner at (1, 1)
+    portals = [Portal((1.0, 1.0), (2.0, 0.0)), Portal((1.0, 1.0), (2.0, 2.0))]
+    crossings = funnel((0.0, 0.5), portals, (0.5, 2.5))
+    assert crossings == [(1.0, 1.0), (1.0, 1.0)]
+    straight = funnel((0.0, 0.0), [Portal((1.0, 1.0), (1.0, -1.0))], (2.0, 0.0))
+    assert straight == [(1.0, 0.0)]
+
+
+@settings(deadline=None, max_examples=60, suppress_health_check=[HealthCheck.filter_too_much])
+@given(strips(), st.floats(0.05, 0.95), st.floats(0.05, 0.95))
+def test_funnel_matches_a_visibility_graph(strip: Any, u: float, v: float) -> None:
+    """The funnel through a random corridor's portals (not inset) is as long as the shortest
+    path inside the corridor polygon, found by a visibility graph."""
+    left, right = strip
+    planned = strip_plan(left, right)
+    if planned is None:
+        return
+    abstraction, _witness, triangles = planned
+    weights = np.array([u, v, 1.0]) / (u + v + 1.0)
+    sx, sy = (abstraction.corners(0).T @ weights).tolist()
+    ex, ey = (abstraction.corners(len(triangles) - 1).T @ weights[::-1]).tolist()
+    start, end = (sx, sy), (ex, ey)
+    portals = []
+    for t in range(len(triangles) - 1):
+        e = int(np.flatnonzero(abstraction.neighbors[t] == t + 1)[0])
+        corners = abstraction.corners(t).tolist()
+        portals.append(Portal(tuple(corners[(e + 2) % 3]), tuple(corners[(e + 1) % 3])))
+    crossings = funnel(start, portals, end)
+    polyline = [start, *crossings, end]
+    length = sum(math.dist(a, b) for a, b in itertools.pairwise(polyline))
+    corridor = shapely.Polygon([*right, *reversed(left)])
+    best = geodesic(corridor, start, end)
+    assert length == pytest.approx(best, rel=1e-7, abs=1e-9)
+
+
+def _exact_conditions(step: dict[str, Any], max_speed: float, disturbance: float) -> list[str]:
+    """The vertex conditions of one affine step, in exact rationals from its corners."""
+    corners = [[Fraction(c) for c in p] for p in step["vertices"]]
+    velocities = [[Fraction(c) for c in w] for w in step["vertex_velocities"]]
+    problems = []
+    tolerance = Fraction(1, 10**9) * Fraction(max_speed)
+    for i, (wx, wy) in enumerate(velocities):
+        if math.sqrt(wx * wx + wy * wy) > max_speed * (1 + 1e-9):
+            problems.append(f"vertex {i} faster than max_speed")
+        for facet in range(3):
+            if facet == i:
+                continue
+            (ax, ay), (bx, by) = corners[(facet + 1) % 3], corners[(facet + 2) % 3]
+            # outward normal of a counter-clockwise triangle's edge a -> b: (by - ay, ax - bx)
+            nx, ny = by - ay, ax - bx
+            length = Fraction(math.sqrt(nx * nx + ny * ny))
+            across = (nx * wx + ny * wy) / length
+            if facet == step["exit_edge"] and across <= Fraction(disturbance) + tolerance:
+                problems.append(f"vertex {i} does not cross the exit facet")
+            if facet != step["exit_edge"] and -across <= Fraction(disturbance) + tolerance:
+                problems.append(f"vertex {i} not pushed inside facet {facet}")
+    if step["exit_edge"] is not None:
+        (ax, ay), (bx, by) = (corners[(step["exit_edge"] + k) % 3] for k in (1, 2))
+        nx, ny = by - ay, ax - bx
+        wx, wy = velocities[step["exit_edge"]]
+        if nx * wx + ny * wy <= 0:
+            problems.append("the vertex opposite the exit does not move toward it")
+    return problems
+
+
+@pytest.mark.slow
+@settings(
+    deadline=None,
+    max_examples=12,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much],
+)
+@given(missions(), st.sampled_from([0.0, 0.05]))
+def test_following_fields_keep_every_guarantee(document: dict[str, Any], push: float) -> None:
+    """On random missions (with and without a disturbance) the followed fields meet every
+    vertex condition and the speed bound (checked here in exact arithmetic), and the
+    simulated trace satisfies the task (the independent verifier, run by compile)."""
+    from tlmpc.api import compile as compile_mission
+    from tlmpc.base.errors import TlmpcError
+
+    document = {**document, "robot": {**document["robot"], "disturbance": push}}
+    try:
+        compiled = compile_mission(document)
+    except TlmpcError as failure:  # an unsatisfiable task, or a corner that cannot reject it
+        codes = {d.code for d in failure.diagnostics}
+        assert codes <= {"P001", "P002", "P003", "C032", "C034", "A005"}, codes
+        return
+    controllers = compiled.artifacts["controllers.json"]
+    assert controllers["stats"]["follow_status"] == "Solved"
+    for step in controllers["steps"]:
+        if step.get("kind", "affine") == "affine" and step["exit_edge"] is not None:
+            assert _exact_conditions(step, 1.0, push) == []
+    assert compiled.summary["verdict"]["satisfied"]
+
+
+def _length_until(trace: Any, triangle: int) -> tuple[float, tuple[float, float]]:
+    """The trace's length until it first enters ``triangle``, and the point where it does."""
+    points = trace.points
+    stop = trace.triangles.index(triangle)
+    x, y = points[stop].tolist()
+    return float(np.hypot(*np.diff(points[: stop + 1], axis=0).T).sum()), (x, y)
+
+
+@settings(deadline=None, max_examples=40, suppress_health_check=[HealthCheck.filter_too_much])
+@given(strips())
+def test_followed_trajectory_is_near_the_shortest_path(strip: Any) -> None:
+    """Through a random corridor, the followed trajectory until it enters the last triangle,
+    plus the straight way from there to the stay's target, is within 10 % of the shortest path
+    from the start to that target (visibility graph; any path to the target crosses the last
+    portal, so the ratio is at least 1); the trace stays in the planned triangles."""
+    planned = strip_plan(*strip)
+    if planned is None:
+        return
+    abstraction, witness, triangles = planned
+    sx, sy = abstraction.corners(0).mean(axis=0).tolist()
+    robot = Robot(start=(sx, sy), max_speed=1.0)
+    mission = cast(Mission, type("M", (), {"robot": robot})())
+    last = len(triangles) - 1
+    controllers = synthesize(abstraction, witness, robot)
+    trace = simulate(abstraction, controllers, mission)
+    assert set(trace.triangles) <= set(range(len(triangles)))
+    travelled, entry = _length_until(trace, last)
+    target = controllers.steps[-1].target
+    assert target is not None
+    corridor = shapely.Polygon([*strip[1], *reversed(strip[0])])
+    best = geodesic(corridor, (sx, sy), (target[0], target[1]))
+    assert best - 1e-9 <= travelled + math.dist(entry, target) <= 1.10 * best + 1e-9
