@@ -12,7 +12,9 @@ each sampled piece refined by the step's own matrix exponential):
   shortest_paths.py: a visibility graph on shapely geometry, independent of tlmpc);
 * **time ratio**: the time the task is met over that shortest length at ``max_speed``;
 * **lap ratio** (patrols): one lap of the trajectory's cycle over the shortest closed tour
-  touching the targets in the lap's cyclic order.
+  touching the targets in the lap's cyclic order;
+* **robustness**: the verifier's (how far the trajectory stays from every label boundary that
+  would change the verdict): a path that hugs the shortest one passes closer to them.
 
 Targets are given per workload as ordered groups: the regions of a group are taken in the
 order the trajectory first enters them (so the oracle compares the same visiting order; a
@@ -246,12 +248,14 @@ def run(only: tuple[str, ...] = ()) -> list[dict[str, Any]]:
         row: dict[str, Any] = {"workload": workload.name}
         for label, follow in (("before", False), ("after", True)):
             try:
-                measured = _measure(workload, _compile(workload, follow))
+                compiled = _compile(workload, follow)
+                measured = _measure(workload, compiled)
             except Exception as failure:  # a mission this generator made unsolvable
                 row["note"] = f"{type(failure).__name__}: {str(failure)[:60]}"
                 break
             for key, value in measured.items():
                 row[f"{key} {label}"] = round(value, 3)
+            row[f"robustness {label}"] = round(compiled.summary["verdict"]["robustness"], 4)
         rows.append(row)
     return rows
 
