@@ -235,3 +235,22 @@ def test_followed_trajectory_is_near_the_shortest_path(strip: Any) -> None:
     corridor = shapely.Polygon([*strip[1], *reversed(strip[0])])
     best = geodesic(corridor, (sx, sy), (target[0], target[1]))
     assert best - 1e-9 <= travelled + math.dist(entry, target) <= 1.10 * best + 1e-9
+
+
+@given(st.lists(st.floats(-5, 5), min_size=6, max_size=6), st.integers(0, 2))
+def test_exit_portal_ends_are_seen_from_inside(coords: list[float], exit_edge: int) -> None:
+    """Facing out across the exit edge, the portal's left end is on the left: the funnel's
+    sides depend on it."""
+    from tlmpc.control.channel import ChannelStep, exit_portal
+
+    a, b, c = (coords[0], coords[1]), (coords[2], coords[3]), (coords[4], coords[5])
+    area = _ccw(a, b, c)
+    if abs(area) < 1e-3:
+        return
+    corners = (a, b, c) if area > 0 else (a, c, b)
+    portal = exit_portal(ChannelStep(corners=corners, exit_edge=exit_edge))
+    inside = corners[exit_edge]
+    mid = ((portal.left[0] + portal.right[0]) / 2, (portal.left[1] + portal.right[1]) / 2)
+    # facing from the opposite corner toward the edge, the left end lies to the left
+    assert _ccw(inside, mid, portal.left) > 0
+    assert _ccw(inside, mid, portal.right) < 0
