@@ -293,7 +293,7 @@ def follow_channel(
             stay=step.exit_edge is None,
         )
         for step, guide in affine
-        if step.through is None and guide is not None
+        if step.through is None and guide is not None and not _needle(step.geometry)
     ]
     floor = float(speeds.min()) / max_speed if len(speeds) else 0.0
     result = solve_follow(
@@ -318,3 +318,19 @@ def _corners(vertices: FloatArray) -> tuple[Point, Point, Point]:
 def _point(vertex: FloatArray) -> Point:
     x, y = vertex.tolist()
     return (x, y)
+
+
+#: A triangle whose smallest height is below this fraction of its longest edge is a needle:
+#: a field turned toward the path across it changes by O(1) over its tiny width, a gain so
+#: large that the exact simulation's matrix exponential overflows.  Needles are not asked to
+#: follow the path: their fields only keep the vertex conditions (and the floor).
+NEEDLE = 0.05
+
+
+def _needle(geometry: TriangleGeometry) -> bool:
+    corners = geometry.vertices.tolist()
+    longest = max(
+        float(np.hypot(corners[i][0] - corners[i - 1][0], corners[i][1] - corners[i - 1][1]))
+        for i in range(3)
+    )
+    return bool(float(geometry.heights.min()) < NEEDLE * longest)
