@@ -44,6 +44,8 @@ ALIGNMENT = 10.0
 KEEP_SPEED = 0.9
 #: Relative and absolute duality gap at which the following solves stop.
 OBJECTIVE_GAP = 1e-4
+#: Weight of the vertex program's objective (the guaranteed speeds) in both solves.
+GUARANTEE = 1.0
 #: Every guaranteed exit speed keeps at least this fraction of the vertex program's floor.
 KEEP_FLOOR = 0.5
 
@@ -147,6 +149,11 @@ def follow_program(
     vals: list[float] = []
     bounds: list[float] = []
     costs = np.zeros(total)
+    # The vertex program's own objective (floor + a tenth of the mean guaranteed speed) at
+    # weight GUARANTEE: without it the fields nobody's path weighs (a stay's, a needle's) sit
+    # at the floor, and a stay converges slowly.
+    costs[2 * runs + steps] = -GUARANTEE
+    costs[2 * runs : 2 * runs + steps] = -0.1 * GUARANTEE / max(steps, 1)
     for point in points:
         slack = size + point.step
         # t >= sign (d x f): A x <= 0 with A = (sign d x, -1); not asked when not weighed
