@@ -28,6 +28,13 @@ Point = tuple[float, float]
 
 #: Each portal keeps this fraction of its length clear at both ends.
 PORTAL_INSET = 0.03
+#: ... and this much at an end on a label boundary (a region's edge or corner), so that the
+#: path does not graze a region it must avoid: the verifier's robustness (the distance to the
+#: nearest boundary that decides the verdict) would vanish with it.
+LABEL_INSET = 0.25
+#: The triangle where the plan enters a new label is left near the middle of its exit edge,
+#: so that the path goes into the region it visits rather than grazing its edge.
+ENTERED_INSET = 0.4
 
 
 @dataclass(frozen=True, slots=True)
@@ -48,6 +55,10 @@ class ChannelStep:
     corners: tuple[Point, Point, Point]
     exit_edge: int | None
     through: Point | None = None
+    #: Per corner: does it lie on a label boundary (a region's edge)?
+    labelled: tuple[bool, bool, bool] = (False, False, False)
+    #: Does the plan enter a new label in this triangle (its label differs from the last)?
+    entered: bool = False
 
 
 @dataclass(frozen=True, slots=True)
@@ -65,13 +76,27 @@ def _cross(origin: Point, a: Point, b: Point) -> float:
     return (a[0] - origin[0]) * (b[1] - origin[1]) - (a[1] - origin[1]) * (b[0] - origin[0])
 
 
-def inset(portal: Portal, fraction: float = PORTAL_INSET) -> Portal:
-    """``portal`` shrunk toward its midpoint by ``fraction`` of its length at each end."""
+def inset(portal: Portal, left: float = PORTAL_INSET, right: float = PORTAL_INSET) -> Portal:
+    """``portal`` shrunk toward its midpoint by ``left`` and ``right`` of its length at its
+    two ends."""
     (lx, ly), (rx, ry) = portal.left, portal.right
     dx, dy = rx - lx, ry - ly
-    return Portal(
-        (lx + fraction * dx, ly + fraction * dy), (rx - fraction * dx, ry - fraction * dy)
-    )
+    return Portal((lx + left * dx, ly + left * dy), (rx - right * dx, ry - right * dy))
+
+
+def _inset_exit(step: ChannelStep) -> Portal:
+    """The exit portal shrunk: by :data:`ENTERED_INSET` at both ends where the plan has just
+    entered a new label, else by :data:`LABEL_INSET` at an end on a label boundary and
+    :data:`PORTAL_INSET` elsewhere."""
+    portal = exit_portal(step)
+    if step.through is not None or step.exit_edge is None:
+        return portal
+    if step.entered:
+        return inset(portal, ENTERED_INSET, ENTERED_INSET)
+    e = step.exit_edge
+    left = LABEL_INSET if step.labelled[(e + 2) % 3] else PORTAL_INSET
+    right = LABEL_INSET if step.labelled[(e + 1) % 3] else PORTAL_INSET
+    return inset(portal, left, right)
 
 
 def exit_portal(step: ChannelStep) -> Portal:
@@ -185,7 +210,7 @@ def channel_guides(
         order = list(range(loop_start)) + cycle * LAPS
         moving = order
         end = None
-    portals = [inset(exit_portal(steps[i])) for i in moving]
+    portals = [_inset_exit(steps[i]) for i in moving]
     if end is None:
         last = portals.pop()
         end = ((last.left[0] + last.right[0]) / 2.0, (last.left[1] + last.right[1]) / 2.0)

@@ -282,13 +282,24 @@ def follow_channel(
 
     ``form`` is the vertex program's conic form, ``speeds`` its solution's guaranteed speeds.
     """
+    # A vertex is on a label boundary when the triangles around it do not all share a label.
+    letters = abstraction.letter_of[abstraction.triangles]
+    count = len(abstraction.vertices)
+    lowest = np.full(count, np.iinfo(np.int64).max)
+    highest = np.full(count, -1)
+    np.minimum.at(lowest, abstraction.triangles.reshape(-1), letters.reshape(-1))
+    np.maximum.at(highest, abstraction.triangles.reshape(-1), letters.reshape(-1))
+    boundary = (lowest != highest).tolist()
+    label = abstraction.letter_of.tolist()
     channel = [
         ChannelStep(
+            labelled=_flags([boundary[v] for v in abstraction.triangles[step.triangle].tolist()]),
+            entered=index > 0 and label[step.triangle] != label[steps[index - 1].triangle],
             corners=_corners(step.geometry.vertices),
             exit_edge=step.exit_edge,
             through=None if step.through is None else _point(abstraction.vertices[step.through]),
         )
-        for step in steps
+        for index, step in enumerate(steps)
     ]
     guides = channel_guides(channel, loop_start, start)
     affine = [(step, guide) for step, guide in zip(steps, guides, strict=True)]
@@ -341,3 +352,7 @@ def _needle(geometry: TriangleGeometry) -> bool:
         for i in range(3)
     )
     return bool(float(geometry.heights.min()) < NEEDLE * longest)
+
+
+def _flags(values: list[bool]) -> tuple[bool, bool, bool]:
+    return (values[0], values[1], values[2])
