@@ -283,12 +283,12 @@ def follow_channel(
     ``form`` is the vertex program's conic form, ``speeds`` its solution's guaranteed speeds.
     """
     # A vertex is on a label boundary when the triangles around it do not all share a label.
-    letters = abstraction.letter_of[abstraction.triangles]
+    letters = np.repeat(abstraction.letter_of, 3)  # each corner's triangle's letter
     count = len(abstraction.vertices)
     lowest = np.full(count, np.iinfo(np.int64).max)
     highest = np.full(count, -1)
-    np.minimum.at(lowest, abstraction.triangles.reshape(-1), letters.reshape(-1))
-    np.maximum.at(highest, abstraction.triangles.reshape(-1), letters.reshape(-1))
+    np.minimum.at(lowest, abstraction.triangles.reshape(-1), letters)
+    np.maximum.at(highest, abstraction.triangles.reshape(-1), letters)
     boundary = (lowest != highest).tolist()
     label = abstraction.letter_of.tolist()
     channel = [
