@@ -70,6 +70,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--heading", type=float, default=0.0, help="unicycle: initial heading in radians"
     )
+    parser.add_argument(
+        "--sensors",
+        metavar="SOURCE",
+        help="reactive missions: random, adversarial, or a CSV FILE of timed readings "
+        "(default random)",
+    )
+    parser.add_argument(
+        "--events", metavar="N", help="reactive missions: events to run (default 200)"
+    )
     parser.add_argument("-o", "--output", type=Path, help="write the trace.json here")
     parser.add_argument("--json", action="store_true", help="print the report as JSON")
 
@@ -81,6 +90,10 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     from tlmpc.runtime import Executor, make_disturbance, run_closed_loop
     from tlmpc.verify import verify_document
 
+    if args.sensors is not None or args.events is not None or (args.out / "strategy.json").exists():
+        from tlmpc.commands.simulate_reactive import run_reactive_command
+
+        return run_reactive_command(args, out, err)
     if args.disturbance is not None:
         bound = float("nan")
         with contextlib.suppress(ValueError):
