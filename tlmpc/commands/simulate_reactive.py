@@ -105,13 +105,25 @@ def run_reactive_command(args: argparse.Namespace, out: TextIO, err: TextIO) -> 
         environment = ScriptedEnvironment(sensors, read_sensor_file(path, sensors), str(path))
     run = run_reactive(executor, environment, events=events)
     if args.output is not None:
-        from tlmpc.commands.simulate import _write
-
         _write(args.output, run.trace)
     document = _report(args, run, environment.name)
     reporter = Reporter.for_args(args, out, err)
     reporter.finish(EXIT_OK, document, _text(document))
     return EXIT_OK
+
+
+def _write(path: Path, document: dict[str, Any]) -> None:
+    """Write the trace atomically (U083 when it cannot be written, as for a static run)."""
+    from tlmpc.base.errors import TlmpcError
+    from tlmpc.io.artifacts import dumps
+    from tlmpc.io.outdir import replace_file
+
+    try:
+        replace_file(path, dumps(document).encode("utf-8"))
+    except TlmpcError as exc:
+        raise UsageError(
+            [error("U083", d.message, hint=d.hint, file=str(path)) for d in exc.diagnostics]
+        ) from None
 
 
 def _report(args: argparse.Namespace, run: Any, environment: str) -> dict[str, Any]:
