@@ -16,6 +16,7 @@ Shares no code with tlmpc's executor, environments or verifier:
 
 from __future__ import annotations
 
+import itertools
 import warnings
 from collections.abc import Mapping, Sequence
 from typing import Any
@@ -41,7 +42,7 @@ def check_free_space(trace: Mapping[str, Any]) -> None:
     """Every piece of the piecewise-linear trajectory stays in free space."""
     space = free_space(trace).buffer(TOLERANCE)
     points = [(x, y) for _, x, y in trace["points"]]
-    for a, b in zip(points, points[1:], strict=False):
+    for a, b in itertools.pairwise(points):
         piece = shapely.LineString([a, b]) if a != b else shapely.Point(a)
         assert space.covers(piece), f"the piece {a} -> {b} leaves free space"
 
@@ -103,7 +104,7 @@ def check_strategy_replay(trace: Mapping[str, Any], strategy: Mapping[str, Any])
         )
 
     steps = face_steps(trace, strategy)
-    t0, reading0, face0 = steps[0]
+    _t0, reading0, face0 = steps[0]
     current = {n for n in strategy["initial"] if matches(n, reading0, face0, False)}
     assert current, "no initial node reads the first reading"
     previous_face = face0
@@ -111,7 +112,8 @@ def check_strategy_replay(trace: Mapping[str, Any], strategy: Mapping[str, Any])
         moved = face != previous_face
         if moved:
             assert face in adjacent[previous_face], f"t={t}: face {previous_face} -> {face}"
-            heading = {nodes[n]["state"]["goal"] for n in _stutter_closure(current, successors, nodes, inputs)}
+            before = _stutter_closure(current, successors, nodes, inputs)
+            heading = {nodes[n]["state"]["goal"] for n in before}
             assert face in heading, f"t={t}: entered face {face}, the strategy headed for {heading}"
         reachable = _stutter_closure(current, successors, nodes, inputs)
         current = {
@@ -123,7 +125,8 @@ def check_strategy_replay(trace: Mapping[str, Any], strategy: Mapping[str, Any])
         assert current, f"t={t}: no transition of the strategy reads {reading} in face {face}"
         for name in actions:  # the actions shown are the strategy's answer (or a stutter's)
             shown = signal_value(trace["signals"][name], t)
-            answers = {nodes[n]["state"][name] for n in _stutter_closure(current, successors, nodes, inputs)}
+            after = _stutter_closure(current, successors, nodes, inputs)
+            answers = {nodes[n]["state"][name] for n in after}
             assert shown in answers, f"t={t}: action {name}={shown}, the strategy gives {answers}"
         previous_face = face
     return len(steps)
@@ -164,7 +167,7 @@ def word(trace: Mapping[str, Any]) -> list[frozenset[str]]:
     points = np.asarray([(p[1], p[2]) for p in trace["points"]])
     instants = sorted(set(times) | {float(t) for s in signals.values() for t, _ in s})
     letters: list[frozenset[str]] = []
-    for a, b in zip(instants, instants[1:], strict=False):
+    for a, b in itertools.pairwise(instants):
         middle = 0.5 * (a + b)
         x = np.interp(middle, times, points[:, 0])
         y = np.interp(middle, times, points[:, 1])
@@ -180,6 +183,7 @@ def word(trace: Mapping[str, Any]) -> list[frozenset[str]]:
 def three_valued(formula: str, letters: Sequence[frozenset[str]], props: Sequence[str]) -> str:
     """LTL3 verdict of ``formula`` on the finite word (Spot): satisfied, violated or
     inconclusive."""
+
     def literal(letter: frozenset[str]) -> str:
         return " & ".join(p if p in letter else f"!{p}" for p in props) or "1"
 

@@ -14,14 +14,14 @@ from hypothesis import strategies as st
 
 pytest.importorskip("spot")
 
-from reactive_runs import check_run, parts, three_valued, word  # noqa: E402
+from reactive_runs import check_run, parts, three_valued, word
 
-from tlmpc.abstraction import build_abstraction  # noqa: E402
-from tlmpc.mission import load_mission  # noqa: E402
-from tlmpc.mission.load import load_mission_text  # noqa: E402
-from tlmpc.mission.model import Mission  # noqa: E402
-from tlmpc.reactive.synthesize import strategy_to_json, synthesize  # noqa: E402
-from tlmpc.runtime.environments import (  # noqa: E402
+from tlmpc.abstraction import build_abstraction
+from tlmpc.mission import load_mission
+from tlmpc.mission.load import load_mission_text
+from tlmpc.mission.model import Mission
+from tlmpc.reactive.synthesize import strategy_to_json, synthesize
+from tlmpc.runtime.environments import (
     AdversarialEnvironment,
     Change,
     Environment,
@@ -29,9 +29,9 @@ from tlmpc.runtime.environments import (  # noqa: E402
     ScriptedEnvironment,
     time_scale,
 )
-from tlmpc.runtime.reactive import ReactiveExecutor  # noqa: E402
-from tlmpc.runtime.reactive_loop import ReactiveRun, run_reactive  # noqa: E402
-from tlmpc.runtime.strategy_machine import StrategyMachine  # noqa: E402
+from tlmpc.runtime.reactive import ReactiveExecutor
+from tlmpc.runtime.reactive_loop import ReactiveRun, run_reactive
+from tlmpc.runtime.strategy_machine import StrategyMachine
 
 ROOT = Path(__file__).resolve().parents[2]
 

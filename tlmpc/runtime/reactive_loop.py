@@ -174,8 +174,9 @@ def trace_document(executor: ReactiveExecutor) -> dict[str, Any]:
         "end": "open",
         "triangles": list(motion.triangles),
         "crossings": list(motion.crossings),
-        "sensors": list(mission.reactive.sensor_names),
-        "actions": list(mission.reactive.actions),
+        # in the mission file's order, as the strategy's game declares them
+        "sensors": list(executor.machine.sensors),
+        "actions": list(executor.machine.actions),
         "assumptions": [to_text(part.formula) for part in mission.reactive.assumptions],
         "signals": signals,
     }
