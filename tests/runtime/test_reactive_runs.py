@@ -5,6 +5,7 @@ and task part on the run's word."""
 
 from __future__ import annotations
 
+import itertools
 from pathlib import Path
 from typing import Any
 
@@ -90,6 +91,10 @@ def test_guard_runs_keep_assumptions_and_task(guard: Compiled, kind: str, seed: 
 def test_every_face_change_is_an_arrival_or_both(guard: Compiled) -> None:
     run = play(guard, "random", 3, events=80)
     executor = run.executor
+    arrivals = [e for e in executor.events if e.kind in ("arrival", "both")]
+    assert len(arrivals) >= 10
+    # every face entered is held for a positive time before the next one is entered
+    assert all(a.time < b.time for a, b in itertools.pairwise(arrivals))
     for before, after in zip(executor.events, executor.events[1:], strict=False):
         if after.face != before.face:
             assert after.kind in ("arrival", "both")

@@ -430,11 +430,6 @@ def _area(corners: FloatArray) -> float:
     return 0.5 * abs(float((bx - ax) * (cy - ay) - (by - ay) * (cx - ax)))
 
 
-def load_executor(output: str | os.PathLike[str]) -> ReactiveExecutor:
-    """:meth:`ReactiveExecutor.from_output`, as a function."""
-    return ReactiveExecutor.from_output(output)
-
-
 def executor_summary(executor: ReactiveExecutor) -> dict[str, Any]:
     """Counts of a run for reports."""
     kinds: dict[str, int] = {}
