@@ -136,6 +136,7 @@ def _report(args: argparse.Namespace, run: Any, environment: str) -> dict[str, A
         "out": str(args.out),
         "environment": environment,
         "seed": args.seed,
+        **({"sensor_file": args.sensors} if environment == "file" else {}),
         "events": summary["events"] - 1,
         "by_kind": summary["by_kind"],
         "stopped": run.stopped,
@@ -155,9 +156,13 @@ def _text(report: dict[str, Any]) -> str:
         "events": "the event budget was spent",
         "rest": "the robot rests and nothing changes any more",
     }[report["stopped"]]
+    against = (
+        f"the readings of {report['sensor_file']}"
+        if report["environment"] == "file"
+        else f"the {report['environment']} environment (seed {report['seed']})"
+    )
     return (
-        f"{report['out']}: ran {report['events']} event(s) against the {report['environment']} "
-        f"environment (seed {report['seed']}): {why}\n"
+        f"{report['out']}: ran {report['events']} event(s) against {against}: {why}\n"
         f"  events: {kinds}\n"
         f"  {report['samples']} samples, {report['seconds']:.4g} s simulated, "
         f"{report['faces_visited']} face(s) visited, {report['controller_solves']} "
