@@ -23,7 +23,6 @@ robot's behaviour, after a dwell, and rests where they only repeat it.
 
 from __future__ import annotations
 
-import heapq
 import itertools
 import math
 import os
@@ -34,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from tlmpc.abstraction.model import Abstraction, FloatArray
+from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
 from tlmpc.base.errors import UsageError, error
 from tlmpc.control.geometry import triangle_geometry
 from tlmpc.control.model import StepController
@@ -134,8 +133,7 @@ class ReactiveExecutor:
         self.legs: list[Leg] = []
         self._cache: dict[tuple[int, int | None], StepController] = {}
         self.solves = 0
-        centers = abstraction.vertices[abstraction.triangles].mean(axis=1)
-        self._centers: FloatArray = centers
+        self._inside_faces, self._portals = _face_graph(abstraction, self.face_of)
 
     @classmethod
     def from_output(cls, output: str | os.PathLike[str]) -> ReactiveExecutor:
@@ -291,36 +289,27 @@ class ReactiveExecutor:
     def route(self, triangle: int, goal: int) -> list[int]:
         """The shortest chain of triangles (by centre distance) from ``triangle`` through its
         face to the first triangle of the neighbouring face ``goal``."""
-        face_of, neighbors = self.face_of, self.abstraction.neighbors
-        face = int(face_of[triangle])
-        distance = {triangle: 0.0}
-        before: dict[int, int] = {}
-        queue = [(0.0, triangle)]
-        while queue:
-            d, t = heapq.heappop(queue)
-            if d > distance[t]:
-                continue
-            entries = [int(n) for n in neighbors[t].tolist() if n >= 0 and face_of[n] == goal]
-            if entries:
-                path = [t]
-                while path[-1] in before:
-                    path.append(before[path[-1]])
-                return [*reversed(path), min(entries)]
-            for n in neighbors[t].tolist():
-                if n < 0 or int(face_of[n]) != face:
-                    continue
-                step = d + float(np.linalg.norm(self._centers[t] - self._centers[n]))
-                if step < distance.get(n, math.inf):
-                    distance[n], before[n] = step, t
-                    heapq.heappush(queue, (step, n))
-        raise UsageError(
-            error(
-                "Q124",
-                f"the strategy heads from face {face} for face {goal}, which does not share "
-                "an edge with it",
-                hint="strategy.json and abstraction.json do not belong together: compile again",
+        from scipy.sparse.csgraph import dijkstra
+
+        face = int(self.face_of[triangle])
+        portals = self._portals.get((face, goal))
+        if portals is None:
+            raise UsageError(
+                error(
+                    "Q124",
+                    f"the strategy heads from face {face} for face {goal}, which does not "
+                    "share an edge with it",
+                    hint="strategy.json and abstraction.json do not belong together: compile again",
+                )
             )
-        )
+        inside, entries = portals
+        distance, before = dijkstra(self._inside_faces, indices=triangle, return_predecessors=True)
+        # the nearest triangle on the edge with the goal face (first in the list on a tie)
+        best = int(np.argmin(distance[inside]))
+        path = [int(inside[best])]
+        while path[-1] != triangle:
+            path.append(int(before[path[-1]]))
+        return [*reversed(path), int(entries[best])]
 
     def _controllers(self, route: list[int]) -> list[StepController]:
         """One field per route triangle (exits, then a stay in the last), from the cache or
@@ -423,6 +412,43 @@ class ReactiveExecutor:
         self.time = horizon
         self.motion.add(horizon, self.point, self.triangle)
         return False
+
+
+def _face_graph(
+    abstraction: Abstraction, face_of: IntArray
+) -> tuple[Any, dict[tuple[int, int], tuple[IntArray, IntArray]]]:
+    """The graph of edges between triangles of one face (weighted by the distance of their
+    centres, for routes), and for each pair of neighbouring faces (f, g) the triangles of f
+    on their common edge with, for each, its neighbour in g (the lowest one)."""
+    from scipy.sparse import csr_matrix
+
+    count = abstraction.num_triangles
+    centers = abstraction.vertices[abstraction.triangles].mean(axis=1)
+    rows = np.repeat(np.arange(count, dtype=np.int64), 3)
+    cols = abstraction.neighbors.reshape(-1).astype(np.int64)
+    real = cols >= 0
+    rows, cols = rows[real], cols[real]
+    same = face_of[rows] == face_of[cols]
+    weights = np.linalg.norm(centers[rows[same]] - centers[cols[same]], axis=1)
+    graph = csr_matrix((weights, (rows[same], cols[same])), shape=(count, count))
+    portals: dict[tuple[int, int], tuple[IntArray, IntArray]] = {}
+    across = ~same
+    crossing = sorted(
+        zip(
+            face_of[rows[across]].tolist(),
+            face_of[cols[across]].tolist(),
+            rows[across].tolist(),
+            cols[across].tolist(),
+            strict=True,
+        )
+    )
+    for (face, goal), group in itertools.groupby(crossing, key=lambda c: (c[0], c[1])):
+        entry: dict[int, int] = {}
+        for _, _, triangle, other in group:
+            entry[triangle] = min(entry.get(triangle, other), other)
+        inside = np.array(sorted(entry), dtype=np.int64)
+        portals[(face, goal)] = (inside, np.array([entry[t] for t in inside.tolist()]))
+    return graph, portals
 
 
 def _area(corners: FloatArray) -> float:
