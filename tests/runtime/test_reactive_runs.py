@@ -257,3 +257,46 @@ def test_a_robot_with_nothing_to_do_rests() -> None:
     run = run_reactive(executor, quiet, events=30)
     assert run.stopped == "rest"
     check_run(run.trace, found[2])
+
+
+def test_online_commands_drive_a_robot_through_the_task(guard: Compiled) -> None:
+    """A point robot integrated with small steps from the executor's velocity commands
+    (pose and readings in, velocity out) keeps to free space, moves only between
+    neighbouring faces, and patrols home and post while the readings change."""
+    import numpy as np
+    import shapely
+    from reactive_runs import free_space
+
+    executor = executor_of(guard)
+    space = free_space({"workspace": guard[0].workspace.to_json()}).buffer(1e-6)
+    point = np.array(guard[0].robot.start, dtype=float)
+    dt = 0.01
+    faces = [executor.face_of[executor.abstraction.start]]
+    regions_seen: list[frozenset[str]] = []
+    for k in range(9000):
+        t = k * dt
+        person = 10.0 <= t % 30.0 < 14.0
+        vx, vy = executor.command(point, t, {"person": person, "alarm": False})
+        assert executor.status == "following", t
+        point = point + dt * np.array([vx, vy])
+        assert space.covers(shapely.Point(point)), (t, point)
+        face = int(executor.face)
+        if face != faces[-1]:
+            assert face in executor.machine.adjacent[faces[-1]]
+            faces.append(face)
+            regions_seen.append(frozenset(executor.face_regions()))
+        if person:  # the camera answers the person at once
+            assert executor.actions["camera"], t
+    assert sum("home" in r for r in regions_seen) >= 3
+    assert sum("post" in r for r in regions_seen) >= 3
+    assert any("exit" in r for r in regions_seen)
+
+
+def test_a_robot_pushed_into_another_face_is_off_course(guard: Compiled) -> None:
+    executor = executor_of(guard)
+    start = guard[0].robot.start
+    executor.command(start, 0.0, {"person": False, "alarm": False})
+    assert executor.status == "following"
+    # carried into the lab (never a goal here) in one jump
+    assert executor.command((5.0, 5.0), 1.0, {"person": False, "alarm": False}) == (0.0, 0.0)
+    assert executor.status == "off_course"

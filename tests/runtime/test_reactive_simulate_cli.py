@@ -144,3 +144,58 @@ def test_usage_errors(guard: Path, tmp_path: Path) -> None:
     status, _, err = run("simulate", str(static), "--sensors", "random")
     assert status == 2
     assert "error[U100]" in err
+
+
+def test_a_strategy_of_another_mission_is_refused(guard: Path, tmp_path: Path) -> None:
+    import shutil
+
+    other = tmp_path / "other"
+    shutil.copytree(guard, other)
+    strategy = json.loads((other / "strategy.json").read_text())
+    strategy["inputs"][0]["name"] = "visitor"
+    (other / "strategy.json").write_text(json.dumps(strategy))
+    status, _, err = run("simulate", str(other), "--events", "5")
+    assert status == 2
+    assert "error[Q123]" in err
+
+
+def test_an_assumption_no_environment_can_keep_stops_the_run(tmp_path: Path) -> None:
+    """ "G !r1" promises the robot is never in r1; the robot, asked to visit r1, wins the
+    game vacuously (the environment cannot keep both that and the robot's arrival), but a
+    real arrival in r1 leaves no reading that keeps the promise."""
+    mission = tmp_path / "promise.yaml"
+    mission.write_text(
+        "version: 1\n"
+        "workspace: {boundary: {rect: [0, 0, 3, 2]}}\n"
+        "regions:\n  r0: {rect: [0, 0, 1, 2]}\n  r1: {rect: [2, 0, 3, 2]}\n"
+        "sensors: {s: null}\n"
+        'assumptions:\n  - "G !r1"\n'
+        "robot: {start: [1.5, 1]}\n"
+        "task:\n  - visit r1 infinitely often\n"
+    )
+    out = tmp_path / "out"
+    code, _, err = run("compile", str(mission), "-o", str(out))
+    assert code == 0, err
+    status, _, err = run("simulate", str(out), "--events", "20")
+    assert status == 1
+    assert "error[Q121]" in err
+    assert "G !r1" in err
+
+
+def test_fairness_assumptions_are_met_within_the_bound(guard: Path, tmp_path: Path) -> None:
+    from reactive_runs import word
+
+    from tlmpc.runtime.environments import FAIRNESS_BOUND
+
+    for kind in ("random", "adversarial"):
+        trace_path = tmp_path / f"{kind}.json"
+        code, _, err = run(
+            "simulate", str(guard), "--sensors", kind, "--events", "80", "-o", str(trace_path)
+        )
+        assert code == 0, err
+        letters = word(json.loads(trace_path.read_text()))
+        longest = run_length = 0
+        for letter in letters:  # G F !person: the longest stretch of letters with a person
+            run_length = run_length + 1 if "person" in letter else 0
+            longest = max(longest, run_length)
+        assert 1 <= longest <= FAIRNESS_BOUND, kind

@@ -26,7 +26,7 @@ from __future__ import annotations
 import itertools
 import math
 import os
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -39,6 +39,7 @@ from tlmpc.control.geometry import triangle_geometry
 from tlmpc.control.model import StepController
 from tlmpc.mission.model import Mission
 from tlmpc.planning.model import Witness
+from tlmpc.runtime.locate import Locator
 from tlmpc.runtime.strategy_machine import StrategyMachine
 from tlmpc.simulate.exact import exit_step, expm_small
 
@@ -133,6 +134,10 @@ class ReactiveExecutor:
         self.legs: list[Leg] = []
         self._cache: dict[tuple[int, int | None], StepController] = {}
         self.solves = 0
+        #: ``following``, or ``off_course`` once the robot (pushed by something the strategy
+        #: does not know of) entered a face it was not heading for: it then stops
+        self.status = "following"
+        self._locator: Locator | None = None
         self._inside_faces, self._portals = _face_graph(abstraction, self.face_of)
 
     @classmethod
@@ -262,6 +267,95 @@ class ReactiveExecutor:
         self.events.append(
             Event(self.time, kind, dict(sensors), self.face, node, self.goal, dict(actions))
         )
+        self._plan()
+
+    # --- online use: pose in, velocity out -------------------------------------------------
+
+    def command(
+        self, point: Sequence[float], t: float, sensors: Mapping[str, bool]
+    ) -> tuple[float, float]:
+        """The velocity for a robot at ``point`` at time ``t`` (not decreasing) reading
+        ``sensors``: the events the readings and the position make are taken first (a
+        sensor change, an arrival in the goal face, both, or a due stutter step).  A robot
+        found in a face it was not heading for is ``off_course`` and gets zero velocity."""
+        where = np.asarray(point, dtype=np.float64)
+        if where.shape != (2,) or not np.all(np.isfinite(where)) or not math.isfinite(t):
+            raise UsageError(
+                error(
+                    "Q125",
+                    f"a position is (x, y) of finite numbers with a finite time, not "
+                    f"{tuple(point)!r} at t={t!r}",
+                    hint="pass the robot's (reference) point in the mission's frame",
+                )
+            )
+        if self._locator is None:
+            self._locator = Locator.of(self.abstraction)
+        reading = {s: bool(sensors[s]) for s in self.machine.sensors}
+        if self.node < 0:
+            found = self._locator.locate(where)
+            if found is None:
+                raise UsageError(
+                    error("Q125", f"the start {tuple(point)!r} is outside the free space")
+                )
+            self.triangle, self.face = found, int(self.face_of[found])
+            self.point, self.time = where, float(t)
+            if not self.start(reading):
+                raise UsageError(
+                    error(
+                        "Q125",
+                        f"the strategy serves no start with the readings {reading}",
+                        hint="the first readings break an initial assumption",
+                    )
+                )
+            return self.velocity(where)
+        self.time = max(self.time, float(t))
+        if self.status != "following":
+            return (0.0, 0.0)
+        entered = self._locator.walk(self.triangle, self.point, where)
+        if entered is None:
+            found = self._locator.locate(where)
+            entered = [] if found is None or found == self.triangle else [found]
+        self.point = where
+        arrived = False
+        for triangle in entered:
+            face = int(self.face_of[triangle])
+            if face != self.face and (arrived or face != self.goal):
+                self.status = "off_course"
+                return (0.0, 0.0)
+            self.triangle = triangle
+            if face != self.face:
+                self.face, arrived = face, True
+        if arrived or reading != self.sensors:
+            if not self.react(reading, arrived=arrived):
+                self.status = "off_course"  # the readings break an assumption
+                return (0.0, 0.0)
+        else:
+            stutter = self.stutter_answer()
+            if stutter is not None and t >= self.events[-1].time + self.dwell_time():
+                self.stutter(stutter)
+        if self.legs and self.legs[0].kind == "dwell" and t >= self.legs[0].until:
+            self.legs.pop(0)
+        while len(self.legs) > 1 and self.legs[0].controller.triangle != self.triangle:
+            if self.legs[0].controller.next_triangle == self.triangle:
+                self.legs.pop(0)  # crossed into the route's next triangle
+            else:
+                break
+        if self.legs and self.legs[0].controller.triangle != self.triangle:
+            self._plan_from_here()  # pushed off the route inside the face
+        return self.velocity(where)
+
+    def velocity(self, point: FloatArray) -> tuple[float, float]:
+        """The current leg's field at ``point``, within ``max_speed``."""
+        controller = self.legs[0].controller
+        u = controller.gain @ point + controller.offset
+        speed = float(np.hypot(u[0], u[1]))
+        limit = self.mission.robot.max_speed
+        if speed > limit:  # only just outside the triangle: the field is bounded inside
+            u = u * (limit / speed)
+        return float(u[0]), float(u[1])
+
+    def _plan_from_here(self) -> None:
+        self.legs = []
         self._plan()
 
     # --- motion --------------------------------------------------------------------------
