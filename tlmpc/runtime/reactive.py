@@ -272,7 +272,7 @@ class ReactiveExecutor:
     # --- online use: pose in, velocity out -------------------------------------------------
 
     def command(
-        self, point: Sequence[float], t: float, sensors: Mapping[str, bool]
+        self, point: Sequence[float] | FloatArray, t: float, sensors: Mapping[str, bool]
     ) -> tuple[float, float]:
         """The velocity for a robot at ``point`` at time ``t`` (not decreasing) reading
         ``sensors``: the events the readings and the position make are taken first (a
