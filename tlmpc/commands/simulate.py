@@ -30,7 +30,9 @@ adversarial (the worst push at every instant).  The executor tracks the plan ste
 the plan or re-plans when the robot is pushed into another triangle.  The run lasts --cycles
 laps of the plan's cycle (or dwell times in a final stay; default 2) or --duration seconds;
 the trajectory (of the reference point, for a unicycle) is verified by the independent
-verifier and written with -o.  See docs/cli.md and docs/control.md."""
+verifier and written with -o.  For a reactive mission (OUT has strategy.json) the strategy
+runs against --sensors random, adversarial or a CSV file of timed readings for --events
+events.  See docs/cli.md and docs/control.md."""
 
 
 def _positive(text: str, what: str, code: str) -> float:

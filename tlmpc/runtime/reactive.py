@@ -303,8 +303,10 @@ class ReactiveExecutor:
                 raise UsageError(
                     error(
                         "Q125",
-                        f"the strategy serves no start with the readings {reading}",
-                        hint="the first readings break an initial assumption",
+                        f"the strategy serves no start in face {self.face} with the "
+                        f"readings {reading}",
+                        hint="start the robot in the face of the mission's robot.start, with "
+                        "readings that keep the initial assumptions",
                     )
                 )
             return self.velocity(where)
