@@ -199,3 +199,18 @@ def test_fairness_assumptions_are_met_within_the_bound(guard: Path, tmp_path: Pa
             run_length = run_length + 1 if "person" in letter else 0
             longest = max(longest, run_length)
         assert 1 <= longest <= FAIRNESS_BOUND, kind
+
+
+def test_a_strategy_on_other_faces_is_refused(guard: Path, tmp_path: Path) -> None:
+    import shutil
+
+    other = tmp_path / "other"
+    shutil.copytree(guard, other)
+    strategy = json.loads((other / "strategy.json").read_text())
+    labels = strategy["faces"]["labels"]
+    labels[1], labels[3] = labels[3], labels[1]  # home and post swapped
+    (other / "strategy.json").write_text(json.dumps(strategy))
+    status, _, err = run("simulate", str(other), "--events", "5")
+    assert status == 2
+    assert "error[Q123]" in err
+    assert "faces" in err

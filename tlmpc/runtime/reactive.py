@@ -39,6 +39,7 @@ from tlmpc.control.geometry import triangle_geometry
 from tlmpc.control.model import StepController
 from tlmpc.mission.model import Mission
 from tlmpc.planning.model import Witness
+from tlmpc.reactive.faces import faces_of
 from tlmpc.runtime.locate import Locator
 from tlmpc.runtime.strategy_machine import StrategyMachine
 from tlmpc.simulate.exact import exit_step, expm_small
@@ -111,16 +112,16 @@ class ReactiveExecutor:
         self.mission = mission
         self.abstraction = abstraction
         self.machine = machine
-        if len(machine.face_of) != abstraction.num_triangles:
+        self.face_of = np.asarray(machine.face_of, dtype=np.int64)
+        faces = faces_of(abstraction)  # the strategy's faces must be the abstraction's
+        if not np.array_equal(faces.face_of, self.face_of) or faces.letters != machine.labels:
             raise UsageError(
                 error(
                     "Q123",
-                    f"strategy.json has faces for {len(machine.face_of)} triangles, the "
-                    f"abstraction {abstraction.num_triangles}",
+                    "strategy.json's faces are not those of abstraction.json",
                     hint="the output folder mixes two compilations: compile the mission again",
                 )
             )
-        self.face_of = np.asarray(machine.face_of, dtype=np.int64)
         self.sensors: dict[str, bool] = {}
         self.actions: dict[str, bool] = {}
         self.events: list[Event] = []
