@@ -337,6 +337,7 @@ def test_online_commands_drive_a_robot_through_the_task(guard: Compiled) -> None
     dt = 0.01
     faces = [executor.face_of[executor.abstraction.start]]
     regions_seen: list[frozenset[str]] = []
+    entered = -1.0
     for k in range(9000):
         t = k * dt
         person = 10.0 <= t % 30.0 < 14.0
@@ -347,7 +348,10 @@ def test_online_commands_drive_a_robot_through_the_task(guard: Compiled) -> None
         face = int(executor.face)
         if face != faces[-1]:
             assert face in executor.machine.adjacent[faces[-1]]
+            # a face entered is held a while (the robot dwells before leaving by its entry)
+            assert t - entered >= 5 * dt, (t, faces[-1])
             faces.append(face)
+            entered = t
             regions_seen.append(frozenset(executor.face_regions()))
         if person:  # the camera answers the person at once
             assert executor.actions["camera"], t

@@ -131,6 +131,7 @@ class ReactiveExecutor:
         self.time = 0.0
         self.point = np.asarray(mission.robot.start, dtype=np.float64)
         self.triangle = abstraction.start
+        self._came_from: int | None = None  # the triangle before the last crossing
         self.face = int(self.face_of[self.triangle])
         self.legs: list[Leg] = []
         self._cache: dict[tuple[int, int | None], StepController] = {}
@@ -325,7 +326,7 @@ class ReactiveExecutor:
             if face != self.face and (arrived or face != self.goal):
                 self.status = "off_course"
                 return (0.0, 0.0)
-            self.triangle = triangle
+            self._came_from, self.triangle = self.triangle, triangle
             if face != self.face:
                 self.face, arrived = face, True
         if arrived or reading != self.sensors:
@@ -378,7 +379,12 @@ class ReactiveExecutor:
         gap = float(
             geometry.offsets[first.exit_edge] - geometry.normals[first.exit_edge] @ self.point
         )
-        if gap <= ON_EDGE * float(geometry.heights[first.exit_edge]):
+        # Just arrived and heading back where it came from (online, the robot is a sample
+        # period inside, not on the edge), or standing on the exit edge: dwell first.
+        last = self.events[-1] if self.events else None
+        arrived = last is not None and last.kind in ("arrival", "both") and last.time == self.time
+        back = arrived and first.next_triangle == self._came_from
+        if back or gap <= ON_EDGE * float(geometry.heights[first.exit_edge]):
             stay = self._controllers([self.triangle])[0]
             legs.insert(0, Leg("dwell", stay, self.time + self.dwell_time()))
         self.legs = legs
@@ -491,7 +497,7 @@ class ReactiveExecutor:
         if crossing <= horizon:
             for t, p in zip(times[:-1], points[:-1], strict=True):
                 self.motion.add(self.time + t, p, self.triangle)
-            self.triangle = controller.next_triangle
+            self._came_from, self.triangle = self.triangle, controller.next_triangle
             self.point = np.asarray(points[-1], dtype=np.float64)
             self.time = crossing
             self.motion.add(crossing, self.point, self.triangle)
