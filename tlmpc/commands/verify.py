@@ -204,6 +204,10 @@ def _text(path: Path, verdict: Verdict) -> str:
     if len(verdict.conjuncts) > 1 or verdict.ending == "open" or timed:
         for report in verdict.conjuncts:
             lines.append(f"  {report.conjunct}: {report.outcome}: {report.progress}")
+    if verdict.reactive is not None:
+        from tlmpc.verify.blame import blame_lines
+
+        lines.extend(blame_lines(verdict.reactive, float(verdict.stats["start_time"])))
     for violation in verdict.violations:
         lines.append(f"  violation: {violation.message}")
     lines.append(f"  robustness: {verdict.robustness:.6g}")
