@@ -165,7 +165,8 @@ def assume_guarantee(
             robot=None,
         )
     if ending != "open":
-        # Two-valued and nothing broke at an instant: liveness decides, assumptions first.
+        # Nothing broke at an instant: liveness decides, the assumptions' first.  (Two-valued
+        # unless a signal is unknown somewhere: then a part may be undecided.)
         failed = next((a for a in assumed if a.outcome == "violated"), None)
         if failed is not None:
             return AssumeGuarantee(
@@ -176,7 +177,8 @@ def assume_guarantee(
                 environment=failed,
                 robot=None,
             )
-        if guarantee == "violated":
+        kept = all(a.outcome == "satisfied" for a in assumed)
+        if guarantee == "violated" and kept:
             broken = next((g for g in promised if g.outcome == "violated"), None)
             return AssumeGuarantee(
                 outcome="violated",
@@ -187,7 +189,7 @@ def assume_guarantee(
                 robot=broken,
             )
         return AssumeGuarantee(
-            outcome="satisfied",
+            outcome="satisfied" if guarantee == "satisfied" else "inconclusive",
             blame=None,
             assumptions=assumed,
             guarantees=promised,
