@@ -12,6 +12,7 @@ piece of the run has one value of every signal: the value at the piece's first i
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -46,22 +47,18 @@ class Signal:
         return value.astype(bool), unknown
 
 
+#: The words a boolean sample may be written as (after stripping and lower-casing).
+WORDS = {"true": True, "false": False, "1": True, "0": False, "1.0": True, "0.0": False}
+
+
 def as_boolean(value: Any) -> bool | None:
     """``True``/``False`` for a boolean sample (true/false/1/0, any case), None otherwise."""
+    if isinstance(value, str):
+        return WORDS.get(value.strip().lower())
     if isinstance(value, bool | np.bool_):
         return bool(value)
     if isinstance(value, int | float | np.integer | np.floating):
-        if value == 1:
-            return True
-        if value == 0:
-            return False
-        return None
-    if isinstance(value, str):
-        word = value.strip().lower()
-        if word in ("true", "1", "1.0"):
-            return True
-        if word in ("false", "0", "0.0"):
-            return False
+        return True if value == 1 else False if value == 0 else None
     return None
 
 
@@ -91,9 +88,9 @@ def make_signal(name: str, times: Sequence[Any], values: Sequence[Any], where: W
     clock = np.full(len(times), np.nan)
     bits = np.zeros(len(values), dtype=bool)
     for index, (t, v) in enumerate(zip(times, values, strict=True)):
-        what, line = where.sample(index)
         bit = as_boolean(v)
         if bit is None and sum(d.code == "V030" for d in found) < MAX_LISTED:
+            what, line = where.sample(index)
             found.append(
                 error(
                     "V030",
@@ -106,8 +103,9 @@ def make_signal(name: str, times: Sequence[Any], values: Sequence[Any], where: W
             )
         bits[index] = bool(bit)
         number = t if isinstance(t, int | float) and not isinstance(t, bool) else None
-        if number is None or not np.isfinite(number):
+        if number is None or not math.isfinite(number):
             if sum(d.code == "V031" for d in found) < MAX_LISTED:
+                what, line = where.sample(index)
                 found.append(
                     error(
                         "V031",
@@ -118,7 +116,7 @@ def make_signal(name: str, times: Sequence[Any], values: Sequence[Any], where: W
                     )
                 )
             continue
-        clock[index] = float(number)
+        clock[index] = number
     if not found:
         steps = np.flatnonzero(np.diff(clock) <= 0)
         for index in steps[:MAX_LISTED].tolist():
