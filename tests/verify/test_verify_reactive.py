@@ -407,3 +407,10 @@ def test_parse_round_trip_of_assumptions() -> None:
         to_text(parse_ltl("G F !alarm")),
         to_text(parse_ltl("G !alarm")),
     ]
+
+
+def test_violations_name_a_sensor_as_a_sensor() -> None:
+    verdict = _verify(corridor([(0, False), (3, True)]), "G !alarm", [])
+    assert verdict.violations[0].message.startswith("`alarm` is true at t=3 s")
+    verdict = _verify(corridor([(0, True)]), "G(alarm -> !lab)", [])
+    assert verdict.violations[0].message.startswith("entered lab at t=4 s")

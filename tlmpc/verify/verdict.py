@@ -460,6 +460,7 @@ def verify_trace(trace: TraceInput) -> Verdict:
         labels=pieces.labels,
         names=names,
         origin=trace.start,
+        signals=frozenset(trace.sensors) | frozenset(trace.actions),
     )
     reports, violations = conjunct_reports(conjuncts, outcomes, truth, line)
 
