@@ -221,3 +221,24 @@ def judge(
         return Judgement("satisfied", None, None, None)
     good = all(ltl3(g, word, props, unknown, longest) == 1 for g in guarantees)
     return Judgement("satisfied" if good else "inconclusive", None, None, None)
+
+
+def closed_pieces(run: Run) -> tuple[list[Letter], list[bool]]:
+    """The run as point and open pieces under the closed convention: an instant's letter has
+    the rectangles whose closure contains its point, a stretch's those containing its middle;
+    both with the signals' values at their (first) instant."""
+    times = instants(run)
+    word: list[Letter] = []
+    is_point: list[bool] = []
+    for index, s in enumerate(times):
+        sensors = {name for name, pts in run.signals.items() if _signal(pts, s)}
+        x, y = _position(run, s)
+        regions = {name for name, rect in run.rects.items() if _inside(rect, x, y)}
+        word.append(frozenset(regions | sensors))
+        is_point.append(True)
+        if index + 1 < len(times):
+            x, y = _position(run, (s + times[index + 1]) / 2)
+            regions = {name for name, rect in run.rects.items() if _inside(rect, x, y)}
+            word.append(frozenset(regions | sensors))
+            is_point.append(False)
+    return word, is_point

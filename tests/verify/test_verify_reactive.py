@@ -12,9 +12,11 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from continuous_ltl import closed_holds
 from hypothesis import event, given, settings
 from hypothesis import strategies as st
-from reactive_run import Run, instants, judge
+from reactive_run import Run, closed_pieces, instants, judge
+from strategies import formulas
 
 from tlmpc.cli import main
 from tlmpc.ltl.ast import (
@@ -414,3 +416,21 @@ def test_violations_name_a_sensor_as_a_sensor() -> None:
     assert verdict.violations[0].message.startswith("`alarm` is true at t=3 s")
     verdict = _verify(corridor([(0, True)]), "G(alarm -> !lab)", [])
     assert verdict.violations[0].message.startswith("entered lab at t=4 s")
+
+
+@given(runs(), formulas(PROPS, max_leaves=5), formulas(PROPS, max_leaves=3))
+def test_closed_convention_stay_verdicts_agree_with_the_definition(
+    run: Run, guarantee: Formula, assumption: Formula
+) -> None:
+    # every operator, any formula: on a stay the verdicts are two-valued and exact
+    doc = document(run, to_text(guarantee), [to_text(assumption)], end="stay")
+    doc["boundary"] = "closed"
+    judged = verify_document(doc).reactive
+    assert judged is not None
+    word, is_point = closed_pieces(run)
+    last = len(word) - 1
+    for part, formula in zip(
+        (*judged.assumptions, *judged.guarantees), [assumption, *_parts(guarantee)], strict=True
+    ):
+        expected = closed_holds(formula, word, is_point, last, 0)
+        assert part.outcome == ("satisfied" if expected else "violated"), to_text(formula)

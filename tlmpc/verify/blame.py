@@ -66,8 +66,12 @@ class Prefixes:
         self.is_point = is_point
         self.cache: dict[int, Semantics] = {}
 
-    def outcome(self, formula: Formula, cut: int) -> Outcome:
-        """The verdict of ``formula`` on the first ``cut`` pieces, the rest unknown."""
+    def outcome(self, formula: Formula, cut: int, *, keep: bool = True) -> Outcome:
+        """The verdict of ``formula`` on the first ``cut`` pieces, the rest unknown.
+
+        ``keep``: remember the cut's evaluator (its sub-formulas' values), for more formulas
+        asked at the same cut; a bisection visits each cut once and keeps nothing, so its
+        memory stays that of one evaluation."""
         semantics = self.cache.get(cut)
         if semantics is None:
             semantics = Semantics(
@@ -77,7 +81,8 @@ class Prefixes:
                 is_point=None if self.is_point is None else self.is_point[:cut],
                 timing=Timing(self.starts[:cut], float(self.starts[cut - 1])),
             )
-            self.cache[cut] = semantics
+            if keep:
+                self.cache[cut] = semantics
         return outcome_of_value(*semantics.at_start(formula))
 
 
@@ -101,7 +106,7 @@ def breaking_time(
     def bad(cut: int) -> bool:
         if ending == "open" and cut == size:
             return True  # the log itself: its verdict (with its last point's unknowns)
-        return prefixes.outcome(formula, cut) == "violated"
+        return prefixes.outcome(formula, cut, keep=False) == "violated"
 
     if not cuts or not bad(cuts[-1]):
         return None  # fails only in the limit (on the loop, or on its repetitions)
