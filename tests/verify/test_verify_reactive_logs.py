@@ -280,3 +280,20 @@ def test_batch_and_monitor_refuse_a_reactive_mission(tmp_path: Path) -> None:
     status = main(["monitor", "--mission", str(path), str(log)], out=monitor_out, err=monitor_err)
     assert status == 2
     assert "error[U110]" in monitor_err.getvalue()
+
+
+def test_bag_strings_and_repeated_stamps(tmp_path: Path) -> None:
+    pytest.importorskip("rosbags")
+    unbound = mission(tmp_path, sensors="  alarm: null")
+    words = {"/alarm": [(0, "false"), (3 * SECOND, "True")]}
+    strings = write_bag(tmp_path / "s.bag", "ros1", POSES, words, bool_type="std_msgs/msg/String")
+    status, data = result("--mission", str(unbound), str(strings))
+    assert status == 1
+    assert data["reactive"]["robot"]["elapsed"] == pytest.approx(4.0)
+    twice = {"/alarm": [(0, False), (SECOND, True), (SECOND, False)]}
+    repeated = write_bag(tmp_path / "r.bag", "ros1", POSES, twice)
+    status, out, _ = verify("--mission", str(unbound), str(repeated), "--json")
+    assert status == 2
+    found = json.loads(out)["diagnostics"][0]
+    assert found["code"] == "V031"
+    assert "sample 2 at /alarm" in found["message"]
