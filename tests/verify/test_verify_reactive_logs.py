@@ -91,6 +91,7 @@ def test_assumptions_from_the_mission(tmp_path: Path) -> None:
     assert data["reactive"]["vacuous"] is True
     _, out, _ = verify("--mission", str(path), str(csv_log(tmp_path, ALARM_AT_3)))
     assert "the environment broke an assumption at t=3 s: `G !alarm`" in out
+    assert ": satisfied (vacuously: the environment broke an assumption): " in out
 
 
 def test_times_count_from_the_log_start(tmp_path: Path) -> None:
