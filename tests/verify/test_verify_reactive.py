@@ -434,3 +434,47 @@ def test_closed_convention_stay_verdicts_agree_with_the_definition(
     ):
         expected = closed_holds(formula, word, is_point, last, 0)
         assert part.outcome == ("satisfied" if expected else "violated"), to_text(formula)
+
+
+TIMED = [
+    "G(s -> F[0,{k}] a)",
+    "F[0,{k}] (a & s)",
+    "G[0,{k}] !b",
+    "a U[0,{k}] s",
+    "G(a -> G[0,{k}] !s)",
+    "G(s -> (a U[0,{k}] b))",
+    "!s U[1,{k}] a",
+]
+
+
+@given(runs(), st.sampled_from(TIMED), st.integers(1, 4), st.sampled_from(["open", "stay"]))
+def test_bisection_finds_the_first_bad_cut_with_time_bounds(
+    run: Run, template: str, bound: int, end: str
+) -> None:
+    """Bad prefixes stay bad (also in dense time), so the bisection's answer is the first bad
+    cut a linear scan finds."""
+    from tlmpc.verify import blame
+
+    checked: list[tuple[float | None, float | None]] = []
+    bisect = blame.breaking_time
+
+    def scanning(formula: Formula, full: Any, prefixes: Any, ending: Any) -> float | None:
+        found = bisect(formula, full, prefixes, ending)
+        first = None
+        if full == "violated":
+            size = len(prefixes.starts)
+            for cut in range(1, size + 1, 2):
+                last = ending == "open" and cut == size
+                if last or prefixes.outcome(formula, cut, keep=False) == "violated":
+                    first = float(prefixes.starts[cut - 1])
+                    break
+        checked.append((found, first))
+        return found
+
+    ltl = template.format(k=bound)
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(blame, "breaking_time", scanning)
+        verify_document(document(run, ltl, [ltl.replace("a", "b")], end=end))
+    assert checked
+    for found, first in checked:
+        assert found == first
