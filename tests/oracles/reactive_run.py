@@ -185,7 +185,8 @@ def stay_holds(formula: Formula, word: Sequence[Letter]) -> bool:
 
 @dataclass(frozen=True)
 class Judgement:
-    """The oracle's assume-guarantee verdict."""
+    """The oracle's assume-guarantee verdict, with the earliest instants at which an
+    assumption and a guarantee part broke (whoever is to blame)."""
 
     outcome: str
     blame: str | None
@@ -210,12 +211,12 @@ def judge(
     env = min((t for t in env_times if t is not None), default=None)
     rob = min((t for t in rob_times if t is not None), default=None)
     if rob is not None and (env is None or rob < env):
-        return Judgement("violated", "robot", None, rob)
+        return Judgement("violated", "robot", env, rob)
     if env is not None:
-        return Judgement("satisfied", "environment", env, None)
+        return Judgement("satisfied", "environment", env, rob)
     if not open_end:
         if not all(stay_holds(a, word) for a in assumptions):
-            return Judgement("satisfied", "environment", None, None)
+            return Judgement("satisfied", "environment", None, rob)
         if not all(stay_holds(g, word) for g in guarantees):
             return Judgement("violated", "robot", None, None)
         return Judgement("satisfied", None, None, None)

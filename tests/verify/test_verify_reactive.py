@@ -257,6 +257,9 @@ def test_environment_breaks_first_and_the_guarantee_is_vacuous() -> None:
     assert data["vacuous"] is True
     assert data["environment"]["elapsed"] == pytest.approx(3.0)
     assert data["guarantees"][0]["broken_at"] == pytest.approx(4.0)
+    # both times: the robot broke its guarantee too, after the environment
+    assert data["robot"]["elapsed"] == pytest.approx(4.0)
+    assert data["blame"] == "environment"
 
 
 def test_a_tie_goes_to_the_environment() -> None:

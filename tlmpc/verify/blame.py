@@ -27,7 +27,7 @@ from tlmpc.ltl.ast import Formula, bounded_operators
 from tlmpc.ltl.printer import to_text
 from tlmpc.verify.clock import at
 from tlmpc.verify.evaluate import Value
-from tlmpc.verify.model import AssumeGuarantee, Outcome, PartVerdict
+from tlmpc.verify.model import AssumeGuarantee, Blame, Outcome, PartVerdict
 from tlmpc.verify.semantics import PieceEnding, Semantics, Timing
 
 FloatArray = npt.NDArray[np.float64]
@@ -121,8 +121,29 @@ def breaking_time(
 
 
 def _first(parts: Sequence[PartVerdict]) -> PartVerdict | None:
+    """The part broken at the earliest instant; else the first that fails in the limit."""
     timed = [p for p in parts if p.broken is not None]
-    return min(timed, key=lambda p: p.broken or 0.0) if timed else None
+    if timed:
+        return min(timed, key=lambda p: p.broken or 0.0)
+    return next((p for p in parts if p.outcome == "violated"), None)
+
+
+def _blame(
+    environment: PartVerdict | None,
+    robot: PartVerdict | None,
+    assumed: Sequence[PartVerdict],
+    guarantee: Outcome,
+) -> tuple[Outcome, Blame | None]:
+    """Who is to blame, and the run's outcome (docs/semantics.md)."""
+    env_time = None if environment is None else environment.broken
+    robot_time = None if robot is None else robot.broken
+    if robot_time is not None and (env_time is None or robot_time < env_time):
+        return "violated", "robot"  # strictly first: a tie goes to the environment
+    if environment is not None:
+        return "satisfied", "environment"  # at an instant no later, or in the limit
+    if robot is not None and all(a.outcome == "satisfied" for a in assumed):
+        return "violated", "robot"  # in the limit, every assumption kept
+    return ("satisfied" if guarantee == "satisfied" else "inconclusive"), None
 
 
 def assume_guarantee(
@@ -134,7 +155,10 @@ def assume_guarantee(
     ending: PieceEnding,
 ) -> AssumeGuarantee:
     """The strict GR(1) verdict of a run: ``guarantee`` is the whole guarantee's verdict,
-    ``full`` gives a formula's verdict on the whole run, ``guarantees`` are its parts."""
+    ``full`` gives a formula's verdict on the whole run, ``guarantees`` are its parts.
+
+    On an open log a part is violated only with a bad prefix, so whatever fails has a
+    breaking time; failures in the limit exist only on loops and stays."""
 
     def judge(formula: Formula) -> PartVerdict:
         outcome = full(formula)
@@ -147,69 +171,14 @@ def assume_guarantee(
     assumed = tuple(judge(a) for a in assumptions)
     promised = tuple(judge(g) for g in guarantees)
     environment, robot = _first(assumed), _first(promised)
-    # the robot breaks first: strictly before the environment (the critical comparison)
-    robot_first = robot is not None and (
-        environment is None or (robot.broken or 0.0) < (environment.broken or 0.0)
-    )
-    if robot is not None and robot_first:
-        return AssumeGuarantee(
-            outcome="violated",
-            blame="robot",
-            assumptions=assumed,
-            guarantees=promised,
-            environment=None,
-            robot=robot,
-        )
-    if environment is not None:
-        return AssumeGuarantee(
-            outcome="satisfied",
-            blame="environment",
-            assumptions=assumed,
-            guarantees=promised,
-            environment=environment,
-            robot=None,
-        )
-    if ending != "open":
-        # Nothing broke at an instant: liveness decides, the assumptions' first.  (Two-valued
-        # unless a signal is unknown somewhere: then a part may be undecided.)
-        failed = next((a for a in assumed if a.outcome == "violated"), None)
-        if failed is not None:
-            return AssumeGuarantee(
-                outcome="satisfied",
-                blame="environment",
-                assumptions=assumed,
-                guarantees=promised,
-                environment=failed,
-                robot=None,
-            )
-        kept = all(a.outcome == "satisfied" for a in assumed)
-        if guarantee == "violated" and kept:
-            broken = next((g for g in promised if g.outcome == "violated"), None)
-            return AssumeGuarantee(
-                outcome="violated",
-                blame="robot",
-                assumptions=assumed,
-                guarantees=promised,
-                environment=None,
-                robot=broken,
-            )
-        return AssumeGuarantee(
-            outcome="satisfied" if guarantee == "satisfied" else "inconclusive",
-            blame=None,
-            assumptions=assumed,
-            guarantees=promised,
-            environment=None,
-            robot=None,
-        )
-    # An open log where nothing broke: satisfied only when no continuation can break the
-    # guarantee; otherwise the rest of the run decides.
+    outcome, blame = _blame(environment, robot, assumed, guarantee)
     return AssumeGuarantee(
-        outcome="satisfied" if guarantee == "satisfied" else "inconclusive",
-        blame=None,
+        outcome=outcome,
+        blame=blame,
         assumptions=assumed,
         guarantees=promised,
-        environment=None,
-        robot=None,
+        environment=environment,
+        robot=robot,
     )
 
 
@@ -219,18 +188,20 @@ def blame_lines(judged: AssumeGuarantee, start: float) -> list[str]:
     def when(part: PartVerdict) -> str:
         if part.broken is None:
             return "in the limit (on the repeating part, at no single instant)"
-        return at(part.broken, start)
+        return "at " + at(part.broken, start)
 
     lines: list[str] = []
-    if judged.environment is not None:
-        lines.append(
-            f"  the environment broke an assumption at {when(judged.environment)}: "
-            f"`{judged.environment.part}`; the guarantee holds vacuously"
-        )
-    if judged.robot is not None:
-        lines.append(
-            f"  the robot broke a guarantee at {when(judged.robot)}: `{judged.robot.part}`"
-        )
+    environment, robot = judged.environment, judged.robot
+    if environment is not None:
+        line = f"  the environment broke an assumption {when(environment)}: `{environment.part}`"
+        if judged.blame == "environment":
+            line += "; the guarantee holds vacuously"
+        lines.append(line)
+    if robot is not None:
+        line = f"  the robot broke a guarantee {when(robot)}: `{robot.part}`"
+        if judged.blame == "environment":
+            line += " (after the environment did: not to blame)"
+        lines.append(line)
     for part in judged.assumptions:
         lines.append(f"  assumption {part.part}: {part.outcome}")
     return lines

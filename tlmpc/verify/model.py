@@ -88,9 +88,10 @@ class AssumeGuarantee:
     blame: Blame | None
     assumptions: tuple[PartVerdict, ...]
     guarantees: tuple[PartVerdict, ...]
-    #: the assumption the environment broke first (when it is to blame)
+    #: the assumption the environment broke first (at the earliest instant, else in the
+    #: limit), whoever is to blame; None when it kept every assumption (or may have)
     environment: PartVerdict | None
-    #: the guarantee part the robot broke first (when it is to blame)
+    #: the guarantee part the robot broke first, likewise
     robot: PartVerdict | None
 
 
