@@ -200,7 +200,7 @@ def blame_lines(judged: AssumeGuarantee, start: float) -> list[str]:
     if robot is not None:
         line = f"  the robot broke a guarantee {when(robot)}: `{robot.part}`"
         if judged.blame == "environment":
-            line += " (after the environment did: not to blame)"
+            line += " (no earlier than the environment: not to blame)"
         lines.append(line)
     for part in judged.assumptions:
         lines.append(f"  assumption {part.part}: {part.outcome}")
