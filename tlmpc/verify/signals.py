@@ -85,6 +85,20 @@ def make_signal(name: str, times: Sequence[Any], values: Sequence[Any], where: W
     Refuses (V030) a value that is not a boolean, (V031) a time that is not a finite number or
     does not increase — every problem at once, each with its sample (and line)."""
     found: list[Diagnostic] = []
+    words = [as_boolean(v) for v in values]
+    if None not in words and all(type(t) is float or type(t) is int for t in times):
+        # the common case, without per-sample bookkeeping
+        clock = np.asarray(times, dtype=np.float64)
+        if np.isfinite(clock).all():
+            return _increasing(name, clock, np.asarray(words, dtype=bool), where, found)
+    clock, bits = _checked(name, times, values, where, found)  # says where and why
+    return _increasing(name, clock, bits, where, found)
+
+
+def _checked(
+    name: str, times: Sequence[Any], values: Sequence[Any], where: Where, found: list[Diagnostic]
+) -> tuple[FloatArray, BoolArray]:
+    """Sample by sample: each value a boolean (V030), each time a finite number (V031)."""
     clock = np.full(len(times), np.nan)
     bits = np.zeros(len(values), dtype=bool)
     for index, (t, v) in enumerate(zip(times, values, strict=True)):
@@ -117,6 +131,13 @@ def make_signal(name: str, times: Sequence[Any], values: Sequence[Any], where: W
                 )
             continue
         clock[index] = number
+    return clock, bits
+
+
+def _increasing(
+    name: str, clock: FloatArray, bits: BoolArray, where: Where, found: list[Diagnostic]
+) -> Signal:
+    """Refuse (V031) a time that does not come after the one before; the change points."""
     if not found:
         steps = np.flatnonzero(np.diff(clock) <= 0)
         for index in steps[:MAX_LISTED].tolist():
