@@ -67,6 +67,34 @@ def test_simulate_writes_a_checked_trace(guard: Path, tmp_path: Path, kind: str)
     check_run(trace, json.loads((guard / "strategy.json").read_text()))
 
 
+@pytest.mark.parametrize("kind", ["random", "adversarial"])
+@pytest.mark.parametrize("seed", ["0", "3"])
+def test_simulate_reports_the_verifiers_verdict(
+    guard: Path, tmp_path: Path, kind: str, seed: str
+) -> None:
+    trace_path = tmp_path / "trace.json"
+    code, out, err = run(
+        "simulate",
+        str(guard),
+        "--sensors",
+        kind,
+        "--seed",
+        seed,
+        "--events",
+        "60",
+        "--json",
+        "-o",
+        str(trace_path),
+    )
+    result = json.loads(out)["result"]
+    # the command's verdict is the standalone verifier's on the trace it wrote ...
+    verify_code, verify_out, _ = run("verify", str(trace_path), "--json")
+    assert json.loads(verify_out)["result"]["verdict"] == result["outcome"]
+    # ... and an open run of a winning strategy breaks no guarantee: goals stay inconclusive
+    assert result["outcome"] == "inconclusive"
+    assert (code, verify_code) == (0, 4), err
+
+
 def test_json_report(guard: Path) -> None:
     code, out, _ = run("simulate", str(guard), "--events", "10", "--json")
     assert code == 0

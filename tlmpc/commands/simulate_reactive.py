@@ -5,16 +5,20 @@ that keeps the mission's assumptions, for ``--events`` events; the trace (positi
 and action signals, the assumptions and the task) is written with ``-o``.  Exit 0 when the
 run finished; 1 when a sensor file breaks an assumption (Q120) or no environment can keep
 them (Q121); 2 on bad flags, an unreadable file or an output folder that is not a reactive
-compilation.
+compilation.  The trace is verified by the independent verifier: exit 1 also when the
+robot broke a guarantee (the run is open, so goals met so far are inconclusive: exit 0).
 """
 
 from __future__ import annotations
 
 import argparse
 from pathlib import Path
-from typing import Any, TextIO
+from typing import TYPE_CHECKING, Any, TextIO
 
 from tlmpc.base.errors import UsageError, error
+
+if TYPE_CHECKING:
+    from tlmpc.verify.model import Verdict
 
 
 def _events(text: str | None) -> int:
@@ -39,7 +43,7 @@ def _events(text: str | None) -> int:
 
 def run_reactive_command(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Run a reactive mission's strategy against an environment and report."""
-    from tlmpc.base.errors import EXIT_OK
+    from tlmpc.base.errors import EXIT_NEGATIVE, EXIT_OK
     from tlmpc.io.report import Reporter
     from tlmpc.runtime.environments import (
         AdversarialEnvironment,
@@ -51,6 +55,7 @@ def run_reactive_command(args: argparse.Namespace, out: TextIO, err: TextIO) -> 
     from tlmpc.runtime.reactive import REACTIVE_ARTIFACTS, ReactiveExecutor
     from tlmpc.runtime.reactive_loop import run_reactive
     from tlmpc.runtime.sensor_file import read_sensor_file
+    from tlmpc.verify import verify_document
 
     events = _events(args.events)
     if not (args.out / "strategy.json").exists():
@@ -104,12 +109,14 @@ def run_reactive_command(args: argparse.Namespace, out: TextIO, err: TextIO) -> 
         path = Path(source)
         environment = ScriptedEnvironment(sensors, read_sensor_file(path, sensors), str(path))
     run = run_reactive(executor, environment, events=events)
+    verdict = verify_document(run.trace)
     if args.output is not None:
         _write(args.output, run.trace)
-    document = _report(args, run, environment.name)
+    document = _report(args, run, environment.name, verdict)
+    code = EXIT_NEGATIVE if verdict.outcome == "violated" else EXIT_OK
     reporter = Reporter.for_args(args, out, err)
-    reporter.finish(EXIT_OK, document, _text(document))
-    return EXIT_OK
+    reporter.finish(code, document, _text(document))
+    return code
 
 
 def _write(path: Path, document: dict[str, Any]) -> None:
@@ -126,7 +133,9 @@ def _write(path: Path, document: dict[str, Any]) -> None:
         ) from None
 
 
-def _report(args: argparse.Namespace, run: Any, environment: str) -> dict[str, Any]:
+def _report(
+    args: argparse.Namespace, run: Any, environment: str, verdict: Verdict
+) -> dict[str, Any]:
     from tlmpc.runtime.reactive import executor_summary
 
     executor = run.executor
@@ -147,6 +156,8 @@ def _report(args: argparse.Namespace, run: Any, environment: str) -> dict[str, A
         "formula": trace["ltl"],
         "assumptions": trace["assumptions"],
         "ending": trace["end"],
+        "outcome": verdict.outcome,
+        "violations": [v.message for v in verdict.violations],
     }
 
 
@@ -161,9 +172,16 @@ def _text(report: dict[str, Any]) -> str:
         if report["environment"] == "file"
         else f"the {report['environment']} environment (seed {report['seed']})"
     )
+    outcome = {
+        "satisfied": "satisfied",
+        "violated": "VIOLATED",
+        "inconclusive": "inconclusive (the run goes on; no guarantee broken so far)",
+    }[report["outcome"]]
     return (
         f"{report['out']}: ran {report['events']} event(s) against {against}: {why}\n"
-        f"  events: {kinds}\n"
+        f"  verified: {outcome}\n"
+        + "".join(f"  violation: {v}\n" for v in report["violations"])
+        + f"  events: {kinds}\n"
         f"  {report['samples']} samples, {report['seconds']:.4g} s simulated, "
         f"{report['faces_visited']} face(s) visited, {report['controller_solves']} "
         f"controller solve(s); trace ends: {report['ending']}\n"
