@@ -111,14 +111,14 @@ def build_product(
     closed = convention == "closed"
     classes = LetterClasses.of(automaton, list(abstraction.letters))
     tri_class = classes.letter_class[abstraction.letter_of]
-    moves = _ts_moves(abstraction, allowed, starts, bounces=bounces)
-    weight = _move_weights(abstraction, moves, start_point, metric)
+    moves = ts_moves(abstraction, allowed, starts, bounces=bounces)
+    weight = move_weights(abstraction, moves, start_point, metric)
     if closed:
-        move_kind = _crossing_move_kinds(abstraction, automaton, classes, tri_class, moves)
+        move_kind = crossing_move_kinds(abstraction, automaton, classes, tri_class, moves)
     else:
         move_kind = tri_class[abstraction.neighbors].reshape(-1)[moves.exit]
-    successors = _Successors(classes, automaton)
-    stay_cell, stay_class = _stutter_cells(abstraction, allowed, starts, tri_class)
+    successors = Successors(classes, automaton)
+    stay_cell, stay_class = stutter_cells(abstraction, allowed, starts, tri_class)
     nq = automaton.num_states
     size = abstraction.num_triangles * SLOTS * nq
     stutter_accepting = np.zeros(size, dtype=bool)
@@ -129,7 +129,7 @@ def build_product(
         graph=graph,
         accepting=accepting,
         stutter_accepting=stutter_accepting,
-        initial=_initial_nodes(automaton, classes, tri_class, allowed, starts, start_letter),
+        initial=initial_nodes(automaton, classes, tri_class, allowed, starts, start_letter),
         num_automaton_states=nq,
         num_nodes=size,
     )
@@ -181,7 +181,7 @@ class _Moves:
     exit_ok: BoolArray  # (m, 3): edge i of t leads from an allowed triangle to another
 
 
-def _ts_moves(
+def ts_moves(
     abstraction: Abstraction,
     allowed: BoolArray,
     starts: tuple[StartCell, ...],
@@ -226,7 +226,7 @@ def entry_slots(neighbors: IntArray) -> IntArray:
     return slot
 
 
-def _move_weights(
+def move_weights(
     abstraction: Abstraction, moves: _Moves, start_point: tuple[float, float], metric: str
 ) -> FloatArray:
     """Each move's weight: one under ``"hops"``, else its length (:func:`_move_lengths`)."""
@@ -236,7 +236,7 @@ def _move_weights(
     return lengths
 
 
-def _crossing_move_kinds(
+def crossing_move_kinds(
     abstraction: Abstraction,
     automaton: Automaton,
     classes: LetterClasses,
@@ -245,7 +245,7 @@ def _crossing_move_kinds(
 ) -> IntArray:
     """Each move's kind under the closed convention, which reads the crossing instant's
     letter (both sides' labels and the point marker) before the entered triangle's: kind
-    ``(c + 1) * stride + k`` reads class ``c``, then ``k`` (see :class:`_Successors`).
+    ``(c + 1) * stride + k`` reads class ``c``, then ``k`` (see :class:`Successors`).
     The crossing letters' new classes are numbered before ``stride`` is fixed."""
     neighbors = abstraction.neighbors
     letters = list(abstraction.letters)
@@ -268,7 +268,7 @@ def _crossing_move_kinds(
     return move_kind
 
 
-def _stutter_cells(
+def stutter_cells(
     abstraction: Abstraction,
     allowed: BoolArray,
     starts: tuple[StartCell, ...],
@@ -294,9 +294,9 @@ def _stutter_cells(
 StayEdges = tuple[IntArray, int, list[tuple[int, bool]]]
 
 
-class _Successors:
+class Successors:
     """Automaton successors per kind of move (one letter class, or a crossing class and an
-    entered class, see :func:`_crossing_move_kinds`)."""
+    entered class, see :func:`crossing_move_kinds`)."""
 
     def __init__(self, classes: LetterClasses, automaton: Automaton) -> None:
         self.rows = classes.rows
@@ -354,7 +354,7 @@ def _product_edges(
     moves: _Moves,
     move_kind: IntArray,
     weight: FloatArray,
-    successors: _Successors,
+    successors: Successors,
     stay_edges: list[StayEdges],
 ) -> tuple[Graph, BoolArray]:
     """The product's edges written straight into CSR order, and their acceptance marks.
@@ -451,7 +451,7 @@ def _product_edges(
     return Graph(indptr=indptr, sources=src, targets=dst, weights=wgt, num_nodes=size), acc
 
 
-def _initial_nodes(
+def initial_nodes(
     automaton: Automaton,
     classes: LetterClasses,
     tri_class: IntArray,
@@ -466,11 +466,11 @@ def _initial_nodes(
     if start_letter is not None:
         point_row = successor_table(automaton, [start_letter])[0]
         entry_states = list(dict.fromkeys(q for q, _ in point_row[automaton.initial]))
-    initial_nodes: set[int] = set()
+    found: set[int] = set()
     for cell in starts:
         if not allowed[cell.triangle]:
             continue
         row = classes.rows[int(tri_class[cell.triangle])]
         for q0 in entry_states:
-            initial_nodes.update((cell.triangle * SLOTS + START_SLOT) * nq + q for q, _ in row[q0])
-    return np.array(sorted(initial_nodes), dtype=np.int64)
+            found.update((cell.triangle * SLOTS + START_SLOT) * nq + q for q, _ in row[q0])
+    return np.array(sorted(found), dtype=np.int64)

@@ -1,0 +1,338 @@
+"""The minimum-cost lasso on a product expanded on demand, guided by lower bounds.
+
+The same lasso as :func:`tlmpc.planning.plan.plan` finds on the built product, with the same
+cost (``prefix + beta * cycle``) and the same promise (docs/planning.md): the least of
+
+* ``d0(s)`` over the accepting stays ``s``, and
+* ``d0(u) + beta * (w(u, v) + d(v, u))`` over the accepting edges ``u -> v``,
+
+but without building the product.  The searches are label-correcting searches in buckets of
+``f = g + h`` (A* with an admissible bound ``h``, :mod:`tlmpc.planning.bounds`), on the edges
+:meth:`~tlmpc.planning.lazy.LazyProduct.expand` gives:
+
+1. the *prefix search* from the initial nodes, guided by a bound on the whole lasso still to
+   pay (to a stay, or to an accepting edge plus ``beta`` times the cheapest way back);
+2. each accepting edge ``u -> v`` it expands becomes a *candidate* with the lower bound
+   ``g(u) + beta * (w + b(v, u))``; candidates are closed (a search from ``v`` back to ``u``
+   guided by a bound on reaching ``u``) in increasing order of their bound, interleaved with
+   the prefix search so that the one with the smallest bound or ``f`` goes first;
+3. everything stops when no bound nor ``f`` is below the best lasso found.
+
+A node whose ``f`` reaches the incumbent is never expanded: every lasso through it costs at
+least that much.  Closing searches are capped as on the built product (``stats.optimal``).
+"""
+
+from __future__ import annotations
+
+import heapq
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from tlmpc.abstraction.model import FloatArray, IntArray
+from tlmpc.planning.bounds import CostToGo, RegionGraph, cost_to_go, region_graph
+from tlmpc.planning.lazy import Edges, LazyProduct
+from tlmpc.planning.product import BoolArray
+from tlmpc.planning.search import BUCKET_WIDTH, _relax
+
+Bound = Callable[[IntArray], FloatArray]
+
+
+@dataclass(slots=True)
+class _Arrays:
+    """A search's per-node arrays, reset where touched so that one set serves many."""
+
+    dist: FloatArray
+    pred: IntArray
+    via: FloatArray
+    queued: BoolArray
+    touched: list[IntArray] = field(default_factory=list)
+
+    @staticmethod
+    def of(size: int) -> _Arrays:
+        """Fresh arrays for ``size`` nodes."""
+        return _Arrays(
+            dist=np.full(size, np.inf),
+            pred=np.full(size, -1, dtype=np.int64),
+            via=np.full(size, np.inf),
+            queued=np.zeros(size, dtype=bool),
+        )
+
+    def reset(self) -> None:
+        """Back to unreached everywhere (only the touched nodes are written)."""
+        for nodes in self.touched:
+            self.dist[nodes] = np.inf
+            self.pred[nodes] = -1
+            self.via[nodes] = np.inf
+            self.queued[nodes] = False
+        self.touched = []
+
+
+class GuidedSearch:
+    """A label-correcting search on a lazy product in buckets of ``f = g + bound``.
+
+    :meth:`step` expands the nodes of the lowest bucket (every edge out of them) and
+    returns those edges; offers whose ``g + bound`` reaches ``ceiling`` are dropped (no path
+    through them can beat it).  Distances are exact for every node whose ``f`` lies below
+    :meth:`lowest` once the search has stepped past it.
+    """
+
+    def __init__(
+        self, product: LazyProduct, arrays: _Arrays, sources: IntArray, bound: Bound
+    ) -> None:
+        self.product = product
+        self.arrays = arrays
+        self.bound = bound
+        sources = np.unique(np.asarray(sources, dtype=np.int64))
+        estimate = bound(sources)
+        sources = sources[np.isfinite(estimate)]
+        arrays.dist[sources] = 0.0
+        arrays.queued[sources] = True
+        arrays.touched.append(sources)
+        self.frontier = sources
+        self.estimate = estimate[np.isfinite(estimate)]  # the bound at each frontier node
+        weights = product.move_weight
+        self.width = BUCKET_WIDTH * float(weights.mean()) if len(weights) else 1.0
+        self.reached = len(sources)
+
+    def lowest(self) -> float:
+        """The least ``f`` in the frontier (inf when it is empty)."""
+        if not len(self.frontier):
+            return np.inf
+        return float((self.arrays.dist[self.frontier] + self.estimate).min())
+
+    def step(self, ceiling: float = np.inf) -> tuple[Edges, IntArray]:
+        """Expand the lowest bucket; returns its edges and the nodes whose distance got
+        shorter (queued again)."""
+        arrays = self.arrays
+        f = arrays.dist[self.frontier] + self.estimate
+        take = f <= float(f.min()) + self.width
+        active = self.frontier[take]
+        self.frontier, self.estimate = self.frontier[~take], self.estimate[~take]
+        arrays.queued[active] = False
+        edges = self.product.expand(active)
+        du = arrays.dist[edges.tails]
+        d = du + edges.weights
+        v = edges.heads
+        keep = d + self.bound(v) < ceiling
+        improved = _relax(
+            arrays.dist, arrays.via, arrays.pred, v[keep], d[keep], du[keep], edges.tails[keep]
+        )
+        fresh = improved[~arrays.queued[improved]]
+        arrays.queued[fresh] = True
+        arrays.touched.append(fresh)
+        self.reached += len(fresh)
+        self.frontier = np.concatenate([self.frontier, fresh])
+        self.estimate = np.concatenate([self.estimate, self.bound(fresh)])
+        return edges, improved
+
+    def path(self, target: int) -> list[int]:
+        """The nodes from a source to ``target`` along the predecessors."""
+        nodes = [target]
+        while self.arrays.pred[nodes[-1]] >= 0:
+            nodes.append(int(self.arrays.pred[nodes[-1]]))
+        nodes.reverse()
+        return nodes
+
+
+@dataclass(frozen=True, slots=True)
+class GuidedLasso:
+    """The best lasso: its cost bound, the prefix's nodes (to the anchor) and the cycle's
+    (from the anchor, without coming back to it; one node for a stay), with the search's
+    statistics."""
+
+    cost: float
+    prefix: list[int]
+    cycle: list[int]
+    searches: int
+    optimal: bool
+    reached: int
+
+
+class _Bounds:
+    """The bounds the lasso search needs, each computed once."""
+
+    def __init__(self, product: LazyProduct, graph: RegionGraph, beta: float) -> None:
+        self.product = product
+        self.graph = graph
+        self.beta = beta
+        self.returns: dict[int, CostToGo] = {}
+        nq = graph.num_states
+        stays = product.stutter_accepts[graph.classes].T  # (Q, local)
+        stay = np.where(stays | stays[:, [graph.background]], 0.0, np.inf)
+        self.stay = stay
+        self.lasso = cost_to_go(graph, np.minimum(stay, self._accepting_terminal(nq)))
+
+    def back_to(self, q: int) -> CostToGo:
+        """A bound on the cost from any node to a node of state ``q``."""
+        if q not in self.returns:
+            terminal = np.full((self.graph.num_states, len(self.graph.classes)), np.inf)
+            terminal[q, :] = 0.0
+            self.returns[q] = cost_to_go(self.graph, terminal)
+        return self.returns[q]
+
+    def _accepting_terminal(self, nq: int) -> FloatArray:
+        """(Q, local): per region-level node, ``beta`` times a bound on closing a cycle
+        through an accepting edge taken there (its move, then the way back to its tail's
+        state)."""
+        graph, product = self.graph, self.product
+        count = len(graph.classes)
+        terminal = np.full((nq, count), np.inf)
+        local_of = {int(c): i for i, c in enumerate(graph.classes.tolist())}
+        kinds, states, width = product.marked.shape
+        for kind in range(kinds):
+            entered = local_of.get(int(product.kind_class[kind]))
+            if entered is None:
+                continue
+            for q in range(states):
+                for j in range(width):
+                    if not product.marked[kind, q, j]:
+                        continue
+                    back = self.back_to(q)
+                    q_next = int(product.successor[kind, q, j])
+                    for c in range(count):
+                        landmark = entered not in (graph.background, c)
+                        at = entered if landmark else c
+                        # The way to the landmark is paid partly before the edge (at
+                        # weight one) and partly by it (at beta): at least the lesser.
+                        move = min(1.0, self.beta) * graph.delta[c, entered] if landmark else 0.0
+                        cost = move + self.beta * back.at_region(q_next, at)
+                        terminal[q, c] = min(terminal[q, c], cost)
+        stutter_marked = product.stutter_marked[graph.classes]  # (local, Q, J)
+        for c in range(count):
+            for other in {c, graph.background}:
+                for q in range(nq):
+                    for j in range(stutter_marked.shape[2]):
+                        if stutter_marked[other, q, j]:
+                            q_next = int(product.stutter_successor[graph.classes[other], q, j])
+                            cost = self.back_to(q).at_region(q_next, c)
+                            terminal[q, c] = min(terminal[q, c], self.beta * cost)
+        return terminal
+
+    def closing(self, target: int) -> Bound:
+        """A bound on the cost from any node to the node ``target``: the region-level one
+        to its state, and the straight line to its cell's position."""
+        nq = self.product.num_states
+        back = self.back_to(target % nq)
+        position = self.product.position
+        goal = position[target // nq]
+        scale = self.graph.scale
+
+        def bound(nodes: IntArray) -> FloatArray:
+            straight = np.linalg.norm(position[nodes // nq] - goal, axis=1) * scale
+            result: FloatArray = np.maximum(back(nodes), straight * (1.0 - 1e-9))
+            return result
+
+        return bound
+
+
+def guided_lasso(
+    product: LazyProduct,
+    allowed_cells: BoolArray,
+    *,
+    beta: float,
+    max_searches: int,
+) -> GuidedLasso | None:
+    """The minimum-cost accepting lasso of ``product`` (None when there is none), see the
+    module doc; past ``max_searches`` closing searches the best found, ``optimal`` false."""
+    graph = region_graph(product, allowed_cells)
+    bounds = _Bounds(product, graph, beta)
+    prefix = GuidedSearch(product, _Arrays.of(product.num_nodes), product.initial, bounds.lasso)
+    closing_arrays: _Arrays | None = None
+    best: tuple[float, list[int], list[int]] | None = None
+    candidates: list[tuple[float, int, int, float, float]] = []  # bound, u, v, w, g(u)
+    searches = 0
+    capped = False
+    for node in prefix.frontier[product.stays_accepting(prefix.frontier)].tolist():
+        best = _better(best, (0.0, [node], [node]))
+    while True:
+        incumbent = best[0] if best is not None else np.inf
+        f = prefix.lowest()
+        if candidates and candidates[0][0] < min(f, incumbent):
+            _, u, v, w, g = heapq.heappop(candidates)
+            if prefix.arrays.dist[u] < g:
+                continue  # u got nearer since: its expansion offered this edge again
+            if searches >= max_searches and best is not None:
+                capped = True
+                break
+            if closing_arrays is None:
+                closing_arrays = _Arrays.of(product.num_nodes)
+            limit = (incumbent - g) / max(beta, 1e-12) - w
+            back, back_path = _close(product, closing_arrays, v, u, bounds.closing(u), limit)
+            searches += 1
+            if back is not None:
+                total = g + beta * (w + back)
+                if total < incumbent - 1e-12:
+                    best = (total, prefix.path(u), [u, *back_path[:-1]])
+            continue
+        if f >= incumbent or not np.isfinite(f):
+            break
+        edges, improved = prefix.step(ceiling=incumbent)
+        staying = improved[product.stays_accepting(improved)]
+        if len(staying):
+            node = int(staying[np.argmin(prefix.arrays.dist[staying])])
+            if prefix.arrays.dist[node] < incumbent - 1e-12:
+                best = (float(prefix.arrays.dist[node]), prefix.path(node), [node])
+        for offer in _candidates(edges, prefix.arrays.dist, bounds, incumbent):
+            heapq.heappush(candidates, offer)
+    if best is None:
+        return None
+    cost, prefix_nodes, cycle_nodes = best
+    return GuidedLasso(
+        cost=cost,
+        prefix=prefix_nodes,
+        cycle=cycle_nodes,
+        searches=searches,
+        optimal=not capped,
+        reached=prefix.reached,
+    )
+
+
+def _candidates(
+    edges: Edges, dist: FloatArray, bounds: _Bounds, incumbent: float
+) -> list[tuple[float, int, int, float, float]]:
+    """The accepting edges among ``edges`` as cycle candidates ``(bound, u, v, w, g(u))``
+    whose bound ``g(u) + beta * (w + b(v, u))`` is below the incumbent."""
+    found: list[tuple[float, int, int, float, float]] = []
+    marked = np.flatnonzero(edges.accepting)
+    if not len(marked):
+        return found
+    tails, heads, weights = edges.tails[marked], edges.heads[marked], edges.weights[marked]
+    for tail in np.unique(tails).tolist():
+        mine = tails == tail
+        back = bounds.closing(tail)(heads[mine])
+        g = float(dist[tail])
+        for head, weight, b in zip(
+            heads[mine].tolist(), weights[mine].tolist(), back.tolist(), strict=True
+        ):
+            estimate = g + bounds.beta * (weight + b)
+            if estimate < incumbent:
+                found.append((estimate, tail, head, weight, g))
+    return found
+
+
+def _better(
+    best: tuple[float, list[int], list[int]] | None, offer: tuple[float, list[int], list[int]]
+) -> tuple[float, list[int], list[int]]:
+    if best is None or offer[0] < best[0] - 1e-12:
+        return offer
+    return best
+
+
+def _close(
+    product: LazyProduct, arrays: _Arrays, start: int, target: int, bound: Bound, limit: float
+) -> tuple[float | None, list[int]]:
+    """The cheapest path from ``start`` to ``target`` if it costs at most ``limit``."""
+    arrays.reset()
+    search = GuidedSearch(product, arrays, np.array([start], dtype=np.int64), bound)
+    while True:
+        found = float(arrays.dist[target])
+        ceiling = min(found, limit) if np.isfinite(found) else limit
+        if search.lowest() >= ceiling or not len(search.frontier):
+            break
+        search.step(ceiling=ceiling if np.isfinite(ceiling) else np.inf)
+    found = float(arrays.dist[target])
+    if not np.isfinite(found) or found > limit:
+        return None, []
+    return found, search.path(target)
