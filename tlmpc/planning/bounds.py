@@ -51,6 +51,19 @@ class RegionGraph:
     closure: BoolArray  # (local, Q, Q): states reached for free with that last landmark
     entering: list[tuple[int, IntArray, IntArray]]  # (landmark, from states, to states)
     scale: float  # weight per unit of Euclidean length, at least (for the straight bound)
+    backwards: Graph  # the transition system's moves, reversed
+
+    def distance_to(self, cells: IntArray) -> FloatArray:
+        """Per cell: the transition system's least cost from it to any of ``cells``."""
+        distance, _ = shortest_paths(self.backwards, cells)
+        return distance
+
+    def region_minimum(self, per_cell: FloatArray) -> FloatArray:
+        """Per local class: the least value over its cells."""
+        allowed = self.cell_local >= 0
+        least = np.full(len(self.classes), np.inf)
+        np.minimum.at(least, self.cell_local[allowed], per_cell[allowed])
+        return least
 
     @property
     def num_states(self) -> int:
@@ -71,7 +84,10 @@ def region_graph(product: LazyProduct, allowed_cells: BoolArray) -> RegionGraph:
     local_of[present] = np.arange(len(present))
     cell_local = np.where(allowed_cells, local_of[cell_class], -1)
     landmarks = np.array([c for c in range(len(present)) if c != background], dtype=np.int64)
-    distance = _landmark_distances(product, cell_local, landmarks)
+    cells = product.num_cells
+    sources = np.repeat(np.arange(cells, dtype=np.int64), np.diff(product.move_indptr))
+    backwards, _ = Graph.from_edges(product.move_target, sources, product.move_weight, cells)
+    distance = _landmark_distances(backwards, cell_local, landmarks)
     count = len(present)
     delta = np.zeros((count, count))
     for index, landmark in enumerate(landmarks.tolist()):
@@ -103,6 +119,7 @@ def region_graph(product: LazyProduct, allowed_cells: BoolArray) -> RegionGraph:
         closure=closure,
         entering=entering,
         scale=_straight_scale(product),
+        backwards=backwards,
     )
 
 
@@ -124,14 +141,10 @@ def _reflexive_closure(step: BoolArray) -> BoolArray:
         reach = wider
 
 
-def _landmark_distances(
-    product: LazyProduct, cell_local: IntArray, landmarks: IntArray
-) -> FloatArray:
+def _landmark_distances(backwards: Graph, cell_local: IntArray, landmarks: IntArray) -> FloatArray:
     """(landmarks, cells): the transition system's least cost from each cell to entering a
     triangle of each landmark (entered cells, not the start slot), inf where unreachable."""
-    cells = product.num_cells
-    sources = np.repeat(np.arange(cells, dtype=np.int64), np.diff(product.move_indptr))
-    backwards, _ = Graph.from_edges(product.move_target, sources, product.move_weight, cells)
+    cells = backwards.num_nodes
     entered = np.ones(cells, dtype=bool)
     entered[SLOTS - 1 :: SLOTS] = False
     distance = np.empty((len(landmarks), cells))
@@ -158,18 +171,27 @@ def _straight_scale(product: LazyProduct) -> float:
 class CostToGo:
     """A lower bound on the cost from any product node to a target set with terminal costs:
     ``min(free[q, c], min over landmarks l of D[l](cell) + leg[q, c, l])`` for a node in
-    state ``q`` in a cell of local class ``c``."""
+    state ``q`` in a cell of local class ``c``.
+
+    With ``final`` the targets are the cells ``final`` measures the way to, in the states
+    ``reach`` tells: a node whose free steps reach such a state is bounded by ``final`` at its
+    own cell rather than by the region-level ``free``."""
 
     graph: RegionGraph
     free: FloatArray  # (Q, local)
     leg: FloatArray  # (Q, local, landmarks)
+    final: FloatArray | None = None  # per cell: the cost still to pay in a target state
+    reach: BoolArray | None = None  # (Q, local): free steps reach a target state
 
     def __call__(self, nodes: IntArray) -> FloatArray:
         """The bound at each node (inf: no target reachable; nodes of allowed cells)."""
         nq = self.graph.num_states
         cell, q = nodes // nq, nodes % nq
         c = self.graph.cell_local[cell]
-        bound = self.free[q, c]
+        if self.final is not None and self.reach is not None:
+            bound = np.where(self.reach[q, c], self.final[cell], np.inf)
+        else:
+            bound = self.free[q, c]
         if len(self.graph.landmarks):
             via = self.graph.distance[:, cell].T + self.leg[q, c]
             bound = np.minimum(bound, via.min(axis=1))
@@ -182,6 +204,17 @@ class CostToGo:
         for index, landmark in enumerate(self.graph.landmarks.tolist()):
             value = min(value, float(self.graph.delta[c, landmark] + self.leg[q, c, index]))
         return value
+
+
+def cost_to_go_to_cells(graph: RegionGraph, state: int, final: FloatArray) -> CostToGo:
+    """A bound on the cost from any node to a node in ``state`` at a cell ``final``
+    measures the way to (per cell: the transition system's least cost from it)."""
+    nq = graph.num_states
+    terminal = np.full((nq, len(graph.classes)), np.inf)
+    terminal[state, :] = graph.region_minimum(final)
+    bound = cost_to_go(graph, terminal)
+    reach = graph.closure[:, :, state].T  # (Q, local)
+    return CostToGo(graph=graph, free=bound.free, leg=bound.leg, final=final, reach=reach)
 
 
 def cost_to_go(graph: RegionGraph, terminal: FloatArray) -> CostToGo:

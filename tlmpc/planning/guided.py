@@ -29,9 +29,16 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
+import numpy.typing as npt
 
 from tlmpc.abstraction.model import FloatArray, IntArray
-from tlmpc.planning.bounds import CostToGo, RegionGraph, cost_to_go, region_graph
+from tlmpc.planning.bounds import (
+    CostToGo,
+    RegionGraph,
+    cost_to_go,
+    cost_to_go_to_cells,
+    region_graph,
+)
 from tlmpc.planning.lazy import Edges, LazyProduct
 from tlmpc.planning.product import BoolArray
 from tlmpc.planning.search import BUCKET_WIDTH, _relax
@@ -47,6 +54,7 @@ class _Arrays:
     pred: IntArray
     via: FloatArray
     queued: BoolArray
+    estimate: npt.NDArray[np.float32]  # the bound at each node met (nan: not computed)
     touched: list[IntArray] = field(default_factory=list)
 
     @staticmethod
@@ -57,6 +65,7 @@ class _Arrays:
             pred=np.full(size, -1, dtype=np.int64),
             via=np.full(size, np.inf),
             queued=np.zeros(size, dtype=bool),
+            estimate=np.full(size, np.nan, dtype=np.float32),
         )
 
     def reset(self) -> None:
@@ -66,6 +75,7 @@ class _Arrays:
             self.pred[nodes] = -1
             self.via[nodes] = np.inf
             self.queued[nodes] = False
+            self.estimate[nodes] = np.nan
         self.touched = []
 
 
@@ -79,22 +89,43 @@ class GuidedSearch:
     """
 
     def __init__(
-        self, product: LazyProduct, arrays: _Arrays, sources: IntArray, bound: Bound
+        self,
+        product: LazyProduct,
+        arrays: _Arrays,
+        sources: IntArray,
+        bound: Bound,
+        offsets: FloatArray | None = None,
     ) -> None:
         self.product = product
         self.arrays = arrays
         self.bound = bound
-        sources = np.unique(np.asarray(sources, dtype=np.int64))
-        estimate = bound(sources)
-        sources = sources[np.isfinite(estimate)]
-        arrays.dist[sources] = 0.0
+        if offsets is None:
+            sources = np.unique(np.asarray(sources, dtype=np.int64))
+            offsets = np.zeros(len(sources))
+        estimate = self.estimate_at(sources)
+        finite = np.isfinite(estimate)
+        sources, offsets = sources[finite], offsets[finite]
+        arrays.dist[sources] = offsets
         arrays.queued[sources] = True
         arrays.touched.append(sources)
         self.frontier = sources
-        self.estimate = estimate[np.isfinite(estimate)]  # the bound at each frontier node
+        self.estimate = estimate[finite]  # the bound at each frontier node
         weights = product.move_weight
         self.width = BUCKET_WIDTH * float(weights.mean()) if len(weights) else 1.0
         self.reached = len(sources)
+
+    def estimate_at(self, nodes: IntArray) -> FloatArray:
+        """The bound at ``nodes``, computed once per node (kept in single precision,
+        rounded down so that it stays a lower bound)."""
+        known = self.arrays.estimate[nodes]
+        unknown = np.isnan(known)
+        if unknown.any():
+            fresh = nodes[unknown]
+            exact = self.bound(fresh) * (1.0 - 1e-6)
+            known[unknown] = exact.astype(np.float32)
+            self.arrays.estimate[fresh] = known[unknown]
+            self.arrays.touched.append(fresh)
+        return known.astype(np.float64)
 
     def lowest(self) -> float:
         """The least ``f`` in the frontier (inf when it is empty)."""
@@ -115,7 +146,7 @@ class GuidedSearch:
         du = arrays.dist[edges.tails]
         d = du + edges.weights
         v = edges.heads
-        keep = d + self.bound(v) < ceiling
+        keep = d + self.estimate_at(v) < ceiling
         improved = _relax(
             arrays.dist, arrays.via, arrays.pred, v[keep], d[keep], du[keep], edges.tails[keep]
         )
@@ -124,7 +155,7 @@ class GuidedSearch:
         arrays.touched.append(fresh)
         self.reached += len(fresh)
         self.frontier = np.concatenate([self.frontier, fresh])
-        self.estimate = np.concatenate([self.estimate, self.bound(fresh)])
+        self.estimate = np.concatenate([self.estimate, self.estimate_at(fresh)])
         return edges, improved
 
     def path(self, target: int) -> list[int]:
@@ -158,6 +189,9 @@ class _Bounds:
         self.graph = graph
         self.beta = beta
         self.returns: dict[int, CostToGo] = {}
+        self.cell_distance: dict[int, FloatArray] = {}
+        self.to_cell: dict[tuple[int, int], CostToGo] = {}
+        self.arounds: dict[tuple[int, int], CostToGo] = {}
         nq = graph.num_states
         stays = product.stutter_accepts[graph.classes].T  # (Q, local)
         stay = np.where(stays | stays[:, [graph.background]], 0.0, np.inf)
@@ -171,6 +205,15 @@ class _Bounds:
             terminal[q, :] = 0.0
             self.returns[q] = cost_to_go(self.graph, terminal)
         return self.returns[q]
+
+    def around(self, q: int, landmark: int) -> CostToGo:
+        """A bound on the cost from any node to a node of state ``q`` and then into a
+        triangle of ``landmark`` (a local class other than the background)."""
+        key = (q, landmark)
+        if key not in self.arounds:
+            index = int(np.flatnonzero(self.graph.landmarks == landmark)[0])
+            self.arounds[key] = cost_to_go_to_cells(self.graph, q, self.graph.distance[index])
+        return self.arounds[key]
 
     def _accepting_terminal(self, nq: int) -> FloatArray:
         """(Q, local): per region-level node, ``beta`` times a bound on closing a cycle
@@ -198,6 +241,10 @@ class _Bounds:
                         # weight one) and partly by it (at beta): at least the lesser.
                         move = min(1.0, self.beta) * graph.delta[c, entered] if landmark else 0.0
                         cost = move + self.beta * back.at_region(q_next, at)
+                        if entered != graph.background:
+                            # The cycle itself: back to q, then into that landmark again.
+                            around = self.around(q, entered).at_region(q_next, entered)
+                            cost = max(cost, self.beta * around)
                         terminal[q, c] = min(terminal[q, c], cost)
         stutter_marked = product.stutter_marked[graph.classes]  # (local, Q, J)
         for c in range(count):
@@ -212,9 +259,16 @@ class _Bounds:
 
     def closing(self, target: int) -> Bound:
         """A bound on the cost from any node to the node ``target``: the region-level one
-        to its state, and the straight line to its cell's position."""
+        to its state and then its cell, and the straight line to its cell's position."""
         nq = self.product.num_states
-        back = self.back_to(target % nq)
+        cell, state = target // nq, target % nq
+        if (cell, state) not in self.to_cell:
+            if cell not in self.cell_distance:
+                self.cell_distance[cell] = self.graph.distance_to(np.array([cell]))
+            self.to_cell[cell, state] = cost_to_go_to_cells(
+                self.graph, state, self.cell_distance[cell]
+            )
+        back = self.to_cell[cell, state]
         position = self.product.position
         goal = position[target // nq]
         scale = self.graph.scale
@@ -258,11 +312,20 @@ def guided_lasso(
                 break
             if closing_arrays is None:
                 closing_arrays = _Arrays.of(product.num_nodes)
-            limit = (incumbent - g) / max(beta, 1e-12) - w
-            back, back_path = _close(product, closing_arrays, v, u, bounds.closing(u), limit)
+            # Every pending candidate out of u closes in the same search: from all their
+            # heads at once, each starting at its edge's weight.
+            same = [c for c in candidates if c[1] == u and c[4] == g]
+            candidates = [c for c in candidates if not (c[1] == u and c[4] == g)]
+            heapq.heapify(candidates)
+            heads = np.array([v] + [c[2] for c in same], dtype=np.int64)
+            weights = np.array([w] + [c[3] for c in same])
+            limit = (incumbent - g) / max(beta, 1e-12)
+            back, back_path = _close(
+                product, closing_arrays, heads, weights, u, bounds.closing(u), limit
+            )
             searches += 1
             if back is not None:
-                total = g + beta * (w + back)
+                total = g + beta * back
                 if total < incumbent - 1e-12:
                     best = (total, prefix.path(u), [u, *back_path[:-1]])
             continue
@@ -321,17 +384,25 @@ def _better(
 
 
 def _close(
-    product: LazyProduct, arrays: _Arrays, start: int, target: int, bound: Bound, limit: float
+    product: LazyProduct,
+    arrays: _Arrays,
+    heads: IntArray,
+    weights: FloatArray,
+    target: int,
+    bound: Bound,
+    limit: float,
 ) -> tuple[float | None, list[int]]:
-    """The cheapest path from ``start`` to ``target`` if it costs at most ``limit``."""
+    """The cheapest way from ``target`` through one of its accepting edges (to ``heads``,
+    of ``weights``) back to ``target``, if it costs at most ``limit``: its cost and its nodes
+    from the head to ``target``."""
     arrays.reset()
-    search = GuidedSearch(product, arrays, np.array([start], dtype=np.int64), bound)
+    search = GuidedSearch(product, arrays, heads, bound, offsets=weights)
     while True:
         found = float(arrays.dist[target])
         ceiling = min(found, limit) if np.isfinite(found) else limit
         if search.lowest() >= ceiling or not len(search.frontier):
             break
-        search.step(ceiling=ceiling if np.isfinite(ceiling) else np.inf)
+        search.step(ceiling=ceiling)
     found = float(arrays.dist[target])
     if not np.isfinite(found) or found > limit:
         return None, []

@@ -10,7 +10,6 @@ gives the edges out of any set of nodes, so a search guided towards its goal
 
 from __future__ import annotations
 
-import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -128,14 +127,23 @@ class LazyProduct:
 
     def path_weights(self, nodes: list[int]) -> list[float]:
         """The weights of the edges ``nodes[k] -> nodes[k + 1]`` (KeyError when missing)."""
-        found: list[float] = []
-        for tail, head in itertools.pairwise(nodes):
-            edges = self.expand(np.array([tail], dtype=np.int64))
-            hit = np.flatnonzero(edges.heads == head)
-            if not len(hit):
-                raise KeyError((tail, head))
-            found.append(float(edges.weights[int(hit[0])]))
-        return found
+        if len(nodes) < 2:
+            return []
+        path = np.asarray(nodes, dtype=np.int64)
+        tails, heads = path[:-1], path[1:]
+        # Every edge out of every tail, then per step the edge to the next node.
+        edges = self.expand(np.unique(tails))
+        key = edges.tails * self.num_nodes + edges.heads
+        sort = np.argsort(key, kind="stable")
+        wanted = tails * self.num_nodes + heads
+        at = np.searchsorted(key[sort], wanted)
+        at = np.minimum(at, len(key) - 1)
+        hit = key[sort][at] == wanted
+        if not hit.all():
+            step = int(np.flatnonzero(~hit)[0])
+            raise KeyError((int(tails[step]), int(heads[step])))
+        weights: list[float] = edges.weights[sort][at].tolist()
+        return weights
 
 
 def lazy_product(
