@@ -16,6 +16,7 @@ from __future__ import annotations
 import json
 from dataclasses import replace
 from pathlib import Path
+from typing import Literal
 
 import numpy as np
 import pytest
@@ -38,6 +39,7 @@ from tlmpc.planning.explain import invariant_mask
 from tlmpc.planning.guided import _Bounds
 from tlmpc.planning.lazy import LazyProduct, lazy_product
 from tlmpc.planning.mission import automaton_for
+from tlmpc.planning.model import Witness
 from tlmpc.planning.plan import plan
 from tlmpc.planning.product import SLOTS, Product, build_product
 
@@ -119,7 +121,9 @@ def _edge_rows(product: Product, lazy: LazyProduct, node: int) -> tuple[list[obj
 @pytest.mark.parametrize("spec", ["example1", "patrol", "reach-avoid"])
 @pytest.mark.parametrize("boundary", ["right", "closed"])
 @pytest.mark.parametrize("bounces", [False, True])
-def test_lazy_product_has_the_built_products_edges(spec: str, boundary: str, bounces: bool) -> None:
+def test_lazy_product_has_the_built_products_edges(
+    spec: str, boundary: Literal["right", "closed"], bounces: bool
+) -> None:
     mission = load_mission(ROOT / "specs" / f"{spec}.yaml")
     mission = replace(mission, options=replace(mission.options, boundary=boundary))
     abstraction, working, arguments = _inputs(mission, bounces)
@@ -184,7 +188,7 @@ def test_bounds_never_exceed_the_exact_distances(spec: str, beta: float) -> None
 def _costs_agree(mission: Mission, bounces: bool) -> str:
     abstraction = build_abstraction(mission)
     automaton = automaton_for(mission, abstraction)
-    found = []
+    found: list[Witness | None] = []
     for guided in (False, True):
         try:
             found.append(
