@@ -45,6 +45,10 @@ from tlmpc.planning.search import BUCKET_WIDTH, _relax
 
 Bound = Callable[[IntArray], FloatArray]
 
+#: Closing searches run side by side up to this many product nodes in all (their arrays,
+#: about 30 bytes a node).
+CLOSING_NODES = 26_000_000
+
 
 @dataclass(slots=True)
 class _Arrays:
@@ -95,10 +99,12 @@ class GuidedSearch:
         sources: IntArray,
         bound: Bound,
         offsets: FloatArray | None = None,
+        copy_size: int = 0,
     ) -> None:
         self.product = product
         self.arrays = arrays
         self.bound = bound
+        self.copy_size = copy_size  # nonzero: node n is node n % copy_size of copy n // it
         if offsets is None:
             sources = np.unique(np.asarray(sources, dtype=np.int64))
             offsets = np.zeros(len(sources))
@@ -133,19 +139,32 @@ class GuidedSearch:
             return np.inf
         return float((self.arrays.dist[self.frontier] + self.estimate).min())
 
-    def step(self, ceiling: float = np.inf) -> tuple[Edges, IntArray]:
+    def prune(self, ceilings: FloatArray) -> None:
+        """Drop the frontier nodes whose ``f`` reaches their copy's ceiling."""
+        copy = self.frontier // self.copy_size
+        keep = self.arrays.dist[self.frontier] + self.estimate < ceilings[copy]
+        self.arrays.queued[self.frontier[~keep]] = False
+        self.frontier, self.estimate = self.frontier[keep], self.estimate[keep]
+
+    def step(self, ceiling: float | FloatArray = np.inf) -> tuple[Edges, IntArray]:
         """Expand the lowest bucket; returns its edges and the nodes whose distance got
-        shorter (queued again)."""
+        shorter (queued again).  ``ceiling`` may be one per copy."""
         arrays = self.arrays
         f = arrays.dist[self.frontier] + self.estimate
         take = f <= float(f.min()) + self.width
         active = self.frontier[take]
         self.frontier, self.estimate = self.frontier[~take], self.estimate[~take]
         arrays.queued[active] = False
-        edges = self.product.expand(active)
+        if self.copy_size:
+            local = active % self.copy_size
+            edges = self.product.expand(local, base=active - local)
+        else:
+            edges = self.product.expand(active)
         du = arrays.dist[edges.tails]
         d = du + edges.weights
         v = edges.heads
+        if isinstance(ceiling, np.ndarray):
+            ceiling = ceiling[v // self.copy_size]
         keep = d + self.estimate_at(v) < ceiling
         improved = _relax(
             arrays.dist, arrays.via, arrays.pred, v[keep], d[keep], du[keep], edges.tails[keep]
@@ -159,11 +178,14 @@ class GuidedSearch:
         return edges, improved
 
     def path(self, target: int) -> list[int]:
-        """The nodes from a source to ``target`` along the predecessors."""
+        """The nodes from a source to ``target`` along the predecessors (in the product's
+        own numbers when the search runs in copies)."""
         nodes = [target]
         while self.arrays.pred[nodes[-1]] >= 0:
             nodes.append(int(self.arrays.pred[nodes[-1]]))
         nodes.reverse()
+        if self.copy_size:
+            return [node % self.copy_size for node in nodes]
         return nodes
 
 
@@ -294,6 +316,9 @@ def guided_lasso(
     bounds = _Bounds(product, graph, beta)
     prefix = GuidedSearch(product, _Arrays.of(product.num_nodes), product.initial, bounds.lasso)
     closing_arrays: _Arrays | None = None
+    # Closing searches run side by side, each in its own copy of the node numbers, as many as
+    # CLOSING_NODES allows.
+    width = max(1, min(max_searches, CLOSING_NODES // max(product.num_nodes, 1)))
     best: tuple[float, list[int], list[int]] | None = None
     candidates: list[tuple[float, int, int, float, float]] = []  # bound, u, v, w, g(u)
     searches = 0
@@ -304,29 +329,26 @@ def guided_lasso(
         incumbent = best[0] if best is not None else np.inf
         f = prefix.lowest()
         if candidates and candidates[0][0] < min(f, incumbent):
-            _, u, v, w, g = heapq.heappop(candidates)
-            if prefix.arrays.dist[u] < g:
-                continue  # u got nearer since: its expansion offered this edge again
             if searches >= max_searches and best is not None:
                 capped = True
                 break
-            if closing_arrays is None:
-                closing_arrays = _Arrays.of(product.num_nodes)
-            # Every pending candidate out of u closes in the same search: from all their
-            # heads at once, each starting at its edge's weight.
-            same = [c for c in candidates if c[1] == u and c[4] == g]
-            candidates = [c for c in candidates if not (c[1] == u and c[4] == g)]
+            room = max_searches - searches if best is not None else len(candidates)
+            groups = _next_groups(candidates, prefix.arrays.dist, incumbent, beta, room, width)
+            candidates = [c for c in candidates if (c[1], c[4]) not in groups.taken]
             heapq.heapify(candidates)
-            heads = np.array([v] + [c[2] for c in same], dtype=np.int64)
-            weights = np.array([w] + [c[3] for c in same])
-            limit = (incumbent - g) / max(beta, 1e-12)
-            back, back_path = _close(
-                product, closing_arrays, heads, weights, u, bounds.closing(u), limit
-            )
-            searches += 1
-            if back is not None:
+            if not groups.tails:
+                continue
+            needed = product.num_nodes * len(groups.tails)
+            if closing_arrays is None or len(closing_arrays.dist) < needed:
+                closing_arrays = None  # released before the larger one is allocated
+                closing_arrays = _Arrays.of(needed)
+            results = _close_together(product, closing_arrays, groups, bounds)
+            searches += len(groups.tails)
+            for u, g, (back, back_path) in zip(groups.tails, groups.g, results, strict=True):
+                if back is None:
+                    continue
                 total = g + beta * back
-                if total < incumbent - 1e-12:
+                if total < (best[0] if best is not None else np.inf) - 1e-12:
                     best = (total, prefix.path(u), [u, *back_path[:-1]])
             continue
         if f >= incumbent or not np.isfinite(f):
@@ -383,27 +405,86 @@ def _better(
     return best
 
 
-def _close(
-    product: LazyProduct,
-    arrays: _Arrays,
-    heads: IntArray,
-    weights: FloatArray,
-    target: int,
-    bound: Bound,
-    limit: float,
-) -> tuple[float | None, list[int]]:
-    """The cheapest way from ``target`` through one of its accepting edges (to ``heads``,
-    of ``weights``) back to ``target``, if it costs at most ``limit``: its cost and its nodes
-    from the head to ``target``."""
-    arrays.reset()
-    search = GuidedSearch(product, arrays, heads, bound, offsets=weights)
-    while True:
-        found = float(arrays.dist[target])
-        ceiling = min(found, limit) if np.isfinite(found) else limit
-        if search.lowest() >= ceiling or not len(search.frontier):
+@dataclass(slots=True)
+class _Groups:
+    """Closing searches to run side by side: per accepting edges' tail ``u`` (at distance
+    ``g`` from the start), its edges' heads and weights and the limit the incumbent allows;
+    ``taken`` are the (tail, g) pairs removed from the candidates (stale ones included)."""
+
+    tails: list[int] = field(default_factory=list)
+    g: list[float] = field(default_factory=list)
+    heads: list[IntArray] = field(default_factory=list)
+    weights: list[FloatArray] = field(default_factory=list)
+    limits: list[float] = field(default_factory=list)
+    taken: set[tuple[int, float]] = field(default_factory=set)
+
+
+def _next_groups(
+    candidates: list[tuple[float, int, int, float, float]],
+    dist: FloatArray,
+    incumbent: float,
+    beta: float,
+    room: int,
+    width: int,
+) -> _Groups:
+    """The candidates to close next, in order of their bound: every pending candidate out of
+    one tail closes in one search (from all its heads at once, each starting at its edge's
+    weight), up to ``width`` tails, fewer than ``room``, all with bounds below the incumbent.
+    Candidates whose tail got nearer since are dropped: its expansion offered them again."""
+    groups = _Groups()
+    for bound, u, _, _, g in sorted(candidates):
+        if len(groups.tails) >= min(width, room) or bound >= incumbent:
             break
-        search.step(ceiling=ceiling)
-    found = float(arrays.dist[target])
-    if not np.isfinite(found) or found > limit:
-        return None, []
-    return found, search.path(target)
+        if (u, g) in groups.taken:
+            continue
+        groups.taken.add((u, g))
+        if dist[u] < g:
+            continue
+        same = [c for c in candidates if c[1] == u and c[4] == g]
+        groups.tails.append(u)
+        groups.g.append(g)
+        groups.heads.append(np.array([c[2] for c in same], dtype=np.int64))
+        groups.weights.append(np.array([c[3] for c in same]))
+        groups.limits.append((incumbent - g) / max(beta, 1e-12))
+    return groups
+
+
+def _close_together(
+    product: LazyProduct, arrays: _Arrays, groups: _Groups, bounds: _Bounds
+) -> list[tuple[float | None, list[int]]]:
+    """Per group: the cheapest way from its tail ``u`` through one of its accepting edges
+    back to ``u`` if it costs at most the group's limit, its cost and its nodes from the head
+    to ``u``; the searches share their rounds."""
+    arrays.reset()
+    size = product.num_nodes
+    count = len(groups.tails)
+    base = np.arange(count, dtype=np.int64) * size
+    sources = np.concatenate([heads + base[k] for k, heads in enumerate(groups.heads)])
+    offsets = np.concatenate(groups.weights)
+    targets = np.array(groups.tails, dtype=np.int64) + base
+    limits = np.array(groups.limits)
+    own = [bounds.closing(u) for u in groups.tails]
+
+    def bound(nodes: IntArray) -> FloatArray:
+        copy = nodes // size
+        result = np.empty(len(nodes))
+        for k in np.unique(copy).tolist():
+            mine = copy == k
+            result[mine] = own[k](nodes[mine] - k * size)
+        return result
+
+    search = GuidedSearch(product, arrays, sources, bound, offsets=offsets, copy_size=size)
+    while True:
+        ceilings = np.minimum(arrays.dist[targets], limits)
+        search.prune(ceilings)
+        if not len(search.frontier):
+            break
+        search.step(ceiling=ceilings)
+    found: list[tuple[float | None, list[int]]] = []
+    for k in range(count):
+        distance = float(arrays.dist[targets[k]])
+        if not np.isfinite(distance) or distance > limits[k]:
+            found.append((None, []))
+        else:
+            found.append((distance, search.path(int(targets[k]))))
+    return found

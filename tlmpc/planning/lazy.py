@@ -76,9 +76,11 @@ class LazyProduct:
         """Number of product nodes (reached or not)."""
         return self.num_cells * self.num_states
 
-    def expand(self, nodes: IntArray) -> Edges:
+    def expand(self, nodes: IntArray, base: IntArray | None = None) -> Edges:
         """Every product edge out of ``nodes``: per node its moves (each with its automaton
-        successors), then its stutter edges; (tail, head) pairs are distinct."""
+        successors), then its stutter edges; (tail, head) pairs are distinct.  With
+        ``base``, node ``k`` stands for ``base[k] + nodes[k]`` in tails and heads (searches
+        that run side by side, each in its own copy of the node numbers)."""
         nq = self.num_states
         cell = nodes // nq
         state = nodes % nq
@@ -87,6 +89,9 @@ class LazyProduct:
         ends = np.cumsum(counts)
         total = int(ends[-1]) if len(ends) else 0
         moves = np.repeat(starts - ends + counts, counts) + np.arange(total, dtype=np.int64)
+        shift = np.zeros(total, dtype=np.int64) if base is None else np.repeat(base, counts)
+        if base is not None:
+            nodes = nodes + base
         tail = np.repeat(nodes, counts)
         q = np.repeat(state, counts)
         kind = self.move_kind[moves]
@@ -98,7 +103,7 @@ class LazyProduct:
             following = self.successor[kind, q, j]
             ok = following >= 0
             tails.append(tail[ok])
-            heads.append(self.move_target[moves[ok]] * nq + following[ok])
+            heads.append(self.move_target[moves[ok]] * nq + following[ok] + shift[ok])
             weights.append(self.move_weight[moves[ok]])
             marks.append(self.marked[kind[ok], q[ok], j])
         staying = self.cell_class[cell] >= 0
