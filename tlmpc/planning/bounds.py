@@ -5,8 +5,9 @@ automaton in state ``q``, and ``c`` the letter class of the last *landmark* tria
 (every letter class of the allowed triangles is a landmark but the most common one, the
 *background*).  An edge reads one kind of move or a stutter step:
 
-* into a background triangle, into a triangle of ``c`` itself, or a stutter step: the
-  landmark stays ``c``, and the edge costs nothing;
+* from a triangle of ``c`` or of the background into one of those, or a stutter step: the
+  landmark stays ``c``, and the edge costs nothing (the robot is in one of those: entering
+  any other landmark would have made it the last);
 * into a triangle of another landmark ``c'``: it costs ``delta(c, c')``, the least cost in
   the transition system alone (no automaton) from any cell of a ``c`` triangle to entering a
   ``c'`` triangle.
@@ -99,8 +100,12 @@ def region_graph(product: LazyProduct, allowed_cells: BoolArray) -> RegionGraph:
     entering: list[tuple[int, IntArray, IntArray]] = []
     free_kinds = kind_local == background
     for c in range(count):
+        # While c is the last landmark the robot is in a triangle of c or of the background:
+        # only moves leaving one of those (under the closed convention the crossing letter
+        # tells, e.g. leaving a room reads it) into one of those are free.
+        leaves = product.kind_left[:, present[c]] | product.kind_left[:, present[background]]
         step = np.zeros((nq, nq), dtype=bool)
-        _mark(step, product.successor[free_kinds | (kind_local == c)])
+        _mark(step, product.successor[(free_kinds | (kind_local == c)) & leaves])
         for stutter_class in {int(present[c]), int(present[background])}:
             _mark(step, product.stutter_successor[stutter_class][None])
         closure[c] = _reflexive_closure(step)

@@ -63,6 +63,7 @@ class LazyProduct:
     successor: IntArray  # (kinds, Q, J)
     marked: BoolArray  # (kinds, Q, J)
     kind_class: IntArray  # per kind: the letter class of the triangle it enters
+    kind_left: BoolArray  # (kinds, classes): some move of the kind leaves a triangle of the class
     triangle_class: IntArray  # per triangle: its letter's class
     cell_class: IntArray  # per cell: its triangle's letter class (-1: no stutter there)
     stutter_successor: IntArray  # (classes, Q, J')
@@ -185,6 +186,8 @@ def lazy_product(
     successor, marked = _padded([successors.by_kind[k] for k in kinds], nq)
     kind_class = np.zeros(len(kinds), dtype=np.int64)
     kind_class[move_kind] = tri_class[moves.target // SLOTS]
+    kind_left = np.zeros((len(kinds), len(classes.rows)), dtype=bool)
+    kind_left[move_kind, tri_class[moves.source // SLOTS]] = True
     cells = abstraction.num_triangles * SLOTS
     stay_cell, stay_class = stutter_cells(abstraction, allowed, starts, tri_class)
     cell_class = np.full(cells, -1, dtype=np.int64)
@@ -216,6 +219,7 @@ def lazy_product(
         successor=successor,
         marked=marked,
         kind_class=kind_class,
+        kind_left=kind_left,
         triangle_class=tri_class,
         cell_class=cell_class,
         stutter_successor=stutter_successor,
