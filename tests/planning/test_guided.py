@@ -347,3 +347,32 @@ def test_passages_beyond_the_build_budget_are_p060(monkeypatch: pytest.MonkeyPat
             passages=True,
         )
     assert raised.value.diagnostics[0].code == "P060"
+
+
+@pytest.mark.parametrize("spec", ["patrol", "example1"])
+def test_guided_resume_costs_what_the_built_product_gives(spec: str) -> None:
+    """A re-plan under way starts in the start triangle in given automaton states."""
+    mission = load_mission(ROOT / "specs" / f"{spec}.yaml")
+    abstraction = build_abstraction(mission)
+    automaton = automaton_for(mission, abstraction)
+    working = degeneralize(automaton) if automaton.num_acc >= 2 else automaton
+    for state in range(working.num_states):
+        costs: list[float | None] = []
+        for guided in (False, True):
+            try:
+                witness = plan(
+                    abstraction,
+                    automaton,
+                    formula=mission.formula,
+                    options=mission.options,
+                    start_point=mission.robot.start,
+                    resume=frozenset({state}),
+                    guided=guided,
+                )
+                costs.append(witness.cost)
+            except NoPlanError:
+                costs.append(None)
+        if costs[0] is None or costs[1] is None:
+            assert costs[0] is costs[1]
+        else:
+            assert costs[1] == pytest.approx(costs[0], rel=1e-9, abs=1e-9)
