@@ -140,7 +140,8 @@ def _reflexive_closure(step: BoolArray) -> BoolArray:
     """Reachability in zero or more steps."""
     reach = step | np.eye(len(step), dtype=bool)
     while True:
-        wider = (reach.astype(np.int64) @ reach.astype(np.int64)) > 0
+        # Squaring in single precision (BLAS): entries count paths, exact up to 2**24 states.
+        wider = (reach.astype(np.float32) @ reach.astype(np.float32)) > 0
         if (wider == reach).all():
             return reach
         reach = wider
