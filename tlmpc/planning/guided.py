@@ -41,7 +41,7 @@ from tlmpc.planning.bounds import (
 )
 from tlmpc.planning.lazy import Edges, LazyProduct
 from tlmpc.planning.product import BoolArray
-from tlmpc.planning.search import BUCKET_WIDTH, _relax
+from tlmpc.planning.search import BUCKET_WIDTH, relax_offers
 
 Bound = Callable[[IntArray], FloatArray]
 
@@ -166,7 +166,7 @@ class GuidedSearch:
         if isinstance(ceiling, np.ndarray):
             ceiling = ceiling[v // self.copy_size]
         keep = d + self.estimate_at(v) < ceiling
-        improved = _relax(
+        improved = relax_offers(
             arrays.dist, arrays.via, arrays.pred, v[keep], d[keep], du[keep], edges.tails[keep]
         )
         fresh = improved[~arrays.queued[improved]]
