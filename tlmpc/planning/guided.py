@@ -116,6 +116,7 @@ class GuidedSearch:
         arrays.touched.append(sources)
         self.frontier = sources
         self.estimate = estimate[finite]  # the bound at each frontier node
+        self.f = offsets + self.estimate  # g + bound at each frontier node
         weights = product.move_weight
         self.width = BUCKET_WIDTH * float(weights.mean()) if len(weights) else 1.0
         self.reached = len(sources)
@@ -137,20 +138,23 @@ class GuidedSearch:
         """The least ``f`` in the frontier (inf when it is empty)."""
         if not len(self.frontier):
             return np.inf
-        return float((self.arrays.dist[self.frontier] + self.estimate).min())
+        return float(self.f.min())
 
     def prune(self, ceilings: FloatArray) -> None:
         """Drop the frontier nodes whose ``f`` reaches their copy's ceiling."""
-        copy = self.frontier // self.copy_size
-        keep = self.arrays.dist[self.frontier] + self.estimate < ceilings[copy]
+        keep = self.f < ceilings[self.frontier // self.copy_size]
         self.arrays.queued[self.frontier[~keep]] = False
-        self.frontier, self.estimate = self.frontier[keep], self.estimate[keep]
+        self.frontier, self.estimate, self.f = (
+            self.frontier[keep],
+            self.estimate[keep],
+            self.f[keep],
+        )
 
     def step(self, ceiling: float | FloatArray = np.inf) -> tuple[Edges, IntArray]:
         """Expand the lowest bucket; returns its edges and the nodes whose distance got
         shorter (queued again).  ``ceiling`` may be one per copy."""
         arrays = self.arrays
-        f = arrays.dist[self.frontier] + self.estimate
+        f = self.f
         take = f <= float(f.min()) + self.width
         active = self.frontier[take]
         self.frontier, self.estimate = self.frontier[~take], self.estimate[~take]
@@ -175,6 +179,8 @@ class GuidedSearch:
         self.reached += len(fresh)
         self.frontier = np.concatenate([self.frontier, fresh])
         self.estimate = np.concatenate([self.estimate, self.estimate_at(fresh)])
+        # Distances of queued nodes may have got shorter: f is read anew.
+        self.f = arrays.dist[self.frontier] + self.estimate
         return edges, improved
 
     def path(self, target: int) -> list[int]:
@@ -296,8 +302,9 @@ class _Bounds:
         scale = self.graph.scale
 
         def bound(nodes: IntArray) -> FloatArray:
-            straight = np.linalg.norm(position[nodes // nq] - goal, axis=1) * scale
-            result: FloatArray = np.maximum(back(nodes), straight * (1.0 - 1e-9))
+            offset = position[nodes // nq] - goal
+            straight = np.sqrt(offset[:, 0] * offset[:, 0] + offset[:, 1] * offset[:, 1])
+            result: FloatArray = np.maximum(back(nodes), straight * (scale * (1.0 - 1e-9)))
             return result
 
         return bound
