@@ -319,6 +319,8 @@ def guided_lasso(
 ) -> GuidedLasso | None:
     """The minimum-cost accepting lasso of ``product`` (None when there is none), see the
     module doc; past ``max_searches`` closing searches the best found, ``optimal`` false."""
+    if not len(product.initial):
+        return None
     graph = region_graph(product, allowed_cells)
     bounds = _Bounds(product, graph, beta)
     prefix = GuidedSearch(product, _Arrays.of(product.num_nodes), product.initial, bounds.lasso)
