@@ -56,11 +56,14 @@ def automaton_for(mission: Mission, abstraction: Abstraction) -> Automaton:
     crossing and start letters; under the right-continuous one the task over the mesh's.
     """
     from tlmpc.automata import translate
+    from tlmpc.ltl.bounds import untimed_skeleton
     from tlmpc.planning.boundary import task_formula, task_letters
 
     convention = mission.options.boundary
+    # A bounded task is planned on its untimed skeleton; its bounds are checked on the
+    # compiled trajectory (tlmpc.pipeline.deadlines).
     return translate(
-        task_formula(mission.formula, convention),
+        task_formula(untimed_skeleton(mission.formula), convention),
         letters=task_letters(abstraction, convention, mission.robot.start),
     )
 
@@ -83,6 +86,7 @@ def plan_mission(
     ``resume`` re-plans a run under way from ``abstraction.start`` at ``start_point``, the
     (degeneralized) automaton being in one of these states; it never drops the margin.
     """
+    from tlmpc.ltl.bounds import untimed_skeleton
     from tlmpc.mission.body import requested_margin
 
     def attempt(mesh: Abstraction, task: Automaton) -> Planned:
@@ -93,7 +97,7 @@ def plan_mission(
         planned_mesh, witness = plan_complete(
             mesh,
             task,
-            formula=mission.formula,
+            formula=untimed_skeleton(mission.formula),
             options=mission.options,
             start_point=start_point if start_point is not None else mission.robot.start,
             parts=parts if parts is not None else (lambda: _task_parts(mission)),
@@ -136,9 +140,16 @@ def plan_mission(
 
 
 def _task_parts(mission: Mission) -> Sequence[TaskPart]:
+    """The task's parts as the planner reads them (bounded ones by their skeletons)."""
+    import dataclasses
+
+    from tlmpc.ltl.bounds import untimed_skeleton
     from tlmpc.mission.parts import task_parts
 
-    return task_parts(mission)
+    return [
+        dataclasses.replace(part, formula=untimed_skeleton(part.formula))
+        for part in task_parts(mission)
+    ]
 
 
 def _with_body_notes(failure: NoPlanError, mission: Mission) -> NoPlanError:

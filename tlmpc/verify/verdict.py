@@ -427,8 +427,48 @@ def certify(trace: TraceInput, regions: dict[str, FloatArray], outcome: Outcome)
     )
 
 
-def verify_trace(trace: TraceInput) -> Verdict:
-    """Check ``trace`` against its task under its boundary convention and ending."""
+@dataclasses.dataclass(frozen=True, slots=True)
+class _Truth:
+    """The trace cut into pieces at the crossings of the regions its task mentions, and the
+    exact truth of formulas on them."""
+
+    pieces: Pieces
+    regions: dict[str, FloatArray]
+    names: list[str]
+    unknown: BoolArray | None
+    size: int
+    ending: PieceEnding
+    is_point: BoolArray | None
+    timing: Timing
+    truth: Semantics
+
+    def outcome_function(self) -> Callable[[Formula], Outcome]:
+        """The verdict of a formula at the trace's start (one with finite bounds only is
+        decided on the prefix its bounds reach)."""
+        atoms = truth_atoms(self.pieces.labels, self.names, self.unknown)
+        prefixes: dict[int, Semantics] = {}
+        times, is_point, truth = self.pieces.times, self.is_point, self.truth
+
+        def outcome_of(formula: Formula) -> Outcome:
+            # A formula whose operators all have finite bounds is decided at t=0 by the trace
+            # up to its reach: the searches for time robustness evaluate only that prefix.
+            cut = _prefix_end(times, reach(formula))
+            if cut is None:
+                return _outcome(*truth.at_start(formula))
+            if cut not in prefixes:
+                prefixes[cut] = Semantics(
+                    _prefix_atoms(atoms, cut),
+                    cut,
+                    "open",
+                    is_point=None if is_point is None else is_point[:cut],
+                    timing=Timing(times[:cut], float(times[cut - 1])),
+                )
+            return _outcome(*prefixes[cut].at_start(formula))
+
+        return outcome_of
+
+
+def _truth_of(trace: TraceInput) -> _Truth:
     # Only the regions the task mentions can change its truth (no Next: the semantics is
     # stutter-invariant), so crossings of other regions are not split at.
     mentioned = trace.formula.props()
@@ -448,6 +488,43 @@ def verify_trace(trace: TraceInput) -> Verdict:
         is_point=is_point,
         timing=timing,
     )
+    return _Truth(pieces, regions, names, unknown, size, ending, is_point, timing, truth)
+
+
+@dataclasses.dataclass(frozen=True, slots=True)
+class BoundSlack:
+    """One time bound of a task: the operator's text and by how many seconds it held (> 0)
+    or failed (< 0), the other bounds kept (``inf``/``-inf``: any amount; None: under
+    ``<->``, no direction)."""
+
+    bound: str
+    slack: float | None
+
+
+def bound_slacks(trace: TraceInput) -> tuple[Outcome, tuple[BoundSlack, ...]]:
+    """The task's verdict on ``trace`` and the slack of each of its bounded operators
+    (pre-order): the time robustness of the task with that one bound moved."""
+    found = _truth_of(trace)
+    outcome_of = found.outcome_function()
+    outcome = _outcome(*found.truth.at_start(trace.formula))
+    span = horizon(trace.formula, float(trace.times[-1] - trace.times[0]))
+    slacks = tuple(
+        BoundSlack(
+            bound=to_text(node),
+            slack=time_robustness(trace.formula, outcome, outcome_of, span, only=node),
+        )
+        for node in bounded_operators(trace.formula)
+    )
+    return outcome, slacks
+
+
+def verify_trace(trace: TraceInput) -> Verdict:
+    """Check ``trace`` against its task under its boundary convention and ending."""
+    found = _truth_of(trace)
+    pieces, regions, names, unknown = found.pieces, found.regions, found.names, found.unknown
+    size, ending, is_point, timing = found.size, found.ending, found.is_point, found.timing
+    truth = found.truth
+    loop_start = trace.loop_start if trace.ending == "loop" else None
     task_outcome = _outcome(*truth.at_start(trace.formula))
     conjuncts = _conjuncts(trace.formula)
     outcomes = [_outcome(*truth.at_start(c)) for c in conjuncts]
@@ -464,24 +541,7 @@ def verify_trace(trace: TraceInput) -> Verdict:
     )
     reports, violations = conjunct_reports(conjuncts, outcomes, truth, line)
 
-    atoms = truth_atoms(pieces.labels, names, unknown)
-    prefixes: dict[int, Semantics] = {}
-
-    def outcome_of(formula: Formula) -> Outcome:
-        # A formula whose operators all have finite bounds is decided at t=0 by the trace up
-        # to its reach: the searches for time robustness evaluate only that prefix.
-        cut = _prefix_end(pieces.times, reach(formula))
-        if cut is None:
-            return _outcome(*truth.at_start(formula))
-        if cut not in prefixes:
-            prefixes[cut] = Semantics(
-                _prefix_atoms(atoms, cut),
-                cut,
-                "open",
-                is_point=None if is_point is None else is_point[:cut],
-                timing=Timing(pieces.times[:cut], float(pieces.times[cut - 1])),
-            )
-        return _outcome(*prefixes[cut].at_start(formula))
+    outcome_of = found.outcome_function()
 
     duration = float(trace.times[-1] - trace.times[0])
     reports = [

@@ -1,0 +1,109 @@
+"""Time bounds in ``tlmpc compile``: the compiled trajectory is checked against every bound.
+
+The planner plans a bounded task on its untimed skeleton (:func:`tlmpc.ltl.bounds.untimed_skeleton`)
+and the controllers run at up to ``max_speed``; whether the exact trajectory then meets the
+task's deadlines, durations and periods is decided here by the dense-time verifier, and each
+bound's slack (seconds, signed) goes into ``summary.json``.  When the trajectory misses a
+bound, compile fails with one of two answers:
+
+* **P050**, a proof (exit 1): a deadline no trajectory of the robot can meet, with the
+  earliest time the task's goals can be reached (:mod:`tlmpc.planning.deadlines`);
+* **P051**, no proof (exit 4, inconclusive): the plan found misses a bound, and none of the
+  task's deadlines is proven impossible: another plan might meet it.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any
+
+from tlmpc.abstraction.model import Abstraction
+from tlmpc.base.errors import EXIT_INCONCLUSIVE, Diagnostic, NoPlanError, TlmpcError
+from tlmpc.ltl.ast import bounded_operators
+from tlmpc.mission.model import Mission
+from tlmpc.verify.verdict import BoundSlack, bound_slacks
+
+
+class DeadlineMissedError(TlmpcError):
+    """The plan found misses a time bound and no proof says that every plan must (exit 4)."""
+
+    exit_code = EXIT_INCONCLUSIVE
+
+
+def _seconds(value: float | None) -> float | str | None:
+    """A slack for JSON: a number, ``"inf"``/``"-inf"``, or None (no direction)."""
+    if value is None or math.isfinite(value):
+        return value
+    return "inf" if value > 0 else "-inf"
+
+
+def check_time_bounds(
+    mission: Mission, trace: Mapping[str, Any], abstraction: Abstraction
+) -> dict[str, Any] | None:
+    """The slack of every time bound of the task on the compiled ``trace`` (None: the task
+    has none); raises P050 or P051 when the trace does not satisfy the task.
+
+    ``abstraction`` is the mesh the plan used; the proof is computed on the mesh without
+    margin when the mission asks for one (it must speak of every trajectory).
+    """
+    if not bounded_operators(mission.formula):
+        return None
+    from tlmpc.verify.trace_input import from_document
+
+    outcome, slacks = bound_slacks(from_document(dict(trace)))
+    report = [{"bound": s.bound, "slack": _seconds(s.slack)} for s in slacks]
+    if outcome == "satisfied":
+        return {"bounds": report}
+    proofs = _proofs(mission, abstraction)
+    if proofs:
+        raise NoPlanError(
+            [
+                Diagnostic(
+                    code="P050",
+                    message=p.message,
+                    hint="a later deadline, a faster robot (robot.max_speed) or goals closer "
+                    "to the start; the shortest path is measured in the free space the "
+                    "task's invariants leave",
+                    file=mission.source,
+                    line=p.span.line if p.span is not None else None,
+                    col=p.span.col if p.span is not None else None,
+                )
+                for p in proofs
+            ]
+        )
+    raise DeadlineMissedError(
+        Diagnostic(
+            code="P051",
+            message="no plan was found that meets the task's time bounds (none is proven "
+            "impossible): the minimum-cost plan of the untimed task misses " + _missed(slacks),
+            hint="the plan minimises path length, not each deadline; the earliest arrival "
+            "times are lower bounds the plan did not reach. Looser bounds, a faster robot "
+            "or a task that fixes the order of the goals may help",
+            file=mission.source,
+        )
+    )
+
+
+def _missed(slacks: tuple[BoundSlack, ...]) -> str:
+    """The failing bounds in words (``F[0,30] dock by 3.2 s``)."""
+    failing = [s for s in slacks if s.slack is not None and s.slack < 0]
+    if not failing:
+        return "the task (its bounds together)"
+    parts = []
+    for s in failing:
+        assert s.slack is not None
+        amount = (
+            "(loosening it alone does not help)" if math.isinf(s.slack) else f"by {-s.slack:.4g} s"
+        )
+        parts.append(f"`{s.bound}` {amount}")
+    return ", ".join(parts)
+
+
+def _proofs(mission: Mission, abstraction: Abstraction) -> tuple[Any, ...]:
+    from tlmpc.mission.body import requested_margin
+    from tlmpc.planning.deadlines import deadline_proofs
+    from tlmpc.planning.mission import abstraction_for
+
+    mesh = abstraction_for(mission, 0.0) if requested_margin(mission) > 0.0 else abstraction
+    return deadline_proofs(mission, mesh)
