@@ -2,7 +2,7 @@
 
 A different formulation from tlmpc's (which searches a triangulation's reflex corners and the
 goal's edge feet): the free space is built from the mission's polygons with shapely (the
-workspace minus the holes minus the interiors of the avoided regions), and a visibility graph
+closure of the workspace minus the holes and the avoided regions), and a visibility graph
 joins the start, *every* corner of the free space and points spaced at most ``spacing`` apart
 along the goal's boundary; scipy's Dijkstra gives the shortest path to the nearest of those
 points.  That path is achievable (an upper bound), and the true shortest path is at most
@@ -43,10 +43,10 @@ def free_space(
     for hole in holes:
         space = space.difference(shapely.Polygon(hole))
     for region in avoid:
-        # the region's interior is forbidden, its boundary is not
-        space = space.difference(shapely.Polygon(region)).union(
-            shapely.Polygon(region).boundary.intersection(space)
-        )
+        # the robot may come arbitrarily close to an avoided region, so path lengths are
+        # measured in the closure of what is left (shapely's difference is that closure); a
+        # stretch along the region's boundary is in the region, never free
+        space = space.difference(shapely.Polygon(region))
     return space
 
 

@@ -367,3 +367,44 @@ def test_deadlines_around_the_optimum(
             assert dense_values(parse_ltl(f"F[0,{deadline}] goal"), ticks, QUANTUM)[0]
     if code == "P051":
         assert deadline >= shortest.lower / speed
+
+
+@st.composite
+def hazard_worlds(draw: st.DrawFn) -> dict[str, Any]:
+    """A room with a pillar, a hazard wall to avoid and a goal behind it."""
+    quarter = st.integers(0, 8).map(lambda k: k / 4)
+    holes = [rect(4 + draw(quarter) / 2, 1 + draw(quarter) / 2, 6, 4 + draw(quarter) / 2)]
+    top = 4 + draw(quarter)
+    hazard = rect(7.5, 0, 8.5, top)
+    gx, gy = 9 + draw(quarter), draw(st.integers(0, 5))
+    goal = rect(gx, gy, gx + 1, gy + 1.5)
+    start = (0.5 + draw(quarter), 0.5 + draw(quarter))
+    return {"holes": holes, "hazard": hazard, "goal": goal, "start": start}
+
+
+@settings(max_examples=20, deadline=None)
+@given(hazard_worlds(), st.sampled_from(["right", "closed"]))
+def test_the_earliest_arrival_is_the_oracles_shortest_path(
+    world: dict[str, Any], convention: str
+) -> None:
+    from tlmpc.mission import load_mission_text
+    from tlmpc.planning.deadlines import deadline_proofs
+    from tlmpc.planning.mission import abstraction_for
+
+    text = (
+        mission_text(
+            size=(12, 8),
+            holes=world["holes"],
+            regions={"goal": world["goal"], "hazard": world["hazard"]},
+            start=world["start"],
+            speed=1.0,
+            ltl="F[0,0] goal & G !hazard",
+        )
+        + f"options: {{boundary: {convention}}}\n"
+    )
+    mission = load_mission_text(text, "m.yaml")
+    (proof,) = deadline_proofs(mission, abstraction_for(mission, 0.0))
+    space = free_space(rect(0, 0, 12, 8), world["holes"], [world["hazard"]])
+    shortest = Oracle(space, world["start"], [world["goal"]], spacing=0.05).reach(0)
+    assert proof.earliest <= shortest.upper + 1e-9  # sound: a path that short exists
+    assert proof.earliest >= shortest.lower - 1e-6  # and exact: none is shorter

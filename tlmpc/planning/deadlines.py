@@ -177,38 +177,50 @@ def _reflex_corners(abstraction: Abstraction, allowed: np.ndarray) -> FloatArray
 
 
 def _goal(free: _Free, proposition: Formula, convention: str) -> _Goal:
-    """Where ``proposition`` can hold: allowed triangles whose label satisfies it or, under
-    the closed convention, whose label joined with a neighbour's at an edge or a corner does
-    (a boundary point carries every region that touches it)."""
+    """Where ``proposition`` can hold: the allowed triangles whose label satisfies it and,
+    under the closed convention, the edges and corners of allowed triangles where the labels
+    of the triangles meeting there do (a boundary point carries every region touching it)."""
     abstraction = free.abstraction
     letters = abstraction.letters
     ok_letter = np.array([holds(proposition, set(letter)) for letter in letters], dtype=bool)
     chosen = free.allowed & ok_letter[abstraction.letter_of]
+    tris = abstraction.triangles[chosen]
+    points = abstraction.vertices
+    parts = [shapely.Polygon(points[t]) for t in tris]
     if convention == "closed":
-        regions_at: list[set[str]] = [set() for _ in range(len(abstraction.vertices))]
+        # where the label alone fails, a boundary point may still carry the regions of every
+        # triangle touching it: the edges and corners of allowed triangles where it holds
+        regions_at: list[set[str]] = [set() for _ in range(len(points))]
         for t, corners in enumerate(abstraction.triangles.tolist()):
             for v in corners:
                 regions_at[v].update(abstraction.labels(t))
         for t in np.flatnonzero(free.allowed & ~chosen).tolist():
             own = set(abstraction.labels(t))
-            around = [regions_at[v] for v in abstraction.triangles[t].tolist()]
-            across = [
-                own | set(abstraction.labels(n))
-                for n in abstraction.neighbors[t].tolist()
-                if n >= 0
-            ]
-            if any(holds(proposition, s) for s in [*around, *across]):
-                chosen[t] = True
-    tris = abstraction.triangles[chosen]
-    points = abstraction.vertices
-    polygons = [shapely.Polygon(points[t]) for t in tris]
-    shape = shapely.union_all(polygons) if polygons else shapely.Polygon()
-    boundary = shapely.get_parts(shapely.boundary(shape)) if polygons else []
+            corners = abstraction.triangles[t].tolist()
+            for i, n in enumerate(abstraction.neighbors[t].tolist()):
+                if n >= 0 and holds(proposition, own | set(abstraction.labels(n))):
+                    ends = [corners[(i + 1) % 3], corners[(i + 2) % 3]]
+                    parts.append(shapely.LineString(points[ends]))
+            parts.extend(
+                shapely.Point(points[v]) for v in corners if holds(proposition, regions_at[v])
+            )
+    shape = shapely.union_all(parts) if parts else shapely.Polygon()
     edges: list[list[list[float]]] = []
-    for ring in boundary:
-        coords = shapely.get_coordinates(ring)
-        edges.extend([coords[k].tolist(), coords[k + 1].tolist()] for k in range(len(coords) - 1))
-    corners = np.array([e[0] for e in edges], dtype=float).reshape(-1, 2)
+    for part in shapely.get_parts(shape):
+        if isinstance(part, shapely.Point):
+            edges.append([[part.x, part.y], [part.x, part.y]])
+            continue
+        lines = (
+            shapely.get_parts(shapely.boundary(part))
+            if isinstance(part, shapely.Polygon)
+            else [part]
+        )
+        for line in lines:
+            coords = shapely.get_coordinates(line)
+            edges.extend(
+                [coords[k].tolist(), coords[k + 1].tolist()] for k in range(len(coords) - 1)
+            )
+    corners = np.array([e[0] for e in edges] + [e[1] for e in edges], dtype=float).reshape(-1, 2)
     return _Goal(
         to_text(proposition), shape, np.array(edges, dtype=float).reshape(-1, 2, 2), corners
     )
