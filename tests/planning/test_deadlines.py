@@ -408,3 +408,31 @@ def test_the_earliest_arrival_is_the_oracles_shortest_path(
     shortest = Oracle(space, world["start"], [world["goal"]], spacing=0.05).reach(0)
     assert proof.earliest <= shortest.upper + 1e-9  # sound: a path that short exists
     assert proof.earliest >= shortest.lower - 1e-6  # and exact: none is shorter
+
+
+def test_the_shipped_example_and_its_documented_numbers(tmp_path: Path) -> None:
+    spec = Path(__file__).resolve().parents[2] / "specs" / "deadline.yaml"
+    text = spec.read_text()
+    code, found = compile_text(tmp_path, text)
+    assert code == "ok"
+    slacks = [b["slack"] for b in found["summary"]["bounds"]]
+    assert [f"{s:.2f}" for s in slacks] == ["13.34", "8.21"]  # docs/examples.md
+    entry = first_entry(found["trace"], DOCK)
+    assert f"{entry:.2f}" == "31.66"  # docs/planning.md
+    assert slacks[0] == pytest.approx(45 - entry, abs=1e-6)
+    from tlmpc.io.schema_check import validation_errors
+
+    assert validation_errors(found["summary"], "summary") == []
+    path = tmp_path / "deadline-20.yaml"
+    path.write_text(text.replace("within 45 s", "within 20 s"))
+    code, shown = run("compile", str(path), "-o", str(tmp_path / "out"), "-q")
+    assert code == 1
+    assert (
+        f"{path}:17:5: error[P050]: no plan meets the deadline of `F[0,20] dock`: reaching "
+        in shown
+    )
+    assert "takes at least 21.51 s > 20 s (a path of at least 10.76 at speed 0.5)" in shown
+    path.write_text(text.replace("within 45 s", "within 30 s"))
+    code, shown = run("compile", str(path), "-o", str(tmp_path / "out"), "-q")
+    assert code == 4
+    assert "misses `F[0,30] dock` by 1.662 s" in shown

@@ -20,8 +20,10 @@ from typing import Any
 
 from tlmpc.abstraction.model import Abstraction
 from tlmpc.base.errors import EXIT_INCONCLUSIVE, Diagnostic, NoPlanError, TlmpcError
-from tlmpc.ltl.ast import bounded_operators
+from tlmpc.ltl.ast import And, bounded_operators
+from tlmpc.ltl.printer import to_text
 from tlmpc.mission.model import Mission
+from tlmpc.planning.deadlines import DeadlineProof
 from tlmpc.verify.verdict import BoundSlack, bound_slacks
 
 
@@ -66,10 +68,11 @@ def check_time_bounds(
                     "to the start; the shortest path is measured in the free space the "
                     "task's invariants leave",
                     file=mission.source,
-                    line=p.span.line if p.span is not None else None,
-                    col=p.span.col if p.span is not None else None,
+                    line=where[0],
+                    col=where[1],
                 )
                 for p in proofs
+                for where in [_position(mission, p)]
             ]
         )
     raise DeadlineMissedError(
@@ -86,23 +89,35 @@ def check_time_bounds(
 
 
 def _missed(slacks: tuple[BoundSlack, ...]) -> str:
-    """The failing bounds in words (``F[0,30] dock by 3.2 s``)."""
-    failing = [s for s in slacks if s.slack is not None and s.slack < 0]
-    if not failing:
-        return "the task (its bounds together)"
-    parts = []
-    for s in failing:
-        assert s.slack is not None
-        amount = (
-            "(loosening it alone does not help)" if math.isinf(s.slack) else f"by {-s.slack:.4g} s"
-        )
-        parts.append(f"`{s.bound}` {amount}")
-    return ", ".join(parts)
+    """The failing bounds in words (``F[0,30] dock by 3.2 s``): those that a finite loosening
+    of their own would fix; else those that no loosening of their own fixes."""
+    finite = [s for s in slacks if s.slack is not None and -math.inf < s.slack < 0]
+    if finite:
+        return ", ".join(f"`{s.bound}` by {-(s.slack or 0.0):.4g} s" for s in finite)
+    hopeless = [s for s in slacks if s.slack == -math.inf]
+    if hopeless:
+        return ", ".join(f"`{s.bound}`" for s in hopeless) + " (no loosening of one bound helps)"
+    return "the task (its bounds together)"
 
 
-def _proofs(mission: Mission, abstraction: Abstraction) -> tuple[Any, ...]:
+def _position(mission: Mission, proof: DeadlineProof) -> tuple[int | None, int | None]:
+    """Where the proof's conjunct was written: its own position in ``ltl``, else the task
+    phrase it comes from."""
+    if proof.span is not None:
+        return proof.span.line, proof.span.col
+    from tlmpc.mission.parts import task_parts
+
+    for part in task_parts(mission):
+        formula = part.formula
+        conjuncts = formula.args if isinstance(formula, And) else (formula,)
+        if proof.anchor in {to_text(c) for c in conjuncts}:
+            return part.line, part.col
+    return None, None
+
+
+def _proofs(mission: Mission, abstraction: Abstraction) -> tuple[DeadlineProof, ...]:
     from tlmpc.mission.body import requested_margin
-    from tlmpc.planning.deadlines import deadline_proofs
+    from tlmpc.planning.deadlines import deadline_proofs  # shapely work: on failure only
     from tlmpc.planning.mission import abstraction_for
 
     mesh = abstraction_for(mission, 0.0) if requested_margin(mission) > 0.0 else abstraction

@@ -78,6 +78,8 @@ class DeadlineProof:
     distance: float
     speed: float
     span: Span | None = None
+    #: The top-level conjunct of the task the proof is about (the first, for several).
+    anchor: str = ""
 
     @property
     def message(self) -> str:
@@ -381,6 +383,7 @@ def deadline_proofs(mission: Mission, abstraction: Abstraction) -> tuple[Deadlin
             distance=distance,
             speed=speed,
             span=part.span,
+            anchor=to_text(part),
         )
 
     def keep(found: DeadlineProof | None) -> bool:
@@ -453,4 +456,5 @@ def _every_order(
         distance=found.distance,
         speed=found.speed,
         span=single[0][0].span,
+        anchor=to_text(single[0][0]),
     )
