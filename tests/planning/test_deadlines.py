@@ -436,3 +436,17 @@ def test_the_shipped_example_and_its_documented_numbers(tmp_path: Path) -> None:
     code, shown = run("compile", str(path), "-o", str(tmp_path / "out"), "-q")
     assert code == 4
     assert "misses `F[0,30] dock` by 1.662 s" in shown
+
+
+def test_deadlines_on_two_goals_one_order_meets_both_so_no_proof(tmp_path: Path) -> None:
+    # a is on the way to b: a then b meets both deadlines; b first would make a late
+    a, b = rect(3, 3.5, 4, 4.5), rect(10, 3.5, 11, 4.5)
+    start = (1.0, 4.0)
+    oracle = Oracle(free_space(rect(0, 0, 12, 8), [], []), start, [a, b], spacing=0.05)
+    to_a, then_b = oracle.reach(0).upper, oracle.sequence(0, 1).upper
+    ltl = f"F[0,{to_a + 0.5}] a & F[0,{then_b + 0.5}] b"
+    text = mission_text(
+        size=(12, 8), holes=[], regions={"a": a, "b": b}, start=start, speed=1.0, ltl=ltl
+    )
+    code, _ = compile_text(tmp_path, text)
+    assert code in ("ok", "P051")
