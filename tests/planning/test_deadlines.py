@@ -424,6 +424,12 @@ def test_the_shipped_example_and_its_documented_numbers(tmp_path: Path) -> None:
 
     assert validation_errors(found["summary"], "summary") == []
     path = tmp_path / "deadline-20.yaml"
+    out = tmp_path / "compiled"
+    assert run("compile", str(spec), "-o", str(out), "-q")[0] == 0
+    for model in ("promela", "smv"):  # the model checkers' LTL has no bounds: refused
+        code, shown = run("export", str(out), "--format", model, "-o", str(tmp_path / model))
+        assert code == 1
+        assert f"<formula>:1:1: error[L045]: the {model} export cannot take the time bound" in shown
     path.write_text(text.replace("within 45 s", "within 20 s"))
     code, shown = run("compile", str(path), "-o", str(tmp_path / "out"), "-q")
     assert code == 1
