@@ -198,6 +198,11 @@ def test_a_deadline_between_the_proof_and_the_plan_is_no_plan_found(tmp_path: Pa
     assert code == "P051"
     assert "none is proven impossible" in found["message"]
     assert "`F[0,25] dock` by" in found["message"]
+    by_hand = (math.sqrt(32) + math.sqrt(26)) / 0.5
+    assert (
+        f"the earliest any trajectory can do it: reaching dock from the start takes at least "
+        f"{by_hand:.4g} s (bound 25 s)" in found["message"]
+    )
 
 
 def test_cli_exit_codes_and_locations(tmp_path: Path) -> None:

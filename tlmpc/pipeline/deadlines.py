@@ -15,7 +15,7 @@ bound, compile fails with one of two answers:
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 from tlmpc.abstraction.model import Abstraction
@@ -23,8 +23,11 @@ from tlmpc.base.errors import EXIT_INCONCLUSIVE, Diagnostic, NoPlanError, TlmpcE
 from tlmpc.ltl.ast import And, bounded_operators
 from tlmpc.ltl.printer import to_text
 from tlmpc.mission.model import Mission
-from tlmpc.planning.deadlines import DeadlineProof
+from tlmpc.planning.deadlines import DeadlineBound
 from tlmpc.verify.verdict import BoundSlack, bound_slacks
+
+#: At most this many lower bounds are quoted in a P051 message.
+MAX_SHOWN = 3
 
 
 class DeadlineMissedError(TlmpcError):
@@ -57,7 +60,8 @@ def check_time_bounds(
     report = [{"bound": s.bound, "slack": _seconds(s.slack)} for s in slacks]
     if outcome == "satisfied":
         return {"bounds": report}
-    proofs = _proofs(mission, abstraction)
+    bounds = _bounds(mission, abstraction)
+    proofs = [b for b in bounds if b.proven]
     if proofs:
         raise NoPlanError(
             [
@@ -75,15 +79,21 @@ def check_time_bounds(
                 for where in [_position(mission, p)]
             ]
         )
+    where = _first_missed(mission, slacks)
     raise DeadlineMissedError(
         Diagnostic(
             code="P051",
             message="no plan was found that meets the task's time bounds (none is proven "
-            "impossible): the minimum-cost plan of the untimed task misses " + _missed(slacks),
-            hint="the plan minimises path length, not each deadline; the earliest arrival "
-            "times are lower bounds the plan did not reach. Looser bounds, a faster robot "
-            "or a task that fixes the order of the goals may help",
+            "impossible): the minimum-cost plan of the untimed task misses "
+            + _missed(slacks)
+            + _earliest(bounds),
+            hint="the plan minimises path length, not the time to each goal, and its "
+            "controllers do not drive the shortest path at full speed: deadlines between the "
+            "earliest possible time and the plan's are not decided. Looser bounds, a faster "
+            "robot or a task that fixes the order of the goals may help",
             file=mission.source,
+            line=where[0],
+            col=where[1],
         )
     )
 
@@ -100,7 +110,38 @@ def _missed(slacks: tuple[BoundSlack, ...]) -> str:
     return "the task (its bounds together)"
 
 
-def _position(mission: Mission, proof: DeadlineProof) -> tuple[int | None, int | None]:
+def _earliest(bounds: Sequence[DeadlineBound]) -> str:
+    """What the proofs found short of a proof: the earliest times, against the deadlines."""
+    if not bounds:
+        return ""
+    shown = [
+        f"{b.what} takes at least {b.earliest:.4g} s (bound {b.deadline:.4g} s)"
+        for b in bounds[:MAX_SHOWN]
+    ]
+    return "; the earliest any trajectory can do it: " + ", ".join(shown)
+
+
+def _first_missed(
+    mission: Mission, slacks: tuple[BoundSlack, ...]
+) -> tuple[int | None, int | None]:
+    """Where the first bound the plan misses was written (None, None: not known)."""
+    for found in slacks:
+        if found.slack is not None and found.slack < 0:
+            return _located(mission, found.bound)
+    return None, None
+
+
+def _located(mission: Mission, text: str) -> tuple[int | None, int | None]:
+    """The task part whose formula holds the operator printed as ``text``."""
+    from tlmpc.mission.parts import task_parts
+
+    for part in task_parts(mission):
+        if any(to_text(node) == text for node in part.formula.walk()):
+            return part.line, part.col
+    return None, None
+
+
+def _position(mission: Mission, proof: DeadlineBound) -> tuple[int | None, int | None]:
     """Where the proof's conjunct was written: its own position in ``ltl``, else the task
     phrase it comes from."""
     if proof.span is not None:
@@ -115,10 +156,10 @@ def _position(mission: Mission, proof: DeadlineProof) -> tuple[int | None, int |
     return None, None
 
 
-def _proofs(mission: Mission, abstraction: Abstraction) -> tuple[DeadlineProof, ...]:
+def _bounds(mission: Mission, abstraction: Abstraction) -> tuple[DeadlineBound, ...]:
     from tlmpc.mission.body import requested_margin
-    from tlmpc.planning.deadlines import deadline_proofs  # shapely work: on failure only
+    from tlmpc.planning.deadlines import deadline_bounds
     from tlmpc.planning.mission import abstraction_for
 
     mesh = abstraction_for(mission, 0.0) if requested_margin(mission) > 0.0 else abstraction
-    return deadline_proofs(mission, mesh)
+    return deadline_bounds(mission, mesh)

@@ -63,8 +63,9 @@ TOLERANCE = 1e-9
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
-class DeadlineProof:
-    """A deadline of the task that no trajectory of the robot can meet.
+class DeadlineBound:
+    """A lower bound on the time a deadline of the task needs: a proof that no trajectory of
+    the robot meets it when :attr:`proven`.
 
     ``earliest`` (seconds) is a lower bound on the time the task's ``conjunct`` needs, as
     ``distance`` (map units) at ``speed``; ``deadline`` is what the task allows; ``what``
@@ -80,6 +81,11 @@ class DeadlineProof:
     span: Span | None = None
     #: The top-level conjunct of the task the proof is about (the first, for several).
     anchor: str = ""
+
+    @property
+    def proven(self) -> bool:
+        """True when the deadline cannot be met: it comes before the earliest time."""
+        return self.earliest > self.deadline
 
     @property
     def message(self) -> str:
@@ -324,8 +330,16 @@ def _all_pairs(length: FloatArray) -> FloatArray:
     return out
 
 
-def deadline_proofs(mission: Mission, abstraction: Abstraction) -> tuple[DeadlineProof, ...]:
-    """Every deadline of the mission's task that no trajectory can meet, with its proof.
+def deadline_proofs(mission: Mission, abstraction: Abstraction) -> tuple[DeadlineBound, ...]:
+    """Every deadline of the mission's task that no trajectory can meet, with its proof (the
+    :func:`deadline_bounds` that are proven)."""
+    return tuple(b for b in deadline_bounds(mission, abstraction) if b.proven)
+
+
+def deadline_bounds(mission: Mission, abstraction: Abstraction) -> tuple[DeadlineBound, ...]:
+    """The lower bound on the time of every deadline of the task in the fragment (see the
+    module doc), proven impossible or not; one per conjunct and kind of check, stopping at
+    the first proof of a conjunct.
 
     ``abstraction`` must cover the robot's whole free space (the mesh built without margin):
     the proof speaks of every trajectory, not only of those keeping the margin.
@@ -369,13 +383,11 @@ def deadline_proofs(mission: Mission, abstraction: Abstraction) -> tuple[Deadlin
     for p in patrolled:
         goal(p)
     paths = _Paths(free, list(goals.values()))
-    proofs: list[DeadlineProof] = []
+    bounds: list[DeadlineBound] = []
 
-    def proof(part: Formula, what: str, deadline: float, distance: float) -> DeadlineProof | None:
+    def bound(part: Formula, what: str, deadline: float, distance: float) -> DeadlineBound:
         distance = max(0.0, distance - TOLERANCE * free.scale)
-        if distance / speed <= deadline:
-            return None
-        return DeadlineProof(
+        return DeadlineBound(
             conjunct=to_text(part),
             what=what,
             deadline=deadline,
@@ -386,10 +398,11 @@ def deadline_proofs(mission: Mission, abstraction: Abstraction) -> tuple[Deadlin
             anchor=to_text(part),
         )
 
-    def keep(found: DeadlineProof | None) -> bool:
+    def keep(found: DeadlineBound | None) -> bool:
+        """Record ``found``; True when it is a proof."""
         if found is not None:
-            proofs.append(found)
-        return found is not None
+            bounds.append(found)
+        return found is not None and found.proven
 
     for part, chain, deadline in deadlines:
         reached = paths.through([goal(p) for p, _ in chain])
@@ -401,60 +414,61 @@ def deadline_proofs(mission: Mission, abstraction: Abstraction) -> tuple[Deadlin
                     break
                 total += window
                 gap = paths.leg(goal(chain[index - 1][0]), goal(p))
-                if keep(proof(part, f"going from {names[-1]} to {to_text(p)}", window, gap)):
+                if keep(bound(part, f"going from {names[-1]} to {to_text(p)}", window, gap)):
                     break
             names.append(to_text(p))
             what = "reaching " + ", then ".join(names) + " from the start"
-            if keep(proof(part, what, total, reached[index])):
+            if keep(bound(part, what, total, reached[index])):
                 break
     single = [(part, chain[0][0], d) for part, chain, d in deadlines if len(chain) == 1]
-    if 2 <= len(single) <= MAX_ORDERS_OF and not proofs:
-        keep(_every_order(single, paths, goal, proof))
+    if 2 <= len(single) <= MAX_ORDERS_OF and not any(b.proven for b in bounds):
+        keep(_every_order(single, paths, goal, bound))
     for part, p, period in periods:
         for q in patrolled:
             if q != p:
                 gap = paths.leg(goal(p), goal(q))
                 what = f"a round trip from {to_text(p)} to {to_text(q)} and back"
-                if keep(proof(part, what, period, 2 * gap)):
+                if keep(bound(part, what, period, 2 * gap)):
                     break
-    return tuple(proofs)
+    return tuple(bounds)
 
 
 def _every_order(
     single: Sequence[tuple[Formula, Formula, float]],
     paths: _Paths,
     goal: Callable[[Formula], _Goal],
-    proof: Callable[[Formula, str, float, float], DeadlineProof | None],
-) -> DeadlineProof | None:
+    bound: Callable[[Formula, str, float, float], DeadlineBound],
+) -> DeadlineBound | None:
     """Deadlines from the start on several goals ``(conjunct, goal, deadline)``: the goals
     are first reached in some order; a proof when every order misses one of the deadlines
     (stated for the order that misses by the least)."""
-    closest: tuple[float, DeadlineProof] | None = None
+    closest: tuple[float, DeadlineBound] | None = None
     for order in itertools.permutations(range(len(single))):
         reached = paths.through([goal(single[k][1]) for k in order])
         names = [to_text(single[k][1]) for k in order]
-        missed: DeadlineProof | None = None
+        missed: DeadlineBound | None = None
         for position, k in enumerate(order):
             what = "reaching " + ", then ".join(names[: position + 1]) + " from the start"
-            missed = proof(single[k][0], what, single[k][2], reached[position])
-            if missed is not None:
+            found = bound(single[k][0], what, single[k][2], reached[position])
+            if found.proven:
+                missed = found
                 break
         if missed is None:
             return None  # this order may meet every deadline
-        late = missed.earliest - missed.deadline
-        if closest is None or late < closest[0]:
-            closest = (late, missed)
+        lateness = missed.earliest - missed.deadline
+        if closest is None or lateness < closest[0]:
+            closest = (lateness, missed)
     assert closest is not None
-    found = closest[1]
+    best = closest[1]
     whole = And(tuple(part for part, _, _ in single))
-    return DeadlineProof(
+    return DeadlineBound(
         conjunct=to_text(whole),
-        what=f"{found.what} (the order that comes closest; every order of first visits misses "
+        what=f"{best.what} (the order that comes closest; every order of first visits misses "
         f"a deadline)",
-        deadline=found.deadline,
-        earliest=found.earliest,
-        distance=found.distance,
-        speed=found.speed,
+        deadline=best.deadline,
+        earliest=best.earliest,
+        distance=best.distance,
+        speed=best.speed,
         span=single[0][0].span,
         anchor=to_text(single[0][0]),
     )
