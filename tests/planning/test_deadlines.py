@@ -432,20 +432,20 @@ def test_the_shipped_example_and_its_documented_numbers(tmp_path: Path) -> None:
     out = tmp_path / "compiled"
     assert run("compile", str(spec), "-o", str(out), "-q")[0] == 0
     for model in ("promela", "smv"):  # the model checkers' LTL has no bounds: refused
-        code, shown = run("export", str(out), "--format", model, "-o", str(tmp_path / model))
-        assert code == 1
+        status, shown = run("export", str(out), "--format", model, "-o", str(tmp_path / model))
+        assert status == 1
         assert f"<formula>:1:1: error[L045]: the {model} export cannot take the time bound" in shown
     path.write_text(text.replace("within 45 s", "within 20 s"))
-    code, shown = run("compile", str(path), "-o", str(tmp_path / "out"), "-q")
-    assert code == 1
+    status, shown = run("compile", str(path), "-o", str(tmp_path / "out"), "-q")
+    assert status == 1
     assert (
         f"{path}:17:5: error[P050]: no plan meets the deadline of `F[0,20] dock`: reaching "
         in shown
     )
     assert "takes at least 21.51 s > 20 s (a path of at least 10.76 at speed 0.5)" in shown
     path.write_text(text.replace("within 45 s", "within 30 s"))
-    code, shown = run("compile", str(path), "-o", str(tmp_path / "out"), "-q")
-    assert code == 4
+    status, shown = run("compile", str(path), "-o", str(tmp_path / "out"), "-q")
+    assert status == 4
     assert "misses `F[0,30] dock` by 1.662 s" in shown
 
 
