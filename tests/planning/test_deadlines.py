@@ -461,3 +461,21 @@ def test_deadlines_on_two_goals_one_order_meets_both_so_no_proof(tmp_path: Path)
     )
     code, _ = compile_text(tmp_path, text)
     assert code in ("ok", "P051")
+
+
+def test_the_proof_counts_the_disturbance_as_speed() -> None:
+    from tlmpc.mission import load_mission_text
+    from tlmpc.planning.deadlines import deadline_proofs
+    from tlmpc.planning.mission import abstraction_for
+
+    # the dock is 10 m away in an empty room (from (1, 1) to its corner (10, 6): sqrt(106));
+    # a robot pushed by up to 0.5 m/s on top of its 0.5 m/s may cover it at 1 m/s
+    base = mission_text(
+        size=(12, 8), holes=[], regions={"dock": DOCK}, start=(1, 1), speed=0.5, ltl="F[0,0] dock"
+    )
+    for extra, speed in [("", 0.5), (", disturbance: 0.5", 1.0)]:
+        text = base.replace("max_speed: 0.5}", f"max_speed: 0.5{extra}}}")
+        mission = load_mission_text(text, "m.yaml")
+        (proof,) = deadline_proofs(mission, abstraction_for(mission, 0.0))
+        assert proof.speed == speed
+        assert proof.earliest == pytest.approx(math.sqrt(106) / speed, abs=1e-6)
