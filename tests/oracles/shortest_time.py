@@ -125,3 +125,28 @@ class Oracle:
             )
             best = min(best, self.dist[0, k] + onward)
         return Interval(max(0.0, float(best) - self.spacing), float(best))
+
+    def _onward(self, k: int, goal: int) -> float:
+        """From node ``k`` into goal ``goal`` (0 when already inside)."""
+        if self.goal_shapes[goal].buffer(1e-9).covers(shapely.Point(self.nodes[k])):
+            return 0.0
+        return float(min(self.dist[k, m] for m in self.goal_nodes[goal]))
+
+    def feasible_sequence(self, first: int, second: int, reach: float, step: float) -> bool:
+        """Whether some path enters ``first`` within ``reach`` (a length) and from there
+        enters ``second`` within ``step`` more: a witness among the points placed on
+        ``first``'s boundary (every such path is achievable; False proves nothing)."""
+        start_in = self.goal_shapes[first].buffer(1e-9).covers(shapely.Point(self.nodes[0]))
+        via = [0] if start_in else self.goal_nodes[first]
+        return any(self.dist[0, k] <= reach and self._onward(k, second) <= step for k in via)
+
+    def feasible_order(self, goals: Sequence[int], limits: Sequence[float]) -> bool:
+        """Whether a path enters ``goals[0]`` within ``limits[0]``, then ``goals[1]`` within
+        ``limits[1]`` from the start (lengths), for two goals: a witness as above."""
+        first, second = goals
+        start_in = self.goal_shapes[first].buffer(1e-9).covers(shapely.Point(self.nodes[0]))
+        via = [0] if start_in else self.goal_nodes[first]
+        return any(
+            self.dist[0, k] <= limits[0] and self.dist[0, k] + self._onward(k, second) <= limits[1]
+            for k in via
+        )

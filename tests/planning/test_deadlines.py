@@ -479,3 +479,56 @@ def test_the_proof_counts_the_disturbance_as_speed() -> None:
         (proof,) = deadline_proofs(mission, abstraction_for(mission, 0.0))
         assert proof.speed == speed
         assert proof.earliest == pytest.approx(math.sqrt(106) / speed, abs=1e-6)
+
+
+@st.composite
+def two_goal_worlds(draw: st.DrawFn) -> dict[str, Any]:
+    """A room with a pillar and two goals; the start in the lower left."""
+    quarter = st.integers(0, 8).map(lambda k: k / 4)
+    holes = [rect(4.5, 2 + draw(quarter) / 2, 6.5, 5)] if draw(st.booleans()) else []
+    ax, ay = 1 + draw(quarter), 6 + draw(quarter) / 4
+    bx, by = 9 + draw(quarter) / 2, draw(quarter) * 0.75
+    return {
+        "holes": holes,
+        "a": rect(ax, ay, ax + 1, ay + 1),
+        "b": rect(bx, by, bx + 1.5, by + 1),
+        "start": (0.5 + draw(quarter) / 2, 0.5 + draw(quarter) / 2),
+    }
+
+
+@pytest.mark.slow
+@settings(max_examples=25, deadline=None)
+@given(two_goal_worlds(), st.floats(0.5, 1.5), st.floats(0.5, 1.5), st.booleans())
+def test_proofs_on_sequences_and_orders_are_right(
+    world: dict[str, Any], first: float, second: float, nested: bool
+) -> None:
+    """Whatever the deadlines, a proof is never contradicted by a path the oracle finds."""
+    from tlmpc.mission import load_mission_text
+    from tlmpc.planning.deadlines import deadline_proofs
+    from tlmpc.planning.mission import abstraction_for
+
+    space = free_space(rect(0, 0, 12, 8), world["holes"], [])
+    oracle = Oracle(space, world["start"], [world["a"], world["b"]], spacing=0.05)
+    to_a = oracle.reach(0).upper
+    gap = shapely.distance(shapely.Polygon(world["a"]), shapely.Polygon(world["b"]))
+    t1 = round(to_a * first, 3)
+    t2 = round((gap if nested else oracle.sequence(0, 1).upper) * second, 3)
+    ltl = f"F[0,{t1}](a & F[0,{t2}] b)" if nested else f"F[0,{t1}] a & F[0,{t2}] b"
+    text = mission_text(
+        size=(12, 8),
+        holes=world["holes"],
+        regions={"a": world["a"], "b": world["b"]},
+        start=world["start"],
+        speed=1.0,
+        ltl=ltl,
+    )
+    mission = load_mission_text(text, "m.yaml")
+    proofs = deadline_proofs(mission, abstraction_for(mission, 0.0))
+    event("proven" if proofs else "not proven")
+    if not proofs:
+        return
+    if nested:
+        assert not oracle.feasible_sequence(0, 1, t1, t2)
+    else:
+        assert not oracle.feasible_order([0, 1], [t1, t2])
+        assert not oracle.feasible_order([1, 0], [t2, t1])
