@@ -439,7 +439,7 @@ def test_the_shipped_example_and_its_documented_numbers(tmp_path: Path) -> None:
     status, shown = run("compile", str(path), "-o", str(tmp_path / "out"), "-q")
     assert status == 1
     assert (
-        f"{path}:17:5: error[P050]: no plan meets the deadline of `F[0,20] dock`: reaching "
+        f"{path}:18:5: error[P050]: no plan meets the deadline of `F[0,20] dock`: reaching "
         in shown
     )
     assert "takes at least 21.51 s > 20 s (a path of at least 10.76 at speed 0.5)" in shown
