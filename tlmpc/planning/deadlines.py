@@ -7,22 +7,25 @@ hazard), divided by that speed.  For the fragment where that decides the questio
 finds the shortest such paths and turns every deadline they cannot meet into a proof:
 
 * a **deadline from the start** ``F[0,T] p`` (``visit p within T s``), and a **sequence**
-  ``F[0,T1](p1 & F[0,T2](p2 & ...))``: the j-th goal is reached no sooner than the shortest
-  path from the start through p1, ..., pj, against ``T1 + ... + Tj``; and each step is no
-  shorter than the distance between its two goals, against its own ``Tj``;
+  ``F[0,T1](p1 & F[0,T2](p2 & ...))``: p1 is reached no sooner than the shortest path into
+  it, each later goal no sooner than that plus the ways between the goals before it (against
+  ``T1 + ... + Tj``), and each way from one goal to the next takes its own time (against
+  ``Tj``);
 * a **conjunction of deadlines** ``F[0,T1] p1 & F[0,T2] p2 & ...`` (up to
-  :data:`MAX_ORDERS_OF` of them): the goals are reached in some order; the task is impossible
-  when every order misses one of its deadlines;
+  :data:`MAX_ORDERS_OF` of them): the goals are first reached in some order; the task is
+  impossible when every order misses one of its deadlines;
 * a **revisit period** ``G F[0,T] p`` (``visit p at least every T s``): the first visit is a
   deadline from the start, and when the task also makes the robot visit another region q
-  again and again, every trip from p to q and back is at least twice their distance long.
+  again and again, every trip from p to q and back is at least twice the way between them.
 
-The shortest paths are exact in the plane: a shortest path bends only at reflex corners of
-the free space, at corners of the goal regions, or touches a goal's edge where it is
-reflected, so a shortest-path search over those points (their mutual visibility tested with
-a tolerance that only ever adds segments) finds it.  Distances between goals are straight
-lines (obstacles ignored), which can only make them shorter.  Every number here is a lower
-bound on the true time, so a deadline below it cannot be met: a proof.
+The shortest path from the start into a goal is exact (to a tolerance): it bends only at
+reflex corners of the free space and ends at a corner of the goal or at the foot of its last
+corner on an edge of the goal, so a search over those corners (their mutual visibility tested
+on the free space grown by :data:`TOLERANCE`, which only ever adds segments) finds it.  The
+way between two goals is bounded from below: a path through the corners, or one straight
+segment no shorter than the distance between the goals.  Past :data:`MAX_CORNERS` corners
+every path is a straight line (obstacles ignored).  Every number here is a lower bound on the
+true time, lowered again by the tolerance, so a deadline below it cannot be met: a proof.
 """
 
 from __future__ import annotations
