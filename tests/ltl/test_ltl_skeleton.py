@@ -10,8 +10,25 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from strategies import bounded_formulas, formulas
 
-from tlmpc.ltl.ast import Formula, bounded_operators
-from tlmpc.ltl.bounds import untimed_skeleton
+from tlmpc.ltl.ast import (
+    And,
+    BoundedEventually,
+    BoundedGlobally,
+    BoundedUntil,
+    Equiv,
+    Eventually,
+    Formula,
+    Globally,
+    Implies,
+    Not,
+    Or,
+    Release,
+    StrongRelease,
+    Until,
+    WeakUntil,
+    bounded_operators,
+)
+from tlmpc.ltl.bounds import holding_skeleton, untimed_skeleton
 from tlmpc.ltl.parser import parse_ltl
 
 
@@ -69,3 +86,55 @@ def test_skeletons_of_the_phrases_and_negations(task: str, skeleton: str) -> Non
     if bounded_operators(expected):
         expected = untimed_skeleton(expected)  # the equivalence, read as two implications
     assert untimed_skeleton(parse_ltl(task)) == expected
+
+
+def _deadlines_dropped(formula: Formula) -> Formula:
+    """``formula`` with ``F[a,b]`` read as ``F`` and ``U[a,b]`` as ``U`` (durations kept)."""
+    again = _deadlines_dropped
+    match formula:
+        case BoundedEventually(arg, _):
+            return Eventually(again(arg))
+        case BoundedUntil(left, right, _):
+            return Until(again(left), again(right))
+        case BoundedGlobally(arg, interval):
+            return BoundedGlobally(again(arg), interval)
+        case Not(arg) | Eventually(arg) | Globally(arg):
+            return type(formula)(again(arg))
+        case And(args) | Or(args):
+            return type(formula)(tuple(again(a) for a in args))
+        case Implies(left, right) | Equiv(left, right) | Until(left, right):
+            return type(formula)(again(left), again(right))
+        case Release(left, right) | WeakUntil(left, right) | StrongRelease(left, right):
+            return type(formula)(again(left), again(right))
+        case _:
+            return formula
+
+
+@settings(max_examples=300)
+@given(bounded_formulas(("a", "b", "c"), max_leaves=5), traces())
+def test_the_holding_skeleton_keeps_durations_and_implies_the_skeleton(
+    formula: Formula, trace: TickTrace
+) -> None:
+    holding = holding_skeleton(formula)
+    assert not bounded_operators(holding)
+    held = dense_values(holding, trace, 0.25)
+    skeleton = dense_values(untimed_skeleton(formula), trace, 0.25)
+    durations = dense_values(_deadlines_dropped(formula), trace, 0.25)
+    for t, value in held.items():
+        if value:
+            assert skeleton[t]
+            assert durations[t]
+
+
+@pytest.mark.parametrize(
+    ("task", "holding"),
+    [
+        ("F G[0,5] a", "F G a"),
+        ("F[0,30] dock & F G[0,5] home", "F dock & F G home"),
+        ("G(a -> F[0,5] !a)", "G(a -> F !a)"),
+        ("!F[0,5] a", "!F a"),
+        ("G[2,4] a", "G a"),
+    ],
+)
+def test_holding_skeletons(task: str, holding: str) -> None:
+    assert holding_skeleton(parse_ltl(task)) == parse_ltl(holding)

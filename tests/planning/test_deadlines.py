@@ -534,3 +534,23 @@ def test_proofs_on_sequences_and_orders_are_right(
     else:
         assert not oracle.feasible_order([0, 1], [t1, t2])
         assert not oracle.feasible_order([1, 0], [t2, t1])
+
+
+def test_a_duration_is_planned_as_a_stay_for_good(tmp_path: Path) -> None:
+    # the skeleton alone (F a & G(b -> F !b) & F b) may pass through a in a moment; the plan
+    # that stays in a for good meets "stay in a for at least 5 s"
+    a, b = rect(4, 3, 6, 5), rect(9, 3, 11, 5)
+    ltl = "F G[0,5] a & G(b -> F[0,3] !b) & F b"
+    text = mission_text(
+        size=(12, 8), holes=[], regions={"a": a, "b": b}, start=(1, 1), speed=1.0, ltl=ltl
+    )
+    code, found = compile_text(tmp_path, text)
+    assert code == "ok"
+    assert found["trace"]["end"] == "stay"
+    last = found["trace"]["points"][-1]
+    assert shapely.Polygon(a).contains(shapely.Point(last[1], last[2]))
+    ticks = tick_trace(found["trace"], ["a", "b"], 0.125)
+    assert dense_values(parse_ltl(ltl), ticks, 0.125)[0]
+    slacks = {b["bound"]: b["slack"] for b in found["summary"]["bounds"]}
+    assert slacks["G[0,5] a"] == "inf"  # it stays for good
+    assert 0 < slacks["F[0,3] !b"] < 3

@@ -90,39 +90,68 @@ def untimed_skeleton(formula: Formula) -> Formula:
     return _relax(formula, True)
 
 
-def _relax(formula: Formula, positive: bool) -> Formula:
-    """The untimed weakening (``positive``) or strengthening of ``formula``."""
+def holding_skeleton(formula: Formula) -> Formula:
+    """``formula`` with its durations made to hold forever: an untimed formula whose runs
+    keep every ``G[a,b]`` of the task (where it occurs positively: ``G[a,b] φ`` -> ``G φ``,
+    which implies it), the deadlines relaxed as in :func:`untimed_skeleton` (``F[a,b] φ`` ->
+    ``F φ``, ``U[a,b]`` -> ``U``: no untimed formula meets a deadline by itself), and the
+    bounds under a negation weakened (so that the negation is strengthened).
+
+    A plan of it is a plan of :func:`untimed_skeleton` that also stays where the task asks
+    the robot to stay for a while ("stay in X for at least T s" plans as ``F G X``); it may
+    have none where the task has one, so the planner then falls back to the skeleton.
+    """
+    if not bounded_operators(formula):
+        return formula
+    return _relax(formula, False, deadlines=True)
+
+
+def _relax(formula: Formula, positive: bool, deadlines: bool = False) -> Formula:
+    """The untimed weakening (``positive``) or strengthening of ``formula``; with
+    ``deadlines``, ``F[a,b]`` and ``U[a,b]`` take their weakened form either way."""
     match formula:
         case Const() | Prop():
             return formula
         case Not(arg):
-            return Not(_relax(arg, not positive), span=formula.span)
+            return Not(_relax(arg, not positive, deadlines), span=formula.span)
         case And(args):
-            return And(tuple(_relax(a, positive) for a in args), span=formula.span)
+            return And(tuple(_relax(a, positive, deadlines) for a in args), span=formula.span)
         case Or(args):
-            return Or(tuple(_relax(a, positive) for a in args), span=formula.span)
+            return Or(tuple(_relax(a, positive, deadlines) for a in args), span=formula.span)
         case Implies(left, right):
-            return Implies(_relax(left, not positive), _relax(right, positive), span=formula.span)
+            return Implies(
+                _relax(left, not positive, deadlines),
+                _relax(right, positive, deadlines),
+                span=formula.span,
+            )
         case Equiv(left, right):
             if not bounded_operators(formula):
                 return formula
             both = And((Implies(left, right), Implies(right, left)), span=formula.span)
-            return _relax(both, positive)
+            return _relax(both, positive, deadlines)
         case Eventually(arg):
-            return Eventually(_relax(arg, positive), span=formula.span)
+            return Eventually(_relax(arg, positive, deadlines), span=formula.span)
         case Globally(arg):
-            return Globally(_relax(arg, positive), span=formula.span)
+            return Globally(_relax(arg, positive, deadlines), span=formula.span)
         case Until(left, right) | Release(left, right) | WeakUntil(left, right):
-            return type(formula)(_relax(left, positive), _relax(right, positive), span=formula.span)
+            return type(formula)(
+                _relax(left, positive, deadlines),
+                _relax(right, positive, deadlines),
+                span=formula.span,
+            )
         case StrongRelease(left, right):
-            return StrongRelease(_relax(left, positive), _relax(right, positive), span=formula.span)
+            return StrongRelease(
+                _relax(left, positive, deadlines),
+                _relax(right, positive, deadlines),
+                span=formula.span,
+            )
         case BoundedEventually(arg, interval):
-            inner = _relax(arg, positive)
-            if positive:
+            inner = _relax(arg, positive, deadlines)
+            if positive or deadlines:
                 return Eventually(inner, span=formula.span)
             return inner if interval.low == 0.0 else Globally(inner, span=formula.span)
         case BoundedGlobally(arg, interval):
-            inner = _relax(arg, positive)
+            inner = _relax(arg, positive, deadlines)
             if not positive:
                 return Globally(inner, span=formula.span)
             if math.isinf(interval.high):
@@ -130,8 +159,8 @@ def _relax(formula: Formula, positive: bool) -> Formula:
                 return always if interval.low == 0.0 else Eventually(always, span=formula.span)
             return inner if interval.low == 0.0 else Eventually(inner, span=formula.span)
         case BoundedUntil(left, right, interval):
-            first, second = _relax(left, positive), _relax(right, positive)
-            if positive:
+            first, second = _relax(left, positive, deadlines), _relax(right, positive, deadlines)
+            if positive or deadlines:
                 return Until(first, second, span=formula.span)
             if interval.low == 0.0:
                 return second

@@ -275,7 +275,7 @@ def _plan(c: Compilation) -> StageResult:
     abstraction, witness = planned.abstraction, planned.witness
     products: dict[Product[Any], Any] = {}
     artifacts: dict[str, Any] = {}
-    if planned.margin_dropped:
+    if planned.automaton is not c.get(AUTOMATON):  # without margin, or the durations held
         products.update(provide(AUTOMATON, planned.automaton))
         artifacts["automaton.json"] = automaton_to_json(planned.automaton)
         artifacts["automaton.hoa"] = to_hoa(planned.automaton)
