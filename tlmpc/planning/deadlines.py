@@ -102,13 +102,13 @@ class DeadlineBound:
 
 @dataclass(frozen=True, slots=True)
 class _Goal:
-    """A propositional goal as a point set: the union of the closed triangles where it can
-    hold (a superset, so distances to it are never too long)."""
+    """A propositional goal as a point set: where it can hold (see :func:`_goal`; a superset,
+    so distances to it are never too long), its boundary segments and their ends."""
 
     name: str
     shape: shapely.Geometry
-    edges: FloatArray  # (k, 2, 2): the boundary segments of the union
-    corners: FloatArray  # (c, 2)
+    edges: FloatArray  # (k, 2, 2): boundary segments (a lone point: a segment of length 0)
+    corners: FloatArray  # (2k, 2): their ends
 
 
 def _chain(formula: Formula) -> list[tuple[Formula, float | None]] | None:
