@@ -123,5 +123,16 @@ def _run_locked(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         tail = ""
         if verdict is not None:
             tail = f"; trace verifies (robustness {verdict['robustness']:.4g})"
+        bounds = summary.get("bounds")
+        if bounds:  # each time bound with its slack on the trajectory
+            held = ", ".join(f"{b['bound']} by {_seconds(b['slack'])}" for b in bounds)
+            tail += f"; time bounds held: {held}"
         reporter.note(f"wrote {len(artifacts)} artifacts to {destination}{tail}")
     return reporter.finish(EXIT_OK, summary)
+
+
+def _seconds(slack: object) -> str:
+    """A bound's slack as printed: ``13.34 s``, ``any amount`` (``inf``), ``-`` (none)."""
+    if isinstance(slack, int | float):
+        return f"{slack:.4g} s"
+    return "any amount" if slack == "inf" else "-"

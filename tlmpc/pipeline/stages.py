@@ -217,12 +217,9 @@ def _abstraction(c: Compilation) -> StageResult:
     )
     from tlmpc.abstraction.build import mesh_size_diagnostic
     from tlmpc.abstraction.layout import planning_layout
-    from tlmpc.ltl.bounds import refuse_bounds
     from tlmpc.mission.body import requested_margin
 
     mission = c.get(MISSION)
-    # Refused before the triangulation's work: the planner cannot honour a time bound.
-    refuse_bounds(mission.formula, file=mission.source, purpose="planning")
     # A body or a margin: the configuration space, goal cores and grown avoided regions are
     # triangulated (the body's own diagnostics came with the load stage).
     layout = planning_layout(mission, requested_margin(mission))
@@ -243,13 +240,12 @@ def _abstraction(c: Compilation) -> StageResult:
 
 def _automaton(c: Compilation) -> StageResult:
     from tlmpc.automata import automaton_to_json, to_hoa
-    from tlmpc.ltl.bounds import refuse_bounds
     from tlmpc.planning.mission import automaton_for
 
     mission = c.get(MISSION)
-    refuse_bounds(mission.formula, file=mission.source, purpose="planning")
-    # Under the closed convention the planner reads boundary instants too (their letters and
-    # a rewritten task; see tlmpc/planning/boundary.py).
+    # A bounded task's automaton is its untimed skeleton's (the bounds are checked on the
+    # simulated trajectory).  Under the closed convention the planner reads boundary
+    # instants too (their letters and a rewritten task; see tlmpc/planning/boundary.py).
     automaton = automaton_for(mission, c.get(ABSTRACTION))
     return StageResult(
         products=provide(AUTOMATON, automaton),
@@ -278,7 +274,7 @@ def _plan(c: Compilation) -> StageResult:
     planned = plan_mission(c.get(MISSION), built, c.get(AUTOMATON))
     abstraction, witness = planned.abstraction, planned.witness
     artifacts: dict[str, Any] = {}
-    if planned.margin_dropped:
+    if planned.automaton is not c.get(AUTOMATON):  # without margin, or the durations held
         artifacts["automaton.json"] = automaton_to_json(planned.automaton)
         artifacts["automaton.hoa"] = to_hoa(planned.automaton)
     artifacts["witness.json"] = witness_to_json(witness, abstraction)
@@ -331,14 +327,18 @@ def _simulate(c: Compilation) -> StageResult:
     document = trace_to_json(trace, mission)
     points: list[list[float]] = document["points"]  # type: ignore[assignment]
     clearance, margin = _clearance(document, mission)
+    from tlmpc.pipeline.deadlines import check_time_bounds
     from tlmpc.verify.clearance import margin_warnings
+
+    # Every time bound checked on the exact trajectory (P050/P051 when one is missed).
+    bounds = check_time_bounds(mission, document, abstraction)
 
     return StageResult(
         products=provide(TRACE, document),
         artifacts={"trace.json": document},
         sizes={"samples": len(points), "duration": round(float(points[-1][0]), 3)},
         warnings=tuple(margin_warnings(clearance, margin, mission.source)),
-        summary={"clearance": clearance.to_json(margin)},
+        summary={"clearance": clearance.to_json(margin), **(bounds or {})},
     )
 
 
@@ -454,7 +454,8 @@ STAGES: tuple[Stage, ...] = (
         run=_plan,
         requires=(MISSION, ABSTRACTION, AUTOMATON),
         # the mesh refined where the plan turns around, and the mesh and automaton rebuilt
-        # without the margin when no plan keeps it
+        # without the margin when no plan keeps it (or the automaton of a task's durations
+        # held for good, tlmpc.ltl.bounds.holding_skeleton)
         provides=(WITNESS, ABSTRACTION, AUTOMATON),
         aliases=("witness", "planning"),
         worlds=_STATIC,

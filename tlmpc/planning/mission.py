@@ -24,6 +24,7 @@ from dataclasses import dataclass
 from tlmpc.abstraction.model import Abstraction
 from tlmpc.automata.model import Automaton
 from tlmpc.base.errors import Diagnostic, NoPlanError
+from tlmpc.ltl.ast import Formula
 from tlmpc.mission.model import Mission, TaskPart
 from tlmpc.planning.model import Witness
 
@@ -49,18 +50,25 @@ def abstraction_for(mission: Mission, margin: float) -> Abstraction:
     return build_abstraction(mission, planning_layout(mission, margin))
 
 
-def automaton_for(mission: Mission, abstraction: Abstraction) -> Automaton:
-    """The task's automaton over the letters the planner reads on ``abstraction``.
+def automaton_for(
+    mission: Mission, abstraction: Abstraction, *, formula: Formula | None = None
+) -> Automaton:
+    """The task's automaton over the letters the planner reads on ``abstraction``
+    (``formula``: another untimed task of the mission's, planned instead).
 
     Under the closed convention: the rewritten task over the mesh's letters plus the
     crossing and start letters; under the right-continuous one the task over the mesh's.
     """
     from tlmpc.automata import translate
+    from tlmpc.ltl.bounds import untimed_skeleton
     from tlmpc.planning.boundary import task_formula, task_letters
 
     convention = mission.options.boundary
+    # A bounded task is planned on its untimed skeleton; its bounds are checked on the
+    # compiled trajectory (tlmpc.pipeline.deadlines).
+    task = untimed_skeleton(mission.formula) if formula is None else formula
     return translate(
-        task_formula(mission.formula, convention),
+        task_formula(task, convention),
         letters=task_letters(abstraction, convention, mission.robot.start),
     )
 
@@ -83,9 +91,14 @@ def plan_mission(
     ``resume`` re-plans a run under way from ``abstraction.start`` at ``start_point``, the
     (degeneralized) automaton being in one of these states; it never drops the margin.
     """
+    from tlmpc.ltl.bounds import holding_skeleton, untimed_skeleton
     from tlmpc.mission.body import requested_margin
 
-    def attempt(mesh: Abstraction, task: Automaton) -> Planned:
+    skeleton = untimed_skeleton(mission.formula)
+
+    def attempt(
+        mesh: Abstraction, task: Automaton, formula: Formula = skeleton, explain: bool = True
+    ) -> Planned:
         from tlmpc.planning.budget import check_product_size
         from tlmpc.planning.complete import plan_complete
 
@@ -93,15 +106,26 @@ def plan_mission(
         planned_mesh, witness = plan_complete(
             mesh,
             task,
-            formula=mission.formula,
+            formula=formula,
             options=mission.options,
             start_point=start_point if start_point is not None else mission.robot.start,
             parts=parts if parts is not None else (lambda: _task_parts(mission)),
             file=mission.source,
             resume=resume,
-            explain=resume is None,
+            explain=explain and resume is None,
         )
         return Planned(abstraction=planned_mesh, automaton=task, witness=witness)
+
+    holding = holding_skeleton(mission.formula)
+    if resume is None and holding != skeleton:
+        # Durations ("stay in X for at least T s") are met by a plan that stays for good,
+        # when there is one; else the skeleton's plan, whose bounds are then checked.
+        try:
+            return attempt(
+                abstraction, automaton_for(mission, abstraction, formula=holding), holding, False
+            )
+        except NoPlanError:
+            pass
 
     try:
         return attempt(abstraction, automaton)
@@ -136,9 +160,16 @@ def plan_mission(
 
 
 def _task_parts(mission: Mission) -> Sequence[TaskPart]:
+    """The task's parts as the planner reads them (bounded ones by their skeletons)."""
+    import dataclasses
+
+    from tlmpc.ltl.bounds import untimed_skeleton
     from tlmpc.mission.parts import task_parts
 
-    return task_parts(mission)
+    return [
+        dataclasses.replace(part, formula=untimed_skeleton(part.formula))
+        for part in task_parts(mission)
+    ]
 
 
 def _with_body_notes(failure: NoPlanError, mission: Mission) -> NoPlanError:

@@ -420,8 +420,40 @@ def certify(trace: TraceInput, regions: dict[str, FloatArray], outcome: Outcome)
     )
 
 
-def verify_trace(trace: TraceInput) -> Verdict:
-    """Check ``trace`` against its task under its boundary convention and ending."""
+@dataclasses.dataclass(frozen=True, slots=True)
+class _Truth:
+    """The trace cut into pieces at the crossings of the regions its task mentions, and the
+    exact truth of formulas on them."""
+
+    pieces: Pieces
+    regions: dict[str, FloatArray]
+    names: list[str]
+    unknown: BoolArray | None
+    size: int
+    ending: PieceEnding
+    is_point: BoolArray | None
+    timing: Timing
+    truth: Semantics
+
+    prefixes: Prefixes
+
+    def outcome_function(self) -> Callable[[Formula], Outcome]:
+        """The verdict of a formula at the trace's start (one with finite bounds only is
+        decided on the prefix its bounds reach)."""
+        times, truth, prefixes = self.pieces.times, self.truth, self.prefixes
+
+        def outcome_of(formula: Formula) -> Outcome:
+            # A formula whose operators all have finite bounds is decided at t=0 by the trace
+            # up to its reach: the searches for time robustness evaluate only that prefix.
+            cut = _prefix_end(times, reach(formula))
+            if cut is None:
+                return _outcome(*truth.at_start(formula))
+            return prefixes.outcome(formula, cut)
+
+        return outcome_of
+
+
+def _truth_of(trace: TraceInput) -> _Truth:
     # Only the regions the task mentions can change its truth (no Next: the semantics is
     # stutter-invariant), so crossings of other regions are not split at.
     mentioned = trace.formula.props().union(*(a.props() for a in trace.assumptions))
@@ -447,6 +479,44 @@ def verify_trace(trace: TraceInput) -> Verdict:
         is_point=is_point,
         timing=timing,
     )
+    prefixes = Prefixes(truth_atoms(pieces.labels, names, unknown), pieces.times, is_point)
+    return _Truth(pieces, regions, names, unknown, size, ending, is_point, timing, truth, prefixes)
+
+
+@dataclasses.dataclass(frozen=True, slots=True)
+class BoundSlack:
+    """One time bound of a task: the operator's text and by how many seconds it held (> 0)
+    or failed (< 0), the other bounds kept (``inf``/``-inf``: any amount; None: under
+    ``<->``, no direction)."""
+
+    bound: str
+    slack: float | None
+
+
+def bound_slacks(trace: TraceInput) -> tuple[Outcome, tuple[BoundSlack, ...]]:
+    """The task's verdict on ``trace`` and the slack of each of its bounded operators
+    (pre-order): the time robustness of the task with that one bound moved."""
+    found = _truth_of(trace)
+    outcome_of = found.outcome_function()
+    outcome = _outcome(*found.truth.at_start(trace.formula))
+    span = horizon(trace.formula, float(trace.times[-1] - trace.times[0]))
+    slacks = tuple(
+        BoundSlack(
+            bound=to_text(node),
+            slack=time_robustness(trace.formula, outcome, outcome_of, span, only=node),
+        )
+        for node in bounded_operators(trace.formula)
+    )
+    return outcome, slacks
+
+
+def verify_trace(trace: TraceInput) -> Verdict:
+    """Check ``trace`` against its task under its boundary convention and ending."""
+    found = _truth_of(trace)
+    pieces, regions, names, unknown = found.pieces, found.regions, found.names, found.unknown
+    size, ending, is_point, timing = found.size, found.ending, found.is_point, found.timing
+    truth = found.truth
+    loop_start = trace.loop_start if trace.ending == "loop" else None
     task_outcome = _outcome(*truth.at_start(trace.formula))
     conjuncts = _conjuncts(trace.formula)
     outcomes = [_outcome(*truth.at_start(c)) for c in conjuncts]
@@ -464,17 +534,7 @@ def verify_trace(trace: TraceInput) -> Verdict:
     )
     reports, violations = conjunct_reports(conjuncts, outcomes, truth, line)
 
-    atoms = truth_atoms(pieces.labels, names, unknown)
-    prefixes = Prefixes(atoms, pieces.times, is_point)
-
-    def outcome_of(formula: Formula) -> Outcome:
-        # A formula whose operators all have finite bounds is decided at t=0 by the trace up
-        # to its reach: the searches for time robustness evaluate only that prefix.
-        cut = _prefix_end(pieces.times, reach(formula))
-        if cut is None:
-            return _outcome(*truth.at_start(formula))
-        return prefixes.outcome(formula, cut)
-
+    outcome_of = found.outcome_function()
     reactive: AssumeGuarantee | None = None
     if trace.reactive:
         reactive = assume_guarantee(
@@ -482,7 +542,7 @@ def verify_trace(trace: TraceInput) -> Verdict:
             conjuncts,
             task_outcome,
             lambda formula: _outcome(*truth.at_start(formula)),
-            prefixes,
+            found.prefixes,
             ending,
         )
 
