@@ -44,6 +44,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--format", choices=("json", "dot"), default="json", help="strategy format for -o"
     )
     parser.add_argument(
+        "--symbolic",
+        action="store_true",
+        help="with -o (JSON): write the strategy as decision diagrams, one per output bit, "
+        "instead of listing the machine's nodes (for strategies too large to list)",
+    )
+    parser.add_argument(
         "--all-init",
         action="store_true",
         help="every initial state allowed by both initial conditions must be winning "
@@ -89,6 +95,14 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         _fail_flag(args, fmt or "these", "--all-init")
     if args.one_side_init and fmt != "gr1c":
         _fail_flag(args, fmt or "these", "--one-side-init")
+    if args.symbolic and (args.output is None or args.format != "json"):
+        raise UsageError(
+            error(
+                "Q063",
+                "--symbolic applies to a JSON strategy written with -o",
+                hint="add -o FILE.json (and leave --format at json)",
+            )
+        )
     if args.all_init and args.one_side_init:
         raise UsageError(
             error(
@@ -123,6 +137,28 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             from tlmpc.io.outdir import replace_file
             from tlmpc.synth.strategy import extract, to_dot, to_json
 
+            if args.symbolic:
+                from tlmpc.synth.symbolic_strategy import (
+                    reachable_size,
+                    symbolic_document,
+                    symbolic_strategy,
+                )
+
+                size = reachable_size(solution)
+                symbolic = symbolic_strategy(solution)
+                document = symbolic_document(symbolic, size)
+                replace_file(args.output, document_text(document).encode("utf-8"))
+                result["strategy"] = {
+                    "file": str(args.output),
+                    "diagram nodes": len(symbolic.diagram.nodes),
+                    "reachable nodes": size.nodes,
+                    "reachable transitions": size.transitions,
+                }
+                reporter.note(
+                    f"wrote {args.output} ({len(symbolic.diagram.nodes)} diagram nodes; "
+                    f"{size.nodes} reachable nodes, {size.transitions} transitions)"
+                )
+                return reporter.finish(EXIT_OK, result, "realizable\n")
             machine = extract(solution)
             text = to_dot(machine) if args.format == "dot" else document_text(to_json(machine))
             replace_file(args.output, text.encode("utf-8"))

@@ -393,8 +393,10 @@ def _synthesize(c: Compilation) -> StageResult:
 
     mission = c.get(MISSION)
     synthesis = synthesize(mission, c.get(ABSTRACTION))
-    if synthesis.strategy is None:
+    if not synthesis.realizable:
         raise NoPlanError(unrealizable(synthesis, mission))
+    assert synthesis.size is not None
+    assert synthesis.symbolic is not None
     game = synthesis.game
     return StageResult(
         artifacts={"strategy.json": strategy_to_json(synthesis)},
@@ -403,7 +405,9 @@ def _synthesize(c: Compilation) -> StageResult:
             "variables": len(game.spec.variables),
             "parts": len(game.spec.parts),
             "fixpoint steps": synthesis.solution.cpre_count,
-            "strategy nodes": len(synthesis.strategy.states),
+            "strategy nodes": synthesis.size.nodes,
+            "strategy transitions": synthesis.size.transitions,
+            "strategy diagram nodes": len(synthesis.symbolic.diagram.nodes),
         },
         summary={"reactive": {"realizable": True, "faces": game.faces.count}},
     )

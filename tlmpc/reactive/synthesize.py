@@ -25,6 +25,18 @@ from tlmpc.synth.solver import Game, Solution, solve
 from tlmpc.synth.spec import Part
 from tlmpc.synth.strategy import MealyMachine, extract, to_json
 from tlmpc.synth.symbolic import Encoding
+from tlmpc.synth.symbolic_strategy import (
+    LoopSize,
+    SymbolicStrategy,
+    reachable_size,
+    symbolic_document,
+    symbolic_strategy,
+)
+
+#: the explicit machine is built (and listed in strategy.json beside the symbolic form) when it
+#: has at most this many transitions; the symbolic form scales with the sensors, the explicit
+#: one with 2^sensors transitions per node
+EXPLICIT_TRANSITIONS = 10_000
 
 
 def mission_game(mission: Mission, abstraction: Abstraction) -> MissionGame:
@@ -50,12 +62,16 @@ def mission_game(mission: Mission, abstraction: Abstraction) -> MissionGame:
 
 @dataclass(frozen=True)
 class Synthesis:
-    """The outcome: the solved game; the strategy when realizable, else a core (task parts)
-    and the environment's counterstrategy."""
+    """The outcome: the solved game; the strategy when realizable (``symbolic`` always, the
+    explicit ``strategy`` when it has at most :data:`EXPLICIT_TRANSITIONS` transitions, and
+    the explicit machine's ``size`` counted symbolically), else a core (task parts) and the
+    environment's counterstrategy."""
 
     game: MissionGame
     solution: Solution
     strategy: MealyMachine | None = None
+    symbolic: SymbolicStrategy | None = None
+    size: LoopSize | None = None
     core: tuple[TaskPart, ...] | None = None
     counter: CounterStrategy | None = None
 
@@ -65,13 +81,23 @@ class Synthesis:
         return self.solution.realizable
 
 
-def synthesize(mission: Mission, abstraction: Abstraction) -> Synthesis:
+def synthesize(
+    mission: Mission, abstraction: Abstraction, *, explicit_transitions: int = EXPLICIT_TRANSITIONS
+) -> Synthesis:
     """Solve the mission's game: its strategy, or a core and a counterstrategy."""
     game = mission_game(mission, abstraction)
     encoding = Encoding(game.spec)
     solution = solve(Game.build(game.spec, encoding))
     if solution.realizable:
-        return Synthesis(game=game, solution=solution, strategy=extract(solution))
+        size = reachable_size(solution)
+        machine = extract(solution) if size.transitions <= explicit_transitions else None
+        return Synthesis(
+            game=game,
+            solution=solution,
+            strategy=machine,
+            symbolic=symbolic_strategy(solution),
+            size=size,
+        )
     counter = extract_counterstrategy(solution)
     core = minimal_core(game.spec, encoding, group=lambda part: _source_key(game, part))
     parts: dict[int, TaskPart] = {}
@@ -82,10 +108,13 @@ def synthesize(mission: Mission, abstraction: Abstraction) -> Synthesis:
 
 
 def strategy_to_json(synthesis: Synthesis) -> dict[str, Any]:
-    """``strategy.json`` of a reactive mission: the Mealy machine and the faces it moves on."""
-    assert synthesis.strategy is not None
+    """``strategy.json`` of a reactive mission: the strategy (symbolic, and the explicit Mealy
+    machine when it is small enough) and the faces it moves on."""
+    assert synthesis.symbolic is not None
     faces = synthesis.game.faces
-    document = to_json(synthesis.strategy)
+    document = symbolic_document(synthesis.symbolic, synthesis.size)
+    if synthesis.strategy is not None:
+        document = {**to_json(synthesis.strategy), **document}
     document["faces"] = {
         "labels": [list(letter) for letter in faces.letters],
         "adjacent": [list(a) for a in faces.adjacent],
