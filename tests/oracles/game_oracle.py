@@ -22,6 +22,7 @@ from tlmpc.synth.spec import (
     Const,
     Expr,
     GameSpec,
+    Linear,
     Nary,
     Not,
     Part,
@@ -52,6 +53,20 @@ def evaluate(expr: Expr, now: State, nxt: State | None = None) -> bool:
             "<=": number <= expr.value,
             ">": number > expr.value,
             ">=": number >= expr.value,
+        }[expr.op]
+    if isinstance(expr, Linear):
+        total = 0
+        for coef, name, primed in expr.terms:
+            source = nxt if primed else now
+            assert source is not None, "a next value outside a transition"
+            total += coef * int(source[name])
+        return {
+            "=": total == expr.value,
+            "!=": total != expr.value,
+            "<": total < expr.value,
+            "<=": total <= expr.value,
+            ">": total > expr.value,
+            ">=": total >= expr.value,
         }[expr.op]
     if isinstance(expr, Not):
         return not evaluate(expr.arg, now, nxt)
@@ -209,7 +224,7 @@ def ltl(expr: Expr) -> str:
         return "1" if expr.value else "0"
     if isinstance(expr, Atom):
         return f"X({expr.name})" if expr.primed else expr.name
-    if isinstance(expr, Compare):
+    if isinstance(expr, Compare | Linear):
         raise ValueError("integer variables have no Spot form here")
     if isinstance(expr, Not):
         return f"!({ltl(expr.arg)})"

@@ -16,7 +16,7 @@ if TYPE_CHECKING:
     from tlmpc.synth.spec import GameSpec
 
 NAME = "synth"
-HELP = "GR(1) synthesis of a gr1c (.spc), slugs (.slugsin) or TLSF specification"
+HELP = "GR(1) synthesis of a gr1c (.spc), slugs (.slugsin, .structuredslugs) or TLSF specification"
 DESCRIPTION = """\
 Decide whether SPEC is realizable: whether the system has a strategy that meets its guarantees
 whatever the environment does within its assumptions (docs/synthesis.md gives each format's
@@ -31,10 +31,12 @@ SHOWN_NODES = 40
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Register the command's flags."""
-    parser.add_argument("spec", type=Path, help="the specification (.spc, .slugsin or .tlsf)")
+    parser.add_argument(
+        "spec", type=Path, help="the specification (.spc, .slugsin, .structuredslugs or .tlsf)"
+    )
     parser.add_argument(
         "--input-format",
-        choices=("gr1c", "slugsin", "tlsf"),
+        choices=("gr1c", "slugsin", "structuredslugs", "tlsf"),
         help="the specification's format (default: by its suffix)",
     )
     parser.add_argument(
@@ -91,7 +93,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
 
     reporter = Reporter.for_args(args, out, err)
     fmt = args.input_format or format_of(str(args.spec))
-    if args.all_init and fmt not in ("gr1c", "slugsin"):
+    if args.all_init and fmt not in ("gr1c", "slugsin", "structuredslugs"):
         _fail_flag(args, fmt or "these", "--all-init")
     if args.one_side_init and fmt != "gr1c":
         _fail_flag(args, fmt or "these", "--one-side-init")
