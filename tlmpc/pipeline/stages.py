@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
-from tlmpc.base.errors import NoPlanError, TlmpcError, error
+from tlmpc.base.errors import TlmpcError, error
 from tlmpc.base.progress import heartbeat
 from tlmpc.base.version import __version__
 
@@ -389,12 +389,21 @@ def _verify(c: Compilation) -> StageResult:
 
 
 def _synthesize(c: Compilation) -> StageResult:
-    from tlmpc.reactive.synthesize import strategy_to_json, synthesize, unrealizable
+    from tlmpc.reactive.synthesize import (
+        UnrealizableError,
+        counterstrategy_to_json,
+        strategy_to_json,
+        synthesize,
+        unrealizable,
+    )
 
     mission = c.get(MISSION)
     synthesis = synthesize(mission, c.get(ABSTRACTION))
     if not synthesis.realizable:
-        raise NoPlanError(unrealizable(synthesis, mission))
+        shown = dict(c.documents)
+        if synthesis.counter is not None:
+            shown["counterstrategy.json"] = counterstrategy_to_json(synthesis, c.get(ABSTRACTION))
+        raise UnrealizableError(unrealizable(synthesis, mission), shown)
     assert synthesis.size is not None
     assert synthesis.symbolic is not None
     game = synthesis.game

@@ -12,9 +12,9 @@ from dataclasses import dataclass
 from typing import Any
 
 from tlmpc.abstraction.model import Abstraction
-from tlmpc.base.errors import Diagnostic, InvalidInputError, error
+from tlmpc.base.errors import Diagnostic, InvalidInputError, NoPlanError, error
 from tlmpc.mission.model import Mission, TaskPart
-from tlmpc.reactive.explain import counter_play
+from tlmpc.reactive.explain import counter_play, counter_play_steps, place
 from tlmpc.reactive.faces import Faces, faces_of
 from tlmpc.reactive.fragment import reading
 from tlmpc.reactive.game import MissionGame, build_game
@@ -121,6 +121,66 @@ def strategy_to_json(synthesis: Synthesis) -> dict[str, Any]:
         "face_of": faces.face_of.tolist(),
     }
     return document
+
+
+class UnrealizableError(NoPlanError):
+    """An unrealizable reactive mission (exit 1): its diagnostics, and the artifacts that show
+    how the environment wins (``mission.json``, ``abstraction.json``,
+    ``counterstrategy.json``), which ``tlmpc compile`` writes before it reports."""
+
+    def __init__(self, diagnostics: list[Diagnostic], artifacts: dict[str, Any]) -> None:
+        super().__init__(diagnostics)
+        self.artifacts = artifacts
+
+
+def face_points(abstraction: Abstraction, faces: Faces) -> list[list[float]]:
+    """A point inside each face: the centroid of its triangle nearest to the mean of its
+    triangles' centroids (a mean alone may lie outside a bent face)."""
+    import numpy as np
+
+    vertices = np.asarray(abstraction.vertices, dtype=np.float64)
+    triangles = np.asarray(abstraction.triangles, dtype=np.int64)
+    centroids = vertices[triangles].mean(axis=1)
+    points: list[list[float]] = []
+    for face in range(faces.count):
+        members = np.flatnonzero(faces.face_of == face)
+        inside = centroids[members]
+        middle = inside.mean(axis=0)
+        best = int(np.argmin(((inside - middle) ** 2).sum(axis=1)))
+        points.append([float(inside[best][0]), float(inside[best][1])])
+    return points
+
+
+def counterstrategy_to_json(synthesis: Synthesis, abstraction: Abstraction) -> dict[str, Any]:
+    """``counterstrategy.json`` (schemas/counterstrategy.schema.json): the core, and one play
+    of the environment's winning strategy in the mission's words and places."""
+    assert synthesis.counter is not None
+    game = synthesis.game
+    letters = game.faces.letters
+    play = counter_play_steps(synthesis.counter, game)
+    points = face_points(abstraction, game.faces)
+    return {
+        "format": "tlmpc.counterstrategy/1",
+        "core": [
+            {"text": part.text, "line": part.line, "col": part.col} for part in synthesis.core or ()
+        ],
+        "nodes": len(synthesis.counter.states),
+        "play": [
+            {
+                "step": step.step,
+                "face": step.face,
+                "regions": list(letters[step.face]),
+                "place": place(letters[step.face]),
+                "position": points[step.face],
+                "heading": step.heading,
+                "heading_position": points[step.heading],
+                "sensors": dict(step.sensors),
+            }
+            for step in play.steps
+        ],
+        "stuck": play.stuck,
+        "again_from": play.again_from,
+    }
 
 
 def _source_key(game: MissionGame, part: Part) -> int | None:
