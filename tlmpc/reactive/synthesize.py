@@ -141,14 +141,15 @@ def face_points(abstraction: Abstraction, faces: Faces) -> list[list[float]]:
     vertices = np.asarray(abstraction.vertices, dtype=np.float64)
     triangles = np.asarray(abstraction.triangles, dtype=np.int64)
     centroids = vertices[triangles].mean(axis=1)
-    points: list[list[float]] = []
-    for face in range(faces.count):
-        members = np.flatnonzero(faces.face_of == face)
-        inside = centroids[members]
-        middle = inside.mean(axis=0)
-        best = int(np.argmin(((inside - middle) ** 2).sum(axis=1)))
-        points.append([float(inside[best][0]), float(inside[best][1])])
-    return points
+    face_of = np.asarray(faces.face_of, dtype=np.int64)
+    counts = np.bincount(face_of, minlength=faces.count)
+    mean_x = np.bincount(face_of, weights=centroids[:, 0], minlength=faces.count) / counts
+    mean_y = np.bincount(face_of, weights=centroids[:, 1], minlength=faces.count) / counts
+    distance = (centroids[:, 0] - mean_x[face_of]) ** 2 + (centroids[:, 1] - mean_y[face_of]) ** 2
+    # by face, then distance, then triangle number: the first of each face is its point
+    order = np.lexsort((np.arange(len(face_of)), distance, face_of))
+    first = order[np.searchsorted(face_of[order], np.arange(faces.count))]
+    return [[float(centroids[t][0]), float(centroids[t][1])] for t in first.tolist()]
 
 
 def counterstrategy_to_json(synthesis: Synthesis, abstraction: Abstraction) -> dict[str, Any]:
