@@ -25,6 +25,7 @@ from test_oracles import games, spc
 
 from tlmpc.synth.readers import read_spec
 from tlmpc.synth.readers.gr1c import parse_gr1c
+from tlmpc.synth.readers.structuredslugs import parse_structuredslugs
 from tlmpc.synth.solver import Game, solve
 from tlmpc.synth.strategy import extract, machine_from_json, to_json
 from tlmpc.synth.symbolic_strategy import (
@@ -110,20 +111,58 @@ def test_the_symbolic_strategy_takes_the_explicit_machines_moves(name: str) -> N
         assert stepped == (after, explicit.node_goals[target])
 
 
-def test_the_explicit_machine_reads_back_and_steps() -> None:
-    spec = read_spec(str(_published("gr1c/tests/specs/arbiter4.spc")))
+COUNTER = """\
+[INPUT]
+x
+go
+[OUTPUT]
+y: 1...4
+b
+[ENV_INIT]
+!x
+[SYS_INIT]
+y = 1
+[ENV_TRANS]
+x -> x'
+[SYS_TRANS]
+(go & y < 4) -> y' = y + 1
+!go -> (y' = y | y' = 1)
+b' <-> x'
+[ENV_LIVENESS]
+go'
+[SYS_LIVENESS]
+y = 4
+y = 1 | b
+"""
+
+
+def test_the_explicit_and_symbolic_machines_read_back_and_step_alike() -> None:
+    spec = parse_structuredslugs(COUNTER, file="counter.structuredslugs")
     solution = solve(Game.build(spec))
+    assert solution.realizable
+    strategy = symbolic_strategy(solution)
+    check_strategy(spec, explore(spec, strategy))
+    explicit = extract(solution, minimal=False)
+    size = reachable_size(solution)
+    assert (size.nodes, size.transitions) == (len(explicit.states), len(explicit.transitions))
+    read = symbolic_from_json(json.loads(json.dumps(symbolic_document(strategy, size))))
+    inputs = [v.name for v in explicit.inputs]
+    for source, target in explicit.transitions:
+        after = explicit.states[target]
+        stepped = read.step(
+            explicit.states[source], explicit.node_goals[source], {k: after[k] for k in inputs}
+        )
+        assert stepped == (after, explicit.node_goals[target])
     machine = extract(solution)
     document = json.loads(json.dumps(to_json(machine)))
     jsonschema.validate(document, SCHEMA)
-    read = machine_from_json(document)
-    assert read == machine
-    inputs = [v.name for v in machine.inputs]
+    listed = machine_from_json(document)
+    assert listed == machine
     for source, target in machine.transitions:
         x = {k: machine.states[target][k] for k in inputs}
-        assert read.successor(source, x) == target
+        assert listed.successor(source, x) == target
     for node in machine.initial:
-        assert read.start({k: machine.states[node][k] for k in inputs}) == node
+        assert listed.start({k: machine.states[node][k] for k in inputs}) == node
 
 
 def test_a_step_that_breaks_the_assumption_is_refused() -> None:

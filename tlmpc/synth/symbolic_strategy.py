@@ -31,7 +31,14 @@ from dd import cudd
 
 from tlmpc.synth.solver import Solution
 from tlmpc.synth.spec import Variable
-from tlmpc.synth.strategy import Value, goal_strategies
+from tlmpc.synth.strategy import (
+    Value,
+    goal_strategies,
+    ordered_bits,
+    smallest,
+    variable_from_json,
+    variable_json,
+)
 from tlmpc.synth.symbolic import Encoding, Function
 
 #: the diagrams' terminal node ids
@@ -214,8 +221,6 @@ def _starting_set(solution: Solution) -> Function:
         return env_start & sys_start & solution.winning
     if mode == "one_side" and not game.spec.select("env", "init"):
         # the system picks one start: the lexicographically first winning one
-        from tlmpc.synth.strategy import ordered_bits, smallest
-
         bits = ordered_bits(enc, "env", False) + ordered_bits(enc, "sys", False)
         start = smallest(enc, sys_start & env_start & solution.winning, bits)
         assert start is not None
@@ -227,8 +232,6 @@ def _starting_set(solution: Solution) -> Function:
 
 def symbolic_strategy(solution: Solution) -> SymbolicStrategy:
     """The winning strategy of a realizable game as decision diagrams."""
-    from tlmpc.synth.strategy import ordered_bits
-
     game = solution.game
     enc = game.enc
     bdd = enc.bdd
@@ -341,8 +344,6 @@ class LoopSize:
 def reachable_size(solution: Solution, strategy: SymbolicStrategy | None = None) -> LoopSize:
     """Count the nodes and transitions of the explicit machine (before merging) by symbolic
     reachability over the determinized strategy."""
-    from tlmpc.synth.strategy import ordered_bits
-
     game = solution.game
     enc = game.enc
     bdd = enc.bdd
@@ -414,8 +415,6 @@ def symbolic_json(strategy: SymbolicStrategy) -> dict[str, Any]:
 
 def symbolic_document(strategy: SymbolicStrategy, size: LoopSize | None = None) -> dict[str, Any]:
     """A ``strategy.json`` holding the symbolic form alone (no explicit nodes)."""
-    from tlmpc.synth.strategy import variable_json
-
     document: dict[str, Any] = {
         "format": "tlmpc.strategy/1",
         "source": {"file": strategy.source_file, "format": strategy.source_format},
@@ -432,8 +431,6 @@ def symbolic_document(strategy: SymbolicStrategy, size: LoopSize | None = None) 
 
 def symbolic_from_json(document: Mapping[str, Any]) -> SymbolicStrategy:
     """The symbolic strategy of a ``strategy.json`` (its ``symbolic`` member)."""
-    from tlmpc.synth.strategy import variable_from_json
-
     part = document["symbolic"]
     return SymbolicStrategy(
         inputs=tuple(variable_from_json(v, "env") for v in document["inputs"]),
