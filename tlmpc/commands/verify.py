@@ -198,12 +198,19 @@ def _text(path: Path, verdict: Verdict) -> str:
         "stay": "the robot stays at its last point forever",
         "loop": "the loop repeats forever",
     }[verdict.ending]
-    lines.append(f"{path}: {status[verdict.outcome]}: {verdict.formula}")
+    word = status[verdict.outcome]
+    if verdict.reactive is not None and verdict.reactive.blame == "environment":
+        word += " (vacuously: the environment broke an assumption)"
+    lines.append(f"{path}: {word}: {verdict.formula}")
     lines.append(f"  boundary convention: {verdict.convention}; {ending}; {verdict.pieces} pieces")
     timed = any(r.time_robustness is not None for r in verdict.conjuncts)
     if len(verdict.conjuncts) > 1 or verdict.ending == "open" or timed:
         for report in verdict.conjuncts:
             lines.append(f"  {report.conjunct}: {report.outcome}: {report.progress}")
+    if verdict.reactive is not None:
+        from tlmpc.verify.blame import blame_lines
+
+        lines.extend(blame_lines(verdict.reactive, float(verdict.stats["start_time"])))
     for violation in verdict.violations:
         lines.append(f"  violation: {violation.message}")
     lines.append(f"  robustness: {verdict.robustness:.6g}")

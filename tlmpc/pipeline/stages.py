@@ -277,10 +277,8 @@ def _plan(c: Compilation) -> StageResult:
     # for every later stage.
     planned = plan_mission(c.get(MISSION), built, c.get(AUTOMATON))
     abstraction, witness = planned.abstraction, planned.witness
-    products: dict[Product[Any], Any] = {}
     artifacts: dict[str, Any] = {}
     if planned.margin_dropped:
-        products.update(provide(AUTOMATON, planned.automaton))
         artifacts["automaton.json"] = automaton_to_json(planned.automaton)
         artifacts["automaton.hoa"] = to_hoa(planned.automaton)
     artifacts["witness.json"] = witness_to_json(witness, abstraction)
@@ -291,7 +289,7 @@ def _plan(c: Compilation) -> StageResult:
     )
     return StageResult(
         products={
-            **products,
+            **provide(AUTOMATON, planned.automaton),
             **provide(ABSTRACTION, abstraction),
             **provide(WITNESS, witness),
         },
@@ -468,7 +466,9 @@ STAGES: tuple[Stage, ...] = (
         name="plan",
         run=_plan,
         requires=(MISSION, ABSTRACTION, AUTOMATON),
-        provides=(WITNESS, ABSTRACTION),  # the mesh, refined where the plan turns around
+        # the mesh refined where the plan turns around, and the mesh and automaton rebuilt
+        # without the margin when no plan keeps it
+        provides=(WITNESS, ABSTRACTION, AUTOMATON),
         aliases=("witness", "planning"),
         worlds=_STATIC,
     ),
@@ -618,8 +618,12 @@ def run_stages(
             name=stage.name, seconds=time.perf_counter() - started, sizes=result.sizes
         )
         missing = [p.name for p in stage.provides if p not in result.products]
-        if missing:  # a programming error: the stage list and the stage disagree
-            raise RuntimeError(f"stage {stage.name} did not provide {', '.join(missing)}")
+        undeclared = [p.name for p in result.products if p not in stage.provides]
+        if missing or undeclared:  # a programming error: the stage list and the stage disagree
+            raise RuntimeError(
+                f"stage {stage.name} does not provide what it declares (missing: "
+                f"{', '.join(missing) or '-'}; undeclared: {', '.join(undeclared) or '-'})"
+            )
         products.update(result.products)
         artifacts.update(result.artifacts)
         written.update(result.artifacts)
