@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
-from tlmpc.base.errors import NoPlanError, TlmpcError, error
+from tlmpc.base.errors import TlmpcError, error
 from tlmpc.base.progress import heartbeat
 from tlmpc.base.version import __version__
 
@@ -387,12 +387,23 @@ def _verify(c: Compilation) -> StageResult:
 
 
 def _synthesize(c: Compilation) -> StageResult:
-    from tlmpc.reactive.synthesize import strategy_to_json, synthesize, unrealizable
+    from tlmpc.reactive.synthesize import (
+        UnrealizableError,
+        counterstrategy_to_json,
+        strategy_to_json,
+        synthesize,
+        unrealizable,
+    )
 
     mission = c.get(MISSION)
     synthesis = synthesize(mission, c.get(ABSTRACTION))
-    if synthesis.strategy is None:
-        raise NoPlanError(unrealizable(synthesis, mission))
+    if not synthesis.realizable:
+        shown = dict(c.documents)
+        if synthesis.counter is not None:
+            shown["counterstrategy.json"] = counterstrategy_to_json(synthesis, c.get(ABSTRACTION))
+        raise UnrealizableError(unrealizable(synthesis, mission), shown)
+    assert synthesis.size is not None
+    assert synthesis.symbolic is not None
     game = synthesis.game
     return StageResult(
         artifacts={"strategy.json": strategy_to_json(synthesis)},
@@ -401,7 +412,9 @@ def _synthesize(c: Compilation) -> StageResult:
             "variables": len(game.spec.variables),
             "parts": len(game.spec.parts),
             "fixpoint steps": synthesis.solution.cpre_count,
-            "strategy nodes": len(synthesis.strategy.states),
+            "strategy nodes": synthesis.size.nodes,
+            "strategy transitions": synthesis.size.transitions,
+            "strategy diagram nodes": len(synthesis.symbolic.diagram.nodes),
         },
         summary={"reactive": {"realizable": True, "faces": game.faces.count}},
     )
