@@ -242,3 +242,51 @@ def test_a_strategy_on_other_faces_is_refused(guard: Path, tmp_path: Path) -> No
     assert status == 2
     assert "error[Q123]" in err
     assert "faces" in err
+
+
+FOUR_SENSORS = """version: 1
+name: four-sensors
+workspace:
+  boundary: {rect: [0, 0, 10, 6]}
+  holes: [{rect: [4, 2, 6, 4]}]
+regions:
+  home: {rect: [0.5, 0.5, 2, 2]}
+  exit: {rect: [8, 4, 9.5, 5.5]}
+  lab: {rect: [4, 4.5, 6, 6]}
+  post: {rect: [8, 0.5, 9.5, 2]}
+sensors: {person: null, alarm: null, door: null, smoke: null}
+actions: {camera: null}
+assumptions: ["G F !person", "G F !smoke"]
+robot: {start: [1, 1], max_speed: 1.0}
+task:
+  - if you sense person then visit exit
+  - visit post infinitely often unless alarm
+  - visit home infinitely often unless smoke
+  - never enter lab while alarm
+  - never enter lab while door
+  - if you sense smoke then visit exit
+  - if you sense person then do camera
+"""
+
+
+@pytest.mark.parametrize("kind", ["random", "adversarial"])
+def test_a_strategy_written_only_symbolically_runs(tmp_path: Path, kind: str) -> None:
+    mission = tmp_path / "four.yaml"
+    mission.write_text(FOUR_SENSORS)
+    out = tmp_path / "out"
+    code, _, err = run("compile", str(mission), "-o", str(out))
+    assert code == 0, err
+    strategy = json.loads((out / "strategy.json").read_text())
+    assert "nodes" not in strategy  # too large to list: the executor steps the diagrams
+    trace_path = tmp_path / "trace.json"
+    code, _, err = run(
+        "simulate", str(out), "--sensors", kind, "--events", "60", "-o", str(trace_path)
+    )
+    assert code == 0, err
+    trace = json.loads(trace_path.read_text())
+    assert validation_errors(trace, "trace") == []
+    code, verified, _ = run("verify", str(trace_path), "--json")
+    assert json.loads(verified)["result"]["verdict"] == "inconclusive"
+    # the run changed sensors and moved the robot between faces
+    assert any(len(points) > 1 for points in trace["signals"].values())
+    assert len({(round(x, 6), round(y, 6)) for _, x, y in trace["points"]}) > 10

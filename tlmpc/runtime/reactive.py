@@ -41,7 +41,7 @@ from tlmpc.mission.model import Mission
 from tlmpc.planning.model import Witness
 from tlmpc.reactive.faces import faces_of
 from tlmpc.runtime.locate import Locator
-from tlmpc.runtime.strategy_machine import StrategyMachine
+from tlmpc.runtime.strategy_machine import Stepper, strategy_stepper
 from tlmpc.simulate.exact import exit_step, expm_small
 
 #: The artifacts a reactive output folder must hold for the executor.
@@ -105,9 +105,7 @@ class ReactiveExecutor:
     robot arrives in its goal face) and :meth:`react` to what happened.
     """
 
-    def __init__(
-        self, *, mission: Mission, abstraction: Abstraction, machine: StrategyMachine
-    ) -> None:
+    def __init__(self, *, mission: Mission, abstraction: Abstraction, machine: Stepper) -> None:
         assert mission.reactive is not None
         self.mission = mission
         self.abstraction = abstraction
@@ -172,7 +170,7 @@ class ReactiveExecutor:
                     file=str(folder),
                 )
             )
-        machine = StrategyMachine.of_json(
+        machine = strategy_stepper(
             artifacts["strategy.json"],
             mission.reactive.sensor_names,
             mission.reactive.actions,

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Protocol
 
 from tlmpc.base.errors import UsageError, error
 
@@ -22,6 +22,43 @@ Value = int | bool
 FACE = "face"
 GOAL = "goal"
 MOVED = "moved"
+
+
+class Stepper(Protocol):
+    """What the executor asks of a strategy: this explicit machine, or the symbolic one
+    (``tlmpc.reactive.stepper``) for strategies too large to list node by node."""
+
+    @property
+    def sensors(self) -> Sequence[str]: ...
+    @property
+    def actions(self) -> Sequence[str]: ...
+    @property
+    def counters(self) -> Sequence[int]: ...
+    @property
+    def labels(self) -> Sequence[tuple[str, ...]]: ...
+    @property
+    def adjacent(self) -> Sequence[tuple[int, ...]]: ...
+    @property
+    def face_of(self) -> Sequence[int]: ...
+    def start(self, sensors: Mapping[str, bool], face: int) -> int | None: ...
+    def answer(
+        self, node: int, sensors: Mapping[str, bool], face: int, moved: bool
+    ) -> int | None: ...
+    def goal(self, node: int) -> int: ...
+    def action_values(self, node: int) -> dict[str, bool]: ...
+    def behaviour(self, node: int) -> tuple[Value, ...]: ...
+
+
+def strategy_stepper(
+    document: Mapping[str, Any], sensors: Sequence[str], actions: Sequence[str], file: str
+) -> Stepper:
+    """The stepper of a reactive ``strategy.json``: its explicit machine when the file lists
+    one (small strategies), else its symbolic form."""
+    if "nodes" in document:
+        return StrategyMachine.of_json(document, sensors, actions, file)
+    from tlmpc.reactive.stepper import SymbolicMachine
+
+    return SymbolicMachine.of_json(document, sensors, actions, file)
 
 
 @dataclass(frozen=True)
@@ -132,4 +169,4 @@ class StrategyMachine:
         return (self.goal(node), *(bool(self.nodes[node][a]) for a in self.actions))
 
 
-__all__ = ["FACE", "GOAL", "MOVED", "StrategyMachine"]
+__all__ = ["FACE", "GOAL", "MOVED", "Stepper", "StrategyMachine", "strategy_stepper"]
