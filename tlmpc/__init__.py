@@ -31,13 +31,23 @@ if TYPE_CHECKING:
         check,
         compile,
         executor,
+        reactive_executor,
         read_output,
         translate,
         verify_trace,
     )
 
 _FACADE = frozenset(
-    {"Compiled", "check", "compile", "executor", "read_output", "translate", "verify_trace"}
+    {
+        "Compiled",
+        "check",
+        "compile",
+        "executor",
+        "reactive_executor",
+        "read_output",
+        "translate",
+        "verify_trace",
+    }
 )
 
 
@@ -62,6 +72,7 @@ __all__ = [
     "check",
     "compile",
     "executor",
+    "reactive_executor",
     "read_output",
     "translate",
     "verify_trace",

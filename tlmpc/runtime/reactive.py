@@ -40,6 +40,7 @@ from tlmpc.control.model import StepController
 from tlmpc.mission.model import Mission
 from tlmpc.planning.model import Witness
 from tlmpc.reactive.faces import faces_of
+from tlmpc.runtime.executor import CompiledOutput
 from tlmpc.runtime.locate import Locator
 from tlmpc.runtime.strategy_machine import Stepper, strategy_stepper
 from tlmpc.simulate.exact import exit_step, expm_small
@@ -141,14 +142,18 @@ class ReactiveExecutor:
         self._inside_faces, self._portals = _face_graph(abstraction, self.face_of)
 
     @classmethod
-    def from_output(cls, output: str | os.PathLike[str]) -> ReactiveExecutor:
-        """The executor of a compiled reactive output folder."""
+    def from_output(cls, output: CompiledOutput | str | os.PathLike[str]) -> ReactiveExecutor:
+        """The executor of a compiled reactive output folder (or an in-memory compilation)."""
         from tlmpc.abstraction.io import abstraction_from_json
         from tlmpc.io.artifacts import read_artifacts
         from tlmpc.mission.io import mission_from_json
 
-        folder = Path(output)
-        artifacts = read_artifacts(folder, REACTIVE_ARTIFACTS)
+        artifacts: Mapping[str, Any]
+        if isinstance(output, str | os.PathLike):
+            folder = Path(output)
+            artifacts = read_artifacts(folder, REACTIVE_ARTIFACTS)
+        else:
+            folder, artifacts = Path(output.source), output.artifacts
         missing = [name for name in REACTIVE_ARTIFACTS if name not in artifacts]
         if missing:
             raise UsageError(
