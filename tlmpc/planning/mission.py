@@ -26,6 +26,7 @@ from tlmpc.automata.model import Automaton
 from tlmpc.base.errors import Diagnostic, NoPlanError
 from tlmpc.mission.model import Mission, TaskPart
 from tlmpc.planning.model import Witness
+from tlmpc.planning.robust import witness_realisable
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -87,9 +88,25 @@ def plan_mission(
 
     def attempt(mesh: Abstraction, task: Automaton) -> Planned:
         from tlmpc.planning.budget import check_product_size
-        from tlmpc.planning.complete import plan_complete
 
         check_product_size(mesh, task)  # a diagnostic, not an exhausted machine
+        first = complete(mesh, task, None)
+        ratio = mission.robot.disturbance / mission.robot.max_speed
+        if witness_realisable(first.abstraction, first.witness, ratio):
+            return first
+        # A step no controller realises (a needle, or a corner too sharp for the
+        # disturbance): plan again on the steps that are realisable, where the mesh has
+        # enough of them; otherwise the control stage states the plan's true bound.
+        from tlmpc.planning.complete import RefinementError
+
+        try:
+            return complete(mesh, task, ratio)
+        except (NoPlanError, RefinementError):
+            return first  # U-turn fans may have no realisable route either
+
+    def complete(mesh: Abstraction, task: Automaton, reject: float | None) -> Planned:
+        from tlmpc.planning.complete import plan_complete
+
         planned_mesh, witness = plan_complete(
             mesh,
             task,
@@ -99,7 +116,8 @@ def plan_mission(
             parts=parts if parts is not None else (lambda: _task_parts(mission)),
             file=mission.source,
             resume=resume,
-            explain=resume is None,
+            explain=resume is None and reject is None,
+            reject=reject,
         )
         return Planned(abstraction=planned_mesh, automaton=task, witness=witness)
 

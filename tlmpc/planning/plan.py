@@ -34,6 +34,7 @@ from tlmpc.planning.explain import explain_no_plan, invariant_mask
 from tlmpc.planning.model import Witness
 from tlmpc.planning.passages import PassageCells, add_vertex_passages
 from tlmpc.planning.product import SLOTS, START_SLOT, Product, build_product
+from tlmpc.planning.robust import realisable
 from tlmpc.planning.search import closing_searches, shortest_paths
 
 #: At most this many cycle candidates are closed with a shortest-path search; past it the
@@ -94,6 +95,7 @@ def plan(
     bounces: bool = False,
     resume: frozenset[int] | None = None,
     passages: bool = False,
+    reject: float | None = None,
 ) -> Witness:
     """A minimum-cost accepting lasso (raises :class:`NoPlanError` with an explanation).
 
@@ -102,7 +104,9 @@ def plan(
     ``resume`` re-plans a run under way: the robot is in the start triangle and has already
     read its label, the (degeneralized) automaton being in any of these states.
     ``passages=True`` also lets the lasso pass through mesh vertices where labels meet
-    (:mod:`tlmpc.planning.passages`).
+    (:mod:`tlmpc.planning.passages`).  With ``reject`` (a disturbance over max_speed) only
+    the moves and stays the controllers realise under it are used
+    (:mod:`tlmpc.planning.robust`).
     """
     started = time.perf_counter()
     allowed = invariant_mask(abstraction, formula)
@@ -124,6 +128,7 @@ def plan(
         convention=options.boundary,
         start_label=start_label,
         bounces=bounces,
+        realisable=None if reject is None else realisable(abstraction, reject),
     )
     cells: PassageCells | None = None
     if passages:

@@ -92,6 +92,7 @@ def build_product(
     convention: str = "right",
     start_label: tuple[str, ...] = (),
     bounces: bool = False,
+    realisable: tuple[BoolArray, BoolArray] | None = None,
 ) -> Product:
     """The product graph restricted to ``allowed`` triangles.
 
@@ -105,6 +106,8 @@ def build_product(
     with ``convention="closed"`` the automaton reads crossing letters and, first of all,
     ``start_label`` (the regions whose closure holds the start point).  A blocked edge may be
     left at the first move only with ``bounces`` (it is a U-turn in that triangle).
+    ``realisable`` restricts the moves (leave t by edge i, (m, 3)) and the final stays ((m,))
+    to those the controllers realise (:func:`tlmpc.planning.robust.realisable`).
     """
     m = abstraction.num_triangles
     nq = automaton.num_states
@@ -143,6 +146,8 @@ def build_product(
     # computed once and read for every slot.
     inside = np.append(allowed, False)  # index -1 (no neighbour) reads "not allowed"
     exit_ok = allowed[:, None] & inside[neighbors]
+    if realisable is not None:
+        exit_ok &= realisable[0]
     valid = np.empty((m, SLOTS, 3), dtype=bool)
     valid[:, :START_SLOT, :] = exit_ok[:, None, :]
     if not bounces:
@@ -217,11 +222,13 @@ def build_product(
     stay_succ: dict[int, list[list[tuple[int, bool]]]] = {}
     for cls in stay_classes:
         stays = stay_cell[stay_class == cls]
+        # the run may end staying only where a stay field exists
+        final = stays if realisable is None else stays[realisable[1][stays // SLOTS]]
         stay_succ[cls] = []
         for q in range(nq):
             found = successors_of(cls, q)
             if found.get(q, False):
-                stutter_accepting[stays * nq + q] = True
+                stutter_accepting[final * nq + q] = True
             # Staying in the same state is the node itself: no edge.
             stay_succ[cls].append([(q2, mark) for q2, mark in found.items() if q2 != q])
 
