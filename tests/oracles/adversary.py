@@ -50,11 +50,15 @@ def adversaries(
         pushes.append(lambda t, x: back)
     for j in range(3):
         along = d * np.array([-normals[j][1], normals[j][0]])
-        pushes.append(lambda t, x, a=along: a)
-        pushes.append(lambda t, x, a=along: -a)
-        outward = d * normals[j]
-        pushes.append(lambda t, x, a=outward: a)
+        pushes += [_steady(along), _steady(-along), _steady(d * normals[j])]
     return pushes
+
+
+def _steady(push: np.ndarray) -> Push:
+    def steady(t: float, x: np.ndarray) -> np.ndarray:
+        return push
+
+    return steady
 
 
 def starts(vertices: np.ndarray) -> list[np.ndarray]:
@@ -114,4 +118,5 @@ def check_step(step: dict[str, Any], d: float, max_speed: float) -> None:
             else:
                 assert crossed == [exit_edge], (step["step"], crossed, x0)
                 assert when is not None
+                assert bound is not None
                 assert when <= float(bound) * (1 + 1e-6), (step["step"], when)
