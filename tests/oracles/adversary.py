@@ -76,26 +76,40 @@ def starts(vertices: np.ndarray) -> list[np.ndarray]:
 def run(
     step: dict[str, Any], d: float, x0: np.ndarray, push: Push, horizon: float
 ) -> tuple[list[int], float | None]:
-    """(the facets crossed, the time the first was crossed) for one adversarial run."""
+    """(the facets crossed, the time the first was crossed) for one adversarial run.
+
+    Integrated in barycentric coordinates: lambda_i = (c_i - n_i x) / h_i, facet i is
+    lambda_i = 0, and lambda_i' = -n_i (sum_j lambda_j w_j + push) / h_i with w_j the field
+    at corner j. Each coordinate is of order one whatever the triangle's shape or place, so
+    the solver's relative tolerance is a tolerance on the distance to each facet over its
+    height (in map coordinates a sliver 1e-8 wide at 5 from the origin is below it).
+    """
     vertices = np.asarray(step["vertices"], dtype=float)
     gain, offset = np.asarray(step["K"], dtype=float), np.asarray(step["g"], dtype=float)
     normals, offsets = facets(vertices)
+    heights = offsets - np.einsum("ij,ij->i", normals, vertices)
     origin = vertices[0]
-    w0 = gain @ origin + offset  # evaluate in the triangle's frame (far-out maps)
+    corner_field = np.array([gain @ (v - origin) for v in vertices]) + (gain @ origin + offset)
+    rates = -(normals @ corner_field.T) / heights[:, None]  # d lambda_i / d lambda_j
+    lam0 = (offsets - normals @ x0) / heights
 
-    def flow(t: float, x: np.ndarray) -> np.ndarray:
-        return np.asarray(w0 + gain @ (x - origin) + push(t, x))
+    def flow(t: float, lam: np.ndarray) -> np.ndarray:
+        x = lam @ vertices
+        return np.asarray(rates @ lam - (normals @ push(t, x)) / heights)
 
     def crossing_of(facet: int) -> Callable[[float, np.ndarray], float]:
-        def crossing(t: float, x: np.ndarray) -> float:
-            return float(normals[facet] @ x - offsets[facet])
+        def crossing(t: float, lam: np.ndarray) -> float:
+            return float(lam[facet])
 
         crossing.terminal = True  # type: ignore[attr-defined]
-        crossing.direction = 1  # type: ignore[attr-defined]
+        crossing.direction = -1  # type: ignore[attr-defined]
         return crossing
 
     events = [crossing_of(facet) for facet in range(3)]
-    result = solve_ivp(flow, (0.0, horizon), x0, events=events, rtol=1e-10, atol=1e-13)
+    # LSODA switches to a stiff method where a sliver's rates (max_speed / its width) are huge
+    result = solve_ivp(
+        flow, (0.0, horizon), lam0, method="LSODA", events=events, rtol=1e-10, atol=1e-13
+    )
     crossed = [facet for facet in range(3) if len(result.t_events[facet])]
     when = min((float(result.t_events[f][0]) for f in crossed), default=None)
     return crossed, when
