@@ -96,3 +96,24 @@ def test_slivers_a_field_can_still_push_from_compile(height: float, task: str) -
     controllers = compiled.artifacts["controllers.json"]
     for step in controllers["steps"]:
         check_vertex_conditions(step, controllers["max_speed"])
+
+
+#: A tip of about 2e-9 radians (1e-8 over 4): realisable, but the solver's field misses the
+#: re-check there; the best-push field does not.
+SLIVER = [
+    [2.20384904009969, 2.3575531343551006],
+    [6.3302528986242885, 2.3575531343551006],
+    [4.267050969361989, 2.3575531443551005],
+]
+
+
+def test_where_the_solver_misses_a_sliver_the_best_push_field_holds() -> None:
+    mission = _needle("left", "patrol b and c", (2.772895461972917, 0.08322334781304659))
+    mission["regions"]["b"] = SLIVER
+    compiled = tlmpc.compile(mission, until="verify")
+    assert compiled.summary["verdict"]["satisfied"] is True
+    controllers = compiled.artifacts["controllers.json"]
+    for step in controllers["steps"]:
+        check_vertex_conditions(step, controllers["max_speed"])
+    reasons = {jump["reason"] for jump in controllers["jumps"]}
+    assert "a needle's field is built from its own geometry" in reasons
