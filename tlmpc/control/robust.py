@@ -101,7 +101,9 @@ def disturbance_hint(disturbance: float, max_speed: float, bound: Corner) -> str
     lines = [
         f"this plan's triangles reject disturbances below {bound.push:.6g} "
         f"({bound.push / max_speed:.4f} x max_speed), the push of its weakest corner "
-        f"({x:.6g}, {y:.6g}) in step {bound.step}, angle {bound.angle:.6g} degrees"
+        f"({x:.6g}, {y:.6g}) in step {bound.step}, angle {bound.angle:.6g} degrees (the "
+        "planner takes a route through corners that reject the disturbance wherever this mesh "
+        "has one; it has none)"
     ]
     ceiling = math.sin(math.radians(MAX_MIN_ANGLE) / 2.0)
     if ratio < ceiling:
