@@ -117,3 +117,15 @@ def test_where_the_solver_misses_a_sliver_the_best_push_field_holds() -> None:
         check_vertex_conditions(step, controllers["max_speed"])
     reasons = {jump["reason"] for jump in controllers["jumps"]}
     assert "a needle's field is built from its own geometry" in reasons
+
+
+def test_the_c050_push_is_the_tips_own() -> None:
+    """The push C050 reports is max_speed * sin(a / 2) of the tip (recomputed here), not a
+    value lost to cancellation (the bisector of two nearly opposite normals)."""
+    mission = _needle("left", "stay in b", (5.0, 0.1))
+    with pytest.raises(tlmpc.InvalidInputError) as refused:
+        tlmpc.compile(mission, until="control")
+    message = refused.value.diagnostics[0].message
+    push = float(message.split("pushes more than ")[1].split(" along")[0])
+    tip = math.atan2(1e-8, 7.0)
+    assert push == pytest.approx(math.sin(tip / 2), rel=1e-2)

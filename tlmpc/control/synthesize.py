@@ -36,6 +36,7 @@ from tlmpc.control.geometry import (
 from tlmpc.control.model import Controllers, StepController, VelocityJump
 from tlmpc.control.robust import (
     Corner,
+    best_direction,
     best_push_velocities,
     corner_angle,
     disturbance_hint,
@@ -510,7 +511,8 @@ def _corner(
         triangle=step.triangle,
         position=(x, y),
         angle=corner_angle(corners, local),
-        push=best_push(normals, max_speed),
+        # (best_direction keeps a sliver corner's digits; best_push drops its bisector)
+        push=best_direction(normals)[0] * max_speed,
         kept=step.exit_edge is None or step.exit_edge == local,
     )
 
