@@ -163,15 +163,18 @@ def lazy_product(
     convention: str = "right",
     start_label: tuple[str, ...] = (),
     bounces: bool = False,
+    realisable: tuple[BoolArray, BoolArray] | None = None,
 ) -> LazyProduct:
     """The product :func:`~tlmpc.planning.product.build_product` would build from the same
-    arguments, as tables (nothing per product node)."""
+    arguments, as tables (nothing per product node).  With ``realisable`` a triangle without
+    a stay field has no stutter at all (the built product drops only its final stays: the
+    tables keep stutter per letter class, so this one is more restrictive, still sound)."""
     if starts is None:
         starts = start_cells(abstraction, start_point)
     closed = convention == "closed"
     classes = LetterClasses.of(automaton, list(abstraction.letters))
     tri_class = classes.letter_class[abstraction.letter_of]
-    moves = ts_moves(abstraction, allowed, starts, bounces=bounces)
+    moves = ts_moves(abstraction, allowed, starts, bounces=bounces, realisable=realisable)
     weight = move_weights(abstraction, moves, start_point, metric)
     if closed:
         raw_kind = crossing_move_kinds(abstraction, automaton, classes, tri_class, moves)
@@ -192,6 +195,8 @@ def lazy_product(
     stay_cell, stay_class = stutter_cells(abstraction, allowed, starts, tri_class)
     cell_class = np.full(cells, -1, dtype=np.int64)
     cell_class[stay_cell] = stay_class
+    if realisable is not None:
+        cell_class[~np.repeat(realisable[1], SLOTS)] = -1
     num_classes = len(classes.rows)
     stutter_tables: list[list[list[tuple[int, bool]]]] = []
     stutter_accepts = np.zeros((num_classes, nq), dtype=bool)

@@ -27,6 +27,7 @@ from tlmpc.base.errors import Diagnostic, NoPlanError
 from tlmpc.ltl.ast import Formula
 from tlmpc.mission.model import Mission, TaskPart
 from tlmpc.planning.model import Witness
+from tlmpc.planning.robust import witness_realisable
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -100,9 +101,27 @@ def plan_mission(
         mesh: Abstraction, task: Automaton, formula: Formula = skeleton, explain: bool = True
     ) -> Planned:
         from tlmpc.planning.budget import check_product_size
-        from tlmpc.planning.complete import plan_complete
 
         check_product_size(mesh, task)  # a diagnostic, not an exhausted machine
+        first = complete(mesh, task, formula, explain, None)
+        ratio = mission.robot.disturbance / mission.robot.max_speed
+        if witness_realisable(first.abstraction, first.witness, ratio):
+            return first
+        # A step no controller realises (a needle, or a corner too sharp for the
+        # disturbance): plan again on the steps that are realisable, where the mesh has
+        # enough of them; otherwise the control stage states the plan's true bound.
+        from tlmpc.planning.complete import RefinementError
+
+        try:
+            return complete(mesh, task, formula, explain, ratio)
+        except (NoPlanError, RefinementError):
+            return first  # U-turn fans may have no realisable route either
+
+    def complete(
+        mesh: Abstraction, task: Automaton, formula: Formula, explain: bool, reject: float | None
+    ) -> Planned:
+        from tlmpc.planning.complete import plan_complete
+
         planned_mesh, witness = plan_complete(
             mesh,
             task,
@@ -112,7 +131,8 @@ def plan_mission(
             parts=parts if parts is not None else (lambda: _task_parts(mission)),
             file=mission.source,
             resume=resume,
-            explain=explain and resume is None,
+            explain=explain and resume is None and reject is None,
+            reject=reject,
         )
         return Planned(abstraction=planned_mesh, automaton=task, witness=witness)
 

@@ -38,6 +38,7 @@ from tlmpc.planning.lazy import lazy_product
 from tlmpc.planning.model import Witness
 from tlmpc.planning.passages import PassageCells, add_vertex_passages
 from tlmpc.planning.product import SLOTS, START_SLOT, BoolArray, Product, build_product
+from tlmpc.planning.robust import realisable
 from tlmpc.planning.search import closing_searches, shortest_paths
 
 #: At most this many cycle candidates are closed with a shortest-path search; past it the
@@ -99,6 +100,7 @@ def plan(
     resume: frozenset[int] | None = None,
     passages: bool = False,
     guided: bool | None = None,
+    reject: float | None = None,
 ) -> Witness:
     """A minimum-cost accepting lasso (raises :class:`NoPlanError` with an explanation).
 
@@ -110,6 +112,8 @@ def plan(
     (:mod:`tlmpc.planning.passages`).  ``guided`` searches the product expanded on demand
     (:mod:`tlmpc.planning.guided`: the same cost, for products too large to build); by
     default only when the product would not fit the budget (:mod:`tlmpc.planning.budget`).
+    With ``reject`` (a disturbance over max_speed) only the moves and stays the controllers
+    realise under it are used (:mod:`tlmpc.planning.robust`).
     """
     started = time.perf_counter()
     allowed = invariant_mask(abstraction, formula)
@@ -134,6 +138,7 @@ def plan(
             )
         )
 
+    realisable_steps = None if reject is None else realisable(abstraction, reject)
     if guided is None:
         guided = not estimate_product(abstraction, automaton).fits
     if guided:
@@ -149,6 +154,7 @@ def plan(
             convention=options.boundary,
             start_label=start_label,
             bounces=bounces,
+            realisable=realisable_steps,
         )
         if resume is not None:
             initial = _resumed(abstraction, allowed, working, resume)
@@ -184,6 +190,7 @@ def plan(
         convention=options.boundary,
         start_label=start_label,
         bounces=bounces,
+        realisable=realisable_steps,
     )
     cells: PassageCells | None = None
     if passages:

@@ -92,6 +92,7 @@ def build_product(
     convention: str = "right",
     start_label: tuple[str, ...] = (),
     bounces: bool = False,
+    realisable: tuple[BoolArray, BoolArray] | None = None,
 ) -> Product:
     """The product graph restricted to ``allowed`` triangles.
 
@@ -105,13 +106,15 @@ def build_product(
     with ``convention="closed"`` the automaton reads crossing letters and, first of all,
     ``start_label`` (the regions whose closure holds the start point).  A blocked edge may be
     left at the first move only with ``bounces`` (it is a U-turn in that triangle).
+    ``realisable`` restricts the moves (leave t by edge i, (m, 3)) and the final stays ((m,))
+    to those the controllers realise (:func:`tlmpc.planning.robust.realisable`).
     """
     if starts is None:
         starts = start_cells(abstraction, start_point)
     closed = convention == "closed"
     classes = LetterClasses.of(automaton, list(abstraction.letters))
     tri_class = classes.letter_class[abstraction.letter_of]
-    moves = ts_moves(abstraction, allowed, starts, bounces=bounces)
+    moves = ts_moves(abstraction, allowed, starts, bounces=bounces, realisable=realisable)
     weight = move_weights(abstraction, moves, start_point, metric)
     if closed:
         move_kind = crossing_move_kinds(abstraction, automaton, classes, tri_class, moves)
@@ -122,7 +125,12 @@ def build_product(
     nq = automaton.num_states
     size = abstraction.num_triangles * SLOTS * nq
     stutter_accepting = np.zeros(size, dtype=bool)
-    stay_edges = successors.stutter_edges(stay_cell, stay_class, stutter_accepting)
+    stay_edges = successors.stutter_edges(
+        stay_cell,
+        stay_class,
+        stutter_accepting,
+        stay_ok=None if realisable is None else realisable[1],
+    )
     graph, accepting = _product_edges(moves, move_kind, weight, successors, stay_edges)
     start_letter = tuple(sorted({*start_label, POINT})) if closed else None
     return Product(
@@ -187,9 +195,11 @@ def ts_moves(
     starts: tuple[StartCell, ...],
     *,
     bounces: bool,
+    realisable: tuple[BoolArray, BoolArray] | None = None,
 ) -> _Moves:
-    """Every move of D between ``allowed`` triangles.  Per (t, i) arrays (m, 3) are
-    computed once and read for every slot."""
+    """Every move of D between ``allowed`` triangles (and, with ``realisable``, only the
+    moves the controllers realise).  Per (t, i) arrays (m, 3) are computed once and read for
+    every slot."""
     m = abstraction.num_triangles
     neighbors = abstraction.neighbors
     is_start = np.zeros(m, dtype=bool)
@@ -199,6 +209,8 @@ def ts_moves(
         blocked[cell.triangle, list(cell.blocked)] = True
     inside = np.append(allowed, False)  # index -1 (no neighbour) reads "not allowed"
     exit_ok = allowed[:, None] & inside[neighbors]
+    if realisable is not None:
+        exit_ok &= realisable[0]
     valid = np.empty((m, SLOTS, 3), dtype=bool)
     valid[:, :START_SLOT, :] = exit_ok[:, None, :]
     if not bounces:
@@ -330,20 +342,27 @@ class Successors:
         return kinds
 
     def stutter_edges(
-        self, stay_cell: IntArray, stay_class: IntArray, stutter_accepting: BoolArray
+        self,
+        stay_cell: IntArray,
+        stay_class: IntArray,
+        stutter_accepting: BoolArray,
+        *,
+        stay_ok: BoolArray | None = None,
     ) -> list[StayEdges]:
         """The stutter edges per (class, state), in that order; marks in
-        ``stutter_accepting`` the nodes whose stutter loop accepts.  Staying in the same
-        state is the node itself: no edge."""
+        ``stutter_accepting`` the nodes whose stutter loop accepts (with ``stay_ok``, per
+        triangle, only where a stay field exists: the run may end staying only there).
+        Staying in the same state is the node itself: no edge."""
         nq = self.num_states
         classes = np.flatnonzero(np.bincount(stay_class)).tolist() if len(stay_cell) else []
         edges: list[StayEdges] = []
         for cls in classes:
             stays = stay_cell[stay_class == cls]
+            final = stays if stay_ok is None else stays[stay_ok[stays // SLOTS]]
             for q in range(nq):
                 found = self.after(cls, q)
                 if found.get(q, False):
-                    stutter_accepting[stays * nq + q] = True
+                    stutter_accepting[final * nq + q] = True
                 others = [(q2, mark) for q2, mark in found.items() if q2 != q]
                 if others:
                     edges.append((stays, q, others))
