@@ -33,10 +33,7 @@ from tlmpc.base.errors import (
     TlmpcError,
     best_first,
 )
-
-#: Ctrl-C (128 + SIGINT) and SIGTERM (128 + SIGTERM), the shell's conventions.
-EXIT_INTERRUPTED = 130
-EXIT_TERMINATED = 143
+from tlmpc.base.startup import EXIT_INTERRUPTED, EXIT_TERMINATED
 
 #: Every exit code of every command, with its meaning (the one definition; ``--help`` and
 #: ``docs/cli.md`` show this table).
