@@ -26,8 +26,9 @@ from typing import Any, TextIO
 
 from tlmpc.base import startup
 from tlmpc.base.errors import EXIT_INTERNAL, EXIT_USAGE, TlmpcError, error, printable
+from tlmpc.base.startup import EXIT_INTERRUPTED, EXIT_TERMINATED
 from tlmpc.base.version import __version__
-from tlmpc.io.report import EXIT_INTERRUPTED, EXIT_TERMINATED, Reporter, exit_code_epilog
+from tlmpc.io.report import Reporter, exit_code_epilog
 
 #: Subcommand modules, in the order ``--help`` lists them.
 COMMAND_MODULES = (

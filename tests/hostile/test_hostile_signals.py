@@ -242,3 +242,23 @@ def test_a_signal_while_a_file_is_replaced_finds_old_or_new(
         signal.signal(signal.SIGTERM, previous)
     assert [p.name for p in tmp_path.iterdir()] == ["plan.csv"]
     assert target.read_bytes() in (b"old\n", b"new\n")
+
+
+@pytest.mark.parametrize(("number", "code"), [(signal.SIGTERM, 143), (signal.SIGINT, 130)])
+def test_the_command_signalled_right_after_the_package_starts_ends_cleanly(
+    number: int, code: int
+) -> None:
+    # a process that is the console script (by its name) receives the signal once the package's
+    # first lines ran, while the command's modules are still to be imported
+    program = (
+        "import os, sys\n"
+        "sys.argv[0] = os.path.join('bin', 'tlmpc')\n"
+        "import tlmpc\n"
+        f"os.kill(os.getpid(), {int(number)})\n"
+        "import tlmpc.cli\n"
+        "print('went on')\n"
+    )
+    done = subprocess.run([sys.executable, "-c", program], capture_output=True, text=True)
+    assert done.returncode == code, done.stderr
+    assert done.stdout == ""
+    assert done.stderr == ("tlmpc: terminated\n" if code == 143 else "tlmpc: interrupted\n")
