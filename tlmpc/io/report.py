@@ -95,9 +95,16 @@ class Reporter:
         return reporter
 
     def diagnose(self, diagnostics: Iterable[Diagnostic]) -> None:
-        """Print diagnostics on standard error (and keep them for the JSON envelope)."""
-        for diagnostic in diagnostics:
-            self.diagnostics.append(diagnostic)
+        """Print diagnostics on standard error (and keep them for the JSON envelope).
+
+        Warnings alike but for names and numbers are printed as one line
+        (:func:`tlmpc.io.aggregate.aggregate`); the envelope keeps each of them.
+        """
+        from tlmpc.io.aggregate import aggregate
+
+        batch = list(diagnostics)
+        self.diagnostics.extend(batch)
+        for diagnostic in aggregate(batch):
             self.err.write(diagnostic.format() + "\n")
 
     def note(self, text: str) -> None:
