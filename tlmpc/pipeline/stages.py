@@ -236,7 +236,7 @@ def _abstraction(c: Compilation) -> StageResult:
             "letters": len(abstraction.letters),
         },
         warnings=tuple(abstraction_diagnostics(abstraction, mission))
-        if layout is None
+        if layout is None or layout.free is None
         else tuple(d for d in [mesh_size_diagnostic(abstraction, mission)] if d is not None),
     )
 
