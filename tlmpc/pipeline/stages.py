@@ -272,14 +272,14 @@ def _plan(c: Compilation) -> StageResult:
     from tlmpc.planning.mission import plan_mission
 
     built = c.get(ABSTRACTION)
-    # The plan may need U-turns (a locally refined mesh) or, when no plan keeps the margin,
-    # the mesh and automaton without it: either replaces the built one (and its artifacts)
+    # The plan may need U-turns (a locally refined mesh) or, when no plan reaches the goal
+    # depth or keeps the margin, the mesh and automaton without them: either replaces the built one (and its artifacts)
     # for every later stage.
     planned = plan_mission(c.get(MISSION), built, c.get(AUTOMATON))
     abstraction, witness = planned.abstraction, planned.witness
     products: dict[Product[Any], Any] = {}
     artifacts: dict[str, Any] = {}
-    if planned.margin_dropped:
+    if planned.remeshed:
         products.update(provide(AUTOMATON, planned.automaton))
         artifacts["automaton.json"] = automaton_to_json(planned.automaton)
         artifacts["automaton.hoa"] = to_hoa(planned.automaton)

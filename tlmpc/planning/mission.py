@@ -32,13 +32,14 @@ from tlmpc.planning.model import Witness
 class Planned:
     """A planned mission: the mesh the witness refers to (refined where the plan turns
     around, or rebuilt without the margin), the automaton it was planned with, the witness,
-    and warnings (R008 when the margin was dropped)."""
+    and notes (A030 when the goal depth was dropped, R008 when the margin was)."""
 
     abstraction: Abstraction
     automaton: Automaton
     witness: Witness
     notes: tuple[Diagnostic, ...] = ()
-    margin_dropped: bool = False
+    #: planned on a mesh rebuilt without the goal depth or the margin (with its own automaton)
+    remeshed: bool = False
 
 
 def abstraction_for(mission: Mission, margin: float, *, deep: bool = True) -> Abstraction:
@@ -122,7 +123,7 @@ def plan_mission(
         except NoPlanError as again:
             first = again
         else:
-            return replace(planned, notes=(_shallow_note(mission, first),))
+            return replace(planned, notes=(_shallow_note(mission, first),), remeshed=True)
     if margin <= 0.0:
         raise _with_body_notes(first, mission) from None
     plain = abstraction_for(mission, 0.0, deep=False)
@@ -144,7 +145,7 @@ def plan_mission(
         automaton=planned.automaton,
         witness=planned.witness,
         notes=(note,),
-        margin_dropped=True,
+        remeshed=True,
     )
 
 
