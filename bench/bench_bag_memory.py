@@ -40,7 +40,7 @@ started = time.perf_counter()
 done = subprocess.run(sys.argv[1:], capture_output=True, text=True)
 print(json.dumps({"code": done.returncode, "seconds": time.perf_counter() - started,
     "peak_kib": resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss,
-    "err": done.stderr[-300:]}))
+    "answer": (done.stdout.strip().splitlines() or done.stderr.strip().splitlines() or [""])[0]}))
 """
 
 _READ_WHOLE = """
@@ -137,6 +137,7 @@ def main() -> None:
                         "exit": str(result["code"]),
                         "peak memory": f"{peak:,.0f} MiB",
                         "wall time": f"{float(str(result['seconds'])):.1f} s",
+                        "answer": str(result["answer"])[-48:],
                     }
                 )
     print(markdown_table(rows))

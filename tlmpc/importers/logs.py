@@ -469,7 +469,7 @@ def read_bag(path: Path, topic: str | None = None, frame: str | None = None) -> 
 
 
 #: Poses per chunk of :func:`iter_bag_chunks` (and of the whole reader's gathering).
-BAG_CHUNK = 65_536
+BAG_CHUNK = 8_192
 
 
 #: Bags with more pose messages than this are verified as a stream (``tlmpc verify``): memory
