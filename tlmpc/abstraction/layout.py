@@ -105,9 +105,7 @@ def deepens_goals(mission: Mission) -> bool:
     return requested is None or requested > 0.0
 
 
-def planning_layout(
-    mission: Mission, margin: float, *, deep: bool = True
-) -> PlanningLayout | None:
+def planning_layout(mission: Mission, margin: float, *, deep: bool = True) -> PlanningLayout | None:
     """The layout for ``mission`` with ``margin`` and, with ``deep``, the goal depth; None
     for a point robot without margin whose goals keep their shapes."""
     radius = obstacle_offset(mission)

@@ -273,8 +273,8 @@ def _plan(c: Compilation) -> StageResult:
 
     built = c.get(ABSTRACTION)
     # The plan may need U-turns (a locally refined mesh) or, when no plan reaches the goal
-    # depth or keeps the margin, the mesh and automaton without them: either replaces the built one (and its artifacts)
-    # for every later stage.
+    # depth or keeps the margin, the mesh and automaton without them: either replaces the
+    # built one (and its artifacts) for every later stage.
     planned = plan_mission(c.get(MISSION), built, c.get(AUTOMATON))
     abstraction, witness = planned.abstraction, planned.witness
     products: dict[Product[Any], Any] = {}
