@@ -95,7 +95,9 @@ def write_long_bag(path: Path, messages: int) -> Path:
     return path
 
 
-def measure(source: Path, argv: list[str]) -> dict[str, object]:
+def measure(source: Path, argv: list[str], cwd: Path) -> dict[str, object]:
+    """Run ``argv`` with ``source`` first on the import path, from ``cwd`` (not this checkout:
+    ``python -m`` and ``-c`` put the working directory before ``PYTHONPATH``)."""
     env = {**os.environ, "PYTHONPATH": str(source)}
     done = subprocess.run(
         [sys.executable, "-c", _MEASURE, *argv],
@@ -103,6 +105,7 @@ def measure(source: Path, argv: list[str]) -> dict[str, object]:
         text=True,
         env=env,
         check=True,
+        cwd=cwd,
     )
     result: dict[str, object] = json.loads(done.stdout)
     return result
@@ -127,7 +130,7 @@ def main() -> None:
                             str(MISSION)]),
                 ("read whole", [sys.executable, "-c", _READ_WHOLE, str(bag)]),
             ):  # fmt: skip
-                result = measure(source, argv)
+                result = measure(source, argv, Path(scratch))
                 peak = int(str(result["peak_kib"])) / 1024
                 rows.append(
                     {
