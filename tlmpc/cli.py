@@ -191,6 +191,10 @@ def _on_redelivery(number: int, frame: object) -> None:
     raise _signalled() or KeyboardInterrupt()
 
 
+def _after_the_run(handler: Any) -> Any:
+    return signal.SIG_IGN if handler is startup.end_at_once else handler
+
+
 def _signalled() -> BaseException | None:
     """The exception of the first signal this run received, if any: an exception raised by a
     signal handler inside C code (an extension module being imported, say) may reach us as
@@ -269,10 +273,13 @@ def main(
                 safe_err.flush()
         return EXIT_USAGE
     finally:
+        # The command's own run is over (its output whole or removed): the start-up guard,
+        # put back, would turn a finished run into an interrupted one, so a late signal of
+        # the command's process is ignored while it exits.
         if previous is not None:
-            signal.signal(signal.SIGTERM, previous)
+            signal.signal(signal.SIGTERM, _after_the_run(previous))
         if previous_int is not None:
-            signal.signal(signal.SIGINT, previous_int)
+            signal.signal(signal.SIGINT, _after_the_run(previous_int))
         sys.unraisablehook = previous_hook
         if previous_alarm is not None:
             signal.setitimer(signal.ITIMER_REAL, 0.0)
