@@ -147,7 +147,7 @@ def _run_one(args: argparse.Namespace, path: Path, out: TextIO, err: TextIO) -> 
     from tlmpc.verify import declare_ending, read_trace, verdict_to_json, verify_trace
 
     report = Reporter.for_args(args, out, err)
-    if is_log(path) and _too_large_for_memory(path):
+    if is_log(path) and _too_large_for_memory(path, args.topic):
         verdict = _streamed(args, path)
         report.note(
             f"{path}: streamed ({verdict.stats['samples']:,} samples, "
@@ -163,15 +163,23 @@ def _run_one(args: argparse.Namespace, path: Path, out: TextIO, err: TextIO) -> 
     return report.finish(OUTCOME_EXIT[verdict.outcome], verdict_to_json(verdict), text)
 
 
-def _too_large_for_memory(path: Path) -> bool:
-    from tlmpc.importers.logs import CSV_SUFFIXES
+def _too_large_for_memory(path: Path, topic: str | None) -> bool:
+    """A CSV log past the whole reader's size, or a bag of many pose messages: streamed."""
+    from tlmpc.base.errors import TlmpcError
+    from tlmpc.importers.logs import BAG_STREAM_FROM, CSV_SUFFIXES, bag_pose_count
     from tlmpc.verify.trace_input import is_large_csv
 
-    return path.suffix.lower() in CSV_SUFFIXES and path.is_file() and is_large_csv(path)
+    if path.suffix.lower() in CSV_SUFFIXES and not path.is_dir():
+        return path.is_file() and is_large_csv(path)
+    try:
+        return bag_pose_count(path, topic) > BAG_STREAM_FROM
+    except TlmpcError:
+        return False  # the whole reader gives the same diagnostic
 
 
 def _streamed(args: argparse.Namespace, path: Path) -> Verdict:
-    """A CSV log too large to hold whole, verified in constant memory (docs/verify.md)."""
+    """A CSV log too large to hold whole or a long bag, verified in constant memory
+    (docs/verify.md)."""
     from tlmpc.fleet.stream import verify_log
     from tlmpc.importers.logs import parse_columns, parse_transform
     from tlmpc.verify.trace_input import mission_document

@@ -233,7 +233,7 @@ def _abstraction(c: Compilation) -> StageResult:
             "letters": len(abstraction.letters),
         },
         warnings=tuple(abstraction_diagnostics(abstraction, mission))
-        if layout is None
+        if layout is None or layout.free is None
         else tuple(d for d in [mesh_size_diagnostic(abstraction, mission)] if d is not None),
     )
 
@@ -268,9 +268,9 @@ def _plan(c: Compilation) -> StageResult:
     from tlmpc.planning.mission import plan_mission
 
     built = c.get(ABSTRACTION)
-    # The plan may need U-turns (a locally refined mesh) or, when no plan keeps the margin,
-    # the mesh and automaton without it: either replaces the built one (and its artifacts)
-    # for every later stage.
+    # The plan may need U-turns (a locally refined mesh) or, when no plan reaches the goal
+    # depth or keeps the margin, the mesh and automaton without them: either replaces the
+    # built one (and its artifacts) for every later stage.
     planned = plan_mission(c.get(MISSION), built, c.get(AUTOMATON))
     abstraction, witness = planned.abstraction, planned.witness
     artifacts: dict[str, Any] = {}

@@ -19,7 +19,7 @@ margin; it may still refine the mesh for a U-turn, and then returns the refined 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from tlmpc.abstraction.model import Abstraction
 from tlmpc.automata.model import Automaton
@@ -34,21 +34,23 @@ from tlmpc.planning.robust import witness_realisable
 class Planned:
     """A planned mission: the mesh the witness refers to (refined where the plan turns
     around, or rebuilt without the margin), the automaton it was planned with, the witness,
-    and warnings (R008 when the margin was dropped)."""
+    and notes (A030 when the goal depth was dropped, R008 when the margin was)."""
 
     abstraction: Abstraction
     automaton: Automaton
     witness: Witness
     notes: tuple[Diagnostic, ...] = ()
-    margin_dropped: bool = False
+    #: planned on a mesh rebuilt without the goal depth or the margin (with its own automaton)
+    remeshed: bool = False
 
 
-def abstraction_for(mission: Mission, margin: float) -> Abstraction:
-    """The triangulated workspace of ``mission`` planned with ``margin`` (and its body)."""
+def abstraction_for(mission: Mission, margin: float, *, deep: bool = True) -> Abstraction:
+    """The triangulated workspace of ``mission`` planned with ``margin`` (and its body), and
+    with ``deep`` the goal depth."""
     from tlmpc.abstraction import build_abstraction
     from tlmpc.abstraction.layout import planning_layout
 
-    return build_abstraction(mission, planning_layout(mission, margin))
+    return build_abstraction(mission, planning_layout(mission, margin, deep=deep))
 
 
 def automaton_for(
@@ -146,17 +148,28 @@ def plan_mission(
             )
         except NoPlanError:
             pass
+    from tlmpc.abstraction.layout import deepens_goals
 
     try:
         return attempt(abstraction, automaton)
     except NoPlanError as failure:
         if resume is not None:
             raise
-        margin = requested_margin(mission)
-        if margin <= 0.0:
-            raise _with_body_notes(failure, mission) from None
         first = failure
-    plain = abstraction_for(mission, 0.0)
+    margin = requested_margin(mission)
+    if deepens_goals(mission):
+        # the goal depth is an objective: plan again reaching the goals only as deep as the
+        # margin asks (overlapping goals' cores may not meet where the regions do)
+        shallow = abstraction_for(mission, margin, deep=False)
+        try:
+            planned = attempt(shallow, automaton_for(mission, shallow))
+        except NoPlanError as again:
+            first = again
+        else:
+            return replace(planned, notes=(_shallow_note(mission, first),), remeshed=True)
+    if margin <= 0.0:
+        raise _with_body_notes(first, mission) from None
+    plain = abstraction_for(mission, 0.0, deep=False)
     try:
         planned = attempt(plain, automaton_for(mission, plain))
     except NoPlanError as again:
@@ -175,7 +188,20 @@ def plan_mission(
         automaton=planned.automaton,
         witness=planned.witness,
         notes=(note,),
-        margin_dropped=True,
+        remeshed=True,
+    )
+
+
+def _shallow_note(mission: Mission, failure: NoPlanError) -> Diagnostic:
+    reason = failure.diagnostics[0].message if failure.diagnostics else "no plan"
+    return Diagnostic(
+        code="A030",
+        severity="note",
+        message=f"no plan reaches the goal depth ({reason}); planned to enter the goals only "
+        "as deep as the margin asks",
+        hint="goals that overlap only near their edges have deep parts that do not meet; "
+        "set options.goal_depth to a smaller depth (0: the margin's) to plan with it",
+        file=mission.source,
     )
 
 
