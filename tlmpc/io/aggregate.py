@@ -2,10 +2,11 @@
 
 A map with dozens of racks gives dozens of warnings that differ only in a name, a number or a
 line ("region 'rack7' is not reachable...", "a passage only 0.05 wide at (3, 4)...").  Printed
-one by one they bury everything else.  :func:`aggregate` folds the warnings and notes of one
-report that share their code, severity, file and *shape* (the message and hint with every quoted
-name and every number taken out) into one diagnostic: the first one's text, how many there are,
-and what differs in the others.  Errors are never folded: each is a thing to fix at its place.
+one by one they bury everything else.  :func:`aggregate` folds the warnings of one report that
+share their code, file and *shape* (the message and hint with every quoted name and every
+number taken out) into one diagnostic: the first one's text, how many there are, and what
+differs in the others.  Errors are never folded: each is a thing to fix at its place; nor are
+notes: they explain an error or a warning, often as steps in order (the environment's play).
 """
 
 from __future__ import annotations
@@ -44,15 +45,15 @@ def _key(diagnostic: Diagnostic) -> tuple[object, ...]:
 
 
 def aggregate(diagnostics: Sequence[Diagnostic]) -> list[Diagnostic]:
-    """The diagnostics with each group of two or more alike warnings (or notes) folded into
-    one, at the place of the group's first member; errors and lone warnings unchanged."""
+    """The diagnostics with each group of two or more alike warnings folded into one, at the
+    place of the group's first member; errors, notes and lone warnings unchanged."""
     groups: dict[tuple[object, ...], list[Diagnostic]] = {}
     for diagnostic in diagnostics:
-        if diagnostic.severity != "error":
+        if diagnostic.severity == "warning":
             groups.setdefault(_key(diagnostic), []).append(diagnostic)
     result = []
     for diagnostic in diagnostics:
-        if diagnostic.severity == "error":
+        if diagnostic.severity != "warning":
             result.append(diagnostic)
             continue
         group = groups[_key(diagnostic)]
