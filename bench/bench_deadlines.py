@@ -94,7 +94,7 @@ def run(repeats: int = 3) -> list[dict[str, Any]]:
                     break
             document["ltl"] = far.replace("100000", "0")
             mission = load_mission_text(yaml.safe_dump(document, sort_keys=False), "m.yaml")
-            mesh = abstraction_for(mission, 0.0)
+            mesh = abstraction_for(mission, 0.0, deep=False)
             proofs, proof_s = _median(
                 functools.partial(deadlines.deadline_proofs, mission, mesh), repeats
             )

@@ -32,7 +32,7 @@ def _needle(tip: str, task: str, start: tuple[float, float]) -> dict[str, Any]:
         "workspace": {"boundary": [[0, 0], [10, 0], [10, 10], [0, 10]]},
         "regions": {"b": shapes[tip], "c": [[8.5, 0.2], [9.8, 0.2], [9.8, 0.8]]},
         "robot": {"start": list(start), "max_speed": 1.0},
-        "options": {"min_angle": None},
+        "options": {"min_angle": None, "goal_depth": 0},  # the needle as drawn, no core
         "task": [task],
     }
 

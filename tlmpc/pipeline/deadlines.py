@@ -157,9 +157,13 @@ def _position(mission: Mission, proof: DeadlineBound) -> tuple[int | None, int |
 
 
 def _bounds(mission: Mission, abstraction: Abstraction) -> tuple[DeadlineBound, ...]:
+    from tlmpc.abstraction.layout import deepens_goals
     from tlmpc.mission.body import requested_margin
     from tlmpc.planning.deadlines import deadline_bounds
     from tlmpc.planning.mission import abstraction_for
 
-    mesh = abstraction_for(mission, 0.0) if requested_margin(mission) > 0.0 else abstraction
+    # the proof speaks of every trajectory: the regions as they are (not the goals' cores the
+    # planner aims for) in the whole free space (not the part that keeps the margin)
+    exact = requested_margin(mission) <= 0.0 and not deepens_goals(mission)
+    mesh = abstraction if exact else abstraction_for(mission, 0.0, deep=False)
     return deadline_bounds(mission, mesh)
