@@ -16,19 +16,16 @@ import numpy as np
 
 from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
 from tlmpc.automata.model import Automaton
-from tlmpc.planning.boundary import POINT, StartCell, start_cells
+from tlmpc.planning.boundary import POINT, StartCell
 from tlmpc.planning.product import (
     SLOTS,
     STUTTER_COST,
     BoolArray,
-    LetterClasses,
     Successors,
-    crossing_move_kinds,
     edge_midpoints,
     initial_nodes,
-    move_weights,
+    move_table,
     stutter_cells,
-    ts_moves,
 )
 
 
@@ -169,17 +166,20 @@ def lazy_product(
     arguments, as tables (nothing per product node).  With ``realisable`` a triangle without
     a stay field has no stutter at all (the built product drops only its final stays: the
     tables keep stutter per letter class, so this one is more restrictive, still sound)."""
-    if starts is None:
-        starts = start_cells(abstraction, start_point)
+    table = move_table(
+        abstraction,
+        automaton,
+        allowed=allowed,
+        start_point=start_point,
+        metric=metric,
+        starts=starts,
+        convention=convention,
+        bounces=bounces,
+        realisable=realisable,
+    )
+    starts, classes, tri_class = table.starts, table.classes, table.tri_class
+    moves, weight, raw_kind = table.moves, table.weight, table.kind
     closed = convention == "closed"
-    classes = LetterClasses.of(automaton, list(abstraction.letters))
-    tri_class = classes.letter_class[abstraction.letter_of]
-    moves = ts_moves(abstraction, allowed, starts, bounces=bounces, realisable=realisable)
-    weight = move_weights(abstraction, moves, start_point, metric)
-    if closed:
-        raw_kind = crossing_move_kinds(abstraction, automaton, classes, tri_class, moves)
-    else:
-        raw_kind = tri_class[abstraction.neighbors].reshape(-1)[moves.exit]
     successors = Successors(classes, automaton)
     kinds = successors.of_moves(raw_kind)
     compact = np.zeros(max(kinds, default=0) + 1, dtype=np.int64)

@@ -109,17 +109,20 @@ def build_product(
     ``realisable`` restricts the moves (leave t by edge i, (m, 3)) and the final stays ((m,))
     to those the controllers realise (:func:`tlmpc.planning.robust.realisable`).
     """
-    if starts is None:
-        starts = start_cells(abstraction, start_point)
+    table = move_table(
+        abstraction,
+        automaton,
+        allowed=allowed,
+        start_point=start_point,
+        metric=metric,
+        starts=starts,
+        convention=convention,
+        bounces=bounces,
+        realisable=realisable,
+    )
+    starts, classes, tri_class = table.starts, table.classes, table.tri_class
+    moves, weight, move_kind = table.moves, table.weight, table.kind
     closed = convention == "closed"
-    classes = LetterClasses.of(automaton, list(abstraction.letters))
-    tri_class = classes.letter_class[abstraction.letter_of]
-    moves = ts_moves(abstraction, allowed, starts, bounces=bounces, realisable=realisable)
-    weight = move_weights(abstraction, moves, start_point, metric)
-    if closed:
-        move_kind = crossing_move_kinds(abstraction, automaton, classes, tri_class, moves)
-    else:
-        move_kind = tri_class[abstraction.neighbors].reshape(-1)[moves.exit]
     successors = Successors(classes, automaton)
     stay_cell, stay_class = stutter_cells(abstraction, allowed, starts, tri_class)
     nq = automaton.num_states
@@ -141,6 +144,47 @@ def build_product(
         num_automaton_states=nq,
         num_nodes=size,
     )
+
+
+@dataclass(frozen=True, slots=True)
+class MoveTable:
+    """What the built and the lazy product share: the start cells, the letter classes (and
+    each triangle's), the moves of D with their weights and kinds (a letter class, or under
+    the closed convention a crossing kind, see :func:`crossing_move_kinds`)."""
+
+    starts: tuple[StartCell, ...]
+    classes: LetterClasses
+    tri_class: IntArray
+    moves: _Moves
+    weight: FloatArray
+    kind: IntArray
+
+
+def move_table(
+    abstraction: Abstraction,
+    automaton: Automaton,
+    *,
+    allowed: BoolArray,
+    start_point: tuple[float, float],
+    metric: str,
+    starts: tuple[StartCell, ...] | None,
+    convention: str,
+    bounces: bool,
+    realisable: tuple[BoolArray, BoolArray] | None,
+) -> MoveTable:
+    """The moves of the product over ``abstraction`` and ``automaton`` (arguments as for
+    :func:`build_product`)."""
+    if starts is None:
+        starts = start_cells(abstraction, start_point)
+    classes = LetterClasses.of(automaton, list(abstraction.letters))
+    tri_class = classes.letter_class[abstraction.letter_of]
+    moves = ts_moves(abstraction, allowed, starts, bounces=bounces, realisable=realisable)
+    weight = move_weights(abstraction, moves, start_point, metric)
+    if convention == "closed":
+        kind = crossing_move_kinds(abstraction, automaton, classes, tri_class, moves)
+    else:
+        kind = tri_class[abstraction.neighbors].reshape(-1)[moves.exit]
+    return MoveTable(starts, classes, tri_class, moves, weight, kind)
 
 
 Row = list[tuple[tuple[int, int], ...]]

@@ -26,7 +26,8 @@ from tlmpc.synth.spec import (
     Variable,
 )
 
-_SECTIONS: dict[str, tuple[Owner, str]] = {
+#: slugs' sections: who owns each and what it holds (the structured format has the same)
+SECTIONS: dict[str, tuple[Owner, str]] = {
     "[INPUT]": ("env", "vars"),
     "[OUTPUT]": ("sys", "vars"),
     "[ENV_INIT]": ("env", "init"),
@@ -82,7 +83,7 @@ def parse_slugsin(
             continue
         start = line_start + raw.index(stripped[0])
         if stripped.startswith("["):
-            if stripped not in _SECTIONS:
+            if stripped not in SECTIONS:
                 raise source.fail(
                     "Q031",
                     f"unknown section {stripped!r}",
@@ -90,7 +91,7 @@ def parse_slugsin(
                     "slugsin sections are [INPUT] [OUTPUT] [ENV_INIT] [SYS_INIT] [ENV_TRANS] "
                     "[SYS_TRANS] [ENV_LIVENESS] [SYS_LIVENESS]",
                 )
-            section = _SECTIONS[stripped]
+            section = SECTIONS[stripped]
             continue
         if section is None:
             raise source.fail(

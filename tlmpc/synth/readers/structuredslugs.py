@@ -27,7 +27,7 @@ import re
 from dataclasses import dataclass
 from typing import Literal
 
-from tlmpc.synth.readers.slugsin import _allowed, _formula, _Line
+from tlmpc.synth.readers.slugsin import SECTIONS, _allowed, _formula, _Line
 from tlmpc.synth.readers.source import Source
 from tlmpc.synth.spec import (
     Atom,
@@ -45,16 +45,6 @@ from tlmpc.synth.spec import (
     Variable,
 )
 
-_SECTIONS: dict[str, tuple[Owner, str]] = {
-    "[INPUT]": ("env", "vars"),
-    "[OUTPUT]": ("sys", "vars"),
-    "[ENV_INIT]": ("env", "init"),
-    "[SYS_INIT]": ("sys", "init"),
-    "[ENV_TRANS]": ("env", "safety"),
-    "[SYS_TRANS]": ("sys", "safety"),
-    "[ENV_LIVENESS]": ("env", "liveness"),
-    "[SYS_LIVENESS]": ("sys", "liveness"),
-}
 _OTHER_TOOLS = ("[OBSERVABLE_INPUT]", "[UNOBSERVABLE_INPUT]", "[CONTROLLABLE_INPUT]")
 _WORD = re.compile(r"[a-zA-Z_.'@][a-zA-Z0-9_.'@]*")
 _NUMBER = re.compile(r"[0-9]+")
@@ -428,7 +418,7 @@ def parse_structuredslugs(
                     "tlmpc synth reads GR(1) games: declare the variables under [INPUT] or "
                     "[OUTPUT]",
                 )
-            if stripped not in _SECTIONS:
+            if stripped not in SECTIONS:
                 raise source.fail(
                     "Q131",
                     f"unknown section {stripped!r}",
@@ -436,7 +426,7 @@ def parse_structuredslugs(
                     "structuredslugs sections are [INPUT] [OUTPUT] [ENV_INIT] [SYS_INIT] "
                     "[ENV_TRANS] [SYS_TRANS] [ENV_LIVENESS] [SYS_LIVENESS]",
                 )
-            section = _SECTIONS[stripped]
+            section = SECTIONS[stripped]
             continue
         if section is None:
             raise source.fail(
