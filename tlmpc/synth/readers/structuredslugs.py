@@ -27,7 +27,7 @@ import re
 from dataclasses import dataclass
 from typing import Literal
 
-from tlmpc.synth.readers.slugsin import SECTIONS, _allowed, _formula, _Line
+from tlmpc.synth.readers.slugsin import _allowed, _formula, _Line, section_lines
 from tlmpc.synth.readers.source import Source
 from tlmpc.synth.spec import (
     Atom,
@@ -400,39 +400,15 @@ def parse_structuredslugs(
     source = Source(file, text)
     variables: dict[str, Variable] = {}
     parts: list[Part] = []
-    section: tuple[Owner, str] | None = None
-    offset = 0
-    for raw in text.split("\n"):
-        line_start = offset
-        offset += len(raw) + 1
-        stripped = raw.strip()
-        if not stripped or stripped.startswith("#"):
-            continue
-        start = line_start + raw.index(stripped[0])
-        if stripped.startswith("["):
-            if stripped in _OTHER_TOOLS:
-                raise source.fail(
-                    "Q131",
-                    f"the section {stripped} belongs to slugs' other synthesis modes",
-                    start,
-                    "tlmpc synth reads GR(1) games: declare the variables under [INPUT] or "
-                    "[OUTPUT]",
-                )
-            if stripped not in SECTIONS:
-                raise source.fail(
-                    "Q131",
-                    f"unknown section {stripped!r}",
-                    start,
-                    "structuredslugs sections are [INPUT] [OUTPUT] [ENV_INIT] [SYS_INIT] "
-                    "[ENV_TRANS] [SYS_TRANS] [ENV_LIVENESS] [SYS_LIVENESS]",
-                )
-            section = SECTIONS[stripped]
-            continue
-        if section is None:
-            raise source.fail(
-                "Q131", "a line before any section", start, "start the file with [INPUT]"
-            )
-        owner, what = section
+    for owner, what, stripped, start in section_lines(
+        source,
+        text,
+        code="Q131",
+        unknown_hint="structuredslugs sections are [INPUT] [OUTPUT] [ENV_INIT] [SYS_INIT] "
+        "[ENV_TRANS] [SYS_TRANS] [ENV_LIVENESS] [SYS_LIVENESS]",
+        first_hint="start the file with [INPUT]",
+        other_tools=_OTHER_TOOLS,
+    ):
         if what == "vars":
             variable = _declaration(source, stripped, start, owner, variables)
             variables[variable.name] = variable
