@@ -6,6 +6,7 @@ from __future__ import annotations
 import io
 import json
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -93,6 +94,41 @@ def test_simulate_reports_the_verifiers_verdict(
     # ... and an open run of a winning strategy breaks no guarantee: goals stay inconclusive
     assert result["outcome"] == "inconclusive"
     assert (code, verify_code) == (0, 4), err
+
+
+def test_a_run_that_breaks_a_guarantee_exits_1(
+    guard: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from tlmpc.runtime import reactive_loop
+
+    real = reactive_loop.run_reactive
+
+    def camera_never_on(*args: Any, **kwargs: Any) -> reactive_loop.ReactiveRun:
+        # the robot forgets "if you sense person then do camera" while the run is recorded
+        run = real(*args, **kwargs)
+        start = run.trace["points"][0][0]
+        run.trace["signals"]["camera"] = [[start, False]]
+        return run
+
+    monkeypatch.setattr(reactive_loop, "run_reactive", camera_never_on)
+    trace_path = tmp_path / "trace.json"
+    code, out, _ = run(
+        "simulate",
+        str(guard),
+        "--sensors",
+        "adversarial",
+        "--events",
+        "60",
+        "--json",
+        "-o",
+        str(trace_path),
+    )
+    trace = json.loads(trace_path.read_text())
+    assert any(value for _, value in trace["signals"]["person"])  # a person was sensed
+    result = json.loads(out)["result"]
+    assert result["outcome"] == "violated"
+    assert code == 1
+    assert any("G(person -> camera)" in v for v in result["violations"])
 
 
 def test_json_report(guard: Path) -> None:
