@@ -63,3 +63,37 @@ def write_mission(document: dict[str, Any], directory: Path) -> Path:
     path = directory / f"{document['name']}.yaml"
     path.write_text(yaml.safe_dump(document, sort_keys=False), encoding="utf-8")
     return path
+
+
+def grid_task(n: int, task: str, count: int) -> dict[str, Any]:
+    """The ``n x n`` grid of rooms (:func:`grid_of_rooms`) with a harder task over ``count``
+    rooms spread over the map: ``"cover"`` visits them all while avoiding the room in the
+    middle, ``"patrol"`` visits each of them again and again."""
+    document = grid_of_rooms(n)
+    rooms = spread_rooms(n, count)
+    if task == "cover":
+        middle = f"r{n // 2}_{n // 2}"
+        document["task"] = [f"visit {' and '.join(rooms)}", f"avoid {middle}"]
+    elif task == "patrol":
+        document["task"] = [f"patrol {', '.join(rooms)}"]
+    else:
+        raise ValueError(f"unknown task {task!r}")
+    document["name"] = f"grid-{n}x{n}-{task}-{count}"
+    return document
+
+
+def spread_rooms(n: int, count: int) -> list[str]:
+    """``count`` rooms of the ``n x n`` grid spread over it (a deterministic pseudo-random
+    choice: a linear congruential walk, so the bench needs no seeded generator), never the
+    start room nor the middle one."""
+    chosen: list[str] = []
+    state = 12345
+    taken = {(0, 0), (n // 2, n // 2)}
+    while len(chosen) < count:
+        state = (state * 1103515245 + 12345) % (1 << 31)
+        i, j = state % n, (state // n) % n
+        if (i, j) in taken:
+            continue
+        taken.add((i, j))
+        chosen.append(f"r{i}_{j}")
+    return chosen

@@ -13,9 +13,15 @@ The Python facade (see ``docs/python-api.md``)::
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+# first: a Ctrl-C or SIGTERM while the command is still importing ends it cleanly (the
+# guard does nothing when tlmpc is imported as a library)
+from tlmpc.base.startup import guard_start as _guard_start
 
-from tlmpc.base.errors import (
+_guard_start()
+
+from typing import TYPE_CHECKING, Any  # noqa: E402
+
+from tlmpc.base.errors import (  # noqa: E402
     Diagnostic,
     InvalidInputError,
     NoPlanError,
@@ -23,7 +29,7 @@ from tlmpc.base.errors import (
     TlmpcError,
     UsageError,
 )
-from tlmpc.base.version import __version__
+from tlmpc.base.version import __version__  # noqa: E402
 
 if TYPE_CHECKING:
     from tlmpc.api import (
@@ -31,13 +37,23 @@ if TYPE_CHECKING:
         check,
         compile,
         executor,
+        reactive_executor,
         read_output,
         translate,
         verify_trace,
     )
 
 _FACADE = frozenset(
-    {"Compiled", "check", "compile", "executor", "read_output", "translate", "verify_trace"}
+    {
+        "Compiled",
+        "check",
+        "compile",
+        "executor",
+        "reactive_executor",
+        "read_output",
+        "translate",
+        "verify_trace",
+    }
 )
 
 
@@ -62,6 +78,7 @@ __all__ = [
     "check",
     "compile",
     "executor",
+    "reactive_executor",
     "read_output",
     "translate",
     "verify_trace",

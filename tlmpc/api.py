@@ -32,6 +32,7 @@ from tlmpc.base.errors import Diagnostic, UsageError, error
 if TYPE_CHECKING:
     from tlmpc.automata.model import Automaton
     from tlmpc.runtime import Executor
+    from tlmpc.runtime.reactive import ReactiveExecutor
     from tlmpc.verify.model import Verdict
 
 MissionSource = str | os.PathLike[str] | Mapping[str, Any]
@@ -313,9 +314,45 @@ def executor(output: Compiled | str | os.PathLike[str]) -> Executor:
 
     ``executor(out).command(pose, t)`` returns the velocity to apply (``(vx, vy)``, or
     ``(v, omega)`` for a unicycle), tracking the plan step and recovering when the robot is
-    pushed off its plan; ``.progress`` reports the task's progress.  See docs/python-api.md.
+    pushed off its plan; ``.progress`` reports the task's progress.  A reactive mission's
+    output is refused (R025): its executor is :func:`reactive_executor`.  See
+    docs/python-api.md.
     """
     from tlmpc.runtime import Executor
 
     _expect(output, (Compiled, *_PATH), "output must be a Compiled result or a path", "executor")
+    if _is_reactive(output):
+        raise UsageError(
+            error(
+                "R025",
+                "the output is a reactive mission's (it has a strategy, not a plan)",
+                hint="use tlmpc.reactive_executor(output): its command(point, t, sensors) "
+                "also reads the sensors",
+            )
+        )
     return Executor.from_output(output)
+
+
+def reactive_executor(output: Compiled | str | os.PathLike[str]) -> ReactiveExecutor:
+    """The runtime executor of a compiled reactive mission (an output folder or a
+    :class:`Compiled`).
+
+    ``reactive_executor(out).command(point, t, sensors)`` returns the velocity ``(vx, vy)``
+    to apply, stepping the mission's strategy at every event (a sensor change, an arrival);
+    ``.events`` lists them.  See docs/python-api.md and docs/semantics.md.
+    """
+    from tlmpc.runtime.reactive import ReactiveExecutor
+
+    _expect(
+        output,
+        (Compiled, *_PATH),
+        "output must be a Compiled result or a path",
+        "reactive_executor",
+    )
+    return ReactiveExecutor.from_output(output)
+
+
+def _is_reactive(output: Compiled | str | os.PathLike[str]) -> bool:
+    if isinstance(output, Compiled):
+        return "strategy.json" in output.artifacts
+    return (Path(output) / "strategy.json").is_file()

@@ -24,9 +24,11 @@ from collections.abc import Sequence
 from types import ModuleType
 from typing import Any, TextIO
 
+from tlmpc.base import startup
 from tlmpc.base.errors import EXIT_INTERNAL, EXIT_USAGE, TlmpcError, error, printable
+from tlmpc.base.startup import EXIT_INTERRUPTED, EXIT_TERMINATED
 from tlmpc.base.version import __version__
-from tlmpc.io.report import EXIT_INTERRUPTED, EXIT_TERMINATED, Reporter, exit_code_epilog
+from tlmpc.io.report import Reporter, exit_code_epilog
 
 #: Subcommand modules, in the order ``--help`` lists them.
 COMMAND_MODULES = (
@@ -161,6 +163,38 @@ def _on_sigint(number: int, frame: object) -> None:
     raise KeyboardInterrupt
 
 
+def _redeliver(previous: Any) -> Any:
+    """An unraisable-exception hook that delivers a swallowed signal again.
+
+    A signal handler's exception raised while Python runs a callback it cannot propagate from
+    (a weak reference's, a finaliser, an import lock's) is printed as "Exception ignored" and
+    dropped, and the run would go on as if nothing happened.  The hook arms a one-shot timer
+    instead: its SIGALRM a moment later raises the same exception in ordinary code, where it
+    ends the run.  (Sending the signal from here would run its handler inside this hook.)
+    """
+
+    def hook(unraisable: Any) -> None:
+        exc = unraisable.exc_value
+        if isinstance(exc, (KeyboardInterrupt, _Terminated)) and _RECEIVED:
+            signal.setitimer(signal.ITIMER_REAL, _REDELIVERY_DELAY)
+            return
+        previous(unraisable)
+
+    return hook
+
+
+#: Seconds after a swallowed signal at which it is delivered again.
+_REDELIVERY_DELAY = 0.001
+
+
+def _on_redelivery(number: int, frame: object) -> None:
+    raise _signalled() or KeyboardInterrupt()
+
+
+def _after_the_run(handler: Any) -> Any:
+    return signal.SIG_IGN if handler is startup.end_at_once else handler
+
+
 def _signalled() -> BaseException | None:
     """The exception of the first signal this run received, if any: an exception raised by a
     signal handler inside C code (an extension module being imported, say) may reach us as
@@ -205,9 +239,13 @@ def main(
     previous: Any = None
     previous_int: Any = None
     _RECEIVED.clear()
+    previous_hook = sys.unraisablehook
+    previous_alarm: Any = None
     if threading.current_thread() is threading.main_thread():
+        sys.unraisablehook = _redeliver(previous_hook)
+        previous_alarm = signal.signal(signal.SIGALRM, _on_redelivery)
         previous = signal.signal(signal.SIGTERM, _on_sigterm)
-        if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+        if signal.getsignal(signal.SIGINT) in (signal.default_int_handler, startup.end_at_once):
             previous_int = signal.signal(signal.SIGINT, _on_sigint)
     try:
         code = _main(argv, safe_out, safe_err)
@@ -235,10 +273,17 @@ def main(
                 safe_err.flush()
         return EXIT_USAGE
     finally:
+        # The command's own run is over (its output whole or removed): the start-up guard,
+        # put back, would turn a finished run into an interrupted one, so a late signal of
+        # the command's process is ignored while it exits.
         if previous is not None:
-            signal.signal(signal.SIGTERM, previous)
+            signal.signal(signal.SIGTERM, _after_the_run(previous))
         if previous_int is not None:
-            signal.signal(signal.SIGINT, previous_int)
+            signal.signal(signal.SIGINT, _after_the_run(previous_int))
+        sys.unraisablehook = previous_hook
+        if previous_alarm is not None:
+            signal.setitimer(signal.ITIMER_REAL, 0.0)
+            signal.signal(signal.SIGALRM, previous_alarm)
 
 
 def _main(argv: Sequence[str] | None, out: TextIO, err: TextIO) -> int:

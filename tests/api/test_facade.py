@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import subprocess
 import sys
 from pathlib import Path
@@ -138,3 +139,22 @@ def test_the_repr_of_a_compiled_mission_is_one_short_line() -> None:
     assert f"triangles={triangles['triangles']}" in text
     assert f"satisfied={summary['verdict']['satisfied']}" in text
     assert f"artifacts={len(compiled.artifacts)}" in text
+
+
+def test_reactive_outputs_have_their_own_executor(tmp_path: Path) -> None:
+    from tlmpc.runtime.reactive import ReactiveExecutor
+
+    root = Path(__file__).resolve().parents[2]
+    compiled = tlmpc.compile(root / "specs" / "reactive" / "guard.yaml")
+    with pytest.raises(tlmpc.UsageError) as refused:
+        tlmpc.executor(compiled)
+    assert refused.value.diagnostics[0].code == "R025"
+    executor = tlmpc.reactive_executor(compiled)
+    assert isinstance(executor, ReactiveExecutor)
+    vx, vy = executor.command((1.0, 1.0), 0.0, {"person": True, "alarm": False})
+    assert math.isfinite(vx)
+    assert math.isfinite(vy)
+    assert executor.actions == {"camera": True}  # "if you sense person then do camera"
+    static = tlmpc.compile(root / "specs" / "example1.yaml")
+    with pytest.raises(tlmpc.UsageError):
+        tlmpc.reactive_executor(static)

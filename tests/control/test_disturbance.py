@@ -121,7 +121,7 @@ def test_every_disturbed_run_follows_the_plan(disturbance: float) -> None:
 
 def test_a_disturbance_no_field_can_reject_is_located() -> None:
     with pytest.raises(tlmpc.InvalidInputError) as caught:
-        _compile(0.3)
+        _compile(0.45)
     codes = {d.code for d in caught.value.diagnostics}
     assert codes == {"C032"}
     assert all(d.path == "$.robot.disturbance" for d in caught.value.diagnostics)

@@ -6,7 +6,7 @@
 * C032's hint: a corner of angle a pushed inside both its facets rejects at most
   max_speed * sin(a / 2) (independent: the largest component of a velocity of norm s along
   two inward normals 180 - a apart).  Where a larger ``min_angle`` is enough, following the
-  hint compiles; above the largest ``min_angle`` the hint says no mesh can, and why.
+  hint compiles; above the largest ``min_angle`` the hint says none guarantees it, and why.
 """
 
 from __future__ import annotations
@@ -71,21 +71,34 @@ def _example1(disturbance: float, min_angle: float | None = None) -> dict[str, A
     return dict(mission)
 
 
+def _wedge(disturbance: float, min_angle: float | None) -> dict[str, Any]:
+    """A 20-degree wedge meshed as it is (no refinement): one triangle is too sharp to stay in."""
+    t = math.tan(math.radians(10.0))
+    return {
+        "version": 1,
+        "workspace": {"boundary": [[0, 0], [10, -10 * t], [10, 10 * t]]},
+        "regions": {"a": [[6, -0.5], [9, -0.5], [9, 0.5], [6, 0.5]]},
+        "robot": {"start": [7.5, 0], "max_speed": 1.0, "disturbance": disturbance},
+        "options": {"min_angle": min_angle},
+        "task": ["stay in a"],
+    }
+
+
 def test_following_the_min_angle_hint_compiles() -> None:
     with pytest.raises(tlmpc.InvalidInputError) as refused:
-        tlmpc.compile(_example1(0.27), until="control")
+        tlmpc.compile(_wedge(0.25, None), until="control")
     hint = refused.value.diagnostics[0].hint or ""
     assert refused.value.diagnostics[0].code == "C032"
-    needed = float(hint.split("above ")[1].split(" degrees")[0])
-    assert needed == pytest.approx(math.degrees(2 * math.asin(0.27)), rel=1e-2)
-    tlmpc.compile(_example1(0.27, min_angle=math.ceil(needed)), until="control")
+    needed = float(hint.split("min_angle above ")[1].split(" degrees")[0])
+    assert needed == pytest.approx(math.degrees(2 * math.asin(0.25)), rel=1e-2)
+    tlmpc.compile(_wedge(0.25, math.ceil(needed)), until="control")
 
 
-def test_above_the_largest_min_angle_the_hint_says_no_mesh_can() -> None:
+def test_above_the_largest_min_angle_the_hint_says_no_min_angle_guarantees_it() -> None:
     with pytest.raises(tlmpc.InvalidInputError) as refused:
-        tlmpc.compile(_example1(0.3, min_angle=33), until="control")
+        tlmpc.compile(_example1(0.45, min_angle=33), until="control")
     diagnostic = refused.value.diagnostics[0]
     assert diagnostic.code == "C032"
-    assert "no mesh here can reject it" in (diagnostic.hint or "")
+    assert "no options.min_angle guarantees it" in (diagnostic.hint or "")
     ceiling = math.sin(math.radians(34.0) / 2.0)
-    assert f"{ceiling:.4g}" in (diagnostic.hint or "")
+    assert f"{ceiling:.3f} x max_speed" in (diagnostic.hint or "")

@@ -68,6 +68,9 @@ CASES: dict[str, Expect] = {
     "patrol": Expect(
         loop_visits=frozenset({"alpha", "bravo", "charlie"}), never=frozenset({"lake"})
     ),
+    # "visit dock within 45 s", "avoid hazard", "eventually stay in home" and
+    # G(dock -> F[0,40] home): dock, then home, where it stays
+    "deadline": Expect(order=_steps("dock", "home"), never=frozenset({"hazard"}), ends_in="home"),
     # "visit dock then return to home", "avoid hazard", "eventually stay in home"
     "reach-avoid": Expect(
         order=_steps("dock", "home"), never=frozenset({"hazard"}), ends_in="home"

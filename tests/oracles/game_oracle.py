@@ -10,6 +10,7 @@ goal on its inner edges.
 from __future__ import annotations
 
 import itertools
+from collections import deque
 from collections.abc import Iterator, Mapping
 
 from tlmpc.base.graphs import csr, strong_components
@@ -21,12 +22,14 @@ from tlmpc.synth.spec import (
     Const,
     Expr,
     GameSpec,
+    Linear,
     Nary,
     Not,
     Part,
     Variable,
 )
-from tlmpc.synth.strategy import MealyMachine
+from tlmpc.synth.strategy import MealyMachine, _key
+from tlmpc.synth.symbolic_strategy import SymbolicStrategy
 
 Value = int | bool
 State = Mapping[str, Value]
@@ -50,6 +53,20 @@ def evaluate(expr: Expr, now: State, nxt: State | None = None) -> bool:
             "<=": number <= expr.value,
             ">": number > expr.value,
             ">=": number >= expr.value,
+        }[expr.op]
+    if isinstance(expr, Linear):
+        total = 0
+        for coef, name, primed in expr.terms:
+            source = nxt if primed else now
+            assert source is not None, "a next value outside a transition"
+            total += coef * int(source[name])
+        return {
+            "=": total == expr.value,
+            "!=": total != expr.value,
+            "<": total < expr.value,
+            "<=": total <= expr.value,
+            ">": total > expr.value,
+            ">=": total >= expr.value,
         }[expr.op]
     if isinstance(expr, Not):
         return not evaluate(expr.arg, now, nxt)
@@ -207,7 +224,7 @@ def ltl(expr: Expr) -> str:
         return "1" if expr.value else "0"
     if isinstance(expr, Atom):
         return f"X({expr.name})" if expr.primed else expr.name
-    if isinstance(expr, Compare):
+    if isinstance(expr, Compare | Linear):
         raise ValueError("integer variables have no Spot form here")
     if isinstance(expr, Not):
         return f"!({ltl(expr.arg)})"
@@ -235,4 +252,53 @@ def strict_ltl_of(spec: GameSpec) -> str:
     return (
         f"({conj(spec.select('env', 'init'))}) -> (({conj(spec.select('sys', 'init'))}) & "
         f"(({sys_safety}) W !({env_safety})) & (({assumption}) -> ({guarantee})))"
+    )
+
+
+def explore(spec: GameSpec, strategy: SymbolicStrategy) -> MealyMachine:
+    """The explicit machine the symbolic strategy induces: from its first states, every input
+    allowed by the environment's safety (the oracle's evaluator decides) is stepped."""
+    inputs, outputs = spec.owned("env"), spec.owned("sys")
+    env_init = spec.select("env", "init")
+    env_safety = spec.select("env", "safety")
+    index: dict[tuple[tuple[Value, ...], int], int] = {}
+    states: list[dict[str, Value]] = []
+    goals: list[int] = []
+    transitions: list[tuple[int, int]] = []
+    queue: deque[int] = deque()
+
+    def node(state: dict[str, Value], goal: int) -> int:
+        key = (_key(state), goal)
+        if key not in index:
+            index[key] = len(states)
+            states.append(state)
+            goals.append(goal)
+            queue.append(index[key])
+        return index[key]
+
+    initial: list[int] = []
+    for x in valuations(inputs):
+        if holds(env_init, x):
+            first = strategy.start(x)
+            if first is not None:
+                initial.append(node(first, 0))
+    while queue:
+        source = queue.popleft()
+        for x in valuations(inputs):
+            if not holds(env_safety, states[source], {**states[source], **x}):
+                continue
+            stepped = strategy.step(states[source], goals[source], x)
+            assert stepped is not None, (states[source], x)
+            transitions.append((source, node(*stepped)))
+    return MealyMachine(
+        inputs=inputs,
+        outputs=outputs,
+        goals=strategy.goals,
+        init_mode=spec.init_mode,
+        states=tuple(states),
+        node_goals=tuple(goals),
+        initial=tuple(initial),
+        transitions=tuple(transitions),
+        source_file=spec.file,
+        source_format=spec.source_format,
     )

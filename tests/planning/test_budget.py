@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import io
+import json
 import sys
 from pathlib import Path
 
@@ -44,6 +45,7 @@ def test_too_large_product_is_p040_before_building(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     monkeypatch.setattr(budget, "MAX_PRODUCT_NODES", 1000)
+    monkeypatch.setattr(budget, "MAX_GUIDED_NODES", 1000)
 
     def never(*args: object, **kwargs: object) -> None:
         raise AssertionError("the product was built")
@@ -55,3 +57,20 @@ def test_too_large_product_is_p040_before_building(
     assert code == 2
     assert "error[P040]" in err.getvalue()
     assert not (tmp_path / "out").exists()
+
+
+def test_product_beyond_the_build_budget_is_searched_as_expanded(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(budget, "MAX_PRODUCT_NODES", 1000)
+
+    def never(*args: object, **kwargs: object) -> None:
+        raise AssertionError("the product was built")
+
+    monkeypatch.setattr(sys.modules["tlmpc.planning.plan"], "build_product", never)
+    out, err = io.StringIO(), io.StringIO()
+    spec = str(ROOT / "specs" / "example1.yaml")
+    code = main(["compile", spec, "-o", str(tmp_path / "out"), "-q"], out=out, err=err)
+    assert code == 0, err.getvalue()
+    witness = json.loads((tmp_path / "out" / "witness.json").read_text())
+    assert witness["stats"]["search"] == "guided"

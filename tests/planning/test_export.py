@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import io
+import json
 from pathlib import Path
 
 import pytest
@@ -55,7 +56,8 @@ def test_dot_has_one_node_per_triangle(example1: Path) -> None:
     code, dot, _ = run_cli("export", str(example1), "--format", "dot")
     assert code == 0
     assert dot.startswith("graph ")
-    assert dot.count("label=") == 80  # Example 1's 80 triangles
+    triangles = json.loads((example1 / "abstraction.json").read_text())["triangles"]
+    assert dot.count("label=") == len(triangles)  # one node per triangle of the mesh
 
 
 def test_errors_exit_2_and_write_nothing(example1: Path, tmp_path: Path) -> None:

@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections import deque
 
 import pytest
-from game_oracle import check_counterstrategy, check_strategy
+from game_oracle import check_counterstrategy, check_strategy, explore
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -186,6 +186,8 @@ def _check_explicitly(found: Synthesis, mission: Mission) -> None:
     spec = found.game.spec
     if found.strategy is not None:
         check_strategy(spec, found.strategy)
+        assert found.symbolic is not None
+        check_strategy(spec, explore(spec, found.symbolic))
         pieces, _ = reading(mission_parts(mission), None)
         first = [p for p in pieces if p.owner == "sys" and p.kind in ("init", "invariant")]
         for node in found.strategy.initial:

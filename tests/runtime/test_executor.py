@@ -37,6 +37,8 @@ def _mission(task: str, **robot: Any) -> dict[str, Any]:
         "regions": {"a": {"rect": [4, 3, 6, 4]}, "b": {"rect": [8.5, 0, 10, 1]}},
         "robot": {"start": [1, 1], "max_speed": 1.0, **robot},
         "task": [task],
+        # the recoveries below are set up on this corridor's plain mesh (goals not cored)
+        "options": {"goal_depth": 0},
     }
 
 

@@ -179,19 +179,21 @@ def test_cli_shows_progress_and_time_robustness(tmp_path: Path) -> None:
     assert result["conjuncts"][0]["time_robustness"] == -0.5
 
 
-def test_compile_refuses_time_bounds_at_the_operator(tmp_path: Path) -> None:
+def test_compile_plans_time_bounds_and_automaton_refuses_them(tmp_path: Path) -> None:
     mission = tmp_path / "m.yaml"
     mission.write_text(
         "version: 1\nname: timed\nworkspace:\n  boundary: {rect: [0, 0, 20, 10]}\n"
         "regions:\n  a: {rect: [4, 0, 6, 10]}\nrobot: {start: [1, 5], max_speed: 1.0}\n"
-        'ltl: "F a & F[0,30] a"\n'
+        'ltl: "F a & F[0,2] a"\n'
     )
+    # a is 3 m away at 1 m/s: the deadline of 2 s is proven impossible, at the operator
     code, out, err = run("compile", str(mission), "-o", str(tmp_path / "out"), "-q")
     assert code == 1
-    assert f"{mission}:8:13: error[L045]" in out + err
+    assert f"{mission}:8:13: error[P050]" in out + err
+    assert "at least 3 s > 2 s" in out + err
     code, out, err = run("check", str(mission), "--explain")
     assert code == 0
-    assert "F a & F[0,30] a" in out
+    assert "F a & F[0,2] a" in out
     code, out, err = run("automaton", "G F[0,5] a")
     assert code == 1
     assert "<formula>:1:3: error[L045]" in out + err

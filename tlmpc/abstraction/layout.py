@@ -9,8 +9,9 @@
   label the triangles change with the task (its negation normal form):
 
   - a region that occurs only positively (a goal: visit, stay, reach) labels its **core**, the
-    region eroded by m (by half its inradius when it is smaller: then the core is a small
-    patch around its pole of inaccessibility);
+    region eroded by its goal depth (:func:`goal_depth`: at least m, by default a quarter of
+    its inradius; by half its inradius when that is smaller: then the core is a small patch
+    around its pole of inaccessibility), so that a visit is a visit and not a touch;
   - a region that occurs only negatively (avoid it) labels its **grown** shape, the region
     dilated by m (when the robot starts within m of it, except within 2 m of the start);
   - a region of both polarities, or not in the task, keeps its shape.
@@ -18,7 +19,12 @@
 A task is monotone in each proposition of one polarity, so a run that satisfies it with the
 cores and grown shapes satisfies it with the true regions: planning here is sound, and
 every guarantee of the later stages carries over to the true labels.  It may be infeasible
-where the plain mission is not; the plan stage then plans without the margin and says so.
+where the plain mission is not; the plan stage then plans without the goal depth, then
+without the margin, and says so.
+
+A point robot without margin keeps the mission's own free space and the shapes of the regions
+that are not goals (``free`` and those shapes are ``None`` in its layout): only its goals'
+cores change the mesh.
 """
 
 from __future__ import annotations
@@ -45,10 +51,18 @@ SNAP_SLACK = 2.0
 #: (a smaller patch would be a sliver of the grid's size in the mesh).
 START_ROOM = 1e3
 
+#: The default goal depth, as a fraction of the goal region's inradius (``options.goal_depth``
+#: unset): deep enough that a visit shows in a picture, scale-free, and half way from the
+#: boundary to the cap of half the inradius, so goals that overlap keep cores that meet.
+GOAL_DEPTH_FRACTION = 0.25
+
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class PlanningLayout:
-    """Free space and region shapes to triangulate (shapely geometries, regions in order)."""
+    """Free space and region shapes to triangulate (shapely geometries, regions in order).
+
+    ``free`` None: the mission's own free space; a region's shape None: its own polygon (a
+    point robot without margin, whose goals alone are cored)."""
 
     free: Any
     regions: tuple[Any, ...]
@@ -56,26 +70,48 @@ class PlanningLayout:
     radius: float
 
 
-def core(region: Any, depth: float) -> Any:
-    """``region`` eroded by ``depth``, or by half its inradius when it is thinner than that."""
+def inradius(region: Any) -> float:
+    """The radius of the largest disc in ``region`` (about its pole of inaccessibility)."""
     from shapely.ops import polylabel
 
-    if depth <= 0.0:
-        return region
     size = max(region.bounds[2] - region.bounds[0], region.bounds[3] - region.bounds[1])
     pole = polylabel(region, tolerance=1e-3 * size)
-    inradius = region.exterior.distance(pole)
+    radius = float(region.exterior.distance(pole))
     for interior in region.interiors:
-        inradius = min(inradius, interior.distance(pole))
-    reach = conservative_offset(min(depth, 0.5 * inradius))
+        radius = min(radius, float(interior.distance(pole)))
+    return radius
+
+
+def goal_depth(region: Any, margin: float, requested: float | None) -> float:
+    """How deep a path must go into the goal ``region``: the margin, or ``requested``
+    (``options.goal_depth``; unset: :data:`GOAL_DEPTH_FRACTION` of the inradius) when deeper.
+
+    :func:`core` caps it at half the inradius."""
+    wanted = GOAL_DEPTH_FRACTION * inradius(region) if requested is None else requested
+    return max(margin, wanted)
+
+
+def core(region: Any, depth: float) -> Any:
+    """``region`` eroded by ``depth``, or by half its inradius when it is thinner than that."""
+    if depth <= 0.0:
+        return region
+    reach = conservative_offset(min(depth, 0.5 * inradius(region)))
     return region.buffer(-reach, quad_segs=ARC_SEGMENTS)
 
 
-def planning_layout(mission: Mission, margin: float) -> PlanningLayout | None:
-    """The layout for ``mission`` with ``margin``; None for a point robot without margin."""
+def deepens_goals(mission: Mission) -> bool:
+    """Whether the goal depth asks more than the margin does (on some region)."""
+    requested = mission.options.goal_depth
+    return requested is None or requested > 0.0
+
+
+def planning_layout(mission: Mission, margin: float, *, deep: bool = True) -> PlanningLayout | None:
+    """The layout for ``mission`` with ``margin`` and, with ``deep``, the goal depth; None
+    for a point robot without margin whose goals keep their shapes."""
     radius = obstacle_offset(mission)
+    deep = deep and deepens_goals(mission)
     if radius <= 0.0 and margin <= 0.0:
-        return None
+        return _point_layout(mission) if deep else None
     raw = workspace_free_space(mission)
     # two steps of the snapping grid more: the free space is snapped, and then noded with the
     # regions' rings, each moving a vertex by up to a step's half diagonal
@@ -96,13 +132,14 @@ def planning_layout(mission: Mission, margin: float) -> PlanningLayout | None:
         window = raw.intersection(shapely.box(x - half, y - half, x + half, y + half))
         exact = erode(window, radius, through=mission.robot.start)
         free = shapely.make_valid(shapely.union(free, exact.intersection(near_start)))
-    signs = polarities(mission.formula) if margin > 0.0 else {}
+    signs = polarities(mission.formula) if margin > 0.0 or deep else {}
     shapes: list[Any] = []
     for region in mission.regions:
         shape = shapely.Polygon(region.polygon)
         sign = signs.get(region.name)
         if sign == "positive":
-            inner = core(shape, margin)
+            depth = goal_depth(shape, margin, mission.options.goal_depth) if deep else margin
+            inner = core(shape, depth)
             shape = inner if not inner.is_empty else shape
         elif sign == "negative":
             grown = shape.buffer(conservative_offset(margin), quad_segs=ARC_SEGMENTS)
@@ -113,3 +150,20 @@ def planning_layout(mission: Mission, margin: float) -> PlanningLayout | None:
             shape = shapely.union(shape, grown)
         shapes.append(shape)
     return PlanningLayout(free=free, regions=tuple(shapes), margin=margin, radius=radius)
+
+
+def _point_layout(mission: Mission) -> PlanningLayout | None:
+    """A point robot without margin: the mission's free space, its goals' cores at the goal
+    depth, every other region as it is; None when the task visits no region."""
+    signs = polarities(mission.formula)
+    shapes: list[Any] = []
+    for region in mission.regions:
+        shape: Any = None
+        if signs.get(region.name) == "positive":
+            polygon = shapely.Polygon(region.polygon)
+            inner = core(polygon, goal_depth(polygon, 0.0, mission.options.goal_depth))
+            shape = inner if not inner.is_empty else None
+        shapes.append(shape)
+    if all(shape is None for shape in shapes):
+        return None
+    return PlanningLayout(free=None, regions=tuple(shapes), margin=0.0, radius=0.0)

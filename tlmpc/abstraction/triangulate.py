@@ -227,9 +227,14 @@ def pslg(
     nearly touching or nearly collinear input becomes exactly touching or collinear.
     """
     grid = grid_size(mission)
-    if layout is None:
+    if layout is None or layout.free is None:
         free = free_space(mission, grid)
         regions = _snapped_many([r.polygon for r in mission.regions], grid)
+        if layout is not None:  # a point robot's goal cores
+            regions = [
+                own if shape is None else shapely.set_precision(shape, grid)
+                for own, shape in zip(regions, layout.regions, strict=True)
+            ]
     else:
         free = _snapped_free(layout.free, grid, mission)
         regions = [shapely.set_precision(shape, grid) for shape in layout.regions]

@@ -99,13 +99,28 @@ def _run_locked(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
 
     # One pause for compiling and writing: re-enabling in between would trigger a full
     # collection over everything the compilation still holds.
+    from tlmpc.reactive.synthesize import UnrealizableError
+
     with collector_paused():
-        result = compile_mission(
-            args.mission,
-            until=args.until,
-            progress=None if args.quiet else progress,  # --quiet: no heartbeat either
-            figures=("svg", "png") if args.png else ("svg",),
-        )
+        try:
+            result = compile_mission(
+                args.mission,
+                until=args.until,
+                progress=None if args.quiet else progress,  # --quiet: no heartbeat either
+                figures=("svg", "png") if args.png else ("svg",),
+            )
+        except UnrealizableError as failure:
+            # an unrealizable reactive mission: OUT shows how the environment wins
+            # (tlmpc plot / view draw counterstrategy.json); the answer is still exit 1
+            with staging_directory(destination) as staging:
+                write_artifacts(staging, dict(failure.artifacts))
+                commit(staging, destination, force=args.force)
+            if not args.json and not args.quiet:
+                reporter.note(
+                    f"wrote {len(failure.artifacts)} artifacts to {destination} "
+                    "(the environment's winning play: tlmpc plot / tlmpc view)"
+                )
+            raise
         reporter.diagnose(result.warnings)
         with staging_directory(destination) as staging:
             artifacts = dict(result.artifacts)
@@ -123,5 +138,16 @@ def _run_locked(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         tail = ""
         if verdict is not None:
             tail = f"; trace verifies (robustness {verdict['robustness']:.4g})"
+        bounds = summary.get("bounds")
+        if bounds:  # each time bound with its slack on the trajectory
+            held = ", ".join(f"{b['bound']} by {_seconds(b['slack'])}" for b in bounds)
+            tail += f"; time bounds held: {held}"
         reporter.note(f"wrote {len(artifacts)} artifacts to {destination}{tail}")
     return reporter.finish(EXIT_OK, summary)
+
+
+def _seconds(slack: object) -> str:
+    """A bound's slack as printed: ``13.34 s``, ``any amount`` (``inf``), ``-`` (none)."""
+    if isinstance(slack, int | float):
+        return f"{slack:.4g} s"
+    return "any amount" if slack == "inf" else "-"

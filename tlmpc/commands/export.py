@@ -66,6 +66,11 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     mission = documents["mission.json"]
     formula = parse_ltl(mission["formula"])
     title = str(mission.get("name", "mission"))
+    if args.format in ("promela", "smv"):
+        from tlmpc.ltl.bounds import refuse_bounds
+
+        # SPIN's and NuSMV's LTL have no time bounds (L045 rather than a dropped bound)
+        refuse_bounds(formula, file="<formula>", purpose=f"the {args.format} export")
     if args.format == "promela":
         text = to_promela(abstraction, formula, title, bounce=args.bounce)
     elif args.format == "smv":

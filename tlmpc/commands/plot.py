@@ -32,6 +32,7 @@ _INPUTS = {
     "abstraction.json": "tlmpc.abstraction/",
     "witness.json": "tlmpc.witness/",
     "trace.json": "tlmpc.trace/",
+    "counterstrategy.json": "tlmpc.counterstrategy/",
 }
 
 

@@ -30,7 +30,9 @@ adversarial (the worst push at every instant).  The executor tracks the plan ste
 the plan or re-plans when the robot is pushed into another triangle.  The run lasts --cycles
 laps of the plan's cycle (or dwell times in a final stay; default 2) or --duration seconds;
 the trajectory (of the reference point, for a unicycle) is verified by the independent
-verifier and written with -o.  See docs/cli.md and docs/control.md."""
+verifier and written with -o.  For a reactive mission (OUT has strategy.json) the strategy
+runs against --sensors random, adversarial or a CSV file of timed readings for --events
+events.  See docs/cli.md and docs/control.md."""
 
 
 def _positive(text: str, what: str, code: str) -> float:
@@ -70,6 +72,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--heading", type=float, default=0.0, help="unicycle: initial heading in radians"
     )
+    parser.add_argument(
+        "--sensors",
+        metavar="SOURCE",
+        help="reactive missions: random, adversarial, or a CSV FILE of timed readings "
+        "(default random)",
+    )
+    parser.add_argument(
+        "--events", metavar="N", help="reactive missions: events to run (default 200)"
+    )
     parser.add_argument("-o", "--output", type=Path, help="write the trace.json here")
     parser.add_argument("--json", action="store_true", help="print the report as JSON")
 
@@ -81,6 +92,10 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     from tlmpc.runtime import Executor, make_disturbance, run_closed_loop
     from tlmpc.verify import verify_document
 
+    if args.sensors is not None or args.events is not None or (args.out / "strategy.json").exists():
+        from tlmpc.commands.simulate_reactive import run_reactive_command
+
+        return run_reactive_command(args, out, err)
     if args.disturbance is not None:
         bound = float("nan")
         with contextlib.suppress(ValueError):

@@ -16,7 +16,7 @@ if TYPE_CHECKING:
     from tlmpc.synth.spec import GameSpec
 
 NAME = "synth"
-HELP = "GR(1) synthesis of a gr1c (.spc), slugs (.slugsin) or TLSF specification"
+HELP = "GR(1) synthesis of a gr1c (.spc), slugs (.slugsin, .structuredslugs) or TLSF specification"
 DESCRIPTION = """\
 Decide whether SPEC is realizable: whether the system has a strategy that meets its guarantees
 whatever the environment does within its assumptions (docs/synthesis.md gives each format's
@@ -31,10 +31,12 @@ SHOWN_NODES = 40
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Register the command's flags."""
-    parser.add_argument("spec", type=Path, help="the specification (.spc, .slugsin or .tlsf)")
+    parser.add_argument(
+        "spec", type=Path, help="the specification (.spc, .slugsin, .structuredslugs or .tlsf)"
+    )
     parser.add_argument(
         "--input-format",
-        choices=("gr1c", "slugsin", "tlsf"),
+        choices=("gr1c", "slugsin", "structuredslugs", "tlsf"),
         help="the specification's format (default: by its suffix)",
     )
     parser.add_argument(
@@ -42,6 +44,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--format", choices=("json", "dot"), default="json", help="strategy format for -o"
+    )
+    parser.add_argument(
+        "--symbolic",
+        action="store_true",
+        help="with -o (JSON): write the strategy as decision diagrams, one per output bit, "
+        "instead of listing the machine's nodes (for strategies too large to list)",
     )
     parser.add_argument(
         "--all-init",
@@ -85,10 +93,18 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
 
     reporter = Reporter.for_args(args, out, err)
     fmt = args.input_format or format_of(str(args.spec))
-    if args.all_init and fmt not in ("gr1c", "slugsin"):
+    if args.all_init and fmt not in ("gr1c", "slugsin", "structuredslugs"):
         _fail_flag(args, fmt or "these", "--all-init")
     if args.one_side_init and fmt != "gr1c":
         _fail_flag(args, fmt or "these", "--one-side-init")
+    if args.symbolic and (args.output is None or args.format != "json"):
+        raise UsageError(
+            error(
+                "Q063",
+                "--symbolic applies to a JSON strategy written with -o",
+                hint="add -o FILE.json (and leave --format at json)",
+            )
+        )
     if args.all_init and args.one_side_init:
         raise UsageError(
             error(
@@ -123,6 +139,28 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             from tlmpc.io.outdir import replace_file
             from tlmpc.synth.strategy import extract, to_dot, to_json
 
+            if args.symbolic:
+                from tlmpc.synth.symbolic_strategy import (
+                    reachable_size,
+                    symbolic_document,
+                    symbolic_strategy,
+                )
+
+                size = reachable_size(solution)
+                symbolic = symbolic_strategy(solution)
+                document = symbolic_document(symbolic, size)
+                replace_file(args.output, document_text(document).encode("utf-8"))
+                result["strategy"] = {
+                    "file": str(args.output),
+                    "diagram nodes": len(symbolic.diagram.nodes),
+                    "reachable nodes": size.nodes,
+                    "reachable transitions": size.transitions,
+                }
+                reporter.note(
+                    f"wrote {args.output} ({len(symbolic.diagram.nodes)} diagram nodes; "
+                    f"{size.nodes} reachable nodes, {size.transitions} transitions)"
+                )
+                return reporter.finish(EXIT_OK, result, "realizable\n")
             machine = extract(solution)
             text = to_dot(machine) if args.format == "dot" else document_text(to_json(machine))
             replace_file(args.output, text.encode("utf-8"))

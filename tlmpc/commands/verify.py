@@ -147,7 +147,7 @@ def _run_one(args: argparse.Namespace, path: Path, out: TextIO, err: TextIO) -> 
     from tlmpc.verify import declare_ending, read_trace, verdict_to_json, verify_trace
 
     report = Reporter.for_args(args, out, err)
-    if is_log(path) and _too_large_for_memory(path):
+    if is_log(path) and _too_large_for_memory(path, args.topic):
         verdict = _streamed(args, path)
         report.note(
             f"{path}: streamed ({verdict.stats['samples']:,} samples, "
@@ -163,15 +163,23 @@ def _run_one(args: argparse.Namespace, path: Path, out: TextIO, err: TextIO) -> 
     return report.finish(OUTCOME_EXIT[verdict.outcome], verdict_to_json(verdict), text)
 
 
-def _too_large_for_memory(path: Path) -> bool:
-    from tlmpc.importers.logs import CSV_SUFFIXES
+def _too_large_for_memory(path: Path, topic: str | None) -> bool:
+    """A CSV log past the whole reader's size, or a bag of many pose messages: streamed."""
+    from tlmpc.base.errors import TlmpcError
+    from tlmpc.importers.logs import BAG_STREAM_FROM, CSV_SUFFIXES, bag_pose_count
     from tlmpc.verify.trace_input import is_large_csv
 
-    return path.suffix.lower() in CSV_SUFFIXES and path.is_file() and is_large_csv(path)
+    if path.suffix.lower() in CSV_SUFFIXES and not path.is_dir():
+        return path.is_file() and is_large_csv(path)
+    try:
+        return bag_pose_count(path, topic) > BAG_STREAM_FROM
+    except TlmpcError:
+        return False  # the whole reader gives the same diagnostic
 
 
 def _streamed(args: argparse.Namespace, path: Path) -> Verdict:
-    """A CSV log too large to hold whole, verified in constant memory (docs/verify.md)."""
+    """A CSV log too large to hold whole or a long bag, verified in constant memory
+    (docs/verify.md)."""
     from tlmpc.fleet.stream import verify_log
     from tlmpc.importers.logs import parse_columns, parse_transform
     from tlmpc.verify.trace_input import mission_document
@@ -198,12 +206,19 @@ def _text(path: Path, verdict: Verdict) -> str:
         "stay": "the robot stays at its last point forever",
         "loop": "the loop repeats forever",
     }[verdict.ending]
-    lines.append(f"{path}: {status[verdict.outcome]}: {verdict.formula}")
+    word = status[verdict.outcome]
+    if verdict.reactive is not None and verdict.reactive.blame == "environment":
+        word += " (vacuously: the environment broke an assumption)"
+    lines.append(f"{path}: {word}: {verdict.formula}")
     lines.append(f"  boundary convention: {verdict.convention}; {ending}; {verdict.pieces} pieces")
     timed = any(r.time_robustness is not None for r in verdict.conjuncts)
     if len(verdict.conjuncts) > 1 or verdict.ending == "open" or timed:
         for report in verdict.conjuncts:
             lines.append(f"  {report.conjunct}: {report.outcome}: {report.progress}")
+    if verdict.reactive is not None:
+        from tlmpc.verify.blame import blame_lines
+
+        lines.extend(blame_lines(verdict.reactive, float(verdict.stats["start_time"])))
     for violation in verdict.violations:
         lines.append(f"  violation: {violation.message}")
     lines.append(f"  robustness: {verdict.robustness:.6g}")

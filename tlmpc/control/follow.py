@@ -46,7 +46,7 @@ KEEP_SPEED = 0.9
 OBJECTIVE_GAP = 1e-4
 #: Weight of the vertex program's objective (the guaranteed speeds) in both solves.
 GUARANTEE = 1.0
-#: Every guaranteed exit speed keeps at least this fraction of the vertex program's floor.
+#: Every step's guaranteed exit speed keeps at least this fraction of the vertex program's.
 KEEP_FLOOR = 0.5
 
 
@@ -128,7 +128,7 @@ def follow_program(
     cones: Sequence[tuple[str, int]],
     runs: int,
     steps: int,
-    floor: float,
+    floors: Sequence[float],
     follow: Sequence[FollowStep],
     *,
     alignment: float,
@@ -138,8 +138,9 @@ def follow_program(
     step; returns (A, costs, b, cones) for x = (w, s, f, t).
 
     Minimises ``alignment`` * sum(weight t) - sum(weight d·f) over the path points, with
-    |d x f| <= t there, f >= KEEP_FLOOR * ``floor`` (the vertex program's floor, unit speed)
-    and, given ``speeds`` (one per path point), d·f >= that speed at each.
+    |d x f| <= t there, s_k >= KEEP_FLOOR * ``floors[k]`` (the vertex program's guaranteed
+    speed of step k, unit speed) and, given ``speeds`` (one per path point), d·f >= that
+    speed at each.
     """
     rows_a, size = constraints.shape
     total = size + len(follow)
@@ -171,10 +172,11 @@ def follow_program(
             cols += point.columns
             vals += [-c for c in point.along]
             bounds.append(-speed)
-    rows.append(len(bounds))  # f >= KEEP_FLOOR * floor: -f + s = -KEEP_FLOOR * floor
-    cols.append(2 * runs + steps)
-    vals.append(-1.0)
-    bounds.append(-KEEP_FLOOR * floor)
+    for k, kept in enumerate(floors):  # s_k >= KEEP_FLOOR * floor_k: -s_k + s = -that
+        rows.append(len(bounds))
+        cols.append(2 * runs + k)
+        vals.append(-1.0)
+        bounds.append(-KEEP_FLOOR * kept)
     for k in range(len(follow)):  # t >= 0: -t + s = 0
         rows.append(len(bounds))
         cols.append(size + k)
@@ -230,13 +232,13 @@ def solve_follow(
     cones: Sequence[tuple[str, int]],
     runs: int,
     steps: int,
-    floor: float,
+    floors: Sequence[float],
     follow: Sequence[FollowStep],
 ) -> FollowResult | None:
     """Two solves: the fastest fields along the path (no alignment), then the best aligned
     ones that keep :data:`KEEP_SPEED` of that speed at every path point.  None when either
     does not solve (the vertex program's velocities then stand)."""
-    common = (constraints, offsets, cones, runs, steps, floor, follow)
+    common = (constraints, offsets, cones, runs, steps, floors, follow)
     fastest = _clarabel(*follow_program(*common, alignment=0.0))
     if fastest is None:
         return None
@@ -313,9 +315,9 @@ def follow_channel(
         for step, guide in affine
         if step.through is None and guide is not None and not _needle(step.geometry)
     ]
-    floor = float(speeds.min()) / max_speed if len(speeds) else 0.0
+    floors = (speeds / max_speed).tolist()
     result = solve_follow(
-        form.constraints, form.offsets, form.cones, runs, len(speeds), floor, follow
+        form.constraints, form.offsets, form.cones, runs, len(speeds), floors, follow
     )
     if result is None:
         return None

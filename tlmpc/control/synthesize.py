@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -35,6 +35,14 @@ from tlmpc.control.geometry import (
     triangle_geometry,
 )
 from tlmpc.control.model import Controllers, StepController, VelocityJump
+from tlmpc.control.robust import (
+    Corner,
+    best_direction,
+    best_push_velocities,
+    corner_angle,
+    disturbance_hint,
+    weakest,
+)
 from tlmpc.control.sparse import CscMatrix, Triplets, stacked_csc
 from tlmpc.mission.model import Robot
 from tlmpc.planning.model import Witness
@@ -492,6 +500,24 @@ def _violated_condition(
     return None
 
 
+def _corner(
+    abstraction: Abstraction, index: int, step: _Step, local: int, max_speed: float
+) -> Corner:
+    """Corner ``local`` of ``step`` and its push (what it can reject)."""
+    normals = [a for a, _ in _normals(step, local)]
+    corners = step.geometry.vertices.tolist()
+    x, y = corners[local]
+    return Corner(
+        step=index,
+        triangle=step.triangle,
+        position=(x, y),
+        angle=corner_angle(corners, local),
+        # (best_direction keeps a sliver corner's digits; best_push drops its bisector)
+        push=best_direction(normals)[0] * max_speed,
+        kept=step.exit_edge is None or step.exit_edge == local,
+    )
+
+
 def _check_rejectable(
     abstraction: Abstraction, steps: list[_Step], robot: Robot, source: str | None
 ) -> None:
@@ -510,6 +536,7 @@ def _check_rejectable(
             )
         )
     problems = []
+    pushes: list[Corner] = []
     for index, step in enumerate(steps):
         if step.through is not None:
             # The pursuit law closes in on the corner at s - d, but a push across the pursuit
@@ -534,49 +561,24 @@ def _check_rejectable(
             continue
         corners = abstraction.triangles[step.triangle].tolist()
         for local in range(3):
-            normals = [a for a, _ in _normals(step, local)]
-            best = best_push(normals, robot.max_speed)
-            if best <= robot.disturbance * (1.0 + RECHECK_TOLERANCE):
+            corner = _corner(abstraction, index, step, local, robot.max_speed)
+            pushes.append(corner)
+            if corner.push <= robot.disturbance * (1.0 + RECHECK_TOLERANCE):
                 x, y = abstraction.vertices[corners[local]].tolist()
                 problems.append(
                     error(
                         "C032",
                         f"plan step {index} (triangle {step.triangle}): at the corner "
                         f"({x:.6g}, {y:.6g}) a velocity within max_speed pushes at most "
-                        f"{best:.4g} along every facet it must, not more than the "
+                        f"{corner.push:.4g} along every facet it must, not more than the "
                         f"disturbance {robot.disturbance:g}",
-                        hint=_angle_hint(robot),
                         file=source,
                         path="$.robot.disturbance",
                     )
                 )
     if problems:
-        raise InvalidInputError(problems[:10])
-
-
-#: The largest smallest-angle bound the triangulator meets (degrees; the mission format's
-#: ``options.min_angle`` allows up to 34).
-MAX_MIN_ANGLE = 34.0
-
-
-def _angle_hint(robot: Robot) -> str:
-    """What the mesh can do about a disturbance: a corner of angle a pushed inside both of
-    its facets rejects at most max_speed * sin(a / 2), so ``min_angle`` helps only up to
-    max_speed * sin(MAX_MIN_ANGLE / 2)."""
-    ratio = robot.disturbance / robot.max_speed
-    ceiling = math.sin(math.radians(MAX_MIN_ANGLE) / 2.0)
-    if ratio < ceiling:
-        needed = math.degrees(2.0 * math.asin(ratio))
-        return (
-            f"raise options.min_angle above {needed:.3g} degrees (a corner of angle a rejects "
-            f"at most max_speed * sin(a / 2)), lower robot.disturbance, or raise max_speed"
-        )
-    return (
-        f"no mesh here can reject it: a corner of angle a rejects at most max_speed * "
-        f"sin(a / 2), and options.min_angle is at most {MAX_MIN_ANGLE:g} degrees, so the "
-        f"largest disturbance a mesh supports is {ceiling * robot.max_speed:.4g} "
-        f"({ceiling:.3f} x max_speed); lower robot.disturbance or raise max_speed"
-    )
+        hint = disturbance_hint(robot.disturbance, robot.max_speed, weakest(pushes))
+        raise InvalidInputError([replace(p, hint=hint) for p in problems[:10]])
 
 
 def pursuit_controller(
@@ -666,64 +668,49 @@ def synthesize(
             )
             continue
         w = velocities[[column[r] for r in step.runs]]
-        geometry = step.geometry
-        target = None
-        if step.exit_edge is None:
-            center = geometry.incenter()
-            gain, offset = affine_law(geometry.vertices, w)
-            inward = min(-geometry.normals[j] @ w[i] for i in range(3) for j in range(3) if j != i)
-            if inward <= 0 or np.max(np.linalg.eigvals(gain).real) >= 0:
-                # The program's optimum is degenerate here: use the radial field to x*.
-                kappa = robot.max_speed / max(np.linalg.norm(center - v) for v in geometry.vertices)
-                w = kappa * (center - geometry.vertices)
-                inward = min(
-                    -geometry.normals[j] @ w[i] for i in range(3) for j in range(3) if j != i
-                )
-            gain, offset = affine_law(geometry.vertices, w)
-            speed, bound = float(inward), float("inf")
-            # The field's own equilibrium (the program puts it at the incenter, to the
-            # solver's tolerance): the state converges there, so that is the target.
-            equilibrium = np.linalg.solve(gain, -offset)
-            target = (float(equilibrium[0]), float(equilibrium[1]))
-        else:
-            gain, offset = affine_law(geometry.vertices, w)
-            nx, ny = geometry.normals[step.exit_edge].tolist()
-            delta = min(nx * wx + ny * wy for wx, wy in w.tolist())  # numpy's 2-vector dot
-            speed = delta
-            # under a disturbance |w| <= d the state still crosses at delta - d or faster
-            closing = delta - robot.disturbance
-            bound = (
-                float(geometry.heights[step.exit_edge] / closing) if closing > 0 else float("inf")
-            )
-        controllers.append(
-            StepController(
-                step=index,
-                triangle=step.triangle,
-                exit_edge=step.exit_edge,
-                next_triangle=step.next_triangle,
-                vertices=geometry.vertices,
-                velocities=w,
-                gain=gain,
-                offset=offset,
-                exit_speed=speed,
-                exit_time_bound=bound,
-                target=target,
-            )
-        )
-    for controller in controllers:
+        controllers.append(_affine_controller(index, step, w, robot))
+    for position, controller in enumerate(controllers):
         if controller.is_vertex:
             continue  # the pursuit law's guarantees hold by construction (docs/control.md)
         problem = _violated_condition(controller, robot.max_speed, robot.disturbance)
-        if problem is not None:
-            raise SolverError(
+        if problem is None:
+            continue
+        # A needle: the solver's tolerance swamps the little its sliver corners can push.
+        # The best-push field (or a stay's radial field), built from the geometry alone,
+        # meets every row to rounding where any field can.
+        step = steps[position]
+        rebuilt = _geometric_controller(position, step, robot)
+        if _violated_condition(rebuilt, robot.max_speed, robot.disturbance) is None:
+            controllers[position] = rebuilt
+            jumps.extend(_own_velocity_jumps(abstraction, steps, position, loop_start))
+            continue
+        floor = robot.disturbance + RECHECK_TOLERANCE * robot.max_speed
+        pushes = [_corner(abstraction, position, step, k, robot.max_speed) for k in range(3)]
+        bound = weakest(pushes)
+        if bound.push <= floor * (1.0 + RECHECK_TOLERANCE):
+            x, y = bound.position
+            raise InvalidInputError(
                 error(
-                    "C030",
-                    f"plan step {controller.step} (triangle {controller.triangle}): the solved "
-                    f"field fails the re-check: {problem}",
-                    hint="the triangle may be a needle: raise options.min_angle, or report "
-                    "this mission",
+                    "C050",
+                    f"plan step {position} (triangle {step.triangle}) has a corner of "
+                    f"{bound.angle:.3g} degrees at ({x:.6g}, {y:.6g}) where no velocity within "
+                    f"max_speed pushes more than {bound.push:.3g} along the facets it must: "
+                    "not more than the disturbance plus the controllers' stated tolerance "
+                    f"(1e-9 x max_speed, {floor:.3g} in all)",
+                    hint="a needle triangle: set options.min_angle (e.g. 20) to refine the mesh "
+                    "around it; if the corner is a region's or obstacle's own corner this "
+                    "sharp, blunt it",
+                    file=source,
                 )
             )
+        raise SolverError(
+            error(
+                "C030",
+                f"plan step {controller.step} (triangle {controller.triangle}): the solved "
+                f"field fails the re-check: {problem}",
+                hint="please report this mission",
+            )
+        )
     if any(c.exit_speed <= 0 for c in controllers):
         worst = min(controllers, key=lambda c: c.exit_speed)
         raise SolverError(
@@ -748,3 +735,82 @@ def synthesize(
             **following,
         },
     )
+
+
+def _affine_controller(
+    index: int, step: _Step, w: FloatArray, robot: Robot, *, radial: bool = False
+) -> StepController:
+    """The affine field of ``step`` through the vertex velocities ``w`` (for a stay with
+    ``radial``, or where the solved field is degenerate, the radial field to the incenter)."""
+    geometry = step.geometry
+    target = None
+    if step.exit_edge is None:
+        center = geometry.incenter()
+        gain, offset = affine_law(geometry.vertices, w)
+        inward = min(-geometry.normals[j] @ w[i] for i in range(3) for j in range(3) if j != i)
+        if radial or inward <= 0 or np.max(np.linalg.eigvals(gain).real) >= 0:
+            # The program's optimum is degenerate here: use the radial field to x*.
+            kappa = robot.max_speed / max(np.linalg.norm(center - v) for v in geometry.vertices)
+            w = kappa * (center - geometry.vertices)
+            inward = min(-geometry.normals[j] @ w[i] for i in range(3) for j in range(3) if j != i)
+        gain, offset = affine_law(geometry.vertices, w)
+        speed, bound = float(inward), float("inf")
+        # The field's own equilibrium (the program puts it at the incenter, to the
+        # solver's tolerance): the state converges there, so that is the target.
+        equilibrium = np.linalg.solve(gain, -offset)
+        target = (float(equilibrium[0]), float(equilibrium[1]))
+    else:
+        gain, offset = affine_law(geometry.vertices, w)
+        nx, ny = geometry.normals[step.exit_edge].tolist()
+        delta = min(nx * wx + ny * wy for wx, wy in w.tolist())  # numpy's 2-vector dot
+        speed = delta
+        # under a disturbance |w| <= d the state still crosses at delta - d or faster
+        closing = delta - robot.disturbance
+        bound = float(geometry.heights[step.exit_edge] / closing) if closing > 0 else float("inf")
+    return StepController(
+        step=index,
+        triangle=step.triangle,
+        exit_edge=step.exit_edge,
+        next_triangle=step.next_triangle,
+        vertices=geometry.vertices,
+        velocities=w,
+        gain=gain,
+        offset=offset,
+        exit_speed=speed,
+        exit_time_bound=bound,
+        target=target,
+    )
+
+
+def _geometric_controller(index: int, step: _Step, robot: Robot) -> StepController:
+    """The field of ``step`` from its geometry alone: the best-push field of an exit step,
+    the radial field of a stay (each corner pushes its corner push, see control.robust)."""
+    if step.exit_edge is None:
+        return _affine_controller(index, step, np.zeros((3, 2)), robot, radial=True)
+    rows = [_normals(step, local) for local in range(3)]
+    w = np.array(best_push_velocities(rows, robot.max_speed), dtype=np.float64)
+    return _affine_controller(index, step, w, robot)
+
+
+def _own_velocity_jumps(
+    abstraction: Abstraction, steps: list[_Step], position: int, loop_start: int | None
+) -> list[VelocityJump]:
+    """Jumps at the corners step ``position`` shares with its neighbours in the plan, once
+    its velocities are its own."""
+    reason = "a needle's field is built from its own geometry"
+    corners = abstraction.triangles[steps[position].triangle].tolist()
+    following = position + 1
+    if following == len(steps) and loop_start is not None:
+        following = loop_start  # the cycle's wrap
+    found = []
+    # (the step where the field changes, the neighbour sharing corners with this one)
+    for at, neighbour in ((position, position - 1), (following, following)):
+        if not 0 <= neighbour < len(steps) or neighbour == position:
+            continue
+        if steps[neighbour].through is not None:
+            continue  # no velocity is shared across a vertex passage
+        for vertex in abstraction.triangles[steps[neighbour].triangle].tolist():
+            if vertex in corners:
+                x, y = abstraction.vertices[vertex].tolist()
+                found.append(VelocityJump(step=at, vertex=vertex, position=(x, y), reason=reason))
+    return found

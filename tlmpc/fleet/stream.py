@@ -241,8 +241,15 @@ def _log_chunks(
     transform: tuple[float, float, float] | None,
     frame: str | None,
     block_chars: int,
+    whole_bag: bool,
 ) -> Iterator[tuple[FloatArray, tuple[int, ...]]]:
-    from tlmpc.importers.logs import CSV_SUFFIXES, apply_transform, iter_csv_chunks, read_log
+    from tlmpc.importers.logs import (
+        CSV_SUFFIXES,
+        apply_transform,
+        iter_bag_chunks,
+        iter_csv_chunks,
+        read_log,
+    )
 
     if path.suffix.lower() in CSV_SUFFIXES and path.is_file():
         if topic is not None or frame is not None:
@@ -250,8 +257,15 @@ def _log_chunks(
         for chunk in iter_csv_chunks(path, columns, block_chars):
             yield apply_transform(chunk.samples, transform), chunk.lines
         return
-    # A bag is sorted by stamp as a whole: read it, then stream its samples.
-    log = read_log(path, topic=topic, columns=columns, transform=transform, frame=frame)
+    if columns is not None or (frame is not None and transform is not None):
+        read_log(path, columns=columns, transform=transform, frame=frame)  # the diagnostic
+    # A bag whose stamps come in order streams chunk by chunk (iter_bag_chunks raises
+    # BagOutOfOrder otherwise); ``whole_bag`` reads it whole and sorts it by stamp.
+    if not whole_bag:
+        for poses in iter_bag_chunks(path, topic, frame):
+            yield apply_transform(poses, transform), ()
+        return
+    log = read_log(path, topic=topic, transform=transform, frame=frame)
     for start in range(0, max(len(log.samples), 1), BAG_CHUNK):
         yield log.samples[start : start + BAG_CHUNK], ()
 
@@ -271,7 +285,45 @@ def verify_log(
 ) -> StreamedVerdict:
     """Verify the log at ``path`` against ``document`` (a sample-less ``tlmpc.trace/1``, see
     :func:`tlmpc.verify.trace_input.mission_document`), a CSV log ``block_chars`` characters at
-    a time."""
+    a time, a bag a chunk of messages at a time (a bag whose stamps go back somewhere is
+    verified again from the start, read whole and sorted)."""
+    from tlmpc.importers.logs import BagOutOfOrder
+
+    def attempt(whole_bag: bool) -> StreamedVerdict:
+        return _verify_log(
+            path,
+            document,
+            convention=convention,
+            topic=topic,
+            columns=columns,
+            transform=transform,
+            frame=frame,
+            assume_stay=assume_stay,
+            loop_from=loop_from,
+            block_chars=block_chars,
+            whole_bag=whole_bag,
+        )
+
+    try:
+        return attempt(whole_bag=False)
+    except BagOutOfOrder:
+        return attempt(whole_bag=True)
+
+
+def _verify_log(
+    path: Path,
+    document: Mapping[str, Any],
+    *,
+    convention: str | None,
+    topic: str | None,
+    columns: Sequence[str] | None,
+    transform: tuple[float, float, float] | None,
+    frame: str | None,
+    assume_stay: bool,
+    loop_from: float | None,
+    block_chars: int,
+    whole_bag: bool,
+) -> StreamedVerdict:
     file = str(path)
     reducer = Reducer(document, pin_time=loop_from)
     top_speed = 0.0
@@ -285,6 +337,7 @@ def verify_log(
         transform=transform,
         frame=frame,
         block_chars=block_chars,
+        whole_bag=whole_bag,
     )
     for samples in _checked_chunks(chunks, file):
         joined = samples if last is None else np.vstack([last, samples])

@@ -24,9 +24,11 @@ This module imports nothing from the planning stages; ``rosbags`` is imported on
 
 from __future__ import annotations
 
+import contextlib
 import math
 import re
-from collections.abc import Iterator, Sequence
+from array import array
+from collections.abc import Generator, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -449,11 +451,75 @@ def _listing(connections: Sequence[tuple[str, str, int]]) -> str:
 
 
 def read_bag(path: Path, topic: str | None = None, frame: str | None = None) -> Log:
-    """Poses from a ROS 1 bag, a ROS 2 bag directory or an MCAP file.
+    """Poses from a ROS 1 bag, a ROS 2 bag directory or an MCAP file, sorted by stamp.
 
     With ``frame``, each pose is expressed in that frame through the bag's ``/tf`` and
-    ``/tf_static`` at its stamp (see :mod:`tlmpc.importers.frames`).
+    ``/tf_static`` at its stamp (see :mod:`tlmpc.importers.frames`).  The poses are gathered in
+    flat arrays (24 bytes a message); :func:`iter_bag_chunks` reads in constant memory.
     """
+    stamps = array("q")
+    xs = array("d")
+    ys = array("d")
+    with _opened_bag(path, topic) as (reader, chosen, chosen_topic):
+        for chunk in _pose_chunks(reader, chosen, frame, str(path), BAG_CHUNK):
+            stamps.extend(chunk[0])
+            xs.extend(chunk[1])
+            ys.extend(chunk[2])
+    return Log(samples=_sorted_samples(stamps, xs, ys), source=str(path), topic=chosen_topic)
+
+
+#: Poses per chunk of :func:`iter_bag_chunks` (and of the whole reader's gathering).
+BAG_CHUNK = 8_192
+
+
+#: Bags with more pose messages than this are verified as a stream (``tlmpc verify``): memory
+#: constant in the number of messages instead of growing with it.
+BAG_STREAM_FROM = 100_000
+
+
+def bag_pose_count(path: Path, topic: str | None = None) -> int:
+    """How many messages the bag's pose topic declares (its index; the reader's diagnostics)."""
+    with _opened_bag(path, topic, limit=False) as (_, chosen, _):
+        return sum(int(c.msgcount) for c in chosen)
+
+
+class BagOutOfOrder(Exception):
+    """The bag's pose stamps go back in time where it was read in order: it cannot be streamed
+    (a stream cannot be sorted); read it whole with :func:`read_bag` instead."""
+
+
+def iter_bag_chunks(
+    path: Path,
+    topic: str | None = None,
+    frame: str | None = None,
+    chunk: int = BAG_CHUNK,
+) -> Iterator[FloatArray]:
+    """The bag's poses ``[t, x, y]`` in chunks of at most ``chunk``, in the order the bag
+    stores them, holding one chunk at a time (memory constant in the number of messages).
+
+    Raises :class:`BagOutOfOrder` at the first stamp earlier than the one before it (a
+    recording whose header stamps disagree with its log times); the diagnostics and the
+    message limit (M060–M066, M102–M106) are :func:`read_bag`'s.
+    """
+    last = -(2**63)
+    with _opened_bag(path, topic) as (reader, chosen, _):
+        for stamps, xs, ys in _pose_chunks(reader, chosen, frame, str(path), chunk):
+            ordered = np.asarray(stamps, dtype=np.int64)
+            if len(ordered) and (ordered[0] < last or np.any(np.diff(ordered) < 0)):
+                raise BagOutOfOrder(str(path))
+            if len(ordered):
+                last = int(ordered[-1])
+            yield np.column_stack(
+                [ordered / 1e9, np.asarray(xs, dtype=np.float64), np.asarray(ys, dtype=np.float64)]
+            ).reshape(-1, 3)
+
+
+@contextlib.contextmanager
+def _opened_bag(
+    path: Path, topic: str | None, *, limit: bool = True
+) -> Iterator[tuple[Any, list[Any], str]]:
+    """The open reader, the chosen pose connections and their topic (diagnostics M060–M066;
+    M066 for a declared count over the limit only with ``limit``)."""
     require("rosbags.highlevel", "reading a ROS bag or MCAP log", file=str(path))
     from rosbags.highlevel import AnyReader
     from rosbags.typesys import Stores, get_typestore
@@ -471,86 +537,127 @@ def read_bag(path: Path, topic: str | None = None, frame: str | None = None) -> 
             hint="expected a ROS 1 .bag, a ROS 2 bag directory (sqlite3 or MCAP) or a .mcap file",
         ) from None
     try:
-        everything = [(c.topic, c.msgtype, c.msgcount) for c in reader.connections]
-        poses = [c for c in reader.connections if c.msgtype in POSE_TYPES]
-        if topic is not None:
-            chosen = [c for c in reader.connections if c.topic == topic]
-            if not chosen:
-                raise _fail(
-                    "M062",
-                    f"the bag has no topic {topic!r}",
-                    file,
-                    hint=f"topics: {_listing(everything) or '(none)'}",
-                )
-            wrong = [c for c in chosen if c.msgtype not in POSE_TYPES]
-            if wrong:
-                listing = _listing([(c.topic, c.msgtype, c.msgcount) for c in poses])
-                raise _fail(
-                    "M063",
-                    f"topic {topic!r} carries {wrong[0].msgtype}, not a pose",
-                    file,
-                    hint="pose topics carry "
-                    + ", ".join(POSE_TYPES)
-                    + (f"; this bag has {listing}" if poses else ""),
-                )
-        else:
-            topics = sorted({c.topic for c in poses})
-            if not topics:
-                raise _fail(
-                    "M061",
-                    "the bag has no pose topic (nav_msgs/Odometry, geometry_msgs/PoseStamped "
-                    "or PoseWithCovarianceStamped)",
-                    file,
-                    hint=f"topics: {_listing(everything) or '(none)'}",
-                )
-            if len(topics) > 1:
-                listing = _listing([(c.topic, c.msgtype, c.msgcount) for c in poses])
-                raise _fail(
-                    "M064",
-                    f"the bag has {len(topics)} pose topics; choose one with --topic",
-                    file,
-                    hint=listing,
-                )
-            chosen = [c for c in poses if c.topic == topics[0]]
-            topic = topics[0]
+        chosen, topic = _chosen_connections(reader, topic, file)
         declared = sum(int(c.msgcount) for c in chosen)
-        if declared > MAX_LOG_SAMPLES:
+        if limit and declared > MAX_LOG_SAMPLES:
             raise _too_many(file)
-        rows: list[tuple[int, float, float]] = []
-        frames: list[tuple[int, float, float, float, str]] = []
-        try:
-            for connection, log_time, raw in reader.messages(connections=chosen):
-                message: Any = reader.deserialize(raw, connection.msgtype)
-                pose: Any = message
-                for part in POSE_TYPES[connection.msgtype].split("."):
-                    pose = getattr(pose, part)
-                stamp = message.header.stamp
-                nanoseconds = int(stamp.sec) * 1_000_000_000 + int(stamp.nanosec)
-                when = nanoseconds if nanoseconds else int(log_time)
-                rows.append((when, float(pose.position.x), float(pose.position.y)))
-                if len(rows) > MAX_LOG_SAMPLES:  # a bag whose index understates its messages
-                    raise _too_many(file)
-                if frame is not None:
-                    frames.append(
-                        (
-                            when,
-                            float(pose.position.x),
-                            float(pose.position.y),
-                            float(pose.position.z),
-                            str(message.header.frame_id),
-                        )
-                    )
-            if frame is not None:
-                rows = _in_frame(reader, frames, frame, file)
-        except UsageError:
-            raise
-        except Exception as exc:
-            raise _fail(
-                "M065", f"cannot read the bag's messages: {type(exc).__name__}: {exc}", file
-            ) from None
+        yield reader, chosen, topic
     finally:
         reader.close()
-    return Log(samples=_sorted_samples(rows), source=file, topic=topic)
+
+
+def _chosen_connections(reader: Any, topic: str | None, file: str) -> tuple[list[Any], str]:
+    everything = [(c.topic, c.msgtype, c.msgcount) for c in reader.connections]
+    poses = [c for c in reader.connections if c.msgtype in POSE_TYPES]
+    if topic is not None:
+        chosen = [c for c in reader.connections if c.topic == topic]
+        if not chosen:
+            raise _fail(
+                "M062",
+                f"the bag has no topic {topic!r}",
+                file,
+                hint=f"topics: {_listing(everything) or '(none)'}",
+            )
+        wrong = [c for c in chosen if c.msgtype not in POSE_TYPES]
+        if wrong:
+            listing = _listing([(c.topic, c.msgtype, c.msgcount) for c in poses])
+            raise _fail(
+                "M063",
+                f"topic {topic!r} carries {wrong[0].msgtype}, not a pose",
+                file,
+                hint="pose topics carry "
+                + ", ".join(POSE_TYPES)
+                + (f"; this bag has {listing}" if poses else ""),
+            )
+        return chosen, topic
+    topics = sorted({c.topic for c in poses})
+    if not topics:
+        raise _fail(
+            "M061",
+            "the bag has no pose topic (nav_msgs/Odometry, geometry_msgs/PoseStamped "
+            "or PoseWithCovarianceStamped)",
+            file,
+            hint=f"topics: {_listing(everything) or '(none)'}",
+        )
+    if len(topics) > 1:
+        listing = _listing([(c.topic, c.msgtype, c.msgcount) for c in poses])
+        raise _fail(
+            "M064",
+            f"the bag has {len(topics)} pose topics; choose one with --topic",
+            file,
+            hint=listing,
+        )
+    return [c for c in poses if c.topic == topics[0]], topics[0]
+
+
+def _pose_chunks(
+    reader: Any, chosen: list[Any], frame: str | None, file: str, size: int
+) -> Iterator[tuple[list[int], list[float], list[float]]]:
+    """The poses (stamp ns, x, y) of ``chosen`` in stored order, ``size`` at a time, in
+    ``frame`` when given; counts them against :data:`MAX_LOG_SAMPLES` as they come."""
+    tree: Any = None
+    count = 0
+    try:
+        batch: list[tuple[int, float, float, float, str]] = []
+        for connection, log_time, raw in reader.messages(connections=chosen):
+            message: Any = reader.deserialize(raw, connection.msgtype)
+            pose: Any = message
+            for part in POSE_TYPES[connection.msgtype].split("."):
+                pose = getattr(pose, part)
+            stamp = message.header.stamp
+            nanoseconds = int(stamp.sec) * 1_000_000_000 + int(stamp.nanosec)
+            when = nanoseconds if nanoseconds else int(log_time)
+            count += 1
+            if count > MAX_LOG_SAMPLES:  # a bag whose index understates its messages
+                raise _too_many(file)
+            position = pose.position
+            batch.append(
+                (
+                    when,
+                    float(position.x),
+                    float(position.y),
+                    float(position.z),
+                    str(message.header.frame_id) if frame is not None else "",
+                )
+            )
+            if len(batch) == size:
+                tree = yield from _emit(reader, batch, frame, tree, file)
+                batch = []
+        if batch:
+            yield from _emit(reader, batch, frame, tree, file)
+    except UsageError:
+        raise
+    except Exception as exc:
+        raise _fail(
+            "M065", f"cannot read the bag's messages: {type(exc).__name__}: {exc}", file
+        ) from None
+
+
+def _emit(
+    reader: Any,
+    batch: list[tuple[int, float, float, float, str]],
+    frame: str | None,
+    tree: Any,
+    file: str,
+) -> Generator[tuple[list[int], list[float], list[float]], None, Any]:
+    """One chunk of poses, in ``frame`` when given; returns the tf tree (read on first need,
+    once per bag) for the next chunk."""
+    from tlmpc.importers.frames import frame_name
+
+    if frame is None or all(frame_name(f) == frame_name(frame) for *_, f in batch):
+        yield [p[0] for p in batch], [p[1] for p in batch], [p[2] for p in batch]
+        return tree
+    if tree is None:
+        tree = _tf_tree(reader, sorted({f for *_, f in batch}), frame, file)
+    stamps = np.asarray([p[0] for p in batch], dtype=np.int64)
+    positions = np.asarray([p[1:4] for p in batch], dtype=np.float64).reshape(-1, 3)
+    sources = np.asarray([frame_name(p[4]) for p in batch])
+    result = np.empty_like(positions)
+    for source in sorted(set(sources.tolist())):
+        picked = sources == source
+        result[picked] = tree.express(frame, source, stamps[picked], positions[picked])
+    yield stamps.tolist(), result[:, 0].tolist(), result[:, 1].tolist()
+    return tree
 
 
 def _too_many(file: str) -> UsageError:
@@ -582,17 +689,13 @@ def _check_bag_path(path: Path, file: str) -> None:
         )
 
 
-def _in_frame(
-    reader: Any, poses: list[tuple[int, float, float, float, str]], frame: str, file: str
-) -> list[tuple[int, float, float]]:
-    """The poses (stamp, x, y, z, frame id) expressed in ``frame`` through the bag's tf."""
-    from tlmpc.importers.frames import TF_TYPE, TransformCollector, frame_name
+def _tf_tree(reader: Any, logged: list[str], frame: str, file: str) -> Any:
+    """The transform tree of the bag's ``/tf`` and ``/tf_static`` (read in a pass of its own);
+    M102 when it has none while poses are in ``logged`` frames other than ``frame``."""
+    from tlmpc.importers.frames import TF_TYPE, TransformCollector
 
-    if all(frame_name(f) == frame_name(frame) for *_, f in poses):
-        return [(t, x, y) for t, x, y, _, _ in poses]
     connections = [c for c in reader.connections if c.msgtype == TF_TYPE]
     if not connections:
-        logged = sorted({f for *_, f in poses})
         raise _fail(
             "M102",
             f"--frame {frame}: the poses are in {', '.join(map(repr, logged))} and the bag has "
@@ -616,29 +719,20 @@ def _in_frame(
                 rotation=(float(r.x), float(r.y), float(r.z), float(r.w)),
                 static=static,
             )
-    tree = collector.tree()
-    stamps = np.asarray([p[0] for p in poses], dtype=np.int64)
-    positions = np.asarray([p[1:4] for p in poses], dtype=np.float64).reshape(-1, 3)
-    sources = np.asarray([frame_name(p[4]) for p in poses])
-    result = np.empty_like(positions)
-    for source in sorted(set(sources.tolist())):
-        chosen = sources == source
-        result[chosen] = tree.express(frame, source, stamps[chosen], positions[chosen])
-    return [
-        (int(t), float(x), float(y))
-        for t, (x, y) in zip(stamps.tolist(), result[:, :2].tolist(), strict=True)
-    ]
+    return collector.tree()
 
 
-def _sorted_samples(rows: list[tuple[int, float, float]]) -> FloatArray:
+def _sorted_samples(stamps: array[int], xs: array[float], ys: array[float]) -> FloatArray:
     """Sorted by integer nanoseconds (exact, stable), then seconds.
 
     Repeated stamps are kept: the verifier refuses them (V020) as it does in a CSV log, since
     two poses at one instant are not a trajectory and keeping one would hide the other."""
-    rows.sort(key=lambda r: r[0])
-    samples = np.empty((len(rows), 3), dtype=np.float64)
-    for i, (ns, x, y) in enumerate(rows):
-        samples[i] = (ns / 1e9, x, y)
+    nanoseconds = np.frombuffer(stamps, dtype=np.int64) if len(stamps) else np.zeros(0, np.int64)
+    order = np.argsort(nanoseconds, kind="stable")
+    samples = np.empty((len(stamps), 3), dtype=np.float64)
+    samples[:, 0] = nanoseconds[order] / 1e9
+    samples[:, 1] = np.frombuffer(xs, dtype=np.float64)[order] if len(xs) else 0.0
+    samples[:, 2] = np.frombuffer(ys, dtype=np.float64)[order] if len(ys) else 0.0
     return samples
 
 

@@ -229,6 +229,7 @@ ARTIFACT_SCHEMAS = {
     "verdict.json": ("tlmpc.verdict/", "verdict"),
     "summary.json": ("tlmpc.summary/", "summary"),
     "strategy.json": ("tlmpc.strategy/", "strategy"),
+    "counterstrategy.json": ("tlmpc.counterstrategy/", "counterstrategy"),
 }
 
 

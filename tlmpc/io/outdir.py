@@ -198,10 +198,26 @@ def output_lock(out: Path) -> Iterator[None]:
     The lock file is removed when the run ends; after taking the lock we check that the file
     we locked is still the one at the path (another run may have removed it meanwhile).
     """
-    import fcntl
-
     out = _absolute(out)
     lock = _lock_name(out)
+    fd: int | None = None
+    try:
+        # a signal while the lock is taken is delivered once ``fd`` says whether we hold it,
+        # so the lock file never outlives a run that Ctrl-C or SIGTERM ended
+        with _signals_blocked():
+            fd = _take_lock(out, lock)
+        yield
+    finally:
+        if fd is not None:
+            with contextlib.suppress(OSError):
+                os.unlink(lock)
+            os.close(fd)
+
+
+def _take_lock(out: Path, lock: Path) -> int:
+    """Create (or open) ``lock`` and hold its exclusive lock; return its descriptor."""
+    import fcntl
+
     while True:
         try:
             fd = os.open(lock, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_CLOEXEC, 0o666)
@@ -231,14 +247,8 @@ def output_lock(out: Path) -> Iterator[None]:
         except OSError:
             same = False
         if same:
-            break
+            return fd
         os.close(fd)  # the file was replaced while we waited: lock the new one
-    try:
-        yield
-    finally:
-        with contextlib.suppress(OSError):
-            os.unlink(lock)
-        os.close(fd)
 
 
 def clean_stale(out: Path) -> list[str]:
@@ -290,6 +300,18 @@ def staging_directory(out: Path) -> Iterator[Path]:
     """A new temporary directory beside ``out`` holding the marker; removed on exit unless
     it was committed."""
     out = _absolute(out)
+    staging: Path | None = None
+    try:
+        # a signal while the folder is made is delivered once ``staging`` names it
+        with _signals_blocked():
+            staging = _new_staging(out)
+        yield staging
+    finally:
+        if staging is not None:
+            shutil.rmtree(staging, ignore_errors=True)
+
+
+def _new_staging(out: Path) -> Path:
     try:
         staging = Path(tempfile.mkdtemp(prefix=f".{out.name}.tlmpc-new-", dir=out.parent))
     except OSError as exc:
@@ -300,10 +322,7 @@ def staging_directory(out: Path) -> Iterator[Path]:
     except OSError as exc:
         shutil.rmtree(staging, ignore_errors=True)
         raise io_error(exc, staging, "write") from None
-    try:
-        yield staging
-    finally:
-        shutil.rmtree(staging, ignore_errors=True)
+    return staging
 
 
 def write_artifacts(staging: Path, artifacts: Mapping[str, Any]) -> None:
@@ -446,18 +465,21 @@ def replace_file(path: Path, data: bytes) -> None:
             )
         )
     mode = stat.S_IMODE(info.st_mode) if info is not None else 0o666 & ~_umask()
-    try:
-        handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
-    except OSError as exc:
-        raise io_error(exc, path.parent, "create a temporary file in") from None
-    try:
-        with os.fdopen(handle, "wb") as stream:
-            stream.write(data)
-        os.chmod(temporary, mode)
-        os.replace(temporary, path)
-    except OSError as exc:
-        Path(temporary).unlink(missing_ok=True)
-        raise io_error(exc, path, "write") from None
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise
+    # the data is in memory: a signal waits for the few system calls below, so it finds
+    # either the old file or the new one and never a temporary file beside it
+    with _signals_blocked():
+        try:
+            handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+        except OSError as exc:
+            raise io_error(exc, path.parent, "create a temporary file in") from None
+        try:
+            with os.fdopen(handle, "wb") as stream:
+                stream.write(data)
+            os.chmod(temporary, mode)
+            os.replace(temporary, path)
+        except OSError as exc:
+            Path(temporary).unlink(missing_ok=True)
+            raise io_error(exc, path, "write") from None
+        except BaseException:
+            Path(temporary).unlink(missing_ok=True)
+            raise

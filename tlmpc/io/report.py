@@ -33,10 +33,7 @@ from tlmpc.base.errors import (
     TlmpcError,
     best_first,
 )
-
-#: Ctrl-C (128 + SIGINT) and SIGTERM (128 + SIGTERM), the shell's conventions.
-EXIT_INTERRUPTED = 130
-EXIT_TERMINATED = 143
+from tlmpc.base.startup import EXIT_INTERRUPTED, EXIT_TERMINATED
 
 #: Every exit code of every command, with its meaning (the one definition; ``--help`` and
 #: ``docs/cli.md`` show this table).
@@ -98,9 +95,16 @@ class Reporter:
         return reporter
 
     def diagnose(self, diagnostics: Iterable[Diagnostic]) -> None:
-        """Print diagnostics on standard error (and keep them for the JSON envelope)."""
-        for diagnostic in diagnostics:
-            self.diagnostics.append(diagnostic)
+        """Print diagnostics on standard error (and keep them for the JSON envelope).
+
+        Warnings alike but for names and numbers are printed as one line
+        (:func:`tlmpc.io.aggregate.aggregate`); the envelope keeps each of them.
+        """
+        from tlmpc.io.aggregate import aggregate
+
+        batch = list(diagnostics)
+        self.diagnostics.extend(batch)
+        for diagnostic in aggregate(batch):
             self.err.write(diagnostic.format() + "\n")
 
     def note(self, text: str) -> None:

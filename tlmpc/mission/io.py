@@ -70,6 +70,7 @@ def mission_from_json(document: Mapping[str, Any]) -> Mission:
             beta=float(options["beta"]),
             boundary=options["boundary"],
             margin=options.get("margin"),
+            goal_depth=options.get("goal_depth"),
         ),
         source=document["source"],
         reactive=_reactive(document.get("reactive")),

@@ -728,6 +728,7 @@ def _load_data(text: str, file: str, stem: str) -> tuple[Mission | None, list[Di
             beta=float(options.get("beta", defaults.beta)),
             boundary=options.get("boundary", defaults.boundary),
             margin=float(options["margin"]) if "margin" in options else None,
+            goal_depth=float(options["goal_depth"]) if "goal_depth" in options else None,
         ),
         source=file,
         task_positions=_task_positions(data, doc),

@@ -125,6 +125,9 @@ class Options:
     #: Clearance and depth objective; ``None`` is the default of
     #: :func:`tlmpc.mission.body.requested_margin` (see docs/mission-format.md).
     margin: float | None = None
+    #: Depth to reach into the regions the task visits; ``None`` is the default of
+    #: :func:`tlmpc.abstraction.layout.goal_depth` (a quarter of the region's inradius).
+    goal_depth: float | None = None
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -258,6 +261,7 @@ class Mission:
                 "beta": self.options.beta,
                 "boundary": self.options.boundary,
                 "margin": self.options.margin,
+                "goal_depth": self.options.goal_depth,
             },
         }
         if self.reactive is not None:

@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
-from tlmpc.base.errors import NoPlanError, TlmpcError, error
+from tlmpc.base.errors import TlmpcError, error
 from tlmpc.base.progress import heartbeat
 from tlmpc.base.version import __version__
 
@@ -217,12 +217,9 @@ def _abstraction(c: Compilation) -> StageResult:
     )
     from tlmpc.abstraction.build import mesh_size_diagnostic
     from tlmpc.abstraction.layout import planning_layout
-    from tlmpc.ltl.bounds import refuse_bounds
     from tlmpc.mission.body import requested_margin
 
     mission = c.get(MISSION)
-    # Refused before the triangulation's work: the planner cannot honour a time bound.
-    refuse_bounds(mission.formula, file=mission.source, purpose="planning")
     # A body or a margin: the configuration space, goal cores and grown avoided regions are
     # triangulated (the body's own diagnostics came with the load stage).
     layout = planning_layout(mission, requested_margin(mission))
@@ -236,20 +233,19 @@ def _abstraction(c: Compilation) -> StageResult:
             "letters": len(abstraction.letters),
         },
         warnings=tuple(abstraction_diagnostics(abstraction, mission))
-        if layout is None
+        if layout is None or layout.free is None
         else tuple(d for d in [mesh_size_diagnostic(abstraction, mission)] if d is not None),
     )
 
 
 def _automaton(c: Compilation) -> StageResult:
     from tlmpc.automata import automaton_to_json, to_hoa
-    from tlmpc.ltl.bounds import refuse_bounds
     from tlmpc.planning.mission import automaton_for
 
     mission = c.get(MISSION)
-    refuse_bounds(mission.formula, file=mission.source, purpose="planning")
-    # Under the closed convention the planner reads boundary instants too (their letters and
-    # a rewritten task; see tlmpc/planning/boundary.py).
+    # A bounded task's automaton is its untimed skeleton's (the bounds are checked on the
+    # simulated trajectory).  Under the closed convention the planner reads boundary
+    # instants too (their letters and a rewritten task; see tlmpc/planning/boundary.py).
     automaton = automaton_for(mission, c.get(ABSTRACTION))
     return StageResult(
         products=provide(AUTOMATON, automaton),
@@ -272,15 +268,13 @@ def _plan(c: Compilation) -> StageResult:
     from tlmpc.planning.mission import plan_mission
 
     built = c.get(ABSTRACTION)
-    # The plan may need U-turns (a locally refined mesh) or, when no plan keeps the margin,
-    # the mesh and automaton without it: either replaces the built one (and its artifacts)
-    # for every later stage.
+    # The plan may need U-turns (a locally refined mesh) or, when no plan reaches the goal
+    # depth or keeps the margin, the mesh and automaton without them: either replaces the
+    # built one (and its artifacts) for every later stage.
     planned = plan_mission(c.get(MISSION), built, c.get(AUTOMATON))
     abstraction, witness = planned.abstraction, planned.witness
-    products: dict[Product[Any], Any] = {}
     artifacts: dict[str, Any] = {}
-    if planned.margin_dropped:
-        products.update(provide(AUTOMATON, planned.automaton))
+    if planned.automaton is not c.get(AUTOMATON):  # without margin, or the durations held
         artifacts["automaton.json"] = automaton_to_json(planned.automaton)
         artifacts["automaton.hoa"] = to_hoa(planned.automaton)
     artifacts["witness.json"] = witness_to_json(witness, abstraction)
@@ -291,7 +285,7 @@ def _plan(c: Compilation) -> StageResult:
     )
     return StageResult(
         products={
-            **products,
+            **provide(AUTOMATON, planned.automaton),
             **provide(ABSTRACTION, abstraction),
             **provide(WITNESS, witness),
         },
@@ -333,14 +327,18 @@ def _simulate(c: Compilation) -> StageResult:
     document = trace_to_json(trace, mission)
     points: list[list[float]] = document["points"]  # type: ignore[assignment]
     clearance, margin = _clearance(document, mission)
+    from tlmpc.pipeline.deadlines import check_time_bounds
     from tlmpc.verify.clearance import margin_warnings
+
+    # Every time bound checked on the exact trajectory (P050/P051 when one is missed).
+    bounds = check_time_bounds(mission, document, abstraction)
 
     return StageResult(
         products=provide(TRACE, document),
         artifacts={"trace.json": document},
         sizes={"samples": len(points), "duration": round(float(points[-1][0]), 3)},
         warnings=tuple(margin_warnings(clearance, margin, mission.source)),
-        summary={"clearance": clearance.to_json(margin)},
+        summary={"clearance": clearance.to_json(margin), **(bounds or {})},
     )
 
 
@@ -389,12 +387,23 @@ def _verify(c: Compilation) -> StageResult:
 
 
 def _synthesize(c: Compilation) -> StageResult:
-    from tlmpc.reactive.synthesize import strategy_to_json, synthesize, unrealizable
+    from tlmpc.reactive.synthesize import (
+        UnrealizableError,
+        counterstrategy_to_json,
+        strategy_to_json,
+        synthesize,
+        unrealizable,
+    )
 
     mission = c.get(MISSION)
     synthesis = synthesize(mission, c.get(ABSTRACTION))
-    if synthesis.strategy is None:
-        raise NoPlanError(unrealizable(synthesis, mission))
+    if not synthesis.realizable:
+        shown = dict(c.documents)
+        if synthesis.counter is not None:
+            shown["counterstrategy.json"] = counterstrategy_to_json(synthesis, c.get(ABSTRACTION))
+        raise UnrealizableError(unrealizable(synthesis, mission), shown)
+    assert synthesis.size is not None
+    assert synthesis.symbolic is not None
     game = synthesis.game
     return StageResult(
         artifacts={"strategy.json": strategy_to_json(synthesis)},
@@ -403,7 +412,9 @@ def _synthesize(c: Compilation) -> StageResult:
             "variables": len(game.spec.variables),
             "parts": len(game.spec.parts),
             "fixpoint steps": synthesis.solution.cpre_count,
-            "strategy nodes": len(synthesis.strategy.states),
+            "strategy nodes": synthesis.size.nodes,
+            "strategy transitions": synthesis.size.transitions,
+            "strategy diagram nodes": len(synthesis.symbolic.diagram.nodes),
         },
         summary={"reactive": {"realizable": True, "faces": game.faces.count}},
     )
@@ -455,7 +466,10 @@ STAGES: tuple[Stage, ...] = (
         name="plan",
         run=_plan,
         requires=(MISSION, ABSTRACTION, AUTOMATON),
-        provides=(WITNESS, ABSTRACTION),  # the mesh, refined where the plan turns around
+        # the mesh refined where the plan turns around, and the mesh and automaton rebuilt
+        # without the margin when no plan keeps it (or the automaton of a task's durations
+        # held for good, tlmpc.ltl.bounds.holding_skeleton)
+        provides=(WITNESS, ABSTRACTION, AUTOMATON),
         aliases=("witness", "planning"),
         worlds=_STATIC,
     ),
@@ -605,8 +619,12 @@ def run_stages(
             name=stage.name, seconds=time.perf_counter() - started, sizes=result.sizes
         )
         missing = [p.name for p in stage.provides if p not in result.products]
-        if missing:  # a programming error: the stage list and the stage disagree
-            raise RuntimeError(f"stage {stage.name} did not provide {', '.join(missing)}")
+        undeclared = [p.name for p in result.products if p not in stage.provides]
+        if missing or undeclared:  # a programming error: the stage list and the stage disagree
+            raise RuntimeError(
+                f"stage {stage.name} does not provide what it declares (missing: "
+                f"{', '.join(missing) or '-'}; undeclared: {', '.join(undeclared) or '-'})"
+            )
         products.update(result.products)
         artifacts.update(result.artifacts)
         written.update(result.artifacts)

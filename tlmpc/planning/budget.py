@@ -3,8 +3,10 @@
 The product of the transition system (``m`` triangles, four entry slots each) and the
 automaton (``Q`` states, ``K`` acceptance sets, degeneralized into at most ``Q * (K + 1)``
 states) is built as numpy arrays: about 60 bytes per edge while building and 25 in the final
-graph, plus the search's arrays per node.  An estimate from the sizes alone lets a
-too-large mission stop with a diagnostic (P040) instead of exhausting the machine's memory.
+graph, plus the search's arrays per node.  A product within the budget is built; a larger one
+is searched as it is expanded (:mod:`tlmpc.planning.guided`), which stores per node only the
+searches' arrays (50 bytes), so only a product with more nodes than that search allows stops
+with a diagnostic (P040) instead of exhausting the machine's memory.
 """
 
 from __future__ import annotations
@@ -20,6 +22,8 @@ from tlmpc.base.errors import UsageError, error
 #: at 128M edges, holds 24M, and compiles in about 4 GB.
 MAX_PRODUCT_NODES = 40_000_000
 MAX_PRODUCT_EDGES = 160_000_000
+#: The most nodes the guided search handles: two searches' arrays, 50 bytes a node.
+MAX_GUIDED_NODES = 32_000_000
 
 SLOTS = 4  # as in tlmpc.planning.product: three entry edges and the start
 MOVES_PER_NODE = 4  # leave through one of three edges (two after entering) or stutter
@@ -52,9 +56,10 @@ def estimate_product(abstraction: Abstraction, automaton: Automaton) -> ProductS
 
 
 def check_product_size(abstraction: Abstraction, automaton: Automaton) -> ProductSize:
-    """The estimate; raises :class:`UsageError` (P040) when the product would not fit."""
+    """The estimate; raises :class:`UsageError` (P040) when the product would not fit even
+    the guided search (a product beyond the budget for building it is searched that way)."""
     size = estimate_product(abstraction, automaton)
-    if not size.fits:
+    if not size.fits and size.nodes > MAX_GUIDED_NODES:
         raise UsageError(
             error(
                 "P040",
@@ -62,9 +67,27 @@ def check_product_size(abstraction: Abstraction, automaton: Automaton) -> Produc
                 f"triangles) and the automaton ({automaton.num_states:,} states, "
                 f"{automaton.num_acc} acceptance sets) would have up to {size.nodes:,} nodes "
                 f"and {size.edges:,} edges, more than the planner's budget "
-                f"({MAX_PRODUCT_NODES:,} nodes, {MAX_PRODUCT_EDGES:,} edges)",
+                f"({MAX_PRODUCT_NODES:,} nodes and {MAX_PRODUCT_EDGES:,} edges to build it, "
+                f"{MAX_GUIDED_NODES:,} nodes to search it as it is expanded)",
                 hint="use a coarser mesh (a larger options.max_area), or split the task into "
                 "smaller missions",
             )
         )
     return size
+
+
+def passages_too_large(abstraction: Abstraction, automaton: Automaton) -> UsageError:
+    """P060: the plan needs vertex passages, which only the built product has, and the
+    product is beyond the budget for building it."""
+    size = estimate_product(abstraction, automaton)
+    return UsageError(
+        error(
+            "P060",
+            "no plan exists along the mesh's edges, and the search through mesh vertices "
+            f"needs the product built: up to {size.nodes:,} nodes and {size.edges:,} edges, "
+            f"more than the planner's budget ({MAX_PRODUCT_NODES:,} nodes, "
+            f"{MAX_PRODUCT_EDGES:,} edges)",
+            hint="use a coarser mesh (a larger options.max_area), or widen the passage the "
+            "plan must take so that it runs through an edge",
+        )
+    )

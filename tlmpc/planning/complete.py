@@ -65,6 +65,7 @@ def plan_complete(
     file: str | None = None,
     resume: frozenset[int] | None = None,
     explain: bool = True,
+    reject: float | None = None,
 ) -> tuple[Abstraction, Witness]:
     """A witness on ``abstraction`` or on a locally refined copy of it (returned with it).
 
@@ -76,26 +77,54 @@ def plan_complete(
 
     try:
         return abstraction, _attempt(
-            abstraction, automaton, formula, options, start_point, resume=resume
+            abstraction,
+            automaton,
+            formula,
+            options,
+            start_point,
+            resume=resume,
+            reject=reject,
         )
     except NoPlanError as first:
         no_bounce_failure = first
     try:
         return _refined(
-            abstraction, automaton, formula, options, start_point, passages=False, resume=resume
+            abstraction,
+            automaton,
+            formula,
+            options,
+            start_point,
+            passages=False,
+            resume=resume,
+            reject=reject,
         )
     except NoPlanError:
-        pass
+        if reject:
+            raise no_bounce_failure from None  # no law here reaches a point under a push
     # The one place vertex passages come in: no plan exists along edges alone.
     try:
         return abstraction, _attempt(
-            abstraction, automaton, formula, options, start_point, passages=True, resume=resume
+            abstraction,
+            automaton,
+            formula,
+            options,
+            start_point,
+            passages=True,
+            resume=resume,
+            reject=reject,
         )
     except NoPlanError:
         pass
     try:
         return _refined(
-            abstraction, automaton, formula, options, start_point, passages=True, resume=resume
+            abstraction,
+            automaton,
+            formula,
+            options,
+            start_point,
+            passages=True,
+            resume=resume,
+            reject=reject,
         )
     except NoPlanError:
         if not explain:
@@ -151,6 +180,7 @@ def _attempt(
     bounces: bool = False,
     passages: bool = False,
     resume: frozenset[int] | None = None,
+    reject: float | None = None,
 ) -> Witness:
     return plan(
         mesh,
@@ -161,6 +191,7 @@ def _attempt(
         bounces=bounces,
         passages=passages,
         resume=resume,
+        reject=reject,
     )
 
 
@@ -173,6 +204,7 @@ def _refined(
     *,
     passages: bool,
     resume: frozenset[int] | None = None,
+    reject: float | None = None,
 ) -> tuple[Abstraction, Witness]:
     """A no-bounce witness on a mesh refined where a bouncing lasso turns around; raises
     :class:`NoPlanError` when no bouncing lasso exists on ``abstraction``."""
@@ -188,6 +220,7 @@ def _refined(
                 bounces=True,
                 passages=passages,
                 resume=resume,
+                reject=reject,
             )
         except NoPlanError:
             if mesh is abstraction:
@@ -199,7 +232,14 @@ def _refined(
         mesh = split_triangles(mesh, turns, start_point)
         try:
             witness = _attempt(
-                mesh, automaton, formula, options, start_point, passages=passages, resume=resume
+                mesh,
+                automaton,
+                formula,
+                options,
+                start_point,
+                passages=passages,
+                resume=resume,
+                reject=reject,
             )
         except NoPlanError:
             continue

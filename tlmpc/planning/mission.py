@@ -19,48 +19,59 @@ margin; it may still refine the mesh for a U-turn, and then returns the refined 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from tlmpc.abstraction.model import Abstraction
 from tlmpc.automata.model import Automaton
 from tlmpc.base.errors import Diagnostic, NoPlanError
+from tlmpc.ltl.ast import Formula
 from tlmpc.mission.model import Mission, TaskPart
 from tlmpc.planning.model import Witness
+from tlmpc.planning.robust import witness_realisable
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Planned:
     """A planned mission: the mesh the witness refers to (refined where the plan turns
     around, or rebuilt without the margin), the automaton it was planned with, the witness,
-    and warnings (R008 when the margin was dropped)."""
+    and notes (A030 when the goal depth was dropped, R008 when the margin was)."""
 
     abstraction: Abstraction
     automaton: Automaton
     witness: Witness
     notes: tuple[Diagnostic, ...] = ()
-    margin_dropped: bool = False
+    #: planned on a mesh rebuilt without the goal depth or the margin (with its own automaton)
+    remeshed: bool = False
 
 
-def abstraction_for(mission: Mission, margin: float) -> Abstraction:
-    """The triangulated workspace of ``mission`` planned with ``margin`` (and its body)."""
+def abstraction_for(mission: Mission, margin: float, *, deep: bool = True) -> Abstraction:
+    """The triangulated workspace of ``mission`` planned with ``margin`` (and its body), and
+    with ``deep`` the goal depth."""
     from tlmpc.abstraction import build_abstraction
     from tlmpc.abstraction.layout import planning_layout
 
-    return build_abstraction(mission, planning_layout(mission, margin))
+    return build_abstraction(mission, planning_layout(mission, margin, deep=deep))
 
 
-def automaton_for(mission: Mission, abstraction: Abstraction) -> Automaton:
-    """The task's automaton over the letters the planner reads on ``abstraction``.
+def automaton_for(
+    mission: Mission, abstraction: Abstraction, *, formula: Formula | None = None
+) -> Automaton:
+    """The task's automaton over the letters the planner reads on ``abstraction``
+    (``formula``: another untimed task of the mission's, planned instead).
 
     Under the closed convention: the rewritten task over the mesh's letters plus the
     crossing and start letters; under the right-continuous one the task over the mesh's.
     """
     from tlmpc.automata import translate
+    from tlmpc.ltl.bounds import untimed_skeleton
     from tlmpc.planning.boundary import task_formula, task_letters
 
     convention = mission.options.boundary
+    # A bounded task is planned on its untimed skeleton; its bounds are checked on the
+    # compiled trajectory (tlmpc.pipeline.deadlines).
+    task = untimed_skeleton(mission.formula) if formula is None else formula
     return translate(
-        task_formula(mission.formula, convention),
+        task_formula(task, convention),
         letters=task_letters(abstraction, convention, mission.robot.start),
     )
 
@@ -83,36 +94,82 @@ def plan_mission(
     ``resume`` re-plans a run under way from ``abstraction.start`` at ``start_point``, the
     (degeneralized) automaton being in one of these states; it never drops the margin.
     """
+    from tlmpc.ltl.bounds import holding_skeleton, untimed_skeleton
     from tlmpc.mission.body import requested_margin
 
-    def attempt(mesh: Abstraction, task: Automaton) -> Planned:
+    skeleton = untimed_skeleton(mission.formula)
+
+    def attempt(
+        mesh: Abstraction, task: Automaton, formula: Formula = skeleton, explain: bool = True
+    ) -> Planned:
         from tlmpc.planning.budget import check_product_size
-        from tlmpc.planning.complete import plan_complete
 
         check_product_size(mesh, task)  # a diagnostic, not an exhausted machine
+        first = complete(mesh, task, formula, explain, None)
+        ratio = mission.robot.disturbance / mission.robot.max_speed
+        if witness_realisable(first.abstraction, first.witness, ratio):
+            return first
+        # A step no controller realises (a needle, or a corner too sharp for the
+        # disturbance): plan again on the steps that are realisable, where the mesh has
+        # enough of them; otherwise the control stage states the plan's true bound.
+        from tlmpc.planning.complete import RefinementError
+
+        try:
+            return complete(mesh, task, formula, explain, ratio)
+        except (NoPlanError, RefinementError):
+            return first  # U-turn fans may have no realisable route either
+
+    def complete(
+        mesh: Abstraction, task: Automaton, formula: Formula, explain: bool, reject: float | None
+    ) -> Planned:
+        from tlmpc.planning.complete import plan_complete
+
         planned_mesh, witness = plan_complete(
             mesh,
             task,
-            formula=mission.formula,
+            formula=formula,
             options=mission.options,
             start_point=start_point if start_point is not None else mission.robot.start,
             parts=parts if parts is not None else (lambda: _task_parts(mission)),
             file=mission.source,
             resume=resume,
-            explain=resume is None,
+            explain=explain and resume is None and reject is None,
+            reject=reject,
         )
         return Planned(abstraction=planned_mesh, automaton=task, witness=witness)
+
+    holding = holding_skeleton(mission.formula)
+    if resume is None and holding != skeleton:
+        # Durations ("stay in X for at least T s") are met by a plan that stays for good,
+        # when there is one; else the skeleton's plan, whose bounds are then checked.
+        try:
+            return attempt(
+                abstraction, automaton_for(mission, abstraction, formula=holding), holding, False
+            )
+        except NoPlanError:
+            pass
+    from tlmpc.abstraction.layout import deepens_goals
 
     try:
         return attempt(abstraction, automaton)
     except NoPlanError as failure:
         if resume is not None:
             raise
-        margin = requested_margin(mission)
-        if margin <= 0.0:
-            raise _with_body_notes(failure, mission) from None
         first = failure
-    plain = abstraction_for(mission, 0.0)
+    margin = requested_margin(mission)
+    if deepens_goals(mission):
+        # the goal depth is an objective: plan again reaching the goals only as deep as the
+        # margin asks (overlapping goals' cores may not meet where the regions do)
+        shallow = abstraction_for(mission, margin, deep=False)
+        try:
+            planned = attempt(shallow, automaton_for(mission, shallow))
+        except NoPlanError as again:
+            first = again
+        else:
+            return replace(planned, notes=(_shallow_note(mission, first),), remeshed=True)
+    if margin <= 0.0:
+        raise _with_body_notes(first, mission) from None
+    plain = abstraction_for(mission, 0.0, deep=False)
     try:
         planned = attempt(plain, automaton_for(mission, plain))
     except NoPlanError as again:
@@ -131,14 +188,34 @@ def plan_mission(
         automaton=planned.automaton,
         witness=planned.witness,
         notes=(note,),
-        margin_dropped=True,
+        remeshed=True,
+    )
+
+
+def _shallow_note(mission: Mission, failure: NoPlanError) -> Diagnostic:
+    reason = failure.diagnostics[0].message if failure.diagnostics else "no plan"
+    return Diagnostic(
+        code="A030",
+        severity="note",
+        message=f"no plan reaches the goal depth ({reason}); planned to enter the goals only "
+        "as deep as the margin asks",
+        hint="goals that overlap only near their edges have deep parts that do not meet; "
+        "set options.goal_depth to a smaller depth (0: the margin's) to plan with it",
+        file=mission.source,
     )
 
 
 def _task_parts(mission: Mission) -> Sequence[TaskPart]:
+    """The task's parts as the planner reads them (bounded ones by their skeletons)."""
+    import dataclasses
+
+    from tlmpc.ltl.bounds import untimed_skeleton
     from tlmpc.mission.parts import task_parts
 
-    return task_parts(mission)
+    return [
+        dataclasses.replace(part, formula=untimed_skeleton(part.formula))
+        for part in task_parts(mission)
+    ]
 
 
 def _with_body_notes(failure: NoPlanError, mission: Mission) -> NoPlanError:

@@ -25,7 +25,7 @@ Plans use passages only when no plan exists without them (see
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -83,88 +83,208 @@ def add_vertex_passages(
     numpy over all corners at once, as the product is.
     """
     nq = automaton.num_states
-    m = abstraction.num_triangles
-    base = m * SLOTS * nq
-    closed = convention == "closed"
-    triangles = abstraction.triangles
-    vertices = abstraction.vertices
-    neighbors = abstraction.neighbors
-    contacts = contact_vertices(abstraction)
-    # Cells: the corners (t, k) of allowed triangles at contact vertices, grouped by vertex.
-    at_contact = np.isin(triangles, contacts) & allowed[:, None]
-    cell_t, cell_k = np.nonzero(at_contact)
-    cell_v = triangles[cell_t, cell_k]
-    order = np.argsort(cell_v, kind="stable")
-    cell_t, cell_k, cell_v = cell_t[order], cell_k[order], cell_v[order]
-    _, group_start, group_size = np.unique(cell_v, return_index=True, return_counts=True)
-    keep = np.repeat(group_size >= 2, group_size)
-    cell_t, cell_k, cell_v = cell_t[keep], cell_k[keep], cell_v[keep]
-    _, group_start, group_size = np.unique(cell_v, return_index=True, return_counts=True)
-    cells_info = PassageCells(base=base, triangle=cell_t.astype(np.int64), vertex=cell_v)
-    count = len(cell_t)
+    base = abstraction.num_triangles * SLOTS * nq
+    corners = _ArrivalCorners.around_contacts(abstraction, allowed)
+    cells_info = PassageCells(
+        base=base, triangle=corners.triangle.astype(np.int64), vertex=corners.vertex
+    )
+    count = len(corners.triangle)
     if count == 0:
         return product, cells_info
-    arrival_off = base + np.arange(count, dtype=np.int64) * nq
+    arrival = base + np.arange(count, dtype=np.int64) * nq  # each cell's first node
+    letters = _LetterIds(list(abstraction.letters))
+    moves = _PassageMoves()
+    point_letter = (
+        _vertex_point_letter_ids(abstraction, corners, letters)
+        if convention == "closed"
+        else np.full(count, -1, dtype=np.int64)
+    )
+    source, target = corners.pairs(bounces=bounces)
+    _add_arrivals_from_entries(
+        moves, abstraction, corners, source, target, arrival, point_letter, nq, bounces=bounces
+    )
+    _add_arrivals_from_start(
+        moves, abstraction, corners, source, target, arrival, point_letter, starts, start_point, nq
+    )
+    _add_departures(
+        moves,
+        abstraction,
+        corners,
+        arrival,
+        letters,
+        allowed,
+        nq,
+        bounces=bounces,
+        closed=convention == "closed",
+    )
+    reader = _WordReader(automaton, letters.letters)
+    edges = _passage_edges(moves, reader, metric, nq)
+    size = base + count * nq
+    stutter = np.zeros(size, dtype=bool)
+    stutter[: product.num_nodes] = product.stutter_accepting
+    own = reader.letter_class[abstraction.letter_of[corners.triangle]]
+    edges += _arrival_stutter_edges(own, arrival, reader, stutter, nq)
+    return _with_edges(product, edges, stutter, size), cells_info
 
-    def midpoints(t: IntArray, edge: IntArray) -> FloatArray:
-        a = vertices[triangles[t, (edge + 1) % 3]]
-        b = vertices[triangles[t, (edge + 2) % 3]]
-        middle: FloatArray = (a + b) / 2.0
-        return middle
 
-    def weights(lengths: FloatArray) -> FloatArray:
-        if metric == "hops":
-            return np.ones(len(lengths))
-        result: FloatArray = lengths + STUTTER_COST
-        return result
+@dataclass(frozen=True, slots=True)
+class _ArrivalCorners:
+    """The corners ``(t, k)`` of allowed triangles at contact vertices (``v`` is corner
+    ``k`` of ``t``), grouped by vertex; only vertices with two corners or more."""
 
-    # Letters read, as ids into a local table: the triangles' letters first.
-    letters: list[Letter] = list(abstraction.letters)
-    letter_ids: dict[Letter, int] = {letter: i for i, letter in enumerate(letters)}
+    triangle: IntArray
+    corner: IntArray
+    vertex: IntArray
+    group_start: IntArray  # per vertex, in increasing order: its first corner
+    group_size: IntArray
 
-    def letter_id(letter: Letter) -> int:
-        if letter not in letter_ids:
-            letter_ids[letter] = len(letters)
-            letters.append(letter)
-        return letter_ids[letter]
-
-    # --- into a cell: every pair (source corner, target cell) around one vertex -----------
-    per_cell_group = np.repeat(np.arange(len(group_size)), group_size)
-    sizes = group_size[per_cell_group]
-    source = np.repeat(np.arange(count), sizes)  # source corner index
-    within = np.arange(len(source)) - np.repeat(np.cumsum(sizes) - sizes, sizes)
-    target = group_start[per_cell_group][source] + within  # target cell index
-    if not bounces:
-        distinct = cell_t[source] != cell_t[target]
-        source, target = source[distinct], target[distinct]
-    src_t, src_k = cell_t[source], cell_k[source]
-    entries = [src_k, (src_k + 1) % 3, (src_k + 2) % 3] if bounces else [src_k]
-    move_src: list[IntArray] = []
-    move_dst: list[IntArray] = []
-    move_len: list[FloatArray] = []
-    move_first: list[IntArray] = []  # the letter read first (-1: none)
-    move_second: list[IntArray] = []
-    corner_point = vertices[cell_v[source]]
-    if closed:
-        point_ids = {
-            v: letter_id(letter) for v, letter in vertex_point_letters(abstraction).items()
-        }
-        at_vertex = np.array([point_ids[v] for v in cell_v.tolist()], dtype=np.int64)
-    else:
-        at_vertex = np.full(count, -1, dtype=np.int64)
-    entered_letter = abstraction.letter_of[cell_t[target]]
-    for entry in entries:
-        valid = neighbors[src_t, entry] >= 0
-        move_src.append((src_t[valid] * SLOTS + entry[valid]) * nq)
-        move_dst.append(arrival_off[target[valid]])
-        move_len.append(
-            np.linalg.norm(corner_point[valid] - midpoints(src_t[valid], entry[valid]), axis=1)
+    @staticmethod
+    def around_contacts(abstraction: Abstraction, allowed: BoolArray) -> _ArrivalCorners:
+        """The corners of ``allowed`` triangles at :func:`contact_vertices`."""
+        triangles = abstraction.triangles
+        at_contact = np.isin(triangles, contact_vertices(abstraction)) & allowed[:, None]
+        cell_t, cell_k = np.nonzero(at_contact)
+        cell_v = triangles[cell_t, cell_k]
+        order = np.argsort(cell_v, kind="stable")
+        cell_t, cell_k, cell_v = cell_t[order], cell_k[order], cell_v[order]
+        _, group_start, group_size = np.unique(cell_v, return_index=True, return_counts=True)
+        keep = np.repeat(group_size >= 2, group_size)
+        cell_t, cell_k, cell_v = cell_t[keep], cell_k[keep], cell_v[keep]
+        _, group_start, group_size = np.unique(cell_v, return_index=True, return_counts=True)
+        return _ArrivalCorners(
+            triangle=cell_t,
+            corner=cell_k,
+            vertex=cell_v,
+            group_start=group_start,
+            group_size=group_size,
         )
-        move_first.append(at_vertex[target[valid]])
-        move_second.append(entered_letter[valid])
-    # From the start, off both edges of its triangle through the vertex (a start on such an
-    # edge would slide along it, even while searching with bounces: refinement does not see
-    # the start's edges).
+
+    def pairs(self, *, bounces: bool) -> tuple[IntArray, IntArray]:
+        """Every (source corner, target cell) around one vertex; the same triangle on both
+        sides only with ``bounces`` (a U-turn at the vertex)."""
+        count = len(self.triangle)
+        per_cell_group = np.repeat(np.arange(len(self.group_size)), self.group_size)
+        sizes = self.group_size[per_cell_group]
+        source = np.repeat(np.arange(count), sizes)
+        within = np.arange(len(source)) - np.repeat(np.cumsum(sizes) - sizes, sizes)
+        target = self.group_start[per_cell_group][source] + within
+        if not bounces:
+            distinct = self.triangle[source] != self.triangle[target]
+            source, target = source[distinct], target[distinct]
+        return source, target
+
+
+class _LetterIds:
+    """Letters read, as ids into a local table: the triangles' letters first, then the
+    vertices' and crossings' letters as they are met."""
+
+    def __init__(self, letters: list[Letter]) -> None:
+        self.letters = letters
+        self.ids: dict[Letter, int] = {letter: i for i, letter in enumerate(letters)}
+
+    def id_of(self, letter: Letter) -> int:
+        """The id of ``letter``, appended to the table if new."""
+        if letter not in self.ids:
+            self.ids[letter] = len(self.letters)
+            self.letters.append(letter)
+        return self.ids[letter]
+
+
+@dataclass(slots=True)
+class _PassageMoves:
+    """Moves into and out of arrival cells: source and target node offsets (automaton state
+    0), length, and the letters read (``first`` is -1 when only ``second`` is read)."""
+
+    source: list[IntArray] = field(default_factory=list)
+    target: list[IntArray] = field(default_factory=list)
+    length: list[FloatArray] = field(default_factory=list)
+    first: list[IntArray] = field(default_factory=list)
+    second: list[IntArray] = field(default_factory=list)
+
+    def add(
+        self,
+        source: IntArray,
+        target: IntArray,
+        length: FloatArray,
+        first: IntArray,
+        second: IntArray,
+    ) -> None:
+        """Append a batch of moves."""
+        self.source.append(source)
+        self.target.append(target)
+        self.length.append(length)
+        self.first.append(first)
+        self.second.append(second)
+
+
+def _edge_midpoints(abstraction: Abstraction, t: IntArray, edge: IntArray) -> FloatArray:
+    """The midpoint of edge ``edge`` (opposite that corner) of each triangle ``t``."""
+    vertices, triangles = abstraction.vertices, abstraction.triangles
+    a = vertices[triangles[t, (edge + 1) % 3]]
+    b = vertices[triangles[t, (edge + 2) % 3]]
+    middle: FloatArray = (a + b) / 2.0
+    return middle
+
+
+def _vertex_point_letter_ids(
+    abstraction: Abstraction, corners: _ArrivalCorners, letters: _LetterIds
+) -> IntArray:
+    """Per cell, the id of its vertex's point letter (read at the instant the robot is
+    there, under the closed convention)."""
+    point_ids = {
+        v: letters.id_of(letter) for v, letter in vertex_point_letters(abstraction).items()
+    }
+    return np.array([point_ids[v] for v in corners.vertex.tolist()], dtype=np.int64)
+
+
+def _add_arrivals_from_entries(
+    moves: _PassageMoves,
+    abstraction: Abstraction,
+    corners: _ArrivalCorners,
+    source: IntArray,
+    target: IntArray,
+    arrival: IntArray,
+    point_letter: IntArray,
+    nq: int,
+    *,
+    bounces: bool,
+) -> None:
+    """Passages from a triangle entered through the edge opposite the vertex (any entry
+    edge, with ``bounces``) to the vertex, into the target cell."""
+    src_t, src_k = corners.triangle[source], corners.corner[source]
+    corner_point = abstraction.vertices[corners.vertex[source]]
+    entered_letter = abstraction.letter_of[corners.triangle[target]]
+    entries = [src_k, (src_k + 1) % 3, (src_k + 2) % 3] if bounces else [src_k]
+    for entry in entries:
+        valid = abstraction.neighbors[src_t, entry] >= 0
+        moves.add(
+            (src_t[valid] * SLOTS + entry[valid]) * nq,
+            arrival[target[valid]],
+            np.linalg.norm(
+                corner_point[valid] - _edge_midpoints(abstraction, src_t[valid], entry[valid]),
+                axis=1,
+            ),
+            point_letter[target[valid]],
+            entered_letter[valid],
+        )
+
+
+def _add_arrivals_from_start(
+    moves: _PassageMoves,
+    abstraction: Abstraction,
+    corners: _ArrivalCorners,
+    source: IntArray,
+    target: IntArray,
+    arrival: IntArray,
+    point_letter: IntArray,
+    starts: tuple[StartCell, ...],
+    start_point: tuple[float, float],
+    nq: int,
+) -> None:
+    """Passages from the start, off both edges of its triangle through the vertex (a start
+    on such an edge would slide along it, even while searching with bounces: refinement
+    does not see the start's edges)."""
+    src_t, src_k = corners.triangle[source], corners.corner[source]
     start_ok = np.zeros(len(source), dtype=bool)
     for cell in starts:
         blocked = np.zeros(3, dtype=bool)
@@ -172,15 +292,36 @@ def add_vertex_passages(
         mine = src_t == cell.triangle
         through_blocked = blocked[(src_k + 1) % 3] | blocked[(src_k + 2) % 3]
         start_ok |= mine & ~through_blocked
+    corner_point = abstraction.vertices[corners.vertex[source]]
     start_xy = np.asarray(start_point, dtype=np.float64)
-    move_src.append((src_t[start_ok] * SLOTS + START_SLOT) * nq)
-    move_dst.append(arrival_off[target[start_ok]])
-    move_len.append(np.linalg.norm(corner_point[start_ok] - start_xy[None, :], axis=1))
-    move_first.append(at_vertex[target[start_ok]])
-    move_second.append(entered_letter[start_ok])
+    entered_letter = abstraction.letter_of[corners.triangle[target]]
+    moves.add(
+        (src_t[start_ok] * SLOTS + START_SLOT) * nq,
+        arrival[target[start_ok]],
+        np.linalg.norm(corner_point[start_ok] - start_xy[None, :], axis=1),
+        point_letter[target[start_ok]],
+        entered_letter[start_ok],
+    )
 
-    # --- out of a cell: through the edge opposite the vertex (any edge, with bounces) -----
-    cells = np.arange(count)
+
+def _add_departures(
+    moves: _PassageMoves,
+    abstraction: Abstraction,
+    corners: _ArrivalCorners,
+    arrival: IntArray,
+    letters: _LetterIds,
+    allowed: BoolArray,
+    nq: int,
+    *,
+    bounces: bool,
+    closed: bool,
+) -> None:
+    """Moves out of each cell through the edge opposite the vertex (any edge, with
+    ``bounces``) into an allowed neighbour; under the closed convention they read the
+    crossing letter first."""
+    cell_t, cell_k = corners.triangle, corners.corner
+    neighbors = abstraction.neighbors
+    cells = np.arange(len(cell_t))
     exits = [cell_k, (cell_k + 1) % 3, (cell_k + 2) % 3] if bounces else [cell_k]
     for exit_edge in exits:
         n = neighbors[cell_t, exit_edge]
@@ -189,96 +330,154 @@ def add_vertex_passages(
         t2, e2, n2 = cell_t[valid], exit_edge[valid], n[valid]
         back = neighbors[n2]
         slot = np.where(back[:, 0] == t2, 0, np.where(back[:, 1] == t2, 1, 2)).astype(np.int64)
-        move_src.append(arrival_off[cells[valid]])
-        move_dst.append((n2 * SLOTS + slot) * nq)
-        move_len.append(np.linalg.norm(midpoints(t2, e2) - vertices[cell_v[valid]], axis=1))
         if closed:
-            stride = len(abstraction.letters)
-            pairs = abstraction.letter_of[t2] * stride + abstraction.letter_of[n2]
-            unique_pairs, inverse = np.unique(pairs, return_inverse=True)
-            crossing = np.array(
-                [
-                    letter_id(crossing_letter(letters[key // stride], letters[key % stride]))
-                    for key in unique_pairs.tolist()
-                ],
-                dtype=np.int64,
-            )
-            move_first.append(crossing[inverse.reshape(-1)])
+            first = _crossing_letter_ids(abstraction, letters, t2, n2)
         else:
-            move_first.append(np.full(len(t2), -1, dtype=np.int64))
-        move_second.append(abstraction.letter_of[n2])
+            first = np.full(len(t2), -1, dtype=np.int64)
+        moves.add(
+            arrival[cells[valid]],
+            (n2 * SLOTS + slot) * nq,
+            np.linalg.norm(
+                _edge_midpoints(abstraction, t2, e2) - abstraction.vertices[corners.vertex[valid]],
+                axis=1,
+            ),
+            first,
+            abstraction.letter_of[n2],
+        )
 
-    src_off = np.concatenate(move_src)
-    dst_off = np.concatenate(move_dst)
-    weight = weights(np.concatenate(move_len))
-    first = np.concatenate(move_first)
-    second = np.concatenate(move_second)
 
-    table = successor_table(automaton, letters)
-    full = (1 << automaton.num_acc) - 1
-    # Letters with one projection on the automaton's propositions share one row (the table
-    # caches it): moves are grouped by those classes, not by letters (maps have many).
-    rows: list[list[tuple[tuple[int, int], ...]]] = []
-    row_index: dict[int, int] = {}
-    letter_class = np.empty(len(letters), dtype=np.int64)
-    for index, row in enumerate(table):
-        letter_class[index] = row_index.setdefault(id(row), len(rows))
-        if letter_class[index] == len(rows):
-            rows.append(row)
+def _crossing_letter_ids(
+    abstraction: Abstraction, letters: _LetterIds, left: IntArray, entered: IntArray
+) -> IntArray:
+    """The id of the crossing letter between each pair of adjacent triangles."""
+    stride = len(abstraction.letters)
+    pairs = abstraction.letter_of[left] * stride + abstraction.letter_of[entered]
+    unique_pairs, inverse = np.unique(pairs, return_inverse=True)
+    table = letters.letters
+    crossing = np.array(
+        [
+            letters.id_of(crossing_letter(table[key // stride], table[key % stride]))
+            for key in unique_pairs.tolist()
+        ],
+        dtype=np.int64,
+    )
+    ids: IntArray = crossing[inverse.reshape(-1)]
+    return ids
 
-    def read(q: int, word: tuple[int, ...]) -> dict[int, bool]:
+
+class _WordReader:
+    """The automaton's successors over words of one or two letters, by letter class:
+    letters with one projection on the automaton's propositions share one row of the
+    successor table (it caches it), so moves are grouped by classes, not by letters (maps
+    have many)."""
+
+    def __init__(self, automaton: Automaton, letters: list[Letter]) -> None:
+        table = successor_table(automaton, letters)
+        self.full = (1 << automaton.num_acc) - 1
+        self.rows: list[list[tuple[tuple[int, int], ...]]] = []
+        row_index: dict[int, int] = {}
+        self.letter_class = np.empty(len(letters), dtype=np.int64)
+        for index, row in enumerate(table):
+            self.letter_class[index] = row_index.setdefault(id(row), len(self.rows))
+            if self.letter_class[index] == len(self.rows):
+                self.rows.append(row)
+
+    def read(self, q: int, word: tuple[int, ...]) -> dict[int, bool]:
+        """The states after reading ``word`` (letter classes) from ``q``, each with whether
+        some run to it saw every acceptance set."""
         frontier: dict[int, int] = {q: 0}
         for cls in word:
             following: dict[int, int] = {}
             for state, mask in frontier.items():
-                for q_next, mark in rows[cls][state]:
+                for q_next, mark in self.rows[cls][state]:
                     following[q_next] = following.get(q_next, 0) | mask | mark
             frontier = following
-        return {state: mask == full for state, mask in frontier.items()}
+        return {state: mask == self.full for state, mask in frontier.items()}
 
-    sources: list[IntArray] = []
-    targets: list[IntArray] = []
-    costs: list[FloatArray] = []
-    marks: list[BoolArray] = []
-    classes = len(rows) + 1
+
+@dataclass(slots=True)
+class _EdgeBatches:
+    """Product edges as batches of arrays (sources, targets, costs, acceptance marks)."""
+
+    sources: list[IntArray] = field(default_factory=list)
+    targets: list[IntArray] = field(default_factory=list)
+    costs: list[FloatArray] = field(default_factory=list)
+    marks: list[BoolArray] = field(default_factory=list)
+
+    def add(self, source: IntArray, target: IntArray, cost: FloatArray, mark: bool) -> None:
+        """Append a batch of edges that share one mark."""
+        self.sources.append(source)
+        self.targets.append(target)
+        self.costs.append(cost)
+        self.marks.append(np.full(len(source), mark))
+
+    def __iadd__(self, other: _EdgeBatches) -> _EdgeBatches:
+        self.sources += other.sources
+        self.targets += other.targets
+        self.costs += other.costs
+        self.marks += other.marks
+        return self
+
+
+def _passage_edges(moves: _PassageMoves, reader: _WordReader, metric: str, nq: int) -> _EdgeBatches:
+    """The product edges of the passage moves: per kind of move (the classes of the letters
+    it reads) and automaton state, one edge per successor state."""
+    src_off = np.concatenate(moves.source)
+    dst_off = np.concatenate(moves.target)
+    lengths = np.concatenate(moves.length)
+    weight = np.ones(len(lengths)) if metric == "hops" else lengths + STUTTER_COST
+    first = np.concatenate(moves.first)
+    second = np.concatenate(moves.second)
+    letter_class = reader.letter_class
+    classes = len(reader.rows) + 1
     first_class = np.where(first >= 0, letter_class[np.maximum(first, 0)], -1)
     key = (first_class + 1) * classes + letter_class[second]
     kinds, kind_of = np.unique(key, return_inverse=True)
     kind_of = kind_of.reshape(-1)
+    edges = _EdgeBatches()
     for index, kind in enumerate(kinds.tolist()):
-        moves = np.flatnonzero(kind_of == index)
+        selected = np.flatnonzero(kind_of == index)
         x, y = kind // classes - 1, kind % classes
         word = (x, y) if x >= 0 else (y,)
         for q in range(nq):
-            for q_next, accepting in read(q, word).items():
-                sources.append(src_off[moves] + q)
-                targets.append(dst_off[moves] + q_next)
-                costs.append(weight[moves])
-                marks.append(np.full(len(moves), accepting))
-    # Stutter in a cell: reading its triangle's letter again.
-    size = base + count * nq
-    stutter = np.zeros(size, dtype=bool)
-    stutter[: product.num_nodes] = product.stutter_accepting
-    own = letter_class[abstraction.letter_of[cell_t]]
+            for q_next, accepting in reader.read(q, word).items():
+                edges.add(
+                    src_off[selected] + q, dst_off[selected] + q_next, weight[selected], accepting
+                )
+    return edges
+
+
+def _arrival_stutter_edges(
+    own: IntArray, arrival: IntArray, reader: _WordReader, stutter: BoolArray, nq: int
+) -> _EdgeBatches:
+    """Stutter in a cell: reading its triangle's letter (class ``own``) again.  Marks in
+    ``stutter`` the nodes whose stutter loop accepts; staying in the same state is no edge."""
+    edges = _EdgeBatches()
     for cls in np.unique(own).tolist():
         stays = np.flatnonzero(own == cls)
         for q in range(nq):
-            for q_next, accepting in read(q, (cls,)).items():
+            for q_next, accepting in reader.read(q, (cls,)).items():
                 if q_next == q:
                     if accepting:
-                        stutter[arrival_off[stays] + q] = True
+                        stutter[arrival[stays] + q] = True
                     continue
-                sources.append(arrival_off[stays] + q)
-                targets.append(arrival_off[stays] + q_next)
-                costs.append(np.full(len(stays), STUTTER_COST))
-                marks.append(np.full(len(stays), accepting))
+                edges.add(
+                    arrival[stays] + q,
+                    arrival[stays] + q_next,
+                    np.full(len(stays), STUTTER_COST),
+                    accepting,
+                )
+    return edges
 
+
+def _with_edges(product: Product, edges: _EdgeBatches, stutter: BoolArray, size: int) -> Product:
+    """``product`` grown to ``size`` nodes with ``edges`` added, stable by source: every
+    node's ordinary edges keep their order, passages come after."""
     old = product.graph
-    new_src = np.concatenate(sources) if sources else np.zeros(0, dtype=np.int64)
-    new_dst = np.concatenate(targets) if targets else np.zeros(0, dtype=np.int64)
-    new_cost = np.concatenate(costs) if costs else np.zeros(0)
-    new_mark = np.concatenate(marks) if marks else np.zeros(0, dtype=bool)
-    # Stable by source: every node's ordinary edges keep their order, passages come after.
+    new_src = np.concatenate(edges.sources) if edges.sources else np.zeros(0, dtype=np.int64)
+    new_dst = np.concatenate(edges.targets) if edges.targets else np.zeros(0, dtype=np.int64)
+    new_cost = np.concatenate(edges.costs) if edges.costs else np.zeros(0)
+    new_mark = np.concatenate(edges.marks) if edges.marks else np.zeros(0, dtype=bool)
     graph, order = Graph.from_edges(
         np.concatenate([old.sources, new_src]),
         np.concatenate([old.targets, new_dst]),
@@ -286,10 +485,9 @@ def add_vertex_passages(
         size,
     )
     accepting_edges = np.concatenate([product.accepting, new_mark])[order]
-    extended = replace(
+    return replace(
         product, graph=graph, accepting=accepting_edges, stutter_accepting=stutter, num_nodes=size
     )
-    return extended, cells_info
 
 
 def passage_turns(abstraction: Abstraction, witness: Witness) -> list[int]:

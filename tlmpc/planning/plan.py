@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import dataclasses
 import time
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -30,10 +31,14 @@ from tlmpc.base.graphs import strong_components
 from tlmpc.ltl.ast import Formula
 from tlmpc.mission.model import Options
 from tlmpc.planning.boundary import start_cells, start_point_label
+from tlmpc.planning.budget import estimate_product, passages_too_large
 from tlmpc.planning.explain import explain_no_plan, invariant_mask
+from tlmpc.planning.guided import guided_lasso
+from tlmpc.planning.lazy import lazy_product
 from tlmpc.planning.model import Witness
 from tlmpc.planning.passages import PassageCells, add_vertex_passages
-from tlmpc.planning.product import SLOTS, START_SLOT, Product, build_product
+from tlmpc.planning.product import SLOTS, START_SLOT, BoolArray, Product, build_product
+from tlmpc.planning.robust import realisable
 from tlmpc.planning.search import closing_searches, shortest_paths
 
 #: At most this many cycle candidates are closed with a shortest-path search; past it the
@@ -94,6 +99,8 @@ def plan(
     bounces: bool = False,
     resume: frozenset[int] | None = None,
     passages: bool = False,
+    guided: bool | None = None,
+    reject: float | None = None,
 ) -> Witness:
     """A minimum-cost accepting lasso (raises :class:`NoPlanError` with an explanation).
 
@@ -102,7 +109,11 @@ def plan(
     ``resume`` re-plans a run under way: the robot is in the start triangle and has already
     read its label, the (degeneralized) automaton being in any of these states.
     ``passages=True`` also lets the lasso pass through mesh vertices where labels meet
-    (:mod:`tlmpc.planning.passages`).
+    (:mod:`tlmpc.planning.passages`).  ``guided`` searches the product expanded on demand
+    (:mod:`tlmpc.planning.guided`: the same cost, for products too large to build); by
+    default only when the product would not fit the budget (:mod:`tlmpc.planning.budget`).
+    With ``reject`` (a disturbance over max_speed) only the moves and stays the controllers
+    realise under it are used (:mod:`tlmpc.planning.robust`).
     """
     started = time.perf_counter()
     allowed = invariant_mask(abstraction, formula)
@@ -114,6 +125,61 @@ def plan(
     # Only the closed convention reads the start point's own letter.
     closed = options.boundary == "closed"
     start_label = start_point_label(abstraction, start_point) if closed else ()
+
+    def why() -> NoPlanError:
+        return NoPlanError(
+            explain_no_plan(
+                abstraction,
+                automaton,
+                formula,
+                allowed,
+                starts=starts,
+                start_label=start_label if closed else None,
+            )
+        )
+
+    realisable_steps = None if reject is None else realisable(abstraction, reject)
+    if guided is None:
+        guided = not estimate_product(abstraction, automaton).fits
+    if guided:
+        if passages:
+            raise passages_too_large(abstraction, automaton)
+        lazy = lazy_product(
+            abstraction,
+            working,
+            allowed=allowed,
+            start_point=start_point,
+            metric=options.cost,
+            starts=starts,
+            convention=options.boundary,
+            start_label=start_label,
+            bounces=bounces,
+            realisable=realisable_steps,
+        )
+        if resume is not None:
+            initial = _resumed(abstraction, allowed, working, resume)
+            lazy = dataclasses.replace(lazy, initial=initial)
+        found = guided_lasso(
+            lazy,
+            np.repeat(allowed, SLOTS),
+            beta=options.beta,
+            max_searches=MAX_CYCLE_SEARCHES,
+        )
+        if found is None or not working.edges:
+            raise why()
+        return _witness(
+            abstraction,
+            working.num_states,
+            lambda nodes: float(sum(lazy.path_weights(nodes))),
+            (found.cost, found.prefix, found.cycle),
+            options,
+            started,
+            found.searches,
+            found.optimal,
+            working,
+            found.reached,
+            {"product_nodes": lazy.num_nodes, "search": "guided"},
+        )
     product = build_product(
         abstraction,
         working,
@@ -124,6 +190,7 @@ def plan(
         convention=options.boundary,
         start_label=start_label,
         bounces=bounces,
+        realisable=realisable_steps,
     )
     cells: PassageCells | None = None
     if passages:
@@ -139,24 +206,10 @@ def plan(
             bounces=bounces,
         )
 
-    def why() -> NoPlanError:
-        return NoPlanError(
-            explain_no_plan(
-                abstraction,
-                automaton,
-                formula,
-                allowed,
-                starts=starts,
-                start_label=start_label if closed else None,
-            )
-        )
-
     if resume is not None:
-        nodes = sorted(
-            (abstraction.start * SLOTS + START_SLOT) * working.num_states + q for q in resume
+        product = dataclasses.replace(
+            product, initial=_resumed(abstraction, allowed, working, resume)
         )
-        initial = np.array(nodes if allowed[abstraction.start] else [], dtype=np.int64)
-        product = dataclasses.replace(product, initial=initial)
     if len(product.initial) == 0 or not working.edges:
         raise why()
     # A stay ends the search early: no lasso costs less than its prefix (see module doc).
@@ -189,8 +242,30 @@ def plan(
         raise why()
     reached = int(np.isfinite(dist).sum())
     return _witness(
-        abstraction, product, best, options, started, searches, exhausted, working, reached, cells
+        abstraction,
+        product.num_automaton_states,
+        lambda nodes: _path_cost(product, nodes),
+        best,
+        options,
+        started,
+        searches,
+        exhausted,
+        working,
+        reached,
+        {"product_nodes": product.num_nodes, "product_edges": int(product.graph.nnz)},
+        cells,
     )
+
+
+def _resumed(
+    abstraction: Abstraction, allowed: BoolArray, automaton: Automaton, resume: frozenset[int]
+) -> IntArray:
+    """The initial nodes of a re-plan under way: the start triangle's start slot, in any
+    of the states ``resume``."""
+    nodes = sorted(
+        (abstraction.start * SLOTS + START_SLOT) * automaton.num_states + q for q in resume
+    )
+    return np.array(nodes if allowed[abstraction.start] else [], dtype=np.int64)
 
 
 def _close_cycles(
@@ -257,7 +332,8 @@ def _close_cycles(
 
 def _witness(
     abstraction: Abstraction,
-    product: Product,
+    nq: int,
+    path_cost: Callable[[list[int]], float],
     best: tuple[float, list[int], list[int]],
     options: Options,
     started: float,
@@ -265,10 +341,10 @@ def _witness(
     exhausted: bool,
     automaton: Automaton,
     reached: int,
+    sizes: dict[str, Any],
     cells: PassageCells | None = None,
 ) -> Witness:
     _, prefix_nodes, cycle_nodes = best
-    nq = product.num_automaton_states
     anchor = cycle_nodes[0]
     # prefix_nodes ends at the anchor; the cycle starts at the anchor's triangle.
     prefix_tris, prefix_states, prefix_through = _collapse(prefix_nodes, nq, cells)
@@ -286,12 +362,11 @@ def _witness(
     wrap = None if cells is None or len(cycle_nodes) == 1 else cells.vertex_of(anchor, nq)
     if wrap is not None:
         through[len(prefix_tris) + len(cycle_tris) - 1] = wrap
-    prefix_cost = _path_cost(product, prefix_nodes)
-    cycle_cost = 0.0 if len(cycle_nodes) == 1 else _path_cost(product, [*cycle_nodes, anchor])
+    prefix_cost = path_cost(prefix_nodes)
+    cycle_cost = 0.0 if len(cycle_nodes) == 1 else path_cost([*cycle_nodes, anchor])
     stats: dict[str, Any] = {
-        "product_nodes": product.num_nodes,
+        **sizes,
         "product_reached": reached,
-        "product_edges": int(product.graph.nnz),
         "cycle_searches": searches,
         "optimal": exhausted,
         "automaton_states": automaton.num_states,

@@ -92,6 +92,7 @@ def build_product(
     convention: str = "right",
     start_label: tuple[str, ...] = (),
     bounces: bool = False,
+    realisable: tuple[BoolArray, BoolArray] | None = None,
 ) -> Product:
     """The product graph restricted to ``allowed`` triangles.
 
@@ -105,44 +106,155 @@ def build_product(
     with ``convention="closed"`` the automaton reads crossing letters and, first of all,
     ``start_label`` (the regions whose closure holds the start point).  A blocked edge may be
     left at the first move only with ``bounces`` (it is a U-turn in that triangle).
+    ``realisable`` restricts the moves (leave t by edge i, (m, 3)) and the final stays ((m,))
+    to those the controllers realise (:func:`tlmpc.planning.robust.realisable`).
     """
-    m = abstraction.num_triangles
-    nq = automaton.num_states
-    neighbors = abstraction.neighbors
-    closed = convention == "closed"
-    letters = list(abstraction.letters)
-    table = successor_table(automaton, letters)
-    # Letters with the same projection on the automaton's propositions behave the same: the
-    # table shares one row between them.  A class per row, numbered by first occurrence.
-    class_index: dict[int, int] = {}
-    class_rows: list[list[tuple[tuple[int, int], ...]]] = []
-
-    def class_of(row: list[tuple[tuple[int, int], ...]]) -> int:
-        key = id(row)
-        if key not in class_index:
-            class_index[key] = len(class_rows)
-            class_rows.append(row)
-        return class_index[key]
-
-    letter_class = np.array(
-        [class_index.setdefault(id(row), len(class_index)) for row in table], dtype=np.int64
+    table = move_table(
+        abstraction,
+        automaton,
+        allowed=allowed,
+        start_point=start_point,
+        metric=metric,
+        starts=starts,
+        convention=convention,
+        bounces=bounces,
+        realisable=realisable,
     )
-    class_rows.extend({id(row): row for row in table}.values())  # in order of first occurrence
-    tri_class = letter_class[abstraction.letter_of]
+    starts, classes, tri_class = table.starts, table.classes, table.tri_class
+    moves, weight, move_kind = table.moves, table.weight, table.kind
+    closed = convention == "closed"
+    successors = Successors(classes, automaton)
+    stay_cell, stay_class = stutter_cells(abstraction, allowed, starts, tri_class)
+    nq = automaton.num_states
+    size = abstraction.num_triangles * SLOTS * nq
+    stutter_accepting = np.zeros(size, dtype=bool)
+    stay_edges = successors.stutter_edges(
+        stay_cell,
+        stay_class,
+        stutter_accepting,
+        stay_ok=None if realisable is None else realisable[1],
+    )
+    graph, accepting = _product_edges(moves, move_kind, weight, successors, stay_edges)
+    start_letter = tuple(sorted({*start_label, POINT})) if closed else None
+    return Product(
+        graph=graph,
+        accepting=accepting,
+        stutter_accepting=stutter_accepting,
+        initial=initial_nodes(automaton, classes, tri_class, allowed, starts, start_letter),
+        num_automaton_states=nq,
+        num_nodes=size,
+    )
+
+
+@dataclass(frozen=True, slots=True)
+class MoveTable:
+    """What the built and the lazy product share: the start cells, the letter classes (and
+    each triangle's), the moves of D with their weights and kinds (a letter class, or under
+    the closed convention a crossing kind, see :func:`crossing_move_kinds`)."""
+
+    starts: tuple[StartCell, ...]
+    classes: LetterClasses
+    tri_class: IntArray
+    moves: _Moves
+    weight: FloatArray
+    kind: IntArray
+
+
+def move_table(
+    abstraction: Abstraction,
+    automaton: Automaton,
+    *,
+    allowed: BoolArray,
+    start_point: tuple[float, float],
+    metric: str,
+    starts: tuple[StartCell, ...] | None,
+    convention: str,
+    bounces: bool,
+    realisable: tuple[BoolArray, BoolArray] | None,
+) -> MoveTable:
+    """The moves of the product over ``abstraction`` and ``automaton`` (arguments as for
+    :func:`build_product`)."""
     if starts is None:
         starts = start_cells(abstraction, start_point)
+    classes = LetterClasses.of(automaton, list(abstraction.letters))
+    tri_class = classes.letter_class[abstraction.letter_of]
+    moves = ts_moves(abstraction, allowed, starts, bounces=bounces, realisable=realisable)
+    weight = move_weights(abstraction, moves, start_point, metric)
+    if convention == "closed":
+        kind = crossing_move_kinds(abstraction, automaton, classes, tri_class, moves)
+    else:
+        kind = tri_class[abstraction.neighbors].reshape(-1)[moves.exit]
+    return MoveTable(starts, classes, tri_class, moves, weight, kind)
+
+
+Row = list[tuple[tuple[int, int], ...]]
+
+
+@dataclass(slots=True)
+class LetterClasses:
+    """Letters with the same projection on the automaton's propositions behave the same: the
+    successor table shares one row between them.  A class per row, numbered by first
+    occurrence (the table's letters first, then the rows :meth:`class_of` meets)."""
+
+    rows: list[Row]
+    index: dict[int, int]  # id of a row -> its class
+    letter_class: IntArray  # per letter of the table the classes were made from
+
+    @staticmethod
+    def of(automaton: Automaton, letters: list[tuple[str, ...]]) -> LetterClasses:
+        """The classes of ``letters``."""
+        table = successor_table(automaton, letters)
+        index: dict[int, int] = {}
+        letter_class = np.array(
+            [index.setdefault(id(row), len(index)) for row in table], dtype=np.int64
+        )
+        rows = list({id(row): row for row in table}.values())  # in order of first occurrence
+        return LetterClasses(rows=rows, index=index, letter_class=letter_class)
+
+    def class_of(self, row: Row) -> int:
+        """The class of a row of a successor table, numbered anew if it is new."""
+        key = id(row)
+        if key not in self.index:
+            self.index[key] = len(self.rows)
+            self.rows.append(row)
+        return self.index[key]
+
+
+@dataclass(frozen=True, slots=True)
+class _Moves:
+    """The moves of D, ``(t, s) --i--> (n, s')`` with ``i != s`` unless bouncing, laid out on
+    the (triangle, slot, exit) grid, whose flat order is the nodes' order: they come out
+    sorted by source cell without a sort."""
+
+    flat: IntArray  # (t * SLOTS + s) * 3 + i
+    source: IntArray  # the cell t * SLOTS + s
+    exit: IntArray  # t * 3 + i
+    target: IntArray  # the cell entered, n * SLOTS + s'
+    exit_ok: BoolArray  # (m, 3): edge i of t leads from an allowed triangle to another
+
+
+def ts_moves(
+    abstraction: Abstraction,
+    allowed: BoolArray,
+    starts: tuple[StartCell, ...],
+    *,
+    bounces: bool,
+    realisable: tuple[BoolArray, BoolArray] | None = None,
+) -> _Moves:
+    """Every move of D between ``allowed`` triangles (and, with ``realisable``, only the
+    moves the controllers realise).  Per (t, i) arrays (m, 3) are computed once and read for
+    every slot."""
+    m = abstraction.num_triangles
+    neighbors = abstraction.neighbors
     is_start = np.zeros(m, dtype=bool)
     blocked = np.zeros((m, 3), dtype=bool)
     for cell in starts:
         is_start[cell.triangle] = True
         blocked[cell.triangle, list(cell.blocked)] = True
-
-    # --- moves of D: (t, s) --i--> (n, s') with i != s -------------------------------------
-    # Laid out on the (triangle, slot, exit) grid, whose flat order is the nodes' order: the
-    # moves come out sorted by source cell without a sort.  Per (t, i) arrays (m, 3) are
-    # computed once and read for every slot.
     inside = np.append(allowed, False)  # index -1 (no neighbour) reads "not allowed"
     exit_ok = allowed[:, None] & inside[neighbors]
+    if realisable is not None:
+        exit_ok &= realisable[0]
     valid = np.empty((m, SLOTS, 3), dtype=bool)
     valid[:, :START_SLOT, :] = exit_ok[:, None, :]
     if not bounces:
@@ -150,93 +262,181 @@ def build_product(
     # The start slot exists in start triangles only; their edges through the start point
     # are not left at t = 0 (that never enters the triangle).
     valid[:, START_SLOT, :] = exit_ok & is_start[:, None] & (~blocked | bounces)
-    moves = np.flatnonzero(valid)  # (t * SLOTS + s) * 3 + i
-    move_src = moves // 3  # the cell t * SLOTS + s
-    move_exit = moves // (SLOTS * 3) * 3 + moves % 3  # t * 3 + i
-    # The slot of t among n's neighbours (argmax over a 3-wide boolean axis is slow).
+    moves = np.flatnonzero(valid)
+    move_exit = moves // (SLOTS * 3) * 3 + moves % 3
+    return _Moves(
+        flat=moves,
+        source=moves // 3,
+        exit=move_exit,
+        target=(neighbors * SLOTS + entry_slots(neighbors)).reshape(-1)[move_exit],
+        exit_ok=exit_ok,
+    )
+
+
+def entry_slots(neighbors: IntArray) -> IntArray:
+    """(m, 3): the slot of t among the neighbours of its i-th neighbour (garbage where
+    there is none).  Two comparisons: argmax over a 3-wide boolean axis is slow."""
     back = neighbors[np.maximum(neighbors, 0)]
-    own = np.arange(m, dtype=np.int64)[:, None]
-    slot = np.where(back[:, :, 0] == own, 0, np.where(back[:, :, 1] == own, 1, 2))
-    move_dst = (neighbors * SLOTS + slot).reshape(-1)[move_exit]
+    own = np.arange(len(neighbors), dtype=np.int64)[:, None]
+    slot: IntArray = np.where(back[:, :, 0] == own, 0, np.where(back[:, :, 1] == own, 1, 2))
+    return slot
+
+
+def move_weights(
+    abstraction: Abstraction, moves: _Moves, start_point: tuple[float, float], metric: str
+) -> FloatArray:
+    """Each move's weight: one under ``"hops"``, else its length (:func:`_move_lengths`)."""
     if metric == "hops":
-        weight = np.ones(len(moves))
-    else:
-        weight = _move_lengths(abstraction, start_point).reshape(-1)[moves]
-    # A move's kind: the class of the entered triangle's letter, and under the closed
-    # convention the class of the crossing instant's letter read before it.
+        return np.ones(len(moves.flat))
+    lengths: FloatArray = _move_lengths(abstraction, start_point).reshape(-1)[moves.flat]
+    return lengths
+
+
+def crossing_move_kinds(
+    abstraction: Abstraction,
+    automaton: Automaton,
+    classes: LetterClasses,
+    tri_class: IntArray,
+    moves: _Moves,
+) -> IntArray:
+    """Each move's kind under the closed convention, which reads the crossing instant's
+    letter (both sides' labels and the point marker) before the entered triangle's: kind
+    ``(c + 1) * stride + k`` reads class ``c``, then ``k`` (see :class:`Successors`).
+    The crossing letters' new classes are numbered before ``stride`` is fixed."""
+    neighbors = abstraction.neighbors
+    letters = list(abstraction.letters)
+    count = len(letters)
     exit_kind = tri_class[neighbors].reshape(-1)  # (m * 3,): garbage where there is no exit
-    if closed:
-        count = len(letters)
-        exits = np.flatnonzero(exit_ok)
-        entered = neighbors.reshape(-1)[exits]
-        pair = abstraction.letter_of[exits // 3] * count + abstraction.letter_of[entered]
-        unique_pairs, pair_index = np.unique(pair, return_inverse=True)
-        crossing = [
-            crossing_letter(letters[key // count], letters[key % count])
-            for key in unique_pairs.tolist()
-        ]
-        crossing_class = np.array(
-            [class_of(row) for row in successor_table(automaton, crossing)], dtype=np.int64
-        ).reshape(-1)
-    # Kinds below ``stride`` read one letter; (c + 1) * stride + k reads c, then k.
-    stride = len(class_rows) + 1
-    if closed:
-        exit_kind[exits] += (crossing_class[pair_index.reshape(-1)] + 1) * stride
-    move_kind = exit_kind[move_exit]
+    exits = np.flatnonzero(moves.exit_ok)
+    entered = neighbors.reshape(-1)[exits]
+    pair = abstraction.letter_of[exits // 3] * count + abstraction.letter_of[entered]
+    unique_pairs, pair_index = np.unique(pair, return_inverse=True)
+    crossing = [
+        crossing_letter(letters[key // count], letters[key % count])
+        for key in unique_pairs.tolist()
+    ]
+    crossing_class = np.array(
+        [classes.class_of(row) for row in successor_table(automaton, crossing)], dtype=np.int64
+    ).reshape(-1)
+    stride = len(classes.rows) + 1
+    exit_kind[exits] += (crossing_class[pair_index.reshape(-1)] + 1) * stride
+    move_kind: IntArray = exit_kind[moves.exit]
+    return move_kind
 
-    # --- stutter: (t, s) stays, reading its own label again --------------------------------
+
+def stutter_cells(
+    abstraction: Abstraction,
+    allowed: BoolArray,
+    starts: tuple[StartCell, ...],
+    tri_class: IntArray,
+) -> tuple[IntArray, IntArray]:
+    """The cells ``t * SLOTS + s`` that may stay (reading their own label again), and the
+    class of that label: every entered slot of an allowed triangle, and the start slot of
+    an allowed start triangle."""
+    m = abstraction.num_triangles
+    is_start = np.zeros(m, dtype=bool)
+    for cell in starts:
+        is_start[cell.triangle] = True
     stay_ok = np.empty((m, SLOTS), dtype=bool)
-    stay_ok[:, :START_SLOT] = allowed[:, None] & (neighbors >= 0)
+    stay_ok[:, :START_SLOT] = allowed[:, None] & (abstraction.neighbors >= 0)
     stay_ok[:, START_SLOT] = allowed & is_start
-    stay_cell = np.flatnonzero(stay_ok)  # t * SLOTS + s
-    stay_class = tri_class[stay_cell // SLOTS]
+    stay_cell = np.flatnonzero(stay_ok)
+    stay_class: IntArray = tri_class[stay_cell // SLOTS]
+    return stay_cell, stay_class
 
-    stutter_accepting = np.zeros(m * SLOTS * nq, dtype=bool)
-    full = (1 << automaton.num_acc) - 1
 
-    def successors_of(kind: int, q: int) -> dict[int, bool]:
+#: Stutter edges of one automaton state ``q`` out of the cells ``stays``: the cells, ``q``,
+#: and the successors (state, accepting).
+StayEdges = tuple[IntArray, int, list[tuple[int, bool]]]
+
+
+class Successors:
+    """Automaton successors per kind of move (one letter class, or a crossing class and an
+    entered class, see :func:`crossing_move_kinds`)."""
+
+    def __init__(self, classes: LetterClasses, automaton: Automaton) -> None:
+        self.rows = classes.rows
+        self.stride = len(classes.rows) + 1
+        self.full = (1 << automaton.num_acc) - 1
+        self.num_states = automaton.num_states
+        self.by_kind: dict[int, list[list[tuple[int, bool]]]] = {}
+
+    def after(self, kind: int, q: int) -> dict[int, bool]:
         """Automaton successors of ``q`` over a move of ``kind`` (one or two letters).
 
         Parallel automaton edges would give duplicate pairs: one per successor, accepting if
         any is (every (node, node') pair is then unique).
         """
         found: dict[int, bool] = {}
-        if kind >= stride:
-            for q_mid, mask in class_rows[kind // stride - 1][q]:
-                for q_next, mask_next in class_rows[kind % stride][q_mid]:
-                    found[q_next] = found.get(q_next, False) or (mask | mask_next) == full
+        if kind >= self.stride:
+            for q_mid, mask in self.rows[kind // self.stride - 1][q]:
+                for q_next, mask_next in self.rows[kind % self.stride][q_mid]:
+                    found[q_next] = found.get(q_next, False) or (mask | mask_next) == self.full
             return found
-        for q_next, mask in class_rows[kind][q]:
-            found[q_next] = found.get(q_next, False) or mask == full
+        for q_next, mask in self.rows[kind][q]:
+            found[q_next] = found.get(q_next, False) or mask == self.full
         return found
 
-    # Successors per kind that occurs (kinds are small integers: a count finds them).
-    move_kinds = np.flatnonzero(np.bincount(move_kind)).tolist() if len(moves) else []
-    stay_classes = np.flatnonzero(np.bincount(stay_class)).tolist() if len(stay_cell) else []
-    move_succ = {k: [list(successors_of(k, q).items()) for q in range(nq)] for k in move_kinds}
-    stay_succ: dict[int, list[list[tuple[int, bool]]]] = {}
-    for cls in stay_classes:
-        stays = stay_cell[stay_class == cls]
-        stay_succ[cls] = []
-        for q in range(nq):
-            found = successors_of(cls, q)
-            if found.get(q, False):
-                stutter_accepting[stays * nq + q] = True
-            # Staying in the same state is the node itself: no edge.
-            stay_succ[cls].append([(q2, mark) for q2, mark in found.items() if q2 != q])
+    def of_moves(self, move_kind: IntArray) -> list[int]:
+        """The kinds that occur among the moves (small integers: a count finds them), with
+        their successors tabulated in :attr:`by_kind`."""
+        kinds: list[int] = np.flatnonzero(np.bincount(move_kind)).tolist() if len(move_kind) else []
+        for k in kinds:
+            self.by_kind[k] = [list(self.after(k, q).items()) for q in range(self.num_states)]
+        return kinds
 
-    # --- the edges, written straight into CSR order ----------------------------------------
-    # A node's edges: its moves in exit order, each with its successors in turn, then its
-    # stutter edges.  Degrees first, then each edge's position, then one write per array;
-    # every pass handles one automaton state's edges (1-d arrays, no sort).
-    cells = m * SLOTS
-    size = cells * nq
-    # A cell's moves (at most three) are adjacent in ``moves``: a move's rank among them
-    # says which of the one or two moves before it share its node.
-    rank = np.zeros(len(moves), dtype=np.int64)
-    rank[1:] += move_src[1:] == move_src[:-1]
-    rank[2:] += move_src[2:] == move_src[:-2]
-    moves_of_cell = np.bincount(move_src, minlength=cells)
+    def stutter_edges(
+        self,
+        stay_cell: IntArray,
+        stay_class: IntArray,
+        stutter_accepting: BoolArray,
+        *,
+        stay_ok: BoolArray | None = None,
+    ) -> list[StayEdges]:
+        """The stutter edges per (class, state), in that order; marks in
+        ``stutter_accepting`` the nodes whose stutter loop accepts (with ``stay_ok``, per
+        triangle, only where a stay field exists: the run may end staying only there).
+        Staying in the same state is the node itself: no edge."""
+        nq = self.num_states
+        classes = np.flatnonzero(np.bincount(stay_class)).tolist() if len(stay_cell) else []
+        edges: list[StayEdges] = []
+        for cls in classes:
+            stays = stay_cell[stay_class == cls]
+            final = stays if stay_ok is None else stays[stay_ok[stays // SLOTS]]
+            for q in range(nq):
+                found = self.after(cls, q)
+                if found.get(q, False):
+                    stutter_accepting[final * nq + q] = True
+                others = [(q2, mark) for q2, mark in found.items() if q2 != q]
+                if others:
+                    edges.append((stays, q, others))
+        return edges
+
+
+def _product_edges(
+    moves: _Moves,
+    move_kind: IntArray,
+    weight: FloatArray,
+    successors: Successors,
+    stay_edges: list[StayEdges],
+) -> tuple[Graph, BoolArray]:
+    """The product's edges written straight into CSR order, and their acceptance marks.
+
+    A node's edges: its moves in exit order, each with its successors in turn, then its
+    stutter edges.  Degrees first, then each edge's position, then one write per array;
+    every pass handles one automaton state's edges (1-d arrays, no sort).
+    """
+    nq = successors.num_states
+    cells = len(moves.exit_ok) * SLOTS
+    move_kinds = successors.of_moves(move_kind)
+    by_kind = successors.by_kind
+    # A cell's moves (at most three) are adjacent: a move's rank among them says which of
+    # the one or two moves before it share its node.
+    source = moves.source
+    rank = np.zeros(len(source), dtype=np.int64)
+    rank[1:] += source[1:] == source[:-1]
+    rank[2:] += source[2:] == source[:-2]
+    moves_of_cell = np.bincount(source, minlength=cells)
 
     def degrees(q: int) -> int | IntArray:
         """How many edges each move gives out of its node (cell, q): one number when every
@@ -244,7 +444,7 @@ def build_product(
         array over the moves."""
         degree = np.zeros(max(move_kinds, default=0) + 1, dtype=np.int64)
         for k in move_kinds:
-            degree[k] = len(move_succ[k][q])
+            degree[k] = len(by_kind[k][q])
         counts = {int(degree[k]) for k in move_kinds}
         if len(counts) <= 1:
             return counts.pop() if counts else 0
@@ -256,7 +456,7 @@ def build_product(
         per_move = degrees(q)
         if isinstance(per_move, int):
             return rank * per_move
-        offset = np.zeros(len(moves), dtype=np.int64)
+        offset = np.zeros(len(source), dtype=np.int64)
         offset[1:] = per_move[:-1] * (rank[1:] >= 1)
         offset[2:] += per_move[:-2] * (rank[2:] >= 2)
         return offset
@@ -267,25 +467,23 @@ def build_product(
         if isinstance(per_move, int):
             out_degree[:, q] = moves_of_cell * per_move
         else:
-            out_degree[:, q] = np.bincount(move_src, weights=per_move, minlength=cells)
+            out_degree[:, q] = np.bincount(source, weights=per_move, minlength=cells)
     # A node's stutter edges come after its moves.
-    stay_edges: list[tuple[IntArray, int, IntArray, list[tuple[int, bool]]]] = []
-    for cls in stay_classes:
-        stays = stay_cell[stay_class == cls]
-        for q in range(nq):
-            if stay_succ[cls][q]:
-                stay_edges.append((stays, q, out_degree[stays, q], stay_succ[cls][q]))
-                out_degree[stays, q] += len(stay_succ[cls][q])
+    stutter_before: list[IntArray] = []
+    for stays, q, found in stay_edges:
+        stutter_before.append(out_degree[stays, q])
+        out_degree[stays, q] += len(found)
+    size = cells * nq
     indptr = np.zeros(size + 1, dtype=np.int64)
     np.cumsum(out_degree.reshape(-1), out=indptr[1:])
     nnz = int(indptr[-1])
     dst = np.empty(nnz, dtype=np.int64)
     wgt = np.empty(nnz)
     acc = np.zeros(nnz, dtype=bool)
-    move_node = move_src * nq
-    move_target = move_dst * nq
+    move_node = source * nq
+    move_target = moves.target * nq
     for q in range(nq):
-        width = max((len(move_succ[k][q]) for k in move_kinds), default=0)
+        width = max((len(by_kind[k][q]) for k in move_kinds), default=0)
         if not width:
             continue
         first = indptr[move_node + q] + offsets(q)
@@ -294,8 +492,8 @@ def build_product(
             following = np.full(max(move_kinds) + 1, -1, dtype=np.int64)
             marked = np.zeros(len(following), dtype=bool)
             for k in move_kinds:
-                if j < len(move_succ[k][q]):
-                    following[k], marked[k] = move_succ[k][q][j]
+                if j < len(by_kind[k][q]):
+                    following[k], marked[k] = by_kind[k][q][j]
             # Every move, or those whose kind has a j-th successor (a slice: no copies).
             rows: slice | IntArray = slice(None)
             if not (following[move_kinds] >= 0).all():
@@ -305,35 +503,37 @@ def build_product(
             wgt[at] = weight[rows]
             if marked.any():
                 acc[at] = marked.take(move_kind[rows])
-    for stays, q, before, successors in stay_edges:
+    for (stays, q, found), before in zip(stay_edges, stutter_before, strict=True):
         node = stays * nq
         first = indptr[node + q] + before
-        for j, (q_next, accepting) in enumerate(successors):
+        for j, (q_next, accepting) in enumerate(found):
             dst[first + j] = node + q_next
             wgt[first + j] = STUTTER_COST
             acc[first + j] = accepting
     src = np.repeat(np.arange(size, dtype=np.int64), out_degree.reshape(-1))
-    graph = Graph(indptr=indptr, sources=src, targets=dst, weights=wgt, num_nodes=size)
-    accepting_edges = acc
-    # Initial nodes: each start triangle after reading (the start point's letter, under the
-    # closed convention, then) its own label.
+    return Graph(indptr=indptr, sources=src, targets=dst, weights=wgt, num_nodes=size), acc
+
+
+def initial_nodes(
+    automaton: Automaton,
+    classes: LetterClasses,
+    tri_class: IntArray,
+    allowed: BoolArray,
+    starts: tuple[StartCell, ...],
+    start_letter: tuple[str, ...] | None,
+) -> IntArray:
+    """Each allowed start triangle's start node after reading (``start_letter``, the start
+    point's letter under the closed convention, then) its own label."""
+    nq = automaton.num_states
     entry_states = [automaton.initial]
-    if closed:
-        point_row = successor_table(automaton, [tuple(sorted({*start_label, POINT}))])[0]
+    if start_letter is not None:
+        point_row = successor_table(automaton, [start_letter])[0]
         entry_states = list(dict.fromkeys(q for q, _ in point_row[automaton.initial]))
-    initial_nodes: set[int] = set()
+    found: set[int] = set()
     for cell in starts:
         if not allowed[cell.triangle]:
             continue
-        row = class_rows[int(tri_class[cell.triangle])]
+        row = classes.rows[int(tri_class[cell.triangle])]
         for q0 in entry_states:
-            initial_nodes.update((cell.triangle * SLOTS + START_SLOT) * nq + q for q, _ in row[q0])
-    initial = np.array(sorted(initial_nodes), dtype=np.int64)
-    return Product(
-        graph=graph,
-        accepting=accepting_edges,
-        stutter_accepting=stutter_accepting,
-        initial=initial,
-        num_automaton_states=nq,
-        num_nodes=size,
-    )
+            found.update((cell.triangle * SLOTS + START_SLOT) * nq + q for q, _ in row[q0])
+    return np.array(sorted(found), dtype=np.int64)

@@ -108,7 +108,7 @@ def _out_edges(graph: Graph, nodes: IntArray) -> IntArray:
     return shift + np.arange(total, dtype=np.int64)
 
 
-def _relax(
+def relax_offers(
     dist: FloatArray,
     via: FloatArray,
     pred: IntArray,
@@ -203,7 +203,7 @@ def shortest_paths(
         if limit < np.inf:
             keep = d <= limit
             u, v, du, d = u[keep], v[keep], du[keep], d[keep]
-        improved = _relax(dist, via, pred, v, d, du, u)
+        improved = relax_offers(dist, via, pred, v, d, du, u)
         if goals is not None and len(improved):
             hit = goals[improved]
             if hit.any():
@@ -273,7 +273,7 @@ def closing_searches(
         keep = d <= limit[v // n]
         if not keep.all():
             u, v, du, d = u[keep], v[keep], du[keep], d[keep]
-        improved = _relax(dist, via, pred, v, d, du, u)
+        improved = relax_offers(dist, via, pred, v, d, du, u)
         reached = improved[is_goal[improved]]
         if len(reached):
             searches = reached // n

@@ -9,6 +9,8 @@ one; steps that differ only in the task's memory are shown once.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 from tlmpc.reactive.game import FACE, GOAL, MOVED, MissionGame
 from tlmpc.synth.counter import CounterStrategy
 
@@ -21,17 +23,32 @@ def place(letters: tuple[str, ...]) -> str:
     return " & ".join(letters) if letters else "free space"
 
 
-def counter_play(counter: CounterStrategy, game: MissionGame) -> list[str]:
-    """The lines of one play of the counterstrategy (empty when it has no start)."""
+@dataclass(frozen=True, slots=True)
+class PlayStep:
+    """One step of a play of the counterstrategy: where the robot is, what it senses, and the
+    face it heads for (its own: it stays)."""
+
+    step: int
+    face: int
+    heading: int
+    sensors: tuple[tuple[str, bool], ...]
+
+
+@dataclass(frozen=True, slots=True)
+class Play:
+    """A play: its steps; ``stuck`` when the robot is left without an allowed move after the
+    last one; ``again_from`` the step the play repeats from forever (None: it ends there)."""
+
+    steps: tuple[PlayStep, ...]
+    stuck: bool
+    again_from: int | None
+
+
+def counter_play_steps(counter: CounterStrategy, game: MissionGame) -> Play:
+    """One play of the counterstrategy (empty when it has no start)."""
     if not counter.initial:
-        return []
+        return Play((), False, None)
     sensors = [v.name for v in game.spec.owned("env") if v.is_bool and v.name != MOVED]
-    letters = game.faces.letters
-
-    def reading(state: dict[str, int | bool]) -> str:
-        on = [s for s in sensors if state.get(s)]
-        return ("sensing " + ", ".join(on)) if on else "sensing nothing"
-
     # nodes from which the robot can avoid getting stuck forever (a greatest fixpoint)
     safe = {n for n, answers in enumerate(counter.answers) if answers}
     while True:
@@ -39,24 +56,24 @@ def counter_play(counter: CounterStrategy, game: MissionGame) -> list[str]:
         if kept == safe:
             break
         safe = kept
-    lines: list[str] = []
+    steps: list[PlayStep] = []
     seen: dict[int, int] = {}
     node = counter.initial[0]
     step = 0
     while node not in seen and step < MAX_STEPS:
         seen[node] = step
         state = counter.states[node]
-        here, heading = int(state[FACE]), int(state[GOAL])
-        line = (
-            f"in {place(letters[here])}, {reading(state)}, heading for "
-            f"{'its own place' if heading == here else place(letters[heading])}"
+        steps.append(
+            PlayStep(
+                step=step,
+                face=int(state[FACE]),
+                heading=int(state[GOAL]),
+                sensors=tuple((s, bool(state.get(s))) for s in sensors),
+            )
         )
-        if not lines or not lines[-1].endswith(line):  # the same but for the task's memory
-            lines.append(f"{step}: {line}")
         answers = counter.answers[node]
         if not answers:
-            lines.append(f"{step + 1}: the robot has no allowed move left")
-            return lines
+            return Play(tuple(steps), True, None)
 
         # the robot's best-looking answer: one from which it need never get stuck, and that
         # keeps it moving (a play where it idles or walks into a forbidden place shows
@@ -67,6 +84,26 @@ def counter_play(counter: CounterStrategy, game: MissionGame) -> list[str]:
 
         node = min(answers, key=merit)
         step += 1
-    if node in seen:
-        lines.append(f"then again from step {seen[node]}, forever")
+    return Play(tuple(steps), False, seen.get(node))
+
+
+def counter_play(counter: CounterStrategy, game: MissionGame) -> list[str]:
+    """The lines of one play of the counterstrategy (empty when it has no start)."""
+    play = counter_play_steps(counter, game)
+    letters = game.faces.letters
+    lines: list[str] = []
+    for entry in play.steps:
+        on = [name for name, value in entry.sensors if value]
+        reading = ("sensing " + ", ".join(on)) if on else "sensing nothing"
+        heading = entry.heading
+        line = (
+            f"in {place(letters[entry.face])}, {reading}, heading for "
+            f"{'its own place' if heading == entry.face else place(letters[heading])}"
+        )
+        if not lines or not lines[-1].endswith(line):  # the same but for the task's memory
+            lines.append(f"{entry.step}: {line}")
+    if play.stuck:
+        lines.append(f"{play.steps[-1].step + 1}: the robot has no allowed move left")
+    elif play.again_from is not None:
+        lines.append(f"then again from step {play.again_from}, forever")
     return lines

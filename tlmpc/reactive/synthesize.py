@@ -12,9 +12,9 @@ from dataclasses import dataclass
 from typing import Any
 
 from tlmpc.abstraction.model import Abstraction
-from tlmpc.base.errors import Diagnostic, InvalidInputError, error
+from tlmpc.base.errors import Diagnostic, InvalidInputError, NoPlanError, error
 from tlmpc.mission.model import Mission, TaskPart
-from tlmpc.reactive.explain import counter_play
+from tlmpc.reactive.explain import counter_play, counter_play_steps, place
 from tlmpc.reactive.faces import Faces, faces_of
 from tlmpc.reactive.fragment import reading
 from tlmpc.reactive.game import MissionGame, build_game
@@ -25,6 +25,18 @@ from tlmpc.synth.solver import Game, Solution, solve
 from tlmpc.synth.spec import Part
 from tlmpc.synth.strategy import MealyMachine, extract, to_json
 from tlmpc.synth.symbolic import Encoding
+from tlmpc.synth.symbolic_strategy import (
+    LoopSize,
+    SymbolicStrategy,
+    reachable_size,
+    symbolic_document,
+    symbolic_strategy,
+)
+
+#: the explicit machine is built (and listed in strategy.json beside the symbolic form) when it
+#: has at most this many transitions; the symbolic form scales with the sensors, the explicit
+#: one with 2^sensors transitions per node
+EXPLICIT_TRANSITIONS = 10_000
 
 
 def mission_game(mission: Mission, abstraction: Abstraction) -> MissionGame:
@@ -50,12 +62,16 @@ def mission_game(mission: Mission, abstraction: Abstraction) -> MissionGame:
 
 @dataclass(frozen=True)
 class Synthesis:
-    """The outcome: the solved game; the strategy when realizable, else a core (task parts)
-    and the environment's counterstrategy."""
+    """The outcome: the solved game; the strategy when realizable (``symbolic`` always, the
+    explicit ``strategy`` when it has at most :data:`EXPLICIT_TRANSITIONS` transitions, and
+    the explicit machine's ``size`` counted symbolically), else a core (task parts) and the
+    environment's counterstrategy."""
 
     game: MissionGame
     solution: Solution
     strategy: MealyMachine | None = None
+    symbolic: SymbolicStrategy | None = None
+    size: LoopSize | None = None
     core: tuple[TaskPart, ...] | None = None
     counter: CounterStrategy | None = None
 
@@ -65,13 +81,23 @@ class Synthesis:
         return self.solution.realizable
 
 
-def synthesize(mission: Mission, abstraction: Abstraction) -> Synthesis:
+def synthesize(
+    mission: Mission, abstraction: Abstraction, *, explicit_transitions: int = EXPLICIT_TRANSITIONS
+) -> Synthesis:
     """Solve the mission's game: its strategy, or a core and a counterstrategy."""
     game = mission_game(mission, abstraction)
     encoding = Encoding(game.spec)
     solution = solve(Game.build(game.spec, encoding))
     if solution.realizable:
-        return Synthesis(game=game, solution=solution, strategy=extract(solution))
+        size = reachable_size(solution)
+        machine = extract(solution) if size.transitions <= explicit_transitions else None
+        return Synthesis(
+            game=game,
+            solution=solution,
+            strategy=machine,
+            symbolic=symbolic_strategy(solution),
+            size=size,
+        )
     counter = extract_counterstrategy(solution)
     core = minimal_core(game.spec, encoding, group=lambda part: _source_key(game, part))
     parts: dict[int, TaskPart] = {}
@@ -82,16 +108,80 @@ def synthesize(mission: Mission, abstraction: Abstraction) -> Synthesis:
 
 
 def strategy_to_json(synthesis: Synthesis) -> dict[str, Any]:
-    """``strategy.json`` of a reactive mission: the Mealy machine and the faces it moves on."""
-    assert synthesis.strategy is not None
+    """``strategy.json`` of a reactive mission: the strategy (symbolic, and the explicit Mealy
+    machine when it is small enough) and the faces it moves on."""
+    assert synthesis.symbolic is not None
     faces = synthesis.game.faces
-    document = to_json(synthesis.strategy)
+    document = symbolic_document(synthesis.symbolic, synthesis.size)
+    if synthesis.strategy is not None:
+        document = {**to_json(synthesis.strategy), **document}
     document["faces"] = {
         "labels": [list(letter) for letter in faces.letters],
         "adjacent": [list(a) for a in faces.adjacent],
         "face_of": faces.face_of.tolist(),
     }
     return document
+
+
+class UnrealizableError(NoPlanError):
+    """An unrealizable reactive mission (exit 1): its diagnostics, and the artifacts that show
+    how the environment wins (``mission.json``, ``abstraction.json``,
+    ``counterstrategy.json``), which ``tlmpc compile`` writes before it reports."""
+
+    def __init__(self, diagnostics: list[Diagnostic], artifacts: dict[str, Any]) -> None:
+        super().__init__(diagnostics)
+        self.artifacts = artifacts
+
+
+def face_points(abstraction: Abstraction, faces: Faces) -> list[list[float]]:
+    """A point inside each face: the centroid of its triangle nearest to the mean of its
+    triangles' centroids (a mean alone may lie outside a bent face)."""
+    import numpy as np
+
+    vertices = np.asarray(abstraction.vertices, dtype=np.float64)
+    triangles = np.asarray(abstraction.triangles, dtype=np.int64)
+    centroids = vertices[triangles].mean(axis=1)
+    face_of = np.asarray(faces.face_of, dtype=np.int64)
+    counts = np.bincount(face_of, minlength=faces.count)
+    mean_x = np.bincount(face_of, weights=centroids[:, 0], minlength=faces.count) / counts
+    mean_y = np.bincount(face_of, weights=centroids[:, 1], minlength=faces.count) / counts
+    distance = (centroids[:, 0] - mean_x[face_of]) ** 2 + (centroids[:, 1] - mean_y[face_of]) ** 2
+    # by face, then distance, then triangle number: the first of each face is its point
+    order = np.lexsort((np.arange(len(face_of)), distance, face_of))
+    first = order[np.searchsorted(face_of[order], np.arange(faces.count))]
+    return [[float(centroids[t][0]), float(centroids[t][1])] for t in first.tolist()]
+
+
+def counterstrategy_to_json(synthesis: Synthesis, abstraction: Abstraction) -> dict[str, Any]:
+    """``counterstrategy.json`` (schemas/counterstrategy.schema.json): the core, and one play
+    of the environment's winning strategy in the mission's words and places."""
+    assert synthesis.counter is not None
+    game = synthesis.game
+    letters = game.faces.letters
+    play = counter_play_steps(synthesis.counter, game)
+    points = face_points(abstraction, game.faces)
+    return {
+        "format": "tlmpc.counterstrategy/1",
+        "core": [
+            {"text": part.text, "line": part.line, "col": part.col} for part in synthesis.core or ()
+        ],
+        "nodes": len(synthesis.counter.states),
+        "play": [
+            {
+                "step": step.step,
+                "face": step.face,
+                "regions": list(letters[step.face]),
+                "place": place(letters[step.face]),
+                "position": points[step.face],
+                "heading": step.heading,
+                "heading_position": points[step.heading],
+                "sensors": dict(step.sensors),
+            }
+            for step in play.steps
+        ],
+        "stuck": play.stuck,
+        "again_from": play.again_from,
+    }
 
 
 def _source_key(game: MissionGame, part: Part) -> int | None:

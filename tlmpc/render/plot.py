@@ -31,6 +31,7 @@ from tlmpc.render.layout import (
     layout,
 )
 from tlmpc.render.scene import Scene, build_scene, viridis
+from tlmpc.render.svg import PLAY_COLOUR
 
 View = tuple[float, float, float, float]
 
@@ -134,6 +135,19 @@ def figure_of(scene: Scene) -> Any:
             ha="center",
             va="baseline",
             path_effects=halo,
+            zorder=8,
+        )
+    for mark in scene.play:
+        px, py = canvas.pixel(mark.position)
+        text(
+            px + 8,
+            py + 4,
+            mark.text,
+            FONT_PX,
+            "play-text",
+            va="baseline",
+            color=PLAY_COLOUR,
+            path_effects=[withStroke(linewidth=3 * _PT, foreground="white")],
             zorder=8,
         )
     for number, violation in enumerate(scene.violations, start=1):
@@ -403,6 +417,27 @@ def draw_scene(axes: Any, scene: Scene) -> None:
             markeredgewidth=1.6 * _PT,
             linestyle="none",
             zorder=5.8,
+        )
+    if len(scene.play_route) >= 2:
+        axes.plot(
+            *zip(*scene.play_route, strict=True),
+            color=PLAY_COLOUR,
+            linewidth=2 * _PT,
+            linestyle=(0, (6, 3)),
+            zorder=6.5,
+            gid="play",
+        )
+    for mark in scene.play:
+        axes.plot(
+            [mark.position[0]],
+            [mark.position[1]],
+            marker="o",
+            markerfacecolor=PLAY_COLOUR,
+            markeredgecolor="white",
+            markersize=10 * _PT,
+            linestyle="none",
+            zorder=6.6,
+            gid="play-step",
         )
     for violation in scene.violations:
         vx, vy = violation.position

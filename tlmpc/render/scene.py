@@ -100,6 +100,15 @@ class Path:
 
 
 @dataclass(frozen=True, slots=True)
+class PlayMark:
+    """A place of an unrealizable mission's counterstrategy play: the steps the robot is
+    there, and what it senses at each (``counterstrategy.json``)."""
+
+    position: Point
+    text: str
+
+
+@dataclass(frozen=True, slots=True)
 class Scene:
     """Everything one figure shows, in world coordinates."""
 
@@ -125,6 +134,10 @@ class Scene:
     #: the points of every polygon in ``regions``, in order, as rows ``x, y`` (when the scene
     #: converted them in one array anyway: the SVG writer then need not convert them again)
     region_points: FloatArray | None = field(default=None, compare=False)
+    #: an unrealizable reactive mission: the places of the environment's winning play, in
+    #: the order visited (closing back to where it repeats from, if it does)
+    play: tuple[PlayMark, ...] = ()
+    play_route: tuple[Point, ...] = ()
 
 
 def _polygon(points: Sequence[Sequence[float]]) -> Polygon:
@@ -338,6 +351,28 @@ def _violations(verdict: Mapping[str, Any] | None) -> tuple[Violation, ...]:
     return tuple(found)
 
 
+def play_marks(document: Mapping[str, Any]) -> tuple[tuple[PlayMark, ...], tuple[Point, ...]]:
+    """The marks and the route of a ``counterstrategy.json`` play: one mark per place, its
+    text the steps spent there with the sensors on at each (``2 alarm``), in step order."""
+    texts: dict[Point, list[str]] = {}
+    route: list[Point] = []
+    steps = list(document.get("play", []))
+    for entry in steps:
+        x, y = entry["position"]
+        here = (float(x), float(y))
+        on = [name for name, value in sorted(entry["sensors"].items()) if value]
+        texts.setdefault(here, []).append(" ".join([str(entry["step"]), *on]))
+        if not route or route[-1] != here:
+            route.append(here)
+    again = document.get("again_from")
+    if again is not None and steps:
+        x, y = steps[min(int(again), len(steps) - 1)]["position"]
+        if route[-1] != (float(x), float(y)):
+            route.append((float(x), float(y)))
+    marks = tuple(PlayMark(position=p, text=", ".join(t)) for p, t in texts.items())
+    return marks, tuple(route)
+
+
 def build_scene(
     artifacts: Mapping[str, Any],
     *,
@@ -417,8 +452,13 @@ def build_scene(
     trajectory = arc_length_path(trace["points"]) if trace is not None else None
     start_value = mission.get("robot", {}).get("start")
     start = (float(start_value[0]), float(start_value[1])) if start_value else None
+    counter = artifacts.get("counterstrategy.json")
+    marks, route = play_marks(counter) if counter is not None else ((), ())
+    title = str(mission.get("name") or "tlmpc plan")
+    if counter is not None:
+        title += ": unrealizable, how the environment wins"
     return Scene(
-        title=str(mission.get("name") or "tlmpc plan"),
+        title=title,
         view=view,
         boundary=boundary,
         holes=holes,
@@ -437,4 +477,6 @@ def build_scene(
         components=components,
         component_holes=component_holes,
         region_points=region_points,
+        play=marks,
+        play_route=route,
     )

@@ -37,6 +37,10 @@ _COLOUR_STEPS = 48  # the trajectory is drawn in this many colours along its len
 _MIN_STEP_PX = 0.4  # consecutive samples closer than this on screen are merged
 
 
+#: the colour of a counterstrategy play (an unrealizable reactive mission)
+PLAY_COLOUR = "#7b2cbf"
+
+
 def escape(text: str) -> str:
     """Text for an SVG element: XML-escaped, with control characters (which XML 1.0 does not
     allow at all), newlines and direction controls as visible escapes."""
@@ -282,6 +286,20 @@ def render_svg(scene: Scene) -> bytes:
         parts.append(
             f'<circle cx="{_fmt(sx)}" cy="{_fmt(sy)}" r="4" fill="#fff" stroke="#000" '
             'stroke-width="1.6"/>'
+        )
+    if len(scene.play_route) >= 2:
+        parts.append(
+            f'<path d="{_polyline(canvas, scene.play_route)}" stroke="{PLAY_COLOUR}" '
+            'stroke-width="2" stroke-dasharray="6 3" fill="none"/>'
+        )
+    for mark in scene.play:
+        px, py = canvas.pixel(mark.position)
+        text = escape(mark.text)
+        parts.append(
+            f'<circle cx="{_fmt(px)}" cy="{_fmt(py)}" r="5" fill="{PLAY_COLOUR}" stroke="#fff"/>'
+            f'<text x="{_fmt(px + 8)}" y="{_fmt(py + 4)}" stroke="#fff" stroke-width="3">'
+            f'{text}</text><text x="{_fmt(px + 8)}" y="{_fmt(py + 4)}" fill="{PLAY_COLOUR}">'
+            f"{text}</text>"
         )
     for number, violation in enumerate(scene.violations, start=1):
         vx, vy = canvas.pixel(violation.position)

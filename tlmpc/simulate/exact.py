@@ -293,6 +293,12 @@ def _exit_step(controller: StepController, x0: FloatArray) -> tuple[list[float],
     return [*times, float(crossing)], [*points, np.array([ax + along * dx, ay + along * dy])]
 
 
+def exit_step(controller: StepController, x0: FloatArray) -> tuple[list[float], list[FloatArray]]:
+    """Times (from 0) and exact points of the flow of an exit step's field from ``x0`` until it
+    crosses the exit edge; the last pair is the crossing, snapped onto the edge."""
+    return _exit_step(controller, x0)
+
+
 def _wrong_exit(controller: StepController, facets: list[int], where: FloatArray) -> NoReturn:
     raise SolverError(
         error(

@@ -81,6 +81,17 @@ class Compare:
     primed: bool = False
 
 
+@dataclass(frozen=True, slots=True)
+class Linear:
+    """A comparison of integer arithmetic over variables: ``sum(coef * var) op value``, with
+    each term ``(coef, name, primed)``; exact integers, no overflow (slugs' structured
+    format writes ``level' = level + 1``)."""
+
+    terms: tuple[tuple[int, str, bool], ...]
+    op: Literal["=", "!=", "<", "<=", ">", ">="]
+    value: int
+
+
 @dataclass(frozen=True, slots=True, eq=False)
 class Not:
     """Negation."""
@@ -105,7 +116,7 @@ class Binary:
     right: Expr
 
 
-Expr = Const | Atom | Compare | Not | Nary | Binary
+Expr = Const | Atom | Compare | Linear | Not | Nary | Binary
 
 
 def walk(expr: Expr) -> list[Expr]:
@@ -130,7 +141,11 @@ def walk(expr: Expr) -> list[Expr]:
 
 def support(expr: Expr) -> set[tuple[str, bool]]:
     """The ``(variable, primed)`` pairs that ``expr`` mentions."""
-    return {(n.name, n.primed) for n in walk(expr) if isinstance(n, Atom | Compare)}
+    found = {(n.name, n.primed) for n in walk(expr) if isinstance(n, Atom | Compare)}
+    for node in walk(expr):
+        if isinstance(node, Linear):
+            found |= {(name, primed) for _, name, primed in node.terms}
+    return found
 
 
 # --- parts and the specification --------------------------------------------------------------

@@ -13,12 +13,14 @@ outputs of that node's state.
 from __future__ import annotations
 
 from collections import deque
+from collections.abc import Mapping
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 from tlmpc.base.errors import UsageError, error
 from tlmpc.synth.solver import Solution
-from tlmpc.synth.spec import Variable
+from tlmpc.synth.spec import Owner, Variable
 from tlmpc.synth.symbolic import Encoding, Function
 
 #: the largest machine written explicitly (a budget of nodes, not of time)
@@ -41,6 +43,28 @@ class MealyMachine:
     transitions: tuple[tuple[int, int], ...]
     source_file: str
     source_format: str
+
+    @cached_property
+    def _successors(self) -> dict[int, dict[tuple[Value, ...], int]]:
+        inputs = [v.name for v in self.inputs]
+        table: dict[int, dict[tuple[Value, ...], int]] = {}
+        for source, target in self.transitions:
+            key = tuple(self.states[target][name] for name in inputs)
+            table.setdefault(source, {})[key] = target
+        return table
+
+    def start(self, inputs: Mapping[str, Value]) -> int | None:
+        """The initial node whose inputs are ``inputs`` (None: no initial node has them)."""
+        for node in self.initial:
+            if all(self.states[node][v.name] == inputs[v.name] for v in self.inputs):
+                return node
+        return None
+
+    def successor(self, node: int, inputs: Mapping[str, Value]) -> int | None:
+        """The node the machine moves to from ``node`` when the environment plays ``inputs``
+        (None: the environment's safety assumption does not allow them there)."""
+        key = tuple(inputs[v.name] for v in self.inputs)
+        return self._successors.get(node, {}).get(key)
 
 
 def goal_strategies(solution: Solution) -> list[Function]:
@@ -269,10 +293,35 @@ def minimize(machine: MealyMachine) -> MealyMachine:
     )
 
 
-def _variable_json(variable: Variable) -> dict[str, Any]:
+def variable_json(variable: Variable) -> dict[str, Any]:
+    """A variable as ``strategy.json`` lists it."""
     if variable.is_bool:
         return {"name": variable.name, "type": "bool"}
     return {"name": variable.name, "type": "int", "low": variable.low, "high": variable.high}
+
+
+def variable_from_json(document: Mapping[str, Any], owner: Owner) -> Variable:
+    """A variable of ``strategy.json``'s ``inputs`` (``env``) or ``outputs`` (``sys``)."""
+    if document["type"] == "bool":
+        return Variable(str(document["name"]), owner)
+    return Variable(str(document["name"]), owner, int(document["low"]), int(document["high"]))
+
+
+def machine_from_json(document: Mapping[str, Any]) -> MealyMachine:
+    """The explicit machine of a ``strategy.json`` that lists its nodes."""
+    nodes = sorted(document["nodes"], key=lambda n: int(n["id"]))
+    return MealyMachine(
+        inputs=tuple(variable_from_json(v, "env") for v in document["inputs"]),
+        outputs=tuple(variable_from_json(v, "sys") for v in document["outputs"]),
+        goals=int(document["goals"]),
+        init_mode=str(document["initial_quantification"]),
+        states=tuple(dict(n["state"]) for n in nodes),
+        node_goals=tuple(int(n["goal"]) for n in nodes),
+        initial=tuple(int(i) for i in document["initial"]),
+        transitions=tuple((int(a), int(b)) for a, b in document["transitions"]),
+        source_file=str(document["source"]["file"]),
+        source_format=str(document["source"]["format"]),
+    )
 
 
 def to_json(machine: MealyMachine) -> dict[str, Any]:
@@ -281,8 +330,8 @@ def to_json(machine: MealyMachine) -> dict[str, Any]:
         "format": "tlmpc.strategy/1",
         "source": {"file": machine.source_file, "format": machine.source_format},
         "initial_quantification": machine.init_mode,
-        "inputs": [_variable_json(v) for v in machine.inputs],
-        "outputs": [_variable_json(v) for v in machine.outputs],
+        "inputs": [variable_json(v) for v in machine.inputs],
+        "outputs": [variable_json(v) for v in machine.outputs],
         "goals": machine.goals,
         "nodes": [
             {"id": i, "goal": g, "state": state}
@@ -324,4 +373,14 @@ def to_dot(machine: MealyMachine) -> str:
     return "\n".join(lines) + "\n"
 
 
-__all__ = ["MealyMachine", "extract", "goal_strategies", "minimize", "to_dot", "to_json"]
+__all__ = [
+    "MealyMachine",
+    "extract",
+    "goal_strategies",
+    "machine_from_json",
+    "minimize",
+    "to_dot",
+    "to_json",
+    "variable_from_json",
+    "variable_json",
+]

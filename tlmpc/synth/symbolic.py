@@ -23,6 +23,7 @@ from tlmpc.synth.spec import (
     Const,
     Expr,
     GameSpec,
+    Linear,
     Nary,
     Not,
     Owner,
@@ -176,6 +177,8 @@ class Encoding:
                 if test(value, node.value):
                     result |= self.value_cube(variable, value, node.primed)
             return result
+        if isinstance(node, Linear):
+            return self._linear(node)
         if isinstance(node, Not):
             return ~memo[id(node.arg)]
         if isinstance(node, Nary):
@@ -198,6 +201,30 @@ class Encoding:
         if node.op == "->":
             return ~left | right
         return bdd.apply("equiv", left, right)
+
+    def _linear(self, node: Linear) -> Function:
+        """``sum(coef * var) op value``: the partial sums, one variable at a time, each with
+        the BDD of the values that give it (exact integers; the sums stay few because the
+        ranges are small)."""
+        bdd = self.bdd
+        test = _COMPARE[node.op]
+        partial: dict[int, Function] = {0: bdd.true}
+        for coef, name, primed in node.terms:
+            variable = self.spec.variable(name)
+            assert variable.low is not None
+            assert variable.high is not None
+            grown: dict[int, Function] = {}
+            for value in range(variable.low, variable.high + 1):
+                cube = self.value_cube(variable, value, primed)
+                for total, reached in partial.items():
+                    key = total + coef * value
+                    grown[key] = grown.get(key, bdd.false) | (reached & cube)
+            partial = grown
+        result = bdd.false
+        for total, reached in partial.items():
+            if test(total, node.value):
+                result |= reached
+        return result
 
     def part(self, part: Part) -> Function:
         """The BDD of one part (cached)."""

@@ -65,6 +65,36 @@ class Certificate:
     reason: str
 
 
+#: Who broke a reactive run: the environment (an assumption) or the robot (a guarantee).
+Blame = Literal["environment", "robot"]
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class PartVerdict:
+    """One assumption or guarantee part: its own verdict on the run and when it broke."""
+
+    part: str
+    outcome: Outcome
+    #: the earliest instant (the log's clock) at which the run's prefix was bad for the part;
+    #: None when it never was (it holds, is undecided, or fails only in the limit)
+    broken: float | None
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
+class AssumeGuarantee:
+    """The assume-guarantee verdict of a reactive run."""
+
+    outcome: Outcome
+    blame: Blame | None
+    assumptions: tuple[PartVerdict, ...]
+    guarantees: tuple[PartVerdict, ...]
+    #: the assumption the environment broke first (at the earliest instant, else in the
+    #: limit), whoever is to blame; None when it kept every assumption (or may have)
+    environment: PartVerdict | None
+    #: the guarantee part the robot broke first, likewise
+    robot: PartVerdict | None
+
+
 @dataclass(frozen=True, slots=True, kw_only=True, eq=False)
 class Verdict(ContentEquality):
     """The verifier's answer for one trace."""
@@ -82,6 +112,8 @@ class Verdict(ContentEquality):
     conjuncts: tuple[ConjunctReport, ...] = ()
     violations: tuple[Violation, ...] = ()
     stats: Mapping[str, Any] = field(default_factory=dict)
+    #: A reactive run's assume-guarantee verdict (``outcome`` is its outcome); None else.
+    reactive: AssumeGuarantee | None = None
 
     @property
     def satisfied(self) -> bool:

@@ -40,6 +40,8 @@ class Timeline:
     labels: BoolArray
     names: list[str]
     origin: float = 0.0  # the time of the log's first sample: times are reported from it
+    #: the names that are sensors or actions, not regions (a reactive run's)
+    signals: frozenset[str] = frozenset()
 
     @property
     def size(self) -> int:
@@ -101,13 +103,16 @@ def _globally_violations(
             )
             found.append(Violation(conjunct=text, time=time, position=position, message=message))
             continue
-        inside = [line.names[i] for i in np.flatnonzero(line.labels[first])]
+        true = [line.names[i] for i in np.flatnonzero(line.labels[first])]
+        inside = [name for name in true if name not in line.signals]
         forbidden = [
             n.arg.name
             for n in inner.walk()
-            if isinstance(n, Not) and isinstance(n.arg, Prop) and n.arg.name in inside
+            if isinstance(n, Not) and isinstance(n.arg, Prop) and n.arg.name in true
         ]
-        if forbidden:
+        if forbidden and forbidden[0] in line.signals:
+            message = f"`{forbidden[0]}` is true at {at(time, line.origin)} at {_place(position)}"
+        elif forbidden:
             message = f"entered {forbidden[0]} at {at(time, line.origin)} at {_place(position)}"
         else:
             where = ", ".join(inside) if inside else "free space"

@@ -27,6 +27,7 @@ from collections.abc import Callable
 from typing import assert_never
 
 from tlmpc.ltl.ast import (
+    BOUNDED,
     FALSE,
     TRUE,
     And,
@@ -69,11 +70,22 @@ def _shrink(interval: Interval, amount: float) -> Interval | None:
     return Interval(interval.low, high)
 
 
-def tighten(formula: Formula, amount: float, positive: bool = True) -> Formula:
-    """``formula`` with every finite bound made ``amount`` seconds harder to meet."""
+def tighten(
+    formula: Formula, amount: float, positive: bool = True, *, only: Formula | None = None
+) -> Formula:
+    """``formula`` with every finite bound made ``amount`` seconds harder to meet (with
+    ``only``: that bounded node alone, the very object, not an equal one elsewhere)."""
 
     def again(f: Formula, sign: bool = positive) -> Formula:
-        return tighten(f, amount, sign)
+        return tighten(f, amount, sign, only=only)
+
+    if only is not None and formula is not only and isinstance(formula, BOUNDED):
+        # another bound: kept as it is, its operands still searched for ``only``
+        match formula:
+            case BoundedEventually(arg, interval) | BoundedGlobally(arg, interval):
+                return type(formula)(again(arg), interval)
+            case BoundedUntil(left, right, interval):
+                return BoundedUntil(again(left), again(right), interval)
 
     match formula:
         case Const() | Prop():
@@ -142,17 +154,23 @@ def horizon(formula: Formula, duration: float) -> float:
 
 
 def time_robustness(
-    formula: Formula, outcome: str, outcome_of: Callable[[Formula], str], reach: float
+    formula: Formula,
+    outcome: str,
+    outcome_of: Callable[[Formula], str],
+    reach: float,
+    *,
+    only: Formula | None = None,
 ) -> float | None:
     """The time robustness of ``formula`` whose verdict is ``outcome``; ``outcome_of`` gives the
-    verdict of a tightened formula; ``reach`` bounds the search (see :func:`horizon`)."""
+    verdict of a tightened formula; ``reach`` bounds the search (see :func:`horizon`).  With
+    ``only`` (a bounded node of ``formula``): the slack of that one bound, the others kept."""
     if outcome == "inconclusive" or not bounded_operators(formula):
         return None
     try:
         if outcome == "satisfied":
 
             def good(amount: float) -> bool:
-                return outcome_of(tighten(formula, amount)) == "satisfied"
+                return outcome_of(tighten(formula, amount, only=only)) == "satisfied"
 
             if good(reach):
                 return math.inf
@@ -160,7 +178,7 @@ def time_robustness(
         else:
 
             def good(amount: float) -> bool:
-                return outcome_of(tighten(formula, -amount)) != "violated"
+                return outcome_of(tighten(formula, -amount, only=only)) != "violated"
 
             if not good(reach):
                 return -math.inf

@@ -20,6 +20,7 @@ from tlmpc.base.errors import UsageError, error
 from tlmpc.ltl.ast import Formula
 from tlmpc.verify.model import Ending
 from tlmpc.verify.samples import check_samples
+from tlmpc.verify.signals import Signal, signals_of_document
 
 if TYPE_CHECKING:
     from tlmpc.mission.model import Mission
@@ -51,6 +52,17 @@ class TraceInput:
     #: When the log started, if before ``times[0]`` (a stretch of a longer log, as the live
     #: monitor checks): messages give times from here.
     origin: float | None = None
+    #: A reactive run's sensors and actions (propositions whose values are in ``signals``)
+    #: and the environment's assumptions; ``formula`` is then the robot's guarantee.
+    sensors: tuple[str, ...] = ()
+    actions: tuple[str, ...] = ()
+    assumptions: tuple[Formula, ...] = ()
+    signals: Mapping[str, Signal] = field(default_factory=dict, compare=False)
+
+    @property
+    def reactive(self) -> bool:
+        """Whether the run has sensors, actions or assumptions (assume-guarantee verdict)."""
+        return bool(self.sensors or self.actions or self.assumptions)
 
     @property
     def start(self) -> float:
@@ -124,8 +136,12 @@ def _certifying_speed(speed: Any) -> float | None:
     return float(speed) if speed > 0 else None
 
 
-def _formula(text: Any, names: set[str], file: str | None) -> Formula:
+def _formula(
+    text: Any, names: set[str], file: str | None, *, assumption: int | None = None
+) -> Formula:
     if not isinstance(text, str):
+        if assumption is not None:
+            raise _fail("V034", f"assumption {assumption} is not an LTL string", file)
         raise _fail("V006", "the trace has no `ltl` task", file)
     from tlmpc.base.errors import InvalidInputError
     from tlmpc.ltl.parser import parse_ltl  # lark: only when a formula is read as text
@@ -135,20 +151,78 @@ def _formula(text: Any, names: set[str], file: str | None) -> Formula:
     except InvalidInputError as exc:
         raise UsageError(exc.diagnostics) from None
     unknown = sorted(formula.props() - names)
+    if unknown and assumption is not None:
+        raise _fail(
+            "V034",
+            f"assumption {assumption} names unknown propositions: {', '.join(unknown)}",
+            file,
+            hint="an assumption speaks of the trace's regions, sensors and actions",
+        )
     if unknown:
         raise _fail(
             "V007",
             f"the task names unknown regions: {', '.join(unknown)}",
             file,
-            hint="every region in `ltl` must be defined under `regions`",
+            hint="every region in `ltl` must be defined under `regions` (a reactive trace's "
+            "sensors and actions under `sensors` and `actions`)",
         )
     return formula
 
 
+def _names(
+    document: Mapping[str, Any], key: str, regions: set[str], file: str | None
+) -> tuple[str, ...]:
+    value = document.get(key)
+    if value is None:
+        return ()
+    if not isinstance(value, list) or not all(isinstance(v, str) and v for v in value):
+        raise _fail("V033", f"`{key}` is not a list of names", file)
+    clash = sorted(set(value) & regions)
+    if clash or len(set(value)) != len(value):
+        twice = clash or sorted(v for v in set(value) if value.count(v) > 1)
+        raise _fail(
+            "V033",
+            f"`{key}` names {', '.join(map(repr, twice))} twice (or also as a region)",
+            file,
+        )
+    return tuple(value)
+
+
+def _reactive_fields(
+    document: Mapping[str, Any],
+    regions: set[str],
+    file: str | None,
+    signals: Mapping[str, Signal] | None,
+) -> dict[str, Any]:
+    """The sensors, actions, assumptions and signals of a reactive trace (all empty else)."""
+    sensors = _names(document, "sensors", regions, file)
+    actions = _names(document, "actions", regions | set(sensors), file)
+    texts = document.get("assumptions") or []
+    if not isinstance(texts, list):
+        raise _fail("V034", "`assumptions` is not a list of LTL strings", file)
+    known = regions | set(sensors) | set(actions)
+    assumptions = tuple(
+        _formula(text, known, file, assumption=index) for index, text in enumerate(texts)
+    )
+    if signals is None:
+        signals = signals_of_document(document, [*sensors, *actions], file)
+    return {
+        "sensors": sensors,
+        "actions": actions,
+        "assumptions": assumptions,
+        "signals": dict(signals),
+    }
+
+
 def from_document(
-    document: Mapping[str, Any], *, file: str | None = None, convention: str | None = None
+    document: Mapping[str, Any],
+    *,
+    file: str | None = None,
+    convention: str | None = None,
+    signals: Mapping[str, Signal] | None = None,
 ) -> TraceInput:
-    """Validate a ``tlmpc.trace/1`` document."""
+    """Validate a ``tlmpc.trace/1`` document (``signals``, read from a log, replace the
+    document's own)."""
     fmt = document.get("format")
     if not isinstance(fmt, str) or not fmt.startswith("tlmpc.trace/"):
         raise _fail(
@@ -209,11 +283,13 @@ def from_document(
             hint="`end` is stay or open without a loop_start, loop with one (or leave it out)",
         )
     ending: Ending = "loop" if loop is not None else ("stay" if end == "stay" else "open")
+    reactive = _reactive_fields(document, set(regions), file, signals)
+    propositions = set(regions) | set(reactive["sensors"]) | set(reactive["actions"])
     return TraceInput(
         times=samples[:, 0].copy(),
         points=samples[:, 1:].copy(),
         loop_start=loop,
-        formula=_formula(document.get("ltl"), set(regions), file),
+        formula=_formula(document.get("ltl"), propositions, file),
         regions=regions,
         boundary_polygon=_polygon(boundary, "workspace boundary", file) if boundary else None,
         holes=holes,
@@ -223,6 +299,7 @@ def from_document(
         max_speed=_certifying_speed(speed),
         source=file,
         radius=_radius(document.get("radius"), file),
+        **reactive,
     )
 
 
@@ -363,7 +440,17 @@ def mission_document(path: Path, mission_path: Path | None) -> dict[str, Any]:
         raise _fail(
             "V010", "a CSV trace needs --mission MISSION.yaml for its regions and task", str(path)
         )
-    return _mission_fields(_load_mission(mission_path))
+    mission = _load_mission(mission_path)
+    if mission.reactive is not None:
+        raise _fail(
+            "U110",
+            f"{mission_path} is a reactive mission: verifying many logs at once, streaming a "
+            "long log and live monitoring read positions only, not sensor values",
+            str(path),
+            hint=f"verify each log on its own: tlmpc verify --mission {mission_path} LOG "
+            "(a log over the size limit: thin it out first)",
+        )
+    return _mission_fields(mission)
 
 
 def _mission_fields(mission: Mission) -> dict[str, Any]:
@@ -380,6 +467,20 @@ def _mission_fields(mission: Mission) -> dict[str, Any]:
         "radius": body_radius(mission.robot),
         "points": [],
         "loop_start": None,
+        **_reactive_document(mission),
+    }
+
+
+def _reactive_document(mission: Mission) -> dict[str, Any]:
+    """A reactive mission's sensors, actions and assumptions as trace fields (none else)."""
+    from tlmpc.ltl.printer import to_text
+
+    if mission.reactive is None:
+        return {}
+    return {
+        "sensors": list(mission.reactive.sensor_names),
+        "actions": list(mission.reactive.actions),
+        "assumptions": [to_text(part.formula) for part in mission.reactive.assumptions],
     }
 
 
@@ -401,7 +502,12 @@ def _log_trace(
     samples = _samples(log.samples, str(path), list(log.lines) or None)
     document = _mission_fields(mission)
     document["points"] = samples.tolist()
-    return from_document(document, file=str(path), convention=convention)
+    signals = None
+    if mission.reactive is not None:
+        from tlmpc.verify.log_signals import read_signals
+
+        signals = read_signals(path, mission.reactive, options.columns)
+    return from_document(document, file=str(path), convention=convention, signals=signals)
 
 
 def from_csv(

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Set
 from typing import Any
 
 import numpy as np
@@ -14,13 +14,16 @@ import shapely
 
 from tlmpc.ltl.ast import And, Formula, Globally, bounded_operators
 from tlmpc.ltl.printer import to_text
-from tlmpc.verify.clock import at
+from tlmpc.verify.blame import Prefixes, assume_guarantee
+from tlmpc.verify.clock import at, elapsed
 from tlmpc.verify.evaluate import Value, truth_atoms
 from tlmpc.verify.model import (
+    AssumeGuarantee,
     Certificate,
     ConjunctReport,
     Counterexample,
     Outcome,
+    PartVerdict,
     Verdict,
     Violation,
 )
@@ -28,6 +31,7 @@ from tlmpc.verify.pieces import Pieces, build_pieces, merge_pieces, region_membe
 from tlmpc.verify.progress import Timeline, conjunct_reports, runs, timed_progress
 from tlmpc.verify.robustness import piece_atoms, tube_atoms, tube_radii
 from tlmpc.verify.semantics import PieceEnding, Semantics, Timing
+from tlmpc.verify.signals import change_times, signal_labels, with_cuts
 from tlmpc.verify.time_robustness import horizon, reach, time_robustness
 from tlmpc.verify.trace_input import TraceInput
 
@@ -142,17 +146,6 @@ def _prefix_end(starts: FloatArray, span: float) -> int | None:
     if index % 2 or index >= len(starts):
         return None
     return index + 1
-
-
-def _prefix_atoms(atoms: Callable[[str], Value], cut: int) -> Callable[[str], Value]:
-    def prefix(name: str) -> Value:
-        lo, hi = atoms(name)
-        if lo is hi:
-            both = lo[:cut]
-            return both, both
-        return lo[:cut], hi[:cut]
-
-    return prefix
 
 
 def _with_time_robustness(
@@ -427,16 +420,54 @@ def certify(trace: TraceInput, regions: dict[str, FloatArray], outcome: Outcome)
     )
 
 
-def verify_trace(trace: TraceInput) -> Verdict:
-    """Check ``trace`` against its task under its boundary convention and ending."""
+@dataclasses.dataclass(frozen=True, slots=True)
+class _Truth:
+    """The trace cut into pieces at the crossings of the regions its task mentions, and the
+    exact truth of formulas on them."""
+
+    pieces: Pieces
+    regions: dict[str, FloatArray]
+    names: list[str]
+    unknown: BoolArray | None
+    size: int
+    ending: PieceEnding
+    is_point: BoolArray | None
+    timing: Timing
+    truth: Semantics
+
+    prefixes: Prefixes
+
+    def outcome_function(self) -> Callable[[Formula], Outcome]:
+        """The verdict of a formula at the trace's start (one with finite bounds only is
+        decided on the prefix its bounds reach)."""
+        times, truth, prefixes = self.pieces.times, self.truth, self.prefixes
+
+        def outcome_of(formula: Formula) -> Outcome:
+            # A formula whose operators all have finite bounds is decided at t=0 by the trace
+            # up to its reach: the searches for time robustness evaluate only that prefix.
+            cut = _prefix_end(times, reach(formula))
+            if cut is None:
+                return _outcome(*truth.at_start(formula))
+            return prefixes.outcome(formula, cut)
+
+        return outcome_of
+
+
+def _truth_of(trace: TraceInput) -> _Truth:
     # Only the regions the task mentions can change its truth (no Next: the semantics is
     # stutter-invariant), so crossings of other regions are not split at.
-    mentioned = trace.formula.props()
+    mentioned = trace.formula.props().union(*(a.props() for a in trace.assumptions))
     regions = {n: p for n, p in trace.regions.items() if n in mentioned}
     names = list(regions)
     loop_start = trace.loop_start if trace.ending == "loop" else None
-    pieces = build_pieces(trace.times, trace.points, loop_start, regions, trace.convention)
+    times, points, loop_sample = trace.times, trace.points, loop_start
+    if trace.signals:
+        # a sample at every signal change: the run is cut there as at a region crossing
+        times, points, moved = with_cuts(times, points, change_times(trace.signals))
+        loop_sample = None if loop_start is None else int(moved[loop_start])
+    pieces = build_pieces(times, points, loop_sample, regions, trace.convention)
     unknown = _last_point_unknown(trace, pieces, regions)
+    pieces, unknown, names = _with_signals(trace, pieces, unknown, names, mentioned)
     size = len(pieces.is_point)
     ending = _piece_ending(trace, pieces)
     is_point = pieces.is_point if trace.convention == "closed" else None
@@ -448,6 +479,44 @@ def verify_trace(trace: TraceInput) -> Verdict:
         is_point=is_point,
         timing=timing,
     )
+    prefixes = Prefixes(truth_atoms(pieces.labels, names, unknown), pieces.times, is_point)
+    return _Truth(pieces, regions, names, unknown, size, ending, is_point, timing, truth, prefixes)
+
+
+@dataclasses.dataclass(frozen=True, slots=True)
+class BoundSlack:
+    """One time bound of a task: the operator's text and by how many seconds it held (> 0)
+    or failed (< 0), the other bounds kept (``inf``/``-inf``: any amount; None: under
+    ``<->``, no direction)."""
+
+    bound: str
+    slack: float | None
+
+
+def bound_slacks(trace: TraceInput) -> tuple[Outcome, tuple[BoundSlack, ...]]:
+    """The task's verdict on ``trace`` and the slack of each of its bounded operators
+    (pre-order): the time robustness of the task with that one bound moved."""
+    found = _truth_of(trace)
+    outcome_of = found.outcome_function()
+    outcome = _outcome(*found.truth.at_start(trace.formula))
+    span = horizon(trace.formula, float(trace.times[-1] - trace.times[0]))
+    slacks = tuple(
+        BoundSlack(
+            bound=to_text(node),
+            slack=time_robustness(trace.formula, outcome, outcome_of, span, only=node),
+        )
+        for node in bounded_operators(trace.formula)
+    )
+    return outcome, slacks
+
+
+def verify_trace(trace: TraceInput) -> Verdict:
+    """Check ``trace`` against its task under its boundary convention and ending."""
+    found = _truth_of(trace)
+    pieces, regions, names, unknown = found.pieces, found.regions, found.names, found.unknown
+    size, ending, is_point, timing = found.size, found.ending, found.is_point, found.timing
+    truth = found.truth
+    loop_start = trace.loop_start if trace.ending == "loop" else None
     task_outcome = _outcome(*truth.at_start(trace.formula))
     conjuncts = _conjuncts(trace.formula)
     outcomes = [_outcome(*truth.at_start(c)) for c in conjuncts]
@@ -461,27 +530,21 @@ def verify_trace(trace: TraceInput) -> Verdict:
         labels=pieces.labels,
         names=names,
         origin=trace.start,
+        signals=frozenset(trace.sensors) | frozenset(trace.actions),
     )
     reports, violations = conjunct_reports(conjuncts, outcomes, truth, line)
 
-    atoms = truth_atoms(pieces.labels, names, unknown)
-    prefixes: dict[int, Semantics] = {}
-
-    def outcome_of(formula: Formula) -> Outcome:
-        # A formula whose operators all have finite bounds is decided at t=0 by the trace up
-        # to its reach: the searches for time robustness evaluate only that prefix.
-        cut = _prefix_end(pieces.times, reach(formula))
-        if cut is None:
-            return _outcome(*truth.at_start(formula))
-        if cut not in prefixes:
-            prefixes[cut] = Semantics(
-                _prefix_atoms(atoms, cut),
-                cut,
-                "open",
-                is_point=None if is_point is None else is_point[:cut],
-                timing=Timing(pieces.times[:cut], float(pieces.times[cut - 1])),
-            )
-        return _outcome(*prefixes[cut].at_start(formula))
+    outcome_of = found.outcome_function()
+    reactive: AssumeGuarantee | None = None
+    if trace.reactive:
+        reactive = assume_guarantee(
+            trace.assumptions,
+            conjuncts,
+            task_outcome,
+            lambda formula: _outcome(*truth.at_start(formula)),
+            found.prefixes,
+            ending,
+        )
 
     duration = float(trace.times[-1] - trace.times[0])
     reports = [
@@ -496,10 +559,11 @@ def verify_trace(trace: TraceInput) -> Verdict:
             trace.formula, task_outcome, outcome_of, horizon(trace.formula, duration)
         )
     excursions, workspace_rho = workspace_violations(trace)
-    outcome: Outcome = "violated" if excursions else task_outcome
+    judged = task_outcome if reactive is None else reactive.outcome
+    outcome: Outcome = "violated" if excursions else judged
     # Robustness on the same pieces and recursion as the truth: the signs agree.
     space = Semantics(
-        piece_atoms(regions, pieces.positions, pieces.labels, unknown),
+        _space_atoms(regions, pieces, unknown, names),
         size,
         ending,
         is_point=is_point,
@@ -509,7 +573,10 @@ def verify_trace(trace: TraceInput) -> Verdict:
     rho = lo if lo > 0 else hi if hi < 0 else 0.0
     if excursions and workspace_rho is not None:
         rho = min(rho, workspace_rho)
-    certificate = certify(trace, regions, task_outcome)
+    if trace.reactive:
+        certificate = _reactive_certificate(trace)
+    else:
+        certificate = certify(trace, regions, task_outcome)
     if excursions and certificate.certified:
         certificate = Certificate(
             certified=task_outcome == "violated",
@@ -538,7 +605,67 @@ def verify_trace(trace: TraceInput) -> Verdict:
             "start_time": float(trace.times[0]),
             "duration": float(trace.times[-1] - trace.times[0]),
         },
+        reactive=reactive,
     )
+
+
+def _reactive_certificate(trace: TraceInput) -> Certificate:
+    """No certificate for a reactive run: it bounds the robot's motion between samples, and
+    nothing bounds the sensors' values between theirs."""
+    gaps = np.diff(trace.times)
+    speeds = np.linalg.norm(np.diff(trace.points, axis=0), axis=1) / gaps if len(gaps) else gaps
+    return Certificate(
+        certified=False,
+        max_speed=trace.max_speed,
+        observed_speed=float(speeds.max()) if len(speeds) else 0.0,
+        max_gap=float(gaps.max()) if len(gaps) else 0.0,
+        bound=None,
+        margin=None,
+        reason="not computed for a reactive run (the certificate bounds the robot's motion "
+        "between samples, not the sensors' values)",
+    )
+
+
+def _with_signals(
+    trace: TraceInput,
+    pieces: Pieces,
+    unknown: BoolArray | None,
+    names: list[str],
+    mentioned: Set[str],
+) -> tuple[Pieces, BoolArray | None, list[str]]:
+    """The pieces' labels with a column for each sensor and action the formulas mention: its
+    value at the piece's first instant (unknown before the signal's first sample, and
+    throughout for an action the log does not carry)."""
+    signal_names = [n for n in (*trace.sensors, *trace.actions) if n in mentioned]
+    if not signal_names:
+        return pieces, unknown, names
+    values, unknown_signals = signal_labels(trace.signals, signal_names, pieces.times)
+    labels = np.hstack([pieces.labels, values])
+    if unknown is None and not unknown_signals.any():
+        combined = None
+    else:
+        regions_unknown = np.zeros_like(pieces.labels) if unknown is None else unknown
+        combined = np.hstack([regions_unknown, unknown_signals])
+    return dataclasses.replace(pieces, labels=labels), combined, [*names, *signal_names]
+
+
+def _space_atoms(
+    regions: dict[str, FloatArray], pieces: Pieces, unknown: BoolArray | None, names: list[str]
+) -> Callable[[str], Value]:
+    """Robustness atoms: signed distances for regions; for a sensor or an action, +inf while
+    it holds and -inf while it does not (no motion changes it), 0 where it is unknown."""
+    distances = piece_atoms(regions, pieces.positions, pieces.labels, unknown)
+
+    def atom(name: str) -> Value:
+        if name in regions:
+            return distances(name)
+        column = names.index(name)
+        value = np.where(pieces.labels[:, column], np.inf, -np.inf)
+        if unknown is not None:
+            value = np.where(unknown[:, column], 0.0, value)
+        return value, value
+
+    return atom
 
 
 def _number(value: float | None) -> float | str | None:
@@ -570,9 +697,36 @@ def _report(report: ConjunctReport) -> dict[str, Any]:
     }
 
 
+def _part(part: PartVerdict | None, start: float) -> dict[str, Any] | None:
+    if part is None:
+        return None
+    return {
+        "part": part.part,
+        "verdict": part.outcome,
+        "broken_at": part.broken,
+        "elapsed": None if part.broken is None else elapsed(part.broken, start),
+    }
+
+
+def reactive_to_json(judged: AssumeGuarantee, start: float) -> dict[str, Any]:
+    """The ``reactive`` object of ``tlmpc.verdict/1``: blame, both times, every part."""
+    return {
+        "verdict": judged.outcome,
+        "blame": judged.blame,
+        "vacuous": judged.blame == "environment",
+        "environment": _part(judged.environment, start),
+        "robot": _part(judged.robot, start),
+        "assumptions": [_part(p, start) for p in judged.assumptions],
+        "guarantees": [_part(p, start) for p in judged.guarantees],
+    }
+
+
 def verdict_to_json(verdict: Verdict) -> dict[str, Any]:
     """``tlmpc.verdict/1``."""
     certificate = verdict.certificate
+    extra: dict[str, Any] = {}
+    if verdict.reactive is not None:
+        extra["reactive"] = reactive_to_json(verdict.reactive, float(verdict.stats["start_time"]))
     return {
         "format": "tlmpc.verdict/1",
         "verdict": verdict.outcome,
@@ -597,4 +751,5 @@ def verdict_to_json(verdict: Verdict) -> dict[str, Any]:
         "counterexample": _example(verdict.counterexample),
         "workspace_violation": _example(verdict.workspace_violation),
         "stats": dict(verdict.stats),
+        **extra,
     }

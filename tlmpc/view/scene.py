@@ -72,6 +72,7 @@ def _scene(
     verdict: dict[str, Any] | None,
     mesh: dict[str, Any] | None,
     formula: str,
+    counterstrategy: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
     boundary = _points(workspace["boundary"])
     holes = [_points(h) for h in workspace.get("holes", [])]
@@ -100,6 +101,16 @@ def _scene(
             "outside": _outside_intervals(samples, boundary, holes, components) if samples else [],
         }
     )
+    if counterstrategy is not None:
+        # the same marks and route as plot's (render.scene is the one scene model)
+        from tlmpc.render.scene import play_marks
+
+        marks, route = play_marks(counterstrategy)
+        scene["title"] = f"{title}: unrealizable, how the environment wins"
+        scene["play"] = {
+            "marks": [{"at": list(m.position), "text": m.text} for m in marks],
+            "route": [list(p) for p in route],
+        }
     return scene
 
 
@@ -119,7 +130,8 @@ def scene_from_output(directory: Path) -> dict[str, Any]:
         )
     # each checked against its schema (finite numbers) and against the others
     documents = read_artifacts(
-        directory, ("mission.json", "abstraction.json", "trace.json", "verdict.json")
+        directory,
+        ("mission.json", "abstraction.json", "trace.json", "verdict.json", "counterstrategy.json"),
     )
     mission = documents["mission.json"]
     mesh = None
@@ -148,6 +160,7 @@ def scene_from_output(directory: Path) -> dict[str, Any]:
         verdict=verdict,
         mesh=mesh,
         formula=str(mission.get("formula", "")),
+        counterstrategy=documents.get("counterstrategy.json"),
     )
 
 

@@ -1,4 +1,5 @@
-"""Readers of the community's GR(1) formats: gr1c ``.spc``, slugs ``.slugsin`` and TLSF.
+"""Readers of the community's GR(1) formats: gr1c ``.spc``, slugs ``.slugsin`` and
+``.structuredslugs``, and TLSF.
 
 Each reader follows its source tool's semantics (docs/synthesis.md) and returns a
 :class:`~tlmpc.synth.spec.GameSpec`; what it refuses is a located diagnostic (codes ``Q0xx``).
@@ -12,7 +13,12 @@ from tlmpc.base.errors import UsageError, error
 from tlmpc.synth.spec import GameSpec, InitMode
 
 #: file suffix -> format name
-FORMATS = {".spc": "gr1c", ".slugsin": "slugsin", ".tlsf": "tlsf"}
+FORMATS = {
+    ".spc": "gr1c",
+    ".slugsin": "slugsin",
+    ".structuredslugs": "structuredslugs",
+    ".tlsf": "tlsf",
+}
 
 
 def format_of(path: str) -> str | None:
@@ -74,6 +80,12 @@ def parse_spec(
         from tlmpc.synth.readers.slugsin import parse_slugsin
 
         return parse_slugsin(text, file=file, init_mode=init_mode or "forall_env_exists_sys")
+    if fmt == "structuredslugs":
+        from tlmpc.synth.readers.structuredslugs import parse_structuredslugs
+
+        return parse_structuredslugs(
+            text, file=file, init_mode=init_mode or "forall_env_exists_sys"
+        )
     if fmt == "tlsf":
         from tlmpc.synth.readers.tlsf import parse_tlsf
 

@@ -11,6 +11,8 @@ may mention the next step (goals on transitions).  Every line is one part of the
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+
 from tlmpc.synth.readers.source import Source
 from tlmpc.synth.spec import (
     Atom,
@@ -26,7 +28,8 @@ from tlmpc.synth.spec import (
     Variable,
 )
 
-_SECTIONS: dict[str, tuple[Owner, str]] = {
+#: slugs' sections: who owns each and what it holds (the structured format has the same)
+SECTIONS: dict[str, tuple[Owner, str]] = {
     "[INPUT]": ("env", "vars"),
     "[OUTPUT]": ("sys", "vars"),
     "[ENV_INIT]": ("env", "init"),
@@ -65,13 +68,19 @@ class _Line:
         return token
 
 
-def parse_slugsin(
-    text: str, *, file: str = "<input>", init_mode: InitMode = "forall_env_exists_sys"
-) -> GameSpec:
-    """Read a slugs specification."""
-    source = Source(file, text)
-    variables: dict[str, Variable] = {}
-    parts: list[Part] = []
+def section_lines(
+    source: Source,
+    text: str,
+    *,
+    code: str,
+    unknown_hint: str,
+    first_hint: str,
+    other_tools: tuple[str, ...] = (),
+) -> Iterator[tuple[Owner, str, str, int]]:
+    """The lines of a slugs file (either format) under its sections: (owner, what the section
+    holds, the stripped line, its offset), comments and blank lines skipped; ``code`` is the
+    reader's code for an unknown section or a line before any, ``other_tools`` sections that
+    belong to slugs' other synthesis modes."""
     section: tuple[Owner, str] | None = None
     offset = 0
     for raw in text.split("\n"):
@@ -82,24 +91,38 @@ def parse_slugsin(
             continue
         start = line_start + raw.index(stripped[0])
         if stripped.startswith("["):
-            if stripped not in _SECTIONS:
+            if stripped in other_tools:
                 raise source.fail(
-                    "Q031",
-                    f"unknown section {stripped!r}",
+                    code,
+                    f"the section {stripped} belongs to slugs' other synthesis modes",
                     start,
-                    "slugsin sections are [INPUT] [OUTPUT] [ENV_INIT] [SYS_INIT] [ENV_TRANS] "
-                    "[SYS_TRANS] [ENV_LIVENESS] [SYS_LIVENESS]",
+                    "tlmpc synth reads GR(1) games: declare the variables under [INPUT] or "
+                    "[OUTPUT]",
                 )
-            section = _SECTIONS[stripped]
+            if stripped not in SECTIONS:
+                raise source.fail(code, f"unknown section {stripped!r}", start, unknown_hint)
+            section = SECTIONS[stripped]
             continue
         if section is None:
-            raise source.fail(
-                "Q031",
-                "a line before any section",
-                start,
-                "start the file with [INPUT] or [OUTPUT]",
-            )
-        owner, what = section
+            raise source.fail(code, "a line before any section", start, first_hint)
+        yield (*section, stripped, start)
+
+
+def parse_slugsin(
+    text: str, *, file: str = "<input>", init_mode: InitMode = "forall_env_exists_sys"
+) -> GameSpec:
+    """Read a slugs specification."""
+    source = Source(file, text)
+    variables: dict[str, Variable] = {}
+    parts: list[Part] = []
+    for owner, what, stripped, start in section_lines(
+        source,
+        text,
+        code="Q031",
+        unknown_hint="slugsin sections are [INPUT] [OUTPUT] [ENV_INIT] [SYS_INIT] [ENV_TRANS] "
+        "[SYS_TRANS] [ENV_LIVENESS] [SYS_LIVENESS]",
+        first_hint="start the file with [INPUT] or [OUTPUT]",
+    ):
         if what == "vars":
             name = stripped
             if name in variables or any(ch.isspace() for ch in name) or name.endswith("'"):

@@ -1,0 +1,155 @@
+"""Hard tasks at scale: cover-6 while avoiding one room, and patrol-20, on the grid maps.
+
+``python bench/bench_scale_tasks.py`` plans each workload (``bench.workloads.grid_task`` on
+``grid_of_rooms`` maps of 10k, 30k and 100k triangles) in a fresh interpreter per run, with
+the guided search (the product expanded on demand) and, where the product can be built, with
+the built product, and prints a markdown table: the planning stage's CPU seconds
+(``time.process_time``; the median of ``--repeats`` runs), the process's peak RSS (mission
+loading and the mesh included), the plan's cost (which must agree between the two searches),
+the nodes the search reached and the closing searches it made.  ``--compile`` adds a row per
+workload for the whole ``tlmpc compile`` (every stage but the figure) in CPU seconds.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+from typing import Any
+
+ROOT = Path(__file__).resolve().parent.parent
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))
+
+GRIDS = {"10k": 35, "30k": 61, "100k": 112}
+TASKS = (("cover", 6), ("patrol", 20))
+#: The built product is planned only where it fits the machine (the 100k products do not).
+BUILT_UP_TO = ("10k", "30k")
+
+PLAN_PROGRAM = """
+import gc, json, resource, sys, time
+from pathlib import Path
+gc.disable()
+from tlmpc.abstraction import build_abstraction
+from tlmpc.mission import load_mission
+from tlmpc.planning.mission import automaton_for
+from tlmpc.planning.plan import plan
+mission = load_mission(Path(sys.argv[1]))
+abstraction = build_abstraction(mission)
+automaton = automaton_for(mission, abstraction)
+started = time.process_time()
+witness = plan(abstraction, automaton, formula=mission.formula, options=mission.options,
+               start_point=mission.robot.start, guided=sys.argv[2] == "guided")
+cpu = time.process_time() - started
+print(json.dumps({
+    "cpu": cpu,
+    "peak_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
+    "cost": witness.cost,
+    "triangles": abstraction.num_triangles,
+    "states": witness.stats["automaton_states"],
+    "reached": witness.stats["product_reached"],
+    "nodes": witness.stats["product_nodes"],
+    "searches": witness.stats["cycle_searches"],
+    "optimal": witness.stats["optimal"],
+    "plan": f"{len(witness.prefix)}+{len(witness.cycle)}",
+}))
+"""
+
+COMPILE_PROGRAM = """
+import gc, json, resource, sys, time
+from pathlib import Path
+gc.disable()
+started = time.process_time()
+from tlmpc.pipeline.stages import STAGES, Compilation, run_stages
+compilation = Compilation(source=Path(sys.argv[1]), text=None, figures=())
+for stage in STAGES:
+    if stage.name == "plot":
+        continue
+    compilation = run_stages([stage], compilation).compilation
+print(json.dumps({
+    "cpu": time.process_time() - started,
+    "peak_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
+}))
+"""
+
+
+def _run(program: str, *arguments: str) -> dict[str, Any]:
+    done = subprocess.run(
+        [sys.executable, "-c", program, *arguments],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        check=False,
+    )
+    if done.returncode != 0:
+        return {"error": done.stderr.strip().splitlines()[-1] if done.stderr else "failed"}
+    result: dict[str, Any] = json.loads(done.stdout.strip().splitlines()[-1])
+    return result
+
+
+def rows(repeats: int, grids: list[str], compile_too: bool) -> list[dict[str, Any]]:
+    """One row per workload and search."""
+    from bench.workloads import grid_task, write_mission
+
+    table: list[dict[str, Any]] = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for grid in grids:
+            for task, count in TASKS:
+                path = write_mission(grid_task(GRIDS[grid], task, count), Path(tmp))
+                searches = ["guided", "built"] if grid in BUILT_UP_TO else ["guided"]
+                for search in searches:
+                    runs = [_run(PLAN_PROGRAM, str(path), search) for _ in range(repeats)]
+                    if any("error" in run for run in runs):
+                        error = next(run["error"] for run in runs if "error" in run)
+                        table.append(
+                            {"workload": f"{task}-{count} {grid}", "search": search, "note": error}
+                        )
+                        continue
+                    last = runs[-1]
+                    table.append(
+                        {
+                            "workload": f"{task}-{count} {grid}",
+                            "search": search,
+                            "triangles": last["triangles"],
+                            "automaton states": last["states"],
+                            "product nodes": last["nodes"],
+                            "reached": last["reached"],
+                            "closing searches": last["searches"],
+                            "plan CPU s": round(statistics.median(r["cpu"] for r in runs), 2),
+                            "peak MB": round(max(r["peak_mb"] for r in runs)),
+                            "cost": f"{last['cost']:.6f}",
+                            "plan": last["plan"],
+                            "optimal": last["optimal"],
+                        }
+                    )
+                if compile_too:
+                    whole = _run(COMPILE_PROGRAM, str(path))
+                    table.append(
+                        {
+                            "workload": f"{task}-{count} {grid}",
+                            "search": "whole compile",
+                            "plan CPU s": round(whole.get("cpu", float("nan")), 2),
+                            "peak MB": round(whole.get("peak_mb", float("nan"))),
+                            "note": whole.get("error", "every stage but the figure"),
+                        }
+                    )
+    return table
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--grids", nargs="+", default=list(GRIDS), choices=list(GRIDS))
+    parser.add_argument("--compile", action="store_true", help="add the whole compile")
+    arguments = parser.parse_args()
+    from bench.tables import markdown_table
+
+    print(markdown_table(rows(arguments.repeats, arguments.grids, arguments.compile)))
+
+
+if __name__ == "__main__":
+    main()

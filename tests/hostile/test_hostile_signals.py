@@ -1,0 +1,266 @@
+"""Ctrl-C and SIGTERM at any moment of a real ``tlmpc compile`` process, start-up included.
+
+Each run gets its signal after a different delay, so the signals land all over the run: in the
+interpreter's start-up, in the imports, in the stages, in the writing of OUT, after the end.
+Whatever the moment, the run ends in one of these ways and no other:
+
+* exit 130 (Ctrl-C) or 143 (SIGTERM), no traceback, nothing written: neither OUT nor a
+  temporary file or lock beside it;
+* exit 0, OUT whole (the files of an undisturbed run, each JSON one complete), when the signal
+  came after the end;
+* killed by the signal itself with nothing on standard error: the interpreter had not started
+  running code yet (the shell reports 130/143 all the same);
+* for Ctrl-C only: Python's own ``KeyboardInterrupt`` from before the guard of the package's
+  first lines was in place (the interpreter's start-up, locating the package, importing the
+  guard: no frame of the package past the guard's call) and nothing written.
+
+The delays are spread over the run; nothing here asserts how long anything took.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+PACKAGE = ROOT / "tlmpc"
+MISSION = ROOT / "specs" / "example1.yaml"
+
+#: A traceback frame: its file and line.
+FRAME = re.compile(r'^  File "([^"]+)", line (\d+)', re.MULTILINE)
+
+#: The line of the package's ``__init__`` that installs the guard.
+GUARD_LINE = next(
+    number
+    for number, line in enumerate((PACKAGE / "__init__.py").read_text().splitlines(), start=1)
+    if line.startswith("_guard_start()")
+)
+
+
+def _before_the_guard(file: str, line: int) -> bool:
+    """Whether a traceback frame is code that runs before the guard is in place."""
+    path = Path(file)
+    if not path.is_relative_to(PACKAGE):
+        return True
+    if path == PACKAGE / "__init__.py":
+        return line <= GUARD_LINE
+    # the guard's own module and the package it sits in, imported by the line above
+    return path in (PACKAGE / "base" / "__init__.py", PACKAGE / "base" / "startup.py")
+
+
+#: Delays (seconds) after the start at which the signal is sent: dense over the start-up.
+DELAYS = [0.0, 0.002, 0.005, 0.01, 0.02, 0.03, 0.045, 0.06, 0.08, 0.1, 0.13, 0.16, 0.2, 0.25]
+DELAYS += [0.3, 0.4, 0.5, 0.7, 1.0]
+
+
+def _entry(kind: str) -> list[str]:
+    if kind == "module":
+        return [sys.executable, "-m", "tlmpc"]
+    script = Path(sys.executable).parent / "tlmpc"
+    if not script.exists():
+        pytest.skip("the tlmpc console script is not installed in this environment")
+    return [str(script)]
+
+
+def _outcome(number: int, code: int, err: str, folder: Path, whole: set[str]) -> str:
+    """Which allowed ending this run had; fails the test on any other."""
+    left = sorted(p.name for p in folder.iterdir())
+    if left != []:  # written: then whole, and the run ended as a finished run
+        out = folder / "out"
+        assert {p.name for p in out.iterdir()} == whole
+        for path in out.glob("*.json"):
+            json.loads(path.read_text())
+        assert left == ["out"], left
+        assert code == 0, (code, err)
+        assert "Traceback" not in err, err
+        assert "Exception ignored" not in err, err
+        return "finished"
+    assert left == [], f"exit {code} left {left}: {err}"
+    if code == 128 + number:
+        assert "Traceback" not in err, err
+        assert "Exception ignored" not in err, err
+        return "clean"
+    if code == -number and err == "":
+        return "before the interpreter ran"
+    frames = FRAME.findall(err)
+    assert number == signal.SIGINT, (code, err)
+    assert err.rstrip().endswith("KeyboardInterrupt"), (code, err)
+    assert all(_before_the_guard(file, int(line)) for file, line in frames), err
+    return "in the interpreter's start-up"
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("kind", ["script", "module"])
+@pytest.mark.parametrize("number", [signal.SIGINT, signal.SIGTERM], ids=["int", "term"])
+def test_a_signal_at_any_moment_ends_cleanly(
+    tmp_path: Path, kind: str, number: signal.Signals
+) -> None:
+    reference = tmp_path / "reference"
+    subprocess.run([*_entry(kind), "compile", str(MISSION), "-o", str(reference), "-q"], check=True)
+    whole = {p.name for p in reference.iterdir()}
+    seen: dict[str, int] = {}
+    for k, delay in enumerate(DELAYS):
+        folder = tmp_path / str(k)
+        folder.mkdir()
+        process = subprocess.Popen(
+            [*_entry(kind), "compile", str(MISSION), "-o", str(folder / "out")],
+            cwd=folder,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        time.sleep(delay)
+        process.send_signal(number)
+        _, err = process.communicate()
+        outcome = _outcome(number, process.returncode, err, folder, whole)
+        seen[outcome] = seen.get(outcome, 0) + 1
+    # the delays reach past the imports into the run: most runs end by the documented code
+    assert seen.get("clean", 0) >= len(DELAYS) // 2, seen
+
+
+def test_a_library_import_installs_no_handler() -> None:
+    code = (
+        "import signal\n"
+        "def handlers(): return signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)\n"
+        "before = handlers()\n"
+        "import tlmpc, tlmpc.cli\n"
+        "print(before == handlers())\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=ROOT
+    )
+    assert done.stdout.strip() == "True"
+
+
+@pytest.mark.parametrize(
+    ("argv", "orig_argv", "expected"),
+    [
+        (["/venv/bin/tlmpc", "compile"], ["/venv/bin/python", "/venv/bin/tlmpc", "compile"], True),
+        (["C:\\env\\Scripts\\tlmpc.exe"], ["tlmpc.exe"], True),
+        (["-m"], ["python3", "-X", "dev", "-m", "tlmpc", "check"], True),
+        (["-m"], ["python3", "-m", "tlmpcx"], False),
+        (["-m"], ["python3", "-m", "pytest", "tlmpc"], False),
+        (["-c"], ["python3", "-c", "import tlmpc", "-m", "tlmpc"], False),
+        (["app.py"], ["python3", "app.py", "-m", "tlmpc"], False),
+        (["/home/u/tlmpc-tools/run.py"], ["python3", "/home/u/tlmpc-tools/run.py"], False),
+    ],
+)
+def test_the_command_is_recognised_by_how_python_started(
+    argv: list[str], orig_argv: list[str], expected: bool
+) -> None:
+    from tlmpc.base.startup import is_the_command
+
+    assert is_the_command(argv, orig_argv) is expected
+
+
+class _RaisesInFinaliser:
+    """An object whose finaliser receives the signal: Python cannot propagate the handler's
+    exception from there and drops it as "Exception ignored"."""
+
+    def __init__(self, number: int) -> None:
+        self.number = number
+
+    def __del__(self) -> None:
+        signal.raise_signal(self.number)
+
+
+@pytest.mark.parametrize(("number", "code"), [(signal.SIGTERM, 143), (signal.SIGINT, 130)])
+def test_a_signal_swallowed_by_a_finaliser_still_ends_the_run(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str], number: int, code: int
+) -> None:
+    import tlmpc.cli
+
+    steps = [0]
+    budget = 30_000_000  # seconds of work if nothing ends it
+
+    def run(*args: object) -> int:
+        _RaisesInFinaliser(number)  # dropped at once: its finaliser runs here
+        while steps[0] < budget:  # ordinary code: the signal must end the run in here
+            steps[0] += 1
+        return 0
+
+    monkeypatch.setattr("tlmpc.commands.automaton.run", run)
+    assert tlmpc.cli.main(["automaton", "G a"]) == code
+    assert steps[0] < budget
+    assert "Exception ignored" not in capsys.readouterr().err
+
+
+def _signal_after(original: Any, number: int) -> Any:
+    """``original``, then the signal: it arrives right after the call created something."""
+
+    def call(*args: Any, **kwargs: Any) -> Any:
+        result = original(*args, **kwargs)
+        signal.raise_signal(number)
+        return result
+
+    return call
+
+
+@pytest.mark.parametrize("moment", ["lock", "staging"])
+def test_a_signal_while_out_is_prepared_leaves_nothing(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, moment: str
+) -> None:
+    import fcntl
+    import tempfile
+
+    import tlmpc.cli
+
+    if moment == "lock":  # the lock file exists, its lock is just taken
+        monkeypatch.setattr(fcntl, "flock", _signal_after(fcntl.flock, signal.SIGTERM))
+    else:  # the staging folder is just made
+        monkeypatch.setattr(tempfile, "mkdtemp", _signal_after(tempfile.mkdtemp, signal.SIGTERM))
+    code = tlmpc.cli.main(["compile", str(MISSION), "-o", str(tmp_path / "out"), "-q"])
+    assert code == 143
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_signal_while_a_file_is_replaced_finds_old_or_new(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import tempfile
+
+    from tlmpc.io.outdir import replace_file
+
+    target = tmp_path / "plan.csv"
+    target.write_bytes(b"old\n")
+
+    def terminated(number: int, frame: object) -> None:
+        raise SystemExit("terminated")
+
+    monkeypatch.setattr(tempfile, "mkstemp", _signal_after(tempfile.mkstemp, signal.SIGTERM))
+    previous = signal.signal(signal.SIGTERM, terminated)
+    try:
+        with pytest.raises(SystemExit):
+            replace_file(target, b"new\n")
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+    assert [p.name for p in tmp_path.iterdir()] == ["plan.csv"]
+    assert target.read_bytes() in (b"old\n", b"new\n")
+
+
+@pytest.mark.parametrize(("number", "code"), [(signal.SIGTERM, 143), (signal.SIGINT, 130)])
+def test_the_command_signalled_right_after_the_package_starts_ends_cleanly(
+    number: int, code: int
+) -> None:
+    # a process that is the console script (by its name) receives the signal once the package's
+    # first lines ran, while the command's modules are still to be imported
+    program = (
+        "import os, sys\n"
+        "sys.argv[0] = os.path.join('bin', 'tlmpc')\n"
+        "import tlmpc\n"
+        f"os.kill(os.getpid(), {int(number)})\n"
+        "import tlmpc.cli\n"
+        "print('went on')\n"
+    )
+    done = subprocess.run([sys.executable, "-c", program], capture_output=True, text=True)
+    assert done.returncode == code, done.stderr
+    assert done.stdout == ""
+    assert done.stderr == ("tlmpc: terminated\n" if code == 143 else "tlmpc: interrupted\n")

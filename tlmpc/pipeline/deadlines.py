@@ -1,0 +1,169 @@
+"""Time bounds in ``tlmpc compile``: the compiled trajectory is checked against every bound.
+
+The planner plans a bounded task on its untimed skeleton (:func:`tlmpc.ltl.bounds.untimed_skeleton`)
+and the controllers run at up to ``max_speed``; whether the exact trajectory then meets the
+task's deadlines, durations and periods is decided here by the dense-time verifier, and each
+bound's slack (seconds, signed) goes into ``summary.json``.  When the trajectory misses a
+bound, compile fails with one of two answers:
+
+* **P050**, a proof (exit 1): a deadline no trajectory of the robot can meet, with the
+  earliest time the task's goals can be reached (:mod:`tlmpc.planning.deadlines`);
+* **P051**, no proof (exit 4, inconclusive): the plan found misses a bound, and none of the
+  task's deadlines is proven impossible: another plan might meet it.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+from tlmpc.abstraction.model import Abstraction
+from tlmpc.base.errors import EXIT_INCONCLUSIVE, Diagnostic, NoPlanError, TlmpcError
+from tlmpc.ltl.ast import And, bounded_operators
+from tlmpc.ltl.printer import to_text
+from tlmpc.mission.model import Mission
+from tlmpc.planning.deadlines import DeadlineBound
+from tlmpc.verify.verdict import BoundSlack, bound_slacks
+
+#: At most this many lower bounds are quoted in a P051 message.
+MAX_SHOWN = 3
+
+
+class DeadlineMissedError(TlmpcError):
+    """The plan found misses a time bound and no proof says that every plan must (exit 4)."""
+
+    exit_code = EXIT_INCONCLUSIVE
+
+
+def _seconds(value: float | None) -> float | str | None:
+    """A slack for JSON: a number, ``"inf"``/``"-inf"``, or None (no direction)."""
+    if value is None or math.isfinite(value):
+        return value
+    return "inf" if value > 0 else "-inf"
+
+
+def check_time_bounds(
+    mission: Mission, trace: Mapping[str, Any], abstraction: Abstraction
+) -> dict[str, Any] | None:
+    """The slack of every time bound of the task on the compiled ``trace`` (None: the task
+    has none); raises P050 or P051 when the trace does not satisfy the task.
+
+    ``abstraction`` is the mesh the plan used; the proof is computed on the mesh without
+    margin when the mission asks for one (it must speak of every trajectory).
+    """
+    if not bounded_operators(mission.formula):
+        return None
+    from tlmpc.verify.trace_input import from_document
+
+    outcome, slacks = bound_slacks(from_document(dict(trace)))
+    report = [{"bound": s.bound, "slack": _seconds(s.slack)} for s in slacks]
+    if outcome == "satisfied":
+        return {"bounds": report}
+    bounds = _bounds(mission, abstraction)
+    proofs = [b for b in bounds if b.proven]
+    if proofs:
+        raise NoPlanError(
+            [
+                Diagnostic(
+                    code="P050",
+                    message=p.message,
+                    hint="a later deadline, a faster robot (robot.max_speed) or goals closer "
+                    "to the start; the shortest path is measured in the free space the "
+                    "task's invariants leave",
+                    file=mission.source,
+                    line=where[0],
+                    col=where[1],
+                )
+                for p in proofs
+                for where in [_position(mission, p)]
+            ]
+        )
+    where = _first_missed(mission, slacks)
+    raise DeadlineMissedError(
+        Diagnostic(
+            code="P051",
+            message="no plan was found that meets the task's time bounds (none is proven "
+            "impossible): the minimum-cost plan of the untimed task misses "
+            + _missed(slacks)
+            + _earliest(bounds),
+            hint="the plan minimises path length, not the time to each goal, and its "
+            "controllers do not drive the shortest path at full speed: deadlines between the "
+            "earliest possible time and the plan's are not decided. Looser bounds, a faster "
+            "robot or a task that fixes the order of the goals may help",
+            file=mission.source,
+            line=where[0],
+            col=where[1],
+        )
+    )
+
+
+def _missed(slacks: tuple[BoundSlack, ...]) -> str:
+    """The failing bounds in words (``F[0,30] dock by 3.2 s``): those that a finite loosening
+    of their own would fix; else those that no loosening of their own fixes."""
+    finite = [s for s in slacks if s.slack is not None and -math.inf < s.slack < 0]
+    if finite:
+        return ", ".join(f"`{s.bound}` by {-(s.slack or 0.0):.4g} s" for s in finite)
+    hopeless = [s for s in slacks if s.slack == -math.inf]
+    if hopeless:
+        return ", ".join(f"`{s.bound}`" for s in hopeless) + " (no loosening of one bound helps)"
+    return "the task (its bounds together)"
+
+
+def _earliest(bounds: Sequence[DeadlineBound]) -> str:
+    """What the proofs found short of a proof: the earliest times, against the deadlines."""
+    if not bounds:
+        return ""
+    shown = [
+        f"{b.what} takes at least {b.earliest:.4g} s (bound {b.deadline:.4g} s)"
+        for b in bounds[:MAX_SHOWN]
+    ]
+    return "; the earliest any trajectory can do it: " + ", ".join(shown)
+
+
+def _first_missed(
+    mission: Mission, slacks: tuple[BoundSlack, ...]
+) -> tuple[int | None, int | None]:
+    """Where the first bound the plan misses was written (None, None: not known)."""
+    for found in slacks:
+        if found.slack is not None and found.slack < 0:
+            return _located(mission, found.bound)
+    return None, None
+
+
+def _located(mission: Mission, text: str) -> tuple[int | None, int | None]:
+    """The task part whose formula holds the operator printed as ``text``."""
+    from tlmpc.mission.parts import task_parts
+
+    for part in task_parts(mission):
+        if any(to_text(node) == text for node in part.formula.walk()):
+            return part.line, part.col
+    return None, None
+
+
+def _position(mission: Mission, proof: DeadlineBound) -> tuple[int | None, int | None]:
+    """Where the proof's conjunct was written: its own position in ``ltl``, else the task
+    phrase it comes from."""
+    if proof.span is not None:
+        return proof.span.line, proof.span.col
+    from tlmpc.mission.parts import task_parts
+
+    for part in task_parts(mission):
+        formula = part.formula
+        conjuncts = formula.args if isinstance(formula, And) else (formula,)
+        if proof.anchor in {to_text(c) for c in conjuncts}:
+            return part.line, part.col
+    return None, None
+
+
+def _bounds(mission: Mission, abstraction: Abstraction) -> tuple[DeadlineBound, ...]:
+    from tlmpc.abstraction.layout import deepens_goals
+    from tlmpc.mission.body import requested_margin
+    from tlmpc.planning.deadlines import deadline_bounds
+    from tlmpc.planning.mission import abstraction_for
+
+    # the proof speaks of every trajectory: the regions as they are (not the goals' cores the
+    # planner aims for) in the whole free space (not the part that keeps the margin)
+    exact = requested_margin(mission) <= 0.0 and not deepens_goals(mission)
+    mesh = abstraction if exact else abstraction_for(mission, 0.0, deep=False)
+    return deadline_bounds(mission, mesh)

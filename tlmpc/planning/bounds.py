@@ -1,0 +1,260 @@
+"""Lower bounds on the cost still to pay from a product node: the guided search's heuristic.
+
+The bounds come from a small *region-level* graph.  Its nodes are pairs ``(q, c)``: the
+automaton in state ``q``, and ``c`` the letter class of the last *landmark* triangle entered
+(every letter class of the allowed triangles is a landmark but the most common one, the
+*background*).  An edge reads one kind of move or a stutter step:
+
+* from a triangle of ``c`` or of the background into one of those, or a stutter step: the
+  landmark stays ``c``, and the edge costs nothing (the robot is in one of those: entering
+  any other landmark would have made it the last);
+* into a triangle of another landmark ``c'``: it costs ``delta(c, c')``, the least cost in
+  the transition system alone (no automaton) from any cell of a ``c`` triangle to entering a
+  ``c'`` triangle.
+
+Every product path maps onto a path of this graph that costs no more (the region-level graph
+has every automaton step the product has, and the product's path from the last ``c``
+triangle to the ``c'`` one costs at least ``delta(c, c')``), so its least cost to a target is
+a lower bound.  For a concrete node the first leg is bounded by ``D[c'](cell)``, the cost from
+that very cell to entering a ``c'`` triangle (one multi-source search per landmark on the
+transition system, backwards).  The distances of the transition system are those of the
+product's own moves and weights (:class:`~tlmpc.planning.lazy.LazyProduct`), so the bounds
+hold for whatever edge costs the product is given.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from tlmpc.abstraction.model import FloatArray, IntArray
+from tlmpc.planning.lazy import LazyProduct
+from tlmpc.planning.product import SLOTS, BoolArray
+from tlmpc.planning.search import Graph, shortest_paths
+
+#: Bounds are scaled down by this factor: the searches add the same weights in other orders,
+#: so a bound equal to the true cost could exceed it by a rounding error.
+SAFETY = 1.0 - 1e-9
+
+
+@dataclass(frozen=True, slots=True)
+class RegionGraph:
+    """The region-level graph of a lazy product (see the module doc), with the transition
+    system's distances to each landmark."""
+
+    classes: IntArray  # letter class of each local class index (background included)
+    background: int  # local index of the background class
+    landmarks: IntArray  # local indices of the landmarks
+    cell_local: IntArray  # per cell: its triangle's local class (-1: not allowed)
+    distance: FloatArray  # (landmarks, cells): cost from the cell to entering the landmark
+    delta: FloatArray  # (local, local): region-to-region lower bound (0 from the background)
+    closure: BoolArray  # (local, Q, Q): states reached for free with that last landmark
+    entering: list[tuple[int, IntArray, IntArray]]  # (landmark, from states, to states)
+    scale: float  # weight per unit of Euclidean length, at least (for the straight bound)
+    backwards: Graph  # the transition system's moves, reversed
+
+    def distance_to(self, cells: IntArray) -> FloatArray:
+        """Per cell: the transition system's least cost from it to any of ``cells``."""
+        distance, _ = shortest_paths(self.backwards, cells)
+        return distance
+
+    def region_minimum(self, per_cell: FloatArray) -> FloatArray:
+        """Per local class: the least value over its cells."""
+        allowed = self.cell_local >= 0
+        least = np.full(len(self.classes), np.inf)
+        np.minimum.at(least, self.cell_local[allowed], per_cell[allowed])
+        return least
+
+    @property
+    def num_states(self) -> int:
+        """The automaton's number of states."""
+        return int(self.closure.shape[1])
+
+
+def region_graph(product: LazyProduct, allowed_cells: BoolArray) -> RegionGraph:
+    """The region-level graph of ``product`` over the cells ``allowed_cells``."""
+    nq = product.num_states
+    cell_class = np.repeat(product.triangle_class, SLOTS)
+    present = np.unique(cell_class[allowed_cells])
+    counts = np.bincount(
+        np.searchsorted(present, cell_class[allowed_cells]), minlength=len(present)
+    )
+    background = int(np.argmax(counts)) if len(present) else 0
+    local_of = np.full(int(cell_class.max(initial=0)) + 1, -1, dtype=np.int64)
+    local_of[present] = np.arange(len(present))
+    cell_local = np.where(allowed_cells, local_of[cell_class], -1)
+    landmarks = np.array([c for c in range(len(present)) if c != background], dtype=np.int64)
+    cells = product.num_cells
+    sources = np.repeat(np.arange(cells, dtype=np.int64), np.diff(product.move_indptr))
+    backwards, _ = Graph.from_edges(product.move_target, sources, product.move_weight, cells)
+    distance = _landmark_distances(backwards, cell_local, landmarks)
+    count = len(present)
+    delta = np.zeros((count, count))
+    for index, landmark in enumerate(landmarks.tolist()):
+        for c in landmarks.tolist():
+            inside = distance[index][cell_local == c]
+            delta[c, landmark] = float(inside.min()) if len(inside) else np.inf
+    kind_local = local_of[product.kind_class]
+    closure = np.zeros((count, nq, nq), dtype=bool)
+    entering: list[tuple[int, IntArray, IntArray]] = []
+    free_kinds = kind_local == background
+    for c in range(count):
+        # While c is the last landmark the robot is in a triangle of c or of the background:
+        # only moves leaving one of those (under the closed convention the crossing letter
+        # tells, e.g. leaving a room reads it) into one of those are free.
+        leaves = product.kind_left[:, present[c]] | product.kind_left[:, present[background]]
+        step = np.zeros((nq, nq), dtype=bool)
+        _mark(step, product.successor[(free_kinds | (kind_local == c)) & leaves])
+        for stutter_class in {int(present[c]), int(present[background])}:
+            _mark(step, product.stutter_successor[stutter_class][None])
+        closure[c] = _reflexive_closure(step)
+    for c in landmarks.tolist():
+        into = np.zeros((nq, nq), dtype=bool)
+        _mark(into, product.successor[kind_local == c])
+        tails, heads = np.nonzero(into)
+        entering.append((c, tails, heads))
+    return RegionGraph(
+        classes=present,
+        background=background,
+        landmarks=landmarks,
+        cell_local=cell_local,
+        distance=distance,
+        delta=delta,
+        closure=closure,
+        entering=entering,
+        scale=_straight_scale(product),
+        backwards=backwards,
+    )
+
+
+def _mark(step: BoolArray, successor: IntArray) -> None:
+    """Set ``step[q, q']`` for every successor ``q'`` of ``q`` in the (kinds, Q, J) table."""
+    kinds, states, width = successor.shape
+    q = np.broadcast_to(np.arange(states)[None, :, None], (kinds, states, width))
+    ok = successor >= 0
+    step[q[ok], successor[ok]] = True
+
+
+def _reflexive_closure(step: BoolArray) -> BoolArray:
+    """Reachability in zero or more steps."""
+    reach = step | np.eye(len(step), dtype=bool)
+    while True:
+        # Squaring in single precision (BLAS): entries count paths, exact up to 2**24 states.
+        wider = (reach.astype(np.float32) @ reach.astype(np.float32)) > 0
+        if (wider == reach).all():
+            return reach
+        reach = wider
+
+
+def _landmark_distances(backwards: Graph, cell_local: IntArray, landmarks: IntArray) -> FloatArray:
+    """(landmarks, cells): the transition system's least cost from each cell to entering a
+    triangle of each landmark (entered cells, not the start slot), inf where unreachable."""
+    cells = backwards.num_nodes
+    entered = np.ones(cells, dtype=bool)
+    entered[SLOTS - 1 :: SLOTS] = False
+    distance = np.empty((len(landmarks), cells))
+    for index, landmark in enumerate(landmarks.tolist()):
+        goal = np.flatnonzero(entered & (cell_local == landmark))
+        distance[index], _ = shortest_paths(backwards, goal)
+    return distance
+
+
+def _straight_scale(product: LazyProduct) -> float:
+    """The least weight per unit of straight-line length over the moves: a path's cost is at
+    least this times the distance between its ends' positions."""
+    sources = np.repeat(np.arange(product.num_cells, dtype=np.int64), np.diff(product.move_indptr))
+    length = np.linalg.norm(
+        product.position[product.move_target] - product.position[sources], axis=1
+    )
+    moving = length > 0
+    if not moving.any():
+        return 0.0
+    return float((product.move_weight[moving] / length[moving]).min())
+
+
+@dataclass(frozen=True, slots=True)
+class CostToGo:
+    """A lower bound on the cost from any product node to a target set with terminal costs:
+    ``min(free[q, c], min over landmarks l of D[l](cell) + leg[q, c, l])`` for a node in
+    state ``q`` in a cell of local class ``c``.
+
+    With ``final`` the targets are the cells ``final`` measures the way to, in the states
+    ``reach`` tells: a node whose free steps reach such a state is bounded by ``final`` at its
+    own cell rather than by the region-level ``free``."""
+
+    graph: RegionGraph
+    free: FloatArray  # (Q, local)
+    leg: FloatArray  # (Q, local, landmarks)
+    final: FloatArray | None = None  # per cell: the cost still to pay in a target state
+    reach: BoolArray | None = None  # (Q, local): free steps reach a target state
+
+    def __call__(self, nodes: IntArray) -> FloatArray:
+        """The bound at each node (inf: no target reachable; nodes of allowed cells)."""
+        nq = self.graph.num_states
+        cell, q = nodes // nq, nodes % nq
+        c = self.graph.cell_local[cell]
+        if self.final is not None and self.reach is not None:
+            bound = np.where(self.reach[q, c], self.final[cell], np.inf)
+        else:
+            bound = self.free[q, c]
+        if len(self.graph.landmarks):
+            via = self.graph.distance[:, cell].T + self.leg[q, c]
+            bound = np.minimum(bound, via.min(axis=1))
+        result: FloatArray = bound * SAFETY
+        return result
+
+    def at_region(self, q: int, c: int) -> float:
+        """The bound at the region-level node ``(q, c)``."""
+        value = float(self.free[q, c])
+        for index, landmark in enumerate(self.graph.landmarks.tolist()):
+            value = min(value, float(self.graph.delta[c, landmark] + self.leg[q, c, index]))
+        return value
+
+
+def cost_to_go_to_cells(graph: RegionGraph, state: int, final: FloatArray) -> CostToGo:
+    """A bound on the cost from any node to a node in ``state`` at a cell ``final``
+    measures the way to (per cell: the transition system's least cost from it)."""
+    nq = graph.num_states
+    terminal = np.full((nq, len(graph.classes)), np.inf)
+    terminal[state, :] = graph.region_minimum(final)
+    bound = cost_to_go(graph, terminal)
+    reach = graph.closure[:, :, state].T  # (Q, local)
+    return CostToGo(graph=graph, free=bound.free, leg=bound.leg, final=final, reach=reach)
+
+
+def cost_to_go(graph: RegionGraph, terminal: FloatArray) -> CostToGo:
+    """The least region-level cost to a node ``(q, c)`` plus its ``terminal[q, c]`` (inf:
+    not a target), as a bound on concrete nodes (see :class:`CostToGo`).
+
+    Bellman-Ford on the region-level graph: with nonnegative costs it settles within as many
+    rounds as the graph has nodes, and in practice within the number of landmarks a cheapest
+    path enters.
+    """
+    nq = graph.num_states
+    count = len(graph.classes)
+    closure = graph.closure
+    # free[q, c]: a target reached without entering another landmark.
+    free = np.where(closure, terminal.T[:, None, :], np.inf).min(axis=2).T
+    value = free.copy()  # the region-level node's cost to go
+    leg = np.full((nq, count, len(graph.landmarks)), np.inf)
+    for _ in range(nq * count + 1):
+        for index, (landmark, tails, heads) in enumerate(graph.entering):
+            # Entering the landmark from state tail: the cheapest head's cost to go there.
+            after = np.full(nq, np.inf)
+            np.minimum.at(after, tails, value[heads, landmark])
+            leg[:, :, index] = _masked_min(closure, after).T
+        updated = free.copy()
+        for index, landmark in enumerate(graph.landmarks.tolist()):
+            updated = np.minimum(updated, graph.delta[:, landmark][None, :] + leg[:, :, index])
+        if np.array_equal(updated, value):
+            break
+        value = updated
+    return CostToGo(graph=graph, free=free, leg=leg)
+
+
+def _masked_min(reach: BoolArray, cost: FloatArray) -> FloatArray:
+    """(local, Q): per class c and state q, the least ``cost[q']`` over the ``q'`` that
+    ``reach[c, q]`` holds."""
+    result: FloatArray = np.where(reach, cost[None, None, :], np.inf).min(axis=2)
+    return result

@@ -1,0 +1,499 @@
+"""The minimum-cost lasso on a product expanded on demand, guided by lower bounds.
+
+The same lasso as :func:`tlmpc.planning.plan.plan` finds on the built product, with the same
+cost (``prefix + beta * cycle``) and the same promise (docs/planning.md): the least of
+
+* ``d0(s)`` over the accepting stays ``s``, and
+* ``d0(u) + beta * (w(u, v) + d(v, u))`` over the accepting edges ``u -> v``,
+
+but without building the product.  The searches are label-correcting searches in buckets of
+``f = g + h`` (A* with an admissible bound ``h``, :mod:`tlmpc.planning.bounds`), on the edges
+:meth:`~tlmpc.planning.lazy.LazyProduct.expand` gives:
+
+1. the *prefix search* from the initial nodes, guided by a bound on the whole lasso still to
+   pay (to a stay, or to an accepting edge plus ``beta`` times the cheapest way back);
+2. each accepting edge ``u -> v`` it expands becomes a *candidate* with the lower bound
+   ``g(u) + beta * (w + b(v, u))``; candidates are closed (a search from ``v`` back to ``u``
+   guided by a bound on reaching ``u``) in increasing order of their bound, interleaved with
+   the prefix search so that the one with the smallest bound or ``f`` goes first;
+3. everything stops when no bound nor ``f`` is below the best lasso found.
+
+A node whose ``f`` reaches the incumbent is never expanded: every lasso through it costs at
+least that much.  Closing searches are capped as on the built product (``stats.optimal``).
+"""
+
+from __future__ import annotations
+
+import heapq
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+import numpy.typing as npt
+
+from tlmpc.abstraction.model import FloatArray, IntArray
+from tlmpc.planning.bounds import (
+    CostToGo,
+    RegionGraph,
+    cost_to_go,
+    cost_to_go_to_cells,
+    region_graph,
+)
+from tlmpc.planning.lazy import Edges, LazyProduct
+from tlmpc.planning.product import BoolArray
+from tlmpc.planning.search import BUCKET_WIDTH, relax_offers
+
+Bound = Callable[[IntArray], FloatArray]
+
+#: Closing searches run side by side up to this many product nodes in all (their arrays,
+#: about 30 bytes a node).
+CLOSING_NODES = 26_000_000
+
+
+@dataclass(slots=True)
+class _Arrays:
+    """A search's per-node arrays, reset where touched so that one set serves many."""
+
+    dist: FloatArray
+    pred: IntArray
+    via: FloatArray
+    queued: BoolArray
+    estimate: npt.NDArray[np.float32]  # the bound at each node met (nan: not computed)
+    touched: list[IntArray] = field(default_factory=list)
+
+    @staticmethod
+    def of(size: int) -> _Arrays:
+        """Fresh arrays for ``size`` nodes."""
+        return _Arrays(
+            dist=np.full(size, np.inf),
+            pred=np.full(size, -1, dtype=np.int64),
+            via=np.full(size, np.inf),
+            queued=np.zeros(size, dtype=bool),
+            estimate=np.full(size, np.nan, dtype=np.float32),
+        )
+
+    def reset(self) -> None:
+        """Back to unreached everywhere (only the touched nodes are written)."""
+        for nodes in self.touched:
+            self.dist[nodes] = np.inf
+            self.pred[nodes] = -1
+            self.via[nodes] = np.inf
+            self.queued[nodes] = False
+            self.estimate[nodes] = np.nan
+        self.touched = []
+
+
+class GuidedSearch:
+    """A label-correcting search on a lazy product in buckets of ``f = g + bound``.
+
+    :meth:`step` expands the nodes of the lowest bucket (every edge out of them) and
+    returns those edges; offers whose ``g + bound`` reaches ``ceiling`` are dropped (no path
+    through them can beat it).  Distances are exact for every node whose ``f`` lies below
+    :meth:`lowest` once the search has stepped past it.
+    """
+
+    def __init__(
+        self,
+        product: LazyProduct,
+        arrays: _Arrays,
+        sources: IntArray,
+        bound: Bound,
+        offsets: FloatArray | None = None,
+        copy_size: int = 0,
+    ) -> None:
+        self.product = product
+        self.arrays = arrays
+        self.bound = bound
+        self.copy_size = copy_size  # nonzero: node n is node n % copy_size of copy n // it
+        if offsets is None:
+            sources = np.unique(np.asarray(sources, dtype=np.int64))
+            offsets = np.zeros(len(sources))
+        estimate = self.estimate_at(sources)
+        finite = np.isfinite(estimate)
+        sources, offsets = sources[finite], offsets[finite]
+        arrays.dist[sources] = offsets
+        arrays.queued[sources] = True
+        arrays.touched.append(sources)
+        self.frontier = sources
+        self.estimate = estimate[finite]  # the bound at each frontier node
+        self.f = offsets + self.estimate  # g + bound at each frontier node
+        weights = product.move_weight
+        self.width = BUCKET_WIDTH * float(weights.mean()) if len(weights) else 1.0
+        self.reached = len(sources)
+
+    def estimate_at(self, nodes: IntArray) -> FloatArray:
+        """The bound at ``nodes``, computed once per node (kept in single precision,
+        rounded down so that it stays a lower bound)."""
+        known = self.arrays.estimate[nodes]
+        unknown = np.isnan(known)
+        if unknown.any():
+            fresh = nodes[unknown]
+            exact = self.bound(fresh) * (1.0 - 1e-6)
+            known[unknown] = exact.astype(np.float32)
+            self.arrays.estimate[fresh] = known[unknown]
+            self.arrays.touched.append(fresh)
+        return known.astype(np.float64)
+
+    def lowest(self) -> float:
+        """The least ``f`` in the frontier (inf when it is empty)."""
+        if not len(self.frontier):
+            return np.inf
+        return float(self.f.min())
+
+    def prune(self, ceilings: FloatArray) -> None:
+        """Drop the frontier nodes whose ``f`` reaches their copy's ceiling."""
+        keep = self.f < ceilings[self.frontier // self.copy_size]
+        self.arrays.queued[self.frontier[~keep]] = False
+        self.frontier, self.estimate, self.f = (
+            self.frontier[keep],
+            self.estimate[keep],
+            self.f[keep],
+        )
+
+    def step(self, ceiling: float | FloatArray = np.inf) -> tuple[Edges, IntArray]:
+        """Expand the lowest bucket; returns its edges and the nodes whose distance got
+        shorter (queued again).  ``ceiling`` may be one per copy."""
+        arrays = self.arrays
+        f = self.f
+        take = f <= float(f.min()) + self.width
+        active = self.frontier[take]
+        self.frontier, self.estimate = self.frontier[~take], self.estimate[~take]
+        arrays.queued[active] = False
+        if self.copy_size:
+            local = active % self.copy_size
+            edges = self.product.expand(local, base=active - local)
+        else:
+            edges = self.product.expand(active)
+        du = arrays.dist[edges.tails]
+        d = du + edges.weights
+        v = edges.heads
+        if isinstance(ceiling, np.ndarray):
+            ceiling = ceiling[v // self.copy_size]
+        keep = d + self.estimate_at(v) < ceiling
+        improved = relax_offers(
+            arrays.dist, arrays.via, arrays.pred, v[keep], d[keep], du[keep], edges.tails[keep]
+        )
+        fresh = improved[~arrays.queued[improved]]
+        arrays.queued[fresh] = True
+        arrays.touched.append(fresh)
+        self.reached += len(fresh)
+        self.frontier = np.concatenate([self.frontier, fresh])
+        self.estimate = np.concatenate([self.estimate, self.estimate_at(fresh)])
+        # Distances of queued nodes may have got shorter: f is read anew.
+        self.f = arrays.dist[self.frontier] + self.estimate
+        return edges, improved
+
+    def path(self, target: int) -> list[int]:
+        """The nodes from a source to ``target`` along the predecessors (in the product's
+        own numbers when the search runs in copies)."""
+        nodes = [target]
+        while self.arrays.pred[nodes[-1]] >= 0:
+            nodes.append(int(self.arrays.pred[nodes[-1]]))
+        nodes.reverse()
+        if self.copy_size:
+            return [node % self.copy_size for node in nodes]
+        return nodes
+
+
+@dataclass(frozen=True, slots=True)
+class GuidedLasso:
+    """The best lasso: its cost bound, the prefix's nodes (to the anchor) and the cycle's
+    (from the anchor, without coming back to it; one node for a stay), with the search's
+    statistics."""
+
+    cost: float
+    prefix: list[int]
+    cycle: list[int]
+    searches: int
+    optimal: bool
+    reached: int
+
+
+class _Bounds:
+    """The bounds the lasso search needs, each computed once."""
+
+    def __init__(self, product: LazyProduct, graph: RegionGraph, beta: float) -> None:
+        self.product = product
+        self.graph = graph
+        self.beta = beta
+        self.returns: dict[int, CostToGo] = {}
+        self.cell_distance: dict[int, FloatArray] = {}
+        self.to_cell: dict[tuple[int, int], CostToGo] = {}
+        self.arounds: dict[tuple[int, int], CostToGo] = {}
+        nq = graph.num_states
+        stays = product.stutter_accepts[graph.classes].T  # (Q, local)
+        stay = np.where(stays | stays[:, [graph.background]], 0.0, np.inf)
+        self.stay = stay
+        self.lasso = cost_to_go(graph, np.minimum(stay, self._accepting_terminal(nq)))
+
+    def back_to(self, q: int) -> CostToGo:
+        """A bound on the cost from any node to a node of state ``q``."""
+        if q not in self.returns:
+            terminal = np.full((self.graph.num_states, len(self.graph.classes)), np.inf)
+            terminal[q, :] = 0.0
+            self.returns[q] = cost_to_go(self.graph, terminal)
+        return self.returns[q]
+
+    def around(self, q: int, landmark: int) -> CostToGo:
+        """A bound on the cost from any node to a node of state ``q`` and then into a
+        triangle of ``landmark`` (a local class other than the background)."""
+        key = (q, landmark)
+        if key not in self.arounds:
+            index = int(np.flatnonzero(self.graph.landmarks == landmark)[0])
+            self.arounds[key] = cost_to_go_to_cells(self.graph, q, self.graph.distance[index])
+        return self.arounds[key]
+
+    def _accepting_terminal(self, nq: int) -> FloatArray:
+        """(Q, local): per region-level node, ``beta`` times a bound on closing a cycle
+        through an accepting edge taken there (its move, then the way back to its tail's
+        state)."""
+        graph, product = self.graph, self.product
+        count = len(graph.classes)
+        terminal = np.full((nq, count), np.inf)
+        local_of = {int(c): i for i, c in enumerate(graph.classes.tolist())}
+        kinds, states, width = product.marked.shape
+        for kind in range(kinds):
+            entered = local_of.get(int(product.kind_class[kind]))
+            if entered is None:
+                continue
+            for q in range(states):
+                for j in range(width):
+                    if not product.marked[kind, q, j]:
+                        continue
+                    back = self.back_to(q)
+                    q_next = int(product.successor[kind, q, j])
+                    for c in range(count):
+                        landmark = entered not in (graph.background, c)
+                        at = entered if landmark else c
+                        # The way to the landmark is paid partly before the edge (at
+                        # weight one) and partly by it (at beta): at least the lesser.
+                        move = min(1.0, self.beta) * graph.delta[c, entered] if landmark else 0.0
+                        cost = move + self.beta * back.at_region(q_next, at)
+                        if entered != graph.background:
+                            # The cycle itself: back to q, then into that landmark again.
+                            around = self.around(q, entered).at_region(q_next, entered)
+                            cost = max(cost, self.beta * around)
+                        terminal[q, c] = min(terminal[q, c], cost)
+        stutter_marked = product.stutter_marked[graph.classes]  # (local, Q, J)
+        for c in range(count):
+            for other in {c, graph.background}:
+                for q in range(nq):
+                    for j in range(stutter_marked.shape[2]):
+                        if stutter_marked[other, q, j]:
+                            q_next = int(product.stutter_successor[graph.classes[other], q, j])
+                            cost = self.back_to(q).at_region(q_next, c)
+                            terminal[q, c] = min(terminal[q, c], self.beta * cost)
+        return terminal
+
+    def closing(self, target: int) -> Bound:
+        """A bound on the cost from any node to the node ``target``: the region-level one
+        to its state and then its cell, and the straight line to its cell's position."""
+        nq = self.product.num_states
+        cell, state = target // nq, target % nq
+        if (cell, state) not in self.to_cell:
+            if cell not in self.cell_distance:
+                self.cell_distance[cell] = self.graph.distance_to(np.array([cell]))
+            self.to_cell[cell, state] = cost_to_go_to_cells(
+                self.graph, state, self.cell_distance[cell]
+            )
+        back = self.to_cell[cell, state]
+        position = self.product.position
+        goal = position[target // nq]
+        scale = self.graph.scale
+
+        def bound(nodes: IntArray) -> FloatArray:
+            offset = position[nodes // nq] - goal
+            straight = np.sqrt(offset[:, 0] * offset[:, 0] + offset[:, 1] * offset[:, 1])
+            result: FloatArray = np.maximum(back(nodes), straight * (scale * (1.0 - 1e-9)))
+            return result
+
+        return bound
+
+
+def guided_lasso(
+    product: LazyProduct,
+    allowed_cells: BoolArray,
+    *,
+    beta: float,
+    max_searches: int,
+) -> GuidedLasso | None:
+    """The minimum-cost accepting lasso of ``product`` (None when there is none), see the
+    module doc; past ``max_searches`` closing searches the best found, ``optimal`` false."""
+    if not len(product.initial):
+        return None
+    graph = region_graph(product, allowed_cells)
+    bounds = _Bounds(product, graph, beta)
+    prefix = GuidedSearch(product, _Arrays.of(product.num_nodes), product.initial, bounds.lasso)
+    closing_arrays: _Arrays | None = None
+    # Closing searches run side by side, each in its own copy of the node numbers, as many as
+    # CLOSING_NODES allows.
+    width = max(1, min(max_searches, CLOSING_NODES // max(product.num_nodes, 1)))
+    best: tuple[float, list[int], list[int]] | None = None
+    candidates: list[tuple[float, int, int, float, float]] = []  # bound, u, v, w, g(u)
+    searches = 0
+    capped = False
+    for node in prefix.frontier[product.stays_accepting(prefix.frontier)].tolist():
+        best = _better(best, (0.0, [node], [node]))
+    while True:
+        incumbent = best[0] if best is not None else np.inf
+        f = prefix.lowest()
+        if candidates and candidates[0][0] < min(f, incumbent):
+            if searches >= max_searches and best is not None:
+                capped = True
+                break
+            room = max_searches - searches if best is not None else len(candidates)
+            groups = _next_groups(candidates, prefix.arrays.dist, incumbent, beta, room, width)
+            candidates = [c for c in candidates if (c[1], c[4]) not in groups.taken]
+            heapq.heapify(candidates)
+            if not groups.tails:
+                continue
+            needed = product.num_nodes * len(groups.tails)
+            if closing_arrays is None or len(closing_arrays.dist) < needed:
+                closing_arrays = None  # released before the larger one is allocated
+                closing_arrays = _Arrays.of(needed)
+            results = _close_together(product, closing_arrays, groups, bounds)
+            searches += len(groups.tails)
+            for u, g, (back, back_path) in zip(groups.tails, groups.g, results, strict=True):
+                if back is None:
+                    continue
+                total = g + beta * back
+                if total < (best[0] if best is not None else np.inf) - 1e-12:
+                    best = (total, prefix.path(u), [u, *back_path[:-1]])
+            continue
+        if f >= incumbent or not np.isfinite(f):
+            break
+        edges, improved = prefix.step(ceiling=incumbent)
+        staying = improved[product.stays_accepting(improved)]
+        if len(staying):
+            node = int(staying[np.argmin(prefix.arrays.dist[staying])])
+            if prefix.arrays.dist[node] < incumbent - 1e-12:
+                best = (float(prefix.arrays.dist[node]), prefix.path(node), [node])
+        for offer in _candidates(edges, prefix.arrays.dist, bounds, incumbent):
+            heapq.heappush(candidates, offer)
+    if best is None:
+        return None
+    cost, prefix_nodes, cycle_nodes = best
+    return GuidedLasso(
+        cost=cost,
+        prefix=prefix_nodes,
+        cycle=cycle_nodes,
+        searches=searches,
+        optimal=not capped,
+        reached=prefix.reached,
+    )
+
+
+def _candidates(
+    edges: Edges, dist: FloatArray, bounds: _Bounds, incumbent: float
+) -> list[tuple[float, int, int, float, float]]:
+    """The accepting edges among ``edges`` as cycle candidates ``(bound, u, v, w, g(u))``
+    whose bound ``g(u) + beta * (w + b(v, u))`` is below the incumbent."""
+    found: list[tuple[float, int, int, float, float]] = []
+    marked = np.flatnonzero(edges.accepting)
+    if not len(marked):
+        return found
+    tails, heads, weights = edges.tails[marked], edges.heads[marked], edges.weights[marked]
+    for tail in np.unique(tails).tolist():
+        mine = tails == tail
+        back = bounds.closing(tail)(heads[mine])
+        g = float(dist[tail])
+        for head, weight, b in zip(
+            heads[mine].tolist(), weights[mine].tolist(), back.tolist(), strict=True
+        ):
+            estimate = g + bounds.beta * (weight + b)
+            if estimate < incumbent:
+                found.append((estimate, tail, head, weight, g))
+    return found
+
+
+def _better(
+    best: tuple[float, list[int], list[int]] | None, offer: tuple[float, list[int], list[int]]
+) -> tuple[float, list[int], list[int]]:
+    if best is None or offer[0] < best[0] - 1e-12:
+        return offer
+    return best
+
+
+@dataclass(slots=True)
+class _Groups:
+    """Closing searches to run side by side: per accepting edges' tail ``u`` (at distance
+    ``g`` from the start), its edges' heads and weights and the limit the incumbent allows;
+    ``taken`` are the (tail, g) pairs removed from the candidates (stale ones included)."""
+
+    tails: list[int] = field(default_factory=list)
+    g: list[float] = field(default_factory=list)
+    heads: list[IntArray] = field(default_factory=list)
+    weights: list[FloatArray] = field(default_factory=list)
+    limits: list[float] = field(default_factory=list)
+    taken: set[tuple[int, float]] = field(default_factory=set)
+
+
+def _next_groups(
+    candidates: list[tuple[float, int, int, float, float]],
+    dist: FloatArray,
+    incumbent: float,
+    beta: float,
+    room: int,
+    width: int,
+) -> _Groups:
+    """The candidates to close next, in order of their bound: every pending candidate out of
+    one tail closes in one search (from all its heads at once, each starting at its edge's
+    weight), up to ``width`` tails, fewer than ``room``, all with bounds below the incumbent.
+    Candidates whose tail got nearer since are dropped: its expansion offered them again."""
+    groups = _Groups()
+    for bound, u, _, _, g in sorted(candidates):
+        if len(groups.tails) >= min(width, room) or bound >= incumbent:
+            break
+        if (u, g) in groups.taken:
+            continue
+        groups.taken.add((u, g))
+        if dist[u] < g:
+            continue
+        same = [c for c in candidates if c[1] == u and c[4] == g]
+        groups.tails.append(u)
+        groups.g.append(g)
+        groups.heads.append(np.array([c[2] for c in same], dtype=np.int64))
+        groups.weights.append(np.array([c[3] for c in same]))
+        groups.limits.append((incumbent - g) / max(beta, 1e-12))
+    return groups
+
+
+def _close_together(
+    product: LazyProduct, arrays: _Arrays, groups: _Groups, bounds: _Bounds
+) -> list[tuple[float | None, list[int]]]:
+    """Per group: the cheapest way from its tail ``u`` through one of its accepting edges
+    back to ``u`` if it costs at most the group's limit, its cost and its nodes from the head
+    to ``u``; the searches share their rounds."""
+    arrays.reset()
+    size = product.num_nodes
+    count = len(groups.tails)
+    base = np.arange(count, dtype=np.int64) * size
+    sources = np.concatenate([heads + base[k] for k, heads in enumerate(groups.heads)])
+    offsets = np.concatenate(groups.weights)
+    targets = np.array(groups.tails, dtype=np.int64) + base
+    limits = np.array(groups.limits)
+    own = [bounds.closing(u) for u in groups.tails]
+
+    def bound(nodes: IntArray) -> FloatArray:
+        copy = nodes // size
+        result = np.empty(len(nodes))
+        for k in np.unique(copy).tolist():
+            mine = copy == k
+            result[mine] = own[k](nodes[mine] - k * size)
+        return result
+
+    search = GuidedSearch(product, arrays, sources, bound, offsets=offsets, copy_size=size)
+    while True:
+        ceilings = np.minimum(arrays.dist[targets], limits)
+        search.prune(ceilings)
+        if not len(search.frontier):
+            break
+        search.step(ceiling=ceilings)
+    found: list[tuple[float | None, list[int]]] = []
+    for k in range(count):
+        distance = float(arrays.dist[targets[k]])
+        if not np.isfinite(distance) or distance > limits[k]:
+            found.append((None, []))
+        else:
+            found.append((distance, search.path(int(targets[k]))))
+    return found

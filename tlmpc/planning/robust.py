@@ -1,0 +1,80 @@
+"""Which moves and stays the controllers can realise under a disturbance, from the angles.
+
+A step in triangle t leaving by edge i needs, at each corner, a velocity within max_speed
+that pushes along the normals of the facets through it (inward on the kept ones, outward on
+the exit) by more than the disturbance d. In the plane that best push is, with a the
+triangle's angle at the corner (docs/control.md):
+
+* max_speed * sin(a / 2) at the corner opposite the exit (both its facets kept) and at
+  every corner of a stay;
+* max_speed * cos(a / 2) at the two corners on the exit edge (one facet kept, one crossed).
+
+So a move or stay is *realisable* for the ratio r = d / max_speed (plus the controllers'
+stated tolerance) exactly when those values exceed r. The planner is first run on every move;
+when its plan has a step that is not realisable (a needle, or a corner too sharp for the
+disturbance), it runs again on the realisable ones only, where the mesh has them.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import numpy.typing as npt
+
+from tlmpc.abstraction.model import Abstraction, FloatArray
+from tlmpc.planning.model import Witness
+
+BoolArray = npt.NDArray[np.bool_]
+
+#: The controllers' re-check demands each push with this much to spare, relative to
+#: max_speed (control.synthesize.RECHECK_TOLERANCE), and a little more for rounding here.
+TOLERANCE = 2e-9
+
+
+def corner_angles(abstraction: Abstraction) -> FloatArray:
+    """(m, 3): each triangle's interior angle at each corner, in radians (atan2 of the cross
+    and dot products of the two edges: accurate for slivers, where acos of a cosine is not)."""
+    corners = abstraction.vertices[abstraction.triangles]  # (m, 3, 2)
+    angles = np.empty(corners.shape[:2])
+    for i in range(3):
+        u = corners[:, (i + 1) % 3] - corners[:, i]
+        w = corners[:, (i + 2) % 3] - corners[:, i]
+        cross = np.abs(u[:, 0] * w[:, 1] - u[:, 1] * w[:, 0])
+        dot = u[:, 0] * w[:, 0] + u[:, 1] * w[:, 1]
+        angles[:, i] = np.arctan2(cross, dot)
+    return angles
+
+
+def realisable(abstraction: Abstraction, ratio: float) -> tuple[BoolArray, BoolArray]:
+    """(m, 3) moves (leave t by edge i) and (m,) stays realisable under the disturbance
+    ``ratio`` x max_speed (with the controllers' tolerance)."""
+    need = ratio + TOLERANCE
+    half = corner_angles(abstraction) / 2.0
+    kept = np.sin(half) > need  # a corner held on both facets
+    crossing = np.cos(half) > need  # a corner on the exit edge
+    moves = np.empty(kept.shape, dtype=bool)
+    for i in range(3):
+        moves[:, i] = kept[:, i] & crossing[:, (i + 1) % 3] & crossing[:, (i + 2) % 3]
+    stays: BoolArray = np.asarray(kept.all(axis=1), dtype=bool)
+    return moves, stays
+
+
+def witness_realisable(abstraction: Abstraction, witness: Witness, ratio: float) -> bool:
+    """True when every step of ``witness`` is realisable under ``ratio`` x max_speed (a
+    vertex passage only without a disturbance: no law here reaches a point under one)."""
+    moves, stays = realisable(abstraction, ratio)
+    path = [*witness.prefix, *witness.cycle]
+    passages = dict(witness.passages)
+    for index, triangle in enumerate(path):
+        if witness.is_stay and index == len(path) - 1:
+            if not stays[triangle]:
+                return False
+            continue
+        following = path[index + 1] if index + 1 < len(path) else witness.cycle[0]
+        if index in passages:
+            if ratio > 0.0:
+                return False
+            continue
+        edges = np.flatnonzero(abstraction.neighbors[triangle] == following)
+        if len(edges) != 1 or not moves[triangle, int(edges[0])]:
+            return False
+    return True
