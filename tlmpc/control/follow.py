@@ -15,10 +15,13 @@ length (so time, not triangle count, is what it saves):
 
     sum_k len_k (d·f(p) + d·f(q)) / 2 - ALIGNMENT * len_k t_k
 
-while every guaranteed exit speed stays at least :data:`KEEP_FLOOR` times the one the vertex
-program reached (its exit-time bounds grow by at most 1 / KEEP_FLOOR).  A stay has one piece,
-from its entry to its target, where the field vanishes: parallel at p suffices.  Where a
-bend, a shared vertex velocity or the margins make exact alignment impossible, the slack
+plus the vertex program's own objective (the guaranteed speeds, the smallest weighted most,
+so the weakest step's exit-time bound stays the vertex program's).  It is solved *instead of*
+the vertex program (same rows, one Clarabel solve); where the path bends across a portal the
+velocity runs are split beforehand (:func:`bends`), since a velocity shared at both ends of
+a portal makes the two fields equal along it and the flow could not turn there.  A stay has
+one piece, from its entry to its target, where the field vanishes: parallel at p suffices.
+Where a shared vertex velocity or the margins make exact alignment impossible, the slack
 stays positive and the flow deviates as little as the objective allows; every vertex
 condition, the speed bound and the disturbance rows are the vertex program's own rows,
 and the re-check after solving is the same.
@@ -26,35 +29,37 @@ and the re-check after solving is the same.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
 
-from tlmpc.abstraction.model import Abstraction, FloatArray
+from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
 from tlmpc.control.channel import ChannelStep, Guide, Point, channel_guides
 from tlmpc.control.geometry import TriangleGeometry
 from tlmpc.control.sparse import CscMatrix, Triplets, stacked_csc
 
-#: Weight of the misalignment slack against the speed along the path.
-ALIGNMENT = 10.0
-#: The aligned fields keep at least this fraction of the fastest fields' speed along the path
-#: at every point where the path is followed.
-KEEP_SPEED = 0.9
-#: Relative and absolute duality gap at which the following solves stop.
+#: Weight of the misalignment slack against the speed along the path.  Below 1 a field
+#: never trades speed for alignment at a loss (a field of speed v at angle θ to the path
+#: scores v (cos θ - ALIGNMENT sin θ)): the flow keeps speed and turns where the rows allow.
+ALIGNMENT = 0.5
+#: Relative and absolute duality gap at which the following solve stops.
 OBJECTIVE_GAP = 1e-4
-#: Weight of the vertex program's objective (the guaranteed speeds) in both solves.
+#: Weight of the vertex program's objective (the guaranteed speeds).
 GUARANTEE = 1.0
-#: Every step's guaranteed exit speed keeps at least this fraction of the vertex program's.
-KEEP_FLOOR = 0.5
+#: ... and the floor (the smallest guaranteed speed) this many times more.
+FLOOR_WEIGHT = 10.0
 
 
 class ConicLike(Protocol):
-    """A conic form (A, b, cones) as :func:`tlmpc.control.synthesize.conic_form` gives it."""
+    """A conic form (A, q, b, cones) as :func:`tlmpc.control.synthesize.conic_form` gives it."""
 
     @property
     def constraints(self) -> CscMatrix: ...
+    @property
+    def costs(self) -> FloatArray: ...
     @property
     def offsets(self) -> FloatArray: ...
     @property
@@ -87,39 +92,52 @@ def _csc_triplets(matrix: CscMatrix) -> Triplets:
 
 
 @dataclass(frozen=True, slots=True)
-class _Point:
-    """A point of the path where the field is asked to run along d: the program columns and
-    coefficients of d·f (``along``) and d x f (``across``), its step, its weight."""
+class _PathPoints:
+    """The points of the path where the field is asked to run along d, one row each: their
+    step (index into the followed steps), the program columns (w_x, w_y of the three corners)
+    and coefficients of d·f (``along``) and d x f (``across``) there, and their weight."""
 
-    step: int
-    columns: list[int]
-    along: list[float]
-    across: list[float]
-    weight: float
+    step: IntArray  # (P,)
+    columns: IntArray  # (P, 6)
+    along: FloatArray  # (P, 6)
+    across: FloatArray  # (P, 6)
+    weight: FloatArray  # (P,)
 
 
-def _path_points(follow: Sequence[FollowStep]) -> list[_Point]:
-    lengths = [
-        float(np.hypot(s.guide.exit[0] - s.guide.entry[0], s.guide.exit[1] - s.guide.entry[1]))
-        for s in follow
-    ]
-    scale = sum(lengths) or 1.0
-    points: list[_Point] = []
-    for k, (step, length) in enumerate(zip(follow, lengths, strict=True)):
-        if length <= 0.0:
-            continue  # nothing to follow
-        dx = (step.guide.exit[0] - step.guide.entry[0]) / length
-        dy = (step.guide.exit[1] - step.guide.entry[1]) / length
-        where = [step.guide.entry] if step.stay else [step.guide.entry, step.guide.exit]
-        for point in where:
-            lambdas = step.geometry.barycentric(np.asarray(point, dtype=np.float64)).tolist()
-            columns, along, across = [], [], []
-            for local, column in enumerate(step.columns):
-                columns += [2 * column, 2 * column + 1]
-                along += [dx * lambdas[local], dy * lambdas[local]]
-                across += [-dy * lambdas[local], dx * lambdas[local]]  # d x f = dx fy - dy fx
-            points.append(_Point(k, columns, along, across, length / scale / len(where)))
-    return points
+def _path_points(follow: Sequence[FollowStep]) -> _PathPoints:
+    """Each followed step's entry point and (but for a stay) its exit point, in step order,
+    weighted by the step's share of the path's length (so time, not triangle count, counts)."""
+    count = len(follow)
+    if count == 0:
+        empty = np.zeros((0, 6))
+        return _PathPoints(
+            np.zeros(0, dtype=np.int64), np.zeros((0, 6), dtype=np.int64), empty, empty, np.zeros(0)
+        )
+    entry = np.array([s.guide.entry for s in follow], dtype=np.float64).reshape(count, 2)
+    exit_ = np.array([s.guide.exit for s in follow], dtype=np.float64).reshape(count, 2)
+    stay = np.array([s.stay for s in follow], dtype=bool)
+    normals = np.array([s.geometry.normals for s in follow], dtype=np.float64)
+    offsets = np.array([s.geometry.offsets for s in follow], dtype=np.float64)
+    heights = np.array([s.geometry.heights for s in follow], dtype=np.float64)
+    columns = np.array([s.columns for s in follow], dtype=np.int64).reshape(count, 3)
+    delta = exit_ - entry
+    lengths = np.hypot(delta[:, 0], delta[:, 1])
+    scale = float(lengths.sum()) or 1.0
+    moving = lengths > 0.0  # a piece of no length has nothing to follow
+    # Rows in step order: entry then exit (a stay has its entry alone).
+    steps = np.concatenate([np.flatnonzero(moving), np.flatnonzero(moving & ~stay)])
+    where = np.concatenate([entry[moving], exit_[moving & ~stay]])
+    order = np.argsort(steps, kind="stable")
+    steps, where = steps[order], where[order]
+    lambdas = (offsets[steps] - np.einsum("pij,pj->pi", normals[steps], where)) / heights[steps]
+    safe = np.where(moving, lengths, 1.0)
+    dx, dy = (delta[:, 0] / safe)[steps], (delta[:, 1] / safe)[steps]
+    pair = np.stack([2 * columns[steps], 2 * columns[steps] + 1], axis=2).reshape(-1, 6)
+    along = np.stack([dx[:, None] * lambdas, dy[:, None] * lambdas], axis=2).reshape(-1, 6)
+    # d x f = dx fy - dy fx
+    across = np.stack([-dy[:, None] * lambdas, dx[:, None] * lambdas], axis=2).reshape(-1, 6)
+    weight = lengths[steps] / scale / np.where(stay[steps], 1.0, 2.0)
+    return _PathPoints(steps, pair, along, across, weight)
 
 
 def follow_program(
@@ -128,74 +146,73 @@ def follow_program(
     cones: Sequence[tuple[str, int]],
     runs: int,
     steps: int,
-    floors: Sequence[float],
     follow: Sequence[FollowStep],
     *,
     alignment: float,
-    speeds: Sequence[float] | None = None,
 ) -> tuple[CscMatrix, FloatArray, FloatArray, list[tuple[str, int]]]:
     """The vertex program's conic form (x = (w, s, f)) extended by one slack t per followed
     step; returns (A, costs, b, cones) for x = (w, s, f, t).
 
     Minimises ``alignment`` * sum(weight t) - sum(weight d·f) over the path points, with
-    |d x f| <= t there, s_k >= KEEP_FLOOR * ``floors[k]`` (the vertex program's guaranteed
-    speed of step k, unit speed) and, given ``speeds`` (one per path point), d·f >= that
-    speed at each.
+    |d x f| <= t there, minus the vertex program's own objective (:data:`GUARANTEE`,
+    :data:`FLOOR_WEIGHT`).
     """
     rows_a, size = constraints.shape
     total = size + len(follow)
     points = _path_points(follow)
-    rows: list[int] = []
-    cols: list[int] = []
-    vals: list[float] = []
-    bounds: list[float] = []
+    count = len(points.step)
     costs = np.zeros(total)
     # The vertex program's own objective (floor + a tenth of the mean guaranteed speed) at
     # weight GUARANTEE: without it the fields nobody's path weighs (a stay's, a needle's) sit
-    # at the floor, and a stay converges slowly.
-    costs[2 * runs + steps] = -GUARANTEE
+    # at the floor, and a stay converges slowly.  The floor weighs FLOOR_WEIGHT times more:
+    # the fastest solve stands in for the vertex program, whose floor it then keeps (the
+    # weakest step's exit-time bound is the run's longest).
+    costs[2 * runs + steps] = -FLOOR_WEIGHT * GUARANTEE
     costs[2 * runs : 2 * runs + steps] = -0.1 * GUARANTEE / max(steps, 1)
-    for point in points:
-        slack = size + point.step
-        # t >= sign (d x f): A x <= 0 with A = (sign d x, -1); not asked when not weighed
-        for sign in (1.0, -1.0) if alignment > 0.0 else ():
-            rows += [len(bounds)] * (len(point.columns) + 1)
-            cols += [*point.columns, slack]
-            vals += [sign * c for c in point.across] + [-1.0]
-            bounds.append(0.0)
-        for column, coefficient in zip(point.columns, point.along, strict=True):
-            costs[column] -= point.weight * coefficient
-        costs[slack] += alignment * point.weight
-    if speeds is not None:  # d·f >= speed: -(d·f) + s = -speed
-        for point, speed in zip(points, speeds, strict=True):
-            rows += [len(bounds)] * len(point.columns)
-            cols += point.columns
-            vals += [-c for c in point.along]
-            bounds.append(-speed)
-    for k, kept in enumerate(floors):  # s_k >= KEEP_FLOOR * floor_k: -s_k + s = -that
-        rows.append(len(bounds))
-        cols.append(2 * runs + k)
-        vals.append(-1.0)
-        bounds.append(-KEEP_FLOOR * kept)
-    for k in range(len(follow)):  # t >= 0: -t + s = 0
-        rows.append(len(bounds))
-        cols.append(size + k)
-        vals.append(-1.0)
-        bounds.append(0.0)
+    np.add.at(costs, points.columns.ravel(), -(points.weight[:, None] * points.along).ravel())
+    np.add.at(costs, size + points.step, alignment * points.weight)
+    blocks: list[tuple[FloatArray, IntArray, FloatArray]] = []  # (values, columns, bounds)
+    slack = (size + points.step)[:, None]
+    minus = -np.ones((count, 1))
+    for sign in (1.0, -1.0) if alignment > 0.0 else ():
+        # t >= sign (d x f): sign (d x f) - t + s = 0; not asked when not weighed
+        blocks.append(
+            (
+                np.hstack([sign * points.across, minus]),
+                np.hstack([points.columns, slack]),
+                np.zeros(count),
+            )
+        )
+    blocks.append(  # t >= 0: -t + s = 0
+        (-np.ones((len(follow), 1)), size + np.arange(len(follow))[:, None], np.zeros(len(follow)))
+    )
+    rows, cols, vals, bounds, start = [], [], [], [], 0
+    for values, columns, bound in blocks:
+        height, width = values.shape
+        rows.append(np.repeat(np.arange(start, start + height), width))
+        cols.append(columns.ravel())
+        vals.append(values.ravel())
+        bounds.append(bound)
+        start += height
     base = _csc_triplets(constraints)
     widened = Triplets(base.rows, base.cols, base.values, (rows_a, total))
-    extra = Triplets.build(rows, cols, vals, (len(bounds), total))
-    matrix = stacked_csc([(0, widened), (rows_a, extra)], (rows_a + len(bounds), total))
+    extra = Triplets.build(
+        np.concatenate(rows), np.concatenate(cols), np.concatenate(vals), (start, total)
+    )
+    matrix = stacked_csc([(0, widened), (rows_a, extra)], (rows_a + start, total))
     return (
         matrix,
         costs,
-        np.concatenate([offsets, np.asarray(bounds)]),
-        [*cones, ("nonnegative", len(bounds))],
+        np.concatenate([offsets, *bounds]),
+        [*cones, ("nonnegative", start)],
     )
 
 
 def _clarabel(
-    matrix: CscMatrix, costs: FloatArray, b: FloatArray, cones: Sequence[tuple[str, int]]
+    matrix: CscMatrix,
+    costs: FloatArray,
+    b: FloatArray,
+    cones: Sequence[tuple[str, int]],
 ) -> FloatArray | None:
     """Clarabel's solution x of min costs·x, A x + s = b, s in the cones; None unless solved."""
     import clarabel
@@ -232,21 +249,12 @@ def solve_follow(
     cones: Sequence[tuple[str, int]],
     runs: int,
     steps: int,
-    floors: Sequence[float],
     follow: Sequence[FollowStep],
 ) -> FollowResult | None:
-    """Two solves: the fastest fields along the path (no alignment), then the best aligned
-    ones that keep :data:`KEEP_SPEED` of that speed at every path point.  None when either
-    does not solve (the vertex program's velocities then stand)."""
-    common = (constraints, offsets, cones, runs, steps, floors, follow)
-    fastest = _clarabel(*follow_program(*common, alignment=0.0))
-    if fastest is None:
-        return None
-    points = _path_points(follow)
-    reached = [float(np.dot(fastest[p.columns], p.along)) for p in points]
-    # (a point the fastest fields cross against d keeps its speed to the same fraction)
-    speeds = [v - (1.0 - KEEP_SPEED) * abs(v) for v in reached]
-    x = _clarabel(*follow_program(*common, alignment=ALIGNMENT, speeds=speeds))
+    """One solve of :func:`follow_program` at :data:`ALIGNMENT`; None when it does not
+    solve (the vertex program is then solved on its own)."""
+    common = (constraints, offsets, cones, runs, steps, follow)
+    x = _clarabel(*follow_program(*common, alignment=ALIGNMENT))
     if x is None:
         return None
     slacks = x[constraints.shape[1] :]
@@ -267,23 +275,14 @@ class PlanStep(Protocol):
     through: int | None
 
 
-def follow_channel(
+def path_guides(
     abstraction: Abstraction,
     steps: Sequence[PlanStep],
     loop_start: int | None,
     start: tuple[float, float],
-    form: ConicLike,
-    runs: int,
-    column: Mapping[int, int],
-    speeds: FloatArray,
-    max_speed: float,
-    disturbance: float,
-) -> tuple[FloatArray, dict[str, float | str]] | None:
-    """Velocities per run (R, 2, at ``max_speed``) whose flow follows the channel's shortest
-    path, and stats; None when the following program does not solve.
-
-    ``form`` is the vertex program's conic form, ``speeds`` its solution's guaranteed speeds.
-    """
+) -> list[Guide | None]:
+    """The channel's shortest path, one straight piece per step (None for a vertex
+    passage), with the portal insets of :mod:`tlmpc.control.channel`."""
     # A vertex is on a label boundary when the triangles around it do not all share a label.
     letters = np.repeat(abstraction.letter_of, 3)  # each corner's triangle's letter
     count = len(abstraction.vertices)
@@ -303,8 +302,71 @@ def follow_channel(
         )
         for index, step in enumerate(steps)
     ]
-    guides = channel_guides(channel, loop_start, start)
-    affine = [(step, guide) for step, guide in zip(steps, guides, strict=True)]
+    return channel_guides(channel, loop_start, start)
+
+
+#: The path bends across a portal when the sine of the angle between the pieces on its two
+#: sides exceeds this.
+BEND = 1e-3
+
+
+def bends(
+    abstraction: Abstraction,
+    steps: Sequence[PlanStep],
+    loop_start: int | None,
+    guides: Sequence[Guide | None],
+) -> frozenset[tuple[int, int]]:
+    """(step, mesh vertex) pairs where step's field should not share the vertex's velocity
+    with the step before: the two ends of a portal across which the path bends.
+
+    A velocity shared by both steps at both ends of a portal makes the two fields equal all
+    along it; the path's crossing point would then need one direction on both sides, and the
+    flow could only turn gradually, triangles away from the bend.  A stay has its own
+    velocities already.
+    """
+    split: set[tuple[int, int]] = set()
+    pairs = [(index - 1, index) for index in range(1, len(steps))]
+    if loop_start is not None:
+        pairs.append((len(steps) - 1, loop_start))  # the cycle's wrap
+    for before, after in pairs:
+        first, second = guides[before], guides[after]
+        if first is None or second is None or steps[after].exit_edge is None:
+            continue
+        if abs(_sine(first, second)) <= BEND:
+            continue
+        shared = set(abstraction.triangles[steps[before].triangle].tolist())
+        split.update(
+            (after, vertex)
+            for vertex in abstraction.triangles[steps[after].triangle].tolist()
+            if vertex in shared
+        )
+    return frozenset(split)
+
+
+def _sine(first: Guide, second: Guide) -> float:
+    """The sine of the angle from the direction of ``first`` to that of ``second`` (0 when
+    either piece is a point)."""
+    ax, ay = first.exit[0] - first.entry[0], first.exit[1] - first.entry[1]
+    bx, by = second.exit[0] - second.entry[0], second.exit[1] - second.entry[1]
+    norms = math.hypot(ax, ay) * math.hypot(bx, by)
+    return (ax * by - ay * bx) / norms if norms > 0.0 else 0.0
+
+
+def follow_channel(
+    steps: Sequence[PlanStep],
+    guides: Sequence[Guide | None],
+    form: ConicLike,
+    runs: int,
+    column: Mapping[int, int],
+    max_speed: float,
+    disturbance: float,
+) -> tuple[FloatArray, dict[str, float | str]] | None:
+    """Velocities per run (R, 2, at ``max_speed``) whose flow follows ``guides`` (the
+    channel's shortest path, :func:`path_guides`), and stats; None when the following program
+    does not solve.
+
+    ``form`` is the vertex program's conic form (``steps`` guaranteed speeds).
+    """
     follow = [
         FollowStep(
             geometry=step.geometry,
@@ -312,12 +374,11 @@ def follow_channel(
             guide=guide,
             stay=step.exit_edge is None,
         )
-        for step, guide in affine
+        for step, guide in zip(steps, guides, strict=True)
         if step.through is None and guide is not None and not _needle(step.geometry)
     ]
-    floors = (speeds / max_speed).tolist()
     result = solve_follow(
-        form.constraints, form.offsets, form.cones, runs, len(speeds), floors, follow
+        form.constraints, form.offsets, form.cones, runs, len(form.costs) - 2 * runs - 1, follow
     )
     if result is None:
         return None

@@ -25,7 +25,7 @@ import numpy as np
 
 from tlmpc.abstraction.model import Abstraction, FloatArray
 from tlmpc.base.errors import InvalidInputError, SolverError, error
-from tlmpc.control.follow import follow_channel
+from tlmpc.control.follow import bends, follow_channel, path_guides
 from tlmpc.control.geometry import (
     TriangleGeometry,
     affine_law,
@@ -52,6 +52,8 @@ Vector = tuple[float, float]
 
 #: Invariance margin: non-exit facets are pushed inward at least MARGIN times the exit speed.
 MARGIN = 0.3
+#: Why a velocity run is split where the followed path bends.
+BENDS = "the path to follow bends across this edge"
 
 
 @dataclass(slots=True)
@@ -219,7 +221,10 @@ def _assign_runs(
     *,
     push: float = 0.0,
     max_speed: float = 1.0,
+    split: frozenset[tuple[int, int]] = frozenset(),
 ) -> tuple[_Runs, list[VelocityJump]]:
+    """Velocity runs; ``split`` holds (step, vertex) pairs that start a new run (where the
+    path to follow bends, :func:`tlmpc.control.follow.bends`)."""
     runs = _Runs(push, max_speed)
     jumps: list[VelocityJump] = []
     previous: dict[int, int] = {}  # global vertex -> run id at the previous step
@@ -235,6 +240,8 @@ def _assign_runs(
             reason = None
             if run is not None and step.exit_edge is None:
                 reason = "the stay field has its own vertex velocities"
+            elif run is not None and (index, vertex) in split:
+                reason = BENDS
             elif run is not None and not runs.try_extend(run, normals):
                 reason = "the path turns 180° or more around this vertex"
             if run is None or reason is not None:
@@ -251,14 +258,17 @@ def _assign_runs(
         first = steps[loop_start]
         first_vertices = abstraction.triangles[first.triangle].tolist()
         for local, vertex in enumerate(first_vertices):
-            if vertex in previous and not runs.try_merge(previous[vertex], first.runs[local]):
+            if vertex not in previous:
+                continue
+            bent = (loop_start, vertex) in split
+            if bent or not runs.try_merge(previous[vertex], first.runs[local]):
                 x, y = abstraction.vertices[vertex].tolist()
                 jumps.append(
                     VelocityJump(
                         step=loop_start,
                         vertex=vertex,
                         position=(x, y),
-                        reason="the cycle turns 180° or more around this vertex",
+                        reason=BENDS if bent else "the cycle turns 180° or more around this vertex",
                     )
                 )
     for step in steps:
@@ -640,19 +650,23 @@ def synthesize(
         if robot.disturbance > 0.0
         else 0.0
     )
-    _, jumps = _assign_runs(abstraction, steps, loop_start, push=push, max_speed=robot.max_speed)
+    guides = path_guides(abstraction, steps, loop_start, robot.start) if follow else None
+    split = bends(abstraction, steps, loop_start, guides) if guides is not None else frozenset()
+    _, jumps = _assign_runs(
+        abstraction, steps, loop_start, push=push, max_speed=robot.max_speed, split=split
+    )
     affine = [step for step in steps if step.through is None]
     program, column = vertex_program(affine, robot.max_speed, robot.disturbance)
     built = time.perf_counter()
-    velocities, speeds = solve_vertex_program(program)
     following: dict[str, float | str] = {"follow_status": "off"}
-    if follow and affine:
+    followed = None
+    if guides is not None and affine:  # (its first solve stands in for the vertex program's)
         followed = follow_channel(
-            abstraction, steps, loop_start, robot.start, conic_form(program), program.runs,
-            column, speeds, robot.max_speed, robot.disturbance,
+            steps, guides, conic_form(program), program.runs, column, robot.max_speed,
+            robot.disturbance,
         )  # fmt: skip
         following = {"follow_status": "failed"} if followed is None else followed[1]
-        velocities = velocities if followed is None else followed[0]
+    velocities = solve_vertex_program(program)[0] if followed is None else followed[0]
     solved = time.perf_counter()
     controllers = []
     for index, step in enumerate(steps):
