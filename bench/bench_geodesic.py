@@ -25,6 +25,7 @@ Run: ``python bench/bench_geodesic.py`` (about a minute).
 from __future__ import annotations
 
 import functools
+import math
 import random
 import sys
 from dataclasses import dataclass
@@ -112,16 +113,30 @@ def generated(seed: int, *, radius: float = 0.0, patrol: bool = False) -> Worklo
     return Workload(name, document, groups, avoid=("pond",), patrol=patrol)
 
 
-def _compile(workload: Workload, follow: bool) -> Any:
+def _compile(workload: Workload, follow: bool) -> tuple[Any, float]:
+    """The compiled mission and the length of the path its fields follow (the channel's
+    shortest path with the portal insets; nan before)."""
     import importlib
 
     from tlmpc.api import compile as compile_mission
 
     control = importlib.import_module("tlmpc.control")
-    synthesize = importlib.import_module("tlmpc.control.synthesize").synthesize
-    with mock.patch.object(control, "synthesize", functools.partial(synthesize, follow=follow)):
+    module = importlib.import_module("tlmpc.control.synthesize")
+    original, guides = module.path_guides, []
+
+    def recorded(*args: Any) -> Any:
+        guides[:] = original(*args)
+        return list(guides)
+
+    fields = functools.partial(module.synthesize, follow=follow)
+    with (
+        mock.patch.object(control, "synthesize", fields),
+        mock.patch.object(module, "path_guides", recorded),
+    ):
         mission = workload.mission
-        return compile_mission(str(mission) if isinstance(mission, Path) else mission)
+        compiled = compile_mission(str(mission) if isinstance(mission, Path) else mission)
+    length = sum(math.dist(g.entry, g.exit) for g in guides if g is not None)
+    return compiled, length if guides else float("nan")
 
 
 def _fine_trajectory(artifacts: Any, pieces: int = 8) -> tuple[Any, Any]:
@@ -148,6 +163,12 @@ def _fine_trajectory(artifacts: Any, pieces: int = 8) -> tuple[Any, Any]:
         times.append(t1)
         points.append(samples[k, 1:])
     return np.asarray(times), np.asarray(points)
+
+
+def _travelled(artifacts: Any) -> float:
+    """The whole trajectory's length (to the end of the trace)."""
+    _, points = _fine_trajectory(artifacts)
+    return float(np.hypot(*np.diff(points, axis=0).T).sum())
 
 
 def _order(points: Any, shapes: dict[str, Any], groups: Any, begin: int = 0) -> tuple[list, int]:
@@ -248,7 +269,7 @@ def run(only: tuple[str, ...] = ()) -> list[dict[str, Any]]:
         row: dict[str, Any] = {"workload": workload.name}
         for label, follow in (("before", False), ("after", True)):
             try:
-                compiled = _compile(workload, follow)
+                compiled, guided = _compile(workload, follow)
                 measured = _measure(workload, compiled)
             except Exception as failure:  # a mission this generator made unsolvable
                 row["note"] = f"{type(failure).__name__}: {str(failure)[:60]}"
@@ -256,6 +277,8 @@ def run(only: tuple[str, ...] = ()) -> list[dict[str, Any]]:
             for key, value in measured.items():
                 row[f"{key} {label}"] = round(value, 3)
             row[f"robustness {label}"] = round(compiled.summary["verdict"]["robustness"], 4)
+            if follow and not workload.patrol:  # how closely the flow keeps to its path
+                row["trajectory / its path"] = round(_travelled(compiled.artifacts) / guided, 3)
         rows.append(row)
     return rows
 

@@ -256,3 +256,69 @@ def test_exit_portal_ends_are_seen_from_inside(coords: list[float], exit_edge: i
     # facing from the opposite corner toward the edge, the left end lies to the left
     assert _ccw(inside, mid, portal.left) > 0
     assert _ccw(inside, mid, portal.right) < 0
+
+
+def _discontinuities(abstraction: Abstraction, controllers: Any) -> set[tuple[int, int]]:
+    """(step, mesh vertex) where a step's velocity at a corner it shares with the step before
+    differs from that one's (a stay's own field excepted: it is reported by its own rule)."""
+    found = set()
+    steps = controllers.steps
+    for k in range(1, len(steps)):
+        before, after = steps[k - 1], steps[k]
+        if before.is_vertex or after.is_vertex:
+            continue
+        corners = abstraction.triangles[before.triangle].tolist()
+        for local, vertex in enumerate(abstraction.triangles[after.triangle].tolist()):
+            if vertex in corners:
+                here = after.velocities[local]
+                there = before.velocities[corners.index(vertex)]
+                if not np.allclose(here, there, rtol=0.0, atol=1e-12):
+                    found.add((k, vertex))
+    return found
+
+
+@settings(deadline=None, max_examples=30, suppress_health_check=[HealthCheck.filter_too_much])
+@given(strips())
+def test_velocity_jumps_are_exactly_where_the_fields_jump(strip: Any) -> None:
+    """Every corner where consecutive fields differ is listed as a velocity jump and every
+    listed jump is one (the bends' splits included)."""
+    planned = strip_plan(*strip)
+    if planned is None:
+        return
+    abstraction, witness, _ = planned
+    sx, sy = abstraction.corners(0).mean(axis=0).tolist()
+    controllers = synthesize(abstraction, witness, Robot(start=(sx, sy), max_speed=1.0))
+    listed = {(j.step, j.vertex) for j in controllers.jumps}
+    assert _discontinuities(abstraction, controllers) == listed
+
+
+def test_a_bent_corridor_splits_its_runs_at_the_bend() -> None:
+    """An L-shaped corridor (east, then north): its shortest path turns at the inner corner,
+    so the fields jump there (reason: the bend), and the trajectory keeps within 10 % of the
+    shortest path to the stay's target (visibility graph), shorter than the vertex program's
+    own fields (1.093 against 1.112)."""
+    from tlmpc.control.synthesize import BENDS
+
+    centre = [(0.0, 0.0), (1.0, 0.0), (2.0, 0.0), (3.0, 0.0), (3.0, 1.0), (3.0, 2.0), (3.0, 3.0)]
+    left = [(x - 0.5 * (x >= 3.0), y + 0.5 * (x < 3.0)) for x, y in centre]
+    right = [(x + 0.5 * (x >= 3.0), y - 0.5 * (x < 3.0)) for x, y in centre]
+    left[3], right[3] = (2.5, 0.5), (3.5, -0.5)  # the corner's diagonal
+    planned = strip_plan(left, right)
+    assert planned is not None
+    abstraction, witness, triangles = planned
+    sx, sy = abstraction.corners(0).mean(axis=0).tolist()
+    robot = Robot(start=(sx, sy), max_speed=1.0)
+    controllers = synthesize(abstraction, witness, robot)
+    assert any(jump.reason == BENDS for jump in controllers.jumps)
+    mission = cast(Mission, type("M", (), {"robot": robot})())
+    corridor = shapely.Polygon([*right, *reversed(left)])
+    ratios = []
+    for fields in (controllers, synthesize(abstraction, witness, robot, follow=False)):
+        trace = simulate(abstraction, fields, mission)
+        travelled, entry = _length_until(trace, len(triangles) - 1)
+        target = fields.steps[-1].target
+        assert target is not None
+        best = geodesic(corridor, (sx, sy), (target[0], target[1]))
+        ratios.append((travelled + math.dist(entry, target)) / best)
+    assert ratios[0] <= 1.10
+    assert ratios[0] < ratios[1]

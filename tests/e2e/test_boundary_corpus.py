@@ -13,6 +13,7 @@ from __future__ import annotations
 import copy
 from typing import Any
 
+import numpy as np
 import pytest
 import shapely
 from face_graph import face_graph, satisfiable_on
@@ -209,11 +210,13 @@ def test_starts_on_mesh_vertices_and_edges(start: tuple[float, float], ltl: str)
     checked(closed)
 
 
+@pytest.mark.parametrize("hurry", [2.0, 1.00001])
 def test_a_compiled_trace_faster_than_max_speed_fails_the_self_check(
-    monkeypatch: pytest.MonkeyPatch,
+    monkeypatch: pytest.MonkeyPatch, hurry: float
 ) -> None:
     """The verifier's speed check guards compiled traces too (the trace stays on its path and
-    satisfies the task, only twice as fast)."""
+    satisfies the task, only faster: its fastest chord at twice max_speed, or 1e-5 above it,
+    far above the rounding of its samples)."""
     import dataclasses
 
     import tlmpc.simulate
@@ -223,7 +226,9 @@ def test_a_compiled_trace_faster_than_max_speed_fails_the_self_check(
 
     def hurried(*args: Any) -> Any:
         trace = honest(*args)
-        return dataclasses.replace(trace, times=trace.times * 0.5)
+        # the fastest chord at ``hurry`` x max_speed (1 here)
+        fastest = float((np.hypot(*np.diff(trace.points, axis=0).T) / np.diff(trace.times)).max())
+        return dataclasses.replace(trace, times=trace.times * fastest / hurry)
 
     monkeypatch.setattr(tlmpc.simulate, "simulate", hurried)
     with pytest.raises(SelfCheckError) as caught:
