@@ -8,6 +8,7 @@ trace.
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
 from fractions import Fraction
@@ -278,18 +279,58 @@ def _discontinuities(abstraction: Abstraction, controllers: Any) -> set[tuple[in
 
 
 @settings(deadline=None, max_examples=30, suppress_health_check=[HealthCheck.filter_too_much])
-@given(strips())
-def test_velocity_jumps_are_exactly_where_the_fields_jump(strip: Any) -> None:
+@given(strips(), st.sampled_from([0.0, 0.05]))
+def test_velocity_jumps_are_exactly_where_the_fields_jump(strip: Any, push: float) -> None:
     """Every corner where consecutive fields differ is listed as a velocity jump and every
-    listed jump is one (the bends' splits included)."""
+    listed jump is one (the bends' splits included); the followed fields themselves pass the
+    re-check (a strip has no needle, so no field is rebuilt from its geometry)."""
+    from tlmpc.base.errors import InvalidInputError
+
     planned = strip_plan(*strip)
     if planned is None:
         return
     abstraction, witness, _ = planned
     sx, sy = abstraction.corners(0).mean(axis=0).tolist()
-    controllers = synthesize(abstraction, witness, Robot(start=(sx, sy), max_speed=1.0))
+    robot = Robot(start=(sx, sy), max_speed=1.0, disturbance=push)
+    try:
+        controllers = synthesize(abstraction, witness, robot)
+    except InvalidInputError:  # a corner too sharp to reject the push (C032)
+        return
+    assert controllers.stats["follow_status"] == "Solved"
     listed = {(j.step, j.vertex) for j in controllers.jumps}
     assert _discontinuities(abstraction, controllers) == listed
+    assert not any("needle" in j.reason for j in controllers.jumps)
+
+
+@settings(deadline=None, max_examples=30, suppress_health_check=[HealthCheck.filter_too_much])
+@given(strips(), st.data())
+def test_the_path_enters_a_new_label_through_the_middle_of_the_edge(
+    strip: Any, data: st.DataObject
+) -> None:
+    """Where the plan enters a new label, the followed path leaves that triangle through the
+    middle 20 % of its exit edge (so it goes into the region rather than grazing its edge)."""
+    from tlmpc.control.follow import path_guides
+    from tlmpc.control.synthesize import plan_steps
+
+    planned = strip_plan(*strip)
+    if planned is None:
+        return
+    abstraction, witness, triangles = planned
+    if len(triangles) < 3:
+        return
+    change = data.draw(st.integers(1, len(triangles) - 2))
+    letters = np.asarray([0] * change + [1] * (len(triangles) - change), dtype=np.int64)
+    abstraction = dataclasses.replace(abstraction, letter_of=letters, letters=((), ("r",)))
+    steps, loop_start = plan_steps(abstraction, witness)
+    sx, sy = abstraction.corners(0).mean(axis=0).tolist()
+    guide = path_guides(abstraction, steps, loop_start, (sx, sy))[change]
+    assert guide is not None
+    exit_edge = steps[change].exit_edge
+    assert exit_edge is not None
+    corners = abstraction.corners(change)
+    a, b = corners[(exit_edge + 1) % 3], corners[(exit_edge + 2) % 3]
+    middle = (a + b) / 2
+    assert math.dist(guide.exit, middle.tolist()) <= 0.1 * math.dist(a, b) + 1e-9
 
 
 def test_a_bent_corridor_splits_its_runs_at_the_bend() -> None:
