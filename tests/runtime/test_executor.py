@@ -246,7 +246,9 @@ def test_a_push_back_along_the_cycle_reenters_the_plan() -> None:
     dt = default_dt(plan, 1.0)
     # Let the robot reach the middle of its first lap, then push it back to the lap's start.
     probe = run_closed_loop(tlmpc.executor(compiled), lambda t, p, e: np.zeros(2), bound=0.0)
-    middle_time = 0.5 * probe.trace["points"][-1][0]
+    points = probe.trace["points"]  # the prefix, then one lap from points[loop_start]
+    lap_start = points[probe.trace["loop_start"]][0]
+    middle_time = lap_start + 0.5 * (points[-1][0] - lap_start)
     target = executor.abstraction.corners(plan.steps[plan.loop_start].triangle).mean(axis=0)
     run = run_closed_loop(executor, _kick(middle_time, dt, target), bound=0.0, dt=dt, cycles=2)
     assert run.progress.reentries + run.progress.replans >= 1
