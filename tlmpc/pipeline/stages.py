@@ -264,14 +264,15 @@ def _automaton(c: Compilation) -> StageResult:
 def _plan(c: Compilation) -> StageResult:
     from tlmpc.abstraction import abstraction_to_json
     from tlmpc.automata import automaton_to_json, to_hoa
+    from tlmpc.pipeline.mintime import plan_minimum_time
     from tlmpc.planning import witness_to_json
-    from tlmpc.planning.mission import plan_mission
 
     built = c.get(ABSTRACTION)
     # The plan may need U-turns (a locally refined mesh) or, when no plan reaches the goal
     # depth or keeps the margin, the mesh and automaton without them: either replaces the
-    # built one (and its artifacts) for every later stage.
-    planned = plan_mission(c.get(MISSION), built, c.get(AUTOMATON))
+    # built one (and its artifacts) for every later stage.  Under the time metric the plan
+    # is re-weighed with its exact simulated step times (tlmpc.pipeline.mintime).
+    planned = plan_minimum_time(c.get(MISSION), built, c.get(AUTOMATON))
     abstraction, witness = planned.abstraction, planned.witness
     artifacts: dict[str, Any] = {}
     if planned.automaton is not c.get(AUTOMATON):  # without margin, or the durations held
