@@ -1,0 +1,283 @@
+"""Planning for minimum time (``options.cost: time``).
+
+References: a brute-force search of our own over every simple reach plan of a small mesh
+(``brute_time``: the planner's choice is not consulted, each plan is timed by the exact
+simulation), first-entry times read off the trace, the independent shortest-path oracle
+(``shortest_time``) for "no plan meets the deadline", and ``tlmpc verify`` on every compiled
+trajectory.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import io
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from brute_time import fastest_visit
+from hypothesis import HealthCheck, event, given, settings
+from hypothesis import strategies as st
+from shortest_time import Oracle, free_space
+
+from tlmpc.abstraction.model import Abstraction
+from tlmpc.base.errors import NoPlanError
+from tlmpc.cli import main
+from tlmpc.mission.load import load_mission
+from tlmpc.mission.model import Mission
+from tlmpc.pipeline.deadlines import DeadlineMissedError
+from tlmpc.pipeline.mintime import MAX_REPLANS, measure, plan_minimum_time
+from tlmpc.pipeline.stages import ABSTRACTION, AUTOMATON, MISSION, WITNESS, compile_mission
+from tlmpc.planning.mission import move_times, plan_mission
+from tlmpc.planning.product import _move_lengths, move_weight_grid
+from tlmpc.planning.timing import MoveTimes, move_key
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def rect(x0: float, y0: float, x1: float, y1: float) -> list[list[float]]:
+    return [[x0, y0], [x1, y0], [x1, y1], [x0, y1]]
+
+
+def small_mission(
+    *,
+    holes: list[list[list[float]]],
+    goal: list[list[float]],
+    start: tuple[float, float],
+    speed: float,
+    ltl: str,
+    cost: str | None = None,
+) -> str:
+    """A 6 x 4 room on a coarse mesh (no angle bound), goals entered as they are."""
+    lines = [
+        "version: 1",
+        "name: small",
+        "workspace:",
+        "  boundary: {rect: [0, 0, 6, 4]}",
+    ]
+    if holes:
+        lines.append("  holes:")
+        lines.extend(f"    - {json.dumps(h)}" for h in holes)
+    lines += [
+        "regions:",
+        f"  goal: {json.dumps(goal)}",
+        f"robot: {{start: {json.dumps(list(start))}, max_speed: {speed}}}",
+        f'ltl: "{ltl}"',
+        "options:",
+        "  min_angle: null",
+        "  goal_depth: 0",
+    ]
+    if cost is not None:
+        lines.append(f"  cost: {cost}")
+    return "\n".join(lines) + "\n"
+
+
+@st.composite
+def small_worlds(draw: st.DrawFn) -> dict[str, Any]:
+    """A 6 x 4 room, maybe a pillar, a 1 x 1 goal on the right, a start on the left; every
+    coordinate a multiple of a quarter metre; speeds powers of two (the first plan is then
+    exactly the length metric's, see docs/planning.md)."""
+    quarter = st.integers(0, 4).map(lambda k: k / 4)
+    holes = []
+    if draw(st.booleans()):
+        x, y = 2.5 + draw(quarter), 1.0 + draw(quarter)
+        holes.append(rect(x, y, x + 0.75, y + 1.25))
+    gx, gy = 4.5 + draw(quarter) / 2, 0.25 + 2.5 * draw(quarter)
+    start = (0.5 + draw(quarter), 0.5 + 2.5 * draw(quarter))
+    speed = draw(st.sampled_from([0.5, 1.0, 2.0]))
+    return {
+        "holes": holes,
+        "goal": rect(gx, gy, gx + 1.0, gy + 1.0),
+        "start": start,
+        "speed": speed,
+    }
+
+
+def compiled(tmp: Path, text: str) -> Any:
+    return compile_mission(tmp / "m.yaml", text=text)
+
+
+def goal_entry(abstraction: Abstraction, trace: dict[str, Any]) -> float:
+    """The first sample time at which the trace is in a triangle labelled goal."""
+    for t, tri in zip(trace["points"], trace["triangles"], strict=True):
+        if "goal" in abstraction.labels(tri):
+            return float(t[0])
+    return float("inf")
+
+
+# --- the weights -----------------------------------------------------------------------
+
+
+def test_time_weights_are_lengths_at_top_speed_with_measured_moves_replaced(
+    tmp_path: Path,
+) -> None:
+    text = small_mission(
+        holes=[], goal=rect(4.5, 1.0, 5.5, 2.0), start=(0.5, 0.5), speed=0.5, ltl="F goal"
+    )
+    result = compiled(tmp_path, text)
+    mesh = result.compilation.get(ABSTRACTION)
+    start = (0.5, 0.5)
+    lengths = _move_lengths(mesh, start)
+    estimate = move_weight_grid(mesh, start, "time", MoveTimes(speed=0.5))
+    np.testing.assert_allclose(estimate, lengths / 0.5, rtol=1e-15)
+    key = move_key(mesh, 3, 0, 1)
+    measured = move_weight_grid(mesh, start, "time", MoveTimes(speed=0.5, measured={key: 7.25}))
+    assert measured[3, 0, 1] == 7.25
+    changed = np.argwhere(measured != estimate)
+    assert changed.tolist() == [[3, 0, 1]]
+    # keyed by corners, not index: a measurement of a triangle the mesh lacks changes nothing
+    gone = (((10**6, 10**6 + 1, 10**6 + 2), 0, 1), 1.0)
+    again = move_weight_grid(mesh, start, "time", MoveTimes(speed=0.5, measured=dict([gone])))
+    np.testing.assert_array_equal(again, estimate)
+    with pytest.raises(ValueError, match="time metric needs"):
+        move_weight_grid(mesh, start, "time", None)
+
+
+def test_time_is_the_default_for_bounded_tasks_and_an_explicit_cost_wins(tmp_path: Path) -> None:
+    goal = rect(4.5, 1.0, 5.5, 2.0)
+    path = tmp_path / "m.yaml"
+    for ltl, cost, expected in [
+        ("F goal", None, "length"),
+        ("F[0,60] goal", None, "time"),
+        ("F[0,60] goal", "length", "length"),
+        ("F goal", "time", "time"),
+        ("F[0,60] goal", "hops", "hops"),
+    ]:
+        path.write_text(
+            small_mission(holes=[], goal=goal, start=(0.5, 0.5), speed=1.0, ltl=ltl, cost=cost)
+        )
+        mission = load_mission(path)
+        assert mission.options.cost == expected, (ltl, cost)
+        assert (move_times(mission) is not None) == (expected == "time")
+
+
+# --- the plan of least exact time ------------------------------------------------------
+
+
+def _with_cost(mission: Mission, cost: str) -> Mission:
+    return dataclasses.replace(mission, options=dataclasses.replace(mission.options, cost=cost))  # type: ignore[arg-type]
+
+
+@pytest.mark.slow
+@settings(max_examples=8, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(small_worlds())
+def test_the_fastest_plan_against_brute_force(
+    tmp_path_factory: pytest.TempPathFactory, world: dict[str, Any]
+) -> None:
+    """The kept plan is never slower than the length metric's plan, never faster than the
+    fastest simple plan the brute force finds, and its recorded exact time is its trace's."""
+    text = small_mission(
+        holes=world["holes"],
+        goal=world["goal"],
+        start=world["start"],
+        speed=world["speed"],
+        ltl="F goal",
+        cost="time",
+    )
+    tmp = tmp_path_factory.mktemp("m")
+    result = compiled(tmp, text)
+    compilation = result.compilation
+    mission = compilation.get(MISSION)
+    mesh = compilation.get(ABSTRACTION)
+    witness = compilation.get(WITNESS)
+    planner = goal_entry(mesh, result.artifacts["trace.json"])
+    assert witness.metric == "time"
+    assert witness.stats["time_rounds"] <= MAX_REPLANS + 1
+    assert witness.stats["exact_time"] == min(witness.stats["exact_times"])
+    # the stay's triangle is entered at the recorded exact time (the first goal triangle)
+    assert witness.stats["exact_time"] == pytest.approx(planner, abs=1e-9)
+    # the length metric's plan on the same mesh and automaton
+    length = plan_mission(_with_cost(mission, "length"), mesh, compilation.get(AUTOMATON))
+    length_time = measure(mission, length).exact_time
+    assert planner <= length_time + 1e-9
+    start = witness.prefix[0] if witness.prefix else witness.cycle[0]
+    brute = fastest_visit(mission, mesh, start, "goal", budget=300)
+    event(f"complete={brute.complete}")
+    if brute.complete and not witness.passages:
+        # every simple plan was timed: none is faster than the planner's by more than rounding
+        assert brute.time <= planner + 1e-9
+        ratio = planner / brute.time if brute.time > 0 else 1.0
+        event(f"planner/brute <= {np.ceil(ratio * 20) / 20:.2f}")
+
+
+def test_the_shipped_deadline_spec_keeps_its_fastest_round(tmp_path: Path) -> None:
+    result = compiled(tmp_path, (ROOT / "specs" / "deadline.yaml").read_text())
+    witness = result.compilation.get(WITNESS)
+    assert witness.metric == "time"
+    times = witness.stats["exact_times"]
+    assert witness.stats["exact_time"] == min(times)
+    assert len(times) >= 2  # re-planned at least once with the measured times
+    first, *_ = times
+    mission = result.compilation.get(MISSION)
+    again = plan_minimum_time(mission, *_built(tmp_path, mission))
+    assert again.witness == witness  # deterministic: the same plan, the same numbers
+    assert witness.stats["exact_time"] <= first
+
+
+def _built(tmp: Path, mission: Mission) -> tuple[Any, Any]:
+    result = compile_mission(
+        tmp / "again.yaml", text=(ROOT / "specs" / "deadline.yaml").read_text(), until="automaton"
+    )
+    return result.compilation.get(ABSTRACTION), result.compilation.get(AUTOMATON)
+
+
+# --- deadlines around the plan's time ------------------------------------------------
+
+
+def run(*argv: str) -> tuple[int, str]:
+    out, err = io.StringIO(), io.StringIO()
+    return main(list(argv), out=out, err=err), out.getvalue() + err.getvalue()
+
+
+@pytest.mark.slow
+@settings(max_examples=8, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(small_worlds(), st.floats(0.7, 1.15))
+def test_deadlines_around_the_plans_time(
+    tmp_path_factory: pytest.TempPathFactory, world: dict[str, Any], factor: float
+) -> None:
+    """Compiled: every bound met on the trajectory (``tlmpc verify`` agrees, slack >= 0);
+    P050: the true shortest time exceeds the deadline and no simple plan meets it; else P051."""
+    tmp = tmp_path_factory.mktemp("m")
+    kwargs = {
+        "holes": world["holes"],
+        "goal": world["goal"],
+        "start": world["start"],
+        "speed": world["speed"],
+    }
+    free = compiled(tmp, small_mission(ltl="F goal", cost="time", **kwargs))
+    mesh = free.compilation.get(ABSTRACTION)
+    planned = goal_entry(mesh, free.artifacts["trace.json"])
+    deadline = round(planned * factor * 64) / 64
+    text = small_mission(ltl=f"F[0,{deadline}] goal", **kwargs)
+    try:
+        result = compiled(tmp, text)
+    except NoPlanError as failure:
+        assert failure.diagnostics[0].code == "P050"
+        event("P050")
+        oracle = Oracle(
+            free_space(rect(0, 0, 6, 4), world["holes"], []),
+            world["start"],
+            [world["goal"]],
+            spacing=0.02,
+        )
+        assert oracle.reach(0).lower / world["speed"] > deadline
+        mission = free.compilation.get(MISSION)
+        witness = free.compilation.get(WITNESS)
+        start = witness.prefix[0] if witness.prefix else witness.cycle[0]
+        assert fastest_visit(mission, mesh, start, "goal", budget=200).time > deadline
+        return
+    except DeadlineMissedError as failure:
+        assert failure.diagnostics[0].code == "P051"
+        event("P051")
+        return
+    event("ok")
+    (bound,) = result.summary()["bounds"]
+    assert bound["slack"] >= 0.0
+    assert bound["time"] == pytest.approx(deadline - bound["slack"], abs=1e-9)
+    assert bound["lower_bound"] is not None and bound["lower_bound"] <= bound["time"] + 1e-9
+    path = tmp / "trace.json"
+    path.write_text(json.dumps(result.artifacts["trace.json"]))
+    status, shown = run("verify", str(path))
+    assert status == 0, shown
