@@ -86,7 +86,7 @@ def fastest_visit(
 ) -> Fastest:
     """The fastest simple plan from triangle ``start`` into ``region`` (see the module doc)."""
     goal = np.array([region in abstraction.labels(t) for t in range(abstraction.num_triangles)])
-    best = (float("inf"), (start,))
+    best: tuple[float, tuple[int, ...]] = (float("inf"), (start,))
     timed = 0
     for path in simple_paths(abstraction, start, goal, budget + 1):
         if timed == budget:
