@@ -41,7 +41,7 @@ from tlmpc.simulate.exact import Trace
 
 #: At most this many re-plans after the first plan (each costs a plan, a controller
 #: synthesis and an exact simulation).
-MAX_REPLANS = 6
+MAX_REPLANS = 8
 #: A plan's exact time "equals" its planned cost within this fraction of it (rounding).
 FIXED_POINT_TOLERANCE = 1e-9
 
