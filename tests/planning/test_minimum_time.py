@@ -209,6 +209,7 @@ def test_the_shipped_deadline_spec_keeps_its_fastest_round(tmp_path: Path) -> No
     times = witness.stats["exact_times"]
     assert witness.stats["exact_time"] == min(times)
     assert len(times) >= 2  # re-planned at least once with the measured times
+    assert len(set(times)) == len(times)  # never the same plan twice
     first, *_ = times
     mission = result.compilation.get(MISSION)
     again = plan_minimum_time(mission, *_built(tmp_path, mission))
@@ -277,9 +278,74 @@ def test_deadlines_around_the_plans_time(
     (bound,) = result.summary()["bounds"]
     assert bound["slack"] >= 0.0
     assert bound["time"] == pytest.approx(deadline - bound["slack"], abs=1e-9)
+    # the goal is a union of triangles: it is first entered at a crossing sample
+    entry = goal_entry(result.compilation.get(ABSTRACTION), result.artifacts["trace.json"])
+    assert bound["time"] == pytest.approx(entry, abs=1e-6)
     assert bound["lower_bound"] is not None
     assert bound["lower_bound"] <= bound["time"] + 1e-9
     path = tmp / "trace.json"
     path.write_text(json.dumps(result.artifacts["trace.json"]))
     status, shown = run("verify", str(path))
     assert status == 0, shown
+
+
+# --- the exact time and the measured moves, read off the trace --------------------------
+
+
+def _moves_of(mesh: Abstraction, path: list[int]) -> list[tuple[int, int, int]]:
+    """(triangle, entry slot, exit edge) of each step of ``path`` that leaves its triangle
+    for the next one (slot 3 for the first), from the mesh's neighbour table."""
+    found = []
+    for k in range(len(path) - 1):
+        here, after = path[k], path[k + 1]
+        sides = mesh.neighbors[here].tolist()
+        slot = 3 if k == 0 else sides.index(path[k - 1])
+        found.append((here, slot, sides.index(after)))
+    return found
+
+
+def test_a_stay_plans_measured_moves_are_its_steps_and_add_up_to_its_time(tmp_path: Path) -> None:
+    text = small_mission(
+        holes=[rect(2.5, 1.0, 3.25, 3.0)],
+        goal=rect(4.75, 1.5, 5.75, 2.5),
+        start=(0.5, 2.0),
+        speed=1.0,
+        ltl="F goal",
+        cost="time",
+    )
+    result = compiled(tmp_path, text)
+    compilation = result.compilation
+    mission, mesh = compilation.get(MISSION), compilation.get(ABSTRACTION)
+    witness = compilation.get(WITNESS)
+    path = [*witness.prefix, *witness.cycle]
+    found = measure(mission, plan_minimum_time(mission, mesh, compilation.get(AUTOMATON)))
+    expected = {move_key(mesh, *move) for move in _moves_of(mesh, path)}
+    assert set(found.moves) == expected
+    assert sum(found.moves.values()) == pytest.approx(found.exact_time, rel=1e-12)
+    entry = goal_entry(mesh, result.artifacts["trace.json"])
+    assert found.exact_time == pytest.approx(entry, abs=1e-9)
+
+
+def test_a_patrols_exact_time_is_its_prefix_and_one_lap(tmp_path: Path) -> None:
+    text = (ROOT / "specs" / "patrol.yaml").read_text().replace("cost: length", "cost: time")
+    result = compiled(tmp_path, text)
+    witness = result.compilation.get(WITNESS)
+    trace = result.artifacts["trace.json"]
+    assert not witness.is_stay
+    times = [p[0] for p in trace["points"]]
+    triangles = trace["triangles"]
+    # the first lap starts when the robot first enters the cycle's first triangle (after the
+    # prefix); the second at the trace's loop start; the trace ends after the second lap
+    if witness.prefix:
+        first = next(j for j in range(1, len(times)) if triangles[j] == witness.cycle[0])
+        prefix_time = times[first]
+    else:
+        prefix_time = 0.0
+    lap = times[-1] - times[trace["loop_start"]]
+    exact = prefix_time + witness.beta * lap
+    assert witness.stats["exact_time"] == pytest.approx(exact, rel=1e-9)
+    assert witness.stats["exact_time"] == min(witness.stats["exact_times"])
+    # each round simulated a plan not simulated before
+    rounds = witness.stats["exact_times"]
+    assert len(set(rounds)) == len(rounds)
+    assert witness.stats["time_rounds"] == len(rounds)

@@ -92,17 +92,38 @@ def check_time_bounds(
         Diagnostic(
             code="P051",
             message="no plan was found that meets the task's time bounds (none is proven "
-            "impossible): the minimum-cost plan of the untimed task misses "
+            f"impossible): the {_planned(mission)} plan of the untimed task misses "
             + _missed(slacks)
             + _earliest(bounds),
-            hint="the plan minimises path length, not the time to each goal, and its "
-            "controllers do not drive the shortest path at full speed: deadlines between the "
-            "earliest possible time and the plan's are not decided. Looser bounds, a faster "
-            "robot or a task that fixes the order of the goals may help",
+            hint=_why_no_plan(mission)
+            + ": deadlines between the earliest possible time and the plan's are not "
+            "decided. Looser bounds, a faster robot or a task that fixes the order of the "
+            "goals may help",
             file=mission.source,
             line=where[0],
             col=where[1],
         )
+    )
+
+
+def _planned(mission: Mission) -> str:
+    """What the plan minimised, in words."""
+    return {"time": "minimum-time", "length": "shortest", "hops": "fewest-moves"}.get(
+        mission.options.cost, "minimum-cost"
+    )
+
+
+def _why_no_plan(mission: Mission) -> str:
+    """Why a plan can miss a deadline that some trajectory meets."""
+    if mission.options.cost == "time":
+        return (
+            "the plan minimises the exact time of the whole run (not the time to each goal), "
+            "and its controllers do not drive the shortest path at full speed"
+        )
+    return (
+        f"the plan minimises {'path length' if mission.options.cost == 'length' else 'moves'}"
+        ", not time (options.cost: time plans for it), and its controllers do not drive the "
+        "shortest path at full speed"
     )
 
 
