@@ -349,3 +349,57 @@ def test_a_patrols_exact_time_is_its_prefix_and_one_lap(tmp_path: Path) -> None:
     rounds = witness.stats["exact_times"]
     assert len(set(rounds)) == len(rounds)
     assert witness.stats["time_rounds"] == len(rounds)
+
+
+def _lasso_moves(
+    mesh: Abstraction, prefix: list[int], cycle: list[int]
+) -> tuple[list[Any], list[Any]]:
+    """The moves of a lasso's prefix (into the cycle's first triangle) and of one lap of its
+    cycle (each cycle triangle entered from the one before it, around the wrap)."""
+    head = _moves_of(mesh, [*prefix, cycle[0]]) if prefix else []
+    lap = []
+    if len(cycle) > 1:
+        for k, here in enumerate(cycle):
+            sides = mesh.neighbors[here].tolist()
+            before, after = cycle[k - 1], cycle[(k + 1) % len(cycle)]
+            slot = sides.index(before)
+            lap.append((here, slot, sides.index(after)))
+    return head, lap
+
+
+@pytest.mark.parametrize("spec", ["patrol", "deadline"])
+def test_the_guided_search_reads_the_same_time_weights(spec: str, tmp_path: Path) -> None:
+    """One weight array for both searches: with measured times in it, the product expanded
+    on demand finds a lasso of the built product's cost, and each lasso's cost is the sum
+    of the weights of its moves (measured where measured)."""
+    from tlmpc.planning.plan import plan
+
+    text = (ROOT / "specs" / f"{spec}.yaml").read_text().replace("cost: length", "cost: time")
+    result = compiled(tmp_path, text)
+    compilation = result.compilation
+    mission, mesh = compilation.get(MISSION), compilation.get(ABSTRACTION)
+    planned = plan_minimum_time(mission, mesh, compilation.get(AUTOMATON))
+    assert planned.formula is not None
+    # every measured move ten times slower: the plans must go round them where they can
+    slow = {key: 10 * seconds for key, seconds in measure(mission, planned).moves.items()}
+    times = MoveTimes(speed=mission.robot.max_speed, measured=slow)
+    found = [
+        plan(
+            mesh,
+            planned.automaton,
+            formula=planned.formula,
+            options=mission.options,
+            start_point=mission.robot.start,
+            guided=guided,
+            times=times,
+        )
+        for guided in (False, True)
+    ]
+    built, searched = found
+    assert searched.stats["search"] == "guided"
+    assert searched.cost == pytest.approx(built.cost, rel=1e-9)
+    grid = move_weight_grid(mesh, mission.robot.start, "time", times)
+    for lasso in found:
+        head, lap = _lasso_moves(mesh, list(lasso.prefix), list(lasso.cycle))
+        total = sum(float(grid[m]) for m in head) + lasso.beta * sum(float(grid[m]) for m in lap)
+        assert lasso.cost == pytest.approx(total, rel=1e-7)
