@@ -403,3 +403,40 @@ def test_the_guided_search_reads_the_same_time_weights(spec: str, tmp_path: Path
         head, lap = _lasso_moves(mesh, list(lasso.prefix), list(lasso.cycle))
         total = sum(float(grid[m]) for m in head) + lasso.beta * sum(float(grid[m]) for m in lap)
         assert lasso.cost == pytest.approx(total, rel=1e-7)
+
+
+def test_a_round_that_meets_the_bounds_is_preferred_to_a_faster_one(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The selection rule alone: rounds measured as (exact time, bounds met) = (10, no),
+    (12, yes), (11, yes), then a repeat: the 11 s round is kept."""
+    from tlmpc.pipeline import mintime
+
+    result = compiled(tmp_path, (ROOT / "specs" / "deadline.yaml").read_text())
+    compilation = result.compilation
+    mission, mesh = compilation.get(MISSION), compilation.get(ABSTRACTION)
+    rounds = iter([(10.0, False), (12.0, True), (11.0, True), (9.0, False)])
+    base = compilation.get(WITNESS).prefix
+    marks = iter(range(1, 10))
+
+    def fake_measure(_: Mission, planned: Any) -> mintime.Measured:
+        exact, met = next(rounds)
+        return mintime.Measured(exact_time=exact, moves={}, meets_bounds=met)
+
+    def fake_replan(_: Mission, planned: Any, times: MoveTimes) -> Any:
+        mark = next(marks)
+        if mark == 3:  # the third re-plan repeats the second plan
+            mark = 2
+        first = planned.witness.prefix[: len(base)]
+        # a plan of its own: the first plan's prefix and a mark in its shape
+        witness = dataclasses.replace(planned.witness, prefix=(*first, -mark), stats={"mark": mark})
+        return dataclasses.replace(planned, witness=witness)
+
+    monkeypatch.setattr(mintime, "measure", fake_measure)
+    monkeypatch.setattr(mintime, "replan", fake_replan)
+    kept = mintime.plan_minimum_time(mission, mesh, compilation.get(AUTOMATON))
+    assert kept.witness.stats["exact_times"] == [10.0, 12.0, 11.0]
+    assert kept.witness.stats["bounds_met"] == [False, True, True]
+    assert kept.witness.stats["exact_time"] == 11.0
+    assert kept.witness.stats["mark"] == 2
+    assert kept.witness.stats["time_fixed_point"] is True
