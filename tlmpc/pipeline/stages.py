@@ -296,6 +296,14 @@ def _plan(c: Compilation) -> StageResult:
             "prefix": len(witness.prefix),
             "cycle": len(witness.cycle),
             "cost": round(witness.cost, 6),
+            **(
+                {
+                    "exact time": round(witness.stats["exact_time"], 3),
+                    "rounds": witness.stats["time_rounds"],
+                }
+                if "exact_time" in witness.stats
+                else {}
+            ),
             "product nodes": witness.stats.get("product_nodes"),
             "reached": witness.stats.get("product_reached"),
             **({"triangles after U-turn splits": abstraction.num_triangles} if refined else {}),
