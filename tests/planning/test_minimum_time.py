@@ -449,3 +449,39 @@ def test_a_round_that_meets_the_bounds_is_preferred_to_a_faster_one(
     assert kept.witness.stats["exact_time"] == 11.0
     assert kept.witness.stats["mark"] == 2
     assert kept.witness.stats["time_fixed_point"] is True
+
+
+def test_each_bounds_time_and_lower_bound_on_a_patrol_with_a_sequence(tmp_path: Path) -> None:
+    """Per bound: the plan's time is never below the proof's lower bound, and the lower
+    bounds are the independent oracle's: the shortest path around the lake into bravo, the
+    straight way from bravo to charlie, twice the gap between alpha and bravo."""
+    import shapely
+
+    text = (ROOT / "specs" / "patrol.yaml").read_text()
+    task = '"G F[0,200] alpha & F[0,300] (bravo & F[0,300] charlie)"'
+    text = text.replace("options: {cost: length, beta: 1.0}", f"ltl: {task}")
+    result = compiled(tmp_path, text)
+    assert result.compilation.get(WITNESS).metric == "time"  # the default with bounds
+    bounds = {b["bound"]: b for b in result.summary()["bounds"]}
+    assert list(bounds) == [
+        "F[0,200] alpha",
+        "F[0,300] (bravo & F[0,300] charlie)",
+        "F[0,300] charlie",
+    ]
+    for found in bounds.values():
+        assert found["lower_bound"] <= found["time"]
+        assert found["time"] == pytest.approx(
+            float(found["bound"].split(",")[1].split("]")[0]) - found["slack"], abs=1e-6
+        )
+    regions = result.artifacts["trace.json"]["regions"]
+    workspace = [[0, 0], [14, 0], [14, 9], [7, 11], [0, 9]]
+    space = free_space(workspace, [regions["lake"]], [])
+    oracle = Oracle(space, (2.0, 5.0), [regions["bravo"]], spacing=0.02)
+    shortest = oracle.reach(0)
+    bravo = bounds["F[0,300] (bravo & F[0,300] charlie)"]["lower_bound"]
+    assert shortest.lower - 1e-6 <= bravo <= shortest.upper + 1e-6  # speed 1
+    polygon = {name: shapely.Polygon(regions[name]) for name in ("alpha", "bravo", "charlie")}
+    leg = shapely.distance(polygon["bravo"], polygon["charlie"])
+    assert bounds["F[0,300] charlie"]["lower_bound"] == pytest.approx(leg, abs=1e-6)
+    gap = shapely.distance(polygon["alpha"], polygon["bravo"])
+    assert bounds["F[0,200] alpha"]["lower_bound"] == pytest.approx(2 * gap, abs=1e-6)
