@@ -1,4 +1,5 @@
-"""Vertex velocities whose flow follows the channel's shortest path (a second program).
+"""Vertex velocities whose flow follows the channel's shortest path (the vertex program's rows,
+another objective).
 
 The vertex program (:mod:`tlmpc.control.synthesize`) only asks every state to leave by the
 planned facet; its flow wanders from triangle to triangle.  Here the same constraints are kept
@@ -165,7 +166,7 @@ def follow_program(
     # The vertex program's own objective (floor + a tenth of the mean guaranteed speed) at
     # weight GUARANTEE: without it the fields nobody's path weighs (a stay's, a needle's) sit
     # at the floor, and a stay converges slowly.  The floor weighs FLOOR_WEIGHT times more:
-    # the fastest solve stands in for the vertex program, whose floor it then keeps (the
+    # this solve stands in for the vertex program, whose floor it then keeps (the
     # weakest step's exit-time bound is the run's longest).
     costs[2 * runs + steps] = -FLOOR_WEIGHT * GUARANTEE
     costs[2 * runs : 2 * runs + steps] = -0.1 * GUARANTEE / max(steps, 1)

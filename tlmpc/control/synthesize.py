@@ -636,8 +636,8 @@ def synthesize(
     to any additive velocity disturbance up to ``robot.disturbance``.
 
     ``source`` names the mission file in diagnostics.  With ``follow`` (the default) the
-    fields are then re-chosen so that their flow follows the shortest path through the plan's
-    channel (:mod:`tlmpc.control.follow`), under the same constraints.
+    fields are chosen so that their flow follows the shortest path through the plan's
+    channel (:mod:`tlmpc.control.follow`), under the vertex program's constraints.
     """
     started = time.perf_counter()
     steps, loop_start = plan_steps(abstraction, witness)
@@ -660,7 +660,7 @@ def synthesize(
     built = time.perf_counter()
     following: dict[str, float | str] = {"follow_status": "off"}
     followed = None
-    if guides is not None and affine:  # (its first solve stands in for the vertex program's)
+    if guides is not None and affine:  # (its solve stands in for the vertex program's)
         followed = follow_channel(
             steps, guides, conic_form(program), program.runs, column, robot.max_speed,
             robot.disturbance,
