@@ -24,6 +24,7 @@ hold for whatever edge costs the product is given.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -49,6 +50,8 @@ class RegionGraph:
     cell_local: IntArray  # per cell: its triangle's local class (-1: not allowed)
     distance: FloatArray  # (landmarks, cells): cost from the cell to entering the landmark
     delta: FloatArray  # (local, local): region-to-region lower bound (0 from the background)
+    entry: BoolArray  # per cell: entered from a triangle of another class (a boundary entry)
+    delta_entry: FloatArray  # (local, local): as delta, from the entry cells of the region
     closure: BoolArray  # (local, Q, Q): states reached for free with that last landmark
     entering: list[tuple[int, IntArray, IntArray]]  # (landmark, from states, to states)
     scale: float  # weight per unit of Euclidean length, at least (for the straight bound)
@@ -59,11 +62,15 @@ class RegionGraph:
         distance, _ = shortest_paths(self.backwards, cells)
         return distance
 
-    def region_minimum(self, per_cell: FloatArray) -> FloatArray:
-        """Per local class: the least value over its cells."""
-        allowed = self.cell_local >= 0
+    def region_minimum(self, per_cell: FloatArray, *, entered: bool = False) -> FloatArray:
+        """Per local class: the least value over its cells (``entered``: over the landmark's
+        boundary entry cells, where the robot is right after entering it; the background's
+        over all its cells)."""
+        pick = self.cell_local >= 0
+        if entered:
+            pick &= self.entry | (self.cell_local == self.background)
         least = np.full(len(self.classes), np.inf)
-        np.minimum.at(least, self.cell_local[allowed], per_cell[allowed])
+        np.minimum.at(least, self.cell_local[pick], per_cell[pick])
         return least
 
     @property
@@ -89,12 +96,21 @@ def region_graph(product: LazyProduct, allowed_cells: BoolArray) -> RegionGraph:
     sources = np.repeat(np.arange(cells, dtype=np.int64), np.diff(product.move_indptr))
     backwards, _ = Graph.from_edges(product.move_target, sources, product.move_weight, cells)
     distance = _landmark_distances(backwards, cell_local, landmarks)
+    # A boundary entry cell is entered by a move from a triangle of another local class: the
+    # robot is in one right after the region-level graph's landmark changed to its class.
+    entry = np.zeros(cells, dtype=bool)
+    moved_from = cell_local[sources]
+    entry[product.move_target[(moved_from != cell_local[product.move_target])]] = True
+    entry &= cell_local >= 0
     count = len(present)
     delta = np.zeros((count, count))
+    delta_entry = np.zeros((count, count))
     for index, landmark in enumerate(landmarks.tolist()):
         for c in landmarks.tolist():
             inside = distance[index][cell_local == c]
             delta[c, landmark] = float(inside.min()) if len(inside) else np.inf
+            entered = distance[index][(cell_local == c) & entry]
+            delta_entry[c, landmark] = float(entered.min()) if len(entered) else np.inf
     kind_local = local_of[product.kind_class]
     closure = np.zeros((count, nq, nq), dtype=bool)
     entering: list[tuple[int, IntArray, IntArray]] = []
@@ -121,6 +137,8 @@ def region_graph(product: LazyProduct, allowed_cells: BoolArray) -> RegionGraph:
         cell_local=cell_local,
         distance=distance,
         delta=delta,
+        entry=entry,
+        delta_entry=delta_entry,
         closure=closure,
         entering=entering,
         scale=_straight_scale(product),
@@ -181,11 +199,14 @@ class CostToGo:
 
     With ``final`` the targets are the cells ``final`` measures the way to, in the states
     ``reach`` tells: a node whose free steps reach such a state is bounded by ``final`` at its
-    own cell rather than by the region-level ``free``."""
+    own cell rather than by the region-level ``free``.  ``value[q, c]`` is the region-level
+    cost right after entering landmark ``c`` in state ``q`` (the robot in one of its boundary
+    entry cells), which :meth:`at_region` gives for ``entered=True``."""
 
     graph: RegionGraph
     free: FloatArray  # (Q, local)
     leg: FloatArray  # (Q, local, landmarks)
+    value: FloatArray  # (Q, local): the cost to go right after entering the class
     final: FloatArray | None = None  # per cell: the cost still to pay in a target state
     reach: BoolArray | None = None  # (Q, local): free steps reach a target state
 
@@ -204,8 +225,12 @@ class CostToGo:
         result: FloatArray = bound * SAFETY
         return result
 
-    def at_region(self, q: int, c: int) -> float:
-        """The bound at the region-level node ``(q, c)``."""
+    def at_region(self, q: int, c: int, *, entered: bool = False) -> float:
+        """The bound at the region-level node ``(q, c)``: anywhere in ``c`` or the
+        background with ``c`` the last landmark, or with ``entered`` right after entering
+        landmark ``c`` (in one of its boundary entry cells)."""
+        if entered:
+            return float(self.value[q, c])
         value = float(self.free[q, c])
         for index, landmark in enumerate(self.graph.landmarks.tolist()):
             value = min(value, float(self.graph.delta[c, landmark] + self.leg[q, c, index]))
@@ -218,25 +243,33 @@ def cost_to_go_to_cells(graph: RegionGraph, state: int, final: FloatArray) -> Co
     nq = graph.num_states
     terminal = np.full((nq, len(graph.classes)), np.inf)
     terminal[state, :] = graph.region_minimum(final)
-    bound = cost_to_go(graph, terminal)
+    terminal_entered = np.full_like(terminal, np.inf)
+    terminal_entered[state, :] = graph.region_minimum(final, entered=True)
+    bound = cost_to_go(graph, terminal, terminal_entered)
     reach = graph.closure[:, :, state].T  # (Q, local)
-    return CostToGo(graph=graph, free=bound.free, leg=bound.leg, final=final, reach=reach)
+    return dataclasses.replace(bound, final=final, reach=reach)
 
 
-def cost_to_go(graph: RegionGraph, terminal: FloatArray) -> CostToGo:
+def cost_to_go(
+    graph: RegionGraph, terminal: FloatArray, terminal_entered: FloatArray | None = None
+) -> CostToGo:
     """The least region-level cost to a node ``(q, c)`` plus its ``terminal[q, c]`` (inf:
     not a target), as a bound on concrete nodes (see :class:`CostToGo`).
+    ``terminal_entered`` (at least ``terminal``) may tell more of a target reached right
+    after entering landmark ``c``.
 
     Bellman-Ford on the region-level graph: with nonnegative costs it settles within as many
     rounds as the graph has nodes, and in practice within the number of landmarks a cheapest
-    path enters.
+    path enters.  Every leg after the first starts where its landmark was entered, so it
+    costs at least ``delta_entry``: the least cost from that landmark's boundary entry cells.
     """
     nq = graph.num_states
     count = len(graph.classes)
     closure = graph.closure
     # free[q, c]: a target reached without entering another landmark.
-    free = np.where(closure, terminal.T[:, None, :], np.inf).min(axis=2).T
-    value = free.copy()  # the region-level node's cost to go
+    free = _closure_min(closure, terminal)
+    after_entry = free if terminal_entered is None else _closure_min(closure, terminal_entered)
+    value = after_entry.copy()  # the region-level node's cost to go, right after entering
     leg = np.full((nq, count, len(graph.landmarks)), np.inf)
     for _ in range(nq * count + 1):
         for index, (landmark, tails, heads) in enumerate(graph.entering):
@@ -244,13 +277,21 @@ def cost_to_go(graph: RegionGraph, terminal: FloatArray) -> CostToGo:
             after = np.full(nq, np.inf)
             np.minimum.at(after, tails, value[heads, landmark])
             leg[:, :, index] = _masked_min(closure, after).T
-        updated = free.copy()
+        updated = after_entry.copy()
         for index, landmark in enumerate(graph.landmarks.tolist()):
-            updated = np.minimum(updated, graph.delta[:, landmark][None, :] + leg[:, :, index])
+            step = graph.delta_entry[:, landmark][None, :] + leg[:, :, index]
+            updated = np.minimum(updated, step)
         if np.array_equal(updated, value):
             break
         value = updated
-    return CostToGo(graph=graph, free=free, leg=leg)
+    return CostToGo(graph=graph, free=free, leg=leg, value=value)
+
+
+def _closure_min(closure: BoolArray, terminal: FloatArray) -> FloatArray:
+    """(Q, local): the least ``terminal[q', c]`` over the states ``q'`` free steps with
+    last landmark ``c`` reach from ``q``."""
+    result: FloatArray = np.where(closure, terminal.T[:, None, :], np.inf).min(axis=2).T
+    return result
 
 
 def _masked_min(reach: BoolArray, cost: FloatArray) -> FloatArray:

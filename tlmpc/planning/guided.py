@@ -224,7 +224,8 @@ class _Bounds:
         stays = product.stutter_accepts[graph.classes].T  # (Q, local)
         stay = np.where(stays | stays[:, [graph.background]], 0.0, np.inf)
         self.stay = stay
-        self.lasso = cost_to_go(graph, np.minimum(stay, self._accepting_terminal(nq)))
+        anywhere, entered = self._accepting_terminal(nq)
+        self.lasso = cost_to_go(graph, np.minimum(stay, anywhere), np.minimum(stay, entered))
 
     def back_to(self, q: int) -> CostToGo:
         """A bound on the cost from any node to a node of state ``q``."""
@@ -243,13 +244,15 @@ class _Bounds:
             self.arounds[key] = cost_to_go_to_cells(self.graph, q, self.graph.distance[index])
         return self.arounds[key]
 
-    def _accepting_terminal(self, nq: int) -> FloatArray:
-        """(Q, local): per region-level node, ``beta`` times a bound on closing a cycle
-        through an accepting edge taken there (its move, then the way back to its tail's
-        state)."""
+    def _accepting_terminal(self, nq: int) -> tuple[FloatArray, FloatArray]:
+        """(Q, local) twice: per region-level node, ``beta`` times a bound on closing a
+        cycle through an accepting edge taken there (its move, then the way back to its
+        tail's state); first anywhere in the region, then right after entering it (the way
+        to the edge's landmark counted from the region's boundary entry cells)."""
         graph, product = self.graph, self.product
         count = len(graph.classes)
         terminal = np.full((nq, count), np.inf)
+        entered_terminal = np.full((nq, count), np.inf)
         local_of = {int(c): i for i, c in enumerate(graph.classes.tolist())}
         kinds, states, width = product.marked.shape
         for kind in range(kinds):
@@ -265,15 +268,25 @@ class _Bounds:
                     for c in range(count):
                         landmark = entered not in (graph.background, c)
                         at = entered if landmark else c
-                        # The way to the landmark is paid partly before the edge (at
-                        # weight one) and partly by it (at beta): at least the lesser.
-                        move = min(1.0, self.beta) * graph.delta[c, entered] if landmark else 0.0
-                        cost = move + self.beta * back.at_region(q_next, at)
-                        if entered != graph.background:
+                        # After the edge: its head is a boundary entry cell of a landmark it
+                        # enters, anywhere in c or the background otherwise.
+                        rest = self.beta * back.at_region(q_next, at, entered=landmark)
+                        if landmark:
                             # The cycle itself: back to q, then into that landmark again.
+                            around = self.around(q, entered).at_region(
+                                q_next, entered, entered=True
+                            )
+                            rest = max(rest, self.beta * around)
+                        elif entered != graph.background:
                             around = self.around(q, entered).at_region(q_next, entered)
-                            cost = max(cost, self.beta * around)
-                        terminal[q, c] = min(terminal[q, c], cost)
+                            rest = max(rest, self.beta * around)
+                        # The way to the landmark is paid partly before the edge (at weight
+                        # one) and partly by it (at beta): at least the lesser.
+                        weight = min(1.0, self.beta)
+                        move = weight * graph.delta[c, entered] if landmark else 0.0
+                        terminal[q, c] = min(terminal[q, c], move + rest)
+                        move = weight * graph.delta_entry[c, entered] if landmark else 0.0
+                        entered_terminal[q, c] = min(entered_terminal[q, c], move + rest)
         stutter_marked = product.stutter_marked[graph.classes]  # (local, Q, J)
         for c in range(count):
             for other in {c, graph.background}:
@@ -281,9 +294,10 @@ class _Bounds:
                     for j in range(stutter_marked.shape[2]):
                         if stutter_marked[other, q, j]:
                             q_next = int(product.stutter_successor[graph.classes[other], q, j])
-                            cost = self.back_to(q).at_region(q_next, c)
-                            terminal[q, c] = min(terminal[q, c], self.beta * cost)
-        return terminal
+                            cost = self.beta * self.back_to(q).at_region(q_next, c)
+                            terminal[q, c] = min(terminal[q, c], cost)
+                            entered_terminal[q, c] = min(entered_terminal[q, c], cost)
+        return terminal, entered_terminal
 
     def closing(self, target: int) -> Bound:
         """A bound on the cost from any node to the node ``target``: the region-level one
