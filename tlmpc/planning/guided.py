@@ -90,6 +90,13 @@ class GuidedSearch:
     returns those edges; offers whose ``g + bound`` reaches ``ceiling`` are dropped (no path
     through them can beat it).  Distances are exact for every node whose ``f`` lies below
     :meth:`lowest` once the search has stepped past it.
+
+    The queued nodes are kept per bucket (``f`` in ``[k w, (k + 1) w)`` for the bucket
+    width ``w``), so a round reads only the nodes it expands, not every node waiting: a
+    guided search's frontier holds hundreds of times more nodes than one bucket.  A node
+    whose distance got shorter is queued again in its new bucket (never below the bucket
+    being expanded); the entry it had is skipped when its bucket comes (the node is no
+    longer queued, or was queued again and is expanded at most once more).
     """
 
     def __init__(
@@ -114,12 +121,14 @@ class GuidedSearch:
         arrays.dist[sources] = offsets
         arrays.queued[sources] = True
         arrays.touched.append(sources)
-        self.frontier = sources
-        self.estimate = estimate[finite]  # the bound at each frontier node
-        self.f = offsets + self.estimate  # g + bound at each frontier node
+        self.sources = sources
         weights = product.move_weight
         self.width = BUCKET_WIDTH * float(weights.mean()) if len(weights) else 1.0
         self.reached = len(sources)
+        self.buckets: dict[int, list[IntArray]] = {}  # key -> queued nodes (maybe stale)
+        self.keys: list[int] = []  # a heap of the buckets' keys
+        self.floor = 0  # the key of the bucket expanded last
+        self._queue(sources, offsets + estimate[finite])
 
     def estimate_at(self, nodes: IntArray) -> FloatArray:
         """The bound at ``nodes``, computed once per node (kept in single precision,
@@ -134,31 +143,56 @@ class GuidedSearch:
             self.arrays.touched.append(fresh)
         return known.astype(np.float64)
 
-    def lowest(self) -> float:
-        """The least ``f`` in the frontier (inf when it is empty)."""
-        if not len(self.frontier):
-            return np.inf
-        return float(self.f.min())
+    def _queue(self, nodes: IntArray, f: FloatArray) -> None:
+        """Put ``nodes`` (distinct, finite ``f``) in their buckets."""
+        if not len(nodes):
+            return
+        keys = np.maximum((f / self.width).astype(np.int64), self.floor)
+        low, high = int(keys.min()), int(keys.max())
+        for key in [low] if low == high else np.unique(keys).tolist():
+            mine = nodes if low == high else nodes[keys == key]
+            if key in self.buckets:
+                self.buckets[key].append(mine)
+            else:
+                self.buckets[key] = [mine]
+                heapq.heappush(self.keys, key)
 
-    def prune(self, ceilings: FloatArray) -> None:
-        """Drop the frontier nodes whose ``f`` reaches their copy's ceiling."""
-        keep = self.f < ceilings[self.frontier // self.copy_size]
-        self.arrays.queued[self.frontier[~keep]] = False
-        self.frontier, self.estimate, self.f = (
-            self.frontier[keep],
-            self.estimate[keep],
-            self.f[keep],
-        )
+    def _lowest_bucket(self) -> IntArray | None:
+        """The queued nodes of the lowest bucket that has any (None: nothing queued)."""
+        while self.keys:
+            key = self.keys[0]
+            parts = self.buckets[key]
+            nodes = parts[0] if len(parts) == 1 else np.unique(np.concatenate(parts))
+            nodes = nodes[self.arrays.queued[nodes]]
+            if len(nodes):
+                self.buckets[key] = [nodes]
+                return nodes
+            del self.buckets[key]
+            heapq.heappop(self.keys)
+        return None
+
+    def lowest(self) -> float:
+        """The least ``f`` of a queued node (inf when none is)."""
+        nodes = self._lowest_bucket()
+        if nodes is None:
+            return np.inf
+        return float((self.arrays.dist[nodes] + self.arrays.estimate[nodes]).min())
 
     def step(self, ceiling: float | FloatArray = np.inf) -> tuple[Edges, IntArray]:
         """Expand the lowest bucket; returns its edges and the nodes whose distance got
-        shorter (queued again).  ``ceiling`` may be one per copy."""
+        shorter (queued again).  ``ceiling`` may be one per copy: then the bucket's nodes
+        whose ``f`` reaches their copy's ceiling are dropped, not expanded."""
         arrays = self.arrays
-        f = self.f
-        take = f <= float(f.min()) + self.width
-        active = self.frontier[take]
-        self.frontier, self.estimate = self.frontier[~take], self.estimate[~take]
+        active = self._lowest_bucket()
+        if active is None:
+            active = np.zeros(0, dtype=np.int64)
+        else:
+            self.floor = heapq.heappop(self.keys)
+            del self.buckets[self.floor]
         arrays.queued[active] = False
+        if isinstance(ceiling, np.ndarray):
+            f = arrays.dist[active] + arrays.estimate[active]
+            active = active[f < ceiling[active // self.copy_size]]
         if self.copy_size:
             local = active % self.copy_size
             edges = self.product.expand(local, base=active - local)
@@ -177,10 +211,8 @@ class GuidedSearch:
         arrays.queued[fresh] = True
         arrays.touched.append(fresh)
         self.reached += len(fresh)
-        self.frontier = np.concatenate([self.frontier, fresh])
-        self.estimate = np.concatenate([self.estimate, self.estimate_at(fresh)])
-        # Distances of queued nodes may have got shorter: f is read anew.
-        self.f = arrays.dist[self.frontier] + self.estimate
+        # Every improved node goes in the bucket of its new f (queued ones too: theirs fell).
+        self._queue(improved, arrays.dist[improved] + self.estimate_at(improved))
         return edges, improved
 
     def path(self, target: int) -> list[int]:
@@ -346,7 +378,7 @@ def guided_lasso(
     candidates: list[tuple[float, int, int, float, float]] = []  # bound, u, v, w, g(u)
     searches = 0
     capped = False
-    for node in prefix.frontier[product.stays_accepting(prefix.frontier)].tolist():
+    for node in prefix.sources[product.stays_accepting(prefix.sources)].tolist():
         best = _better(best, (0.0, [node], [node]))
     while True:
         incumbent = best[0] if best is not None else np.inf
@@ -499,8 +531,7 @@ def _close_together(
     search = GuidedSearch(product, arrays, sources, bound, offsets=offsets, copy_size=size)
     while True:
         ceilings = np.minimum(arrays.dist[targets], limits)
-        search.prune(ceilings)
-        if not len(search.frontier):
+        if search.lowest() >= float(ceilings.max()):
             break
         search.step(ceiling=ceilings)
     found: list[tuple[float | None, list[int]]] = []
