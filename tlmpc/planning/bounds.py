@@ -105,12 +105,11 @@ def region_graph(product: LazyProduct, allowed_cells: BoolArray) -> RegionGraph:
     count = len(present)
     delta = np.zeros((count, count))
     delta_entry = np.zeros((count, count))
+    inside = _ClassCells(cell_local, landmarks, np.ones(cells, dtype=bool))
+    entered = _ClassCells(cell_local, landmarks, entry)
     for index, landmark in enumerate(landmarks.tolist()):
-        for c in landmarks.tolist():
-            inside = distance[index][cell_local == c]
-            delta[c, landmark] = float(inside.min()) if len(inside) else np.inf
-            entered = distance[index][(cell_local == c) & entry]
-            delta_entry[c, landmark] = float(entered.min()) if len(entered) else np.inf
+        delta[landmarks, landmark] = inside.least(distance[index])
+        delta_entry[landmarks, landmark] = entered.least(distance[index])
     kind_local = local_of[product.kind_class]
     closure = np.zeros((count, nq, nq), dtype=bool)
     entering: list[tuple[int, IntArray, IntArray]] = []
@@ -144,6 +143,30 @@ def region_graph(product: LazyProduct, allowed_cells: BoolArray) -> RegionGraph:
         scale=_straight_scale(product),
         backwards=backwards,
     )
+
+
+class _ClassCells:
+    """The cells of each of some classes (among those ``pick`` holds), grouped so that the
+    least of a per-cell value over each class is one pass."""
+
+    def __init__(self, cell_local: IntArray, classes: IntArray, pick: BoolArray) -> None:
+        cells = np.flatnonzero(pick & np.isin(cell_local, classes))
+        order = np.argsort(cell_local[cells], kind="stable")
+        self.cells = cells[order]
+        grouped = cell_local[self.cells]
+        self.starts = np.searchsorted(grouped, classes)  # classes ascending
+        self.present = np.searchsorted(grouped, classes, side="right") > self.starts
+
+    def least(self, per_cell: FloatArray) -> FloatArray:
+        """Per class: the least value over its cells (inf for a class without cells)."""
+        result = np.full(len(self.starts), np.inf)
+        if len(self.cells):
+            # The present classes' runs start strictly increasing, each ending where the
+            # next begins (the last at the end).
+            result[self.present] = np.minimum.reduceat(
+                per_cell[self.cells], self.starts[self.present]
+            )
+        return result
 
 
 def _mark(step: BoolArray, successor: IntArray) -> None:
@@ -207,6 +230,7 @@ class CostToGo:
     free: FloatArray  # (Q, local)
     leg: FloatArray  # (Q, local, landmarks)
     value: FloatArray  # (Q, local): the cost to go right after entering the class
+    anywhere: FloatArray  # (Q, local): the cost to go anywhere in the class or background
     final: FloatArray | None = None  # per cell: the cost still to pay in a target state
     reach: BoolArray | None = None  # (Q, local): free steps reach a target state
 
@@ -229,12 +253,7 @@ class CostToGo:
         """The bound at the region-level node ``(q, c)``: anywhere in ``c`` or the
         background with ``c`` the last landmark, or with ``entered`` right after entering
         landmark ``c`` (in one of its boundary entry cells)."""
-        if entered:
-            return float(self.value[q, c])
-        value = float(self.free[q, c])
-        for index, landmark in enumerate(self.graph.landmarks.tolist()):
-            value = min(value, float(self.graph.delta[c, landmark] + self.leg[q, c, index]))
-        return value
+        return float(self.value[q, c] if entered else self.anywhere[q, c])
 
 
 def cost_to_go_to_cells(graph: RegionGraph, state: int, final: FloatArray) -> CostToGo:
@@ -270,21 +289,29 @@ def cost_to_go(
     free = _closure_min(closure, terminal)
     after_entry = free if terminal_entered is None else _closure_min(closure, terminal_entered)
     value = after_entry.copy()  # the region-level node's cost to go, right after entering
-    leg = np.full((nq, count, len(graph.landmarks)), np.inf)
+    landmarks = len(graph.landmarks)
+    leg = np.full((nq, count, landmarks), np.inf)
+    # The entering edges of every landmark in one table: (landmark index, tail, head).
+    index = np.concatenate(
+        [np.full(len(tails), k, dtype=np.int64) for k, (_, tails, _) in enumerate(graph.entering)]
+        or [np.zeros(0, dtype=np.int64)]
+    )
+    tails = np.concatenate([t for _, t, _ in graph.entering] or [np.zeros(0, dtype=np.int64)])
+    heads = np.concatenate([h for _, _, h in graph.entering] or [np.zeros(0, dtype=np.int64)])
+    entered = graph.landmarks[index]
+    into = graph.delta_entry[:, graph.landmarks]  # (local, landmarks)
     for _ in range(nq * count + 1):
-        for index, (landmark, tails, heads) in enumerate(graph.entering):
-            # Entering the landmark from state tail: the cheapest head's cost to go there.
-            after = np.full(nq, np.inf)
-            np.minimum.at(after, tails, value[heads, landmark])
-            leg[:, :, index] = _masked_min(closure, after).T
-        updated = after_entry.copy()
-        for index, landmark in enumerate(graph.landmarks.tolist()):
-            step = graph.delta_entry[:, landmark][None, :] + leg[:, :, index]
-            updated = np.minimum(updated, step)
+        # Entering a landmark from state tail: the cheapest head's cost to go there.
+        after = np.full((landmarks, nq), np.inf)
+        np.minimum.at(after, (index, tails), value[heads, entered])
+        leg = _masked_min(closure, after)
+        updated = np.minimum(after_entry, (into[None, :, :] + leg).min(axis=2, initial=np.inf))
         if np.array_equal(updated, value):
             break
         value = updated
-    return CostToGo(graph=graph, free=free, leg=leg, value=value)
+    # Anywhere in c: the next landmark is at least delta away (from any cell of c).
+    away = (graph.delta[:, graph.landmarks][None, :, :] + leg).min(axis=2, initial=np.inf)
+    return CostToGo(graph=graph, free=free, leg=leg, value=value, anywhere=np.minimum(free, away))
 
 
 def _closure_min(closure: BoolArray, terminal: FloatArray) -> FloatArray:
@@ -294,8 +321,19 @@ def _closure_min(closure: BoolArray, terminal: FloatArray) -> FloatArray:
     return result
 
 
+#: Elements of the temporary array :func:`_masked_min` fills at once.
+_MASKED_CHUNK = 1 << 22
+
+
 def _masked_min(reach: BoolArray, cost: FloatArray) -> FloatArray:
-    """(local, Q): per class c and state q, the least ``cost[q']`` over the ``q'`` that
-    ``reach[c, q]`` holds."""
-    result: FloatArray = np.where(reach, cost[None, None, :], np.inf).min(axis=2)
+    """(Q, local, landmarks): per state q, class c and landmark l, the least ``cost[l, q']``
+    over the ``q'`` that ``reach[c, q]`` holds (landmarks a chunk at a time)."""
+    landmarks, nq = cost.shape
+    count = reach.shape[0]
+    result = np.full((nq, count, landmarks), np.inf)
+    chunk = max(1, _MASKED_CHUNK // max(1, count * nq * nq))
+    for first in range(0, landmarks, chunk):
+        part = cost[first : first + chunk]  # (chunk, Q)
+        least = np.where(reach[None], part[:, None, None, :], np.inf).min(axis=3)
+        result[:, :, first : first + chunk] = least.transpose(2, 1, 0)
     return result

@@ -46,8 +46,9 @@ from tlmpc.planning.search import BUCKET_WIDTH, relax_offers
 Bound = Callable[[IntArray], FloatArray]
 
 #: Closing searches run side by side up to this many product nodes in all (their arrays,
-#: about 30 bytes a node).
-CLOSING_NODES = 26_000_000
+#: about 30 bytes a node, are written whole when allocated: on a product of millions of
+#: nodes that costs more than the rounds the searches would share, so they run one by one).
+CLOSING_NODES = 4_000_000
 
 
 @dataclass(slots=True)
@@ -209,8 +210,7 @@ class GuidedSearch:
         )
         fresh = improved[~arrays.queued[improved]]
         arrays.queued[fresh] = True
-        arrays.touched.append(fresh)
-        self.reached += len(fresh)
+        self.reached += len(fresh)  # (estimate_at recorded them for the reset: every v was)
         # Every improved node goes in the bucket of its new f (queued ones too: theirs fell).
         self._queue(improved, arrays.dist[improved] + self.estimate_at(improved))
         return edges, improved
