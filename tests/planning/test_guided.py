@@ -373,6 +373,57 @@ def test_guided_lasso_costs_what_the_built_product_gives(
     event(_costs_agree(mission, bounces))
 
 
+def _rooms_text(n: int, rooms: list[tuple[int, int]], task: str, beta: float) -> str:
+    """An n x n floor of unit cells, a square room in each chosen cell (the grids the
+    guided search is built for, small enough for the built product)."""
+    regions = "\n".join(
+        f"  r{i}_{j}: {{rect: [{i + 0.25}, {j + 0.25}, {i + 0.75}, {j + 0.75}]}}" for i, j in rooms
+    )
+    names = [f"r{i}_{j}" for i, j in rooms]
+    if task == "patrol":
+        tasks = [f"patrol {', '.join(names)}"]
+    else:  # cover the others while avoiding the last
+        tasks = [f"visit {' and '.join(names[:-1])}", f"avoid {names[-1]}"]
+    return (
+        f"version: 1\nworkspace: {{boundary: {{rect: [0, 0, {n}, {n}]}}}}\n"
+        f"regions:\n{regions}\nrobot: {{start: [0.1, 0.1]}}\n"
+        f"task: {json.dumps(tasks)}\n"
+        f"options: {{beta: {beta}, min_angle: null, max_area: null}}\n"
+    )
+
+
+@pytest.mark.slow
+@settings(
+    max_examples=max(6, settings().max_examples // 4),
+    deadline=None,
+    suppress_health_check=[HealthCheck.too_slow],
+)
+@given(
+    st.integers(3, 8).flatmap(
+        lambda n: st.tuples(
+            st.just(n),
+            st.lists(
+                st.tuples(st.integers(0, n - 1), st.integers(0, n - 1)),
+                min_size=3,
+                max_size=6,
+                unique=True,
+            ),
+        )
+    ),
+    st.sampled_from(["patrol", "cover"]),
+    st.sampled_from([0.5, 1.0, 2.5]),
+)
+def test_guided_lasso_costs_what_the_built_product_gives_on_grids_of_rooms(
+    grid: tuple[int, list[tuple[int, int]]], task: str, beta: float
+) -> None:
+    """Medium missions of the kind the guided search is for: many rooms, a patrol of
+    several (long cycles, many candidates) or a cover avoiding one, on a floor of up to
+    514 triangles."""
+    n, rooms = grid
+    mission = load_mission_text(_rooms_text(n, rooms, task, beta), "rooms.yaml")
+    event(_costs_agree(mission, False))
+
+
 @pytest.mark.parametrize("spec", ["example1", "example6", "example7", "patrol", "reach-avoid"])
 def test_guided_lasso_on_the_shipped_missions(spec: str) -> None:
     mission = load_mission(ROOT / "specs" / f"{spec}.yaml")
