@@ -275,6 +275,48 @@ def test_bounds_never_exceed_the_exact_distances_on_generated_missions(
     _check_bounds(mission, beta)
 
 
+@pytest.mark.parametrize("spec", ["example1", "patrol", "far-cycle"])
+@pytest.mark.parametrize("guided", [False, True])
+def test_guided_search_settles_nodes_at_dijkstras_distances(spec: str, guided: bool) -> None:
+    """Run to exhaustion (no ceiling), the bucketed search gives every node scipy's Dijkstra
+    distance from the initial nodes, with the zero bound and with the lasso bound (a node
+    the lasso bound calls hopeless, inf, is never queued)."""
+    from tlmpc.planning.guided import GuidedSearch, _Arrays
+
+    mission = _load(spec)
+    abstraction, working, arguments = _inputs(mission, False)
+    product = build_product(abstraction, working, **arguments)  # type: ignore[arg-type]
+    lazy = lazy_product(abstraction, working, **arguments)  # type: ignore[arg-type]
+    allowed = np.repeat(arguments["allowed"], SLOTS)  # type: ignore[call-overload]
+    graph = product.graph
+    matrix = csr_matrix(
+        (graph.weights, (graph.sources, graph.targets)),
+        shape=(product.num_nodes, product.num_nodes),
+    )
+    exact = dijkstra(matrix, indices=product.initial, min_only=True)
+    if guided:
+        bound = _Bounds(lazy, region_graph(lazy, allowed), 1.0).lasso
+    else:
+
+        def bound(nodes: np.ndarray) -> np.ndarray:
+            return np.zeros(len(nodes))
+
+    search = GuidedSearch(lazy, _Arrays.of(lazy.num_nodes), lazy.initial, bound)
+    rounds = 0
+    while np.isfinite(search.lowest()):
+        search.step()
+        rounds += 1
+    assert rounds > 1
+    found = search.arrays.dist
+    hopeless = ~np.isfinite(bound(np.arange(lazy.num_nodes)))
+    # Nodes the bound rules out are cut off, and so is whatever is reached only through them.
+    check = ~hopeless & np.isfinite(found)
+    assert check.sum() > lazy.num_nodes // 20
+    assert np.array_equal(found[check], exact[check])
+    if not guided:
+        assert np.array_equal(np.isfinite(found), np.isfinite(exact))
+
+
 def _costs_agree(mission: Mission, bounces: bool) -> str:
     abstraction = build_abstraction(mission)
     automaton = automaton_for(mission, abstraction)
