@@ -14,6 +14,7 @@ Three claims, each against an independent computation:
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 from typing import Literal
@@ -294,13 +295,13 @@ def test_guided_search_settles_nodes_at_dijkstras_distances(spec: str, guided: b
         shape=(product.num_nodes, product.num_nodes),
     )
     exact = dijkstra(matrix, indices=product.initial, min_only=True)
+
+    def zero(nodes: np.ndarray) -> np.ndarray:
+        return np.zeros(len(nodes))
+
+    bound: Callable[[np.ndarray], np.ndarray] = zero
     if guided:
         bound = _Bounds(lazy, region_graph(lazy, allowed), 1.0).lasso
-    else:
-
-        def bound(nodes: np.ndarray) -> np.ndarray:
-            return np.zeros(len(nodes))
-
     search = GuidedSearch(lazy, _Arrays.of(lazy.num_nodes), lazy.initial, bound)
     rounds = 0
     while np.isfinite(search.lowest()):
