@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from tlmpc.base.errors import UsageError, error
+from tlmpc.io.arrays import ArrayList, TableList, encoded_pieces, has_standins, plain
 from tlmpc.io.schema_check import validation_errors
 
 
@@ -45,10 +46,10 @@ def dumps(document: Any, shared: SharedTexts | None = None) -> str:
     try:
         text = _compact(document, shared)
     except ValueError:  # a non-finite float somewhere: JSON has none
-        document = _finite(document)
+        document = _finite(plain(document))
         text = json.dumps(document, sort_keys=True, separators=(",", ":"), allow_nan=False)
     if len(text) < INDENT_BELOW:
-        text = json.dumps(document, indent=2, sort_keys=True, allow_nan=False)
+        text = json.dumps(plain(document), indent=2, sort_keys=True, allow_nan=False)
     return text + "\n"
 
 
@@ -115,14 +116,25 @@ class SharedTexts:
 def _compact(document: Any, shared: SharedTexts | None) -> str:
     """What ``json.dumps(document, sort_keys=True, separators=(",", ":"), allow_nan=False)``
     returns, with the top-level values of a dict holding a shared key taken from ``shared``."""
-    if shared is None or type(document) is not dict or shared.keys.isdisjoint(document):
+    standins = has_standins(document)
+    if not standins and (
+        shared is None or type(document) is not dict or shared.keys.isdisjoint(document)
+    ):
         return _COMPACT.encode(document)
     # The encoder sorts the items of a dict by key and writes each value independently of
     # its surroundings: the same text, piece by piece.  (The document has a text key, the
     # shared one: a key of another type beside it fails to sort here as in the encoder.)
     pieces = ["{"]
     for key in sorted(document):  # one join: the texts of a mesh are megabytes, copied once
-        pieces += (_COMPACT.encode(key), ":", shared.text(key, document[key]), ",")
+        value = document[key]
+        pieces += (_COMPACT.encode(key), ":")
+        if isinstance(value, ArrayList | TableList):  # a block of rows at a time
+            pieces += encoded_pieces(value, _COMPACT)
+        elif shared is not None:
+            pieces.append(shared.text(key, value))
+        else:
+            pieces.append(_COMPACT.encode(value))
+        pieces.append(",")
     pieces[-1] = "}"
     return "".join(pieces)
 
