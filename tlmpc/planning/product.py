@@ -33,8 +33,8 @@ SLOTS = 4  # three edges, and "no entry edge yet" for the start
 START_SLOT = 3
 #: Weight of a stutter step: the searches need positive weights, and stutter is free.
 STUTTER_COST = 1e-9
-#: Node and edge numbers below this are held in 32 bits (half the memory of a product's
-#: index arrays); from it on, in 64 bits.
+#: Node and edge numbers up to this count are held in 32 bits (half the memory of a product's
+#: index arrays: the numbers 0 .. 2**31 - 1); beyond it, in 64 bits.
 INT32_LIMIT = 2**31
 
 BoolArray = npt.NDArray[np.bool_]
@@ -53,13 +53,13 @@ class Product(ContentEquality):
 
 
 def index_dtype(count: int) -> type[np.signedinteger[Any]]:
-    """The integer type for numbers below ``count``: 32 bits while they fit, else 64 bits.
+    """The integer type for the numbers ``0 .. count - 1``: 32 bits while they fit, else 64.
 
-    Every array of node numbers of a product (and the products of these numbers with small
-    factors, which stay below the node count) uses it; 64 bits beyond 2**31 - 1, so a
-    product too large for 32-bit numbers is built the same, only larger.
+    A product's node numbers (and its cells and moves, numbered below its node count) and
+    its edge positions use it, so a product too large for 32-bit numbers is built the same,
+    only larger: nothing is computed in 32 bits that could pass 2**31 - 1.
     """
-    return np.int32 if count < INT32_LIMIT else np.int64
+    return np.int32 if count <= INT32_LIMIT else np.int64
 
 
 def edge_midpoints(abstraction: Abstraction) -> FloatArray:
@@ -135,7 +135,8 @@ def build_product(
         convention=convention,
         bounces=bounces,
         realisable=realisable,
-        dtype=index_dtype(size),
+        # moves are numbered on the (triangle, slot, exit) grid, cells below the node count
+        dtype=index_dtype(max(size, abstraction.num_triangles * SLOTS * 3)),
     )
     starts, classes, tri_class = table.starts, table.classes, table.tri_class
     moves, weight, move_kind = table.moves, table.weight, table.kind
