@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import json
 import math
+import tempfile
+from pathlib import Path
 from typing import Any
 from unittest import mock
 
@@ -22,7 +24,8 @@ from hypothesis.extra import numpy as hnp
 
 from tlmpc.io import arrays
 from tlmpc.io.arrays import ArrayList, TableList, plain
-from tlmpc.io.artifacts import INDENT_BELOW, artifact_texts, dumps
+from tlmpc.io.artifacts import INDENT_BELOW, artifact_texts, dump_pieces, dumps
+from tlmpc.io.outdir import write_artifacts
 
 
 def _finite(value: Any) -> Any:
@@ -94,10 +97,16 @@ def test_a_document_with_arrays_is_written_as_its_plain_lists(
     pair: tuple[dict[str, Any], dict[str, Any]],
 ) -> None:
     held, simple = pair
+    expected = _reference(simple)
     with mock.patch.object(arrays, "BLOCK_ROWS", 3):
-        assert dumps(held) == _reference(simple)
-        assert dict(artifact_texts({"m.json": held})) == {"m.json": _reference(simple)}
-    assert dumps(held) == _reference(simple)
+        assert dumps(held) == expected
+        assert dict(artifact_texts({"m.json": held})) == {"m.json": expected}
+        assert "".join(dump_pieces(held)) == expected
+        with tempfile.TemporaryDirectory() as folder:  # the file, written piece by piece
+            write_artifacts(Path(folder), {"m.json": held, "plain.json": simple})
+            assert (Path(folder) / "m.json").read_bytes() == expected.encode("utf-8")
+            assert (Path(folder) / "plain.json").read_bytes() == expected.encode("utf-8")
+    assert dumps(held) == expected
     assert plain(held) == simple
 
 
@@ -108,6 +117,7 @@ def test_non_finite_numbers_in_arrays_are_written_as_text(
     held, simple = pair
     with mock.patch.object(arrays, "BLOCK_ROWS", 2):
         assert dumps(held) == _reference(simple)
+        assert "".join(dump_pieces(held)) == _reference(simple)
 
 
 def test_arrays_read_like_their_lists() -> None:
@@ -147,3 +157,4 @@ def test_a_large_mesh_document_is_written_block_by_block_as_its_lists() -> None:
         "letters": letters,
     }
     assert dumps(held) == _reference(simple)
+    assert "".join(dump_pieces(held)) == _reference(simple)

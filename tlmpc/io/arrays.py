@@ -17,7 +17,7 @@ a list) and ``numpy.asarray`` of an :class:`ArrayList` is its array.
 from __future__ import annotations
 
 import json
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:  # numpy is imported where arrays are encoded (``tlmpc check`` has none)
@@ -73,11 +73,6 @@ class ArrayList:
         plain: list[Any] = self.array.tolist()
         return plain
 
-    def blocks(self) -> Iterator[list[Any]]:
-        """The plain list, a block of rows at a time."""
-        for start in range(0, len(self.array), BLOCK_ROWS):
-            yield self.array[start : start + BLOCK_ROWS].tolist()
-
 
 class TableList:
     """The list ``[table[i] for i in index]``: a long list of a few distinct values (each
@@ -119,26 +114,38 @@ def encoded_pieces(value: Standin, encoder: json.JSONEncoder) -> Iterator[str]:
     """The pieces of ``encoder.encode(value.tolist())``, a block of rows at a time.
 
     ``encoder`` must write compactly (``separators=(",", ":")``): the pieces are joined by
-    ``,``.  A non-finite float raises ValueError, as the encoder does on the list.
+    ``,``.  What the encoder would refuse (a non-finite float: ValueError) is refused here,
+    before the first piece is made, so that a writer never holds half a text it must drop.
     """
-    if not len(value):
-        yield "[]"
-        return
-    yield "["
-    if isinstance(value, TableList):
-        import numpy as np
+    import numpy as np
 
-        texts = np.array([encoder.encode(item) for item in value.table], dtype=object)
-        for start in range(0, len(value.index), BLOCK_ROWS):
-            if start:
-                yield ","
-            yield ",".join(texts[value.index[start : start + BLOCK_ROWS]].tolist())
-    else:
-        for number, block in enumerate(value.blocks()):
-            if number:
-                yield ","
-            yield encoder.encode(block)[1:-1]
+    if isinstance(value, TableList):
+        texts = np.array([_item_text(item, encoder) for item in value.table], dtype=object)
+        return _joined(len(value.index), lambda a, b: ",".join(texts[value.index[a:b]].tolist()))
+    array = value.array
+    if array.dtype.kind == "f" and not np.isfinite(array).all():
+        raise ValueError("Out of range float values are not JSON compliant")
+    return _joined(len(array), lambda a, b: encoder.encode(array[a:b].tolist())[1:-1])
+
+
+def _joined(count: int, block: Callable[[int, int], str]) -> Iterator[str]:
+    """``[`` + the texts of the blocks of ``count`` rows, joined by ``,`` + ``]``."""
+    yield "["
+    for start in range(0, count, BLOCK_ROWS):
+        if start:
+            yield ","
+        yield block(start, start + BLOCK_ROWS)
     yield "]"
+
+
+def _item_text(item: Any, encoder: json.JSONEncoder) -> str:
+    """``encoder.encode(item)``; a list of strings (a label set) joined from the encoder's
+    own string encoding, a tenth of the time for the many letters of a large map."""
+    if type(item) is list and all(type(name) is str for name in item):
+        quote = json.encoder.encode_basestring_ascii if encoder.ensure_ascii else None
+        if quote is not None:
+            return "[" + ",".join(map(quote, item)) + "]"
+    return encoder.encode(item)
 
 
 def has_standins(document: Any) -> bool:

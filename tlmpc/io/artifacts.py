@@ -53,6 +53,22 @@ def dumps(document: Any, shared: SharedTexts | None = None) -> str:
     return text + "\n"
 
 
+def artifact_pieces(
+    artifacts: Mapping[str, Any],
+) -> Iterator[tuple[str, str | bytes | Iterator[str]]]:
+    """``(name, content)`` of each artifact as :func:`artifact_texts` gives it, except that a
+    document holding arrays comes as the pieces of its text (:func:`dump_pieces`), to be
+    written one after the other."""
+    shared = SharedTexts.among(artifacts.values())
+    for name, content in artifacts.items():
+        if isinstance(content, str | bytes):
+            yield name, content
+        elif has_standins(content):
+            yield name, dump_pieces(content, shared)
+        else:
+            yield name, dumps(content, shared)
+
+
 def artifact_texts(artifacts: Mapping[str, Any]) -> Iterator[tuple[str, str | bytes]]:
     """``(name, text)`` of each artifact, one at a time: texts and bytes as they are, JSON
     documents by :func:`dumps`, a large value that several documents hold under the same
@@ -116,27 +132,70 @@ class SharedTexts:
 def _compact(document: Any, shared: SharedTexts | None) -> str:
     """What ``json.dumps(document, sort_keys=True, separators=(",", ":"), allow_nan=False)``
     returns, with the top-level values of a dict holding a shared key taken from ``shared``."""
-    standins = has_standins(document)
-    if not standins and (
+    if not has_standins(document) and (
         shared is None or type(document) is not dict or shared.keys.isdisjoint(document)
     ):
         return _COMPACT.encode(document)
+    return "".join(_compact_pieces(document, shared))  # the texts of a mesh, copied once
+
+
+def _compact_pieces(document: dict[Any, Any], shared: SharedTexts | None) -> Iterator[str]:
+    """The pieces of :func:`_compact`'s text of a dict, its stand-ins a block at a time.
+
+    Every value the encoder could refuse is encoded (or checked) here, before the first
+    piece: the pieces that follow cannot fail.
+    """
     # The encoder sorts the items of a dict by key and writes each value independently of
     # its surroundings: the same text, piece by piece.  (The document has a text key, the
     # shared one: a key of another type beside it fails to sort here as in the encoder.)
-    pieces = ["{"]
-    for key in sorted(document):  # one join: the texts of a mesh are megabytes, copied once
+    texts: list[str | Iterator[str]] = []
+    for key in sorted(document):
         value = document[key]
-        pieces += (_COMPACT.encode(key), ":")
-        if isinstance(value, ArrayList | TableList):  # a block of rows at a time
-            pieces += encoded_pieces(value, _COMPACT)
+        if isinstance(value, ArrayList | TableList):
+            texts.append(encoded_pieces(value, _COMPACT))
         elif shared is not None:
-            pieces.append(shared.text(key, value))
+            texts.append(shared.text(key, value))
         else:
-            pieces.append(_COMPACT.encode(value))
-        pieces.append(",")
-    pieces[-1] = "}"
-    return "".join(pieces)
+            texts.append(_COMPACT.encode(value))
+    keys = [_COMPACT.encode(key) for key in sorted(document)]
+    return _pieces(keys, texts)
+
+
+def _pieces(keys: list[str], texts: list[str | Iterator[str]]) -> Iterator[str]:
+    yield "{"
+    for number, (key, text) in enumerate(zip(keys, texts, strict=True)):
+        yield ("," if number else "") + key + ":"
+        if isinstance(text, str):
+            yield text
+        else:
+            yield from text
+    yield "}"
+
+
+def dump_pieces(document: Any, shared: SharedTexts | None = None) -> Iterator[str]:
+    """The pieces of :func:`dumps`'s text, a large document's arrays a block of rows at a
+    time (the whole text of a mesh is never held)."""
+    if not has_standins(document):
+        yield dumps(document, shared)
+        return
+    try:
+        pieces = _compact_pieces(document, shared)
+    except ValueError:  # a non-finite float: the whole document the slow way
+        yield dumps(document, shared)
+        return
+    head: list[str] = []
+    length = 0
+    for piece in pieces:
+        head.append(piece)
+        length += len(piece)
+        if length >= INDENT_BELOW:
+            break
+    else:  # short: written indented, as dumps writes it
+        yield json.dumps(plain(document), indent=2, sort_keys=True, allow_nan=False) + "\n"
+        return
+    yield from head
+    yield from pieces
+    yield "\n"
 
 
 def json_text(document: Any) -> str:

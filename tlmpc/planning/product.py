@@ -458,7 +458,7 @@ def _product_edges(
     # A cell's moves (at most three) are adjacent: a move's rank among them says which of
     # the one or two moves before it share its node.
     source = moves.source
-    rank = np.zeros(len(source), dtype=np.int8)
+    rank = np.zeros(len(source), dtype=np.int32)
     rank[1:] += source[1:] == source[:-1]
     rank[2:] += source[2:] == source[:-2]
     moves_of_cell = np.bincount(source, minlength=cells)
@@ -476,11 +476,11 @@ def _product_edges(
         per_move: IntArray = degree.take(move_kind)
         return per_move
 
-    def offsets(q: int) -> IntArray:
+    def offsets(q: int) -> npt.NDArray[np.signedinteger[Any]]:
         """Per move, how many edges of its node (cell, q) come before its own."""
         per_move = degrees(q)
         if isinstance(per_move, int):
-            return rank.astype(np.int64) * per_move
+            return rank * per_move
         offset = np.zeros(len(source), dtype=np.int64)
         offset[1:] = per_move[:-1] * (rank[1:] >= 1)
         offset[2:] += per_move[:-2] * (rank[2:] >= 2)
@@ -535,8 +535,7 @@ def _product_edges(
             dst[first + j] = node + q_next
             wgt[first + j] = STUTTER_COST
             acc[first + j] = accepting
-    src = np.repeat(np.arange(size, dtype=node_type), degree_of_node)
-    return Graph(indptr=indptr, sources=src, targets=dst, weights=wgt, num_nodes=size), acc
+    return Graph(indptr=indptr, targets=dst, weights=wgt, num_nodes=size), acc
 
 
 def initial_nodes(
