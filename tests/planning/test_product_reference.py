@@ -206,6 +206,7 @@ def _edges(product: Product) -> dict[tuple[int, int], tuple[float, bool]]:
     assert (np.diff(graph.indptr) >= 0).all()
     runs = np.repeat(np.arange(graph.num_nodes), np.diff(graph.indptr))
     assert np.array_equal(runs, graph.sources), "edges grouped by source, as indptr says"
+    assert np.array_equal(graph.source_of(np.arange(graph.nnz)), runs), "tails looked up"
     found = {
         (int(u), int(v)): (float(w), bool(a))
         for u, v, w, a in zip(

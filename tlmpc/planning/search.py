@@ -209,7 +209,7 @@ def shortest_paths(
         edges = np.repeat(starts - ends + counts, counts) + np.arange(total)
         u = np.repeat(active, counts)
         du = np.repeat(current[take], counts)
-        v = targets[edges]
+        v = targets[edges].astype(np.int64, copy=False)  # indexes many arrays: cast once
         d = du + weights[edges]
         if limit < np.inf:
             keep = d <= limit
