@@ -211,3 +211,14 @@ def test_touching_components_join_the_pieces_that_share_a_vertex(
                         group[a] = group[b] = low
                         changed = True
     assert _touching_components(abstraction).tolist() == group
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(0, 50))
+def test_centroids_are_the_mean_of_the_corners_bit_for_bit(seed: int, count: int) -> None:
+    from tlmpc.abstraction.build import _centroids
+
+    rng = np.random.default_rng(seed)
+    vertices = rng.normal(size=(max(count, 1), 2)) * 10.0 ** rng.integers(-8, 9)
+    triangles = rng.integers(0, len(vertices), size=(count, 3))
+    expected = vertices[triangles].mean(axis=1) if count else np.zeros((0, 2))
+    assert _centroids(vertices, triangles).tobytes() == expected.tobytes()
