@@ -200,9 +200,9 @@ def main(argv: list[str] | None = None) -> int:
                     traced = _child(tree, COMPILE_PROGRAM, str(path), args.trace)
                     print(f"\n{workload} {name}: largest live allocations after {args.trace}")
                     for entry in traced["top"]:
-                        print(
+                        print(  # the innermost frames first: where it was allocated
                             f"  {entry['mb']:8.1f} MB {entry['count']:>8} "
-                            + " <- ".join(reversed(entry["where"][-3:]))
+                            + " <- ".join(entry["where"][:4])
                         )
     return 0
 
