@@ -10,7 +10,11 @@ searched (``path corners``: exact among that many corners; ``straight``: obstacl
 past the corner limit), and median wall seconds of the proof search and of the per-bound
 slacks (one bisection of 40 exact evaluations per bound).
 
-``python bench/bench_deadlines.py`` prints a markdown table.
+A second table compares the metrics the plan minimises: the same missions compiled with
+``options.cost: length`` and ``options.cost: time`` in one run, each plan's first entry into
+the goal over the earliest possible time, with the medians over the missions.
+
+``python bench/bench_deadlines.py`` prints the two markdown tables.
 """
 
 from __future__ import annotations
@@ -59,9 +63,67 @@ def _median(function: Any, repeats: int) -> tuple[Any, float]:
     return value, statistics.median(times)
 
 
+def _entry(trace: dict[str, Any], goal: str) -> float | None:
+    """The first time the trace's polyline touches the closed goal (None: never)."""
+    import shapely
+
+    region = shapely.Polygon(trace["regions"][goal])
+    for (t0, x0, y0), (t1, x1, y1) in itertools.pairwise(trace["points"]):
+        segment = shapely.LineString([(x0, y0), (x1, y1)])
+        if segment.intersects(region):
+            hit = segment.intersection(region)
+            along = min(segment.project(shapely.Point(c)) for c in hit.coords)
+            return float(t0 + (t1 - t0) * along / max(segment.length, 1e-300))
+    return None
+
+
+def run_metrics(repeats: int = 3) -> list[dict[str, Any]]:
+    """The plan's first entry into the goal over the earliest possible time, planned with
+    ``options.cost: length`` and ``time`` side by side (one row per mission, then the
+    medians), with the time metric's rounds and the median wall seconds of each compile."""
+    from tlmpc.mission import load_mission_text
+    from tlmpc.pipeline.stages import WITNESS, compile_mission
+    from tlmpc.planning import deadlines
+    from tlmpc.planning.mission import abstraction_for
+
+    rows: list[dict[str, Any]] = []
+    with tempfile.TemporaryDirectory() as folder:
+        for name, document, goal, rest in _missions():
+            document = dict(document)
+            document.pop("task", None)
+            far = f"F[0,100000] {goal}" + (f" & {rest}" if rest else "")
+            document["ltl"] = far.replace("100000", "0")
+            mission = load_mission_text(yaml.safe_dump(document, sort_keys=False), "m.yaml")
+            proofs = deadlines.deadline_proofs(mission, abstraction_for(mission, 0.0, deep=False))
+            earliest = proofs[0].earliest if proofs else 0.0
+            row: dict[str, Any] = {"mission": name, "earliest possible (s)": round(earliest, 2)}
+            for metric in ("length", "time"):
+                document["ltl"] = far
+                document["options"] = {**(document.get("options") or {}), "cost": metric}
+                text = yaml.safe_dump(document, sort_keys=False)
+                path = Path(folder) / "m.yaml"
+                result, seconds = _median(
+                    functools.partial(compile_mission, path, text=text, figures=()), repeats
+                )
+                entry = _entry(result.artifacts["trace.json"], goal)
+                row[f"{metric}: enters (s)"] = round(entry or float("nan"), 2)
+                row[f"{metric} / earliest"] = (
+                    round((entry or 0.0) / earliest, 3) if earliest else None
+                )
+                row[f"{metric}: compile s"] = round(seconds, 3)
+                if metric == "time":
+                    row["time rounds"] = result.compilation.get(WITNESS).stats.get("time_rounds")
+            rows.append(row)
+    ratios = {
+        key: statistics.median(r[key] for r in rows if r[key] is not None)
+        for key in ("length / earliest", "time / earliest")
+    }
+    rows.append({"mission": "median", **{k: round(v, 3) for k, v in ratios.items()}})
+    return rows
+
+
 def run(repeats: int = 3) -> list[dict[str, Any]]:
     """One row per mission."""
-    import shapely
 
     from tlmpc.ltl.ast import Prop
     from tlmpc.ltl.bounds import untimed_skeleton
@@ -83,15 +145,7 @@ def run(repeats: int = 3) -> list[dict[str, Any]]:
             text = yaml.safe_dump(document, sort_keys=False)
             result = compile_mission(Path(folder) / "m.yaml", text=text)
             trace = result.artifacts["trace.json"]
-            region = shapely.Polygon(trace["regions"][goal])
-            entry = None
-            for (t0, x0, y0), (t1, x1, y1) in itertools.pairwise(trace["points"]):
-                segment = shapely.LineString([(x0, y0), (x1, y1)])
-                if segment.intersects(region):
-                    hit = segment.intersection(region)
-                    along = min(segment.project(shapely.Point(c)) for c in hit.coords)
-                    entry = t0 + (t1 - t0) * along / max(segment.length, 1e-300)
-                    break
+            entry = _entry(trace, goal)
             document["ltl"] = far.replace("100000", "0")
             mission = load_mission_text(yaml.safe_dump(document, sort_keys=False), "m.yaml")
             mesh = abstraction_for(mission, 0.0, deep=False)
@@ -128,3 +182,5 @@ if __name__ == "__main__":
     from bench.tables import markdown_table
 
     print(markdown_table(run()))
+    print()
+    print(markdown_table(run_metrics()))

@@ -148,8 +148,9 @@ def _compact_pieces(document: dict[Any, Any], shared: SharedTexts | None) -> Ite
     # The encoder sorts the items of a dict by key and writes each value independently of
     # its surroundings: the same text, piece by piece.  (The document has a text key, the
     # shared one: a key of another type beside it fails to sort here as in the encoder.)
+    order = sorted(document)
     texts: list[str | Iterator[str]] = []
-    for key in sorted(document):
+    for key in order:
         value = document[key]
         if isinstance(value, ArrayList | TableList):
             texts.append(encoded_pieces(value, _COMPACT))
@@ -157,7 +158,7 @@ def _compact_pieces(document: dict[Any, Any], shared: SharedTexts | None) -> Ite
             texts.append(shared.text(key, value))
         else:
             texts.append(_COMPACT.encode(value))
-    keys = [_COMPACT.encode(key) for key in sorted(document)]
+    keys = [_COMPACT.encode(key) for key in order]
     return _pieces(keys, texts)
 
 

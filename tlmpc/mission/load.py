@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 
 from tlmpc.base.errors import Diagnostic, InvalidInputError, best_first, error
 from tlmpc.io.schema_check import is_valid, load_schema
-from tlmpc.ltl.ast import Formula, Prop, conjoin
+from tlmpc.ltl.ast import Formula, Prop, bounded_operators, conjoin
 from tlmpc.ltl.keywords import KEYWORDS
 from tlmpc.ltl.transform import substitute
 from tlmpc.mission.geometry import check_layout, check_shape
@@ -724,7 +724,9 @@ def _load_data(text: str, file: str, stem: str) -> tuple[Mission | None, list[Di
         options=Options(
             min_angle=options.get("min_angle", defaults.min_angle),
             max_area=options.get("max_area", defaults.max_area),
-            cost=options.get("cost", defaults.cost),
+            # a task with time bounds is planned for minimum time unless the mission says
+            # otherwise (docs/planning.md)
+            cost=options.get("cost", "time" if bounded_operators(formula) else defaults.cost),
             beta=float(options.get("beta", defaults.beta)),
             boundary=options.get("boundary", defaults.boundary),
             margin=float(options["margin"]) if "margin" in options else None,

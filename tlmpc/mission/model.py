@@ -15,7 +15,7 @@ from tlmpc.ltl.ast import Formula
 Point = tuple[float, float]
 Polygon = tuple[Point, ...]
 
-CostMetric = Literal["length", "hops"]
+CostMetric = Literal["length", "hops", "time"]
 BoundaryConvention = Literal["right", "closed"]
 RobotModel = Literal["point", "unicycle"]
 

@@ -20,7 +20,16 @@ from typing import Any
 
 from tlmpc.abstraction.model import Abstraction
 from tlmpc.base.errors import EXIT_INCONCLUSIVE, Diagnostic, NoPlanError, TlmpcError
-from tlmpc.ltl.ast import And, bounded_operators
+from tlmpc.ltl.ast import (
+    And,
+    BoundedEventually,
+    BoundedUntil,
+    Equiv,
+    Formula,
+    Implies,
+    Not,
+    bounded_operators,
+)
 from tlmpc.ltl.printer import to_text
 from tlmpc.mission.model import Mission
 from tlmpc.planning.deadlines import DeadlineBound
@@ -57,10 +66,9 @@ def check_time_bounds(
     from tlmpc.verify.trace_input import from_document
 
     outcome, slacks = bound_slacks(from_document(dict(trace)))
-    report = [{"bound": s.bound, "slack": _seconds(s.slack)} for s in slacks]
-    if outcome == "satisfied":
-        return {"bounds": report}
     bounds = _bounds(mission, abstraction)
+    if outcome == "satisfied":
+        return {"bounds": bound_report(mission.formula, slacks, bounds)}
     proofs = [b for b in bounds if b.proven]
     if proofs:
         raise NoPlanError(
@@ -84,18 +92,93 @@ def check_time_bounds(
         Diagnostic(
             code="P051",
             message="no plan was found that meets the task's time bounds (none is proven "
-            "impossible): the minimum-cost plan of the untimed task misses "
+            f"impossible): the {_planned(mission)} plan of the untimed task misses "
             + _missed(slacks)
             + _earliest(bounds),
-            hint="the plan minimises path length, not the time to each goal, and its "
-            "controllers do not drive the shortest path at full speed: deadlines between the "
-            "earliest possible time and the plan's are not decided. Looser bounds, a faster "
-            "robot or a task that fixes the order of the goals may help",
+            hint=_why_no_plan(mission)
+            + ": deadlines between the earliest possible time and the plan's are not "
+            "decided. Looser bounds, a faster robot or a task that fixes the order of the "
+            "goals may help",
             file=mission.source,
             line=where[0],
             col=where[1],
         )
     )
+
+
+def _planned(mission: Mission) -> str:
+    """What the plan minimised, in words."""
+    return {"time": "minimum-time", "length": "shortest", "hops": "fewest-moves"}.get(
+        mission.options.cost, "minimum-cost"
+    )
+
+
+def _why_no_plan(mission: Mission) -> str:
+    """Why a plan can miss a deadline that some trajectory meets."""
+    if mission.options.cost == "time":
+        return (
+            "the plan minimises the exact time of the whole run (not the time to each goal), "
+            "and its controllers do not drive the shortest path at full speed"
+        )
+    return (
+        f"the plan minimises {'path length' if mission.options.cost == 'length' else 'moves'}"
+        ", not time (options.cost: time plans for it), and its controllers do not drive the "
+        "shortest path at full speed"
+    )
+
+
+def bound_report(
+    formula: Formula, slacks: Sequence[BoundSlack], bounds: Sequence[DeadlineBound]
+) -> list[dict[str, Any]]:
+    """``summary.json``'s ``bounds``: per bounded operator of ``formula`` (pre-order) its
+    ``slack``; for a deadline (``F[0,T]``, ``U[0,T]`` occurring positively) the plan's
+    exact ``time`` for it (``T - slack``: the tightest deadline the trajectory meets); and
+    where the proof search bounds that operator's own window, its ``lower_bound`` (the
+    earliest any trajectory can do it, seconds).  None where a number has no meaning."""
+    deadlines = _positive_deadlines(formula)
+    earliest: dict[str, float] = {}
+    for proof in bounds:
+        if proof.operator:
+            earliest[proof.operator] = max(earliest.get(proof.operator, 0.0), proof.earliest)
+    report: list[dict[str, Any]] = []
+    for index, found in enumerate(slacks):
+        high = deadlines.get(index)
+        time = None
+        if high is not None and found.slack is not None and math.isfinite(found.slack):
+            time = high - found.slack
+        report.append(
+            {
+                "bound": found.bound,
+                "slack": _seconds(found.slack),
+                "time": time,
+                "lower_bound": earliest.get(found.bound),
+            }
+        )
+    return report
+
+
+def _positive_deadlines(formula: Formula) -> dict[int, float]:
+    """The deadline ``T`` of each ``F[0,T]``/``U[0,T]`` (finite ``T``) that occurs only
+    positively, by its index among the formula's bounded operators (pre-order)."""
+    index_of = {id(node): k for k, node in enumerate(bounded_operators(formula))}
+    found: dict[int, float] = {}
+    stack: list[tuple[Formula, bool | None]] = [(formula, True)]
+    while stack:
+        node, positive = stack.pop()
+        if isinstance(node, BoundedEventually | BoundedUntil) and positive:
+            interval = node.interval
+            if interval.low == 0.0 and math.isfinite(interval.high):
+                found[index_of[id(node)]] = interval.high
+        if isinstance(node, Not):
+            stack.append((node.arg, None if positive is None else not positive))
+        elif isinstance(node, Implies):
+            stack.append((node.left, None if positive is None else not positive))
+            stack.append((node.right, positive))
+        elif isinstance(node, Equiv):
+            stack.extend((child, None) for child in node.children())
+        else:
+            stack.extend((child, positive) for child in node.children())
+    return found
 
 
 def _missed(slacks: tuple[BoundSlack, ...]) -> str:

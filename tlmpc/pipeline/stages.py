@@ -261,14 +261,15 @@ def _automaton(c: Compilation) -> StageResult:
 def _plan(c: Compilation) -> StageResult:
     from tlmpc.abstraction.io import abstraction_document
     from tlmpc.automata import automaton_to_json, to_hoa
+    from tlmpc.pipeline.mintime import plan_minimum_time
     from tlmpc.planning import witness_to_json
-    from tlmpc.planning.mission import plan_mission
 
     built = c.get(ABSTRACTION)
     # The plan may need U-turns (a locally refined mesh) or, when no plan reaches the goal
     # depth or keeps the margin, the mesh and automaton without them: either replaces the
-    # built one (and its artifacts) for every later stage.
-    planned = plan_mission(c.get(MISSION), built, c.get(AUTOMATON))
+    # built one (and its artifacts) for every later stage.  Under the time metric the plan
+    # is re-weighed with its exact simulated step times (tlmpc.pipeline.mintime).
+    planned = plan_minimum_time(c.get(MISSION), built, c.get(AUTOMATON))
     abstraction, witness = planned.abstraction, planned.witness
     artifacts: dict[str, Any] = {}
     if planned.automaton is not c.get(AUTOMATON):  # without margin, or the durations held
@@ -292,6 +293,14 @@ def _plan(c: Compilation) -> StageResult:
             "prefix": len(witness.prefix),
             "cycle": len(witness.cycle),
             "cost": round(witness.cost, 6),
+            **(
+                {
+                    "exact time": round(witness.stats["exact_time"], 3),
+                    "rounds": witness.stats["time_rounds"],
+                }
+                if "exact_time" in witness.stats
+                else {}
+            ),
             "product nodes": witness.stats.get("product_nodes"),
             "reached": witness.stats.get("product_reached"),
             **({"triangles after U-turn splits": abstraction.num_triangles} if refined else {}),

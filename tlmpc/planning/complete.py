@@ -25,6 +25,7 @@ from tlmpc.planning.explain import explain_infeasible
 from tlmpc.planning.model import Witness
 from tlmpc.planning.passages import passage_turns
 from tlmpc.planning.plan import plan
+from tlmpc.planning.timing import MoveTimes
 
 #: Rounds of refinement before giving up (one always suffices; see the module docstring).
 MAX_ROUNDS = 3
@@ -66,13 +67,15 @@ def plan_complete(
     resume: frozenset[int] | None = None,
     explain: bool = True,
     reject: float | None = None,
+    times: MoveTimes | None = None,
 ) -> tuple[Abstraction, Witness]:
     """A witness on ``abstraction`` or on a locally refined copy of it (returned with it).
 
     Raises :class:`NoPlanError` only when no trajectory in the plane satisfies the task;
     ``parts`` gives the task's parts for that explanation (called only then, and only with
     ``explain``: a run re-planning under way needs no explanation).  ``resume`` re-plans a
-    run under way (see :func:`tlmpc.planning.plan.plan`).
+    run under way (see :func:`tlmpc.planning.plan.plan`); ``times`` weighs the moves under
+    the ``time`` metric (:mod:`tlmpc.planning.timing`).
     """
 
     try:
@@ -84,6 +87,7 @@ def plan_complete(
             start_point,
             resume=resume,
             reject=reject,
+            times=times,
         )
     except NoPlanError as first:
         no_bounce_failure = first
@@ -97,6 +101,7 @@ def plan_complete(
             passages=False,
             resume=resume,
             reject=reject,
+            times=times,
         )
     except NoPlanError:
         if reject:
@@ -112,6 +117,7 @@ def plan_complete(
             passages=True,
             resume=resume,
             reject=reject,
+            times=times,
         )
     except NoPlanError:
         pass
@@ -125,6 +131,7 @@ def plan_complete(
             passages=True,
             resume=resume,
             reject=reject,
+            times=times,
         )
     except NoPlanError:
         if not explain:
@@ -181,6 +188,7 @@ def _attempt(
     passages: bool = False,
     resume: frozenset[int] | None = None,
     reject: float | None = None,
+    times: MoveTimes | None = None,
 ) -> Witness:
     return plan(
         mesh,
@@ -192,6 +200,7 @@ def _attempt(
         passages=passages,
         resume=resume,
         reject=reject,
+        times=times,
     )
 
 
@@ -205,6 +214,7 @@ def _refined(
     passages: bool,
     resume: frozenset[int] | None = None,
     reject: float | None = None,
+    times: MoveTimes | None = None,
 ) -> tuple[Abstraction, Witness]:
     """A no-bounce witness on a mesh refined where a bouncing lasso turns around; raises
     :class:`NoPlanError` when no bouncing lasso exists on ``abstraction``."""
@@ -221,6 +231,7 @@ def _refined(
                 passages=passages,
                 resume=resume,
                 reject=reject,
+                times=times,
             )
         except NoPlanError:
             if mesh is abstraction:
@@ -240,6 +251,7 @@ def _refined(
                 passages=passages,
                 resume=resume,
                 reject=reject,
+                times=times,
             )
         except NoPlanError:
             continue

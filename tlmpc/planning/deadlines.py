@@ -84,6 +84,9 @@ class DeadlineBound:
     span: Span | None = None
     #: The top-level conjunct of the task the proof is about (the first, for several).
     anchor: str = ""
+    #: The bounded operator (as printed) whose own window ``deadline`` is, when it is one
+    #: operator's (empty for sums of windows and for several deadlines together).
+    operator: str = ""
 
     @property
     def proven(self) -> bool:
@@ -114,12 +117,20 @@ class _Goal:
 def _chain(formula: Formula) -> list[tuple[Formula, float | None]] | None:
     """``p1 & F[0,T2](p2 & ...)`` as ``[(p1, None), (p2, T2), ...]`` (an unbounded ``F``
     step: ``T = None``, the chain ends there); None outside the fragment."""
-    steps: list[tuple[Formula, float | None]] = []
+    found = _chain_operators(formula)
+    return None if found is None else [(goal, window) for goal, window, _ in found]
+
+
+def _chain_operators(formula: Formula) -> list[tuple[Formula, float | None, str]] | None:
+    """:func:`_chain` with the bounded operator (as printed) that brings each step's window
+    (empty for the first step and unbounded ones)."""
+    steps: list[tuple[Formula, float | None, str]] = []
     current: Formula | None = formula
     window: float | None = None
+    operator = ""
     while current is not None:
         if is_propositional(current):
-            steps.append((current, window))
+            steps.append((current, window, operator))
             return steps
         if not isinstance(current, And):
             return None
@@ -128,12 +139,12 @@ def _chain(formula: Formula) -> list[tuple[Formula, float | None]] | None:
         if len(rest) != 1 or not goals:
             return None
         goal = goals[0] if len(goals) == 1 else And(tuple(goals))
-        steps.append((goal, window))
+        steps.append((goal, window, operator))
         nxt = rest[0]
         if isinstance(nxt, BoundedEventually) and nxt.interval.low == 0.0:
-            current, window = nxt.arg, nxt.interval.high
+            current, window, operator = nxt.arg, nxt.interval.high, to_text(nxt)
         elif isinstance(nxt, Eventually):
-            current, window = nxt.arg, None
+            current, window, operator = nxt.arg, None, ""
         else:
             return None
     return steps  # pragma: no cover - the loop returns
@@ -361,21 +372,26 @@ def deadline_bounds(mission: Mission, abstraction: Abstraction) -> tuple[Deadlin
         return goals[p]
 
     deadlines: list[tuple[Formula, list[tuple[Formula, float | None]], float]] = []
+    #: per deadline: the operator of each step's own window (the first: the deadline's)
+    operators: list[list[str]] = []
     patrolled: list[Formula] = []
-    periods: list[tuple[Formula, Formula, float]] = []
+    periods: list[tuple[Formula, Formula, float, str]] = []
     for part in conjuncts:
         match part:
             case BoundedEventually(arg, interval) if interval.low == 0.0:
-                chain = _chain(arg)
-                if chain is not None and math.isfinite(interval.high):
-                    deadlines.append((part, chain, interval.high))
+                steps = _chain_operators(arg)
+                if steps is not None and math.isfinite(interval.high):
+                    deadlines.append((part, [(g, w) for g, w, _ in steps], interval.high))
+                    operators.append([to_text(part), *(o for _, _, o in steps[1:])])
             case Globally(BoundedEventually(arg, interval)) if (
                 interval.low == 0.0 and is_propositional(arg)
             ):
                 patrolled.append(arg)
                 if math.isfinite(interval.high):
-                    periods.append((part, arg, interval.high))
+                    inner = to_text(BoundedEventually(arg, interval))
+                    periods.append((part, arg, interval.high, inner))
                     deadlines.append((part, [(arg, None)], interval.high))
+                    operators.append([inner])
             case Globally(Eventually(arg)) if is_propositional(arg):
                 patrolled.append(arg)
             case _:
@@ -388,7 +404,9 @@ def deadline_bounds(mission: Mission, abstraction: Abstraction) -> tuple[Deadlin
     paths = _Paths(free, list(goals.values()))
     bounds: list[DeadlineBound] = []
 
-    def bound(part: Formula, what: str, deadline: float, distance: float) -> DeadlineBound:
+    def bound(
+        part: Formula, what: str, deadline: float, distance: float, operator: str = ""
+    ) -> DeadlineBound:
         distance = max(0.0, distance - TOLERANCE * free.scale)
         return DeadlineBound(
             conjunct=to_text(part),
@@ -399,6 +417,7 @@ def deadline_bounds(mission: Mission, abstraction: Abstraction) -> tuple[Deadlin
             speed=speed,
             span=part.span,
             anchor=to_text(part),
+            operator=operator,
         )
 
     def keep(found: DeadlineBound | None) -> bool:
@@ -407,7 +426,7 @@ def deadline_bounds(mission: Mission, abstraction: Abstraction) -> tuple[Deadlin
             bounds.append(found)
         return found is not None and found.proven
 
-    for part, chain, deadline in deadlines:
+    for (part, chain, deadline), own in zip(deadlines, operators, strict=True):
         reached = paths.through([goal(p) for p, _ in chain])
         total = deadline
         names: list[str] = []
@@ -417,21 +436,22 @@ def deadline_bounds(mission: Mission, abstraction: Abstraction) -> tuple[Deadlin
                     break
                 total += window
                 gap = paths.leg(goal(chain[index - 1][0]), goal(p))
-                if keep(bound(part, f"going from {names[-1]} to {to_text(p)}", window, gap)):
+                what = f"going from {names[-1]} to {to_text(p)}"
+                if keep(bound(part, what, window, gap, own[index])):
                     break
             names.append(to_text(p))
             what = "reaching " + ", then ".join(names) + " from the start"
-            if keep(bound(part, what, total, reached[index])):
+            if keep(bound(part, what, total, reached[index], own[0] if index == 0 else "")):
                 break
     single = [(part, chain[0][0], d) for part, chain, d in deadlines if len(chain) == 1]
     if 2 <= len(single) <= MAX_ORDERS_OF and not any(b.proven for b in bounds):
         keep(_every_order(single, paths, goal, bound))
-    for part, p, period in periods:
+    for part, p, period, inner in periods:
         for q in patrolled:
             if q != p:
                 gap = paths.leg(goal(p), goal(q))
                 what = f"a round trip from {to_text(p)} to {to_text(q)} and back"
-                if keep(bound(part, what, period, 2 * gap)):
+                if keep(bound(part, what, period, 2 * gap, inner)):
                     break
     return tuple(bounds)
 

@@ -27,6 +27,7 @@ from tlmpc.planning.product import (
     move_table,
     stutter_cells,
 )
+from tlmpc.planning.timing import MoveTimes
 
 
 @dataclass(frozen=True, slots=True)
@@ -161,6 +162,7 @@ def lazy_product(
     start_label: tuple[str, ...] = (),
     bounces: bool = False,
     realisable: tuple[BoolArray, BoolArray] | None = None,
+    times: MoveTimes | None = None,
 ) -> LazyProduct:
     """The product :func:`~tlmpc.planning.product.build_product` would build from the same
     arguments, as tables (nothing per product node).  With ``realisable`` a triangle without
@@ -176,6 +178,7 @@ def lazy_product(
         convention=convention,
         bounces=bounces,
         realisable=realisable,
+        times=times,
     )
     starts, classes, tri_class = table.starts, table.classes, table.tri_class
     moves, weight, raw_kind = table.moves, table.weight, table.kind

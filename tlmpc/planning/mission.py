@@ -28,6 +28,7 @@ from tlmpc.ltl.ast import Formula
 from tlmpc.mission.model import Mission, TaskPart
 from tlmpc.planning.model import Witness
 from tlmpc.planning.robust import witness_realisable
+from tlmpc.planning.timing import MoveTimes
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -42,6 +43,8 @@ class Planned:
     notes: tuple[Diagnostic, ...] = ()
     #: planned on a mesh rebuilt without the goal depth or the margin (with its own automaton)
     remeshed: bool = False
+    #: the untimed task the plan was made for (the skeleton, or the holding skeleton)
+    formula: Formula | None = None
 
 
 def abstraction_for(mission: Mission, margin: float, *, deep: bool = True) -> Abstraction:
@@ -98,6 +101,7 @@ def plan_mission(
     from tlmpc.mission.body import requested_margin
 
     skeleton = untimed_skeleton(mission.formula)
+    times = move_times(mission)
 
     def attempt(
         mesh: Abstraction, task: Automaton, formula: Formula = skeleton, explain: bool = True
@@ -135,8 +139,9 @@ def plan_mission(
             resume=resume,
             explain=explain and resume is None and reject is None,
             reject=reject,
+            times=times,
         )
-        return Planned(abstraction=planned_mesh, automaton=task, witness=witness)
+        return Planned(abstraction=planned_mesh, automaton=task, witness=witness, formula=formula)
 
     holding = holding_skeleton(mission.formula)
     if resume is None and holding != skeleton:
@@ -183,13 +188,52 @@ def plan_mission(
         "options.margin to plan with a smaller one",
         file=mission.source,
     )
-    return Planned(
-        abstraction=planned.abstraction,
-        automaton=planned.automaton,
-        witness=planned.witness,
-        notes=(note,),
-        remeshed=True,
+    return replace(planned, notes=(note,), remeshed=True)
+
+
+def move_times(mission: Mission, measured: MoveTimes | None = None) -> MoveTimes | None:
+    """What the ``time`` metric weighs moves with for ``mission`` (None under the other
+    metrics): ``measured`` when given, else the estimates at the robot's top speed."""
+    if mission.options.cost != "time":
+        return None
+    return measured if measured is not None else MoveTimes(speed=mission.robot.max_speed)
+
+
+def replan(mission: Mission, planned: Planned, times: MoveTimes) -> Planned:
+    """``planned`` planned again with the moves weighing ``times``: on its own mesh, with its
+    own automaton and task (no fallback: the plan it replaces exists there), U-turn
+    refinement and vertex passages as the first plan needed them."""
+    from tlmpc.planning.complete import plan_complete
+
+    formula = planned.formula
+    if formula is None:
+        from tlmpc.ltl.bounds import untimed_skeleton
+
+        formula = untimed_skeleton(mission.formula)
+    ratio = mission.robot.disturbance / mission.robot.max_speed
+    reject = None
+    mesh, witness = plan_complete(
+        planned.abstraction,
+        planned.automaton,
+        formula=formula,
+        options=mission.options,
+        start_point=mission.robot.start,
+        explain=False,
+        times=times,
     )
+    if not witness_realisable(mesh, witness, ratio):
+        reject = ratio
+        mesh, witness = plan_complete(
+            planned.abstraction,
+            planned.automaton,
+            formula=formula,
+            options=mission.options,
+            start_point=mission.robot.start,
+            explain=False,
+            reject=reject,
+            times=times,
+        )
+    return replace(planned, abstraction=mesh, witness=witness)
 
 
 def _shallow_note(mission: Mission, failure: NoPlanError) -> Diagnostic:

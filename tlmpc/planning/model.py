@@ -34,7 +34,7 @@ class Witness(ContentEquality):
     cycle_states: tuple[int, ...]  # automaton state after reading each cycle triangle
     word: tuple[tuple[str, ...], ...]  # label set of each triangle of prefix + cycle
     cost: float
-    metric: Literal["length", "hops"]
+    metric: Literal["length", "hops", "time"]
     beta: float
     prefix_cost: float
     cycle_cost: float

@@ -38,6 +38,7 @@ from tlmpc.planning.contacts import contact_vertices, vertex_point_letters
 from tlmpc.planning.model import Witness
 from tlmpc.planning.product import SLOTS, START_SLOT, STUTTER_COST, BoolArray, Product
 from tlmpc.planning.search import Graph
+from tlmpc.planning.timing import MoveTimes
 
 Letter = tuple[str, ...]
 
@@ -74,6 +75,7 @@ def add_vertex_passages(
     metric: str,
     convention: str,
     bounces: bool = False,
+    times: MoveTimes | None = None,
 ) -> tuple[Product, PassageCells]:
     """``product`` with vertex passages (see the module doc) and its arrival cells.
 
@@ -118,7 +120,7 @@ def add_vertex_passages(
         closed=convention == "closed",
     )
     reader = _WordReader(automaton, letters.letters)
-    edges = _passage_edges(moves, reader, metric, nq)
+    edges = _passage_edges(moves, reader, metric, nq, times)
     size = base + count * nq
     stutter = np.zeros(size, dtype=bool)
     stutter[: product.num_nodes] = product.stutter_accepting
@@ -419,12 +421,21 @@ class _EdgeBatches:
         return self
 
 
-def _passage_edges(moves: _PassageMoves, reader: _WordReader, metric: str, nq: int) -> _EdgeBatches:
+def _passage_edges(
+    moves: _PassageMoves,
+    reader: _WordReader,
+    metric: str,
+    nq: int,
+    times: MoveTimes | None = None,
+) -> _EdgeBatches:
     """The product edges of the passage moves: per kind of move (the classes of the letters
-    it reads) and automaton state, one edge per successor state."""
+    it reads) and automaton state, one edge per successor state.  Under ``"time"`` a
+    passage weighs its length at top speed (its pursuit runs at ``max_speed``)."""
     src_off = np.concatenate(moves.source)
     dst_off = np.concatenate(moves.target)
     lengths = np.concatenate(moves.length)
+    if metric == "time" and times is not None:
+        lengths = lengths * times.seconds_per_length()
     weight = np.ones(len(lengths)) if metric == "hops" else lengths + STUTTER_COST
     first = np.concatenate(moves.first)
     second = np.concatenate(moves.second)

@@ -40,6 +40,7 @@ from tlmpc.planning.passages import PassageCells, add_vertex_passages
 from tlmpc.planning.product import SLOTS, START_SLOT, BoolArray, Product, build_product
 from tlmpc.planning.robust import realisable
 from tlmpc.planning.search import closing_searches, shortest_paths
+from tlmpc.planning.timing import MoveTimes
 
 #: At most this many cycle candidates are closed with a shortest-path search; past it the
 #: witness is the best found and records ``optimal: false``.
@@ -101,6 +102,7 @@ def plan(
     passages: bool = False,
     guided: bool | None = None,
     reject: float | None = None,
+    times: MoveTimes | None = None,
 ) -> Witness:
     """A minimum-cost accepting lasso (raises :class:`NoPlanError` with an explanation).
 
@@ -114,8 +116,12 @@ def plan(
     default only when the product would not fit the budget (:mod:`tlmpc.planning.budget`).
     With ``reject`` (a disturbance over max_speed) only the moves and stays the controllers
     realise under it are used (:mod:`tlmpc.planning.robust`).
+    Under ``options.cost: time`` the moves weigh ``times`` (:mod:`tlmpc.planning.timing`;
+    without it, their lengths at unit speed).
     """
     started = time.perf_counter()
+    if options.cost == "time" and times is None:
+        times = MoveTimes(speed=1.0)
     allowed = invariant_mask(abstraction, formula)
     working = degeneralize(automaton) if automaton.num_acc >= 2 else automaton
     if start_point is None:
@@ -155,6 +161,7 @@ def plan(
             start_label=start_label,
             bounces=bounces,
             realisable=realisable_steps,
+            times=times,
         )
         if resume is not None:
             initial = _resumed(abstraction, allowed, working, resume)
@@ -191,6 +198,7 @@ def plan(
         start_label=start_label,
         bounces=bounces,
         realisable=realisable_steps,
+        times=times,
     )
     cells: PassageCells | None = None
     if passages:
@@ -204,6 +212,7 @@ def plan(
             metric=options.cost,
             convention=options.boundary,
             bounces=bounces,
+            times=times,
         )
 
     if resume is not None:

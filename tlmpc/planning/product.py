@@ -28,6 +28,7 @@ from tlmpc.automata.model import Automaton
 from tlmpc.base.content import ContentEquality
 from tlmpc.planning.boundary import POINT, StartCell, crossing_letter, start_cells
 from tlmpc.planning.search import Graph
+from tlmpc.planning.timing import MoveTimes, move_time_table
 
 SLOTS = 4  # three edges, and "no entry edge yet" for the start
 START_SLOT = 3
@@ -107,11 +108,13 @@ def build_product(
     start_label: tuple[str, ...] = (),
     bounces: bool = False,
     realisable: tuple[BoolArray, BoolArray] | None = None,
+    times: MoveTimes | None = None,
 ) -> Product:
     """The product graph restricted to ``allowed`` triangles.
 
     ``metric`` is ``"length"`` (Euclidean length through the crossed edges' midpoints,
-    starting at ``start_point``) or ``"hops"`` (one per move).  ``bounces=True`` also allows
+    starting at ``start_point``), ``"hops"`` (one per move) or ``"time"`` (seconds per move,
+    ``times``: :mod:`tlmpc.planning.timing`).  ``bounces=True`` also allows
     leaving a triangle through its entry edge: that graph is stutter-equivalent to the face
     graph of the region arrangement, so it decides whether *any* continuous trajectory
     satisfies the task (see docs/planning.md); its bounces are realised by refinement.
@@ -135,6 +138,7 @@ def build_product(
         convention=convention,
         bounces=bounces,
         realisable=realisable,
+        times=times,
         # moves are numbered on the (triangle, slot, exit) grid, cells below the node count
         dtype=index_dtype(max(size, abstraction.num_triangles * SLOTS * 3)),
     )
@@ -187,6 +191,7 @@ def move_table(
     convention: str,
     bounces: bool,
     realisable: tuple[BoolArray, BoolArray] | None,
+    times: MoveTimes | None = None,
     dtype: type[np.signedinteger[Any]] = np.int64,
 ) -> MoveTable:
     """The moves of the product over ``abstraction`` and ``automaton`` (arguments as for
@@ -200,7 +205,7 @@ def move_table(
     moves = ts_moves(
         abstraction, allowed, starts, bounces=bounces, realisable=realisable, dtype=dtype
     )
-    weight = move_weights(abstraction, moves, start_point, metric)
+    weight = move_weights(abstraction, moves, start_point, metric, times)
     if convention == "closed":
         kind = crossing_move_kinds(abstraction, automaton, classes, tri_class, moves)
     else:
@@ -306,13 +311,36 @@ def entry_slots(neighbors: IntArray) -> IntArray:
 
 
 def move_weights(
-    abstraction: Abstraction, moves: _Moves, start_point: tuple[float, float], metric: str
+    abstraction: Abstraction,
+    moves: _Moves,
+    start_point: tuple[float, float],
+    metric: str,
+    times: MoveTimes | None = None,
 ) -> FloatArray:
-    """Each move's weight: one under ``"hops"``, else its length (:func:`_move_lengths`)."""
+    """Each move's weight: one under ``"hops"``, its seconds under ``"time"``
+    (:func:`~tlmpc.planning.timing.move_time_table` of ``times``), else its length
+    (:func:`_move_lengths`)."""
     if metric == "hops":
         return np.ones(len(moves.flat))
-    lengths: FloatArray = _move_lengths(abstraction, start_point).reshape(-1)[moves.flat]
-    return lengths
+    grid = move_weight_grid(abstraction, start_point, metric, times)
+    weights: FloatArray = grid.reshape(-1)[moves.flat]
+    return weights
+
+
+def move_weight_grid(
+    abstraction: Abstraction,
+    start_point: tuple[float, float],
+    metric: str,
+    times: MoveTimes | None = None,
+) -> FloatArray:
+    """(m, SLOTS, 3): the weight of every move of D on the (triangle, slot, exit) grid under
+    ``"length"`` or ``"time"`` (which needs ``times``)."""
+    lengths = _move_lengths(abstraction, start_point)
+    if metric != "time":
+        return lengths
+    if times is None:
+        raise ValueError("the time metric needs the robot's speed (MoveTimes)")
+    return move_time_table(abstraction, lengths, times)
 
 
 def crossing_move_kinds(

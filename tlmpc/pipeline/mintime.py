@@ -1,0 +1,206 @@
+"""Planning for minimum time (``options.cost: time``): plan, simulate exactly, re-weigh, re-plan.
+
+The time a plan step takes depends on its controller and on where the robot enters the
+triangle, and both exist only once the whole plan is known (the controllers of consecutive
+steps share their vertex velocities).  So the minimum-time plan is found by iterating:
+
+1. plan with every move weighing its estimate (its length at top speed,
+   :mod:`tlmpc.planning.timing`);
+2. synthesise the plan's controllers and simulate its trajectory exactly (the control and
+   simulate stages' own code); the plan's **exact time** is the time its trajectory needs for
+   the prefix plus ``beta`` times one lap of the cycle (the second simulated lap, entered from
+   the end of the first; a stay: the time to enter its triangle);
+3. every move the plan used now weighs the time its step took on that trajectory (a move
+   used twice: its last use; the cycle's from the second lap); the other moves keep their
+   weights, and the plan is made again;
+4. stop at a **fixed point** (the new plan is one already simulated, or the plan's exact
+   time equals its planned cost: every weight on it is measured where it was used) or after
+   :data:`MAX_REPLANS` re-plans, and keep the plan of least exact time (the first on ties)
+   among those whose trajectory meets the task's time bounds (the dense-time verifier's
+   verdict), or among all when none does.
+
+Every round is deterministic, so the result is the same bytes on any machine.  What is
+promised is stated in docs/planning.md: the kept plan is the fastest of those simulated (that
+meet the time bounds, when one does), and
+at a fixed point no plan is cheaper under the weights (exact times of the moves where the
+simulated plans used them, estimates elsewhere).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
+from typing import Any
+
+from tlmpc.abstraction.model import Abstraction
+from tlmpc.automata.model import Automaton
+from tlmpc.base.errors import TlmpcError
+from tlmpc.control.model import Controllers, StepController
+from tlmpc.ltl.ast import bounded_operators
+from tlmpc.mission.model import Mission
+from tlmpc.planning.mission import Planned, plan_mission, replan
+from tlmpc.planning.product import START_SLOT
+from tlmpc.planning.timing import MoveKey, MoveTimes, move_key
+from tlmpc.simulate.exact import Trace
+
+#: At most this many re-plans after the first plan (each costs a plan, a controller
+#: synthesis and an exact simulation).
+MAX_REPLANS = 8
+#: A plan's exact time "equals" its planned cost within this fraction of it (rounding).
+FIXED_POINT_TOLERANCE = 1e-9
+
+
+@dataclass(frozen=True, slots=True)
+class Measured:
+    """A plan's exact time and the simulated time of each move it used; whether its
+    trajectory meets the task's time bounds (True for a task without any)."""
+
+    exact_time: float
+    moves: Mapping[MoveKey, float]
+    meets_bounds: bool = True
+
+
+def plan_minimum_time(mission: Mission, abstraction: Abstraction, automaton: Automaton) -> Planned:
+    """The plan of ``mission`` (as :func:`~tlmpc.planning.mission.plan_mission`) of least
+    exact time among the rounds of the module doc, preferring those whose trajectory meets
+    the task's time bounds; other metrics: the plan as it is.
+
+    The witness's ``stats`` record ``exact_time`` (seconds), ``time_rounds`` (plans
+    simulated), ``time_fixed_point``, ``exact_times`` (each round's, in order) and, for a
+    task with time bounds, ``bounds_met`` (each round's).
+    """
+    first = plan_mission(mission, abstraction, automaton)
+    if mission.options.cost != "time":
+        return first
+    speed = mission.robot.max_speed
+    measured: dict[MoveKey, float] = {}
+    history: list[float] = []
+    met: list[bool] = []
+    seen = {_shape(first)}
+    best: tuple[tuple[bool, float], Planned] | None = None
+    current = first
+    fixed = False
+    for round_index in range(MAX_REPLANS + 1):
+        try:
+            found = measure(mission, current)
+        except TlmpcError:
+            # the control or simulate stage will say why (for the first plan), or the
+            # re-plan is not realised: the best plan so far stands
+            break
+        history.append(found.exact_time)
+        met.append(found.meets_bounds)
+        # a plan that meets the time bounds first, then the faster
+        key = (not found.meets_bounds, found.exact_time)
+        if best is None or key < best[0]:
+            best = (key, current)
+        cost = current.witness.cost
+        if abs(found.exact_time - cost) <= FIXED_POINT_TOLERANCE * max(found.exact_time, 1.0):
+            fixed = True
+            break
+        if round_index == MAX_REPLANS:
+            break
+        measured.update(found.moves)
+        try:
+            following = replan(mission, current, MoveTimes(speed=speed, measured=dict(measured)))
+        except TlmpcError:
+            break
+        shape = _shape(following)
+        if shape in seen:
+            fixed = True
+            break
+        seen.add(shape)
+        current = following
+    if best is None:
+        return first
+    (_, exact), chosen = best
+    stats: dict[str, Any] = {
+        **chosen.witness.stats,
+        "exact_time": exact,
+        "time_rounds": len(history),
+        "time_fixed_point": fixed,
+        "exact_times": history,
+        **({"bounds_met": met} if bounded_operators(mission.formula) else {}),
+    }
+    return replace(chosen, witness=replace(chosen.witness, stats=stats))
+
+
+def _shape(planned: Planned) -> tuple[Any, ...]:
+    """What makes two plans the same run: the mesh's size, the triangles and passages."""
+    w = planned.witness
+    return (planned.abstraction.num_triangles, w.prefix, w.cycle, w.passages)
+
+
+def measure(mission: Mission, planned: Planned) -> Measured:
+    """Synthesise ``planned``'s controllers, simulate them exactly and time every step."""
+    from tlmpc.control import synthesize
+    from tlmpc.simulate import simulate
+
+    controllers = synthesize(
+        planned.abstraction, planned.witness, mission.robot, source=mission.source
+    )
+    trace = simulate(planned.abstraction, controllers, mission)
+    found = step_times(planned.abstraction, controllers, trace, planned.witness.beta)
+    if not bounded_operators(mission.formula):
+        return found
+    from tlmpc.simulate import trace_to_json
+    from tlmpc.verify.trace_input import from_document
+    from tlmpc.verify.verdict import bound_slacks
+
+    outcome, _ = bound_slacks(from_document(trace_to_json(trace, mission)))
+    return replace(found, meets_bounds=outcome == "satisfied")
+
+
+def step_times(
+    abstraction: Abstraction, controllers: Controllers, trace: Trace, beta: float
+) -> Measured:
+    """The exact time of the run ``trace`` of ``controllers`` (see the module doc) and the
+    time of each move of D it made, keyed by :func:`~tlmpc.planning.timing.move_key`.
+
+    The simulator runs the steps in order and then the cycle once more; every step but a
+    stay ends at a crossing sample (``trace.crossings``, one per such step in that order).
+    """
+    steps = controllers.steps
+    order = list(range(len(steps)))
+    loop = controllers.loop_start
+    if loop is not None:
+        order += order[loop:]
+    moving = [p for p, k in enumerate(order) if not steps[k].is_stay]
+    exit_time = {p: float(trace.times[trace.crossings[n]]) for n, p in enumerate(moving)}
+    moves: dict[MoveKey, float] = {}
+    previous_end = 0.0
+    for position, index in enumerate(order):
+        step = steps[index]
+        if step.is_stay:
+            break
+        end = exit_time[position]
+        slot = _entry_slot(abstraction, order, steps, position)
+        if slot is not None and step.exit_edge is not None:
+            moves[move_key(abstraction, step.triangle, slot, step.exit_edge)] = end - previous_end
+        previous_end = end
+    first_pass = len(steps)
+    if loop is None:
+        arrived = max((exit_time[p] for p in moving), default=0.0)
+        return Measured(exact_time=arrived, moves=moves)
+    prefix_time = exit_time[loop - 1] if loop > 0 else 0.0
+    lap = exit_time[len(order) - 1] - exit_time[first_pass - 1]
+    return Measured(exact_time=prefix_time + beta * lap, moves=moves)
+
+
+def _entry_slot(
+    abstraction: Abstraction,
+    order: list[int],
+    steps: tuple[StepController, ...],
+    position: int,
+) -> int | None:
+    """The edge of the step's triangle the robot entered it by (the start slot for the first
+    step); None next to a vertex passage (the move is not one of D's)."""
+    step = steps[order[position]]
+    if step.is_vertex:
+        return None
+    if position == 0:
+        return START_SLOT
+    before = steps[order[position - 1]]
+    if before.is_vertex:
+        return None
+    sides = abstraction.neighbors[step.triangle].tolist()
+    return sides.index(before.triangle) if before.triangle in sides else None
