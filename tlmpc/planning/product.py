@@ -542,7 +542,7 @@ def _product_edges(
         first = indptr[move_node + q] + offsets(q)
         for j in range(width):
             # The j-th successor of q over each kind of move (-1: none), and its mark.
-            following = np.full(max(move_kinds) + 1, -1, dtype=np.int64)
+            following = np.full(max(move_kinds) + 1, -1, dtype=node_type)  # a state
             marked = np.zeros(len(following), dtype=bool)
             for k in move_kinds:
                 if j < len(by_kind[k][q]):
@@ -551,7 +551,7 @@ def _product_edges(
             rows: slice | IntArray = slice(None)
             if not (following[move_kinds] >= 0).all():
                 rows = np.flatnonzero(following.take(move_kind) >= 0)
-            at = first[rows] + j
+            at = first if j == 0 and isinstance(rows, slice) else first[rows] + j
             dst[at] = move_target[rows] + following.take(move_kind[rows])
             wgt[at] = weight[rows]
             if marked.any():
