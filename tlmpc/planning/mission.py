@@ -117,7 +117,9 @@ def plan_mission(
         try:
             return complete(mesh, task, formula, explain, ratio)
         except (NoPlanError, RefinementError):
-            return first  # U-turn fans may have no realisable route either
+            # U-turn fans may have no realisable route either. The control stage refuses
+            # this plan (C032) and states the largest disturbance any plan on its mesh rejects.
+            return _with_supported(first, mission, formula, start_point)
 
     def complete(
         mesh: Abstraction, task: Automaton, formula: Formula, explain: bool, reject: float | None
@@ -138,25 +140,62 @@ def plan_mission(
         )
         return Planned(abstraction=planned_mesh, automaton=task, witness=witness)
 
+    from tlmpc.abstraction.layout import deepens_goals
+
+    margin = requested_margin(mission)
+
+    def realisable_depth(
+        planned: Planned, formula: Formula = skeleton, explain: bool = True
+    ) -> Planned:
+        """The goal depth yields to the disturbance: when the plan to the goal cores has a
+        step no controller realises, plan again entering the goals only as deep as the
+        margin asks (the cores' corners may be all that is too sharp)."""
+        ratio = mission.robot.disturbance / mission.robot.max_speed
+        if resume is not None or ratio <= 0.0 or not deepens_goals(mission):
+            return planned
+        if witness_realisable(planned.abstraction, planned.witness, ratio):
+            return planned
+        shallow = abstraction_for(mission, margin, deep=False)
+        try:
+            again = attempt(
+                shallow, automaton_for(mission, shallow, formula=formula), formula, explain
+            )
+        except NoPlanError:
+            return planned
+        if witness_realisable(again.abstraction, again.witness, ratio):
+            note = _shallow_for_disturbance(mission, planned.witness)
+            return replace(again, notes=(note,), remeshed=True)
+        # Neither realises the disturbance: the plan on the mesh whose plans reject more goes
+        # on to be refused, stating that mesh's bound (C032: the mission compiles below it).
+        deep_bound, shallow_bound = _supported_of(planned.witness), _supported_of(again.witness)
+        if shallow_bound is not None and (deep_bound is None or shallow_bound > deep_bound):
+            return replace(again, remeshed=True)
+        return planned
+
     holding = holding_skeleton(mission.formula)
     if resume is None and holding != skeleton:
         # Durations ("stay in X for at least T s") are met by a plan that stays for good,
         # when there is one; else the skeleton's plan, whose bounds are then checked.
         try:
-            return attempt(
-                abstraction, automaton_for(mission, abstraction, formula=holding), holding, False
+            return realisable_depth(
+                attempt(
+                    abstraction,
+                    automaton_for(mission, abstraction, formula=holding),
+                    holding,
+                    False,
+                ),
+                holding,
+                False,
             )
         except NoPlanError:
             pass
-    from tlmpc.abstraction.layout import deepens_goals
 
     try:
-        return attempt(abstraction, automaton)
+        return realisable_depth(attempt(abstraction, automaton))
     except NoPlanError as failure:
         if resume is not None:
             raise
         first = failure
-    margin = requested_margin(mission)
     if deepens_goals(mission):
         # the goal depth is an objective: plan again reaching the goals only as deep as the
         # margin asks (overlapping goals' cores may not meet where the regions do)
@@ -202,6 +241,58 @@ def _shallow_note(mission: Mission, failure: NoPlanError) -> Diagnostic:
         hint="goals that overlap only near their edges have deep parts that do not meet; "
         "set options.goal_depth to a smaller depth (0: the margin's) to plan with it",
         file=mission.source,
+    )
+
+
+#: The witness statistic that carries the largest disturbance any plan on its mesh rejects
+#: (in the units of max_speed), set only on a plan with a step that does not reject the
+#: mission's: the control stage states it when it refuses the plan (C032).
+SUPPORTED = "supported_disturbance"
+
+
+def _with_supported(
+    planned: Planned, mission: Mission, formula: Formula, start_point: tuple[float, float] | None
+) -> Planned:
+    """``planned`` with the largest disturbance any plan on its mesh rejects in its
+    witness's statistics (:mod:`tlmpc.planning.bottleneck`), when that can be computed."""
+    from tlmpc.planning.bottleneck import supported_ratio
+
+    ratio = supported_ratio(
+        planned.abstraction,
+        planned.automaton,
+        formula=formula,
+        options=mission.options,
+        start_point=start_point if start_point is not None else mission.robot.start,
+    )
+    if ratio is None:
+        return planned
+    stats = {**planned.witness.stats, SUPPORTED: ratio * mission.robot.max_speed}
+    return replace(planned, witness=replace(planned.witness, stats=stats))
+
+
+def _supported_of(witness: Witness) -> float | None:
+    value = witness.stats.get(SUPPORTED)
+    return None if value is None else float(value)
+
+
+def _shallow_for_disturbance(mission: Mission, deep: Witness) -> Diagnostic:
+    """A040: the goal depth was given up for the disturbance."""
+    disturbance = mission.robot.disturbance
+    requested = mission.options.goal_depth
+    bound = _supported_of(deep)
+    reach = f"; any plan to the goal cores rejects at most {bound:.6g}" if bound is not None else ""
+    return Diagnostic(
+        code="A040",
+        severity="warning",
+        message=f"the goals' cores (options.goal_depth) add corners too sharp for "
+        f"robot.disturbance {disturbance:g}{reach}; planned to enter the goals only as deep "
+        "as the margin asks, where every step rejects it",
+        hint="a goal core's corners are held on both facets: a corner of angle a rejects at "
+        "most max_speed * sin(a / 2); set options.goal_depth to 0 to plan at the margin's "
+        "depth without this warning"
+        + ("" if bound is None else ", or lower robot.disturbance below the bound to keep it"),
+        file=mission.source,
+        path="$.options.goal_depth" if requested is not None else "$.robot.disturbance",
     )
 
 
