@@ -17,7 +17,6 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-import networkx as nx
 import numpy as np
 from brute_lasso import START, _successors
 from starts import start_triangles
@@ -27,6 +26,8 @@ from tlmpc.automata.guards import holds
 from tlmpc.automata.model import Automaton
 
 Node = tuple[int, int, int]
+#: node -> successor -> (width, carries the mark)
+Edges = dict[Node, dict[Node, tuple[float, bool]]]
 
 
 def corner_angles(abstraction: Abstraction, t: int) -> list[float]:
@@ -56,7 +57,7 @@ def stay_width(abstraction: Abstraction, t: int) -> float:
 
 def product_graph(
     abstraction: Abstraction, automaton: Automaton, start_point: Sequence[float]
-) -> tuple[nx.DiGraph, list[Node]]:
+) -> tuple[Edges, list[Node]]:
     """The reachable product, each edge with its width (``inf`` for a stutter) and whether
     it carries the acceptance mark; and the initial nodes."""
     blocked = start_triangles(abstraction, start_point)
@@ -68,15 +69,13 @@ def product_graph(
             if e.src == automaton.initial and holds(e.guard, set(abstraction.labels(start)))
         }
     )
-    graph: nx.DiGraph = nx.DiGraph()
-    graph.add_nodes_from(roots)
+    graph: Edges = {}
     stack = list(roots)
-    seen: set[Node] = set()
     while stack:
         node = stack.pop()
-        if node in seen:
+        if node in graph:
             continue
-        seen.add(node)
+        out = graph[node] = {}
         t = node[0]
         for following, _, accepting in _successors(
             abstraction, automaton, node, start_point, "hops", blocked
@@ -87,37 +86,40 @@ def product_graph(
             else:
                 sides = [int(x) for x in abstraction.neighbors[t]]
                 width = move_width(abstraction, t, sides.index(n))
-            if graph.has_edge(node, following):
-                graph[node][following]["accepting"] |= accepting
-            else:
-                graph.add_edge(node, following, width=width, accepting=accepting)
+            marked = out[following][1] if following in out else False
+            out[following] = (width, marked or accepting)
             stack.append(following)
     return graph, roots
 
 
-def _reach(graph: nx.DiGraph, sources: list[Node], floor: float, *, reverse: bool) -> set[Node]:
+def _reach(graph: Edges, sources: list[Node], floor: float, *, reverse: bool) -> set[Node]:
     """The nodes reached from (or, with ``reverse``, reaching) ``sources`` along edges of
     width >= ``floor`` (a plain depth-first search)."""
+    if reverse:
+        flipped: Edges = {}
+        for node, out in graph.items():
+            for other, data in out.items():
+                flipped.setdefault(other, {})[node] = data
+        graph = flipped
     seen = set(sources)
     stack = list(sources)
     while stack:
         node = stack.pop()
-        nearby = graph.predecessors(node) if reverse else graph.successors(node)
-        for other in nearby:
-            edge = graph[other][node] if reverse else graph[node][other]
-            if edge["width"] >= floor and other not in seen:
+        for other, (width, _) in graph.get(node, {}).items():
+            if width >= floor and other not in seen:
                 seen.add(other)
                 stack.append(other)
     return seen
 
 
-def has_lasso(abstraction: Abstraction, graph: nx.DiGraph, roots: list[Node], floor: float) -> bool:
+def has_lasso(abstraction: Abstraction, graph: Edges, roots: list[Node], floor: float) -> bool:
     """By definition: an accepting edge u -> v with u reached from the start and v reaching
     u again, every step of width >= ``floor`` (a return that never leaves the cell is a stay,
     counted by the triangle's stay width), or an accepting stay."""
     reached = _reach(graph, roots, floor, reverse=False)
-    for u, v, data in graph.edges(data=True):
-        if not data["accepting"] or u not in reached or data["width"] < floor:
+    edges = [(u, v, data) for u, out in graph.items() for v, data in out.items()]
+    for u, v, (width, accepting) in edges:
+        if not accepting or u not in reached or width < floor:
             continue
         cell = u[:2]
         if u == v:  # an accepting stutter loop: the run ends staying
@@ -141,7 +143,7 @@ def widest_lasso(
     """The largest w such that some accepting lasso uses only steps of width >= w, tried at
     every width that occurs on the mesh, one after the other (None: no lasso at all)."""
     graph, roots = product_graph(abstraction, automaton, start_point)
-    candidates = {data["width"] for _, _, data in graph.edges(data=True)}
+    candidates = {width for out in graph.values() for width, _ in out.values()}
     candidates |= {stay_width(abstraction, t) for t in range(abstraction.num_triangles)}
     best: float | None = None
     for floor in sorted(w for w in candidates if math.isfinite(w)):

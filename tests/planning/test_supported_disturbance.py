@@ -73,6 +73,9 @@ def _mission(
 )
 # Two regions sharing an edge, a patrol between them.
 @example("patrol a, b", [(0, 0, 2, 2), (2, 0, 2, 2), (4, 3, 1, 1)], (3.0, 2.5))
+# Overlapping regions: the patrol's automaton cycles while the robot stays in the overlap
+# (a stay, which needs the triangle's stay width, not a moving cycle).
+@example("patrol a, b", [(0, 0, 3, 3), (1, 1, 3, 3), (4, 3, 1, 1)], (5.5, 4.5))
 def test_the_widest_lasso_is_the_brute_force_maximum(
     task: str, regions: list[tuple[int, int, int, int]], start: tuple[float, float]
 ) -> None:
@@ -97,6 +100,7 @@ def test_the_widest_lasso_is_the_brute_force_maximum(
         assert found is None
         return
     event("lasso")
+    assert found is not None
     assert found == pytest.approx(expected, abs=1e-12)
     # The planner's own threshold: a plan on the realisable steps just below, none at it.
     planned = plan(
