@@ -30,7 +30,9 @@ import tlmpc
 from tlmpc.abstraction import build_abstraction
 from tlmpc.automata import translate
 from tlmpc.automata.degeneralize import degeneralize
+from tlmpc.automata.model import Automaton, Edge
 from tlmpc.base.errors import InvalidInputError, NoPlanError
+from tlmpc.ltl.ast import Const, Not, Prop
 from tlmpc.mission import load_mission_text
 from tlmpc.planning.bottleneck import supported_ratio
 from tlmpc.planning.plan import plan
@@ -216,3 +218,38 @@ def test_a_mission_compiles_under_disturbance_whenever_it_does_at_goal_depth_zer
         return
     compiled = tlmpc.compile(_random_mission(task, regions, ratio, depth), until="control")
     event("yielded" if any(w.code == "A040" for w in compiled.warnings) else "kept the depth")
+
+
+def _two_beat() -> Automaton:
+    """``G F b`` read in two beats: b takes state 0 to 1 and 1 back to 0 with the mark, and
+    no state keeps b on a self-loop; a robot that stays in ``b`` is accepted by the cycle
+    0 -> 1 -> 0 of stutter steps, with no accepting stutter loop to show it."""
+    b = Prop("b")
+    return Automaton(
+        aps=("b",),
+        num_states=2,
+        initial=0,
+        edges=(
+            Edge(src=0, dst=1, guard=b),
+            Edge(src=1, dst=0, guard=b, marks=frozenset({0})),
+            Edge(src=0, dst=0, guard=Not(b)),
+            Edge(src=1, dst=1, guard=Not(b)),
+        ),
+        num_acc=1,
+    )
+
+
+@pytest.mark.parametrize("start", [(0.5, 0.5), (3.0, 2.5), (5.5, 4.5)])
+def test_a_cycle_of_stutter_steps_is_a_stay(start: tuple[float, float]) -> None:
+    text = _mission("visit b", [(4, 3, 1, 1), (0, 0, 3, 2), (5, 0, 1, 1)], start)
+    mission = load_mission_text(text, "m.yaml")
+    mesh = build_abstraction(mission)
+    automaton = _two_beat()
+    found = supported_ratio(
+        mesh,
+        automaton,
+        formula=Const(True),
+        options=mission.options,
+        start_point=mission.robot.start,
+    )
+    assert found == pytest.approx(widest_lasso(mesh, automaton, start), abs=1e-12)
