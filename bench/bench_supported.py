@@ -1,11 +1,12 @@
 """The largest disturbance each mission's meshes support, and where compiling stops.
 
 For every shipped spec (and a few missions of our own): the largest disturbance any plan
-rejects on the mesh with the goal cores (the default goal depth) and on the mesh whose goals
-are entered only as deep as the margin asks (``tlmpc.planning.bottleneck``, the widest-lasso
-search), both over ``max_speed``; then the largest ratio at which ``tlmpc compile`` (until
-the control stage) succeeds, found by bisection on the compiler itself, and whether the goal
-depth had to yield (A040) there.
+rejects on the mesh with the goal cores (the default goal depth), with cores at half and a
+quarter of it, and on the mesh whose goals are entered only as deep as the margin asks
+(``tlmpc.planning.bottleneck``, the widest-lasso search), over ``max_speed`` ("-": no plan
+without U-turns on that mesh); then the largest ratio at which ``tlmpc compile`` (until
+the control stage) succeeds, found by bisection on the compiler itself (to 2^-16), and
+whether the goal depth had to yield (A040) there.
 
     python bench/bench_supported.py
 """
@@ -62,19 +63,19 @@ def _document(name: str) -> dict[str, Any]:
     return loaded
 
 
-def _mesh_bounds(document: dict[str, Any]) -> tuple[float | None, float | None]:
+def _mesh_bounds(document: dict[str, Any]) -> list[float | None]:
     import json
 
     from tlmpc.ltl.bounds import untimed_skeleton
     from tlmpc.mission import load_mission_text
     from tlmpc.mission.body import requested_margin
     from tlmpc.planning.bottleneck import supported_ratio
-    from tlmpc.planning.mission import abstraction_for, automaton_for
+    from tlmpc.planning.mission import SHALLOWER, abstraction_for, automaton_for
 
     mission = load_mission_text(json.dumps(document), "m.yaml")
     found = []
-    for deep in (True, False):
-        mesh = abstraction_for(mission, requested_margin(mission), deep=deep)
+    for scale in (1.0, *SHALLOWER, 0.0):
+        mesh = abstraction_for(mission, requested_margin(mission), deep=scale > 0, scale=scale)
         found.append(
             supported_ratio(
                 mesh,
@@ -84,7 +85,7 @@ def _mesh_bounds(document: dict[str, Any]) -> tuple[float | None, float | None]:
                 start_point=mission.robot.start,
             )
         )
-    return found[0], found[1]
+    return found
 
 
 def _compiles(document: dict[str, Any], ratio: float) -> tuple[bool, bool]:
@@ -102,9 +103,9 @@ def _compiles(document: dict[str, Any], ratio: float) -> tuple[bool, bool]:
 
 
 def _largest_compiling(document: dict[str, Any]) -> tuple[float, bool]:
-    low, high = 0.0, 0.5
+    low, high = 0.0, 1.0  # C033 refuses a disturbance of max_speed or more
     yielded = False
-    for _ in range(14):
+    for _ in range(16):
         middle = (low + high) / 2.0
         ok, warned = _compiles(document, middle)
         if ok:
@@ -116,25 +117,24 @@ def _largest_compiling(document: dict[str, Any]) -> tuple[float, bool]:
 
 def main() -> None:
     def show(value: float | None) -> str:
-        return "-" if value is None else f"{value:.4f}"
+        return "-" if value is None else f"{value:.5f}"
 
     rows = []
     for name in (*SPECS, *OWN):
         started = time.perf_counter()
         document = _document(name)
-        deep, shallow = _mesh_bounds(document)
+        bounds = _mesh_bounds(document)
         largest, yielded = _largest_compiling(document)
         rows.append(
             [
                 name,
-                show(deep),
-                show(shallow),
-                f"{largest:.4f}",
+                *(show(bound) for bound in bounds),
+                f"{largest:.5f}",
                 "yes" if yielded else "no",
                 f"{time.perf_counter() - started:.1f}",
             ]
         )
-    header = ["mission", "goal cores", "margin depth", "compiles up to", "A040", "seconds"]
+    header = ["mission", "cores", "half", "quarter", "margin depth", "compiles up to", "A040", "s"]
     widths = [max(len(str(r[k])) for r in [header, *rows]) for k in range(len(header))]
     for row in [header, ["-" * w for w in widths], *rows]:
         print("| " + " | ".join(str(c).ljust(w) for c, w in zip(row, widths, strict=True)) + " |")

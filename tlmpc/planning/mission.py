@@ -44,13 +44,15 @@ class Planned:
     remeshed: bool = False
 
 
-def abstraction_for(mission: Mission, margin: float, *, deep: bool = True) -> Abstraction:
+def abstraction_for(
+    mission: Mission, margin: float, *, deep: bool = True, scale: float = 1.0
+) -> Abstraction:
     """The triangulated workspace of ``mission`` planned with ``margin`` (and its body), and
-    with ``deep`` the goal depth."""
+    with ``deep`` the goal depth (times ``scale``)."""
     from tlmpc.abstraction import build_abstraction
     from tlmpc.abstraction.layout import planning_layout
 
-    return build_abstraction(mission, planning_layout(mission, margin, deep=deep))
+    return build_abstraction(mission, planning_layout(mission, margin, deep=deep, scale=scale))
 
 
 def automaton_for(
@@ -148,29 +150,32 @@ def plan_mission(
         planned: Planned, formula: Formula = skeleton, explain: bool = True
     ) -> Planned:
         """The goal depth yields to the disturbance: when the plan to the goal cores has a
-        step no controller realises, plan again entering the goals only as deep as the
-        margin asks (the cores' corners may be all that is too sharp)."""
+        step no controller realises, plan again to shallower cores (half, then a quarter of
+        the goal depth), then entering the goals only as deep as the margin asks (the cores'
+        corners may be all that is too sharp); the first plan whose steps all realise it."""
         ratio = mission.robot.disturbance / mission.robot.max_speed
         if resume is not None or ratio <= 0.0 or not deepens_goals(mission):
             return planned
         if witness_realisable(planned.abstraction, planned.witness, ratio):
             return planned
-        shallow = abstraction_for(mission, margin, deep=False)
-        try:
-            again = attempt(
-                shallow, automaton_for(mission, shallow, formula=formula), formula, explain
-            )
-        except NoPlanError:
-            return planned
-        if witness_realisable(again.abstraction, again.witness, ratio):
-            note = _shallow_for_disturbance(mission, planned.witness)
-            return replace(again, notes=(note,), remeshed=True)
-        # Neither realises the disturbance: the plan on the mesh whose plans reject more goes
+        tried = [planned]
+        for scale in (*SHALLOWER, 0.0):
+            mesh = abstraction_for(mission, margin, deep=scale > 0.0, scale=scale)
+            try:
+                again = attempt(
+                    mesh, automaton_for(mission, mesh, formula=formula), formula, explain
+                )
+            except NoPlanError:
+                continue
+            if witness_realisable(again.abstraction, again.witness, ratio):
+                note = _shallow_for_disturbance(mission, planned.witness, scale)
+                return replace(again, notes=(note,), remeshed=True)
+            tried.append(again)
+        # None realises the disturbance: the plan on the mesh whose plans reject the most goes
         # on to be refused, stating that mesh's bound (C032: the mission compiles below it).
-        deep_bound, shallow_bound = _supported_of(planned.witness), _supported_of(again.witness)
-        if shallow_bound is not None and (deep_bound is None or shallow_bound > deep_bound):
-            return replace(again, remeshed=True)
-        return planned
+        bounds = [_supported_of(plan.witness) for plan in tried]
+        best = max(range(len(tried)), key=lambda k: (bounds[k] is not None, bounds[k] or 0.0, -k))
+        return tried[0] if best == 0 else replace(tried[best], remeshed=True)
 
     holding = holding_skeleton(mission.formula)
     if resume is None and holding != skeleton:
@@ -275,8 +280,13 @@ def _supported_of(witness: Witness) -> float | None:
     return None if value is None else float(value)
 
 
-def _shallow_for_disturbance(mission: Mission, deep: Witness) -> Diagnostic:
-    """A040: the goal depth was given up for the disturbance."""
+#: The fractions of the goal depth tried, in turn, when the goal cores' corners are too sharp
+#: for the disturbance (before the margin's depth).
+SHALLOWER = (0.5, 0.25)
+
+
+def _shallow_for_disturbance(mission: Mission, deep: Witness, scale: float) -> Diagnostic:
+    """A040: the goal depth was given up, or reduced to ``scale`` of it, for the disturbance."""
     disturbance = mission.robot.disturbance
     requested = mission.options.goal_depth
     bound = _supported_of(deep)
@@ -285,11 +295,16 @@ def _shallow_for_disturbance(mission: Mission, deep: Witness) -> Diagnostic:
         code="A040",
         severity="warning",
         message=f"the goals' cores (options.goal_depth) add corners too sharp for "
-        f"robot.disturbance {disturbance:g}{reach}; planned to enter the goals only as deep "
-        "as the margin asks, where every step rejects it",
+        f"robot.disturbance {disturbance:g}{reach}; planned "
+        + (
+            f"with cores {scale:g} x the goal depth deep (at least the margin)"
+            if scale > 0.0
+            else "to enter the goals only as deep as the margin asks"
+        )
+        + ", where every step rejects it",
         hint="a goal core's corners are held on both facets: a corner of angle a rejects at "
-        "most max_speed * sin(a / 2); set options.goal_depth to 0 to plan at the margin's "
-        "depth without this warning"
+        "most max_speed * sin(a / 2); set options.goal_depth to a smaller depth (0: the "
+        "margin's) to plan with it without this warning"
         + ("" if bound is None else ", or lower robot.disturbance below the bound to keep it"),
         file=mission.source,
         path="$.options.goal_depth" if requested is not None else "$.robot.disturbance",
