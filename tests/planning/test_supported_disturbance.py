@@ -167,6 +167,12 @@ def test_the_goal_depth_yields_to_the_disturbance() -> None:
     assert warnings[0].severity == "warning"
     assert warnings[0].path == "$.robot.disturbance"
     assert "0.35" in warnings[0].message
+    # half the goal depth is enough there (the widest lasso on that mesh is 0.354)
+    assert "with cores 0.5 x the goal depth deep" in warnings[0].message
+    # at 0.38 only the regions as drawn carry it (a 45 degree corner: sin 22.5 = 0.3827)
+    drawn = tlmpc.compile(_example1(0.38), until="control")
+    (warning,) = [w for w in drawn.warnings if w.code == "A040"]
+    assert "only as deep as the margin asks" in warning.message
     controllers = compiled.artifacts["controllers.json"]
     for step in controllers["steps"]:
         check_step(step, 0.35, controllers["max_speed"])
