@@ -250,7 +250,7 @@ def _shallow_note(mission: Mission, failure: NoPlanError) -> Diagnostic:
 
 
 #: The witness statistic that carries the largest disturbance any plan on its mesh rejects
-#: (in the units of max_speed), set only on a plan with a step that does not reject the
+#: (in the units of robot.disturbance), set only on a plan with a step that does not reject the
 #: mission's: the control stage states it when it refuses the plan (C032).
 SUPPORTED = "supported_disturbance"
 
