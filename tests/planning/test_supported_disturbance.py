@@ -75,6 +75,8 @@ def _mission(
 )
 # Two regions sharing an edge, a patrol between them.
 @example("patrol a, b", [(0, 0, 2, 2), (2, 0, 2, 2), (4, 3, 1, 1)], (3.0, 2.5))
+# The start's own triangle is the bottleneck: wide cycles elsewhere are not reached above it.
+@example("visit a", [(1, 3, 1, 2), (4, 0, 2, 3), (3, 0, 1, 1)], (5.9, 0.1))
 # Overlapping regions: the patrol's automaton cycles while the robot stays in the overlap
 # (a stay, which needs the triangle's stay width, not a moving cycle).
 @example("patrol a, b", [(0, 0, 3, 3), (1, 1, 3, 3), (4, 3, 1, 1)], (5.5, 4.5))
