@@ -15,8 +15,8 @@ stays, after degeneralization) is a stay too.
 W* is one of the finitely many widths, and "some lasso uses only steps of width >= w" is
 monotone in w, so a binary search over the sorted distinct widths finds it exactly: each
 probe keeps the product's edges of width >= w and asks whether an accepting stay is
-reachable from an initial node, or a reachable accepting edge lies on a cycle of the kept
-graph (its strongly connected component). A component inside one cell (one triangle and entry
+reachable from an initial node, or an accepting edge lies on a cycle of the kept graph
+(its strongly connected component). A component inside one cell (one triangle and entry
 slot) holds stutter edges alone: its cycles are stays and count only where the triangle's
 stay is wide enough. The planner, restricted to the steps wider than d / max_speed plus the
 controllers' tolerance, finds a plan exactly when W* exceeds that.
@@ -26,15 +26,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
+from tlmpc.abstraction.model import Abstraction, FloatArray
 from tlmpc.automata.degeneralize import degeneralize
 from tlmpc.automata.model import Automaton
+from tlmpc.base.graphs import strong_components
 from tlmpc.ltl.ast import Formula
 from tlmpc.mission.model import Options
 from tlmpc.planning.boundary import start_cells, start_point_label
 from tlmpc.planning.budget import estimate_product
 from tlmpc.planning.explain import invariant_mask
-from tlmpc.planning.product import SLOTS, BoolArray, Product, build_product
+from tlmpc.planning.product import SLOTS, Product, build_product
 from tlmpc.planning.robust import step_widths
 
 
@@ -102,63 +103,35 @@ def widest_lasso(
 
 def _has_lasso(product: Product, widths: FloatArray, stays: FloatArray, floor: float) -> bool:
     """Whether an accepting lasso uses only steps of width >= ``floor``."""
-    # scipy's strongly connected components (compiled): a probe on a product of 10^5 nodes
-    # took 0.4 s with the interpreted Tarjan search, a dozen probes per mesh. Only a plan the
-    # controllers cannot realise gets here, so a compile that succeeds outright loads no scipy.
-    from scipy.sparse import csr_matrix
-    from scipy.sparse.csgraph import connected_components
-
     graph = product.graph
-    size = graph.num_nodes
     nq = product.num_automaton_states
     kept = widths >= floor
-    indptr = np.zeros(size + 1, dtype=np.int64)
-    np.cumsum(np.bincount(graph.sources[kept], minlength=size), out=indptr[1:])
+    indptr = np.zeros(graph.num_nodes + 1, dtype=np.int64)
+    np.cumsum(np.bincount(graph.sources[kept], minlength=graph.num_nodes), out=indptr[1:])
     targets = graph.targets[kept]  # the graph's edges are grouped by source: still CSR
-    reached = _reachable(indptr, targets, product.initial, size)
+    # Tarjan's search from the initial nodes labels exactly the nodes they reach.
+    component = np.asarray(
+        strong_components(indptr, targets, roots=product.initial.tolist()), dtype=np.int64
+    )
     wide_stay = stays >= floor
-    triangle_of = np.arange(size) // nq // SLOTS
-    if (product.stutter_accepting & reached & wide_stay[triangle_of]).any():
+    triangle_of = np.arange(graph.num_nodes) // nq // SLOTS
+    if (product.stutter_accepting & (component >= 0) & wide_stay[triangle_of]).any():
         return True
     accepting = np.flatnonzero(product.accepting & kept)
     heads, tails = graph.sources[accepting], graph.targets[accepting]
-    reached_heads = reached[heads]
-    if not reached_heads.any():
-        return False
-    adjacency = csr_matrix((np.ones(len(targets), dtype=np.int8), targets, indptr), (size, size))
-    _, component = connected_components(adjacency, directed=True, connection="strong")
-    inside = reached_heads & (component[heads] == component[tails])
+    inside = (component[heads] >= 0) & (component[heads] == component[tails])
     if not inside.any():
         return False
     # A component spanning two cells has a cycle through each of its edges that moves; one
-    # inside a single cell holds stutter edges alone: it is a stay of that triangle.
-    cell = np.arange(size) // nq
+    # inside a single cell is a stay of that triangle.
+    cell = np.arange(graph.num_nodes) // nq
+    members = component >= 0
     count = int(component.max()) + 1
     lowest = np.full(count, np.iinfo(np.int64).max)
     highest = np.full(count, -1)
-    np.minimum.at(lowest, component, cell)
-    np.maximum.at(highest, component, cell)
+    np.minimum.at(lowest, component[members], cell[members])
+    np.maximum.at(highest, component[members], cell[members])
     looped = component[heads[inside]]
     moving = lowest[looped] != highest[looped]
     staying = wide_stay[triangle_of[heads[inside]]]
     return bool((moving | staying).any())
-
-
-def _reachable(indptr: IntArray, targets: IntArray, initial: IntArray, size: int) -> BoolArray:
-    """The nodes reachable from ``initial`` (breadth first, a frontier at a time)."""
-    seen = np.zeros(size, dtype=bool)
-    frontier = np.unique(initial)
-    seen[frontier] = True
-    while len(frontier):
-        starts = indptr[frontier]
-        counts = indptr[frontier + 1] - starts
-        total = int(counts.sum())
-        if not total:
-            break
-        # every edge out of the frontier: its start offset repeated, plus its rank there
-        first = np.repeat(starts - (np.cumsum(counts) - counts), counts)
-        following = targets[np.arange(total) + first]
-        following = np.unique(following[~seen[following]])
-        seen[following] = True
-        frontier = following
-    return seen
