@@ -34,7 +34,8 @@ from tlmpc.planning.robust import witness_realisable
 class Planned:
     """A planned mission: the mesh the witness refers to (refined where the plan turns
     around, or rebuilt without the margin), the automaton it was planned with, the witness,
-    and notes (A030 when the goal depth was dropped, R008 when the margin was)."""
+    and notes (A030 when the goal depth was dropped, A040 when it yielded to the disturbance,
+    R008 when the margin was dropped)."""
 
     abstraction: Abstraction
     automaton: Automaton
