@@ -46,21 +46,34 @@ def corner_angles(abstraction: Abstraction, triangles: IntArray | None = None) -
     return angles
 
 
+def step_widths(
+    abstraction: Abstraction, triangles: IntArray | None = None
+) -> tuple[FloatArray, FloatArray]:
+    """(m, 3) and (m,): the largest disturbance ratio (d / max_speed) each move (leave t by
+    edge i) and each stay rejects, before the controllers' tolerance: the smallest push of
+    its corners (sin(a / 2) where both facets are kept, cos(a / 2) on the exit edge); with
+    ``triangles``, the rows of those triangles only."""
+    half = corner_angles(abstraction, triangles) / 2.0
+    kept = np.sin(half)  # a corner held on both facets
+    crossing = np.cos(half)  # a corner on the exit edge
+    moves = np.empty(kept.shape)
+    for i in range(3):
+        moves[:, i] = np.minimum(
+            kept[:, i], np.minimum(crossing[:, (i + 1) % 3], crossing[:, (i + 2) % 3])
+        )
+    stays: FloatArray = kept.min(axis=1)
+    return moves, stays
+
+
 def realisable(
     abstraction: Abstraction, ratio: float, triangles: IntArray | None = None
 ) -> tuple[BoolArray, BoolArray]:
     """(m, 3) moves (leave t by edge i) and (m,) stays realisable under the disturbance
-    ``ratio`` x max_speed (with the controllers' tolerance); with ``triangles``, the rows of
-    those triangles only."""
+    ``ratio`` x max_speed (with the controllers' tolerance): their width exceeds it; with
+    ``triangles``, the rows of those triangles only."""
     need = ratio + TOLERANCE
-    half = corner_angles(abstraction, triangles) / 2.0
-    kept = np.sin(half) > need  # a corner held on both facets
-    crossing = np.cos(half) > need  # a corner on the exit edge
-    moves = np.empty(kept.shape, dtype=bool)
-    for i in range(3):
-        moves[:, i] = kept[:, i] & crossing[:, (i + 1) % 3] & crossing[:, (i + 2) % 3]
-    stays: BoolArray = np.asarray(kept.all(axis=1), dtype=bool)
-    return moves, stays
+    moves, stays = step_widths(abstraction, triangles)
+    return np.asarray(moves > need, dtype=bool), np.asarray(stays > need, dtype=bool)
 
 
 def witness_realisable(abstraction: Abstraction, witness: Witness, ratio: float) -> bool:
