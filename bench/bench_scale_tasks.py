@@ -8,6 +8,10 @@ the built product, and prints a markdown table: the planning stage's CPU seconds
 loading and the mesh included), the plan's cost (which must agree between the two searches),
 the nodes the search reached and the closing searches it made.  ``--compile`` adds a row per
 workload for the whole ``tlmpc compile`` (every stage but the figure) in CPU seconds.
+
+``--baseline DIR`` runs every measurement side by side with another tree of the project
+(its runs alternate with this tree's, each in a fresh interpreter started in that tree) and
+adds its medians and nodes reached as "before" columns; the costs must agree.
 """
 
 from __future__ import annotations
@@ -77,12 +81,13 @@ print(json.dumps({
 """
 
 
-def _run(program: str, *arguments: str) -> dict[str, Any]:
+def _run(program: str, *arguments: str, tree: Path = ROOT) -> dict[str, Any]:
+    # ``python -c`` imports tlmpc from its working directory: the tree measured.
     done = subprocess.run(
         [sys.executable, "-c", program, *arguments],
         capture_output=True,
         text=True,
-        cwd=ROOT,
+        cwd=tree,
         check=False,
     )
     if done.returncode != 0:
@@ -91,7 +96,26 @@ def _run(program: str, *arguments: str) -> dict[str, Any]:
     return result
 
 
-def rows(repeats: int, grids: list[str], compile_too: bool) -> list[dict[str, Any]]:
+def _side_by_side(
+    program: str, arguments: list[str], repeats: int, baseline: Path | None
+) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
+    """This tree's runs and the baseline's (empty without one), alternating."""
+    mine: list[dict[str, Any]] = []
+    before: list[dict[str, Any]] = []
+    for _ in range(repeats):
+        if baseline is not None:
+            before.append(_run(program, *arguments, tree=baseline))
+        mine.append(_run(program, *arguments))
+    return mine, before
+
+
+def _median(runs: list[dict[str, Any]], key: str) -> float:
+    return round(statistics.median(r[key] for r in runs), 2)
+
+
+def rows(
+    repeats: int, grids: list[str], compile_too: bool, baseline: Path | None = None
+) -> list[dict[str, Any]]:
     """One row per workload and search."""
     from bench.workloads import grid_task, write_mission
 
@@ -102,41 +126,52 @@ def rows(repeats: int, grids: list[str], compile_too: bool) -> list[dict[str, An
                 path = write_mission(grid_task(GRIDS[grid], task, count), Path(tmp))
                 searches = ["guided", "built"] if grid in BUILT_UP_TO else ["guided"]
                 for search in searches:
-                    runs = [_run(PLAN_PROGRAM, str(path), search) for _ in range(repeats)]
-                    if any("error" in run for run in runs):
-                        error = next(run["error"] for run in runs if "error" in run)
+                    runs, before = _side_by_side(
+                        PLAN_PROGRAM, [str(path), search], repeats, baseline
+                    )
+                    if any("error" in run for run in runs + before):
+                        error = next(run["error"] for run in runs + before if "error" in run)
                         table.append(
                             {"workload": f"{task}-{count} {grid}", "search": search, "note": error}
                         )
                         continue
                     last = runs[-1]
-                    table.append(
-                        {
-                            "workload": f"{task}-{count} {grid}",
-                            "search": search,
-                            "triangles": last["triangles"],
-                            "automaton states": last["states"],
-                            "product nodes": last["nodes"],
-                            "reached": last["reached"],
-                            "closing searches": last["searches"],
-                            "plan CPU s": round(statistics.median(r["cpu"] for r in runs), 2),
-                            "peak MB": round(max(r["peak_mb"] for r in runs)),
-                            "cost": f"{last['cost']:.6f}",
-                            "plan": last["plan"],
-                            "optimal": last["optimal"],
-                        }
-                    )
+                    row: dict[str, Any] = {
+                        "workload": f"{task}-{count} {grid}",
+                        "search": search,
+                        "triangles": last["triangles"],
+                        "automaton states": last["states"],
+                        "product nodes": last["nodes"],
+                        "reached": last["reached"],
+                        "closing searches": last["searches"],
+                        "plan CPU s": _median(runs, "cpu"),
+                        "peak MB": round(max(r["peak_mb"] for r in runs)),
+                        "cost": f"{last['cost']:.6f}",
+                        "plan": last["plan"],
+                        "optimal": last["optimal"],
+                    }
+                    if before:
+                        row["reached before"] = before[-1]["reached"]
+                        row["closing searches before"] = before[-1]["searches"]
+                        row["plan CPU s before"] = _median(before, "cpu")
+                        row["peak MB before"] = round(max(r["peak_mb"] for r in before))
+                        row["cost before"] = f"{before[-1]['cost']:.6f}"
+                    table.append(row)
                 if compile_too:
-                    whole = _run(COMPILE_PROGRAM, str(path))
-                    table.append(
-                        {
-                            "workload": f"{task}-{count} {grid}",
-                            "search": "whole compile",
-                            "plan CPU s": round(whole.get("cpu", float("nan")), 2),
-                            "peak MB": round(whole.get("peak_mb", float("nan"))),
-                            "note": whole.get("error", "every stage but the figure"),
-                        }
-                    )
+                    wholes, before = _side_by_side(COMPILE_PROGRAM, [str(path)], repeats, baseline)
+                    failed = [run["error"] for run in wholes + before if "error" in run]
+                    row = {
+                        "workload": f"{task}-{count} {grid}",
+                        "search": "whole compile",
+                        "note": failed[0] if failed else "every stage but the figure",
+                    }
+                    if not failed:
+                        row["plan CPU s"] = _median(wholes, "cpu")
+                        row["peak MB"] = round(max(r["peak_mb"] for r in wholes))
+                        if before:
+                            row["plan CPU s before"] = _median(before, "cpu")
+                            row["peak MB before"] = round(max(r["peak_mb"] for r in before))
+                    table.append(row)
     return table
 
 
@@ -145,10 +180,13 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--grids", nargs="+", default=list(GRIDS), choices=list(GRIDS))
     parser.add_argument("--compile", action="store_true", help="add the whole compile")
+    parser.add_argument("--baseline", type=Path, help="another tree, measured side by side")
     arguments = parser.parse_args()
     from bench.tables import markdown_table
 
-    print(markdown_table(rows(arguments.repeats, arguments.grids, arguments.compile)))
+    baseline = arguments.baseline.resolve() if arguments.baseline else None
+    table = rows(arguments.repeats, arguments.grids, arguments.compile, baseline)
+    print(markdown_table(table))
 
 
 if __name__ == "__main__":

@@ -215,7 +215,10 @@ def compile(
                 )
             )
     result = compile_mission(source, text=text, until=until)
-    artifacts = dict(result.artifacts)
+    from tlmpc.io.arrays import plain
+
+    # plain lists for the caller (the pipeline keeps large ones as arrays until written)
+    artifacts = {name: plain(document) for name, document in result.artifacts.items()}
     artifacts["summary.json"] = result.summary()
     return Compiled(artifacts=artifacts, source=str(source), warnings=result.warnings)
 

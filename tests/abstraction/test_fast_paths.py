@@ -156,3 +156,69 @@ def test_min_angle_is_the_smallest_corner_angle(seed: int) -> None:
     got = _min_angle(corners).tolist()
     want = _reference_min_angle(corners)
     assert np.allclose(got, want, rtol=1e-9, atol=1e-9)
+
+
+@st.composite
+def _meshes_in_pieces(draw: st.DrawFn) -> tuple[IntArray, IntArray]:
+    """Triangles over a few shared vertices, each in a drawn component (numbered from 0)."""
+    count = draw(st.integers(1, 30))
+    vertices = draw(st.integers(3, 40))
+    triangles = np.array(
+        draw(
+            st.lists(
+                st.lists(st.integers(0, vertices - 1), min_size=3, max_size=3),
+                min_size=count,
+                max_size=count,
+            )
+        ),
+        dtype=np.int64,
+    )
+    pieces = draw(st.lists(st.integers(0, 6), min_size=count, max_size=count))
+    _, component = np.unique(np.array(pieces), return_inverse=True)
+    return triangles, component.reshape(-1).astype(np.int64)
+
+
+@given(_meshes_in_pieces())
+def test_touching_components_join_the_pieces_that_share_a_vertex(
+    mesh: tuple[IntArray, IntArray],
+) -> None:
+    from tlmpc.abstraction.build import _touching_components
+    from tlmpc.abstraction.model import Abstraction
+
+    triangles, component = mesh
+    abstraction = Abstraction(
+        vertices=np.zeros((int(triangles.max()) + 1, 2)),
+        triangles=triangles,
+        neighbors=np.full(triangles.shape, -1, dtype=np.int64),
+        letter_of=np.zeros(len(triangles), dtype=np.int64),
+        letters=((),),
+        start=0,
+        component=component,
+        regions={},
+    )
+    # The definition, pair by pair: two triangles of one component, or with a common vertex,
+    # are in one group; a group is named by its lowest component.
+    group = component.tolist()
+    changed = True
+    while changed:
+        changed = False
+        for a in range(len(triangles)):
+            for b in range(len(triangles)):
+                touch = set(triangles[a].tolist()) & set(triangles[b].tolist())
+                if touch or component[a] == component[b]:
+                    low = min(group[a], group[b])
+                    if group[a] != low or group[b] != low:
+                        group[a] = group[b] = low
+                        changed = True
+    assert _touching_components(abstraction).tolist() == group
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(0, 50))
+def test_centroids_are_the_mean_of_the_corners_bit_for_bit(seed: int, count: int) -> None:
+    from tlmpc.abstraction.build import _centroids
+
+    rng = np.random.default_rng(seed)
+    vertices = rng.normal(size=(max(count, 1), 2)) * 10.0 ** rng.integers(-8, 9)
+    triangles = rng.integers(0, len(vertices), size=(count, 3))
+    expected = vertices[triangles].mean(axis=1) if count else np.zeros((0, 2))
+    assert _centroids(vertices, triangles).tobytes() == expected.tobytes()

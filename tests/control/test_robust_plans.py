@@ -41,8 +41,8 @@ def _rhombus(disturbance: float, task: str) -> dict[str, Any]:
             "b": [[0, 0], [10, 0], [5, 10 * HALF]],
         },
         "robot": {"start": [5, -3], "max_speed": 1.0, "disturbance": disturbance},
-        # the goal's core would add sharper corners: these tests are about the controllers
-        "options": {"min_angle": 20, "goal_depth": 0},
+        # the goal's core adds sharper corners: the goal depth yields to the disturbance (A040)
+        "options": {"min_angle": 20},
         "task": [task],
     }
 
@@ -50,7 +50,6 @@ def _rhombus(disturbance: float, task: str) -> dict[str, Any]:
 def _example1(disturbance: float) -> dict[str, Any]:
     mission = yaml.safe_load((ROOT / "specs" / "example1.yaml").read_text())
     mission["robot"]["disturbance"] = disturbance
-    mission.setdefault("options", {})["goal_depth"] = 0  # the mesh without goal cores
     return dict(mission)
 
 

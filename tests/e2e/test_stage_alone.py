@@ -10,6 +10,7 @@ from typing import Any
 
 import pytest
 
+from tlmpc.io.artifacts import dumps
 from tlmpc.io.outdir import write_artifacts
 from tlmpc.pipeline.stages import (
     MISSION,
@@ -44,11 +45,11 @@ def test_every_stage_reproduces_its_artifacts_from_its_inputs(tmp_path: Path, sp
         assert alone.artifacts, stage.name
         for name, document in alone.artifacts.items():
             expected = (
-                json.loads(json.dumps(whole.artifacts[name]))
+                json.loads(dumps(whole.artifacts[name]))
                 if name.endswith(".json")
                 else whole.artifacts[name]
             )
-            got = json.loads(json.dumps(document)) if name.endswith(".json") else document
+            got = json.loads(dumps(document)) if name.endswith(".json") else document
             assert _without_timings(got) == _without_timings(expected), (stage.name, name)
 
 

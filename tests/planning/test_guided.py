@@ -14,6 +14,7 @@ Three claims, each against an independent computation:
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 from typing import Literal
@@ -174,7 +175,12 @@ def _load(spec: str) -> Mission:
 @pytest.mark.parametrize("spec", ["example1", "patrol", "reach-avoid", "far-cycle"])
 @pytest.mark.parametrize("beta", [0.25, 1.0, 4.0])
 def test_bounds_never_exceed_the_exact_distances(spec: str, beta: float) -> None:
-    mission = _load(spec)
+    _check_bounds(_load(spec), beta)
+
+
+def _check_bounds(mission: Mission, beta: float) -> None:
+    """The closing and lasso bounds at every node against scipy's exact distances on the
+    built product (a few closing targets, every accepting edge's tail)."""
     abstraction, working, arguments = _inputs(mission, False)
     product = build_product(abstraction, working, **arguments)  # type: ignore[arg-type]
     lazy = lazy_product(abstraction, working, **arguments)  # type: ignore[arg-type]
@@ -211,18 +217,105 @@ def test_bounds_never_exceed_the_exact_distances(spec: str, beta: float) -> None
         around = float((graph.weights[mine] + exact[graph.targets[mine]]).min())
         to_go = np.minimum(to_go, exact + beta * around)
     nodes = np.flatnonzero(np.isfinite(to_go) & allowed.repeat(lazy.num_states))
-    assert len(nodes)
+    if not len(nodes):
+        return  # no lasso from anywhere: nothing to bound
     assert (bounds.lasso(nodes) <= to_go[nodes] + 1e-9).all()
+    if not len(lazy.initial):
+        return
     # The lasso bound at the start is at most the cheapest lasso's cost.
-    witness = plan(
-        abstraction,
-        automaton_for(mission, abstraction),
-        formula=mission.formula,
-        options=replace(mission.options, beta=beta),
-        start_point=mission.robot.start,
-        guided=False,
-    )
+    try:
+        witness = plan(
+            abstraction,
+            automaton_for(mission, abstraction),
+            formula=mission.formula,
+            options=replace(mission.options, beta=beta),
+            start_point=mission.robot.start,
+            guided=False,
+        )
+    except NoPlanError:
+        return
     assert float(bounds.lasso(lazy.initial).min()) <= witness.cost + 1e-9
+
+
+@pytest.mark.slow
+@settings(
+    max_examples=max(8, settings().max_examples // 4),
+    deadline=None,
+    suppress_health_check=[HealthCheck.too_slow],
+)
+@given(
+    st.sampled_from(TASKS),
+    st.lists(
+        st.tuples(st.integers(0, 8), st.integers(0, 6), st.integers(1, 4), st.integers(1, 4)),
+        min_size=3,
+        max_size=3,
+    ),
+    st.booleans(),
+    st.sampled_from(["length", "hops"]),
+    st.sampled_from([0.25, 1.0, 4.0]),
+    st.sampled_from(["right", "closed"]),
+)
+@example("patrol a, b", [(2, 2, 4, 4), (6, 2, 1, 4), (0, 6, 1, 1)], False, "length", 1.0, "right")
+def test_bounds_never_exceed_the_exact_distances_on_generated_missions(
+    task: str,
+    regions: list[tuple[int, int, int, int]],
+    hole: bool,
+    cost: str,
+    beta: float,
+    boundary: str,
+) -> None:
+    """Regions large enough that a robot inside one is far from where it was entered: the
+    bounds counted from a region's entry cells must hold only right after an entry."""
+    try:
+        mission = load_mission_text(
+            _mission_text(task, regions, hole, cost, beta, boundary), "m.yaml"
+        )
+    except InvalidInputError:
+        event("invalid map")
+        return
+    _check_bounds(mission, beta)
+
+
+@pytest.mark.parametrize("spec", ["example1", "patrol", "far-cycle"])
+@pytest.mark.parametrize("guided", [False, True])
+def test_guided_search_settles_nodes_at_dijkstras_distances(spec: str, guided: bool) -> None:
+    """Run to exhaustion (no ceiling), the bucketed search gives every node scipy's Dijkstra
+    distance from the initial nodes, with the zero bound and with the lasso bound (a node
+    the lasso bound calls hopeless, inf, is never queued)."""
+    from tlmpc.planning.guided import GuidedSearch, _Arrays
+
+    mission = _load(spec)
+    abstraction, working, arguments = _inputs(mission, False)
+    product = build_product(abstraction, working, **arguments)  # type: ignore[arg-type]
+    lazy = lazy_product(abstraction, working, **arguments)  # type: ignore[arg-type]
+    allowed = np.repeat(arguments["allowed"], SLOTS)  # type: ignore[call-overload]
+    graph = product.graph
+    matrix = csr_matrix(
+        (graph.weights, (graph.sources, graph.targets)),
+        shape=(product.num_nodes, product.num_nodes),
+    )
+    exact = dijkstra(matrix, indices=product.initial, min_only=True)
+
+    def zero(nodes: np.ndarray) -> np.ndarray:
+        return np.zeros(len(nodes))
+
+    bound: Callable[[np.ndarray], np.ndarray] = zero
+    if guided:
+        bound = _Bounds(lazy, region_graph(lazy, allowed), 1.0).lasso
+    search = GuidedSearch(lazy, _Arrays.of(lazy.num_nodes), lazy.initial, bound)
+    rounds = 0
+    while np.isfinite(search.lowest()):
+        search.step()
+        rounds += 1
+    assert rounds > 1
+    found = search.arrays.dist
+    hopeless = ~np.isfinite(bound(np.arange(lazy.num_nodes)))
+    # Nodes the bound rules out are cut off, and so is whatever is reached only through them.
+    check = ~hopeless & np.isfinite(found)
+    assert check.sum() > lazy.num_nodes // 20
+    assert np.array_equal(found[check], exact[check])
+    if not guided:
+        assert np.array_equal(np.isfinite(found), np.isfinite(exact))
 
 
 def _costs_agree(mission: Mission, bounces: bool) -> str:
@@ -321,6 +414,57 @@ def test_guided_lasso_costs_what_the_built_product_gives(
         event("invalid map")
         return
     event(_costs_agree(mission, bounces))
+
+
+def _rooms_text(n: int, rooms: list[tuple[int, int]], task: str, beta: float) -> str:
+    """An n x n floor of unit cells, a square room in each chosen cell (the grids the
+    guided search is built for, small enough for the built product)."""
+    regions = "\n".join(
+        f"  r{i}_{j}: {{rect: [{i + 0.25}, {j + 0.25}, {i + 0.75}, {j + 0.75}]}}" for i, j in rooms
+    )
+    names = [f"r{i}_{j}" for i, j in rooms]
+    if task == "patrol":
+        tasks = [f"patrol {', '.join(names)}"]
+    else:  # cover the others while avoiding the last
+        tasks = [f"visit {' and '.join(names[:-1])}", f"avoid {names[-1]}"]
+    return (
+        f"version: 1\nworkspace: {{boundary: {{rect: [0, 0, {n}, {n}]}}}}\n"
+        f"regions:\n{regions}\nrobot: {{start: [0.1, 0.1]}}\n"
+        f"task: {json.dumps(tasks)}\n"
+        f"options: {{beta: {beta}, min_angle: null, max_area: null}}\n"
+    )
+
+
+@pytest.mark.slow
+@settings(
+    max_examples=max(6, settings().max_examples // 4),
+    deadline=None,
+    suppress_health_check=[HealthCheck.too_slow],
+)
+@given(
+    st.integers(3, 8).flatmap(
+        lambda n: st.tuples(
+            st.just(n),
+            st.lists(
+                st.tuples(st.integers(0, n - 1), st.integers(0, n - 1)),
+                min_size=3,
+                max_size=6,
+                unique=True,
+            ),
+        )
+    ),
+    st.sampled_from(["patrol", "cover"]),
+    st.sampled_from([0.5, 1.0, 2.5]),
+)
+def test_guided_lasso_costs_what_the_built_product_gives_on_grids_of_rooms(
+    grid: tuple[int, list[tuple[int, int]]], task: str, beta: float
+) -> None:
+    """Medium missions of the kind the guided search is for: many rooms, a patrol of
+    several (long cycles, many candidates) or a cover avoiding one, on a floor of up to
+    514 triangles."""
+    n, rooms = grid
+    mission = load_mission_text(_rooms_text(n, rooms, task, beta), "rooms.yaml")
+    event(_costs_agree(mission, False))
 
 
 @pytest.mark.parametrize("spec", ["example1", "example6", "example7", "patrol", "reach-avoid"])

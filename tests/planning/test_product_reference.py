@@ -16,6 +16,7 @@ from __future__ import annotations
 import math
 from functools import cache
 from typing import Any
+from unittest import mock
 
 import numpy as np
 import numpy.typing as npt
@@ -29,8 +30,9 @@ from tlmpc.abstraction.starts import StartCell
 from tlmpc.automata.model import Automaton, Edge
 from tlmpc.ltl.ast import FALSE, TRUE, And, Formula, Not, Or, Prop
 from tlmpc.mission import load_mission_text
+from tlmpc.planning import product as product_module
 from tlmpc.planning.boundary import POINT
-from tlmpc.planning.product import Product, build_product
+from tlmpc.planning.product import INT32_LIMIT, Product, build_product, index_dtype
 
 APS = ("a", "b", "c")
 SLOTS, START = 4, 3
@@ -204,6 +206,7 @@ def _edges(product: Product) -> dict[tuple[int, int], tuple[float, bool]]:
     assert (np.diff(graph.indptr) >= 0).all()
     runs = np.repeat(np.arange(graph.num_nodes), np.diff(graph.indptr))
     assert np.array_equal(runs, graph.sources), "edges grouped by source, as indptr says"
+    assert np.array_equal(graph.source_of(np.arange(graph.nnz)), runs), "tails looked up"
     found = {
         (int(u), int(v)): (float(w), bool(a))
         for u, v, w, a in zip(
@@ -240,15 +243,24 @@ def test_product_is_its_definition(
     )
     start_label = tuple(sorted(data.draw(st.sets(st.sampled_from(APS)))))
     kwargs: dict[str, Any] = {"start_point": start, "metric": metric, "starts": starts}
-    product = build_product(
-        abstraction,
-        automaton,
-        allowed=np.array(allowed, dtype=bool),
-        convention="closed" if closed else "right",
-        start_label=start_label,
-        bounces=bounces,
-        **kwargs,
-    )
+    # Numbers from the 32-bit limit on are held in 64 bits: the limit moved down to this
+    # product's node count (or below) takes the 64-bit way here, which must give the same.
+    size = m * SLOTS * automaton.num_states
+    limit = data.draw(st.sampled_from([INT32_LIMIT, 0, size - 1, size]))
+    with mock.patch.object(product_module, "INT32_LIMIT", limit):
+        product = build_product(
+            abstraction,
+            automaton,
+            allowed=np.array(allowed, dtype=bool),
+            convention="closed" if closed else "right",
+            start_label=start_label,
+            bounces=bounces,
+            **kwargs,
+        )
+    narrow = np.dtype(np.int32)
+    assert (product.graph.targets.dtype == narrow) == (size <= limit)
+    assert (product.graph.sources.dtype == narrow) == (size <= limit)
+    assert (product.graph.indptr.dtype == narrow) == (product.graph.nnz + 1 <= limit)
     edges, stutter, initial = reference(
         abstraction,
         automaton,
@@ -265,3 +277,10 @@ def test_product_is_its_definition(
     stays: npt.NDArray[np.int64] = np.flatnonzero(product.stutter_accepting)
     assert set(stays.tolist()) == stutter
     assert product.initial.tolist() == sorted(initial)
+
+
+def test_numbers_past_32_bits_are_held_in_64() -> None:
+    assert index_dtype(2**31) is np.int32  # 0 .. 2**31 - 1: the largest int32 is the last
+    assert index_dtype(2**31 + 1) is np.int64
+    assert index_dtype(2**40) is np.int64
+    assert np.iinfo(np.int32).max == INT32_LIMIT - 1

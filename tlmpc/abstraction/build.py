@@ -50,7 +50,7 @@ def _labels(
 ) -> tuple[IntArray, tuple[tuple[str, ...], ...]]:
     """Each triangle's letter (the set of regions holding its centroid) and the letters,
     ordered by size, then by names."""
-    centroids = vertices[triangles].mean(axis=1)
+    centroids = _centroids(vertices, triangles)
     names = [r.name for r in mission.regions]
     tree = shapely.STRtree(shapes)
     hits = tree.query(shapely.points(centroids), predicate="within")
@@ -83,6 +83,17 @@ def _labels(
     for t, key in several_keys.items():
         letter_of[t] = index[key]
     return letter_of, tuple(ordered)
+
+
+def _centroids(vertices: FloatArray, triangles: IntArray) -> FloatArray:
+    """``vertices[triangles].mean(axis=1)``, the same floats: the mean over three corners
+    adds them in order and divides by three, here without the (m, 3, 2) array of corners."""
+    centroids = np.empty((len(triangles), 2))
+    first, second, third = triangles[:, 0], triangles[:, 1], triangles[:, 2]
+    for axis in range(2):
+        along = vertices[:, axis]
+        centroids[:, axis] = (along[first] + along[second] + along[third]) / 3.0
+    return centroids
 
 
 def connected_components(neighbors: IntArray) -> IntArray:
@@ -295,9 +306,23 @@ def _piece_of(mission: Mission, polygon: tuple[tuple[float, float], ...]) -> str
 def _touching_components(abstraction: Abstraction) -> Any:
     """Each triangle's component, with components that share a mesh vertex merged: pieces
     of free space that touch at a point are connected through it (a plan may pass through
-    the point, see docs/planning.md), so a region beyond such a point is reachable."""
+    the point, see docs/planning.md), so a region beyond such a point is reachable.
+
+    Each merged group is numbered by its lowest component.  Around each vertex every
+    component is joined to the lowest one there (a scatter-minimum, no sort of the corners):
+    the same groups as joining them in any other order.
+    """
     component = np.asarray(abstraction.component, dtype=np.int64)
     count = int(component.max()) + 1 if len(component) else 0
+    if count <= 1:
+        return component
+    corners = abstraction.triangles.reshape(-1)
+    around = np.repeat(component, 3)
+    lowest = np.full(len(abstraction.vertices), count, dtype=np.int64)
+    np.minimum.at(lowest, corners, around)
+    joined = lowest[corners] != around
+    # Few pairs (one per component meeting another at a vertex): packed, then deduplicated.
+    pairs = np.unique(lowest[corners][joined] * count + around[joined]).tolist()
     parent = list(range(count))
 
     def root(c: int) -> int:
@@ -306,13 +331,8 @@ def _touching_components(abstraction: Abstraction) -> Any:
             c = parent[c]
         return c
 
-    # the components around each vertex: one row per (vertex, component) pair
-    pairs = np.unique(
-        np.stack([abstraction.triangles.ravel(), np.repeat(component, 3)], axis=1), axis=0
-    )
-    shared = np.flatnonzero(pairs[1:, 0] == pairs[:-1, 0])
-    for k in shared.tolist():
-        a, b = root(int(pairs[k, 1])), root(int(pairs[k + 1, 1]))
+    for key in pairs:
+        a, b = root(key // count), root(key % count)
         if a != b:
             parent[max(a, b)] = min(a, b)
     roots = np.array([root(c) for c in range(count)], dtype=np.int64)

@@ -8,23 +8,32 @@ from typing import Any
 import numpy as np
 
 from tlmpc.abstraction.model import Abstraction
+from tlmpc.io.arrays import ArrayList, TableList, plain
 
 FORMAT = "tlmpc.abstraction/1"
 
 
 def abstraction_to_json(abstraction: Abstraction) -> dict[str, Any]:
-    """The artifact document (labels per triangle as lists of region names)."""
+    """The artifact document (labels per triangle as lists of region names), plain lists."""
+    document: dict[str, Any] = plain(abstraction_document(abstraction))
+    return document
+
+
+def abstraction_document(abstraction: Abstraction) -> dict[str, Any]:
+    """The artifact document as the pipeline keeps it until it is written: the per-vertex
+    and per-triangle lists are stand-ins holding the arrays (:mod:`tlmpc.io.arrays`), which
+    the writer encodes into the same text as :func:`abstraction_to_json`'s lists."""
     letters = [list(letter) for letter in abstraction.letters]
     return {
         "format": FORMAT,
-        "vertices": abstraction.vertices.tolist(),
-        "triangles": abstraction.triangles.tolist(),
-        "neighbors": abstraction.neighbors.tolist(),
-        "labels": list(map(letters.__getitem__, abstraction.letter_of.tolist())),
+        "vertices": ArrayList(abstraction.vertices),
+        "triangles": ArrayList(abstraction.triangles),
+        "neighbors": ArrayList(abstraction.neighbors),
+        "labels": TableList(letters, abstraction.letter_of),
         "letters": letters,
-        "letter_of": abstraction.letter_of.tolist(),
+        "letter_of": ArrayList(abstraction.letter_of),
         "start": abstraction.start,
-        "components": abstraction.component.tolist(),
+        "components": ArrayList(abstraction.component),
         "regions": {name: list(map(list, poly)) for name, poly in abstraction.regions.items()},
         "stats": dict(abstraction.stats),
     }

@@ -82,13 +82,14 @@ def inradius(region: Any) -> float:
     return radius
 
 
-def goal_depth(region: Any, margin: float, requested: float | None) -> float:
+def goal_depth(region: Any, margin: float, requested: float | None, scale: float = 1.0) -> float:
     """How deep a path must go into the goal ``region``: the margin, or ``requested``
-    (``options.goal_depth``; unset: :data:`GOAL_DEPTH_FRACTION` of the inradius) when deeper.
+    (``options.goal_depth``; unset: :data:`GOAL_DEPTH_FRACTION` of the inradius) times
+    ``scale`` (a shallower try, see :func:`planning_layout`) when deeper.
 
     :func:`core` caps it at half the inradius."""
     wanted = GOAL_DEPTH_FRACTION * inradius(region) if requested is None else requested
-    return max(margin, wanted)
+    return max(margin, scale * wanted)
 
 
 def core(region: Any, depth: float) -> Any:
@@ -105,13 +106,17 @@ def deepens_goals(mission: Mission) -> bool:
     return requested is None or requested > 0.0
 
 
-def planning_layout(mission: Mission, margin: float, *, deep: bool = True) -> PlanningLayout | None:
-    """The layout for ``mission`` with ``margin`` and, with ``deep``, the goal depth; None
-    for a point robot without margin whose goals keep their shapes."""
+def planning_layout(
+    mission: Mission, margin: float, *, deep: bool = True, scale: float = 1.0
+) -> PlanningLayout | None:
+    """The layout for ``mission`` with ``margin`` and, with ``deep``, the goal depth (times
+    ``scale``: the plan stage tries shallower goals when the cores' corners are too sharp
+    for the disturbance); None for a point robot without margin whose goals keep their
+    shapes."""
     radius = obstacle_offset(mission)
     deep = deep and deepens_goals(mission)
     if radius <= 0.0 and margin <= 0.0:
-        return _point_layout(mission) if deep else None
+        return _point_layout(mission, scale) if deep else None
     raw = workspace_free_space(mission)
     # two steps of the snapping grid more: the free space is snapped, and then noded with the
     # regions' rings, each moving a vertex by up to a step's half diagonal
@@ -138,7 +143,8 @@ def planning_layout(mission: Mission, margin: float, *, deep: bool = True) -> Pl
         shape = shapely.Polygon(region.polygon)
         sign = signs.get(region.name)
         if sign == "positive":
-            depth = goal_depth(shape, margin, mission.options.goal_depth) if deep else margin
+            requested = mission.options.goal_depth
+            depth = goal_depth(shape, margin, requested, scale) if deep else margin
             inner = core(shape, depth)
             shape = inner if not inner.is_empty else shape
         elif sign == "negative":
@@ -152,7 +158,7 @@ def planning_layout(mission: Mission, margin: float, *, deep: bool = True) -> Pl
     return PlanningLayout(free=free, regions=tuple(shapes), margin=margin, radius=radius)
 
 
-def _point_layout(mission: Mission) -> PlanningLayout | None:
+def _point_layout(mission: Mission, scale: float = 1.0) -> PlanningLayout | None:
     """A point robot without margin: the mission's free space, its goals' cores at the goal
     depth, every other region as it is; None when the task visits no region."""
     signs = polarities(mission.formula)
@@ -161,7 +167,7 @@ def _point_layout(mission: Mission) -> PlanningLayout | None:
         shape: Any = None
         if signs.get(region.name) == "positive":
             polygon = shapely.Polygon(region.polygon)
-            inner = core(polygon, goal_depth(polygon, 0.0, mission.options.goal_depth))
+            inner = core(polygon, goal_depth(polygon, 0.0, mission.options.goal_depth, scale))
             shape = inner if not inner.is_empty else None
         shapes.append(shape)
     if all(shape is None for shape in shapes):

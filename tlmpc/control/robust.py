@@ -83,13 +83,20 @@ def weakest(corners: Sequence[Corner]) -> Corner:
     return min(corners, key=lambda corner: corner.push)
 
 
+#: What "below the bound" leaves to spare: the controllers' re-check tolerance.
+TOLERANCE_NOTE = "2e-9 x max_speed to spare"
+
 #: The largest smallest-angle bound the triangulator meets (degrees; the mission format's
 #: ``options.min_angle`` allows up to 34).
 MAX_MIN_ANGLE = 34.0
 
 
-def disturbance_hint(disturbance: float, max_speed: float, bound: Corner) -> str:
-    """C032's hint: the plan's own bound, what ``min_angle`` guarantees, and the stay limit.
+def disturbance_hint(
+    disturbance: float, max_speed: float, bound: Corner, *, supported: float | None = None
+) -> str:
+    """C032's hint: the largest disturbance any plan on the mesh rejects (``supported``, from
+    the planner's widest-lasso search, when known), the plan's own bound, what ``min_angle``
+    guarantees, and the stay limit.
 
     Every statement is a fact about triangles: a kept corner of angle a pushes at most
     max_speed * sin(a / 2); ``min_angle`` = m guarantees every angle >= m, hence a push of
@@ -98,13 +105,21 @@ def disturbance_hint(disturbance: float, max_speed: float, bound: Corner) -> str
     """
     ratio = disturbance / max_speed
     x, y = bound.position
-    lines = [
+    lines = []
+    if supported is not None:
+        lines.append(
+            f"the largest disturbance any plan on this mesh rejects is {supported:.6g} "
+            f"({supported / max_speed:.4f} x max_speed; every one below it, with "
+            f"{TOLERANCE_NOTE}, has a plan): the widest route's weakest corner, over every plan "
+            "the task admits"
+        )
+    lines.append(
         f"this plan's triangles reject disturbances below {bound.push:.6g} "
         f"({bound.push / max_speed:.4f} x max_speed), the push of its weakest corner "
         f"({x:.6g}, {y:.6g}) in step {bound.step}, angle {bound.angle:.6g} degrees (the "
         "planner takes a route through corners that reject the disturbance wherever this mesh "
         "has one; it has none)"
-    ]
+    )
     ceiling = math.sin(math.radians(MAX_MIN_ANGLE) / 2.0)
     if ratio < ceiling:
         needed = math.degrees(2.0 * math.asin(ratio))

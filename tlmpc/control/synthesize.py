@@ -529,7 +529,11 @@ def _corner(
 
 
 def _check_rejectable(
-    abstraction: Abstraction, steps: list[_Step], robot: Robot, source: str | None
+    abstraction: Abstraction,
+    steps: list[_Step],
+    robot: Robot,
+    source: str | None,
+    supported: float | None = None,
 ) -> None:
     """Located errors where no vertex velocity can reject ``robot.disturbance`` (C032/C033),
     and where the plan passes through a single point, which no law here reaches under a
@@ -587,7 +591,9 @@ def _check_rejectable(
                     )
                 )
     if problems:
-        hint = disturbance_hint(robot.disturbance, robot.max_speed, weakest(pushes))
+        hint = disturbance_hint(
+            robot.disturbance, robot.max_speed, weakest(pushes), supported=supported
+        )
         raise InvalidInputError([replace(p, hint=hint) for p in problems[:10]])
 
 
@@ -642,7 +648,15 @@ def synthesize(
     started = time.perf_counter()
     steps, loop_start = plan_steps(abstraction, witness)
     if robot.disturbance > 0.0:
-        _check_rejectable(abstraction, steps, robot, source)
+        # the planner's widest-lasso search, recorded on a plan it could not make realisable
+        supported = witness.stats.get("supported_disturbance")
+        _check_rejectable(
+            abstraction,
+            steps,
+            robot,
+            source,
+            None if supported is None else float(supported),
+        )
     # A velocity shared along a vertex run must push harder than the disturbance along every
     # facet the run collects (without one, merely positive along each: push 0).
     push = (

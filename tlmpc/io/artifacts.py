@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from tlmpc.base.errors import UsageError, error
+from tlmpc.io.arrays import ArrayList, TableList, encoded_pieces, has_standins, plain
 from tlmpc.io.schema_check import validation_errors
 
 
@@ -45,11 +46,27 @@ def dumps(document: Any, shared: SharedTexts | None = None) -> str:
     try:
         text = _compact(document, shared)
     except ValueError:  # a non-finite float somewhere: JSON has none
-        document = _finite(document)
+        document = _finite(plain(document))
         text = json.dumps(document, sort_keys=True, separators=(",", ":"), allow_nan=False)
     if len(text) < INDENT_BELOW:
-        text = json.dumps(document, indent=2, sort_keys=True, allow_nan=False)
+        text = json.dumps(plain(document), indent=2, sort_keys=True, allow_nan=False)
     return text + "\n"
+
+
+def artifact_pieces(
+    artifacts: Mapping[str, Any],
+) -> Iterator[tuple[str, str | bytes | Iterator[str]]]:
+    """``(name, content)`` of each artifact as :func:`artifact_texts` gives it, except that a
+    document holding arrays comes as the pieces of its text (:func:`dump_pieces`), to be
+    written one after the other."""
+    shared = SharedTexts.among(artifacts.values())
+    for name, content in artifacts.items():
+        if isinstance(content, str | bytes):
+            yield name, content
+        elif has_standins(content):
+            yield name, dump_pieces(content, shared)
+        else:
+            yield name, dumps(content, shared)
 
 
 def artifact_texts(artifacts: Mapping[str, Any]) -> Iterator[tuple[str, str | bytes]]:
@@ -115,16 +132,71 @@ class SharedTexts:
 def _compact(document: Any, shared: SharedTexts | None) -> str:
     """What ``json.dumps(document, sort_keys=True, separators=(",", ":"), allow_nan=False)``
     returns, with the top-level values of a dict holding a shared key taken from ``shared``."""
-    if shared is None or type(document) is not dict or shared.keys.isdisjoint(document):
+    if not has_standins(document) and (
+        shared is None or type(document) is not dict or shared.keys.isdisjoint(document)
+    ):
         return _COMPACT.encode(document)
+    return "".join(_compact_pieces(document, shared))  # the texts of a mesh, copied once
+
+
+def _compact_pieces(document: dict[Any, Any], shared: SharedTexts | None) -> Iterator[str]:
+    """The pieces of :func:`_compact`'s text of a dict, its stand-ins a block at a time.
+
+    Every value the encoder could refuse is encoded (or checked) here, before the first
+    piece: the pieces that follow cannot fail.
+    """
     # The encoder sorts the items of a dict by key and writes each value independently of
     # its surroundings: the same text, piece by piece.  (The document has a text key, the
     # shared one: a key of another type beside it fails to sort here as in the encoder.)
-    pieces = ["{"]
-    for key in sorted(document):  # one join: the texts of a mesh are megabytes, copied once
-        pieces += (_COMPACT.encode(key), ":", shared.text(key, document[key]), ",")
-    pieces[-1] = "}"
-    return "".join(pieces)
+    order = sorted(document)
+    texts: list[str | Iterator[str]] = []
+    for key in order:
+        value = document[key]
+        if isinstance(value, ArrayList | TableList):
+            texts.append(encoded_pieces(value, _COMPACT))
+        elif shared is not None:
+            texts.append(shared.text(key, value))
+        else:
+            texts.append(_COMPACT.encode(value))
+    keys = [_COMPACT.encode(key) for key in order]
+    return _pieces(keys, texts)
+
+
+def _pieces(keys: list[str], texts: list[str | Iterator[str]]) -> Iterator[str]:
+    yield "{"
+    for number, (key, text) in enumerate(zip(keys, texts, strict=True)):
+        yield ("," if number else "") + key + ":"
+        if isinstance(text, str):
+            yield text
+        else:
+            yield from text
+    yield "}"
+
+
+def dump_pieces(document: Any, shared: SharedTexts | None = None) -> Iterator[str]:
+    """The pieces of :func:`dumps`'s text, a large document's arrays a block of rows at a
+    time (the whole text of a mesh is never held)."""
+    if not has_standins(document):
+        yield dumps(document, shared)
+        return
+    try:
+        pieces = _compact_pieces(document, shared)
+    except ValueError:  # a non-finite float: the whole document the slow way
+        yield dumps(document, shared)
+        return
+    head: list[str] = []
+    length = 0
+    for piece in pieces:
+        head.append(piece)
+        length += len(piece)
+        if length >= INDENT_BELOW:
+            break
+    else:  # short: written indented, as dumps writes it
+        yield json.dumps(plain(document), indent=2, sort_keys=True, allow_nan=False) + "\n"
+        return
+    yield from head
+    yield from pieces
+    yield "\n"
 
 
 def json_text(document: Any) -> str:

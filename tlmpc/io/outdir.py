@@ -35,7 +35,7 @@ from pathlib import Path
 from typing import Any
 
 from tlmpc.base.errors import UsageError, error
-from tlmpc.io.artifacts import ARTIFACT_SCHEMAS, artifact_texts, dumps
+from tlmpc.io.artifacts import ARTIFACT_SCHEMAS, artifact_pieces, dumps
 
 #: The marker file every output directory holds; its first line starts with MARKER_FORMAT.
 MARKER = ".tlmpc-output"
@@ -291,6 +291,10 @@ def _write(path: Path, content: Any) -> None:
         path.write_bytes(content)
     elif isinstance(content, str):
         path.write_text(content, encoding="utf-8")
+    elif isinstance(content, Iterator):  # the pieces of a large document's text
+        with path.open("w", encoding="utf-8") as stream:
+            for piece in content:
+                stream.write(piece)
     else:
         path.write_text(dumps(content), encoding="utf-8")
 
@@ -328,8 +332,9 @@ def _new_staging(out: Path) -> Path:
 def write_artifacts(staging: Path, artifacts: Mapping[str, Any]) -> None:
     """Write each artifact (JSON document, text or bytes) into ``staging``."""
     # A large value several documents hold (the regions) is encoded once; each text is
-    # written as soon as it is made, so that only one is held at a time.
-    for name, content in artifact_texts(artifacts):
+    # written as soon as it is made, so that only one is held at a time, and a document
+    # holding arrays (the mesh) a block of rows at a time.
+    for name, content in artifact_pieces(artifacts):
         try:
             _write(staging / name, content)
         except OSError as exc:

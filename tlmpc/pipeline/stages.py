@@ -210,12 +210,9 @@ def _body_notes(mission: Mission, text: str | None) -> list[Diagnostic]:
 
 
 def _abstraction(c: Compilation) -> StageResult:
-    from tlmpc.abstraction import (
-        abstraction_diagnostics,
-        abstraction_to_json,
-        build_abstraction,
-    )
+    from tlmpc.abstraction import abstraction_diagnostics, build_abstraction
     from tlmpc.abstraction.build import mesh_size_diagnostic
+    from tlmpc.abstraction.io import abstraction_document
     from tlmpc.abstraction.layout import planning_layout
     from tlmpc.mission.body import requested_margin
 
@@ -226,7 +223,7 @@ def _abstraction(c: Compilation) -> StageResult:
     abstraction = build_abstraction(mission, layout)
     return StageResult(
         products=provide(ABSTRACTION, abstraction),
-        artifacts={"abstraction.json": abstraction_to_json(abstraction)},
+        artifacts={"abstraction.json": abstraction_document(abstraction)},
         sizes={
             "triangles": abstraction.num_triangles,
             "vertices": int(abstraction.vertices.shape[0]),
@@ -262,7 +259,7 @@ def _automaton(c: Compilation) -> StageResult:
 
 
 def _plan(c: Compilation) -> StageResult:
-    from tlmpc.abstraction import abstraction_to_json
+    from tlmpc.abstraction.io import abstraction_document
     from tlmpc.automata import automaton_to_json, to_hoa
     from tlmpc.pipeline.mintime import plan_minimum_time
     from tlmpc.planning import witness_to_json
@@ -280,7 +277,7 @@ def _plan(c: Compilation) -> StageResult:
         artifacts["automaton.hoa"] = to_hoa(planned.automaton)
     artifacts["witness.json"] = witness_to_json(witness, abstraction)
     if abstraction is not built:
-        artifacts["abstraction.json"] = abstraction_to_json(abstraction)
+        artifacts["abstraction.json"] = abstraction_document(abstraction)
     refined = abstraction.stats.get("split_for_u_turns", 0) != built.stats.get(
         "split_for_u_turns", 0
     )

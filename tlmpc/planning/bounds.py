@@ -24,6 +24,7 @@ hold for whatever edge costs the product is given.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -49,6 +50,8 @@ class RegionGraph:
     cell_local: IntArray  # per cell: its triangle's local class (-1: not allowed)
     distance: FloatArray  # (landmarks, cells): cost from the cell to entering the landmark
     delta: FloatArray  # (local, local): region-to-region lower bound (0 from the background)
+    entry: BoolArray  # per cell: entered from a triangle of another class (a boundary entry)
+    delta_entry: FloatArray  # (local, local): as delta, from the entry cells of the region
     closure: BoolArray  # (local, Q, Q): states reached for free with that last landmark
     entering: list[tuple[int, IntArray, IntArray]]  # (landmark, from states, to states)
     scale: float  # weight per unit of Euclidean length, at least (for the straight bound)
@@ -59,11 +62,15 @@ class RegionGraph:
         distance, _ = shortest_paths(self.backwards, cells)
         return distance
 
-    def region_minimum(self, per_cell: FloatArray) -> FloatArray:
-        """Per local class: the least value over its cells."""
-        allowed = self.cell_local >= 0
+    def region_minimum(self, per_cell: FloatArray, *, entered: bool = False) -> FloatArray:
+        """Per local class: the least value over its cells (``entered``: over the landmark's
+        boundary entry cells, where the robot is right after entering it; the background's
+        over all its cells)."""
+        pick = self.cell_local >= 0
+        if entered:
+            pick &= self.entry | (self.cell_local == self.background)
         least = np.full(len(self.classes), np.inf)
-        np.minimum.at(least, self.cell_local[allowed], per_cell[allowed])
+        np.minimum.at(least, self.cell_local[pick], per_cell[pick])
         return least
 
     @property
@@ -89,12 +96,20 @@ def region_graph(product: LazyProduct, allowed_cells: BoolArray) -> RegionGraph:
     sources = np.repeat(np.arange(cells, dtype=np.int64), np.diff(product.move_indptr))
     backwards, _ = Graph.from_edges(product.move_target, sources, product.move_weight, cells)
     distance = _landmark_distances(backwards, cell_local, landmarks)
+    # A boundary entry cell is entered by a move from a triangle of another local class: the
+    # robot is in one right after the region-level graph's landmark changed to its class.
+    entry = np.zeros(cells, dtype=bool)
+    moved_from = cell_local[sources]
+    entry[product.move_target[(moved_from != cell_local[product.move_target])]] = True
+    entry &= cell_local >= 0
     count = len(present)
     delta = np.zeros((count, count))
+    delta_entry = np.zeros((count, count))
+    inside = _ClassCells(cell_local, landmarks, np.ones(cells, dtype=bool))
+    entered = _ClassCells(cell_local, landmarks, entry)
     for index, landmark in enumerate(landmarks.tolist()):
-        for c in landmarks.tolist():
-            inside = distance[index][cell_local == c]
-            delta[c, landmark] = float(inside.min()) if len(inside) else np.inf
+        delta[landmarks, landmark] = inside.least(distance[index])
+        delta_entry[landmarks, landmark] = entered.least(distance[index])
     kind_local = local_of[product.kind_class]
     closure = np.zeros((count, nq, nq), dtype=bool)
     entering: list[tuple[int, IntArray, IntArray]] = []
@@ -121,11 +136,37 @@ def region_graph(product: LazyProduct, allowed_cells: BoolArray) -> RegionGraph:
         cell_local=cell_local,
         distance=distance,
         delta=delta,
+        entry=entry,
+        delta_entry=delta_entry,
         closure=closure,
         entering=entering,
         scale=_straight_scale(product),
         backwards=backwards,
     )
+
+
+class _ClassCells:
+    """The cells of each of some classes (among those ``pick`` holds), grouped so that the
+    least of a per-cell value over each class is one pass."""
+
+    def __init__(self, cell_local: IntArray, classes: IntArray, pick: BoolArray) -> None:
+        cells = np.flatnonzero(pick & np.isin(cell_local, classes))
+        order = np.argsort(cell_local[cells], kind="stable")
+        self.cells = cells[order]
+        grouped = cell_local[self.cells]
+        self.starts = np.searchsorted(grouped, classes)  # classes ascending
+        self.present = np.searchsorted(grouped, classes, side="right") > self.starts
+
+    def least(self, per_cell: FloatArray) -> FloatArray:
+        """Per class: the least value over its cells (inf for a class without cells)."""
+        result = np.full(len(self.starts), np.inf)
+        if len(self.cells):
+            # The present classes' runs start strictly increasing, each ending where the
+            # next begins (the last at the end).
+            result[self.present] = np.minimum.reduceat(
+                per_cell[self.cells], self.starts[self.present]
+            )
+        return result
 
 
 def _mark(step: BoolArray, successor: IntArray) -> None:
@@ -181,11 +222,15 @@ class CostToGo:
 
     With ``final`` the targets are the cells ``final`` measures the way to, in the states
     ``reach`` tells: a node whose free steps reach such a state is bounded by ``final`` at its
-    own cell rather than by the region-level ``free``."""
+    own cell rather than by the region-level ``free``.  ``value[q, c]`` is the region-level
+    cost right after entering landmark ``c`` in state ``q`` (the robot in one of its boundary
+    entry cells), which :meth:`at_region` gives for ``entered=True``."""
 
     graph: RegionGraph
     free: FloatArray  # (Q, local)
     leg: FloatArray  # (Q, local, landmarks)
+    value: FloatArray  # (Q, local): the cost to go right after entering the class
+    anywhere: FloatArray  # (Q, local): the cost to go anywhere in the class or background
     final: FloatArray | None = None  # per cell: the cost still to pay in a target state
     reach: BoolArray | None = None  # (Q, local): free steps reach a target state
 
@@ -204,12 +249,11 @@ class CostToGo:
         result: FloatArray = bound * SAFETY
         return result
 
-    def at_region(self, q: int, c: int) -> float:
-        """The bound at the region-level node ``(q, c)``."""
-        value = float(self.free[q, c])
-        for index, landmark in enumerate(self.graph.landmarks.tolist()):
-            value = min(value, float(self.graph.delta[c, landmark] + self.leg[q, c, index]))
-        return value
+    def at_region(self, q: int, c: int, *, entered: bool = False) -> float:
+        """The bound at the region-level node ``(q, c)``: anywhere in ``c`` or the
+        background with ``c`` the last landmark, or with ``entered`` right after entering
+        landmark ``c`` (in one of its boundary entry cells)."""
+        return float(self.value[q, c] if entered else self.anywhere[q, c])
 
 
 def cost_to_go_to_cells(graph: RegionGraph, state: int, final: FloatArray) -> CostToGo:
@@ -218,43 +262,78 @@ def cost_to_go_to_cells(graph: RegionGraph, state: int, final: FloatArray) -> Co
     nq = graph.num_states
     terminal = np.full((nq, len(graph.classes)), np.inf)
     terminal[state, :] = graph.region_minimum(final)
-    bound = cost_to_go(graph, terminal)
+    terminal_entered = np.full_like(terminal, np.inf)
+    terminal_entered[state, :] = graph.region_minimum(final, entered=True)
+    bound = cost_to_go(graph, terminal, terminal_entered)
     reach = graph.closure[:, :, state].T  # (Q, local)
-    return CostToGo(graph=graph, free=bound.free, leg=bound.leg, final=final, reach=reach)
+    return dataclasses.replace(bound, final=final, reach=reach)
 
 
-def cost_to_go(graph: RegionGraph, terminal: FloatArray) -> CostToGo:
+def cost_to_go(
+    graph: RegionGraph, terminal: FloatArray, terminal_entered: FloatArray | None = None
+) -> CostToGo:
     """The least region-level cost to a node ``(q, c)`` plus its ``terminal[q, c]`` (inf:
     not a target), as a bound on concrete nodes (see :class:`CostToGo`).
+    ``terminal_entered`` (at least ``terminal``) may tell more of a target reached right
+    after entering landmark ``c``.
 
     Bellman-Ford on the region-level graph: with nonnegative costs it settles within as many
     rounds as the graph has nodes, and in practice within the number of landmarks a cheapest
-    path enters.
+    path enters.  Every leg after the first starts where its landmark was entered, so it
+    costs at least ``delta_entry``: the least cost from that landmark's boundary entry cells.
     """
     nq = graph.num_states
     count = len(graph.classes)
     closure = graph.closure
     # free[q, c]: a target reached without entering another landmark.
-    free = np.where(closure, terminal.T[:, None, :], np.inf).min(axis=2).T
-    value = free.copy()  # the region-level node's cost to go
-    leg = np.full((nq, count, len(graph.landmarks)), np.inf)
+    free = _closure_min(closure, terminal)
+    after_entry = free if terminal_entered is None else _closure_min(closure, terminal_entered)
+    value = after_entry.copy()  # the region-level node's cost to go, right after entering
+    landmarks = len(graph.landmarks)
+    leg = np.full((nq, count, landmarks), np.inf)
+    # The entering edges of every landmark in one table: (landmark index, tail, head).
+    index = np.concatenate(
+        [np.full(len(tails), k, dtype=np.int64) for k, (_, tails, _) in enumerate(graph.entering)]
+        or [np.zeros(0, dtype=np.int64)]
+    )
+    tails = np.concatenate([t for _, t, _ in graph.entering] or [np.zeros(0, dtype=np.int64)])
+    heads = np.concatenate([h for _, _, h in graph.entering] or [np.zeros(0, dtype=np.int64)])
+    entered = graph.landmarks[index]
+    into = graph.delta_entry[:, graph.landmarks]  # (local, landmarks)
     for _ in range(nq * count + 1):
-        for index, (landmark, tails, heads) in enumerate(graph.entering):
-            # Entering the landmark from state tail: the cheapest head's cost to go there.
-            after = np.full(nq, np.inf)
-            np.minimum.at(after, tails, value[heads, landmark])
-            leg[:, :, index] = _masked_min(closure, after).T
-        updated = free.copy()
-        for index, landmark in enumerate(graph.landmarks.tolist()):
-            updated = np.minimum(updated, graph.delta[:, landmark][None, :] + leg[:, :, index])
+        # Entering a landmark from state tail: the cheapest head's cost to go there.
+        after = np.full((landmarks, nq), np.inf)
+        np.minimum.at(after, (index, tails), value[heads, entered])
+        leg = _masked_min(closure, after)
+        updated = np.minimum(after_entry, (into[None, :, :] + leg).min(axis=2, initial=np.inf))
         if np.array_equal(updated, value):
             break
         value = updated
-    return CostToGo(graph=graph, free=free, leg=leg)
+    # Anywhere in c: the next landmark is at least delta away (from any cell of c).
+    away = (graph.delta[:, graph.landmarks][None, :, :] + leg).min(axis=2, initial=np.inf)
+    return CostToGo(graph=graph, free=free, leg=leg, value=value, anywhere=np.minimum(free, away))
+
+
+def _closure_min(closure: BoolArray, terminal: FloatArray) -> FloatArray:
+    """(Q, local): the least ``terminal[q', c]`` over the states ``q'`` free steps with
+    last landmark ``c`` reach from ``q``."""
+    result: FloatArray = np.where(closure, terminal.T[:, None, :], np.inf).min(axis=2).T
+    return result
+
+
+#: Elements of the temporary array :func:`_masked_min` fills at once.
+_MASKED_CHUNK = 1 << 22
 
 
 def _masked_min(reach: BoolArray, cost: FloatArray) -> FloatArray:
-    """(local, Q): per class c and state q, the least ``cost[q']`` over the ``q'`` that
-    ``reach[c, q]`` holds."""
-    result: FloatArray = np.where(reach, cost[None, None, :], np.inf).min(axis=2)
+    """(Q, local, landmarks): per state q, class c and landmark l, the least ``cost[l, q']``
+    over the ``q'`` that ``reach[c, q]`` holds (landmarks a chunk at a time)."""
+    landmarks, nq = cost.shape
+    count = reach.shape[0]
+    result = np.full((nq, count, landmarks), np.inf)
+    chunk = max(1, _MASKED_CHUNK // max(1, count * nq * nq))
+    for first in range(0, landmarks, chunk):
+        part = cost[first : first + chunk]  # (chunk, Q)
+        least = np.where(reach[None], part[:, None, None, :], np.inf).min(axis=3)
+        result[:, :, first : first + chunk] = least.transpose(2, 1, 0)
     return result

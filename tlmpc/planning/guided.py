@@ -46,8 +46,9 @@ from tlmpc.planning.search import BUCKET_WIDTH, relax_offers
 Bound = Callable[[IntArray], FloatArray]
 
 #: Closing searches run side by side up to this many product nodes in all (their arrays,
-#: about 30 bytes a node).
-CLOSING_NODES = 26_000_000
+#: about 30 bytes a node, are written whole when allocated: on a product of millions of
+#: nodes that costs more than the rounds the searches would share, so they run one by one).
+CLOSING_NODES = 4_000_000
 
 
 @dataclass(slots=True)
@@ -90,6 +91,13 @@ class GuidedSearch:
     returns those edges; offers whose ``g + bound`` reaches ``ceiling`` are dropped (no path
     through them can beat it).  Distances are exact for every node whose ``f`` lies below
     :meth:`lowest` once the search has stepped past it.
+
+    The queued nodes are kept per bucket (``f`` in ``[k w, (k + 1) w)`` for the bucket
+    width ``w``), so a round reads only the nodes it expands, not every node waiting: a
+    guided search's frontier holds hundreds of times more nodes than one bucket.  A node
+    whose distance got shorter is queued again in its new bucket (never below the bucket
+    being expanded); the entry it had is skipped when its bucket comes (the node is no
+    longer queued, or was queued again and is expanded at most once more).
     """
 
     def __init__(
@@ -114,12 +122,14 @@ class GuidedSearch:
         arrays.dist[sources] = offsets
         arrays.queued[sources] = True
         arrays.touched.append(sources)
-        self.frontier = sources
-        self.estimate = estimate[finite]  # the bound at each frontier node
-        self.f = offsets + self.estimate  # g + bound at each frontier node
+        self.sources = sources
         weights = product.move_weight
         self.width = BUCKET_WIDTH * float(weights.mean()) if len(weights) else 1.0
         self.reached = len(sources)
+        self.buckets: dict[int, list[IntArray]] = {}  # key -> queued nodes (maybe stale)
+        self.keys: list[int] = []  # a heap of the buckets' keys
+        self.floor = 0  # the key of the bucket expanded last
+        self._queue(sources, offsets + estimate[finite])
 
     def estimate_at(self, nodes: IntArray) -> FloatArray:
         """The bound at ``nodes``, computed once per node (kept in single precision,
@@ -134,31 +144,56 @@ class GuidedSearch:
             self.arrays.touched.append(fresh)
         return known.astype(np.float64)
 
-    def lowest(self) -> float:
-        """The least ``f`` in the frontier (inf when it is empty)."""
-        if not len(self.frontier):
-            return np.inf
-        return float(self.f.min())
+    def _queue(self, nodes: IntArray, f: FloatArray) -> None:
+        """Put ``nodes`` (distinct, finite ``f``) in their buckets."""
+        if not len(nodes):
+            return
+        keys = np.maximum((f / self.width).astype(np.int64), self.floor)
+        low, high = int(keys.min()), int(keys.max())
+        for key in [low] if low == high else np.unique(keys).tolist():
+            mine = nodes if low == high else nodes[keys == key]
+            if key in self.buckets:
+                self.buckets[key].append(mine)
+            else:
+                self.buckets[key] = [mine]
+                heapq.heappush(self.keys, key)
 
-    def prune(self, ceilings: FloatArray) -> None:
-        """Drop the frontier nodes whose ``f`` reaches their copy's ceiling."""
-        keep = self.f < ceilings[self.frontier // self.copy_size]
-        self.arrays.queued[self.frontier[~keep]] = False
-        self.frontier, self.estimate, self.f = (
-            self.frontier[keep],
-            self.estimate[keep],
-            self.f[keep],
-        )
+    def _lowest_bucket(self) -> IntArray | None:
+        """The queued nodes of the lowest bucket that has any (None: nothing queued)."""
+        while self.keys:
+            key = self.keys[0]
+            parts = self.buckets[key]
+            nodes = parts[0] if len(parts) == 1 else np.unique(np.concatenate(parts))
+            nodes = nodes[self.arrays.queued[nodes]]
+            if len(nodes):
+                self.buckets[key] = [nodes]
+                return nodes
+            del self.buckets[key]
+            heapq.heappop(self.keys)
+        return None
+
+    def lowest(self) -> float:
+        """The least ``f`` of a queued node (inf when none is)."""
+        nodes = self._lowest_bucket()
+        if nodes is None:
+            return np.inf
+        return float((self.arrays.dist[nodes] + self.arrays.estimate[nodes]).min())
 
     def step(self, ceiling: float | FloatArray = np.inf) -> tuple[Edges, IntArray]:
         """Expand the lowest bucket; returns its edges and the nodes whose distance got
-        shorter (queued again).  ``ceiling`` may be one per copy."""
+        shorter (queued again).  ``ceiling`` may be one per copy: then the bucket's nodes
+        whose ``f`` reaches their copy's ceiling are dropped, not expanded."""
         arrays = self.arrays
-        f = self.f
-        take = f <= float(f.min()) + self.width
-        active = self.frontier[take]
-        self.frontier, self.estimate = self.frontier[~take], self.estimate[~take]
+        active = self._lowest_bucket()
+        if active is None:
+            active = np.zeros(0, dtype=np.int64)
+        else:
+            self.floor = heapq.heappop(self.keys)
+            del self.buckets[self.floor]
         arrays.queued[active] = False
+        if isinstance(ceiling, np.ndarray):
+            f = arrays.dist[active] + arrays.estimate[active]
+            active = active[f < ceiling[active // self.copy_size]]
         if self.copy_size:
             local = active % self.copy_size
             edges = self.product.expand(local, base=active - local)
@@ -175,12 +210,9 @@ class GuidedSearch:
         )
         fresh = improved[~arrays.queued[improved]]
         arrays.queued[fresh] = True
-        arrays.touched.append(fresh)
-        self.reached += len(fresh)
-        self.frontier = np.concatenate([self.frontier, fresh])
-        self.estimate = np.concatenate([self.estimate, self.estimate_at(fresh)])
-        # Distances of queued nodes may have got shorter: f is read anew.
-        self.f = arrays.dist[self.frontier] + self.estimate
+        self.reached += len(fresh)  # (estimate_at recorded them for the reset: every v was)
+        # Every improved node goes in the bucket of its new f (queued ones too: theirs fell).
+        self._queue(improved, arrays.dist[improved] + self.estimate_at(improved))
         return edges, improved
 
     def path(self, target: int) -> list[int]:
@@ -224,7 +256,8 @@ class _Bounds:
         stays = product.stutter_accepts[graph.classes].T  # (Q, local)
         stay = np.where(stays | stays[:, [graph.background]], 0.0, np.inf)
         self.stay = stay
-        self.lasso = cost_to_go(graph, np.minimum(stay, self._accepting_terminal(nq)))
+        anywhere, entered = self._accepting_terminal(nq)
+        self.lasso = cost_to_go(graph, np.minimum(stay, anywhere), np.minimum(stay, entered))
 
     def back_to(self, q: int) -> CostToGo:
         """A bound on the cost from any node to a node of state ``q``."""
@@ -243,13 +276,15 @@ class _Bounds:
             self.arounds[key] = cost_to_go_to_cells(self.graph, q, self.graph.distance[index])
         return self.arounds[key]
 
-    def _accepting_terminal(self, nq: int) -> FloatArray:
-        """(Q, local): per region-level node, ``beta`` times a bound on closing a cycle
-        through an accepting edge taken there (its move, then the way back to its tail's
-        state)."""
+    def _accepting_terminal(self, nq: int) -> tuple[FloatArray, FloatArray]:
+        """(Q, local) twice: per region-level node, ``beta`` times a bound on closing a
+        cycle through an accepting edge taken there (its move, then the way back to its
+        tail's state); first anywhere in the region, then right after entering it (the way
+        to the edge's landmark counted from the region's boundary entry cells)."""
         graph, product = self.graph, self.product
         count = len(graph.classes)
         terminal = np.full((nq, count), np.inf)
+        entered_terminal = np.full((nq, count), np.inf)
         local_of = {int(c): i for i, c in enumerate(graph.classes.tolist())}
         kinds, states, width = product.marked.shape
         for kind in range(kinds):
@@ -265,15 +300,25 @@ class _Bounds:
                     for c in range(count):
                         landmark = entered not in (graph.background, c)
                         at = entered if landmark else c
-                        # The way to the landmark is paid partly before the edge (at
-                        # weight one) and partly by it (at beta): at least the lesser.
-                        move = min(1.0, self.beta) * graph.delta[c, entered] if landmark else 0.0
-                        cost = move + self.beta * back.at_region(q_next, at)
-                        if entered != graph.background:
+                        # After the edge: its head is a boundary entry cell of a landmark it
+                        # enters, anywhere in c or the background otherwise.
+                        rest = self.beta * back.at_region(q_next, at, entered=landmark)
+                        if landmark:
                             # The cycle itself: back to q, then into that landmark again.
+                            around = self.around(q, entered).at_region(
+                                q_next, entered, entered=True
+                            )
+                            rest = max(rest, self.beta * around)
+                        elif entered != graph.background:
                             around = self.around(q, entered).at_region(q_next, entered)
-                            cost = max(cost, self.beta * around)
-                        terminal[q, c] = min(terminal[q, c], cost)
+                            rest = max(rest, self.beta * around)
+                        # The way to the landmark is paid partly before the edge (at weight
+                        # one) and partly by it (at beta): at least the lesser.
+                        weight = min(1.0, self.beta)
+                        move = weight * graph.delta[c, entered] if landmark else 0.0
+                        terminal[q, c] = min(terminal[q, c], move + rest)
+                        move = weight * graph.delta_entry[c, entered] if landmark else 0.0
+                        entered_terminal[q, c] = min(entered_terminal[q, c], move + rest)
         stutter_marked = product.stutter_marked[graph.classes]  # (local, Q, J)
         for c in range(count):
             for other in {c, graph.background}:
@@ -281,9 +326,10 @@ class _Bounds:
                     for j in range(stutter_marked.shape[2]):
                         if stutter_marked[other, q, j]:
                             q_next = int(product.stutter_successor[graph.classes[other], q, j])
-                            cost = self.back_to(q).at_region(q_next, c)
-                            terminal[q, c] = min(terminal[q, c], self.beta * cost)
-        return terminal
+                            cost = self.beta * self.back_to(q).at_region(q_next, c)
+                            terminal[q, c] = min(terminal[q, c], cost)
+                            entered_terminal[q, c] = min(entered_terminal[q, c], cost)
+        return terminal, entered_terminal
 
     def closing(self, target: int) -> Bound:
         """A bound on the cost from any node to the node ``target``: the region-level one
@@ -332,7 +378,7 @@ def guided_lasso(
     candidates: list[tuple[float, int, int, float, float]] = []  # bound, u, v, w, g(u)
     searches = 0
     capped = False
-    for node in prefix.frontier[product.stays_accepting(prefix.frontier)].tolist():
+    for node in prefix.sources[product.stays_accepting(prefix.sources)].tolist():
         best = _better(best, (0.0, [node], [node]))
     while True:
         incumbent = best[0] if best is not None else np.inf
@@ -485,8 +531,7 @@ def _close_together(
     search = GuidedSearch(product, arrays, sources, bound, offsets=offsets, copy_size=size)
     while True:
         ceilings = np.minimum(arrays.dist[targets], limits)
-        search.prune(ceilings)
-        if not len(search.frontier):
+        if search.lowest() >= float(ceilings.max()):
             break
         search.step(ceiling=ceilings)
     found: list[tuple[float | None, list[int]]] = []

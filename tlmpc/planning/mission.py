@@ -35,7 +35,8 @@ from tlmpc.planning.timing import MoveTimes
 class Planned:
     """A planned mission: the mesh the witness refers to (refined where the plan turns
     around, or rebuilt without the margin), the automaton it was planned with, the witness,
-    and notes (A030 when the goal depth was dropped, R008 when the margin was)."""
+    and notes (A030 when the goal depth was dropped, A040 when it yielded to the disturbance,
+    R008 when the margin was dropped)."""
 
     abstraction: Abstraction
     automaton: Automaton
@@ -47,13 +48,15 @@ class Planned:
     formula: Formula | None = None
 
 
-def abstraction_for(mission: Mission, margin: float, *, deep: bool = True) -> Abstraction:
+def abstraction_for(
+    mission: Mission, margin: float, *, deep: bool = True, scale: float = 1.0
+) -> Abstraction:
     """The triangulated workspace of ``mission`` planned with ``margin`` (and its body), and
-    with ``deep`` the goal depth."""
+    with ``deep`` the goal depth (times ``scale``)."""
     from tlmpc.abstraction import build_abstraction
     from tlmpc.abstraction.layout import planning_layout
 
-    return build_abstraction(mission, planning_layout(mission, margin, deep=deep))
+    return build_abstraction(mission, planning_layout(mission, margin, deep=deep, scale=scale))
 
 
 def automaton_for(
@@ -121,7 +124,9 @@ def plan_mission(
         try:
             return complete(mesh, task, formula, explain, ratio)
         except (NoPlanError, RefinementError):
-            return first  # U-turn fans may have no realisable route either
+            # U-turn fans may have no realisable route either. The control stage refuses
+            # this plan (C032) and states the largest disturbance any plan on its mesh rejects.
+            return _with_supported(first, mission, formula, start_point)
 
     def complete(
         mesh: Abstraction, task: Automaton, formula: Formula, explain: bool, reject: float | None
@@ -143,25 +148,65 @@ def plan_mission(
         )
         return Planned(abstraction=planned_mesh, automaton=task, witness=witness, formula=formula)
 
+    from tlmpc.abstraction.layout import deepens_goals
+
+    margin = requested_margin(mission)
+
+    def realisable_depth(
+        planned: Planned, formula: Formula = skeleton, explain: bool = True
+    ) -> Planned:
+        """The goal depth yields to the disturbance: when the plan to the goal cores has a
+        step no controller realises, plan again to shallower cores (half, then a quarter of
+        the goal depth), then entering the goals only as deep as the margin asks (the cores'
+        corners may be all that is too sharp); the first plan whose steps all realise it."""
+        ratio = mission.robot.disturbance / mission.robot.max_speed
+        if resume is not None or ratio <= 0.0 or not deepens_goals(mission):
+            return planned
+        if witness_realisable(planned.abstraction, planned.witness, ratio):
+            return planned
+        tried = [planned]
+        for scale in (*SHALLOWER, 0.0):
+            mesh = abstraction_for(mission, margin, deep=scale > 0.0, scale=scale)
+            try:
+                again = attempt(
+                    mesh, automaton_for(mission, mesh, formula=formula), formula, explain
+                )
+            except NoPlanError:
+                continue
+            if witness_realisable(again.abstraction, again.witness, ratio):
+                note = _shallow_for_disturbance(mission, planned.witness, scale)
+                return replace(again, notes=(note,), remeshed=True)
+            tried.append(again)
+        # None realises the disturbance: the plan on the mesh whose plans reject the most goes
+        # on to be refused, stating that mesh's bound (C032: the mission compiles below it).
+        bounds = [_supported_of(plan.witness) for plan in tried]
+        best = max(range(len(tried)), key=lambda k: (bounds[k] is not None, bounds[k] or 0.0, -k))
+        return tried[0] if best == 0 else replace(tried[best], remeshed=True)
+
     holding = holding_skeleton(mission.formula)
     if resume is None and holding != skeleton:
         # Durations ("stay in X for at least T s") are met by a plan that stays for good,
         # when there is one; else the skeleton's plan, whose bounds are then checked.
         try:
-            return attempt(
-                abstraction, automaton_for(mission, abstraction, formula=holding), holding, False
+            return realisable_depth(
+                attempt(
+                    abstraction,
+                    automaton_for(mission, abstraction, formula=holding),
+                    holding,
+                    False,
+                ),
+                holding,
+                False,
             )
         except NoPlanError:
             pass
-    from tlmpc.abstraction.layout import deepens_goals
 
     try:
-        return attempt(abstraction, automaton)
+        return realisable_depth(attempt(abstraction, automaton))
     except NoPlanError as failure:
         if resume is not None:
             raise
         first = failure
-    margin = requested_margin(mission)
     if deepens_goals(mission):
         # the goal depth is an objective: plan again reaching the goals only as deep as the
         # margin asks (overlapping goals' cores may not meet where the regions do)
@@ -246,6 +291,68 @@ def _shallow_note(mission: Mission, failure: NoPlanError) -> Diagnostic:
         hint="goals that overlap only near their edges have deep parts that do not meet; "
         "set options.goal_depth to a smaller depth (0: the margin's) to plan with it",
         file=mission.source,
+    )
+
+
+#: The witness statistic that carries the largest disturbance any plan on its mesh rejects
+#: (in the units of robot.disturbance), set only on a plan with a step that does not reject the
+#: mission's: the control stage states it when it refuses the plan (C032).
+SUPPORTED = "supported_disturbance"
+
+
+def _with_supported(
+    planned: Planned, mission: Mission, formula: Formula, start_point: tuple[float, float] | None
+) -> Planned:
+    """``planned`` with the largest disturbance any plan on its mesh rejects in its
+    witness's statistics (:mod:`tlmpc.planning.bottleneck`), when that can be computed."""
+    from tlmpc.planning.bottleneck import supported_ratio
+
+    ratio = supported_ratio(
+        planned.abstraction,
+        planned.automaton,
+        formula=formula,
+        options=mission.options,
+        start_point=start_point if start_point is not None else mission.robot.start,
+    )
+    if ratio is None:
+        return planned
+    stats = {**planned.witness.stats, SUPPORTED: ratio * mission.robot.max_speed}
+    return replace(planned, witness=replace(planned.witness, stats=stats))
+
+
+def _supported_of(witness: Witness) -> float | None:
+    value = witness.stats.get(SUPPORTED)
+    return None if value is None else float(value)
+
+
+#: The fractions of the goal depth tried, in turn, when the goal cores' corners are too sharp
+#: for the disturbance (before the margin's depth).
+SHALLOWER = (0.5, 0.25)
+
+
+def _shallow_for_disturbance(mission: Mission, deep: Witness, scale: float) -> Diagnostic:
+    """A040: the goal depth was given up, or reduced to ``scale`` of it, for the disturbance."""
+    disturbance = mission.robot.disturbance
+    requested = mission.options.goal_depth
+    bound = _supported_of(deep)
+    reach = f"; any plan to the goal cores rejects at most {bound:.6g}" if bound is not None else ""
+    return Diagnostic(
+        code="A040",
+        severity="warning",
+        message=f"the goals' cores (options.goal_depth) add corners too sharp for "
+        f"robot.disturbance {disturbance:g}{reach}; planned "
+        + (
+            f"with cores {scale:g} x the goal depth deep (at least the margin)"
+            if scale > 0.0
+            else "to enter the goals only as deep as the margin asks"
+        )
+        + ", where every step rejects it",
+        hint="a goal core's corners are held on both facets: a corner of angle a rejects at "
+        "most max_speed * sin(a / 2); set options.goal_depth to a smaller depth (0: the "
+        "margin's) to plan with it without this warning"
+        + ("" if bound is None else ", or lower robot.disturbance below the bound to keep it"),
+        file=mission.source,
+        path="$.options.goal_depth" if requested is not None else "$.robot.disturbance",
     )
 
 

@@ -233,16 +233,16 @@ def plan(
     # Moving cycles through accepting edges.
     graph = product.graph
     marked = np.flatnonzero(product.accepting)
-    marked = marked[np.isfinite(dist[graph.sources[marked]])]
+    marked = marked[np.isfinite(dist[graph.source_of(marked)])]
     # In (u, v) order: equal bounds are closed in that order (a stable sort below).
-    marked = marked[np.lexsort((graph.targets[marked], graph.sources[marked]))]
+    marked = marked[np.lexsort((graph.targets[marked], graph.source_of(marked)))]
     best, searches, exhausted = _close_cycles(product, dist, pred, marked, best, options.beta)
     if best is None and not exhausted:
         # The cap stopped the search before any cycle closed.  Only edges inside one strongly
         # connected component close; keeping those, the first search succeeds, so the cap
         # never hides the existence of a lasso (computed only here: it costs a graph pass).
         scc = np.asarray(strong_components(graph.indptr, graph.targets))
-        closable = scc[graph.sources[marked]] == scc[graph.targets[marked]]
+        closable = scc[graph.source_of(marked)] == scc[graph.targets[marked]]
         best, more, exhausted = _close_cycles(
             product, dist, pred, marked[closable], None, options.beta
         )
@@ -295,7 +295,7 @@ def _close_cycles(
     if not len(marked):
         return best, searches, True
     graph = product.graph
-    us = graph.sources[marked]
+    us = graph.source_of(marked)
     vs = graph.targets[marked]
     edge_w = graph.weights[marked]
     bound = dist[us] + beta * edge_w

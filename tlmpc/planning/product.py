@@ -17,6 +17,7 @@ entered triangle's; the start reads its point letter before its triangle's.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -33,6 +34,9 @@ SLOTS = 4  # three edges, and "no entry edge yet" for the start
 START_SLOT = 3
 #: Weight of a stutter step: the searches need positive weights, and stutter is free.
 STUTTER_COST = 1e-9
+#: Node and edge numbers up to this count are held in 32 bits (half the memory of a product's
+#: index arrays: the numbers 0 .. 2**31 - 1); beyond it, in 64 bits.
+INT32_LIMIT = 2**31
 
 BoolArray = npt.NDArray[np.bool_]
 
@@ -47,6 +51,16 @@ class Product(ContentEquality):
     initial: IntArray
     num_automaton_states: int
     num_nodes: int
+
+
+def index_dtype(count: int) -> type[np.signedinteger[Any]]:
+    """The integer type for the numbers ``0 .. count - 1``: 32 bits while they fit, else 64.
+
+    A product's node numbers (and its cells and moves, numbered below its node count) and
+    its edge positions use it, so a product too large for 32-bit numbers is built the same,
+    only larger: nothing is computed in 32 bits that could pass 2**31 - 1.
+    """
+    return np.int32 if count <= INT32_LIMIT else np.int64
 
 
 def edge_midpoints(abstraction: Abstraction) -> FloatArray:
@@ -112,6 +126,8 @@ def build_product(
     ``realisable`` restricts the moves (leave t by edge i, (m, 3)) and the final stays ((m,))
     to those the controllers realise (:func:`tlmpc.planning.robust.realisable`).
     """
+    nq = automaton.num_states
+    size = abstraction.num_triangles * SLOTS * nq
     table = move_table(
         abstraction,
         automaton,
@@ -123,14 +139,14 @@ def build_product(
         bounces=bounces,
         realisable=realisable,
         times=times,
+        # moves are numbered on the (triangle, slot, exit) grid, cells below the node count
+        dtype=index_dtype(max(size, abstraction.num_triangles * SLOTS * 3)),
     )
     starts, classes, tri_class = table.starts, table.classes, table.tri_class
     moves, weight, move_kind = table.moves, table.weight, table.kind
     closed = convention == "closed"
     successors = Successors(classes, automaton)
     stay_cell, stay_class = stutter_cells(abstraction, allowed, starts, tri_class)
-    nq = automaton.num_states
-    size = abstraction.num_triangles * SLOTS * nq
     stutter_accepting = np.zeros(size, dtype=bool)
     stay_edges = successors.stutter_edges(
         stay_cell,
@@ -176,20 +192,25 @@ def move_table(
     bounces: bool,
     realisable: tuple[BoolArray, BoolArray] | None,
     times: MoveTimes | None = None,
+    dtype: type[np.signedinteger[Any]] = np.int64,
 ) -> MoveTable:
     """The moves of the product over ``abstraction`` and ``automaton`` (arguments as for
-    :func:`build_product`)."""
+    :func:`build_product`), their numbers (cells, exits, kinds) as ``dtype``: the built
+    product's :func:`index_dtype` of its node count (the lazy product multiplies cells by
+    automaton states in 64 bits)."""
     if starts is None:
         starts = start_cells(abstraction, start_point)
     classes = LetterClasses.of(automaton, list(abstraction.letters))
     tri_class = classes.letter_class[abstraction.letter_of]
-    moves = ts_moves(abstraction, allowed, starts, bounces=bounces, realisable=realisable)
+    moves = ts_moves(
+        abstraction, allowed, starts, bounces=bounces, realisable=realisable, dtype=dtype
+    )
     weight = move_weights(abstraction, moves, start_point, metric, times)
     if convention == "closed":
         kind = crossing_move_kinds(abstraction, automaton, classes, tri_class, moves)
     else:
         kind = tri_class[abstraction.neighbors].reshape(-1)[moves.exit]
-    return MoveTable(starts, classes, tri_class, moves, weight, kind)
+    return MoveTable(starts, classes, tri_class, moves, weight, kind.astype(dtype, copy=False))
 
 
 Row = list[tuple[tuple[int, int], ...]]
@@ -245,10 +266,11 @@ def ts_moves(
     *,
     bounces: bool,
     realisable: tuple[BoolArray, BoolArray] | None = None,
+    dtype: type[np.signedinteger[Any]] = np.int64,
 ) -> _Moves:
     """Every move of D between ``allowed`` triangles (and, with ``realisable``, only the
-    moves the controllers realise).  Per (t, i) arrays (m, 3) are computed once and read for
-    every slot."""
+    moves the controllers realise), numbered in ``dtype``.  Per (t, i) arrays (m, 3) are
+    computed once and read for every slot."""
     m = abstraction.num_triangles
     neighbors = abstraction.neighbors
     is_start = np.zeros(m, dtype=bool)
@@ -267,13 +289,14 @@ def ts_moves(
     # The start slot exists in start triangles only; their edges through the start point
     # are not left at t = 0 (that never enters the triangle).
     valid[:, START_SLOT, :] = exit_ok & is_start[:, None] & (~blocked | bounces)
-    moves = np.flatnonzero(valid)
+    moves = np.flatnonzero(valid).astype(dtype, copy=False)
     move_exit = moves // (SLOTS * 3) * 3 + moves % 3
+    entered = (neighbors * SLOTS + entry_slots(neighbors)).reshape(-1).astype(dtype, copy=False)
     return _Moves(
         flat=moves,
         source=moves // 3,
         exit=move_exit,
-        target=(neighbors * SLOTS + entry_slots(neighbors)).reshape(-1)[move_exit],
+        target=entered[move_exit],
         exit_ok=exit_ok,
     )
 
@@ -456,12 +479,14 @@ def _product_edges(
     """
     nq = successors.num_states
     cells = len(moves.exit_ok) * SLOTS
+    size = cells * nq
+    node_type = index_dtype(size)  # node numbers (the moves' cells are numbered alike)
     move_kinds = successors.of_moves(move_kind)
     by_kind = successors.by_kind
     # A cell's moves (at most three) are adjacent: a move's rank among them says which of
     # the one or two moves before it share its node.
     source = moves.source
-    rank = np.zeros(len(source), dtype=np.int64)
+    rank = np.zeros(len(source), dtype=np.int32)
     rank[1:] += source[1:] == source[:-1]
     rank[2:] += source[2:] == source[:-2]
     moves_of_cell = np.bincount(source, minlength=cells)
@@ -479,7 +504,7 @@ def _product_edges(
         per_move: IntArray = degree.take(move_kind)
         return per_move
 
-    def offsets(q: int) -> IntArray:
+    def offsets(q: int) -> npt.NDArray[np.signedinteger[Any]]:
         """Per move, how many edges of its node (cell, q) come before its own."""
         per_move = degrees(q)
         if isinstance(per_move, int):
@@ -489,7 +514,7 @@ def _product_edges(
         offset[2:] += per_move[:-2] * (rank[2:] >= 2)
         return offset
 
-    out_degree = np.empty((cells, nq), dtype=np.int64)
+    out_degree = np.empty((cells, nq), dtype=np.int32)  # a node's edges: a handful
     for q in range(nq):
         per_move = degrees(q)
         if isinstance(per_move, int):
@@ -501,15 +526,15 @@ def _product_edges(
     for stays, q, found in stay_edges:
         stutter_before.append(out_degree[stays, q])
         out_degree[stays, q] += len(found)
-    size = cells * nq
-    indptr = np.zeros(size + 1, dtype=np.int64)
-    np.cumsum(out_degree.reshape(-1), out=indptr[1:])
-    nnz = int(indptr[-1])
-    dst = np.empty(nnz, dtype=np.int64)
+    degree_of_node = out_degree.reshape(-1)
+    nnz = int(degree_of_node.sum())
+    indptr = np.zeros(size + 1, dtype=index_dtype(nnz + 1))
+    np.cumsum(degree_of_node, out=indptr[1:])
+    dst = np.empty(nnz, dtype=node_type)
     wgt = np.empty(nnz)
     acc = np.zeros(nnz, dtype=bool)
-    move_node = source * nq
-    move_target = moves.target * nq
+    move_node = source.astype(node_type, copy=False) * nq
+    move_target = moves.target.astype(node_type, copy=False) * nq
     for q in range(nq):
         width = max((len(by_kind[k][q]) for k in move_kinds), default=0)
         if not width:
@@ -517,7 +542,7 @@ def _product_edges(
         first = indptr[move_node + q] + offsets(q)
         for j in range(width):
             # The j-th successor of q over each kind of move (-1: none), and its mark.
-            following = np.full(max(move_kinds) + 1, -1, dtype=np.int64)
+            following = np.full(max(move_kinds) + 1, -1, dtype=node_type)  # a state
             marked = np.zeros(len(following), dtype=bool)
             for k in move_kinds:
                 if j < len(by_kind[k][q]):
@@ -526,7 +551,7 @@ def _product_edges(
             rows: slice | IntArray = slice(None)
             if not (following[move_kinds] >= 0).all():
                 rows = np.flatnonzero(following.take(move_kind) >= 0)
-            at = first[rows] + j
+            at = first if j == 0 and isinstance(rows, slice) else first[rows] + j
             dst[at] = move_target[rows] + following.take(move_kind[rows])
             wgt[at] = weight[rows]
             if marked.any():
@@ -538,8 +563,7 @@ def _product_edges(
             dst[first + j] = node + q_next
             wgt[first + j] = STUTTER_COST
             acc[first + j] = accepting
-    src = np.repeat(np.arange(size, dtype=np.int64), out_degree.reshape(-1))
-    return Graph(indptr=indptr, sources=src, targets=dst, weights=wgt, num_nodes=size), acc
+    return Graph(indptr=indptr, targets=dst, weights=wgt, num_nodes=size), acc
 
 
 def initial_nodes(

@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
-from tlmpc.abstraction.model import Abstraction, FloatArray
+from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
 from tlmpc.planning.model import Witness
 
 BoolArray = npt.NDArray[np.bool_]
@@ -30,10 +30,12 @@ BoolArray = npt.NDArray[np.bool_]
 TOLERANCE = 2e-9
 
 
-def corner_angles(abstraction: Abstraction) -> FloatArray:
+def corner_angles(abstraction: Abstraction, triangles: IntArray | None = None) -> FloatArray:
     """(m, 3): each triangle's interior angle at each corner, in radians (atan2 of the cross
-    and dot products of the two edges: accurate for slivers, where acos of a cosine is not)."""
-    corners = abstraction.vertices[abstraction.triangles]  # (m, 3, 2)
+    and dot products of the two edges: accurate for slivers, where acos of a cosine is not).
+    With ``triangles``, the rows of those triangles only (each the same floats)."""
+    chosen = abstraction.triangles if triangles is None else abstraction.triangles[triangles]
+    corners = abstraction.vertices[chosen]  # (m, 3, 2)
     angles = np.empty(corners.shape[:2])
     for i in range(3):
         u = corners[:, (i + 1) % 3] - corners[:, i]
@@ -44,29 +46,49 @@ def corner_angles(abstraction: Abstraction) -> FloatArray:
     return angles
 
 
-def realisable(abstraction: Abstraction, ratio: float) -> tuple[BoolArray, BoolArray]:
-    """(m, 3) moves (leave t by edge i) and (m,) stays realisable under the disturbance
-    ``ratio`` x max_speed (with the controllers' tolerance)."""
-    need = ratio + TOLERANCE
-    half = corner_angles(abstraction) / 2.0
-    kept = np.sin(half) > need  # a corner held on both facets
-    crossing = np.cos(half) > need  # a corner on the exit edge
-    moves = np.empty(kept.shape, dtype=bool)
+def step_widths(
+    abstraction: Abstraction, triangles: IntArray | None = None
+) -> tuple[FloatArray, FloatArray]:
+    """(m, 3) and (m,): the largest disturbance ratio (d / max_speed) each move (leave t by
+    edge i) and each stay rejects, before the controllers' tolerance: the smallest push of
+    its corners (sin(a / 2) where both facets are kept, cos(a / 2) on the exit edge); with
+    ``triangles``, the rows of those triangles only."""
+    half = corner_angles(abstraction, triangles) / 2.0
+    kept = np.sin(half)  # a corner held on both facets
+    crossing = np.cos(half)  # a corner on the exit edge
+    moves = np.empty(kept.shape)
     for i in range(3):
-        moves[:, i] = kept[:, i] & crossing[:, (i + 1) % 3] & crossing[:, (i + 2) % 3]
-    stays: BoolArray = np.asarray(kept.all(axis=1), dtype=bool)
+        moves[:, i] = np.minimum(
+            kept[:, i], np.minimum(crossing[:, (i + 1) % 3], crossing[:, (i + 2) % 3])
+        )
+    stays: FloatArray = kept.min(axis=1)
     return moves, stays
+
+
+def realisable(
+    abstraction: Abstraction, ratio: float, triangles: IntArray | None = None
+) -> tuple[BoolArray, BoolArray]:
+    """(m, 3) moves (leave t by edge i) and (m,) stays realisable under the disturbance
+    ``ratio`` x max_speed (with the controllers' tolerance): their width exceeds it; with
+    ``triangles``, the rows of those triangles only."""
+    need = ratio + TOLERANCE
+    moves, stays = step_widths(abstraction, triangles)
+    return np.asarray(moves > need, dtype=bool), np.asarray(stays > need, dtype=bool)
 
 
 def witness_realisable(abstraction: Abstraction, witness: Witness, ratio: float) -> bool:
     """True when every step of ``witness`` is realisable under ``ratio`` x max_speed (a
     vertex passage only without a disturbance: no law here reaches a point under one)."""
-    moves, stays = realisable(abstraction, ratio)
     path = [*witness.prefix, *witness.cycle]
+    # Only the path's triangles (a few thousand of a million-triangle mesh): row k of the
+    # tables is triangle on_path[k].
+    on_path = np.unique(np.asarray(path, dtype=np.int64))
+    moves, stays = realisable(abstraction, ratio, on_path)
+    row = dict(zip(on_path.tolist(), range(len(on_path)), strict=True))
     passages = dict(witness.passages)
     for index, triangle in enumerate(path):
         if witness.is_stay and index == len(path) - 1:
-            if not stays[triangle]:
+            if not stays[row[triangle]]:
                 return False
             continue
         following = path[index + 1] if index + 1 < len(path) else witness.cycle[0]
@@ -75,6 +97,6 @@ def witness_realisable(abstraction: Abstraction, witness: Witness, ratio: float)
                 return False
             continue
         edges = np.flatnonzero(abstraction.neighbors[triangle] == following)
-        if len(edges) != 1 or not moves[triangle, int(edges[0])]:
+        if len(edges) != 1 or not moves[row[triangle], int(edges[0])]:
             return False
     return True

@@ -41,12 +41,12 @@ BUCKET_WIDTH = 1.0
 class Graph(ContentEquality):
     """A weighted directed graph with its edges grouped by source (CSR).
 
-    ``indptr[u]:indptr[u + 1]`` are the edges out of ``u``; ``sources``, ``targets`` and
-    ``weights`` give each edge's ends and weight (all weights positive).
+    ``indptr[u]:indptr[u + 1]`` are the edges out of ``u``; ``targets`` and ``weights`` give
+    each edge's head and weight (all weights positive), :attr:`sources` its tail (made when
+    asked: a large product does not hold one more number per edge).
     """
 
     indptr: IntArray
-    sources: IntArray
     targets: IntArray
     weights: FloatArray
     num_nodes: int
@@ -55,6 +55,18 @@ class Graph(ContentEquality):
     def nnz(self) -> int:
         """Number of edges."""
         return len(self.targets)
+
+    @property
+    def sources(self) -> IntArray:
+        """Each edge's tail (an array as long as the edges, made anew at each call)."""
+        counts = np.diff(self.indptr)
+        tails: IntArray = np.repeat(np.arange(self.num_nodes, dtype=self.targets.dtype), counts)
+        return tails
+
+    def source_of(self, edges: IntArray) -> IntArray:
+        """The tails of ``edges`` (edge numbers), looked up in ``indptr``."""
+        tails: IntArray = np.searchsorted(self.indptr, edges, side="right") - 1
+        return tails
 
     @staticmethod
     def from_edges(
@@ -67,7 +79,6 @@ class Graph(ContentEquality):
         np.cumsum(np.bincount(sources, minlength=num_nodes), out=indptr[1:])
         graph = Graph(
             indptr=indptr,
-            sources=sources[order],
             targets=targets[order],
             weights=weights[order],
             num_nodes=num_nodes,
@@ -198,7 +209,7 @@ def shortest_paths(
         edges = np.repeat(starts - ends + counts, counts) + np.arange(total)
         u = np.repeat(active, counts)
         du = np.repeat(current[take], counts)
-        v = targets[edges]
+        v = targets[edges].astype(np.int64, copy=False)  # indexes many arrays: cast once
         d = du + weights[edges]
         if limit < np.inf:
             keep = d <= limit
