@@ -256,19 +256,9 @@ def replan(mission: Mission, planned: Planned, times: MoveTimes) -> Planned:
 
         formula = untimed_skeleton(mission.formula)
     ratio = mission.robot.disturbance / mission.robot.max_speed
-    reject = None
-    mesh, witness = plan_complete(
-        planned.abstraction,
-        planned.automaton,
-        formula=formula,
-        options=mission.options,
-        start_point=mission.robot.start,
-        explain=False,
-        times=times,
-    )
-    if not witness_realisable(mesh, witness, ratio):
-        reject = ratio
-        mesh, witness = plan_complete(
+
+    def attempt(reject: float | None) -> tuple[Abstraction, Witness]:
+        return plan_complete(
             planned.abstraction,
             planned.automaton,
             formula=formula,
@@ -278,6 +268,10 @@ def replan(mission: Mission, planned: Planned, times: MoveTimes) -> Planned:
             reject=reject,
             times=times,
         )
+
+    mesh, witness = attempt(None)
+    if not witness_realisable(mesh, witness, ratio):
+        mesh, witness = attempt(ratio)
     return replace(planned, abstraction=mesh, witness=witness)
 
 
