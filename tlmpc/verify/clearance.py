@@ -75,7 +75,8 @@ def _segments(points: np.ndarray[Any, Any]) -> Any:
 
 
 def _closest(points: np.ndarray[Any, Any], segment: int, target: Any) -> tuple[float, float]:
-    piece = _segments(points)[segment] if len(points) > 1 else shapely.Point(points[0])
+    # only the one segment: building every segment again costs as much as the measurement
+    piece = _segments(points[segment : segment + 2])[0]
     a, _ = shapely.shortest_line(piece, target).coords
     return (float(a[0]), float(a[1]))
 
@@ -137,10 +138,19 @@ def measure(trace: TraceInput) -> Clearance:
             forbidden[name] = float(distance[worst])
             forbidden_positions[name] = _closest(points, worst, region)
         else:
-            inside = np.asarray(shapely.covers(region, shapely.points(points)), dtype=bool)
+            # only the samples in the region's bounding box can be covered by it: a shapely
+            # point for each of them, not for every sample of a long path once per region
+            minx, miny, maxx, maxy = region.bounds
+            boxed = points[
+                (points[:, 0] >= minx)
+                & (points[:, 0] <= maxx)
+                & (points[:, 1] >= miny)
+                & (points[:, 1] <= maxy)
+            ]
+            inside = np.asarray(shapely.covers(region, shapely.points(boxed)), dtype=bool)
             if not inside.any():
                 continue
-            candidates = points[inside]
+            candidates = boxed[inside]
             deep = np.asarray(
                 shapely.distance(region.boundary, shapely.points(candidates)), dtype=np.float64
             )

@@ -71,7 +71,9 @@ def crossing_parameters(points: FloatArray, polygons: Sequence[FloatArray]) -> l
         t0 = float(((q[k] - p[k]) @ r[k]) / rr[k])
         t1 = float(((q[k] + s[k] - p[k]) @ r[k]) / rr[k])
         found[int(seg_idx[k])].extend([t0, t1])
-    for index, values in enumerate(found):
+    # only the segments that met a boundary (a long path has hundreds of thousands of others)
+    for index in np.unique(seg_idx).tolist():
+        values = found[index]
         inside = sorted(v for v in values if MERGE < v < 1.0 - MERGE)
         merged: list[float] = []
         for v in inside:
