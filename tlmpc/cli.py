@@ -252,14 +252,8 @@ def main(
         safe_out.flush()
         safe_err.flush()
         return code
-    except KeyboardInterrupt:
-        with contextlib.suppress(Exception):
-            safe_err.write("tlmpc: interrupted\n")
-        return EXIT_INTERRUPTED
-    except _Terminated:
-        with contextlib.suppress(Exception):
-            safe_err.write("tlmpc: terminated\n")
-        return EXIT_TERMINATED
+    except (KeyboardInterrupt, _Terminated) as signalled:
+        return _ended_by(signalled, safe_err)
     except _OutputLost as lost:
         _silence(raw_out if lost.stream == "standard output" else raw_err)
         if lost.stream == "standard output" and not isinstance(lost.cause, BrokenPipeError):
@@ -272,6 +266,14 @@ def main(
                 safe_err.write(diagnostic.format() + "\n")
                 safe_err.flush()
         return EXIT_USAGE
+    except Exception:
+        # A signal's exception can come up disguised from where the run starts (the parser
+        # imports the command's module): CPython wraps an exception raised in a class's
+        # ``__set_name__`` in a RuntimeError, C code in an ImportError.
+        disguised = _signalled()
+        if disguised is None:
+            raise
+        return _ended_by(disguised, safe_err)
     finally:
         # The command's own run is over (its output whole or removed): the start-up guard,
         # put back, would turn a finished run into an interrupted one, so a late signal of
@@ -284,6 +286,14 @@ def main(
         if previous_alarm is not None:
             signal.setitimer(signal.ITIMER_REAL, 0.0)
             signal.signal(signal.SIGALRM, previous_alarm)
+
+
+def _ended_by(signalled: BaseException, err: TextIO) -> int:
+    """Say that Ctrl-C or SIGTERM ended the run; its exit code (130 or 143)."""
+    terminated = isinstance(signalled, _Terminated)
+    with contextlib.suppress(Exception):
+        err.write("tlmpc: terminated\n" if terminated else "tlmpc: interrupted\n")
+    return EXIT_TERMINATED if terminated else EXIT_INTERRUPTED
 
 
 def _main(argv: Sequence[str] | None, out: TextIO, err: TextIO) -> int:

@@ -264,3 +264,44 @@ def test_the_command_signalled_right_after_the_package_starts_ends_cleanly(
     assert done.returncode == code, done.stderr
     assert done.stdout == ""
     assert done.stderr == ("tlmpc: terminated\n" if code == 143 else "tlmpc: interrupted\n")
+
+
+class _FakeSetName:
+    """A descriptor whose ``__set_name__`` raises what the handler of ``number`` raises, the way
+    a signal arriving inside a class body being created (an import) reaches it."""
+
+    def __init__(self, number: int) -> None:
+        self.number = number
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        import tlmpc.cli as cli
+
+        handler = cli._on_sigterm if self.number == signal.SIGTERM else cli._on_sigint
+        handler(self.number, None)
+
+
+@pytest.mark.parametrize(("number", "code"), [(signal.SIGTERM, 143), (signal.SIGINT, 130)])
+def test_a_signal_disguised_by_an_import_while_the_parser_is_built_ends_cleanly(
+    monkeypatch: pytest.MonkeyPatch, number: int, code: int
+) -> None:
+    # CPython 3.11 wraps an exception raised in __set_name__ in a RuntimeError: a signal during
+    # the import of a module defining such a class (ipaddress's cached properties, say) came up
+    # as that RuntimeError, outside the run's own handlers, and printed a traceback
+    import io
+
+    import tlmpc.cli as cli
+
+    def build_parser(only: str | None = None) -> Any:
+        type("Imported", (), {"attribute": _FakeSetName(number)})
+        raise AssertionError("the signal's exception did not come up")
+
+    monkeypatch.setattr(cli, "build_parser", build_parser)
+    out, err = io.StringIO(), io.StringIO()
+    previous = signal.getsignal(signal.SIGTERM), signal.getsignal(signal.SIGINT)
+    try:
+        assert cli.main(["check", "mission.yaml"], out, err) == code
+    finally:
+        signal.signal(signal.SIGTERM, previous[0])
+        signal.signal(signal.SIGINT, previous[1])
+    expected = "terminated" if number == signal.SIGTERM else "interrupted"
+    assert err.getvalue() == f"tlmpc: {expected}\n"
