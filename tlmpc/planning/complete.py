@@ -13,6 +13,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from typing import Protocol
 
 from tlmpc.abstraction.model import Abstraction
 from tlmpc.abstraction.refine import split_triangles
@@ -26,6 +27,15 @@ from tlmpc.planning.model import Witness
 from tlmpc.planning.passages import passage_turns
 from tlmpc.planning.plan import plan
 from tlmpc.planning.timing import MoveTimes
+
+
+class Attempt(Protocol):
+    """One planning attempt on a mesh of the task's map (U-turns, vertex passages as asked)."""
+
+    def __call__(
+        self, mesh: Abstraction, *, bounces: bool = False, passages: bool = False
+    ) -> Witness: ...
+
 
 #: Rounds of refinement before giving up (one always suffices; see the module docstring).
 MAX_ROUNDS = 3
@@ -78,61 +88,36 @@ def plan_complete(
     the ``time`` metric (:mod:`tlmpc.planning.timing`).
     """
 
-    try:
-        return abstraction, _attempt(
-            abstraction,
+    def attempt(mesh: Abstraction, *, bounces: bool = False, passages: bool = False) -> Witness:
+        return plan(
+            mesh,
             automaton,
-            formula,
-            options,
-            start_point,
+            formula=formula,
+            options=options,
+            start_point=start_point,
+            bounces=bounces,
+            passages=passages,
             resume=resume,
             reject=reject,
             times=times,
         )
+
+    try:
+        return abstraction, attempt(abstraction)
     except NoPlanError as first:
         no_bounce_failure = first
     try:
-        return _refined(
-            abstraction,
-            automaton,
-            formula,
-            options,
-            start_point,
-            passages=False,
-            resume=resume,
-            reject=reject,
-            times=times,
-        )
+        return _refined(abstraction, attempt, start_point, passages=False)
     except NoPlanError:
         if reject:
             raise no_bounce_failure from None  # no law here reaches a point under a push
     # The one place vertex passages come in: no plan exists along edges alone.
     try:
-        return abstraction, _attempt(
-            abstraction,
-            automaton,
-            formula,
-            options,
-            start_point,
-            passages=True,
-            resume=resume,
-            reject=reject,
-            times=times,
-        )
+        return abstraction, attempt(abstraction, passages=True)
     except NoPlanError:
         pass
     try:
-        return _refined(
-            abstraction,
-            automaton,
-            formula,
-            options,
-            start_point,
-            passages=True,
-            resume=resume,
-            reject=reject,
-            times=times,
-        )
+        return _refined(abstraction, attempt, start_point, passages=True)
     except NoPlanError:
         if not explain:
             raise no_bounce_failure from None
@@ -177,62 +162,19 @@ def _feasibility(
     return feasible
 
 
-def _attempt(
-    mesh: Abstraction,
-    automaton: Automaton,
-    formula: Formula,
-    options: Options,
-    start_point: tuple[float, float],
-    *,
-    bounces: bool = False,
-    passages: bool = False,
-    resume: frozenset[int] | None = None,
-    reject: float | None = None,
-    times: MoveTimes | None = None,
-) -> Witness:
-    return plan(
-        mesh,
-        automaton,
-        formula=formula,
-        options=options,
-        start_point=start_point,
-        bounces=bounces,
-        passages=passages,
-        resume=resume,
-        reject=reject,
-        times=times,
-    )
-
-
 def _refined(
     abstraction: Abstraction,
-    automaton: Automaton,
-    formula: Formula,
-    options: Options,
+    attempt: Attempt,
     start_point: tuple[float, float],
     *,
     passages: bool,
-    resume: frozenset[int] | None = None,
-    reject: float | None = None,
-    times: MoveTimes | None = None,
 ) -> tuple[Abstraction, Witness]:
     """A no-bounce witness on a mesh refined where a bouncing lasso turns around; raises
     :class:`NoPlanError` when no bouncing lasso exists on ``abstraction``."""
     mesh = abstraction
     for _ in range(MAX_ROUNDS):
         try:
-            bouncing = _attempt(
-                mesh,
-                automaton,
-                formula,
-                options,
-                start_point,
-                bounces=True,
-                passages=passages,
-                resume=resume,
-                reject=reject,
-                times=times,
-            )
+            bouncing = attempt(mesh, bounces=True, passages=passages)
         except NoPlanError:
             if mesh is abstraction:
                 raise
@@ -242,17 +184,7 @@ def _refined(
             turns = sorted({*turns, *passage_turns(mesh, bouncing)})
         mesh = split_triangles(mesh, turns, start_point)
         try:
-            witness = _attempt(
-                mesh,
-                automaton,
-                formula,
-                options,
-                start_point,
-                passages=passages,
-                resume=resume,
-                reject=reject,
-                times=times,
-            )
+            witness = attempt(mesh, passages=passages)
         except NoPlanError:
             continue
         return mesh, witness
