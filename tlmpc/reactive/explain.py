@@ -11,7 +11,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from tlmpc.reactive.game import FACE, GOAL, MOVED, MissionGame
+from tlmpc.reactive.game import MissionGame
+from tlmpc.reactive.nodes import FACE, GOAL, MOVED
 from tlmpc.synth.counter import CounterStrategy
 
 #: the longest play shown (steps)

@@ -34,6 +34,7 @@ from tlmpc.ltl.ast import And, Const, Equiv, Formula, Implies, Not, Or, Prop
 from tlmpc.mission.model import Mission, TaskPart
 from tlmpc.reactive.faces import Faces
 from tlmpc.reactive.fragment import Owner, Piece
+from tlmpc.reactive.nodes import FACE, GOAL, MOVED
 from tlmpc.synth.spec import (
     Atom,
     Binary,
@@ -48,10 +49,6 @@ from tlmpc.synth.spec import (
 )
 from tlmpc.synth.spec import Const as SpecConst
 from tlmpc.synth.spec import Not as SpecNot
-
-FACE = "face"
-GOAL = "goal"
-MOVED = "moved"
 
 #: The texts of the motion's parts, as a core names them.
 MOTION_TEXTS = {

@@ -18,11 +18,9 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from tlmpc.base.errors import UsageError, error
-from tlmpc.reactive.game import FACE, GOAL, MOVED
+from tlmpc.reactive.nodes import FACE, GOAL, MOVED, NodeBehaviour, Value
 from tlmpc.synth.spec import Variable
 from tlmpc.synth.symbolic_strategy import SymbolicStrategy, symbolic_from_json
-
-Value = int | bool
 
 
 def _values(variable: Variable) -> list[Value]:
@@ -34,7 +32,7 @@ def _values(variable: Variable) -> list[Value]:
 
 
 @dataclass
-class SymbolicMachine:
+class SymbolicMachine(NodeBehaviour):
     """The symbolic strategy with the explicit machine's interface (nodes met so far)."""
 
     strategy: SymbolicStrategy
@@ -139,18 +137,6 @@ class SymbolicMachine:
                     break
             self._answers[(node, key)] = found
         return self._answers[(node, key)]
-
-    def goal(self, node: int) -> int:
-        """The face the robot heads for at ``node``."""
-        return int(self.nodes[node][GOAL])
-
-    def action_values(self, node: int) -> dict[str, bool]:
-        """The actions' values at ``node``."""
-        return {a: bool(self.nodes[node][a]) for a in self.actions}
-
-    def behaviour(self, node: int) -> tuple[Value, ...]:
-        """What the robot shows at ``node``: its goal and its actions (not its memory)."""
-        return (self.goal(node), *(bool(self.nodes[node][a]) for a in self.actions))
 
 
 __all__ = ["SymbolicMachine"]

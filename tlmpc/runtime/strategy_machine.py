@@ -15,13 +15,7 @@ from dataclasses import dataclass
 from typing import Any, Protocol
 
 from tlmpc.base.errors import UsageError, error
-
-Value = int | bool
-
-#: The game's variables of the robot's motion (tlmpc.reactive.game).
-FACE = "face"
-GOAL = "goal"
-MOVED = "moved"
+from tlmpc.reactive.nodes import FACE, GOAL, MOVED, NodeBehaviour, Value
 
 
 class Stepper(Protocol):
@@ -62,7 +56,7 @@ def strategy_stepper(
 
 
 @dataclass(frozen=True)
-class StrategyMachine:
+class StrategyMachine(NodeBehaviour):
     """The Mealy machine of ``strategy.json`` with its transitions indexed by visible input.
 
     ``visible`` are the environment inputs the executor reads (sensors, ``face``, ``moved``);
@@ -156,17 +150,5 @@ class StrategyMachine:
         the reading breaks an assumption or a rule of the motion)."""
         return self.answers[node].get(self.key(sensors, face, moved))
 
-    def goal(self, node: int) -> int:
-        """The face the robot heads for at ``node``."""
-        return int(self.nodes[node][GOAL])
 
-    def action_values(self, node: int) -> dict[str, bool]:
-        """The actions' values at ``node``."""
-        return {a: bool(self.nodes[node][a]) for a in self.actions}
-
-    def behaviour(self, node: int) -> tuple[Value, ...]:
-        """What the robot shows at ``node``: its goal and its actions (not its memory)."""
-        return (self.goal(node), *(bool(self.nodes[node][a]) for a in self.actions))
-
-
-__all__ = ["FACE", "GOAL", "MOVED", "Stepper", "StrategyMachine", "strategy_stepper"]
+__all__ = ["Stepper", "StrategyMachine", "strategy_stepper"]
