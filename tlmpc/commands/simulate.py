@@ -88,6 +88,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Simulate, verify and report."""
     from tlmpc.base.errors import EXIT_NEGATIVE
+    from tlmpc.commands.simulate_reactive import check_seed
     from tlmpc.io.report import OUTCOME_EXIT, Reporter
     from tlmpc.runtime import Executor, make_disturbance, run_closed_loop
     from tlmpc.verify import verify_document
@@ -118,14 +119,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             raise UsageError(error("U081", f"--cycles must be a whole number, not {args.cycles!r}"))
         cycles = int(cycles_value)
     dt = _positive(args.dt, "--dt", "U082") if args.dt is not None else None
-    if not 0 <= args.seed < 2**128:
-        raise UsageError(
-            error(
-                "U084",
-                f"--seed must be a whole number from 0 to 2**128 - 1, not {args.seed}",
-                hint="any seed in range gives a reproducible disturbance, e.g. --seed 1",
-            )
-        )
+    check_seed(args.seed, "disturbance")
     if args.output is not None:
         from tlmpc.io.outputs import refuse_input_as_output
         from tlmpc.runtime.executor import EXECUTOR_ARTIFACTS

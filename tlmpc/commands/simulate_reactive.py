@@ -41,6 +41,19 @@ def _events(text: str | None) -> int:
     return value
 
 
+def check_seed(seed: int, drawn: str) -> None:
+    """U084 unless ``seed`` is one of the 2**128 seeds of the ``drawn`` thing (a static
+    run's disturbance, a reactive run's environment)."""
+    if not 0 <= seed < 2**128:
+        raise UsageError(
+            error(
+                "U084",
+                f"--seed must be a whole number from 0 to 2**128 - 1, not {seed}",
+                hint=f"any seed in range gives a reproducible {drawn}, e.g. --seed 1",
+            )
+        )
+
+
 def run_reactive_command(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Run a reactive mission's strategy against an environment and report."""
     from tlmpc.base.errors import EXIT_NEGATIVE, EXIT_OK
@@ -83,14 +96,7 @@ def run_reactive_command(args: argparse.Namespace, out: TextIO, err: TextIO) -> 
                     hint=f"drop {flag}",
                 )
             )
-    if not 0 <= args.seed < 2**128:
-        raise UsageError(
-            error(
-                "U084",
-                f"--seed must be a whole number from 0 to 2**128 - 1, not {args.seed}",
-                hint="any seed in range gives a reproducible environment, e.g. --seed 1",
-            )
-        )
+    check_seed(args.seed, "environment")
     if args.output is not None:
         from tlmpc.io.outputs import refuse_input_as_output
 
