@@ -78,7 +78,10 @@ def _arrays(finite: bool = True) -> st.SearchStrategy[npt.NDArray[Any]]:
 
 @st.composite
 def _tables(draw: st.DrawFn) -> tuple[list[Any], npt.NDArray[np.int64]]:
-    table = draw(st.lists(st.lists(st.text(max_size=4), max_size=3), min_size=1, max_size=6))
+    # label sets (lists of names), now and then with an item of another kind among them
+    names = st.lists(st.text(max_size=4), max_size=3)
+    other = st.integers() | st.none() | st.lists(st.integers() | st.text(max_size=2), max_size=2)
+    table = draw(st.lists(names | other if draw(st.booleans()) else names, min_size=1, max_size=6))
     index = draw(hnp.arrays(np.int64, st.integers(0, 60), elements=st.integers(0, len(table) - 1)))
     return table, index
 
