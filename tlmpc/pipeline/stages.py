@@ -637,8 +637,12 @@ def run_stages(
         for product in stage.requires:
             compilation.get(product)  # a clear error instead of a failure deep inside
         started = time.perf_counter()
-        with heartbeat(stage.name, sys.stderr) if progress else contextlib.nullcontext():
-            result = stage.run(compilation)
+        try:
+            with heartbeat(stage.name, sys.stderr) if progress else contextlib.nullcontext():
+                result = stage.run(compilation)
+        except TlmpcError as exc:
+            exc.diagnostics = _placed(exc.diagnostics, compilation)
+            raise
         report = StageReport(
             name=stage.name, seconds=time.perf_counter() - started, sizes=result.sizes
         )
@@ -655,7 +659,7 @@ def run_stages(
         compilation = dataclasses.replace(
             compilation, products=dict(products), documents=dict(artifacts)
         )
-        warnings.extend(result.warnings)
+        warnings.extend(_placed(result.warnings, compilation))
         extras.update(result.summary)
         reports.append(report)
         if progress is not None:
@@ -669,6 +673,16 @@ def run_stages(
         warnings=tuple(warnings),
         extras=extras,
     )
+
+
+def _placed(
+    diagnostics: tuple[Diagnostic, ...], compilation: Compilation
+) -> tuple[Diagnostic, ...]:
+    """The stage's diagnostics of the mission file with the line and column of the value
+    their JSON path names (a later stage knows the value, not where it is written)."""
+    from tlmpc.mission.placement import placed
+
+    return placed(diagnostics, str(compilation.source), compilation.text)
 
 
 def compile_mission(
