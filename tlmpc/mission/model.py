@@ -45,7 +45,8 @@ def regions_document(pairs: list[tuple[str, Polygon]]) -> dict[str, list[list[fl
     a hundred thousand regions builds this document once for its three artifacts, and the
     writer, finding the same object under the same key, encodes it once.  The document is
     shared, so it must not be changed (no stage does; the polygons it comes from are
-    immutable tuples).
+    immutable tuples).  The module keeps the last document (and its pairs) until another
+    is built: one map's regions, which the compile's artifacts hold anyway.
     """
     global _last_regions
     if _last_regions is not None:
