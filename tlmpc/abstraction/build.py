@@ -62,7 +62,12 @@ def _labels(
     single_region = np.zeros(len(triangles), dtype=np.int64)
     single_region[tri_of[alone]] = region_of[alone]
     single = np.flatnonzero(count == 1)
-    used, single_key = np.unique(single_region[single], return_inverse=True)
+    # The regions holding some triangle alone, ascending, and each such triangle's rank among
+    # them: np.unique's answer, by counting (region numbers are small) instead of sorting.
+    single_of = single_region[single]
+    present = np.bincount(single_of, minlength=len(names)) > 0
+    used = np.flatnonzero(present)
+    single_key = (np.cumsum(present, dtype=np.int64) - 1)[single_of]
     several: dict[int, list[str]] = {}
     for t, r in zip(tri_of[~alone].tolist(), region_of[~alone].tolist(), strict=True):
         several.setdefault(t, []).append(names[r])
@@ -124,9 +129,12 @@ def connected_components(neighbors: IntArray) -> IntArray:
             if np.array_equal(jumped, root):
                 break
             root = jumped
-    # The root of a component is its lowest triangle: number components in that order.
-    _, labels = np.unique(root, return_inverse=True)
-    return np.asarray(labels, dtype=np.int64).reshape(-1)
+    # The root of a component is its lowest triangle: number components in that order (a
+    # root's number is how many roots come before it; no sort of a million roots).
+    is_root = root == np.arange(count, dtype=np.int64)
+    number = np.cumsum(is_root, dtype=np.int64) - 1
+    labels: IntArray = number[root]
+    return labels
 
 
 def build_abstraction(mission: Mission, layout: PlanningLayout | None = None) -> Abstraction:

@@ -189,13 +189,14 @@ def _unique_rows(rows: IntArray) -> tuple[IntArray, IntArray]:
     return np.asarray(first, dtype=np.int64), np.asarray(inverse, dtype=np.int64).reshape(-1)
 
 
-def _segments_of(lines: Sequence[Any]) -> FloatArray:
-    """All straight segments of the given linework as an (s, 2, 2) array."""
+def _chains_of(lines: Sequence[Any]) -> tuple[FloatArray, IntArray]:
+    """The points of the given linework, line after line, and the straight segments as the
+    index of each one's first point (the second is the next point, of the same line)."""
     points, owner = shapely.get_coordinates(lines, return_index=True)
     if len(points) < 2:
-        return np.zeros((0, 2, 2))
-    same = owner[1:] == owner[:-1]
-    return np.stack([points[:-1][same], points[1:][same]], axis=1)
+        return np.zeros((0, 2)), np.zeros(0, dtype=np.int64)
+    starts: IntArray = np.flatnonzero(owner[1:] == owner[:-1])
+    return points, starts
 
 
 def _needs_noding(rings: list[Any]) -> bool:
@@ -246,18 +247,19 @@ def pslg(
         linework = shapely.union_all(
             [*free_rings, *(c for c in clipped if not c.is_empty)], grid_size=grid
         )
-        segments = _segments_of(list(shapely.get_parts(linework)))
+        points, starts = _chains_of(list(shapely.get_parts(linework)))
     else:
         # No region ring meets the free space's boundary, so each ring lies wholly inside the
         # free space or wholly outside it (in a hole, or beyond the boundary).  Rings outside
         # must not become segments: Triangle would keep the triangles they enclose.
-        segments = _segments_of([*free_rings, *_inside(free, region_rings)])
+        points, starts = _chains_of([*free_rings, *_inside(free, region_rings)])
     minx, miny, _, _ = free.bounds
-    flat = segments.reshape(-1, 2)
-    keys = np.round((flat - np.array([minx, miny])) / grid).astype(np.int64)
+    # Each point once per line, not once per segment end: the same vertices (a point's first
+    # appearance comes in the same order either way) from a sort of half as many keys.
+    keys = np.round((points - np.array([minx, miny])) / grid).astype(np.int64)
     first, inverse = _unique_rows(keys)
-    vertices = flat[first]
-    edges = inverse.reshape(-1, 2)
+    vertices = points[first]
+    edges = np.stack([inverse[starts], inverse[starts + 1]], axis=1)
     edges = edges[edges[:, 0] != edges[:, 1]]
     edges = np.sort(edges, axis=1)
     edges = edges[_unique_rows(edges)[0]]

@@ -93,15 +93,20 @@ _COMPACT = json.JSONEncoder(
 class SharedTexts:
     """Compact texts of top-level values by key, for the values that several documents hold.
 
-    A value is looked up by its ``marshal`` bytes, which tell every type apart (``1``,
-    ``1.0`` and ``True``; ``0.0`` and ``-0.0``) and fix the order of every dict and list:
-    equal bytes, equal data, the same JSON text.  A value ``marshal`` refuses (a subclass,
-    say) is simply encoded again.
+    A value is found again when it is the very object encoded before under that key (the
+    stages share the regions' document among their artifacts), else by its ``marshal``
+    bytes, which tell every type apart (``1``, ``1.0`` and ``True``; ``0.0`` and ``-0.0``)
+    and fix the order of every dict and list: equal bytes, equal data, the same JSON text.
+    The bytes are taken only when a key holds a value that is not one encoded before (a
+    hundred thousand regions take a tenth of a second to marshal).  A value ``marshal``
+    refuses (a subclass, say) is simply encoded again.
     """
 
     def __init__(self, keys: set[str]) -> None:
         self.keys = keys
-        self.texts: dict[tuple[str, bytes], str] = {}
+        #: per key, the values encoded so far (held, so that their ids stay theirs), their
+        #: texts, and their marshal bytes once some other value needed them
+        self.encoded: dict[str, list[tuple[Any, str, bytes | None]]] = {}
 
     @classmethod
     def among(cls, documents: Iterable[Any]) -> SharedTexts:
@@ -119,13 +124,29 @@ class SharedTexts:
         """The compact JSON text of ``value``, held at ``key`` of a document."""
         if key not in self.keys or type(value) not in (dict, list):
             return _COMPACT.encode(value)
+        encoded = self.encoded.setdefault(key, [])
+        for held, text, _ in encoded:
+            if held is value:
+                return text
+        if not encoded:  # the first value under this key: no bytes to compare with yet
+            text = _COMPACT.encode(value)
+            encoded.append((value, text, None))
+            return text
         try:
-            fingerprint = (key, marshal.dumps(value))
+            fingerprint = marshal.dumps(value)
         except ValueError:
             return _COMPACT.encode(value)
-        text = self.texts.get(fingerprint)
-        if text is None:
-            text = self.texts[fingerprint] = _COMPACT.encode(value)
+        for number, (held, text, known) in enumerate(encoded):
+            if known is None:  # encoded before without its bytes: take them now
+                try:
+                    known = marshal.dumps(held)
+                except ValueError:
+                    continue
+                encoded[number] = (held, text, known)
+            if known == fingerprint:
+                return text
+        text = _COMPACT.encode(value)
+        encoded.append((value, text, fingerprint))
         return text
 
 

@@ -412,12 +412,12 @@ def _outruns(trace: Mapping[str, Any], speed: float) -> bool:
 
 def _synthesize(c: Compilation) -> StageResult:
     from tlmpc.reactive.synthesize import (
-        UnrealizableError,
         counterstrategy_to_json,
         strategy_to_json,
         synthesize,
         unrealizable,
     )
+    from tlmpc.reactive.unrealizable import UnrealizableError
 
     mission = c.get(MISSION)
     synthesis = synthesize(mission, c.get(ABSTRACTION))

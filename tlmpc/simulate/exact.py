@@ -414,14 +414,12 @@ def trace_header(mission: Mission, max_speed: float) -> dict[str, Any]:
     verifies on its own: task, regions, every workspace piece, convention, speed, body."""
     from tlmpc.ltl.printer import to_text
     from tlmpc.mission.body import body_radius
-
-    def poly(points: tuple[tuple[float, float], ...]) -> list[list[float]]:
-        return list(map(list, points))  # thousands of regions: no per-point Python frame
+    from tlmpc.mission.model import regions_document
 
     return {
         "format": "tlmpc.trace/1",
         "ltl": to_text(mission.formula),
-        "regions": {r.name: poly(r.polygon) for r in mission.regions},
+        "regions": regions_document([(r.name, r.polygon) for r in mission.regions]),
         "workspace": mission.workspace.to_json(),
         "boundary": mission.options.boundary,
         "max_speed": max_speed,
