@@ -45,6 +45,7 @@ from tlmpc.control.robust import (
 )
 from tlmpc.control.sparse import CscMatrix, Triplets, stacked_csc
 from tlmpc.mission.model import Robot
+from tlmpc.planning.mission import on_cells
 from tlmpc.planning.model import Witness
 
 #: A unit normal as Python floats.
@@ -645,6 +646,11 @@ def synthesize(
     fields are chosen so that their flow follows the shortest path through the plan's
     channel (:mod:`tlmpc.control.follow`), under the vertex program's constraints.
     """
+    if on_cells(witness):
+        # a plan made on convex cells: its steps are cell steps (tlmpc.control.cells)
+        from tlmpc.control.cells import synthesize_cells
+
+        return synthesize_cells(abstraction, witness, robot, source=source)
     started = time.perf_counter()
     steps, loop_start = plan_steps(abstraction, witness)
     if robot.disturbance > 0.0:

@@ -46,6 +46,9 @@ class Planned:
     remeshed: bool = False
     #: the untimed task the plan was made for (the skeleton, or the holding skeleton)
     formula: Formula | None = None
+    #: the mesh the plan was asked on, before any refinement for a U-turn (the convex cells'
+    #: rung plans on it: a fan's triangles split the cells a U-turn needs none of)
+    unrefined: Abstraction | None = None
 
 
 def abstraction_for(
@@ -146,7 +149,13 @@ def plan_mission(
             reject=reject,
             times=times,
         )
-        return Planned(abstraction=planned_mesh, automaton=task, witness=witness, formula=formula)
+        return Planned(
+            abstraction=planned_mesh,
+            automaton=task,
+            witness=witness,
+            formula=formula,
+            unrefined=mesh,
+        )
 
     from tlmpc.abstraction.layout import deepens_goals
 
@@ -160,10 +169,12 @@ def plan_mission(
         the goal depth), then entering the goals only as deep as the margin asks (the cores'
         corners may be all that is too sharp); the first plan whose steps all realise it."""
         ratio = mission.robot.disturbance / mission.robot.max_speed
-        if resume is not None or ratio <= 0.0 or not deepens_goals(mission):
+        if resume is not None or ratio <= 0.0:
             return planned
         if witness_realisable(planned.abstraction, planned.witness, ratio):
             return planned
+        if not deepens_goals(mission):
+            return _on_cells(mission, planned, start_point) or planned
         tried = [planned]
         for scale in (*SHALLOWER, 0.0):
             mesh = abstraction_for(mission, margin, deep=scale > 0.0, scale=scale)
@@ -177,8 +188,14 @@ def plan_mission(
                 note = _shallow_for_disturbance(mission, planned.witness, scale)
                 return replace(again, notes=(note,), remeshed=True)
             tried.append(again)
-        # None realises the disturbance: the plan on the mesh whose plans reject the most goes
-        # on to be refused, stating that mesh's bound (C032: the mission compiles below it).
+        # None realises the disturbance on triangles: the last rung, convex cells, on each
+        # mesh in turn (the goal depth first).
+        for position, tried_plan in enumerate(tried):
+            on_cells = _on_cells(mission, tried_plan, start_point)
+            if on_cells is not None:
+                return on_cells if position == 0 else replace(on_cells, remeshed=True)
+        # None realises it on cells either: the plan on the mesh whose plans reject the most
+        # goes on to be refused, stating that mesh's bound (C032: the mission compiles below it).
         bounds = [_supported_of(plan.witness) for plan in tried]
         best = max(range(len(tried)), key=lambda k: (bounds[k] is not None, bounds[k] or 0.0, -k))
         return tried[0] if best == 0 else replace(tried[best], remeshed=True)
@@ -257,7 +274,7 @@ def replan(mission: Mission, planned: Planned, times: MoveTimes) -> Planned:
         formula = untimed_skeleton(mission.formula)
     ratio = mission.robot.disturbance / mission.robot.max_speed
 
-    def attempt(reject: float | None) -> tuple[Abstraction, Witness]:
+    def attempt(reject: float | None, cells: bool = False) -> tuple[Abstraction, Witness]:
         return plan_complete(
             planned.abstraction,
             planned.automaton,
@@ -267,8 +284,21 @@ def replan(mission: Mission, planned: Planned, times: MoveTimes) -> Planned:
             explain=False,
             reject=reject,
             times=times,
+            cells=cells,
         )
 
+    if on_cells(planned.witness):
+        # planned on cells: so again (the plan it replaces exists there)
+        mesh, witness = attempt(ratio, cells=True)
+        from tlmpc.planning.cells import partition, witness_on_cells
+        from tlmpc.planning.robust import TOLERANCE
+
+        if witness_on_cells(
+            partition(mesh), witness.prefix, witness.cycle, witness.is_stay, ratio, TOLERANCE
+        ):
+            witness = replace(witness, stats={**witness.stats, ON_CELLS: True})
+            return replace(planned, abstraction=mesh, witness=witness)
+        return planned
     mesh, witness = attempt(None)
     if not witness_realisable(mesh, witness, ratio):
         mesh, witness = attempt(ratio)
@@ -311,7 +341,72 @@ def _with_supported(
     if ratio is None:
         return planned
     stats = {**planned.witness.stats, SUPPORTED: ratio * mission.robot.max_speed}
+    on_cells = supported_ratio(
+        planned.abstraction,
+        planned.automaton,
+        formula=formula,
+        options=mission.options,
+        start_point=start_point if start_point is not None else mission.robot.start,
+        cells=True,
+    )
+    if on_cells is not None:
+        stats[SUPPORTED_CELLS] = on_cells * mission.robot.max_speed
     return replace(planned, witness=replace(planned.witness, stats=stats))
+
+
+#: The witness statistic of the bound on cells (:mod:`tlmpc.planning.cells`): at most this
+#: much disturbance any plan on the mesh's convex cells rejects, set with SUPPORTED.
+SUPPORTED_CELLS = "supported_disturbance_cells"
+#: The witness statistic that marks a plan made on convex cells: its steps are cell steps.
+ON_CELLS = "cells"
+
+
+def _on_cells(
+    mission: Mission, planned: Planned, start_point: tuple[float, float] | None
+) -> Planned | None:
+    """The last rung of the plan stage: ``planned``'s task planned again on the convex
+    cells of its mesh (:mod:`tlmpc.planning.cells`), when every cell step of that plan
+    rejects the mission's disturbance; None otherwise."""
+    from tlmpc.ltl.bounds import untimed_skeleton
+    from tlmpc.planning.cells import partition, witness_on_cells
+    from tlmpc.planning.complete import RefinementError, plan_complete
+    from tlmpc.planning.robust import TOLERANCE
+
+    from tlmpc.planning.plan import plan
+
+    ratio = mission.robot.disturbance / mission.robot.max_speed
+    formula = planned.formula if planned.formula is not None else untimed_skeleton(mission.formula)
+    mesh = planned.unrefined if planned.unrefined is not None else planned.abstraction
+    where = start_point if start_point is not None else mission.robot.start
+    cells = partition(mesh)
+    # A U-turn inside one cell is no turn for the cell's field: the triangles' U-turns are
+    # allowed first; a plan that turns back across an interface is refused below, and the
+    # planner without U-turns (refined where they are needed) tried then.
+    attempts = (
+        lambda: (mesh, plan(mesh, planned.automaton, formula=formula, options=mission.options,
+                            start_point=where, bounces=True, reject=ratio,
+                            times=move_times(mission), cells=True)),
+        lambda: plan_complete(mesh, planned.automaton, formula=formula, options=mission.options,
+                              start_point=where, explain=False, reject=ratio,
+                              times=move_times(mission), cells=True),
+    )  # fmt: skip
+    for attempt in attempts:
+        try:
+            found, witness = attempt()
+        except (NoPlanError, RefinementError):
+            continue
+        on = cells if found is mesh else partition(found)
+        if not witness.passages and witness_on_cells(
+            on, witness.prefix, witness.cycle, witness.is_stay, ratio, TOLERANCE
+        ):
+            witness = replace(witness, stats={**witness.stats, ON_CELLS: True})
+            return replace(planned, abstraction=found, witness=witness, formula=formula)
+    return None
+
+
+def on_cells(witness: Witness) -> bool:
+    """True for a plan made on convex cells (its controllers are cell fields)."""
+    return bool(witness.stats.get(ON_CELLS, False))
 
 
 def _supported_of(witness: Witness) -> float | None:
