@@ -535,6 +535,7 @@ def _check_rejectable(
     robot: Robot,
     source: str | None,
     supported: float | None = None,
+    on_cells: float | None = None,
 ) -> None:
     """Located errors where no vertex velocity can reject ``robot.disturbance`` (C032/C033),
     and where the plan passes through a single point, which no law here reaches under a
@@ -593,7 +594,11 @@ def _check_rejectable(
                 )
     if problems:
         hint = disturbance_hint(
-            robot.disturbance, robot.max_speed, weakest(pushes), supported=supported
+            robot.disturbance,
+            robot.max_speed,
+            weakest(pushes),
+            supported=supported,
+            on_cells=on_cells,
         )
         raise InvalidInputError([replace(p, hint=hint) for p in problems[:10]])
 
@@ -656,12 +661,14 @@ def synthesize(
     if robot.disturbance > 0.0:
         # the planner's widest-lasso search, recorded on a plan it could not make realisable
         supported = witness.stats.get("supported_disturbance")
+        cells_bound = witness.stats.get("supported_disturbance_cells")
         _check_rejectable(
             abstraction,
             steps,
             robot,
             source,
             None if supported is None else float(supported),
+            None if cells_bound is None else float(cells_bound),
         )
     # A velocity shared along a vertex run must push harder than the disturbance along every
     # facet the run collects (without one, merely positive along each: push 0).
