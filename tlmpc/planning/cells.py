@@ -219,7 +219,10 @@ def _fan_widths(groups: list[list[Vector]], turns: npt.NDArray[np.float64]) -> F
     for normals in groups:
         angles = np.array([math.atan2(y, x) for x, y in normals])
         every = np.concatenate(
-            [np.broadcast_to(angles, (len(turns), len(angles))), np.mod(turns, 2 * math.pi)[:, None]],
+            [
+                np.broadcast_to(angles, (len(turns), len(angles))),
+                np.mod(turns, 2 * math.pi)[:, None],
+            ],
             axis=1,
         )
         every = np.sort(np.mod(every, 2.0 * math.pi), axis=1)

@@ -370,9 +370,8 @@ def _on_cells(
     from tlmpc.ltl.bounds import untimed_skeleton
     from tlmpc.planning.cells import partition, witness_on_cells
     from tlmpc.planning.complete import RefinementError, plan_complete
-    from tlmpc.planning.robust import TOLERANCE
-
     from tlmpc.planning.plan import plan
+    from tlmpc.planning.robust import TOLERANCE
 
     ratio = mission.robot.disturbance / mission.robot.max_speed
     formula = planned.formula if planned.formula is not None else untimed_skeleton(mission.formula)

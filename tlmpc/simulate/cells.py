@@ -73,9 +73,9 @@ def _stay(
             error("C011", f"plan step {controller.step}: the stay field does not converge")
         )
     horizon = math.log(1.0 / STAY_CONTRACTION) / kappa
-    times = [
-        float(t) for t in horizon * (np.geomspace(1.0, 1001.0, STAY_SAMPLES) - 1.0) / 1000.0
-    ][1:]
+    times = [float(t) for t in horizon * (np.geomspace(1.0, 1001.0, STAY_SAMPLES) - 1.0) / 1000.0][
+        1:
+    ]
     points = [centre + math.exp(-kappa * t) * (x0 - centre) for t in times]
     last = points[-1]
     times.append(times[-1] + max(float(np.linalg.norm(last - centre)) / max_speed, 1e-9) + 1e-9)
