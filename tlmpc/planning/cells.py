@@ -41,6 +41,7 @@ the area centroid, a fixed number of halvings).
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass
 from functools import cached_property
@@ -171,7 +172,7 @@ def vertex_push(normals: list[Vector]) -> float:
         return 1.0
     angles = sorted(math.atan2(y, x) for x, y in normals)
     # the arc holding them all is the circle less its widest gap between consecutive angles
-    gaps = [b - a for a, b in zip(angles, angles[1:], strict=False)]
+    gaps = [b - a for a, b in itertools.pairwise(angles)]
     gaps.append(angles[0] + 2.0 * math.pi - angles[-1])
     spread = 2.0 * math.pi - max(gaps)
     return math.cos(spread / 2.0) if spread < math.pi else 0.0

@@ -162,9 +162,16 @@ def _move(
         earliest, facet = dt, -1
         for j in range(3):
 
-            def height(s: float, j: int = j) -> float:
+            def height(
+                s: float,
+                j: int = j,
+                matrix: FloatArray = matrix,
+                previous: FloatArray = previous,
+                normals: FloatArray = geometry.normals,
+                offsets: FloatArray = offsets,
+            ) -> float:
                 y = expm(s * matrix) @ previous
-                return float(geometry.normals[j] @ y[:2] - offsets[j])
+                return float(normals[j] @ y[:2] - offsets[j])
 
             if height(dt) <= 0.0:
                 continue
