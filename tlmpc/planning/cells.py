@@ -56,7 +56,7 @@ Vector = tuple[float, float]
 
 #: A corner counts as collinear (180 degrees) when its turn is below this, relative to the
 #: product of its two side lengths.
-COLLINEAR = 1e-12
+COLLINEAR = 1e-8
 #: The stay centre's pattern search halves its step this many times.
 CENTRE_HALVINGS = 40
 
