@@ -49,14 +49,21 @@ def synthesize_cells(
             )
         )
     path = [*witness.prefix, *witness.cycle]
+
+    def after(i: int) -> int:
+        return path[i + 1] if i + 1 < len(path) else witness.cycle[0]
+
     steps = []
     for index, group in enumerate(groups):
-        following = group.indices[-1] + 1
-        if group.target is None:
-            nxt = None
-        else:
-            nxt = path[following] if following < len(path) else witness.cycle[0]
-        steps.append(_cell_step(cells, index, group, path[group.indices[0]], nxt, robot))
+        nxt, last = None, group.indices[-1]
+        if group.target is not None:
+            # the plan's triangle where the group leaves its cell (a run that wraps round the
+            # cycle leaves from its first part)
+            last = next(i for i in group.indices if cells.cell_of[after(i)] == group.target)
+            nxt = after(last)
+        steps.append(
+            _cell_step(cells, index, group, path[group.indices[0]], nxt, last, robot)
+        )
     for controller in steps:
         problem = violated(controller, robot.max_speed, robot.disturbance)
         if problem is not None:
@@ -83,7 +90,13 @@ def synthesize_cells(
 
 
 def _cell_step(
-    cells: Cells, index: int, group: CellGroup, first: int, nxt: int | None, robot: Robot
+    cells: Cells,
+    index: int,
+    group: CellGroup,
+    first: int,
+    nxt: int | None,
+    last: int,
+    robot: Robot,
 ) -> StepController:
     cell = cells.cells[group.cell]
     points = cells.abstraction.vertices
@@ -145,6 +158,7 @@ def _cell_step(
         direction=direction,
         cell=group.cell,
         target_cell=group.target,
+        plan_index=last,
     )
     entry = piece_of[first]
     return StepController(

@@ -58,6 +58,7 @@ def _cell_to_json(field: CellField) -> dict[str, Any]:
         "g": field.offsets.tolist(),
         "across": [list(row) for row in field.neighbours],
         "direction": list(field.direction) if field.direction is not None else None,
+        "plan_index": field.plan_index,
     }
 
 
@@ -73,6 +74,7 @@ def _cell_from_json(document: Mapping[str, Any]) -> CellField:
         direction=None if document["direction"] is None else _point(document["direction"]),
         cell=int(document["cell"]),
         target_cell=None if document["target_cell"] is None else int(document["target_cell"]),
+        plan_index=int(document["plan_index"]),
     )
 
 

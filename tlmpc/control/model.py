@@ -30,6 +30,9 @@ class CellField(ContentEquality):
     direction: tuple[float, float] | None
     cell: int
     target_cell: int | None
+    #: the index (into the witness's prefix + cycle) of the triangle whose automaton state
+    #: the step ends in: the one it leaves the cell from (a stay: the last)
+    plan_index: int = 0
 
     def piece_of(self, triangle: int) -> int | None:
         """The piece of ``triangle`` (None when it is not in the cell)."""
@@ -79,6 +82,8 @@ class StepController(ContentEquality):
     @property
     def is_stay(self) -> bool:
         """True for the stay field that converges inside its triangle."""
+        if self.kind == "cell":
+            return self.cell is not None and self.cell.direction is None
         return self.exit_edge is None and self.kind == "affine"
 
     @property
