@@ -79,7 +79,7 @@ def test_adversarial_runs_leave_only_through_the_interface(rooms: Any, kind: str
             if loop.polygon.contains(Point(p)):
                 starts.append(p)
         for k, start in enumerate(starts):
-            outcome, gap = loop.run(start, d, kind, dt=0.01, horizon=40.0, seed=k)
+            outcome, gap = loop.run(start.tolist(), d, kind, dt=0.01, horizon=40.0, seed=k)
             if loop.direction is None:
                 assert outcome == "held", (step["step"], start, outcome, gap)
             else:

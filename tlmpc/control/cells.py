@@ -61,9 +61,7 @@ def synthesize_cells(
             # cycle leaves from its first part)
             last = next(i for i in group.indices if cells.cell_of[after(i)] == group.target)
             nxt = after(last)
-        steps.append(
-            _cell_step(cells, index, group, path[group.indices[0]], nxt, last, robot)
-        )
+        steps.append(_cell_step(cells, index, group, path[group.indices[0]], nxt, last, robot))
     for controller in steps:
         problem = violated(controller, robot.max_speed, robot.disturbance)
         if problem is not None:

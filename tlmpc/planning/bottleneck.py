@@ -106,9 +106,7 @@ def widest_lasso(
     ``groups`` (per triangle) joins triangles into cells whose inner moves are no steps."""
     widths = edge_widths(product, abstraction, moves)
     candidates = np.unique(np.concatenate([widths[np.isfinite(widths)], stays]))
-    if not len(candidates) or not _has_lasso(
-        product, widths, stays, float(candidates[0]), groups
-    ):
+    if not len(candidates) or not _has_lasso(product, widths, stays, float(candidates[0]), groups):
         return None
     low, high = 0, len(candidates) - 1  # the lasso exists at candidates[low]
     while low < high:

@@ -1,10 +1,10 @@
 """Convex cells of a mesh and the disturbance their fields reject (beyond a triangle's angles).
 
 A *cell* is a connected group of triangles with one label set and one component whose union
-is a convex polygon. The partition is greedy and deterministic (Hertel-Mehlhorn style): the
-triangles are taken in index order, each one not yet placed seeds a cell, and the cell grows
-across its boundary edges (breadth first, in the order its sides are met) by every neighbour
-of the same letter and component that keeps the union convex (collinear corners allowed).
+is a convex polygon. The partition is deterministic (Hertel-Mehlhorn style): every edge between
+two such triangles is a candidate, sharpest first (the smallest triangle angle at its ends,
+then by index), and the two cells across it merge when their union is convex (collinear
+corners allowed).
 
 A *cell move* leaves cell C for a neighbour cell C' across their interface I (every mesh edge
 the two share: a single segment, as both are convex). Its field is the continuous piecewise
@@ -23,13 +23,10 @@ min_k a_k·u over |u| <= 1 for the vertex's normals a_k, which is cos(s / 2) for
 spanning an arc of s < 180 degrees (the bisector of the arc's ends attains it, and any other
 direction is farther than s / 2 from one end).
 
-The direction xi is chosen exactly. Measured as angles from I's outward normal, the inward
-normals of the kept sides of a convex cell lie strictly between -180 and 180 degrees, in
-boundary order; a vertex whose kept normals span [a_v, b_v] spans max(b_v, t) - min(a_v, t)
-with xi at angle t. The largest spread over the vertices, max(S, B - t, t - A) with S the
-largest kept spread, B the largest b_v and A the smallest a_v, is least at t = (A + B) / 2,
-where it is max(S, (B - A) / 2). The move's *width* (in units of max_speed) is the smallest
-vertex push with that xi.
+The direction xi is searched over a fixed fan (FAN directions round the circle from I's mean
+outward normal, then a finer fan about the best); the move's *width* (in units of max_speed)
+is the smallest vertex push at the best xi found. Where I meets a collinear kept side the
+normal of I is infeasible (its two rows are opposite) and a tilted xi is not: hence a search.
 
 A *cell stay* uses the radial law u = kappa (c - x), affine on the whole cell, with
 kappa = max_speed / R (R the largest distance from c to a corner): on every side it pushes
@@ -196,9 +193,11 @@ def _move(cells: Cells, cell: int, target: int) -> CellMove:
     groups = [normals for normals in cells.vertex_normals(move).values() if normals]
     # the fan: every FAN_STEP around the circle from I's outward normal, then a finer fan
     # about the best of it
-    turns = base + np.arange(FAN) * (2.0 * math.pi / FAN)
+    turns: FloatArray = base + np.arange(FAN, dtype=np.float64) * (2.0 * math.pi / FAN)
     best = float(turns[int(np.argmax(_fan_widths(groups, turns)))])
-    fine = best + (np.arange(2 * FINE + 1) - FINE) * (2.0 * math.pi / FAN / FINE)
+    fine: FloatArray = best + (np.arange(2 * FINE + 1, dtype=np.float64) - FINE) * (
+        2.0 * math.pi / FAN / FINE
+    )
     best = float(fine[int(np.argmax(_fan_widths(groups, fine)))])
     xi = (math.cos(best), math.sin(best))
     width = min(vertex_push([*normals, xi]) for normals in groups)

@@ -78,7 +78,7 @@ def plan_complete(
     explain: bool = True,
     reject: float | None = None,
     times: MoveTimes | None = None,
-    cells: bool = False,
+    on_cells: bool = False,
 ) -> tuple[Abstraction, Witness]:
     """A witness on ``abstraction`` or on a locally refined copy of it (returned with it).
 
@@ -86,7 +86,7 @@ def plan_complete(
     ``parts`` gives the task's parts for that explanation (called only then, and only with
     ``explain``: a run re-planning under way needs no explanation).  ``resume`` re-plans a
     run under way (see :func:`tlmpc.planning.plan.plan`); ``times`` weighs the moves under
-    the ``time`` metric (:mod:`tlmpc.planning.timing`); ``cells`` plans the moves and stays
+    the ``time`` metric (:mod:`tlmpc.planning.timing`); ``on_cells`` plans the moves and stays
     of convex cells that reject ``reject`` (:mod:`tlmpc.planning.cells`).
     """
 
@@ -102,7 +102,7 @@ def plan_complete(
             resume=resume,
             reject=reject,
             times=times,
-            cells=cells,
+            on_cells=on_cells,
         )
 
     try:

@@ -284,7 +284,7 @@ def replan(mission: Mission, planned: Planned, times: MoveTimes) -> Planned:
             explain=False,
             reject=reject,
             times=times,
-            cells=cells,
+            on_cells=cells,
         )
 
     if on_cells(planned.witness):
@@ -381,14 +381,36 @@ def _on_cells(
     # A U-turn inside one cell is no turn for the cell's field: the triangles' U-turns are
     # allowed first; a plan that turns back across an interface is refused below, and the
     # planner without U-turns (refined where they are needed) tried then.
-    attempts = (
-        lambda: (mesh, plan(mesh, planned.automaton, formula=formula, options=mission.options,
-                            start_point=where, bounces=True, reject=ratio,
-                            times=move_times(mission), cells=True)),
-        lambda: plan_complete(mesh, planned.automaton, formula=formula, options=mission.options,
-                              start_point=where, explain=False, reject=ratio,
-                              times=move_times(mission), cells=True),
-    )  # fmt: skip
+    times = move_times(mission)
+
+    def turning() -> tuple[Abstraction, Witness]:
+        witness = plan(
+            mesh,
+            planned.automaton,
+            formula=formula,
+            options=mission.options,
+            start_point=where,
+            bounces=True,
+            reject=ratio,
+            times=times,
+            on_cells=True,
+        )
+        return mesh, witness
+
+    def refined() -> tuple[Abstraction, Witness]:
+        return plan_complete(
+            mesh,
+            planned.automaton,
+            formula=formula,
+            options=mission.options,
+            start_point=where,
+            explain=False,
+            reject=ratio,
+            times=times,
+            on_cells=True,
+        )
+
+    attempts: tuple[Callable[[], tuple[Abstraction, Witness]], ...] = (turning, refined)
     for attempt in attempts:
         try:
             found, witness = attempt()

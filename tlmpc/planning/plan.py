@@ -103,7 +103,7 @@ def plan(
     guided: bool | None = None,
     reject: float | None = None,
     times: MoveTimes | None = None,
-    cells: bool = False,
+    on_cells: bool = False,
 ) -> Witness:
     """A minimum-cost accepting lasso (raises :class:`NoPlanError` with an explanation).
 
@@ -116,7 +116,7 @@ def plan(
     (:mod:`tlmpc.planning.guided`: the same cost, for products too large to build); by
     default only when the product would not fit the budget (:mod:`tlmpc.planning.budget`).
     With ``reject`` (a disturbance over max_speed) only the moves and stays the controllers
-    realise under it are used (:mod:`tlmpc.planning.robust`); with ``cells`` too, those the
+    realise under it are used (:mod:`tlmpc.planning.robust`); with ``on_cells``, those the
     convex cells' fields realise (:mod:`tlmpc.planning.cells`).
     Under ``options.cost: time`` the moves weigh ``times`` (:mod:`tlmpc.planning.timing`;
     without it, their lengths at unit speed).
@@ -147,7 +147,7 @@ def plan(
         )
 
     realisable_steps = None if reject is None else realisable(abstraction, reject)
-    if reject is not None and cells:
+    if reject is not None and on_cells:
         from tlmpc.planning.cells import cell_realisable, partition
 
         realisable_steps = cell_realisable(partition(abstraction), reject, TOLERANCE)
