@@ -15,6 +15,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -145,3 +146,64 @@ def test_stated_widths_equal_an_independent_program() -> None:
             assert _lp_width(rows, move.xi) == pytest.approx(move.width, abs=1e-6)
             checked += 1
     assert checked >= 10
+
+
+def _first_move(compiled: Any) -> Any:
+    from tlmpc.control.io import controllers_from_json
+
+    controllers = controllers_from_json(compiled.artifacts["controllers.json"])
+    return next(c for c in controllers.steps if c.cell is not None and not c.is_stay)
+
+
+def test_the_recheck_counts_the_disturbance(rooms: Any) -> None:
+    """The re-check holds every row to the disturbance: the move's field (width 0.7071)
+    passes at 0.6 and fails at 0.71, where its kept corners push less than d."""
+    from tlmpc.control.cells import violated
+
+    move = _first_move(rooms)
+    assert violated(move, 1.0, 0.6) is None
+    assert violated(move, 1.0, 0.71) is not None
+    slow = replace(
+        move,
+        cell=replace(move.cell, velocities=move.cell.velocities * 0.5),
+    )
+    assert violated(slow, 1.0, 0.4) is not None  # 0.5 x 0.7071 < 0.4 along xi and inward
+    # nine tenths of full speed along xi, a tenth as solved: the flow rows hold (> 0.9),
+    # a kept corner's row only just (0.07 > 0, < 0.6)
+    along = np.broadcast_to(np.asarray(move.cell.direction), move.cell.velocities.shape)
+    velocities = 0.9 * along + 0.1 * move.cell.velocities
+    flowing = replace(move, cell=replace(move.cell, velocities=velocities))
+    problem = violated(flowing, 1.0, 0.6)
+    assert problem is not None and "kept side" in problem
+    # the kept rows as solved, the flow direction turned 40 degrees: the corner velocities
+    # (45 degrees either side of xi) move along it by cos 5 and cos 85 degrees, 0.087 < 0.6
+    (x, y), turn = move.cell.direction, math.radians(40.0)
+    direction = (x * math.cos(turn) - y * math.sin(turn), x * math.sin(turn) + y * math.cos(turn))
+    tilted = replace(move, cell=replace(move.cell, direction=direction))
+    problem = violated(tilted, 1.0, 0.6)
+    assert problem is not None and "along xi" in problem
+
+
+def test_the_simulation_refuses_a_field_that_leaves_by_a_kept_side(rooms: Any) -> None:
+    """A move's field turned round (every velocity negated, the interface now behind it)
+    leaves across a kept side: the exact simulation reports C031 instead of ending the step."""
+    from tlmpc.base.errors import SolverError
+    from tlmpc.simulate.cells import cell_step
+
+    move = _first_move(rooms)
+    field = move.cell
+    assert field.direction is not None
+    turned = replace(
+        move,
+        exit_speed=move.exit_speed,
+        cell=replace(
+            field,
+            velocities=-field.velocities,
+            gains=-field.gains,
+            offsets=-field.offsets,
+            direction=(-field.direction[0], -field.direction[1]),
+        ),
+    )
+    with pytest.raises(SolverError) as caught:
+        cell_step(turned, np.array([1.5, 1.5]), 1.0)
+    assert caught.value.diagnostics[0].code == "C031"
