@@ -310,6 +310,12 @@ def partition(abstraction: Abstraction) -> Cells:
             )
             candidates.append((key, t, there))
     candidates.sort()
+    faces = abstraction.stats.get("cell_faces")
+    if faces is not None and len(faces) == count:
+        # the convex cells' mesh (tlmpc.abstraction.lines): its faces are the cells, convex
+        # and meeting side to side; a merge across two would leave a part of a side between
+        # them and the next
+        candidates = [c for c in candidates if faces[c[1]] == faces[c[2]]]
     owner = list(range(count))  # union-find over triangles
     boundary: dict[int, list[int]] = {t: list(triangles[t]) for t in range(count)}
 

@@ -174,7 +174,11 @@ def plan_mission(
         if witness_realisable(planned.abstraction, planned.witness, ratio):
             return planned
         if not deepens_goals(mission):
-            return _on_cells(mission, planned, start_point) or planned
+            return (
+                _on_cells(mission, planned, start_point)
+                or _on_lines(mission, margin, planned, start_point)
+                or planned
+            )
         tried = [planned]
         for scale in (*SHALLOWER, 0.0):
             mesh = abstraction_for(mission, margin, deep=scale > 0.0, scale=scale)
@@ -194,6 +198,9 @@ def plan_mission(
             on_cells = _on_cells(mission, tried_plan, start_point)
             if on_cells is not None:
                 return on_cells if position == 0 else replace(on_cells, remeshed=True)
+        on_lines = _on_lines(mission, margin, planned, start_point)
+        if on_lines is not None:
+            return on_lines
         # None realises it on cells either: the plan on the mesh whose plans reject the most
         # goes on to be refused, stating that mesh's bound (C032: the mission compiles below it).
         bounds = [_supported_of(plan.witness) for plan in tried]
@@ -422,6 +429,33 @@ def _on_cells(
         ):
             witness = replace(witness, stats={**witness.stats, ON_CELLS: True})
             return replace(planned, abstraction=found, witness=witness, formula=formula)
+    return None
+
+
+def _on_lines(
+    mission: Mission, margin: float, planned: Planned, start_point: tuple[float, float] | None
+) -> Planned | None:
+    """The cells' rung on the convex cells' own mesh (every side extended across the free
+    space, :mod:`tlmpc.abstraction.lines`: convex faces that meet side to side), with the
+    goal depth, then the margin's; None where no plan there rejects the disturbance, or the
+    mesh would exceed its size budget."""
+    from tlmpc.abstraction import build_abstraction
+    from tlmpc.abstraction.layout import deepens_goals, planning_layout
+    from tlmpc.abstraction.triangulate import lines_fit
+
+    formula = planned.formula
+    for deep in (True, False) if deepens_goals(mission) else (False,):
+        layout = planning_layout(mission, margin, deep=deep)
+        if not lines_fit(mission, layout):
+            continue
+        mesh = build_abstraction(mission, layout, lines=True)
+        task = automaton_for(mission, mesh, formula=formula)
+        candidate = Planned(
+            abstraction=mesh, automaton=task, witness=planned.witness, formula=formula
+        )
+        found = _on_cells(mission, candidate, start_point)
+        if found is not None:
+            return replace(found, remeshed=True)
     return None
 
 
