@@ -11,6 +11,7 @@ square of the number of sides, so it is built only up to :data:`MAX_SIDES` of th
 
 from __future__ import annotations
 
+import itertools
 import math
 from typing import Any
 
@@ -33,7 +34,7 @@ def extended_lines(free: Any, rings: list[Any]) -> list[Any]:
     found = []
     for ring in rings:
         coords = np.asarray(ring.coords, dtype=np.float64)
-        for a, b in zip(coords[:-1], coords[1:], strict=True):
+        for a, b in itertools.pairwise(coords):
             length = float(np.hypot(*(b - a)))
             if length == 0.0:
                 continue
