@@ -15,7 +15,7 @@ from __future__ import annotations
 import subprocess
 import sys
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 import pytest
@@ -58,7 +58,9 @@ def test_compiles_on_cells_and_verifies(compiled: Any, tmp_path: Path) -> None:
 
 @pytest.mark.slow
 @pytest.mark.parametrize("model", ["adversarial", "random"])
-def test_closed_loop_runs_at_the_full_bound_verify(compiled: Any, model: str) -> None:
+def test_closed_loop_runs_at_the_full_bound_verify(
+    compiled: Any, model: Literal["random", "adversarial"]
+) -> None:
     executor = tlmpc.executor(compiled)
     bound = RATIO * executor.mission.robot.max_speed
     hold = 10 * default_dt(executor.plan, executor.mission.robot.max_speed + bound)
