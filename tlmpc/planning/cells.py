@@ -51,6 +51,11 @@ from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
 BoolArray = npt.NDArray[np.bool_]
 Vector = tuple[float, float]
 
+#: The convex cells' rung's budget, in triangles of the mesh: the partition and the fan search
+#: of every cell move run in Python, about a millisecond a move (a mesh of Example 8's size,
+#: nine thousand triangles, would take minutes per mesh tried).
+MAX_TRIANGLES = 4000
+
 #: A corner counts as collinear (180 degrees) when its turn is below this, relative to the
 #: product of its two side lengths.
 COLLINEAR = 1e-8
@@ -191,7 +196,7 @@ def _move(cells: Cells, cell: int, target: int) -> CellMove:
     base = math.atan2(ny, nx)
     move = CellMove(cell=cell, target=target, xi=(nx, ny), width=0.0, kept=kept, interface=())
     groups = [normals for normals in cells.vertex_normals(move).values() if normals]
-    # the fan: every FAN_STEP around the circle from I's outward normal, then a finer fan
+    # the fan: FAN directions round the circle from I's outward normal, then a finer fan
     # about the best of it
     turns: FloatArray = base + np.arange(FAN, dtype=np.float64) * (2.0 * math.pi / FAN)
     best = float(turns[int(np.argmax(_fan_widths(groups, turns)))])

@@ -348,13 +348,19 @@ def _with_supported(
     if ratio is None:
         return planned
     stats = {**planned.witness.stats, SUPPORTED: ratio * mission.robot.max_speed}
-    on_cells = supported_ratio(
-        planned.abstraction,
-        planned.automaton,
-        formula=formula,
-        options=mission.options,
-        start_point=start_point if start_point is not None else mission.robot.start,
-        cells=True,
+    from tlmpc.planning.cells import MAX_TRIANGLES
+
+    on_cells = (
+        supported_ratio(
+            planned.abstraction,
+            planned.automaton,
+            formula=formula,
+            options=mission.options,
+            start_point=start_point if start_point is not None else mission.robot.start,
+            cells=True,
+        )
+        if planned.abstraction.num_triangles <= MAX_TRIANGLES
+        else None
     )
     if on_cells is not None:
         stats[SUPPORTED_CELLS] = on_cells * mission.robot.max_speed
@@ -375,7 +381,7 @@ def _on_cells(
     cells of its mesh (:mod:`tlmpc.planning.cells`), when every cell step of that plan
     rejects the mission's disturbance; None otherwise."""
     from tlmpc.ltl.bounds import untimed_skeleton
-    from tlmpc.planning.cells import partition, witness_on_cells
+    from tlmpc.planning.cells import MAX_TRIANGLES, partition, witness_on_cells
     from tlmpc.planning.complete import RefinementError, plan_complete
     from tlmpc.planning.plan import plan
     from tlmpc.planning.robust import TOLERANCE
@@ -383,6 +389,8 @@ def _on_cells(
     ratio = mission.robot.disturbance / mission.robot.max_speed
     formula = planned.formula if planned.formula is not None else untimed_skeleton(mission.formula)
     mesh = planned.unrefined if planned.unrefined is not None else planned.abstraction
+    if mesh.num_triangles > MAX_TRIANGLES:
+        return None  # beyond the rung's budget
     where = start_point if start_point is not None else mission.robot.start
     cells = partition(mesh)
     # A U-turn inside one cell is no turn for the cell's field: the triangles' U-turns are
@@ -442,6 +450,7 @@ def _on_lines(
     from tlmpc.abstraction import build_abstraction
     from tlmpc.abstraction.layout import deepens_goals, planning_layout
     from tlmpc.abstraction.triangulate import lines_fit
+    from tlmpc.planning.cells import MAX_TRIANGLES
 
     formula = planned.formula
     for deep in (True, False) if deepens_goals(mission) else (False,):
@@ -449,6 +458,8 @@ def _on_lines(
         if not lines_fit(mission, layout):
             continue
         mesh = build_abstraction(mission, layout, lines=True)
+        if mesh.num_triangles > MAX_TRIANGLES:
+            continue
         task = automaton_for(mission, mesh, formula=formula)
         candidate = Planned(
             abstraction=mesh, automaton=task, witness=planned.witness, formula=formula
