@@ -491,7 +491,7 @@ def cell_groups(
             loop[0] = [*head.pop(), *loop[0]]
         groups = [
             CellGroup(int(here[path[r[0]]]), int(here[path[nxt[0]]]), tuple(r))
-            for r, nxt in zip(head, [*head[1:], loop[0]], strict=True)
+            for r, nxt in zip(head, [*head[1:], loop[0]][: len(head)], strict=True)
         ]
         indices = [i for r in loop for i in r]
         groups.append(CellGroup(last, None, tuple(indices)))
