@@ -64,6 +64,30 @@ def test_just_above_the_square_bound_is_refused_with_the_cell_bound() -> None:
     assert f"plans reject at most {math.sqrt(0.5):.6g}" in hint
 
 
+def test_example1_beyond_every_cell_states_the_cells_bound() -> None:
+    """At 0.7 Example 1 is refused; the hint states both bounds: triangles sin 22.5 degrees
+    and, larger, what its cells (on the mesh of its extended sides) carry at most; just below
+    that value a plan on cells exists where the widest lasso found it (below 0.646 it compiles
+    at 0.6)."""
+    from pathlib import Path
+
+    import yaml
+
+    doc = yaml.safe_load(
+        (Path(__file__).resolve().parents[2] / "specs" / "example1.yaml").read_text()
+    )
+    doc["robot"]["disturbance"] = 0.7
+    with pytest.raises(TlmpcError) as caught:
+        tlmpc.compile(doc, until="control")
+    hint = caught.value.diagnostics[0].hint or ""
+    assert "any plan on this mesh rejects is 0.382683" in hint
+    stated = float(hint.split("plans reject at most ")[1].split(" ")[0])
+    assert math.sin(math.radians(22.5)) < stated < 0.7
+    doc["robot"]["disturbance"] = 0.6
+    compiled = tlmpc.compile(doc, until="control")
+    assert {s.get("kind") for s in compiled.artifacts["controllers.json"]["steps"]} == {"cell"}
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("kind", ["kept", "against", "random"])
 def test_adversarial_runs_leave_only_through_the_interface(rooms: Any, kind: str) -> None:

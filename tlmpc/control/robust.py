@@ -120,7 +120,8 @@ def disturbance_hint(
         )
     if on_cells is not None:
         lines.append(
-            f"on the mesh's convex cells (the plan stage's last rung) plans reject at most "
+            "on convex cells (the plan stage's last rung: the mesh's, and a mesh of the map's "
+            f"sides extended across it) plans reject at most "
             f"{on_cells:.6g} ({on_cells / max_speed:.4f} x max_speed): the widest route's "
             "weakest cell step"
         )

@@ -174,11 +174,11 @@ def plan_mission(
         if witness_realisable(planned.abstraction, planned.witness, ratio):
             return planned
         if not deepens_goals(mission):
-            return (
-                _on_cells(mission, planned, start_point)
-                or _on_lines(mission, margin, planned, start_point)
-                or planned
-            )
+            on_cells = _on_cells(mission, planned, start_point)
+            if on_cells is not None:
+                return on_cells
+            on_lines, lines_bound = _on_lines(mission, margin, planned, start_point)
+            return on_lines or _with_cells_bound(planned, lines_bound, mission)
         tried = [planned]
         for scale in (*SHALLOWER, 0.0):
             mesh = abstraction_for(mission, margin, deep=scale > 0.0, scale=scale)
@@ -198,14 +198,20 @@ def plan_mission(
             on_cells = _on_cells(mission, tried_plan, start_point)
             if on_cells is not None:
                 return on_cells if position == 0 else replace(on_cells, remeshed=True)
-        on_lines = _on_lines(mission, margin, planned, start_point)
+        on_lines, lines_bound = _on_lines(mission, margin, planned, start_point)
         if on_lines is not None:
             return on_lines
         # None realises it on cells either: the plan on the mesh whose plans reject the most
-        # goes on to be refused, stating that mesh's bound (C032: the mission compiles below it).
+        # goes on to be refused, stating that mesh's bound (C032: the mission compiles below it)
+        # and the cells' (the largest over the meshes tried).
         bounds = [_supported_of(plan.witness) for plan in tried]
         best = max(range(len(tried)), key=lambda k: (bounds[k] is not None, bounds[k] or 0.0, -k))
-        return tried[0] if best == 0 else replace(tried[best], remeshed=True)
+        cells_bounds = [plan.witness.stats.get(SUPPORTED_CELLS) for plan in tried]
+        known = [float(b) / mission.robot.max_speed for b in cells_bounds if b is not None]
+        if lines_bound is not None:
+            known.append(lines_bound)
+        chosen = _with_cells_bound(tried[best], max(known) if known else None, mission)
+        return chosen if best == 0 else replace(chosen, remeshed=True)
 
     holding = holding_skeleton(mission.formula)
     if resume is None and holding != skeleton:
@@ -440,19 +446,35 @@ def _on_cells(
     return None
 
 
+def _with_cells_bound(planned: Planned, ratio: float | None, mission: Mission) -> Planned:
+    """``planned`` (to be refused) stating ``ratio`` x max_speed as the largest disturbance
+    plans on convex cells reject, where that is more than it states already."""
+    if ratio is None:
+        return planned
+    value = ratio * mission.robot.max_speed
+    known = planned.witness.stats.get(SUPPORTED_CELLS)
+    if known is not None and float(known) >= value:
+        return planned
+    stats = {**planned.witness.stats, SUPPORTED_CELLS: value}
+    return replace(planned, witness=replace(planned.witness, stats=stats))
+
+
 def _on_lines(
     mission: Mission, margin: float, planned: Planned, start_point: tuple[float, float] | None
-) -> Planned | None:
+) -> tuple[Planned | None, float | None]:
     """The cells' rung on the convex cells' own mesh (every side extended across the free
     space, :mod:`tlmpc.abstraction.lines`: convex faces that meet side to side), with the
-    goal depth, then the margin's; None where no plan there rejects the disturbance, or the
-    mesh would exceed its size budget."""
+    goal depth, then the margin's: the plan there, or (None, the largest disturbance ratio any
+    plan on those meshes' cells rejects, None when none was built: over the size budgets)."""
     from tlmpc.abstraction import build_abstraction
     from tlmpc.abstraction.layout import deepens_goals, planning_layout
     from tlmpc.abstraction.triangulate import lines_fit
+    from tlmpc.ltl.bounds import untimed_skeleton
+    from tlmpc.planning.bottleneck import supported_ratio
     from tlmpc.planning.cells import MAX_TRIANGLES
 
     formula = planned.formula
+    bound: float | None = None
     for deep in (True, False) if deepens_goals(mission) else (False,):
         layout = planning_layout(mission, margin, deep=deep)
         if not lines_fit(mission, layout):
@@ -466,8 +488,18 @@ def _on_lines(
         )
         found = _on_cells(mission, candidate, start_point)
         if found is not None:
-            return replace(found, remeshed=True)
-    return None
+            return replace(found, remeshed=True), None
+        supported = supported_ratio(
+            mesh,
+            task,
+            formula=formula if formula is not None else untimed_skeleton(mission.formula),
+            options=mission.options,
+            start_point=start_point if start_point is not None else mission.robot.start,
+            cells=True,
+        )
+        if supported is not None and (bound is None or supported > bound):
+            bound = supported
+    return None, bound
 
 
 def on_cells(witness: Witness) -> bool:
