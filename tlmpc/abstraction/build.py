@@ -137,16 +137,27 @@ def connected_components(neighbors: IntArray) -> IntArray:
     return labels
 
 
-def build_abstraction(mission: Mission, layout: PlanningLayout | None = None) -> Abstraction:
+def build_abstraction(
+    mission: Mission, layout: PlanningLayout | None = None, *, lines: bool = False
+) -> Abstraction:
     """Triangulate ``mission``'s workspace and build the transition system D.
 
     With a ``layout`` (a robot with a body, a margin), its free space and region shapes are
-    triangulated and label the triangles instead of the mission's own.
+    triangulated and label the triangles instead of the mission's own. With ``lines``, the
+    convex cells' mesh: every side extended across the free space, no inner points, and each
+    triangle's face of that arrangement in ``stats["cell_faces"]``
+    (:mod:`tlmpc.abstraction.lines`).
     """
     started = time.perf_counter()
     # One geometry for planning and verifying: refuse what snapping to the grid would reshape.
     refuse_subgrid_features(mission)
-    vertices, triangles, neighbors, shapes = triangulate(mission, layout)
+    faces = None
+    if lines:
+        from tlmpc.abstraction.triangulate import lines_mesh
+
+        vertices, triangles, neighbors, shapes, faces = lines_mesh(mission, layout)
+    else:
+        vertices, triangles, neighbors, shapes = triangulate(mission, layout)
     letter_of, letters = _labels(mission, vertices, triangles, shapes)
     # The lowest-numbered triangle holding the start exactly (a start on an edge or vertex
     # lies in several: the planner starts from any of them).
@@ -174,6 +185,8 @@ def build_abstraction(mission: Mission, layout: PlanningLayout | None = None) ->
         "components": int(component.max() + 1) if len(component) else 0,
         "min_angle_deg": round(float(angles.min()), 6) if len(angles) else None,
         "seconds": round(time.perf_counter() - started, 6),
+        # the convex cells' mesh: the face of its arrangement each triangle lies in
+        **({"cell_faces": faces} if faces is not None else {}),
     }
     return Abstraction(
         vertices=vertices,

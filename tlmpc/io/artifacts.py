@@ -520,16 +520,30 @@ def _cross_check_results(
             raise _tampered(path, "controllers.json: a step names a missing triangle")
         # the steps are one path: each leaves into the triangle of the next (the last into
         # the loop's first, unless it is a final stay)
-        successor = [*(s["triangle"] for s in steps[1:]), None]
+        # (a cell step leaves into any triangle of the next step's cell)
+        following = [*steps[1:], None]
         if loop is not None:
-            successor[-1] = steps[loop]["triangle"]
+            following[-1] = steps[loop]
         if any(
-            s["next_triangle"] is not None and s["next_triangle"] != after
-            for s, after in zip(steps, successor, strict=True)
+            s["next_triangle"] is not None
+            and (
+                after is None
+                or (
+                    s["next_triangle"] not in after["cell"]["triangles"]
+                    if "cell" in after
+                    else s["next_triangle"] != after["triangle"]
+                )
+            )
+            for s, after in zip(steps, following, strict=True)
         ) or (loop is None and not steps[-1]["stay"]):
             raise _tampered(path, "controllers.json: the steps do not follow one another")
         witness = documents.get("witness.json")
-        if witness is not None and len(steps) != len(witness["prefix"]) + len(witness["cycle"]):
+        on_cells = any("cell" in s for s in steps)  # cell steps group the witness's triangles
+        if (
+            witness is not None
+            and not on_cells
+            and len(steps) != len(witness["prefix"]) + len(witness["cycle"])
+        ):
             raise _tampered(
                 path, "controllers.json and witness.json have different numbers of steps"
             )

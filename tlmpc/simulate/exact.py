@@ -27,6 +27,7 @@ from tlmpc.base.errors import SolverError, error
 from tlmpc.control.geometry import largest_of, triangle_geometry
 from tlmpc.control.model import Controllers, StepController
 from tlmpc.mission.model import Mission
+from tlmpc.simulate.cells import cell_step
 
 #: Samples per step (besides the crossings): grid points near SAMPLES_PER_STEP - 1 evenly
 #: spaced times.
@@ -372,6 +373,24 @@ def simulate(abstraction: Abstraction, controllers: Controllers, mission: Missio
         controller = steps[index]
         if loop_start_step is not None and index == loop_start_step and position == len(steps):
             loop_index = len(points) - 1  # the crossing into the second lap
+        if controller.is_cell:
+            cell_times, cell_points, cell_triangles, cell_crossings = cell_step(
+                controller, x, controllers.max_speed
+            )
+            for t, point, triangle, crossed in zip(
+                cell_times, cell_points, cell_triangles, cell_crossings, strict=True
+            ):
+                if t <= 0.0:
+                    continue
+                times.append(now + t)
+                points.append(point)
+                step_of.append(index)
+                triangle_of.append(triangle)
+                if crossed:
+                    crossings.append(len(points) - 1)
+            now = times[-1]
+            x = points[-1]
+            continue
         if controller.is_vertex:
             rel_times, rel_points = pursuit_step(controller, x, controllers.max_speed)
         elif controller.exit_edge is None:
