@@ -1,6 +1,7 @@
 """The verifier's distance to a region's boundary, computed a coordinate at a time into
 buffers, is bit for bit the row-wise definition: the same operations on the same numbers
-(the reported robustness and the certificate's margin are printed to the last digit)."""
+(the reported robustness and the certificate's margin are printed to the last digit); the
+containment test asked only inside a region's bounding box is shapely's on every point."""
 
 from __future__ import annotations
 
@@ -60,3 +61,30 @@ def test_ring_distance_on_a_trace_sized_array_is_the_row_wise_definition() -> No
     inner = np.minimum.reduce([x - 10.0, 12.5 - x, y - 10.0, 13.25 - y])
     expected = np.where(outside, np.hypot(dx, dy), inner)
     assert np.allclose(got, expected, rtol=0, atol=1e-12)
+
+
+@given(
+    st.lists(st.tuples(coordinate, coordinate), min_size=3, max_size=9),
+    st.lists(st.tuples(coordinate, coordinate), min_size=0, max_size=200),
+    st.floats(0.0, 1.0),
+)
+def test_containment_asked_in_the_bounding_box_only_is_shapelys(
+    corners: list[tuple[float, float]], probes: list[tuple[float, float]], share: float
+) -> None:
+    import shapely
+
+    from tlmpc.verify.robustness import _contains
+
+    ring = np.asarray(corners, dtype=np.float64)
+    shape = shapely.Polygon(ring)
+    # corners, edge midpoints, the centroid and points between a corner and the centroid
+    middle = ring.mean(axis=0)
+    extra = [
+        *ring,
+        *((ring + np.roll(ring, -1, axis=0)) / 2),
+        middle,
+        ring[0] * share + middle * (1 - share),
+    ]
+    points = np.asarray([*probes, *extra], dtype=np.float64).reshape(-1, 2)
+    expected = shapely.contains_xy(shape, points[:, 0], points[:, 1])
+    assert _contains(shape, ring, points).tolist() == expected.tolist()

@@ -73,6 +73,18 @@ def _ring_distance(polygon: FloatArray, points: FloatArray) -> FloatArray:
     return best
 
 
+def _contains(shape: shapely.Polygon, corners: FloatArray, points: FloatArray) -> BoolArray:
+    """``shapely.contains_xy`` of each point: asked only of the points in the polygon's
+    (closed) bounding box, since no point outside it lies in the polygon's interior (a region
+    is small against a trace that crosses the whole map)."""
+    xs, ys = points[:, 0], points[:, 1]
+    (left, bottom), (right, top) = corners.min(axis=0), corners.max(axis=0)
+    near = np.flatnonzero((xs >= left) & (xs <= right) & (ys >= bottom) & (ys <= top))
+    inside = np.zeros(len(points), dtype=bool)
+    inside[near] = shapely.contains_xy(shape, xs[near], ys[near])
+    return inside
+
+
 def signed_distance(
     polygon: FloatArray, points: FloatArray, geoms: npt.NDArray[np.object_] | None = None
 ) -> FloatArray:
@@ -82,13 +94,14 @@ def signed_distance(
     its exterior ring: one distance computation serves both signs.
     """
     shape = shapely.Polygon(polygon)
+    corners = np.asarray(polygon, dtype=np.float64)
     if len(polygon) <= DIRECT_EDGES:
-        distance = _ring_distance(np.asarray(polygon, dtype=np.float64), points)
+        distance = _ring_distance(corners, points)
     else:
         if geoms is None:
             geoms = shapely.points(points)
         distance = np.asarray(shapely.distance(shape.exterior, geoms), dtype=np.float64)
-    inside = shapely.contains_xy(shape, points[:, 0], points[:, 1])
+    inside = _contains(shape, corners, points)
     result: FloatArray = np.where(inside, distance, -distance)
     return result
 
