@@ -33,3 +33,25 @@ def test_the_request_is_off_inside_and_restored_after(setting: bool) -> None:
         assert _current() is setting
     finally:
         switch(before)
+
+
+def test_stages_run_on_plain_pages_and_the_request_comes_back() -> None:
+    from pathlib import Path
+
+    from tlmpc.pipeline.stages import Compilation, Stage, StageResult, run_stages
+
+    seen: list[bool] = []
+
+    def probe(_: Compilation) -> StageResult:
+        seen.append(_current())
+        return StageResult()
+
+    switch = _switch()
+    assert switch is not None
+    before = switch(True)
+    try:
+        run_stages([Stage(name="probe", run=probe)], Compilation(source=Path("mission.yaml")))
+        assert seen == [False]
+        assert _current() is True
+    finally:
+        switch(before)
