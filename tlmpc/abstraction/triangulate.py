@@ -251,7 +251,7 @@ def pslg(
         own = [*free_rings, *(c for c in clipped if not c.is_empty)]
         sides = [*free_rings, *_inside_rings(free, region_rings)]
         linework = shapely.union_all([*own, *extended_lines(free, sides)], grid_size=grid)
-        segments = _segments_of(list(shapely.get_parts(linework)))
+        points, starts = _chains_of(list(shapely.get_parts(linework)))
     elif _needs_noding([*free_rings, *region_rings]):
         clipped = [shapely.intersection(shapely.boundary(r), free, grid_size=grid) for r in regions]
         linework = shapely.union_all(
