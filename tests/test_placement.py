@@ -23,7 +23,7 @@ regions:
 robot:
   start: [5, 5]
   max_speed: 1.0
-  disturbance:   0.45
+  disturbance:   0.75
 task:
   - visit a
 """
@@ -80,7 +80,7 @@ def test_an_unreadable_source_leaves_the_diagnostics_as_they_were(tmp_path: Path
     assert placed(diagnostics, missing) == diagnostics
 
 
-def test_a_disturbance_too_large_for_the_mesh_is_refused_at_its_value(tmp_path: Path) -> None:
+def test_a_disturbance_too_large_for_any_cell_is_refused_at_its_value(tmp_path: Path) -> None:
     source = tmp_path / "m.yaml"
     source.write_text(MISSION, encoding="utf-8")
     with pytest.raises(InvalidInputError) as caught:

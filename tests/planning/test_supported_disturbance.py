@@ -218,6 +218,9 @@ def _random_mission(
 )
 # Example-1-like: goal cores whose corners are sharper than the regions' own.
 @example("visit a then b", [(0, 0, 3, 3), (5, 3, 3, 3), (3, 0, 1, 1)], 0.35, None)
+# No plan reaches the goal depth at all (b's core lies inside c): the plan entering b only as
+# deep as the margin asks must carry the disturbance too (on cells, as at goal depth 0).
+@example("avoid c until b", [(0, 0, 1, 1)] * 3, 0.25, None)
 def test_a_mission_compiles_under_disturbance_whenever_it_does_at_goal_depth_zero(
     task: str, regions: list[tuple[int, int, int, int]], ratio: float, depth: float | None
 ) -> None:

@@ -161,6 +161,15 @@ def plan_mission(
 
     margin = requested_margin(mission)
 
+    def on_cells_rung(planned: Planned) -> Planned:
+        """``planned``'s task on the convex cells of its mesh, then of the cells' own mesh;
+        else ``planned`` with the bound on cells (the control stage refuses it, C032)."""
+        on_cells = _on_cells(mission, planned, start_point)
+        if on_cells is not None:
+            return on_cells
+        on_lines, lines_bound = _on_lines(mission, margin, planned, start_point)
+        return on_lines or _with_cells_bound(planned, lines_bound, mission)
+
     def realisable_depth(
         planned: Planned, formula: Formula = skeleton, explain: bool = True
     ) -> Planned:
@@ -174,11 +183,7 @@ def plan_mission(
         if witness_realisable(planned.abstraction, planned.witness, ratio):
             return planned
         if not deepens_goals(mission):
-            on_cells = _on_cells(mission, planned, start_point)
-            if on_cells is not None:
-                return on_cells
-            on_lines, lines_bound = _on_lines(mission, margin, planned, start_point)
-            return on_lines or _with_cells_bound(planned, lines_bound, mission)
+            return on_cells_rung(planned)
         tried = [planned]
         for scale in (*SHALLOWER, 0.0):
             mesh = abstraction_for(mission, margin, deep=scale > 0.0, scale=scale)
@@ -246,7 +251,13 @@ def plan_mission(
         except NoPlanError as again:
             first = again
         else:
-            return replace(planned, notes=(_shallow_note(mission, first),), remeshed=True)
+            ratio = mission.robot.disturbance / mission.robot.max_speed
+            if ratio > 0.0 and not witness_realisable(planned.abstraction, planned.witness, ratio):
+                # the shallow plan must carry the disturbance too: the cells' rung, as for
+                # any plan without goal cores
+                planned = on_cells_rung(planned)
+            notes = (_shallow_note(mission, first), *planned.notes)
+            return replace(planned, notes=notes, remeshed=True)
     if margin <= 0.0:
         raise _with_body_notes(first, mission) from None
     plain = abstraction_for(mission, 0.0, deep=False)
