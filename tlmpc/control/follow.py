@@ -39,6 +39,7 @@ import numpy as np
 
 from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
 from tlmpc.control.channel import ChannelStep, Guide, Point, channel_guides
+from tlmpc.control.clearance import exposed_vertices
 from tlmpc.control.geometry import TriangleGeometry
 from tlmpc.control.sparse import CscMatrix, Triplets, stacked_csc
 
@@ -292,11 +293,17 @@ def path_guides(
     np.minimum.at(lowest, abstraction.triangles.reshape(-1), letters)
     np.maximum.at(highest, abstraction.triangles.reshape(-1), letters)
     boundary = (lowest != highest).tolist()
+    # ... and needs an inset only where it is a region's own boundary (tlmpc.control.clearance)
+    corners = [abstraction.triangles[step.triangle].tolist() for step in steps]
+    exposed = exposed_vertices(abstraction, (v for c in corners for v in c if boundary[v]))
+    flags = [_flags([v in exposed for v in c]) for c in corners]
     label = abstraction.letter_of.tolist()
     channel = [
         ChannelStep(
-            labelled=_flags([boundary[v] for v in abstraction.triangles[step.triangle].tolist()]),
-            entered=index > 0 and label[step.triangle] != label[steps[index - 1].triangle],
+            labelled=flags[index],
+            entered=index > 0
+            and label[step.triangle] != label[steps[index - 1].triangle]
+            and any(flags[index]),
             corners=_corners(step.geometry.vertices),
             exit_edge=step.exit_edge,
             through=None if step.through is None else _point(abstraction.vertices[step.through]),
