@@ -307,8 +307,9 @@ def test_velocity_jumps_are_exactly_where_the_fields_jump(strip: Any, push: floa
 def test_the_path_enters_a_new_label_through_the_middle_of_the_edge(
     strip: Any, data: st.DataObject
 ) -> None:
-    """Where the plan enters a new label, the followed path leaves that triangle through the
-    middle 20 % of its exit edge (so it goes into the region rather than grazing its edge)."""
+    """Where the plan enters a new label whose boundary is the region's own, the followed path
+    leaves that triangle through the middle 20 % of its exit edge (so it goes into the region
+    rather than grazing its edge)."""
     from tlmpc.control.follow import path_guides
     from tlmpc.control.synthesize import plan_steps
 
@@ -319,8 +320,7 @@ def test_the_path_enters_a_new_label_through_the_middle_of_the_edge(
     if len(triangles) < 3:
         return
     change = data.draw(st.integers(1, len(triangles) - 2))
-    letters = np.asarray([0] * change + [1] * (len(triangles) - change), dtype=np.int64)
-    abstraction = dataclasses.replace(abstraction, letter_of=letters, letters=((), ("r",)))
+    abstraction = _labelled_from(abstraction, change, own=True)
     steps, loop_start = plan_steps(abstraction, witness)
     sx, sy = abstraction.corners(0).mean(axis=0).tolist()
     guide = path_guides(abstraction, steps, loop_start, (sx, sy))[change]
@@ -331,6 +331,59 @@ def test_the_path_enters_a_new_label_through_the_middle_of_the_edge(
     a, b = corners[(exit_edge + 1) % 3], corners[(exit_edge + 2) % 3]
     middle = (a + b) / 2
     assert math.dist(guide.exit, middle.tolist()) <= 0.1 * math.dist(a, b) + 1e-9
+
+
+def _labelled_from(abstraction: Abstraction, change: int, *, own: bool) -> Abstraction:
+    """``abstraction`` with the triangles from ``change`` on labelled ``r``: the region is
+    their union (``own``: the label boundary is the region's own), or that union grown by a
+    tenth of the mesh (the label is a core of it, as a goal's in the planning layout)."""
+    count = abstraction.num_triangles
+    letters = np.asarray([0] * change + [1] * (count - change), dtype=np.int64)
+    union = shapely.union_all(
+        [shapely.Polygon(abstraction.corners(t).tolist()) for t in range(change, count)]
+    )
+    if not own:
+        extent = float(np.ptp(abstraction.vertices, axis=0).max())
+        union = union.buffer(0.1 * extent, join_style="mitre")
+    ring = tuple((float(x), float(y)) for x, y in list(union.exterior.coords)[:-1])
+    return dataclasses.replace(
+        abstraction, letter_of=letters, letters=((), ("r",)), regions={"r": ring}
+    )
+
+
+@settings(deadline=None, max_examples=30, suppress_health_check=[HealthCheck.filter_too_much])
+@given(strips(), st.data())
+def test_label_insets_only_where_the_label_is_the_regions_own_boundary(
+    strip: Any, data: st.DataObject
+) -> None:
+    """A label whose region lies beyond it (a goal's core, a grown avoided region) needs no
+    inset: the path through the channel is then the one without label insets, and never
+    longer than the one with them."""
+    from tlmpc.control.follow import path_guides
+    from tlmpc.control.synthesize import plan_steps
+
+    planned = strip_plan(*strip)
+    if planned is None:
+        return
+    abstraction, witness, triangles = planned
+    if len(triangles) < 3:
+        return
+    change = data.draw(st.integers(1, len(triangles) - 2))
+    sx, sy = abstraction.corners(0).mean(axis=0).tolist()
+
+    def length(mesh: Abstraction) -> float:
+        steps, loop_start = plan_steps(mesh, witness)
+        guides = path_guides(mesh, steps, loop_start, (sx, sy))
+        return sum(math.dist(g.entry, g.exit) for g in guides if g is not None)
+
+    cored, own = _labelled_from(abstraction, change, own=False), _labelled_from(
+        abstraction, change, own=True
+    )
+    unlabelled = dataclasses.replace(
+        abstraction, letter_of=np.zeros(len(triangles), dtype=np.int64), letters=((),)
+    )
+    assert math.isclose(length(cored), length(unlabelled), rel_tol=1e-12, abs_tol=1e-12)
+    assert length(cored) <= length(own) * (1 + 1e-12) + 1e-12
 
 
 def test_a_bent_corridor_splits_its_runs_at_the_bend() -> None:

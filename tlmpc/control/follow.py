@@ -38,7 +38,7 @@ from typing import Protocol
 import numpy as np
 
 from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
-from tlmpc.control.channel import ChannelStep, Guide, Point, channel_guides
+from tlmpc.control.channel import ChannelStep, Guide, Point, channel_guides, channel_pieces
 from tlmpc.control.clearance import exposed_vertices
 from tlmpc.control.geometry import TriangleGeometry
 from tlmpc.control.sparse import CscMatrix, Triplets, stacked_csc
@@ -282,9 +282,12 @@ def path_guides(
     steps: Sequence[PlanStep],
     loop_start: int | None,
     start: tuple[float, float],
+    *,
+    passages: bool = False,
 ) -> list[Guide | None]:
     """The channel's shortest path, one straight piece per step (None for a vertex
-    passage), with the portal insets of :mod:`tlmpc.control.channel`."""
+    passage, unless ``passages``: then its piece to the corner), with the portal insets of
+    :mod:`tlmpc.control.channel`."""
     # A vertex is on a label boundary when the triangles around it do not all share a label.
     letters = np.repeat(abstraction.letter_of, 3)  # each corner's triangle's letter
     count = len(abstraction.vertices)
@@ -310,6 +313,8 @@ def path_guides(
         )
         for index, step in enumerate(steps)
     ]
+    if passages:
+        return list(channel_pieces(channel, loop_start, start))
     return channel_guides(channel, loop_start, start)
 
 
