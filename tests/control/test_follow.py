@@ -376,8 +376,9 @@ def test_label_insets_only_where_the_label_is_the_regions_own_boundary(
         guides = path_guides(mesh, steps, loop_start, (sx, sy))
         return sum(math.dist(g.entry, g.exit) for g in guides if g is not None)
 
-    cored, own = _labelled_from(abstraction, change, own=False), _labelled_from(
-        abstraction, change, own=True
+    cored, own = (
+        _labelled_from(abstraction, change, own=False),
+        _labelled_from(abstraction, change, own=True),
     )
     unlabelled = dataclasses.replace(
         abstraction, letter_of=np.zeros(len(triangles), dtype=np.int64), letters=((),)
