@@ -16,14 +16,14 @@ import numpy as np
 import pytest
 import shapely
 import yaml
-from brute_time import path_witness, simple_paths
+from brute_time import simple_paths
 from hypothesis import HealthCheck, given, settings
 from shortest_paths import geodesic
 from strategies import missions
 
 from tlmpc.base.errors import TlmpcError
 from tlmpc.pipeline import shortest
-from tlmpc.pipeline.shortest import plan_shortest, pull
+from tlmpc.pipeline.shortest import pull
 from tlmpc.pipeline.stages import ABSTRACTION, AUTOMATON, MISSION, WITNESS, compile_mission
 from tlmpc.planning.mission import Planned, plan_mission
 
@@ -162,4 +162,3 @@ def test_random_missions_keep_the_shorter_route(document: dict[str, Any]) -> Non
     kept = Planned(abstraction=c.get(ABSTRACTION), automaton=c.get(AUTOMATON), witness=witness)
     assert pull(mission, kept).length <= pull(mission, first).length * (1 + 1e-12) + 1e-12
     assert witness.stats["path_length"] in witness.stats["path_lengths"]
-    assert plan_shortest is not None
