@@ -42,7 +42,7 @@ def _room(holes: list[list[float]], goal: list[float], start: list[float]) -> st
     return yaml.safe_dump(document)
 
 
-ROOMS = [
+ROOMS: list[tuple[list[list[float]], list[float], list[float]]] = [
     ([[2, 1, 3, 4]], [6.5, 3.5, 7.8, 4.8], [0.5, 0.5]),
     ([[2, 0.8, 2.6, 3], [4.5, 2, 5.2, 4.6]], [6.8, 0.2, 7.8, 1.4], [0.4, 4.5]),
     ([[1.5, 1.5, 2.5, 3.5], [4, 0.5, 4.6, 2.2], [5.5, 3, 6.5, 4]], [7, 2, 7.8, 3], [0.3, 2.5]),
