@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -26,6 +27,8 @@ from tlmpc.pipeline import shortest
 from tlmpc.pipeline.shortest import pull
 from tlmpc.pipeline.stages import ABSTRACTION, AUTOMATON, MISSION, WITNESS, compile_mission
 from tlmpc.planning.mission import Planned, plan_mission
+
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def _room(holes: list[list[float]], goal: list[float], start: list[float]) -> str:
@@ -117,17 +120,41 @@ def test_rounds_are_deterministic_and_respect_the_node_budget(
         runs.append(json.dumps(document, sort_keys=True, default=str))
     assert runs[0] == runs[1]  # the wall-clock seconds aside
     monkeypatch.setattr(shortest, "NODE_BUDGET", 0)
-    result = compile_mission("room.yaml", text=text, until="plan")
+    result = compile_mission(ROOT / "specs" / "example7.yaml", until="plan")
     stats = result.compilation.get(WITNESS).stats
     assert stats["length_rounds"] == 1  # no re-plan fits a budget of no nodes
 
 
+def test_a_lassos_moves_are_keyed_by_the_edges_they_enter_by() -> None:
+    """Each move pulled is one the lasso makes: its triangle entered from the step before
+    (the cycle's first from the cycle's last), left toward the step after."""
+    from tlmpc.planning.product import START_SLOT
+    from tlmpc.planning.timing import move_key
+
+    result = compile_mission(ROOT / "specs" / "patrol.yaml", until="plan")
+    c = result.compilation
+    abstraction, witness = c.get(ABSTRACTION), c.get(WITNESS)
+    planned = Planned(abstraction=abstraction, automaton=c.get(AUTOMATON), witness=witness)
+    assert not witness.is_stay
+    assert not witness.passages
+    path = [*witness.prefix, *witness.cycle]
+    loop = len(witness.prefix)
+    expected = set()
+    for index, triangle in enumerate(path):
+        after = path[index + 1] if index + 1 < len(path) else path[loop]
+        if index == loop:
+            before: int | None = path[-1]
+        else:
+            before = path[index - 1] if index > 0 else None
+        sides = abstraction.neighbors[triangle].tolist()
+        slot = START_SLOT if before is None else sides.index(before)
+        expected.add(move_key(abstraction, triangle, slot, sides.index(after)))
+    assert set(pull(c.get(MISSION), planned).moves) == expected
+
+
 def test_a_replan_finds_a_shorter_channel_on_a_shipped_spec() -> None:
     """Example 7's first channel is not its shortest: the loop keeps a shorter one."""
-    from pathlib import Path
-
-    root = Path(__file__).resolve().parents[2]
-    result = compile_mission(root / "specs" / "example7.yaml", until="plan")
+    result = compile_mission(ROOT / "specs" / "example7.yaml", until="plan")
     stats = result.compilation.get(WITNESS).stats
     assert stats["length_rounds"] >= 2
     assert stats["path_length"] < stats["path_lengths"][0] * (1 - 1e-3)
