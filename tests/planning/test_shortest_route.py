@@ -127,7 +127,8 @@ def test_rounds_are_deterministic_and_respect_the_node_budget(
 
 def test_a_lassos_moves_are_keyed_by_the_edges_they_enter_by() -> None:
     """Each move pulled is one the lasso makes: its triangle entered from the step before
-    (the cycle's first from the cycle's last), left toward the step after."""
+    (the cycle's first from the cycle's last, which a product node's entry slot makes the
+    prefix's last too), left toward the step after."""
     from tlmpc.planning.product import START_SLOT
     from tlmpc.planning.timing import move_key
 
