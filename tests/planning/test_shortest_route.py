@@ -119,10 +119,16 @@ def test_rounds_are_deterministic_and_respect_the_node_budget(
         document["stats"] = {k: v for k, v in document["stats"].items() if k != "seconds"}
         runs.append(json.dumps(document, sort_keys=True, default=str))
     assert runs[0] == runs[1]  # the wall-clock seconds aside
-    monkeypatch.setattr(shortest, "NODE_BUDGET", 0)
-    result = compile_mission(ROOT / "specs" / "example7.yaml", until="plan")
-    stats = result.compilation.get(WITNESS).stats
-    assert stats["length_rounds"] == 1  # no re-plan fits a budget of no nodes
+    example7 = ROOT / "specs" / "example7.yaml"
+    unlimited = compile_mission(example7, until="plan").compilation.get(WITNESS).stats
+    assert unlimited["length_rounds"] >= 3
+    nodes = unlimited["product_nodes"]  # every plan on this mesh builds the same product
+    monkeypatch.setattr(shortest, "NODE_BUDGET", 2 * nodes)
+    stats = compile_mission(example7, until="plan").compilation.get(WITNESS).stats
+    assert stats["length_rounds"] == 2  # the first plan and one re-plan fit
+    monkeypatch.setattr(shortest, "NODE_BUDGET", 2 * nodes - 1)
+    stats = compile_mission(example7, until="plan").compilation.get(WITNESS).stats
+    assert "path_length" not in stats  # no re-plan fits: the plan is not even pulled
 
 
 def test_a_lassos_moves_are_keyed_by_the_edges_they_enter_by() -> None:

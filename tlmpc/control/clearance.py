@@ -12,9 +12,9 @@ vanishes.  Only those *exposed* vertices need the channel's label insets
 (:mod:`tlmpc.control.channel`).
 
 Read from the mesh and the regions alone (no task): a vertex on a label boundary is exposed
-when it lies within :data:`TOUCH` of the mesh's extent of some region's own boundary (of any
-region: a core's corner that happens to lie on another region's edge is exposed too, which
-only keeps an inset that was not needed).
+when it lies within :data:`TOUCH` of the mesh's extent of the boundary of a region that labels
+a triangle around it (a core's corner that happens to lie on such a region's edge is exposed
+too, which only keeps an inset that was not needed).
 """
 
 from __future__ import annotations
@@ -33,27 +33,42 @@ TOUCH = 1e-6
 def exposed_vertices(abstraction: Abstraction, candidates: Iterable[int]) -> frozenset[int]:
     """Those of ``candidates`` (mesh vertices on a label boundary) that lie on the boundary
     of a region itself (see the module doc)."""
-    chosen = sorted(set(candidates))
-    if not chosen or not abstraction.regions:
+    chosen = np.asarray(sorted(set(candidates)), dtype=np.int64)
+    if len(chosen) == 0 or not abstraction.regions:
         return frozenset()
+    # the regions that label a triangle around a candidate: only their edges are measured
+    around = np.isin(abstraction.triangles, chosen).any(axis=1)
+    letters = np.unique(abstraction.letter_of[around]).tolist()
+    names = sorted({name for k in letters for name in abstraction.letters[k]})
+    rings = [
+        np.asarray(abstraction.regions[name], dtype=np.float64).reshape(-1, 2)
+        for name in names
+        if name in abstraction.regions
+    ]
+    rings = [ring for ring in rings if len(ring) >= 2]
+    if not rings:
+        return frozenset()
+    starts = np.concatenate(rings)
+    ends = np.concatenate([np.roll(ring, -1, axis=0) for ring in rings])
     vertices = abstraction.vertices
     extent = float(np.ptp(vertices, axis=0).max()) if len(vertices) > 1 else 0.0
-    tolerance = TOUCH * extent
-    points = vertices[np.asarray(chosen, dtype=np.int64)]
+    points = vertices[chosen]
     near = np.zeros(len(chosen), dtype=bool)
-    for name in sorted(abstraction.regions):
-        ring = np.asarray(abstraction.regions[name], dtype=np.float64).reshape(-1, 2)
-        if len(ring) >= 2:
-            near |= _to_ring(points, ring) <= tolerance
-    return frozenset(v for v, hit in zip(chosen, near.tolist(), strict=True) if hit)
+    for first in range(0, len(points), CHUNK):
+        block = slice(first, first + CHUNK)
+        near[block] = _to_segments(points[block], starts, ends) <= TOUCH * extent
+    return frozenset(chosen[near].tolist())
 
 
-def _to_ring(points: FloatArray, ring: FloatArray) -> FloatArray:
-    """(P,): each point's distance to the closed polygonal ring through ``ring``'s corners."""
-    end = np.roll(ring, -1, axis=0)
-    edge = end - ring  # (E, 2)
+#: Points measured at once (bounds the (points x edges) arrays).
+CHUNK = 256
+
+
+def _to_segments(points: FloatArray, starts: FloatArray, ends: FloatArray) -> FloatArray:
+    """(P,): each point's distance to the nearest of the segments ``starts`` -> ``ends``."""
+    edge = ends - starts  # (E, 2)
     squared = np.maximum(np.einsum("ij,ij->i", edge, edge), 1e-300)
-    rel = points[:, None, :] - ring[None, :, :]  # (P, E, 2)
+    rel = points[:, None, :] - starts[None, :, :]  # (P, E, 2)
     u = np.clip(np.einsum("pej,ej->pe", rel, edge) / squared, 0.0, 1.0)
     gap = rel - u[:, :, None] * edge[None, :, :]
     distance: FloatArray = np.sqrt(np.einsum("pej,pej->pe", gap, gap)).min(axis=1)

@@ -46,7 +46,7 @@ MAX_REPLANS = 6
 #: ... and none that would bring the products of all the plans made past this many nodes (a
 #: re-plan costs about what the plan before it did, counted by its product's nodes: on a
 #: large mesh the loop stops early or does not run at all, deterministically).
-NODE_BUDGET = 200_000
+NODE_BUDGET = 100_000
 
 
 @dataclass(frozen=True, slots=True)
@@ -59,13 +59,15 @@ class Pulled:
 
 def plan_shortest(mission: Mission, planned: Planned) -> Planned:
     """``planned`` or a re-plan of it whose channel's shortest path is shorter (see the
-    module doc); other metrics, or a plan of a run under way: ``planned`` as it is.
+    module doc); under other metrics, or when not even one re-plan fits the budget:
+    ``planned`` as it is (without the statistics below).
 
     The witness's ``stats`` record ``path_length`` (the kept plan's), ``path_lengths``
     (each round's, in order), ``length_rounds`` and ``length_fixed_point``.
     """
-    if mission.options.cost != "length":
-        return planned
+    spent = _nodes(planned)  # product nodes of the plans made so far
+    if mission.options.cost != "length" or spent + spent > NODE_BUDGET:
+        return planned  # (no re-plan would fit the budget: nothing to pull for)
     try:
         first = pull(mission, planned)
     except TlmpcError:  # the control stage will say what is wrong with the plan
@@ -74,7 +76,6 @@ def plan_shortest(mission: Mission, planned: Planned) -> Planned:
     history = [first.length]
     measured: dict[MoveKey, float] = dict(first.moves)
     seen = {_shape(planned)}
-    spent = 0  # product nodes of the plans made so far (the first's counts too)
     fixed = False
     current = planned
     # The moves no plan made keep their midpoint lengths scaled as the first plan's path
@@ -83,10 +84,10 @@ def plan_shortest(mission: Mission, planned: Planned) -> Planned:
     cost = planned.witness.cost
     ratio = first.length / cost if cost > 0.0 and first.length > 0.0 else 1.0
     for _ in range(MAX_REPLANS):
-        # a re-plan costs about what the last plan did: stop before the budget is passed
-        spent += _nodes(current)
-        if spent > NODE_BUDGET:
+        # a re-plan costs about what the last plan did: none that would pass the budget
+        if spent + _nodes(current) > NODE_BUDGET:
             break
+        spent += _nodes(current)
         weights = MoveTimes(speed=1.0 / ratio, measured=dict(measured))
         try:
             following = replan(mission, current, weights)
