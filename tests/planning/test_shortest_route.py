@@ -86,7 +86,10 @@ def test_kept_route_is_never_longer_than_the_midpoint_plan(index: int) -> None:
     assert math.isclose(witness.stats["path_length"], kept_length, rel_tol=1e-12)
     assert witness.stats["path_lengths"][0] == pytest.approx(first_length, rel=1e-12)
     assert kept_length <= first_length * (1 + 1e-12)
-    assert kept_length == min(witness.stats["path_lengths"])
+    # the kept one is within the stated gain of the least pulled (and is the least when a
+    # re-plan is more than that shorter)
+    least = min(witness.stats["path_lengths"])
+    assert least <= kept_length <= least / (1.0 - shortest.MIN_GAIN) * (1 + 1e-12)
     abstraction = c.get(ABSTRACTION)
     goal_cells = np.array(
         ["goal" in abstraction.labels(t) for t in range(abstraction.num_triangles)]
