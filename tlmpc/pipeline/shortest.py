@@ -19,14 +19,17 @@ for the ``time`` metric (:mod:`tlmpc.pipeline.mintime`), the planner iterates:
    again;
 4. stop at a **fixed point** (the new plan is one already pulled), after
    :data:`MAX_REPLANS` re-plans, or before the plans' products would pass
-   :data:`NODE_BUDGET` nodes; keep the plan of least path length (the first on ties, and a
-   later one only when it is more than :data:`MIN_GAIN` shorter: never longer than the
-   first plan's).
+   :data:`NODE_BUDGET` nodes.  The kept plan starts as the first; a re-plan replaces it
+   when its path is more than :data:`MIN_GAIN` shorter *and* its exact time (the time metric's
+   measure: controllers synthesised, trajectory simulated, prefix + ``beta`` x lap) is not
+   longer (at most :data:`MAX_TIME_CHECKS` re-plans are simulated).  So the kept plan is
+   never longer nor slower than the first.
 
 Every round is deterministic (operations are counted, no clock is read).  What is promised
-(docs/planning.md): the kept plan's path is the shortest of the plans pulled, so never
-longer than the midpoint plan's; it is not a proof that no channel has a shorter path (the
-moves no plan made keep their midpoint weights).
+(docs/planning.md): the kept plan's path is never longer, and its trajectory never slower,
+than the midpoint plan's; it is not a proof that no channel has a shorter path (the moves no
+plan made keep estimates) nor that the kept one is the shortest of those pulled (a shorter
+one may be slower).
 """
 
 from __future__ import annotations
@@ -46,6 +49,9 @@ from tlmpc.planning.timing import MoveKey, MoveTimes, move_key
 #: the fields' speeds, which the path's length does not see, differ more than that between
 #: channels (a bench room's re-plan 0.03 % shorter took 10 % longer).
 MIN_GAIN = 0.002
+#: At most this many re-plans are simulated to check that they are not slower (each costs a
+#: controller synthesis and an exact simulation, as a round of the time metric does).
+MAX_TIME_CHECKS = 2
 #: At most this many re-plans after the first plan.
 MAX_REPLANS = 6
 #: ... and none that would bring the products of all the plans made past this many nodes (a
@@ -68,7 +74,8 @@ def plan_shortest(mission: Mission, planned: Planned) -> Planned:
     ``planned`` as it is (without the statistics below).
 
     The witness's ``stats`` record ``path_length`` (the kept plan's), ``path_lengths``
-    (each round's, in order), ``length_rounds`` and ``length_fixed_point``.
+    (each round's, in order), ``length_rounds``, ``length_fixed_point`` and
+    ``length_time_checks`` (the exact times of the re-plans short enough to be simulated).
     """
     spent = _nodes(planned)  # product nodes of the plans made so far
     if mission.options.cost != "length" or spent + spent > NODE_BUDGET:
@@ -78,6 +85,8 @@ def plan_shortest(mission: Mission, planned: Planned) -> Planned:
     except TlmpcError:  # the control stage will say what is wrong with the plan
         return planned
     best, best_length = planned, first.length
+    best_time: float | None = None  # the kept plan's exact time, once a re-plan needs it
+    checked: list[float] = []  # the exact times of the re-plans short enough to check
     history = [first.length]
     measured: dict[MoveKey, float] = dict(first.moves)
     seen = {_shape(planned)}
@@ -105,8 +114,15 @@ def plan_shortest(mission: Mission, planned: Planned) -> Planned:
             break
         seen.add(shape)
         history.append(found.length)
-        if found.length < best_length * (1.0 - MIN_GAIN):
-            best, best_length = following, found.length
+        if found.length < best_length * (1.0 - MIN_GAIN) and len(checked) < MAX_TIME_CHECKS:
+            # ... and only when its trajectory is not slower (the length does not see the
+            # fields' speeds): both are simulated, as the time metric measures a plan
+            if best_time is None:
+                best_time = _exact_time(mission, best)
+            time = _exact_time(mission, following)
+            checked.append(time)
+            if time <= best_time:
+                best, best_length, best_time = following, found.length, time
         measured.update(found.moves)
         current = following
     stats: dict[str, Any] = {
@@ -115,8 +131,20 @@ def plan_shortest(mission: Mission, planned: Planned) -> Planned:
         "path_lengths": history,
         "length_rounds": len(history),
         "length_fixed_point": fixed,
+        "length_time_checks": checked,
     }
     return replace(best, witness=replace(best.witness, stats=stats))
+
+
+def _exact_time(mission: Mission, planned: Planned) -> float:
+    """The plan's exact time (:func:`tlmpc.pipeline.mintime.measure`: prefix + beta x lap of
+    its simulated trajectory); inf when its controllers or simulation fail."""
+    from tlmpc.pipeline.mintime import measure
+
+    try:
+        return measure(mission, planned).exact_time
+    except TlmpcError:
+        return math.inf
 
 
 def _nodes(planned: Planned) -> int:
