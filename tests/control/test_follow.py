@@ -420,3 +420,51 @@ def test_a_bent_corridor_splits_its_runs_at_the_bend() -> None:
         ratios.append((travelled + math.dist(entry, target)) / best)
     assert ratios[0] <= 1.10
     assert ratios[0] < ratios[1]
+
+
+def test_the_middle_inset_only_where_a_label_is_exposed_or_by_a_wall() -> None:
+    """On a room whose goal lies in the middle (its core labels the mesh), the channel marks
+    a step as entering a new label only when its triangle has a corner on a wall or on a
+    region's own boundary (shapely measures both); entering the core away from both is not
+    marked."""
+    from unittest import mock
+
+    import yaml
+
+    from tlmpc.control import follow as follow_module
+    from tlmpc.control.channel import channel_guides
+    from tlmpc.control.synthesize import plan_steps
+    from tlmpc.pipeline.stages import ABSTRACTION, MISSION, WITNESS, compile_mission
+
+    document = {
+        "version": 1,
+        "name": "middle",
+        "workspace": {"boundary": {"rect": [0, 0, 8, 5]}},
+        "regions": {"goal": {"rect": [3, 1.5, 5, 3.5]}},
+        "robot": {"start": [0.5, 0.5], "max_speed": 1.0},
+        "task": ["visit goal"],
+    }
+    result = compile_mission("middle.yaml", text=yaml.safe_dump(document), until="plan")
+    c = result.compilation
+    abstraction, witness, mission = c.get(ABSTRACTION), c.get(WITNESS), c.get(MISSION)
+    steps, loop_start = plan_steps(abstraction, witness)
+    captured: list[Any] = []
+    original = channel_guides
+
+    def capture(channel: Any, *rest: Any) -> Any:
+        captured.extend(channel)
+        return original(channel, *rest)
+
+    with mock.patch.object(follow_module, "channel_guides", capture):
+        follow_module.path_guides(abstraction, steps, loop_start, mission.robot.start)
+    outer = shapely.box(0, 0, 8, 5).exterior
+    region = shapely.box(3, 1.5, 5, 3.5).exterior
+    label = abstraction.letter_of.tolist()
+    changes = 0
+    for index, (step, seen) in enumerate(zip(steps, captured, strict=True)):
+        changed = index > 0 and label[step.triangle] != label[steps[index - 1].triangle]
+        points = [shapely.Point(p) for p in abstraction.corners(step.triangle).tolist()]
+        near = any(outer.distance(p) < 1e-9 or region.distance(p) < 1e-9 for p in points)
+        assert seen.entered == (changed and near)
+        changes += changed and not near
+    assert changes > 0  # the core is entered away from walls and from the region's edge
