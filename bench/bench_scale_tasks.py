@@ -7,7 +7,9 @@ the built product, and prints a markdown table: the planning stage's CPU seconds
 (``time.process_time``; the median of ``--repeats`` runs), the process's peak RSS (mission
 loading and the mesh included), the plan's cost (which must agree between the two searches),
 the nodes the search reached and the closing searches it made.  ``--compile`` adds a row per
-workload for the whole ``tlmpc compile`` (every stage but the figure) in CPU seconds.
+workload for the whole ``tlmpc compile`` (every stage but the figure) in CPU seconds, and a
+second table with each stage's CPU seconds (medians); ``--compile-only`` measures the whole
+compile alone.
 
 ``--baseline DIR`` runs every measurement side by side with another tree of the project
 (its runs alternate with this tree's, each in a fresh interpreter started in that tree) and
@@ -70,13 +72,17 @@ gc.disable()
 started = time.process_time()
 from tlmpc.pipeline.stages import STAGES, Compilation, run_stages
 compilation = Compilation(source=Path(sys.argv[1]), text=None, figures=())
+stages = {}
 for stage in STAGES:
     if stage.name == "plot":
         continue
+    before = time.process_time()
     compilation = run_stages([stage], compilation).compilation
+    stages[stage.name] = time.process_time() - before
 print(json.dumps({
     "cpu": time.process_time() - started,
     "peak_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
+    "stages": stages,
 }))
 """
 
@@ -113,10 +119,26 @@ def _median(runs: list[dict[str, Any]], key: str) -> float:
     return round(statistics.median(r[key] for r in runs), 2)
 
 
+def _stage_row(workload: str, tree: str, runs: list[dict[str, Any]]) -> dict[str, Any]:
+    """Each stage's median CPU seconds over ``runs`` (the stages that ran), and their sum."""
+    names = [name for name in runs[0]["stages"] if name != "synthesize"]
+    row: dict[str, Any] = {"workload": workload, "tree": tree}
+    for name in names:
+        row[name] = round(statistics.median(r["stages"][name] for r in runs), 2)
+    row["whole compile"] = _median(runs, "cpu")
+    return row
+
+
 def rows(
-    repeats: int, grids: list[str], compile_too: bool, baseline: Path | None = None
+    repeats: int,
+    grids: list[str],
+    compile_too: bool,
+    baseline: Path | None = None,
+    plan_too: bool = True,
+    stage_table: list[dict[str, Any]] | None = None,
 ) -> list[dict[str, Any]]:
-    """One row per workload and search."""
+    """One row per workload and search; with ``stage_table``, the whole compile's stages are
+    appended there (this tree's and the baseline's medians)."""
     from bench.workloads import grid_task, write_mission
 
     table: list[dict[str, Any]] = []
@@ -125,6 +147,8 @@ def rows(
             for task, count in TASKS:
                 path = write_mission(grid_task(GRIDS[grid], task, count), Path(tmp))
                 searches = ["guided", "built"] if grid in BUILT_UP_TO else ["guided"]
+                if not plan_too:
+                    searches = []
                 for search in searches:
                     runs, before = _side_by_side(
                         PLAN_PROGRAM, [str(path), search], repeats, baseline
@@ -171,6 +195,11 @@ def rows(
                         if before:
                             row["plan CPU s before"] = _median(before, "cpu")
                             row["peak MB before"] = round(max(r["peak_mb"] for r in before))
+                        if stage_table is not None:
+                            workload = f"{task}-{count} {grid}"
+                            if before:
+                                stage_table.append(_stage_row(workload, "before", before))
+                            stage_table.append(_stage_row(workload, "now", wholes))
                     table.append(row)
     return table
 
@@ -180,13 +209,29 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--grids", nargs="+", default=list(GRIDS), choices=list(GRIDS))
     parser.add_argument("--compile", action="store_true", help="add the whole compile")
+    parser.add_argument(
+        "--compile-only", action="store_true", help="the whole compile alone (no plan rows)"
+    )
     parser.add_argument("--baseline", type=Path, help="another tree, measured side by side")
     arguments = parser.parse_args()
     from bench.tables import markdown_table
 
     baseline = arguments.baseline.resolve() if arguments.baseline else None
-    table = rows(arguments.repeats, arguments.grids, arguments.compile, baseline)
+    stages: list[dict[str, Any]] = []
+    table = rows(
+        arguments.repeats,
+        arguments.grids,
+        arguments.compile or arguments.compile_only,
+        baseline,
+        plan_too=not arguments.compile_only,
+        stage_table=stages,
+    )
     print(markdown_table(table))
+    if stages:
+        print()
+        print("CPU seconds per stage of the whole compile (medians):")
+        print()
+        print(markdown_table(stages))
 
 
 if __name__ == "__main__":

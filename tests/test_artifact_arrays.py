@@ -54,7 +54,11 @@ _FLOATS = st.one_of(
     st.floats(allow_nan=False, allow_infinity=False),
     st.sampled_from([0.0, -0.0, 1e-300, 5e-324, 1.7976931348623157e308, 0.1, 1 / 3]),
 )
-_SHAPES = st.tuples(st.integers(0, 40)) | st.tuples(st.integers(0, 40), st.integers(1, 3))
+_SHAPES = (
+    st.tuples(st.integers(0, 40))
+    | st.tuples(st.integers(0, 40), st.integers(0, 3))
+    | st.tuples(st.integers(0, 6), st.integers(0, 3), st.integers(0, 2))  # the encoder's path
+)
 
 
 def _arrays(finite: bool = True) -> st.SearchStrategy[npt.NDArray[Any]]:
@@ -63,12 +67,21 @@ def _arrays(finite: bool = True) -> st.SearchStrategy[npt.NDArray[Any]]:
         hnp.arrays(np.float64, _SHAPES, elements=floats),
         hnp.arrays(np.int64, _SHAPES, elements=st.integers(-(2**63), 2**63 - 1)),
         hnp.arrays(np.int32, _SHAPES, elements=st.integers(-(2**31), 2**31 - 1)),
+        # every kind the formatting tells apart: unsigned, narrow floats, booleans
+        hnp.arrays(np.uint64, _SHAPES, elements=st.integers(0, 2**64 - 1)),
+        hnp.arrays(np.uint8, _SHAPES),
+        hnp.arrays(np.float32, _SHAPES, elements=st.floats(width=32, allow_nan=finite is False)),
+        hnp.arrays(np.float16, _SHAPES, elements=st.floats(width=16, allow_infinity=not finite)),
+        hnp.arrays(np.bool_, _SHAPES),
     )
 
 
 @st.composite
 def _tables(draw: st.DrawFn) -> tuple[list[Any], npt.NDArray[np.int64]]:
-    table = draw(st.lists(st.lists(st.text(max_size=4), max_size=3), min_size=1, max_size=6))
+    # label sets (lists of names), now and then with an item of another kind among them
+    names = st.lists(st.text(max_size=4), max_size=3)
+    other = st.integers() | st.none() | st.lists(st.integers() | st.text(max_size=2), max_size=2)
+    table = draw(st.lists(names | other if draw(st.booleans()) else names, min_size=1, max_size=6))
     index = draw(hnp.arrays(np.int64, st.integers(0, 60), elements=st.integers(0, len(table) - 1)))
     return table, index
 
@@ -108,6 +121,21 @@ def test_a_document_with_arrays_is_written_as_its_plain_lists(
             assert (Path(folder) / "plain.json").read_bytes() == expected.encode("utf-8")
     assert dumps(held) == expected
     assert plain(held) == simple
+
+
+@given(_arrays(), st.integers(1, 5))
+def test_an_array_is_encoded_as_the_standard_encoder_writes_its_list(
+    array: npt.NDArray[Any], block_rows: int
+) -> None:
+    encoder = json.JSONEncoder(separators=(",", ":"), allow_nan=False)
+    expected = json.dumps(array.tolist(), separators=(",", ":"), allow_nan=False)
+    with mock.patch.object(arrays, "BLOCK_ROWS", block_rows):
+        assert "".join(arrays.encoded_pieces(ArrayList(array), encoder)) == expected
+        # a view with strides (a column, every other row) reads as its own list
+        if array.ndim == 2:
+            view = array[::2, ::-1]
+            expected = json.dumps(view.tolist(), separators=(",", ":"), allow_nan=False)
+            assert "".join(arrays.encoded_pieces(ArrayList(view), encoder)) == expected
 
 
 @given(_documents(finite=False))

@@ -254,3 +254,31 @@ def test_region_rings_outside_the_free_space_are_no_segments(
     assert labelled == pytest.approx(expected, abs=1e-12)
     codes = [d.code for d in abstraction_diagnostics(a, mission)]
     assert codes == ([] if expected > 0 else ["A010"])
+
+
+@settings(deadline=None, max_examples=40)
+@given(workspaces())
+def test_the_pslg_is_the_noded_linework_each_point_once(mission: Mission) -> None:
+    """Its vertices are the distinct points of the linework (distinct on the snapping grid,
+    in grid order), its segments the distinct pieces between them, and together they draw
+    exactly the free space's boundary and the region boundaries inside the free space."""
+    import numpy as np
+    import shapely
+
+    from tlmpc.abstraction.triangulate import free_space, pslg
+    from tlmpc.mission.resolution import grid_size
+
+    vertices, segments, _, regions = pslg(mission)
+    grid = grid_size(mission)
+    free = free_space(mission, grid)
+    keys = np.round((vertices - np.array(free.bounds[:2])) / grid).astype(np.int64)
+    assert [tuple(k) for k in keys.tolist()] == sorted({tuple(k) for k in keys.tolist()})
+    assert len({tuple(e) for e in segments.tolist()}) == len(segments)
+    assert all(a < b for a, b in segments.tolist())
+    drawn = shapely.union_all(shapely.linestrings(vertices[segments]))
+    inside = [shapely.intersection(shapely.boundary(r), free) for r in regions]
+    expected = shapely.union_all([shapely.boundary(free), *inside])
+    assert shapely.hausdorff_distance(drawn, expected) <= 4 * grid
+    assert shapely.length(drawn) == pytest.approx(shapely.length(expected), rel=1e-9, abs=grid)
+    used = np.unique(segments)
+    assert used.tolist() == list(range(len(vertices)))  # every vertex ends some segment

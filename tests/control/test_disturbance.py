@@ -120,8 +120,9 @@ def test_every_disturbed_run_follows_the_plan(disturbance: float) -> None:
 
 
 def test_a_disturbance_no_field_can_reject_is_located() -> None:
+    # (0.7: beyond Example 1's triangles, 0.383, and its convex cells, 0.646)
     with pytest.raises(tlmpc.InvalidInputError) as caught:
-        _compile(0.45)
+        _compile(0.7)
     codes = {d.code for d in caught.value.diagnostics}
     assert codes == {"C032"}
     assert all(d.path == "$.robot.disturbance" for d in caught.value.diagnostics)

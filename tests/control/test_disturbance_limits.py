@@ -84,19 +84,20 @@ def _wedge(disturbance: float, min_angle: float | None) -> dict[str, Any]:
     }
 
 
-def test_following_the_min_angle_hint_compiles() -> None:
-    with pytest.raises(tlmpc.InvalidInputError) as refused:
-        tlmpc.compile(_wedge(0.25, None), until="control")
-    hint = refused.value.diagnostics[0].hint or ""
-    assert refused.value.diagnostics[0].code == "C032"
-    needed = float(hint.split("min_angle above ")[1].split(" degrees")[0])
-    assert needed == pytest.approx(math.degrees(2 * math.asin(0.25)), rel=1e-2)
-    tlmpc.compile(_wedge(0.25, math.ceil(needed)), until="control")
+def test_the_wedge_compiles_on_cells_or_with_the_min_angle_a_corner_needs() -> None:
+    """As meshed, the wedge's triangles are too sharp for 0.25: the convex cells carry it; with
+    a min_angle whose corners push more than 0.25 (2 asin 0.25, about 29 degrees) the
+    triangles do."""
+    on_cells = tlmpc.compile(_wedge(0.25, None), until="control")
+    assert {s.get("kind") for s in on_cells.artifacts["controllers.json"]["steps"]} == {"cell"}
+    needed = math.degrees(2 * math.asin(0.25))
+    meshed = tlmpc.compile(_wedge(0.25, math.ceil(needed)), until="control")
+    assert all("kind" not in s for s in meshed.artifacts["controllers.json"]["steps"])
 
 
 def test_above_the_largest_min_angle_the_hint_says_no_min_angle_guarantees_it() -> None:
     with pytest.raises(tlmpc.InvalidInputError) as refused:
-        tlmpc.compile(_example1(0.45, min_angle=33), until="control")
+        tlmpc.compile(_example1(0.7, min_angle=33), until="control")
     diagnostic = refused.value.diagnostics[0]
     assert diagnostic.code == "C032"
     assert "no options.min_angle guarantees it" in (diagnostic.hint or "")

@@ -62,7 +62,12 @@ def _labels(
     single_region = np.zeros(len(triangles), dtype=np.int64)
     single_region[tri_of[alone]] = region_of[alone]
     single = np.flatnonzero(count == 1)
-    used, single_key = np.unique(single_region[single], return_inverse=True)
+    # The regions holding some triangle alone, ascending, and each such triangle's rank among
+    # them: np.unique's answer, by counting (region numbers are small) instead of sorting.
+    single_of = single_region[single]
+    present = np.bincount(single_of, minlength=len(names)) > 0
+    used = np.flatnonzero(present)
+    single_key = (np.cumsum(present, dtype=np.int64) - 1)[single_of]
     several: dict[int, list[str]] = {}
     for t, r in zip(tri_of[~alone].tolist(), region_of[~alone].tolist(), strict=True):
         several.setdefault(t, []).append(names[r])
@@ -124,21 +129,35 @@ def connected_components(neighbors: IntArray) -> IntArray:
             if np.array_equal(jumped, root):
                 break
             root = jumped
-    # The root of a component is its lowest triangle: number components in that order.
-    _, labels = np.unique(root, return_inverse=True)
-    return np.asarray(labels, dtype=np.int64).reshape(-1)
+    # The root of a component is its lowest triangle: number components in that order (a
+    # root's number is how many roots come before it; no sort of a million roots).
+    is_root = root == np.arange(count, dtype=np.int64)
+    number = np.cumsum(is_root, dtype=np.int64) - 1
+    labels: IntArray = number[root]
+    return labels
 
 
-def build_abstraction(mission: Mission, layout: PlanningLayout | None = None) -> Abstraction:
+def build_abstraction(
+    mission: Mission, layout: PlanningLayout | None = None, *, lines: bool = False
+) -> Abstraction:
     """Triangulate ``mission``'s workspace and build the transition system D.
 
     With a ``layout`` (a robot with a body, a margin), its free space and region shapes are
-    triangulated and label the triangles instead of the mission's own.
+    triangulated and label the triangles instead of the mission's own. With ``lines``, the
+    convex cells' mesh: every side extended across the free space, no inner points, and each
+    triangle's face of that arrangement in ``stats["cell_faces"]``
+    (:mod:`tlmpc.abstraction.lines`).
     """
     started = time.perf_counter()
     # One geometry for planning and verifying: refuse what snapping to the grid would reshape.
     refuse_subgrid_features(mission)
-    vertices, triangles, neighbors, shapes = triangulate(mission, layout)
+    faces = None
+    if lines:
+        from tlmpc.abstraction.triangulate import lines_mesh
+
+        vertices, triangles, neighbors, shapes, faces = lines_mesh(mission, layout)
+    else:
+        vertices, triangles, neighbors, shapes = triangulate(mission, layout)
     letter_of, letters = _labels(mission, vertices, triangles, shapes)
     # The lowest-numbered triangle holding the start exactly (a start on an edge or vertex
     # lies in several: the planner starts from any of them).
@@ -166,6 +185,8 @@ def build_abstraction(mission: Mission, layout: PlanningLayout | None = None) ->
         "components": int(component.max() + 1) if len(component) else 0,
         "min_angle_deg": round(float(angles.min()), 6) if len(angles) else None,
         "seconds": round(time.perf_counter() - started, 6),
+        # the convex cells' mesh: the face of its arrangement each triangle lies in
+        **({"cell_faces": faces} if faces is not None else {}),
     }
     return Abstraction(
         vertices=vertices,

@@ -9,6 +9,7 @@ import numpy as np
 
 from tlmpc.abstraction.model import Abstraction
 from tlmpc.io.arrays import ArrayList, TableList, plain
+from tlmpc.mission.model import regions_document
 
 FORMAT = "tlmpc.abstraction/1"
 
@@ -34,7 +35,7 @@ def abstraction_document(abstraction: Abstraction) -> dict[str, Any]:
         "letter_of": ArrayList(abstraction.letter_of),
         "start": abstraction.start,
         "components": ArrayList(abstraction.component),
-        "regions": {name: list(map(list, poly)) for name, poly in abstraction.regions.items()},
+        "regions": regions_document(list(abstraction.regions.items())),
         "stats": dict(abstraction.stats),
     }
 

@@ -58,21 +58,24 @@ def cells_in(
     point: tuple[float, float],
 ) -> tuple[StartCell, ...]:
     """:func:`start_cells` on raw arrays."""
-    corners = vertices[triangles]
     x, y = float(point[0]), float(point[1])
     # Bounding boxes column by column (a reduction over an axis of three is several times
-    # slower on a million triangles).
-    xs, ys = corners[:, :, 0], corners[:, :, 1]
-    candidates = np.flatnonzero(
+    # slower on a million triangles): the x extents of every triangle, the y extents only of
+    # those whose x extent holds the point (no (m, 3, 2) array of corners).
+    xs = vertices[:, 0][triangles]
+    near = np.flatnonzero(
         (np.minimum(np.minimum(xs[:, 0], xs[:, 1]), xs[:, 2]) <= x)
         & (x <= np.maximum(np.maximum(xs[:, 0], xs[:, 1]), xs[:, 2]))
-        & (np.minimum(np.minimum(ys[:, 0], ys[:, 1]), ys[:, 2]) <= y)
-        & (y <= np.maximum(np.maximum(ys[:, 0], ys[:, 1]), ys[:, 2]))
     )
+    ys = vertices[:, 1][triangles[near]]
+    candidates = near[
+        (np.minimum(np.minimum(ys[:, 0], ys[:, 1]), ys[:, 2]) <= y)
+        & (y <= np.maximum(np.maximum(ys[:, 0], ys[:, 1]), ys[:, 2]))
+    ]
     p = (Fraction(x), Fraction(y))
     cells: list[StartCell] = []
     for t in candidates.tolist():
-        exact = [(Fraction(float(u)), Fraction(float(v))) for u, v in corners[t]]
+        exact = [(Fraction(float(u)), Fraction(float(v))) for u, v in vertices[triangles[t]]]
         # Edge i is opposite vertex i; a counter-clockwise triangle has every orientation
         # of an inside point non-negative.
         sides = [_orientation(exact[(i + 1) % 3], exact[(i + 2) % 3], p) for i in range(3)]

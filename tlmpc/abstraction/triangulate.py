@@ -189,13 +189,14 @@ def _unique_rows(rows: IntArray) -> tuple[IntArray, IntArray]:
     return np.asarray(first, dtype=np.int64), np.asarray(inverse, dtype=np.int64).reshape(-1)
 
 
-def _segments_of(lines: Sequence[Any]) -> FloatArray:
-    """All straight segments of the given linework as an (s, 2, 2) array."""
+def _chains_of(lines: Sequence[Any]) -> tuple[FloatArray, IntArray]:
+    """The points of the given linework, line after line, and the straight segments as the
+    index of each one's first point (the second is the next point, of the same line)."""
     points, owner = shapely.get_coordinates(lines, return_index=True)
     if len(points) < 2:
-        return np.zeros((0, 2, 2))
-    same = owner[1:] == owner[:-1]
-    return np.stack([points[:-1][same], points[1:][same]], axis=1)
+        return np.zeros((0, 2)), np.zeros(0, dtype=np.int64)
+    starts: IntArray = np.flatnonzero(owner[1:] == owner[:-1])
+    return points, starts
 
 
 def _needs_noding(rings: list[Any]) -> bool:
@@ -217,7 +218,7 @@ def _inside(free: Any, rings: list[Any]) -> list[Any]:
 
 
 def pslg(
-    mission: Mission, layout: PlanningLayout | None = None
+    mission: Mission, layout: PlanningLayout | None = None, *, lines: bool = False
 ) -> tuple[FloatArray, IntArray, FloatArray, list[Any]]:
     """The planar straight-line graph and the snapped region shapes.
 
@@ -225,6 +226,8 @@ def pslg(
     after snapping to the grid (the shapes whose boundaries are the constraint segments).
     All geometry is snap-rounded to a grid of a billionth of the workspace's extent, so
     nearly touching or nearly collinear input becomes exactly touching or collinear.
+    With ``lines``, every side is extended across the free space
+    (:mod:`tlmpc.abstraction.lines`).
     """
     grid = grid_size(mission)
     if layout is None or layout.free is None:
@@ -241,23 +244,32 @@ def pslg(
     parts = _polygons(free)
     free_rings = [ring for part in parts for ring in _rings(part)]
     region_rings = _rings_of_all(regions)
-    if _needs_noding([*free_rings, *region_rings]):
+    if lines:
+        from tlmpc.abstraction.lines import extended_lines
+
+        clipped = [shapely.intersection(shapely.boundary(r), free, grid_size=grid) for r in regions]
+        own = [*free_rings, *(c for c in clipped if not c.is_empty)]
+        sides = [*free_rings, *_inside_rings(free, region_rings)]
+        linework = shapely.union_all([*own, *extended_lines(free, sides)], grid_size=grid)
+        points, starts = _chains_of(list(shapely.get_parts(linework)))
+    elif _needs_noding([*free_rings, *region_rings]):
         clipped = [shapely.intersection(shapely.boundary(r), free, grid_size=grid) for r in regions]
         linework = shapely.union_all(
             [*free_rings, *(c for c in clipped if not c.is_empty)], grid_size=grid
         )
-        segments = _segments_of(list(shapely.get_parts(linework)))
+        points, starts = _chains_of(list(shapely.get_parts(linework)))
     else:
         # No region ring meets the free space's boundary, so each ring lies wholly inside the
         # free space or wholly outside it (in a hole, or beyond the boundary).  Rings outside
         # must not become segments: Triangle would keep the triangles they enclose.
-        segments = _segments_of([*free_rings, *_inside(free, region_rings)])
+        points, starts = _chains_of([*free_rings, *_inside(free, region_rings)])
     minx, miny, _, _ = free.bounds
-    flat = segments.reshape(-1, 2)
-    keys = np.round((flat - np.array([minx, miny])) / grid).astype(np.int64)
+    # Each point once per line, not once per segment end: the same vertices (a point's first
+    # appearance comes in the same order either way) from a sort of half as many keys.
+    keys = np.round((points - np.array([minx, miny])) / grid).astype(np.int64)
     first, inverse = _unique_rows(keys)
-    vertices = flat[first]
-    edges = inverse.reshape(-1, 2)
+    vertices = points[first]
+    edges = np.stack([inverse[starts], inverse[starts + 1]], axis=1)
     edges = edges[edges[:, 0] != edges[:, 1]]
     edges = np.sort(edges, axis=1)
     edges = edges[_unique_rows(edges)[0]]
@@ -295,14 +307,33 @@ def triangulate(
     With a ``layout``, its free space (configuration space, margin band removed) and region
     shapes (cores of goals, grown forbidden regions) replace the mission's.
     """
-    vertices, segments, seeds, regions = pslg(mission, layout)
+    points, triangles, neighbors, regions, _ = _triangulate(mission, layout)
+    return points, triangles, neighbors, regions
+
+
+def lines_mesh(
+    mission: Mission, layout: PlanningLayout | None = None
+) -> tuple[FloatArray, IntArray, IntArray, list[Any], list[int]]:
+    """:func:`triangulate` of the convex cells' mesh (every side extended across the free
+    space, :mod:`tlmpc.abstraction.lines`; no inner points), and the face of the arrangement
+    each triangle lies in (numbered by its lowest triangle)."""
+    points, triangles, neighbors, regions, faces = _triangulate(mission, layout, lines=True)
+    assert faces is not None
+    return points, triangles, neighbors, regions, faces
+
+
+def _triangulate(
+    mission: Mission, layout: PlanningLayout | None = None, *, lines: bool = False
+) -> tuple[FloatArray, IntArray, IntArray, list[Any], list[int] | None]:
+    vertices, segments, seeds, regions = pslg(mission, layout, lines=lines)
     options = "pznQ"
-    if mission.options.min_angle is not None and mission.options.min_angle > 0:
+    # (the convex cells' mesh has no inner points: its triangles join back into its faces)
+    if not lines and mission.options.min_angle is not None and mission.options.min_angle > 0:
         options += f"q{mission.options.min_angle:g}"
         # Input angles smaller than the bound can make refinement run away (Triangle's
         # guarantee needs input angles >= 60 degrees); cap the Steiner points it may add.
         options += f"S{max(MIN_STEINER, STEINER_PER_VERTEX * len(vertices))}"
-    if mission.options.max_area is not None:
+    if not lines and mission.options.max_area is not None:
         options += f"a{mission.options.max_area:.17g}"
     data: dict[str, Any] = {"vertices": vertices, "segments": segments}
     if len(seeds):
@@ -311,4 +342,60 @@ def triangulate(
     points = np.asarray(result["vertices"], dtype=np.float64)
     triangles = np.asarray(result["triangles"], dtype=np.int64)
     neighbors = np.asarray(result["neighbors"], dtype=np.int64)
-    return points, triangles, neighbors, regions
+    faces = _faces(triangles, neighbors, result.get("segments")) if lines else None
+    return points, triangles, neighbors, regions, faces
+
+
+def _faces(triangles: IntArray, neighbors: IntArray, segments: Any) -> list[int]:
+    """Triangles joined across every edge that is no constraint segment (lowest index)."""
+    constrained = set()
+    if segments is not None:
+        for a, b in np.asarray(segments, dtype=np.int64).tolist():
+            constrained.add((min(a, b), max(a, b)))
+    rows = triangles.tolist()
+    owner = list(range(len(rows)))
+
+    def find(t: int) -> int:
+        while owner[t] != t:
+            owner[t] = owner[owner[t]]
+            t = owner[t]
+        return t
+
+    for t, row in enumerate(neighbors.tolist()):
+        for edge, there in enumerate(row):
+            if there < 0:
+                continue
+            a, b = rows[t][(edge + 1) % 3], rows[t][(edge + 2) % 3]
+            if (min(a, b), max(a, b)) in constrained:
+                continue
+            x, y = find(t), find(there)
+            if x != y:
+                owner[max(x, y)] = min(x, y)
+    return [find(t) for t in range(len(rows))]
+
+
+def lines_fit(mission: Mission, layout: PlanningLayout | None = None) -> bool:
+    """Whether the convex cells' mesh of ``mission`` stays within its size budget
+    (:data:`tlmpc.abstraction.lines.MAX_SIDES` sides to extend)."""
+    from tlmpc.abstraction.lines import MAX_SIDES, side_count
+
+    grid = grid_size(mission)
+    if layout is None or layout.free is None:
+        free = free_space(mission, grid)
+        regions = [shapely.Polygon(r.polygon) for r in mission.regions]
+    else:
+        free = layout.free
+        regions = [shape for shape in layout.regions if shape is not None]
+    rings = [ring for part in _polygons(free) for ring in _rings(part)]
+    return side_count([*rings, *_rings_of_all(regions)]) <= MAX_SIDES
+
+
+def _inside_rings(free: Any, rings: list[Any]) -> list[Any]:
+    """The parts of ``rings`` inside ``free`` (clipped)."""
+    found = []
+    for ring in rings:
+        part = shapely.intersection(ring, free)
+        for piece in shapely.get_parts(part):
+            if piece.geom_type == "LineString" and not piece.is_empty:
+                found.append(piece)
+    return found

@@ -99,7 +99,7 @@ def _run_locked(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
 
     # One pause for compiling and writing: re-enabling in between would trigger a full
     # collection over everything the compilation still holds.
-    from tlmpc.reactive.synthesize import UnrealizableError
+    from tlmpc.reactive.unrealizable import UnrealizableError
 
     with collector_paused():
         try:

@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from tlmpc.control.model import Controllers, StepController, VelocityJump
+from tlmpc.control.model import CellField, Controllers, StepController, VelocityJump
 
 FORMAT = "tlmpc.controllers/1"
 
@@ -35,6 +35,7 @@ def controllers_to_json(controllers: Controllers) -> dict[str, Any]:
                 "exit_time_bound": None if math.isinf(c.exit_time_bound) else c.exit_time_bound,
                 "target": list(c.target) if c.target is not None else None,
                 **({"kind": c.kind} if c.kind != "affine" else {}),
+                **({"cell": _cell_to_json(c.cell)} if c.cell is not None else {}),
             }
             for c in controllers.steps
         ],
@@ -44,6 +45,37 @@ def controllers_to_json(controllers: Controllers) -> dict[str, Any]:
         ],
         "stats": dict(controllers.stats),
     }
+
+
+def _cell_to_json(field: CellField) -> dict[str, Any]:
+    return {
+        "cell": field.cell,
+        "target_cell": field.target_cell,
+        "triangles": list(field.triangles),
+        "vertices": field.vertices.tolist(),
+        "vertex_velocities": field.velocities.tolist(),
+        "K": field.gains.tolist(),
+        "g": field.offsets.tolist(),
+        "across": [list(row) for row in field.neighbours],
+        "direction": list(field.direction) if field.direction is not None else None,
+        "plan_index": field.plan_index,
+    }
+
+
+def _cell_from_json(document: Mapping[str, Any]) -> CellField:
+    count = len(document["triangles"])
+    return CellField(
+        triangles=tuple(int(t) for t in document["triangles"]),
+        vertices=_array(document["vertices"], (count, 3, 2)),
+        velocities=_array(document["vertex_velocities"], (count, 3, 2)),
+        gains=_array(document["K"], (count, 2, 2)),
+        offsets=_array(document["g"], (count, 2)),
+        neighbours=tuple((int(a), int(b), int(c)) for a, b, c in document["across"]),
+        direction=None if document["direction"] is None else _point(document["direction"]),
+        cell=int(document["cell"]),
+        target_cell=None if document["target_cell"] is None else int(document["target_cell"]),
+        plan_index=int(document["plan_index"]),
+    )
 
 
 def _array(value: Any, shape: tuple[int, ...]) -> np.ndarray[Any, np.dtype[np.float64]]:
@@ -75,6 +107,7 @@ def controllers_from_json(document: Mapping[str, Any]) -> Controllers:
                 ),
                 target=None if s["target"] is None else _point(s["target"]),
                 kind=s.get("kind", "affine"),
+                cell=_cell_from_json(s["cell"]) if "cell" in s else None,
             )
             for s in document["steps"]
         ),

@@ -92,7 +92,12 @@ MAX_MIN_ANGLE = 34.0
 
 
 def disturbance_hint(
-    disturbance: float, max_speed: float, bound: Corner, *, supported: float | None = None
+    disturbance: float,
+    max_speed: float,
+    bound: Corner,
+    *,
+    supported: float | None = None,
+    on_cells: float | None = None,
 ) -> str:
     """C032's hint: the largest disturbance any plan on the mesh rejects (``supported``, from
     the planner's widest-lasso search, when known), the plan's own bound, what ``min_angle``
@@ -112,6 +117,13 @@ def disturbance_hint(
             f"({supported / max_speed:.4f} x max_speed; every one below it, with "
             f"{TOLERANCE_NOTE}, has a plan): the widest route's weakest corner, over every plan "
             "the task admits"
+        )
+    if on_cells is not None:
+        lines.append(
+            "on convex cells (the plan stage's last rung: the mesh's, and a mesh of the map's "
+            f"sides extended across it) plans reject at most "
+            f"{on_cells:.6g} ({on_cells / max_speed:.4f} x max_speed): the widest route's "
+            "weakest cell step"
         )
     lines.append(
         f"this plan's triangles reject disturbances below {bound.push:.6g} "

@@ -45,6 +45,7 @@ from tlmpc.control.robust import (
 )
 from tlmpc.control.sparse import CscMatrix, Triplets, stacked_csc
 from tlmpc.mission.model import Robot
+from tlmpc.planning.mission import on_cells
 from tlmpc.planning.model import Witness
 
 #: A unit normal as Python floats.
@@ -534,6 +535,7 @@ def _check_rejectable(
     robot: Robot,
     source: str | None,
     supported: float | None = None,
+    on_cells: float | None = None,
 ) -> None:
     """Located errors where no vertex velocity can reject ``robot.disturbance`` (C032/C033),
     and where the plan passes through a single point, which no law here reaches under a
@@ -592,7 +594,11 @@ def _check_rejectable(
                 )
     if problems:
         hint = disturbance_hint(
-            robot.disturbance, robot.max_speed, weakest(pushes), supported=supported
+            robot.disturbance,
+            robot.max_speed,
+            weakest(pushes),
+            supported=supported,
+            on_cells=on_cells,
         )
         raise InvalidInputError([replace(p, hint=hint) for p in problems[:10]])
 
@@ -645,17 +651,24 @@ def synthesize(
     fields are chosen so that their flow follows the shortest path through the plan's
     channel (:mod:`tlmpc.control.follow`), under the vertex program's constraints.
     """
+    if on_cells(witness):
+        # a plan made on convex cells: its steps are cell steps (tlmpc.control.cells)
+        from tlmpc.control.cells import synthesize_cells
+
+        return synthesize_cells(abstraction, witness, robot, source=source)
     started = time.perf_counter()
     steps, loop_start = plan_steps(abstraction, witness)
     if robot.disturbance > 0.0:
         # the planner's widest-lasso search, recorded on a plan it could not make realisable
         supported = witness.stats.get("supported_disturbance")
+        cells_bound = witness.stats.get("supported_disturbance_cells")
         _check_rejectable(
             abstraction,
             steps,
             robot,
             source,
             None if supported is None else float(supported),
+            None if cells_bound is None else float(cells_bound),
         )
     # A velocity shared along a vertex run must push harder than the disturbance along every
     # facet the run collects (without one, merely positive along each: push 0).

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import json
 from collections.abc import Callable, Iterator, Sequence
+from itertools import chain
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:  # numpy is imported where arrays are encoded (``tlmpc check`` has none)
@@ -120,12 +121,39 @@ def encoded_pieces(value: Standin, encoder: json.JSONEncoder) -> Iterator[str]:
     import numpy as np
 
     if isinstance(value, TableList):
-        texts = np.array([_item_text(item, encoder) for item in value.table], dtype=object)
+        texts = np.array(_item_texts(value.table, encoder), dtype=object)
         return _joined(len(value.index), lambda a, b: ",".join(texts[value.index[a:b]].tolist()))
     array = value.array
     if array.dtype.kind == "f" and not np.isfinite(array).all():
         raise ValueError("Out of range float values are not JSON compliant")
-    return _joined(len(array), lambda a, b: encoder.encode(array[a:b].tolist())[1:-1])
+    return _joined(len(array), _rows_text(array, encoder))
+
+
+#: How the encoder writes a Python number of each dtype kind: ``int.__repr__`` (what ``%d``
+#: gives for an int) and ``float.__repr__`` (``%r`` of a float; the finite ones only, checked
+#: before).  Booleans, strings and objects are left to the encoder.
+_NUMBER_FORMATS = {"i": "%d", "u": "%d", "f": "%r"}
+
+
+def _rows_text(array: npt.NDArray[Any], encoder: json.JSONEncoder) -> Callable[[int, int], str]:
+    """The text of rows ``a:b`` of ``array`` as the compact encoder writes their list,
+    without the brackets around it.
+
+    A number array of one or two dimensions is formatted with one ``%`` per block, from a
+    template of the rows' shape and the block's numbers as a flat ``tolist``: the same
+    ``repr`` of each number the encoder takes, without a Python list per row (three times
+    faster on a mesh's million triangles).
+    """
+    spec = _NUMBER_FORMATS.get(array.dtype.kind)
+    if spec is None or array.ndim not in (1, 2):
+        return lambda a, b: encoder.encode(array[a:b].tolist())[1:-1]
+    row = spec if array.ndim == 1 else "[" + ",".join([spec] * array.shape[1]) + "]"
+
+    def block(a: int, b: int) -> str:
+        rows = array[a:b]
+        return ",".join([row] * len(rows)) % tuple(rows.ravel().tolist())
+
+    return block
 
 
 def _joined(count: int, block: Callable[[int, int], str]) -> Iterator[str]:
@@ -136,6 +164,19 @@ def _joined(count: int, block: Callable[[int, int], str]) -> Iterator[str]:
             yield ","
         yield block(start, start + BLOCK_ROWS)
     yield "]"
+
+
+def _item_texts(items: list[Any], encoder: json.JSONEncoder) -> list[str]:
+    """:func:`_item_text` of each item; when every item is a list of strings (the letters of
+    a map of a hundred thousand rooms), with the types checked once for all of them."""
+    quote = json.encoder.encode_basestring_ascii if encoder.ensure_ascii else None
+    if (
+        quote is not None
+        and set(map(type, items)) <= {list}
+        and set(map(type, chain.from_iterable(items))) <= {str}
+    ):
+        return ["[" + ",".join(map(quote, item)) + "]" for item in items]
+    return [_item_text(item, encoder) for item in items]
 
 
 def _item_text(item: Any, encoder: json.JSONEncoder) -> str:

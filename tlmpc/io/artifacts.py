@@ -93,15 +93,20 @@ _COMPACT = json.JSONEncoder(
 class SharedTexts:
     """Compact texts of top-level values by key, for the values that several documents hold.
 
-    A value is looked up by its ``marshal`` bytes, which tell every type apart (``1``,
-    ``1.0`` and ``True``; ``0.0`` and ``-0.0``) and fix the order of every dict and list:
-    equal bytes, equal data, the same JSON text.  A value ``marshal`` refuses (a subclass,
-    say) is simply encoded again.
+    A value is found again when it is the very object encoded before under that key (the
+    stages share the regions' document among their artifacts), else by its ``marshal``
+    bytes, which tell every type apart (``1``, ``1.0`` and ``True``; ``0.0`` and ``-0.0``)
+    and fix the order of every dict and list: equal bytes, equal data, the same JSON text.
+    The bytes are taken only when a key holds a value that is not one encoded before (a
+    hundred thousand regions take a tenth of a second to marshal).  A value ``marshal``
+    refuses (a subclass, say) is simply encoded again.
     """
 
     def __init__(self, keys: set[str]) -> None:
         self.keys = keys
-        self.texts: dict[tuple[str, bytes], str] = {}
+        #: per key, the values encoded so far (held, so that their ids stay theirs), their
+        #: texts, and their marshal bytes once some other value needed them
+        self.encoded: dict[str, list[tuple[Any, str, bytes | None]]] = {}
 
     @classmethod
     def among(cls, documents: Iterable[Any]) -> SharedTexts:
@@ -119,13 +124,29 @@ class SharedTexts:
         """The compact JSON text of ``value``, held at ``key`` of a document."""
         if key not in self.keys or type(value) not in (dict, list):
             return _COMPACT.encode(value)
+        encoded = self.encoded.setdefault(key, [])
+        for held, text, _ in encoded:
+            if held is value:
+                return text
+        if not encoded:  # the first value under this key: no bytes to compare with yet
+            text = _COMPACT.encode(value)
+            encoded.append((value, text, None))
+            return text
         try:
-            fingerprint = (key, marshal.dumps(value))
+            fingerprint = marshal.dumps(value)
         except ValueError:
             return _COMPACT.encode(value)
-        text = self.texts.get(fingerprint)
-        if text is None:
-            text = self.texts[fingerprint] = _COMPACT.encode(value)
+        for number, (held, text, known) in enumerate(encoded):
+            if known is None:  # encoded before without its bytes: take them now
+                try:
+                    known = marshal.dumps(held)
+                except ValueError:
+                    continue
+                encoded[number] = (held, text, known)
+            if known == fingerprint:
+                return text
+        text = _COMPACT.encode(value)
+        encoded.append((value, text, fingerprint))
         return text
 
 
@@ -499,16 +520,30 @@ def _cross_check_results(
             raise _tampered(path, "controllers.json: a step names a missing triangle")
         # the steps are one path: each leaves into the triangle of the next (the last into
         # the loop's first, unless it is a final stay)
-        successor = [*(s["triangle"] for s in steps[1:]), None]
+        # (a cell step leaves into any triangle of the next step's cell)
+        following = [*steps[1:], None]
         if loop is not None:
-            successor[-1] = steps[loop]["triangle"]
+            following[-1] = steps[loop]
         if any(
-            s["next_triangle"] is not None and s["next_triangle"] != after
-            for s, after in zip(steps, successor, strict=True)
+            s["next_triangle"] is not None
+            and (
+                after is None
+                or (
+                    s["next_triangle"] not in after["cell"]["triangles"]
+                    if "cell" in after
+                    else s["next_triangle"] != after["triangle"]
+                )
+            )
+            for s, after in zip(steps, following, strict=True)
         ) or (loop is None and not steps[-1]["stay"]):
             raise _tampered(path, "controllers.json: the steps do not follow one another")
         witness = documents.get("witness.json")
-        if witness is not None and len(steps) != len(witness["prefix"]) + len(witness["cycle"]):
+        on_cells = any("cell" in s for s in steps)  # cell steps group the witness's triangles
+        if (
+            witness is not None
+            and not on_cells
+            and len(steps) != len(witness["prefix"]) + len(witness["cycle"])
+        ):
             raise _tampered(
                 path, "controllers.json and witness.json have different numbers of steps"
             )

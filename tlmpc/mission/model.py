@@ -32,6 +32,34 @@ class Region:
     polygon: Polygon
 
 
+#: The last regions document built and the (name, polygon) pairs it was built from.
+_last_regions: tuple[list[tuple[str, Polygon]], dict[str, list[list[float]]]] | None = None
+
+
+def regions_document(pairs: list[tuple[str, Polygon]]) -> dict[str, list[list[float]]]:
+    """``{name: [[x, y], ...]}``: the regions as ``mission.json``, ``abstraction.json`` and
+    ``trace.json`` hold them.
+
+    Asked again for the same polygons (the very tuples, under the same names, in the same
+    order), it returns the document it built last, the same object: a compile of a map with
+    a hundred thousand regions builds this document once for its three artifacts, and the
+    writer, finding the same object under the same key, encodes it once.  The document is
+    shared, so it must not be changed (no stage does; the polygons it comes from are
+    immutable tuples).  The module keeps the last document (and its pairs) until another
+    is built: one map's regions, which the compile's artifacts hold anyway.
+    """
+    global _last_regions
+    if _last_regions is not None:
+        held, document = _last_regions
+        if len(held) == len(pairs) and all(
+            a[1] is b[1] and a[0] == b[0] for a, b in zip(held, pairs, strict=True)
+        ):
+            return document
+    document = {name: list(map(list, polygon)) for name, polygon in pairs}
+    _last_regions = (pairs, document)
+    return document
+
+
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Component:
     """One connected piece of free space: an outer boundary minus its holes."""
@@ -240,7 +268,7 @@ class Mission:
             "name": self.name,
             "source": self.source,
             "workspace": self.workspace.to_json(),
-            "regions": {r.name: poly(r.polygon) for r in self.regions},
+            "regions": regions_document([(r.name, r.polygon) for r in self.regions]),
             "groups": {k: list(v) for k, v in self.groups.items()},
             "robot": {
                 "start": list(self.robot.start),

@@ -17,7 +17,6 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from itertools import chain
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -26,6 +25,8 @@ import shapely
 from tlmpc.base.errors import Diagnostic, InvalidInputError, error
 from tlmpc.mission.grid import GRID, ON_GRID, grid_size
 from tlmpc.mission.model import Mission, Polygon
+from tlmpc.mission.placement import placed
+from tlmpc.mission.yamlpos import json_path
 
 #: A snapped feature must lie within this many grid steps of the written one, and conversely
 #: (snap-rounding moves every point by at most half a diagonal step).
@@ -108,30 +109,15 @@ def subgrid_problems(mission: Mission) -> list[Diagnostic]:
                         f"the snapping grid ({grid:g}): the mesh would make them touch",
                     )
                 )
-    return [_located(mission, code, path, message) for code, path, message in problems]
-
-
-def _located(mission: Mission, code: str, path: tuple[str | int, ...], message: str) -> Diagnostic:
-    line = col = None
-    if mission.source is not None:
-        from tlmpc.mission.yamlpos import load_positioned
-
-        try:
-            text = Path(mission.source).read_text(encoding="utf-8")
-        except OSError:
-            text = None
-        document = load_positioned(text, mission.source)[0] if text is not None else None
-        if document is not None:
-            line, col = document.value_at(path)
-    return error(
-        code,
-        message,
-        hint="make the feature wider than the grid (about a billionth of the map's size) "
-        "or remove it; features are never silently dropped",
-        file=mission.source,
-        line=line,
-        col=col,
+    hint = (
+        "make the feature wider than the grid (about a billionth of the map's size) "
+        "or remove it; features are never silently dropped"
     )
+    found = [
+        error(code, message, hint=hint, file=mission.source, path=json_path(path))
+        for code, path, message in problems
+    ]
+    return list(placed(found, mission.source))
 
 
 __all__ = ["GRID", "grid_size", "refuse_subgrid_features", "subgrid_problems"]

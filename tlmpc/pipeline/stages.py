@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
 from tlmpc.base.errors import TlmpcError, error
+from tlmpc.base.pages import plain_pages
 from tlmpc.base.progress import heartbeat
 from tlmpc.base.version import __version__
 
@@ -415,12 +416,12 @@ def _outruns(trace: Mapping[str, Any], speed: float) -> bool:
 
 def _synthesize(c: Compilation) -> StageResult:
     from tlmpc.reactive.synthesize import (
-        UnrealizableError,
         counterstrategy_to_json,
         strategy_to_json,
         synthesize,
         unrealizable,
     )
+    from tlmpc.reactive.unrealizable import UnrealizableError
 
     mission = c.get(MISSION)
     synthesis = synthesize(mission, c.get(ABSTRACTION))
@@ -624,7 +625,21 @@ def run_stages(
     *,
     progress: ProgressFn | None = None,
 ) -> CompileResult:
-    """Run ``stages`` in order on ``compilation``, checking each one's requires and provides."""
+    """Run ``stages`` in order on ``compilation``, checking each one's requires and provides.
+
+    The stages' arrays are allocated without numpy's huge-page request
+    (:mod:`tlmpc.base.pages`: at a million triangles the kernel's compaction on first touch
+    cost about 3 CPU s of the compile)."""
+    with plain_pages():
+        return _run_stages(stages, compilation, progress=progress)
+
+
+def _run_stages(
+    stages: Sequence[Stage],
+    compilation: Compilation,
+    *,
+    progress: ProgressFn | None = None,
+) -> CompileResult:
     artifacts: dict[str, Any] = dict(compilation.documents)
     written: dict[str, Any] = {}
     products: dict[Product[Any], Any] = dict(compilation.products)
@@ -640,8 +655,12 @@ def run_stages(
         for product in stage.requires:
             compilation.get(product)  # a clear error instead of a failure deep inside
         started = time.perf_counter()
-        with heartbeat(stage.name, sys.stderr) if progress else contextlib.nullcontext():
-            result = stage.run(compilation)
+        try:
+            with heartbeat(stage.name, sys.stderr) if progress else contextlib.nullcontext():
+                result = stage.run(compilation)
+        except TlmpcError as exc:
+            exc.diagnostics = _placed(exc.diagnostics, compilation)
+            raise
         report = StageReport(
             name=stage.name, seconds=time.perf_counter() - started, sizes=result.sizes
         )
@@ -658,7 +677,7 @@ def run_stages(
         compilation = dataclasses.replace(
             compilation, products=dict(products), documents=dict(artifacts)
         )
-        warnings.extend(result.warnings)
+        warnings.extend(_placed(result.warnings, compilation))
         extras.update(result.summary)
         reports.append(report)
         if progress is not None:
@@ -672,6 +691,16 @@ def run_stages(
         warnings=tuple(warnings),
         extras=extras,
     )
+
+
+def _placed(
+    diagnostics: tuple[Diagnostic, ...], compilation: Compilation
+) -> tuple[Diagnostic, ...]:
+    """The stage's diagnostics of the mission file with the line and column of the value
+    their JSON path names (a later stage knows the value, not where it is written)."""
+    from tlmpc.mission.placement import placed
+
+    return placed(diagnostics, str(compilation.source), compilation.text)
 
 
 def compile_mission(

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from tlmpc.abstraction.model import Abstraction, FloatArray
+from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
 from tlmpc.automata.degeneralize import degeneralize
 from tlmpc.automata.model import Automaton
 from tlmpc.base.graphs import strong_components
@@ -46,11 +46,17 @@ def supported_ratio(
     formula: Formula,
     options: Options,
     start_point: tuple[float, float],
+    cells: bool = False,
 ) -> float | None:
     """W* / max_speed for the task ``automaton`` on ``abstraction`` (see the module doc):
     the largest disturbance ratio some plan on this mesh rejects (every ratio below it, plus
     the controllers' tolerance, has a plan). None when the product has no lasso without
-    U-turns or vertex passages, or is too large to build (the guided search's size)."""
+    U-turns or vertex passages, or is too large to build (the guided search's size).
+
+    With ``cells``, the steps are the convex cells' (:mod:`tlmpc.planning.cells`): a move
+    inside one cell is no step of its own, a cycle inside one cell is that cell's stay. A
+    lasso may then enter a cell and leave it back across the same interface, which no cell
+    field realises: the value is an upper bound on what plans on cells reject."""
     if not estimate_product(abstraction, automaton).fits:
         return None
     working = degeneralize(automaton) if automaton.num_acc >= 2 else automaton
@@ -65,8 +71,14 @@ def supported_ratio(
         convention=options.boundary,
         start_label=start_point_label(abstraction, start_point) if closed else (),
     )
-    moves, stays = step_widths(abstraction)
-    return widest_lasso(product, abstraction, moves, stays)
+    if not cells:
+        moves, stays = step_widths(abstraction)
+        return widest_lasso(product, abstraction, moves, stays)
+    from tlmpc.planning.cells import cell_widths, partition
+
+    partitioned = partition(abstraction)
+    moves, stays = cell_widths(partitioned)
+    return widest_lasso(product, abstraction, moves, stays, groups=partitioned.cell_of)
 
 
 def edge_widths(product: Product, abstraction: Abstraction, moves: FloatArray) -> FloatArray:
@@ -84,24 +96,35 @@ def edge_widths(product: Product, abstraction: Abstraction, moves: FloatArray) -
 
 
 def widest_lasso(
-    product: Product, abstraction: Abstraction, moves: FloatArray, stays: FloatArray
+    product: Product,
+    abstraction: Abstraction,
+    moves: FloatArray,
+    stays: FloatArray,
+    groups: IntArray | None = None,
 ) -> float | None:
-    """The bottleneck value of the product's accepting lassos (None when there is none)."""
+    """The bottleneck value of the product's accepting lassos (None when there is none);
+    ``groups`` (per triangle) joins triangles into cells whose inner moves are no steps."""
     widths = edge_widths(product, abstraction, moves)
     candidates = np.unique(np.concatenate([widths[np.isfinite(widths)], stays]))
-    if not len(candidates) or not _has_lasso(product, widths, stays, float(candidates[0])):
+    if not len(candidates) or not _has_lasso(product, widths, stays, float(candidates[0]), groups):
         return None
     low, high = 0, len(candidates) - 1  # the lasso exists at candidates[low]
     while low < high:
         middle = (low + high + 1) // 2
-        if _has_lasso(product, widths, stays, float(candidates[middle])):
+        if _has_lasso(product, widths, stays, float(candidates[middle]), groups):
             low = middle
         else:
             high = middle - 1
     return float(candidates[low])
 
 
-def _has_lasso(product: Product, widths: FloatArray, stays: FloatArray, floor: float) -> bool:
+def _has_lasso(
+    product: Product,
+    widths: FloatArray,
+    stays: FloatArray,
+    floor: float,
+    groups: IntArray | None = None,
+) -> bool:
     """Whether an accepting lasso uses only steps of width >= ``floor``."""
     graph = product.graph
     nq = product.num_automaton_states
@@ -125,6 +148,8 @@ def _has_lasso(product: Product, widths: FloatArray, stays: FloatArray, floor: f
     # A component spanning two cells has a cycle through each of its edges that moves; one
     # inside a single cell is a stay of that triangle.
     cell = np.arange(graph.num_nodes) // nq
+    if groups is not None:
+        cell = groups[triangle_of]
     members = component >= 0
     count = int(component.max()) + 1
     lowest = np.full(count, np.iinfo(np.int64).max)

@@ -78,6 +78,7 @@ def plan_complete(
     explain: bool = True,
     reject: float | None = None,
     times: MoveTimes | None = None,
+    on_cells: bool = False,
 ) -> tuple[Abstraction, Witness]:
     """A witness on ``abstraction`` or on a locally refined copy of it (returned with it).
 
@@ -85,7 +86,8 @@ def plan_complete(
     ``parts`` gives the task's parts for that explanation (called only then, and only with
     ``explain``: a run re-planning under way needs no explanation).  ``resume`` re-plans a
     run under way (see :func:`tlmpc.planning.plan.plan`); ``times`` weighs the moves under
-    the ``time`` metric (:mod:`tlmpc.planning.timing`).
+    the ``time`` metric (:mod:`tlmpc.planning.timing`); ``on_cells`` plans the moves and stays
+    of convex cells that reject ``reject`` (:mod:`tlmpc.planning.cells`).
     """
 
     def attempt(mesh: Abstraction, *, bounces: bool = False, passages: bool = False) -> Witness:
@@ -100,6 +102,7 @@ def plan_complete(
             resume=resume,
             reject=reject,
             times=times,
+            on_cells=on_cells,
         )
 
     try:

@@ -32,6 +32,7 @@ import numpy as np
 import numpy.typing as npt
 
 from tlmpc.abstraction.model import FloatArray, IntArray
+from tlmpc.base.pages import plain_pages
 from tlmpc.planning.bounds import (
     CostToGo,
     RegionGraph,
@@ -64,14 +65,16 @@ class _Arrays:
 
     @staticmethod
     def of(size: int) -> _Arrays:
-        """Fresh arrays for ``size`` nodes."""
-        return _Arrays(
-            dist=np.full(size, np.inf),
-            pred=np.full(size, -1, dtype=np.int64),
-            via=np.full(size, np.inf),
-            queued=np.zeros(size, dtype=bool),
-            estimate=np.full(size, np.nan, dtype=np.float32),
-        )
+        """Fresh arrays for ``size`` nodes (written whole here: on plain pages, see
+        :mod:`tlmpc.base.pages`)."""
+        with plain_pages():
+            return _Arrays(
+                dist=np.full(size, np.inf),
+                pred=np.full(size, -1, dtype=np.int64),
+                via=np.full(size, np.inf),
+                queued=np.zeros(size, dtype=bool),
+                estimate=np.full(size, np.nan, dtype=np.float32),
+            )
 
     def reset(self) -> None:
         """Back to unreached everywhere (only the touched nodes are written)."""

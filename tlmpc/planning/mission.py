@@ -46,6 +46,9 @@ class Planned:
     remeshed: bool = False
     #: the untimed task the plan was made for (the skeleton, or the holding skeleton)
     formula: Formula | None = None
+    #: the mesh the plan was asked on, before any refinement for a U-turn (the convex cells'
+    #: rung plans on it: a fan's triangles split the cells a U-turn needs none of)
+    unrefined: Abstraction | None = None
 
 
 def abstraction_for(
@@ -146,7 +149,13 @@ def plan_mission(
             reject=reject,
             times=times,
         )
-        return Planned(abstraction=planned_mesh, automaton=task, witness=witness, formula=formula)
+        return Planned(
+            abstraction=planned_mesh,
+            automaton=task,
+            witness=witness,
+            formula=formula,
+            unrefined=mesh,
+        )
 
     from tlmpc.abstraction.layout import deepens_goals
 
@@ -160,10 +169,16 @@ def plan_mission(
         the goal depth), then entering the goals only as deep as the margin asks (the cores'
         corners may be all that is too sharp); the first plan whose steps all realise it."""
         ratio = mission.robot.disturbance / mission.robot.max_speed
-        if resume is not None or ratio <= 0.0 or not deepens_goals(mission):
+        if resume is not None or ratio <= 0.0:
             return planned
         if witness_realisable(planned.abstraction, planned.witness, ratio):
             return planned
+        if not deepens_goals(mission):
+            on_cells = _on_cells(mission, planned, start_point)
+            if on_cells is not None:
+                return on_cells
+            on_lines, lines_bound = _on_lines(mission, margin, planned, start_point)
+            return on_lines or _with_cells_bound(planned, lines_bound, mission)
         tried = [planned]
         for scale in (*SHALLOWER, 0.0):
             mesh = abstraction_for(mission, margin, deep=scale > 0.0, scale=scale)
@@ -177,11 +192,26 @@ def plan_mission(
                 note = _shallow_for_disturbance(mission, planned.witness, scale)
                 return replace(again, notes=(note,), remeshed=True)
             tried.append(again)
-        # None realises the disturbance: the plan on the mesh whose plans reject the most goes
-        # on to be refused, stating that mesh's bound (C032: the mission compiles below it).
+        # None realises the disturbance on triangles: the last rung, convex cells, on each
+        # mesh in turn (the goal depth first).
+        for position, tried_plan in enumerate(tried):
+            on_cells = _on_cells(mission, tried_plan, start_point)
+            if on_cells is not None:
+                return on_cells if position == 0 else replace(on_cells, remeshed=True)
+        on_lines, lines_bound = _on_lines(mission, margin, planned, start_point)
+        if on_lines is not None:
+            return on_lines
+        # None realises it on cells either: the plan on the mesh whose plans reject the most
+        # goes on to be refused, stating that mesh's bound (C032: the mission compiles below it)
+        # and the cells' (the largest over the meshes tried).
         bounds = [_supported_of(plan.witness) for plan in tried]
         best = max(range(len(tried)), key=lambda k: (bounds[k] is not None, bounds[k] or 0.0, -k))
-        return tried[0] if best == 0 else replace(tried[best], remeshed=True)
+        cells_bounds = [plan.witness.stats.get(SUPPORTED_CELLS) for plan in tried]
+        known = [float(b) / mission.robot.max_speed for b in cells_bounds if b is not None]
+        if lines_bound is not None:
+            known.append(lines_bound)
+        chosen = _with_cells_bound(tried[best], max(known) if known else None, mission)
+        return chosen if best == 0 else replace(chosen, remeshed=True)
 
     holding = holding_skeleton(mission.formula)
     if resume is None and holding != skeleton:
@@ -257,7 +287,7 @@ def replan(mission: Mission, planned: Planned, times: MoveTimes) -> Planned:
         formula = untimed_skeleton(mission.formula)
     ratio = mission.robot.disturbance / mission.robot.max_speed
 
-    def attempt(reject: float | None) -> tuple[Abstraction, Witness]:
+    def attempt(reject: float | None, cells: bool = False) -> tuple[Abstraction, Witness]:
         return plan_complete(
             planned.abstraction,
             planned.automaton,
@@ -267,8 +297,21 @@ def replan(mission: Mission, planned: Planned, times: MoveTimes) -> Planned:
             explain=False,
             reject=reject,
             times=times,
+            on_cells=cells,
         )
 
+    if on_cells(planned.witness):
+        # planned on cells: so again (the plan it replaces exists there)
+        mesh, witness = attempt(ratio, cells=True)
+        from tlmpc.planning.cells import partition, witness_on_cells
+        from tlmpc.planning.robust import TOLERANCE
+
+        if witness_on_cells(
+            partition(mesh), witness.prefix, witness.cycle, witness.is_stay, ratio, TOLERANCE
+        ):
+            witness = replace(witness, stats={**witness.stats, ON_CELLS: True})
+            return replace(planned, abstraction=mesh, witness=witness)
+        return planned
     mesh, witness = attempt(None)
     if not witness_realisable(mesh, witness, ratio):
         mesh, witness = attempt(ratio)
@@ -311,7 +354,157 @@ def _with_supported(
     if ratio is None:
         return planned
     stats = {**planned.witness.stats, SUPPORTED: ratio * mission.robot.max_speed}
+    from tlmpc.planning.cells import MAX_TRIANGLES
+
+    on_cells = (
+        supported_ratio(
+            planned.abstraction,
+            planned.automaton,
+            formula=formula,
+            options=mission.options,
+            start_point=start_point if start_point is not None else mission.robot.start,
+            cells=True,
+        )
+        if planned.abstraction.num_triangles <= MAX_TRIANGLES
+        else None
+    )
+    if on_cells is not None:
+        stats[SUPPORTED_CELLS] = on_cells * mission.robot.max_speed
     return replace(planned, witness=replace(planned.witness, stats=stats))
+
+
+#: The witness statistic of the bound on cells (:mod:`tlmpc.planning.cells`): at most this
+#: much disturbance any plan on the mesh's convex cells rejects, set with SUPPORTED.
+SUPPORTED_CELLS = "supported_disturbance_cells"
+#: The witness statistic that marks a plan made on convex cells: its steps are cell steps.
+ON_CELLS = "cells"
+
+
+def _on_cells(
+    mission: Mission, planned: Planned, start_point: tuple[float, float] | None
+) -> Planned | None:
+    """The last rung of the plan stage: ``planned``'s task planned again on the convex
+    cells of its mesh (:mod:`tlmpc.planning.cells`), when every cell step of that plan
+    rejects the mission's disturbance; None otherwise."""
+    from tlmpc.ltl.bounds import untimed_skeleton
+    from tlmpc.planning.cells import MAX_TRIANGLES, partition, witness_on_cells
+    from tlmpc.planning.complete import RefinementError, plan_complete
+    from tlmpc.planning.plan import plan
+    from tlmpc.planning.robust import TOLERANCE
+
+    ratio = mission.robot.disturbance / mission.robot.max_speed
+    formula = planned.formula if planned.formula is not None else untimed_skeleton(mission.formula)
+    mesh = planned.unrefined if planned.unrefined is not None else planned.abstraction
+    if mesh.num_triangles > MAX_TRIANGLES:
+        return None  # beyond the rung's budget
+    where = start_point if start_point is not None else mission.robot.start
+    cells = partition(mesh)
+    # A U-turn inside one cell is no turn for the cell's field: the triangles' U-turns are
+    # allowed first; a plan that turns back across an interface is refused below, and the
+    # planner without U-turns (refined where they are needed) tried then.
+    times = move_times(mission)
+
+    def turning() -> tuple[Abstraction, Witness]:
+        witness = plan(
+            mesh,
+            planned.automaton,
+            formula=formula,
+            options=mission.options,
+            start_point=where,
+            bounces=True,
+            reject=ratio,
+            times=times,
+            on_cells=True,
+        )
+        return mesh, witness
+
+    def refined() -> tuple[Abstraction, Witness]:
+        return plan_complete(
+            mesh,
+            planned.automaton,
+            formula=formula,
+            options=mission.options,
+            start_point=where,
+            explain=False,
+            reject=ratio,
+            times=times,
+            on_cells=True,
+        )
+
+    attempts: tuple[Callable[[], tuple[Abstraction, Witness]], ...] = (turning, refined)
+    for attempt in attempts:
+        try:
+            found, witness = attempt()
+        except (NoPlanError, RefinementError):
+            continue
+        on = cells if found is mesh else partition(found)
+        if not witness.passages and witness_on_cells(
+            on, witness.prefix, witness.cycle, witness.is_stay, ratio, TOLERANCE
+        ):
+            witness = replace(witness, stats={**witness.stats, ON_CELLS: True})
+            return replace(planned, abstraction=found, witness=witness, formula=formula)
+    return None
+
+
+def _with_cells_bound(planned: Planned, ratio: float | None, mission: Mission) -> Planned:
+    """``planned`` (to be refused) stating ``ratio`` x max_speed as the largest disturbance
+    plans on convex cells reject, where that is more than it states already."""
+    if ratio is None:
+        return planned
+    value = ratio * mission.robot.max_speed
+    known = planned.witness.stats.get(SUPPORTED_CELLS)
+    if known is not None and float(known) >= value:
+        return planned
+    stats = {**planned.witness.stats, SUPPORTED_CELLS: value}
+    return replace(planned, witness=replace(planned.witness, stats=stats))
+
+
+def _on_lines(
+    mission: Mission, margin: float, planned: Planned, start_point: tuple[float, float] | None
+) -> tuple[Planned | None, float | None]:
+    """The cells' rung on the convex cells' own mesh (every side extended across the free
+    space, :mod:`tlmpc.abstraction.lines`: convex faces that meet side to side), with the
+    goal depth, then the margin's: the plan there, or (None, the largest disturbance ratio any
+    plan on those meshes' cells rejects, None when none was built: over the size budgets)."""
+    from tlmpc.abstraction import build_abstraction
+    from tlmpc.abstraction.layout import deepens_goals, planning_layout
+    from tlmpc.abstraction.triangulate import lines_fit
+    from tlmpc.ltl.bounds import untimed_skeleton
+    from tlmpc.planning.bottleneck import supported_ratio
+    from tlmpc.planning.cells import MAX_TRIANGLES
+
+    formula = planned.formula
+    bound: float | None = None
+    for deep in (True, False) if deepens_goals(mission) else (False,):
+        layout = planning_layout(mission, margin, deep=deep)
+        if not lines_fit(mission, layout):
+            continue
+        mesh = build_abstraction(mission, layout, lines=True)
+        if mesh.num_triangles > MAX_TRIANGLES:
+            continue
+        task = automaton_for(mission, mesh, formula=formula)
+        candidate = Planned(
+            abstraction=mesh, automaton=task, witness=planned.witness, formula=formula
+        )
+        found = _on_cells(mission, candidate, start_point)
+        if found is not None:
+            return replace(found, remeshed=True), None
+        supported = supported_ratio(
+            mesh,
+            task,
+            formula=formula if formula is not None else untimed_skeleton(mission.formula),
+            options=mission.options,
+            start_point=start_point if start_point is not None else mission.robot.start,
+            cells=True,
+        )
+        if supported is not None and (bound is None or supported > bound):
+            bound = supported
+    return None, bound
+
+
+def on_cells(witness: Witness) -> bool:
+    """True for a plan made on convex cells (its controllers are cell fields)."""
+    return bool(witness.stats.get(ON_CELLS, False))
 
 
 def _supported_of(witness: Witness) -> float | None:

@@ -38,7 +38,7 @@ from tlmpc.planning.lazy import lazy_product
 from tlmpc.planning.model import Witness
 from tlmpc.planning.passages import PassageCells, add_vertex_passages
 from tlmpc.planning.product import SLOTS, START_SLOT, BoolArray, Product, build_product
-from tlmpc.planning.robust import realisable
+from tlmpc.planning.robust import TOLERANCE, realisable
 from tlmpc.planning.search import closing_searches, shortest_paths
 from tlmpc.planning.timing import MoveTimes
 
@@ -103,6 +103,7 @@ def plan(
     guided: bool | None = None,
     reject: float | None = None,
     times: MoveTimes | None = None,
+    on_cells: bool = False,
 ) -> Witness:
     """A minimum-cost accepting lasso (raises :class:`NoPlanError` with an explanation).
 
@@ -115,7 +116,8 @@ def plan(
     (:mod:`tlmpc.planning.guided`: the same cost, for products too large to build); by
     default only when the product would not fit the budget (:mod:`tlmpc.planning.budget`).
     With ``reject`` (a disturbance over max_speed) only the moves and stays the controllers
-    realise under it are used (:mod:`tlmpc.planning.robust`).
+    realise under it are used (:mod:`tlmpc.planning.robust`); with ``on_cells``, those the
+    convex cells' fields realise (:mod:`tlmpc.planning.cells`).
     Under ``options.cost: time`` the moves weigh ``times`` (:mod:`tlmpc.planning.timing`;
     without it, their lengths at unit speed).
     """
@@ -145,6 +147,10 @@ def plan(
         )
 
     realisable_steps = None if reject is None else realisable(abstraction, reject)
+    if reject is not None and on_cells:
+        from tlmpc.planning.cells import cell_realisable, partition
+
+        realisable_steps = cell_realisable(partition(abstraction), reject, TOLERANCE)
     if guided is None:
         guided = not estimate_product(abstraction, automaton).fits
     if guided:

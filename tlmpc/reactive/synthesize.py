@@ -12,7 +12,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from tlmpc.abstraction.model import Abstraction
-from tlmpc.base.errors import Diagnostic, InvalidInputError, NoPlanError, error
+from tlmpc.base.errors import Diagnostic, InvalidInputError, error
 from tlmpc.mission.model import Mission, TaskPart
 from tlmpc.reactive.explain import counter_play, counter_play_steps, place
 from tlmpc.reactive.faces import Faces, faces_of
@@ -121,16 +121,6 @@ def strategy_to_json(synthesis: Synthesis) -> dict[str, Any]:
         "face_of": faces.face_of.tolist(),
     }
     return document
-
-
-class UnrealizableError(NoPlanError):
-    """An unrealizable reactive mission (exit 1): its diagnostics, and the artifacts that show
-    how the environment wins (``mission.json``, ``abstraction.json``,
-    ``counterstrategy.json``), which ``tlmpc compile`` writes before it reports."""
-
-    def __init__(self, diagnostics: list[Diagnostic], artifacts: dict[str, Any]) -> None:
-        super().__init__(diagnostics)
-        self.artifacts = artifacts
 
 
 def face_points(abstraction: Abstraction, faces: Faces) -> list[list[float]]:

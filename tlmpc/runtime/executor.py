@@ -74,6 +74,12 @@ class RunPlan:
     def of(cls, witness: Witness, controllers: Controllers) -> RunPlan:
         """The plan of a witness and its controllers (one controller per lasso triangle)."""
         states = (*witness.prefix_states, *witness.cycle_states)
+        if any(c.cell is not None for c in controllers.steps):
+            # cell steps: each ends in the state of the triangle it leaves its cell from
+            states = tuple(
+                states[c.cell.plan_index] if c.cell is not None else states[k]
+                for k, c in enumerate(controllers.steps)
+            )
         if len(states) != len(controllers.steps):
             raise UsageError(
                 error(
@@ -236,7 +242,14 @@ class Executor:
         controller = self.controller
         if controller.is_vertex:
             return self._pursuit(controller, point)
-        u: FloatArray = controller.gain @ point + controller.offset
+        gain, offset = controller.gain, controller.offset
+        if controller.cell is not None:
+            # the law of the cell's triangle the robot is in (the nearest piece just outside)
+            piece = controller.cell.piece_of(self._triangle) if self._triangle is not None else None
+            if piece is None:
+                piece = _nearest_piece(controller.cell.vertices, point)
+            gain, offset = controller.cell.gains[piece], controller.cell.offsets[piece]
+        u: FloatArray = gain @ point + offset
         speed = float(np.hypot(u[0], u[1]))
         limit = self.mission.robot.max_speed
         if speed > limit:  # only just outside the triangle: the field is bounded inside
@@ -412,9 +425,12 @@ class Executor:
             self._stop("violated", triangle)
             return
         following = self.plan.following(self._step)
+        cell = self.controller.cell
+        if cell is not None and triangle in cell.triangles:
+            return  # on through the step's own cell: the same label, the same field
         if (
             following is not None
-            and self.controller.next_triangle == triangle
+            and self._leads_to(following, triangle)
             and self.plan.states[following] in self._states
         ):
             if following <= self._step:  # the cycle wraps around: one more lap done
@@ -422,6 +438,14 @@ class Executor:
             self._step = following
             return
         self._recover(triangle, point)
+
+    def _leads_to(self, following: int, triangle: int) -> bool:
+        """Whether entering ``triangle`` is the move to step ``following`` (for a cell step:
+        into any triangle of the next step's cell)."""
+        nxt = self.plan.steps[following].cell
+        if self.controller.cell is not None and nxt is not None:
+            return triangle in nxt.triangles
+        return self.controller.next_triangle == triangle
 
     def _recover(self, triangle: int, point: FloatArray) -> None:
         step = self._reentry_step(triangle)
@@ -437,7 +461,12 @@ class Executor:
         candidates = [
             index
             for index, controller in enumerate(self.plan.steps)
-            if controller.triangle == triangle and self.plan.states[index] in self._states
+            if (
+                triangle in controller.cell.triangles
+                if controller.cell is not None
+                else controller.triangle == triangle
+            )
+            and self.plan.states[index] in self._states
         ]
         if not candidates:
             return None
@@ -493,3 +522,16 @@ class Executor:
                 step_after=step_after,
             )
         )
+
+
+def _nearest_piece(corners: FloatArray, point: FloatArray) -> int:
+    """The piece (triangle of a cell) whose smallest barycentric weight at ``point`` is
+    largest: the one holding it, or the nearest to it just outside."""
+    best, best_value = 0, -math.inf
+    for piece, (a, b, c) in enumerate(corners.tolist()):
+        matrix = np.array([[a[0], b[0], c[0]], [a[1], b[1], c[1]], [1.0, 1.0, 1.0]])
+        weights = np.linalg.solve(matrix, np.array([point[0], point[1], 1.0]))
+        value = float(weights.min())
+        if value > best_value:
+            best, best_value = piece, value
+    return best

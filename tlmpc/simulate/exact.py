@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, NoReturn
+from typing import Any, NoReturn, cast
 
 import numpy as np
 
@@ -27,6 +27,7 @@ from tlmpc.base.errors import SolverError, error
 from tlmpc.control.geometry import largest_of, triangle_geometry
 from tlmpc.control.model import Controllers, StepController
 from tlmpc.mission.model import Mission
+from tlmpc.simulate.cells import cell_step
 
 #: Samples per step (besides the crossings): grid points near SAMPLES_PER_STEP - 1 evenly
 #: spaced times.
@@ -79,6 +80,11 @@ def _taylor_degree(radius: float, cap: int) -> int:
         degree += 1
     return degree
 
+
+#: 0, 1, ..., m for each Taylor degree m of the local flow (read only).
+_EXPONENTS = tuple(np.arange(degree + 1) for degree in range(41))
+for _exponents in _EXPONENTS:
+    _exponents.setflags(write=False)
 
 #: The identity of the augmented matrices (read only: every use makes a new array).
 _IDENTITY_3 = np.eye(3)
@@ -155,15 +161,21 @@ def bracketed_root(
 
 
 def _local_flow(
-    matrix: FloatArray, base: FloatArray, reach: float, normal: FloatArray, offset: float
+    matrix: FloatArray,
+    base: FloatArray,
+    reach: float,
+    normal: FloatArray,
+    offset: float,
+    norm: float | None = None,
 ) -> tuple[Callable[[float], FloatArray], Callable[[float], float]]:
     """s -> x(s) = expm(sM) base and s -> normal·x(s) - offset for 0 <= s <= reach.
 
     Over a short reach the Taylor series of expm(sM) base is a polynomial in s with vector
     coefficients M^k base / k!, so the exit height is a scalar polynomial: a root search costs
-    a few Horner steps per evaluation instead of a matrix exponential.
+    a few Horner steps per evaluation instead of a matrix exponential.  ``norm`` is the
+    matrix's column norm when known.
     """
-    radius = _column_norm(matrix) * reach
+    radius = (_column_norm(matrix) if norm is None else norm) * reach
     if radius > SERIES_RADIUS:
 
         def far_point(s: float) -> FloatArray:
@@ -181,7 +193,7 @@ def _local_flow(
     heights = (coefficients_of_x[:, :2] @ normal).tolist()
     heights[0] -= offset
     reversed_heights = heights[::-1]
-    exponents = np.arange(degree + 1)
+    exponents = _EXPONENTS[degree]
 
     def point(s: float) -> FloatArray:
         return np.asarray((s**exponents) @ coefficients_of_x, dtype=np.float64)
@@ -195,8 +207,28 @@ def _local_flow(
     return point, height
 
 
-def _exit_step(controller: StepController, x0: FloatArray) -> tuple[list[float], list[FloatArray]]:
-    """Times and points of one exit step, ending with the crossing (snapped to the edge)."""
+@dataclass(frozen=True, slots=True)
+class _ExitFrame:
+    """What an exit step's flow needs of its controller whatever the state it starts from,
+    computed once per controller (a lasso's cycle is simulated twice): the same numbers, by
+    the same operations, as computing them at every step."""
+
+    normal: FloatArray  # the exit facet's outward normal
+    edge_offset: float  # n·x on the exit facet (map coordinates)
+    corners: list[list[float]]
+    tallest: float
+    scale: float  # the triangle's largest coordinate plus its tallest height
+    center: FloatArray
+    matrix: FloatArray  # the augmented matrix of the field relative to ``center``
+    matrix_norm: float  # its column norm
+    offset: float  # n·y on the exit facet (relative to ``center``)
+    others: list[int]  # the two facets it must not cross
+    other_normals: FloatArray
+    other_offsets: FloatArray
+    slack: float
+
+
+def _exit_frame(controller: StepController) -> _ExitFrame:
     assert controller.exit_edge is not None
     geometry = triangle_geometry(controller.vertices)
     normal = geometry.normals[controller.exit_edge]
@@ -205,18 +237,48 @@ def _exit_step(controller: StepController, x0: FloatArray) -> tuple[list[float],
     # their per-call cost was most of the stage.
     corners = geometry.vertices.tolist()
     tallest = largest_of(geometry.heights.tolist())
-    scale = largest_of([abs(c) for corner in corners for c in corner]) + tallest
-    if geometry.offsets[controller.exit_edge] - normal @ x0 <= 1e-12 * scale:
-        return [0.0], [x0]  # already on the exit edge (to rounding): the crossing is now
     # Coordinates relative to the triangle: y = x - center obeys y' = K y + v(center), whose
     # augmented matrix has the size of the field, not of the map's coordinates (far from the
     # origin the global offset g would dominate it and scaling and squaring would lose digits).
     (x1, y1), (x2, y2), (x3, y3) = corners
     center = np.array([(x1 + x2 + x3) / 3, (y1 + y2 + y3) / 3])
     matrix = _augmented(controller.gain, controller.gain @ center + controller.offset)
-    offset = float(geometry.offsets[controller.exit_edge] - normal @ center)
+    # The other two facets, watched too: a field that leaves by an unplanned facet is a bug the
+    # simulation must report, not hide by snapping the crossing onto the planned edge.
+    others = [j for j in range(3) if j != controller.exit_edge]
+    other_normals = geometry.normals[others]
+    return _ExitFrame(
+        normal=normal,
+        edge_offset=geometry.offsets[controller.exit_edge],
+        corners=corners,
+        tallest=tallest,
+        scale=largest_of([abs(c) for corner in corners for c in corner]) + tallest,
+        center=center,
+        matrix=matrix,
+        matrix_norm=_column_norm(matrix),
+        offset=float(geometry.offsets[controller.exit_edge] - normal @ center),
+        others=others,
+        other_normals=other_normals,
+        other_offsets=geometry.offsets[others] - other_normals @ center,
+        slack=WRONG_FACET_TOLERANCE * tallest,
+    )
+
+
+def _exit_step(
+    controller: StepController, x0: FloatArray, frame: _ExitFrame | None = None
+) -> tuple[list[float], list[FloatArray]]:
+    """Times and points of one exit step, ending with the crossing (snapped to the edge);
+    ``frame`` is the controller's :func:`_exit_frame` when already computed."""
+    assert controller.exit_edge is not None
+    if frame is None:
+        frame = _exit_frame(controller)
+    normal, corners, center, matrix = frame.normal, frame.corners, frame.center, frame.matrix
+    if frame.edge_offset - normal @ x0 <= 1e-12 * frame.scale:
+        return [0.0], [x0]  # already on the exit edge (to rounding): the crossing is now
+    offset = frame.offset
     y0 = x0 - center
-    gap = offset - normal @ y0
+    # (numpy's scalar: its division semantics, as computed per step before the frames)
+    gap = cast(float, offset - normal @ y0)
     horizon = gap / controller.exit_speed
     # h(t) < 0 until the crossing and grows at least at the exit speed inside the triangle, so
     # the first grid point with h >= 0 brackets the crossing (one matrix exponential for the
@@ -227,13 +289,9 @@ def _exit_step(controller: StepController, x0: FloatArray) -> tuple[list[float],
     stack[0] = step
     for power in range(1, GRID_CHUNK):
         np.matmul(step, stack[power - 1], out=stack[power])
-    state = np.array([y0[0], y0[1], 1.0])
-    # The other two facets, watched too: a field that leaves by an unplanned facet is a bug the
-    # simulation must report, not hide by snapping the crossing onto the planned edge.
-    others = [j for j in range(3) if j != controller.exit_edge]
-    other_normals = geometry.normals[others]
-    other_offsets = geometry.offsets[others] - other_normals @ center
-    slack = WRONG_FACET_TOLERANCE * tallest
+    start = np.array([y0[0], y0[1], 1.0])
+    state = start
+    others = frame.others
     # All grid states, chunk after chunk from the last state of the one before, then one check
     # of them all (states past the crossing are computed and not used).
     grid_states = np.empty((GRID_POINTS, 3))
@@ -245,7 +303,9 @@ def _exit_step(controller: StepController, x0: FloatArray) -> tuple[list[float],
     # (argmax of a boolean array: its first True, or 0 when there is none).
     reached = grid_states[:, :2] @ normal - offset >= 0.0
     k = int(reached.argmax())
-    beyond = (grid_states[:, :2] @ other_normals.T - other_offsets).max(axis=1) > slack
+    beyond = (grid_states[:, :2] @ frame.other_normals.T - frame.other_offsets).max(
+        axis=1
+    ) > frame.slack
     first_outside = int(beyond.argmax())
     if beyond[first_outside] and (not reached[k] or first_outside < k):
         _wrong_exit(controller, others, grid_states[first_outside, :2] + center)
@@ -258,11 +318,8 @@ def _exit_step(controller: StepController, x0: FloatArray) -> tuple[list[float],
                 hint="please report this mission",
             )
         )
-    start = np.array([y0[0], y0[1], 1.0])
-    inside = [grid_states[:k]]  # grid states before the crossing
-    bracket = (k * dt, start if k == 0 else grid_states[k - 1])
-    lower, before = bracket
-    point, height = _local_flow(matrix, before, dt, normal, offset)
+    lower, before = k * dt, start if k == 0 else grid_states[k - 1]
+    point, height = _local_flow(matrix, before, dt, normal, offset, frame.matrix_norm)
     if height(0.0) >= 0.0:
         within = 0.0  # rounding put the bracket's start on the edge already
     elif height(dt) < 0.0:
@@ -274,9 +331,8 @@ def _exit_step(controller: StepController, x0: FloatArray) -> tuple[list[float],
     crossing = lower + within
     end = point(within)[:2] + center
     # Samples: the grid points nearest to evenly spaced times (exact states, no extra work).
-    grid = np.concatenate(inside)
-    wanted = np.rint(np.arange(1, SAMPLES_PER_STEP) * (crossing / SAMPLES_PER_STEP) / dt)
-    indices = sorted({int(j) for j in wanted.tolist() if 1 <= j <= len(grid)})
+    grid = grid_states[:k]  # grid states before the crossing
+    indices = _sample_indices(float(crossing), float(dt), k)
     times = [float(j * dt) for j in indices]
     points = list(grid[[j - 1 for j in indices], :2] + center)
     # Snap onto the exit edge (the root is exact to ~1e-14; this removes the residue).
@@ -291,6 +347,16 @@ def _exit_step(controller: StepController, x0: FloatArray) -> tuple[list[float],
         _wrong_exit(controller, others, end)
     along = min(max(along, 0.0), 1.0)
     return [*times, float(crossing)], [*points, np.array([ax + along * dx, ay + along * dy])]
+
+
+def _sample_indices(crossing: float, dt: float, count: int) -> list[int]:
+    """The grid points (1 .. ``count``) nearest to the times j * crossing / SAMPLES_PER_STEP,
+    j = 1 .. SAMPLES_PER_STEP - 1, each once, in order: (j * (crossing / SAMPLES_PER_STEP)) / dt
+    rounded half to even, as numpy's ``rint`` rounds (Python's ``round`` on the same floats
+    rounds alike, without numpy's per-call cost)."""
+    share = crossing / SAMPLES_PER_STEP
+    wanted = {round(j * share / dt) for j in range(1, SAMPLES_PER_STEP)}
+    return sorted(j for j in wanted if 1 <= j <= count)
 
 
 def exit_step(controller: StepController, x0: FloatArray) -> tuple[list[float], list[FloatArray]]:
@@ -367,17 +433,39 @@ def simulate(abstraction: Abstraction, controllers: Controllers, mission: Missio
     triangle_of: list[int] = [steps[order[0]].triangle]
     crossings: list[int] = []
     loop_index: int | None = None
+    frames: dict[int, _ExitFrame] = {}  # per plan step: the cycle's second lap reuses them
     now = 0.0
     for position, index in enumerate(order):
         controller = steps[index]
         if loop_start_step is not None and index == loop_start_step and position == len(steps):
             loop_index = len(points) - 1  # the crossing into the second lap
+        if controller.is_cell:
+            cell_times, cell_points, cell_triangles, cell_crossings = cell_step(
+                controller, x, controllers.max_speed
+            )
+            for t, point, triangle, crossed in zip(
+                cell_times, cell_points, cell_triangles, cell_crossings, strict=True
+            ):
+                if t <= 0.0:
+                    continue
+                times.append(now + t)
+                points.append(point)
+                step_of.append(index)
+                triangle_of.append(triangle)
+                if crossed:
+                    crossings.append(len(points) - 1)
+            now = times[-1]
+            x = points[-1]
+            continue
         if controller.is_vertex:
             rel_times, rel_points = pursuit_step(controller, x, controllers.max_speed)
         elif controller.exit_edge is None:
             rel_times, rel_points = _stay_step(controller, x, controllers.max_speed)
         else:
-            rel_times, rel_points = _exit_step(controller, x)
+            frame = frames.get(index)
+            if frame is None:
+                frame = frames[index] = _exit_frame(controller)
+            rel_times, rel_points = _exit_step(controller, x, frame)
         for offset, (t, point) in enumerate(zip(rel_times, rel_points, strict=True)):
             if t <= 0.0:  # already on the exit edge: the current sample is the crossing
                 if controller.next_triangle is not None:
@@ -414,14 +502,12 @@ def trace_header(mission: Mission, max_speed: float) -> dict[str, Any]:
     verifies on its own: task, regions, every workspace piece, convention, speed, body."""
     from tlmpc.ltl.printer import to_text
     from tlmpc.mission.body import body_radius
-
-    def poly(points: tuple[tuple[float, float], ...]) -> list[list[float]]:
-        return list(map(list, points))  # thousands of regions: no per-point Python frame
+    from tlmpc.mission.model import regions_document
 
     return {
         "format": "tlmpc.trace/1",
         "ltl": to_text(mission.formula),
-        "regions": {r.name: poly(r.polygon) for r in mission.regions},
+        "regions": regions_document([(r.name, r.polygon) for r in mission.regions]),
         "workspace": mission.workspace.to_json(),
         "boundary": mission.options.boundary,
         "max_speed": max_speed,

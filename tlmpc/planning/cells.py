@@ -1,0 +1,547 @@
+"""Convex cells of a mesh and the disturbance their fields reject (beyond a triangle's angles).
+
+A *cell* is a connected group of triangles with one label set and one component whose union
+is a convex polygon. The partition is deterministic (Hertel-Mehlhorn style): every edge between
+two such triangles is a candidate, sharpest first (the smallest triangle angle at its ends,
+then by index), and the two cells across it merge when their union is convex (collinear
+corners allowed).
+
+A *cell move* leaves cell C for a neighbour cell C' across their interface I (every mesh edge
+the two share: a single segment, as both are convex). Its field is the continuous piecewise
+affine interpolation of one velocity u_v per mesh vertex of C, with, at every vertex where
+they apply:
+
+* |u_v| <= max_speed;
+* m_e·u_v >= d on both endpoints of every side e of C outside I (m_e its inward unit normal);
+* xi·u_v >= d (plus a margin) at every vertex of C, for one unit direction xi.
+
+All rows are linear in x on each triangle, so they hold on the whole cell: on a kept side the
+closed loop points inward against any push |w| <= d, and xi·x grows at a positive rate, so
+the robot leaves the bounded cell, and only through I. Each vertex's rows involve that vertex
+alone, so the largest d the rows admit is the smallest *vertex push*: the best
+min_k a_k·u over |u| <= 1 for the vertex's normals a_k, which is cos(s / 2) for unit normals
+spanning an arc of s < 180 degrees (the bisector of the arc's ends attains it, and any other
+direction is farther than s / 2 from one end).
+
+The direction xi is searched over a fixed fan (FAN directions round the circle from I's mean
+outward normal, then a finer fan about the best); the move's *width* (in units of max_speed)
+is the smallest vertex push at the best xi found. Where I meets a collinear kept side the
+normal of I is infeasible (its two rows are opposite) and a tilted xi is not: hence a search.
+
+A *cell stay* uses the radial law u = kappa (c - x), affine on the whole cell, with
+kappa = max_speed / R (R the largest distance from c to a corner): on every side it pushes
+inward by kappa times c's distance to the side's line, so its width is r / R (r the smallest
+such distance), and under any push of norm d < kappa r the state converges into the disc of
+radius d / kappa about c, inside the cell. The centre c maximises r / R (a pattern search from
+the area centroid, a fixed number of halvings).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+import numpy.typing as npt
+
+from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
+
+BoolArray = npt.NDArray[np.bool_]
+Vector = tuple[float, float]
+
+#: The convex cells' rung's budget, in triangles of the mesh: the partition and the fan search
+#: of every cell move run in Python, about a millisecond a move (a mesh of Example 8's size,
+#: nine thousand triangles, would take minutes per mesh tried).
+MAX_TRIANGLES = 4000
+
+#: A corner counts as collinear (180 degrees) when its turn is below this, relative to the
+#: product of its two side lengths.
+COLLINEAR = 1e-8
+#: The stay centre's pattern search halves its step this many times.
+CENTRE_HALVINGS = 40
+
+
+@dataclass(frozen=True, slots=True)
+class Side:
+    """One mesh edge on a cell's boundary: from ``start`` to ``end`` (counter-clockwise), the
+    triangle holding it, its local index there, and the cell across it (-1: none)."""
+
+    start: int
+    end: int
+    triangle: int
+    edge: int
+    neighbour: int
+
+
+@dataclass(frozen=True, slots=True)
+class Cell:
+    """A convex union of triangles: its triangles, its boundary (counter-clockwise mesh
+    vertices, collinear ones included), its sides (boundary[k] -> boundary[k + 1]) and all
+    its mesh vertices (the interior ones too), sorted."""
+
+    index: int
+    triangles: tuple[int, ...]
+    boundary: tuple[int, ...]
+    sides: tuple[Side, ...]
+    vertices: tuple[int, ...]
+
+
+@dataclass(frozen=True, slots=True)
+class CellMove:
+    """The field family of leaving ``cell`` for ``target``: the flow direction ``xi``, the
+    width (the largest disturbance over max_speed its rows admit), and the sides kept."""
+
+    cell: int
+    target: int
+    xi: Vector
+    width: float
+    kept: tuple[int, ...]  # indices into the cell's sides
+    interface: tuple[int, ...]  # indices into the cell's sides
+
+
+@dataclass(frozen=True, slots=True)
+class CellStay:
+    """The radial stay of ``cell``: centre, gain kappa / max_speed and width r / R."""
+
+    cell: int
+    centre: Vector
+    rate: float  # kappa / max_speed = 1 / R
+    width: float
+
+
+@dataclass(frozen=True)
+class Cells:
+    """A partition of a mesh's triangles into convex cells."""
+
+    abstraction: Abstraction
+    cell_of: IntArray  # (m,)
+    cells: tuple[Cell, ...]
+
+    def inward(self, cell: int, side: int) -> Vector:
+        """The inward unit normal of a side of ``cell``."""
+        s = self.cells[cell].sides[side]
+        (ax, ay), (bx, by) = self._point(s.start), self._point(s.end)
+        dx, dy = bx - ax, by - ay
+        length = math.hypot(dx, dy)
+        return (-dy / length, dx / length)
+
+    def _point(self, vertex: int) -> Vector:
+        x, y = self.abstraction.vertices[vertex].tolist()
+        return (float(x), float(y))
+
+    def vertex_normals(self, move: CellMove) -> dict[int, list[Vector]]:
+        """Per mesh vertex of the cell: the inward normals of the kept sides through it."""
+        normals: dict[int, list[Vector]] = {v: [] for v in self.cells[move.cell].vertices}
+        for k in move.kept:
+            side = self.cells[move.cell].sides[k]
+            normal = self.inward(move.cell, k)
+            normals[side.start].append(normal)
+            normals[side.end].append(normal)
+        return normals
+
+    def move(self, cell: int, target: int) -> CellMove:
+        """The move from ``cell`` to the adjacent ``target`` (width 0 when they share no
+        edge or the interface is not one run of sides)."""
+        return self._moves.get((cell, target)) or _no_move(cell, target)
+
+    def stay(self, cell: int) -> CellStay:
+        """The radial stay of ``cell``."""
+        return self._stays[cell]
+
+    @cached_property
+    def _moves(self) -> dict[tuple[int, int], CellMove]:
+        moves = {}
+        for cell in self.cells:
+            for target in sorted({s.neighbour for s in cell.sides if s.neighbour >= 0}):
+                moves[cell.index, target] = _move(self, cell.index, target)
+        return moves
+
+    @cached_property
+    def _stays(self) -> tuple[CellStay, ...]:
+        return tuple(_stay(self, cell.index) for cell in self.cells)
+
+
+def _no_move(cell: int, target: int) -> CellMove:
+    return CellMove(cell=cell, target=target, xi=(1.0, 0.0), width=0.0, kept=(), interface=())
+
+
+def vertex_push(normals: list[Vector]) -> float:
+    """max over unit u of min_k a_k·u for unit normals a_k: cos(s / 2) for the arc of s
+    degrees holding them all (1 with no normal, at most 0 when no open half-plane does)."""
+    if not normals:
+        return 1.0
+    angles = sorted(math.atan2(y, x) for x, y in normals)
+    # the arc holding them all is the circle less its widest gap between consecutive angles
+    gaps = [b - a for a, b in itertools.pairwise(angles)]
+    gaps.append(angles[0] + 2.0 * math.pi - angles[-1])
+    spread = 2.0 * math.pi - max(gaps)
+    return math.cos(spread / 2.0) if spread < math.pi else 0.0
+
+
+def _move(cells: Cells, cell: int, target: int) -> CellMove:
+    sides = cells.cells[cell].sides
+    interface = tuple(k for k, s in enumerate(sides) if s.neighbour == target)
+    kept = tuple(k for k, s in enumerate(sides) if s.neighbour != target)
+    count = len(sides)
+    # one run of consecutive sides (cyclically), all on one line: the interface of two convex
+    # cells
+    runs = sum(1 for k in interface if (k - 1) % count not in interface)
+    if runs != 1 or not kept:
+        return _no_move(cell, target)
+    outward = [(-a, -b) for a, b in (cells.inward(cell, k) for k in interface)]
+    nx = sum(a for a, _ in outward) / len(outward)
+    ny = sum(b for _, b in outward) / len(outward)
+    base = math.atan2(ny, nx)
+    move = CellMove(cell=cell, target=target, xi=(nx, ny), width=0.0, kept=kept, interface=())
+    groups = [normals for normals in cells.vertex_normals(move).values() if normals]
+    # the fan: FAN directions round the circle from I's outward normal, then a finer fan
+    # about the best of it
+    turns: FloatArray = base + np.arange(FAN, dtype=np.float64) * (2.0 * math.pi / FAN)
+    best = float(turns[int(np.argmax(_fan_widths(groups, turns)))])
+    fine: FloatArray = best + (np.arange(2 * FINE + 1, dtype=np.float64) - FINE) * (
+        2.0 * math.pi / FAN / FINE
+    )
+    best = float(fine[int(np.argmax(_fan_widths(groups, fine)))])
+    xi = (math.cos(best), math.sin(best))
+    width = min(vertex_push([*normals, xi]) for normals in groups)
+    return CellMove(
+        cell=cell, target=target, xi=xi, width=max(width, 0.0), kept=kept, interface=interface
+    )
+
+
+#: Directions of the fan searched for a cell move's flow direction xi (a full circle), and
+#: the finer fan's half count about the best of them (over one step of the first).
+FAN = 720
+FINE = 50
+
+
+def _fan_widths(groups: list[list[Vector]], turns: npt.NDArray[np.float64]) -> FloatArray:
+    """Per direction angle in ``turns``: the smallest vertex push with xi along it (the
+    vertices' kept normals in ``groups``), vectorised :func:`vertex_push`."""
+    widths = np.ones(len(turns))
+    for normals in groups:
+        angles = np.array([math.atan2(y, x) for x, y in normals])
+        every = np.concatenate(
+            [
+                np.broadcast_to(angles, (len(turns), len(angles))),
+                np.mod(turns, 2 * math.pi)[:, None],
+            ],
+            axis=1,
+        )
+        every = np.sort(np.mod(every, 2.0 * math.pi), axis=1)
+        gaps = np.diff(every, axis=1)
+        wrap = every[:, 0] + 2.0 * math.pi - every[:, -1]
+        widest = np.maximum(gaps.max(axis=1), wrap)
+        spread = 2.0 * math.pi - widest
+        widths = np.minimum(widths, np.where(spread < math.pi, np.cos(spread / 2.0), 0.0))
+    return widths
+
+
+def _stay(cells: Cells, cell: int) -> CellStay:
+    polygon = [cells._point(v) for v in cells.cells[cell].boundary]
+    lines = []
+    for k in range(len(polygon)):
+        (ax, ay), (bx, by) = polygon[k], polygon[(k + 1) % len(polygon)]
+        length = math.hypot(bx - ax, by - ay)
+        lines.append(((ay - by) / length, (bx - ax) / length, ax, ay))
+
+    def ratio(x: float, y: float) -> float:
+        inside = min(nx * (x - ax) + ny * (y - ay) for nx, ny, ax, ay in lines)
+        reach = max(math.hypot(px - x, py - y) for px, py in polygon)
+        return inside / reach if reach > 0.0 else 0.0
+
+    cx, cy = _centroid(polygon)
+    best = ratio(cx, cy)
+    step = max(math.hypot(px - cx, py - cy) for px, py in polygon) / 4.0
+    for _ in range(CENTRE_HALVINGS):
+        moved = True
+        while moved:
+            moved = False
+            for dx, dy in ((step, 0.0), (-step, 0.0), (0.0, step), (0.0, -step)):
+                value = ratio(cx + dx, cy + dy)
+                if value > best:
+                    best, cx, cy, moved = value, cx + dx, cy + dy, True
+                    break
+        step /= 2.0
+    reach = max(math.hypot(px - cx, py - cy) for px, py in polygon)
+    return CellStay(cell=cell, centre=(cx, cy), rate=1.0 / reach, width=max(best, 0.0))
+
+
+def _centroid(polygon: list[Vector]) -> Vector:
+    area = sx = sy = 0.0
+    x0, y0 = polygon[0]
+    for (ax, ay), (bx, by) in zip(polygon, [*polygon[1:], polygon[0]], strict=True):
+        cross = (ax - x0) * (by - y0) - (bx - x0) * (ay - y0)
+        area += cross
+        sx += (ax - x0 + bx - x0) * cross
+        sy += (ay - y0 + by - y0) * cross
+    if area == 0.0:
+        return polygon[0]
+    return (x0 + sx / (3.0 * area), y0 + sy / (3.0 * area))
+
+
+def _turn(a: Vector, b: Vector, c: Vector) -> float:
+    """The cross product (b - a) x (c - b) relative to the sides' lengths: > 0 a left turn."""
+    ux, uy, vx, vy = b[0] - a[0], b[1] - a[1], c[0] - b[0], c[1] - b[1]
+    scale = math.hypot(ux, uy) * math.hypot(vx, vy)
+    return (ux * vy - uy * vx) / scale if scale > 0.0 else 0.0
+
+
+def partition(abstraction: Abstraction) -> Cells:
+    """The convex cells of ``abstraction`` (see the module doc)."""
+    triangles = abstraction.triangles.tolist()
+    neighbours = abstraction.neighbors.tolist()
+    letter = abstraction.letter_of.tolist()
+    component = abstraction.component.tolist()
+    points = [(float(x), float(y)) for x, y in abstraction.vertices.tolist()]
+    count = len(triangles)
+    angles = _corner_angles(points, triangles)
+    # Every inner edge between triangles of one letter and component, sharpest first: the
+    # smallest triangle angle at its ends (merging there widens a corner), then by index.
+    candidates = []
+    for t in range(count):
+        for edge in range(3):
+            there = neighbours[t][edge]
+            if there <= t or letter[there] != letter[t] or component[there] != component[t]:
+                continue
+            back = neighbours[there].index(t)
+            key = min(
+                angles[t][(edge + 1) % 3],
+                angles[t][(edge + 2) % 3],
+                angles[there][(back + 1) % 3],
+                angles[there][(back + 2) % 3],
+            )
+            candidates.append((key, t, there))
+    candidates.sort()
+    faces = abstraction.stats.get("cell_faces")
+    if faces is not None and len(faces) == count:
+        # the convex cells' mesh (tlmpc.abstraction.lines): its faces are the cells, convex
+        # and meeting side to side; a merge across two would leave a part of a side between
+        # them and the next
+        candidates = [c for c in candidates if faces[c[1]] == faces[c[2]]]
+    owner = list(range(count))  # union-find over triangles
+    boundary: dict[int, list[int]] = {t: list(triangles[t]) for t in range(count)}
+
+    def find(t: int) -> int:
+        while owner[t] != t:
+            owner[t] = owner[owner[t]]
+            t = owner[t]
+        return t
+
+    for _, t, there in candidates:
+        a, b = find(t), find(there)
+        if a == b:
+            continue
+        union = _merged(boundary[a], boundary[b], points)
+        if union is None:
+            continue
+        low, high = min(a, b), max(a, b)
+        owner[high] = low
+        boundary[low] = union
+        del boundary[high]
+    roots = sorted(boundary)
+    number = {root: k for k, root in enumerate(roots)}
+    cell_of = [number[find(t)] for t in range(count)]
+    members: list[list[int]] = [[] for _ in roots]
+    for t in range(count):
+        members[cell_of[t]].append(t)
+    cells = []
+    for index, root in enumerate(roots):
+        cycle = boundary[root]
+        edge_of: dict[tuple[int, int], tuple[int, int]] = {}
+        for t in members[index]:
+            for edge in range(3):
+                a, b = triangles[t][(edge + 1) % 3], triangles[t][(edge + 2) % 3]
+                edge_of[a, b] = (t, edge)
+        sides = []
+        for k, a in enumerate(cycle):
+            b = cycle[(k + 1) % len(cycle)]
+            t, edge = edge_of[a, b]
+            there = neighbours[t][edge]
+            sides.append(Side(a, b, t, edge, cell_of[there] if there >= 0 else -1))
+        vertices = sorted({v for t in members[index] for v in triangles[t]})
+        cells.append(
+            Cell(index, tuple(members[index]), tuple(cycle), tuple(sides), tuple(vertices))
+        )
+    return Cells(
+        abstraction=abstraction, cell_of=np.asarray(cell_of, dtype=np.int64), cells=tuple(cells)
+    )
+
+
+def _corner_angles(points: list[Vector], triangles: list[list[int]]) -> list[list[float]]:
+    found = []
+    for corners in triangles:
+        row = []
+        for i in range(3):
+            (px, py), (ax, ay), (bx, by) = (points[corners[(i + k) % 3]] for k in range(3))
+            ux, uy, vx, vy = ax - px, ay - py, bx - px, by - py
+            row.append(math.atan2(abs(ux * vy - uy * vx), ux * vx + uy * vy))
+        found.append(row)
+    return found
+
+
+def _merged(first: list[int], second: list[int], points: list[Vector]) -> list[int] | None:
+    """The boundary of the union of two convex cells sharing one chain of edges, or None when
+    that union is not convex. The chain runs counter-clockwise c_0 .. c_k in ``first`` and
+    backwards in ``second``; its inner vertices fall inside the union."""
+    shared = set(first) & set(second)
+    size = len(first)
+    # the chain's first vertex in ``first``: shared, its predecessor not
+    starts = [i for i in range(size) if first[i] in shared and first[i - 1] not in shared]
+    if len(starts) != 1:
+        return None
+    begin = starts[0]
+    run = 0
+    while run < size and first[(begin + run) % size] in shared:
+        run += 1
+    if run < 2 or run != len(shared):
+        return None
+    c_start, c_end = first[begin], first[(begin + run - 1) % size]
+    # ``first`` from c_end round to c_start, then ``second`` from c_start round to c_end
+    one = [first[(begin + run - 1 + k) % size] for k in range(size - run + 2)]
+    at = second.index(c_start)
+    other_size = len(second)
+    two = [second[(at + k) % other_size] for k in range(other_size - run + 2)]
+    if one[-1] != c_start or two[-1] != c_end:
+        return None
+    union = one[:-1] + two[:-1]
+    for k in range(len(union)):
+        a, b, c = (points[union[(k + j) % len(union)]] for j in range(3))
+        if _turn(a, b, c) < -COLLINEAR:
+            return None
+    return union
+
+
+def cell_realisable(cells: Cells, ratio: float, tolerance: float) -> tuple[BoolArray, BoolArray]:
+    """(m, 3) moves and (m,) stays realisable on cells under ``ratio`` x max_speed: a move
+    inside one cell always (the cell's field carries the robot on; the labels are the same),
+    one into another cell when that cell move's width exceeds the ratio, a stay when its
+    cell's stay does."""
+    abstraction = cells.abstraction
+    need = ratio + tolerance
+    here = cells.cell_of
+    moves = np.zeros(abstraction.neighbors.shape, dtype=bool)
+    stays = np.zeros(len(here), dtype=bool)
+    for t, row in enumerate(abstraction.neighbors.tolist()):
+        for i, there in enumerate(row):
+            if there < 0:
+                continue
+            a, b = int(here[t]), int(here[there])
+            moves[t, i] = a == b or cells.move(a, b).width > need
+        stays[t] = cells.stay(int(here[t])).width > need
+    return moves, stays
+
+
+def cell_widths(cells: Cells) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    """(m, 3) and (m,): per move its width on cells (inf inside one cell: no step of its
+    own) and per triangle its cell's stay width."""
+    abstraction = cells.abstraction
+    here = cells.cell_of
+    moves = np.full(abstraction.neighbors.shape, np.inf)
+    for t, row in enumerate(abstraction.neighbors.tolist()):
+        for i, there in enumerate(row):
+            if there >= 0 and here[t] != here[there]:
+                moves[t, i] = cells.move(int(here[t]), int(here[there])).width
+    stays = np.array([cells.stay(int(c)).width for c in here.tolist()], dtype=np.float64)
+    return moves, stays
+
+
+@dataclass(frozen=True, slots=True)
+class CellGroup:
+    """Consecutive plan steps inside one cell: its cell, the cell it leaves for (None: the
+    robot stays in the cell for good) and the indices of the plan's triangles it covers
+    (into prefix + cycle)."""
+
+    cell: int
+    target: int | None
+    indices: tuple[int, ...]
+
+
+def cell_groups(
+    cells: Cells, prefix: tuple[int, ...], cycle: tuple[int, ...], is_stay: bool
+) -> tuple[list[CellGroup], int | None]:
+    """The plan ``prefix + cycle^omega`` as cell steps, and the first step of a moving cycle.
+
+    Consecutive triangles of one cell are one step. A cycle inside one cell is a stay of that
+    cell (the robot stays in one label set: the same word up to stutter). Where the cycle's
+    last and first runs share a cell, the robot coming round is already in the first run's
+    cell: the last run is part of the first. A prefix ending in the cycle's first cell hands
+    over to the cycle there.
+    """
+    here = cells.cell_of
+    path = [*prefix, *cycle]
+
+    def runs(indices: list[int]) -> list[list[int]]:
+        found: list[list[int]] = []
+        for i in indices:
+            if found and here[path[found[-1][-1]]] == here[path[i]]:
+                found[-1].append(i)
+            else:
+                found.append([i])
+        return found
+
+    head = runs(list(range(len(prefix))))
+    loop = runs(list(range(len(prefix), len(path))))
+    if is_stay or len(loop) == 1:
+        # the robot ends in one cell for good: the prefix's runs up to it, then the stay
+        last = int(here[path[loop[0][0]]])
+        if head and int(here[path[head[-1][0]]]) == last:
+            loop[0] = [*head.pop(), *loop[0]]
+        groups = [
+            CellGroup(int(here[path[r[0]]]), int(here[path[nxt[0]]]), tuple(r))
+            for r, nxt in zip(head, [*head[1:], loop[0]][: len(head)], strict=True)
+        ]
+        indices = [i for r in loop for i in r]
+        groups.append(CellGroup(last, None, tuple(indices)))
+        return groups, None
+    if int(here[path[loop[-1][0]]]) == int(here[path[loop[0][0]]]):
+        loop[0] = [*loop[0], *loop.pop()]
+    if head and int(here[path[head[-1][0]]]) == int(here[path[loop[0][0]]]):
+        loop[0] = [*head.pop(), *loop[0]]
+    ordered = [*head, *loop]
+    following = [*ordered[1:], loop[0]]
+    groups = [
+        CellGroup(int(here[path[r[0]]]), int(here[path[nxt[0]]]), tuple(r))
+        for r, nxt in zip(ordered, following, strict=True)
+    ]
+    return groups, len(head)
+
+
+def group_bounces(groups: list[CellGroup], loop_start: int | None) -> int | None:
+    """The first cell step that leaves for the cell it came from (None: none does). Its field
+    would push the robot straight back across the interface it entered by."""
+    for k, group in enumerate(groups):
+        if group.target is None:
+            continue
+        entries = [groups[k - 1].cell] if k > 0 else []
+        if loop_start is not None and k == loop_start:
+            entries.append(groups[-1].cell)
+        if group.target in entries:
+            return k
+    return None
+
+
+def witness_on_cells(
+    cells: Cells,
+    prefix: tuple[int, ...],
+    cycle: tuple[int, ...],
+    is_stay: bool,
+    ratio: float,
+    tolerance: float,
+) -> bool:
+    """True when every cell step of the plan rejects ``ratio`` x max_speed (with
+    ``tolerance``) and none leaves for the cell it came from."""
+    groups, loop_start = cell_groups(cells, prefix, cycle, is_stay)
+    if group_bounces(groups, loop_start) is not None:
+        return False
+    need = ratio + tolerance
+    for group in groups:
+        if group.target is None:
+            width = cells.stay(group.cell).width
+        else:
+            width = cells.move(group.cell, group.target).width
+        if not width > need:
+            return False
+    return True
