@@ -25,6 +25,7 @@ Run: ``python bench/bench_geodesic.py`` (about a minute).
 from __future__ import annotations
 
 import functools
+import itertools
 import math
 import random
 import sys
@@ -111,6 +112,67 @@ def generated(seed: int, *, radius: float = 0.0, patrol: bool = False) -> Worklo
     name = f"room-{seed}" + (f" r={radius:g}" if radius else "") + (" patrol" if patrol else "")
     groups = (("a", "b", "c"),) if patrol else (("a",), ("b",), ("c",))
     return Workload(name, document, groups, avoid=("pond",), patrol=patrol)
+
+
+def held_out() -> list[Workload]:
+    """Missions written for this bench alone (no shipped spec, no generator): an office
+    floor with a point robot, a warehouse aisle with a body, a patrol around a courtyard."""
+    office = {
+        "version": 1,
+        "name": "office",
+        "workspace": {
+            "boundary": {"rect": [0, 0, 20, 12]},
+            "holes": [
+                {"rect": [4, 0, 4.3, 8]},
+                {"rect": [9, 4, 9.3, 12]},
+                {"rect": [14, 0, 14.3, 7]},
+                {"rect": [16, 9, 20, 9.3]},
+            ],
+        },
+        "regions": {
+            "desk": {"rect": [1, 9, 3, 11]},
+            "printer": {"rect": [11, 0.5, 12.5, 2]},
+            "kitchen": {"rect": [17, 10, 19.5, 11.7]},
+            "wet": {"rect": [6, 5, 7.5, 7]},
+        },
+        "robot": {"start": [1.0, 1.0], "max_speed": 1.0},
+        "task": ["visit desk then printer then kitchen", "avoid wet"],
+    }
+    warehouse = {
+        "version": 1,
+        "name": "warehouse",
+        "workspace": {
+            "boundary": {"rect": [0, 0, 24, 14]},
+            "holes": [{"rect": [3 + 4 * k, 2, 4.2 + 4 * k, 11]} for k in range(5)],
+        },
+        "regions": {
+            "pick": {"rect": [8.4, 12, 10.6, 13.6]},
+            "pack": {"rect": [21.5, 1, 23.5, 3]},
+            "spill": {"rect": [13.5, 5, 14.8, 7]},
+        },
+        "robot": {"start": [1.0, 7.0], "max_speed": 1.5, "radius": 0.3},
+        "task": ["visit pick then pack", "avoid spill"],
+    }
+    courtyard = {
+        "version": 1,
+        "name": "courtyard",
+        "workspace": {
+            "boundary": [[0, 0], [16, 0], [16, 12], [0, 12]],
+            "holes": [[[5, 4], [11, 3.5], [11.5, 8], [6, 8.5]]],
+        },
+        "regions": {
+            "gate": {"rect": [0.5, 5, 2, 7]},
+            "tower": {"rect": [13.5, 9.5, 15.5, 11.5]},
+            "well": {"rect": [12.5, 1, 14, 2.5]},
+        },
+        "robot": {"start": [1.0, 1.0], "max_speed": 1.0, "radius": 0.15},
+        "task": ["patrol gate, tower and well"],
+    }
+    return [
+        Workload("office", office, (("desk",), ("printer",), ("kitchen",)), avoid=("wet",)),
+        Workload("warehouse r=0.3", warehouse, (("pick",), ("pack",)), avoid=("spill",)),
+        Workload("courtyard patrol", courtyard, (("gate", "tower", "well"),), patrol=True),
+    ]
 
 
 def _compile(workload: Workload, follow: bool) -> tuple[Any, float]:
@@ -253,32 +315,170 @@ def _measure(workload: Workload, compiled: Any) -> dict[str, float]:
     return row
 
 
-def run(only: tuple[str, ...] = ()) -> list[dict[str, Any]]:
-    """Rows: every workload's ratios before and after, side by side (``only``: these names)."""
-    workloads = [
+def workloads() -> list[Workload]:
+    """Every workload of the table: the shipped specs, generated rooms, held-out missions."""
+    return [
         *shipped(),
         *(generated(seed) for seed in (1, 2, 3)),
         *(generated(seed, radius=0.2) for seed in (1, 2, 3)),
         *(generated(seed, patrol=True) for seed in (4, 5)),
         generated(6, radius=0.2, patrol=True),
+        *held_out(),
     ]
+
+
+def run(only: tuple[str, ...] = ()) -> list[dict[str, Any]]:
+    """Rows of the tlmpc imported here: every workload's ratios (``only``: these names)."""
     rows = []
-    for workload in workloads:
+    for workload in workloads():
         if only and workload.name not in only:
             continue
         row: dict[str, Any] = {"workload": workload.name}
-        for label, follow in (("before", False), ("after", True)):
-            try:
-                compiled, guided = _compile(workload, follow)
-                measured = _measure(workload, compiled)
-            except Exception as failure:  # a mission this generator made unsolvable
-                row["note"] = f"{type(failure).__name__}: {str(failure)[:60]}"
-                break
-            for key, value in measured.items():
-                row[f"{key} {label}"] = round(value, 3)
-            row[f"robustness {label}"] = round(compiled.summary["verdict"]["robustness"], 4)
-            if follow and not workload.patrol:  # how closely the flow keeps to its path
-                row["trajectory / its path"] = round(_travelled(compiled.artifacts) / guided, 3)
+        try:
+            compiled, guided = _compile(workload, True)
+            measured = _measure(workload, compiled)
+        except Exception as failure:  # a mission this generator made unsolvable
+            row["note"] = f"{type(failure).__name__}: {str(failure)[:60]}"
+            rows.append(row)
+            continue
+        for key, value in measured.items():
+            row[key] = round(value, 3)
+        row["robustness"] = round(compiled.summary["verdict"]["robustness"], 4)
+        if not workload.patrol:  # how closely the flow keeps to its path
+            row["trajectory / its path"] = round(_travelled(compiled.artifacts) / guided, 3)
+        rows.append(row)
+    return rows
+
+
+def side_by_side(baseline: Path, only: tuple[str, ...] = ()) -> list[dict[str, Any]]:
+    """Rows with the ratios of the tlmpc checked out at ``baseline`` (run in a child process
+    importing it) and of this one, column by column."""
+    import json
+    import os
+    import subprocess
+
+    env = {**os.environ, "PYTHONPATH": str(baseline)}
+    command = [sys.executable, str(Path(__file__).resolve()), "--rows", "--tree", str(baseline)]
+    output = subprocess.run(
+        [*command, *only], env=env, check=True, capture_output=True, text=True
+    ).stdout
+    before = {row["workload"]: row for row in json.loads(output)}
+    merged = []
+    for row in run(only):
+        old = before.get(row["workload"], {})
+        joined: dict[str, Any] = {"workload": row["workload"]}
+        for key in ("length", "time", "lap", "lap time", "robustness"):
+            if key in row or key in old:
+                joined[f"{key} before"] = old.get(key, "")
+                joined[f"{key} after"] = row.get(key, "")
+        joined["trajectory / its path"] = row.get("trajectory / its path", "")
+        if "note" in row or "note" in old:
+            joined["note"] = row.get("note", old.get("note", ""))
+        merged.append(joined)
+    return merged
+
+
+def _cut_length(points: Any, shapes: dict[str, Any], groups: Any, step: float = 0.005) -> float:
+    """A polyline's length until it first enters its last target (groups in order), the
+    polyline sampled every ``step`` as the trajectory is."""
+    dense = [points[0]]
+    for a, b in itertools.pairwise(points):
+        count = max(1, int(math.dist(a, b) / step))
+        dense += [a + (b - a) * (j / count) for j in range(1, count + 1)]
+    samples = np.asarray(dense)
+    _, met = _order(samples, shapes, groups)
+    return float(np.hypot(*np.diff(samples[: met + 1], axis=0).T).sum()) if met >= 0 else math.nan
+
+
+def _polyline(guides: Any) -> Any:
+    points: list[Any] = []
+    for guide in guides:
+        if guide is None:
+            continue
+        if not points or tuple(points[-1]) != tuple(guide.entry):
+            points.append(np.asarray(guide.entry))
+        points.append(np.asarray(guide.exit))
+    return np.asarray(points)
+
+
+def gap_rows(only: tuple[str, ...] = ()) -> list[dict[str, Any]]:
+    """Where the length goes, per workload that ends (not patrols): factors whose product is
+    the length ratio, each the next path's length over the one before, all measured until
+    the last target is first entered:
+
+    * **margin**: the shortest path in the planner's free space (eroded by the body and the
+      margin, avoided regions grown) over the one keeping the body's clearance alone;
+    * **goal depth**: ... touching the goals' cores (all but the last target) instead;
+    * **channel**: the channel's shortest path without any inset over that;
+    * **insets**: the path the fields follow (with the portal and label insets) over that;
+    * **controller**: the trajectory over the path it follows.
+    """
+    import importlib
+
+    import shapely
+    import yaml
+    from shortest_paths import VisibilityOracle
+
+    from tlmpc.abstraction.layout import planning_layout
+    from tlmpc.mission.body import body_radius, requested_margin
+    from tlmpc.mission.cspace import workspace_free_space
+    from tlmpc.pipeline.stages import MISSION, compile_mission
+
+    module = importlib.import_module("tlmpc.control.synthesize")
+    channel = importlib.import_module("tlmpc.control.channel")
+    original = module.path_guides
+    calls: list[Any] = []
+
+    def recorded(*args: Any) -> Any:
+        calls.append(args)
+        return original(*args)
+
+    rows = []
+    for workload in workloads():
+        if workload.patrol or (only and workload.name not in only):
+            continue
+
+        source = workload.mission
+        text = None if isinstance(source, Path) else yaml.safe_dump(source)
+        with mock.patch.object(module, "path_guides", recorded):
+            result = compile_mission(source if text is None else "bench.yaml", text=text)
+        mission = result.compilation.get(MISSION)
+        followed = original(*calls[-1])
+        with mock.patch.multiple(channel, PORTAL_INSET=0.0, LABEL_INSET=0.0, ENTERED_INSET=0.0):
+            bare = original(*calls[-1])
+        shapes = {r.name: shapely.Polygon(r.polygon) for r in mission.regions}
+        free = workspace_free_space(mission)
+        for name in workload.avoid:
+            free = free.difference(shapes[name])
+        radius = body_radius(mission.robot)
+        body_free = free.buffer(-radius, quad_segs=16) if radius > 0 else free
+        _, trajectory = _fine_trajectory(result.artifacts)
+        order, _ = _order(trajectory, shapes, workload.groups)
+        start = tuple(mission.robot.start)
+        layout = planning_layout(mission, requested_margin(mission))
+        names = [r.name for r in mission.regions]
+        planned = {
+            name: shapes[name] if layout is None or layout.regions[i] is None else layout.regions[i]
+            for i, name in enumerate(names)
+        }
+        planner_free = free if layout is None or layout.free is None else layout.free
+        for name in workload.avoid:
+            planner_free = planner_free.difference(planned[name])
+        lengths = [
+            VisibilityOracle(body_free, [shapes[n] for n in order], start).path_length(),
+            VisibilityOracle(planner_free, [shapes[n] for n in order], start).path_length(),
+            VisibilityOracle(
+                planner_free, [planned[n] for n in order[:-1]] + [shapes[order[-1]]], start
+            ).path_length(),
+            _cut_length(_polyline(bare), shapes, workload.groups),
+            _cut_length(_polyline(followed), shapes, workload.groups),
+            _cut_length(trajectory, shapes, workload.groups),
+        ]
+        row: dict[str, Any] = {"workload": workload.name, "shortest": round(lengths[0], 3)}
+        names_of = ("margin", "goal depth", "channel", "insets", "controller")
+        for label, (a, b) in zip(names_of, itertools.pairwise(lengths), strict=True):
+            row[label] = round(b / a, 3)
+        row["length ratio"] = round(lengths[-1] / lengths[0], 3)
         rows.append(row)
     return rows
 
@@ -295,5 +495,29 @@ def _table(rows: list[dict[str, Any]]) -> str:
     return "\n".join(lines)
 
 
+def _main(arguments: list[str]) -> None:
+    import json
+
+    if "--tree" in arguments:  # import tlmpc from that checkout (the baseline's child run)
+        at = arguments.index("--tree")
+        sys.path.insert(0, arguments[at + 1])
+        del arguments[at : at + 2]
+    if "--rows" in arguments:
+        arguments.remove("--rows")
+        print(json.dumps(run(tuple(arguments))))
+        return
+    if "--gap" in arguments:
+        arguments.remove("--gap")
+        print(_table(gap_rows(tuple(arguments))))
+        return
+    if "--baseline" in arguments:
+        at = arguments.index("--baseline")
+        baseline = Path(arguments[at + 1])
+        del arguments[at : at + 2]
+        print(_table(side_by_side(baseline, tuple(arguments))))
+        return
+    print(_table(run(tuple(arguments))))
+
+
 if __name__ == "__main__":
-    print(_table(run(tuple(sys.argv[1:]))))
+    _main(sys.argv[1:])

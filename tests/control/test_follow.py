@@ -307,8 +307,9 @@ def test_velocity_jumps_are_exactly_where_the_fields_jump(strip: Any, push: floa
 def test_the_path_enters_a_new_label_through_the_middle_of_the_edge(
     strip: Any, data: st.DataObject
 ) -> None:
-    """Where the plan enters a new label, the followed path leaves that triangle through the
-    middle 20 % of its exit edge (so it goes into the region rather than grazing its edge)."""
+    """Where the plan enters a new label whose boundary is the region's own, the followed path
+    leaves that triangle through the middle 20 % of its exit edge (so it goes into the region
+    rather than grazing its edge)."""
     from tlmpc.control.follow import path_guides
     from tlmpc.control.synthesize import plan_steps
 
@@ -319,8 +320,7 @@ def test_the_path_enters_a_new_label_through_the_middle_of_the_edge(
     if len(triangles) < 3:
         return
     change = data.draw(st.integers(1, len(triangles) - 2))
-    letters = np.asarray([0] * change + [1] * (len(triangles) - change), dtype=np.int64)
-    abstraction = dataclasses.replace(abstraction, letter_of=letters, letters=((), ("r",)))
+    abstraction = _labelled_from(abstraction, change, own=True)
     steps, loop_start = plan_steps(abstraction, witness)
     sx, sy = abstraction.corners(0).mean(axis=0).tolist()
     guide = path_guides(abstraction, steps, loop_start, (sx, sy))[change]
@@ -331,6 +331,63 @@ def test_the_path_enters_a_new_label_through_the_middle_of_the_edge(
     a, b = corners[(exit_edge + 1) % 3], corners[(exit_edge + 2) % 3]
     middle = (a + b) / 2
     assert math.dist(guide.exit, middle.tolist()) <= 0.1 * math.dist(a, b) + 1e-9
+
+
+def _labelled_from(abstraction: Abstraction, change: int, *, own: bool) -> Abstraction:
+    """``abstraction`` with the triangles from ``change`` on labelled ``r``: the region is
+    their union (``own``: the label boundary is the region's own), or that union grown by a
+    tenth of the mesh (the label is a core of it, as a goal's in the planning layout)."""
+    count = abstraction.num_triangles
+    letters = np.asarray([0] * change + [1] * (count - change), dtype=np.int64)
+    union = shapely.union_all(
+        [shapely.Polygon(abstraction.corners(t).tolist()) for t in range(change, count)]
+    )
+    if not own:
+        extent = float(np.ptp(abstraction.vertices, axis=0).max())
+        union = union.buffer(0.1 * extent, join_style="mitre")
+    ring = tuple((float(x), float(y)) for x, y in list(union.exterior.coords)[:-1])
+    return dataclasses.replace(
+        abstraction, letter_of=letters, letters=((), ("r",)), regions={"r": ring}
+    )
+
+
+@settings(deadline=None, max_examples=30, suppress_health_check=[HealthCheck.filter_too_much])
+@given(strips(), st.data())
+def test_label_insets_only_where_the_label_is_the_regions_own_boundary(
+    strip: Any, data: st.DataObject
+) -> None:
+    """A label whose region lies beyond it (a goal's core, a grown avoided region) is not
+    exposed: no vertex of its boundary needs an inset, and the path through the channel is
+    never longer than with the label as the region's own boundary (whose vertices all are)."""
+    from tlmpc.control.clearance import exposed_vertices
+    from tlmpc.control.follow import path_guides
+    from tlmpc.control.synthesize import plan_steps
+
+    planned = strip_plan(*strip)
+    if planned is None:
+        return
+    abstraction, witness, triangles = planned
+    if len(triangles) < 3:
+        return
+    change = data.draw(st.integers(1, len(triangles) - 2))
+    sx, sy = abstraction.corners(0).mean(axis=0).tolist()
+
+    def length(mesh: Abstraction) -> float:
+        steps, loop_start = plan_steps(mesh, witness)
+        guides = path_guides(mesh, steps, loop_start, (sx, sy))
+        return sum(math.dist(g.entry, g.exit) for g in guides if g is not None)
+
+    cored, own = (
+        _labelled_from(abstraction, change, own=False),
+        _labelled_from(abstraction, change, own=True),
+    )
+    # the vertices where the label changes: those of the first labelled triangle's entry edge
+    shared = set(abstraction.triangles[change - 1].tolist()) & set(
+        abstraction.triangles[change].tolist()
+    )
+    assert exposed_vertices(cored, shared) == frozenset()
+    assert exposed_vertices(own, shared) == frozenset(shared)
+    assert length(cored) <= length(own) * (1 + 1e-12) + 1e-12
 
 
 def test_a_bent_corridor_splits_its_runs_at_the_bend() -> None:
@@ -363,3 +420,51 @@ def test_a_bent_corridor_splits_its_runs_at_the_bend() -> None:
         ratios.append((travelled + math.dist(entry, target)) / best)
     assert ratios[0] <= 1.10
     assert ratios[0] < ratios[1]
+
+
+def test_the_middle_inset_only_where_a_label_is_exposed_or_by_a_wall() -> None:
+    """On a room whose goal lies in the middle (its core labels the mesh), the channel marks
+    a step as entering a new label only when its triangle has a corner on a wall or on a
+    region's own boundary (shapely measures both); entering the core away from both is not
+    marked."""
+    from unittest import mock
+
+    import yaml
+
+    from tlmpc.control import follow as follow_module
+    from tlmpc.control.channel import channel_guides
+    from tlmpc.control.synthesize import plan_steps
+    from tlmpc.pipeline.stages import ABSTRACTION, MISSION, WITNESS, compile_mission
+
+    document = {
+        "version": 1,
+        "name": "middle",
+        "workspace": {"boundary": {"rect": [0, 0, 8, 5]}},
+        "regions": {"goal": {"rect": [3, 1.5, 5, 3.5]}},
+        "robot": {"start": [0.5, 0.5], "max_speed": 1.0},
+        "task": ["visit goal"],
+    }
+    result = compile_mission("middle.yaml", text=yaml.safe_dump(document), until="plan")
+    c = result.compilation
+    abstraction, witness, mission = c.get(ABSTRACTION), c.get(WITNESS), c.get(MISSION)
+    steps, loop_start = plan_steps(abstraction, witness)
+    captured: list[Any] = []
+    original = channel_guides
+
+    def capture(channel: Any, *rest: Any) -> Any:
+        captured.extend(channel)
+        return original(channel, *rest)
+
+    with mock.patch.object(follow_module, "channel_guides", capture):
+        follow_module.path_guides(abstraction, steps, loop_start, mission.robot.start)
+    outer = shapely.box(0, 0, 8, 5).exterior
+    region = shapely.box(3, 1.5, 5, 3.5).exterior
+    label = abstraction.letter_of.tolist()
+    changes = 0
+    for index, (step, seen) in enumerate(zip(steps, captured, strict=True)):
+        changed = index > 0 and label[step.triangle] != label[steps[index - 1].triangle]
+        points = [shapely.Point(p) for p in abstraction.corners(step.triangle).tolist()]
+        near = any(outer.distance(p) < 1e-9 or region.distance(p) < 1e-9 for p in points)
+        assert seen.entered == (changed and near)
+        changes += changed and not near
+    assert changes > 0  # the core is entered away from walls and from the region's edge

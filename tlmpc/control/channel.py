@@ -193,7 +193,17 @@ def channel_guides(
     steps: Sequence[ChannelStep], loop_start: int | None, start: Point
 ) -> list[Guide | None]:
     """The shortest path's piece in each step (None for a vertex passage, whose pursuit law
-    is fixed).
+    is fixed): :func:`channel_pieces` without the passages'."""
+    return [
+        None if step.through is not None else piece
+        for step, piece in zip(steps, channel_pieces(steps, loop_start, start), strict=True)
+    ]
+
+
+def channel_pieces(
+    steps: Sequence[ChannelStep], loop_start: int | None, start: Point
+) -> list[Guide]:
+    """The shortest path's piece in each step (a vertex passage's: to its corner).
 
     A plan that ends by staying is pulled from the start to the stay triangle's incenter (the
     stay field's target); a lasso over its prefix and :data:`LAPS` laps of its cycle, the
@@ -223,12 +233,9 @@ def channel_guides(
         lap = 0 if loop_start is None or i < loop_start else (position - loop_start) // len(cycle)
         if lap == (0 if loop_start is None or i < loop_start else LAPS // 2):
             chosen[i] = position
-    guides: list[Guide | None] = []
+    guides: list[Guide] = []
     for i, step in enumerate(steps):
-        if step.through is not None:
-            guides.append(None)
-            continue
-        if step.exit_edge is None:  # the stay: from the last crossing to its target
+        if step.exit_edge is None and step.through is None:  # the stay: to its target
             entry = crossings[len(moving) - 1] if moving else start
             guides.append(Guide(entry, end))
             continue

@@ -38,7 +38,8 @@ from typing import Protocol
 import numpy as np
 
 from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
-from tlmpc.control.channel import ChannelStep, Guide, Point, channel_guides
+from tlmpc.control.channel import ChannelStep, Guide, Point, channel_guides, channel_pieces
+from tlmpc.control.clearance import exposed_vertices
 from tlmpc.control.geometry import TriangleGeometry
 from tlmpc.control.sparse import CscMatrix, Triplets, stacked_csc
 
@@ -281,9 +282,12 @@ def path_guides(
     steps: Sequence[PlanStep],
     loop_start: int | None,
     start: tuple[float, float],
+    *,
+    passages: bool = False,
 ) -> list[Guide | None]:
     """The channel's shortest path, one straight piece per step (None for a vertex
-    passage), with the portal insets of :mod:`tlmpc.control.channel`."""
+    passage, unless ``passages``: then its piece to the corner), with the portal insets of
+    :mod:`tlmpc.control.channel`."""
     # A vertex is on a label boundary when the triangles around it do not all share a label.
     letters = np.repeat(abstraction.letter_of, 3)  # each corner's triangle's letter
     count = len(abstraction.vertices)
@@ -292,17 +296,35 @@ def path_guides(
     np.minimum.at(lowest, abstraction.triangles.reshape(-1), letters)
     np.maximum.at(highest, abstraction.triangles.reshape(-1), letters)
     boundary = (lowest != highest).tolist()
+    # ... and needs an inset only where it is a region's own boundary (tlmpc.control.clearance).
+    # Where the plan enters a new label in a triangle by a wall, the path still leaves it
+    # through the middle of its exit edge: entering a goal by a wall, or leaving it along one,
+    # the path would otherwise hug the wall (robustness is also the distance to leaving the
+    # workspace; pushed past the declared disturbance, runs then left it).
+    corners = [abstraction.triangles[step.triangle].tolist() for step in steps]
+    exposed = exposed_vertices(abstraction, (v for c in corners for v in c if boundary[v]))
+    on_wall = np.zeros(count, dtype=bool)
+    rows, sides = np.nonzero(abstraction.neighbors < 0)  # edge i is opposite corner i
+    for shift in (1, 2):
+        on_wall[abstraction.triangles[rows, (sides + shift) % 3]] = True
+    walls = on_wall.tolist()
+    flags = [_flags([v in exposed for v in c]) for c in corners]
+    near = [any(walls[v] for v in c) for c in corners]
     label = abstraction.letter_of.tolist()
     channel = [
         ChannelStep(
-            labelled=_flags([boundary[v] for v in abstraction.triangles[step.triangle].tolist()]),
-            entered=index > 0 and label[step.triangle] != label[steps[index - 1].triangle],
+            labelled=flags[index],
+            entered=index > 0
+            and label[step.triangle] != label[steps[index - 1].triangle]
+            and (any(flags[index]) or near[index]),
             corners=_corners(step.geometry.vertices),
             exit_edge=step.exit_edge,
             through=None if step.through is None else _point(abstraction.vertices[step.through]),
         )
         for index, step in enumerate(steps)
     ]
+    if passages:
+        return list(channel_pieces(channel, loop_start, start))
     return channel_guides(channel, loop_start, start)
 
 

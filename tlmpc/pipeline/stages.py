@@ -263,6 +263,7 @@ def _plan(c: Compilation) -> StageResult:
     from tlmpc.abstraction.io import abstraction_document
     from tlmpc.automata import automaton_to_json, to_hoa
     from tlmpc.pipeline.mintime import plan_minimum_time
+    from tlmpc.pipeline.shortest import plan_shortest
     from tlmpc.planning import witness_to_json
 
     built = c.get(ABSTRACTION)
@@ -271,6 +272,8 @@ def _plan(c: Compilation) -> StageResult:
     # built one (and its artifacts) for every later stage.  Under the time metric the plan
     # is re-weighed with its exact simulated step times (tlmpc.pipeline.mintime).
     planned = plan_minimum_time(c.get(MISSION), built, c.get(AUTOMATON))
+    # Under the length metric the channel is chosen by its shortest path (pipeline.shortest).
+    planned = plan_shortest(c.get(MISSION), planned)
     abstraction, witness = planned.abstraction, planned.witness
     artifacts: dict[str, Any] = {}
     if planned.automaton is not c.get(AUTOMATON):  # without margin, or the durations held

@@ -334,9 +334,14 @@ def move_weight_grid(
     times: MoveTimes | None = None,
 ) -> FloatArray:
     """(m, SLOTS, 3): the weight of every move of D on the (triangle, slot, exit) grid under
-    ``"length"`` or ``"time"`` (which needs ``times``)."""
+    ``"length"`` (replaced by ``times.measured`` where given) or ``"time"`` (which needs
+    ``times``)."""
     lengths = _move_lengths(abstraction, start_point)
     if metric != "time":
+        # under "length", ``times`` (speed 1) may carry measured lengths of moves: the
+        # channel's shortest path through them (tlmpc.pipeline.shortest)
+        if times is not None and times.measured:
+            return move_time_table(abstraction, lengths, times)
         return lengths
     if times is None:
         raise ValueError("the time metric needs the robot's speed (MoveTimes)")

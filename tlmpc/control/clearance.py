@@ -1,0 +1,75 @@
+"""Which label boundaries of the mesh lie on a region's own boundary.
+
+The planner's mesh is labelled by the planning layout's shapes, not always by the regions
+themselves (:mod:`tlmpc.abstraction.layout`): a goal labels its *core* (the region eroded by
+the goal depth) and, with a margin, an avoided region labels its grown shape.  A mesh vertex
+on the boundary of such a shape is already that far inside (or outside) the region itself, so
+a path through it keeps the verifier's robustness (the distance to the nearest boundary that
+would change the verdict) at that depth.  A vertex on the boundary of a region that labels its
+own shape (a point robot's avoided region without margin, a region of both polarities, a goal
+with ``goal_depth: 0``) is not: a path through it grazes the region and its robustness
+vanishes.  Only those *exposed* vertices need the channel's label insets
+(:mod:`tlmpc.control.channel`).
+
+Read from the mesh and the regions alone (no task): a vertex on a label boundary is exposed
+when it lies within :data:`TOUCH` of the mesh's extent of the boundary of a region that labels
+a triangle around it (a core's corner that happens to lie on such a region's edge is exposed
+too, which only keeps an inset that was not needed).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+import numpy as np
+
+from tlmpc.abstraction.model import Abstraction, FloatArray
+
+#: A vertex "lies on" a region's boundary within this fraction of the mesh's extent: far
+#: below any goal depth or margin, far above the snapping grid (a billionth of the extent).
+TOUCH = 1e-6
+
+
+def exposed_vertices(abstraction: Abstraction, candidates: Iterable[int]) -> frozenset[int]:
+    """Those of ``candidates`` (mesh vertices on a label boundary) that lie on the boundary
+    of a region itself (see the module doc)."""
+    chosen = np.asarray(sorted(set(candidates)), dtype=np.int64)
+    if len(chosen) == 0 or not abstraction.regions:
+        return frozenset()
+    # the regions that label a triangle around a candidate: only their edges are measured
+    around = np.isin(abstraction.triangles, chosen).any(axis=1)
+    letters = np.unique(abstraction.letter_of[around]).tolist()
+    names = sorted({name for k in letters for name in abstraction.letters[k]})
+    rings = [
+        np.asarray(abstraction.regions[name], dtype=np.float64).reshape(-1, 2)
+        for name in names
+        if name in abstraction.regions
+    ]
+    rings = [ring for ring in rings if len(ring) >= 2]
+    if not rings:
+        return frozenset()
+    starts = np.concatenate(rings)
+    ends = np.concatenate([np.roll(ring, -1, axis=0) for ring in rings])
+    vertices = abstraction.vertices
+    extent = float(np.ptp(vertices, axis=0).max()) if len(vertices) > 1 else 0.0
+    points = vertices[chosen]
+    near = np.zeros(len(chosen), dtype=bool)
+    for first in range(0, len(points), CHUNK):
+        block = slice(first, first + CHUNK)
+        near[block] = _to_segments(points[block], starts, ends) <= TOUCH * extent
+    return frozenset(chosen[near].tolist())
+
+
+#: Points measured at once (bounds the (points x edges) arrays).
+CHUNK = 256
+
+
+def _to_segments(points: FloatArray, starts: FloatArray, ends: FloatArray) -> FloatArray:
+    """(P,): each point's distance to the nearest of the segments ``starts`` -> ``ends``."""
+    edge = ends - starts  # (E, 2)
+    squared = np.maximum(np.einsum("ij,ij->i", edge, edge), 1e-300)
+    rel = points[:, None, :] - starts[None, :, :]  # (P, E, 2)
+    u = np.clip(np.einsum("pej,ej->pe", rel, edge) / squared, 0.0, 1.0)
+    gap = rel - u[:, :, None] * edge[None, :, :]
+    distance: FloatArray = np.sqrt(np.einsum("pej,pej->pe", gap, gap)).min(axis=1)
+    return distance

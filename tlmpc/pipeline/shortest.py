@@ -1,0 +1,203 @@
+"""Planning for the shortest path (``options.cost: length``): plan, pull the string, re-weigh,
+re-plan.
+
+The planner weighs a move of the transition system by the segment between the midpoints of
+the edges it crosses; the controllers follow the shortest path through the plan's channel of
+triangles (:mod:`tlmpc.control.channel`, with its portal insets), which is shorter and
+bends only where it must.  Which channel has the shortest such path is not a sum of
+per-move weights known beforehand (a move's piece depends on the whole channel), so, as
+for the ``time`` metric (:mod:`tlmpc.pipeline.mintime`), the planner iterates:
+
+1. plan with every move weighing its midpoint length;
+2. pull the string through the plan's channel (no controller is solved); the plan's
+   **path length** is that path's length over the prefix plus ``beta`` times one lap of the
+   cycle (a stay: to where the path enters its triangle);
+3. every move the plan made now weighs its piece of that path (a move made twice: its last
+   use; the cycle's from the middle lap); the other moves keep their midpoint lengths
+   scaled by the first plan's path length over its cost (unscaled, every move made looks
+   cheaper than any other and the first channel is planned again), and the plan is made
+   again;
+4. stop at a **fixed point** (the new plan is one already pulled), after
+   :data:`MAX_REPLANS` re-plans, or before the plans' products would pass
+   :data:`NODE_BUDGET` nodes.  The kept plan starts as the first; a re-plan replaces it
+   when its path is more than :data:`MIN_GAIN` shorter *and* its exact time (the time metric's
+   measure: controllers synthesised, trajectory simulated, prefix + ``beta`` x lap) is not
+   longer (at most :data:`MAX_TIME_CHECKS` re-plans are simulated).  So the kept plan is
+   never longer nor slower than the first.
+
+Every round is deterministic (operations are counted, no clock is read).  What is promised
+(docs/planning.md): the kept plan's path is never longer, and its trajectory never slower,
+than the midpoint plan's; it is not a proof that no channel has a shorter path (the moves no
+plan made keep estimates) nor that the kept one is the shortest of those pulled (a shorter
+one may be slower).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
+from typing import Any
+
+from tlmpc.base.errors import TlmpcError
+from tlmpc.mission.model import Mission
+from tlmpc.planning.mission import Planned, replan
+from tlmpc.planning.product import START_SLOT, STUTTER_COST
+from tlmpc.planning.timing import MoveKey, MoveTimes, move_key
+
+#: A re-plan replaces the kept plan only when its path is shorter by more than this fraction:
+#: the fields' speeds, which the path's length does not see, differ more than that between
+#: channels (a bench room's re-plan 0.03 % shorter took 10 % longer).
+MIN_GAIN = 0.002
+#: At most this many re-plans are simulated to check that they are not slower (each costs a
+#: controller synthesis and an exact simulation, as a round of the time metric does).
+MAX_TIME_CHECKS = 2
+#: At most this many re-plans after the first plan.
+MAX_REPLANS = 6
+#: ... and none that would bring the products of all the plans made past this many nodes (a
+#: re-plan costs about what the plan before it did, counted by its product's nodes: on a
+#: large mesh the loop stops early or does not run at all, deterministically).
+NODE_BUDGET = 100_000
+
+
+@dataclass(frozen=True, slots=True)
+class Pulled:
+    """A plan's path length (prefix + beta x lap) and each move's piece of the path."""
+
+    length: float
+    moves: Mapping[MoveKey, float]
+
+
+def plan_shortest(mission: Mission, planned: Planned) -> Planned:
+    """``planned`` or a re-plan of it whose channel's shortest path is shorter (see the
+    module doc); under other metrics, or when not even one re-plan fits the budget:
+    ``planned`` as it is (without the statistics below).
+
+    The witness's ``stats`` record ``path_length`` (the kept plan's), ``path_lengths``
+    (each round's, in order), ``length_rounds``, ``length_fixed_point`` and
+    ``length_time_checks`` (the exact times of the re-plans short enough to be simulated).
+    """
+    spent = _nodes(planned)  # product nodes of the plans made so far
+    if mission.options.cost != "length" or spent + spent > NODE_BUDGET:
+        return planned  # (no re-plan would fit the budget: nothing to pull for)
+    try:
+        first = pull(mission, planned)
+    except TlmpcError:  # the control stage will say what is wrong with the plan
+        return planned
+    best, best_length = planned, first.length
+    best_time: float | None = None  # the kept plan's exact time, once a re-plan needs it
+    checked: list[float] = []  # the exact times of the re-plans short enough to check
+    history = [first.length]
+    measured: dict[MoveKey, float] = dict(first.moves)
+    seen = {_shape(planned)}
+    fixed = False
+    current = planned
+    # The moves no plan made keep their midpoint lengths scaled as the first plan's path
+    # compares with its midpoint cost: unscaled, every measured move looks cheaper than
+    # any other and the first channel is always planned again.
+    cost = planned.witness.cost
+    ratio = first.length / cost if cost > 0.0 and first.length > 0.0 else 1.0
+    for _ in range(MAX_REPLANS):
+        # a re-plan costs about what the last plan did: none that would pass the budget
+        if spent + _nodes(current) > NODE_BUDGET:
+            break
+        spent += _nodes(current)
+        weights = MoveTimes(speed=1.0 / ratio, measured=dict(measured))
+        try:
+            following = replan(mission, current, weights)
+            found = pull(mission, following)
+        except TlmpcError:
+            break
+        shape = _shape(following)
+        if shape in seen:
+            fixed = True
+            break
+        seen.add(shape)
+        history.append(found.length)
+        if found.length < best_length * (1.0 - MIN_GAIN) and len(checked) < MAX_TIME_CHECKS:
+            # ... and only when its trajectory is not slower (the length does not see the
+            # fields' speeds): both are simulated, as the time metric measures a plan
+            if best_time is None:
+                best_time = _exact_time(mission, best)
+            time = _exact_time(mission, following)
+            checked.append(time)
+            if time <= best_time:
+                best, best_length, best_time = following, found.length, time
+        measured.update(found.moves)
+        current = following
+    stats: dict[str, Any] = {
+        **best.witness.stats,
+        "path_length": best_length,
+        "path_lengths": history,
+        "length_rounds": len(history),
+        "length_fixed_point": fixed,
+        "length_time_checks": checked,
+    }
+    return replace(best, witness=replace(best.witness, stats=stats))
+
+
+def _exact_time(mission: Mission, planned: Planned) -> float:
+    """The plan's exact time (:func:`tlmpc.pipeline.mintime.measure`: prefix + beta x lap of
+    its simulated trajectory); inf when its controllers or simulation fail."""
+    from tlmpc.pipeline.mintime import measure
+
+    try:
+        return measure(mission, planned).exact_time
+    except TlmpcError:
+        return math.inf
+
+
+def _nodes(planned: Planned) -> int:
+    """The product nodes the plan's search held (built, or reached on demand)."""
+    stats = planned.witness.stats
+    return int(stats.get("product_nodes") or stats.get("product_reached") or 0)
+
+
+def _shape(planned: Planned) -> tuple[Any, ...]:
+    """What makes two plans the same channel: the mesh's size, the triangles and passages."""
+    w = planned.witness
+    return (planned.abstraction.num_triangles, w.prefix, w.cycle, w.passages)
+
+
+def pull(mission: Mission, planned: Planned) -> Pulled:
+    """The shortest path through ``planned``'s channel as the controllers follow it
+    (:func:`tlmpc.control.follow.path_guides`): its length (see the module doc) and the
+    length of each of D's moves on it, keyed by :func:`~tlmpc.planning.timing.move_key`
+    (plus the weights' stutter cost)."""
+    from tlmpc.control.follow import path_guides
+    from tlmpc.control.synthesize import plan_steps
+
+    abstraction, witness = planned.abstraction, planned.witness
+    steps, loop_start = plan_steps(abstraction, witness)
+    pieces = path_guides(abstraction, steps, loop_start, mission.robot.start, passages=True)
+    lengths = [0.0 if p is None else math.dist(p.entry, p.exit) for p in pieces]
+    neighbors = abstraction.neighbors
+    moves: dict[MoveKey, float] = {}
+    prefix = 0.0
+    lap = 0.0
+    for index, step in enumerate(steps):
+        if step.exit_edge is None and step.through is None:
+            break  # the stay: the plan's cost ends where its triangle is entered
+        if loop_start is None or index < loop_start:
+            prefix += lengths[index]
+        else:
+            lap += lengths[index]
+        if step.through is not None or step.exit_edge is None:
+            continue
+        # the edge the piece entered by: the step before's (the cycle's first step: the
+        # wrap's, its piece being the middle lap's)
+        before = index - 1 if index > 0 else None
+        if loop_start is not None and index == loop_start:
+            before = len(steps) - 1
+        if before is None:
+            slot = START_SLOT
+        elif steps[before].through is not None:
+            continue  # entered at a vertex: not one of D's moves
+        else:
+            sides = neighbors[step.triangle].tolist()
+            if steps[before].triangle not in sides:
+                continue
+            slot = sides.index(steps[before].triangle)
+        key = move_key(abstraction, step.triangle, slot, step.exit_edge)
+        moves[key] = lengths[index] + STUTTER_COST
+    return Pulled(length=prefix + witness.beta * lap, moves=moves)
