@@ -42,8 +42,6 @@ class Planned:
     automaton: Automaton
     witness: Witness
     notes: tuple[Diagnostic, ...] = ()
-    #: planned on a mesh rebuilt without the goal depth or the margin (with its own automaton)
-    remeshed: bool = False
     #: the untimed task the plan was made for (the skeleton, or the holding skeleton)
     formula: Formula | None = None
     #: the mesh the plan was asked on, before any refinement for a U-turn (the convex cells'
@@ -195,14 +193,14 @@ def plan_mission(
                 continue
             if witness_realisable(again.abstraction, again.witness, ratio):
                 note = _shallow_for_disturbance(mission, planned.witness, scale)
-                return replace(again, notes=(note,), remeshed=True)
+                return replace(again, notes=(note,))
             tried.append(again)
         # None realises the disturbance on triangles: the last rung, convex cells, on each
         # mesh in turn (the goal depth first).
-        for position, tried_plan in enumerate(tried):
+        for tried_plan in tried:
             on_cells = _on_cells(mission, tried_plan, start_point)
             if on_cells is not None:
-                return on_cells if position == 0 else replace(on_cells, remeshed=True)
+                return on_cells
         on_lines, lines_bound = _on_lines(mission, margin, planned, start_point)
         if on_lines is not None:
             return on_lines
@@ -216,7 +214,7 @@ def plan_mission(
         if lines_bound is not None:
             known.append(lines_bound)
         chosen = _with_cells_bound(tried[best], max(known) if known else None, mission)
-        return chosen if best == 0 else replace(chosen, remeshed=True)
+        return chosen
 
     holding = holding_skeleton(mission.formula)
     if resume is None and holding != skeleton:
@@ -257,7 +255,7 @@ def plan_mission(
                 # any plan without goal cores
                 planned = on_cells_rung(planned)
             notes = (_shallow_note(mission, first), *planned.notes)
-            return replace(planned, notes=notes, remeshed=True)
+            return replace(planned, notes=notes)
     if margin <= 0.0:
         raise _with_body_notes(first, mission) from None
     plain = abstraction_for(mission, 0.0, deep=False)
@@ -274,7 +272,7 @@ def plan_mission(
         "options.margin to plan with a smaller one",
         file=mission.source,
     )
-    return replace(planned, notes=(note,), remeshed=True)
+    return replace(planned, notes=(note,))
 
 
 def move_times(mission: Mission, measured: MoveTimes | None = None) -> MoveTimes | None:
@@ -499,7 +497,7 @@ def _on_lines(
         )
         found = _on_cells(mission, candidate, start_point)
         if found is not None:
-            return replace(found, remeshed=True), None
+            return found, None
         supported = supported_ratio(
             mesh,
             task,
