@@ -125,6 +125,15 @@ def disturbance_hint(
             f"{on_cells:.6g} ({on_cells / max_speed:.4f} x max_speed): the widest route's "
             "weakest cell step"
         )
+    elif supported is not None:
+        from tlmpc.abstraction.lines import MAX_SIDES
+        from tlmpc.planning.cells import MAX_TRIANGLES
+
+        lines.append(
+            "no plan on convex cells (the plan stage's last rung) was tried: the rung plans "
+            f"on meshes of at most {MAX_TRIANGLES} triangles and builds its own mesh for maps "
+            f"of at most {MAX_SIDES} straight sides, and this mission is larger"
+        )
     lines.append(
         f"this plan's triangles reject disturbances below {bound.push:.6g} "
         f"({bound.push / max_speed:.4f} x max_speed), the push of its weakest corner "
