@@ -22,8 +22,9 @@ from __future__ import annotations
 from collections.abc import Iterable
 
 import numpy as np
+import shapely
 
-from tlmpc.abstraction.model import Abstraction, FloatArray
+from tlmpc.abstraction.model import Abstraction
 
 #: A vertex "lies on" a region's boundary within this fraction of the mesh's extent: far
 #: below any goal depth or margin, far above the snapping grid (a billionth of the extent).
@@ -48,28 +49,18 @@ def exposed_vertices(abstraction: Abstraction, candidates: Iterable[int]) -> fro
     rings = [ring for ring in rings if len(ring) >= 2]
     if not rings:
         return frozenset()
-    starts = np.concatenate(rings)
-    ends = np.concatenate([np.roll(ring, -1, axis=0) for ring in rings])
     vertices = abstraction.vertices
     extent = float(np.ptp(vertices, axis=0).max()) if len(vertices) > 1 else 0.0
-    points = vertices[chosen]
+    # A tree of the regions' closed boundaries answers "within TOUCH" per point in about
+    # log(edges) instead of measuring every point against every edge (a map of thousands of
+    # regions has tens of thousands of edges).
+    closed = [np.vstack([ring, ring[:1]]) for ring in rings]
+    owner = np.repeat(np.arange(len(closed)), [len(ring) for ring in closed])
+    boundaries = shapely.linestrings(np.concatenate(closed), indices=owner)
+    tree = shapely.STRtree(boundaries)
+    found = tree.query(
+        shapely.points(vertices[chosen]), predicate="dwithin", distance=TOUCH * extent
+    )
     near = np.zeros(len(chosen), dtype=bool)
-    for first in range(0, len(points), CHUNK):
-        block = slice(first, first + CHUNK)
-        near[block] = _to_segments(points[block], starts, ends) <= TOUCH * extent
+    near[found[0]] = True
     return frozenset(chosen[near].tolist())
-
-
-#: Points measured at once (bounds the (points x edges) arrays).
-CHUNK = 256
-
-
-def _to_segments(points: FloatArray, starts: FloatArray, ends: FloatArray) -> FloatArray:
-    """(P,): each point's distance to the nearest of the segments ``starts`` -> ``ends``."""
-    edge = ends - starts  # (E, 2)
-    squared = np.maximum(np.einsum("ij,ij->i", edge, edge), 1e-300)
-    rel = points[:, None, :] - starts[None, :, :]  # (P, E, 2)
-    u = np.clip(np.einsum("pej,ej->pe", rel, edge) / squared, 0.0, 1.0)
-    gap = rel - u[:, :, None] * edge[None, :, :]
-    distance: FloatArray = np.sqrt(np.einsum("pej,pej->pe", gap, gap)).min(axis=1)
-    return distance
