@@ -76,7 +76,7 @@ def plan_minimum_time(mission: Mission, abstraction: Abstraction, automaton: Aut
     measured: dict[MoveKey, float] = {}
     history: list[float] = []
     met: list[bool] = []
-    seen = {_shape(first)}
+    seen = {first.route()}
     best: tuple[tuple[bool, float], Planned] | None = None
     current = first
     fixed = False
@@ -104,7 +104,7 @@ def plan_minimum_time(mission: Mission, abstraction: Abstraction, automaton: Aut
             following = replan(mission, current, MoveTimes(speed=speed, measured=dict(measured)))
         except TlmpcError:
             break
-        shape = _shape(following)
+        shape = following.route()
         if shape in seen:
             fixed = True
             break
@@ -122,12 +122,6 @@ def plan_minimum_time(mission: Mission, abstraction: Abstraction, automaton: Aut
         **({"bounds_met": met} if bounded_operators(mission.formula) else {}),
     }
     return replace(chosen, witness=replace(chosen.witness, stats=stats))
-
-
-def _shape(planned: Planned) -> tuple[Any, ...]:
-    """What makes two plans the same run: the mesh's size, the triangles and passages."""
-    w = planned.witness
-    return (planned.abstraction.num_triangles, w.prefix, w.cycle, w.passages)
 
 
 def measure(mission: Mission, planned: Planned) -> Measured:

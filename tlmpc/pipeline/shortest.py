@@ -89,7 +89,7 @@ def plan_shortest(mission: Mission, planned: Planned) -> Planned:
     checked: list[float] = []  # the exact times of the re-plans short enough to check
     history = [first.length]
     measured: dict[MoveKey, float] = dict(first.moves)
-    seen = {_shape(planned)}
+    seen = {planned.route()}
     fixed = False
     current = planned
     # The moves no plan made keep their midpoint lengths scaled as the first plan's path
@@ -108,7 +108,7 @@ def plan_shortest(mission: Mission, planned: Planned) -> Planned:
             found = pull(mission, following)
         except TlmpcError:
             break
-        shape = _shape(following)
+        shape = following.route()
         if shape in seen:
             fixed = True
             break
@@ -151,12 +151,6 @@ def _nodes(planned: Planned) -> int:
     """The product nodes the plan's search held (built, or reached on demand)."""
     stats = planned.witness.stats
     return int(stats.get("product_nodes") or stats.get("product_reached") or 0)
-
-
-def _shape(planned: Planned) -> tuple[Any, ...]:
-    """What makes two plans the same channel: the mesh's size, the triangles and passages."""
-    w = planned.witness
-    return (planned.abstraction.num_triangles, w.prefix, w.cycle, w.passages)
 
 
 def pull(mission: Mission, planned: Planned) -> Pulled:

@@ -48,6 +48,12 @@ class Planned:
     #: rung plans on it: a fan's triangles split the cells a U-turn needs none of)
     unrefined: Abstraction | None = None
 
+    def route(self) -> tuple[int, tuple[int, ...], tuple[int, ...], tuple[tuple[int, int], ...]]:
+        """What makes two plans the same route (the re-plan loops' fixed point): the mesh's
+        size, the triangles visited and the vertex passages."""
+        w = self.witness
+        return (self.abstraction.num_triangles, w.prefix, w.cycle, w.passages)
+
 
 def abstraction_for(
     mission: Mission, margin: float, *, deep: bool = True, scale: float = 1.0
