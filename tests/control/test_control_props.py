@@ -34,13 +34,8 @@ from tlmpc.io.schema_check import validation_errors
 from tlmpc.mission.model import Robot
 from tlmpc.pipeline.stages import ABSTRACTION, CONTROLLERS, MISSION, WITNESS
 from tlmpc.planning.model import Witness
-from tlmpc.simulate.exact import (
-    _exit_step,
-    _local_flow,
-    _stay_step,
-    bracketed_root,
-    expm_small,
-)
+from tlmpc.simulate.exact import _exit_step, _local_flow, _stay_step, bracketed_root
+from tlmpc.simulate.matrix import expm_small
 
 
 def _min_angle(v: np.ndarray) -> float:

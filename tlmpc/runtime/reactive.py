@@ -43,7 +43,8 @@ from tlmpc.reactive.faces import faces_of
 from tlmpc.runtime.executor import CompiledOutput
 from tlmpc.runtime.locate import Locator
 from tlmpc.runtime.strategy_machine import Stepper, strategy_stepper
-from tlmpc.simulate.exact import exit_step, expm_small
+from tlmpc.simulate.exact import exit_step
+from tlmpc.simulate.matrix import expm_small
 
 #: The artifacts a reactive output folder must hold for the executor.
 REACTIVE_ARTIFACTS = ("mission.json", "abstraction.json", "strategy.json")

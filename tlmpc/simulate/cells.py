@@ -19,6 +19,7 @@ from tlmpc.abstraction.model import FloatArray
 from tlmpc.base.errors import SolverError, error
 from tlmpc.control.geometry import triangle_geometry
 from tlmpc.control.model import EXIT, KEPT, CellField, StepController
+from tlmpc.simulate.matrix import augmented, expm_small
 
 #: Grid points per piece that bracket its exit before root finding.
 GRID_POINTS = 256
@@ -87,28 +88,6 @@ def _stay(
     return times, points, triangles, [False] * len(points)
 
 
-def expm(matrix: FloatArray) -> FloatArray:
-    """exp(A) of a 3 x 3 matrix: scaling to norm <= 1/2, a Taylor polynomial of degree 18
-    (its first neglected term below 1e-22 there), then squaring."""
-    norm = float(np.abs(matrix).sum(axis=0).max())
-    squarings = max(0, math.ceil(math.log2(norm)) + 1) if norm > 0.5 else 0
-    scaled = matrix * 0.5**squarings
-    identity = np.eye(3)
-    result = identity + scaled / 18.0
-    for k in range(17, 0, -1):
-        result = identity + (scaled @ result) / k
-    for _ in range(squarings):
-        result = result @ result
-    return result
-
-
-def _augmented(gain: FloatArray, offset: FloatArray) -> FloatArray:
-    matrix = np.zeros((3, 3))
-    matrix[:2, :2] = gain
-    matrix[:2, 2] = offset
-    return matrix
-
-
 def _move(
     controller: StepController, field: CellField, x0: FloatArray
 ) -> tuple[list[float], list[FloatArray], list[int], list[bool]]:
@@ -134,11 +113,11 @@ def _move(
         geometry = triangle_geometry(field.vertices[piece])
         size = float(geometry.heights.max())
         centre = field.vertices[piece].mean(axis=0)
-        matrix = _augmented(field.gains[piece], field.gains[piece] @ centre + field.offsets[piece])
+        matrix = augmented(field.gains[piece], field.gains[piece] @ centre + field.offsets[piece])
         reach = float((field.vertices[piece] @ xi).max() - xi @ x)
         horizon = max(reach, 0.0) / speed * 1.02 + 1e-12
         dt = horizon / GRID_POINTS
-        step = expm(dt * matrix)
+        step = expm_small(dt * matrix)
         state = np.array([*(x - centre), 1.0])
         offsets = geometry.offsets - geometry.normals @ centre
         previous, found = state, None
@@ -170,7 +149,7 @@ def _move(
                 normals: FloatArray = geometry.normals,
                 offsets: FloatArray = offsets,
             ) -> float:
-                y = expm(s * matrix) @ previous
+                y = expm_small(s * matrix) @ previous
                 return float(normals[j] @ y[:2] - offsets[j])
 
             if height(dt) <= 0.0:
@@ -189,7 +168,7 @@ def _move(
             if root < earliest or facet < 0:
                 earliest, facet = root, j
         crossing = (found - 1) * dt + earliest
-        end = (expm(earliest * matrix) @ previous)[:2] + centre
+        end = (expm_small(earliest * matrix) @ previous)[:2] + centre
         # samples inside the piece: a few grid states
         for k in (GRID_POINTS // 4, GRID_POINTS // 2, 3 * GRID_POINTS // 4):
             if k < found - 1:

@@ -28,6 +28,7 @@ from tlmpc.control.geometry import largest_of, triangle_geometry
 from tlmpc.control.model import Controllers, StepController
 from tlmpc.mission.model import Mission
 from tlmpc.simulate.cells import cell_step
+from tlmpc.simulate.matrix import augmented, column_norm, expm_small, taylor_degree
 
 #: Samples per step (besides the crossings): grid points near SAMPLES_PER_STEP - 1 evenly
 #: spaced times.
@@ -56,72 +57,10 @@ class Trace(ContentEquality):
     crossings: tuple[int, ...] = ()
 
 
-def _augmented(gain: FloatArray, offset: FloatArray) -> FloatArray:
-    matrix = np.zeros((3, 3))
-    matrix[:2, :2] = gain
-    matrix[:2, 2] = offset
-    return matrix
-
-
-#: 1/k! for the Taylor degrees used here.
-_INVERSE_FACTORIALS = tuple(1.0 / math.factorial(k) for k in range(42))
-#: Truncation error allowed in a series (far below rounding of an O(1) result).
-_TAYLOR_TOLERANCE = 1e-18
-
-
-def _taylor_degree(radius: float, cap: int) -> int:
-    """The first degree m <= cap with radius^(m+1)/(m+1)! <= 1e-18: where the exponential series
-    of a matrix of norm ``radius`` is cut, the first neglected term is below 1e-18."""
-    degree = 1
-    while (
-        degree < cap
-        and radius ** (degree + 1) * _INVERSE_FACTORIALS[degree + 1] > _TAYLOR_TOLERANCE
-    ):
-        degree += 1
-    return degree
-
-
 #: 0, 1, ..., m for each Taylor degree m of the local flow (read only).
 _EXPONENTS = tuple(np.arange(degree + 1) for degree in range(41))
 for _exponents in _EXPONENTS:
     _exponents.setflags(write=False)
-
-#: The identity of the augmented matrices (read only: every use makes a new array).
-_IDENTITY_3 = np.eye(3)
-_IDENTITY_3.setflags(write=False)
-
-
-def _column_norm(matrix: FloatArray) -> float:
-    """The 1-norm (largest column sum of |a_ij|) of a square matrix: the value of
-    ``np.abs(matrix).sum(axis=0).max()``, summed as numpy sums (rows first to last) on
-    Python floats, without numpy's per-call cost on a 3 x 3 matrix."""
-    rows = matrix.tolist()
-    sums = [abs(a) for a in rows[0]]
-    for row in rows[1:]:
-        sums = [total + abs(a) for total, a in zip(sums, row, strict=True)]
-    return largest_of(sums)
-
-
-def expm_small(matrix: FloatArray) -> FloatArray:
-    """exp(A) of a small matrix by scaling and squaring with a Taylor polynomial (Horner form).
-
-    The matrix is scaled to norm s <= 1/2 and the series is cut at the first degree m with
-    s^(m+1)/(m+1)! <= 1e-18 (m <= 18; small steps need far fewer terms).  Squaring amplifies
-    rounding to about 1e-11 relative for the gains that occur here (checked against scipy's
-    ``expm`` in the tests), and it is many times faster than a general call.
-    """
-    norm = _column_norm(matrix)
-    squarings = max(0, math.ceil(math.log2(norm)) + 1) if norm > 0.5 else 0
-    scale = 0.5**squarings
-    scaled = matrix * scale
-    degree = _taylor_degree(norm * scale, 18)
-    identity = _IDENTITY_3 if matrix.shape == (3, 3) else np.eye(matrix.shape[0])
-    result = identity + scaled / degree
-    for k in range(degree - 1, 0, -1):
-        result = identity + (scaled @ result) / k
-    for _ in range(squarings):
-        result = result @ result
-    return result
 
 
 def bracketed_root(
@@ -175,7 +114,7 @@ def _local_flow(
     a few Horner steps per evaluation instead of a matrix exponential.  ``norm`` is the
     matrix's column norm when known.
     """
-    radius = (_column_norm(matrix) if norm is None else norm) * reach
+    radius = (column_norm(matrix) if norm is None else norm) * reach
     if radius > SERIES_RADIUS:
 
         def far_point(s: float) -> FloatArray:
@@ -185,7 +124,7 @@ def _local_flow(
             return float(normal @ far_point(s)[:2] - offset)
 
         return far_point, far_height
-    degree = _taylor_degree(radius, 40)
+    degree = taylor_degree(radius, 40)
     terms = [base]
     for k in range(1, degree + 1):
         terms.append(matrix @ terms[-1] / k)
@@ -242,7 +181,7 @@ def _exit_frame(controller: StepController) -> _ExitFrame:
     # origin the global offset g would dominate it and scaling and squaring would lose digits).
     (x1, y1), (x2, y2), (x3, y3) = corners
     center = np.array([(x1 + x2 + x3) / 3, (y1 + y2 + y3) / 3])
-    matrix = _augmented(controller.gain, controller.gain @ center + controller.offset)
+    matrix = augmented(controller.gain, controller.gain @ center + controller.offset)
     # The other two facets, watched too: a field that leaves by an unplanned facet is a bug the
     # simulation must report, not hide by snapping the crossing onto the planned edge.
     others = [j for j in range(3) if j != controller.exit_edge]
@@ -255,7 +194,7 @@ def _exit_frame(controller: StepController) -> _ExitFrame:
         scale=largest_of([abs(c) for corner in corners for c in corner]) + tallest,
         center=center,
         matrix=matrix,
-        matrix_norm=_column_norm(matrix),
+        matrix_norm=column_norm(matrix),
         offset=float(geometry.offsets[controller.exit_edge] - normal @ center),
         others=others,
         other_normals=other_normals,
