@@ -47,6 +47,7 @@ import numpy as np
 import numpy.typing as npt
 
 from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
+from tlmpc.planning.robust import corner_angles
 
 BoolArray = npt.NDArray[np.bool_]
 Vector = tuple[float, float]
@@ -297,7 +298,7 @@ def partition(abstraction: Abstraction) -> Cells:
     component = abstraction.component.tolist()
     points = [(float(x), float(y)) for x, y in abstraction.vertices.tolist()]
     count = len(triangles)
-    angles = _corner_angles(points, triangles)
+    angles = corner_angles(abstraction).tolist()
     # Every inner edge between triangles of one letter and component, sharpest first: the
     # smallest triangle angle at its ends (merging there widens a corner), then by index.
     candidates = []
@@ -370,18 +371,6 @@ def partition(abstraction: Abstraction) -> Cells:
     )
 
 
-def _corner_angles(points: list[Vector], triangles: list[list[int]]) -> list[list[float]]:
-    found = []
-    for corners in triangles:
-        row = []
-        for i in range(3):
-            (px, py), (ax, ay), (bx, by) = (points[corners[(i + k) % 3]] for k in range(3))
-            ux, uy, vx, vy = ax - px, ay - py, bx - px, by - py
-            row.append(math.atan2(abs(ux * vy - uy * vx), ux * vx + uy * vy))
-        found.append(row)
-    return found
-
-
 def _merged(first: list[int], second: list[int], points: list[Vector]) -> list[int] | None:
     """The boundary of the union of two convex cells sharing one chain of edges, or None when
     that union is not convex. The chain runs counter-clockwise c_0 .. c_k in ``first`` and
@@ -418,20 +407,11 @@ def cell_realisable(cells: Cells, ratio: float, tolerance: float) -> tuple[BoolA
     """(m, 3) moves and (m,) stays realisable on cells under ``ratio`` x max_speed: a move
     inside one cell always (the cell's field carries the robot on; the labels are the same),
     one into another cell when that cell move's width exceeds the ratio, a stay when its
-    cell's stay does."""
-    abstraction = cells.abstraction
+    cell's stay does (the widths of :func:`cell_widths`)."""
     need = ratio + tolerance
-    here = cells.cell_of
-    moves = np.zeros(abstraction.neighbors.shape, dtype=bool)
-    stays = np.zeros(len(here), dtype=bool)
-    for t, row in enumerate(abstraction.neighbors.tolist()):
-        for i, there in enumerate(row):
-            if there < 0:
-                continue
-            a, b = int(here[t]), int(here[there])
-            moves[t, i] = a == b or cells.move(a, b).width > need
-        stays[t] = cells.stay(int(here[t])).width > need
-    return moves, stays
+    moves, stays = cell_widths(cells)
+    crossing = cells.abstraction.neighbors >= 0
+    return np.asarray(crossing & (moves > need), dtype=bool), np.asarray(stays > need, dtype=bool)
 
 
 def cell_widths(cells: Cells) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
