@@ -45,7 +45,7 @@ from tlmpc.control.robust import (
 )
 from tlmpc.control.sparse import CscMatrix, Triplets, stacked_csc
 from tlmpc.mission.model import Robot
-from tlmpc.planning.mission import on_cells
+from tlmpc.planning.mission import SUPPORTED, SUPPORTED_CELLS, on_cells
 from tlmpc.planning.model import Witness
 
 #: A unit normal as Python floats.
@@ -660,8 +660,8 @@ def synthesize(
     steps, loop_start = plan_steps(abstraction, witness)
     if robot.disturbance > 0.0:
         # the planner's widest-lasso search, recorded on a plan it could not make realisable
-        supported = witness.stats.get("supported_disturbance")
-        cells_bound = witness.stats.get("supported_disturbance_cells")
+        supported = witness.stats.get(SUPPORTED)
+        cells_bound = witness.stats.get(SUPPORTED_CELLS)
         _check_rejectable(
             abstraction,
             steps,

@@ -219,8 +219,7 @@ def plan_mission(
         known = [float(b) / mission.robot.max_speed for b in cells_bounds if b is not None]
         if lines_bound is not None:
             known.append(lines_bound)
-        chosen = _with_cells_bound(tried[best], max(known) if known else None, mission)
-        return chosen
+        return _with_cells_bound(tried[best], max(known) if known else None, mission)
 
     holding = holding_skeleton(mission.formula)
     if resume is None and holding != skeleton:
