@@ -247,7 +247,9 @@ class Executor:
             # the law of the cell's triangle the robot is in (the nearest piece just outside)
             piece = controller.cell.piece_of(self._triangle) if self._triangle is not None else None
             if piece is None:
-                piece = _nearest_piece(controller.cell.vertices, point)
+                from tlmpc.simulate.cells import nearest_piece
+
+                piece = nearest_piece(controller.cell, point)
             gain, offset = controller.cell.gains[piece], controller.cell.offsets[piece]
         u: FloatArray = gain @ point + offset
         speed = float(np.hypot(u[0], u[1]))
@@ -522,16 +524,3 @@ class Executor:
                 step_after=step_after,
             )
         )
-
-
-def _nearest_piece(corners: FloatArray, point: FloatArray) -> int:
-    """The piece (triangle of a cell) whose smallest barycentric weight at ``point`` is
-    largest: the one holding it, or the nearest to it just outside."""
-    best, best_value = 0, -math.inf
-    for piece, (a, b, c) in enumerate(corners.tolist()):
-        matrix = np.array([[a[0], b[0], c[0]], [a[1], b[1], c[1]], [1.0, 1.0, 1.0]])
-        weights = np.linalg.solve(matrix, np.array([point[0], point[1], 1.0]))
-        value = float(weights.min())
-        if value > best_value:
-            best, best_value = piece, value
-    return best

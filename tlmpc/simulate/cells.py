@@ -32,6 +32,16 @@ STAY_SAMPLES = 32
 STAY_CONTRACTION = 1e-6
 
 
+def nearest_piece(field: CellField, point: FloatArray) -> int:
+    """The piece whose smallest barycentric weight at ``point`` is largest: the one holding
+    it, or the nearest to it just outside (the executor's choice of law off the pieces)."""
+    lowest = [
+        float(triangle_geometry(field.vertices[piece]).barycentric(point).min())
+        for piece in range(len(field.triangles))
+    ]
+    return lowest.index(max(lowest))
+
+
 def locate(field: CellField, point: FloatArray, velocity_hint: bool = True) -> int | None:
     """The piece holding ``point`` (on a shared facet: the one the field enters)."""
     best, best_value = None, -math.inf
