@@ -13,7 +13,10 @@ Only this module knows how the pieces of planning fit together for a mission:
 
 A re-plan of a run under way (``resume``) keeps the mesh and automaton the run was compiled
 with (the executor's triangles and automaton states refer to them) and so never drops the
-margin; it may still refine the mesh for a U-turn, and then returns the refined one.
+margin nor changes the goal depth; it may still refine the mesh for a U-turn, and then returns
+the refined one. Under a disturbance its ladder is the compile's on that mesh: the triangles,
+their realisable steps, then the convex cells of the mesh (a run compiled on the cells' own
+mesh has that mesh).
 """
 
 from __future__ import annotations
@@ -132,7 +135,10 @@ def plan_mission(
             return complete(mesh, task, formula, explain, ratio)
         except (NoPlanError, RefinementError):
             # U-turn fans may have no realisable route either. The control stage refuses
-            # this plan (C032) and states the largest disturbance any plan on its mesh rejects.
+            # this plan (C032) and states the largest disturbance any plan on its mesh rejects
+            # (a run under way states nothing: it goes on to the cells of its mesh, or stops).
+            if resume is not None:
+                return first
             return _with_supported(first, mission, formula, start_point)
 
     def complete(
@@ -168,7 +174,7 @@ def plan_mission(
     def on_cells_rung(planned: Planned) -> Planned:
         """``planned``'s task on the convex cells of its mesh, then of the cells' own mesh;
         else ``planned`` with the bound on cells (the control stage refuses it, C032)."""
-        on_cells = _on_cells(mission, planned, start_point)
+        on_cells = _on_cells(mission, planned, start_point, resume)
         if on_cells is not None:
             return on_cells
         on_lines, lines_bound = _on_lines(mission, margin, planned, start_point)
@@ -182,10 +188,14 @@ def plan_mission(
         the goal depth), then entering the goals only as deep as the margin asks (the cores'
         corners may be all that is too sharp); the first plan whose steps all realise it."""
         ratio = mission.robot.disturbance / mission.robot.max_speed
-        if resume is not None or ratio <= 0.0:
+        if ratio <= 0.0 or witness_realisable(planned.abstraction, planned.witness, ratio):
             return planned
-        if witness_realisable(planned.abstraction, planned.witness, ratio):
-            return planned
+        if resume is not None:
+            # A run under way keeps the mesh it was compiled with (its triangles and automaton
+            # states refer to it): of the ladder's rungs, the convex cells of that mesh are
+            # left, from the robot's cell and the tracked states. None: the control stage
+            # refuses the triangles' plan and the run stops.
+            return _on_cells(mission, planned, start_point, resume) or planned
         if not deepens_goals(mission):
             return on_cells_rung(planned)
         tried = [planned]
@@ -395,11 +405,16 @@ ON_CELLS = "cells"
 
 
 def _on_cells(
-    mission: Mission, planned: Planned, start_point: tuple[float, float] | None
+    mission: Mission,
+    planned: Planned,
+    start_point: tuple[float, float] | None,
+    resume: frozenset[int] | None = None,
 ) -> Planned | None:
     """The last rung of the plan stage: ``planned``'s task planned again on the convex
     cells of its mesh (:mod:`tlmpc.planning.cells`), when every cell step of that plan
-    rejects the mission's disturbance; None otherwise."""
+    rejects the mission's disturbance; None otherwise. ``resume`` re-plans a run under way
+    from the mesh's start triangle (its cell entered from nowhere: any interface may be
+    left), the automaton being in one of these states."""
     from tlmpc.ltl.bounds import untimed_skeleton
     from tlmpc.planning.cells import MAX_TRIANGLES, partition, witness_on_cells
     from tlmpc.planning.complete import RefinementError, plan_complete
@@ -426,6 +441,7 @@ def _on_cells(
             options=mission.options,
             start_point=where,
             bounces=True,
+            resume=resume,
             reject=ratio,
             times=times,
             on_cells=True,
@@ -439,6 +455,7 @@ def _on_cells(
             formula=formula,
             options=mission.options,
             start_point=where,
+            resume=resume,
             explain=False,
             reject=ratio,
             times=times,
