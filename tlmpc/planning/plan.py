@@ -117,7 +117,10 @@ def plan(
     default only when the product would not fit the budget (:mod:`tlmpc.planning.budget`).
     With ``reject`` (a disturbance over max_speed) only the moves and stays the controllers
     realise under it are used (:mod:`tlmpc.planning.robust`); with ``on_cells``, those the
-    convex cells' fields realise (:mod:`tlmpc.planning.cells`).
+    convex cells' fields realise (:mod:`tlmpc.planning.cells`), searched on a product that
+    also rules out turning back across an interface and loops inside a cell whose stay is too
+    narrow (:mod:`tlmpc.planning.cell_product`; the guided search leaves both to the check
+    of the plan found).
     Under ``options.cost: time`` the moves weigh ``times`` (:mod:`tlmpc.planning.timing`;
     without it, their lengths at unit speed).
     """
