@@ -5,8 +5,9 @@
   inside one cell are that cell's stay: the true largest disturbance the cells support, not
   an upper bound.
 * The planner on cells, under a disturbance, finds a plan exactly when such a lasso is wide
-  enough, and the plan it finds passes the control stage's checks (no step leaves for the
-  cell it came from, every cell step and stay wide enough).
+  enough (just below the bound, and not at it), and the plan it finds passes the control
+  stage's checks (no step leaves for the cell it came from, every cell step and stay wide
+  enough).
 * Two hand-made maps where the triangles' product alone goes wrong: a dead-end room (the
   only lasso turns back) and an overlap whose narrow cell the cheapest patrol loops in while
   a wide one exists further on.
@@ -165,6 +166,10 @@ def test_the_cells_searches_are_the_brute_force_ones(
     found = _bound(mission, mesh, automaton)
     event("no lasso" if expected is None else "lasso")
     assert found == expected  # the same widths, compared as they are
+    if expected is not None:
+        # the bound is the planner's own threshold on cells: a plan just below, none at it
+        assert _plan_on_cells(mission, mesh, automaton, expected - 3 * TOLERANCE) is not None
+        assert _plan_on_cells(mission, mesh, automaton, expected - 0.5 * TOLERANCE) is None
     planned = _plan_on_cells(mission, mesh, automaton, ratio)
     exists = _exists(mission, mesh, automaton, ratio)
     event(f"plan on cells: {exists}")
