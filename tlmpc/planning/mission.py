@@ -178,7 +178,10 @@ def plan_mission(
         if on_cells is not None:
             return on_cells
         on_lines, lines_bound = _on_lines(mission, margin, planned, start_point)
-        return on_lines or _with_cells_bound(planned, lines_bound, mission)
+        if on_lines is not None:
+            return on_lines
+        refused = _with_cells_supported(planned, mission, start_point)
+        return _with_cells_bound(refused, lines_bound, mission)
 
     def realisable_depth(
         planned: Planned, formula: Formula = skeleton, explain: bool = True
@@ -223,6 +226,7 @@ def plan_mission(
         # None realises it on cells either: the plan on the mesh whose plans reject the most
         # goes on to be refused, stating that mesh's bound (C032: the mission compiles below it)
         # and the cells' (the largest over the meshes tried).
+        tried = [_with_cells_supported(plan, mission, start_point) for plan in tried]
         bounds = [_supported_of(plan.witness) for plan in tried]
         best = max(range(len(tried)), key=lambda k: (bounds[k] is not None, bounds[k] or 0.0, -k))
         cells_bounds = [plan.witness.stats.get(SUPPORTED_CELLS) for plan in tried]
@@ -278,6 +282,7 @@ def plan_mission(
         planned = attempt(plain, automaton_for(mission, plain))
     except NoPlanError as again:
         raise _with_body_notes(again, mission) from None
+    planned = _with_cells_supported(planned, mission, start_point)
     reason = first.diagnostics[0].message if first.diagnostics else "no plan"
     note = Diagnostic(
         code="R008",
@@ -378,23 +383,41 @@ def _with_supported(
     if ratio is None:
         return planned
     stats = {**planned.witness.stats, SUPPORTED: ratio * mission.robot.max_speed}
+    return replace(planned, witness=replace(planned.witness, stats=stats))
+
+
+def _with_cells_supported(
+    planned: Planned, mission: Mission, start_point: tuple[float, float] | None
+) -> Planned:
+    """``planned``, a plan about to be refused with its mesh's bound (SUPPORTED), with the
+    largest disturbance plans on the convex cells of its mesh reject (SUPPORTED_CELLS, within
+    the cells' budget). Computed only here, for a refusal: a plan the cells' rung then
+    carries never needs it."""
+    stats = planned.witness.stats
+    if SUPPORTED not in stats or SUPPORTED_CELLS in stats:
+        return planned
+    from tlmpc.ltl.bounds import untimed_skeleton
+    from tlmpc.planning.bottleneck import supported_ratio
     from tlmpc.planning.cells import MAX_TRIANGLES
 
-    on_cells = (
-        supported_ratio(
-            planned.abstraction,
-            planned.automaton,
-            formula=formula,
-            options=mission.options,
-            start_point=start_point if start_point is not None else mission.robot.start,
-            cells=True,
-        )
-        if planned.abstraction.num_triangles <= MAX_TRIANGLES
-        else None
+    if planned.abstraction.num_triangles > MAX_TRIANGLES:
+        return planned
+    on_cells = supported_ratio(
+        planned.abstraction,
+        planned.automaton,
+        formula=planned.formula
+        if planned.formula is not None
+        else untimed_skeleton(mission.formula),
+        options=mission.options,
+        start_point=start_point if start_point is not None else mission.robot.start,
+        cells=True,
     )
-    if on_cells is not None:
-        stats[SUPPORTED_CELLS] = on_cells * mission.robot.max_speed
-    return replace(planned, witness=replace(planned.witness, stats=stats))
+    if on_cells is None:
+        return planned
+    value = on_cells * mission.robot.max_speed
+    return replace(
+        planned, witness=replace(planned.witness, stats={**stats, SUPPORTED_CELLS: value})
+    )
 
 
 #: The witness statistic of the bound on cells (:mod:`tlmpc.planning.cells`): at most this
