@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import pytest
@@ -49,4 +50,23 @@ def test_within_the_budget_the_hint_states_the_cells_bound(tmp_path: Path) -> No
     assert hint is not None
     assert "on convex cells" in hint
     assert "plans reject at most" in hint
+    assert "was tried" not in hint
+
+
+@pytest.mark.parametrize("options", ["", "options: {goal_depth: 0}\n"])
+def test_without_the_cells_own_mesh_the_hint_states_the_mission_mesh_cells_bound(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, options: str
+) -> None:
+    """The bound on the cells of the meshes tried is computed for the refusal alone (a plan
+    the cells' rung carries never needs it): with the cells' own mesh over its budget,
+    Example 1 at 0.5 (with goal cores, the ladder's meshes; without, the one mesh) is
+    refused stating what its meshes' cells reject, a rectangle's corners left by part of a
+    side: cos 67.5 degrees."""
+    monkeypatch.setattr(tlmpc.abstraction.lines, "MAX_SIDES", 3)
+    source = _example1(tmp_path, 0.5)
+    source.write_text(source.read_text(encoding="utf-8") + options, encoding="utf-8")
+    refused = _refusal(source)
+    (hint,) = {d.hint for d in refused.diagnostics if d.code == "C032"}
+    assert hint is not None
+    assert f"plans reject at most {math.cos(math.radians(67.5)):.6g}" in hint
     assert "was tried" not in hint

@@ -7,7 +7,9 @@ the trace verifies (``tlmpc verify`` exits 0); the runtime executor's closed loo
 adversarial and random pushes of the full bound verifies with the independent verifier; and
 an independent adversarial Euler loop (tests/oracles/cell_adversary.py) run on every cell
 step of the plan, from every corner of the cell (a hair inside) and its centroid, leaves
-each move's cell only through its interface and never leaves a stay's.
+each move's cell only through its interface and never leaves a stay's. A push off the plan
+(into the right-hand side, between p4 and p3) is re-planned on cells from where it lands,
+and the run goes on to verify under the adversarial disturbance at the full bound.
 """
 
 from __future__ import annotations
@@ -19,11 +21,12 @@ from typing import Any, Literal
 
 import numpy as np
 import pytest
+import shapely
 import yaml
 from cell_adversary import CellLoop
 
 import tlmpc
-from tlmpc.runtime import make_disturbance, run_closed_loop
+from tlmpc.runtime import Executor, make_disturbance, run_closed_loop
 from tlmpc.runtime.closed_loop import default_dt
 from tlmpc.verify import verify_document
 
@@ -93,3 +96,32 @@ def test_every_cell_step_resists_the_adversary(compiled: Any) -> None:
                     assert outcome == "held", (step["step"], start, kind)
                 elif horizon < CAP:
                     assert outcome == "exit", (step["step"], start, kind, bound)
+
+
+@pytest.mark.slow
+def test_a_push_off_the_plan_is_replanned_on_cells(compiled: Any) -> None:
+    executor = tlmpc.executor(compiled)
+    bound = RATIO * executor.mission.robot.max_speed
+    dt = default_dt(executor.plan, executor.mission.robot.max_speed + bound)
+    target = np.array([9.0, 5.5])
+    declared = make_disturbance("adversarial", bound, 0, dt)
+
+    def push(t: float, point: Any, running: Executor) -> Any:
+        if t < 0.5 * dt:
+            return (target - point) / dt - running.velocity(point)
+        return declared(t, point, running)
+
+    run = run_closed_loop(executor, push, bound=bound, dt=dt)
+    kinds = [r.kind for r in run.recoveries]
+    assert "replan" in kinds, run.recoveries
+    assert "no_plan" not in kinds, run.recoveries
+    # read at the first sample after the push: nothing later
+    assert all(r.time <= 1.5 * dt for r in run.recoveries), run.recoveries
+    assert all(step.kind == "cell" for step in executor.plan.steps)
+    verdict = verify_document(run.trace)
+    assert verdict.satisfied, [v.message for v in verdict.violations]
+    assert run.completed
+    points = [shapely.Point(x, y) for _, x, y in run.trace["points"]]
+    assert all(shapely.box(0, 0, 10, 10).contains(p) for p in points)
+    p1 = shapely.Polygon(_mission()["regions"]["p1"])
+    assert p1.contains(points[-1])

@@ -54,9 +54,10 @@ def supported_ratio(
     U-turns or vertex passages, or is too large to build (the guided search's size).
 
     With ``cells``, the steps are the convex cells' (:mod:`tlmpc.planning.cells`): a move
-    inside one cell is no step of its own, a cycle inside one cell is that cell's stay. A
-    lasso may then enter a cell and leave it back across the same interface, which no cell
-    field realises: the value is an upper bound on what plans on cells reject."""
+    inside one cell is no step of its own, a cycle inside one cell is that cell's stay, and
+    the product's nodes carry the cell the robot entered its cell from
+    (:mod:`tlmpc.planning.cell_product`), so no lasso leaves a cell back across the
+    interface it came in by (no cell field does): the value is what plans on cells reject."""
     if not estimate_product(abstraction, automaton).fits:
         return None
     working = degeneralize(automaton) if automaton.num_acc >= 2 else automaton
@@ -74,19 +75,29 @@ def supported_ratio(
     if not cells:
         moves, stays = step_widths(abstraction)
         return widest_lasso(product, abstraction, moves, stays)
+    from tlmpc.planning.cell_product import cell_product
     from tlmpc.planning.cells import cell_widths, partition
 
     partitioned = partition(abstraction)
     moves, stays = cell_widths(partitioned)
-    return widest_lasso(product, abstraction, moves, stays, groups=partitioned.cell_of)
+    on = cell_product(product, partitioned.cell_of)
+    return widest_lasso(
+        on.product, abstraction, moves, stays, groups=partitioned.cell_of, origin=on.origin
+    )
 
 
-def edge_widths(product: Product, abstraction: Abstraction, moves: FloatArray) -> FloatArray:
-    """Per product edge: the width of its move, ``inf`` for a stutter edge (no step)."""
+def edge_widths(
+    product: Product, abstraction: Abstraction, moves: FloatArray, origin: IntArray | None = None
+) -> FloatArray:
+    """Per product edge: the width of its move, ``inf`` for a stutter edge (no step);
+    ``origin`` maps the nodes of a product on cells to the triangles' product's."""
     graph = product.graph
     nq = product.num_automaton_states
-    here = graph.sources // nq // SLOTS
-    there = graph.targets // nq // SLOTS
+    tails, heads = graph.sources, graph.targets
+    if origin is not None:
+        tails, heads = origin[tails], origin[heads]
+    here = tails // nq // SLOTS
+    there = heads // nq // SLOTS
     widths = np.full(graph.nnz, np.inf)
     moving = np.flatnonzero(here != there)
     sides = abstraction.neighbors[here[moving]] == there[moving, None]
@@ -101,17 +112,20 @@ def widest_lasso(
     moves: FloatArray,
     stays: FloatArray,
     groups: IntArray | None = None,
+    origin: IntArray | None = None,
 ) -> float | None:
     """The bottleneck value of the product's accepting lassos (None when there is none);
-    ``groups`` (per triangle) joins triangles into cells whose inner moves are no steps."""
-    widths = edge_widths(product, abstraction, moves)
+    ``groups`` (per triangle) joins triangles into cells whose inner moves are no steps,
+    ``origin`` maps the nodes of a product on cells to the triangles' product's."""
+    widths = edge_widths(product, abstraction, moves, origin)
     candidates = np.unique(np.concatenate([widths[np.isfinite(widths)], stays]))
-    if not len(candidates) or not _has_lasso(product, widths, stays, float(candidates[0]), groups):
+    first = float(candidates[0]) if len(candidates) else 0.0
+    if not len(candidates) or not _has_lasso(product, widths, stays, first, groups, origin):
         return None
     low, high = 0, len(candidates) - 1  # the lasso exists at candidates[low]
     while low < high:
         middle = (low + high + 1) // 2
-        if _has_lasso(product, widths, stays, float(candidates[middle]), groups):
+        if _has_lasso(product, widths, stays, float(candidates[middle]), groups, origin):
             low = middle
         else:
             high = middle - 1
@@ -124,6 +138,7 @@ def _has_lasso(
     stays: FloatArray,
     floor: float,
     groups: IntArray | None = None,
+    origin: IntArray | None = None,
 ) -> bool:
     """Whether an accepting lasso uses only steps of width >= ``floor``."""
     graph = product.graph
@@ -137,7 +152,8 @@ def _has_lasso(
         strong_components(indptr, targets, roots=product.initial.tolist()), dtype=np.int64
     )
     wide_stay = stays >= floor
-    triangle_of = np.arange(graph.num_nodes) // nq // SLOTS
+    nodes = np.arange(graph.num_nodes) if origin is None else origin
+    triangle_of = nodes // nq // SLOTS
     if (product.stutter_accepting & (component >= 0) & wide_stay[triangle_of]).any():
         return True
     accepting = np.flatnonzero(product.accepting & kept)
@@ -147,7 +163,7 @@ def _has_lasso(
         return False
     # A component spanning two cells has a cycle through each of its edges that moves; one
     # inside a single cell is a stay of that triangle.
-    cell = np.arange(graph.num_nodes) // nq
+    cell = nodes // nq
     if groups is not None:
         cell = groups[triangle_of]
     members = component >= 0

@@ -13,7 +13,10 @@ Only this module knows how the pieces of planning fit together for a mission:
 
 A re-plan of a run under way (``resume``) keeps the mesh and automaton the run was compiled
 with (the executor's triangles and automaton states refer to them) and so never drops the
-margin; it may still refine the mesh for a U-turn, and then returns the refined one.
+margin nor changes the goal depth; it may still refine the mesh for a U-turn, and then returns
+the refined one. Under a disturbance its ladder is the compile's on that mesh: the triangles,
+their realisable steps, then the convex cells of the mesh (a run compiled on the cells' own
+mesh has that mesh).
 """
 
 from __future__ import annotations
@@ -132,7 +135,10 @@ def plan_mission(
             return complete(mesh, task, formula, explain, ratio)
         except (NoPlanError, RefinementError):
             # U-turn fans may have no realisable route either. The control stage refuses
-            # this plan (C032) and states the largest disturbance any plan on its mesh rejects.
+            # this plan (C032) and states the largest disturbance any plan on its mesh rejects
+            # (a run under way states nothing: it goes on to the cells of its mesh, or stops).
+            if resume is not None:
+                return first
             return _with_supported(first, mission, formula, start_point)
 
     def complete(
@@ -168,11 +174,14 @@ def plan_mission(
     def on_cells_rung(planned: Planned) -> Planned:
         """``planned``'s task on the convex cells of its mesh, then of the cells' own mesh;
         else ``planned`` with the bound on cells (the control stage refuses it, C032)."""
-        on_cells = _on_cells(mission, planned, start_point)
+        on_cells = _on_cells(mission, planned, start_point, resume)
         if on_cells is not None:
             return on_cells
         on_lines, lines_bound = _on_lines(mission, margin, planned, start_point)
-        return on_lines or _with_cells_bound(planned, lines_bound, mission)
+        if on_lines is not None:
+            return on_lines
+        refused = _with_cells_supported(planned, mission, start_point)
+        return _with_cells_bound(refused, lines_bound, mission)
 
     def realisable_depth(
         planned: Planned, formula: Formula = skeleton, explain: bool = True
@@ -182,10 +191,14 @@ def plan_mission(
         the goal depth), then entering the goals only as deep as the margin asks (the cores'
         corners may be all that is too sharp); the first plan whose steps all realise it."""
         ratio = mission.robot.disturbance / mission.robot.max_speed
-        if resume is not None or ratio <= 0.0:
+        if ratio <= 0.0 or witness_realisable(planned.abstraction, planned.witness, ratio):
             return planned
-        if witness_realisable(planned.abstraction, planned.witness, ratio):
-            return planned
+        if resume is not None:
+            # A run under way keeps the mesh it was compiled with (its triangles and automaton
+            # states refer to it): of the ladder's rungs, the convex cells of that mesh are
+            # left, from the robot's cell and the tracked states. None: the control stage
+            # refuses the triangles' plan and the run stops.
+            return _on_cells(mission, planned, start_point, resume) or planned
         if not deepens_goals(mission):
             return on_cells_rung(planned)
         tried = [planned]
@@ -213,6 +226,7 @@ def plan_mission(
         # None realises it on cells either: the plan on the mesh whose plans reject the most
         # goes on to be refused, stating that mesh's bound (C032: the mission compiles below it)
         # and the cells' (the largest over the meshes tried).
+        tried = [_with_cells_supported(plan, mission, start_point) for plan in tried]
         bounds = [_supported_of(plan.witness) for plan in tried]
         best = max(range(len(tried)), key=lambda k: (bounds[k] is not None, bounds[k] or 0.0, -k))
         cells_bounds = [plan.witness.stats.get(SUPPORTED_CELLS) for plan in tried]
@@ -268,6 +282,7 @@ def plan_mission(
         planned = attempt(plain, automaton_for(mission, plain))
     except NoPlanError as again:
         raise _with_body_notes(again, mission) from None
+    planned = _with_cells_supported(planned, mission, start_point)
     reason = first.diagnostics[0].message if first.diagnostics else "no plan"
     note = Diagnostic(
         code="R008",
@@ -368,23 +383,41 @@ def _with_supported(
     if ratio is None:
         return planned
     stats = {**planned.witness.stats, SUPPORTED: ratio * mission.robot.max_speed}
+    return replace(planned, witness=replace(planned.witness, stats=stats))
+
+
+def _with_cells_supported(
+    planned: Planned, mission: Mission, start_point: tuple[float, float] | None
+) -> Planned:
+    """``planned``, a plan about to be refused with its mesh's bound (SUPPORTED), with the
+    largest disturbance plans on the convex cells of its mesh reject (SUPPORTED_CELLS, within
+    the cells' budget). Computed only here, for a refusal: a plan the cells' rung then
+    carries never needs it."""
+    stats = planned.witness.stats
+    if SUPPORTED not in stats or SUPPORTED_CELLS in stats:
+        return planned
+    from tlmpc.ltl.bounds import untimed_skeleton
+    from tlmpc.planning.bottleneck import supported_ratio
     from tlmpc.planning.cells import MAX_TRIANGLES
 
-    on_cells = (
-        supported_ratio(
-            planned.abstraction,
-            planned.automaton,
-            formula=formula,
-            options=mission.options,
-            start_point=start_point if start_point is not None else mission.robot.start,
-            cells=True,
-        )
-        if planned.abstraction.num_triangles <= MAX_TRIANGLES
-        else None
+    if planned.abstraction.num_triangles > MAX_TRIANGLES:
+        return planned
+    on_cells = supported_ratio(
+        planned.abstraction,
+        planned.automaton,
+        formula=planned.formula
+        if planned.formula is not None
+        else untimed_skeleton(mission.formula),
+        options=mission.options,
+        start_point=start_point if start_point is not None else mission.robot.start,
+        cells=True,
     )
-    if on_cells is not None:
-        stats[SUPPORTED_CELLS] = on_cells * mission.robot.max_speed
-    return replace(planned, witness=replace(planned.witness, stats=stats))
+    if on_cells is None:
+        return planned
+    value = on_cells * mission.robot.max_speed
+    return replace(
+        planned, witness=replace(planned.witness, stats={**stats, SUPPORTED_CELLS: value})
+    )
 
 
 #: The witness statistic of the bound on cells (:mod:`tlmpc.planning.cells`): at most this
@@ -395,11 +428,16 @@ ON_CELLS = "cells"
 
 
 def _on_cells(
-    mission: Mission, planned: Planned, start_point: tuple[float, float] | None
+    mission: Mission,
+    planned: Planned,
+    start_point: tuple[float, float] | None,
+    resume: frozenset[int] | None = None,
 ) -> Planned | None:
     """The last rung of the plan stage: ``planned``'s task planned again on the convex
     cells of its mesh (:mod:`tlmpc.planning.cells`), when every cell step of that plan
-    rejects the mission's disturbance; None otherwise."""
+    rejects the mission's disturbance; None otherwise. ``resume`` re-plans a run under way
+    from the mesh's start triangle (its cell entered from nowhere: any interface may be
+    left), the automaton being in one of these states."""
     from tlmpc.ltl.bounds import untimed_skeleton
     from tlmpc.planning.cells import MAX_TRIANGLES, partition, witness_on_cells
     from tlmpc.planning.complete import RefinementError, plan_complete
@@ -426,6 +464,7 @@ def _on_cells(
             options=mission.options,
             start_point=where,
             bounces=True,
+            resume=resume,
             reject=ratio,
             times=times,
             on_cells=True,
@@ -439,6 +478,7 @@ def _on_cells(
             formula=formula,
             options=mission.options,
             start_point=where,
+            resume=resume,
             explain=False,
             reject=ratio,
             times=times,

@@ -117,7 +117,10 @@ def plan(
     default only when the product would not fit the budget (:mod:`tlmpc.planning.budget`).
     With ``reject`` (a disturbance over max_speed) only the moves and stays the controllers
     realise under it are used (:mod:`tlmpc.planning.robust`); with ``on_cells``, those the
-    convex cells' fields realise (:mod:`tlmpc.planning.cells`).
+    convex cells' fields realise (:mod:`tlmpc.planning.cells`), searched on a product that
+    also rules out turning back across an interface and loops inside a cell whose stay is too
+    narrow (:mod:`tlmpc.planning.cell_product`; the guided search leaves both to the check
+    of the plan found).
     Under ``options.cost: time`` the moves weigh ``times`` (:mod:`tlmpc.planning.timing`;
     without it, their lengths at unit speed).
     """
@@ -147,10 +150,12 @@ def plan(
         )
 
     realisable_steps = None if reject is None else realisable(abstraction, reject)
+    partitioned = None
     if reject is not None and on_cells:
         from tlmpc.planning.cells import cell_realisable, partition
 
-        realisable_steps = cell_realisable(partition(abstraction), reject, TOLERANCE)
+        partitioned = partition(abstraction)
+        realisable_steps = cell_realisable(partitioned, reject, TOLERANCE)
     if guided is None:
         guided = not estimate_product(abstraction, automaton).fits
     if guided:
@@ -225,6 +230,14 @@ def plan(
         product = dataclasses.replace(
             product, initial=_resumed(abstraction, allowed, working, resume)
         )
+    triangles_product, origin = product, None
+    if partitioned is not None and realisable_steps is not None and not passages:
+        # On cells: no turning back across an interface, no loop inside a cell whose stay
+        # is too narrow (tlmpc.planning.cell_product); the lasso found maps back by origin.
+        from tlmpc.planning.cell_product import cell_product
+
+        on = cell_product(product, partitioned.cell_of, realisable_steps[1])
+        product, origin = on.product, on.origin
     if len(product.initial) == 0 or not working.edges:
         raise why()
     # A stay ends the search early: no lasso costs less than its prefix (see module doc).
@@ -256,10 +269,15 @@ def plan(
     if best is None:
         raise why()
     reached = int(np.isfinite(dist).sum())
+    if origin is not None:
+        # the triangles' product's nodes: those reached, and the lasso's
+        reached = len(np.unique(origin[np.isfinite(dist)]))
+        cost, prefix_nodes, cycle_nodes = best
+        best = (cost, origin[prefix_nodes].tolist(), origin[cycle_nodes].tolist())
     return _witness(
         abstraction,
-        product.num_automaton_states,
-        lambda nodes: _path_cost(product, nodes),
+        triangles_product.num_automaton_states,
+        lambda nodes: _path_cost(triangles_product, nodes),
         best,
         options,
         started,
@@ -267,7 +285,10 @@ def plan(
         exhausted,
         working,
         reached,
-        {"product_nodes": product.num_nodes, "product_edges": int(product.graph.nnz)},
+        {
+            "product_nodes": triangles_product.num_nodes,
+            "product_edges": int(triangles_product.graph.nnz),
+        },
         cells,
     )
 
