@@ -40,6 +40,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections import OrderedDict
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -200,6 +201,14 @@ class _Pending:
     base: float
     groups: list[list[Vector]]
 
+    @property
+    def shape(self) -> tuple[float, tuple[tuple[float, ...], ...]]:
+        """What the search reads: the base angle and each vertex's normals' angles."""
+        return (
+            self.base,
+            tuple(tuple(sorted(math.atan2(y, x) for x, y in n)) for n in self.groups),
+        )
+
 
 def _pending(cells: Cells, cell: int, target: int) -> _Pending | None:
     """The move's rows, or None when it has none (no field leaves by that interface)."""
@@ -216,7 +225,13 @@ def _pending(cells: Cells, cell: int, target: int) -> _Pending | None:
     nx = sum(a for a, _ in outward) / len(outward)
     ny = sum(b for _, b in outward) / len(outward)
     move = CellMove(cell=cell, target=target, xi=(nx, ny), width=0.0, kept=kept, interface=())
-    groups = [normals for normals in cells.vertex_normals(move).values() if normals]
+    # The search reads each vertex's normals by their angles alone, and the smallest push
+    # over the vertices does not see repeats: one vertex per distinct set of angles.
+    distinct: dict[tuple[float, ...], list[Vector]] = {}
+    for normals in cells.vertex_normals(move).values():
+        if normals:
+            distinct.setdefault(tuple(sorted(math.atan2(y, x) for x, y in normals)), normals)
+    groups = [distinct[key] for key in sorted(distinct)]
     return _Pending(cell, target, kept, interface, math.atan2(ny, nx), groups)
 
 
@@ -229,13 +244,23 @@ def _searched_moves(cells: Cells, pending: list[_Pending]) -> list[CellMove]:
     fine: FloatArray = (np.arange(2 * FINE + 1, dtype=np.float64) - FINE) * (
         2.0 * math.pi / FAN / FINE
     )
-    bases: FloatArray = np.array([m.base for m in pending], dtype=np.float64)
-    best = _best_turns(pending, bases, coarse)
-    best = _best_turns(pending, best, fine)
-    moves = []
-    for move, angle in zip(pending, best.tolist(), strict=True):
+    # Moves of the same shape (the same base angle and vertex angles: a map of equal rooms)
+    # have the same search: each shape is searched once.
+    shapes: dict[tuple[float, tuple[tuple[float, ...], ...]], int] = {}
+    unique: list[_Pending] = []
+    for move in pending:
+        if shapes.setdefault(move.shape, len(unique)) == len(unique):
+            unique.append(move)
+    bases: FloatArray = np.array([m.base for m in unique], dtype=np.float64)
+    best = _best_turns(unique, bases, coarse)
+    best = _best_turns(unique, best, fine)
+    found = []
+    for move, angle in zip(unique, best.tolist(), strict=True):
         xi = (math.cos(angle), math.sin(angle))
-        width = min(vertex_push([*normals, xi]) for normals in move.groups)
+        found.append((xi, min(vertex_push([*normals, xi]) for normals in move.groups)))
+    moves = []
+    for move in pending:
+        xi, width = found[shapes[move.shape]]
         moves.append(
             CellMove(
                 cell=move.cell,
@@ -367,8 +392,29 @@ def _turn(a: Vector, b: Vector, c: Vector) -> float:
     return (ux * vy - uy * vx) / scale if scale > 0.0 else 0.0
 
 
+#: The partitions kept for reuse (the most recent meshes'): the plan stage asks for the cells
+#: of one mesh many times (the planner's mask, the widest-lasso search, the witness check),
+#: and each move's search and each stay's centre are computed once per partition.
+KEPT_PARTITIONS = 6
+_partitions: OrderedDict[int, tuple[Abstraction, Cells]] = OrderedDict()
+
+
 def partition(abstraction: Abstraction) -> Cells:
-    """The convex cells of ``abstraction`` (see the module doc)."""
+    """The convex cells of ``abstraction`` (see the module doc); the same object for the same
+    mesh object while it is among the last :data:`KEPT_PARTITIONS` partitioned."""
+    key = id(abstraction)
+    kept = _partitions.get(key)
+    if kept is not None and kept[0] is abstraction:
+        _partitions.move_to_end(key)
+        return kept[1]
+    cells = _partition(abstraction)
+    _partitions[key] = (abstraction, cells)  # the mesh held: its id is not reused meanwhile
+    while len(_partitions) > KEPT_PARTITIONS:
+        _partitions.popitem(last=False)
+    return cells
+
+
+def _partition(abstraction: Abstraction) -> Cells:
     triangles = abstraction.triangles.tolist()
     neighbours = abstraction.neighbors.tolist()
     letter = abstraction.letter_of.tolist()
