@@ -135,9 +135,7 @@ def reflex_extensions(linework: Any, free: Any, budget: int | None = None) -> Re
         pending = pending[reach[pending] <= 2.0 * farthest]  # inside the free space: never
     done = np.isfinite(hits)
     cuts = shapely.linestrings(
-        np.stack(
-            [origins[done], origins[done] + hits[done, None] * directions[done]], axis=1
-        )
+        np.stack([origins[done], origins[done] + hits[done, None] * directions[done]], axis=1)
     )
     crossing = shapely.STRtree(cuts).query(cuts, predicate="intersects")
     work += int(np.count_nonzero(crossing[0] < crossing[1]))

@@ -126,13 +126,15 @@ def disturbance_hint(
             "weakest cell step"
         )
     elif supported is not None:
-        from tlmpc.abstraction.lines import MAX_SIDES
+        from tlmpc.abstraction.lines import MAX_REFLEX_WORK, MAX_SIDES
         from tlmpc.planning.cells import MAX_TRIANGLES
 
         lines.append(
             "no plan on convex cells (the plan stage's last rung) was tried: the rung plans "
             f"on meshes of at most {MAX_TRIANGLES} triangles and builds its own mesh for maps "
-            f"of at most {MAX_SIDES} straight sides, and this mission is larger"
+            f"of at most {MAX_SIDES} straight sides (every side extended) or whose reflex "
+            f"corners' cuts take at most {MAX_REFLEX_WORK} work units, and this mission is "
+            "larger"
         )
     lines.append(
         f"this plan's triangles reject disturbances below {bound.push:.6g} "

@@ -53,10 +53,11 @@ from tlmpc.planning.robust import corner_angles
 BoolArray = npt.NDArray[np.bool_]
 Vector = tuple[float, float]
 
-#: The convex cells' rung's budget, in triangles of the mesh: the partition and the fan search
-#: of every cell move run in Python, about a millisecond a move (a mesh of Example 8's size,
-#: nine thousand triangles, would take minutes per mesh tried).
-MAX_TRIANGLES = 4000
+#: The convex cells' rung's budget, in triangles of the mesh: the partition, each move's rows
+#: and each stay's centre search grow with the mesh (the moves' fan searches run over every
+#: vertex and direction at once, once per distinct shape). Example 8's meshes (9,250
+#: triangles; its reflex cuts' 9,602) fit.
+MAX_TRIANGLES = 12_000
 
 #: A corner counts as collinear (180 degrees) when its turn is below this, relative to the
 #: product of its two side lengths.

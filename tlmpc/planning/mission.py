@@ -134,7 +134,7 @@ def plan_mission(
         except (NoPlanError, RefinementError):
             # U-turn fans may have no realisable route either. The control stage refuses
             # this plan (C032) and states the largest disturbance any plan on its mesh rejects.
-            return _with_supported(first, mission, formula, start_point)
+            return _with_supported(first, mission, formula, start_point, cells=resume is not None)
 
     def complete(
         mesh: Abstraction, task: Automaton, formula: Formula, explain: bool, reject: float | None
@@ -173,7 +173,10 @@ def plan_mission(
         if on_cells is not None:
             return on_cells
         on_lines, lines_bound = _on_lines(mission, margin, planned, start_point)
-        return on_lines or _with_cells_bound(planned, lines_bound, mission)
+        if on_lines is not None:
+            return on_lines
+        refused = _with_cells_supported(planned, mission, start_point)
+        return _with_cells_bound(refused, lines_bound, mission)
 
     def realisable_depth(
         planned: Planned, formula: Formula = skeleton, explain: bool = True
@@ -214,6 +217,7 @@ def plan_mission(
         # None realises it on cells either: the plan on the mesh whose plans reject the most
         # goes on to be refused, stating that mesh's bound (C032: the mission compiles below it)
         # and the cells' (the largest over the meshes tried).
+        tried = [_with_cells_supported(plan, mission, start_point) for plan in tried]
         bounds = [_supported_of(plan.witness) for plan in tried]
         best = max(range(len(tried)), key=lambda k: (bounds[k] is not None, bounds[k] or 0.0, -k))
         cells_bounds = [plan.witness.stats.get(SUPPORTED_CELLS) for plan in tried]
@@ -278,6 +282,7 @@ def plan_mission(
         "options.margin to plan with a smaller one",
         file=mission.source,
     )
+    planned = _with_cells_supported(planned, mission, start_point)
     return replace(planned, notes=(note,))
 
 
@@ -353,10 +358,17 @@ SUPPORTED = "supported_disturbance"
 
 
 def _with_supported(
-    planned: Planned, mission: Mission, formula: Formula, start_point: tuple[float, float] | None
+    planned: Planned,
+    mission: Mission,
+    formula: Formula,
+    start_point: tuple[float, float] | None,
+    *,
+    cells: bool,
 ) -> Planned:
     """``planned`` with the largest disturbance any plan on its mesh rejects in its
-    witness's statistics (:mod:`tlmpc.planning.bottleneck`), when that can be computed."""
+    witness's statistics (:mod:`tlmpc.planning.bottleneck`), when that can be computed; with
+    ``cells`` the bound on its convex cells too (else :func:`_with_cells_supported` adds it
+    where the plan is refused: the cells' rung usually plans instead)."""
     from tlmpc.planning.bottleneck import supported_ratio
 
     ratio = supported_ratio(
@@ -369,22 +381,36 @@ def _with_supported(
     if ratio is None:
         return planned
     stats = {**planned.witness.stats, SUPPORTED: ratio * mission.robot.max_speed}
+    found = replace(planned, witness=replace(planned.witness, stats=stats))
+    return _with_cells_supported(found, mission, start_point) if cells else found
+
+
+def _with_cells_supported(
+    planned: Planned, mission: Mission, start_point: tuple[float, float] | None
+) -> Planned:
+    """``planned`` (refused, its bound on triangles known) with the bound on the convex cells
+    of its mesh, where the mesh is within the cells' budget."""
+    from tlmpc.ltl.bounds import untimed_skeleton
+    from tlmpc.planning.bottleneck import supported_ratio
     from tlmpc.planning.cells import MAX_TRIANGLES
 
-    on_cells = (
-        supported_ratio(
-            planned.abstraction,
-            planned.automaton,
-            formula=formula,
-            options=mission.options,
-            start_point=start_point if start_point is not None else mission.robot.start,
-            cells=True,
-        )
-        if planned.abstraction.num_triangles <= MAX_TRIANGLES
-        else None
+    stats = planned.witness.stats
+    if SUPPORTED not in stats or SUPPORTED_CELLS in stats:
+        return planned
+    if planned.abstraction.num_triangles > MAX_TRIANGLES:
+        return planned
+    formula = planned.formula if planned.formula is not None else untimed_skeleton(mission.formula)
+    on_cells = supported_ratio(
+        planned.abstraction,
+        planned.automaton,
+        formula=formula,
+        options=mission.options,
+        start_point=start_point if start_point is not None else mission.robot.start,
+        cells=True,
     )
-    if on_cells is not None:
-        stats[SUPPORTED_CELLS] = on_cells * mission.robot.max_speed
+    if on_cells is None:
+        return planned
+    stats = {**stats, SUPPORTED_CELLS: on_cells * mission.robot.max_speed}
     return replace(planned, witness=replace(planned.witness, stats=stats))
 
 
