@@ -157,6 +157,16 @@ def test_the_budget_counts_work_not_time(monkeypatch: pytest.MonkeyPatch) -> Non
     cuts = reflex_extensions(linework, free)
     assert cuts.segments is not None
     assert cuts.corners == 4 * 9  # every room's corners, seen from the space between them
+    # the work: a unit per corner, at least three per ray shot (the two sides through its
+    # corner touch it, and what it hits), and one per pair of cuts that meet (brute force)
+    rays = 2 * cuts.corners  # both sides of a right-angled reflex corner go on
+    meeting = sum(
+        1
+        for i, first in enumerate(cuts.segments)
+        for second in cuts.segments[i + 1 :]
+        if first.intersects(second)
+    )
+    assert cuts.work >= cuts.corners + 3 * rays + meeting
     again = reflex_extensions(linework, free, budget=cuts.work - 1)
     assert again.segments is None
     assert reflex_extensions(linework, free, budget=cuts.work).segments is not None
