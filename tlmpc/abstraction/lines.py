@@ -40,7 +40,7 @@ MAX_SIDES = 120
 #: The reflex cuts' budget, in work units: one per reflex corner, one per ray and segment
 #: whose boxes the STRtree pairs while shooting (each doubling of a ray's reach counts
 #: again), and one per pair of cuts that meet (their crossings are vertices of the mesh).
-#: Example 8 (1,156 rooms, 4,624 reflex corners) takes about 60,000.
+#: Example 8 (1,156 rooms, 4,624 reflex corners) takes 63,788.
 MAX_REFLEX_WORK = 1_000_000
 
 #: A corner is reflex when its turn is below minus this, relative to its sides' lengths (the
