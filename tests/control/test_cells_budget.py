@@ -43,6 +43,7 @@ def test_beyond_the_budget_the_hint_says_no_cell_plan_was_tried(
     assert "at most 10 triangles" in hint
     assert "at most 3 straight sides" in hint
     assert "at most 5 work units" in hint
+    assert "(its mesh has " in hint  # the size that exceeds the triangles' budget
 
 
 def test_within_the_budget_the_hint_states_the_cells_bound(tmp_path: Path) -> None:

@@ -98,10 +98,12 @@ def disturbance_hint(
     *,
     supported: float | None = None,
     on_cells: float | None = None,
+    triangles: int | None = None,
 ) -> str:
     """C032's hint: the largest disturbance any plan on the mesh rejects (``supported``, from
-    the planner's widest-lasso search, when known), the plan's own bound, what ``min_angle``
-    guarantees, and the stay limit.
+    the planner's widest-lasso search, when known), the bound on convex cells or the budgets
+    that kept the cells' rung from trying (the mesh's ``triangles`` named), the plan's own
+    bound, what ``min_angle`` guarantees, and the stay limit.
 
     Every statement is a fact about triangles: a kept corner of angle a pushes at most
     max_speed * sin(a / 2); ``min_angle`` = m guarantees every angle >= m, hence a push of
@@ -134,7 +136,7 @@ def disturbance_hint(
             f"on meshes of at most {MAX_TRIANGLES} triangles and builds its own mesh for maps "
             f"of at most {MAX_SIDES} straight sides (every side extended) or whose reflex "
             f"corners' cuts take at most {MAX_REFLEX_WORK} work units, and this mission is "
-            "larger"
+            "larger" + ("" if triangles is None else f" (its mesh has {triangles} triangles)")
         )
     lines.append(
         f"this plan's triangles reject disturbances below {bound.push:.6g} "
