@@ -235,3 +235,45 @@ def test_reflex_faces_are_convex_labelled_and_cover_the_free_space(
     except TlmpcError:
         assume(False)  # an input the loader refuses (a sliver, a start on a side): not ours
     _faces_hold(document)
+
+
+def test_reflex_cell_moves_state_the_rows_optimum() -> None:
+    """On the reflex cuts' cells of an L-shaped room with an L-shaped region across its corner
+    (T-junctions where cuts end on the region's sides), every move's stated width is the
+    optimum of its rows at its xi: an independent second-order cone program (cvxpy) over the
+    cell's polygon, rebuilt here from the boundary's vertices and the sides the move keeps."""
+    import cvxpy as cp
+
+    document = {
+        "version": 1,
+        "workspace": {"boundary": [[0, 0], [6, 0], [6, 2], [2, 2], [2, 6], [0, 6]]},
+        "regions": {"a": [[1, 1], [3, 1], [3, 2], [2, 2], [2, 3], [1, 3]]},
+        "robot": {"start": [0.5, 0.5], "max_speed": 1.0},
+        "ltl": "F a",
+    }
+    mission = load_mission_text(yaml.safe_dump(document), "<reflex>")
+    cells = partition(build_abstraction(mission, lines="reflex"))
+    points = cells.abstraction.vertices
+    checked = 0
+    for cell in cells.cells:
+        for target in sorted({s.neighbour for s in cell.sides if s.neighbour >= 0}):
+            move = cells.move(cell.index, target)
+            if move.width <= 0.0 or checked >= 16:
+                continue
+            rows: dict[int, list[np.ndarray]] = {v: [] for v in cell.boundary}
+            for k in move.kept:
+                side = cell.sides[k]
+                a, b = points[side.start], points[side.end]
+                normal = np.array([a[1] - b[1], b[0] - a[0]]) / math.dist(a.tolist(), b.tolist())
+                rows[side.start].append(normal)
+                rows[side.end].append(normal)
+            d = cp.Variable()
+            constraints = []
+            for normals in rows.values():
+                u = cp.Variable(2)
+                constraints.append(cp.norm(u) <= 1.0)
+                constraints += [n @ u >= d for n in [*normals, np.asarray(move.xi)]]
+            cp.Problem(cp.Maximize(d), constraints).solve()
+            assert float(d.value) == pytest.approx(move.width, abs=1e-6)
+            checked += 1
+    assert checked >= 10
