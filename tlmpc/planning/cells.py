@@ -40,6 +40,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import threading
 from collections import OrderedDict
 from dataclasses import dataclass
 from functools import cached_property
@@ -398,20 +399,23 @@ def _turn(a: Vector, b: Vector, c: Vector) -> float:
 #: and each move's search and each stay's centre are computed once per partition.
 KEPT_PARTITIONS = 6
 _partitions: OrderedDict[int, tuple[Abstraction, Cells]] = OrderedDict()
+_partitions_lock = threading.Lock()
 
 
 def partition(abstraction: Abstraction) -> Cells:
     """The convex cells of ``abstraction`` (see the module doc); the same object for the same
     mesh object while it is among the last :data:`KEPT_PARTITIONS` partitioned."""
     key = id(abstraction)
-    kept = _partitions.get(key)
-    if kept is not None and kept[0] is abstraction:
-        _partitions.move_to_end(key)
-        return kept[1]
+    with _partitions_lock:
+        kept = _partitions.get(key)
+        if kept is not None and kept[0] is abstraction:
+            _partitions.move_to_end(key)
+            return kept[1]
     cells = _partition(abstraction)
-    _partitions[key] = (abstraction, cells)  # the mesh held: its id is not reused meanwhile
-    while len(_partitions) > KEPT_PARTITIONS:
-        _partitions.popitem(last=False)
+    with _partitions_lock:
+        _partitions[key] = (abstraction, cells)  # the mesh held: its id is not reused meanwhile
+        while len(_partitions) > KEPT_PARTITIONS:
+            _partitions.popitem(last=False)
     return cells
 
 
