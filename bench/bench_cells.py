@@ -22,12 +22,50 @@ from typing import Any
 
 ROOT = Path(__file__).resolve().parent.parent
 
-#: (label, spec name (grid6: a 6 x 6 grid of rooms), disturbance ratio)
-ROWS: tuple[tuple[str, str, float], ...] = (
-    ("example8", "example8", 0.5),
-    ("example1", "example1", 0.6),
-    ("rooms 6x6", "grid6", 0.6),
+#: (label, spec name (grid6: a 6 x 6 grid of rooms; obstacles40: 40 seeded polygons in a
+#: 30 x 30 room), disturbance ratio, the simulation's step or None for the mesh's own)
+ROWS: tuple[tuple[str, str, float, float | None], ...] = (
+    ("example8", "example8", 0.5, None),
+    ("example1", "example1", 0.6, None),
+    ("rooms 6x6", "grid6", 0.6, None),
+    ("40 obstacles", "obstacles40", 0.5, 0.002),
 )
+
+
+def _obstacles(count: int, seed: int) -> dict[str, Any]:
+    """``count`` regular polygons (5 to 7 sides) scattered in a 30 x 30 room, apart from each
+    other and from the start and goal corners."""
+    import math
+    import random
+
+    draw = random.Random(seed)
+    holes: list[list[list[float]]] = []
+    placed: list[tuple[float, float, float]] = []
+    while len(holes) < count:
+        cx, cy, r = draw.uniform(2, 28), draw.uniform(2, 28), draw.uniform(0.6, 1.4)
+        if any(math.hypot(cx - x, cy - y) < r + q + 0.8 for x, y, q in placed):
+            continue
+        if math.hypot(cx - 1.5, cy - 1.5) < 3 or math.hypot(cx - 28, cy - 28) < 3:
+            continue
+        sides, turn = draw.choice([5, 6, 7]), draw.uniform(0, 6.28)
+        holes.append(
+            [
+                [
+                    round(cx + r * math.cos(turn + 2 * math.pi * i / sides), 3),
+                    round(cy + r * math.sin(turn + 2 * math.pi * i / sides), 3),
+                ]
+                for i in range(sides)
+            ]
+        )
+        placed.append((cx, cy, r))
+    return {
+        "version": 1,
+        "workspace": {"boundary": {"rect": [0, 0, 30, 30]}, "holes": holes},
+        "regions": {"a": {"rect": [27, 27, 29, 29]}, "b": {"rect": [1, 27, 3, 29]}},
+        "robot": {"start": [1.5, 1.5], "max_speed": 1.0},
+        "options": {"min_angle": None},
+        "task": ["visit a and b"],
+    }
 
 
 def _grid(rooms: int) -> dict[str, Any]:
@@ -51,11 +89,13 @@ def _document(spec: str) -> dict[str, Any]:
 
     if spec == "grid6":
         return _grid(6)
+    if spec == "obstacles40":
+        return _obstacles(40, 4)
     loaded: dict[str, Any] = yaml.safe_load((ROOT / "specs" / f"{spec}.yaml").read_text())
     return loaded
 
 
-def _row(label: str, spec: str, ratio: float, folder: Path) -> list[str]:
+def _row(label: str, spec: str, ratio: float, dt: float | None, folder: Path) -> list[str]:
     import yaml
 
     document = _document(spec)
@@ -78,7 +118,7 @@ def _row(label: str, spec: str, ratio: float, folder: Path) -> list[str]:
         return [label, f"{ratio:g}", str(result["exit"]), "-", "-", "-"]
     abstraction = json.loads((out / "abstraction.json").read_text(encoding="utf-8"))
     controllers = json.loads((out / "controllers.json").read_text(encoding="utf-8"))
-    adversarial = ["--model-disturbance", "adversarial"]
+    adversarial = ["--model-disturbance", "adversarial", *([] if dt is None else ["--dt", str(dt)])]
     simulated = subprocess.run(
         [sys.executable, "-m", "tlmpc", "simulate", str(out), *adversarial],
         capture_output=True,
@@ -101,8 +141,8 @@ def main() -> int:
     header = ["mission", "ratio", "exit", "triangles / cells", "CPU / wall s", "adversarial"]
     rows = []
     with tempfile.TemporaryDirectory(prefix="tlmpc-cells-") as tmp:
-        for label, spec, ratio in ROWS:
-            rows.append(_row(label, spec, ratio, Path(tmp)))
+        for label, spec, ratio, dt in ROWS:
+            rows.append(_row(label, spec, ratio, dt, Path(tmp)))
     widths = [max(len(r[i]) for r in [header, *rows]) for i in range(len(header))]
     for row in [header, ["-" * w for w in widths], *rows]:
         print(" | ".join(cell.ljust(w) for cell, w in zip(row, widths, strict=True)))

@@ -26,17 +26,17 @@ from shapely.geometry import Polygon
 
 import tlmpc.abstraction.lines
 from tlmpc.abstraction import build_abstraction
-from tlmpc.abstraction.lines import OverBudget, reflex_extensions
+from tlmpc.abstraction.lines import Lines, OverBudget, reflex_extensions
 from tlmpc.base.errors import TlmpcError
 from tlmpc.mission.load import load_mission_text
 from tlmpc.mission.resolution import grid_size
 from tlmpc.planning.cells import partition
 
 
-def _faces_hold(document: dict[str, Any]) -> int:
-    """Check the reflex mesh of ``document`` with shapely; the number of faces."""
+def _faces_hold(document: dict[str, Any], kind: Lines = "reflex") -> int:
+    """Check the ``kind`` cuts' mesh of ``document`` with shapely; the number of faces."""
     mission = load_mission_text(yaml.safe_dump(document), "<reflex>")
-    mesh = build_abstraction(mission, lines="reflex")
+    mesh = build_abstraction(mission, lines=kind)
     corners = mesh.vertices[mesh.triangles]
     triangles = [Polygon(c) for c in corners.tolist()]
     boundary = Polygon(document["workspace"]["boundary"])
@@ -98,11 +98,14 @@ def _room_grid(rows: int, columns: int) -> dict[str, Any]:
 
 def test_a_grid_of_rooms_is_cut_into_its_grid() -> None:
     """Rooms on a grid (Example 8's layout): every cut runs from a room's corner to the next
-    room's, so the faces are the grid's rectangles: (2 x 3 + 1) x (2 x 2 + 1) of them."""
+    room's, so the faces are the grid's rectangles: (2 x 3 + 1) x (2 x 2 + 1) of them. Cut by
+    bisectors alone the grid's faces are fewer and not all rectangles."""
     assert _faces_hold(_room_grid(2, 3)) == 7 * 5
+    assert _faces_hold(_room_grid(2, 3), "bisector") != 7 * 5
 
 
-def test_an_l_shaped_room_with_a_region_across_its_corner() -> None:
+@pytest.mark.parametrize("kind", ["reflex", "bisector"])
+def test_an_l_shaped_room_with_a_region_across_its_corner(kind: Lines) -> None:
     document = {
         "version": 1,
         "workspace": {"boundary": [[0, 0], [6, 0], [6, 2], [2, 2], [2, 6], [0, 6]]},
@@ -113,7 +116,7 @@ def test_an_l_shaped_room_with_a_region_across_its_corner() -> None:
         "robot": {"start": [0.5, 0.5], "max_speed": 1.0},
         "ltl": "F a",
     }
-    _faces_hold(document)
+    _faces_hold(document, kind)
 
 
 def test_a_shallow_reflex_corner_is_cut_by_its_bisector() -> None:
@@ -234,7 +237,8 @@ def test_reflex_faces_are_convex_labelled_and_cover_the_free_space(
         load_mission_text(yaml.safe_dump(document), "<reflex>")
     except TlmpcError:
         assume(False)  # an input the loader refuses (a sliver, a start on a side): not ours
-    _faces_hold(document)
+    _faces_hold(document, "reflex")
+    _faces_hold(document, "bisector")
 
 
 def test_reflex_cell_moves_state_the_rows_optimum() -> None:

@@ -146,8 +146,8 @@ def build_abstraction(
     With a ``layout`` (a robot with a body, a margin), its free space and region shapes are
     triangulated and label the triangles instead of the mission's own. With ``lines``, a
     convex cells' mesh: every side extended across the free space (``"arrangement"``) or the
-    reflex corners cut (``"reflex"``), no inner points, and each triangle's face of that
-    linework in ``stats["cell_faces"]`` (:mod:`tlmpc.abstraction.lines`).
+    reflex corners cut (``"reflex"``, ``"bisector"``), no inner points, and each triangle's
+    face of that linework in ``stats["cell_faces"]`` (:mod:`tlmpc.abstraction.lines`).
     """
     started = time.perf_counter()
     # One geometry for planning and verifying: refuse what snapping to the grid would reshape.

@@ -20,7 +20,9 @@ Two decompositions, both convex faces of one label set each:
   cross at four angles below 180), so every face is convex. A face across a side a ray ends
   on keeps a straight corner there (a T-junction): it meets two faces along that side, and
   a cell move to either keeps the other's part of the side (the cell fields allow that).
-  Its work is counted (:data:`MAX_REFLEX_WORK`).
+  Its work is counted (:data:`MAX_REFLEX_WORK`). Extended sides cross each other in open
+  space (up to the square of the corners); the **bisector cuts** (every reflex corner cut by
+  its bisector alone) cross less and, on maps of scattered polygons, keep wider corners.
 """
 
 from __future__ import annotations
@@ -51,8 +53,9 @@ SIDES_WITHIN = 45.0
 
 FloatArray = npt.NDArray[np.float64]
 
-#: The two decompositions: every side extended across the free space, or the reflex cuts.
-Lines = Literal["arrangement", "reflex"]
+#: The decompositions: every side extended across the free space, the reflex cuts (sides
+#: extended near 270 degrees, bisectors elsewhere), or the reflex cuts by bisectors alone.
+Lines = Literal["arrangement", "reflex", "bisector"]
 
 
 class OverBudget(Exception):
@@ -98,10 +101,13 @@ class ReflexCuts:
     work: int
 
 
-def reflex_extensions(linework: Any, free: Any, budget: int | None = None) -> ReflexCuts:
+def reflex_extensions(
+    linework: Any, free: Any, budget: int | None = None, *, bisectors: bool = False
+) -> ReflexCuts:
     """The cuts that make every face of ``linework`` (noded: segments meet at their ends)
     inside ``free`` convex (see the module doc), or no segments when they would take more
-    than ``budget`` work units (default :data:`MAX_REFLEX_WORK`)."""
+    than ``budget`` work units (default :data:`MAX_REFLEX_WORK`). With ``bisectors`` every
+    reflex corner is cut by its bisector alone (one ray a corner: fewer cuts to cross)."""
     if budget is None:
         budget = MAX_REFLEX_WORK
     parts = np.asarray(list(shapely.get_parts(linework)), dtype=object)
@@ -110,7 +116,8 @@ def reflex_extensions(linework: Any, free: Any, budget: int | None = None) -> Re
     starts, ends = points[:-1][joined], points[1:][joined]
     faces = shapely.get_parts(shapely.polygonize(list(parts)))
     faces = faces[shapely.intersects(free, shapely.point_on_surface(faces))]
-    origins, directions, reach, corners = _rays(shapely.orient_polygons(faces))
+    within = -1.0 if bisectors else SIDES_WITHIN
+    origins, directions, reach, corners = _rays(shapely.orient_polygons(faces), within)
     work = corners
     if not len(origins):
         return ReflexCuts(segments=[], corners=0, work=work)
@@ -144,10 +151,11 @@ def reflex_extensions(linework: Any, free: Any, budget: int | None = None) -> Re
     return ReflexCuts(segments=list(cuts), corners=corners, work=work)
 
 
-def _rays(faces: Any) -> tuple[FloatArray, FloatArray, FloatArray, int]:
+def _rays(faces: Any, within: float) -> tuple[FloatArray, FloatArray, FloatArray, int]:
     """The rays cutting the reflex corners of ``faces`` (oriented: the face on the left of
     every ring): origins, unit directions, a first reach (the corner's shorter side), and
-    how many corners they cut."""
+    how many corners they cut. Corners within ``within`` degrees of 270 get both sides
+    extended, the others their bisector."""
     rings = shapely.get_rings(faces)
     coords, ring = shapely.get_coordinates(rings, return_index=True)
     last = np.r_[ring[1:] != ring[:-1], True]
@@ -171,7 +179,7 @@ def _rays(faces: Any) -> tuple[FloatArray, FloatArray, FloatArray, int]:
     # the corner's angle inside the face: 180 plus its right turn
     dot = incoming[:, 0] * outgoing[:, 0] + incoming[:, 1] * outgoing[:, 1]
     angle = 180.0 - np.degrees(np.arctan2(turn[reflex], dot[reflex]))
-    sides = np.abs(angle - 270.0) <= SIDES_WITHIN
+    sides = np.abs(angle - 270.0) <= within
     bisector = forward + backward  # the two extensions' mean points into the face's middle
     bisector = bisector / np.hypot(bisector[:, 0], bisector[:, 1])[:, None]
     origins = np.concatenate([origin[sides], origin[sides], origin[~sides]])

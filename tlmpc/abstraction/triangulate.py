@@ -229,7 +229,8 @@ def pslg(
     nearly touching or nearly collinear input becomes exactly touching or collinear.
     With ``lines``, the linework of a convex cells' mesh (:mod:`tlmpc.abstraction.lines`):
     every side extended across the free space (``"arrangement"``) or the reflex corners cut
-    (``"reflex"``; :class:`~tlmpc.abstraction.lines.OverBudget` beyond its work budget).
+    (``"reflex"``, ``"bisector"``; :class:`~tlmpc.abstraction.lines.OverBudget` beyond its
+    work budget).
     """
     grid = grid_size(mission)
     if layout is None or layout.free is None:
@@ -254,14 +255,14 @@ def pslg(
         sides = [*free_rings, *_inside_rings(free, region_rings)]
         linework = shapely.union_all([*own, *extended_lines(free, sides)], grid_size=grid)
         points, starts = _chains_of(list(shapely.get_parts(linework)))
-    elif lines == "reflex":
+    elif lines in ("reflex", "bisector"):
         from tlmpc.abstraction.lines import OverBudget, reflex_extensions
 
         clipped = [shapely.intersection(shapely.boundary(r), free, grid_size=grid) for r in regions]
         noded = shapely.union_all(
             [*free_rings, *(c for c in clipped if not c.is_empty)], grid_size=grid
         )
-        cuts = reflex_extensions(noded, free)
+        cuts = reflex_extensions(noded, free, bisectors=lines == "bisector")
         if cuts.segments is None:
             raise OverBudget(cuts.work)
         linework = shapely.union_all([noded, *cuts.segments], grid_size=grid)

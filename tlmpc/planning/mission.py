@@ -506,9 +506,9 @@ def _on_lines(
     """The cells' rung on the convex cells' own meshes (:mod:`tlmpc.abstraction.lines`):
     first the arrangement of every side extended across the free space (faces that meet side
     to side), with the goal depth, then the margin's; then the reflex cuts (near-linear in
-    the sides) in the same order. The plan on the first that carries the disturbance, or
-    (None, the largest disturbance ratio any plan on those meshes' cells rejects, None when
-    none was built: over the size budgets)."""
+    the sides), then the bisector cuts, in the same order. The plan on the first that
+    carries the disturbance, or (None, the largest disturbance ratio any plan on those
+    meshes' cells rejects, None when none was built: over the size budgets)."""
     from tlmpc.abstraction import build_abstraction
     from tlmpc.abstraction.layout import deepens_goals, planning_layout
     from tlmpc.abstraction.lines import OverBudget
@@ -520,7 +520,7 @@ def _on_lines(
     formula = planned.formula
     bound: float | None = None
     depths = (True, False) if deepens_goals(mission) else (False,)
-    kinds: tuple[Lines, ...] = ("arrangement", "reflex")
+    kinds: tuple[Lines, ...] = ("arrangement", "reflex", "bisector")
     for kind in kinds:
         for deep in depths:
             layout = planning_layout(mission, margin, deep=deep)
