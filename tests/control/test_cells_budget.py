@@ -34,6 +34,7 @@ def test_beyond_the_budget_the_hint_says_no_cell_plan_was_tried(
 ) -> None:
     monkeypatch.setattr(tlmpc.planning.cells, "MAX_TRIANGLES", 10)
     monkeypatch.setattr(tlmpc.abstraction.lines, "MAX_SIDES", 3)
+    monkeypatch.setattr(tlmpc.abstraction.lines, "MAX_REFLEX_WORK", 5)
     refused = _refusal(_example1(tmp_path, 0.5))  # compiles on cells within the budget
     hints = {d.hint for d in refused.diagnostics if d.code == "C032"}
     assert len(hints) == 1
@@ -42,6 +43,8 @@ def test_beyond_the_budget_the_hint_says_no_cell_plan_was_tried(
     assert "no plan on convex cells (the plan stage's last rung) was tried" in hint
     assert "at most 10 triangles" in hint
     assert "at most 3 straight sides" in hint
+    assert "at most 5 work units" in hint
+    assert "(its mesh has " in hint  # the size that exceeds the triangles' budget
 
 
 def test_within_the_budget_the_hint_states_the_cells_bound(tmp_path: Path) -> None:

@@ -10,6 +10,7 @@ import numpy as np
 import shapely
 
 from tlmpc.abstraction.layout import PlanningLayout
+from tlmpc.abstraction.lines import Lines
 from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
 from tlmpc.abstraction.resolution import refuse_subgrid_features
 from tlmpc.abstraction.starts import cells_in
@@ -138,24 +139,24 @@ def connected_components(neighbors: IntArray) -> IntArray:
 
 
 def build_abstraction(
-    mission: Mission, layout: PlanningLayout | None = None, *, lines: bool = False
+    mission: Mission, layout: PlanningLayout | None = None, *, lines: Lines | None = None
 ) -> Abstraction:
     """Triangulate ``mission``'s workspace and build the transition system D.
 
     With a ``layout`` (a robot with a body, a margin), its free space and region shapes are
-    triangulated and label the triangles instead of the mission's own. With ``lines``, the
-    convex cells' mesh: every side extended across the free space, no inner points, and each
-    triangle's face of that arrangement in ``stats["cell_faces"]``
-    (:mod:`tlmpc.abstraction.lines`).
+    triangulated and label the triangles instead of the mission's own. With ``lines``, a
+    convex cells' mesh: every side extended across the free space (``"arrangement"``) or the
+    reflex corners cut (``"reflex"``, ``"bisector"``), no inner points, and each triangle's
+    face of that linework in ``stats["cell_faces"]`` (:mod:`tlmpc.abstraction.lines`).
     """
     started = time.perf_counter()
     # One geometry for planning and verifying: refuse what snapping to the grid would reshape.
     refuse_subgrid_features(mission)
     faces = None
-    if lines:
+    if lines is not None:
         from tlmpc.abstraction.triangulate import lines_mesh
 
-        vertices, triangles, neighbors, shapes, faces = lines_mesh(mission, layout)
+        vertices, triangles, neighbors, shapes, faces = lines_mesh(mission, layout, lines)
     else:
         vertices, triangles, neighbors, shapes = triangulate(mission, layout)
     letter_of, letters = _labels(mission, vertices, triangles, shapes)

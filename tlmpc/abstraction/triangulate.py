@@ -24,6 +24,7 @@ from tlmpc.mission.resolution import grid_size
 
 if TYPE_CHECKING:
     from tlmpc.abstraction.layout import PlanningLayout
+    from tlmpc.abstraction.lines import Lines
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
@@ -218,7 +219,7 @@ def _inside(free: Any, rings: list[Any]) -> list[Any]:
 
 
 def pslg(
-    mission: Mission, layout: PlanningLayout | None = None, *, lines: bool = False
+    mission: Mission, layout: PlanningLayout | None = None, *, lines: Lines | None = None
 ) -> tuple[FloatArray, IntArray, FloatArray, list[Any]]:
     """The planar straight-line graph and the snapped region shapes.
 
@@ -226,8 +227,10 @@ def pslg(
     after snapping to the grid (the shapes whose boundaries are the constraint segments).
     All geometry is snap-rounded to a grid of a billionth of the workspace's extent, so
     nearly touching or nearly collinear input becomes exactly touching or collinear.
-    With ``lines``, every side is extended across the free space
-    (:mod:`tlmpc.abstraction.lines`).
+    With ``lines``, the linework of a convex cells' mesh (:mod:`tlmpc.abstraction.lines`):
+    every side extended across the free space (``"arrangement"``) or the reflex corners cut
+    (``"reflex"``, ``"bisector"``; :class:`~tlmpc.abstraction.lines.OverBudget` beyond its
+    work budget).
     """
     grid = grid_size(mission)
     if layout is None or layout.free is None:
@@ -244,13 +247,25 @@ def pslg(
     parts = _polygons(free)
     free_rings = [ring for part in parts for ring in _rings(part)]
     region_rings = _rings_of_all(regions)
-    if lines:
+    if lines == "arrangement":
         from tlmpc.abstraction.lines import extended_lines
 
         clipped = [shapely.intersection(shapely.boundary(r), free, grid_size=grid) for r in regions]
         own = [*free_rings, *(c for c in clipped if not c.is_empty)]
         sides = [*free_rings, *_inside_rings(free, region_rings)]
         linework = shapely.union_all([*own, *extended_lines(free, sides)], grid_size=grid)
+        points, starts = _chains_of(list(shapely.get_parts(linework)))
+    elif lines in ("reflex", "bisector"):
+        from tlmpc.abstraction.lines import OverBudget, reflex_extensions
+
+        clipped = [shapely.intersection(shapely.boundary(r), free, grid_size=grid) for r in regions]
+        noded = shapely.union_all(
+            [*free_rings, *(c for c in clipped if not c.is_empty)], grid_size=grid
+        )
+        cuts = reflex_extensions(noded, free, bisectors=lines == "bisector")
+        if cuts.segments is None:
+            raise OverBudget(cuts.work)
+        linework = shapely.union_all([noded, *cuts.segments], grid_size=grid)
         points, starts = _chains_of(list(shapely.get_parts(linework)))
     elif _needs_noding([*free_rings, *region_rings]):
         clipped = [shapely.intersection(shapely.boundary(r), free, grid_size=grid) for r in regions]
@@ -312,28 +327,28 @@ def triangulate(
 
 
 def lines_mesh(
-    mission: Mission, layout: PlanningLayout | None = None
+    mission: Mission, layout: PlanningLayout | None = None, lines: Lines = "arrangement"
 ) -> tuple[FloatArray, IntArray, IntArray, list[Any], list[int]]:
-    """:func:`triangulate` of the convex cells' mesh (every side extended across the free
-    space, :mod:`tlmpc.abstraction.lines`; no inner points), and the face of the arrangement
-    each triangle lies in (numbered by its lowest triangle)."""
-    points, triangles, neighbors, regions, faces = _triangulate(mission, layout, lines=True)
+    """:func:`triangulate` of a convex cells' mesh (the linework of ``lines``,
+    :mod:`tlmpc.abstraction.lines`; no inner points), and the face of that linework each
+    triangle lies in (numbered by its lowest triangle)."""
+    points, triangles, neighbors, regions, faces = _triangulate(mission, layout, lines=lines)
     assert faces is not None
     return points, triangles, neighbors, regions, faces
 
 
 def _triangulate(
-    mission: Mission, layout: PlanningLayout | None = None, *, lines: bool = False
+    mission: Mission, layout: PlanningLayout | None = None, *, lines: Lines | None = None
 ) -> tuple[FloatArray, IntArray, IntArray, list[Any], list[int] | None]:
     vertices, segments, seeds, regions = pslg(mission, layout, lines=lines)
     options = "pznQ"
     # (the convex cells' mesh has no inner points: its triangles join back into its faces)
-    if not lines and mission.options.min_angle is not None and mission.options.min_angle > 0:
+    if lines is None and mission.options.min_angle is not None and mission.options.min_angle > 0:
         options += f"q{mission.options.min_angle:g}"
         # Input angles smaller than the bound can make refinement run away (Triangle's
         # guarantee needs input angles >= 60 degrees); cap the Steiner points it may add.
         options += f"S{max(MIN_STEINER, STEINER_PER_VERTEX * len(vertices))}"
-    if not lines and mission.options.max_area is not None:
+    if lines is None and mission.options.max_area is not None:
         options += f"a{mission.options.max_area:.17g}"
     data: dict[str, Any] = {"vertices": vertices, "segments": segments}
     if len(seeds):
@@ -342,7 +357,7 @@ def _triangulate(
     points = np.asarray(result["vertices"], dtype=np.float64)
     triangles = np.asarray(result["triangles"], dtype=np.int64)
     neighbors = np.asarray(result["neighbors"], dtype=np.int64)
-    faces = _faces(triangles, neighbors, result.get("segments")) if lines else None
+    faces = _faces(triangles, neighbors, result.get("segments")) if lines is not None else None
     return points, triangles, neighbors, regions, faces
 
 

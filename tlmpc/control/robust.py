@@ -98,10 +98,12 @@ def disturbance_hint(
     *,
     supported: float | None = None,
     on_cells: float | None = None,
+    triangles: int | None = None,
 ) -> str:
     """C032's hint: the largest disturbance any plan on the mesh rejects (``supported``, from
-    the planner's widest-lasso search, when known), the plan's own bound, what ``min_angle``
-    guarantees, and the stay limit.
+    the planner's widest-lasso search, when known), the bound on convex cells or the budgets
+    that kept the cells' rung from trying (the mesh's ``triangles`` named), the plan's own
+    bound, what ``min_angle`` guarantees, and the stay limit.
 
     Every statement is a fact about triangles: a kept corner of angle a pushes at most
     max_speed * sin(a / 2); ``min_angle`` = m guarantees every angle >= m, hence a push of
@@ -126,13 +128,15 @@ def disturbance_hint(
             "weakest cell step"
         )
     elif supported is not None:
-        from tlmpc.abstraction.lines import MAX_SIDES
+        from tlmpc.abstraction.lines import MAX_REFLEX_WORK, MAX_SIDES
         from tlmpc.planning.cells import MAX_TRIANGLES
 
         lines.append(
             "no plan on convex cells (the plan stage's last rung) was tried: the rung plans "
             f"on meshes of at most {MAX_TRIANGLES} triangles and builds its own mesh for maps "
-            f"of at most {MAX_SIDES} straight sides, and this mission is larger"
+            f"of at most {MAX_SIDES} straight sides (every side extended) or whose reflex "
+            f"corners' cuts take at most {MAX_REFLEX_WORK} work units, and this mission is "
+            "larger" + ("" if triangles is None else f" (its mesh has {triangles} triangles)")
         )
     lines.append(
         f"this plan's triangles reject disturbances below {bound.push:.6g} "

@@ -599,6 +599,7 @@ def _check_rejectable(
             weakest(pushes),
             supported=supported,
             on_cells=on_cells,
+            triangles=abstraction.num_triangles,
         )
         raise InvalidInputError([replace(p, hint=hint) for p in problems[:10]])
 

@@ -40,6 +40,8 @@ from __future__ import annotations
 
 import itertools
 import math
+import threading
+from collections import OrderedDict
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -52,10 +54,11 @@ from tlmpc.planning.robust import corner_angles
 BoolArray = npt.NDArray[np.bool_]
 Vector = tuple[float, float]
 
-#: The convex cells' rung's budget, in triangles of the mesh: the partition and the fan search
-#: of every cell move run in Python, about a millisecond a move (a mesh of Example 8's size,
-#: nine thousand triangles, would take minutes per mesh tried).
-MAX_TRIANGLES = 4000
+#: The convex cells' rung's budget, in triangles of the mesh: the partition, each move's rows
+#: and each stay's centre search grow with the mesh (the moves' fan searches run over every
+#: vertex and direction at once, once per distinct shape). Example 8's meshes (9,250
+#: triangles; its reflex cuts' 9,602) fit.
+MAX_TRIANGLES = 12_000
 
 #: A corner counts as collinear (180 degrees) when its turn is below this, relative to the
 #: product of its two side lengths.
@@ -154,10 +157,17 @@ class Cells:
     @cached_property
     def _moves(self) -> dict[tuple[int, int], CellMove]:
         moves = {}
+        pending = []
         for cell in self.cells:
             for target in sorted({s.neighbour for s in cell.sides if s.neighbour >= 0}):
-                moves[cell.index, target] = _move(self, cell.index, target)
-        return moves
+                rows = _pending(self, cell.index, target)
+                if rows is None:
+                    moves[cell.index, target] = _no_move(cell.index, target)
+                else:
+                    pending.append(rows)
+        for move in _searched_moves(self, pending):
+            moves[move.cell, move.target] = move
+        return dict(sorted(moves.items()))
 
     @cached_property
     def _stays(self) -> tuple[CellStay, ...]:
@@ -181,7 +191,29 @@ def vertex_push(normals: list[Vector]) -> float:
     return math.cos(spread / 2.0) if spread < math.pi else 0.0
 
 
-def _move(cells: Cells, cell: int, target: int) -> CellMove:
+@dataclass(frozen=True, slots=True)
+class _Pending:
+    """A cell move whose flow direction is still to be searched: the fan's base angle (I's
+    mean outward normal) and, per vertex with kept sides through it, their inward normals."""
+
+    cell: int
+    target: int
+    kept: tuple[int, ...]
+    interface: tuple[int, ...]
+    base: float
+    groups: list[list[Vector]]
+
+    @property
+    def shape(self) -> tuple[float, tuple[tuple[float, ...], ...]]:
+        """What the search reads: the base angle and each vertex's normals' angles."""
+        return (
+            self.base,
+            tuple(tuple(sorted(math.atan2(y, x) for x, y in n)) for n in self.groups),
+        )
+
+
+def _pending(cells: Cells, cell: int, target: int) -> _Pending | None:
+    """The move's rows, or None when it has none (no field leaves by that interface)."""
     sides = cells.cells[cell].sides
     interface = tuple(k for k, s in enumerate(sides) if s.neighbour == target)
     kept = tuple(k for k, s in enumerate(sides) if s.neighbour != target)
@@ -190,26 +222,80 @@ def _move(cells: Cells, cell: int, target: int) -> CellMove:
     # cells
     runs = sum(1 for k in interface if (k - 1) % count not in interface)
     if runs != 1 or not kept:
-        return _no_move(cell, target)
+        return None
     outward = [(-a, -b) for a, b in (cells.inward(cell, k) for k in interface)]
     nx = sum(a for a, _ in outward) / len(outward)
     ny = sum(b for _, b in outward) / len(outward)
-    base = math.atan2(ny, nx)
     move = CellMove(cell=cell, target=target, xi=(nx, ny), width=0.0, kept=kept, interface=())
-    groups = [normals for normals in cells.vertex_normals(move).values() if normals]
-    # the fan: FAN directions round the circle from I's outward normal, then a finer fan
-    # about the best of it
-    turns: FloatArray = base + np.arange(FAN, dtype=np.float64) * (2.0 * math.pi / FAN)
-    best = float(turns[int(np.argmax(_fan_widths(groups, turns)))])
-    fine: FloatArray = best + (np.arange(2 * FINE + 1, dtype=np.float64) - FINE) * (
+    # The search reads each vertex's normals by their angles alone, and the smallest push
+    # over the vertices does not see repeats: one vertex per distinct set of angles.
+    distinct: dict[tuple[float, ...], list[Vector]] = {}
+    for normals in cells.vertex_normals(move).values():
+        if normals:
+            distinct.setdefault(tuple(sorted(math.atan2(y, x) for x, y in normals)), normals)
+    groups = [distinct[key] for key in sorted(distinct)]
+    return _Pending(cell, target, kept, interface, math.atan2(ny, nx), groups)
+
+
+def _searched_moves(cells: Cells, pending: list[_Pending]) -> list[CellMove]:
+    """The moves of ``pending`` with their flow directions: the fan (FAN directions round the
+    circle from I's outward normal), then a finer fan about the best of it, every move's
+    vertices and directions at once (:func:`_fan_widths`); the width is the smallest vertex
+    push at the best direction (the first of equals)."""
+    coarse: FloatArray = np.arange(FAN, dtype=np.float64) * (2.0 * math.pi / FAN)
+    fine: FloatArray = (np.arange(2 * FINE + 1, dtype=np.float64) - FINE) * (
         2.0 * math.pi / FAN / FINE
     )
-    best = float(fine[int(np.argmax(_fan_widths(groups, fine)))])
-    xi = (math.cos(best), math.sin(best))
-    width = min(vertex_push([*normals, xi]) for normals in groups)
-    return CellMove(
-        cell=cell, target=target, xi=xi, width=max(width, 0.0), kept=kept, interface=interface
-    )
+    # Moves of the same shape (the same base angle and vertex angles: a map of equal rooms)
+    # have the same search: each shape is searched once.
+    shapes: dict[tuple[float, tuple[tuple[float, ...], ...]], int] = {}
+    unique: list[_Pending] = []
+    for move in pending:
+        if shapes.setdefault(move.shape, len(unique)) == len(unique):
+            unique.append(move)
+    bases: FloatArray = np.array([m.base for m in unique], dtype=np.float64)
+    best = _best_turns(unique, bases, coarse)
+    best = _best_turns(unique, best, fine)
+    found = []
+    for move, angle in zip(unique, best.tolist(), strict=True):
+        xi = (math.cos(angle), math.sin(angle))
+        found.append((xi, min(vertex_push([*normals, xi]) for normals in move.groups)))
+    moves = []
+    for move in pending:
+        xi, width = found[shapes[move.shape]]
+        moves.append(
+            CellMove(
+                cell=move.cell,
+                target=move.target,
+                xi=xi,
+                width=max(width, 0.0),
+                kept=move.kept,
+                interface=move.interface,
+            )
+        )
+    return moves
+
+
+#: Vertices whose fan is searched at once (bounds the search's arrays to about
+#: FAN x CHUNK floats each).
+CHUNK = 4096
+
+
+def _best_turns(pending: list[_Pending], centres: FloatArray, offsets: FloatArray) -> FloatArray:
+    """Per move: the angle among ``centre + offsets`` whose smallest vertex push is largest
+    (the first such)."""
+    best = np.empty(len(pending), dtype=np.float64)
+    start = 0
+    while start < len(pending):
+        stop, vertices = start, 0
+        while stop < len(pending) and (stop == start or vertices < CHUNK):
+            vertices += len(pending[stop].groups)
+            stop += 1
+        turns = centres[start:stop][None, :] + offsets[:, None]  # (directions, moves)
+        widths = _fan_widths([m.groups for m in pending[start:stop]], turns)
+        best[start:stop] = turns[np.argmax(widths, axis=0), np.arange(stop - start)]
+        start = stop
+    return best
 
 
 #: Directions of the fan searched for a cell move's flow direction xi (a full circle), and
@@ -218,26 +304,44 @@ FAN = 720
 FINE = 50
 
 
-def _fan_widths(groups: list[list[Vector]], turns: npt.NDArray[np.float64]) -> FloatArray:
-    """Per direction angle in ``turns``: the smallest vertex push with xi along it (the
-    vertices' kept normals in ``groups``), vectorised :func:`vertex_push`."""
-    widths = np.ones(len(turns))
+def _fan_widths(moves: list[list[list[Vector]]], turns: FloatArray) -> FloatArray:
+    """(directions, moves): per move and direction angle in ``turns`` (one column per move),
+    the smallest vertex push with xi along it (each vertex's kept normals in ``moves``):
+    :func:`vertex_push` over every vertex and direction at once.
+
+    A vertex of a convex cell lies on two of its sides, so it has one or two normals (one is
+    repeated: a repeated angle adds a gap of zero). Their angles a0 <= a1 are sorted once; xi's
+    angle t falls before a0, between them or after a1, and the circle's gaps are those of
+    the sorted three (the same differences as sorting them, with no sort per direction).
+    """
+    groups = [normals for groups in moves for normals in groups]
+    sizes = [len(groups) for groups in moves]
+    result = np.ones(turns.shape, dtype=np.float64)
+    if not groups:
+        return result
+    if max(len(normals) for normals in groups) > 2:
+        raise ValueError("a vertex of a convex cell lies on at most two of its sides")
+    low, high = [], []
     for normals in groups:
-        angles = np.array([math.atan2(y, x) for x, y in normals])
-        every = np.concatenate(
-            [
-                np.broadcast_to(angles, (len(turns), len(angles))),
-                np.mod(turns, 2 * math.pi)[:, None],
-            ],
-            axis=1,
-        )
-        every = np.sort(np.mod(every, 2.0 * math.pi), axis=1)
-        gaps = np.diff(every, axis=1)
-        wrap = every[:, 0] + 2.0 * math.pi - every[:, -1]
-        widest = np.maximum(gaps.max(axis=1), wrap)
-        spread = 2.0 * math.pi - widest
-        widths = np.minimum(widths, np.where(spread < math.pi, np.cos(spread / 2.0), 0.0))
-    return widths
+        angles = sorted(math.atan2(y, x) % (2.0 * math.pi) for x, y in normals)
+        low.append(angles[0])
+        high.append(angles[-1])
+    a0 = np.array(low, dtype=np.float64)
+    a1 = np.array(high, dtype=np.float64)
+    full = 2.0 * math.pi
+    owner = np.repeat(np.arange(len(moves)), sizes)
+    t = np.mod(np.mod(turns, full), full)[:, owner]  # (directions, vertices)
+    inner = a1 - a0
+    first = np.maximum(np.maximum(a0 - t, inner), t + full - a1)  # t <= a0: [t, a0, a1]
+    middle = np.maximum(np.maximum(t - a0, a1 - t), a0 + full - a1)  # a0 < t <= a1
+    last = np.maximum(np.maximum(inner, t - a1), a0 + full - t)  # a1 < t: [a0, a1, t]
+    widest = np.where(t <= a0, first, np.where(t <= a1, middle, last))
+    spread = full - widest
+    pushes = np.where(spread < math.pi, np.cos(spread / 2.0), 0.0)
+    has = np.flatnonzero(np.asarray(sizes) > 0)
+    starts = np.concatenate([[0], np.cumsum(sizes)[:-1]])[has]
+    result[:, has] = np.minimum(1.0, np.minimum.reduceat(pushes, starts, axis=1))
+    return result
 
 
 def _stay(cells: Cells, cell: int) -> CellStay:
@@ -290,8 +394,32 @@ def _turn(a: Vector, b: Vector, c: Vector) -> float:
     return (ux * vy - uy * vx) / scale if scale > 0.0 else 0.0
 
 
+#: The partitions kept for reuse (the most recent meshes'): the plan stage asks for the cells
+#: of one mesh many times (the planner's mask, the widest-lasso search, the witness check),
+#: and each move's search and each stay's centre are computed once per partition.
+KEPT_PARTITIONS = 6
+_partitions: OrderedDict[int, tuple[Abstraction, Cells]] = OrderedDict()
+_partitions_lock = threading.Lock()
+
+
 def partition(abstraction: Abstraction) -> Cells:
-    """The convex cells of ``abstraction`` (see the module doc)."""
+    """The convex cells of ``abstraction`` (see the module doc); the same object for the same
+    mesh object while it is among the last :data:`KEPT_PARTITIONS` partitioned."""
+    key = id(abstraction)
+    with _partitions_lock:
+        kept = _partitions.get(key)
+        if kept is not None and kept[0] is abstraction:
+            _partitions.move_to_end(key)
+            return kept[1]
+    cells = _partition(abstraction)
+    with _partitions_lock:
+        _partitions[key] = (abstraction, cells)  # the mesh held: its id is not reused meanwhile
+        while len(_partitions) > KEPT_PARTITIONS:
+            _partitions.popitem(last=False)
+    return cells
+
+
+def _partition(abstraction: Abstraction) -> Cells:
     triangles = abstraction.triangles.tolist()
     neighbours = abstraction.neighbors.tolist()
     letter = abstraction.letter_of.tolist()

@@ -24,6 +24,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 
+from tlmpc.abstraction.lines import Lines
 from tlmpc.abstraction.model import Abstraction
 from tlmpc.automata.model import Automaton
 from tlmpc.base.errors import Diagnostic, NoPlanError
@@ -516,12 +517,15 @@ def _with_cells_bound(planned: Planned, ratio: float | None, mission: Mission) -
 def _on_lines(
     mission: Mission, margin: float, planned: Planned, start_point: tuple[float, float] | None
 ) -> tuple[Planned | None, float | None]:
-    """The cells' rung on the convex cells' own mesh (every side extended across the free
-    space, :mod:`tlmpc.abstraction.lines`: convex faces that meet side to side), with the
-    goal depth, then the margin's: the plan there, or (None, the largest disturbance ratio any
-    plan on those meshes' cells rejects, None when none was built: over the size budgets)."""
+    """The cells' rung on the convex cells' own meshes (:mod:`tlmpc.abstraction.lines`):
+    first the arrangement of every side extended across the free space (faces that meet side
+    to side), with the goal depth, then the margin's; then the reflex cuts (near-linear in
+    the sides), then the bisector cuts, in the same order. The plan on the first that
+    carries the disturbance, or (None, the largest disturbance ratio any plan on those
+    meshes' cells rejects, None when none was built: over the size budgets)."""
     from tlmpc.abstraction import build_abstraction
     from tlmpc.abstraction.layout import deepens_goals, planning_layout
+    from tlmpc.abstraction.lines import OverBudget
     from tlmpc.abstraction.triangulate import lines_fit
     from tlmpc.ltl.bounds import untimed_skeleton
     from tlmpc.planning.bottleneck import supported_ratio
@@ -529,30 +533,36 @@ def _on_lines(
 
     formula = planned.formula
     bound: float | None = None
-    for deep in (True, False) if deepens_goals(mission) else (False,):
-        layout = planning_layout(mission, margin, deep=deep)
-        if not lines_fit(mission, layout):
-            continue
-        mesh = build_abstraction(mission, layout, lines=True)
-        if mesh.num_triangles > MAX_TRIANGLES:
-            continue
-        task = automaton_for(mission, mesh, formula=formula)
-        candidate = Planned(
-            abstraction=mesh, automaton=task, witness=planned.witness, formula=formula
-        )
-        found = _on_cells(mission, candidate, start_point)
-        if found is not None:
-            return found, None
-        supported = supported_ratio(
-            mesh,
-            task,
-            formula=formula if formula is not None else untimed_skeleton(mission.formula),
-            options=mission.options,
-            start_point=start_point if start_point is not None else mission.robot.start,
-            cells=True,
-        )
-        if supported is not None and (bound is None or supported > bound):
-            bound = supported
+    depths = (True, False) if deepens_goals(mission) else (False,)
+    kinds: tuple[Lines, ...] = ("arrangement", "reflex", "bisector")
+    for kind in kinds:
+        for deep in depths:
+            layout = planning_layout(mission, margin, deep=deep)
+            if kind == "arrangement" and not lines_fit(mission, layout):
+                continue
+            try:
+                mesh = build_abstraction(mission, layout, lines=kind)
+            except OverBudget:
+                continue
+            if mesh.num_triangles > MAX_TRIANGLES:
+                continue
+            task = automaton_for(mission, mesh, formula=formula)
+            candidate = Planned(
+                abstraction=mesh, automaton=task, witness=planned.witness, formula=formula
+            )
+            found = _on_cells(mission, candidate, start_point)
+            if found is not None:
+                return found, None
+            supported = supported_ratio(
+                mesh,
+                task,
+                formula=formula if formula is not None else untimed_skeleton(mission.formula),
+                options=mission.options,
+                start_point=start_point if start_point is not None else mission.robot.start,
+                cells=True,
+            )
+            if supported is not None and (bound is None or supported > bound):
+                bound = supported
     return None, bound
 
 
