@@ -61,11 +61,12 @@ def test_without_the_cells_own_mesh_the_hint_states_the_mission_mesh_cells_bound
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, options: str
 ) -> None:
     """The bound on the cells of the meshes tried is computed for the refusal alone (a plan
-    the cells' rung carries never needs it): with the cells' own mesh over its budget,
+    the cells' rung carries never needs it): with the cells' own meshes over their budgets,
     Example 1 at 0.5 (with goal cores, the ladder's meshes; without, the one mesh) is
     refused stating what its meshes' cells reject, a rectangle's corners left by part of a
     side: cos 67.5 degrees."""
     monkeypatch.setattr(tlmpc.abstraction.lines, "MAX_SIDES", 3)
+    monkeypatch.setattr(tlmpc.abstraction.lines, "MAX_REFLEX_WORK", 5)
     source = _example1(tmp_path, 0.5)
     source.write_text(source.read_text(encoding="utf-8") + options, encoding="utf-8")
     refused = _refusal(source)
