@@ -122,8 +122,8 @@ def disturbance_hint(
         )
     if on_cells is not None:
         lines.append(
-            "on convex cells (the plan stage's last rung: the mesh's, and a mesh of the map's "
-            f"sides extended across it) plans reject at most "
+            "on convex cells (the plan stage's last rung: the mesh's, and meshes of the map's "
+            f"sides extended or its reflex corners cut) plans reject at most "
             f"{on_cells:.6g} ({on_cells / max_speed:.4f} x max_speed): the widest route's "
             "weakest cell step"
         )
