@@ -444,7 +444,9 @@ def gap_rows(only: tuple[str, ...] = ()) -> list[dict[str, Any]]:
             result = compile_mission(source if text is None else "bench.yaml", text=text)
         mission = result.compilation.get(MISSION)
         followed = original(*calls[-1])
-        with mock.patch.multiple(channel, PORTAL_INSET=0.0, LABEL_INSET=0.0, ENTERED_INSET=0.0):
+        with mock.patch.multiple(
+            channel, PORTAL_INSET=0.0, LABEL_INSET=0.0, ENTERED_INSET=0.0, REACH_ROUNDS=0
+        ):
             bare = original(*calls[-1])
         shapes = {r.name: shapely.Polygon(r.polygon) for r in mission.regions}
         free = workspace_free_space(mission)
