@@ -8,9 +8,9 @@ and on a coarse mesh (a goal's core of two large triangles) that detour is long.
 1. the mission is planned with U-turns allowed (the product with bounces, the moves weighing
    what the ``length`` re-plans weigh them with): its lasso turns around in some triangles;
 2. for each U-turn (the run goes n -> t -> n across edge e), the point p of e where the path
-   should touch t: the string pulled through the run without its U-turns gives the path's
-   entry x into n and exit y out of n, and p minimises |x p| + |p y| on e (the reflection of
-   y across e's line), kept :data:`tlmpc.abstraction.touch.EDGE_MARGIN` from e's ends;
+   should touch t: the string is pulled through the run's portals with the U-turn's two
+   crossings of e replaced by one point of e, and p moves to where the path's way through n,
+   x -> p -> y, is shortest (the reflection of y across e's line), a few rounds;
 3. e is split at p, and t and n with it (:func:`tlmpc.abstraction.touch.split_edges`), and the
    mission is planned again without U-turns on the refined mesh
    (:func:`tlmpc.planning.mission.replan`): it can now enter one half of t near p and leave
@@ -23,7 +23,6 @@ slower.
 
 from __future__ import annotations
 
-import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import replace
@@ -81,53 +80,69 @@ def touch_points(
 ) -> list[tuple[int, int, float]]:
     """``(t, edge, u)`` for each U-turn n -> t -> n of ``run`` (a sequence of adjacent
     triangles): t's local edge facing n and the fraction along it (from its corner
-    ``edge + 1``) where the path should touch t."""
-    turns = [i for i in range(1, len(run) - 1) if run[i - 1] == run[i + 1]]
+    ``edge + 1``) where the path should touch t.
+
+    The string is pulled through the run's portals with each U-turn's two crossings of its
+    edge replaced by one point of that edge (first its middle); each point then moves to
+    where the path's way into and out of n, x -> p -> y, is shortest (:func:`_touch`), and
+    the string is pulled again, :data:`TOUCH_ROUNDS` times.
+    """
+    turns = [
+        i
+        for i in range(1, len(run) - 1)
+        if run[i - 1] == run[i + 1] and run[i - 1] in mesh.neighbors[run[i]].tolist()
+    ]
+    turns = [i for k, i in enumerate(turns) if k == 0 or turns[k - 1] < i - 1]
     if not turns:
         return []
-    # The run without its U-turns: n -> t -> n becomes n (repeated until none is left).
-    reduced = list(run)
-    changed = True
-    while changed:
-        changed = False
-        for i in range(1, len(reduced) - 1):
-            if reduced[i - 1] == reduced[i + 1]:
-                del reduced[i : i + 2]
-                changed = True
-                break
-    portals = [_portal(mesh, a, b) for a, b in itertools.pairwise(reduced)]
-    if any(p is None for p in portals):
-        return []
-    gates = [p for p in portals if p is not None]
-    end = _centroid(mesh, reduced[-1])
-    path = [start, *funnel(start, gates, end), end]
+    edges: dict[int, tuple[int, Point, Point]] = {}
+    for i in turns:
+        t, n = run[i], run[i - 1]
+        edge = mesh.neighbors[t].tolist().index(n)
+        corners = mesh.triangles[t].tolist()
+        edges[i] = (
+            edge,
+            _point(mesh, corners[(edge + 1) % 3]),
+            _point(mesh, corners[(edge + 2) % 3]),
+        )
+    fraction = dict.fromkeys(turns, 0.5)
+    around = set(turns)
+    end = _centroid(mesh, run[-1])
+    for _ in range(TOUCH_ROUNDS):
+        gates: list[Portal] = []
+        at: dict[int, int] = {}  # U-turn -> index of its point among the gates
+        k = 0
+        while k < len(run) - 1:
+            if k + 1 in around:  # n -> t -> n: one point of the edge
+                _, a, b = edges[k + 1]
+                u = fraction[k + 1]
+                p = (a[0] + u * (b[0] - a[0]), a[1] + u * (b[1] - a[1]))
+                at[k + 1] = len(gates)
+                gates.append(Portal(p, p))
+                k += 2
+                continue
+            portal = _portal(mesh, run[k], run[k + 1])
+            if portal is None:
+                return []
+            gates.append(portal)
+            k += 1
+        path = [start, *funnel(start, gates, end), end]
+        for i in turns:
+            _, a, b = edges[i]
+            x, y = path[at[i]], path[at[i] + 2]
+            fraction[i] = _touch(a, b, x, y)
     found: list[tuple[int, int, float]] = []
     seen: set[int] = set()
     for i in turns:
-        n, t = run[i - 1], run[i]
-        sides = mesh.neighbors[t].tolist()
-        if t in seen or n not in sides:
+        if run[i] in seen:
             continue
-        seen.add(t)
-        edge = sides.index(n)
-        corners = mesh.triangles[t].tolist()
-        a = _point(mesh, corners[(edge + 1) % 3])
-        b = _point(mesh, corners[(edge + 2) % 3])
-        # The detour into the edge that costs the path least: over the path's pieces x -> y,
-        # the touch point of each and the length it adds (straight lines: an estimate).
-        best = min(
-            (_detour(a, b, x, y), index) for index, (x, y) in enumerate(itertools.pairwise(path))
-        )
-        found.append((t, edge, best[0][1]))
+        seen.add(run[i])
+        found.append((run[i], edges[i][0], fraction[i]))
     return found
 
 
-def _detour(a: Point, b: Point, x: Point, y: Point) -> tuple[float, float]:
-    """(the length |x p| + |p y| - |x y| adds, the fraction u of p along a -> b) for the
-    touch point p of :func:`_touch`."""
-    u = _touch(a, b, x, y)
-    p = (a[0] + u * (b[0] - a[0]), a[1] + u * (b[1] - a[1]))
-    return math.dist(x, p) + math.dist(p, y) - math.dist(x, y), u
+#: Rounds of moving the touch points and pulling the string again.
+TOUCH_ROUNDS = 3
 
 
 def _touch(a: Point, b: Point, x: Point, y: Point) -> float:
