@@ -108,8 +108,10 @@ def plan_shortest(mission: Mission, planned: Planned) -> Planned:
     # (its own budget, the plan with U-turns and the re-plan on the split mesh: the re-plans
     # below run as they would without it)
     if 2 * _nodes(planned) <= NODE_BUDGET:
-        weights = MoveTimes(speed=1.0 / ratio, measured=dict(measured))
-        touched = touch_candidate(mission, planned, weights)
+        # on the midpoint lengths alone: the first plan's measured pieces would draw the plan
+        # with U-turns back into the first plan's channel (Example 6 touched a core by its
+        # far side edge, its exact time 39.0 s against 38.3 s so)
+        touched = touch_candidate(mission, planned, MoveTimes(speed=1.0))
         found_touch = None if touched is None else _pulled(mission, touched)
         if touched is not None and found_touch is not None:
             seen.add(touched.route())

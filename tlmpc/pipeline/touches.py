@@ -6,7 +6,7 @@ edge it entered by), so the plan crosses the region's first triangle to another 
 and on a coarse mesh (a goal's core of two large triangles) that detour is long.  Here:
 
 1. the mission is planned with U-turns allowed (the product with bounces, the moves weighing
-   what the ``length`` re-plans weigh them with): its lasso turns around in some triangles;
+   their midpoint lengths): its lasso turns around in some triangles;
 2. for each U-turn (the run goes n -> t -> n across edge e), the point p of e where the path
    should touch t: the string is pulled through the run's portals with the U-turn's two
    crossings of e replaced by one point of e, and p moves to where the path's way through n,
