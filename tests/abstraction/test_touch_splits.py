@@ -3,6 +3,7 @@ observation-preserving, and the touch point is the one a brute force finds."""
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -14,7 +15,13 @@ from test_abstraction_props import workspaces
 from test_refine import _check_mesh
 
 from tlmpc.abstraction import build_abstraction
-from tlmpc.abstraction.touch import EDGE_MARGIN, _start_cells, split_edges
+from tlmpc.abstraction.touch import (
+    EDGE_MARGIN,
+    NEEDLE,
+    _start_cells,
+    _thin_halves,
+    split_edges,
+)
 from tlmpc.mission.model import Mission
 from tlmpc.pipeline.touches import _touch
 
@@ -43,6 +50,14 @@ def test_edge_splits_keep_the_mesh_conforming_and_labels_exact(
     _check_mesh(refined, mission)
     area = sum(Polygon(c).area for c in refined.vertices[refined.triangles])
     assert area == pytest.approx(sum(Polygon(c).area for c in built.vertices[built.triangles]))
+    # No half is a needle: its smallest height (twice its area over its longest edge) is at
+    # least NEEDLE of that edge (shapely's area and lengths).
+    for t in range(refined.num_triangles):
+        if t < built.num_triangles and np.array_equal(refined.triangles[t], built.triangles[t]):
+            continue
+        shape = Polygon(refined.vertices[refined.triangles[t]].tolist())
+        longest = max(math.dist(a, b) for a, b in itertools.pairwise(list(shape.exterior.coords)))
+        assert 2 * shape.area / longest >= NEEDLE * longest * (1 - 1e-9)
     # Every new vertex lies on a split edge, at least EDGE_MARGIN of it from both ends.
     for point in refined.vertices[len(built.vertices) :]:
         assert any(_fraction_on(built, t, i, point) is not None for t, i, _ in splits)
@@ -92,7 +107,11 @@ def test_a_split_on_a_wall_or_twice_on_one_triangle_is_skipped(mission: Mission)
     ]
     starts = {c.triangle for c in _start_cells(built, mission.robot.start)}
     free = [
-        (t, i) for t, i in inner if t not in starts and int(built.neighbors[t, i]) not in starts
+        (t, i)
+        for t, i in inner
+        if t not in starts
+        and int(built.neighbors[t, i]) not in starts
+        and not _thin_halves(built, t, i, 0.5, int(built.neighbors[t, i]))
     ]
     if not free:
         return

@@ -52,6 +52,8 @@ def split_edges(
         neighbour = int(abstraction.neighbors[triangle, edge])
         if neighbour < 0 or triangle in touched or neighbour in touched:
             continue
+        if _thin_halves(abstraction, int(triangle), int(edge), u, neighbour):
+            continue
         touched.update((triangle, neighbour))
         chosen.append(
             (int(triangle), int(edge), min(1 - EDGE_MARGIN, max(EDGE_MARGIN, u)), neighbour)
@@ -148,6 +150,32 @@ def _split_one(
     component[second] = component[t]
     if outer_bc >= 0:
         nbr[outer_bc, nbr[outer_bc] == t] = second
+
+
+#: A half whose smallest height is below this fraction of its longest edge is a needle: no
+#: split makes one (the fields of needles only keep the vertex conditions, and a sliver's
+#: half can be crossed in a time the verifier's samples do not resolve).
+NEEDLE = 0.05
+
+
+def _thin_halves(abstraction: Abstraction, t: int, edge: int, u: float, n: int) -> bool:
+    """Whether splitting ``t``'s edge opposite corner ``edge`` at ``u`` (clamped as
+    :func:`split_edges` clamps it) would make a needle of one of the four halves."""
+    u = min(1 - EDGE_MARGIN, max(EDGE_MARGIN, u))
+    corners = abstraction.triangles[t].tolist()
+    c = abstraction.vertices[corners[edge]]
+    a = abstraction.vertices[corners[(edge + 1) % 3]]
+    b = abstraction.vertices[corners[(edge + 2) % 3]]
+    d = abstraction.vertices[next(v for v in abstraction.triangles[n].tolist() if v not in corners)]
+    p = a + u * (b - a)
+    return any(_needle(x, y, z) for x, y, z in ((c, a, p), (c, p, b), (d, b, p), (d, p, a)))
+
+
+def _needle(x: FloatArray, y: FloatArray, z: FloatArray) -> bool:
+    area2 = abs(float((y[0] - x[0]) * (z[1] - x[1]) - (y[1] - x[1]) * (z[0] - x[0])))
+    longest = max(float(np.hypot(*(y - x))), float(np.hypot(*(z - y))), float(np.hypot(*(x - z))))
+    # smallest height = twice the area over the longest edge
+    return longest == 0.0 or area2 / longest < NEEDLE * longest
 
 
 def _start_cells(abstraction: Abstraction, start_point: tuple[float, float]) -> list[Any]:

@@ -118,7 +118,7 @@ def plan_shortest(mission: Mission, planned: Planned) -> Planned:
             touch = {"touch_length": found_touch.length}
             if found_touch.length < best_length * (1.0 - MIN_GAIN):
                 best_time = _exact_time(mission, best)
-                time = _exact_time(mission, touched)
+                time = _verified_time(mission, touched)
                 touch["touch_time"] = time
                 if time <= best_time:
                     best, best_length, best_time = touched, found_touch.length, time
@@ -169,6 +169,28 @@ def _pulled(mission: Mission, planned: Planned) -> Pulled | None:
         return pull(mission, planned)
     except TlmpcError:
         return None
+
+
+def _verified_time(mission: Mission, planned: Planned) -> float:
+    """:func:`_exact_time`, and inf unless the simulated trace also satisfies the task (the
+    self-check's verifier): a plan on a split mesh is checked before it can replace one
+    made on the mesh as built."""
+    from tlmpc.control import synthesize
+    from tlmpc.pipeline.mintime import step_times
+    from tlmpc.simulate import simulate, trace_to_json
+    from tlmpc.verify import verdict_to_json, verify_document
+
+    try:
+        controllers = synthesize(
+            planned.abstraction, planned.witness, mission.robot, source=mission.source
+        )
+        trace = simulate(planned.abstraction, controllers, mission)
+    except TlmpcError:
+        return math.inf
+    verdict = verdict_to_json(verify_document(dict(trace_to_json(trace, mission))))
+    if not verdict["satisfied"]:
+        return math.inf
+    return step_times(planned.abstraction, controllers, trace, planned.witness.beta).exact_time
 
 
 def _exact_time(mission: Mission, planned: Planned) -> float:
