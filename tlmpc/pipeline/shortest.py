@@ -120,7 +120,8 @@ def plan_shortest(mission: Mission, planned: Planned) -> Planned:
                 best_time = _exact_time(mission, best)
                 time = _verified_time(mission, touched)
                 touch["touch_time"] = time
-                if time <= best_time:
+                not_slower = time <= best_time
+                if not_slower:
                     best, best_length, best_time = touched, found_touch.length, time
                     current = touched  # the re-plans go on from it, on its mesh
                     measured.update(found_touch.moves)
