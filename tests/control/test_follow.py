@@ -13,6 +13,7 @@ import itertools
 import math
 from fractions import Fraction
 from typing import Any, cast
+from unittest import mock
 
 import numpy as np
 import pytest
@@ -23,7 +24,7 @@ from shortest_paths import geodesic
 from strategies import missions
 
 from tlmpc.abstraction.model import Abstraction
-from tlmpc.control import synthesize
+from tlmpc.control import channel, synthesize
 from tlmpc.control.channel import Portal, funnel
 from tlmpc.mission.model import Mission, Robot
 from tlmpc.planning.model import Witness
@@ -387,7 +388,10 @@ def test_label_insets_only_where_the_label_is_the_regions_own_boundary(
     )
     assert exposed_vertices(cored, shared) == frozenset()
     assert exposed_vertices(own, shared) == frozenset(shared)
-    assert length(cored) <= length(own) * (1 + 1e-12) + 1e-12
+    # the label insets alone (the widening where a piece could not be followed depends on
+    # the path, so it is not monotone in the insets; it has its own tests)
+    with mock.patch.object(channel, "REACH_ROUNDS", 0):
+        assert length(cored) <= length(own) * (1 + 1e-12) + 1e-12
 
 
 def test_a_bent_corridor_splits_its_runs_at_the_bend() -> None:

@@ -20,6 +20,7 @@ controller has room to follow the path (see docs/control.md).
 from __future__ import annotations
 
 import itertools
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -82,21 +83,6 @@ def inset(portal: Portal, left: float = PORTAL_INSET, right: float = PORTAL_INSE
     (lx, ly), (rx, ry) = portal.left, portal.right
     dx, dy = rx - lx, ry - ly
     return Portal((lx + left * dx, ly + left * dy), (rx - right * dx, ry - right * dy))
-
-
-def _inset_exit(step: ChannelStep) -> Portal:
-    """The exit portal shrunk: by :data:`ENTERED_INSET` at both ends where the plan has just
-    entered a new label, else by :data:`LABEL_INSET` at an end on a label boundary and
-    :data:`PORTAL_INSET` elsewhere."""
-    portal = exit_portal(step)
-    if step.through is not None or step.exit_edge is None:
-        return portal
-    if step.entered:
-        return inset(portal, ENTERED_INSET, ENTERED_INSET)
-    e = step.exit_edge
-    left = LABEL_INSET if step.labelled[(e + 2) % 3] else PORTAL_INSET
-    right = LABEL_INSET if step.labelled[(e + 1) % 3] else PORTAL_INSET
-    return inset(portal, left, right)
 
 
 def exit_portal(step: ChannelStep) -> Portal:
@@ -220,13 +206,20 @@ def channel_pieces(
         order = list(range(loop_start)) + cycle * LAPS
         moving = order
         end = None
-    portals = [_inset_exit(steps[i]) for i in moving]
+    insets = [_exit_insets(steps[i]) for i in moving]
+    crossings = _pulled(steps, moving, insets, start, end)
+    for _ in range(REACH_ROUNDS):
+        wider = [
+            _reachable(steps[i], insets[k], start if k == 0 else crossings[k - 1], crossings[k])
+            for k, i in enumerate(moving)
+        ]
+        if wider == insets:
+            break
+        insets = wider
+        crossings = _pulled(steps, moving, insets, start, end)
     if end is None:
-        last = portals.pop()
-        end = ((last.left[0] + last.right[0]) / 2.0, (last.left[1] + last.right[1]) / 2.0)
-        crossings = [*funnel(start, portals, end), end]
-    else:
-        crossings = funnel(start, portals, end)
+        last = crossings[-1]
+        end = last
     # The pass each step takes: its first in the prefix, the middle lap in the cycle.
     chosen: dict[int, int] = {}
     for position, i in enumerate(moving):
@@ -243,3 +236,82 @@ def channel_pieces(
         entry = start if position == 0 else crossings[position - 1]
         guides.append(Guide(entry, crossings[position]))
     return guides
+
+
+#: Rounds of widening the exit insets where the path, as pulled, could not be followed.
+REACH_ROUNDS = 3
+#: The inset asked where a piece heads toward a kept facet's line at the sine σ of its angle
+#: to it: this times σ.
+REACH_GAIN = 0.5
+#: No end of a portal is inset by more than this fraction (the portal keeps its middle).
+REACH_CAP = 0.45
+
+
+def _exit_insets(step: ChannelStep) -> tuple[float, float]:
+    """The fractions :func:`_inset_exit` keeps clear at the exit portal's left and right
+    ends."""
+    if step.through is not None or step.exit_edge is None:
+        return (0.0, 0.0)
+    if step.entered:
+        return (ENTERED_INSET, ENTERED_INSET)
+    e = step.exit_edge
+    left = LABEL_INSET if step.labelled[(e + 2) % 3] else PORTAL_INSET
+    right = LABEL_INSET if step.labelled[(e + 1) % 3] else PORTAL_INSET
+    return (left, right)
+
+
+def _pulled(
+    steps: Sequence[ChannelStep],
+    moving: Sequence[int],
+    insets: Sequence[tuple[float, float]],
+    start: Point,
+    end: Point | None,
+) -> list[Point]:
+    """The crossings of the exit portals of ``moving`` with these insets (and, without an
+    ``end``, the last portal's midpoint as the end, appended)."""
+    portals = [inset(exit_portal(steps[i]), *insets[k]) for k, i in enumerate(moving)]
+    if end is None:
+        last = portals.pop()
+        middle = ((last.left[0] + last.right[0]) / 2.0, (last.left[1] + last.right[1]) / 2.0)
+        return [*funnel(start, portals, middle), middle]
+    return funnel(start, portals, end)
+
+
+def _reachable(
+    step: ChannelStep, insets: tuple[float, float], entry: Point, exit_: Point
+) -> tuple[float, float]:
+    """``insets`` widened where the piece entry -> exit could not be a flow line.
+
+    At an end a of the exit edge the other facet through a is kept: the field at a points
+    away from it, so near a the flow cannot approach that facet's line.  A piece that ends
+    at the fraction λ of the exit edge from a, heading toward that line with the sine σ of
+    its angle to it (σ > 0), needs a field there that mixes a's velocity with the far end's
+    by λ; with both at most max_speed, λ >= σ is necessary for a flow at full speed along
+    the piece.  The end's inset becomes at least σ (at most :data:`REACH_CAP`)."""
+    if step.through is not None or step.exit_edge is None:
+        return insets
+    dx, dy = exit_[0] - entry[0], exit_[1] - entry[1]
+    norm = math.hypot(dx, dy)
+    if norm == 0.0:
+        return insets
+    e = step.exit_edge
+    corners = step.corners
+    widened = list(insets)
+    # left end: corner e + 2, its other facet runs to corner e; right end: corner e + 1,
+    # its other facet runs from corner e
+    for side, (a, c) in enumerate((((e + 2) % 3, e), ((e + 1) % 3, e))):
+        ax, ay = corners[a]
+        cx, cy = corners[c]
+        ex, ey = cx - ax, cy - ay
+        length = math.hypot(ex, ey)
+        if length == 0.0:
+            continue
+        # the facet's outward normal: the triangle's third corner lies on its other side
+        nx, ny = ey / length, -ex / length
+        (ox, oy) = corners[3 - a - c]
+        if nx * (ox - ax) + ny * (oy - ay) > 0.0:
+            nx, ny = -nx, -ny
+        sigma = (nx * dx + ny * dy) / norm
+        if REACH_GAIN * sigma > widened[side]:
+            widened[side] = min(REACH_CAP, REACH_GAIN * sigma)
+    return (widened[0], widened[1])
