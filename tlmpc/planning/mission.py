@@ -259,7 +259,7 @@ def plan_mission(
     except NoPlanError as failure:
         if resume is not None:
             raise
-        first = failure
+        first = failure.with_traceback(None)  # kept: no cycle through this frame's traceback
     if deepens_goals(mission):
         # the goal depth is an objective: plan again reaching the goals only as deep as the
         # margin asks (overlapping goals' cores may not meet where the regions do)
@@ -267,7 +267,7 @@ def plan_mission(
         try:
             planned = attempt(shallow, automaton_for(mission, shallow))
         except NoPlanError as again:
-            first = again
+            first = again.with_traceback(None)
         else:
             ratio = mission.robot.disturbance / mission.robot.max_speed
             if ratio > 0.0 and not witness_realisable(planned.abstraction, planned.witness, ratio):
