@@ -90,23 +90,44 @@ def split_triangles(
                 # The outer neighbour pointed at t across this edge; it now faces S_i.
                 nbr[n, nbr[n] == t] = s
     vertices.append(np.asarray(new_points, dtype=np.float64).reshape(-1, 2))
-    all_vertices = np.vstack(vertices)
-    cells = cells_in(all_vertices, tri, nbr, letter_of, start_point)
-    fallback = locate_in(all_vertices, tri, start_point)
-    new_start = min(c.triangle for c in cells) if cells else fallback
-    for array in (all_vertices, tri, nbr, letter_of, component):
+    return with_splits(
+        abstraction,
+        np.vstack(vertices),
+        (tri, nbr, letter_of, component),
+        start_point,
+        counter="split_for_u_turns",
+        count=len(targets),
+    )
+
+
+def with_splits(
+    abstraction: Abstraction,
+    vertices: FloatArray,
+    arrays: tuple[Any, Any, Any, Any],
+    start_point: tuple[float, float],
+    *,
+    counter: str,
+    count: int,
+) -> Abstraction:
+    """``abstraction`` with its triangles split: the new ``vertices`` and (triangles,
+    neighbours, letters, components) arrays, made read-only, its start cell found again, and
+    ``count`` more splits in the statistic ``counter``."""
+    tri, nbr, letter_of, component = arrays
+    cells = cells_in(vertices, tri, nbr, letter_of, start_point)
+    new_start = min(c.triangle for c in cells) if cells else locate_in(vertices, tri, start_point)
+    for array in (vertices, tri, nbr, letter_of, component):
         array.setflags(write=False)
     stats: dict[str, Any] = dict(abstraction.stats)
     stats.update(
         {
-            "vertices": len(all_vertices),
+            "vertices": len(vertices),
             "triangles": len(tri),
             "edges": int((nbr >= 0).sum() // 2),
-            "split_for_u_turns": int(stats.get("split_for_u_turns", 0)) + len(targets),
+            counter: int(stats.get(counter, 0)) + count,
         }
     )
     return Abstraction(
-        vertices=all_vertices,
+        vertices=vertices,
         triangles=tri,
         neighbors=nbr,
         letter_of=letter_of,

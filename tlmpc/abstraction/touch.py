@@ -22,8 +22,8 @@ from typing import Any
 
 import numpy as np
 
-from tlmpc.abstraction.build import locate_in
 from tlmpc.abstraction.model import Abstraction, FloatArray
+from tlmpc.abstraction.refine import with_splits
 from tlmpc.abstraction.starts import cells_in
 
 #: A split point keeps at least this fraction of its edge's length from both ends: the halves
@@ -88,30 +88,13 @@ def split_edges(
         _split_one(
             tri, nbr, letter_of, component, neighbour, other_edge, p, second_n, (second_t, triangle)
         )
-    vertices = np.vstack([abstraction.vertices, np.asarray(points, dtype=np.float64)])
-    cells = cells_in(vertices, tri, nbr, letter_of, start_point)
-    new_start = min(c.triangle for c in cells) if cells else locate_in(vertices, tri, start_point)
-    for array in (vertices, tri, nbr, letter_of, component):
-        array.setflags(write=False)
-    stats: dict[str, Any] = dict(abstraction.stats)
-    stats.update(
-        {
-            "vertices": len(vertices),
-            "triangles": len(tri),
-            "edges": int((nbr >= 0).sum() // 2),
-            "split_for_touches": int(stats.get("split_for_touches", 0)) + len(chosen),
-        }
-    )
-    return Abstraction(
-        vertices=vertices,
-        triangles=tri,
-        neighbors=nbr,
-        letter_of=letter_of,
-        letters=abstraction.letters,
-        start=new_start,
-        component=component,
-        regions=abstraction.regions,
-        stats=stats,
+    return with_splits(
+        abstraction,
+        np.vstack([abstraction.vertices, np.asarray(points, dtype=np.float64)]),
+        (tri, nbr, letter_of, component),
+        start_point,
+        counter="split_for_touches",
+        count=len(chosen),
     )
 
 
