@@ -25,6 +25,7 @@ hold for whatever edge costs the product is given.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -48,7 +49,7 @@ class RegionGraph:
     background: int  # local index of the background class
     landmarks: IntArray  # local indices of the landmarks
     cell_local: IntArray  # per cell: its triangle's local class (-1: not allowed)
-    distance: FloatArray  # (landmarks, cells): cost from the cell to entering the landmark
+    distance: FloatArray  # (cells, landmarks): cost from the cell to entering the landmark
     delta: FloatArray  # (local, local): region-to-region lower bound (0 from the background)
     entry: BoolArray  # per cell: entered from a triangle of another class (a boundary entry)
     delta_entry: FloatArray  # (local, local): as delta, from the entry cells of the region
@@ -108,8 +109,8 @@ def region_graph(product: LazyProduct, allowed_cells: BoolArray) -> RegionGraph:
     inside = _ClassCells(cell_local, landmarks, np.ones(cells, dtype=bool))
     entered = _ClassCells(cell_local, landmarks, entry)
     for index, landmark in enumerate(landmarks.tolist()):
-        delta[landmarks, landmark] = inside.least(distance[index])
-        delta_entry[landmarks, landmark] = entered.least(distance[index])
+        delta[landmarks, landmark] = inside.least(distance[:, index])
+        delta_entry[landmarks, landmark] = entered.least(distance[:, index])
     kind_local = local_of[product.kind_class]
     closure = np.zeros((count, nq, nq), dtype=bool)
     entering: list[tuple[int, IntArray, IntArray]] = []
@@ -189,15 +190,16 @@ def _reflexive_closure(step: BoolArray) -> BoolArray:
 
 
 def _landmark_distances(backwards: Graph, cell_local: IntArray, landmarks: IntArray) -> FloatArray:
-    """(landmarks, cells): the transition system's least cost from each cell to entering a
-    triangle of each landmark (entered cells, not the start slot), inf where unreachable."""
+    """(cells, landmarks): the transition system's least cost from each cell to entering a
+    triangle of each landmark (entered cells, not the start slot), inf where unreachable (a
+    cell's row is what a bound reads at once)."""
     cells = backwards.num_nodes
     entered = np.ones(cells, dtype=bool)
     entered[SLOTS - 1 :: SLOTS] = False
-    distance = np.empty((len(landmarks), cells))
+    distance = np.empty((cells, len(landmarks)))
     for index, landmark in enumerate(landmarks.tolist()):
         goal = np.flatnonzero(entered & (cell_local == landmark))
-        distance[index], _ = shortest_paths(backwards, goal)
+        distance[:, index], _ = shortest_paths(backwards, goal)
     return distance
 
 
@@ -243,17 +245,58 @@ class CostToGo:
             bound = np.where(self.reach[q, c], self.final[cell], np.inf)
         else:
             bound = self.free[q, c]
-        if len(self.graph.landmarks):
-            via = self.graph.distance[:, cell].T + self.leg[q, c]
-            bound = np.minimum(bound, via.min(axis=1))
-        result: FloatArray = bound * SAFETY
-        return result
+        return _via_landmarks(self.graph, cell, bound, self.leg[q, c])
 
     def at_region(self, q: int, c: int, *, entered: bool = False) -> float:
         """The bound at the region-level node ``(q, c)``: anywhere in ``c`` or the
         background with ``c`` the last landmark, or with ``entered`` right after entering
         landmark ``c`` (in one of its boundary entry cells)."""
         return float(self.value[q, c] if entered else self.anywhere[q, c])
+
+
+def _via_landmarks(
+    graph: RegionGraph, cell: IntArray, bound: FloatArray, leg: FloatArray
+) -> FloatArray:
+    """``bound`` lowered to the way through the next landmark entered (``leg``: per node,
+    the cost after entering each landmark), scaled by :data:`SAFETY`."""
+    if len(graph.landmarks):
+        bound = np.minimum(bound, (graph.distance[cell] + leg).min(axis=1))
+    result: FloatArray = bound * SAFETY
+    return result
+
+
+@dataclass(frozen=True, slots=True)
+class StackedCostToGo:
+    """Several :class:`CostToGo` to cells (:func:`cost_to_go_to_cells`) of one graph, each
+    node bounded by its own one's: the same values as calling each on its nodes, in one
+    pass over all of them (searches side by side bound their nodes at once)."""
+
+    graph: RegionGraph
+    leg: FloatArray  # (K, Q, local, landmarks)
+    final: FloatArray  # (K, cells)
+    reach: BoolArray  # (K, Q, local)
+
+    @staticmethod
+    def of(bounds: Sequence[CostToGo]) -> StackedCostToGo:
+        """The bounds stacked (each with a ``final`` and ``reach``, over the same graph)."""
+        finals = [b.final for b in bounds]
+        reaches = [b.reach for b in bounds]
+        if any(f is None for f in finals) or any(r is None for r in reaches):
+            raise ValueError("only bounds to cells stack")
+        return StackedCostToGo(
+            graph=bounds[0].graph,
+            leg=np.stack([b.leg for b in bounds]),
+            final=np.stack(finals),  # type: ignore[arg-type]
+            reach=np.stack(reaches),  # type: ignore[arg-type]
+        )
+
+    def __call__(self, which: IntArray, nodes: IntArray) -> FloatArray:
+        """The bound at each node by the ``which``-th bound."""
+        nq = self.graph.num_states
+        cell, q = nodes // nq, nodes % nq
+        c = self.graph.cell_local[cell]
+        bound = np.where(self.reach[which, q, c], self.final[which, cell], np.inf)
+        return _via_landmarks(self.graph, cell, bound, self.leg[which, q, c])
 
 
 def cost_to_go_to_cells(graph: RegionGraph, state: int, final: FloatArray) -> CostToGo:
