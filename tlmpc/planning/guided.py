@@ -87,14 +87,15 @@ class _Arrays:
 
     def meet(self, nodes: IntArray) -> BoolArray:
         """Mark ``nodes`` met, unreached and unqueued where they were not met before; returns
-        which of ``nodes`` were not (their bound is still to be written)."""
+        which of ``nodes`` were not (their bound is still to be written).  ``pred`` and
+        ``via`` are left as they are: the first offer to an unreached node writes both before
+        reading them (:func:`~tlmpc.planning.search.relax_offers`), and a source's are
+        written by the search that starts there."""
         fresh = ~self.seen[nodes]
         if fresh.any():
             new = nodes[fresh]
             self.seen[new] = True
             self.dist[new] = np.inf
-            self.pred[new] = -1
-            self.via[new] = np.inf
             self.queued[new] = False
             self.touched.append(new)
         return fresh
@@ -197,6 +198,8 @@ class GuidedSearch:
         finite = np.isfinite(estimate)
         sources, offsets = sources[finite], offsets[finite]
         arrays.dist[sources] = offsets
+        arrays.pred[sources] = -1
+        arrays.via[sources] = np.inf
         arrays.queued[sources] = True
         self.sources = sources
         weights = product.move_weight
