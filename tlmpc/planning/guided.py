@@ -291,7 +291,8 @@ class GuidedSearch:
         arrays.queued[fresh] = True
         self.reached += len(fresh)  # (every v was met by estimate_at above)
         # Every improved node goes in the bucket of its new f (queued ones too: theirs fell).
-        self._queue(improved, arrays.dist[improved] + self.estimate_at(improved))
+        # (Every improved node is one of v: met, its bound known.)
+        self._queue(improved, self._f(improved))
         return edges, improved
 
     def path(self, target: int) -> list[int]:
