@@ -279,16 +279,16 @@ class StackedCostToGo:
     @staticmethod
     def of(bounds: Sequence[CostToGo]) -> StackedCostToGo:
         """The bounds stacked (each with a ``final`` and ``reach``, over the same graph)."""
-        finals = [b.final for b in bounds]
-        reaches = [b.reach for b in bounds]
-        if any(f is None for f in finals) or any(r is None for r in reaches):
+        finals = [b.final for b in bounds if b.final is not None]
+        reaches = [b.reach for b in bounds if b.reach is not None]
+        if len(finals) < len(bounds) or len(reaches) < len(bounds):
             raise ValueError("only bounds to cells stack")
-        return StackedCostToGo(
-            graph=bounds[0].graph,
-            leg=np.stack([b.leg for b in bounds]),
-            final=np.stack(finals),  # type: ignore[arg-type]
-            reach=np.stack(reaches),  # type: ignore[arg-type]
-        )
+        legs = [b.leg for b in bounds]
+        if len(bounds) == 1:  # views, not a copy of the per-cell array
+            return StackedCostToGo(
+                bounds[0].graph, legs[0][None], finals[0][None], reaches[0][None]
+            )
+        return StackedCostToGo(bounds[0].graph, np.stack(legs), np.stack(finals), np.stack(reaches))
 
     def __call__(self, which: IntArray, nodes: IntArray) -> FloatArray:
         """The bound at each node by the ``which``-th bound."""
