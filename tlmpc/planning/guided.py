@@ -205,6 +205,7 @@ class GuidedSearch:
         weights = product.move_weight
         self.width = BUCKET_WIDTH * float(weights.mean()) if len(weights) else 1.0
         self.reached = len(sources)
+        self.rounds = 0  # steps taken (a round expands one bucket of every copy)
         self.queues = [_Buckets() for _ in range(copies if copy_size else 1)]
         self._queue(sources, offsets + estimate[finite])
 
@@ -260,6 +261,7 @@ class GuidedSearch:
         distance got shorter (queued again).  ``ceiling`` may be one per copy: then the
         bucket's nodes whose ``f`` reaches their copy's ceiling are dropped, not expanded."""
         arrays = self.arrays
+        self.rounds += 1
         buckets: list[IntArray] = []
         for queue in self.queues:
             nodes = queue.lowest(arrays.queued)
@@ -319,6 +321,7 @@ class GuidedLasso:
     searches: int
     optimal: bool
     reached: int
+    rounds: int  # the rounds of the prefix search and of the closing searches
 
 
 class _Bounds:
@@ -473,6 +476,7 @@ def guided_lasso(
     best: tuple[float, list[int], list[int]] | None = None
     candidates: list[tuple[float, int, int, float, float]] = []  # bound, u, v, w, g(u)
     searches = 0
+    rounds = 0  # of the closing searches
     capped = False
     for node in prefix.sources[product.stays_accepting(prefix.sources)].tolist():
         best = _better(best, (0.0, [node], [node]))
@@ -498,7 +502,8 @@ def guided_lasso(
             if closing_arrays is None or len(closing_arrays.dist) < needed:
                 closing_arrays = None  # released before the larger one is allocated
                 closing_arrays = _Arrays.of(needed)
-            results = _close_together(product, closing_arrays, groups, bounds)
+            results, closing_rounds = _close_together(product, closing_arrays, groups, bounds)
+            rounds += closing_rounds
             searches += len(groups.tails)
             for u, g, (back, back_path) in zip(groups.tails, groups.g, results, strict=True):
                 if back is None:
@@ -527,6 +532,7 @@ def guided_lasso(
         searches=searches,
         optimal=not capped,
         reached=prefix.reached,
+        rounds=prefix.rounds + rounds,
     )
 
 
@@ -620,10 +626,10 @@ def _next_groups(
 
 def _close_together(
     product: LazyProduct, arrays: _Arrays, groups: _Groups, bounds: _Bounds
-) -> list[tuple[float | None, list[int]]]:
+) -> tuple[list[tuple[float | None, list[int]]], int]:
     """Per group: the cheapest way from its tail ``u`` through one of its accepting edges
     back to ``u`` if it costs at most the group's limit, its cost and its nodes from the head
-    to ``u``; the searches share their rounds."""
+    to ``u``; the searches share their rounds (returned too)."""
     arrays.reset()
     size = product.num_nodes
     count = len(groups.tails)
@@ -653,7 +659,7 @@ def _close_together(
             found.append((None, []))
         else:
             found.append((distance, search.path(int(targets[k]))))
-    return found
+    return found, search.rounds
 
 
 def _others_limit(g: FloatArray, reached: FloatArray, beta: float) -> FloatArray:
