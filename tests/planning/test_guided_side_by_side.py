@@ -245,3 +245,28 @@ def test_guided_lasso_costs_the_built_products_one_by_one_or_after_waiting(
         mock.patch.object(guided, "LOOKAHEAD", lookahead),
     ):
         event(_costs_agree(mission, False))
+
+
+@pytest.mark.parametrize("spec", ["example1", "patrol", "far-cycle"])
+def test_a_guided_plan_counts_at_least_a_round_per_step_of_its_lasso(spec: str) -> None:
+    """A node at k edges from its search's sources is expanded in round k at the earliest:
+    the rounds are at least the lasso's steps (the prefix search's to the anchor, the closing
+    search's around the cycle; less one each for the sources)."""
+    from tlmpc.abstraction import build_abstraction
+    from tlmpc.planning.mission import automaton_for
+    from tlmpc.planning.plan import plan
+
+    mission = _load(spec)
+    abstraction = build_abstraction(mission)
+    witness = plan(
+        abstraction,
+        automaton_for(mission, abstraction),
+        formula=mission.formula,
+        options=mission.options,
+        start_point=mission.robot.start,
+        guided=True,
+    )
+    rounds = witness.stats["search_rounds"]
+    assert isinstance(rounds, int)
+    cycle = 0 if witness.is_stay else len(witness.cycle)
+    assert rounds >= len(witness.prefix) + cycle - 2
