@@ -34,5 +34,5 @@ def test_buckets_hold_each_node_under_its_key(batches: list[list[tuple[int, int]
         for node, key in batch:
             expected.setdefault(key, []).append(node)
     assert sorted(buckets.keys) == sorted(expected)
-    for key, nodes in expected.items():
-        assert np.concatenate(buckets.parts[key]).tolist() == nodes
+    for key, held in expected.items():
+        assert np.concatenate(buckets.parts[key]).tolist() == held
