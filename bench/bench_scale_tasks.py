@@ -6,10 +6,11 @@ the guided search (the product expanded on demand) and, where the product can be
 the built product, and prints a markdown table: the planning stage's CPU seconds
 (``time.process_time``; the median of ``--repeats`` runs), the process's peak RSS (mission
 loading and the mesh included), the plan's cost (which must agree between the two searches),
-the nodes the search reached and the closing searches it made.  ``--compile`` adds a row per
-workload for the whole ``tlmpc compile`` (every stage but the figure) in CPU seconds, and a
-second table with each stage's CPU seconds (medians); ``--compile-only`` measures the whole
-compile alone.
+the nodes the search reached, the closing searches it made and the guided search's rounds
+(steps of its bucket queues: a search along a long lasso takes about one per edge of it).
+``--compile`` adds a row per workload for the whole ``tlmpc compile`` (every stage but the
+figure) in CPU seconds, and a second table with each stage's CPU seconds (medians);
+``--compile-only`` measures the whole compile alone.
 
 ``--baseline DIR`` runs every measurement side by side with another tree of the project
 (its runs alternate with this tree's, each in a fresh interpreter started in that tree) and
@@ -60,6 +61,7 @@ print(json.dumps({
     "reached": witness.stats["product_reached"],
     "nodes": witness.stats["product_nodes"],
     "searches": witness.stats["cycle_searches"],
+    "rounds": witness.stats.get("search_rounds"),
     "optimal": witness.stats["optimal"],
     "plan": f"{len(witness.prefix)}+{len(witness.cycle)}",
 }))
@@ -168,6 +170,7 @@ def rows(
                         "product nodes": last["nodes"],
                         "reached": last["reached"],
                         "closing searches": last["searches"],
+                        "rounds": last["rounds"] if last["rounds"] is not None else "-",
                         "plan CPU s": _median(runs, "cpu"),
                         "peak MB": round(max(r["peak_mb"] for r in runs)),
                         "cost": f"{last['cost']:.6f}",
@@ -177,6 +180,7 @@ def rows(
                     if before:
                         row["reached before"] = before[-1]["reached"]
                         row["closing searches before"] = before[-1]["searches"]
+                        row["rounds before"] = before[-1].get("rounds") or "-"
                         row["plan CPU s before"] = _median(before, "cpu")
                         row["peak MB before"] = round(max(r["peak_mb"] for r in before))
                         row["cost before"] = f"{before[-1]['cost']:.6f}"

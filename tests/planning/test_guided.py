@@ -308,7 +308,7 @@ def test_guided_search_settles_nodes_at_dijkstras_distances(spec: str, guided: b
         search.step()
         rounds += 1
     assert rounds > 1
-    found = search.arrays.dist
+    found = search.arrays.distance(np.arange(lazy.num_nodes))
     hopeless = ~np.isfinite(bound(np.arange(lazy.num_nodes)))
     # Nodes the bound rules out are cut off, and so is whatever is reached only through them.
     check = ~hopeless & np.isfinite(found)

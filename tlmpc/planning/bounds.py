@@ -25,6 +25,7 @@ hold for whatever edge costs the product is given.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -32,7 +33,7 @@ import numpy as np
 from tlmpc.abstraction.model import FloatArray, IntArray
 from tlmpc.planning.lazy import LazyProduct
 from tlmpc.planning.product import SLOTS, BoolArray
-from tlmpc.planning.search import Graph, shortest_paths
+from tlmpc.planning.search import Graph
 
 #: Bounds are scaled down by this factor: the searches add the same weights in other orders,
 #: so a bound equal to the true cost could exceed it by a rounding error.
@@ -48,7 +49,7 @@ class RegionGraph:
     background: int  # local index of the background class
     landmarks: IntArray  # local indices of the landmarks
     cell_local: IntArray  # per cell: its triangle's local class (-1: not allowed)
-    distance: FloatArray  # (landmarks, cells): cost from the cell to entering the landmark
+    distance: FloatArray  # (cells, landmarks): cost from the cell to entering the landmark
     delta: FloatArray  # (local, local): region-to-region lower bound (0 from the background)
     entry: BoolArray  # per cell: entered from a triangle of another class (a boundary entry)
     delta_entry: FloatArray  # (local, local): as delta, from the entry cells of the region
@@ -59,7 +60,7 @@ class RegionGraph:
 
     def distance_to(self, cells: IntArray) -> FloatArray:
         """Per cell: the transition system's least cost from it to any of ``cells``."""
-        distance, _ = shortest_paths(self.backwards, cells)
+        distance: FloatArray = distances_to(self.backwards, [cells])[:, 0]
         return distance
 
     def region_minimum(self, per_cell: FloatArray, *, entered: bool = False) -> FloatArray:
@@ -108,8 +109,8 @@ def region_graph(product: LazyProduct, allowed_cells: BoolArray) -> RegionGraph:
     inside = _ClassCells(cell_local, landmarks, np.ones(cells, dtype=bool))
     entered = _ClassCells(cell_local, landmarks, entry)
     for index, landmark in enumerate(landmarks.tolist()):
-        delta[landmarks, landmark] = inside.least(distance[index])
-        delta_entry[landmarks, landmark] = entered.least(distance[index])
+        delta[landmarks, landmark] = inside.least(distance[:, index])
+        delta_entry[landmarks, landmark] = entered.least(distance[:, index])
     kind_local = local_of[product.kind_class]
     closure = np.zeros((count, nq, nq), dtype=bool)
     entering: list[tuple[int, IntArray, IntArray]] = []
@@ -189,15 +190,39 @@ def _reflexive_closure(step: BoolArray) -> BoolArray:
 
 
 def _landmark_distances(backwards: Graph, cell_local: IntArray, landmarks: IntArray) -> FloatArray:
-    """(landmarks, cells): the transition system's least cost from each cell to entering a
-    triangle of each landmark (entered cells, not the start slot), inf where unreachable."""
+    """(cells, landmarks): the transition system's least cost from each cell to entering a
+    triangle of each landmark (entered cells, not the start slot), inf where unreachable (a
+    cell's row is what a bound reads at once)."""
     cells = backwards.num_nodes
     entered = np.ones(cells, dtype=bool)
     entered[SLOTS - 1 :: SLOTS] = False
-    distance = np.empty((len(landmarks), cells))
-    for index, landmark in enumerate(landmarks.tolist()):
-        goal = np.flatnonzero(entered & (cell_local == landmark))
-        distance[index], _ = shortest_paths(backwards, goal)
+    goals = [np.flatnonzero(entered & (cell_local == landmark)) for landmark in landmarks.tolist()]
+    return distances_to(backwards, goals)
+
+
+def distances_to(graph: Graph, goals: Sequence[IntArray]) -> FloatArray:
+    """(nodes, goal sets): each node's distance in ``graph`` from the nearest node of each
+    of ``goals`` (inf where none is reached).
+
+    scipy's Dijkstra (compiled; imported here only, so that a compile whose product is built
+    loads no scipy): these are the distances :func:`~tlmpc.planning.search.shortest_paths`
+    gives, bit for bit (both are the unique solution of ``d(v) = min fl(d(u) + w)``, see
+    :mod:`tlmpc.planning.search`), in a fraction of its rounds' time on a large transition
+    system (the guided search's bounds are read from them)."""
+    from scipy.sparse import csr_matrix
+    from scipy.sparse.csgraph import dijkstra
+
+    n = graph.num_nodes
+    distance = np.full((n, len(goals)), np.inf)
+    if not n or not graph.nnz:
+        for index, goal in enumerate(goals):
+            distance[np.asarray(goal, dtype=np.int64), index] = 0.0
+        return distance
+    # Parallel edges stay as they are: Dijkstra relaxes each entry of a row.
+    matrix = csr_matrix((graph.weights, graph.targets, graph.indptr), shape=(n, n))
+    for index, goal in enumerate(goals):
+        if len(goal):
+            distance[:, index] = dijkstra(matrix, indices=goal, min_only=True)
     return distance
 
 
@@ -243,17 +268,58 @@ class CostToGo:
             bound = np.where(self.reach[q, c], self.final[cell], np.inf)
         else:
             bound = self.free[q, c]
-        if len(self.graph.landmarks):
-            via = self.graph.distance[:, cell].T + self.leg[q, c]
-            bound = np.minimum(bound, via.min(axis=1))
-        result: FloatArray = bound * SAFETY
-        return result
+        return _via_landmarks(self.graph, cell, bound, self.leg[q, c])
 
     def at_region(self, q: int, c: int, *, entered: bool = False) -> float:
         """The bound at the region-level node ``(q, c)``: anywhere in ``c`` or the
         background with ``c`` the last landmark, or with ``entered`` right after entering
         landmark ``c`` (in one of its boundary entry cells)."""
         return float(self.value[q, c] if entered else self.anywhere[q, c])
+
+
+def _via_landmarks(
+    graph: RegionGraph, cell: IntArray, bound: FloatArray, leg: FloatArray
+) -> FloatArray:
+    """``bound`` lowered to the way through the next landmark entered (``leg``: per node,
+    the cost after entering each landmark), scaled by :data:`SAFETY`."""
+    if len(graph.landmarks):
+        bound = np.minimum(bound, (graph.distance[cell] + leg).min(axis=1))
+    result: FloatArray = bound * SAFETY
+    return result
+
+
+@dataclass(frozen=True, slots=True)
+class StackedCostToGo:
+    """Several :class:`CostToGo` to cells (:func:`cost_to_go_to_cells`) of one graph, each
+    node bounded by its own one's: the same values as calling each on its nodes, in one
+    pass over all of them (searches side by side bound their nodes at once)."""
+
+    graph: RegionGraph
+    leg: FloatArray  # (K, Q, local, landmarks)
+    final: FloatArray  # (K, cells)
+    reach: BoolArray  # (K, Q, local)
+
+    @staticmethod
+    def of(bounds: Sequence[CostToGo]) -> StackedCostToGo:
+        """The bounds stacked (each with a ``final`` and ``reach``, over the same graph)."""
+        finals = [b.final for b in bounds if b.final is not None]
+        reaches = [b.reach for b in bounds if b.reach is not None]
+        if len(finals) < len(bounds) or len(reaches) < len(bounds):
+            raise ValueError("only bounds to cells stack")
+        legs = [b.leg for b in bounds]
+        if len(bounds) == 1:  # views, not a copy of the per-cell array
+            return StackedCostToGo(
+                bounds[0].graph, legs[0][None], finals[0][None], reaches[0][None]
+            )
+        return StackedCostToGo(bounds[0].graph, np.stack(legs), np.stack(finals), np.stack(reaches))
+
+    def __call__(self, which: IntArray, nodes: IntArray) -> FloatArray:
+        """The bound at each node by the ``which``-th bound."""
+        nq = self.graph.num_states
+        cell, q = nodes // nq, nodes % nq
+        c = self.graph.cell_local[cell]
+        bound = np.where(self.reach[which, q, c], self.final[which, cell], np.inf)
+        return _via_landmarks(self.graph, cell, bound, self.leg[which, q, c])
 
 
 def cost_to_go_to_cells(graph: RegionGraph, state: int, final: FloatArray) -> CostToGo:
@@ -321,19 +387,20 @@ def _closure_min(closure: BoolArray, terminal: FloatArray) -> FloatArray:
     return result
 
 
-#: Elements of the temporary array :func:`_masked_min` fills at once.
-_MASKED_CHUNK = 1 << 22
-
-
 def _masked_min(reach: BoolArray, cost: FloatArray) -> FloatArray:
     """(Q, local, landmarks): per state q, class c and landmark l, the least ``cost[l, q']``
-    over the ``q'`` that ``reach[c, q]`` holds (landmarks a chunk at a time)."""
+    over the ``q'`` that ``reach[c, q]`` holds.
+
+    A running minimum over the ``q'`` (those with a finite cost only): each adds its column
+    to a 0 / inf mask of the (c, q) that reach it, so the temporary is as large as the result
+    and each pass reads contiguous memory (a minimum over the last axis of a
+    (landmarks, local, Q, Q) array was three times slower)."""
     landmarks, nq = cost.shape
     count = reach.shape[0]
-    result = np.full((nq, count, landmarks), np.inf)
-    chunk = max(1, _MASKED_CHUNK // max(1, count * nq * nq))
-    for first in range(0, landmarks, chunk):
-        part = cost[first : first + chunk]  # (chunk, Q)
-        least = np.where(reach[None], part[:, None, None, :], np.inf).min(axis=3)
-        result[:, :, first : first + chunk] = least.transpose(2, 1, 0)
+    least = np.full((landmarks, count, nq), np.inf)
+    columns = cost.T  # (Q', landmarks)
+    for q_next in np.flatnonzero(np.isfinite(columns).any(axis=1)).tolist():
+        mask = np.where(reach[:, :, q_next], 0.0, np.inf)  # (local, Q)
+        np.minimum(least, mask[None] + columns[q_next][:, None, None], out=least)
+    result: FloatArray = np.ascontiguousarray(least.transpose(2, 1, 0))
     return result

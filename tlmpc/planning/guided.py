@@ -36,6 +36,7 @@ from tlmpc.base.pages import plain_pages
 from tlmpc.planning.bounds import (
     CostToGo,
     RegionGraph,
+    StackedCostToGo,
     cost_to_go,
     cost_to_go_to_cells,
     region_graph,
@@ -47,44 +48,126 @@ from tlmpc.planning.search import BUCKET_WIDTH, relax_offers
 Bound = Callable[[IntArray], FloatArray]
 
 #: Closing searches run side by side up to this many product nodes in all (their arrays,
-#: about 30 bytes a node, are written whole when allocated: on a product of millions of
-#: nodes that costs more than the rounds the searches would share, so they run one by one).
-CLOSING_NODES = 4_000_000
+#: about 30 bytes a node, are written only where a search meets a node: the pages of the
+#: others are never written, so a copy costs about what its search reaches).
+CLOSING_NODES = 40_000_000
+#: A candidate due to be closed waits until the prefix search's ``f`` has passed its bound by
+#: this fraction (or the incumbent, or a group is full): the candidates of one anchor region
+#: have bounds that close together, and searches side by side cost the rounds of one.
+LOOKAHEAD = 1e-3
 
 
 @dataclass(slots=True)
 class _Arrays:
-    """A search's per-node arrays, reset where touched so that one set serves many."""
+    """A search's per-node arrays, valid where ``seen`` holds: a node's entries are written
+    when the search first meets it (:meth:`meet`), so that one set serves many searches and
+    the pages of nodes never met are never written (nor, on most systems, even mapped)."""
 
+    seen: BoolArray
     dist: FloatArray
     pred: IntArray
     via: FloatArray
     queued: BoolArray
-    estimate: npt.NDArray[np.float32]  # the bound at each node met (nan: not computed)
+    estimate: npt.NDArray[np.float32]  # the bound at each node met
     touched: list[IntArray] = field(default_factory=list)
 
     @staticmethod
     def of(size: int) -> _Arrays:
-        """Fresh arrays for ``size`` nodes (written whole here: on plain pages, see
-        :mod:`tlmpc.base.pages`)."""
+        """Arrays for ``size`` nodes, none met yet (only ``seen`` is written, with zeros: on
+        plain pages, see :mod:`tlmpc.base.pages`; the others are written per node met)."""
         with plain_pages():
             return _Arrays(
-                dist=np.full(size, np.inf),
-                pred=np.full(size, -1, dtype=np.int64),
-                via=np.full(size, np.inf),
+                seen=np.zeros(size, dtype=bool),
+                dist=np.empty(size),
+                pred=np.empty(size, dtype=np.int64),
+                via=np.empty(size),
                 queued=np.zeros(size, dtype=bool),
-                estimate=np.full(size, np.nan, dtype=np.float32),
+                estimate=np.empty(size, dtype=np.float32),
             )
 
+    def meet(self, nodes: IntArray) -> BoolArray:
+        """Mark ``nodes`` met, unreached and unqueued where they were not met before; returns
+        which of ``nodes`` were not (their bound is still to be written).  ``pred`` and
+        ``via`` are left as they are: the first offer to an unreached node writes both before
+        reading them (:func:`~tlmpc.planning.search.relax_offers`), and a source's are
+        written by the search that starts there."""
+        fresh = ~self.seen[nodes]
+        if fresh.any():
+            new = nodes[fresh]
+            self.seen[new] = True
+            self.dist[new] = np.inf
+            self.queued[new] = False
+            self.touched.append(new)
+        return fresh
+
+    def distance(self, nodes: IntArray) -> FloatArray:
+        """The tentative distance of each of ``nodes`` (inf for a node never met)."""
+        found: FloatArray = np.where(self.seen[nodes], self.dist[nodes], np.inf)
+        return found
+
     def reset(self) -> None:
-        """Back to unreached everywhere (only the touched nodes are written)."""
+        """Back to no node met (only the touched nodes are written)."""
         for nodes in self.touched:
-            self.dist[nodes] = np.inf
-            self.pred[nodes] = -1
-            self.via[nodes] = np.inf
-            self.queued[nodes] = False
-            self.estimate[nodes] = np.nan
+            self.seen[nodes] = False
         self.touched = []
+
+
+def _runs(labels: IntArray) -> list[tuple[int, IntArray]]:
+    """(label, the positions holding it, in their order) per distinct label, ascending: a
+    stable sort and its runs (cheaper than numpy's unique and one pass per label, on the few
+    hundred items of a round)."""
+    if not len(labels):
+        return []
+    order = np.argsort(labels, kind="stable")
+    ordered = labels[order]
+    cuts = (np.flatnonzero(ordered[1:] != ordered[:-1]) + 1).tolist()
+    starts, ends = [0, *cuts], [*cuts, len(order)]
+    firsts = ordered[starts].tolist()
+    return [(first, order[a:b]) for first, a, b in zip(firsts, starts, ends, strict=True)]
+
+
+class _Buckets:
+    """One search's queued nodes by bucket key (``f`` in ``[k w, (k + 1) w)``), maybe stale:
+    a node no longer queued, or queued again in another bucket, is skipped when read."""
+
+    __slots__ = ("floor", "keys", "parts")
+
+    def __init__(self) -> None:
+        self.parts: dict[int, list[IntArray]] = {}  # key -> queued nodes
+        self.keys: list[int] = []  # a heap of the keys
+        self.floor = 0  # the key of the bucket expanded last
+
+    def add(self, nodes: IntArray, keys: IntArray) -> None:
+        """Put ``nodes`` in the buckets ``keys`` (raised to the floor: never below the bucket
+        being expanded)."""
+        keys = np.maximum(keys, self.floor)
+        low, high = int(keys.min()), int(keys.max())
+        runs = [(low, nodes)] if low == high else [(k, nodes[at]) for k, at in _runs(keys)]
+        for key, mine in runs:
+            if key in self.parts:
+                self.parts[key].append(mine)
+            else:
+                self.parts[key] = [mine]
+                heapq.heappush(self.keys, key)
+
+    def lowest(self, queued: BoolArray) -> IntArray | None:
+        """The queued nodes of the lowest bucket that has any (None: nothing queued)."""
+        while self.keys:
+            key = self.keys[0]
+            parts = self.parts[key]
+            nodes = parts[0] if len(parts) == 1 else np.unique(np.concatenate(parts))
+            nodes = nodes[queued[nodes]]
+            if len(nodes):
+                self.parts[key] = [nodes]
+                return nodes
+            del self.parts[key]
+            heapq.heappop(self.keys)
+        return None
+
+    def pop(self) -> None:
+        """Drop the lowest bucket (:meth:`lowest` found it) and make it the floor."""
+        self.floor = heapq.heappop(self.keys)
+        del self.parts[self.floor]
 
 
 class GuidedSearch:
@@ -101,6 +184,11 @@ class GuidedSearch:
     whose distance got shorter is queued again in its new bucket (never below the bucket
     being expanded); the entry it had is skipped when its bucket comes (the node is no
     longer queued, or was queued again and is expanded at most once more).
+
+    Searches side by side (``copy_size``, with ``copies`` of the node numbers) keep a
+    bucket queue each, and a round expands every copy's lowest bucket: each copy goes in the
+    order of its own ``f`` (its ``f`` values may lie far from the others'), and the copies
+    share the rounds all the same.
     """
 
     def __init__(
@@ -111,6 +199,7 @@ class GuidedSearch:
         bound: Bound,
         offsets: FloatArray | None = None,
         copy_size: int = 0,
+        copies: int = 1,
     ) -> None:
         self.product = product
         self.arrays = arrays
@@ -123,80 +212,85 @@ class GuidedSearch:
         finite = np.isfinite(estimate)
         sources, offsets = sources[finite], offsets[finite]
         arrays.dist[sources] = offsets
+        arrays.pred[sources] = -1
+        arrays.via[sources] = np.inf
         arrays.queued[sources] = True
-        arrays.touched.append(sources)
         self.sources = sources
         weights = product.move_weight
         self.width = BUCKET_WIDTH * float(weights.mean()) if len(weights) else 1.0
         self.reached = len(sources)
-        self.buckets: dict[int, list[IntArray]] = {}  # key -> queued nodes (maybe stale)
-        self.keys: list[int] = []  # a heap of the buckets' keys
-        self.floor = 0  # the key of the bucket expanded last
+        self.rounds = 0  # steps taken (a round expands one bucket of every copy)
+        self.queues = [_Buckets() for _ in range(copies if copy_size else 1)]
         self._queue(sources, offsets + estimate[finite])
 
     def estimate_at(self, nodes: IntArray) -> FloatArray:
         """The bound at ``nodes``, computed once per node (kept in single precision,
         rounded down so that it stays a lower bound)."""
-        known = self.arrays.estimate[nodes]
-        unknown = np.isnan(known)
+        unknown = self.arrays.meet(nodes)
         if unknown.any():
             fresh = nodes[unknown]
             exact = self.bound(fresh) * (1.0 - 1e-6)
-            known[unknown] = exact.astype(np.float32)
-            self.arrays.estimate[fresh] = known[unknown]
-            self.arrays.touched.append(fresh)
-        return known.astype(np.float64)
+            self.arrays.estimate[fresh] = exact.astype(np.float32)
+        return self.arrays.estimate[nodes].astype(np.float64)
 
     def _queue(self, nodes: IntArray, f: FloatArray) -> None:
         """Put ``nodes`` (distinct, finite ``f``) in their buckets."""
         if not len(nodes):
             return
-        keys = np.maximum((f / self.width).astype(np.int64), self.floor)
-        low, high = int(keys.min()), int(keys.max())
-        for key in [low] if low == high else np.unique(keys).tolist():
-            mine = nodes if low == high else nodes[keys == key]
-            if key in self.buckets:
-                self.buckets[key].append(mine)
-            else:
-                self.buckets[key] = [mine]
-                heapq.heappush(self.keys, key)
+        keys = (f / self.width).astype(np.int64)
+        if len(self.queues) == 1:
+            self.queues[0].add(nodes, keys)
+            return
+        copy = nodes // self.copy_size
+        low, high = int(copy.min()), int(copy.max())
+        if low == high:
+            self.queues[low].add(nodes, keys)
+            return
+        for k, mine in _runs(copy):
+            self.queues[k].add(nodes[mine], keys[mine])
 
-    def _lowest_bucket(self) -> IntArray | None:
-        """The queued nodes of the lowest bucket that has any (None: nothing queued)."""
-        while self.keys:
-            key = self.keys[0]
-            parts = self.buckets[key]
-            nodes = parts[0] if len(parts) == 1 else np.unique(np.concatenate(parts))
-            nodes = nodes[self.arrays.queued[nodes]]
-            if len(nodes):
-                self.buckets[key] = [nodes]
-                return nodes
-            del self.buckets[key]
-            heapq.heappop(self.keys)
-        return None
+    def _f(self, nodes: IntArray) -> FloatArray:
+        f: FloatArray = self.arrays.dist[nodes] + self.arrays.estimate[nodes]
+        return f
 
     def lowest(self) -> float:
-        """The least ``f`` of a queued node (inf when none is)."""
-        nodes = self._lowest_bucket()
-        if nodes is None:
-            return np.inf
-        return float((self.arrays.dist[nodes] + self.arrays.estimate[nodes]).min())
+        """The least ``f`` of a queued node in the lowest buckets (inf when none is queued;
+        searches side by side: the least over the copies)."""
+        least = np.inf
+        for queue in self.queues:
+            nodes = queue.lowest(self.arrays.queued)
+            if nodes is not None:
+                least = min(least, float(self._f(nodes).min()))
+        return least
+
+    def exhausted(self, ceilings: FloatArray) -> bool:
+        """Whether no copy has a node in its lowest bucket whose ``f`` is below the copy's
+        ceiling (then none has any: the copy's other buckets lie higher)."""
+        for k, queue in enumerate(self.queues):
+            nodes = queue.lowest(self.arrays.queued)
+            if nodes is not None and float(self._f(nodes).min()) < ceilings[k]:
+                return False
+        return True
 
     def step(self, ceiling: float | FloatArray = np.inf) -> tuple[Edges, IntArray]:
-        """Expand the lowest bucket; returns its edges and the nodes whose distance got
-        shorter (queued again).  ``ceiling`` may be one per copy: then the bucket's nodes
-        whose ``f`` reaches their copy's ceiling are dropped, not expanded."""
+        """Expand the lowest bucket (of every copy); returns its edges and the nodes whose
+        distance got shorter (queued again).  ``ceiling`` may be one per copy: then the
+        bucket's nodes whose ``f`` reaches their copy's ceiling are dropped, not expanded."""
         arrays = self.arrays
-        active = self._lowest_bucket()
-        if active is None:
+        self.rounds += 1
+        buckets: list[IntArray] = []
+        for queue in self.queues:
+            nodes = queue.lowest(arrays.queued)
+            if nodes is not None:
+                queue.pop()
+                buckets.append(nodes)
+        if not buckets:
             active = np.zeros(0, dtype=np.int64)
         else:
-            self.floor = heapq.heappop(self.keys)
-            del self.buckets[self.floor]
+            active = buckets[0] if len(buckets) == 1 else np.concatenate(buckets)
         arrays.queued[active] = False
         if isinstance(ceiling, np.ndarray):
-            f = arrays.dist[active] + arrays.estimate[active]
-            active = active[f < ceiling[active // self.copy_size]]
+            active = active[self._f(active) < ceiling[active // self.copy_size]]
         if self.copy_size:
             local = active % self.copy_size
             edges = self.product.expand(local, base=active - local)
@@ -213,9 +307,10 @@ class GuidedSearch:
         )
         fresh = improved[~arrays.queued[improved]]
         arrays.queued[fresh] = True
-        self.reached += len(fresh)  # (estimate_at recorded them for the reset: every v was)
+        self.reached += len(fresh)  # (every v was met by estimate_at above)
         # Every improved node goes in the bucket of its new f (queued ones too: theirs fell).
-        self._queue(improved, arrays.dist[improved] + self.estimate_at(improved))
+        # (Every improved node is one of v: met, its bound known.)
+        self._queue(improved, self._f(improved))
         return edges, improved
 
     def path(self, target: int) -> list[int]:
@@ -242,6 +337,7 @@ class GuidedLasso:
     searches: int
     optimal: bool
     reached: int
+    rounds: int  # the rounds of the prefix search and of the closing searches
 
 
 class _Bounds:
@@ -255,6 +351,7 @@ class _Bounds:
         self.cell_distance: dict[int, FloatArray] = {}
         self.to_cell: dict[tuple[int, int], CostToGo] = {}
         self.arounds: dict[tuple[int, int], CostToGo] = {}
+        self.single: dict[int, Bound] = {}
         nq = graph.num_states
         stays = product.stutter_accepts[graph.classes].T  # (Q, local)
         stay = np.where(stays | stays[:, [graph.background]], 0.0, np.inf)
@@ -276,7 +373,8 @@ class _Bounds:
         key = (q, landmark)
         if key not in self.arounds:
             index = int(np.flatnonzero(self.graph.landmarks == landmark)[0])
-            self.arounds[key] = cost_to_go_to_cells(self.graph, q, self.graph.distance[index])
+            final = np.ascontiguousarray(self.graph.distance[:, index])
+            self.arounds[key] = cost_to_go_to_cells(self.graph, q, final)
         return self.arounds[key]
 
     def _accepting_terminal(self, nq: int) -> tuple[FloatArray, FloatArray]:
@@ -334,9 +432,8 @@ class _Bounds:
                             entered_terminal[q, c] = min(entered_terminal[q, c], cost)
         return terminal, entered_terminal
 
-    def closing(self, target: int) -> Bound:
-        """A bound on the cost from any node to the node ``target``: the region-level one
-        to its state and then its cell, and the straight line to its cell's position."""
+    def _to(self, target: int) -> CostToGo:
+        """The region-level bound to the node ``target``'s state and then its cell."""
         nq = self.product.num_states
         cell, state = target // nq, target % nq
         if (cell, state) not in self.to_cell:
@@ -345,15 +442,30 @@ class _Bounds:
             self.to_cell[cell, state] = cost_to_go_to_cells(
                 self.graph, state, self.cell_distance[cell]
             )
-        back = self.to_cell[cell, state]
+        return self.to_cell[cell, state]
+
+    def closing(self, target: int) -> Bound:
+        """A bound on the cost from any node to the node ``target``: the region-level one
+        to its state and then its cell, and the straight line to its cell's position."""
+        if target not in self.single:
+            self.single[target] = self.closings([target], self.product.num_nodes)
+        return self.single[target]
+
+    def closings(self, targets: list[int], size: int) -> Bound:
+        """:meth:`closing` of each of ``targets`` at once: node ``n`` is node ``n % size``
+        bounded by the closing bound of ``targets[n // size]`` (searches side by side)."""
+        nq = self.product.num_states
+        back = StackedCostToGo.of([self._to(target) for target in targets])
         position = self.product.position
-        goal = position[target // nq]
-        scale = self.graph.scale
+        goal = position[np.array(targets, dtype=np.int64) // nq]
+        scale = self.graph.scale * (1.0 - 1e-9)
 
         def bound(nodes: IntArray) -> FloatArray:
-            offset = position[nodes // nq] - goal
+            which = nodes // size
+            cell_nodes = nodes - which * size
+            offset = position[cell_nodes // nq] - goal[which]
             straight = np.sqrt(offset[:, 0] * offset[:, 0] + offset[:, 1] * offset[:, 1])
-            result: FloatArray = np.maximum(back(nodes), straight * (scale * (1.0 - 1e-9)))
+            result: FloatArray = np.maximum(back(which, cell_nodes), straight * scale)
             return result
 
         return bound
@@ -380,13 +492,19 @@ def guided_lasso(
     best: tuple[float, list[int], list[int]] | None = None
     candidates: list[tuple[float, int, int, float, float]] = []  # bound, u, v, w, g(u)
     searches = 0
+    rounds = 0  # of the closing searches
     capped = False
     for node in prefix.sources[product.stays_accepting(prefix.sources)].tolist():
         best = _better(best, (0.0, [node], [node]))
     while True:
         incumbent = best[0] if best is not None else np.inf
         f = prefix.lowest()
-        if candidates and candidates[0][0] < min(f, incumbent):
+        due = bool(candidates) and candidates[0][0] < min(f, incumbent)
+        if due and width > 1 and f < min(incumbent, candidates[0][0] * (1.0 + LOOKAHEAD)):
+            # The prefix search goes on a little (the candidates met meanwhile close in the
+            # same group: searches side by side share their rounds), unless a group is full.
+            due = _due_tails(candidates, f, width) >= width
+        if due:
             if searches >= max_searches and best is not None:
                 capped = True
                 break
@@ -400,7 +518,8 @@ def guided_lasso(
             if closing_arrays is None or len(closing_arrays.dist) < needed:
                 closing_arrays = None  # released before the larger one is allocated
                 closing_arrays = _Arrays.of(needed)
-            results = _close_together(product, closing_arrays, groups, bounds)
+            results, closing_rounds = _close_together(product, closing_arrays, groups, bounds)
+            rounds += closing_rounds
             searches += len(groups.tails)
             for u, g, (back, back_path) in zip(groups.tails, groups.g, results, strict=True):
                 if back is None:
@@ -429,6 +548,7 @@ def guided_lasso(
         searches=searches,
         optimal=not capped,
         reached=prefix.reached,
+        rounds=prefix.rounds + rounds,
     )
 
 
@@ -453,6 +573,19 @@ def _candidates(
             if estimate < incumbent:
                 found.append((estimate, tail, head, weight, g))
     return found
+
+
+def _due_tails(candidates: list[tuple[float, int, int, float, float]], f: float, most: int) -> int:
+    """How many distinct (tail, g) pairs the candidates whose bound is below ``f`` have,
+    counted up to ``most`` (the heap is walked from its root through those alone)."""
+    tails: set[tuple[int, float]] = set()
+    stack = [0]
+    while stack and len(tails) < most:
+        at = stack.pop()
+        if at < len(candidates) and candidates[at][0] < f:
+            tails.add((candidates[at][1], candidates[at][4]))
+            stack.extend((2 * at + 1, 2 * at + 2))
+    return len(tails)
 
 
 def _better(
@@ -509,10 +642,10 @@ def _next_groups(
 
 def _close_together(
     product: LazyProduct, arrays: _Arrays, groups: _Groups, bounds: _Bounds
-) -> list[tuple[float | None, list[int]]]:
+) -> tuple[list[tuple[float | None, list[int]]], int]:
     """Per group: the cheapest way from its tail ``u`` through one of its accepting edges
     back to ``u`` if it costs at most the group's limit, its cost and its nodes from the head
-    to ``u``; the searches share their rounds."""
+    to ``u``; the searches share their rounds (returned too)."""
     arrays.reset()
     size = product.num_nodes
     count = len(groups.tails)
@@ -521,27 +654,40 @@ def _close_together(
     offsets = np.concatenate(groups.weights)
     targets = np.array(groups.tails, dtype=np.int64) + base
     limits = np.array(groups.limits)
-    own = [bounds.closing(u) for u in groups.tails]
-
-    def bound(nodes: IntArray) -> FloatArray:
-        copy = nodes // size
-        result = np.empty(len(nodes))
-        for k in np.unique(copy).tolist():
-            mine = copy == k
-            result[mine] = own[k](nodes[mine] - k * size)
-        return result
-
-    search = GuidedSearch(product, arrays, sources, bound, offsets=offsets, copy_size=size)
+    bound = bounds.closings(groups.tails, size)
+    search = GuidedSearch(
+        product, arrays, sources, bound, offsets=offsets, copy_size=size, copies=count
+    )
+    g = np.array(groups.g)
     while True:
-        ceilings = np.minimum(arrays.dist[targets], limits)
-        if search.lowest() >= float(ceilings.max()):
+        reached = arrays.distance(targets)
+        limits = np.minimum(limits, _others_limit(g, reached, bounds.beta))
+        ceilings = np.minimum(reached, limits)
+        if search.exhausted(ceilings):
             break
         search.step(ceiling=ceilings)
     found: list[tuple[float | None, list[int]]] = []
+    reached = arrays.distance(targets)
+    limits = np.minimum(limits, _others_limit(g, reached, bounds.beta))
     for k in range(count):
-        distance = float(arrays.dist[targets[k]])
+        distance = float(reached[k])
         if not np.isfinite(distance) or distance > limits[k]:
             found.append((None, []))
         else:
             found.append((distance, search.path(int(targets[k]))))
-    return found
+    return found, search.rounds
+
+
+def _others_limit(g: FloatArray, reached: FloatArray, beta: float) -> FloatArray:
+    """Per copy: the cycle cost past which its lasso cannot beat another copy's lasso found
+    so far (``g + beta * reached``, a real lasso's cost once its tail is reached), with a
+    little room so that rounding never cuts a copy whose lasso ties with the best: a copy's
+    own lasso never limits it."""
+    totals = g + beta * reached
+    if len(totals) < 2:
+        return np.full(len(totals), np.inf)
+    order = np.argsort(totals, kind="stable")
+    others = np.full(len(totals), totals[order[0]])
+    others[order[0]] = totals[order[1]]  # the best copy's: the second best
+    limit: FloatArray = (others - g) / max(beta, 1e-12)
+    return limit + 1e-9 * (1.0 + np.abs(limit))

@@ -196,7 +196,7 @@ def plan(
             found.optimal,
             working,
             found.reached,
-            {"product_nodes": lazy.num_nodes, "search": "guided"},
+            {"product_nodes": lazy.num_nodes, "search": "guided", "search_rounds": found.rounds},
         )
     product = build_product(
         abstraction,
