@@ -33,7 +33,7 @@ import numpy as np
 from tlmpc.abstraction.model import FloatArray, IntArray
 from tlmpc.planning.lazy import LazyProduct
 from tlmpc.planning.product import SLOTS, BoolArray
-from tlmpc.planning.search import Graph
+from tlmpc.planning.search import Graph, shortest_paths
 
 #: Bounds are scaled down by this factor: the searches add the same weights in other orders,
 #: so a bound equal to the true cost could exceed it by a rounding error.
@@ -60,7 +60,7 @@ class RegionGraph:
 
     def distance_to(self, cells: IntArray) -> FloatArray:
         """Per cell: the transition system's least cost from it to any of ``cells``."""
-        distance: FloatArray = distances_to(self.backwards, [cells])[:, 0]
+        distance, _ = shortest_paths(self.backwards, cells)
         return distance
 
     def region_minimum(self, per_cell: FloatArray, *, entered: bool = False) -> FloatArray:
@@ -196,33 +196,10 @@ def _landmark_distances(backwards: Graph, cell_local: IntArray, landmarks: IntAr
     cells = backwards.num_nodes
     entered = np.ones(cells, dtype=bool)
     entered[SLOTS - 1 :: SLOTS] = False
-    goals = [np.flatnonzero(entered & (cell_local == landmark)) for landmark in landmarks.tolist()]
-    return distances_to(backwards, goals)
-
-
-def distances_to(graph: Graph, goals: Sequence[IntArray]) -> FloatArray:
-    """(nodes, goal sets): each node's distance in ``graph`` from the nearest node of each
-    of ``goals`` (inf where none is reached).
-
-    scipy's Dijkstra (compiled; imported here only, so that a compile whose product is built
-    loads no scipy): these are the distances :func:`~tlmpc.planning.search.shortest_paths`
-    gives, bit for bit (both are the unique solution of ``d(v) = min fl(d(u) + w)``, see
-    :mod:`tlmpc.planning.search`), in a fraction of its rounds' time on a large transition
-    system (the guided search's bounds are read from them)."""
-    from scipy.sparse import csr_matrix
-    from scipy.sparse.csgraph import dijkstra
-
-    n = graph.num_nodes
-    distance = np.full((n, len(goals)), np.inf)
-    if not n or not graph.nnz:
-        for index, goal in enumerate(goals):
-            distance[np.asarray(goal, dtype=np.int64), index] = 0.0
-        return distance
-    # Parallel edges stay as they are: Dijkstra relaxes each entry of a row.
-    matrix = csr_matrix((graph.weights, graph.targets, graph.indptr), shape=(n, n))
-    for index, goal in enumerate(goals):
-        if len(goal):
-            distance[:, index] = dijkstra(matrix, indices=goal, min_only=True)
+    distance = np.empty((cells, len(landmarks)))
+    for index, landmark in enumerate(landmarks.tolist()):
+        goal = np.flatnonzero(entered & (cell_local == landmark))
+        distance[:, index], _ = shortest_paths(backwards, goal)
     return distance
 
 
