@@ -11,6 +11,7 @@ result may depend on the machine's speed or load.
 from __future__ import annotations
 
 import os
+import signal
 import sys
 from pathlib import Path
 
@@ -50,6 +51,12 @@ def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line(
         "markers", f"{MISSING_MARK}(what): the test's oracle is missing in CI (fails the test)"
     )
+    # A suite started in the background (`cmd &` in a script) inherits Ctrl-C ignored, and so
+    # would every command the tests start (tlmpc keeps a signal ignored by whoever started
+    # it): the tests of Ctrl-C model a user at a terminal.  A handler does not survive exec,
+    # so the commands start with the default disposition again.
+    if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 def pytest_runtest_setup(item: pytest.Item) -> None:
