@@ -217,9 +217,20 @@ def _describe(
             ]
         from jsonschema.exceptions import best_match
 
-        deepest = best_match(err.context)
-        if deepest is not None and not isinstance(err.instance, list | dict):
-            deepest = err
+        # The shape's kind is the value's own (a mapping with `rect`, or a list of points):
+        # the problems of that kind's branch say what is wrong with it; a value of neither
+        # kind ({polygon: [...]}, a number) is told what a shape is.
+        branches: list[Any] = schema_any.get("anyOf", [])
+        kind = "rect" if isinstance(err.instance, dict) and "rect" in err.instance else None
+        if isinstance(err.instance, list):
+            kind = "pointList"
+        own = [
+            e
+            for e in err.context
+            if kind is not None
+            and str(branches[int(e.relative_schema_path[0])].get("$ref", "")).endswith(kind)
+        ]
+        deepest = best_match(own) if own else err
         if deepest is not None and deepest is not err:
             return _describe(deepest, doc, file, prefix)
         line, col = doc.value_at(path)
