@@ -92,7 +92,7 @@ def product_graph(
     return graph, roots
 
 
-def _reach(graph: Edges, sources: list[Node], floor: float, *, reverse: bool) -> set[Node]:
+def reach(graph: Edges, sources: list[Node], floor: float, *, reverse: bool) -> set[Node]:
     """The nodes reached from (or, with ``reverse``, reaching) ``sources`` along edges of
     width >= ``floor`` (a plain depth-first search)."""
     if reverse:
@@ -116,7 +116,7 @@ def has_lasso(abstraction: Abstraction, graph: Edges, roots: list[Node], floor: 
     """By definition: an accepting edge u -> v with u reached from the start and v reaching
     u again, every step of width >= ``floor`` (a return that never leaves the cell is a stay,
     counted by the triangle's stay width), or an accepting stay."""
-    reached = _reach(graph, roots, floor, reverse=False)
+    reached = reach(graph, roots, floor, reverse=False)
     edges = [(u, v, data) for u, out in graph.items() for v, data in out.items()]
     for u, v, (width, accepting) in edges:
         if not accepting or u not in reached or width < floor:
@@ -126,10 +126,10 @@ def has_lasso(abstraction: Abstraction, graph: Edges, roots: list[Node], floor: 
             if stay_width(abstraction, u[0]) >= floor:
                 return True
             continue
-        back = _reach(graph, [v], floor, reverse=False)
+        back = reach(graph, [v], floor, reverse=False)
         if u not in back:
             continue
-        into_u = _reach(graph, [u], floor, reverse=True)
+        into_u = reach(graph, [u], floor, reverse=True)
         if any(node[:2] != cell for node in back & into_u):
             return True  # a cycle through u -> v that leaves the cell: it moves
         if v[:2] == cell and stay_width(abstraction, u[0]) >= floor:

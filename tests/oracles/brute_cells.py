@@ -28,6 +28,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
+from brute_bottleneck import reach
 from starts import start_triangles
 
 from tlmpc.abstraction.model import Abstraction
@@ -97,28 +98,10 @@ def product_graph(
     return graph, roots
 
 
-def _reach(graph: Edges, sources: list[Node], floor: float, *, reverse: bool) -> set[Node]:
-    if reverse:
-        flipped: Edges = {}
-        for node, out in graph.items():
-            for other, data in out.items():
-                flipped.setdefault(other, {})[node] = data
-        graph = flipped
-    seen = set(sources)
-    stack = list(sources)
-    while stack:
-        node = stack.pop()
-        for other, (width, _) in graph.get(node, {}).items():
-            if width >= floor and other not in seen:
-                seen.add(other)
-                stack.append(other)
-    return seen
-
-
 def has_lasso(cells: Cells, graph: Edges, roots: list[Node], floor: float) -> bool:
     """Whether some lasso of cell visits has every step at least ``floor`` wide (see the
     module doc)."""
-    reached = _reach(graph, roots, floor, reverse=False)
+    reached = reach(graph, roots, floor, reverse=False)
     for u, out in graph.items():
         if u not in reached:
             continue
@@ -130,10 +113,10 @@ def has_lasso(cells: Cells, graph: Edges, roots: list[Node], floor: float) -> bo
                 if stay:
                     return True
                 continue
-            back = _reach(graph, [v], floor, reverse=False)
+            back = reach(graph, [v], floor, reverse=False)
             if u not in back:
                 continue
-            on_cycles = back & _reach(graph, [u], floor, reverse=True)
+            on_cycles = back & reach(graph, [u], floor, reverse=True)
             if any(node[0] != u[0] for node in on_cycles):
                 return True  # a cycle through u -> v that leaves u's cell
             if stay:
