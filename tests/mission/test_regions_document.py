@@ -1,13 +1,17 @@
-"""The regions' document, built once per compile and shared by three artifacts."""
+"""The regions' document, built once per compile and shared by three artifacts (kept in the
+compilation's memo, tlmpc.base.memo)."""
 
 from __future__ import annotations
 
+import contextlib
 from pathlib import Path
 
+import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
 import tlmpc
+from tlmpc.base.memo import memo_scope
 from tlmpc.mission.load import load_mission
 from tlmpc.mission.model import Polygon, regions_document
 
@@ -27,6 +31,15 @@ def _definition(pairs: list[tuple[str, Polygon]]) -> dict[str, list[list[float]]
 
 @given(_PAIRS, _PAIRS, st.booleans())
 def test_the_document_is_always_that_of_the_regions_asked_for(
+    first: list[tuple[str, list[tuple[float, float]]]],
+    second: list[tuple[str, list[tuple[float, float]]]],
+    copies: bool,
+) -> None:
+    with memo_scope():
+        _same_polygons_same_document(first, second, copies)
+
+
+def _same_polygons_same_document(
     first: list[tuple[str, list[tuple[float, float]]]],
     second: list[tuple[str, list[tuple[float, float]]]],
     copies: bool,
@@ -64,7 +77,18 @@ def test_a_compile_shares_one_regions_document_among_its_artifacts() -> None:
     assert regions == _definition([(r.name, r.polygon) for r in mission.regions])
 
 
-def test_equal_polygons_of_other_signs_or_names_get_their_own_document() -> None:
+def test_outside_a_compilation_each_document_is_built_anew() -> None:
+    pairs: list[tuple[str, Polygon]] = [("a", ((0.0, 0.0), (1.0, 0.0), (0.0, 1.0)))]
+    assert regions_document(pairs) is not regions_document(pairs)
+
+
+@pytest.mark.parametrize("scoped", [False, True])
+def test_equal_polygons_of_other_signs_or_names_get_their_own_document(scoped: bool) -> None:
+    with memo_scope() if scoped else contextlib.nullcontext():
+        _signs_and_names()
+
+
+def _signs_and_names() -> None:
     square = ((0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0))
     signed = ((-0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0))
     assert square == signed  # equal for Python, not for JSON

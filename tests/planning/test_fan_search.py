@@ -75,24 +75,28 @@ def test_moves_of_one_shape_share_a_search_and_nothing_else() -> None:
 
 
 def test_a_partition_is_kept_per_mesh_object() -> None:
-    """The same mesh object gives the same partition; another mesh, even of equal content,
-    its own (kept by identity, never by a possibly reused id alone)."""
+    """Within one compilation's memo the same mesh object gives the same partition; another
+    mesh, even of equal content, its own (kept by identity, never by a possibly reused id
+    alone); outside a compilation each ask partitions anew."""
     from pathlib import Path
 
+    from tlmpc.base.memo import memo_scope
     from tlmpc.mission.body import requested_margin
     from tlmpc.mission.load import load_mission
-    from tlmpc.planning.cells import KEPT_PARTITIONS, partition
+    from tlmpc.planning.cells import PARTITIONS, partition
     from tlmpc.planning.mission import abstraction_for
 
     mission = load_mission(Path(__file__).resolve().parents[2] / "specs" / "example1.yaml")
     mesh = abstraction_for(mission, requested_margin(mission))
     other = abstraction_for(mission, requested_margin(mission))
-    first = partition(mesh)
-    assert partition(mesh) is first
-    assert partition(other) is not first
-    assert partition(other).abstraction is other
-    for _ in range(KEPT_PARTITIONS):
-        partition(abstraction_for(mission, requested_margin(mission)))
-    again = partition(mesh)  # pushed out by newer meshes: partitioned afresh, the same cells
-    assert again is not first
-    assert [c.triangles for c in again.cells] == [c.triangles for c in first.cells]
+    assert partition(mesh) is not partition(mesh)
+    with memo_scope():
+        first = partition(mesh)
+        assert partition(mesh) is first
+        assert partition(other) is not first
+        assert partition(other).abstraction is other
+        for _ in range(PARTITIONS.keep):
+            partition(abstraction_for(mission, requested_margin(mission)))
+        again = partition(mesh)  # pushed out by newer meshes: partitioned afresh, the same
+        assert again is not first
+        assert [c.triangles for c in again.cells] == [c.triangles for c in first.cells]

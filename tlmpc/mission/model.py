@@ -10,6 +10,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
+from tlmpc.base.memo import Slot, recall
 from tlmpc.ltl.ast import Formula
 
 Point = tuple[float, float]
@@ -32,32 +33,30 @@ class Region:
     polygon: Polygon
 
 
-#: The last regions document built and the (name, polygon) pairs it was built from.
-_last_regions: tuple[list[tuple[str, Polygon]], dict[str, list[list[float]]]] | None = None
+#: The regions' documents a compilation keeps (the last map's: its three artifacts hold it
+#: anyway).
+REGIONS_DOCUMENTS: Slot[dict[str, list[list[float]]]] = Slot("regions document", keep=1)
 
 
 def regions_document(pairs: list[tuple[str, Polygon]]) -> dict[str, list[list[float]]]:
     """``{name: [[x, y], ...]}``: the regions as ``mission.json``, ``abstraction.json`` and
     ``trace.json`` hold them.
 
-    Asked again for the same polygons (the very tuples, under the same names, in the same
-    order), it returns the document it built last, the same object: a compile of a map with
-    a hundred thousand regions builds this document once for its three artifacts, and the
-    writer, finding the same object under the same key, encodes it once.  The document is
-    shared, so it must not be changed (no stage does; the polygons it comes from are
-    immutable tuples).  The module keeps the last document (and its pairs) until another
-    is built: one map's regions, which the compile's artifacts hold anyway.
+    Asked again in the same compilation for the same polygons (the very tuples, under the
+    same names, in the same order), it returns the document it built, the same object
+    (:mod:`tlmpc.base.memo`): a compile of a map with a hundred thousand regions builds this
+    document once for its three artifacts, and the writer, finding the same object under the
+    same key, encodes it once.  The document is shared, so it must not be changed (no stage
+    does; the polygons it comes from are immutable tuples).
     """
-    global _last_regions
-    if _last_regions is not None:
-        held, document = _last_regions
-        if len(held) == len(pairs) and all(
-            a[1] is b[1] and a[0] == b[0] for a, b in zip(held, pairs, strict=True)
-        ):
-            return document
-    document = {name: list(map(list, polygon)) for name, polygon in pairs}
-    _last_regions = (pairs, document)
-    return document
+    # the polygons by identity (held with the document: their ids stay theirs), names by value
+    key = tuple((name, id(polygon)) for name, polygon in pairs)
+    return recall(
+        REGIONS_DOCUMENTS,
+        key,
+        pairs,
+        lambda: {name: list(map(list, polygon)) for name, polygon in pairs},
+    )
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -40,8 +40,6 @@ from __future__ import annotations
 
 import itertools
 import math
-import threading
-from collections import OrderedDict
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -49,6 +47,7 @@ import numpy as np
 import numpy.typing as npt
 
 from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
+from tlmpc.base.memo import Slot, recall
 from tlmpc.planning.robust import corner_angles
 
 BoolArray = npt.NDArray[np.bool_]
@@ -394,29 +393,18 @@ def _turn(a: Vector, b: Vector, c: Vector) -> float:
     return (ux * vy - uy * vx) / scale if scale > 0.0 else 0.0
 
 
-#: The partitions kept for reuse (the most recent meshes'): the plan stage asks for the cells
-#: of one mesh many times (the planner's mask, the widest-lasso search, the witness check),
-#: and each move's search and each stay's centre are computed once per partition.
-KEPT_PARTITIONS = 6
-_partitions: OrderedDict[int, tuple[Abstraction, Cells]] = OrderedDict()
-_partitions_lock = threading.Lock()
+#: The partitions a compilation keeps for reuse (its most recent meshes'): the plan stage asks
+#: for the cells of one mesh many times (the planner's mask, the widest-lasso search, the
+#: witness check), the control stage again, and each move's search and each stay's centre are
+#: computed once per partition.
+PARTITIONS: Slot[Cells] = Slot("convex cells", keep=6)
 
 
 def partition(abstraction: Abstraction) -> Cells:
-    """The convex cells of ``abstraction`` (see the module doc); the same object for the same
-    mesh object while it is among the last :data:`KEPT_PARTITIONS` partitioned."""
-    key = id(abstraction)
-    with _partitions_lock:
-        kept = _partitions.get(key)
-        if kept is not None and kept[0] is abstraction:
-            _partitions.move_to_end(key)
-            return kept[1]
-    cells = _partition(abstraction)
-    with _partitions_lock:
-        _partitions[key] = (abstraction, cells)  # the mesh held: its id is not reused meanwhile
-        while len(_partitions) > KEPT_PARTITIONS:
-            _partitions.popitem(last=False)
-    return cells
+    """The convex cells of ``abstraction`` (see the module doc); within one compilation the
+    same object for the same mesh object while it is among the last ``PARTITIONS.keep``
+    partitioned (:mod:`tlmpc.base.memo`), a new partition elsewhere."""
+    return recall(PARTITIONS, id(abstraction), abstraction, lambda: _partition(abstraction))
 
 
 def _partition(abstraction: Abstraction) -> Cells:

@@ -475,6 +475,7 @@ class Executor:
         return min(candidates, key=lambda index: self.plan.distance(self._step, index))
 
     def _replan(self, triangle: int, point: FloatArray) -> None:
+        from tlmpc.base.memo import memo_scope
         from tlmpc.control import synthesize
         from tlmpc.planning.mission import plan_mission
 
@@ -485,15 +486,17 @@ class Executor:
             point = abstraction.corners(triangle).mean(axis=0)
         try:
             # Compile's own planning entry, resumed from the tracked automaton states: edges,
-            # U-turn refinement, then vertex passages, on the mesh the run was compiled with.
-            planned = plan_mission(
-                self.mission,
-                abstraction,
-                self.automaton,
-                resume=self._states,
-                start_point=(float(point[0]), float(point[1])),
-            )
-            controllers = synthesize(planned.abstraction, planned.witness, self.mission.robot)
+            # U-turn refinement, then vertex passages, on the mesh the run was compiled with;
+            # one memo for the re-plan, as a compile has (the mesh's cells partitioned once).
+            with memo_scope():
+                planned = plan_mission(
+                    self.mission,
+                    abstraction,
+                    self.automaton,
+                    resume=self._states,
+                    start_point=(float(point[0]), float(point[1])),
+                )
+                controllers = synthesize(planned.abstraction, planned.witness, self.mission.robot)
         except (NoPlanError, SolverError, InvalidInputError):
             self._stop("no_plan", triangle)
             return
