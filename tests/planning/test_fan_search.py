@@ -1,9 +1,11 @@
 """The cell moves' fan search (tlmpc.planning.cells._fan_widths), every vertex and direction at
 once, against its definition: per direction t and move, the smallest over the move's vertices
-of vertex_push(normals + [(cos t, sin t)]), evaluated one at a time (the arc holding the
-normals and xi, by sorting). Random moves of one to three vertices, each with one or two unit
-normals (a convex cell's vertex lies on two sides), and random direction angles, several
-moves in one call; and the refusal of a vertex with three normals."""
+of the corner push of normals + [(cos t, sin t)], evaluated one at a time by the oracle of the
+arc holding the normals and xi (tests/oracles/brute_push.py, by sorting) and by the one
+implementation the final widths and the control stage use (best_direction). Random moves of
+one to three vertices, each with one or two unit normals (a convex cell's vertex lies on two
+sides), and random direction angles, several moves in one call; and the refusal of a vertex
+with three normals."""
 
 from __future__ import annotations
 
@@ -11,10 +13,12 @@ import math
 
 import numpy as np
 import pytest
+from brute_push import arc_push
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from tlmpc.planning.cells import _fan_widths, vertex_push
+from tlmpc.planning.cells import _fan_widths
+from tlmpc.planning.robust import best_direction
 
 angles = st.floats(-math.pi, math.pi, allow_nan=False)
 vertex = st.lists(angles, min_size=1, max_size=2).map(
@@ -35,8 +39,10 @@ def test_every_direction_and_move_is_the_definition(
         for m, groups in enumerate(moves):
             t = float(columns[d, m])
             xi = (math.cos(t), math.sin(t))
-            expected = min(1.0, *(vertex_push([*normals, xi]) for normals in groups))
+            expected = min(1.0, *(arc_push([*normals, xi]) for normals in groups))
             assert found[d, m] == pytest.approx(expected, abs=1e-12)
+            pushed = min(1.0, *(max(best_direction([*n, xi])[0], 0.0) for n in groups))
+            assert found[d, m] == pytest.approx(pushed, abs=1e-12)
 
 
 def test_a_move_without_rows_pushes_fully() -> None:

@@ -3,7 +3,7 @@
 Consecutive plan steps inside one cell are one cell step. A move's field puts at every mesh
 vertex v of the cell the velocity of norm max_speed that pushes hardest along the normals of
 its rows (the kept sides' inward normals through v and the flow direction xi; see
-:func:`tlmpc.control.robust.best_direction`); each triangle of the cell runs the affine
+:func:`tlmpc.planning.robust.best_direction`); each triangle of the cell runs the affine
 interpolation of its three vertex velocities. A stay runs the radial law
 u = kappa (c - x) on the whole cell. Every row is re-checked on the solved velocities with
 the disturbance and the controllers' tolerance (C030), independently of the planner's width.
@@ -19,10 +19,10 @@ from tlmpc.abstraction.model import Abstraction, FloatArray
 from tlmpc.base.errors import InvalidInputError, SolverError, error
 from tlmpc.control.geometry import affine_law
 from tlmpc.control.model import EXIT, KEPT, CellField, Controllers, StepController
-from tlmpc.control.robust import best_direction
 from tlmpc.mission.model import Robot
 from tlmpc.planning.cells import CellGroup, Cells, cell_groups, group_bounces, partition
 from tlmpc.planning.model import Witness
+from tlmpc.planning.robust import best_direction
 
 #: The re-check's tolerance relative to max_speed (the triangle steps' own).
 RECHECK_TOLERANCE = 1e-9

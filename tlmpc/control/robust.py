@@ -2,14 +2,15 @@
 
 At a corner of a step the vertex velocity w must push along every normal a_k its rows collect
 (inward on the facets to keep, outward on the exit facet) by more than the disturbance d. The
-best any |w| <= max_speed can do is the *corner push* max_w min_k a_k·w (see
-:func:`tlmpc.control.geometry.best_push`). For the corner opposite the exit edge, and for
-every corner of a stay, the two kept facets meet at the triangle's angle a there and the push
-is max_speed * sin(a / 2); a corner on the exit edge pushes max_speed * cos(a / 2). Every field
-of a step is an affine interpolation of its three vertex velocities, and each vertex's rows
-involve that vertex alone, so the step is feasible exactly when each corner push exceeds d:
-the plan's triangles reject every disturbance below the smallest corner push of its steps,
-and none from there on (see docs/control.md, "How much disturbance a plan rejects").
+best any |w| <= max_speed can do is the *corner push* max_w min_k a_k·w (its direction and
+value: :func:`tlmpc.planning.robust.best_direction`, which the planner's convex cells use
+too). For the corner opposite the exit edge, and for every corner of a stay, the two kept
+facets meet at the triangle's angle a there and the push is max_speed * sin(a / 2); a corner
+on the exit edge pushes max_speed * cos(a / 2). Every field of a step is an affine
+interpolation of its three vertex velocities, and each vertex's rows involve that vertex
+alone, so the step is feasible exactly when each corner push exceeds d: the plan's triangles
+reject every disturbance below the smallest corner push of its steps, and none from there on
+(see docs/control.md, "How much disturbance a plan rejects").
 
 The *best-push field* puts, at every corner, the velocity of norm max_speed that attains the
 corner push. It is the program's fallback on a needle, where the solver's tolerance (about
@@ -23,8 +24,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-#: A plane vector as two floats.
-Vector = tuple[float, float]
+from tlmpc.planning.robust import Vector, best_direction
 
 
 @dataclass(frozen=True, slots=True)
@@ -37,36 +37,6 @@ class Corner:
     angle: float  # the triangle's angle at the corner, degrees
     push: float  # the corner push, in the units of max_speed
     kept: bool  # both facets through it kept (the corner opposite the exit, or a stay's)
-
-
-def best_direction(normals: Sequence[Vector]) -> tuple[float, Vector]:
-    """The unit u maximising min_k a_k·u over unit normals a_k, and that minimum.
-
-    The maximiser of a minimum of linear functions over the unit disc points along one normal
-    or along the bisector of two (the optimum of a two-dimensional max-min sits where at most
-    two constraints are active), so those directions are the only candidates. The bisector of
-    two nearly opposite normals (a sliver corner) is taken perpendicular to their difference,
-    which keeps its digits where their sum would cancel them.
-    """
-    if not normals:
-        return 1.0, (1.0, 0.0)
-    candidates: list[Vector] = [(float(a[0]), float(a[1])) for a in normals]
-    for i, (ax, ay) in enumerate(normals):
-        for bx, by in normals[i + 1 :]:
-            dx, dy = ax - bx, ay - by
-            length = math.hypot(dx, dy)
-            if length == 0.0:
-                continue
-            ux, uy = -dy / length, dx / length  # perpendicular to a - b: a·u = b·u
-            if ax * ux + ay * uy < 0.0:
-                ux, uy = -ux, -uy
-            candidates.append((ux, uy))
-    best_value, best = -math.inf, candidates[0]
-    for ux, uy in candidates:
-        value = min(ax * ux + ay * uy for ax, ay in normals)
-        if value > best_value:
-            best_value, best = value, (ux, uy)
-    return best_value, best
 
 
 def corner_angle(vertices: Sequence[Vector], local: int) -> float:

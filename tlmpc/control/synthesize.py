@@ -37,7 +37,6 @@ from tlmpc.control.geometry import (
 from tlmpc.control.model import Controllers, StepController, VelocityJump
 from tlmpc.control.robust import (
     Corner,
-    best_direction,
     best_push_velocities,
     corner_angle,
     disturbance_hint,
@@ -47,6 +46,7 @@ from tlmpc.control.sparse import CscMatrix, Triplets, stacked_csc
 from tlmpc.mission.model import Robot
 from tlmpc.planning.mission import SUPPORTED, SUPPORTED_CELLS, on_cells
 from tlmpc.planning.model import Witness
+from tlmpc.planning.robust import best_direction
 
 #: A unit normal as Python floats.
 Vector = tuple[float, float]

@@ -19,9 +19,11 @@ All rows are linear in x on each triangle, so they hold on the whole cell: on a 
 closed loop points inward against any push |w| <= d, and xi·x grows at a positive rate, so
 the robot leaves the bounded cell, and only through I. Each vertex's rows involve that vertex
 alone, so the largest d the rows admit is the smallest *vertex push*: the best
-min_k a_k·u over |u| <= 1 for the vertex's normals a_k, which is cos(s / 2) for unit normals
-spanning an arc of s < 180 degrees (the bisector of the arc's ends attains it, and any other
-direction is farther than s / 2 from one end).
+min_k a_k·u over |u| <= 1 for the vertex's normals a_k (the corner push of
+:func:`tlmpc.planning.robust.best_direction`, whose direction the control stage's cell field
+puts at the vertex), which is cos(s / 2) for unit normals spanning an arc of s < 180 degrees
+(the bisector of the arc's ends attains it, and any other direction is farther than s / 2
+from one end), and none (0) for normals in no open half-plane.
 
 The direction xi is searched over a fixed fan (FAN directions round the circle from I's mean
 outward normal, then a finer fan about the best); the move's *width* (in units of max_speed)
@@ -38,7 +40,6 @@ the area centroid, a fixed number of halvings).
 
 from __future__ import annotations
 
-import itertools
 import math
 from dataclasses import dataclass
 from functools import cached_property
@@ -48,7 +49,7 @@ import numpy.typing as npt
 
 from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
 from tlmpc.base.memo import Slot, recall
-from tlmpc.planning.robust import corner_angles
+from tlmpc.planning.robust import best_direction, corner_angles
 
 BoolArray = npt.NDArray[np.bool_]
 Vector = tuple[float, float]
@@ -177,19 +178,6 @@ def _no_move(cell: int, target: int) -> CellMove:
     return CellMove(cell=cell, target=target, xi=(1.0, 0.0), width=0.0, kept=(), interface=())
 
 
-def vertex_push(normals: list[Vector]) -> float:
-    """max over unit u of min_k a_k·u for unit normals a_k: cos(s / 2) for the arc of s
-    degrees holding them all (1 with no normal, at most 0 when no open half-plane does)."""
-    if not normals:
-        return 1.0
-    angles = sorted(math.atan2(y, x) for x, y in normals)
-    # the arc holding them all is the circle less its widest gap between consecutive angles
-    gaps = [b - a for a, b in itertools.pairwise(angles)]
-    gaps.append(angles[0] + 2.0 * math.pi - angles[-1])
-    spread = 2.0 * math.pi - max(gaps)
-    return math.cos(spread / 2.0) if spread < math.pi else 0.0
-
-
 @dataclass(frozen=True, slots=True)
 class _Pending:
     """A cell move whose flow direction is still to be searched: the fan's base angle (I's
@@ -240,7 +228,8 @@ def _searched_moves(cells: Cells, pending: list[_Pending]) -> list[CellMove]:
     """The moves of ``pending`` with their flow directions: the fan (FAN directions round the
     circle from I's outward normal), then a finer fan about the best of it, every move's
     vertices and directions at once (:func:`_fan_widths`); the width is the smallest vertex
-    push at the best direction (the first of equals)."""
+    push at the best direction (the first of equals), each the corner push of
+    :func:`~tlmpc.planning.robust.best_direction` (at least 0)."""
     coarse: FloatArray = np.arange(FAN, dtype=np.float64) * (2.0 * math.pi / FAN)
     fine: FloatArray = (np.arange(2 * FINE + 1, dtype=np.float64) - FINE) * (
         2.0 * math.pi / FAN / FINE
@@ -258,7 +247,7 @@ def _searched_moves(cells: Cells, pending: list[_Pending]) -> list[CellMove]:
     found = []
     for move, angle in zip(unique, best.tolist(), strict=True):
         xi = (math.cos(angle), math.sin(angle))
-        found.append((xi, min(vertex_push([*normals, xi]) for normals in move.groups)))
+        found.append((xi, min(best_direction([*normals, xi])[0] for normals in move.groups)))
     moves = []
     for move in pending:
         xi, width = found[shapes[move.shape]]
@@ -305,8 +294,11 @@ FINE = 50
 
 def _fan_widths(moves: list[list[list[Vector]]], turns: FloatArray) -> FloatArray:
     """(directions, moves): per move and direction angle in ``turns`` (one column per move),
-    the smallest vertex push with xi along it (each vertex's kept normals in ``moves``):
-    :func:`vertex_push` over every vertex and direction at once.
+    the smallest vertex push with xi along it (each vertex's kept normals in ``moves``), at
+    most 1 and at least 0: the corner push of :func:`~tlmpc.planning.robust.best_direction` of
+    the normals and xi, over every vertex and direction at once, from the arc of the angles
+    (cos(s / 2) for an arc of s < 180 degrees holding them, else 0; the arc is the circle less
+    its widest gap).
 
     A vertex of a convex cell lies on two of its sides, so it has one or two normals (one is
     repeated: a repeated angle adds a gap of zero). Their angles a0 <= a1 are sorted once; xi's

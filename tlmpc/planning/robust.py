@@ -17,6 +17,9 @@ disturbance), it runs again on the realisable ones only, where the mesh has them
 
 from __future__ import annotations
 
+import math
+from collections.abc import Sequence
+
 import numpy as np
 import numpy.typing as npt
 
@@ -24,10 +27,47 @@ from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
 from tlmpc.planning.model import Witness
 
 BoolArray = npt.NDArray[np.bool_]
+#: A plane vector as two floats.
+Vector = tuple[float, float]
 
 #: The controllers' re-check demands each push with this much to spare, relative to
 #: max_speed (control.synthesize.RECHECK_TOLERANCE), and a little more for rounding here.
 TOLERANCE = 2e-9
+
+
+def best_direction(normals: Sequence[Vector]) -> tuple[float, Vector]:
+    """The unit u maximising min_k a_k·u over unit normals a_k, and that minimum: the
+    *corner push* of a vertex whose rows are the a_k (in units of max_speed), the one
+    implementation of it (the control stage's vertex velocities, the convex cells' widths).
+
+    The maximiser of a minimum of linear functions over the unit disc points along one normal
+    or along the bisector of two (the optimum of a two-dimensional max-min sits where at most
+    two constraints are active), so those directions are the only candidates. The bisector of
+    two nearly opposite normals (a sliver corner) is taken perpendicular to their difference,
+    which keeps its digits where their sum would cancel them. Only the bisector on the normals'
+    side is a candidate: where no open half-plane holds the normals (the true maximum is at
+    most 0, no velocity pushes along all of them) the value may be below that maximum, but it
+    is at most 0 all the same; wherever the maximum is positive it is the maximum.
+    """
+    if not normals:
+        return 1.0, (1.0, 0.0)
+    candidates: list[Vector] = [(float(a[0]), float(a[1])) for a in normals]
+    for i, (ax, ay) in enumerate(normals):
+        for bx, by in normals[i + 1 :]:
+            dx, dy = ax - bx, ay - by
+            length = math.hypot(dx, dy)
+            if length == 0.0:
+                continue
+            ux, uy = -dy / length, dx / length  # perpendicular to a - b: a·u = b·u
+            if ax * ux + ay * uy < 0.0:
+                ux, uy = -ux, -uy
+            candidates.append((ux, uy))
+    best_value, best = -math.inf, candidates[0]
+    for ux, uy in candidates:
+        value = min(ax * ux + ay * uy for ax, ay in normals)
+        if value > best_value:
+            best_value, best = value, (ux, uy)
+    return best_value, best
 
 
 def corner_angles(abstraction: Abstraction, triangles: IntArray | None = None) -> FloatArray:
