@@ -35,22 +35,25 @@ STAY_CONTRACTION = 1e-6
 def nearest_piece(field: CellField, point: FloatArray) -> int:
     """The piece whose smallest barycentric weight at ``point`` is largest: the one holding
     it, or the nearest to it just outside (the executor's choice of law off the pieces)."""
-    lowest = [
-        float(triangle_geometry(field.vertices[piece]).barycentric(point).min())
-        for piece in range(len(field.triangles))
-    ]
-    return lowest.index(max(lowest))
+    piece = locate(field, point, velocity_hint=False, outside=True)
+    assert piece is not None  # a cell field has a piece
+    return piece
 
 
-def locate(field: CellField, point: FloatArray, velocity_hint: bool = True) -> int | None:
-    """The piece holding ``point`` (on a shared facet: the one the field enters)."""
+def locate(
+    field: CellField, point: FloatArray, velocity_hint: bool = True, outside: bool = False
+) -> int | None:
+    """The piece holding ``point``: of the pieces holding it (to within :data:`SLACK` of
+    their size; every piece with ``outside``), the one whose smallest barycentric weight is
+    largest, at ``point`` or, with ``velocity_hint``, a little ahead along the field (on a
+    shared facet: the one the field enters); the first of equals; None when none holds it."""
     best, best_value = None, -math.inf
     for piece in range(len(field.triangles)):
         geometry = triangle_geometry(field.vertices[piece])
         weights = geometry.barycentric(point)
         scale = float(geometry.heights.max())
         lowest = float(weights.min())
-        if lowest < -SLACK * max(scale, 1.0):
+        if not outside and lowest < -SLACK * max(scale, 1.0):
             continue
         value = lowest
         if velocity_hint:
