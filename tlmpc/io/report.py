@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import argparse
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, TextIO
 
 from tlmpc.base.errors import (
@@ -74,6 +74,8 @@ class Reporter:
     err: TextIO
     diagnostics: list[Diagnostic] = field(default_factory=list)
     finished: bool = False
+    #: the hints printed so far: each is printed once per run (the envelope keeps them all)
+    hinted: set[str] = field(default_factory=set)
 
     @classmethod
     def for_args(cls, args: argparse.Namespace, out: TextIO, err: TextIO) -> Reporter:
@@ -98,13 +100,20 @@ class Reporter:
         """Print diagnostics on standard error (and keep them for the JSON envelope).
 
         Warnings alike but for names and numbers are printed as one line
-        (:func:`tlmpc.io.aggregate.aggregate`); the envelope keeps each of them.
+        (:func:`tlmpc.io.aggregate.aggregate`); a hint is printed with the first diagnostic
+        of the run that has it, not again (a plan refused at ten corners gets one long hint,
+        not ten); the envelope keeps each diagnostic with its hint.
         """
         from tlmpc.io.aggregate import aggregate
 
         batch = list(diagnostics)
         self.diagnostics.extend(batch)
         for diagnostic in aggregate(batch):
+            hint = diagnostic.hint
+            if hint is not None and hint in self.hinted:
+                diagnostic = replace(diagnostic, hint=None)
+            elif hint is not None:
+                self.hinted.add(hint)
             self.err.write(diagnostic.format() + "\n")
 
     def note(self, text: str) -> None:
