@@ -15,12 +15,12 @@
 
 from __future__ import annotations
 
-import json
 import math
 
 from brute_cells import has_lasso, product_graph, widest_lasso
 from hypothesis import event, example, given, settings
 from hypothesis import strategies as st
+from small_maps import RECTS, TASKS, small_mission
 
 from tlmpc.abstraction import build_abstraction
 from tlmpc.abstraction.model import Abstraction
@@ -35,39 +35,7 @@ from tlmpc.planning.cells import partition, witness_on_cells
 from tlmpc.planning.plan import plan
 from tlmpc.planning.robust import TOLERANCE
 
-TASKS = (
-    "visit a",
-    "visit a then b",
-    "patrol a, b",
-    "visit b while avoiding c",
-    "stay in b",
-    "whenever a, visit b",
-    "avoid c until b",
-)
-
-rects = st.tuples(st.integers(0, 4), st.integers(0, 3), st.integers(1, 3), st.integers(1, 3))
 STARTS = [(5.3, 4.6), (3.1, 2.6), (0.4, 0.7), (5.7, 0.2), (1.2, 3.9)]
-
-
-def _mission_text(
-    task: str,
-    regions: list[tuple[int, int, int, int]],
-    start: tuple[float, float],
-    boundary: str = "{rect: [0, 0, 6, 5]}",
-    quality: bool = False,
-) -> str:
-    """A small mission; ``quality``: the default quality mesh (inner points, cells of many
-    triangles whose interfaces are several mesh edges) instead of the bare triangulation."""
-    lines = "\n".join(
-        f"  {name}: {{rect: [{x0}, {y0}, {x0 + w}, {y0 + h}]}}"
-        for name, (x0, y0, w, h) in zip("abc", regions, strict=True)
-    )
-    options = "{goal_depth: 0}" if quality else "{min_angle: null, goal_depth: 0}"
-    return (
-        f"version: 1\nworkspace:\n  boundary: {boundary}\n"
-        f"regions:\n{lines}\nrobot: {{start: [{start[0]}, {start[1]}]}}\n"
-        f"task: [{json.dumps(task)}]\noptions: {options}\n"
-    )
 
 
 def _setting(text: str) -> tuple[Mission, Abstraction, Automaton] | None:
@@ -132,7 +100,7 @@ def _exists(mission: Mission, mesh: Abstraction, automaton: Automaton, ratio: fl
 @settings(max_examples=max(15, settings().max_examples // 3), deadline=None)
 @given(
     st.sampled_from(TASKS),
-    st.lists(rects, min_size=3, max_size=3),
+    st.lists(RECTS, min_size=3, max_size=3),
     st.sampled_from(STARTS),
     st.sampled_from([0.2, 0.3, 0.4, 0.5, 0.6]),
     st.booleans(),
@@ -157,7 +125,7 @@ def test_the_cells_searches_are_the_brute_force_ones(
     ratio: float,
     quality: bool,
 ) -> None:
-    setting = _setting(_mission_text(task, regions, start, quality=quality))
+    setting = _setting(small_mission(task, regions, start, quality=quality))
     if setting is None:
         event("invalid map")
         return
@@ -179,7 +147,7 @@ def test_the_cells_searches_are_the_brute_force_ones(
 def _dead_end() -> str:
     # A corridor of three rooms; ``a`` is the room at the left end: visiting it and going on
     # to ``b`` at the right end turns back across the only interface of a's cell.
-    return _mission_text(
+    return small_mission(
         "visit a then b",
         [(0, 0, 2, 2), (4, 0, 2, 2), (2, 0, 2, 2)],
         (3.1, 1.1),

@@ -14,7 +14,6 @@ depth yielding to the disturbance.
 
 from __future__ import annotations
 
-import json
 import re
 from pathlib import Path
 from typing import Any
@@ -25,6 +24,7 @@ from adversary import check_step
 from brute_bottleneck import widest_lasso
 from hypothesis import event, example, given, settings
 from hypothesis import strategies as st
+from small_maps import RECTS, TASKS, small_mission
 
 import tlmpc
 from tlmpc.abstraction import build_abstraction
@@ -40,37 +40,11 @@ from tlmpc.planning.robust import TOLERANCE, witness_realisable
 
 ROOT = Path(__file__).resolve().parents[2]
 
-TASKS = (
-    "visit a",
-    "visit a then b",
-    "patrol a, b",
-    "visit b while avoiding c",
-    "stay in b",
-    "whenever a, visit b",
-    "avoid c until b",
-)
-
-rects = st.tuples(st.integers(0, 4), st.integers(0, 3), st.integers(1, 3), st.integers(1, 3))
-
-
-def _mission(
-    task: str, rects: list[tuple[int, int, int, int]], start: tuple[float, float] = (5.5, 4.5)
-) -> str:
-    regions = "\n".join(
-        f"  {name}: {{rect: [{x0}, {y0}, {x0 + w}, {y0 + h}]}}"
-        for name, (x0, y0, w, h) in zip("abc", rects, strict=True)
-    )
-    return (
-        "version: 1\nworkspace:\n  boundary: {rect: [0, 0, 6, 5]}\n"
-        f"regions:\n{regions}\nrobot: {{start: [{start[0]}, {start[1]}]}}\n"
-        f"task: [{json.dumps(task)}]\noptions: {{min_angle: null, goal_depth: 0}}\n"
-    )
-
 
 @settings(max_examples=max(20, settings().max_examples // 2), deadline=None)
 @given(
     st.sampled_from(TASKS),
-    st.lists(rects, min_size=3, max_size=3),
+    st.lists(RECTS, min_size=3, max_size=3),
     st.sampled_from([(5.5, 4.5), (3.0, 2.5), (0.5, 0.5), (5.9, 0.1), (1.0, 4.0)]),
 )
 # Two regions sharing an edge, a patrol between them.
@@ -84,7 +58,7 @@ def test_the_widest_lasso_is_the_brute_force_maximum(
     task: str, regions: list[tuple[int, int, int, int]], start: tuple[float, float]
 ) -> None:
     try:
-        mission = load_mission_text(_mission(task, regions, start), "m.yaml")
+        mission = load_mission_text(small_mission(task, regions, start), "m.yaml")
     except InvalidInputError:
         event("invalid map")
         return
@@ -254,7 +228,7 @@ def _two_beat() -> Automaton:
 
 @pytest.mark.parametrize("start", [(0.5, 0.5), (3.0, 2.5), (5.5, 4.5)])
 def test_a_cycle_of_stutter_steps_is_a_stay(start: tuple[float, float]) -> None:
-    text = _mission("visit b", [(4, 3, 1, 1), (0, 0, 3, 2), (5, 0, 1, 1)], start)
+    text = small_mission("visit b", [(4, 3, 1, 1), (0, 0, 3, 2), (5, 0, 1, 1)], start)
     mission = load_mission_text(text, "m.yaml")
     mesh = build_abstraction(mission)
     automaton = _two_beat()
