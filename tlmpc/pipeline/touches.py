@@ -32,7 +32,7 @@ from tlmpc.abstraction.touch import split_edges
 from tlmpc.base.errors import TlmpcError
 from tlmpc.control.channel import Point, Portal, funnel
 from tlmpc.mission.model import Mission
-from tlmpc.planning.mission import Planned, replan
+from tlmpc.planning.mission import Planned, again, replan
 from tlmpc.planning.timing import MoveTimes
 
 
@@ -40,22 +40,12 @@ def touch_candidate(mission: Mission, planned: Planned, times: MoveTimes) -> Pla
     """``planned`` planned again on its mesh refined where a plan with U-turns would touch a
     triangle and turn back (see the module doc); None when that plan has no such U-turn or
     either plan fails."""
-    from tlmpc.ltl.bounds import untimed_skeleton
     from tlmpc.planning.plan import plan
 
     mesh = planned.abstraction
-    formula = planned.formula if planned.formula is not None else untimed_skeleton(mission.formula)
     start = mission.robot.start
     try:
-        bouncing = plan(
-            mesh,
-            planned.automaton,
-            formula=formula,
-            options=mission.options,
-            start_point=start,
-            bounces=True,
-            times=times,
-        )
+        bouncing = plan(mesh, planned.automaton, **again(mission, planned, times), bounces=True)
     except TlmpcError:
         return None
     if bouncing.passages:

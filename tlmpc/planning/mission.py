@@ -23,13 +23,14 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
+from typing import TypedDict
 
 from tlmpc.abstraction.lines import Lines
 from tlmpc.abstraction.model import Abstraction
 from tlmpc.automata.model import Automaton
 from tlmpc.base.errors import Diagnostic, NoPlanError
 from tlmpc.ltl.ast import Formula
-from tlmpc.mission.model import Mission, TaskPart
+from tlmpc.mission.model import Mission, Options, TaskPart
 from tlmpc.planning.model import Witness
 from tlmpc.planning.robust import witness_realisable
 from tlmpc.planning.timing import MoveTimes
@@ -304,29 +305,55 @@ def move_times(mission: Mission, measured: MoveTimes | None = None) -> MoveTimes
     return measured if measured is not None else MoveTimes(speed=mission.robot.max_speed)
 
 
+class PlanArguments(TypedDict):
+    """The keyword arguments of :func:`~tlmpc.planning.plan.plan` and
+    :func:`~tlmpc.planning.complete.plan_complete` that plan a plan's task again."""
+
+    formula: Formula
+    options: Options
+    start_point: tuple[float, float]
+    times: MoveTimes | None
+
+
+def again(
+    mission: Mission,
+    planned: Planned,
+    times: MoveTimes | None,
+    start_point: tuple[float, float] | None = None,
+) -> PlanArguments:
+    """What plans ``planned``'s task again for ``mission``: its task (the mission's untimed
+    skeleton when it has none of its own), the mission's options, ``start_point`` (the
+    robot's start when None) and the moves weighing ``times`` (the one place that spells
+    them out for a re-plan, the cells' rung and the touch candidate)."""
+    formula = planned.formula
+    if formula is None:
+        from tlmpc.ltl.bounds import untimed_skeleton
+
+        formula = untimed_skeleton(mission.formula)
+    return PlanArguments(
+        formula=formula,
+        options=mission.options,
+        start_point=mission.robot.start if start_point is None else start_point,
+        times=times,
+    )
+
+
 def replan(mission: Mission, planned: Planned, times: MoveTimes) -> Planned:
     """``planned`` planned again with the moves weighing ``times``: on its own mesh, with its
     own automaton and task (no fallback: the plan it replaces exists there), U-turn
     refinement and vertex passages as the first plan needed them."""
     from tlmpc.planning.complete import plan_complete
 
-    formula = planned.formula
-    if formula is None:
-        from tlmpc.ltl.bounds import untimed_skeleton
-
-        formula = untimed_skeleton(mission.formula)
+    arguments = again(mission, planned, times)
     ratio = mission.robot.disturbance / mission.robot.max_speed
 
     def attempt(reject: float | None, cells: bool = False) -> tuple[Abstraction, Witness]:
         return plan_complete(
             planned.abstraction,
             planned.automaton,
-            formula=formula,
-            options=mission.options,
-            start_point=mission.robot.start,
+            **arguments,
             explain=False,
             reject=reject,
-            times=times,
             on_cells=cells,
         )
 
@@ -439,35 +466,30 @@ def _on_cells(
     rejects the mission's disturbance; None otherwise. ``resume`` re-plans a run under way
     from the mesh's start triangle (its cell entered from nowhere: any interface may be
     left), the automaton being in one of these states."""
-    from tlmpc.ltl.bounds import untimed_skeleton
     from tlmpc.planning.cells import MAX_TRIANGLES, partition, witness_on_cells
     from tlmpc.planning.complete import RefinementError, plan_complete
     from tlmpc.planning.plan import plan
     from tlmpc.planning.robust import TOLERANCE
 
     ratio = mission.robot.disturbance / mission.robot.max_speed
-    formula = planned.formula if planned.formula is not None else untimed_skeleton(mission.formula)
     mesh = planned.unrefined if planned.unrefined is not None else planned.abstraction
     if mesh.num_triangles > MAX_TRIANGLES:
         return None  # beyond the rung's budget
-    where = start_point if start_point is not None else mission.robot.start
+    arguments = again(mission, planned, move_times(mission), start_point)
+    formula = arguments["formula"]
     cells = partition(mesh)
     # A U-turn inside one cell is no turn for the cell's field: the triangles' U-turns are
     # allowed first; a plan that turns back across an interface is refused below, and the
     # planner without U-turns (refined where they are needed) tried then.
-    times = move_times(mission)
 
     def turning() -> tuple[Abstraction, Witness]:
         witness = plan(
             mesh,
             planned.automaton,
-            formula=formula,
-            options=mission.options,
-            start_point=where,
+            **arguments,
             bounces=True,
             resume=resume,
             reject=ratio,
-            times=times,
             on_cells=True,
         )
         return mesh, witness
@@ -476,13 +498,10 @@ def _on_cells(
         return plan_complete(
             mesh,
             planned.automaton,
-            formula=formula,
-            options=mission.options,
-            start_point=where,
+            **arguments,
             resume=resume,
             explain=False,
             reject=ratio,
-            times=times,
             on_cells=True,
         )
 
