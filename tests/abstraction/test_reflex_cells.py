@@ -227,6 +227,57 @@ def workspaces(draw: st.DrawFn) -> dict[str, Any]:
     }
 
 
+def _drawn(
+    boundary: list[list[float]], hole: list[list[float]], region: list[list[float]]
+) -> dict[str, Any]:
+    start = Polygon(boundary).difference(Polygon(hole)).representative_point()
+    return {
+        "version": 1,
+        "workspace": {"boundary": boundary, "holes": [hole]},
+        "regions": {"r0": region},
+        "robot": {"start": [start.x, start.y], "max_speed": 1.0},
+        "options": {"min_angle": None},
+        "ltl": "F r0",
+    }
+
+
+#: A region whose corner touches a hole's corner: the face around them has two rings meeting
+#: at that point, and a ray the region's ring shoots from its corner runs into the hole.
+TOUCHING_AT_A_CORNER = _drawn(
+    [[14.2, 10.0], [14.1, 10.1], [8.5, 19.5], [9.2, 0.7]],
+    [[11.7, 5.8], [11.7, 5.8], [12.4, 7.1], [10.6, 5.0], [10.4, 4.3], [11.3, 5.4]],
+    [[11.2, 5.8], [9.0, 7.2], [10.6, 5.0]],
+)
+#: A region across a hole's side: the side is noded where the region's side crosses it and
+#: the region's side clipped there, a pixel apart (a one-pixel segment, a needle triangle).
+CROSSING_A_HOLE = _drawn(
+    [[14.0, 10.0], [14.2, 10.1], [9.1, 18.2], [7.8, 0.4]],
+    [[10.7, 5.3], [10.7, 5.3], [10.7, 5.3], [10.7, 5.3], [9.9, 6.0], [9.4, 6.0], [9.7, 5.3]],
+    [[10.1, 5.9], [9.1, 5.8], [10.7, 4.9]],
+)
+
+
+@pytest.mark.parametrize("document", [TOUCHING_AT_A_CORNER, CROSSING_A_HOLE])
+@pytest.mark.parametrize("kind", ["reflex", "bisector"])
+def test_cuts_stay_out_of_holes_and_regions_at_pinched_corners(
+    document: dict[str, Any], kind: Lines
+) -> None:
+    _faces_hold(document, kind)
+
+
+def test_no_needle_where_a_region_crosses_a_hole() -> None:
+    """The plain mesh too: no triangle thinner than the grid where the region's side meets
+    the hole's (the two snapped crossings are one vertex)."""
+    mission = load_mission_text(yaml.safe_dump(CROSSING_A_HOLE), "<crossing>")
+    mesh = build_abstraction(mission)
+    corners = mesh.vertices[mesh.triangles]
+    first, second = corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]
+    doubled = np.abs(first[:, 0] * second[:, 1] - first[:, 1] * second[:, 0])
+    longest = np.max(np.linalg.norm(corners - np.roll(corners, 1, axis=1), axis=2), axis=1)
+    # the height over the longest side: a needle's is below a few grid steps
+    assert np.min(doubled / longest) > 10 * grid_size(mission)
+
+
 @pytest.mark.slow
 @settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.filter_too_much])
 @given(workspaces())

@@ -52,6 +52,7 @@ COLLINEAR = 1e-8
 SIDES_WITHIN = 45.0
 
 FloatArray = npt.NDArray[np.float64]
+IntArray = npt.NDArray[np.int64]
 
 #: The decompositions: every side extended across the free space, the reflex cuts (sides
 #: extended near 270 degrees, bisectors elsewhere), or the reflex cuts by bisectors alone.
@@ -157,6 +158,7 @@ def _rays(faces: Any, within: float) -> tuple[FloatArray, FloatArray, FloatArray
     how many corners they cut. Corners within ``within`` degrees of 270 get both sides
     extended, the others their bisector."""
     rings = shapely.get_rings(faces)
+    face_of_ring = np.repeat(np.arange(len(faces)), shapely.get_num_interior_rings(faces) + 1)
     coords, ring = shapely.get_coordinates(rings, return_index=True)
     last = np.r_[ring[1:] != ring[:-1], True]
     coords, ring = coords[~last], ring[~last]  # each ring's closing point dropped
@@ -185,7 +187,62 @@ def _rays(faces: Any, within: float) -> tuple[FloatArray, FloatArray, FloatArray
     origins = np.concatenate([origin[sides], origin[sides], origin[~sides]])
     directions = np.concatenate([forward[sides], backward[sides], bisector[~sides]])
     reach = np.concatenate([shorter[sides], shorter[sides], shorter[~sides]])
-    return origins, directions, reach.astype(np.float64), int(np.count_nonzero(reflex))
+    corner = np.flatnonzero(reflex)
+    shot_from = np.concatenate([corner[sides], corner[sides], corner[~sides]])
+    keep = _into_face(coords, before, after, face_of_ring[ring], shot_from, directions)
+    return (
+        origins[keep],
+        directions[keep],
+        reach[keep].astype(np.float64),
+        int(np.count_nonzero(reflex)),
+    )
+
+
+def _into_face(
+    coords: FloatArray,
+    before: FloatArray,
+    after: FloatArray,
+    face: IntArray,
+    shot_from: IntArray,
+    directions: FloatArray,
+) -> npt.NDArray[np.bool_]:
+    """Which rays start into their face. A ray leaves its corner into the face as its own
+    ring sees it, but where rings of one face touch at a point (a hole touching a region's
+    side at a corner) the other rings' corners there take wedges of that side away: a ray
+    into one of them would run through a hole or a region. Such a ray is dropped; the
+    face's own wedges at the point are still cut (a wedge wider than 180 degrees holds a
+    ray of the ring beside it: at 180 degrees from that ring's side, or its bisector)."""
+    keep = np.ones(len(shot_from), dtype=bool)
+    keys = np.concatenate([face[:, None].astype(np.float64), coords], axis=1)
+    _, group, count = np.unique(keys, axis=0, return_inverse=True, return_counts=True)
+    group = group.reshape(-1)
+    pinched = count[group] > 1
+    if not pinched[shot_from].any():
+        return keep
+    members: dict[int, list[int]] = {}
+    for index in np.flatnonzero(pinched).tolist():
+        members.setdefault(int(group[index]), []).append(index)
+    for k in np.flatnonzero(pinched[shot_from]).tolist():
+        own = int(shot_from[k])
+        dx, dy = float(directions[k, 0]), float(directions[k, 1])
+        for other in members[int(group[own])]:
+            if other != own and not _in_wedge(coords[other], before[other], after[other], dx, dy):
+                keep[k] = False
+                break
+    return keep
+
+
+def _in_wedge(
+    point: FloatArray, before: FloatArray, after: FloatArray, dx: float, dy: float
+) -> bool:
+    """Whether direction (dx, dy) from a ring's corner ``point`` lies strictly inside the
+    face's wedge there: counter-clockwise from the side to ``after`` to the side to
+    ``before`` (the face is on the left of its rings)."""
+    ux, uy = float(after[0] - point[0]), float(after[1] - point[1])
+    vx, vy = float(before[0] - point[0]), float(before[1] - point[1])
+    turn = math.atan2(ux * vy - uy * vx, ux * vx + uy * vy) % math.tau or math.tau
+    heading = math.atan2(ux * dy - uy * dx, ux * dx + uy * dy) % math.tau
+    return 0.0 < heading < turn
 
 
 def _first_hits(

@@ -33,6 +33,9 @@ IntArray = npt.NDArray[np.int64]
 #: vertex (a cap, far above what well-shaped inputs need, so refinement always terminates).
 MIN_STEINER = 20_000
 STEINER_PER_VERTEX = 50
+#: Segments at most this many grid steps long are contracted to a point (two neighbouring
+#: pixels are at most the square root of two apart).
+CLOSE_PIXELS = 2.0
 
 
 def _snapped(points: Sequence[tuple[float, float]], grid: float) -> Any:
@@ -218,6 +221,39 @@ def _inside(free: Any, rings: list[Any]) -> list[Any]:
     return [ring for ring, k in zip(rings, keep.tolist(), strict=True) if k]
 
 
+def _merge_close(
+    vertices: FloatArray, edges: IntArray, tolerance: float
+) -> tuple[FloatArray, IntArray]:
+    """The graph with every segment no longer than ``tolerance`` contracted to its end of
+    lower index. Snap rounding nodes two lines that cross within a pixel of each other's
+    vertex at neighbouring pixels (a region's side clipped at a hole's side, and that side
+    noded where the region's side crosses it): a segment one pixel long, which Triangle
+    would keep as a needle triangle joining a region to the space beside it."""
+    span = vertices[edges[:, 1]] - vertices[edges[:, 0]]
+    short = np.hypot(span[:, 0], span[:, 1]) <= tolerance
+    if not short.any():
+        return vertices, edges
+    owner: dict[int, int] = {}
+
+    def find(vertex: int) -> int:
+        while owner.get(vertex, vertex) != vertex:
+            vertex = owner[vertex]
+        return vertex
+
+    for a, b in edges[short].tolist():
+        x, y = find(a), find(b)
+        if x != y:
+            owner[max(x, y)] = min(x, y)
+    root = np.arange(len(vertices))
+    for vertex in owner:
+        root[vertex] = find(vertex)
+    kept = root == np.arange(len(vertices))
+    renumber = np.cumsum(kept) - 1
+    merged = renumber[root[edges]]
+    merged = np.sort(merged[merged[:, 0] != merged[:, 1]], axis=1)
+    return vertices[kept], merged[_unique_rows(merged)[0]]
+
+
 def pslg(
     mission: Mission, layout: PlanningLayout | None = None, *, lines: Lines | None = None
 ) -> tuple[FloatArray, IntArray, FloatArray, list[Any]]:
@@ -288,6 +324,7 @@ def pslg(
     edges = edges[edges[:, 0] != edges[:, 1]]
     edges = np.sort(edges, axis=1)
     edges = edges[_unique_rows(edges)[0]]
+    vertices, edges = _merge_close(vertices, edges, CLOSE_PIXELS * grid)
     seeds = []
     for part in parts:
         for interior in part.interiors:
