@@ -47,6 +47,26 @@ from ci_oracles import MISSING_MARK, in_ci  # noqa: E402
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE") or ("ci" if in_ci() else "dev"))
 
 
+def _examples_independent_of_imports() -> None:
+    """Hypothesis also draws numbers written in the local modules it finds loaded (tlmpc's
+    and the tests'), a set that grows with whatever earlier tests imported: under xdist's
+    work stealing one derandomized test drew other examples from one run to the next, and a
+    failure seen in the suite did not show when the test ran alone. Its own constants only,
+    so a test's examples depend on the test alone (where the internals differ, nothing is
+    changed)."""
+    try:
+        from hypothesis.internal.conjecture import providers
+    except ImportError:  # pragma: no cover - a Hypothesis without the module
+        return
+    empty = getattr(providers, "_local_constants", None)
+    if empty is None or not callable(getattr(providers, "_get_local_constants", None)):
+        return
+    providers._get_local_constants = lambda: empty
+
+
+_examples_independent_of_imports()
+
+
 def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line(
         "markers", f"{MISSING_MARK}(what): the test's oracle is missing in CI (fails the test)"
