@@ -33,7 +33,7 @@ import numpy as np
 from tlmpc.abstraction.model import FloatArray, IntArray
 from tlmpc.planning.lazy import LazyProduct
 from tlmpc.planning.product import SLOTS, BoolArray
-from tlmpc.planning.search import Graph, shortest_paths
+from tlmpc.planning.search import Graph, distances
 
 #: Bounds are scaled down by this factor: the searches add the same weights in other orders,
 #: so a bound equal to the true cost could exceed it by a rounding error.
@@ -57,22 +57,19 @@ class RegionGraph:
     entering: list[tuple[int, IntArray, IntArray]]  # (landmark, from states, to states)
     scale: float  # weight per unit of Euclidean length, at least (for the straight bound)
     backwards: Graph  # the transition system's moves, reversed
+    cells_of: _ClassCells  # every local class's allowed cells
+    entered_cells_of: _ClassCells  # a landmark's boundary entry cells, the background's all
 
     def distance_to(self, cells: IntArray) -> FloatArray:
         """Per cell: the transition system's least cost from it to any of ``cells``."""
-        distance, _ = shortest_paths(self.backwards, cells)
+        distance: FloatArray = distances(self.backwards, cells)
         return distance
 
     def region_minimum(self, per_cell: FloatArray, *, entered: bool = False) -> FloatArray:
         """Per local class: the least value over its cells (``entered``: over the landmark's
         boundary entry cells, where the robot is right after entering it; the background's
         over all its cells)."""
-        pick = self.cell_local >= 0
-        if entered:
-            pick &= self.entry | (self.cell_local == self.background)
-        least = np.full(len(self.classes), np.inf)
-        np.minimum.at(least, self.cell_local[pick], per_cell[pick])
-        return least
+        return (self.entered_cells_of if entered else self.cells_of).least(per_cell)
 
     @property
     def num_states(self) -> int:
@@ -108,6 +105,9 @@ def region_graph(product: LazyProduct, allowed_cells: BoolArray) -> RegionGraph:
     delta_entry = np.zeros((count, count))
     inside = _ClassCells(cell_local, landmarks, np.ones(cells, dtype=bool))
     entered = _ClassCells(cell_local, landmarks, entry)
+    every_class = np.arange(count, dtype=np.int64)
+    cells_of = _ClassCells(cell_local, every_class, cell_local >= 0)
+    entered_cells_of = _ClassCells(cell_local, every_class, entry | (cell_local == background))
     for index, landmark in enumerate(landmarks.tolist()):
         delta[landmarks, landmark] = inside.least(distance[:, index])
         delta_entry[landmarks, landmark] = entered.least(distance[:, index])
@@ -143,6 +143,8 @@ def region_graph(product: LazyProduct, allowed_cells: BoolArray) -> RegionGraph:
         entering=entering,
         scale=_straight_scale(product),
         backwards=backwards,
+        cells_of=cells_of,
+        entered_cells_of=entered_cells_of,
     )
 
 
@@ -199,7 +201,7 @@ def _landmark_distances(backwards: Graph, cell_local: IntArray, landmarks: IntAr
     distance = np.empty((cells, len(landmarks)))
     for index, landmark in enumerate(landmarks.tolist()):
         goal = np.flatnonzero(entered & (cell_local == landmark))
-        distance[:, index], _ = shortest_paths(backwards, goal)
+        distance[:, index] = distances(backwards, goal)
     return distance
 
 
