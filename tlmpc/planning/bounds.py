@@ -57,8 +57,9 @@ class RegionGraph:
     entering: list[tuple[int, IntArray, IntArray]]  # (landmark, from states, to states)
     scale: float  # weight per unit of Euclidean length, at least (for the straight bound)
     backwards: Graph  # the transition system's moves, reversed
-    cells_of: _ClassCells  # every local class's allowed cells
-    entered_cells_of: _ClassCells  # a landmark's boundary entry cells, the background's all
+    cells_of: _ClassCells  # every landmark's cells
+    entered_cells_of: _ClassCells  # every landmark's boundary entry cells
+    background_cells: BoolArray  # per cell: in a triangle of the background
 
     def distance_to(self, cells: IntArray) -> FloatArray:
         """Per cell: the transition system's least cost from it to any of ``cells``."""
@@ -69,7 +70,14 @@ class RegionGraph:
         """Per local class: the least value over its cells (``entered``: over the landmark's
         boundary entry cells, where the robot is right after entering it; the background's
         over all its cells)."""
-        return (self.entered_cells_of if entered else self.cells_of).least(per_cell)
+        least = np.full(len(self.classes), np.inf)
+        least[self.landmarks] = (self.entered_cells_of if entered else self.cells_of).least(
+            per_cell
+        )
+        # The background's cells are most of the map: one pass under a mask, not a gather.
+        if len(least):
+            least[self.background] = np.min(per_cell, where=self.background_cells, initial=np.inf)
+        return least
 
     @property
     def num_states(self) -> int:
@@ -105,9 +113,6 @@ def region_graph(product: LazyProduct, allowed_cells: BoolArray) -> RegionGraph:
     delta_entry = np.zeros((count, count))
     inside = _ClassCells(cell_local, landmarks, np.ones(cells, dtype=bool))
     entered = _ClassCells(cell_local, landmarks, entry)
-    every_class = np.arange(count, dtype=np.int64)
-    cells_of = _ClassCells(cell_local, every_class, cell_local >= 0)
-    entered_cells_of = _ClassCells(cell_local, every_class, entry | (cell_local == background))
     for index, landmark in enumerate(landmarks.tolist()):
         delta[landmarks, landmark] = inside.least(distance[:, index])
         delta_entry[landmarks, landmark] = entered.least(distance[:, index])
@@ -143,8 +148,9 @@ def region_graph(product: LazyProduct, allowed_cells: BoolArray) -> RegionGraph:
         entering=entering,
         scale=_straight_scale(product),
         backwards=backwards,
-        cells_of=cells_of,
-        entered_cells_of=entered_cells_of,
+        cells_of=inside,
+        entered_cells_of=entered,
+        background_cells=cell_local == background,
     )
 
 
