@@ -324,10 +324,11 @@ class GuidedSearch:
         v = edges.heads
         if isinstance(ceiling, np.ndarray):
             ceiling = ceiling[v // self.copy_size]
+        u = edges.tails
         keep = d + self.estimate_at(v) < ceiling
-        improved = relax_offers(
-            arrays.dist, arrays.via, arrays.pred, v[keep], d[keep], du[keep], edges.tails[keep]
-        )
+        if np.count_nonzero(keep) < len(keep):
+            u, v, d, du = u[keep], v[keep], d[keep], du[keep]
+        improved = relax_offers(arrays.dist, arrays.via, arrays.pred, v, d, du, u)
         fresh = improved[~arrays.queued[improved]]
         arrays.queued[fresh] = True
         self.reached += len(fresh)  # (every v was met by estimate_at above)

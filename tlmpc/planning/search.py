@@ -138,7 +138,7 @@ def relax_offers(
     best = dist[v]
     win = d == best  # offers that attain the node's (new) distance
     shorter = best < old
-    if not win.all():
+    if np.count_nonzero(win) < len(win):
         v, du, u, shorter = v[win], du[win], u[win], shorter[win]
     # A shorter distance voids the former predecessor's rank.
     via[v[shorter]] = np.inf
