@@ -685,7 +685,8 @@ def _close_together(
     g = np.array(groups.g)
     while True:
         reached = arrays.distance(targets)
-        limits = np.minimum(limits, _others_limit(g, reached, bounds.beta))
+        if np.isfinite(reached).any():  # (no copy's lasso yet: no copy limits another)
+            limits = np.minimum(limits, _others_limit(g, reached, bounds.beta))
         ceilings = np.minimum(reached, limits)
         if search.exhausted(ceilings):
             break
