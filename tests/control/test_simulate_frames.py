@@ -14,7 +14,7 @@ from hypothesis import example, given
 from hypothesis import strategies as st
 
 import tlmpc.simulate.exact as exact
-from tlmpc.pipeline.stages import CONTROLLERS, MISSION, compile_mission
+from tlmpc.pipeline.stages import ABSTRACTION, CONTROLLERS, MISSION, compile_mission
 from tlmpc.simulate import simulate
 
 SPECS = Path(__file__).resolve().parents[2] / "specs"
@@ -72,3 +72,28 @@ def test_sample_indices_round_ties_to_even() -> None:
     assert exact._sample_indices(20.0, 1.0, 128) == [2, 5, 8, 10, 12, 15, 18]
     assert exact._sample_indices(20.0, 1.0, 10) == [2, 5, 8, 10]  # the last grid point too
     assert exact._sample_indices(20.0, 1.0, 9) == [2, 5, 8]
+
+
+@pytest.mark.parametrize("name", ["patrol.yaml", "example1.yaml", "deadline.yaml"])
+def test_samples_lie_in_their_triangles_and_crossings_in_the_one_entered(name: str) -> None:
+    """Barycentric coordinates (an independent computation): every sample lies in the closed
+    triangle it is labelled with, and a crossing sample, on the edge between two triangles,
+    is labelled with the triangle the trace goes on in (the next sample's)."""
+    result = compile_mission(SPECS / name, until="control")
+    controllers = result.compilation.get(CONTROLLERS)
+    mission = result.compilation.get(MISSION)
+    trace = simulate(None, controllers, mission)  # type: ignore[arg-type]
+    geometry = result.compilation.get(ABSTRACTION)
+    for index, (point, triangle) in enumerate(zip(trace.points, trace.triangles, strict=True)):
+        (ax, ay), (bx, by), (cx, cy) = geometry.corners(triangle).tolist()
+        x, y = point.tolist()
+        area = (bx - ax) * (cy - ay) - (cx - ax) * (by - ay)
+        first = ((bx - x) * (cy - y) - (cx - x) * (by - y)) / area
+        second = ((cx - x) * (ay - y) - (ax - x) * (cy - y)) / area
+        third = 1.0 - first - second
+        assert min(first, second, third) >= -1e-7, (index, triangle)
+    # (A crossing followed at once by another belongs to the triangle between the two.)
+    crossings = set(trace.crossings)
+    followed = [i for i in crossings if i + 1 < len(trace.triangles) and i + 1 not in crossings]
+    assert followed
+    assert all(trace.triangles[i] == trace.triangles[i + 1] for i in followed)

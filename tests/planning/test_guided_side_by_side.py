@@ -270,3 +270,26 @@ def test_a_guided_plan_counts_at_least_a_round_per_step_of_its_lasso(spec: str) 
     assert isinstance(rounds, int)
     cycle = 0 if witness.is_stay else len(witness.cycle)
     assert rounds >= len(witness.prefix) + cycle - 2
+
+
+@pytest.mark.parametrize("spec", ["example1", "patrol", "reach-avoid", "far-cycle"])
+def test_region_minimum_is_the_least_over_each_class_cells(spec: str) -> None:
+    """Per local class, by a loop over the cells: the least value over its allowed cells, or
+    (entered) over a landmark's boundary entry cells and all of the background's."""
+    mission = _load(spec)
+    abstraction, working, arguments = _inputs(mission, False)
+    lazy = lazy_product(abstraction, working, **arguments)  # type: ignore[arg-type]
+    allowed = np.repeat(arguments["allowed"], SLOTS)  # type: ignore[call-overload]
+    graph = region_graph(lazy, allowed)
+    rng = np.random.default_rng(11)
+    values = rng.uniform(0.0, 100.0, lazy.num_cells)
+    values[rng.random(lazy.num_cells) < 0.2] = np.inf
+    for entered in (False, True):
+        expected = [float("inf")] * len(graph.classes)
+        for cell, local in enumerate(graph.cell_local.tolist()):
+            if local < 0:
+                continue
+            if entered and local != graph.background and not graph.entry[cell]:
+                continue
+            expected[local] = min(expected[local], float(values[cell]))
+        assert graph.region_minimum(values, entered=entered).tolist() == expected

@@ -29,7 +29,7 @@ from tlmpc.base.errors import InvalidInputError, NoPlanError
 from tlmpc.base.graphs import strong_components
 from tlmpc.mission import load_mission_text
 from tlmpc.planning.plan import plan
-from tlmpc.planning.search import Graph, closing_searches, shortest_paths
+from tlmpc.planning.search import Graph, closing_searches, distances, shortest_paths
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
@@ -125,6 +125,23 @@ def test_distances_and_predecessors_match_dijkstra(
     graph, sources = case
     _check_against_scipy(graph, sources, limit)
     _check_against_scipy(graph, sources[:1], limit)
+
+
+# Many equal ways into one node: offers that tie at its new distance in one round.
+FAN = _graph([(0, k, 0.5) for k in range(1, 6)] + [(k, 6, 0.25) for k in range(1, 6)], 7)
+
+
+@given(graphs())
+@example((DIAMOND, ZERO))
+@example((FAN, ZERO))
+def test_distances_without_predecessors_are_dijkstras(case: tuple[Graph, IntArray]) -> None:
+    """The search without predecessors (the guided search's bounds): Dijkstra's distances bit
+    for bit, from one source and from several."""
+    graph, sources = case
+    for chosen in (sources, sources[:1]):
+        theirs, _ = _scipy(graph, chosen)
+        ours = distances(graph, chosen)
+        assert ours.view(np.int64).tolist() == theirs.view(np.int64).tolist()
 
 
 @given(graphs(), st.data())

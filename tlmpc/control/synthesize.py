@@ -460,12 +460,17 @@ RECHECK_TOLERANCE = 1e-9
 
 
 def _violated_condition(
-    controller: StepController, max_speed: float, disturbance: float = 0.0
+    controller: StepController,
+    max_speed: float,
+    disturbance: float = 0.0,
+    geometry: TriangleGeometry | None = None,
 ) -> str | None:
     """Which vertex condition the solved field breaks (None when all hold), re-derived from the
     triangle: speed bound, exit across the planned facet, invariance of the two others; for a
-    stay, inward on every facet, equilibrium at its target and a Hurwitz gain."""
-    geometry = triangle_geometry(controller.vertices)
+    stay, inward on every facet, equilibrium at its target and a Hurwitz gain.  ``geometry``
+    is the triangle's when already computed from the very array ``controller.vertices``."""
+    if geometry is None or geometry.vertices is not controller.vertices:
+        geometry = triangle_geometry(controller.vertices)
     # Python floats, numpy's operations in numpy's order (|w| = sqrt(wx wx + wy wy), a dot
     # of two is ax bx + ay by): the array code's values, without its per-call cost.
     w = controller.velocities.tolist()
@@ -714,7 +719,9 @@ def synthesize(
     for position, controller in enumerate(controllers):
         if controller.is_vertex:
             continue  # the pursuit law's guarantees hold by construction (docs/control.md)
-        problem = _violated_condition(controller, robot.max_speed, robot.disturbance)
+        # (The step's geometry is that of the controller's own vertex array: not again.)
+        own = steps[position].geometry
+        problem = _violated_condition(controller, robot.max_speed, robot.disturbance, own)
         if problem is None:
             continue
         # A needle: the solver's tolerance swamps the little its sliver corners can push.

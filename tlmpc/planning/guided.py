@@ -92,8 +92,8 @@ class _Arrays:
         reading them (:func:`~tlmpc.planning.search.relax_offers`), and a source's are
         written by the search that starts there."""
         fresh = ~self.seen[nodes]
-        if fresh.any():
-            new = nodes[fresh]
+        new = nodes[fresh]
+        if len(new):
             self.seen[new] = True
             self.dist[new] = np.inf
             self.queued[new] = False
@@ -126,6 +126,17 @@ def _runs(labels: IntArray) -> list[tuple[int, IntArray]]:
     return [(first, order[a:b]) for first, a, b in zip(firsts, starts, ends, strict=True)]
 
 
+def _sorted_distinct(values: IntArray) -> IntArray:
+    """``np.unique(values)``: a sort and its first of each run (numpy's unique hashes first,
+    several times slower on the few hundred nodes of a bucket)."""
+    ordered = np.sort(values)
+    first = np.empty(len(ordered), dtype=bool)
+    first[:1] = True
+    np.not_equal(ordered[1:], ordered[:-1], out=first[1:])
+    distinct: IntArray = ordered[first]
+    return distinct
+
+
 class _Buckets:
     """One search's queued nodes by bucket key (``f`` in ``[k w, (k + 1) w)``), maybe stale:
     a node no longer queued, or queued again in another bucket, is skipped when read."""
@@ -142,20 +153,26 @@ class _Buckets:
         being expanded)."""
         keys = np.maximum(keys, self.floor)
         low, high = int(keys.min()), int(keys.max())
-        runs = [(low, nodes)] if low == high else [(k, nodes[at]) for k, at in _runs(keys)]
-        for key, mine in runs:
-            if key in self.parts:
-                self.parts[key].append(mine)
-            else:
-                self.parts[key] = [mine]
-                heapq.heappush(self.keys, key)
+        if low == high:
+            self.put(low, nodes)
+            return
+        for key, at in _runs(keys):
+            self.put(key, nodes[at])
+
+    def put(self, key: int, nodes: IntArray) -> None:
+        """Put ``nodes`` in the bucket ``key`` (at least the floor)."""
+        if key in self.parts:
+            self.parts[key].append(nodes)
+        else:
+            self.parts[key] = [nodes]
+            heapq.heappush(self.keys, key)
 
     def lowest(self, queued: BoolArray) -> IntArray | None:
         """The queued nodes of the lowest bucket that has any (None: nothing queued)."""
         while self.keys:
             key = self.keys[0]
             parts = self.parts[key]
-            nodes = parts[0] if len(parts) == 1 else np.unique(np.concatenate(parts))
+            nodes = parts[0] if len(parts) == 1 else _sorted_distinct(np.concatenate(parts))
             nodes = nodes[queued[nodes]]
             if len(nodes):
                 self.parts[key] = [nodes]
@@ -227,8 +244,8 @@ class GuidedSearch:
         """The bound at ``nodes``, computed once per node (kept in single precision,
         rounded down so that it stays a lower bound)."""
         unknown = self.arrays.meet(nodes)
-        if unknown.any():
-            fresh = nodes[unknown]
+        fresh = nodes[unknown]
+        if len(fresh):
             exact = self.bound(fresh) * (1.0 - 1e-6)
             self.arrays.estimate[fresh] = exact.astype(np.float32)
         return self.arrays.estimate[nodes].astype(np.float64)
@@ -246,8 +263,14 @@ class GuidedSearch:
         if low == high:
             self.queues[low].add(nodes, keys)
             return
-        for k, mine in _runs(copy):
-            self.queues[k].add(nodes[mine], keys[mine])
+        # Grouped by copy and key at once: one sort of (key, copy) labels for the round, not
+        # one per copy (each copy's keys raised to its own floor first).
+        copies = len(self.queues)
+        floors = np.array([queue.floor for queue in self.queues], dtype=np.int64)
+        labels = np.maximum(keys, floors[copy]) * copies + copy
+        for label, at in _runs(labels):
+            key, k = divmod(label, copies)
+            self.queues[k].put(key, nodes[at])
 
     def _f(self, nodes: IntArray) -> FloatArray:
         f: FloatArray = self.arrays.dist[nodes] + self.arrays.estimate[nodes]
@@ -301,10 +324,11 @@ class GuidedSearch:
         v = edges.heads
         if isinstance(ceiling, np.ndarray):
             ceiling = ceiling[v // self.copy_size]
+        u = edges.tails
         keep = d + self.estimate_at(v) < ceiling
-        improved = relax_offers(
-            arrays.dist, arrays.via, arrays.pred, v[keep], d[keep], du[keep], edges.tails[keep]
-        )
+        if np.count_nonzero(keep) < len(keep):
+            u, v, d, du = u[keep], v[keep], d[keep], du[keep]
+        improved = relax_offers(arrays.dist, arrays.via, arrays.pred, v, d, du, u)
         fresh = improved[~arrays.queued[improved]]
         arrays.queued[fresh] = True
         self.reached += len(fresh)  # (every v was met by estimate_at above)
@@ -661,7 +685,8 @@ def _close_together(
     g = np.array(groups.g)
     while True:
         reached = arrays.distance(targets)
-        limits = np.minimum(limits, _others_limit(g, reached, bounds.beta))
+        if np.isfinite(reached).any():  # (no copy's lasso yet: no copy limits another)
+            limits = np.minimum(limits, _others_limit(g, reached, bounds.beta))
         ceilings = np.minimum(reached, limits)
         if search.exhausted(ceilings):
             break

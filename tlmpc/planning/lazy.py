@@ -81,14 +81,13 @@ class LazyProduct:
         ``base``, node ``k`` stands for ``base[k] + nodes[k]`` in tails and heads (searches
         that run side by side, each in its own copy of the node numbers)."""
         nq = self.num_states
-        cell = nodes // nq
-        state = nodes % nq
+        cell, state = np.divmod(nodes, nq)
         starts = self.move_indptr[cell]
         counts = self.move_indptr[cell + 1] - starts
         ends = np.cumsum(counts)
         total = int(ends[-1]) if len(ends) else 0
         moves = np.repeat(starts - ends + counts, counts) + np.arange(total, dtype=np.int64)
-        shift = np.zeros(total, dtype=np.int64) if base is None else np.repeat(base, counts)
+        shift = None if base is None else np.repeat(base, counts)
         if base is not None:
             nodes = nodes + base
         tail = np.repeat(nodes, counts)
@@ -102,8 +101,10 @@ class LazyProduct:
             following = self.successor[kind, q, j]
             ok = following >= 0
             tails.append(tail[ok])
-            heads.append(self.move_target[moves[ok]] * nq + following[ok] + shift[ok])
-            weights.append(self.move_weight[moves[ok]])
+            taken = moves[ok]
+            head = self.move_target[taken] * nq + following[ok]
+            heads.append(head if shift is None else head + shift[ok])
+            weights.append(self.move_weight[taken])
             marks.append(self.marked[kind[ok], q[ok], j])
         staying = self.cell_class[cell] >= 0
         stay_nodes, stay_q = nodes[staying], state[staying]
@@ -111,9 +112,10 @@ class LazyProduct:
         for j in range(self.stutter_successor.shape[2]):
             following = self.stutter_successor[stay_class, stay_q, j]
             ok = following >= 0
-            tails.append(stay_nodes[ok])
-            heads.append(stay_nodes[ok] - stay_q[ok] + following[ok])
-            weights.append(np.full(int(ok.sum()), STUTTER_COST))
+            stutter_tails = stay_nodes[ok]
+            tails.append(stutter_tails)
+            heads.append(stutter_tails - stay_q[ok] + following[ok])
+            weights.append(np.full(len(stutter_tails), STUTTER_COST))
             marks.append(self.stutter_marked[stay_class[ok], stay_q[ok], j])
         return Edges(
             tails=np.concatenate(tails) if tails else np.zeros(0, dtype=np.int64),

@@ -138,7 +138,7 @@ def relax_offers(
     best = dist[v]
     win = d == best  # offers that attain the node's (new) distance
     shorter = best < old
-    if not win.all():
+    if np.count_nonzero(win) < len(win):
         v, du, u, shorter = v[win], du[win], u[win], shorter[win]
     # A shorter distance voids the former predecessor's rank.
     via[v[shorter]] = np.inf
@@ -177,10 +177,44 @@ def shortest_paths(
     that goal's distance is exact (ties included), every farther one is left at inf.
     See the module doc for the tie-break among equal predecessors.
     """
+    dist, pred = _search(graph, sources, limit, goals, predecessors=True)
+    assert pred is not None
+    return dist, pred
+
+
+def distances(graph: Graph, sources: IntArray) -> FloatArray:
+    """The distances :func:`shortest_paths` gives (bit for bit: they are the unique solution
+    the module doc names, whatever the order of the relaxations), without predecessors.
+
+    The same search without the tie-break's two keys: a round takes one scatter-minimum
+    instead of three and carries no tails, about a third less time for a search whose paths are
+    not read (the guided search's bounds are distances to whole regions, over every cell)."""
+    dist, _ = _search(graph, sources, np.inf, None, predecessors=False)
+    return dist
+
+
+def relax_distances(dist: FloatArray, v: IntArray, d: FloatArray) -> IntArray:
+    """Take the offers ``d`` to ``v`` (distances only, one scatter-minimum): returns the
+    nodes whose distance got shorter, twice where two offers tie at the new distance."""
+    old = dist[v]
+    np.minimum.at(dist, v, d)
+    improved: IntArray = v[(d < old) & (d == dist[v])]
+    return improved
+
+
+def _search(
+    graph: Graph,
+    sources: IntArray,
+    limit: float,
+    goals: BoolArray | None,
+    *,
+    predecessors: bool,
+) -> tuple[FloatArray, IntArray | None]:
+    """:func:`shortest_paths`, or with ``predecessors`` false :func:`distances` (pred None)."""
     n = graph.num_nodes
     dist = np.full(n, np.inf)
-    pred = np.full(n, -1, dtype=np.int64)
-    via = np.full(n, np.inf)  # d(pred[v]): the tie-break's first key
+    pred = np.full(n, -1, dtype=np.int64) if predecessors else None
+    via = np.full(n, np.inf) if predecessors else None  # d(pred[v]): the tie-break's first key
     queued = np.zeros(n, dtype=bool)
     frontier = np.unique(np.asarray(sources, dtype=np.int64))
     dist[frontier] = 0.0
@@ -190,6 +224,7 @@ def shortest_paths(
         nearest_goal = 0.0
     width = BUCKET_WIDTH * float(graph.weights.mean()) if graph.nnz else 1.0
     indptr, targets, weights = graph.indptr, graph.targets, graph.weights
+    stamp = np.empty(n if pred is None else 0, dtype=np.int64)  # without predecessors
     while len(frontier):
         current = dist[frontier]
         lowest = float(current.min())
@@ -207,10 +242,21 @@ def shortest_paths(
         # As in _out_edges; each edge's tail and its distance, repeated along its run, are
         # read from the active nodes rather than gathered per edge.
         edges = np.repeat(starts - ends + counts, counts) + np.arange(total)
-        u = np.repeat(active, counts)
         du = np.repeat(current[take], counts)
         v = targets[edges].astype(np.int64, copy=False)  # indexes many arrays: cast once
         d = du + weights[edges]
+        if pred is None or via is None:
+            fresh = relax_distances(dist, v, d)
+            fresh = fresh[~queued[fresh]]
+            # Each node once (numpy's unique costs more than the rest of a round): of a node
+            # listed twice, only the position whose write to ``stamp`` stayed (one of them).
+            count = np.arange(len(fresh))
+            stamp[fresh] = count
+            fresh = fresh[stamp[fresh] == count]
+            queued[fresh] = True
+            frontier = np.concatenate([frontier, fresh])
+            continue
+        u = np.repeat(active, counts)
         if limit < np.inf:
             keep = d <= limit
             u, v, du, d = u[keep], v[keep], du[keep], d[keep]
@@ -220,7 +266,7 @@ def shortest_paths(
             if hit.any():
                 nearest_goal = min(nearest_goal, float(dist[improved[hit]].min()))
         frontier = _enqueue(frontier, improved, queued)
-    if len(frontier):
+    if len(frontier) and pred is not None:
         # Stopped at the nearest goal: what lies beyond is not final.
         beyond = dist > nearest_goal
         dist[beyond] = np.inf

@@ -405,6 +405,11 @@ def simulate(abstraction: Abstraction, controllers: Controllers, mission: Missio
             if frame is None:
                 frame = frames[index] = _exit_frame(controller)
             rel_times, rel_points = _exit_step(controller, x, frame)
+        # Per step, not per sample: the last sample is the crossing (but for a stay), in the
+        # next triangle where there is one.
+        last = -1 if controller.is_stay else len(rel_times) - 1
+        inside = controller.triangle
+        beyond = inside if controller.next_triangle is None else controller.next_triangle
         for offset, (t, point) in enumerate(zip(rel_times, rel_points, strict=True)):
             if t <= 0.0:  # already on the exit edge: the current sample is the crossing
                 if controller.next_triangle is not None:
@@ -413,15 +418,12 @@ def simulate(abstraction: Abstraction, controllers: Controllers, mission: Missio
                 continue
             times.append(now + t)
             points.append(point)
-            is_crossing = not controller.is_stay and offset == len(rel_times) - 1
             step_of.append(index)
-            triangle_of.append(
-                controller.next_triangle
-                if is_crossing and controller.next_triangle is not None
-                else controller.triangle
-            )
-            if is_crossing:
+            if offset == last:
+                triangle_of.append(beyond)
                 crossings.append(len(points) - 1)
+            else:
+                triangle_of.append(inside)
         now = times[-1]
         x = points[-1]
     if loop_start_step is not None and loop_index is None:  # pragma: no cover - defensive
