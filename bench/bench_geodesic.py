@@ -260,8 +260,8 @@ def _compile(workload: Workload, follow: bool) -> tuple[Any, float]:
     module = importlib.import_module("tlmpc.control.synthesize")
     original, guides = module.path_guides, []
 
-    def recorded(*args: Any) -> Any:
-        guides[:] = original(*args)
+    def recorded(*args: Any, **keywords: Any) -> Any:
+        guides[:] = original(*args, **keywords)
         return list(guides)
 
     fields = functools.partial(module.synthesize, follow=follow)
@@ -502,11 +502,11 @@ def gap_rows(only: tuple[str, ...] = ()) -> list[dict[str, Any]]:
     module = importlib.import_module("tlmpc.control.synthesize")
     channel = importlib.import_module("tlmpc.control.channel")
     original = module.path_guides
-    calls: list[Any] = []
+    calls: list[tuple[Any, Any]] = []
 
-    def recorded(*args: Any) -> Any:
-        calls.append(args)
-        return original(*args)
+    def recorded(*args: Any, **keywords: Any) -> Any:
+        calls.append((args, keywords))
+        return original(*args, **keywords)
 
     rows = []
     for workload in workloads():
@@ -518,11 +518,12 @@ def gap_rows(only: tuple[str, ...] = ()) -> list[dict[str, Any]]:
         with mock.patch.object(module, "path_guides", recorded):
             result = compile_mission(source if text is None else "bench.yaml", text=text)
         mission = result.compilation.get(MISSION)
-        followed = original(*calls[-1])
+        args, keywords = calls[-1]
+        followed = original(*args, **keywords)
         with mock.patch.multiple(
             channel, PORTAL_INSET=0.0, LABEL_INSET=0.0, ENTERED_INSET=0.0, REACH_ROUNDS=0
         ):
-            bare = original(*calls[-1])
+            bare = original(*args, **keywords)
         shapes = {r.name: shapely.Polygon(r.polygon) for r in mission.regions}
         free = workspace_free_space(mission)
         for name in workload.avoid:
