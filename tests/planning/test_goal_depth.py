@@ -103,6 +103,18 @@ def test_the_default_depth_is_a_tenth_of_a_second_at_max_speed(speed: float, dep
         assert depth <= inset <= depth * 1.03
 
 
+def test_a_body_at_speed_goes_a_tenth_of_a_second_deep() -> None:
+    # a body of radius 0.1 at 4 m/s: 0.4 deep, more than the margin (the radius)
+    document = _mission([(2.0, 2.0, 12.0, 10.0)], 4.0)
+    document["robot"]["radius"] = 0.1
+    layout = planning_layout(load_mission_text(json.dumps(document)), 0.1)
+    assert layout is not None
+    (core,) = layout.regions
+    x0, y0, x1, y1 = core.bounds
+    for inset in (x0 - 2.0, y0 - 2.0, 12.0 - x1, 10.0 - y1):
+        assert 0.4 <= inset <= 0.4 * 1.03
+
+
 def test_a_margin_deeper_than_the_default_depth_is_kept() -> None:
     # a body of radius 0.3: the margin (the radius by default) is deeper than 0.1 s at 1 m/s
     document = _mission([(2.0, 2.0, 12.0, 10.0)])
