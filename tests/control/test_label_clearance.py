@@ -69,9 +69,11 @@ def test_entering_a_label_keeps_the_clearance_at_its_exposed_ends(length: float)
     assert _exit_insets(one)[0] == PORTAL_INSET  # the left end is not exposed
 
 
-def test_entering_a_label_by_a_wall_keeps_the_middle_of_the_edge() -> None:
-    step = _step(10.0, labelled=(False, True, False), entered=True, by_wall=True, clearance=0.1)
-    assert _exit_insets(step) == (ENTERED_INSET, ENTERED_INSET)
+@pytest.mark.parametrize("length", [0.2, 1.0, 10.0])
+def test_entering_a_label_by_a_wall_keeps_the_clearance_at_both_ends(length: float) -> None:
+    step = _step(length, labelled=(False, True, False), entered=True, by_wall=True, clearance=0.1)
+    kept = max(PORTAL_INSET, min(ENTERED_INSET, 0.1 / length))
+    assert _exit_insets(step) == (kept, kept)
 
 
 def test_without_a_clearance_the_fractions_stand() -> None:
