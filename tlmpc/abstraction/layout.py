@@ -63,6 +63,12 @@ GOAL_DEPTH_FRACTION = 0.25
 #: A fixed fraction of the inradius alone made every visit to a large room cost half a metre
 #: or more of detour (Example 6: 1.17 x the shortest path for the depth alone).
 GOAL_DEPTH_TIME = 0.1
+#: ... but never less than this fraction of the workspace's extent: a slow robot on a large
+#: map would otherwise get a rim between core and region far thinner than anything else the
+#: mesh holds (a quality mesh fills a strip of width w along a perimeter p with about p / w
+#: triangles), and a core within a millionth of the extent of its region's edge would count
+#: as that edge (:mod:`tlmpc.control.clearance`).
+GOAL_DEPTH_FLOOR = 1e-3
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -90,22 +96,38 @@ def inradius(region: Any) -> float:
     return radius
 
 
-def default_goal_depth(region: Any, max_speed: float) -> float:
+def default_goal_depth(region: Any, max_speed: float, extent: float = 0.0) -> float:
     """The goal depth when ``options.goal_depth`` is unset: :data:`GOAL_DEPTH_FRACTION` of
-    ``region``'s inradius, at most ``max_speed`` x :data:`GOAL_DEPTH_TIME`."""
-    return min(GOAL_DEPTH_FRACTION * inradius(region), GOAL_DEPTH_TIME * max_speed)
+    ``region``'s inradius, at most ``max_speed`` x :data:`GOAL_DEPTH_TIME` but not below
+    :data:`GOAL_DEPTH_FLOOR` x the workspace's ``extent``."""
+    fraction = GOAL_DEPTH_FRACTION * inradius(region)
+    timed = max(GOAL_DEPTH_TIME * max_speed, GOAL_DEPTH_FLOOR * extent)
+    return min(fraction, timed)
 
 
 def goal_depth(
-    region: Any, margin: float, requested: float | None, scale: float = 1.0, max_speed: float = 1.0
+    region: Any,
+    margin: float,
+    requested: float | None,
+    scale: float = 1.0,
+    max_speed: float = 1.0,
+    extent: float = 0.0,
 ) -> float:
     """How deep a path must go into the goal ``region``: the margin, or ``requested``
-    (``options.goal_depth``; unset: :func:`default_goal_depth` at ``max_speed``) times
-    ``scale`` (a shallower try, see :func:`planning_layout`) when deeper.
+    (``options.goal_depth``; unset: :func:`default_goal_depth` at ``max_speed`` on a
+    workspace of that ``extent``) times ``scale`` (a shallower try, see
+    :func:`planning_layout`) when deeper.
 
     :func:`core` caps it at half the inradius."""
-    wanted = default_goal_depth(region, max_speed) if requested is None else requested
+    wanted = default_goal_depth(region, max_speed, extent) if requested is None else requested
     return max(margin, scale * wanted)
+
+
+def workspace_extent(mission: Mission) -> float:
+    """The larger side of the workspace's bounding box."""
+    xs = [x for piece in mission.workspace.pieces for x, _ in piece.boundary]
+    ys = [y for piece in mission.workspace.pieces for _, y in piece.boundary]
+    return max(max(xs) - min(xs), max(ys) - min(ys))
 
 
 def core(region: Any, depth: float) -> Any:
@@ -160,8 +182,8 @@ def planning_layout(
         sign = signs.get(region.name)
         if sign == "positive":
             requested = mission.options.goal_depth
-            speed = mission.robot.max_speed
-            depth = goal_depth(shape, margin, requested, scale, speed) if deep else margin
+            speed, extent = mission.robot.max_speed, workspace_extent(mission)
+            depth = goal_depth(shape, margin, requested, scale, speed, extent) if deep else margin
             inner = core(shape, depth)
             shape = inner if not inner.is_empty else shape
         elif sign == "negative":
@@ -185,7 +207,8 @@ def _point_layout(mission: Mission, scale: float = 1.0) -> PlanningLayout | None
         if signs.get(region.name) == "positive":
             polygon = shapely.Polygon(region.polygon)
             requested = mission.options.goal_depth
-            depth = goal_depth(polygon, 0.0, requested, scale, mission.robot.max_speed)
+            speed, extent = mission.robot.max_speed, workspace_extent(mission)
+            depth = goal_depth(polygon, 0.0, requested, scale, speed, extent)
             inner = core(polygon, depth)
             shape = inner if not inner.is_empty else None
         shapes.append(shape)
