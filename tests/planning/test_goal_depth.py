@@ -92,7 +92,7 @@ def test_visits_reach_the_goal_depth(
     ("speed", "depth"),
     # a 10 x 8 room (inradius 4, a quarter of it 1.0): 0.1 s at max_speed, at most 1.0, and
     # at least a thousandth of the workspace's extent (20: 0.02) for a robot crawling
-    [(1.0, 0.1), (4.0, 0.4), (20.0, 1.0), (1e-6, 0.02)],
+    [(1.0, 0.1), (4.0, 0.4), (20.0, 1.0), (0.001, 0.02)],
 )
 def test_the_default_depth_is_a_tenth_of_a_second_at_max_speed(speed: float, depth: float) -> None:
     mission = load_mission_text(json.dumps(_mission([(2.0, 2.0, 12.0, 10.0)], speed)))
