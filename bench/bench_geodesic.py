@@ -249,6 +249,92 @@ def held_out_late() -> list[Workload]:
     ]
 
 
+def held_out_depth() -> list[Workload]:
+    """Missions written after the default goal depth (0.1 s at max_speed) and the clearance
+    at a region's own boundary were tuned, measured once: an L-shaped clinic with a body and
+    a margin, a hangar of large bays crossed by a fast point robot, a patrol of three posts
+    round a campus with a body."""
+    clinic = {
+        "version": 1,
+        "name": "clinic",
+        "workspace": {
+            "boundary": [[0, 0], [26, 0], [26, 10], [12, 10], [12, 20], [0, 20]],
+            "holes": [
+                {"rect": [5, 3, 5.3, 10]},
+                {"rect": [5, 12, 9, 12.3]},
+                {"rect": [16, 4, 21, 6.5]},
+                {"rect": [7.5, 15, 8, 20]},
+            ],
+        },
+        "regions": {
+            "reception": {"rect": [1, 1, 4, 4]},
+            "pharmacy": {"rect": [22, 6.5, 25.5, 9.5]},
+            "xray": {"rect": [8.5, 16, 11.5, 19.5]},
+            "wet": {"rect": [9, 5, 11, 7]},
+        },
+        "robot": {"start": [2.5, 8.0], "max_speed": 0.8, "radius": 0.2},
+        "task": ["visit reception then pharmacy then xray", "avoid wet"],
+        "options": {"margin": 0.15},
+    }
+    hangar = {
+        "version": 1,
+        "name": "hangar",
+        "workspace": {
+            "boundary": {"rect": [0, 0, 40, 25]},
+            "holes": [
+                [[8, 8], [16, 9], [15, 14], [9, 15]],
+                [[22, 4], [30, 4], [30, 10], [22, 10]],
+                [[24, 15], [33, 15], [31, 21], [26, 21]],
+            ],
+        },
+        "regions": {
+            "bay1": {"rect": [1, 17, 9, 24]},
+            "bay2": {"rect": [32, 1, 39, 9]},
+            "bay3": {"rect": [34, 16, 39.5, 24.5]},
+            "fuel": {"rect": [17, 16, 21, 20]},
+        },
+        "robot": {"start": [2.0, 2.0], "max_speed": 2.0},
+        "task": ["visit bay1 then bay2 then bay3", "avoid fuel"],
+    }
+    campus = {
+        "version": 1,
+        "name": "campus",
+        "workspace": {
+            "boundary": [[0, 0], [24, 0], [24, 18], [0, 18]],
+            "holes": [
+                {"rect": [4, 4, 10, 8]},
+                {"rect": [13, 3, 19, 7]},
+                [[6, 11], [11, 11], [11, 15], [8, 16]],
+                {"rect": [15, 10, 20, 14]},
+            ],
+        },
+        "regions": {
+            "library": {"rect": [1, 14, 4, 17]},
+            "gym": {"rect": [21, 1, 23.5, 4]},
+            "hall": {"rect": [20.5, 15, 23.5, 17.5]},
+            "pond": {"rect": [11.5, 8, 14, 10]},
+        },
+        "robot": {"start": [1.0, 1.0], "max_speed": 1.5, "radius": 0.25},
+        "task": ["patrol library, gym and hall", "avoid pond"],
+    }
+    return [
+        Workload(
+            "clinic r=0.2 m=0.15",
+            clinic,
+            (("reception",), ("pharmacy",), ("xray",)),
+            avoid=("wet",),
+        ),
+        Workload("hangar v=2", hangar, (("bay1",), ("bay2",), ("bay3",)), avoid=("fuel",)),
+        Workload(
+            "campus r=0.25 patrol",
+            campus,
+            (("library", "gym", "hall"),),
+            avoid=("pond",),
+            patrol=True,
+        ),
+    ]
+
+
 def _compile(workload: Workload, follow: bool) -> tuple[Any, float]:
     """The compiled mission and the length of the path its fields follow (the channel's
     shortest path with the portal insets; nan before)."""
@@ -260,8 +346,8 @@ def _compile(workload: Workload, follow: bool) -> tuple[Any, float]:
     module = importlib.import_module("tlmpc.control.synthesize")
     original, guides = module.path_guides, []
 
-    def recorded(*args: Any) -> Any:
-        guides[:] = original(*args)
+    def recorded(*args: Any, **keywords: Any) -> Any:
+        guides[:] = original(*args, **keywords)
         return list(guides)
 
     fields = functools.partial(module.synthesize, follow=follow)
@@ -399,6 +485,7 @@ def workloads() -> list[Workload]:
         generated(6, radius=0.2, patrol=True),
         *held_out(),
         *held_out_late(),
+        *held_out_depth(),
     ]
 
 
@@ -502,11 +589,11 @@ def gap_rows(only: tuple[str, ...] = ()) -> list[dict[str, Any]]:
     module = importlib.import_module("tlmpc.control.synthesize")
     channel = importlib.import_module("tlmpc.control.channel")
     original = module.path_guides
-    calls: list[Any] = []
+    calls: list[tuple[Any, Any]] = []
 
-    def recorded(*args: Any) -> Any:
-        calls.append(args)
-        return original(*args)
+    def recorded(*args: Any, **keywords: Any) -> Any:
+        calls.append((args, keywords))
+        return original(*args, **keywords)
 
     rows = []
     for workload in workloads():
@@ -518,11 +605,12 @@ def gap_rows(only: tuple[str, ...] = ()) -> list[dict[str, Any]]:
         with mock.patch.object(module, "path_guides", recorded):
             result = compile_mission(source if text is None else "bench.yaml", text=text)
         mission = result.compilation.get(MISSION)
-        followed = original(*calls[-1])
+        args, keywords = calls[-1]
+        followed = original(*args, **keywords)
         with mock.patch.multiple(
             channel, PORTAL_INSET=0.0, LABEL_INSET=0.0, ENTERED_INSET=0.0, REACH_ROUNDS=0
         ):
-            bare = original(*calls[-1])
+            bare = original(*args, **keywords)
         shapes = {r.name: shapely.Polygon(r.polygon) for r in mission.regions}
         free = workspace_free_space(mission)
         for name in workload.avoid:

@@ -33,7 +33,10 @@ def _without_timings(document: Any) -> Any:
     return document
 
 
-@pytest.mark.parametrize("spec", ["example1.yaml", "patrol.yaml", "reach-avoid.yaml"])
+# (not the missions whose plan refines the mesh where its path touches a region, Example 6
+# and reach-avoid: their abstraction.json is the plan stage's refined mesh; the deadline
+# mission has reach-avoid's map and holes)
+@pytest.mark.parametrize("spec", ["example1.yaml", "patrol.yaml", "deadline.yaml"])
 def test_every_stage_reproduces_its_artifacts_from_its_inputs(tmp_path: Path, spec: str) -> None:
     whole = compile_mission(ROOT / "specs" / spec, until="verify")
     write_artifacts(tmp_path, whole.artifacts)

@@ -138,14 +138,14 @@ def test_c032_states_the_largest_disturbance_the_mesh_supports() -> None:
 
 
 def test_the_goal_depth_yields_to_the_disturbance() -> None:
-    # Example 1 at 0.35 compiled before goal cores existed; their corners are sharper
-    compiled = tlmpc.compile(_example1(0.35), until="control")
+    # Example 1 at 0.37 compiled before goal cores existed; their corners are sharper
+    compiled = tlmpc.compile(_example1(0.37), until="control")
     warnings = [w for w in compiled.warnings if w.code == "A040"]
     assert len(warnings) == 1
     assert warnings[0].severity == "warning"
     assert warnings[0].path == "$.robot.disturbance"
-    assert "0.35" in warnings[0].message
-    # half the goal depth is enough there (the widest lasso on that mesh is 0.354)
+    assert "0.37" in warnings[0].message
+    # half the goal depth is enough there
     assert "with cores 0.5 x the goal depth deep" in warnings[0].message
     # at 0.38 only the regions as drawn carry it (a 45 degree corner: sin 22.5 = 0.3827)
     drawn = tlmpc.compile(_example1(0.38), until="control")
@@ -153,9 +153,9 @@ def test_the_goal_depth_yields_to_the_disturbance() -> None:
     assert "only as deep as the margin asks" in warning.message
     controllers = compiled.artifacts["controllers.json"]
     for step in controllers["steps"]:
-        check_step(step, 0.35, controllers["max_speed"])
+        check_step(step, 0.37, controllers["max_speed"])
     # an explicit goal depth is named as the cause
-    explicit = tlmpc.compile(_example1(0.35, goal_depth=0.5), until="control")
+    explicit = tlmpc.compile(_example1(0.37, goal_depth=0.5), until="control")
     assert [w.path for w in explicit.warnings if w.code == "A040"] == ["$.options.goal_depth"]
     # where the goal cores' plan holds, nothing yields and nothing is said
     calm = tlmpc.compile(_example1(0.3), until="control")

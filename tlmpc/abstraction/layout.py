@@ -10,8 +10,9 @@
 
   - a region that occurs only positively (a goal: visit, stay, reach) labels its **core**, the
     region eroded by its goal depth (:func:`goal_depth`: at least m, by default a quarter of
-    its inradius; by half its inradius when that is smaller: then the core is a small patch
-    around its pole of inaccessibility), so that a visit is a visit and not a touch;
+    its inradius but at most what the robot covers in 0.1 s at max_speed; by half its
+    inradius when that is smaller: then the core is a small patch around its pole of
+    inaccessibility), so that a visit is a visit and not a touch;
   - a region that occurs only negatively (avoid it) labels its **grown** shape, the region
     dilated by m (when the robot starts within m of it, except within 2 m of the start);
   - a region of both polarities, or not in the task, keeps its shape.
@@ -51,10 +52,23 @@ SNAP_SLACK = 2.0
 #: (a smaller patch would be a sliver of the grid's size in the mesh).
 START_ROOM = 1e3
 
-#: The default goal depth, as a fraction of the goal region's inradius (``options.goal_depth``
-#: unset): deep enough that a visit shows in a picture, scale-free, and half way from the
-#: boundary to the cap of half the inradius, so goals that overlap keep cores that meet.
+#: The default goal depth (``options.goal_depth`` unset) is the least of two: this fraction
+#: of the goal region's inradius (a small region is entered visibly, half way from the
+#: boundary to the cap of half the inradius, so goals that overlap keep cores that meet) ...
 GOAL_DEPTH_FRACTION = 0.25
+#: ... and the distance the robot covers at ``max_speed`` in this many seconds.  A visit that
+#: goes d deep lasts at least 2 d / max_speed, so a log sampled at least every 2 x this
+#: (0.2 s: 5 Hz) at up to max_speed has a sample inside the region, and the verifier's
+#: certificate (the robot within max_speed x half a gap of a sample) can prove the visit.
+#: A fixed fraction of the inradius alone made every visit to a large room cost half a metre
+#: or more of detour (Example 6: 1.17 x the shortest path for the depth alone).
+GOAL_DEPTH_TIME = 0.1
+#: ... but never less than this fraction of the workspace's extent: a slow robot on a large
+#: map would otherwise get a rim between core and region far thinner than anything else the
+#: mesh holds (a quality mesh fills a strip of width w along a perimeter p with about p / w
+#: triangles), and a core within a millionth of the extent of its region's edge would count
+#: as that edge (:mod:`tlmpc.control.clearance`).
+GOAL_DEPTH_FLOOR = 1e-3
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)
@@ -82,14 +96,38 @@ def inradius(region: Any) -> float:
     return radius
 
 
-def goal_depth(region: Any, margin: float, requested: float | None, scale: float = 1.0) -> float:
+def default_goal_depth(region: Any, max_speed: float, extent: float = 0.0) -> float:
+    """The goal depth when ``options.goal_depth`` is unset: :data:`GOAL_DEPTH_FRACTION` of
+    ``region``'s inradius, at most ``max_speed`` x :data:`GOAL_DEPTH_TIME` but not below
+    :data:`GOAL_DEPTH_FLOOR` x the workspace's ``extent``."""
+    fraction = GOAL_DEPTH_FRACTION * inradius(region)
+    timed = max(GOAL_DEPTH_TIME * max_speed, GOAL_DEPTH_FLOOR * extent)
+    return min(fraction, timed)
+
+
+def goal_depth(
+    region: Any,
+    margin: float,
+    requested: float | None,
+    scale: float = 1.0,
+    max_speed: float = 1.0,
+    extent: float = 0.0,
+) -> float:
     """How deep a path must go into the goal ``region``: the margin, or ``requested``
-    (``options.goal_depth``; unset: :data:`GOAL_DEPTH_FRACTION` of the inradius) times
-    ``scale`` (a shallower try, see :func:`planning_layout`) when deeper.
+    (``options.goal_depth``; unset: :func:`default_goal_depth` at ``max_speed`` on a
+    workspace of that ``extent``) times ``scale`` (a shallower try, see
+    :func:`planning_layout`) when deeper.
 
     :func:`core` caps it at half the inradius."""
-    wanted = GOAL_DEPTH_FRACTION * inradius(region) if requested is None else requested
+    wanted = default_goal_depth(region, max_speed, extent) if requested is None else requested
     return max(margin, scale * wanted)
+
+
+def workspace_extent(mission: Mission) -> float:
+    """The larger side of the workspace's bounding box."""
+    xs = [x for piece in mission.workspace.pieces for x, _ in piece.boundary]
+    ys = [y for piece in mission.workspace.pieces for _, y in piece.boundary]
+    return max(max(xs) - min(xs), max(ys) - min(ys))
 
 
 def core(region: Any, depth: float) -> Any:
@@ -144,7 +182,8 @@ def planning_layout(
         sign = signs.get(region.name)
         if sign == "positive":
             requested = mission.options.goal_depth
-            depth = goal_depth(shape, margin, requested, scale) if deep else margin
+            speed, extent = mission.robot.max_speed, workspace_extent(mission)
+            depth = goal_depth(shape, margin, requested, scale, speed, extent) if deep else margin
             inner = core(shape, depth)
             shape = inner if not inner.is_empty else shape
         elif sign == "negative":
@@ -167,7 +206,10 @@ def _point_layout(mission: Mission, scale: float = 1.0) -> PlanningLayout | None
         shape: Any = None
         if signs.get(region.name) == "positive":
             polygon = shapely.Polygon(region.polygon)
-            inner = core(polygon, goal_depth(polygon, 0.0, mission.options.goal_depth, scale))
+            requested = mission.options.goal_depth
+            speed, extent = mission.robot.max_speed, workspace_extent(mission)
+            depth = goal_depth(polygon, 0.0, requested, scale, speed, extent)
+            inner = core(polygon, depth)
             shape = inner if not inner.is_empty else None
         shapes.append(shape)
     if all(shape is None for shape in shapes):

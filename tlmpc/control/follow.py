@@ -284,10 +284,12 @@ def path_guides(
     start: tuple[float, float],
     *,
     passages: bool = False,
+    clearance: float | None = None,
 ) -> list[Guide | None]:
     """The channel's shortest path, one straight piece per step (None for a vertex
     passage, unless ``passages``: then its piece to the corner), with the portal insets of
-    :mod:`tlmpc.control.channel`."""
+    :mod:`tlmpc.control.channel` (``clearance``: the distance kept from a region's own
+    boundary, :attr:`tlmpc.control.channel.ChannelStep.clearance`)."""
     # A vertex is on a label boundary when the triangles around it do not all share a label.
     letters = np.repeat(abstraction.letter_of, 3)  # each corner's triangle's letter
     count = len(abstraction.vertices)
@@ -317,6 +319,8 @@ def path_guides(
             entered=index > 0
             and label[step.triangle] != label[steps[index - 1].triangle]
             and (any(flags[index]) or near[index]),
+            by_wall=near[index],
+            clearance=clearance,
             corners=_corners(step.geometry.vertices),
             exit_edge=step.exit_edge,
             through=None if step.through is None else _point(abstraction.vertices[step.through]),

@@ -25,6 +25,7 @@ import numpy as np
 
 from tlmpc.abstraction.model import Abstraction, FloatArray
 from tlmpc.base.errors import InvalidInputError, SolverError, error
+from tlmpc.control.channel import label_clearance
 from tlmpc.control.follow import bends, follow_channel, path_guides
 from tlmpc.control.geometry import (
     TriangleGeometry,
@@ -683,7 +684,17 @@ def synthesize(
         if robot.disturbance > 0.0
         else 0.0
     )
-    guides = path_guides(abstraction, steps, loop_start, robot.start) if follow else None
+    guides = (
+        path_guides(
+            abstraction,
+            steps,
+            loop_start,
+            robot.start,
+            clearance=label_clearance(robot.max_speed),
+        )
+        if follow
+        else None
+    )
     split = bends(abstraction, steps, loop_start, guides) if guides is not None else frozenset()
     _, jumps = _assign_runs(
         abstraction, steps, loop_start, push=push, max_speed=robot.max_speed, split=split

@@ -58,7 +58,7 @@ MAX_REPLANS = 6
 #: ... and none that would bring the products of all the plans made past this many nodes (a
 #: re-plan costs about what the plan before it did, counted by its product's nodes: on a
 #: large mesh the loop stops early or does not run at all, deterministically).
-NODE_BUDGET = 100_000
+NODE_BUDGET = 250_000
 
 
 @dataclass(frozen=True, slots=True)
@@ -216,12 +216,16 @@ def pull(mission: Mission, planned: Planned) -> Pulled:
     (:func:`tlmpc.control.follow.path_guides`): its length (see the module doc) and the
     length of each of D's moves on it, keyed by :func:`~tlmpc.planning.timing.move_key`
     (plus the weights' stutter cost)."""
+    from tlmpc.control.channel import label_clearance
     from tlmpc.control.follow import path_guides
     from tlmpc.control.synthesize import plan_steps
 
     abstraction, witness = planned.abstraction, planned.witness
     steps, loop_start = plan_steps(abstraction, witness)
-    pieces = path_guides(abstraction, steps, loop_start, mission.robot.start, passages=True)
+    clearance = label_clearance(mission.robot.max_speed)
+    pieces = path_guides(
+        abstraction, steps, loop_start, mission.robot.start, passages=True, clearance=clearance
+    )
     lengths = [0.0 if p is None else math.dist(p.entry, p.exit) for p in pieces]
     neighbors = abstraction.neighbors
     moves: dict[MoveKey, float] = {}
