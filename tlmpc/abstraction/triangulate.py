@@ -8,7 +8,7 @@ chain of constraint segments, each triangle lies wholly inside or wholly outside
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from itertools import chain
 from typing import TYPE_CHECKING, Any
 
@@ -222,15 +222,27 @@ def _inside(free: Any, rings: list[Any]) -> list[Any]:
 
 
 def _merge_close(
-    vertices: FloatArray, edges: IntArray, tolerance: float
+    vertices: FloatArray,
+    edges: IntArray,
+    tolerance: float,
+    keys: IntArray,
+    written: Callable[[], IntArray],
 ) -> tuple[FloatArray, IntArray]:
-    """The graph with every segment no longer than ``tolerance`` contracted to its end of
-    lower index. Snap rounding nodes two lines that cross within a pixel of each other's
-    vertex at neighbouring pixels (a region's side clipped at a hole's side, and that side
-    noded where the region's side crosses it): a segment one pixel long, which Triangle
-    would keep as a needle triangle joining a region to the space beside it."""
+    """The graph with every segment no longer than ``tolerance`` between two points that
+    noding made (neither one's grid key is among the keys ``written`` gives of the rings'
+    vertices) contracted to its end of
+    lower index. Snap rounding can node one crossing at two neighbouring pixels (a region's
+    side clipped at a hole's side, and that side noded where the region's side crosses it): a
+    segment one pixel long that Triangle would keep as a needle triangle joining a region to
+    the space beside it. Short sides the map itself has (a needle drawn as such, a body's
+    configuration space) are kept as they are."""
     span = vertices[edges[:, 1]] - vertices[edges[:, 0]]
     short = np.hypot(span[:, 0], span[:, 1]) <= tolerance
+    if not short.any():
+        return vertices, edges
+    drawn = {tuple(key) for key in written().tolist()}
+    made = np.array([tuple(key) not in drawn for key in keys.tolist()])
+    short &= made[edges[:, 0]] & made[edges[:, 1]]
     if not short.any():
         return vertices, edges
     owner: dict[int, int] = {}
@@ -324,7 +336,15 @@ def pslg(
     edges = edges[edges[:, 0] != edges[:, 1]]
     edges = np.sort(edges, axis=1)
     edges = edges[_unique_rows(edges)[0]]
-    vertices, edges = _merge_close(vertices, edges, CLOSE_PIXELS * grid)
+    vertices, edges = _merge_close(
+        vertices,
+        edges,
+        CLOSE_PIXELS * grid,
+        keys[first],
+        lambda: np.round(
+            (shapely.get_coordinates([*free_rings, *region_rings]) - np.array([minx, miny])) / grid
+        ).astype(np.int64),
+    )
     seeds = []
     for part in parts:
         for interior in part.interiors:
