@@ -94,7 +94,7 @@ def test_a_disturbance_too_large_for_any_cell_is_refused_at_its_value(tmp_path: 
 
 def test_warnings_of_later_stages_are_placed_too(tmp_path: Path) -> None:
     example = (Path(__file__).parent.parent / "specs" / "example1.yaml").read_text(encoding="utf-8")
-    text = example.replace("max_speed: 1.0}", "max_speed: 1.0, disturbance: 0.35}")
+    text = example.replace("max_speed: 1.0}", "max_speed: 1.0, disturbance: 0.37}")
     assert text != example
     source = tmp_path / "example1.yaml"
     source.write_text(text, encoding="utf-8")
