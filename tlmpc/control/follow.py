@@ -53,6 +53,13 @@ OBJECTIVE_GAP = 1e-4
 GUARANTEE = 1.0
 #: ... and the floor (the smallest guaranteed speed) this many times more.
 FLOOR_WEIGHT = 10.0
+#: ... but only up to this fraction of max_speed (beyond the disturbance: the guaranteed
+#: speeds are what is left of the velocity across the exit facet under the worst
+#: disturbance).  Uncapped, a floor that the split velocity runs (:func:`bends`) raise drew
+#: every step's exit speed up to it, turning the fields off the path to push across their
+#: exit facets (a regular grid's fields crossed at 37° to their pieces).  The weakest step
+#: keeps the vertex program's floor where that is lower, and at least this otherwise.
+FLOOR_CAP = 0.1
 
 
 class ConicLike(Protocol):
@@ -188,6 +195,8 @@ def follow_program(
     blocks.append(  # t >= 0: -t + s = 0
         (-np.ones((len(follow), 1)), size + np.arange(len(follow))[:, None], np.zeros(len(follow)))
     )
+    # f <= FLOOR_CAP: f + s = FLOOR_CAP
+    blocks.append((np.ones((1, 1)), np.array([[2 * runs + steps]]), np.array([FLOOR_CAP])))
     rows, cols, vals, bounds, start = [], [], [], [], 0
     for values, columns, bound in blocks:
         height, width = values.shape
@@ -332,6 +341,15 @@ def path_guides(
 #: sides exceeds this (about 1.7°; sharing a velocity across a smaller turn cost nothing
 #: measurable, and each split is a reported velocity jump).
 BEND = 0.03
+#: Why a velocity run is split where the followed path bends.
+BENDS = "the path to follow bends across this edge"
+#: A vertex's velocity run is also split where sharing its velocity with the run so far
+#: would turn the velocity further than this (radians, about 10°) from some step's piece
+#: of the path than that step's own rows at the vertex do (smaller thresholds, 5° and 2°,
+#: measured the same times on the bench with more jumps).
+DEFLECTION = 0.17
+#: ... and why.
+DEFLECTS = "a velocity shared across this edge would turn a field away from the path"
 
 
 def bends(
@@ -339,16 +357,18 @@ def bends(
     steps: Sequence[PlanStep],
     loop_start: int | None,
     guides: Sequence[Guide | None],
-) -> frozenset[tuple[int, int]]:
+) -> dict[tuple[int, int], str]:
     """(step, mesh vertex) pairs where step's field should not share the vertex's velocity
-    with the step before: the two ends of a portal across which the path bends.
+    with the step before, and why: the two ends of a portal across which the path bends
+    (:data:`BENDS`), and the vertices where sharing would turn a field away from its piece of
+    the path (:data:`DEFLECTS`, :func:`deflections`).
 
     A velocity shared by both steps at both ends of a portal makes the two fields equal all
     along it; the path's crossing point would then need one direction on both sides, and the
     flow could only turn gradually, triangles away from the bend.  A stay has its own
     velocities already.
     """
-    split: set[tuple[int, int]] = set()
+    split: dict[tuple[int, int], str] = {}
     pairs = [(index - 1, index) for index in range(1, len(steps))]
     if loop_start is not None:
         pairs.append((len(steps) - 1, loop_start))  # the cycle's wrap
@@ -359,12 +379,103 @@ def bends(
         if abs(_sine(first, second)) <= BEND:
             continue
         shared = set(abstraction.triangles[steps[before].triangle].tolist())
-        split.update(
-            (after, vertex)
-            for vertex in abstraction.triangles[steps[after].triangle].tolist()
-            if vertex in shared
-        )
-    return frozenset(split)
+        for vertex in abstraction.triangles[steps[after].triangle].tolist():
+            if vertex in shared:
+                split[(after, vertex)] = BENDS
+    for pair in deflections(abstraction, steps, guides, frozenset(split)):
+        split[pair] = DEFLECTS
+    return split
+
+
+#: A run as :func:`deflections` tracks it: the directions its velocity must keep a·w >= 0
+#: with, and each step's (direction of its piece, deviation its own rows force).
+_Run = tuple[list[Point], list[tuple[Point, float]]]
+
+
+def deflections(
+    abstraction: Abstraction,
+    steps: Sequence[PlanStep],
+    guides: Sequence[Guide | None],
+    split: frozenset[tuple[int, int]] = frozenset(),
+) -> set[tuple[int, int]]:
+    """(step, vertex) pairs where the velocity run of the vertex is better split: shared
+    with the run so far, the velocity would be turned more than :data:`DEFLECTION` further
+    from some step's piece of the path than that step's own rows turn it.
+
+    A vertex velocity w of a step must satisfy a·w >= 0 (margins aside) for the inward
+    normals of the non-exit facets through the vertex and the exit facet's outward normal; a
+    run's velocity must satisfy every step's.  Where a step's piece of the path points out of
+    that cone (a corner's wedge the path does not pass through, shared with the steps before
+    it), every field of the run mixes a velocity turned away from its path into its flow and
+    slows down: on a bench office the robot crossed the room at 76 % of max_speed next to a
+    wall's end whose last triangle's wedge pointed 56° off the path.  ``split``: pairs split
+    already (a new run starts there).  Not a bound on anything: a heuristic on where velocity
+    jumps buy speed; every jump is a transversal switch (docs/control.md, Continuity).
+    """
+    found: set[tuple[int, int]] = set()
+    previous: dict[int, _Run] = {}  # per mesh vertex of the step before: its run
+    for index, step in enumerate(steps):
+        if step.through is not None or step.exit_edge is None:
+            previous = {}  # a vertex passage or a stay: nothing shared across it
+            continue
+        direction = _direction(guides[index])
+        current: dict[int, _Run] = {}
+        for local, vertex in enumerate(abstraction.triangles[step.triangle].tolist()):
+            rows = _vertex_normals(step, local)
+            own = [] if direction is None else [(direction, _deviation(direction, rows))]
+            run = previous.get(vertex)
+            current[vertex] = (rows, own)
+            if run is None or (index, vertex) in split:
+                continue
+            joined, wanted = run[0] + rows, run[1] + own
+            turned = [_deviation(d, joined) - alone for d, alone in wanted]
+            if any(math.isinf(t) for t in turned):
+                continue  # no common velocity: the runs split there for their own reason
+            if max(turned, default=0.0) > DEFLECTION:
+                found.add((index, vertex))
+            else:
+                current[vertex] = (joined, wanted)
+        previous = current
+    return found
+
+
+def _direction(guide: Guide | None) -> Point | None:
+    """The unit direction of a piece of the path (None for none or a point)."""
+    if guide is None:
+        return None
+    dx, dy = guide.exit[0] - guide.entry[0], guide.exit[1] - guide.entry[1]
+    norm = math.hypot(dx, dy)
+    return None if norm == 0.0 else (dx / norm, dy / norm)
+
+
+def _vertex_normals(step: PlanStep, local: int) -> list[Point]:
+    """The directions a with a·w >= 0 that the vertex program's rows ask of the velocity at
+    local vertex ``local`` (their margins aside): inward across the non-exit facets through
+    it, across the exit facet."""
+    normals = step.geometry.normals.tolist()
+    rows: list[Point] = [
+        (-normals[facet][0], -normals[facet][1])
+        for facet in range(3)
+        if facet != local and facet != step.exit_edge
+    ]
+    if step.exit_edge is not None:
+        rows.append((normals[step.exit_edge][0], normals[step.exit_edge][1]))
+    return rows
+
+
+def _deviation(direction: Point, normals: Sequence[Point]) -> float:
+    """The angle from ``direction`` to the nearest unit vector u with a·u >= 0 for every a in
+    ``normals``; inf when only the zero vector is left (the cone's edges are the unit vectors
+    perpendicular to one of the a that satisfy the others)."""
+    dx, dy = direction
+    if all(ax * dx + ay * dy >= 0.0 for ax, ay in normals):
+        return 0.0
+    best = math.inf
+    for ax, ay in normals:
+        for ux, uy in ((-ay, ax), (ay, -ax)):
+            if all(bx * ux + by * uy >= -1e-12 for bx, by in normals):
+                best = min(best, math.acos(max(-1.0, min(1.0, ux * dx + uy * dy))))
+    return best
 
 
 def _sine(first: Guide, second: Guide) -> float:
