@@ -387,9 +387,12 @@ def bends(
     return split
 
 
-#: A run as :func:`deflections` tracks it: the directions its velocity must keep a·w >= 0
-#: with, and each step's (direction of its piece, deviation its own rows force).
-_Run = tuple[list[Point], list[tuple[Point, float]]]
+#: An arc of the unit circle: its start angle and its width (radians, width <= pi).
+_Arc = tuple[float, float]
+#: A run as :func:`deflections` tracks it: the arc of directions its velocity may take, and
+#: each of its steps' (direction of its piece, deviation its own rows force).
+_Run = tuple[_Arc | None, list[tuple[float, float]]]
+_TAU = 2.0 * math.pi
 
 
 def deflections(
@@ -404,13 +407,14 @@ def deflections(
 
     A vertex velocity w of a step must satisfy a·w >= 0 (margins aside) for the inward
     normals of the non-exit facets through the vertex and the exit facet's outward normal; a
-    run's velocity must satisfy every step's.  Where a step's piece of the path points out of
-    that cone (a corner's wedge the path does not pass through, shared with the steps before
-    it), every field of the run mixes a velocity turned away from its path into its flow and
-    slows down: on a bench office the robot crossed the room at 76 % of max_speed next to a
-    wall's end whose last triangle's wedge pointed 56° off the path.  ``split``: pairs split
-    already (a new run starts there).  Not a bound on anything: a heuristic on where velocity
-    jumps buy speed; every jump is a transversal switch (docs/control.md, Continuity).
+    run's velocity must satisfy every step's, so its direction lies in the intersection of
+    their half-circles, an arc.  Where a step's piece of the path points out of that arc (a
+    corner's wedge the path does not pass through, shared with the steps before it), the
+    fields of the run mix a velocity turned away from the path into their flow and slow
+    down: on a bench office the robot crossed a room at 76 % of max_speed beside a wall's
+    end whose last triangle's wedge pointed 56° off the path.  ``split``: pairs split
+    already (a new run starts there).  A heuristic on where velocity jumps buy speed, not a
+    bound; every jump is a transversal switch (docs/control.md, Continuity).
     """
     found: set[tuple[int, int]] = set()
     previous: dict[int, _Run] = {}  # per mesh vertex of the step before: its run
@@ -419,19 +423,22 @@ def deflections(
             previous = {}  # a vertex passage or a stay: nothing shared across it
             continue
         direction = _direction(guides[index])
+        # each facet's half-circle of directions u with a·u >= 0, a its outward normal: the
+        # arc starting a quarter turn before a
+        outward = [math.atan2(ny, nx) - 0.5 * math.pi for nx, ny in step.geometry.normals.tolist()]
         current: dict[int, _Run] = {}
         for local, vertex in enumerate(abstraction.triangles[step.triangle].tolist()):
-            rows = _vertex_normals(step, local)
-            own = [] if direction is None else [(direction, _deviation(direction, rows))]
+            arc = _vertex_arc(outward, local, step.exit_edge)
+            own = [] if direction is None else [(direction, _deviation(direction, arc))]
+            current[vertex] = (arc, own)
             run = previous.get(vertex)
-            current[vertex] = (rows, own)
             if run is None or (index, vertex) in split:
                 continue
-            joined, wanted = run[0] + rows, run[1] + own
-            turned = [_deviation(d, joined) - alone for d, alone in wanted]
-            if any(math.isinf(t) for t in turned):
+            joined = _intersect(run[0], arc)
+            if joined is None:
                 continue  # no common velocity: the runs split there for their own reason
-            if max(turned, default=0.0) > DEFLECTION:
+            wanted = run[1] + own
+            if any(_deviation(d, joined) - alone > DEFLECTION for d, alone in wanted):
                 found.add((index, vertex))
             else:
                 current[vertex] = (joined, wanted)
@@ -439,43 +446,52 @@ def deflections(
     return found
 
 
-def _direction(guide: Guide | None) -> Point | None:
-    """The unit direction of a piece of the path (None for none or a point)."""
+def _direction(guide: Guide | None) -> float | None:
+    """The angle of a piece of the path (None for none or a point)."""
     if guide is None:
         return None
     dx, dy = guide.exit[0] - guide.entry[0], guide.exit[1] - guide.entry[1]
-    norm = math.hypot(dx, dy)
-    return None if norm == 0.0 else (dx / norm, dy / norm)
+    return None if dx == 0.0 and dy == 0.0 else math.atan2(dy, dx)
 
 
-def _vertex_normals(step: PlanStep, local: int) -> list[Point]:
-    """The directions a with a·w >= 0 that the vertex program's rows ask of the velocity at
-    local vertex ``local`` (their margins aside): inward across the non-exit facets through
-    it, across the exit facet."""
-    normals = step.geometry.normals.tolist()
-    rows: list[Point] = [
-        (-normals[facet][0], -normals[facet][1])
-        for facet in range(3)
-        if facet != local and facet != step.exit_edge
-    ]
-    if step.exit_edge is not None:
-        rows.append((normals[step.exit_edge][0], normals[step.exit_edge][1]))
-    return rows
+def _vertex_arc(outward: list[float], local: int, exit_edge: int) -> _Arc | None:
+    """The directions u with a·u >= 0 for every direction a the vertex program's rows ask of
+    the velocity at local vertex ``local`` (their margins aside): inward across the non-exit
+    facets through it, across the exit facet; ``outward``: the start of each facet's
+    half-circle across it.  None when only the zero vector is left."""
+    arc: _Arc | None = (outward[exit_edge], math.pi)
+    for facet in range(3):
+        if facet != local and facet != exit_edge:  # inward: the opposite half-circle
+            arc = _intersect(arc, (outward[facet] + math.pi, math.pi))
+    return arc
 
 
-def _deviation(direction: Point, normals: Sequence[Point]) -> float:
-    """The angle from ``direction`` to the nearest unit vector u with a·u >= 0 for every a in
-    ``normals``; inf when only the zero vector is left (the cone's edges are the unit vectors
-    perpendicular to one of the a that satisfy the others)."""
-    dx, dy = direction
-    if all(ax * dx + ay * dy >= 0.0 for ax, ay in normals):
+def _intersect(first: _Arc | None, second: _Arc | None) -> _Arc | None:
+    """The arc common to two arcs, each at most a half-circle wide; None when they share no
+    arc."""
+    if first is None or second is None:
+        return None
+    (start, width), (other, other_width) = first, second
+    ahead = (other - start) % _TAU  # where the second starts, measured from the first
+    if ahead <= width:
+        end = min(width, ahead + other_width)
+        return (other, end - ahead) if end > ahead else None
+    behind = (start - other) % _TAU
+    if behind <= other_width:
+        end = min(other_width, behind + width)
+        return (start, end - behind) if end > behind else None
+    return None
+
+
+def _deviation(direction: float, arc: _Arc | None) -> float:
+    """The angle from ``direction`` to the nearest direction in ``arc`` (inf for none)."""
+    if arc is None:
+        return math.inf
+    start, width = arc
+    ahead = (direction - start) % _TAU
+    if ahead <= width:
         return 0.0
-    best = math.inf
-    for ax, ay in normals:
-        for ux, uy in ((-ay, ax), (ay, -ax)):
-            if all(bx * ux + by * uy >= -1e-12 for bx, by in normals):
-                best = min(best, math.acos(max(-1.0, min(1.0, ux * dx + uy * dy))))
-    return best
+    return min(ahead - width, _TAU - ahead)
 
 
 def _sine(first: Guide, second: Guide) -> float:
