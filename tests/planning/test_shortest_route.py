@@ -226,3 +226,39 @@ def test_random_missions_keep_the_shorter_route(document: dict[str, Any]) -> Non
     assert pull(mission, kept).length <= pull(mission, first).length * (1 + 1e-12) + 1e-12
     pulled = [*witness.stats["path_lengths"], witness.stats.get("touch_length")]
     assert witness.stats["path_length"] in pulled
+
+
+def test_a_detour_gives_the_patrol_a_shorter_cycle_that_is_not_slower() -> None:
+    """The shipped patrol's re-plans stop at a fixed point at once; planned again with its
+    cycle's moves weighing more, it finds another cycle whose path is shorter, simulates it
+    no slower and keeps it: the kept lasso is shorter than the first plan's and no slower
+    (both measured here on their exact trajectories), and the compile verifies."""
+    from tlmpc.pipeline.mintime import measure
+
+    result = compile_mission(ROOT / "specs" / "patrol.yaml", until="verify")
+    assert result.summary()["verdict"]["satisfied"] is True
+    c = result.compilation
+    mission, witness = c.get(MISSION), c.get(WITNESS)
+    stats = witness.stats
+    assert stats["length_fixed_point"]
+    assert stats["length_rounds"] == 1
+    assert stats["length_detours"]
+    assert stats["path_length"] == min(stats["length_detours"])
+    assert stats["path_length"] < stats["path_lengths"][0] * (1.0 - shortest.MIN_GAIN)
+    first = plan_mission(mission, c.get(ABSTRACTION), c.get(AUTOMATON))
+    kept = Planned(abstraction=c.get(ABSTRACTION), automaton=c.get(AUTOMATON), witness=witness)
+    assert pull(mission, kept).length == pytest.approx(stats["path_length"], rel=1e-12)
+    assert pull(mission, kept).length < pull(mission, first).length
+    assert witness.cycle != first.witness.cycle
+    assert measure(mission, kept).exact_time <= measure(mission, first).exact_time
+
+
+def test_a_detour_whose_trace_fails_is_not_kept(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A detour is kept on its exact time checked with the verifier (inf when its trace fails
+    the task): with every such check failing, the patrol keeps its first plan."""
+    monkeypatch.setattr(shortest, "_verified_time", lambda *args: math.inf)
+    compilation = compile_mission(ROOT / "specs" / "patrol.yaml", until="plan").compilation
+    found = compilation.get(WITNESS).stats
+    assert found["length_detours"]
+    assert min(found["length_detours"]) < found["path_lengths"][0]
+    assert found["path_length"] == found["path_lengths"][0]
