@@ -249,6 +249,41 @@ def held_out_late() -> list[Workload]:
     ]
 
 
+def held_out_detours() -> list[Workload]:
+    """A mission written after the velocity-run splits, the floor cap and the cycle detours
+    were tuned, measured once: a depot patrolled by a robot with a body among racks, an
+    L-shaped wall and a puddle to avoid."""
+    depot = {
+        "version": 1,
+        "name": "depot",
+        "workspace": {
+            "boundary": [[0, 0], [18, 0], [18, 12], [6, 12], [0, 9]],
+            "holes": [
+                {"rect": [3, 2, 8, 3]},
+                {"rect": [3, 5, 8, 6]},
+                [[11, 3], [12, 3], [12, 8], [15, 8], [15, 9], [11, 9]],
+            ],
+        },
+        "regions": {
+            "dock": {"rect": [0.5, 0.5, 2.2, 2.2]},
+            "charger": {"rect": [16, 10, 17.5, 11.5]},
+            "inspection": {"rect": [13, 4, 14.5, 6]},
+            "puddle": [[8.5, 9], [10, 8.5], [10.5, 10], [9, 10.6]],
+        },
+        "robot": {"start": [1.5, 7.0], "max_speed": 1.2, "radius": 0.2},
+        "task": ["patrol dock, charger and inspection", "avoid puddle"],
+    }
+    return [
+        Workload(
+            "depot r=0.2 patrol",
+            depot,
+            (("dock", "charger", "inspection"),),
+            avoid=("puddle",),
+            patrol=True,
+        )
+    ]
+
+
 def _compile(workload: Workload, follow: bool) -> tuple[Any, float]:
     """The compiled mission and the length of the path its fields follow (the channel's
     shortest path with the portal insets; nan before)."""
@@ -399,6 +434,7 @@ def workloads() -> list[Workload]:
         generated(6, radius=0.2, patrol=True),
         *held_out(),
         *held_out_late(),
+        *held_out_detours(),
     ]
 
 

@@ -164,7 +164,7 @@ def plan_shortest(mission: Mission, planned: Planned) -> Planned:
         measured.update(found.moves)
         current = following
     detours: list[float] = []  # the detours' path lengths
-    for _ in range(DETOURS if best.witness.cycle and not _stays(best) else 0):
+    for _ in range(0 if best.witness.is_stay else DETOURS):
         if spent + _nodes(best) > NODE_BUDGET:
             break
         spent += _nodes(best)
@@ -203,14 +203,6 @@ def plan_shortest(mission: Mission, planned: Planned) -> Planned:
         **touch,
     }
     return replace(best, witness=replace(best.witness, stats=stats))
-
-
-def _stays(planned: Planned) -> bool:
-    """True when the plan ends by staying (its cycle is one triangle's stutter)."""
-    from tlmpc.control.synthesize import plan_steps
-
-    _, loop_start = plan_steps(planned.abstraction, planned.witness)
-    return loop_start is None
 
 
 def _pulled(mission: Mission, planned: Planned) -> Pulled | None:
