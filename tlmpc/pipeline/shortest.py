@@ -23,7 +23,11 @@ for the ``time`` metric (:mod:`tlmpc.pipeline.mintime`), the planner iterates:
    when its path is more than :data:`MIN_GAIN` shorter *and* its exact time (the time metric's
    measure: controllers synthesised, trajectory simulated, prefix + ``beta`` x lap) is not
    longer (at most :data:`MAX_TIME_CHECKS` re-plans are simulated).  So the kept plan is
-   never longer nor slower than the first.
+   never longer nor slower than the first;
+5. a plan with a moving cycle is then planned again :data:`DETOURS` times at most, with the
+   kept plan's cycle moves weighing :data:`DETOUR_PENALTY` times their pieces (the re-plans
+   steer toward the moves already pulled and rarely leave the first cycle): a **detour**,
+   another cycle, kept on the same terms (shorter, and not slower with its trace verified).
 
 Every round is deterministic (operations are counted, no clock is read).  What is promised
 (docs/planning.md): the kept plan's path is never longer, and its trajectory never slower,
