@@ -19,7 +19,8 @@ each sampled piece refined by the step's own matrix exponential):
 Targets are given per workload as ordered groups: the regions of a group are taken in the
 order the trajectory first enters them (so the oracle compares the same visiting order; a
 better order is the planner's business, not the controllers').  Prints one table.
-Run: ``python bench/bench_geodesic.py`` (about a minute).
+Run: ``python bench/bench_geodesic.py`` (about a minute); ``--speed`` splits the time lost to
+speeds below max_speed by kind of plan step (:func:`speed_rows`).
 """
 
 from __future__ import annotations
@@ -335,6 +336,41 @@ def held_out_depth() -> list[Workload]:
     ]
 
 
+def held_out_detours() -> list[Workload]:
+    """A mission written after the velocity-run splits, the floor cap and the cycle detours
+    were tuned, measured once: a depot patrolled by a robot with a body among racks, an
+    L-shaped wall and a puddle to avoid."""
+    depot = {
+        "version": 1,
+        "name": "depot",
+        "workspace": {
+            "boundary": [[0, 0], [18, 0], [18, 12], [6, 12], [0, 9]],
+            "holes": [
+                {"rect": [3, 2, 8, 3]},
+                {"rect": [3, 5, 8, 6]},
+                [[11, 3], [12, 3], [12, 8], [15, 8], [15, 9], [11, 9]],
+            ],
+        },
+        "regions": {
+            "dock": {"rect": [0.5, 0.5, 2.2, 2.2]},
+            "charger": {"rect": [16, 10, 17.5, 11.5]},
+            "inspection": {"rect": [13, 4, 14.5, 6]},
+            "puddle": [[8.5, 9], [10, 8.5], [10.5, 10], [9, 10.6]],
+        },
+        "robot": {"start": [1.5, 7.0], "max_speed": 1.2, "radius": 0.2},
+        "task": ["patrol dock, charger and inspection", "avoid puddle"],
+    }
+    return [
+        Workload(
+            "depot r=0.2 patrol",
+            depot,
+            (("dock", "charger", "inspection"),),
+            avoid=("puddle",),
+            patrol=True,
+        )
+    ]
+
+
 def _compile(workload: Workload, follow: bool) -> tuple[Any, float]:
     """The compiled mission and the length of the path its fields follow (the channel's
     shortest path with the portal insets; nan before)."""
@@ -486,6 +522,7 @@ def workloads() -> list[Workload]:
         *held_out(),
         *held_out_late(),
         *held_out_depth(),
+        *held_out_detours(),
     ]
 
 
@@ -648,6 +685,77 @@ def gap_rows(only: tuple[str, ...] = ()) -> list[dict[str, Any]]:
     return rows
 
 
+def _category(step: dict[str, Any], index: int, reasons: dict[int, set[str]]) -> str:
+    if step["stay"]:
+        return "stay"
+    if step.get("kind") == "vertex":
+        return "vertex passage"
+    if index == 0:
+        return "first step"
+    if index in reasons:
+        reason = sorted(reasons[index])[0]
+        if "bends" in reason:
+            return "jump: bend"
+        return "jump: deflection" if "away from the path" in reason else "jump: other"
+    return "shared"
+
+
+def speed_rows(only: tuple[str, ...] = ()) -> list[dict[str, Any]]:
+    """Where the time goes, per workload: the time to meet the task (a patrol: one lap)
+    times max_speed minus the distance travelled, as a percentage of that distance, charged
+    to the plan steps the trajectory was in, by kind of step: the stay, vertex passages, the
+    first step, steps entered across a velocity jump (a bend of the path, a deflection split,
+    another reason) and the others (all corner velocities shared with the step before)."""
+    import shapely
+
+    rows = []
+    for workload in workloads():
+        if only and workload.name not in only:
+            continue
+        compiled, _ = _compile(workload, True)
+        artifacts = compiled.artifacts
+        controllers = artifacts["controllers.json"]
+        speed = controllers["max_speed"]
+        trace = artifacts["trace.json"]
+        times, points = _fine_trajectory(artifacts)
+        # the plan step of each fine point: that of the next sample at or after its time
+        samples = np.asarray(trace["points"], dtype=np.float64)
+        at = np.searchsorted(samples[:, 0], times, side="left").clip(0, len(samples) - 1)
+        steps = np.asarray(trace["steps"])[at]
+        if workload.patrol:
+            begin = int(np.searchsorted(times, samples[trace["loop_start"], 0]))
+            end = len(times) - 1
+        else:
+            source = workload.mission
+            from tlmpc.mission import load_mission, load_mission_text
+
+            if isinstance(source, Path):
+                mission = load_mission(source)
+            else:
+                import yaml
+
+                mission = load_mission_text(yaml.safe_dump(source), "generated.yaml")
+            shapes = {r.name: shapely.Polygon(r.polygon) for r in mission.regions}
+            begin, (_, end) = 0, _order(points, shapes, workload.groups)
+        reasons: dict[int, set[str]] = {}
+        for jump in controllers["jumps"]:
+            reasons.setdefault(jump["step"], set()).add(jump["reason"])
+        lost: dict[str, float] = {}
+        travelled = 0.0
+        for k in range(begin, end):
+            dt, ds = times[k + 1] - times[k], float(np.hypot(*(points[k + 1] - points[k])))
+            index = int(steps[k + 1])
+            kind = _category(controllers["steps"][index], index, reasons)
+            lost[kind] = lost.get(kind, 0.0) + dt * speed - ds
+            travelled += ds
+        row: dict[str, Any] = {"workload": workload.name}
+        row["time / length"] = round(1.0 + sum(lost.values()) / travelled, 3)
+        for kind in ("shared", "jump: bend", "jump: deflection", "jump: other", "first step"):
+            row[kind] = round(100.0 * lost.get(kind, 0.0) / travelled, 2)
+        rows.append(row)
+    return rows
+
+
 def _table(rows: list[dict[str, Any]]) -> str:
     columns: list[str] = []
     for row in rows:
@@ -670,6 +778,10 @@ def _main(arguments: list[str]) -> None:
     if "--rows" in arguments:
         arguments.remove("--rows")
         print(json.dumps(run(tuple(arguments))))
+        return
+    if "--speed" in arguments:
+        arguments.remove("--speed")
+        print(_table(speed_rows(tuple(arguments))))
         return
     if "--gap" in arguments:
         arguments.remove("--gap")

@@ -399,7 +399,7 @@ def test_a_bent_corridor_splits_its_runs_at_the_bend() -> None:
     so the fields jump there (reason: the bend), and the trajectory keeps within 10 % of the
     shortest path to the stay's target (visibility graph), shorter than the vertex program's
     own fields (1.093 against 1.112)."""
-    from tlmpc.control.synthesize import BENDS
+    from tlmpc.control.follow import BENDS
 
     centre = [(0.0, 0.0), (1.0, 0.0), (2.0, 0.0), (3.0, 0.0), (3.0, 1.0), (3.0, 2.0), (3.0, 3.0)]
     left = [(x - 0.5 * (x >= 3.0), y + 0.5 * (x < 3.0)) for x, y in centre]

@@ -53,6 +53,15 @@ OBJECTIVE_GAP = 1e-4
 GUARANTEE = 1.0
 #: ... and the floor (the smallest guaranteed speed) this many times more.
 FLOOR_WEIGHT = 10.0
+#: ... but only up to this fraction of max_speed (beyond the disturbance: the guaranteed
+#: speeds are what is left of the velocity across the exit facet under the worst
+#: disturbance).  Uncapped, a floor that the split velocity runs (:func:`bends`) raise drew
+#: every step's exit speed up to it, turning the fields off the path to push across their
+#: exit facets (a regular grid's fields crossed at 37° to their pieces).  The weakest step
+#: keeps the vertex program's floor where that is lower, and at least this otherwise (at
+#: 0.1 the bench's times were up to 1 % shorter, but a corridor's robot pushed at 16 times
+#: its declared disturbance no longer completed its laps in one run of eight).
+FLOOR_CAP = 0.2
 
 
 class ConicLike(Protocol):
@@ -188,6 +197,8 @@ def follow_program(
     blocks.append(  # t >= 0: -t + s = 0
         (-np.ones((len(follow), 1)), size + np.arange(len(follow))[:, None], np.zeros(len(follow)))
     )
+    # f <= FLOOR_CAP: f + s = FLOOR_CAP
+    blocks.append((np.ones((1, 1)), np.array([[2 * runs + steps]]), np.array([FLOOR_CAP])))
     rows, cols, vals, bounds, start = [], [], [], [], 0
     for values, columns, bound in blocks:
         height, width = values.shape
@@ -336,6 +347,15 @@ def path_guides(
 #: sides exceeds this (about 1.7°; sharing a velocity across a smaller turn cost nothing
 #: measurable, and each split is a reported velocity jump).
 BEND = 0.03
+#: Why a velocity run is split where the followed path bends.
+BENDS = "the path to follow bends across this edge"
+#: A vertex's velocity run is also split where sharing its velocity with the run so far
+#: would turn the velocity further than this (radians, about 10°) from some step's piece
+#: of the path than that step's own rows at the vertex do (smaller thresholds, 5° and 2°,
+#: measured the same times on the bench with more jumps).
+DEFLECTION = 0.17
+#: ... and why.
+DEFLECTS = "a velocity shared across this edge would turn a field away from the path"
 
 
 def bends(
@@ -343,16 +363,18 @@ def bends(
     steps: Sequence[PlanStep],
     loop_start: int | None,
     guides: Sequence[Guide | None],
-) -> frozenset[tuple[int, int]]:
+) -> dict[tuple[int, int], str]:
     """(step, mesh vertex) pairs where step's field should not share the vertex's velocity
-    with the step before: the two ends of a portal across which the path bends.
+    with the step before, and why: the two ends of a portal across which the path bends
+    (:data:`BENDS`), and the vertices where sharing would turn a field away from its piece of
+    the path (:data:`DEFLECTS`, :func:`deflections`).
 
     A velocity shared by both steps at both ends of a portal makes the two fields equal all
     along it; the path's crossing point would then need one direction on both sides, and the
     flow could only turn gradually, triangles away from the bend.  A stay has its own
     velocities already.
     """
-    split: set[tuple[int, int]] = set()
+    split: dict[tuple[int, int], str] = {}
     pairs = [(index - 1, index) for index in range(1, len(steps))]
     if loop_start is not None:
         pairs.append((len(steps) - 1, loop_start))  # the cycle's wrap
@@ -363,12 +385,119 @@ def bends(
         if abs(_sine(first, second)) <= BEND:
             continue
         shared = set(abstraction.triangles[steps[before].triangle].tolist())
-        split.update(
-            (after, vertex)
-            for vertex in abstraction.triangles[steps[after].triangle].tolist()
-            if vertex in shared
-        )
-    return frozenset(split)
+        for vertex in abstraction.triangles[steps[after].triangle].tolist():
+            if vertex in shared:
+                split[(after, vertex)] = BENDS
+    for pair in deflections(abstraction, steps, guides, frozenset(split)):
+        split[pair] = DEFLECTS
+    return split
+
+
+#: An arc of the unit circle: its start angle and its width (radians, width <= pi).
+_Arc = tuple[float, float]
+#: A run as :func:`deflections` tracks it: the arc of directions its velocity may take, and
+#: each of its steps' (direction of its piece, deviation its own rows force).
+_Run = tuple[_Arc | None, list[tuple[float, float]]]
+_TAU = 2.0 * math.pi
+
+
+def deflections(
+    abstraction: Abstraction,
+    steps: Sequence[PlanStep],
+    guides: Sequence[Guide | None],
+    split: frozenset[tuple[int, int]] = frozenset(),
+) -> set[tuple[int, int]]:
+    """(step, vertex) pairs where the velocity run of the vertex is better split: shared
+    with the run so far, the velocity would be turned more than :data:`DEFLECTION` further
+    from some step's piece of the path than that step's own rows turn it.
+
+    A vertex velocity w of a step must satisfy a·w >= 0 (margins aside) for the inward
+    normals of the non-exit facets through the vertex and the exit facet's outward normal; a
+    run's velocity must satisfy every step's, so its direction lies in the intersection of
+    their half-circles, an arc.  Where a step's piece of the path points out of that arc (a
+    corner's wedge the path does not pass through, shared with the steps before it), the
+    fields of the run mix a velocity turned away from the path into their flow and slow
+    down: on a bench office the robot crossed a room at 76 % of max_speed beside a wall's
+    end whose last triangle's wedge pointed 56° off the path.  ``split``: pairs split
+    already (a new run starts there).  A heuristic on where velocity jumps buy speed, not a
+    bound; every jump is a transversal switch (docs/control.md, Continuity).
+    """
+    found: set[tuple[int, int]] = set()
+    previous: dict[int, _Run] = {}  # per mesh vertex of the step before: its run
+    for index, step in enumerate(steps):
+        if step.through is not None or step.exit_edge is None:
+            previous = {}  # a vertex passage or a stay: nothing shared across it
+            continue
+        direction = _direction(guides[index])
+        # each facet's half-circle of directions u with a·u >= 0, a its outward normal: the
+        # arc starting a quarter turn before a
+        outward = [math.atan2(ny, nx) - 0.5 * math.pi for nx, ny in step.geometry.normals.tolist()]
+        current: dict[int, _Run] = {}
+        for local, vertex in enumerate(abstraction.triangles[step.triangle].tolist()):
+            arc = _vertex_arc(outward, local, step.exit_edge)
+            own = [] if direction is None else [(direction, _deviation(direction, arc))]
+            current[vertex] = (arc, own)
+            run = previous.get(vertex)
+            if run is None or (index, vertex) in split:
+                continue
+            joined = _intersect(run[0], arc)
+            if joined is None:
+                continue  # no common velocity: the runs split there for their own reason
+            wanted = run[1] + own
+            if any(_deviation(d, joined) - alone > DEFLECTION for d, alone in wanted):
+                found.add((index, vertex))
+            else:
+                current[vertex] = (joined, wanted)
+        previous = current
+    return found
+
+
+def _direction(guide: Guide | None) -> float | None:
+    """The angle of a piece of the path (None for none or a point)."""
+    if guide is None:
+        return None
+    dx, dy = guide.exit[0] - guide.entry[0], guide.exit[1] - guide.entry[1]
+    return None if dx == 0.0 and dy == 0.0 else math.atan2(dy, dx)
+
+
+def _vertex_arc(outward: list[float], local: int, exit_edge: int) -> _Arc | None:
+    """The directions u with a·u >= 0 for every direction a the vertex program's rows ask of
+    the velocity at local vertex ``local`` (their margins aside): inward across the non-exit
+    facets through it, across the exit facet; ``outward``: the start of each facet's
+    half-circle across it.  None when only the zero vector is left."""
+    arc: _Arc | None = (outward[exit_edge], math.pi)
+    for facet in range(3):
+        if facet != local and facet != exit_edge:  # inward: the opposite half-circle
+            arc = _intersect(arc, (outward[facet] + math.pi, math.pi))
+    return arc
+
+
+def _intersect(first: _Arc | None, second: _Arc | None) -> _Arc | None:
+    """The arc common to two arcs, each at most a half-circle wide; None when they share no
+    arc."""
+    if first is None or second is None:
+        return None
+    (start, width), (other, other_width) = first, second
+    ahead = (other - start) % _TAU  # where the second starts, measured from the first
+    if ahead <= width:
+        end = min(width, ahead + other_width)
+        return (other, end - ahead) if end > ahead else None
+    behind = (start - other) % _TAU
+    if behind <= other_width:
+        end = min(other_width, behind + width)
+        return (start, end - behind) if end > behind else None
+    return None
+
+
+def _deviation(direction: float, arc: _Arc | None) -> float:
+    """The angle from ``direction`` to the nearest direction in ``arc`` (inf for none)."""
+    if arc is None:
+        return math.inf
+    start, width = arc
+    ahead = (direction - start) % _TAU
+    if ahead <= width:
+        return 0.0
+    return min(ahead - width, _TAU - ahead)
 
 
 def _sine(first: Guide, second: Guide) -> float:

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -54,8 +55,6 @@ Vector = tuple[float, float]
 
 #: Invariance margin: non-exit facets are pushed inward at least MARGIN times the exit speed.
 MARGIN = 0.3
-#: Why a velocity run is split where the followed path bends.
-BENDS = "the path to follow bends across this edge"
 
 
 @dataclass(slots=True)
@@ -223,10 +222,12 @@ def _assign_runs(
     *,
     push: float = 0.0,
     max_speed: float = 1.0,
-    split: frozenset[tuple[int, int]] = frozenset(),
+    split: Mapping[tuple[int, int], str] | None = None,
 ) -> tuple[_Runs, list[VelocityJump]]:
-    """Velocity runs; ``split`` holds (step, vertex) pairs that start a new run (where the
-    path to follow bends, :func:`tlmpc.control.follow.bends`)."""
+    """Velocity runs; ``split`` maps (step, vertex) pairs that start a new run to why (where
+    the path to follow bends, or sharing would turn a field away from it:
+    :func:`tlmpc.control.follow.bends`)."""
+    split = {} if split is None else split
     runs = _Runs(push, max_speed)
     jumps: list[VelocityJump] = []
     previous: dict[int, int] = {}  # global vertex -> run id at the previous step
@@ -243,7 +244,7 @@ def _assign_runs(
             if run is not None and step.exit_edge is None:
                 reason = "the stay field has its own vertex velocities"
             elif run is not None and (index, vertex) in split:
-                reason = BENDS
+                reason = split[(index, vertex)]
             elif run is not None and not runs.try_extend(run, normals):
                 reason = "the path turns 180° or more around this vertex"
             if run is None or reason is not None:
@@ -262,15 +263,15 @@ def _assign_runs(
         for local, vertex in enumerate(first_vertices):
             if vertex not in previous:
                 continue
-            bent = (loop_start, vertex) in split
-            if bent or not runs.try_merge(previous[vertex], first.runs[local]):
+            bent = split.get((loop_start, vertex))
+            if bent is not None or not runs.try_merge(previous[vertex], first.runs[local]):
                 x, y = abstraction.vertices[vertex].tolist()
                 jumps.append(
                     VelocityJump(
                         step=loop_start,
                         vertex=vertex,
                         position=(x, y),
-                        reason=BENDS if bent else "the cycle turns 180° or more around this vertex",
+                        reason=bent or "the cycle turns 180° or more around this vertex",
                     )
                 )
     for step in steps:
@@ -695,7 +696,7 @@ def synthesize(
         if follow
         else None
     )
-    split = bends(abstraction, steps, loop_start, guides) if guides is not None else frozenset()
+    split = bends(abstraction, steps, loop_start, guides) if guides is not None else {}
     _, jumps = _assign_runs(
         abstraction, steps, loop_start, push=push, max_speed=robot.max_speed, split=split
     )
