@@ -64,6 +64,13 @@ rows = {"imports": {"cpu": cpu(), **status()}}
 artifacts = {}
 reports = []
 top = []
+try:  # one memo for the stages run one at a time, as one compile has
+    from tlmpc.base.memo import memo_scope
+    memo = memo_scope()
+except ImportError:  # a tree from before the memo
+    import contextlib
+    memo = contextlib.nullcontext()
+memo.__enter__()
 for stage in STAGES:
     if stage.name == "synthesize":
         continue

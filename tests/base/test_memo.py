@@ -145,3 +145,28 @@ def test_a_compile_partitions_each_mesh_once(monkeypatch: pytest.MonkeyPatch) ->
     monkeypatch.setattr(cells_module, "partition", asking)
     _, built = _compile_counting(_disturbed(0.44), monkeypatch)
     assert len(asked) > len(built)
+
+
+def _regions_of_two_stages() -> tuple[object, object]:
+    """The regions' documents of mission.json and abstraction.json, the two stages run one at
+    a time (each its own run of the stages)."""
+    from tlmpc.pipeline.stages import STAGES, Compilation, run_stages
+
+    compilation = Compilation(source=ROOT / "specs" / "example1.yaml", text=None, figures=())
+    artifacts: dict[str, Any] = {}
+    for stage in STAGES[:2]:
+        result = run_stages([stage], compilation)
+        compilation = result.compilation
+        artifacts.update(result.artifacts)
+    return artifacts["mission.json"]["regions"], artifacts["abstraction.json"]["regions"]
+
+
+def test_stages_run_one_at_a_time_share_an_open_memo() -> None:
+    """A caller running the stages one at a time inside a memo (the memory bench) shares it as
+    one compile does; without one, each run builds its own."""
+    with memo_scope():
+        mission_regions, mesh_regions = _regions_of_two_stages()
+    assert mission_regions is mesh_regions
+    mission_regions, mesh_regions = _regions_of_two_stages()
+    assert mission_regions == mesh_regions
+    assert mission_regions is not mesh_regions

@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
 from tlmpc.base.errors import TlmpcError, error
-from tlmpc.base.memo import memo_scope
+from tlmpc.base.memo import current_memo, memo_scope
 from tlmpc.base.pages import plain_pages
 from tlmpc.base.progress import heartbeat
 from tlmpc.base.version import __version__
@@ -629,10 +629,11 @@ def run_stages(
     """Run ``stages`` in order on ``compilation``, checking each one's requires and provides.
 
     The run has one memo (:mod:`tlmpc.base.memo`: what its stages compute once and reuse,
-    such as a mesh's convex cells), dropped when it ends.  The stages' arrays are allocated
+    such as a mesh's convex cells), dropped when it ends; a run inside an open memo (a caller
+    running the stages one at a time) shares that one.  The stages' arrays are allocated
     without numpy's huge-page request (:mod:`tlmpc.base.pages`: at a million triangles the
     kernel's compaction on first touch cost about 3 CPU s of the compile)."""
-    with plain_pages(), memo_scope():
+    with plain_pages(), memo_scope(current_memo()):
         return _run_stages(stages, compilation, progress=progress)
 
 
