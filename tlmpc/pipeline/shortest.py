@@ -23,11 +23,7 @@ for the ``time`` metric (:mod:`tlmpc.pipeline.mintime`), the planner iterates:
    when its path is more than :data:`MIN_GAIN` shorter *and* its exact time (the time metric's
    measure: controllers synthesised, trajectory simulated, prefix + ``beta`` x lap) is not
    longer (at most :data:`MAX_TIME_CHECKS` re-plans are simulated).  So the kept plan is
-   never longer nor slower than the first;
-5. a plan with a moving cycle is then planned again :data:`DETOURS` times at most, with the
-   kept plan's cycle moves weighing :data:`DETOUR_PENALTY` times their pieces (the re-plans
-   steer toward the moves already pulled and rarely leave the first cycle): a **detour**,
-   another cycle, kept on the same terms (shorter, and not slower with its trace verified).
+   never longer nor slower than the first.
 
 Every round is deterministic (operations are counted, no clock is read).  What is promised
 (docs/planning.md): the kept plan's path is never longer, and its trajectory never slower,
@@ -65,22 +61,12 @@ MAX_REPLANS = 6
 NODE_BUDGET = 250_000
 
 
-#: After the re-plans, a moving cycle is planned again this many times with the kept
-#: plan's cycle moves weighing DETOUR_PENALTY times their pieces (the other moves as in the
-#: re-plans): the re-plans steer toward the moves already measured, so they rarely leave the
-#: first plan's cycle; a detour is another cycle, compared on the same terms.
-DETOURS = 2
-DETOUR_PENALTY = 1.5
-
-
 @dataclass(frozen=True, slots=True)
 class Pulled:
-    """A plan's path length (prefix + beta x lap), each move's piece of the path, and the
-    moves of its cycle."""
+    """A plan's path length (prefix + beta x lap) and each move's piece of the path."""
 
     length: float
     moves: Mapping[MoveKey, float]
-    cycle: frozenset[MoveKey] = frozenset()
 
 
 def plan_shortest(mission: Mission, planned: Planned) -> Planned:
@@ -167,35 +153,6 @@ def plan_shortest(mission: Mission, planned: Planned) -> Planned:
                 best, best_length, best_time = following, found.length, time
         measured.update(found.moves)
         current = following
-    detours: list[float] = []  # the detours' path lengths
-    for _ in range(0 if best.witness.is_stay else DETOURS):
-        if spent + _nodes(best) > NODE_BUDGET:
-            break
-        spent += _nodes(best)
-        kept = _pulled(mission, best)
-        if kept is None or not kept.cycle:
-            break
-        penalised = dict(measured)
-        for key in kept.cycle:
-            penalised[key] = kept.moves[key] * DETOUR_PENALTY
-        try:
-            detour = replan(mission, best, MoveTimes(speed=1.0 / ratio, measured=penalised))
-            found = pull(mission, detour)
-        except TlmpcError:
-            break
-        measured.update(found.moves)
-        if detour.route() in seen:
-            break
-        seen.add(detour.route())
-        detours.append(found.length)
-        if found.length < best_length * (1.0 - MIN_GAIN):
-            # ... not slower, and its trace verified (as a touch candidate's)
-            if best_time is None:
-                best_time = _exact_time(mission, best)
-            time = _verified_time(mission, detour)
-            checked.append(time)
-            if time <= best_time:
-                best, best_length, best_time = detour, found.length, time
     stats: dict[str, Any] = {
         **best.witness.stats,
         "path_length": best_length,
@@ -203,7 +160,6 @@ def plan_shortest(mission: Mission, planned: Planned) -> Planned:
         "length_rounds": len(history),
         "length_fixed_point": fixed,
         "length_time_checks": checked,
-        "length_detours": detours,
         **touch,
     }
     return replace(best, witness=replace(best.witness, stats=stats))
@@ -273,7 +229,6 @@ def pull(mission: Mission, planned: Planned) -> Pulled:
     lengths = [0.0 if p is None else math.dist(p.entry, p.exit) for p in pieces]
     neighbors = abstraction.neighbors
     moves: dict[MoveKey, float] = {}
-    cycle: set[MoveKey] = set()
     prefix = 0.0
     lap = 0.0
     for index, step in enumerate(steps):
@@ -301,6 +256,4 @@ def pull(mission: Mission, planned: Planned) -> Pulled:
             slot = sides.index(steps[before].triangle)
         key = move_key(abstraction, step.triangle, slot, step.exit_edge)
         moves[key] = lengths[index] + STUTTER_COST
-        if loop_start is not None and index >= loop_start:
-            cycle.add(key)
-    return Pulled(length=prefix + witness.beta * lap, moves=moves, cycle=frozenset(cycle))
+    return Pulled(length=prefix + witness.beta * lap, moves=moves)
