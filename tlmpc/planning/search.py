@@ -163,6 +163,16 @@ def _enqueue(frontier: IntArray, improved: IntArray, queued: BoolArray) -> IntAr
     return np.concatenate([frontier, fresh])
 
 
+def _each_once(nodes: IntArray, stamp: IntArray) -> IntArray:
+    """``nodes`` with each node once, in the order of the positions kept (numpy's unique
+    costs more than the rest of a round): of a node listed twice, only the position whose
+    write to ``stamp`` (scratch, one entry per node) stayed."""
+    count = np.arange(len(nodes))
+    stamp[nodes] = count
+    once: IntArray = nodes[stamp[nodes] == count]
+    return once
+
+
 def shortest_paths(
     graph: Graph,
     sources: IntArray,
@@ -246,15 +256,7 @@ def _search(
         v = targets[edges].astype(np.int64, copy=False)  # indexes many arrays: cast once
         d = du + weights[edges]
         if pred is None or via is None:
-            fresh = relax_distances(dist, v, d)
-            fresh = fresh[~queued[fresh]]
-            # Each node once (numpy's unique costs more than the rest of a round): of a node
-            # listed twice, only the position whose write to ``stamp`` stayed (one of them).
-            count = np.arange(len(fresh))
-            stamp[fresh] = count
-            fresh = fresh[stamp[fresh] == count]
-            queued[fresh] = True
-            frontier = np.concatenate([frontier, fresh])
+            frontier = _enqueue(frontier, _each_once(relax_distances(dist, v, d), stamp), queued)
             continue
         u = np.repeat(active, counts)
         if limit < np.inf:
