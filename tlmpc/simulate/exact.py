@@ -118,7 +118,7 @@ def _local_flow(
     if radius > SERIES_RADIUS:
 
         def far_point(s: float) -> FloatArray:
-            return np.asarray(expm_small(s * matrix) @ base, dtype=np.float64)
+            return np.asarray(expm_small(s * matrix).dot(base), dtype=np.float64)
 
         def far_height(s: float) -> float:
             return float(normal @ far_point(s)[:2] - offset)
@@ -127,15 +127,15 @@ def _local_flow(
     degree = taylor_degree(radius, 40)
     terms = [base]
     for k in range(1, degree + 1):
-        terms.append(matrix @ terms[-1] / k)
+        terms.append(matrix.dot(terms[-1]) / k)
     coefficients_of_x = np.array(terms)  # (degree + 1, 3)
-    heights = (coefficients_of_x[:, :2] @ normal).tolist()
+    heights = coefficients_of_x[:, :2].dot(normal).tolist()
     heights[0] -= offset
     reversed_heights = heights[::-1]
     exponents = _EXPONENTS[degree]
 
     def point(s: float) -> FloatArray:
-        return np.asarray((s**exponents) @ coefficients_of_x, dtype=np.float64)
+        return np.asarray((s**exponents).dot(coefficients_of_x), dtype=np.float64)
 
     def height(s: float) -> float:
         value = 0.0
@@ -212,22 +212,25 @@ def _exit_step(
     if frame is None:
         frame = _exit_frame(controller)
     normal, corners, center, matrix = frame.normal, frame.corners, frame.center, frame.matrix
-    if frame.edge_offset - normal @ x0 <= 1e-12 * frame.scale:
+    if frame.edge_offset - normal.dot(x0) <= 1e-12 * frame.scale:
         return [0.0], [x0]  # already on the exit edge (to rounding): the crossing is now
     offset = frame.offset
     y0 = x0 - center
     # (numpy's scalar: its division semantics, as computed per step before the frames)
-    gap = cast(float, offset - normal @ y0)
+    gap = cast(float, offset - normal.dot(y0))
     horizon = gap / controller.exit_speed
     # h(t) < 0 until the crossing and grows at least at the exit speed inside the triangle, so
     # the first grid point with h >= 0 brackets the crossing (one matrix exponential for the
     # grid step, then matrix-vector products).
-    dt = horizon * 1.02 / GRID_POINTS
+    dt = float(horizon * 1.02 / GRID_POINTS)  # (a Python float: the same double, cheaper sums)
     step = expm_small(dt * matrix)
+    # The products of one matrix or vector are ``dot``s: the same BLAS calls as ``@`` on 2-D
+    # and 1-D arrays (the same bits) at half of matmul's per-call cost; the chunks' stacked
+    # products stay matmuls (``dot`` would make them one product of another shape).
     stack = np.empty((GRID_CHUNK, 3, 3))  # step^1 .. step^GRID_CHUNK: a chunk of grid points
     stack[0] = step
     for power in range(1, GRID_CHUNK):
-        np.matmul(step, stack[power - 1], out=stack[power])
+        np.dot(step, stack[power - 1], out=stack[power])
     start = np.array([y0[0], y0[1], 1.0])
     state = start
     others = frame.others
@@ -240,11 +243,11 @@ def _exit_step(
         state = chunk[-1]
     # The first grid state on or past the exit edge, and the first beyond another facet
     # (argmax of a boolean array: its first True, or 0 when there is none).
-    reached = grid_states[:, :2] @ normal - offset >= 0.0
+    plane = grid_states[:, :2]
+    reached = plane.dot(normal) - offset >= 0.0
     k = int(reached.argmax())
-    beyond = (grid_states[:, :2] @ frame.other_normals.T - frame.other_offsets).max(
-        axis=1
-    ) > frame.slack
+    heights = plane.dot(frame.other_normals.T) - frame.other_offsets
+    beyond = np.maximum(heights[:, 0], heights[:, 1]) > frame.slack
     first_outside = int(beyond.argmax())
     if beyond[first_outside] and (not reached[k] or first_outside < k):
         _wrong_exit(controller, others, grid_states[first_outside, :2] + center)

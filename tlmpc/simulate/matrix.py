@@ -63,7 +63,9 @@ def expm_small(matrix: FloatArray) -> FloatArray:
     The matrix is scaled to norm s <= 1/2 and the series is cut at the first degree m with
     s^(m+1)/(m+1)! <= 1e-18 (m <= 18; small steps need far fewer terms).  Squaring amplifies
     rounding to about 1e-11 relative for the gains that occur here (checked against scipy's
-    ``expm`` in the tests), and it is many times faster than a general call.
+    ``expm`` in the tests), and it is many times faster than a general call.  The products
+    are ``ndarray.dot``: the same BLAS product as ``@`` on these 2-D arrays (the same bits),
+    at half of matmul's per-call cost on a 3 x 3 matrix.
     """
     norm = column_norm(matrix)
     squarings = max(0, math.ceil(math.log2(norm)) + 1) if norm > 0.5 else 0
@@ -73,9 +75,9 @@ def expm_small(matrix: FloatArray) -> FloatArray:
     identity = _IDENTITY_3 if matrix.shape == (3, 3) else np.eye(matrix.shape[0])
     result = identity + scaled / degree
     for k in range(degree - 1, 0, -1):
-        result = identity + (scaled @ result) / k
+        result = identity + scaled.dot(result) / k
     for _ in range(squarings):
-        result = result @ result
+        result = result.dot(result)
     return result
 
 
