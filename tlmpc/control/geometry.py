@@ -120,6 +120,51 @@ def affine_law(vertices: FloatArray, velocities: FloatArray) -> tuple[FloatArray
     return gain, offset
 
 
+def affine_laws(
+    vertices: Sequence[FloatArray], velocities: Sequence[FloatArray]
+) -> list[tuple[FloatArray, FloatArray]]:
+    """:func:`affine_law` of each triangle and its vertex velocities, bit for bit: the frames
+    on Python floats as there, the systems solved by one call of ``np.linalg.solve`` on their
+    stack (LAPACK's solve of each system, as for one; numpy's per-call cost was most of the
+    time for a plan of thousands of steps)."""
+    frames: list[tuple[float, float, float] | None] = []
+    systems: list[list[list[float]]] = []
+    for corners in vertices:
+        (x0, y0), (x1, y1), (x2, y2) = np.asarray(corners, dtype=np.float64).tolist()
+        cx, cy = (x0 + x1 + x2) / 3, (y0 + y1 + y2) / 3
+        dx0, dy0, dx1, dy1, dx2, dy2 = x0 - cx, y0 - cy, x1 - cx, y1 - cy, x2 - cx, y2 - cy
+        size = max(abs(dx0), abs(dy0), abs(dx1), abs(dy1), abs(dx2), abs(dy2))
+        if not (math.isfinite(cx) and math.isfinite(cy) and 0.0 < size < math.inf):
+            frames.append(None)  # solved on its own, with numpy's nan/inf
+            continue
+        frames.append((cx, cy, size))
+        systems.append(
+            [
+                [dx0 / size, dy0 / size, 1.0],
+                [dx1 / size, dy1 / size, 1.0],
+                [dx2 / size, dy2 / size, 1.0],
+            ]
+        )
+    framed = [w for w, frame in zip(velocities, frames, strict=True) if frame is not None]
+    solutions = (
+        np.asarray(np.linalg.solve(np.array(systems), np.array(framed)), dtype=np.float64)
+        if systems
+        else np.zeros((0, 3, 2))
+    )
+    laws: list[tuple[FloatArray, FloatArray]] = []
+    solved = iter(solutions)
+    for corners, w, frame in zip(vertices, velocities, frames, strict=True):
+        if frame is None:
+            laws.append(_affine_law_arrays(np.asarray(corners, dtype=np.float64), w))
+            continue
+        cx, cy, size = frame
+        solution = next(solved)
+        gain: FloatArray = np.ascontiguousarray(solution[:2].T / size)
+        offset: FloatArray = solution[2] - gain @ np.array([cx, cy])
+        laws.append((gain, offset))
+    return laws
+
+
 def _affine_law_arrays(
     vertices: FloatArray, velocities: FloatArray
 ) -> tuple[FloatArray, FloatArray]:

@@ -31,6 +31,7 @@ from tlmpc.control.follow import bends, follow_channel, path_guides
 from tlmpc.control.geometry import (
     TriangleGeometry,
     affine_law,
+    affine_laws,
     best_push,
     half_plane_feasible,
     largest_of,
@@ -714,6 +715,19 @@ def synthesize(
     velocities = solve_vertex_program(program)[0] if followed is None else followed[0]
     solved = time.perf_counter()
     controllers = []
+    # The exit steps' fields, solved at once (a stay may solve its field twice, on its own).
+    exits = {
+        index: velocities[[column[r] for r in step.runs]]
+        for index, step in enumerate(steps)
+        if step.through is None and step.exit_edge is not None
+    }
+    laws = dict(
+        zip(
+            exits,
+            affine_laws([steps[index].geometry.vertices for index in exits], list(exits.values())),
+            strict=True,
+        )
+    )
     for index, step in enumerate(steps):
         if step.through is not None:
             controllers.append(
@@ -724,6 +738,11 @@ def synthesize(
                     robot.max_speed,
                     robot.disturbance,
                 )
+            )
+            continue
+        if index in exits:
+            controllers.append(
+                _affine_controller(index, step, exits[index], robot, law=laws[index])
             )
             continue
         w = velocities[[column[r] for r in step.runs]]
@@ -799,10 +818,17 @@ def synthesize(
 
 
 def _affine_controller(
-    index: int, step: _Step, w: FloatArray, robot: Robot, *, radial: bool = False
+    index: int,
+    step: _Step,
+    w: FloatArray,
+    robot: Robot,
+    *,
+    radial: bool = False,
+    law: tuple[FloatArray, FloatArray] | None = None,
 ) -> StepController:
     """The affine field of ``step`` through the vertex velocities ``w`` (for a stay with
-    ``radial``, or where the solved field is degenerate, the radial field to the incenter)."""
+    ``radial``, or where the solved field is degenerate, the radial field to the incenter);
+    ``law`` is an exit step's ``affine_law(vertices, w)`` when already solved."""
     geometry = step.geometry
     target = None
     if step.exit_edge is None:
@@ -821,7 +847,7 @@ def _affine_controller(
         equilibrium = np.linalg.solve(gain, -offset)
         target = (float(equilibrium[0]), float(equilibrium[1]))
     else:
-        gain, offset = affine_law(geometry.vertices, w)
+        gain, offset = affine_law(geometry.vertices, w) if law is None else law
         nx, ny = geometry.normals[step.exit_edge].tolist()
         delta = min(nx * wx + ny * wy for wx, wy in w.tolist())  # numpy's 2-vector dot
         speed = delta
