@@ -413,6 +413,20 @@ def simulate(abstraction: Abstraction, controllers: Controllers, mission: Missio
         last = -1 if controller.is_stay else len(rel_times) - 1
         inside = controller.triangle
         beyond = inside if controller.next_triangle is None else controller.next_triangle
+        if min(rel_times) > 0.0:  # every sample taken: the step's lists extended at once
+            count = len(rel_times)
+            times.extend([now + t for t in rel_times])
+            points.extend(rel_points)
+            step_of.extend([index] * count)
+            if last < 0:
+                triangle_of.extend([inside] * count)
+            else:
+                triangle_of.extend([inside] * last)
+                triangle_of.append(beyond)
+                crossings.append(len(points) - 1)
+            now = times[-1]
+            x = points[-1]
+            continue
         for offset, (t, point) in enumerate(zip(rel_times, rel_points, strict=True)):
             if t <= 0.0:  # already on the exit edge: the current sample is the crossing
                 if controller.next_triangle is not None:
