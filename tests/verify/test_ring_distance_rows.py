@@ -88,3 +88,15 @@ def test_containment_asked_in_the_bounding_box_only_is_shapelys(
     points = np.asarray([*probes, *extra], dtype=np.float64).reshape(-1, 2)
     expected = shapely.contains_xy(shape, points[:, 0], points[:, 1])
     assert _contains(shape, ring, points).tolist() == expected.tolist()
+
+
+def test_ring_distance_across_block_boundaries_is_the_row_wise_definition() -> None:
+    # The points go a block at a time: every block's rows (the last, shorter one too) give
+    # the numbers of the whole array's.
+    from tlmpc.verify.robustness import RING_BLOCK
+
+    rng = np.random.default_rng(11)
+    ring = rng.uniform(-3.0, 3.0, (7, 2))
+    for count in (1, RING_BLOCK - 1, RING_BLOCK, RING_BLOCK + 1, 3 * RING_BLOCK + 5):
+        points = rng.uniform(-20.0, 20.0, (count, 2))
+        assert _ring_distance(ring, points).tobytes() == _row_wise(ring, points).tobytes()

@@ -114,7 +114,9 @@ class IntervalEvaluator:
         return lo, self._until_side(a[1], b[1])
 
     def _eventually_side(self, b: FloatArray) -> FloatArray:
-        result = np.maximum.accumulate(b[::-1])[::-1].copy()
+        # The running maximum from the end, written backwards into its place (no reversed copy).
+        result = np.empty(len(b), dtype=b.dtype)
+        np.maximum.accumulate(b[::-1], out=result[::-1])
         result[self.loop :] = np.max(b[self.loop :])
         return np.asarray(result, dtype=np.float64)
 
