@@ -295,10 +295,14 @@ class GuidedSearch:
                 return False
         return True
 
-    def step(self, ceiling: float | FloatArray = np.inf) -> tuple[Edges, IntArray]:
+    def step(
+        self, ceiling: float | FloatArray = np.inf, *, marks: bool = True
+    ) -> tuple[Edges, IntArray]:
         """Expand the lowest bucket (of every copy); returns its edges and the nodes whose
         distance got shorter (queued again).  ``ceiling`` may be one per copy: then the
-        bucket's nodes whose ``f`` reaches their copy's ceiling are dropped, not expanded."""
+        bucket's nodes whose ``f`` reaches their copy's ceiling are dropped, not expanded.
+        Without ``marks`` the edges' acceptance marks are not looked up (see
+        :meth:`LazyProduct.expand`)."""
         arrays = self.arrays
         self.rounds += 1
         buckets: list[IntArray] = []
@@ -316,9 +320,9 @@ class GuidedSearch:
             active = active[self._f(active) < ceiling[active // self.copy_size]]
         if self.copy_size:
             local = active % self.copy_size
-            edges = self.product.expand(local, base=active - local)
+            edges = self.product.expand(local, base=active - local, marks=marks)
         else:
-            edges = self.product.expand(active)
+            edges = self.product.expand(active, marks=marks)
         du = arrays.dist[edges.tails]
         d = du + edges.weights
         v = edges.heads
@@ -690,7 +694,7 @@ def _close_together(
         ceilings = np.minimum(reached, limits)
         if search.exhausted(ceilings):
             break
-        search.step(ceiling=ceilings)
+        search.step(ceiling=ceilings, marks=False)  # (its edges' marks are not read)
     found: list[tuple[float | None, list[int]]] = []
     reached = arrays.distance(targets)
     limits = np.minimum(limits, _others_limit(g, reached, bounds.beta))

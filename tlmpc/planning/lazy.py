@@ -75,11 +75,13 @@ class LazyProduct:
         """Number of product nodes (reached or not)."""
         return self.num_cells * self.num_states
 
-    def expand(self, nodes: IntArray, base: IntArray | None = None) -> Edges:
+    def expand(self, nodes: IntArray, base: IntArray | None = None, *, marks: bool = True) -> Edges:
         """Every product edge out of ``nodes``: per node its moves (each with its automaton
         successors), then its stutter edges; (tail, head) pairs are distinct.  With
         ``base``, node ``k`` stands for ``base[k] + nodes[k]`` in tails and heads (searches
-        that run side by side, each in its own copy of the node numbers)."""
+        that run side by side, each in its own copy of the node numbers).  Without
+        ``marks`` the acceptance marks are not looked up (``accepting`` is empty): a search
+        that reads none of them saves their gathers."""
         nq = self.num_states
         cell, state = np.divmod(nodes, nq)
         starts = self.move_indptr[cell]
@@ -96,7 +98,7 @@ class LazyProduct:
         tails: list[IntArray] = []
         heads: list[IntArray] = []
         weights: list[FloatArray] = []
-        marks: list[BoolArray] = []
+        accepting: list[BoolArray] = []
         for j in range(self.successor.shape[2]):
             following = self.successor[kind, q, j]
             ok = following >= 0
@@ -105,7 +107,8 @@ class LazyProduct:
             head = self.move_target[taken] * nq + following[ok]
             heads.append(head if shift is None else head + shift[ok])
             weights.append(self.move_weight[taken])
-            marks.append(self.marked[kind[ok], q[ok], j])
+            if marks:
+                accepting.append(self.marked[kind[ok], q[ok], j])
         staying = self.cell_class[cell] >= 0
         stay_nodes, stay_q = nodes[staying], state[staying]
         stay_class = self.cell_class[cell[staying]]
@@ -116,12 +119,13 @@ class LazyProduct:
             tails.append(stutter_tails)
             heads.append(stutter_tails - stay_q[ok] + following[ok])
             weights.append(np.full(len(stutter_tails), STUTTER_COST))
-            marks.append(self.stutter_marked[stay_class[ok], stay_q[ok], j])
+            if marks:
+                accepting.append(self.stutter_marked[stay_class[ok], stay_q[ok], j])
         return Edges(
             tails=np.concatenate(tails) if tails else np.zeros(0, dtype=np.int64),
             heads=np.concatenate(heads) if heads else np.zeros(0, dtype=np.int64),
             weights=np.concatenate(weights) if weights else np.zeros(0),
-            accepting=np.concatenate(marks) if marks else np.zeros(0, dtype=bool),
+            accepting=np.concatenate(accepting) if accepting else np.zeros(0, dtype=bool),
         )
 
     def stays_accepting(self, nodes: IntArray) -> BoolArray:
