@@ -183,7 +183,7 @@ def _affine_law_arrays(
 def largest_of(values: list[float]) -> float:
     """``max(values)`` as numpy's ``max`` gives it: nan when any value is nan (Python's
     ``max`` answers according to where the nan stands)."""
-    if any(value != value for value in values):
+    if any(map(math.isnan, values)):  # (value != value, in C: called per step and matrix)
         return math.nan
     return max(values)
 
