@@ -12,7 +12,8 @@ each sampled piece refined by the step's own matrix exponential):
   shortest_paths.py: a visibility graph on shapely geometry, independent of tlmpc);
 * **time ratio**: the time the task is met over that shortest length at ``max_speed``;
 * **lap ratio** (patrols): one lap of the trajectory's cycle over the shortest closed tour
-  touching the targets in the lap's cyclic order;
+  touching the targets in the lap's cyclic order; **lap / best order**: over the shortest
+  closed tour touching them in any order (the best lasso's lap);
 * **robustness**: the verifier's (how far the trajectory stays from every label boundary that
   would change the verdict): a path that hugs the shortest one passes closer to them.
 
@@ -500,6 +501,15 @@ def _measure(workload: Workload, compiled: Any) -> dict[str, float]:
         best = _best(key, free, tuple(shapes[n] for n in order), tuple(points[0]))
         row["lap"] = lap / best
         row["lap time"] = float(times[-1] - times[lap_start]) / (best / speed)
+        # ... and over the best tour in any order (the visiting order is the planner's choice)
+        tours = [best]
+        for rest in itertools.permutations(order[1:]):
+            others = (order[0], *rest)
+            if others == tuple(order):
+                continue
+            key = (workload.name, others, True)
+            tours.append(_best(key, free, tuple(shapes[n] for n in others), tuple(points[0])))
+        row["lap / best order"] = lap / min(tours)
         return row
     order, met = _order(points, shapes, workload.groups)
     if met < 0:
@@ -566,7 +576,7 @@ def side_by_side(baseline: Path, only: tuple[str, ...] = ()) -> list[dict[str, A
     for row in run(only):
         old = before.get(row["workload"], {})
         joined: dict[str, Any] = {"workload": row["workload"]}
-        for key in ("length", "time", "lap", "lap time", "robustness"):
+        for key in ("length", "time", "lap", "lap time", "lap / best order", "robustness"):
             if key in row or key in old:
                 joined[f"{key} before"] = old.get(key, "")
                 joined[f"{key} after"] = row.get(key, "")
