@@ -372,6 +372,72 @@ def held_out_detours() -> list[Workload]:
     ]
 
 
+def held_out_orders() -> list[Workload]:
+    """Missions written after the visiting orders were added, measured once: a body of
+    radius 0.15 at 1.2 m/s patrolling five stations round a machine hall, listed as they come
+    to mind, and a slow body of radius 0.25 visiting three rooms of a flat in turn, avoiding a
+    rug."""
+    hall = {
+        "version": 1,
+        "name": "hall",
+        "workspace": {
+            "boundary": [[0, 0], [24, 0], [24, 14], [15, 14], [15, 18], [0, 18]],
+            "holes": [
+                {"rect": [4, 4, 9, 6]},
+                {"rect": [12, 3, 13, 9]},
+                [[16, 8], [20, 7], [21, 10], [17, 11]],
+                {"rect": [5, 10, 10, 12.5]},
+            ],
+        },
+        "regions": {
+            "lathe": {"rect": [21.5, 1, 23.5, 3]},
+            "press": {"rect": [1, 15.5, 3, 17.5]},
+            "mill": {"rect": [20.5, 11.5, 23, 13.5]},
+            "store": {"rect": [1, 1, 3, 3]},
+            "desk": {"rect": [12, 15, 14.5, 17.5]},
+            "oil": {"rect": [13.5, 10, 15.5, 12]},
+        },
+        "robot": {"start": [10.5, 1.5], "max_speed": 1.2, "radius": 0.15},
+        "task": ["patrol lathe, press, mill, store and desk", "avoid oil"],
+    }
+    flat = {
+        "version": 1,
+        "name": "flat",
+        "workspace": {
+            "boundary": {"rect": [0, 0, 15, 11]},
+            "holes": [
+                {"rect": [6, 0, 6.3, 4.5]},
+                {"rect": [6, 6, 6.3, 11]},
+                {"rect": [6.3, 5.5, 11, 5.8]},
+                {"rect": [11.8, 5.5, 15, 5.8]},
+            ],
+        },
+        "regions": {
+            "kitchen": {"rect": [1, 8, 3.5, 10.5]},
+            "bedroom": {"rect": [12, 1, 14.5, 3.5]},
+            "bath": {"rect": [12.5, 8, 14.5, 10.5]},
+            "rug": {"rect": [2, 3, 4.5, 5.5]},
+        },
+        "robot": {"start": [1.0, 1.0], "max_speed": 0.5, "radius": 0.25},
+        "task": ["visit kitchen then bedroom then bath", "avoid rug"],
+    }
+    return [
+        Workload(
+            "hall r=0.15 patrol",
+            hall,
+            (("lathe", "press", "mill", "store", "desk"),),
+            avoid=("oil",),
+            patrol=True,
+        ),
+        Workload(
+            "flat r=0.25 v=0.5",
+            flat,
+            (("kitchen",), ("bedroom",), ("bath",)),
+            avoid=("rug",),
+        ),
+    ]
+
+
 def _compile(workload: Workload, follow: bool) -> tuple[Any, float]:
     """The compiled mission and the length of the path its fields follow (the channel's
     shortest path with the portal insets; nan before)."""
@@ -533,6 +599,7 @@ def workloads() -> list[Workload]:
         *held_out_late(),
         *held_out_depth(),
         *held_out_detours(),
+        *held_out_orders(),
     ]
 
 

@@ -69,7 +69,7 @@ def test_a_patrol_visits_its_goals_in_the_best_order(
     names = tuple(sorted(listing))
     shapes = {r.name: shapely.Polygon(r.polygon) for r in mission.regions}
     free = workspace_free_space(mission)
-    start = tuple(mission.robot.start)
+    start = (float(mission.robot.start[0]), float(mission.robot.start[1]))
 
     def tour(order: tuple[str, ...]) -> float:
         return VisibilityOracle(free, [shapes[n] for n in order], start).tour_length()
