@@ -21,7 +21,9 @@ import yaml
 from shortest_paths import VisibilityOracle
 
 from tlmpc.mission.cspace import workspace_free_space
-from tlmpc.pipeline.stages import MISSION, WITNESS, compile_mission
+from tlmpc.pipeline import shortest
+from tlmpc.pipeline.stages import ABSTRACTION, AUTOMATON, MISSION, WITNESS, compile_mission
+from tlmpc.planning.mission import plan_mission
 
 GOALS = {"sw": [0.5, 0.5, 2.0, 2.0], "se": [10.0, 0.5, 11.5, 2.0], "ne": [10.0, 8.0, 11.5, 9.5]}
 
@@ -79,3 +81,63 @@ def test_a_patrol_visits_its_goals_in_the_best_order(
     assert sorted(planned) == list(names)
     assert math.isclose(tour(planned), best, rel_tol=1e-9), (planned, tour(planned), best)
     assert len(witness.stats["order_lengths"]) == 3
+
+
+FIVE = {
+    "dock": [0.5, 0.5, 2.0, 2.0],
+    "lab": [12.0, 0.5, 13.5, 2.0],
+    "bay": [12.0, 8.0, 13.5, 9.5],
+    "desk": [6.5, 8.2, 8.0, 9.7],
+    "shop": [0.5, 7.5, 2.0, 9.0],
+}
+
+
+def _five(listing: tuple[str, ...]) -> str:
+    """A 14 x 10 room with two pillars and five goals round its walls, patrolled in
+    ``listing``."""
+    document = {
+        "version": 1,
+        "name": "five",
+        "workspace": {
+            "boundary": {"rect": [0, 0, 14, 10]},
+            "holes": [{"rect": [4, 3, 6, 6]}, {"rect": [9, 3.5, 10, 6.5]}],
+        },
+        "regions": {name: {"rect": rect} for name, rect in FIVE.items()},
+        "robot": {"start": [7.0, 1.0], "max_speed": 1.0},
+        "task": [f"patrol {', '.join(listing[:-1])} and {listing[-1]}"],
+    }
+    return yaml.safe_dump(document)
+
+
+@pytest.mark.parametrize(
+    "listing", [("dock", "bay", "shop", "lab", "desk"), ("desk", "dock", "bay", "shop", "lab")]
+)
+def test_past_the_budget_the_tour_order_of_the_sets_is_planned(
+    listing: tuple[str, ...], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """When the plans of every order would pass the budget, the one order of the shortest
+    tour between the sets' triangles is planned: the cycle then visits the five goals in the
+    best order of the tour oracle (brute force over the 12 orders)."""
+    text = _five(listing)
+    built = compile_mission("five.yaml", text=text, until="automaton").compilation
+    first = plan_mission(built.get(MISSION), built.get(ABSTRACTION), built.get(AUTOMATON))
+    nodes = int(first.witness.stats["product_nodes"])
+    # room for the first plan and one more, not for the eleven other orders
+    monkeypatch.setattr(shortest, "NODE_BUDGET", 3 * nodes)
+    result = compile_mission("five.yaml", text=text, until="plan")
+    mission = result.compilation.get(MISSION)
+    witness = result.compilation.get(WITNESS)
+    names = tuple(sorted(listing))
+    shapes = {r.name: shapely.Polygon(r.polygon) for r in mission.regions}
+    free = workspace_free_space(mission)
+    start = (float(mission.robot.start[0]), float(mission.robot.start[1]))
+
+    def tour(order: tuple[str, ...]) -> float:
+        return VisibilityOracle(free, [shapes[n] for n in order], start).tour_length()
+
+    others = [n for n in names if n != "dock"]
+    best = min(tour(("dock", *rest)) for rest in itertools.permutations(others))
+    planned = _cyclic_order(witness, names)
+    assert sorted(planned) == list(names)
+    assert math.isclose(tour(planned), best, rel_tol=1e-9), (planned, tour(planned), best)
+    assert len(witness.stats["order_lengths"]) == 2  # the first plan's order and the tour's

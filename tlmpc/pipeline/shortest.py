@@ -206,14 +206,14 @@ class _Kept:
 
 def order_candidates(mission: Mission, planned: Planned) -> list[Planned]:
     """``planned``'s task planned again (its mesh, the moves weighing their midpoint lengths)
-    once for each other order in which the degeneralization can await the automaton's
-    acceptance sets (:func:`tlmpc.automata.degeneralize.acceptance_orders`): a minimum-cost
-    lasso of one degeneralization visits the sets in its order once a lap, another order
-    only in two laps or more, so a patrol of four goals listed round a square's diagonals
-    would otherwise be planned along them.  None when the automaton has fewer than four sets
-    (one order up to direction) or when all the orders' plans would pass
-    :data:`NODE_BUDGET` product nodes (all of them or none: the choice does not depend on
-    where a budget ran out)."""
+    awaiting the automaton's acceptance sets in other orders
+    (:func:`tlmpc.automata.degeneralize.acceptance_orders`): a minimum-cost lasso of one
+    degeneralization visits the sets in its order once a lap, another order only in two laps
+    or more, so a patrol of four goals listed round a square's diagonals would otherwise be
+    planned along them.  Every other order when all their plans fit :data:`NODE_BUDGET`
+    product nodes; else the one order of the shortest tour between the sets' triangles
+    (:func:`tour_order`), when it is another and one more plan fits.  None when the automaton
+    has fewer than four sets (one order up to direction)."""
     from tlmpc.automata.degeneralize import acceptance_orders, reorder_acceptance
 
     automaton = planned.automaton
@@ -221,16 +221,76 @@ def order_candidates(mission: Mission, planned: Planned) -> list[Planned]:
     if count < 4:
         return []
     orders = math.factorial(count - 1) // 2 - 1  # besides the first plan's
-    if (orders + 1) * _nodes(planned) > NODE_BUDGET:
+    if (orders + 1) * _nodes(planned) <= NODE_BUDGET:
+        chosen = list(itertools.islice(acceptance_orders(count), 1, None))
+    elif 2 * _nodes(planned) <= NODE_BUDGET:
+        best = tour_order(planned)
+        chosen = [] if best is None or best == tuple(range(count)) else [best]
+    else:
         return []
     found = []
-    for order in itertools.islice(acceptance_orders(count), 1, None):
+    for order in chosen:
         reordered = replace(planned, automaton=reorder_acceptance(automaton, order))
         try:
             found.append(replan(mission, reordered, MoveTimes(speed=1.0)))
         except TlmpcError:
             continue
     return found
+
+
+#: :func:`tour_order` compares the orders of at most this many acceptance sets (2,520 orders).
+MAX_TOUR_SETS = 8
+
+
+def tour_order(planned: Planned) -> tuple[int, ...] | None:
+    """The order of the automaton's acceptance sets (one of
+    :func:`~tlmpc.automata.degeneralize.acceptance_orders`, the first of equals) whose closed
+    tour is shortest, a set standing for the triangles whose letter takes an edge it marks
+    and the distance between two sets the shortest walk between their triangles through
+    the mesh's edge midpoints (one multi-source search per set); None past
+    :data:`MAX_TOUR_SETS` sets."""
+    import numpy as np
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import dijkstra
+
+    from tlmpc.automata.degeneralize import acceptance_orders
+    from tlmpc.automata.guards import guard_holds
+
+    automaton, mesh = planned.automaton, planned.abstraction
+    count = automaton.num_acc
+    if count > MAX_TOUR_SETS:
+        return None
+    letters = mesh.letters
+    members: list[set[int]] = [set() for _ in range(count)]  # letters taking a marked edge
+    for edge in automaton.edges:
+        if not edge.marks:
+            continue
+        taking = [i for i, letter in enumerate(letters) if guard_holds(edge.guard, letter)]
+        for mark in edge.marks:
+            members[mark].update(taking)
+    # the mesh's dual graph, two triangles joined by the distance between their centroids
+    centroids = mesh.vertices[mesh.triangles].mean(axis=1)
+    rows, sides = np.nonzero(mesh.neighbors >= 0)
+    columns = mesh.neighbors[rows, sides]
+    weights = np.hypot(*(centroids[rows] - centroids[columns]).T)
+    size = mesh.num_triangles
+    graph = coo_matrix((weights, (rows, columns)), shape=(size, size)).tocsr()
+    letter_of = mesh.letter_of
+    distance = np.zeros((count, count))
+    for mark in range(count):
+        sources = np.flatnonzero(np.isin(letter_of, sorted(members[mark])))
+        if len(sources) == 0:
+            return None
+        reach = dijkstra(graph, indices=sources, min_only=True)
+        for other in range(count):
+            targets = np.isin(letter_of, sorted(members[other]))
+            distance[mark, other] = float(reach[targets].min())
+    best: tuple[float, tuple[int, ...]] | None = None
+    for order in acceptance_orders(count):
+        length = sum(distance[order[i], order[(i + 1) % count]] for i in range(count))
+        if best is None or length < best[0]:
+            best = (length, order)
+    return None if best is None else best[1]
 
 
 def _pulled(mission: Mission, planned: Planned) -> Pulled | None:
