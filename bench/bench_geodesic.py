@@ -438,6 +438,44 @@ def held_out_orders() -> list[Workload]:
     ]
 
 
+def held_out_tours() -> list[Workload]:
+    """A mission written after the tour order (the fallback past the budget) was added,
+    measured once: a point robot at 1.5 m/s patrolling six rooms of a school's corridor
+    loop, avoiding a stairwell."""
+    school = {
+        "version": 1,
+        "name": "school",
+        "workspace": {
+            "boundary": {"rect": [0, 0, 30, 16]},
+            "holes": [
+                {"rect": [4, 4, 13, 12]},
+                {"rect": [17, 4, 26, 12]},
+                {"rect": [14.5, 0, 15.5, 2.5]},
+            ],
+        },
+        "regions": {
+            "art": {"rect": [0.5, 13, 3, 15.5]},
+            "gym": {"rect": [27, 0.5, 29.5, 3]},
+            "music": {"rect": [14, 13.5, 16, 15.5]},
+            "science": {"rect": [0.5, 0.5, 3, 3]},
+            "office": {"rect": [27, 13, 29.5, 15.5]},
+            "library": {"rect": [13.5, 6, 16.5, 9]},
+            "stairs": {"rect": [6, 13, 8, 16]},
+        },
+        "robot": {"start": [10.0, 2.0], "max_speed": 1.5},
+        "task": ["patrol art, gym, music, science, office and library", "avoid stairs"],
+    }
+    return [
+        Workload(
+            "school patrol",
+            school,
+            (("art", "gym", "music", "science", "office", "library"),),
+            avoid=("stairs",),
+            patrol=True,
+        )
+    ]
+
+
 def _compile(workload: Workload, follow: bool) -> tuple[Any, float]:
     """The compiled mission and the length of the path its fields follow (the channel's
     shortest path with the portal insets; nan before)."""
@@ -600,6 +638,7 @@ def workloads() -> list[Workload]:
         *held_out_depth(),
         *held_out_detours(),
         *held_out_orders(),
+        *held_out_tours(),
     ]
 
 
