@@ -25,6 +25,11 @@ for the ``time`` metric (:mod:`tlmpc.pipeline.mintime`), the planner iterates:
    longer (at most :data:`MAX_TIME_CHECKS` re-plans are simulated).  So the kept plan is
    never longer nor slower than the first.
 
+Before the re-plans, an automaton with four acceptance sets or more is planned again awaiting
+the sets in other orders (:func:`order_candidates`), and a plan touching a region and turning
+back is made (:mod:`tlmpc.pipeline.touches`); each is kept on the re-plans' terms, by the
+same check (:meth:`_Kept.offer`).
+
 Every round is deterministic (operations are counted, no clock is read).  What is promised
 (docs/planning.md): the kept plan's path is never longer, and its trajectory never slower,
 than the midpoint plan's; it is not a proof that no channel has a shorter path (the moves no
