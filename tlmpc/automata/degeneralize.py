@@ -11,6 +11,8 @@ each state suffices), and entering an accepting SCC may start at level 0 or at l
 from __future__ import annotations
 
 import dataclasses
+import itertools
+from collections.abc import Iterator, Sequence
 
 from tlmpc.automata.model import Automaton, Edge
 from tlmpc.automata.simplify import merge_parallel, sccs, trim
@@ -132,3 +134,30 @@ def _degeneralize(automaton: Automaton) -> Automaton:
         )
     candidates = [_build(automaton, False), _build(automaton, True)]
     return min(candidates, key=lambda a: (a.num_states, len(a.edges)))
+
+
+def acceptance_orders(count: int) -> Iterator[tuple[int, ...]]:
+    """The orders in which a degeneralization can await ``count`` acceptance sets, one per
+    cycle of visits up to where it starts and which way round it runs: set 0 first, the
+    second set before the last (the reverse order visits the same sets along the same
+    tour).  The identity comes first; ``(count - 1)! / 2`` orders for three sets or more."""
+    if count < 3:
+        yield tuple(range(count))
+        return
+    for rest in itertools.permutations(range(1, count)):
+        if rest[0] < rest[-1]:
+            yield (0, *rest)
+
+
+def reorder_acceptance(automaton: Automaton, order: Sequence[int]) -> Automaton:
+    """The same automaton with acceptance set ``order[i]`` renumbered ``i`` (the language is
+    unchanged): :func:`degeneralize` then awaits the sets in ``order``, and a minimum-cost
+    lasso of its product visits them in that order once a lap."""
+    if sorted(order) != list(range(automaton.num_acc)):
+        raise ValueError(f"not an order of {automaton.num_acc} acceptance sets: {order}")
+    rank = {mark: index for index, mark in enumerate(order)}
+    edges = tuple(
+        dataclasses.replace(edge, marks=frozenset(rank[m] for m in edge.marks))
+        for edge in automaton.edges
+    )
+    return dataclasses.replace(automaton, edges=edges)

@@ -25,6 +25,11 @@ for the ``time`` metric (:mod:`tlmpc.pipeline.mintime`), the planner iterates:
    longer (at most :data:`MAX_TIME_CHECKS` re-plans are simulated).  So the kept plan is
    never longer nor slower than the first.
 
+Before the re-plans, an automaton with four acceptance sets or more is planned again awaiting
+the sets in other orders (:func:`order_candidates`), and a plan touching a region and turning
+back is made (:mod:`tlmpc.pipeline.touches`); each is kept on the re-plans' terms, by the
+same check (:meth:`_Kept.offer`).
+
 Every round is deterministic (operations are counted, no clock is read).  What is promised
 (docs/planning.md): the kept plan's path is never longer, and its trajectory never slower,
 than the midpoint plan's; it is not a proof that no channel has a shorter path (the moves no
@@ -34,6 +39,7 @@ one may be slower).
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
@@ -76,8 +82,10 @@ def plan_shortest(mission: Mission, planned: Planned) -> Planned:
 
     The witness's ``stats`` record ``path_length`` (the kept plan's), ``path_lengths``
     (each round's, in order), ``length_rounds``, ``length_fixed_point`` and
-    ``length_time_checks`` (the exact times of the re-plans short enough to be simulated),
-    and where a plan with U-turns gave a touch candidate (:mod:`tlmpc.pipeline.touches`)
+    ``length_time_checks`` (the exact times of the re-plans short enough to be simulated);
+    where the acceptance sets were awaited in other orders (:func:`order_candidates`)
+    ``order_lengths`` (each order's path length, the first plan's order first); and where a
+    plan with U-turns gave a touch candidate (:mod:`tlmpc.pipeline.touches`)
     ``touch_length`` (its path length) and, when that was short enough to simulate,
     ``touch_time`` (its exact time).
     """
@@ -88,43 +96,56 @@ def plan_shortest(mission: Mission, planned: Planned) -> Planned:
         first = pull(mission, planned)
     except TlmpcError:  # the control stage will say what is wrong with the plan
         return planned
-    best, best_length = planned, first.length
-    best_time: float | None = None  # the kept plan's exact time, once a re-plan needs it
+    kept = _Kept(mission, planned, first.length)
     checked: list[float] = []  # the exact times of the re-plans short enough to check
     history = [first.length]
     measured: dict[MoveKey, float] = dict(first.moves)
     seen = {planned.route()}
     fixed = False
-    current = planned
     # The moves no plan made keep their midpoint lengths scaled as the first plan's path
     # compares with its midpoint cost: unscaled, every measured move looks cheaper than
     # any other and the first channel is always planned again.
     cost = planned.witness.cost
     ratio = first.length / cost if cost > 0.0 and first.length > 0.0 else 1.0
+    extra: dict[str, Any] = {}
+    # The same lasso awaiting the acceptance sets in another order (its own budget, as the
+    # touch candidate's below: the re-plans run as they would without it).  The shortest
+    # path among the orders' plans is kept on the re-plans' terms.
+    ordered = order_candidates(mission, planned)
+    if ordered:
+        lengths = [first.length]
+        best_order: tuple[Planned, Pulled] | None = None
+        for candidate in ordered:
+            found_order = _pulled(mission, candidate)
+            lengths.append(math.inf if found_order is None else found_order.length)
+            if found_order is not None and (
+                best_order is None or found_order.length < best_order[1].length
+            ):
+                best_order = (candidate, found_order)
+            seen.add(candidate.route())
+        extra["order_lengths"] = lengths
+        if best_order is not None and kept.offer(*best_order, verified=True) is not None:
+            measured.update(best_order[1].moves)
     # A plan that touches a region and turns back, on the mesh split where it touches
     # (tlmpc.pipeline.touches): a candidate like the re-plans, kept on the same terms, its
     # exact time checked apart from theirs.
-    touch: dict[str, Any] = {}
     # (its own budget, the plan with U-turns and the re-plan on the split mesh: the re-plans
     # below run as they would without it)
-    if 2 * _nodes(planned) <= NODE_BUDGET:
+    if 2 * _nodes(kept.planned) <= NODE_BUDGET:
         # on the midpoint lengths alone: the first plan's measured pieces would draw the plan
         # with U-turns back into the first plan's channel (Example 6 touched a core by its
         # far side edge, its exact time 39.0 s against 38.3 s so)
-        touched = touch_candidate(mission, planned, MoveTimes(speed=1.0))
+        touched = touch_candidate(mission, kept.planned, MoveTimes(speed=1.0))
         found_touch = None if touched is None else _pulled(mission, touched)
         if touched is not None and found_touch is not None:
             seen.add(touched.route())
-            touch = {"touch_length": found_touch.length}
-            if found_touch.length < best_length * (1.0 - MIN_GAIN):
-                best_time = _exact_time(mission, best)
-                time = _verified_time(mission, touched)
-                touch["touch_time"] = time
-                not_slower = time <= best_time
-                if not_slower:
-                    best, best_length, best_time = touched, found_touch.length, time
-                    current = touched  # the re-plans go on from it, on its mesh
-                    measured.update(found_touch.moves)
+            extra["touch_length"] = found_touch.length
+            time = kept.offer(touched, found_touch, verified=True)
+            if time is not None:
+                extra["touch_time"] = time
+            if kept.planned is touched:
+                measured.update(found_touch.moves)
+    current = kept.planned  # the re-plans go on from the kept plan, on its mesh
     for _ in range(MAX_REPLANS):
         # a re-plan costs about what the last plan did: none that would pass the budget
         if spent + _nodes(current) > NODE_BUDGET:
@@ -142,27 +163,139 @@ def plan_shortest(mission: Mission, planned: Planned) -> Planned:
             break
         seen.add(shape)
         history.append(found.length)
-        if found.length < best_length * (1.0 - MIN_GAIN) and len(checked) < MAX_TIME_CHECKS:
-            # ... and only when its trajectory is not slower (the length does not see the
-            # fields' speeds): both are simulated, as the time metric measures a plan
-            if best_time is None:
-                best_time = _exact_time(mission, best)
-            time = _exact_time(mission, following)
-            checked.append(time)
-            if time <= best_time:
-                best, best_length, best_time = following, found.length, time
+        if len(checked) < MAX_TIME_CHECKS:
+            time = kept.offer(following, found, verified=False)
+            if time is not None:
+                checked.append(time)
         measured.update(found.moves)
         current = following
+    best = kept.planned
     stats: dict[str, Any] = {
         **best.witness.stats,
-        "path_length": best_length,
+        "path_length": kept.length,
         "path_lengths": history,
         "length_rounds": len(history),
         "length_fixed_point": fixed,
         "length_time_checks": checked,
-        **touch,
+        **extra,
     }
     return replace(best, witness=replace(best.witness, stats=stats))
+
+
+class _Kept:
+    """The kept plan, its path length and (once a candidate needed it) its exact time: the
+    one place that decides whether a candidate replaces it."""
+
+    def __init__(self, mission: Mission, planned: Planned, length: float) -> None:
+        self.mission = mission
+        self.planned = planned
+        self.length = length
+        self.time: float | None = None
+
+    def offer(self, candidate: Planned, pulled: Pulled, *, verified: bool) -> float | None:
+        """Keep ``candidate`` when its path is more than :data:`MIN_GAIN` shorter **and** its
+        trajectory is not slower (the length does not see the fields' speeds): both are then
+        simulated, as the time metric measures a plan; ``verified`` also asks its trace to
+        satisfy the task (a plan on another mesh or automaton).  The candidate's exact time
+        when it was simulated, else None."""
+        if not pulled.length < self.length * (1.0 - MIN_GAIN):
+            return None
+        if self.time is None:
+            self.time = _exact_time(self.mission, self.planned)
+        measure = _verified_time if verified else _exact_time
+        time = measure(self.mission, candidate)
+        if time <= self.time:
+            self.planned, self.length, self.time = candidate, pulled.length, time
+        return time
+
+
+def order_candidates(mission: Mission, planned: Planned) -> list[Planned]:
+    """``planned``'s task planned again (its mesh, the moves weighing their midpoint lengths)
+    awaiting the automaton's acceptance sets in other orders
+    (:func:`tlmpc.automata.degeneralize.acceptance_orders`): a minimum-cost lasso of one
+    degeneralization visits the sets in its order once a lap, another order only in two laps
+    or more, so a patrol of four goals listed round a square's diagonals would otherwise be
+    planned along them.  Every other order when all their plans fit :data:`NODE_BUDGET`
+    product nodes; else the one order of the shortest tour between the sets' triangles
+    (:func:`tour_order`), when it is another and one more plan fits.  None when the automaton
+    has fewer than four sets (one order up to direction)."""
+    from tlmpc.automata.degeneralize import acceptance_orders, reorder_acceptance
+
+    automaton = planned.automaton
+    count = automaton.num_acc
+    if count < 4:
+        return []
+    orders = math.factorial(count - 1) // 2 - 1  # besides the first plan's
+    if (orders + 1) * _nodes(planned) <= NODE_BUDGET:
+        chosen = list(itertools.islice(acceptance_orders(count), 1, None))
+    elif 2 * _nodes(planned) <= NODE_BUDGET:
+        best = tour_order(planned)
+        chosen = [] if best is None or best == tuple(range(count)) else [best]
+    else:
+        return []
+    found = []
+    for order in chosen:
+        reordered = replace(planned, automaton=reorder_acceptance(automaton, order))
+        try:
+            found.append(replan(mission, reordered, MoveTimes(speed=1.0)))
+        except TlmpcError:
+            continue
+    return found
+
+
+#: :func:`tour_order` compares the orders of at most this many acceptance sets (2,520 orders).
+MAX_TOUR_SETS = 8
+
+
+def tour_order(planned: Planned) -> tuple[int, ...] | None:
+    """The order of the automaton's acceptance sets (one of
+    :func:`~tlmpc.automata.degeneralize.acceptance_orders`, the first of equals) whose closed
+    tour is shortest, a set standing for the triangles whose letter takes an edge it marks
+    and the distance between two sets the shortest walk between their triangles through
+    the mesh's edge midpoints (one multi-source search per set); None past
+    :data:`MAX_TOUR_SETS` sets."""
+    import numpy as np
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import dijkstra
+
+    from tlmpc.automata.degeneralize import acceptance_orders
+    from tlmpc.automata.guards import guard_holds
+
+    automaton, mesh = planned.automaton, planned.abstraction
+    count = automaton.num_acc
+    if count > MAX_TOUR_SETS:
+        return None
+    letters = mesh.letters
+    members: list[set[int]] = [set() for _ in range(count)]  # letters taking a marked edge
+    for edge in automaton.edges:
+        if not edge.marks:
+            continue
+        taking = [i for i, letter in enumerate(letters) if guard_holds(edge.guard, letter)]
+        for mark in edge.marks:
+            members[mark].update(taking)
+    # the mesh's dual graph, two triangles joined by the distance between their centroids
+    centroids = mesh.vertices[mesh.triangles].mean(axis=1)
+    rows, sides = np.nonzero(mesh.neighbors >= 0)
+    columns = mesh.neighbors[rows, sides]
+    weights = np.hypot(*(centroids[rows] - centroids[columns]).T)
+    size = mesh.num_triangles
+    graph = coo_matrix((weights, (rows, columns)), shape=(size, size)).tocsr()
+    letter_of = mesh.letter_of
+    distance = np.zeros((count, count))
+    for mark in range(count):
+        sources = np.flatnonzero(np.isin(letter_of, sorted(members[mark])))
+        if len(sources) == 0:
+            return None
+        reach = dijkstra(graph, indices=sources, min_only=True)
+        for other in range(count):
+            targets = np.isin(letter_of, sorted(members[other]))
+            distance[mark, other] = float(reach[targets].min())
+    best: tuple[float, tuple[int, ...]] | None = None
+    for order in acceptance_orders(count):
+        length = sum(distance[order[i], order[(i + 1) % count]] for i in range(count))
+        if best is None or length < best[0]:
+            best = (length, order)
+    return None if best is None else best[1]
 
 
 def _pulled(mission: Mission, planned: Planned) -> Pulled | None:
