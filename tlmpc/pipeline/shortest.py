@@ -215,10 +215,11 @@ def order_candidates(mission: Mission, planned: Planned) -> list[Planned]:
     (:func:`tlmpc.automata.degeneralize.acceptance_orders`): a minimum-cost lasso of one
     degeneralization visits the sets in its order once a lap, another order only in two laps
     or more, so a patrol of four goals listed round a square's diagonals would otherwise be
-    planned along them.  Every other order when all their plans fit :data:`NODE_BUDGET`
-    product nodes; else the one order of the shortest tour between the sets' triangles
-    (:func:`tour_order`), when it is another and one more plan fits.  None when the automaton
-    has fewer than four sets (one order up to direction)."""
+    planned along them.  Every other order when there are at most :data:`MAX_ORDER_PLANS`
+    and all their plans fit :data:`NODE_BUDGET` product nodes; else the one order of the
+    shortest tour between the sets' triangles (:func:`tour_order`), when it is another and
+    one more plan fits.  None when the automaton has fewer than four sets (one order up to
+    direction)."""
     from tlmpc.automata.degeneralize import acceptance_orders, reorder_acceptance
 
     automaton = planned.automaton
@@ -226,7 +227,7 @@ def order_candidates(mission: Mission, planned: Planned) -> list[Planned]:
     if count < 4:
         return []
     orders = math.factorial(count - 1) // 2 - 1  # besides the first plan's
-    if (orders + 1) * _nodes(planned) <= NODE_BUDGET:
+    if orders <= MAX_ORDER_PLANS and (orders + 1) * _nodes(planned) <= NODE_BUDGET:
         chosen = list(itertools.islice(acceptance_orders(count), 1, None))
     elif 2 * _nodes(planned) <= NODE_BUDGET:
         best = tour_order(planned)
@@ -243,6 +244,11 @@ def order_candidates(mission: Mission, planned: Planned) -> list[Planned]:
     return found
 
 
+#: Every other order is planned for at most this many (the 11 others of five sets): beyond,
+#: one plan costs more than its nodes say (sixty plans of a 4,004-node product tripled a
+#: six-room patrol's plan stage), and the tour order is planned alone.
+MAX_ORDER_PLANS = 11
+
 #: :func:`tour_order` compares the orders of at most this many acceptance sets (2,520 orders).
 MAX_TOUR_SETS = 8
 
@@ -251,15 +257,14 @@ def tour_order(planned: Planned) -> tuple[int, ...] | None:
     """The order of the automaton's acceptance sets (one of
     :func:`~tlmpc.automata.degeneralize.acceptance_orders`, the first of equals) whose closed
     tour is shortest, a set standing for the triangles whose letter takes an edge it marks
-    and the distance between two sets the shortest walk between their triangles through
-    the mesh's edge midpoints (one multi-source search per set); None past
+    and the distance between two sets the shortest walk between their triangles from
+    centroid to centroid (one multi-source search per set); None past
     :data:`MAX_TOUR_SETS` sets."""
     import numpy as np
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import dijkstra
 
     from tlmpc.automata.degeneralize import acceptance_orders
     from tlmpc.automata.guards import guard_holds
+    from tlmpc.planning.search import Graph, distances
 
     automaton, mesh = planned.automaton, planned.abstraction
     count = automaton.num_acc
@@ -276,17 +281,16 @@ def tour_order(planned: Planned) -> tuple[int, ...] | None:
     # the mesh's dual graph, two triangles joined by the distance between their centroids
     centroids = mesh.vertices[mesh.triangles].mean(axis=1)
     rows, sides = np.nonzero(mesh.neighbors >= 0)
-    columns = mesh.neighbors[rows, sides]
+    columns = mesh.neighbors[rows, sides].astype(np.int64)
     weights = np.hypot(*(centroids[rows] - centroids[columns]).T)
-    size = mesh.num_triangles
-    graph = coo_matrix((weights, (rows, columns)), shape=(size, size)).tocsr()
+    graph, _ = Graph.from_edges(rows.astype(np.int64), columns, weights, mesh.num_triangles)
     letter_of = mesh.letter_of
     distance = np.zeros((count, count))
     for mark in range(count):
         sources = np.flatnonzero(np.isin(letter_of, sorted(members[mark])))
         if len(sources) == 0:
             return None
-        reach = dijkstra(graph, indices=sources, min_only=True)
+        reach = distances(graph, sources)
         for other in range(count):
             targets = np.isin(letter_of, sorted(members[other]))
             distance[mark, other] = float(reach[targets].min())
