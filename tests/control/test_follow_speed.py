@@ -21,6 +21,7 @@ from hypothesis import strategies as st
 
 import tlmpc
 from tlmpc.control import follow
+from tlmpc.control.channel import label_clearance
 from tlmpc.control.geometry import triangle_geometry
 
 #: Unit directions every 0.01°: the brute force's grid.
@@ -189,7 +190,13 @@ def test_the_following_solve_rewards_the_floor_up_to_the_cap_only() -> None:
     compilation = compile_mission(source, until="plan").compilation
     mission, abstraction = compilation.get(MISSION), compilation.get(ABSTRACTION)
     steps, loop_start = plan_steps(abstraction, compilation.get(WITNESS))
-    guides = follow.path_guides(abstraction, steps, loop_start, mission.robot.start)
+    guides = follow.path_guides(
+        abstraction,
+        steps,
+        loop_start,
+        mission.robot.start,
+        clearance=label_clearance(mission.robot.max_speed),
+    )
     split = follow.bends(abstraction, steps, loop_start, guides)
     _assign_runs(abstraction, steps, loop_start, split=split)
     steps = [step for step in steps if step.through is None]  # (no vertex passage here)

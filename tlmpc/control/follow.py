@@ -294,13 +294,14 @@ def path_guides(
     loop_start: int | None,
     start: tuple[float, float],
     *,
+    clearance: float,
     passages: bool = False,
-    clearance: float | None = None,
 ) -> list[Guide | None]:
     """The channel's shortest path, one straight piece per step (None for a vertex
     passage, unless ``passages``: then its piece to the corner), with the portal insets of
     :mod:`tlmpc.control.channel` (``clearance``: the distance kept from a region's own
-    boundary, :attr:`tlmpc.control.channel.ChannelStep.clearance`)."""
+    boundary, :attr:`tlmpc.control.channel.ChannelStep.clearance`; a compile passes
+    :func:`tlmpc.control.channel.label_clearance` of the robot's max_speed)."""
     # A vertex is on a label boundary when the triangles around it do not all share a label.
     letters = np.repeat(abstraction.letter_of, 3)  # each corner's triangle's letter
     count = len(abstraction.vertices)
