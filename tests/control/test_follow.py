@@ -433,6 +433,41 @@ def test_a_bent_corridor_splits_its_runs_at_the_bend() -> None:
     assert ratios[0] < ratios[1]
 
 
+def test_without_a_disturbance_the_lower_floor_cap_keeps_a_bend_closer() -> None:
+    """A point robot without a declared disturbance has its floor rewarded up to
+    FREE_FLOOR_CAP only: round the L-shaped corridor's bend its trajectory (to the stay's
+    target) is shorter than with the disturbed robot's FLOOR_CAP, both measured against the
+    corridor's geodesic (visibility graph on shapely geometry), and within 9.5 % of it."""
+    from tlmpc.control import follow
+
+    centre = [(0.0, 0.0), (1.0, 0.0), (2.0, 0.0), (3.0, 0.0), (3.0, 1.0), (3.0, 2.0), (3.0, 3.0)]
+    left = [(x - 0.5 * (x >= 3.0), y + 0.5 * (x < 3.0)) for x, y in centre]
+    right = [(x + 0.5 * (x >= 3.0), y - 0.5 * (x < 3.0)) for x, y in centre]
+    left[3], right[3] = (2.5, 0.5), (3.5, -0.5)  # the corner's diagonal
+    planned = strip_plan(left, right)
+    assert planned is not None
+    abstraction, witness, triangles = planned
+    sx, sy = abstraction.corners(0).mean(axis=0).tolist()
+    robot = Robot(start=(sx, sy), max_speed=1.0)
+    mission = cast(Mission, type("M", (), {"robot": robot})())
+    corridor = shapely.Polygon([*right, *reversed(left)])
+
+    def ratio() -> float:
+        fields = synthesize(abstraction, witness, robot)
+        trace = simulate(abstraction, fields, mission)
+        travelled, entry = _length_until(trace, len(triangles) - 1)
+        target = fields.steps[-1].target
+        assert target is not None
+        best = geodesic(corridor, (sx, sy), (target[0], target[1]))
+        return (travelled + math.dist(entry, target)) / best
+
+    free = ratio()
+    with mock.patch.object(follow, "FREE_FLOOR_CAP", follow.FLOOR_CAP):
+        capped = ratio()
+    assert free < capped
+    assert free <= 1.095
+
+
 def test_the_middle_inset_only_where_a_label_is_exposed_or_by_a_wall() -> None:
     """On a room whose goal lies in the middle (its core labels the mesh), the channel marks
     a step as entering a new label only when its triangle has a corner on a wall or on a
