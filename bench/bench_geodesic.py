@@ -476,6 +476,67 @@ def held_out_tours() -> list[Workload]:
     ]
 
 
+def held_out_corners() -> list[Workload]:
+    """Missions written after the corner-reach gain and the disturbance-free floor cap were
+    tuned, measured once: a greenhouse crossed by a slow robot with a wide body and a margin
+    between slanted beds, and a library's stacks for a fast point robot with a margin."""
+    greenhouse = {
+        "version": 1,
+        "name": "greenhouse",
+        "workspace": {
+            "boundary": [[0, 0], [26, 0], [26, 16], [0, 16]],
+            "holes": [
+                [[4, 3], [9, 4.5], [8.4, 6], [3.4, 4.5]],
+                [[12, 2], [14, 2], [15, 9], [13, 9]],
+                [[5, 9], [10, 8], [10.4, 9.6], [5.4, 10.6]],
+                [[18, 6], [23, 5], [23.5, 7], [18.5, 8]],
+                [[16, 11], [20, 11], [20, 13.5], [16, 13.5]],
+            ],
+        },
+        "regions": {
+            "seedlings": {"rect": [1, 12, 3.5, 14.5]},
+            "pump": {"rect": [22.5, 1, 24.5, 3]},
+            "potting": {"rect": [22, 12.5, 25, 15]},
+            "wet": [[10.5, 4], [11.6, 4.2], [11.4, 6.5], [10.4, 6]],
+        },
+        "robot": {"start": [1.2, 1.2], "max_speed": 0.6, "radius": 0.35},
+        "options": {"margin": 0.1},
+        "task": ["visit seedlings then pump then potting", "avoid wet"],
+    }
+    library = {
+        "version": 1,
+        "name": "library",
+        "workspace": {
+            "boundary": {"rect": [0, 0, 30, 18]},
+            "holes": [{"rect": [4 + 5 * k, 3, 5 + 5 * k, 8 + (k % 2) * 4]} for k in range(5)]
+            + [{"rect": [6, 13, 16, 14]}],
+        },
+        "regions": {
+            "desk": {"rect": [1, 1, 3, 3]},
+            "archive": {"rect": [26, 14, 29, 17]},
+            "reading": {"rect": [17, 15, 21, 17.5]},
+            "stairs": {"rect": [26, 6, 28, 9]},
+        },
+        "robot": {"start": [2.0, 16.0], "max_speed": 1.8},
+        "options": {"margin": 0.25},
+        "task": ["visit desk then archive then reading", "avoid stairs"],
+    }
+    return [
+        Workload(
+            "greenhouse r=0.35 m=0.1",
+            greenhouse,
+            (("seedlings",), ("pump",), ("potting",)),
+            avoid=("wet",),
+        ),
+        Workload(
+            "library v=1.8 m=0.25",
+            library,
+            (("desk",), ("archive",), ("reading",)),
+            avoid=("stairs",),
+        ),
+    ]
+
+
 def _compile(workload: Workload, follow: bool) -> tuple[Any, float]:
     """The compiled mission and the length of the path its fields follow (the channel's
     shortest path with the portal insets; nan before)."""
@@ -639,6 +700,7 @@ def workloads() -> list[Workload]:
         *held_out_detours(),
         *held_out_orders(),
         *held_out_tours(),
+        *held_out_corners(),
     ]
 
 

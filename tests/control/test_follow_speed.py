@@ -21,6 +21,7 @@ from hypothesis import strategies as st
 
 import tlmpc
 from tlmpc.control import follow
+from tlmpc.control.channel import label_clearance
 from tlmpc.control.geometry import triangle_geometry
 
 #: Unit directions every 0.01°: the brute force's grid.
@@ -149,11 +150,16 @@ def test_the_fields_run_near_max_speed_round_a_walls_end(top: float, goal_x: flo
     assert any(jump["reason"] == follow.DEFLECTS for jump in jumps)
 
 
+@pytest.mark.parametrize("disturbance", [0.0, 0.02])
 @pytest.mark.parametrize("spec", ["example1", "reach-avoid"])
-def test_the_weakest_step_keeps_the_vertex_programs_floor_up_to_the_cap(spec: str) -> None:
+def test_the_weakest_step_keeps_the_vertex_programs_floor_up_to_the_cap(
+    spec: str, disturbance: float
+) -> None:
     """The smallest guaranteed exit speed of the following fields is at least the vertex
-    program's own (solved alone, ``follow=False``) or FLOOR_CAP x max_speed, whichever is
-    less (to the solver's tolerance)."""
+    program's own (solved alone, ``follow=False``) or the cap x max_speed, whichever is
+    less (to the solver's tolerance): FLOOR_CAP under a declared disturbance, FREE_FLOOR_CAP
+    without one."""
+    import dataclasses
     from pathlib import Path
 
     from tlmpc.control import synthesize
@@ -163,18 +169,22 @@ def test_the_weakest_step_keeps_the_vertex_programs_floor_up_to_the_cap(spec: st
     compilation = compile_mission(source, until="plan").compilation
     mission, abstraction = compilation.get(MISSION), compilation.get(ABSTRACTION)
     witness = compilation.get(WITNESS)
-    followed = synthesize(abstraction, witness, mission.robot)
-    alone = synthesize(abstraction, witness, mission.robot, follow=False)
+    robot = dataclasses.replace(mission.robot, disturbance=disturbance)
+    followed = synthesize(abstraction, witness, robot)
+    alone = synthesize(abstraction, witness, robot, follow=False)
     assert followed.stats["follow_status"] == "Solved"
-    cap = follow.FLOOR_CAP * mission.robot.max_speed
+    fraction = follow.FLOOR_CAP if disturbance > 0.0 else follow.FREE_FLOOR_CAP
+    assert follow.floor_cap(disturbance) == fraction
+    cap = fraction * mission.robot.max_speed
     floor = min(float(alone.stats["min_exit_speed"]), cap)
     assert float(followed.stats["min_exit_speed"]) >= floor * (1.0 - 1e-5)
 
 
 def test_the_following_solve_rewards_the_floor_up_to_the_cap_only() -> None:
     """Solved on Example 8's plan, the following program's floor variable (the smallest
-    guaranteed speed it rewards) is at most FLOOR_CAP, while the vertex program alone puts
-    it higher on the same runs (so the cap is what holds it)."""
+    guaranteed speed it rewards) is at most the cap of a robot without a disturbance
+    (FREE_FLOOR_CAP), while the vertex program alone puts it higher on the same runs (so the
+    cap is what holds it)."""
     from pathlib import Path
 
     from tlmpc.control.synthesize import (
@@ -189,7 +199,13 @@ def test_the_following_solve_rewards_the_floor_up_to_the_cap_only() -> None:
     compilation = compile_mission(source, until="plan").compilation
     mission, abstraction = compilation.get(MISSION), compilation.get(ABSTRACTION)
     steps, loop_start = plan_steps(abstraction, compilation.get(WITNESS))
-    guides = follow.path_guides(abstraction, steps, loop_start, mission.robot.start)
+    guides = follow.path_guides(
+        abstraction,
+        steps,
+        loop_start,
+        mission.robot.start,
+        clearance=label_clearance(mission.robot.max_speed),
+    )
     split = follow.bends(abstraction, steps, loop_start, guides)
     _assign_runs(abstraction, steps, loop_start, split=split)
     steps = [step for step in steps if step.through is None]  # (no vertex passage here)
@@ -218,7 +234,9 @@ def test_the_following_solve_rewards_the_floor_up_to_the_cap_only() -> None:
             program.steps,
             chosen,
             alignment=follow.ALIGNMENT,
+            floor_cap=follow.floor_cap(mission.robot.disturbance),
         )
     )
     assert x is not None
-    assert x[floor] <= follow.FLOOR_CAP * (1.0 + 1e-6)
+    assert mission.robot.disturbance == 0.0
+    assert x[floor] <= follow.FREE_FLOOR_CAP * (1.0 + 1e-6)

@@ -76,10 +76,12 @@ def test_entering_a_label_by_a_wall_keeps_the_clearance_at_both_ends(length: flo
     assert _exit_insets(step) == (kept, kept)
 
 
-def test_without_a_clearance_the_fractions_stand() -> None:
-    step = _step(10.0, labelled=(False, False, True))
+def test_a_clearance_wider_than_the_portal_allows_keeps_the_fractions() -> None:
+    # a 10 m clearance on a 10 m portal: a quarter at an exposed end, two fifths at both
+    # ends where a label is entered by a wall (the portal keeps its middle)
+    step = _step(10.0, labelled=(False, False, True), clearance=10.0)
     assert _exit_insets(step) == (LABEL_INSET, PORTAL_INSET)
-    entered = _step(10.0, labelled=(False, False, True), entered=True)
+    entered = _step(10.0, labelled=(False, False, True), entered=True, by_wall=True, clearance=10.0)
     assert _exit_insets(entered) == (ENTERED_INSET, ENTERED_INSET)
 
 

@@ -61,7 +61,7 @@ def test_an_end_is_widened_to_the_gain_times_the_closing_rate(
     entry = (inner[0] + t * 0.01, inner[1])
     assume(math.dist(entry, on_exit) > 1e-3)
     assume(shapely.Polygon(corners).buffer(1e-9).contains(shapely.Point(entry)))
-    step = ChannelStep(corners=corners, exit_edge=e)
+    step = ChannelStep(corners=corners, exit_edge=e, clearance=0.1)
     base = (channel.PORTAL_INSET, channel.PORTAL_INSET)
     widened = _reachable(step, base, entry, on_exit)
     for side, end in ((0, left), (1, right)):
@@ -72,7 +72,7 @@ def test_an_end_is_widened_to_the_gain_times_the_closing_rate(
 
 def test_a_piece_running_away_from_both_facets_keeps_its_insets() -> None:
     corners = ((0.0, 0.0), (4.0, 0.0), (0.0, 4.0))
-    step = ChannelStep(corners=corners, exit_edge=0)  # exit: (4, 0) - (0, 4)
+    step = ChannelStep(corners=corners, exit_edge=0, clearance=0.1)  # exit: (4, 0) - (0, 4)
     # from near the right angle straight out along the diagonal: away from both legs
     assert _reachable(step, (0.03, 0.03), (0.5, 0.5), (2.0, 2.0)) == (0.03, 0.03)
     # heading for the exit edge's end (4, 0) while closing on the leg y = 0 (the other facet

@@ -31,12 +31,13 @@ Point = tuple[float, float]
 
 #: Each portal keeps this fraction of its length clear at both ends.
 PORTAL_INSET = 0.03
-#: ... and this much at an end on a label boundary (a region's edge or corner), so that the
-#: path does not graze a region it must avoid: the verifier's robustness (the distance to the
-#: nearest boundary that decides the verdict) would vanish with it.
+#: An end on an exposed label boundary (a region's own edge or corner) keeps the step's
+#: clearance, so that the path does not graze a region it must avoid (the verifier's
+#: robustness, the distance to the nearest boundary that decides the verdict, would vanish
+#: with it), but at most this fraction of the portal ...
 LABEL_INSET = 0.25
-#: The triangle where the plan enters a new label is left near the middle of its exit edge,
-#: so that the path goes into the region it visits rather than grazing its edge.
+#: ... and at most this fraction where the plan enters a new label (so that the path goes
+#: into the region it visits rather than grazing its edge).
 ENTERED_INSET = 0.4
 
 
@@ -65,6 +66,10 @@ class ChannelStep:
 
     corners: tuple[Point, Point, Point]
     exit_edge: int | None
+    #: The distance the path keeps from a label boundary it must not graze (a region's own
+    #: boundary), along the exit portal (see :func:`_exit_insets`): what a compile passes is
+    #: :func:`label_clearance` of the robot's max_speed.
+    clearance: float
     through: Point | None = None
     #: Per corner: does it lie on a label boundary (a region's edge)?
     labelled: tuple[bool, bool, bool] = (False, False, False)
@@ -72,10 +77,6 @@ class ChannelStep:
     entered: bool = False
     #: Does a corner lie on a wall (the workspace's boundary or an obstacle's)?
     by_wall: bool = False
-    #: The distance the path keeps from a label boundary it must not graze (a region's own
-    #: boundary), along the exit portal; None: the fractions of the portal alone (see
-    #: :func:`_exit_insets`).
-    clearance: float | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -266,25 +267,19 @@ REACH_CAP = 0.45
 def _exit_insets(step: ChannelStep) -> tuple[float, float]:
     """The fractions :func:`_pulled` keeps clear at the exit portal's left and right ends.
 
-    Every end keeps :data:`PORTAL_INSET`.  Without a ``clearance``, an end on an exposed
-    label boundary keeps :data:`LABEL_INSET` of the portal, and where the plan enters a new
-    label both ends keep :data:`ENTERED_INSET`.  With a ``clearance`` those ends keep that
-    distance instead, never more than those fractions of the portal: a quarter of a wide
-    portal kept the path metres from a region it only had to stay clear of, and the middle
-    fifth of a goal's edge made a patrol's lap 10 % longer, where the robustness and the
-    certificate need the tenth of a metre a goal is entered to.  Where the plan enters a new
-    label in a triangle by a wall both ends keep it (the path would otherwise hug the wall:
-    the robustness is also the distance to leaving the workspace)."""
+    Every end keeps :data:`PORTAL_INSET`.  An end on an exposed label boundary keeps the
+    step's ``clearance`` (where the plan enters a new label, the exposed ends keep it too),
+    but never more than :data:`LABEL_INSET` (:data:`ENTERED_INSET` where a label is entered)
+    of the portal: those fractions alone kept the path metres from a region it only had to
+    stay clear of on a wide portal, and the middle fifth of a goal's edge made a patrol's lap
+    10 % longer, where the robustness and the certificate need the tenth of a metre a goal is
+    entered to.  Where the plan enters a new label in a triangle by a wall both ends keep it
+    (the path would otherwise hug the wall: the robustness is also the distance to leaving
+    the workspace)."""
     if step.through is not None or step.exit_edge is None:
         return (0.0, 0.0)
     e = step.exit_edge
     exposed = (step.labelled[(e + 2) % 3], step.labelled[(e + 1) % 3])
-    if step.clearance is None:
-        if step.entered:
-            return (ENTERED_INSET, ENTERED_INSET)
-        left = LABEL_INSET if exposed[0] else PORTAL_INSET
-        right = LABEL_INSET if exposed[1] else PORTAL_INSET
-        return (left, right)
     portal = exit_portal(step)
     length = math.dist(portal.left, portal.right)
     # the clearance as a fraction of the portal, at most the fraction it replaces

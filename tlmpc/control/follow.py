@@ -53,15 +53,28 @@ OBJECTIVE_GAP = 1e-4
 GUARANTEE = 1.0
 #: ... and the floor (the smallest guaranteed speed) this many times more.
 FLOOR_WEIGHT = 10.0
-#: ... but only up to this fraction of max_speed (beyond the disturbance: the guaranteed
-#: speeds are what is left of the velocity across the exit facet under the worst
-#: disturbance).  Uncapped, a floor that the split velocity runs (:func:`bends`) raise drew
-#: every step's exit speed up to it, turning the fields off the path to push across their
-#: exit facets (a regular grid's fields crossed at 37° to their pieces).  The weakest step
-#: keeps the vertex program's floor where that is lower, and at least this otherwise (at
-#: 0.1 the bench's times were up to 1 % shorter, but a corridor's robot pushed at 16 times
-#: its declared disturbance no longer completed its laps in one run of eight).
+#: ... but only up to this fraction of max_speed for a robot with a declared disturbance
+#: (beyond the disturbance: the guaranteed speeds are what is left of the velocity across
+#: the exit facet under the worst disturbance).  Uncapped, a floor that the split velocity
+#: runs (:func:`bends`) raise drew every step's exit speed up to it, turning the fields off
+#: the path to push across their exit facets (a regular grid's fields crossed at 37° to
+#: their pieces).  The weakest step keeps the vertex program's floor where that is lower,
+#: and at least this otherwise (at 0.1 and 0.15 a corridor's robot pushed at 16 times its
+#: declared disturbance no longer completed its laps in one run of eight).
 FLOOR_CAP = 0.2
+#: ... and this fraction for a robot without one (``robot.disturbance`` 0): no push is
+#: claimed there, the floor only bounds the exit time, and a floor at 0.2 held the weakest
+#: step (on Example 1, one in a fan round an obstacle's corner) to push across its exit
+#: facet rather than along the path (on the bench at 0.2 the lengths were up to 1.8 % and
+#: the times up to 2.1 % longer; docs/performance.md).
+FREE_FLOOR_CAP = 0.1
+
+
+def floor_cap(disturbance: float) -> float:
+    """The fraction of max_speed up to which the following program rewards the smallest
+    guaranteed exit speed: :data:`FLOOR_CAP` under a declared disturbance,
+    :data:`FREE_FLOOR_CAP` without one."""
+    return FLOOR_CAP if disturbance > 0.0 else FREE_FLOOR_CAP
 
 
 class ConicLike(Protocol):
@@ -160,6 +173,7 @@ def follow_program(
     follow: Sequence[FollowStep],
     *,
     alignment: float,
+    floor_cap: float,
 ) -> tuple[CscMatrix, FloatArray, FloatArray, list[tuple[str, int]]]:
     """The vertex program's conic form (x = (w, s, f)) extended by one slack t per followed
     step; returns (A, costs, b, cones) for x = (w, s, f, t).
@@ -197,8 +211,8 @@ def follow_program(
     blocks.append(  # t >= 0: -t + s = 0
         (-np.ones((len(follow), 1)), size + np.arange(len(follow))[:, None], np.zeros(len(follow)))
     )
-    # f <= FLOOR_CAP: f + s = FLOOR_CAP
-    blocks.append((np.ones((1, 1)), np.array([[2 * runs + steps]]), np.array([FLOOR_CAP])))
+    # f <= floor_cap: f + s = floor_cap
+    blocks.append((np.ones((1, 1)), np.array([[2 * runs + steps]]), np.array([floor_cap])))
     rows, cols, vals, bounds, start = [], [], [], [], 0
     for values, columns, bound in blocks:
         height, width = values.shape
@@ -263,11 +277,12 @@ def solve_follow(
     runs: int,
     steps: int,
     follow: Sequence[FollowStep],
+    floor_cap: float,
 ) -> FollowResult | None:
     """One solve of :func:`follow_program` at :data:`ALIGNMENT`; None when it does not
     solve (the vertex program is then solved on its own)."""
     common = (constraints, offsets, cones, runs, steps, follow)
-    x = _clarabel(*follow_program(*common, alignment=ALIGNMENT))
+    x = _clarabel(*follow_program(*common, alignment=ALIGNMENT, floor_cap=floor_cap))
     if x is None:
         return None
     slacks = x[constraints.shape[1] :]
@@ -294,13 +309,14 @@ def path_guides(
     loop_start: int | None,
     start: tuple[float, float],
     *,
+    clearance: float,
     passages: bool = False,
-    clearance: float | None = None,
 ) -> list[Guide | None]:
     """The channel's shortest path, one straight piece per step (None for a vertex
     passage, unless ``passages``: then its piece to the corner), with the portal insets of
     :mod:`tlmpc.control.channel` (``clearance``: the distance kept from a region's own
-    boundary, :attr:`tlmpc.control.channel.ChannelStep.clearance`)."""
+    boundary, :attr:`tlmpc.control.channel.ChannelStep.clearance`; a compile passes
+    :func:`tlmpc.control.channel.label_clearance` of the robot's max_speed)."""
     # A vertex is on a label boundary when the triangles around it do not all share a label.
     letters = np.repeat(abstraction.letter_of, 3)  # each corner's triangle's letter
     count = len(abstraction.vertices)
@@ -535,7 +551,13 @@ def follow_channel(
         if step.through is None and guide is not None and not _needle(step.geometry)
     ]
     result = solve_follow(
-        form.constraints, form.offsets, form.cones, runs, len(form.costs) - 2 * runs - 1, follow
+        form.constraints,
+        form.offsets,
+        form.cones,
+        runs,
+        len(form.costs) - 2 * runs - 1,
+        follow,
+        floor_cap(disturbance),
     )
     if result is None:
         return None
