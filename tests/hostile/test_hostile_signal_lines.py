@@ -3,16 +3,17 @@
 The timed test (``test_hostile_signals.py``) sends its signals to real processes after chosen
 delays, so it finds a window a few bytecodes wide only by luck (it once printed a traceback
 from one).  Here the moment is chosen exactly: a profile function raises SIGTERM at the k-th
-point of one ``tlmpc compile`` where Python runs a signal's handler, counting the points in
-``tlmpc/cli.py``, ``tlmpc/commands/compile.py`` and ``tlmpc/io/outdir.py``, for every k until
-the run ends without it: installing and restoring the handlers, the lock, the staging folder,
-the commit and everything after it.
+point of one ``tlmpc compile`` (or ``check``) where Python runs a signal's handler, counting
+the points in ``tlmpc/cli.py``, the command's module and ``tlmpc/io/outdir.py``, for every k
+until the run ends without it: installing and restoring the handlers, the lock, the staging
+folder, the commit and everything after it.
 
-Every run must end one of two ways: exit 143, ``tlmpc: terminated`` and nothing else on
-standard error, nothing written (no OUT, no lock file, no temporary folder); or exit 0, nothing
-on standard error and OUT whole, when the signal came after the output was in place (a late
-signal: the run had done its work).  Never an exception out of ``main``, never a traceback or
-"Exception ignored", and the process's handlers are given back as they were.
+Every run must end one of two ways: exit 143 with ``tlmpc: terminated`` as the last line on
+standard error (after what the run had said, if anything) and nothing written (no OUT, no
+lock file, no temporary folder); or exit 0, standard error as in a run without a signal and
+OUT whole, when the signal came after the output was in place or the run had returned (a
+late signal: the run had done its work).  Never an exception out of ``main``, never a
+traceback or "Exception ignored", and the process's handlers are given back as they were.
 """
 
 from __future__ import annotations
@@ -31,7 +32,8 @@ ROOT = Path(__file__).resolve().parents[2]
 
 #: The files whose points get the signal.
 WATCHED = tuple(
-    str(ROOT / "tlmpc" / name) for name in ("cli.py", "commands/compile.py", "io/outdir.py")
+    str(ROOT / "tlmpc" / name)
+    for name in ("cli.py", "commands/compile.py", "commands/check.py", "io/outdir.py")
 )
 
 MISSION = """\
@@ -79,14 +81,16 @@ class _SignalAtPoint:
                 signal.raise_signal(signal.SIGTERM)
 
 
-def _compile(tmp_path: Path, k: int) -> tuple[int, str, Path, _SignalAtPoint]:
-    """``tlmpc compile`` in this process, the signal at the k-th watched point (the start-up
-    guard in place beforehand, as in the command's process)."""
+def _run(tmp_path: Path, command: str, k: int) -> tuple[int, str, Path, _SignalAtPoint]:
+    """``tlmpc compile`` (or ``check``) in this process, the signal at the k-th watched point
+    (the start-up guard in place beforehand, as in the command's process)."""
     import tlmpc.cli as cli
     from tlmpc.base import startup
 
-    folder = tmp_path / f"run{k}"
+    folder = tmp_path / f"{command}{k}"
     folder.mkdir()
+    mission = str(tmp_path / "mission.yaml")
+    argv = ["compile", mission, "-o", str(folder / "out"), "-q"]
     err = io.StringIO()
     tracer = _SignalAtPoint(k)
     before = signal.getsignal(signal.SIGTERM), signal.getsignal(signal.SIGINT)
@@ -95,9 +99,7 @@ def _compile(tmp_path: Path, k: int) -> tuple[int, str, Path, _SignalAtPoint]:
         sys.setprofile(tracer)
         try:
             code = cli.main(
-                ["compile", str(tmp_path / "mission.yaml"), "-o", str(folder / "out"), "-q"],
-                io.StringIO(),
-                err,
+                argv if command == "compile" else ["check", mission], io.StringIO(), err
             )
         finally:
             sys.setprofile(None)
@@ -110,28 +112,34 @@ def _compile(tmp_path: Path, k: int) -> tuple[int, str, Path, _SignalAtPoint]:
 
 
 @pytest.mark.slow
+@pytest.mark.parametrize("command", ["compile", "check"])
 def test_a_sigterm_at_every_point_of_the_run_ends_it_cleanly(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], command: str
 ) -> None:
+    # check writes nothing: its late signals come while the handlers are given back
     (tmp_path / "mission.yaml").write_text(MISSION)
-    code, err, folder, tracer = _compile(tmp_path, 0)  # k = 0: no signal, the whole output
-    assert (code, err, tracer.sent) == (0, "", False)
-    whole = {p.name: p.read_bytes() for p in (folder / "out").iterdir()}
+    code, said, folder, tracer = _run(tmp_path, command, 0)  # k = 0: no signal
+    assert (code, tracer.sent) == (0, False)
+    written = sorted(p.name for p in folder.iterdir())
+    whole = {p.name: p.read_bytes() for p in (folder / "out").glob("*")}
     endings: dict[str, list[int]] = {"guard": [], "terminated": [], "late": []}
     k = 0
     while tracer.sent or k == 0:
         k += 1
-        code, err, folder, tracer = _compile(tmp_path, k)
+        code, err, folder, tracer = _run(tmp_path, command, k)
         assert "Traceback" not in capsys.readouterr().err
         left = sorted(p.name for p in folder.iterdir())
         if code == 143:
-            assert err == "tlmpc: terminated\n", (k, err)
+            # what the run had said before (check's summary line), then the one line
+            before, _, after = err.rpartition("tlmpc: terminated\n")
+            assert after == "", (k, err)
+            assert said.startswith(before), (k, err)
             assert left == [], (k, left)
             endings["terminated"].append(k)
         else:
-            assert (code, err) == (0, ""), (k, code, err)
-            assert left == ["out"], (k, left)
-            files = {p.name: p.read_bytes() for p in (folder / "out").iterdir()}
+            assert (code, err) == (0, said), (k, code, err)
+            assert left == written, (k, left)
+            files = {p.name: p.read_bytes() for p in (folder / "out").glob("*")}
             assert files.keys() == whole.keys(), k
             for name, data in files.items():
                 if name.endswith(".json"):
@@ -141,7 +149,8 @@ def test_a_sigterm_at_every_point_of_the_run_ends_it_cleanly(
             elif tracer.sent:
                 endings["guard"].append(k)
     # the signal reached the start, the middle and the end of the run: both endings happened,
-    # the late ones after every terminated one (the commit divides them)
+    # the late ones after every terminated one (divided by the commit, or by the handlers given
+    # back when nothing is written)
     assert endings["terminated"], endings
     assert endings["late"], endings
     assert max(endings["guard"], default=0) < min(endings["terminated"]), endings
