@@ -254,6 +254,10 @@ def main(
             code = _main(argv, safe_out, safe_err)
             safe_out.flush()
             safe_err.flush()
+            # a signal whose exception a finaliser swallowed, the run over before it came again
+            swallowed = None if settled.is_settled() else _signalled()
+            if swallowed is not None:
+                code = _ended_by(swallowed, safe_err)
         except _OutputLost as lost:
             code = _output_lost(lost, raw_out, raw_err, safe_err)
         except Exception:

@@ -200,6 +200,27 @@ def test_a_signal_swallowed_by_a_finaliser_still_ends_the_run(
     assert "Exception ignored" not in capsys.readouterr().err
 
 
+@pytest.mark.parametrize(("number", "code"), [(signal.SIGTERM, 143), (signal.SIGINT, 130)])
+def test_a_signal_swallowed_just_before_the_run_returns_still_ends_it(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str], number: int, code: int
+) -> None:
+    # the run is over before the swallowed signal is delivered again: its code is still the
+    # signal's (the handlers are given back, the timer that would deliver it cancelled)
+    import io
+
+    import tlmpc.cli
+
+    def run(*args: object) -> int:
+        _RaisesInFinaliser(number)
+        return 0
+
+    monkeypatch.setattr("tlmpc.commands.automaton.run", run)
+    err = io.StringIO()
+    assert tlmpc.cli.main(["automaton", "G a"], io.StringIO(), err) == code
+    assert err.getvalue() == ("tlmpc: terminated\n" if code == 143 else "tlmpc: interrupted\n")
+    assert "Exception ignored" not in capsys.readouterr().err
+
+
 def _signal_after(original: Any, number: int) -> Any:
     """``original``, then the signal: it arrives right after the call created something."""
 
