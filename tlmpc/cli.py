@@ -24,7 +24,7 @@ from collections.abc import Sequence
 from types import ModuleType
 from typing import Any, TextIO
 
-from tlmpc.base import startup
+from tlmpc.base import settled, startup
 from tlmpc.base.errors import EXIT_INTERNAL, EXIT_USAGE, TlmpcError, error, printable
 from tlmpc.base.startup import EXIT_INTERRUPTED, EXIT_TERMINATED
 from tlmpc.base.version import __version__
@@ -154,11 +154,15 @@ _RECEIVED: list[int] = []
 
 
 def _on_sigterm(number: int, frame: object) -> None:
+    if settled.is_settled():
+        return  # late: the run's output is in place, it ends with its own code
     _RECEIVED.append(number)
     raise _Terminated
 
 
 def _on_sigint(number: int, frame: object) -> None:
+    if settled.is_settled():
+        return
     _RECEIVED.append(number)
     raise KeyboardInterrupt
 
@@ -188,6 +192,8 @@ _REDELIVERY_DELAY = 0.001
 
 
 def _on_redelivery(number: int, frame: object) -> None:
+    if settled.is_settled():
+        return  # the swallowed signal came too late to end the run
     raise _signalled() or KeyboardInterrupt()
 
 
@@ -236,56 +242,100 @@ def main(
     raw_err = err if err is not None else sys.stderr
     safe_out = typing.cast(TextIO, TerminalText(raw_out, "standard output"))
     safe_err = typing.cast(TextIO, TerminalText(raw_err, "standard error"))
-    previous: Any = None
-    previous_int: Any = None
     _RECEIVED.clear()
-    previous_hook = sys.unraisablehook
-    previous_alarm: Any = None
-    if threading.current_thread() is threading.main_thread():
-        sys.unraisablehook = _redeliver(previous_hook)
-        previous_alarm = signal.signal(signal.SIGALRM, _on_redelivery)
-        previous = signal.signal(signal.SIGTERM, _on_sigterm)
-        if signal.getsignal(signal.SIGINT) in (signal.default_int_handler, startup.end_at_once):
-            previous_int = signal.signal(signal.SIGINT, _on_sigint)
+    settled.begin()
+    handlers = _RunHandlers()
+    # Every moment between installing the handlers and restoring them lies inside this outer
+    # ``try``: a signal there, in the inner handlers or in the restoring itself, ends the run
+    # with its code (a ``finally`` would be outside it, and a signal in it a traceback).
     try:
-        code = _main(argv, safe_out, safe_err)
-        safe_out.flush()
-        safe_err.flush()
+        try:
+            handlers.install()
+            code = _main(argv, safe_out, safe_err)
+            safe_out.flush()
+            safe_err.flush()
+            # a signal whose exception a finaliser swallowed, the run over before it came again
+            swallowed = None if settled.is_settled() else _signalled()
+            if swallowed is not None:
+                code = _ended_by(swallowed, safe_err)
+        except _OutputLost as lost:
+            code = _output_lost(lost, raw_out, raw_err, safe_err)
+        except Exception:
+            # A signal's exception can come up disguised from where the run starts (the
+            # parser imports the command's module): CPython wraps an exception raised in a
+            # class's ``__set_name__`` in a RuntimeError, C code in an ImportError.
+            disguised = _signalled()
+            if disguised is None:
+                raise
+            code = _ended_by(disguised, safe_err)
+        handlers.restore()
         return code
     except (KeyboardInterrupt, _Terminated) as signalled:
+        handlers.restore()
         return _ended_by(signalled, safe_err)
-    except _OutputLost as lost:
-        _silence(raw_out if lost.stream == "standard output" else raw_err)
-        if lost.stream == "standard output" and not isinstance(lost.cause, BrokenPipeError):
-            diagnostic = error(
-                "U035",
-                f"cannot write to {lost.stream}: {lost.cause.strerror or lost.cause}",
-                hint="check where the output goes (a full disk? a closed pipe?)",
-            )
-            with contextlib.suppress(Exception):
-                safe_err.write(diagnostic.format() + "\n")
-                safe_err.flush()
-        return EXIT_USAGE
-    except Exception:
-        # A signal's exception can come up disguised from where the run starts (the parser
-        # imports the command's module): CPython wraps an exception raised in a class's
-        # ``__set_name__`` in a RuntimeError, C code in an ImportError.
-        disguised = _signalled()
-        if disguised is None:
-            raise
-        return _ended_by(disguised, safe_err)
-    finally:
+    except BaseException:
+        handlers.restore()
+        raise
+
+
+class _RunHandlers:
+    """The command's handlers of SIGTERM, SIGINT and SIGALRM (and its unraisable-exception
+    hook) for one run, and what they replaced.
+
+    :meth:`install` records each previous handler before it replaces it, so a signal in the
+    middle of installing leaves :meth:`restore` (which may run any number of times) exactly
+    what to put back."""
+
+    def __init__(self) -> None:
+        self.previous: dict[int, Any] = {}
+        self.previous_hook = sys.unraisablehook
+        self.hooked = False
+
+    def install(self) -> None:
+        """Turn SIGTERM and SIGINT into exceptions that unwind the run (main thread only)."""
+        if threading.current_thread() is not threading.main_thread():
+            return
+        self.hooked = True
+        sys.unraisablehook = _redeliver(self.previous_hook)
+        self._replace(signal.SIGALRM, _on_redelivery)
+        self._replace(signal.SIGTERM, _on_sigterm)
+        if signal.getsignal(signal.SIGINT) in (signal.default_int_handler, startup.end_at_once):
+            self._replace(signal.SIGINT, _on_sigint)
+
+    def _replace(self, number: int, handler: Any) -> None:
+        self.previous[number] = signal.getsignal(number)
+        signal.signal(number, handler)
+
+    def restore(self) -> None:
+        """Put back what :meth:`install` replaced; a signal from here on is late."""
+        # first: a signal while the handlers are put back no longer raises
+        settled.settle()
         # The command's own run is over (its output whole or removed): the start-up guard,
         # put back, would turn a finished run into an interrupted one, so a late signal of
         # the command's process is ignored while it exits.
-        if previous is not None:
-            signal.signal(signal.SIGTERM, _after_the_run(previous))
-        if previous_int is not None:
-            signal.signal(signal.SIGINT, _after_the_run(previous_int))
-        sys.unraisablehook = previous_hook
-        if previous_alarm is not None:
+        for number in (signal.SIGTERM, signal.SIGINT):
+            if number in self.previous:
+                signal.signal(number, _after_the_run(self.previous.pop(number)))
+        if self.hooked:
+            sys.unraisablehook = self.previous_hook
+        if signal.SIGALRM in self.previous:
             signal.setitimer(signal.ITIMER_REAL, 0.0)
-            signal.signal(signal.SIGALRM, previous_alarm)
+            signal.signal(signal.SIGALRM, self.previous.pop(signal.SIGALRM))
+
+
+def _output_lost(lost: _OutputLost, raw_out: TextIO, raw_err: TextIO, err: TextIO) -> int:
+    """Standard output or error failed: silence it, say so on stderr if that still works."""
+    _silence(raw_out if lost.stream == "standard output" else raw_err)
+    if lost.stream == "standard output" and not isinstance(lost.cause, BrokenPipeError):
+        diagnostic = error(
+            "U035",
+            f"cannot write to {lost.stream}: {lost.cause.strerror or lost.cause}",
+            hint="check where the output goes (a full disk? a closed pipe?)",
+        )
+        with contextlib.suppress(Exception):
+            err.write(diagnostic.format() + "\n")
+            err.flush()
+    return EXIT_USAGE
 
 
 def _ended_by(signalled: BaseException, err: TextIO) -> int:

@@ -34,6 +34,7 @@ from collections.abc import Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
+from tlmpc.base import settled
 from tlmpc.base.errors import UsageError, error
 from tlmpc.io.artifacts import ARTIFACT_SCHEMAS, artifact_pieces, dumps
 
@@ -424,25 +425,34 @@ def _commit(staging: Path, out: Path, *, force: bool) -> None:
         if not force:  # checked before compiling too; a race must not lose user files
             raise UsageError(error("U012", f"{out} changed and is no longer a tlmpc output"))
         refuse_overwriting(out, [p.name for p in staging.iterdir() if p.name != MARKER])
-        for item in staging.iterdir():
-            if item.name != MARKER:
-                os.replace(item, out / item.name)
+        with _signals_blocked():  # the files arrive all together, like a swapped output
+            for item in staging.iterdir():
+                if item.name != MARKER:
+                    os.replace(item, out / item.name)
+            settled.settle()
         return
     with _signals_blocked():
-        if not out.exists():
-            os.rename(staging, out)
-            return
-        if _exchange(staging, out):
-            shutil.rmtree(staging, ignore_errors=True)  # now the previous output
-            return
-        backup = Path(tempfile.mkdtemp(prefix=f".{out.name}.tlmpc-old-", dir=out.parent))
-        os.rename(out, backup)  # replaces the empty directory mkdtemp made
-        try:
-            os.rename(staging, out)
-        except OSError:
-            os.rename(backup, out)
-            raise
-        shutil.rmtree(backup, ignore_errors=True)
+        _swap(staging, out)
+        # the output is in place: a signal deferred until here, or later, is late
+        settled.settle()
+
+
+def _swap(staging: Path, out: Path) -> None:
+    """Put ``staging`` at ``out`` (a previous output or an empty directory, if any, goes)."""
+    if not out.exists():
+        os.rename(staging, out)
+        return
+    if _exchange(staging, out):
+        shutil.rmtree(staging, ignore_errors=True)  # now the previous output
+        return
+    backup = Path(tempfile.mkdtemp(prefix=f".{out.name}.tlmpc-old-", dir=out.parent))
+    os.rename(out, backup)  # replaces the empty directory mkdtemp made
+    try:
+        os.rename(staging, out)
+    except OSError:
+        os.rename(backup, out)
+        raise
+    shutil.rmtree(backup, ignore_errors=True)
 
 
 def replace_file(path: Path, data: bytes) -> None:
