@@ -97,3 +97,25 @@ def test_samples_lie_in_their_triangles_and_crossings_in_the_one_entered(name: s
     followed = [i for i in crossings if i + 1 < len(trace.triangles) and i + 1 not in crossings]
     assert followed
     assert all(trace.triangles[i] == trace.triangles[i + 1] for i in followed)
+
+
+def test_a_start_on_the_exit_edge_is_the_crossing_into_the_next_triangle() -> None:
+    # The first step's sample at time 0 is not taken: the start itself is the crossing, in
+    # the triangle the step enters; the next step goes on from there.
+    result = compile_mission(SPECS / "patrol.yaml", until="control")
+    controllers = result.compilation.get(CONTROLLERS)
+    mission = result.compilation.get(MISSION)
+    first = controllers.steps[0]
+    assert first.exit_edge is not None
+    assert first.next_triangle is not None
+    corners = np.asarray(first.vertices, dtype=np.float64)
+    edge = first.exit_edge
+    start = (corners[(edge + 1) % 3] + corners[(edge + 2) % 3]) / 2.0
+    on_edge = dataclasses.replace(
+        mission, robot=dataclasses.replace(mission.robot, start=tuple(start.tolist()))
+    )
+    trace = simulate(None, controllers, on_edge)  # type: ignore[arg-type]
+    assert trace.crossings[0] == 0
+    assert trace.triangles[0] == first.next_triangle
+    assert trace.steps[1] == 1  # the next sample is the second step's
+    assert trace.triangles[1] == controllers.steps[1].triangle

@@ -101,23 +101,11 @@ def affine_law(vertices: FloatArray, velocities: FloatArray) -> tuple[FloatArray
     The frame is computed on Python floats with numpy's operations in numpy's order (the
     mean sums the rows first to last), so the system is bit for bit the array code's.
     """
-    (x0, y0), (x1, y1), (x2, y2) = np.asarray(vertices, dtype=np.float64).tolist()
-    cx, cy = (x0 + x1 + x2) / 3, (y0 + y1 + y2) / 3
-    dx0, dy0, dx1, dy1, dx2, dy2 = x0 - cx, y0 - cy, x1 - cx, y1 - cy, x2 - cx, y2 - cy
-    size = max(abs(dx0), abs(dy0), abs(dx1), abs(dy1), abs(dx2), abs(dy2))
-    if not (math.isfinite(cx) and math.isfinite(cy) and 0.0 < size < math.inf):
+    frame = _frame(vertices)
+    if frame is None:
         return _affine_law_arrays(np.asarray(vertices, dtype=np.float64), velocities)
-    system = np.array(
-        [
-            [dx0 / size, dy0 / size, 1.0],
-            [dx1 / size, dy1 / size, 1.0],
-            [dx2 / size, dy2 / size, 1.0],
-        ]
-    )
-    solution = np.asarray(np.linalg.solve(system, velocities), dtype=np.float64)
-    gain: FloatArray = np.ascontiguousarray(solution[:2].T / size)
-    offset: FloatArray = solution[2] - gain @ np.array([cx, cy])
-    return gain, offset
+    solution = np.asarray(np.linalg.solve(np.array(frame[1]), velocities), dtype=np.float64)
+    return _law(solution, frame[0])
 
 
 def affine_laws(
@@ -127,24 +115,8 @@ def affine_laws(
     on Python floats as there, the systems solved by one call of ``np.linalg.solve`` on their
     stack (LAPACK's solve of each system, as for one; numpy's per-call cost was most of the
     time for a plan of thousands of steps)."""
-    frames: list[tuple[float, float, float] | None] = []
-    systems: list[list[list[float]]] = []
-    for corners in vertices:
-        (x0, y0), (x1, y1), (x2, y2) = np.asarray(corners, dtype=np.float64).tolist()
-        cx, cy = (x0 + x1 + x2) / 3, (y0 + y1 + y2) / 3
-        dx0, dy0, dx1, dy1, dx2, dy2 = x0 - cx, y0 - cy, x1 - cx, y1 - cy, x2 - cx, y2 - cy
-        size = max(abs(dx0), abs(dy0), abs(dx1), abs(dy1), abs(dx2), abs(dy2))
-        if not (math.isfinite(cx) and math.isfinite(cy) and 0.0 < size < math.inf):
-            frames.append(None)  # solved on its own, with numpy's nan/inf
-            continue
-        frames.append((cx, cy, size))
-        systems.append(
-            [
-                [dx0 / size, dy0 / size, 1.0],
-                [dx1 / size, dy1 / size, 1.0],
-                [dx2 / size, dy2 / size, 1.0],
-            ]
-        )
+    frames = [_frame(corners) for corners in vertices]
+    systems = [frame[1] for frame in frames if frame is not None]
     framed = [w for w, frame in zip(velocities, frames, strict=True) if frame is not None]
     solutions = (
         np.asarray(np.linalg.solve(np.array(systems), np.array(framed)), dtype=np.float64)
@@ -154,15 +126,39 @@ def affine_laws(
     laws: list[tuple[FloatArray, FloatArray]] = []
     solved = iter(solutions)
     for corners, w, frame in zip(vertices, velocities, frames, strict=True):
-        if frame is None:
+        if frame is None:  # solved on its own, with numpy's nan/inf
             laws.append(_affine_law_arrays(np.asarray(corners, dtype=np.float64), w))
-            continue
-        cx, cy, size = frame
-        solution = next(solved)
-        gain: FloatArray = np.ascontiguousarray(solution[:2].T / size)
-        offset: FloatArray = solution[2] - gain @ np.array([cx, cy])
-        laws.append((gain, offset))
+        else:
+            laws.append(_law(next(solved), frame[0]))
     return laws
+
+
+_Frame = tuple[tuple[float, float, float], list[list[float]]]
+
+
+def _frame(vertices: FloatArray) -> _Frame | None:
+    """The triangle's frame (centre x, y and size) and its system in that frame, on Python
+    floats; None for a point-like or non-finite triangle."""
+    (x0, y0), (x1, y1), (x2, y2) = np.asarray(vertices, dtype=np.float64).tolist()
+    cx, cy = (x0 + x1 + x2) / 3, (y0 + y1 + y2) / 3
+    dx0, dy0, dx1, dy1, dx2, dy2 = x0 - cx, y0 - cy, x1 - cx, y1 - cy, x2 - cx, y2 - cy
+    size = max(abs(dx0), abs(dy0), abs(dx1), abs(dy1), abs(dx2), abs(dy2))
+    if not (math.isfinite(cx) and math.isfinite(cy) and 0.0 < size < math.inf):
+        return None
+    system = [
+        [dx0 / size, dy0 / size, 1.0],
+        [dx1 / size, dy1 / size, 1.0],
+        [dx2 / size, dy2 / size, 1.0],
+    ]
+    return (cx, cy, size), system
+
+
+def _law(solution: FloatArray, frame: tuple[float, float, float]) -> tuple[FloatArray, FloatArray]:
+    """K, g in map coordinates from the solution in the triangle's frame."""
+    cx, cy, size = frame
+    gain: FloatArray = np.ascontiguousarray(solution[:2].T / size)
+    offset: FloatArray = solution[2] - gain @ np.array([cx, cy])
+    return gain, offset
 
 
 def _affine_law_arrays(

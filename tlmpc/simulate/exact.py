@@ -413,34 +413,25 @@ def simulate(abstraction: Abstraction, controllers: Controllers, mission: Missio
         last = -1 if controller.is_stay else len(rel_times) - 1
         inside = controller.triangle
         beyond = inside if controller.next_triangle is None else controller.next_triangle
-        if min(rel_times) > 0.0:  # every sample taken: the step's lists extended at once
-            count = len(rel_times)
-            times.extend([now + t for t in rel_times])
-            points.extend(rel_points)
+        # Samples at time 0 or before (the start already on the exit edge) are not taken: the
+        # current sample is then the crossing.  The sample times rise, so they lead.
+        taken = 0
+        while taken < len(rel_times) and rel_times[taken] <= 0.0:
+            if controller.next_triangle is not None:
+                triangle_of[-1] = controller.next_triangle
+            crossings.append(len(points) - 1)
+            taken += 1
+        count = len(rel_times) - taken
+        if count:  # the step's other samples, its lists extended at once
+            times.extend([now + t for t in rel_times[taken:]])
+            points.extend(rel_points[taken:])
             step_of.extend([index] * count)
             if last < 0:
                 triangle_of.extend([inside] * count)
             else:
-                triangle_of.extend([inside] * last)
+                triangle_of.extend([inside] * (count - 1))
                 triangle_of.append(beyond)
                 crossings.append(len(points) - 1)
-            now = times[-1]
-            x = points[-1]
-            continue
-        for offset, (t, point) in enumerate(zip(rel_times, rel_points, strict=True)):
-            if t <= 0.0:  # already on the exit edge: the current sample is the crossing
-                if controller.next_triangle is not None:
-                    triangle_of[-1] = controller.next_triangle
-                crossings.append(len(points) - 1)
-                continue
-            times.append(now + t)
-            points.append(point)
-            step_of.append(index)
-            if offset == last:
-                triangle_of.append(beyond)
-                crossings.append(len(points) - 1)
-            else:
-                triangle_of.append(inside)
         now = times[-1]
         x = points[-1]
     if loop_start_step is not None and loop_index is None:  # pragma: no cover - defensive
