@@ -29,6 +29,7 @@ from tlmpc.mission.load import load_mission
 from tlmpc.mission.model import Mission
 from tlmpc.pipeline.deadlines import DeadlineMissedError
 from tlmpc.pipeline.mintime import MAX_REPLANS, measure, plan_minimum_time
+from tlmpc.pipeline.shortest import plan_shortest
 from tlmpc.pipeline.stages import ABSTRACTION, AUTOMATON, MISSION, WITNESS, compile_mission
 from tlmpc.planning.mission import move_times, plan_mission
 from tlmpc.planning.product import _move_lengths, move_weight_grid
@@ -195,8 +196,10 @@ def test_the_fastest_plan_against_brute_force(
     assert witness.stats["exact_time"] == min(witness.stats["exact_times"])
     # the stay's triangle is entered at the recorded exact time (the first goal triangle)
     assert witness.stats["exact_time"] == pytest.approx(planner, abs=1e-9)
-    # the length metric's plan on the same mesh and automaton
-    length = plan_mission(_with_cost(mission, "length"), mesh, compilation.get(AUTOMATON))
+    # the length metric's plan on the same mesh and automaton, as that metric compiles it
+    # (its channel chosen by the shortest path)
+    as_length = _with_cost(mission, "length")
+    length = plan_shortest(as_length, plan_mission(as_length, mesh, compilation.get(AUTOMATON)))
     length_time = measure(mission, length).exact_time
     assert planner <= length_time + 1e-9
     start = witness.prefix[0] if witness.prefix else witness.cycle[0]
@@ -221,9 +224,33 @@ def test_the_shipped_deadline_spec_keeps_its_fastest_round(tmp_path: Path) -> No
     assert len(set(times)) == len(times)  # never the same plan twice
     first, *_ = times
     mission = result.compilation.get(MISSION)
-    again = plan_minimum_time(mission, *_built(tmp_path, mission))
+    again = plan_minimum_time(mission, *_built(tmp_path, mission), plan_shortest)
     assert again.witness == witness  # deterministic: the same plan, the same numbers
     assert witness.stats["exact_time"] <= first
+
+
+def test_the_time_metric_is_never_slower_than_the_length_metrics_compile(tmp_path: Path) -> None:
+    # The shipped deadline map asked to reach its dock by a far deadline: the midpoint plan
+    # (the time rounds' first before they started from the length metric's) entered the dock
+    # 1.9 s later than the plan the length metric keeps.
+    import yaml
+
+    document = yaml.safe_load((ROOT / "specs" / "deadline.yaml").read_text())
+    document.pop("task", None)
+    document["ltl"] = "F[0,100000] dock & G !hazard"
+    entries = {}
+    for metric in ("length", "time"):
+        document["options"] = {**(document.get("options") or {}), "cost": metric}
+        text = yaml.safe_dump(document, sort_keys=False)
+        result = compile_mission(tmp_path / f"{metric}.yaml", text=text, figures=())
+        mesh = result.compilation.get(ABSTRACTION)
+        trace = result.artifacts["trace.json"]
+        entries[metric] = next(
+            float(t[0])
+            for t, tri in zip(trace["points"], trace["triangles"], strict=True)
+            if "dock" in mesh.labels(tri)
+        )
+    assert entries["time"] <= entries["length"] + 1e-9
 
 
 def _built(tmp: Path, mission: Mission) -> tuple[Any, Any]:

@@ -28,7 +28,7 @@ simulated plans used them, estimates elsewhere).
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -60,10 +60,20 @@ class Measured:
     meets_bounds: bool = True
 
 
-def plan_minimum_time(mission: Mission, abstraction: Abstraction, automaton: Automaton) -> Planned:
+def plan_minimum_time(
+    mission: Mission,
+    abstraction: Abstraction,
+    automaton: Automaton,
+    shortest: Callable[[Mission, Planned], Planned] | None = None,
+) -> Planned:
     """The plan of ``mission`` (as :func:`~tlmpc.planning.mission.plan_mission`) of least
     exact time among the rounds of the module doc, preferring those whose trajectory meets
     the task's time bounds; other metrics: the plan as it is.
+
+    ``shortest`` (the compile passes :func:`tlmpc.pipeline.shortest.plan_shortest`) turns the
+    first plan into the ``length`` metric's kept plan before the rounds start: the first plan
+    simulated is then the one ``options.cost: length`` compiles, and the kept plan is never
+    slower than it.
 
     The witness's ``stats`` record ``exact_time`` (seconds), ``time_rounds`` (plans
     simulated), ``time_fixed_point``, ``exact_times`` (each round's, in order) and, for a
@@ -72,6 +82,9 @@ def plan_minimum_time(mission: Mission, abstraction: Abstraction, automaton: Aut
     first = plan_mission(mission, abstraction, automaton)
     if mission.options.cost != "time":
         return first
+    if shortest is not None:
+        as_length = replace(mission, options=replace(mission.options, cost="length"))
+        first = shortest(as_length, first)
     speed = mission.robot.max_speed
     measured: dict[MoveKey, float] = {}
     history: list[float] = []

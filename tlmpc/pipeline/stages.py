@@ -272,8 +272,9 @@ def _plan(c: Compilation) -> StageResult:
     # depth or keeps the margin, the mesh and automaton without them: either replaces the
     # built one (and its artifacts) for every later stage.  Under the time metric the plan
     # is re-weighed with its exact simulated step times (tlmpc.pipeline.mintime).
-    planned = plan_minimum_time(c.get(MISSION), built, c.get(AUTOMATON))
-    # Under the length metric the channel is chosen by its shortest path (pipeline.shortest).
+    # Under the length metric the channel is chosen by its shortest path (pipeline.shortest);
+    # the time metric's rounds start from that plan.
+    planned = plan_minimum_time(c.get(MISSION), built, c.get(AUTOMATON), plan_shortest)
     planned = plan_shortest(c.get(MISSION), planned)
     abstraction, witness = planned.abstraction, planned.witness
     artifacts: dict[str, Any] = {}
