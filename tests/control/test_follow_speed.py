@@ -240,3 +240,6 @@ def test_the_following_solve_rewards_the_floor_up_to_the_cap_only() -> None:
     assert x is not None
     assert mission.robot.disturbance == 0.0
     assert x[floor] <= follow.FREE_FLOOR_CAP * (1.0 + 1e-6)
+    # ... and the floor is worth more than what following gains by lowering it: it reaches
+    # the cap (the vertex program alone holds it higher still)
+    assert x[floor] >= follow.FREE_FLOOR_CAP * (1.0 - 1e-4)
