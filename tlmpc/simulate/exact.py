@@ -359,8 +359,19 @@ def pursuit_step(
     return [distance / max_speed], [target]
 
 
-def simulate(abstraction: Abstraction, controllers: Controllers, mission: Mission) -> Trace:
-    """The trajectory from ``mission.robot.start`` under ``controllers``."""
+def simulate(
+    abstraction: Abstraction,
+    controllers: Controllers,
+    mission: Mission,
+    *,
+    max_gap: float | None = None,
+) -> Trace:
+    """The trajectory from ``mission.robot.start`` under ``controllers``.
+
+    With ``max_gap`` no two samples of a step's field or vertex passage are further apart in
+    time (the samples between are the same flow, exactly: :func:`_fill`); the samples
+    without it are all still there, bit for bit.  A cell step keeps
+    its own samples."""
     del abstraction  # the controllers carry their triangles' geometry
     steps = list(controllers.steps)
     order = list(range(len(steps)))
@@ -421,10 +432,15 @@ def simulate(abstraction: Abstraction, controllers: Controllers, mission: Missio
                 triangle_of[-1] = controller.next_triangle
             crossings.append(len(points) - 1)
             taken += 1
-        count = len(rel_times) - taken
+        rest_times, rest_points = list(rel_times[taken:]), list(rel_points[taken:])
+        if max_gap is not None and rest_times:
+            rest_times, rest_points = _fill(
+                controller, x, rest_times, rest_points, max_gap, controllers.max_speed
+            )
+        count = len(rest_times)
         if count:  # the step's other samples, its lists extended at once
-            times.extend([now + t for t in rel_times[taken:]])
-            points.extend(rel_points[taken:])
+            times.extend([now + t for t in rest_times])
+            points.extend(rest_points)
             step_of.extend([index] * count)
             if last < 0:
                 triangle_of.extend([inside] * count)
@@ -444,6 +460,42 @@ def simulate(abstraction: Abstraction, controllers: Controllers, mission: Missio
         loop_start=loop_index,
         crossings=tuple(crossings),
     )
+
+
+def _fill(
+    controller: StepController,
+    x0: FloatArray,
+    rel_times: list[float],
+    rel_points: list[FloatArray],
+    max_gap: float,
+    max_speed: float,
+) -> tuple[list[float], list[FloatArray]]:
+    """The step's samples with more in every gap longer than ``max_gap`` (from the step's
+    start ``x0`` at time 0): a vertex passage's straight line at ``max_speed``, a field's
+    flow x' = K x + g from the sample before, exp(t [[K, g], [0, 0]]) on (x, 1)."""
+    filled_times: list[float] = []
+    filled_points: list[FloatArray] = []
+    flow = np.zeros((3, 3))
+    flow[:2, :2] = controller.gain
+    flow[:2, 2] = controller.offset
+    before_time, before_point = 0.0, np.asarray(x0, dtype=np.float64)
+    for time, point in zip(rel_times, rel_points, strict=True):
+        gap = time - before_time
+        pieces = math.ceil(gap / max_gap) if gap > max_gap else 1
+        for k in range(1, pieces):
+            dt = gap * k / pieces
+            if controller.is_vertex:
+                towards = np.asarray(point, dtype=np.float64) - before_point
+                along = dt * max_speed / float(np.linalg.norm(towards))
+                filled_points.append(before_point + along * towards)
+            else:
+                state = expm_small(dt * flow).dot(np.array([*before_point, 1.0]))
+                filled_points.append(state[:2])
+            filled_times.append(before_time + dt)
+        filled_times.append(time)
+        filled_points.append(point)
+        before_time, before_point = time, np.asarray(point, dtype=np.float64)
+    return filled_times, filled_points
 
 
 def trace_header(mission: Mission, max_speed: float) -> dict[str, Any]:
