@@ -41,17 +41,17 @@ def test_every_stage_reproduces_its_artifacts_from_its_inputs(tmp_path: Path, sp
     whole = compile_mission(ROOT / "specs" / spec, until="verify")
     write_artifacts(tmp_path, whole.artifacts)
     mission = whole.compilation.get(MISSION)
+    # the verify stage samples a trace again when that makes its certificate hold (the
+    # deadline spec's): the simulate stage's own trace.json is the one it wrote before
+    simulated = compile_mission(ROOT / "specs" / spec, until="simulate").artifacts
     for stage in STAGES:
         if not stage.requires or stage.name == "plot" or world_of(mission) not in stage.worlds:
             continue
         alone = run_stage_from_artifacts(stage.name, tmp_path)
         assert alone.artifacts, stage.name
+        wrote = simulated if stage.name == "simulate" else whole.artifacts
         for name, document in alone.artifacts.items():
-            expected = (
-                json.loads(dumps(whole.artifacts[name]))
-                if name.endswith(".json")
-                else whole.artifacts[name]
-            )
+            expected = json.loads(dumps(wrote[name])) if name.endswith(".json") else wrote[name]
             got = json.loads(dumps(document)) if name.endswith(".json") else document
             assert _without_timings(got) == _without_timings(expected), (stage.name, name)
 

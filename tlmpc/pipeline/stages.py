@@ -375,9 +375,6 @@ def _verify(c: Compilation) -> StageResult:
     document = c.get(TRACE)
     verdict = verify_document(dict(document))
     verdict_json = verdict_to_json(verdict)
-    resampled = _sampled_for_certificate(c, document, verdict_json)
-    if resampled is not None:
-        document, verdict_json = resampled
     if not verdict_json["satisfied"]:
         # The compiler's guarantee failed: that is a bug in tlmpc, never the user's fault.
         raise SelfCheckError(
@@ -404,18 +401,22 @@ def _verify(c: Compilation) -> StageResult:
                 hint="please report this mission; the artifacts were not written",
             )
         )
+    # (after the self-checks: a trace faster than max_speed is not certified either, and no
+    # denser sampling mends that)
+    resampled = _sampled_for_certificate(c, document, verdict_json)
     if resampled is None:
         return StageResult(
             products=provide(TRACE, document),
             artifacts={"verdict.json": verdict_json},
             sizes={"robustness": round(float(verdict_json["robustness"]), 6)},
         )
+    denser, dense_verdict = resampled
     return StageResult(
-        products=provide(TRACE, document),
-        artifacts={"trace.json": document, "verdict.json": verdict_json},
+        products=provide(TRACE, denser),
+        artifacts={"trace.json": denser, "verdict.json": dense_verdict},
         sizes={
-            "robustness": round(float(verdict_json["robustness"]), 6),
-            "samples for the certificate": len(document["points"]),
+            "robustness": round(float(dense_verdict["robustness"]), 6),
+            "samples for the certificate": len(denser["points"]),
         },
     )
 
@@ -442,6 +443,7 @@ def _sampled_for_certificate(
         not verdict["satisfied"]
         or certificate["certified"]
         or speed is None
+        or certificate["observed_speed"] > speed  # (denser samples would not mend that)
         or not isinstance(robustness, float)
         or not robustness > 0.0
     ):
