@@ -403,21 +403,18 @@ def _verify(c: Compilation) -> StageResult:
         )
     # (after the self-checks: a trace faster than max_speed is not certified either, and no
     # denser sampling mends that)
+    artifacts: dict[str, Any] = {}
+    resampled_sizes: dict[str, Any] = {}
     resampled = _sampled_for_certificate(c, document, verdict_json)
-    if resampled is None:
-        return StageResult(
-            products=provide(TRACE, document),
-            artifacts={"verdict.json": verdict_json},
-            sizes={"robustness": round(float(verdict_json["robustness"]), 6)},
-        )
-    denser, dense_verdict = resampled
+    if resampled is not None:
+        document, verdict_json = resampled
+        artifacts["trace.json"] = document
+        resampled_sizes["samples for the certificate"] = len(document["points"])
+    artifacts["verdict.json"] = verdict_json
     return StageResult(
-        products=provide(TRACE, denser),
-        artifacts={"trace.json": denser, "verdict.json": dense_verdict},
-        sizes={
-            "robustness": round(float(dense_verdict["robustness"]), 6),
-            "samples for the certificate": len(denser["points"]),
-        },
+        products=provide(TRACE, document),
+        artifacts=artifacts,
+        sizes={"robustness": round(float(verdict_json["robustness"]), 6), **resampled_sizes},
     )
 
 

@@ -370,8 +370,7 @@ def simulate(
 
     With ``max_gap`` no two samples of a step's field or vertex passage are further apart in
     time (the samples between are the same flow, exactly: :func:`_fill`); the samples
-    without it are all still there, bit for bit.  A cell step keeps
-    its own samples."""
+    without it are all still there, bit for bit.  A cell step keeps its own samples."""
     del abstraction  # the controllers carry their triangles' geometry
     steps = list(controllers.steps)
     order = list(range(len(steps)))
@@ -432,7 +431,7 @@ def simulate(
                 triangle_of[-1] = controller.next_triangle
             crossings.append(len(points) - 1)
             taken += 1
-        rest_times, rest_points = list(rel_times[taken:]), list(rel_points[taken:])
+        rest_times, rest_points = rel_times[taken:], rel_points[taken:]
         if max_gap is not None and rest_times:
             rest_times, rest_points = _fill(
                 controller, x, rest_times, rest_points, max_gap, controllers.max_speed
@@ -482,10 +481,10 @@ def _fill(
     for time, point in zip(rel_times, rel_points, strict=True):
         gap = time - before_time
         pieces = math.ceil(gap / max_gap) if gap > max_gap else 1
+        towards = np.asarray(point, dtype=np.float64) - before_point
         for k in range(1, pieces):
             dt = gap * k / pieces
             if controller.is_vertex:
-                towards = np.asarray(point, dtype=np.float64) - before_point
                 along = dt * max_speed / float(np.linalg.norm(towards))
                 filled_points.append(before_point + along * towards)
             else:
