@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Callable
 from typing import Any
 
 import pytest
@@ -52,6 +53,19 @@ def _cyclic_order(witness: Any, names: tuple[str, ...]) -> tuple[str, ...]:
     return tuple(order)
 
 
+def _tour_oracle(mission: Any) -> Callable[[tuple[str, ...]], float]:
+    """The closed tour from the start through the named regions in a given order, on the
+    visibility-graph oracle (shapely geometry of the mission's free space)."""
+    shapes = {r.name: shapely.Polygon(r.polygon) for r in mission.regions}
+    free = workspace_free_space(mission)
+    start = (float(mission.robot.start[0]), float(mission.robot.start[1]))
+
+    def tour(order: tuple[str, ...]) -> float:
+        return VisibilityOracle(free, [shapes[n] for n in order], start).tour_length()
+
+    return tour
+
+
 @pytest.mark.parametrize(
     ("listing", "nw"),
     [
@@ -66,16 +80,9 @@ def test_a_patrol_visits_its_goals_in_the_best_order(
     """Whatever order the task lists the goals in, the plan's cycle visits them in the order
     of the shortest closed tour (brute force over every order with the tour oracle)."""
     result = compile_mission("square.yaml", text=_patrol(listing, nw), until="plan")
-    mission = result.compilation.get(MISSION)
     witness = result.compilation.get(WITNESS)
     names = tuple(sorted(listing))
-    shapes = {r.name: shapely.Polygon(r.polygon) for r in mission.regions}
-    free = workspace_free_space(mission)
-    start = (float(mission.robot.start[0]), float(mission.robot.start[1]))
-
-    def tour(order: tuple[str, ...]) -> float:
-        return VisibilityOracle(free, [shapes[n] for n in order], start).tour_length()
-
+    tour = _tour_oracle(result.compilation.get(MISSION))
     best = min(tour(("sw", *rest)) for rest in itertools.permutations(("ne", "nw", "se")))
     planned = _cyclic_order(witness, names)
     assert sorted(planned) == list(names)
@@ -125,16 +132,9 @@ def test_past_the_budget_the_tour_order_of_the_sets_is_planned(
     # room for the first plan and one more, not for the eleven other orders
     monkeypatch.setattr(shortest, "NODE_BUDGET", 3 * nodes)
     result = compile_mission("five.yaml", text=text, until="plan")
-    mission = result.compilation.get(MISSION)
     witness = result.compilation.get(WITNESS)
     names = tuple(sorted(listing))
-    shapes = {r.name: shapely.Polygon(r.polygon) for r in mission.regions}
-    free = workspace_free_space(mission)
-    start = (float(mission.robot.start[0]), float(mission.robot.start[1]))
-
-    def tour(order: tuple[str, ...]) -> float:
-        return VisibilityOracle(free, [shapes[n] for n in order], start).tour_length()
-
+    tour = _tour_oracle(result.compilation.get(MISSION))
     others = [n for n in names if n != "dock"]
     best = min(tour(("dock", *rest)) for rest in itertools.permutations(others))
     planned = _cyclic_order(witness, names)
