@@ -401,6 +401,42 @@ def test_label_insets_only_where_the_label_is_the_regions_own_boundary(
         assert length(cored) <= length(own) * (1 + 1e-12) + 1e-12
 
 
+class _BentCorridor:
+    """An L-shaped corridor (east, then north) of width 1, planned to a stay at its north end
+    from the first triangle's centroid, and the trajectory's length to the stay's target over
+    the corridor's geodesic (visibility graph on shapely geometry)."""
+
+    def __init__(self) -> None:
+        centre = [
+            (0.0, 0.0),
+            (1.0, 0.0),
+            (2.0, 0.0),
+            (3.0, 0.0),
+            (3.0, 1.0),
+            (3.0, 2.0),
+            (3.0, 3.0),
+        ]
+        left = [(x - 0.5 * (x >= 3.0), y + 0.5 * (x < 3.0)) for x, y in centre]
+        right = [(x + 0.5 * (x >= 3.0), y - 0.5 * (x < 3.0)) for x, y in centre]
+        left[3], right[3] = (2.5, 0.5), (3.5, -0.5)  # the corner's diagonal
+        planned = strip_plan(left, right)
+        assert planned is not None
+        self.abstraction, self.witness, self.triangles = planned
+        sx, sy = self.abstraction.corners(0).mean(axis=0).tolist()
+        self.start = (sx, sy)
+        self.robot = Robot(start=self.start, max_speed=1.0)
+        self.corridor = shapely.Polygon([*right, *reversed(left)])
+
+    def ratio(self, fields: Any) -> float:
+        mission = cast(Mission, type("M", (), {"robot": self.robot})())
+        trace = simulate(self.abstraction, fields, mission)
+        travelled, entry = _length_until(trace, len(self.triangles) - 1)
+        target = fields.steps[-1].target
+        assert target is not None
+        best = geodesic(self.corridor, self.start, (target[0], target[1]))
+        return (travelled + math.dist(entry, target)) / best
+
+
 def test_a_bent_corridor_splits_its_runs_at_the_bend() -> None:
     """An L-shaped corridor (east, then north): its shortest path turns at the inner corner,
     so the fields jump there (reason: the bend), and the trajectory keeps within 10 % of the
@@ -408,27 +444,16 @@ def test_a_bent_corridor_splits_its_runs_at_the_bend() -> None:
     own fields (1.093 against 1.112)."""
     from tlmpc.control.follow import BENDS
 
-    centre = [(0.0, 0.0), (1.0, 0.0), (2.0, 0.0), (3.0, 0.0), (3.0, 1.0), (3.0, 2.0), (3.0, 3.0)]
-    left = [(x - 0.5 * (x >= 3.0), y + 0.5 * (x < 3.0)) for x, y in centre]
-    right = [(x + 0.5 * (x >= 3.0), y - 0.5 * (x < 3.0)) for x, y in centre]
-    left[3], right[3] = (2.5, 0.5), (3.5, -0.5)  # the corner's diagonal
-    planned = strip_plan(left, right)
-    assert planned is not None
-    abstraction, witness, triangles = planned
-    sx, sy = abstraction.corners(0).mean(axis=0).tolist()
-    robot = Robot(start=(sx, sy), max_speed=1.0)
-    controllers = synthesize(abstraction, witness, robot)
+    bent = _BentCorridor()
+    controllers = synthesize(bent.abstraction, bent.witness, bent.robot)
     assert any(jump.reason == BENDS for jump in controllers.jumps)
-    mission = cast(Mission, type("M", (), {"robot": robot})())
-    corridor = shapely.Polygon([*right, *reversed(left)])
-    ratios = []
-    for fields in (controllers, synthesize(abstraction, witness, robot, follow=False)):
-        trace = simulate(abstraction, fields, mission)
-        travelled, entry = _length_until(trace, len(triangles) - 1)
-        target = fields.steps[-1].target
-        assert target is not None
-        best = geodesic(corridor, (sx, sy), (target[0], target[1]))
-        ratios.append((travelled + math.dist(entry, target)) / best)
+    ratios = [
+        bent.ratio(fields)
+        for fields in (
+            controllers,
+            synthesize(bent.abstraction, bent.witness, bent.robot, follow=False),
+        )
+    ]
     assert ratios[0] <= 1.10
     assert ratios[0] < ratios[1]
 
@@ -440,30 +465,10 @@ def test_without_a_disturbance_the_lower_floor_cap_keeps_a_bend_closer() -> None
     corridor's geodesic (visibility graph on shapely geometry), and within 9.5 % of it."""
     from tlmpc.control import follow
 
-    centre = [(0.0, 0.0), (1.0, 0.0), (2.0, 0.0), (3.0, 0.0), (3.0, 1.0), (3.0, 2.0), (3.0, 3.0)]
-    left = [(x - 0.5 * (x >= 3.0), y + 0.5 * (x < 3.0)) for x, y in centre]
-    right = [(x + 0.5 * (x >= 3.0), y - 0.5 * (x < 3.0)) for x, y in centre]
-    left[3], right[3] = (2.5, 0.5), (3.5, -0.5)  # the corner's diagonal
-    planned = strip_plan(left, right)
-    assert planned is not None
-    abstraction, witness, triangles = planned
-    sx, sy = abstraction.corners(0).mean(axis=0).tolist()
-    robot = Robot(start=(sx, sy), max_speed=1.0)
-    mission = cast(Mission, type("M", (), {"robot": robot})())
-    corridor = shapely.Polygon([*right, *reversed(left)])
-
-    def ratio() -> float:
-        fields = synthesize(abstraction, witness, robot)
-        trace = simulate(abstraction, fields, mission)
-        travelled, entry = _length_until(trace, len(triangles) - 1)
-        target = fields.steps[-1].target
-        assert target is not None
-        best = geodesic(corridor, (sx, sy), (target[0], target[1]))
-        return (travelled + math.dist(entry, target)) / best
-
-    free = ratio()
+    bent = _BentCorridor()
+    free = bent.ratio(synthesize(bent.abstraction, bent.witness, bent.robot))
     with mock.patch.object(follow, "FREE_FLOOR_CAP", follow.FLOOR_CAP):
-        capped = ratio()
+        capped = bent.ratio(synthesize(bent.abstraction, bent.witness, bent.robot))
     assert free < capped
     assert free <= 1.095
 
