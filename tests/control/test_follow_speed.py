@@ -220,10 +220,9 @@ def test_the_following_solve_rewards_the_floor_up_to_the_cap_only() -> None:
             geometry=step.geometry,
             columns=(column[step.runs[0]], column[step.runs[1]], column[step.runs[2]]),
             guide=guide,
-            stay=step.exit_edge is None,
         )
         for step, guide in zip(steps, guides, strict=True)
-        if guide is not None
+        if guide is not None and step.exit_edge is not None
     ]
     x = follow._clarabel(
         *follow.follow_program(

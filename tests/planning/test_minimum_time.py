@@ -32,7 +32,7 @@ from tlmpc.pipeline.mintime import MAX_REPLANS, measure, plan_minimum_time
 from tlmpc.pipeline.shortest import plan_shortest
 from tlmpc.pipeline.stages import ABSTRACTION, AUTOMATON, MISSION, WITNESS, compile_mission
 from tlmpc.planning.mission import move_times, plan_mission
-from tlmpc.planning.product import _move_lengths, move_weight_grid
+from tlmpc.planning.product import move_lengths, move_weight_grid
 from tlmpc.planning.timing import MoveTimes, move_key
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -126,7 +126,7 @@ def test_time_weights_are_lengths_at_top_speed_with_measured_moves_replaced(
     result = compiled(tmp_path, text)
     mesh = result.compilation.get(ABSTRACTION)
     start = (0.5, 0.5)
-    lengths = _move_lengths(mesh, start)
+    lengths = move_lengths(mesh, start)
     estimate = move_weight_grid(mesh, start, "time", MoveTimes(speed=0.5))
     np.testing.assert_allclose(estimate, lengths / 0.5, rtol=1e-15)
     key = move_key(mesh, 3, 0, 1)

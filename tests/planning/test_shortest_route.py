@@ -87,12 +87,16 @@ def test_kept_route_is_never_longer_than_the_midpoint_plan(index: int) -> None:
     assert math.isclose(witness.stats["path_length"], kept_length, rel_tol=1e-12)
     assert witness.stats["path_lengths"][0] == pytest.approx(first_length, rel=1e-12)
     assert kept_length <= first_length * (1 + 1e-12)
-    # the kept one is within the stated gain of the least pulled, unless a shorter one was
-    # simulated and found slower
-    least = min(witness.stats["path_lengths"])
-    assert least <= kept_length
-    if kept_length > least / (1.0 - shortest.MIN_GAIN) * (1 + 1e-12):
-        assert witness.stats["length_time_checks"]
+    if "rings_at_corners" in c.get(ABSTRACTION).stats:
+        # the plan on the mesh cut at its corners, kept on its trajectory: one pulled there
+        assert kept_length in witness.stats["ring_lengths"]
+    else:
+        # the kept one is within the stated gain of the least pulled, unless a shorter one
+        # was simulated and found slower
+        least = min(witness.stats["path_lengths"])
+        assert least <= kept_length
+        if kept_length > least / (1.0 - shortest.MIN_GAIN) * (1 + 1e-12):
+            assert witness.stats["length_time_checks"]
     abstraction = c.get(ABSTRACTION)
     goal_cells = np.array(
         ["goal" in abstraction.labels(t) for t in range(abstraction.num_triangles)]
@@ -126,8 +130,9 @@ def test_rounds_are_deterministic_and_respect_the_node_budget(
         runs.append(json.dumps(document, sort_keys=True, default=str))
     assert runs[0] == runs[1]  # the wall-clock seconds aside
     example7 = ROOT / "specs" / "example7.yaml"
-    # the re-plans' budget alone (the touch candidate has a budget of its own)
+    # the re-plans' budget alone (the touch and corner candidates come on top of it)
     monkeypatch.setattr(shortest, "touch_candidate", lambda *args: None)
+    monkeypatch.setattr(shortest, "corner_candidate", lambda *args: None)
     unlimited = compile_mission(example7, until="plan").compilation.get(WITNESS).stats
     assert unlimited["length_rounds"] >= 3
     nodes = unlimited["product_nodes"]  # every plan on this mesh builds the same product
@@ -208,17 +213,28 @@ def test_the_kept_route_is_never_slower_than_the_midpoint_plan() -> None:
     from unittest import mock
 
     from tlmpc.control import follow
+    from tlmpc.pipeline import corners
     from tlmpc.pipeline.mintime import measure
 
     text = yaml.safe_dump(SLOWER_SHORTCUT)
-    with mock.patch.object(follow, "FREE_FLOOR_CAP", follow.FLOOR_CAP):
-        result = compile_mission("room.yaml", text=text, until="plan")
-        c = result.compilation
-        mission, witness = c.get(MISSION), c.get(WITNESS)
-        first = plan_mission(mission, c.get(ABSTRACTION), c.get(AUTOMATON))
-        kept = Planned(abstraction=c.get(ABSTRACTION), automaton=c.get(AUTOMATON), witness=witness)
-        assert min(witness.stats["path_lengths"]) < witness.stats["path_length"]  # one was slower
-        assert measure(mission, kept).exact_time <= measure(mission, first).exact_time
+    for rings in (False, True):  # the re-plans alone, then with the corner candidate
+        with (
+            mock.patch.object(follow, "FREE_FLOOR_CAP", follow.FLOOR_CAP),
+            mock.patch.object(
+                shortest,
+                "corner_candidate",
+                corners.corner_candidate if rings else (lambda *args: None),
+            ),
+        ):
+            result, first = _compiled(text)
+            c = result.compilation
+            mission, witness = c.get(MISSION), c.get(WITNESS)
+            kept = Planned(
+                abstraction=c.get(ABSTRACTION), automaton=c.get(AUTOMATON), witness=witness
+            )
+            if not rings:  # one was slower
+                assert min(witness.stats["path_lengths"]) < witness.stats["path_length"]
+            assert measure(mission, kept).exact_time <= measure(mission, first).exact_time
 
 
 @pytest.mark.parametrize("name", ["example1", "example6", "reach-avoid", "patrol"])
@@ -256,7 +272,11 @@ def test_random_missions_keep_the_shorter_route(document: dict[str, Any]) -> Non
     mission = c.get(MISSION)
     kept = Planned(abstraction=c.get(ABSTRACTION), automaton=c.get(AUTOMATON), witness=witness)
     assert pull(mission, kept).length <= pull(mission, first).length * (1 + 1e-12) + 1e-12
-    pulled = [*witness.stats["path_lengths"], witness.stats.get("touch_length")]
+    pulled = [
+        *witness.stats["path_lengths"],
+        witness.stats.get("touch_length"),
+        *witness.stats.get("ring_lengths", ()),
+    ]
     assert witness.stats["path_length"] in pulled
 
 

@@ -208,23 +208,23 @@ def channel_pieces(
 ) -> list[Guide]:
     """The shortest path's piece in each step (a vertex passage's: to its corner).
 
-    A plan that ends by staying is pulled from the start to the stay triangle's incenter (the
-    stay field's target); a lasso over its prefix and :data:`LAPS` laps of its cycle, the
-    prefix's steps taking the first pass and the cycle's steps the middle lap.
+    A plan that ends by staying is pulled from the start to the nearest point of the stay
+    triangle's entry edge (where the plan's cost ends: the task is met on entering it), and
+    its stay piece runs from there to the triangle's incenter (the stay field's target); a
+    lasso over its prefix and :data:`LAPS` laps of its cycle, the prefix's steps taking the
+    first pass and the cycle's steps the middle lap.
     """
     count = len(steps)
+    stay = loop_start is None and steps[-1].exit_edge is None
     if loop_start is None:
         order = list(range(count))
-        end_step = steps[-1]
-        moving = order[:-1] if end_step.exit_edge is None else order
-        end = _incenter(end_step.corners) if end_step.exit_edge is None else None
+        moving = order[:-1] if stay else order
     else:
         cycle = list(range(loop_start, count))
         order = list(range(loop_start)) + cycle * LAPS
         moving = order
-        end = None
     insets = [_exit_insets(steps[i]) for i in moving]
-    crossings = _pulled(steps, moving, insets, start, end)
+    crossings = _pulled(steps, moving, insets, start, nearest=stay)
     for _ in range(REACH_ROUNDS):
         wider = [
             _reachable(steps[i], insets[k], start if k == 0 else crossings[k - 1], crossings[k])
@@ -233,10 +233,8 @@ def channel_pieces(
         if wider == insets:
             break
         insets = wider
-        crossings = _pulled(steps, moving, insets, start, end)
-    if end is None:
-        last = crossings[-1]
-        end = last
+        crossings = _pulled(steps, moving, insets, start, nearest=stay)
+    end = _incenter(steps[-1].corners) if stay else crossings[-1] if crossings else start
     # The pass each step takes: its first in the prefix, the middle lap in the cycle.
     chosen: dict[int, int] = {}
     for position, i in enumerate(moving):
@@ -296,16 +294,65 @@ def _pulled(
     moving: Sequence[int],
     insets: Sequence[tuple[float, float]],
     start: Point,
-    end: Point | None,
+    *,
+    nearest: bool = False,
 ) -> list[Point]:
-    """The crossings of the exit portals of ``moving`` with these insets (and, without an
-    ``end``, the last portal's midpoint as the end, appended)."""
+    """The crossings of the exit portals of ``moving`` with these insets, the path ending on
+    the last portal: at its midpoint, or (``nearest``) at the point of it nearest the start
+    through the portals before it (:data:`NEAREST_ROUNDS` rounds of moving the end to the
+    point of the portal nearest the path's last corner before it)."""
+    if not moving:
+        return []
     portals = [inset(exit_portal(steps[i]), *insets[k]) for k, i in enumerate(moving)]
-    if end is None:
-        last = portals.pop()
-        middle = ((last.left[0] + last.right[0]) / 2.0, (last.left[1] + last.right[1]) / 2.0)
-        return [*funnel(start, portals, middle), middle]
-    return funnel(start, portals, end)
+    last = portals.pop()
+    end = ((last.left[0] + last.right[0]) / 2.0, (last.left[1] + last.right[1]) / 2.0)
+    crossings = [*funnel(start, portals, end), end]
+    if not nearest:
+        return crossings
+    best = (_length(start, crossings), crossings)
+    for _ in range(NEAREST_ROUNDS):
+        corner = _last_corner(start, crossings)
+        moved = _nearest_on(last, corner)
+        if moved == end:
+            break
+        end = moved
+        crossings = [*funnel(start, portals, end), end]
+        length = _length(start, crossings)
+        if length < best[0]:
+            best = (length, crossings)
+    return best[1]
+
+
+#: At most this many rounds of moving a stay's end along its entry edge (each a funnel; they
+#: stop once the end stays put: the path's last straight piece then meets the edge at a right
+#: angle or at an end, the shortest way to it since the distance is convex along the edge).
+NEAREST_ROUNDS = 16
+
+
+def _length(start: Point, points: Sequence[Point]) -> float:
+    return sum(math.dist(a, b) for a, b in itertools.pairwise([start, *points]))
+
+
+def _last_corner(start: Point, points: Sequence[Point]) -> Point:
+    """The last point before the end of the polyline ``start, *points`` where it bends (the
+    start when it bends nowhere)."""
+    path = [start, *points]
+    end = path[-1]
+    for k in range(len(path) - 2, 0, -1):
+        if abs(_cross(path[k], end, path[k - 1])) > 1e-12 * math.dist(path[k - 1], end) ** 2:
+            return path[k]
+    return start
+
+
+def _nearest_on(portal: Portal, point: Point) -> Point:
+    """The point of ``portal`` nearest ``point``."""
+    (lx, ly), (rx, ry) = portal.left, portal.right
+    ex, ey = rx - lx, ry - ly
+    squared = ex * ex + ey * ey
+    if squared == 0.0:
+        return portal.left
+    u = min(1.0, max(0.0, ((point[0] - lx) * ex + (point[1] - ly) * ey) / squared))
+    return (lx + u * ex, ly + u * ey)
 
 
 def _reachable(

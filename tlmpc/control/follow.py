@@ -20,8 +20,11 @@ plus the vertex program's own objective (the guaranteed speeds, the smallest wei
 so the weakest step's exit-time bound stays the vertex program's).  It is solved *instead of*
 the vertex program (same rows, one Clarabel solve); where the path bends across a portal the
 velocity runs are split beforehand (:func:`bends`), since a velocity shared at both ends of
-a portal makes the two fields equal along it and the flow could not turn there.  A stay has
-one piece, from its entry to its target, where the field vanishes: parallel at p suffices.
+a portal makes the two fields equal along it and the flow could not turn there.  A stay is
+not asked to follow its piece (the task is met where it is entered): its field keeps the
+vertex program's objective, which converges to its target fastest (asked to follow a piece
+from where the path enters it, at the nearest point of its entry edge, the reach-avoid spec's
+stay was guaranteed 0.015 x max_speed inward, the vertex program's own fields 0.07).
 Where a shared vertex velocity or the margins make exact alignment impossible, the slack
 stays positive and the flow deviates as little as the objective allows; every vertex
 condition, the speed bound and the disturbance rows are the vertex program's own rows,
@@ -98,7 +101,6 @@ class FollowStep:
     geometry: TriangleGeometry
     columns: tuple[int, int, int]
     guide: Guide
-    stay: bool
 
 
 @dataclass(frozen=True, slots=True)
@@ -129,8 +131,8 @@ class _PathPoints:
 
 
 def _path_points(follow: Sequence[FollowStep]) -> _PathPoints:
-    """Each followed step's entry point and (but for a stay) its exit point, in step order,
-    weighted by the step's share of the path's length (so time, not triangle count, counts)."""
+    """Each followed step's entry and exit points, in step order, weighted by the step's
+    share of the path's length (so time, not triangle count, counts)."""
     count = len(follow)
     if count == 0:
         empty = np.zeros((0, 6))
@@ -139,7 +141,6 @@ def _path_points(follow: Sequence[FollowStep]) -> _PathPoints:
         )
     entry = np.array([s.guide.entry for s in follow], dtype=np.float64).reshape(count, 2)
     exit_ = np.array([s.guide.exit for s in follow], dtype=np.float64).reshape(count, 2)
-    stay = np.array([s.stay for s in follow], dtype=bool)
     normals = np.array([s.geometry.normals for s in follow], dtype=np.float64)
     offsets = np.array([s.geometry.offsets for s in follow], dtype=np.float64)
     heights = np.array([s.geometry.heights for s in follow], dtype=np.float64)
@@ -148,9 +149,9 @@ def _path_points(follow: Sequence[FollowStep]) -> _PathPoints:
     lengths = np.hypot(delta[:, 0], delta[:, 1])
     scale = float(lengths.sum()) or 1.0
     moving = lengths > 0.0  # a piece of no length has nothing to follow
-    # Rows in step order: entry then exit (a stay has its entry alone).
-    steps = np.concatenate([np.flatnonzero(moving), np.flatnonzero(moving & ~stay)])
-    where = np.concatenate([entry[moving], exit_[moving & ~stay]])
+    # Rows in step order: entry then exit.
+    steps = np.concatenate([np.flatnonzero(moving), np.flatnonzero(moving)])
+    where = np.concatenate([entry[moving], exit_[moving]])
     order = np.argsort(steps, kind="stable")
     steps, where = steps[order], where[order]
     lambdas = (offsets[steps] - np.einsum("pij,pj->pi", normals[steps], where)) / heights[steps]
@@ -160,7 +161,7 @@ def _path_points(follow: Sequence[FollowStep]) -> _PathPoints:
     along = np.stack([dx[:, None] * lambdas, dy[:, None] * lambdas], axis=2).reshape(-1, 6)
     # d x f = dx fy - dy fx
     across = np.stack([-dy[:, None] * lambdas, dx[:, None] * lambdas], axis=2).reshape(-1, 6)
-    weight = lengths[steps] / scale / np.where(stay[steps], 1.0, 2.0)
+    weight = lengths[steps] / scale / 2.0
     return _PathPoints(steps, pair, along, across, weight)
 
 
@@ -545,10 +546,12 @@ def follow_channel(
             geometry=step.geometry,
             columns=(column[step.runs[0]], column[step.runs[1]], column[step.runs[2]]),
             guide=guide,
-            stay=step.exit_edge is None,
         )
         for step, guide in zip(steps, guides, strict=True)
-        if step.through is None and guide is not None and not _needle(step.geometry)
+        if step.through is None
+        and step.exit_edge is not None
+        and guide is not None
+        and not _needle(step.geometry)
     ]
     result = solve_follow(
         form.constraints,

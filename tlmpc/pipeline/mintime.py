@@ -32,6 +32,8 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
 from typing import Any
 
+import numpy as np
+
 from tlmpc.abstraction.model import Abstraction
 from tlmpc.automata.model import Automaton
 from tlmpc.base.errors import TlmpcError
@@ -58,6 +60,8 @@ class Measured:
     exact_time: float
     moves: Mapping[MoveKey, float]
     meets_bounds: bool = True
+    #: The trajectory's length over the same span (prefix + beta x lap), along its samples.
+    exact_length: float = 0.0
 
 
 def plan_minimum_time(
@@ -79,12 +83,15 @@ def plan_minimum_time(
     simulated), ``time_fixed_point``, ``exact_times`` (each round's, in order) and, for a
     task with time bounds, ``bounds_met`` (each round's).
     """
-    first = plan_mission(mission, abstraction, automaton)
     if mission.options.cost != "time":
-        return first
-    if shortest is not None:
+        return plan_mission(mission, abstraction, automaton)
+    if shortest is None:
+        first = plan_mission(mission, abstraction, automaton)
+    else:
+        # the length metric's own first plan (the time metric's weighs the same lengths over
+        # max_speed, whose rounding can break a tie the other way), then its kept plan
         as_length = replace(mission, options=replace(mission.options, cost="length"))
-        first = shortest(as_length, first)
+        first = shortest(as_length, plan_mission(as_length, abstraction, automaton))
     speed = mission.robot.max_speed
     measured: dict[MoveKey, float] = {}
     history: list[float] = []
@@ -123,8 +130,8 @@ def plan_minimum_time(
             break
         seen.add(shape)
         current = following
-    if best is None:
-        return first
+    if best is None:  # (the first plan is the length metric's: the compile's metric is time)
+        return replace(first, witness=replace(first.witness, metric="time"))
     (_, exact), chosen = best
     stats: dict[str, Any] = {
         **chosen.witness.stats,
@@ -134,7 +141,7 @@ def plan_minimum_time(
         "exact_times": history,
         **({"bounds_met": met} if bounded_operators(mission.formula) else {}),
     }
-    return replace(chosen, witness=replace(chosen.witness, stats=stats))
+    return replace(chosen, witness=replace(chosen.witness, metric="time", stats=stats))
 
 
 def measure(mission: Mission, planned: Planned) -> Measured:
@@ -160,8 +167,9 @@ def measure(mission: Mission, planned: Planned) -> Measured:
 def step_times(
     abstraction: Abstraction, controllers: Controllers, trace: Trace, beta: float
 ) -> Measured:
-    """The exact time of the run ``trace`` of ``controllers`` (see the module doc) and the
-    time of each move of D it made, keyed by :func:`~tlmpc.planning.timing.move_key`.
+    """The exact time of the run ``trace`` of ``controllers`` (see the module doc), the
+    trajectory's length over the same span (along the samples) and the time of each move of
+    D it made, keyed by :func:`~tlmpc.planning.timing.move_key`.
 
     The simulator runs the steps in order and then the cycle once more; every step but a
     stay ends at a crossing sample (``trace.crossings``, one per such step in that order).
@@ -185,12 +193,24 @@ def step_times(
             moves[move_key(abstraction, step.triangle, slot, step.exit_edge)] = end - previous_end
         previous_end = end
     first_pass = len(steps)
+    travelled = np.concatenate(
+        [[0.0], np.cumsum(np.hypot(*np.diff(np.asarray(trace.points), axis=0).T))]
+    )
+    exit_length = {n: float(travelled[trace.crossings[k]]) for k, n in enumerate(moving)}
     if loop is None:
-        arrived = max((exit_time[p] for p in moving), default=0.0)
-        return Measured(exact_time=arrived, moves=moves)
+        last = max(moving, default=None)
+        arrived = 0.0 if last is None else exit_time[last]
+        length = 0.0 if last is None else exit_length[last]
+        return Measured(exact_time=arrived, moves=moves, exact_length=length)
     prefix_time = exit_time[loop - 1] if loop > 0 else 0.0
+    prefix_length = exit_length[loop - 1] if loop > 0 else 0.0
     lap = exit_time[len(order) - 1] - exit_time[first_pass - 1]
-    return Measured(exact_time=prefix_time + beta * lap, moves=moves)
+    lap_length = exit_length[len(order) - 1] - exit_length[first_pass - 1]
+    return Measured(
+        exact_time=prefix_time + beta * lap,
+        moves=moves,
+        exact_length=prefix_length + beta * lap_length,
+    )
 
 
 def _entry_slot(

@@ -41,12 +41,15 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
 from typing import Any
 
+import numpy as np
+
 from tlmpc.base.errors import TlmpcError
 from tlmpc.mission.model import Mission
+from tlmpc.pipeline.corners import corner_candidate
 from tlmpc.pipeline.touches import touch_candidate
 from tlmpc.planning.mission import Planned, replan
 from tlmpc.planning.product import START_SLOT, STUTTER_COST
@@ -61,6 +64,8 @@ MIN_GAIN = 0.002
 MAX_TIME_CHECKS = 2
 #: At most this many re-plans after the first plan.
 MAX_REPLANS = 6
+#: At most this many re-plans on the mesh cut at the corners (:mod:`tlmpc.pipeline.corners`).
+MAX_RING_REPLANS = 3
 #: ... and none that would bring the products of all the plans made past this many nodes (a
 #: re-plan costs about what the plan before it did, counted by its product's nodes: on a
 #: large mesh the loop stops early or does not run at all, deterministically).
@@ -101,7 +106,6 @@ def plan_shortest(mission: Mission, planned: Planned) -> Planned:
     history = [first.length]
     measured: dict[MoveKey, float] = dict(first.moves)
     seen = {planned.route()}
-    fixed = False
     # The moves no plan made keep their midpoint lengths scaled as the first plan's path
     # compares with its midpoint cost: unscaled, every measured move looks cheaper than
     # any other and the first channel is always planned again.
@@ -145,41 +149,111 @@ def plan_shortest(mission: Mission, planned: Planned) -> Planned:
                 extra["touch_time"] = time
             if kept.planned is touched:
                 measured.update(found_touch.moves)
-    current = kept.planned  # the re-plans go on from the kept plan, on its mesh
-    for _ in range(MAX_REPLANS):
-        # a re-plan costs about what the last plan did: none that would pass the budget
-        if spent + _nodes(current) > NODE_BUDGET:
-            break
-        spent += _nodes(current)
-        weights = MoveTimes(speed=1.0 / ratio, measured=dict(measured))
-        try:
-            following = replan(mission, current, weights)
-            found = pull(mission, following)
-        except TlmpcError:
-            break
-        shape = following.route()
-        if shape in seen:
-            fixed = True
-            break
-        seen.add(shape)
-        history.append(found.length)
+    # the re-plans go on from the kept plan, on its mesh
+    rounds = _Rounds(mission, kept.planned, ratio, measured=measured, seen=seen, history=history)
+
+    def check(following: Planned, found: Pulled) -> None:
         if len(checked) < MAX_TIME_CHECKS:
             time = kept.offer(following, found, verified=False)
             if time is not None:
                 checked.append(time)
-        measured.update(found.moves)
-        current = following
+
+    spent = rounds.run(MAX_REPLANS, spent, check)
+    # The kept plan planned again on its mesh cut into rings where its path bends round a
+    # corner (tlmpc.pipeline.corners), and re-planned there as above: the shortest path
+    # pulled on that mesh is kept when its trajectory is shorter.
+    if spent + 2 * _nodes(kept.planned) <= NODE_BUDGET:
+        ringed = corner_candidate(mission, kept.planned)
+        found_ring = None if ringed is None else _pulled(mission, ringed)
+        if ringed is not None and found_ring is not None:
+            spent += _nodes(ringed)
+            ring_rounds = _Rounds(
+                mission,
+                ringed,
+                ratio,
+                measured=dict(found_ring.moves),
+                seen={ringed.route()},
+                history=[found_ring.length],
+                best=(ringed, found_ring),
+            )
+            spent = ring_rounds.run(MAX_RING_REPLANS, spent)
+            extra["ring_lengths"] = ring_rounds.history
+            assert ring_rounds.best is not None
+            time = kept.offer_trajectory(*ring_rounds.best)
+            if time is not None:
+                extra["ring_time"] = time
     best = kept.planned
     stats: dict[str, Any] = {
         **best.witness.stats,
         "path_length": kept.length,
         "path_lengths": history,
         "length_rounds": len(history),
-        "length_fixed_point": fixed,
+        "length_fixed_point": rounds.fixed,
         "length_time_checks": checked,
         **extra,
     }
     return replace(best, witness=replace(best.witness, stats=stats))
+
+
+class _Rounds:
+    """Re-plans from a plan, every move a plan made weighing its piece of that plan's path
+    (its last use), the others their midpoint lengths scaled by ``ratio``: the rounds of the
+    module doc, shared by the re-plans on the mesh as built and on the mesh cut at corners."""
+
+    def __init__(
+        self,
+        mission: Mission,
+        planned: Planned,
+        ratio: float,
+        *,
+        measured: dict[MoveKey, float],
+        seen: set[Any],
+        history: list[float],
+        best: tuple[Planned, Pulled] | None = None,
+    ) -> None:
+        self.mission = mission
+        self.current = planned
+        self.ratio = ratio
+        self.measured = measured
+        self.seen = seen
+        self.history = history
+        #: the re-plan (or the given ``best``) whose path was the shortest
+        self.best = best
+        #: whether the rounds stopped at a plan already pulled
+        self.fixed = False
+
+    def run(
+        self,
+        limit: int,
+        spent: int,
+        each: Callable[[Planned, Pulled], None] | None = None,
+    ) -> int:
+        """Up to ``limit`` re-plans, none that would bring the nodes ``spent`` past
+        :data:`NODE_BUDGET`, ``each`` called on every new one; the nodes spent after them."""
+        for _ in range(limit):
+            # a re-plan costs about what the last plan did: none that would pass the budget
+            if spent + _nodes(self.current) > NODE_BUDGET:
+                break
+            spent += _nodes(self.current)
+            weights = MoveTimes(speed=1.0 / self.ratio, measured=dict(self.measured))
+            try:
+                following = replan(self.mission, self.current, weights)
+                found = pull(self.mission, following)
+            except TlmpcError:
+                break
+            shape = following.route()
+            if shape in self.seen:
+                self.fixed = True
+                break
+            self.seen.add(shape)
+            self.history.append(found.length)
+            if each is not None:
+                each(following, found)
+            self.measured.update(found.moves)
+            self.current = following
+            if self.best is None or found.length < self.best[1].length:
+                self.best = (following, found)
+        return spent
 
 
 class _Kept:
@@ -191,6 +265,13 @@ class _Kept:
         self.planned = planned
         self.length = length
         self.time: float | None = None
+        #: the kept plan's trajectory length (prefix + beta x lap), once measured
+        self.travelled: float | None = None
+        #: the midpoint plan (the first kept), its path length and exact time: a plan judged
+        #: by its trajectory (:meth:`offer_trajectory`) keeps the promise against them
+        self.first = planned
+        self.first_length = length
+        self.first_time: float | None = None
 
     def offer(self, candidate: Planned, pulled: Pulled, *, verified: bool) -> float | None:
         """Keep ``candidate`` when its path is more than :data:`MIN_GAIN` shorter **and** its
@@ -200,13 +281,46 @@ class _Kept:
         when it was simulated, else None."""
         if not pulled.length < self.length * (1.0 - MIN_GAIN):
             return None
-        if self.time is None:
-            self.time = _exact_time(self.mission, self.planned)
-        measure = _verified_time if verified else _exact_time
-        time = measure(self.mission, candidate)
+        self._measure_kept()
+        assert self.time is not None
+        time, travelled = _run(self.mission, candidate, verified=verified)
         if time <= self.time:
-            self.planned, self.length, self.time = candidate, pulled.length, time
+            self._keep(candidate, pulled.length, time, travelled)
         return time
+
+    def offer_trajectory(self, candidate: Planned, pulled: Pulled) -> float | None:
+        """Keep ``candidate`` (a plan on another mesh: its trace must satisfy the task) when
+        its **trajectory** is more than :data:`MIN_GAIN` shorter than the kept plan's, its path
+        is not longer and its exact time not longer than the midpoint plan's (so the kept
+        plan keeps the promise of the module doc).  A plan on a mesh cut at the corners
+        follows its path more closely than the plans before, whose path may be as short:
+        the trajectory is what its cut was for.  The candidate's exact time when it was
+        simulated, else None."""
+        if not pulled.length <= self.first_length:
+            return None
+        self._measure_kept()
+        assert self.first_time is not None
+        assert self.travelled is not None
+        time, travelled = _run(self.mission, candidate, verified=True)
+        if time <= self.first_time and travelled < self.travelled * (1.0 - MIN_GAIN):
+            self._keep(candidate, pulled.length, time, travelled)
+        return time
+
+    def _measure_kept(self) -> None:
+        """Simulate the kept plan once (the first time it is simulated it is the midpoint
+        plan: a candidate replaces it only after this)."""
+        if self.time is None:
+            self.time, self.travelled = _run(self.mission, self.planned, verified=False)
+            if self.planned is self.first:
+                self.first_time = self.time
+
+    def _keep(self, candidate: Planned, length: float, time: float, travelled: float) -> None:
+        self.planned, self.length, self.time, self.travelled = (
+            candidate,
+            length,
+            time,
+            travelled,
+        )
 
 
 def order_candidates(mission: Mission, planned: Planned) -> list[Planned]:
@@ -309,37 +423,40 @@ def _pulled(mission: Mission, planned: Planned) -> Pulled | None:
         return None
 
 
-def _verified_time(mission: Mission, planned: Planned) -> float:
-    """:func:`_exact_time`, and inf unless the simulated trace also satisfies the task (the
-    self-check's verifier): a plan on a split mesh is checked before it can replace one
-    made on the mesh as built."""
+def _run(mission: Mission, planned: Planned, *, verified: bool) -> tuple[float, float]:
+    """The plan's exact time and its trajectory's length over the same span
+    (:func:`tlmpc.pipeline.mintime.measure`: prefix + beta x lap of its simulated trajectory,
+    sampled at least every :data:`LENGTH_SAMPLES` th of the mesh's extent); both inf when its
+    controllers or simulation fail or (``verified``) its trace does not satisfy the task
+    (the self-check's verifier: a plan on a split mesh is checked before it can replace one
+    made on the mesh as built)."""
     from tlmpc.control import synthesize
     from tlmpc.pipeline.mintime import step_times
     from tlmpc.simulate import simulate, trace_to_json
     from tlmpc.verify import verdict_to_json, verify_document
 
+    vertices = planned.abstraction.vertices
+    extent = float(np.hypot(*(vertices.max(axis=0) - vertices.min(axis=0))))
+    gap = extent / LENGTH_SAMPLES / mission.robot.max_speed
     try:
         controllers = synthesize(
             planned.abstraction, planned.witness, mission.robot, source=mission.source
         )
-        trace = simulate(planned.abstraction, controllers, mission)
+        trace = simulate(planned.abstraction, controllers, mission, max_gap=gap)
     except TlmpcError:
-        return math.inf
-    verdict = verdict_to_json(verify_document(dict(trace_to_json(trace, mission))))
-    if not verdict["satisfied"]:
-        return math.inf
-    return step_times(planned.abstraction, controllers, trace, planned.witness.beta).exact_time
+        return math.inf, math.inf
+    if verified:
+        verdict = verdict_to_json(verify_document(dict(trace_to_json(trace, mission))))
+        if not verdict["satisfied"]:
+            return math.inf, math.inf
+    found = step_times(planned.abstraction, controllers, trace, planned.witness.beta)
+    return found.exact_time, found.exact_length
 
 
-def _exact_time(mission: Mission, planned: Planned) -> float:
-    """The plan's exact time (:func:`tlmpc.pipeline.mintime.measure`: prefix + beta x lap of
-    its simulated trajectory); inf when its controllers or simulation fail."""
-    from tlmpc.pipeline.mintime import measure
-
-    try:
-        return measure(mission, planned).exact_time
-    except TlmpcError:
-        return math.inf
+#: The samples a plan's trajectory is measured by are at most this fraction of the mesh's
+#: extent apart (at max_speed): a polyline through them is then within a few parts in ten
+#: thousand of the flow's length round the corners' small triangles.
+LENGTH_SAMPLES = 200
 
 
 def _nodes(planned: Planned) -> int:

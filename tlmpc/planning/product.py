@@ -77,7 +77,7 @@ def _midpoints_along(abstraction: Abstraction, axis: int) -> FloatArray:
     return middle
 
 
-def _move_lengths(abstraction: Abstraction, start_point: tuple[float, float]) -> FloatArray:
+def move_lengths(abstraction: Abstraction, start_point: tuple[float, float]) -> FloatArray:
     """(m, SLOTS, 3): the weight of leaving each triangle through edge i after entering by
     edge s, from midpoint to midpoint (from the start point in the start slot).
 
@@ -319,7 +319,7 @@ def move_weights(
 ) -> FloatArray:
     """Each move's weight: one under ``"hops"``, its seconds under ``"time"``
     (:func:`~tlmpc.planning.timing.move_time_table` of ``times``), else its length
-    (:func:`_move_lengths`)."""
+    (:func:`move_lengths`)."""
     if metric == "hops":
         return np.ones(len(moves.flat))
     grid = move_weight_grid(abstraction, start_point, metric, times)
@@ -336,7 +336,7 @@ def move_weight_grid(
     """(m, SLOTS, 3): the weight of every move of D on the (triangle, slot, exit) grid under
     ``"length"`` (replaced by ``times.measured`` where given) or ``"time"`` (which needs
     ``times``)."""
-    lengths = _move_lengths(abstraction, start_point)
+    lengths = move_lengths(abstraction, start_point)
     if metric != "time":
         # under "length", ``times`` (speed 1) may carry measured lengths of moves: the
         # channel's shortest path through them (tlmpc.pipeline.shortest)

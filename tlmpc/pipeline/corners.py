@@ -1,0 +1,167 @@
+"""A candidate plan on the mesh cut into rings where its path bends round a corner.
+
+The path the fields follow bends at the ends of portals (the channel's corners).  A field can
+cross its exit edge only a fraction of that edge away from the corner it turns round (the
+portal insets; and a field running at full speed along a piece that heads toward a wall
+needs as much), so on a fan of long edges the robot swings wide of the corner.  Here the
+kept plan's path is pulled, every corner it bends round is cut into rings of smaller
+triangles (:func:`tlmpc.abstraction.corner.ring_corners`), and the mission is planned
+again on that mesh: one more candidate for :func:`tlmpc.pipeline.shortest.plan_shortest`,
+kept only when its path is shorter and its trajectory not slower.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import replace
+
+import numpy as np
+
+from tlmpc.abstraction.corner import RING_FRACTION, ring_corners, ring_inradius
+from tlmpc.abstraction.model import Abstraction
+from tlmpc.base.errors import TlmpcError
+from tlmpc.control.channel import LABEL_INSET, Guide
+from tlmpc.control.clearance import exposed_vertices
+from tlmpc.mission.model import Mission
+from tlmpc.planning.mission import Planned, replan
+from tlmpc.planning.product import SLOTS, move_lengths
+from tlmpc.planning.timing import MoveTimes, move_key
+from tlmpc.runtime.closed_loop import inradius
+
+#: A corner is cut when the path turns by more than this sine there (about 6°).
+TURN = 0.1
+#: ... and passes it within this fraction of the portal (the corner is the funnel's apex).
+NEAR = 0.34
+#: Rings cut about each corner (each halves the edges about it).
+RINGS = 3
+#: The re-plan on the cut mesh weighs moves outside the kept plan's triangles this many
+#: times their midpoint length (it keeps to the kept channel, now cut finer).
+CORRIDOR = 1.5
+
+
+def corner_candidate(mission: Mission, planned: Planned) -> Planned | None:
+    """``planned`` planned again (moves weighing their midpoint lengths) on its mesh cut into
+    rings about the corners its path bends round; None when it bends round none or the plan
+    fails."""
+    from tlmpc.control.channel import label_clearance
+    from tlmpc.control.follow import path_guides
+    from tlmpc.control.synthesize import plan_steps
+
+    mesh = planned.abstraction
+    start = mission.robot.start
+    try:
+        steps, loop_start = plan_steps(mesh, planned.witness)
+    except TlmpcError:
+        return None
+    guides = path_guides(
+        mesh,
+        steps,
+        loop_start,
+        start,
+        passages=True,
+        clearance=label_clearance(mission.robot.max_speed),
+    )
+    corners = bend_corners(mesh, [(s.triangle, s.exit_edge) for s in steps], guides, loop_start)
+    if not corners:
+        return None
+    clearance = label_clearance(mission.robot.max_speed)
+    route = {*planned.witness.prefix, *planned.witness.cycle}
+    floor = min(inradius(mesh.corners(t)) for t in route)
+    refined, parents = ring_corners(mesh, ring_counts(mesh, corners, clearance, floor), start)
+    if refined is mesh:
+        return None
+    parent_of = list(range(mesh.num_triangles)) + parents
+    corridor = [t for t in range(refined.num_triangles) if parent_of[t] in route]
+    lengths = move_lengths(refined, start)
+    measured = {
+        move_key(refined, t, slot, edge): float(lengths[t, slot, edge])
+        for t in corridor
+        for slot in range(SLOTS)
+        for edge in range(3)
+    }
+    times = MoveTimes(speed=1.0 / CORRIDOR, measured=measured)
+    try:
+        return replan(mission, replace(planned, abstraction=refined), times)
+    except TlmpcError:
+        return None
+
+
+def ring_counts(
+    mesh: Abstraction, corners: Sequence[int], clearance: float, floor: float
+) -> dict[int, int]:
+    """How many rings to cut about each of ``corners``: at most :data:`RINGS`, and
+
+    * no more than leave every triangle about the corner an inradius of at least ``floor``
+      (:func:`tlmpc.abstraction.corner.ring_inradius`; a compile passes the smallest of the
+      kept plan's triangles: the runtime's default sample period,
+      :func:`tlmpc.runtime.closed_loop.default_dt`, is a fraction of it, so the rings never
+      make a run take more samples, nor a robot's controller switch fields faster, than the
+      plan's own triangles do);
+    * about a corner on a region's own boundary
+      (:func:`tlmpc.control.clearance.exposed_vertices`) no more than keep its edges long
+      enough for the path to keep ``clearance`` from it (an end there keeps at most
+      :data:`tlmpc.control.channel.LABEL_INSET` of its portal: more rings would bring the
+      path nearer the region than the clearance the channel promises, and the robustness
+      with it).
+
+    A corner where not even one ring fits is left out."""
+    letters = mesh.letter_of
+    boundary = [
+        v for v in corners if len(set(letters[np.nonzero(mesh.triangles == v)[0]].tolist())) > 1
+    ]
+    exposed = exposed_vertices(mesh, boundary)
+    counts: dict[int, int] = {}
+    for v in dict.fromkeys(corners):
+        kept = math.inf
+        if v in exposed:
+            star = mesh.triangles[np.nonzero(mesh.triangles == v)[0]]
+            edges = mesh.vertices[star[star != v]] - mesh.vertices[v]
+            kept = float(np.hypot(*edges.T).min()) * LABEL_INSET  # what the shortest keeps
+        count = 0
+        while (
+            count < RINGS
+            and RING_FRACTION ** (count + 1) * kept >= clearance
+            and ring_inradius(mesh, v, count + 1) >= floor
+        ):
+            count += 1
+        if count > 0:
+            counts[v] = count
+    return counts
+
+
+def bend_corners(
+    mesh: Abstraction,
+    steps: Sequence[tuple[int, int | None]],
+    guides: Sequence[Guide | None],
+    loop_start: int | None,
+) -> list[int]:
+    """The mesh vertices the path bends round: for each step (triangle, exit edge) whose piece
+    of the path and the next step's turn by more than :data:`TURN`, the end of the exit
+    edge on the inside of the turn, when the path crosses the edge within :data:`NEAR` of
+    it."""
+    found: list[int] = []
+    pairs = [(i, i + 1) for i in range(len(steps) - 1)]
+    if loop_start is not None:
+        pairs.append((len(steps) - 1, loop_start))
+    for before, after in pairs:
+        triangle, edge = steps[before]
+        first, second = guides[before], guides[after]
+        if edge is None or first is None or second is None:
+            continue
+        ax, ay = first.exit[0] - first.entry[0], first.exit[1] - first.entry[1]
+        bx, by = second.exit[0] - second.entry[0], second.exit[1] - second.entry[1]
+        norms = math.hypot(ax, ay) * math.hypot(bx, by)
+        if norms == 0.0:
+            continue
+        turn = (ax * by - ay * bx) / norms
+        if abs(turn) <= TURN:
+            continue
+        corners = mesh.triangles[triangle].tolist()
+        # facing out of a counter-clockwise triangle, corner edge + 2 is on the left
+        inner = corners[(edge + 2) % 3] if turn > 0 else corners[(edge + 1) % 3]
+        outer = corners[(edge + 1) % 3] if turn > 0 else corners[(edge + 2) % 3]
+        width = math.dist(mesh.vertices[inner].tolist(), mesh.vertices[outer].tolist())
+        if math.dist(first.exit, mesh.vertices[inner].tolist()) <= NEAR * width:
+            found.append(inner)
+    return found
