@@ -22,7 +22,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from tlmpc.abstraction.model import Abstraction, FloatArray
+from tlmpc.abstraction.model import Abstraction, FloatArray, triangle_inradius
 from tlmpc.abstraction.refine import with_splits
 from tlmpc.abstraction.starts import cells_in
 
@@ -112,14 +112,7 @@ def ring_inradius(abstraction: Abstraction, corner: int, rings: int) -> float:
     about = list(range(len(star)))
     for _ in range(rings):
         _cut_ring(vertices, tri, nbr, letters, components, at[corner], about, RING_FRACTION)
-    return min(_inradius(*(vertices[v] for v in corners)) for corners in tri)
-
-
-def _inradius(x: FloatArray, y: FloatArray, z: FloatArray) -> float:
-    """Twice the area over the perimeter."""
-    area2 = abs(float((y[0] - x[0]) * (z[1] - x[1]) - (y[1] - x[1]) * (z[0] - x[0])))
-    perimeter = float(np.hypot(*(y - x)) + np.hypot(*(z - y)) + np.hypot(*(x - z)))
-    return area2 / perimeter if perimeter > 0.0 else 0.0
+    return min(triangle_inradius(np.asarray([vertices[v] for v in corners])) for corners in tri)
 
 
 def _stars(abstraction: Abstraction) -> dict[int, list[int]]:

@@ -11,6 +11,7 @@ automaton stage evaluates its guards over exactly these letters.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -56,3 +57,14 @@ class Abstraction(ContentEquality):
         """The (3, 2) vertex coordinates of ``triangle``, counter-clockwise."""
         corners: FloatArray = self.vertices[self.triangles[triangle]]
         return corners
+
+
+def triangle_inradius(corners: FloatArray) -> float:
+    """The radius of the largest disk inside the triangle with these (3, 2) corners: twice its
+    area over its perimeter (0 for a degenerate one)."""
+    (ax, ay), (bx, by), (cx, cy) = corners.tolist()
+    area2 = abs((bx - ax) * (cy - ay) - (by - ay) * (cx - ax))
+    perimeter = (
+        math.hypot(bx - ax, by - ay) + math.hypot(cx - bx, cy - by) + math.hypot(ax - cx, ay - cy)
+    )
+    return area2 / perimeter if perimeter > 0.0 else 0.0

@@ -19,7 +19,7 @@ from dataclasses import replace
 import numpy as np
 
 from tlmpc.abstraction.corner import RING_FRACTION, ring_corners, ring_inradius
-from tlmpc.abstraction.model import Abstraction
+from tlmpc.abstraction.model import Abstraction, triangle_inradius
 from tlmpc.base.errors import TlmpcError
 from tlmpc.control.channel import LABEL_INSET, Guide
 from tlmpc.control.clearance import exposed_vertices
@@ -27,7 +27,6 @@ from tlmpc.mission.model import Mission
 from tlmpc.planning.mission import Planned, replan
 from tlmpc.planning.product import SLOTS, move_lengths
 from tlmpc.planning.timing import MoveTimes, move_key
-from tlmpc.runtime.closed_loop import inradius
 
 #: A corner is cut when the path turns by more than this sine there (about 6°).
 TURN = 0.1
@@ -67,7 +66,7 @@ def corner_candidate(mission: Mission, planned: Planned) -> Planned | None:
         return None
     clearance = label_clearance(mission.robot.max_speed)
     route = {*planned.witness.prefix, *planned.witness.cycle}
-    floor = min(inradius(mesh.corners(t)) for t in route)
+    floor = min(triangle_inradius(mesh.corners(t)) for t in route)
     refined, parents = ring_corners(mesh, ring_counts(mesh, corners, clearance, floor), start)
     if refined is mesh:
         return None

@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from tlmpc.abstraction.model import FloatArray
+from tlmpc.abstraction.model import triangle_inradius
 from tlmpc.base.errors import UsageError, error
 from tlmpc.runtime.disturbance import Disturbance
 from tlmpc.runtime.executor import Executor, RunPlan
@@ -53,17 +53,9 @@ class ClosedLoopRun:
     completed: bool  # the requested laps / dwell were reached (else the trace ends open)
 
 
-def inradius(vertices: FloatArray) -> float:
-    """Radius of the largest disk inside a triangle (2 area / perimeter)."""
-    a, b, c = vertices
-    area = 0.5 * abs(float((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])))
-    perimeter = sum(float(np.linalg.norm(vertices[i] - vertices[(i + 1) % 3])) for i in range(3))
-    return 2.0 * area / perimeter
-
-
 def default_dt(plan: RunPlan, speed: float) -> float:
     """:data:`DT_FRACTION` of the plan's smallest inradius over the largest speed."""
-    return DT_FRACTION * min(inradius(step.vertices) for step in plan.steps) / speed
+    return DT_FRACTION * min(triangle_inradius(step.vertices) for step in plan.steps) / speed
 
 
 def _dwell(plan: RunPlan) -> float:

@@ -33,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
+from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray, triangle_inradius
 from tlmpc.base.errors import UsageError, error
 from tlmpc.control.geometry import triangle_geometry
 from tlmpc.control.model import StepController
@@ -249,13 +249,8 @@ class ReactiveExecutor:
     def dwell_time(self) -> float:
         """How long the robot dwells before a stutter step or before leaving through the edge
         it stands on: the time to cross its triangle's inscribed circle at full speed."""
-        geometry = triangle_geometry(self.abstraction.corners(self.triangle))
-        sides = [
-            float(np.linalg.norm(geometry.vertices[i] - geometry.vertices[(i + 1) % 3]))
-            for i in range(3)
-        ]
-        inradius = 2.0 * _area(geometry.vertices) / sum(sides)
-        return inradius / self.mission.robot.max_speed
+        corners = self.abstraction.corners(self.triangle)
+        return triangle_inradius(corners) / self.mission.robot.max_speed
 
     def _take(self, node: int, sensors: dict[str, bool], kind: str) -> None:
         self.node = node
@@ -556,11 +551,6 @@ def _face_graph(
         inside = np.array(sorted(entry), dtype=np.int64)
         portals[(face, goal)] = (inside, np.array([entry[t] for t in inside.tolist()]))
     return graph, portals
-
-
-def _area(corners: FloatArray) -> float:
-    (ax, ay), (bx, by), (cx, cy) = corners.tolist()
-    return 0.5 * abs(float((bx - ax) * (cy - ay) - (by - ay) * (cx - ax)))
 
 
 def executor_summary(executor: ReactiveExecutor) -> dict[str, Any]:
