@@ -6,8 +6,9 @@ the wall, both scale with the edge's length), so on a coarse fan of long edges a
 the robot swings wide of it.  Cutting every triangle ``(c, a, b)`` about the corner ``c`` at
 the fraction ``f`` of its two edges from ``c`` (points ``p_a`` on ``c a``, ``p_b`` on ``c b``)
 into the triangle ``(c, p_a, p_b)``, ``t`` shrunk by ``f`` about ``c``, and the trapezoid
-``(p_a, a, b, p_b)`` cut along ``p_a b`` leaves a fan of edges ``f`` times as long about the
-corner; ``rings`` cuts nest (each in the triangles the cut before left about ``c``).
+``(p_a, a, b, p_b)``, cut along whichever diagonal leaves its thinner piece the fatter, leaves a
+fan of edges ``f`` times as long about the corner; rings nest (each cut in the triangles the
+cut before left about ``c``).
 
 The mesh stays conforming: an edge through ``c`` is cut at one point shared by the triangles
 on both sides, and every edge away from ``c`` is kept whole.  Every piece keeps its
@@ -97,7 +98,9 @@ def ring_corners(
     return refined, parents
 
 
-def ring_inradius(abstraction: Abstraction, corner: int, rings: int) -> float:
+def ring_inradius(
+    abstraction: Abstraction, corner: int, rings: int, *, fraction: float = RING_FRACTION
+) -> float:
     """The smallest inradius of the triangles about ``corner`` once ``rings`` rings are cut
     about it (as :func:`ring_corners` cuts them: the same cut on a copy of its star alone)."""
     star = np.flatnonzero((abstraction.triangles == corner).any(axis=1)).tolist()
@@ -111,7 +114,7 @@ def ring_inradius(abstraction: Abstraction, corner: int, rings: int) -> float:
     components = [0] * len(star)
     about = list(range(len(star)))
     for _ in range(rings):
-        _cut_ring(vertices, tri, nbr, letters, components, at[corner], about, RING_FRACTION)
+        _cut_ring(vertices, tri, nbr, letters, components, at[corner], about, fraction)
     return min(triangle_inradius(np.asarray([vertices[v] for v in corners])) for corners in tri)
 
 
@@ -163,7 +166,7 @@ def _cut_ring(
     # along p_a b into (p_a, a, b) and (p_a, b, p_b), or along a p_b into (p_a, a, p_b) and
     # (a, b, p_b).  Either way one piece holds the edge (p_a, a) ("a side"), one (b, p_b)
     # ("b side"), one the cut (p_a, p_b) and one the outer edge (a, b).
-    along_pa_b = {t: _fatter(vertices, c, shapes[t][0], shapes[t][1], point_on) for t in star}
+    along_pa_b = {t: _fatter(vertices, shapes[t][0], shapes[t][1], point_on) for t in star}
     a_side = {t: first[t] for t in star}
     b_side = {t: first[t] + 1 for t in star}
     for t in star:
@@ -192,7 +195,7 @@ def _cut_ring(
             row[row.index(t)] = two if not along_pa_b[t] else one
 
 
-def _fatter(vertices: list[FloatArray], c: int, a: int, b: int, point_on: dict[int, int]) -> bool:
+def _fatter(vertices: list[FloatArray], a: int, b: int, point_on: dict[int, int]) -> bool:
     """Whether the trapezoid (p_a, a, b, p_b) of the triangle (c, a, b) is better cut along
     p_a b than along a p_b: its thinner piece is the fatter (height over longest edge)."""
     p_a, p_b = vertices[point_on[a]], vertices[point_on[b]]

@@ -7,7 +7,7 @@ needs as much), so on a fan of long edges the robot swings wide of the corner.  
 kept plan's path is pulled, every corner it bends round is cut into rings of smaller
 triangles (:func:`tlmpc.abstraction.corner.ring_corners`), and the mission is planned
 again on that mesh: one more candidate for :func:`tlmpc.pipeline.shortest.plan_shortest`,
-kept only when its path is shorter and its trajectory not slower.
+kept when its trajectory is shorter and it is not slower than the midpoint plan.
 """
 
 from __future__ import annotations
@@ -40,9 +40,11 @@ CORRIDOR = 1.5
 
 
 def corner_candidate(mission: Mission, planned: Planned) -> Planned | None:
-    """``planned`` planned again (moves weighing their midpoint lengths) on its mesh cut into
-    rings about the corners its path bends round; None when it bends round none or the plan
-    fails."""
+    """``planned`` planned again on its mesh cut into rings about the corners its path bends
+    round (:func:`ring_counts` of them each), the moves in its own triangles' pieces weighing
+    their midpoint lengths and the others :data:`CORRIDOR` times theirs (so the plan keeps to
+    its channel, now cut finer); None when it bends round no corner that takes a ring, or
+    the plan fails."""
     from tlmpc.control.channel import label_clearance
     from tlmpc.control.follow import path_guides
     from tlmpc.control.synthesize import plan_steps
@@ -53,18 +55,11 @@ def corner_candidate(mission: Mission, planned: Planned) -> Planned | None:
         steps, loop_start = plan_steps(mesh, planned.witness)
     except TlmpcError:
         return None
-    guides = path_guides(
-        mesh,
-        steps,
-        loop_start,
-        start,
-        passages=True,
-        clearance=label_clearance(mission.robot.max_speed),
-    )
+    clearance = label_clearance(mission.robot.max_speed)
+    guides = path_guides(mesh, steps, loop_start, start, passages=True, clearance=clearance)
     corners = bend_corners(mesh, [(s.triangle, s.exit_edge) for s in steps], guides, loop_start)
     if not corners:
         return None
-    clearance = label_clearance(mission.robot.max_speed)
     route = {*planned.witness.prefix, *planned.witness.cycle}
     floor = min(triangle_inradius(mesh.corners(t)) for t in route)
     refined, parents = ring_corners(mesh, ring_counts(mesh, corners, clearance, floor), start)

@@ -28,13 +28,18 @@ for the ``time`` metric (:mod:`tlmpc.pipeline.mintime`), the planner iterates:
 Before the re-plans, an automaton with four acceptance sets or more is planned again awaiting
 the sets in other orders (:func:`order_candidates`), and a plan touching a region and turning
 back is made (:mod:`tlmpc.pipeline.touches`); each is kept on the re-plans' terms, by the
-same check (:meth:`_Kept.offer`).
+same check (:meth:`_Kept.offer`).  After them the kept plan is planned again on its mesh cut
+into rings where its path bends round a corner (:mod:`tlmpc.pipeline.corners`), re-planned
+there the same way (:class:`_Rounds`), and the shortest path pulled there is kept when its
+**trajectory** is shorter, its path no longer and its exact time no longer than the midpoint
+plan's (:meth:`_Kept.offer_trajectory`): the cut is for the fields to follow the path closer,
+which the path's length does not see.
 
 Every round is deterministic (operations are counted, no clock is read).  What is promised
 (docs/planning.md): the kept plan's path is never longer, and its trajectory never slower,
 than the midpoint plan's; it is not a proof that no channel has a shorter path (the moves no
 plan made keep estimates) nor that the kept one is the shortest of those pulled (a shorter
-one may be slower).
+one may be slower, and a plan cut at its corners is judged by its trajectory).
 """
 
 from __future__ import annotations
