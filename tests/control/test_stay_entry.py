@@ -154,3 +154,30 @@ def test_a_stay_is_not_asked_to_follow_its_piece() -> None:
         if index not in passages and not thin:
             expected += 1
     assert seen == [expected]
+
+
+def test_without_reach_rounds_the_stay_is_entered_at_the_nearest_inset_point() -> None:
+    """A straight corridor whose stay triangle is entered by the diagonal from (2, 1) to
+    (3, 0), the start low on the left: with the portal insets alone (no widening round) the
+    path runs straight to the diagonal's inset end nearest the start, (2.03, 0.97)."""
+    from unittest import mock
+
+    planned = strip_plan(
+        [(0.0, 1.0), (1.0, 1.0), (2.0, 1.0), (3.0, 1.0)],
+        [(0.0, 0.0), (1.0, 0.0), (2.0, 0.0), (3.0, 0.0)],
+    )
+    assert planned is not None
+    abstraction, _witness, triangles = planned
+    steps = _steps(abstraction, len(triangles))
+    with mock.patch.object(channel, "REACH_ROUNDS", 0):
+        pieces = channel.channel_pieces(steps, None, (0.2, 0.2))
+    inset = channel.PORTAL_INSET
+    assert pieces[-1].entry == pytest.approx((2.0 + inset, 1.0 - inset), abs=1e-12)
+
+
+def test_the_last_corner_is_the_last_bend_before_the_end() -> None:
+    """A polyline bending twice: its last corner is the second bend; a straight one has none
+    but the start."""
+    zigzag = [(1.0, 0.0), (1.0, 1.0), (2.0, 1.0), (3.0, 1.0)]
+    assert channel._last_corner((0.0, 0.0), zigzag) == (1.0, 1.0)
+    assert channel._last_corner((0.0, 0.0), [(1.0, 1.0), (2.0, 2.0)]) == (0.0, 0.0)

@@ -263,3 +263,36 @@ def test_ring_counts_keep_the_clearance_and_the_plans_smallest_triangle(
         if count < min(label_most, corners.RINGS):
             assert smallest_about(count + 1) < floor * (1 + 1e-9)
     assert (cut_some > 0) is cuts
+
+
+def test_a_laps_trajectory_length_weighs_the_lap_by_beta() -> None:
+    """step_times' trajectory length of a lasso: the trace's length (shapely) until the
+    prefix's last crossing plus beta times the length of the second pass of the cycle."""
+    import yaml
+
+    from tlmpc.control import synthesize
+    from tlmpc.pipeline.mintime import step_times
+    from tlmpc.simulate import simulate
+
+    document = yaml.safe_load((ROOT / "specs" / "patrol.yaml").read_text())
+    document["options"] = {"cost": "length", "beta": 0.5}
+    result = compile_mission("patrol.yaml", text=yaml.safe_dump(document), until="plan")
+    c = result.compilation
+    mission, witness = c.get(MISSION), c.get(WITNESS)
+    mesh = _planned(result).abstraction
+    controllers = synthesize(mesh, witness, mission.robot)
+    trace = simulate(mesh, controllers, mission)
+    found = step_times(mesh, controllers, trace, witness.beta)
+    points = np.asarray(trace.points)
+    steps = len(controllers.steps)
+    loop = controllers.loop_start
+    assert loop is not None
+    assert loop > 0
+
+    def along(first: int, last: int) -> float:
+        return float(shapely.LineString(points[first : last + 1]).length) if last > first else 0.0
+
+    crossings = trace.crossings  # one per moving step: the steps, then the cycle again
+    prefix = along(0, crossings[loop - 1])
+    lap = along(crossings[steps - 1], crossings[-1])
+    assert found.exact_length == pytest.approx(prefix + 0.5 * lap, rel=1e-9)
