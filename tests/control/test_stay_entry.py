@@ -89,18 +89,24 @@ def test_round_a_bend_the_stay_is_pulled_to_its_entry_edge_from_the_inner_corner
     assert (2.5, 0.5) in crossings  # the inner corner
 
 
-def test_the_stay_piece_runs_from_the_entry_to_the_incenter() -> None:
-    """The stay's piece starts where the path crosses the entry edge (in a straight corridor,
-    nearer the start than the edge's midpoint is: the entry edge is the diagonal from (2, 1)
-    to (3, 0), the start low on the left) and ends at the stay triangle's incenter (the stay
-    field's target)."""
+def _straight_corridor() -> list[ChannelStep]:
+    """The channel of a straight corridor (0, 0)-(3, 1) cut into six triangles, ending by
+    staying in the last: its stay triangle is entered by the diagonal from (2, 1) to (3, 0)."""
     planned = strip_plan(
         [(0.0, 1.0), (1.0, 1.0), (2.0, 1.0), (3.0, 1.0)],
         [(0.0, 0.0), (1.0, 0.0), (2.0, 0.0), (3.0, 0.0)],
     )
     assert planned is not None
     abstraction, _witness, triangles = planned
-    steps = _steps(abstraction, len(triangles))
+    return _steps(abstraction, len(triangles))
+
+
+def test_the_stay_piece_runs_from_the_entry_to_the_incenter() -> None:
+    """The stay's piece starts where the path crosses the entry edge (in a straight corridor,
+    nearer the start than the edge's midpoint is: the entry edge is the diagonal from (2, 1)
+    to (3, 0), the start low on the left) and ends at the stay triangle's incenter (the stay
+    field's target)."""
+    steps = _straight_corridor()
     pieces = channel.channel_pieces(steps, None, (0.2, 0.2))
     stay = pieces[-1]
     assert stay.entry == pieces[-2].exit
@@ -162,13 +168,7 @@ def test_without_reach_rounds_the_stay_is_entered_at_the_nearest_inset_point() -
     path runs straight to the diagonal's inset end nearest the start, (2.03, 0.97)."""
     from unittest import mock
 
-    planned = strip_plan(
-        [(0.0, 1.0), (1.0, 1.0), (2.0, 1.0), (3.0, 1.0)],
-        [(0.0, 0.0), (1.0, 0.0), (2.0, 0.0), (3.0, 0.0)],
-    )
-    assert planned is not None
-    abstraction, _witness, triangles = planned
-    steps = _steps(abstraction, len(triangles))
+    steps = _straight_corridor()
     with mock.patch.object(channel, "REACH_ROUNDS", 0):
         pieces = channel.channel_pieces(steps, None, (0.2, 0.2))
     inset = channel.PORTAL_INSET
