@@ -31,6 +31,19 @@ from tlmpc.abstraction.model import Abstraction
 TOUCH = 1e-6
 
 
+def label_boundary(abstraction: Abstraction) -> list[bool]:
+    """Per mesh vertex: is it on a label boundary (do the triangles around it not all share
+    a label)?  The candidates :func:`exposed_vertices` narrows."""
+    letters = np.repeat(abstraction.letter_of, 3)  # each corner's triangle's letter
+    count = len(abstraction.vertices)
+    lowest = np.full(count, np.iinfo(np.int64).max)
+    highest = np.full(count, -1)
+    np.minimum.at(lowest, abstraction.triangles.reshape(-1), letters)
+    np.maximum.at(highest, abstraction.triangles.reshape(-1), letters)
+    boundary: list[bool] = (lowest != highest).tolist()
+    return boundary
+
+
 def exposed_vertices(abstraction: Abstraction, candidates: Iterable[int]) -> frozenset[int]:
     """Those of ``candidates`` (mesh vertices on a label boundary) that lie on the boundary
     of a region itself (see the module doc)."""

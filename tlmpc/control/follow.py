@@ -42,7 +42,7 @@ import numpy as np
 
 from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
 from tlmpc.control.channel import ChannelStep, Guide, Point, channel_guides, channel_pieces
-from tlmpc.control.clearance import exposed_vertices
+from tlmpc.control.clearance import exposed_vertices, label_boundary
 from tlmpc.control.geometry import TriangleGeometry
 from tlmpc.control.sparse import CscMatrix, Triplets, stacked_csc
 
@@ -318,22 +318,16 @@ def path_guides(
     :mod:`tlmpc.control.channel` (``clearance``: the distance kept from a region's own
     boundary, :attr:`tlmpc.control.channel.ChannelStep.clearance`; a compile passes
     :func:`tlmpc.control.channel.label_clearance` of the robot's max_speed)."""
-    # A vertex is on a label boundary when the triangles around it do not all share a label.
-    letters = np.repeat(abstraction.letter_of, 3)  # each corner's triangle's letter
-    count = len(abstraction.vertices)
-    lowest = np.full(count, np.iinfo(np.int64).max)
-    highest = np.full(count, -1)
-    np.minimum.at(lowest, abstraction.triangles.reshape(-1), letters)
-    np.maximum.at(highest, abstraction.triangles.reshape(-1), letters)
-    boundary = (lowest != highest).tolist()
-    # ... and needs an inset only where it is a region's own boundary (tlmpc.control.clearance).
+    # A vertex on a label boundary needs an inset only where it is a region's own boundary
+    # (tlmpc.control.clearance).
     # Where the plan enters a new label in a triangle by a wall, the path still leaves it
     # through the middle of its exit edge: entering a goal by a wall, or leaving it along one,
     # the path would otherwise hug the wall (robustness is also the distance to leaving the
     # workspace; pushed past the declared disturbance, runs then left it).
     corners = [abstraction.triangles[step.triangle].tolist() for step in steps]
+    boundary = label_boundary(abstraction)
     exposed = exposed_vertices(abstraction, (v for c in corners for v in c if boundary[v]))
-    on_wall = np.zeros(count, dtype=bool)
+    on_wall = np.zeros(len(abstraction.vertices), dtype=bool)
     rows, sides = np.nonzero(abstraction.neighbors < 0)  # edge i is opposite corner i
     for shift in (1, 2):
         on_wall[abstraction.triangles[rows, (sides + shift) % 3]] = True
@@ -399,7 +393,7 @@ def bends(
         first, second = guides[before], guides[after]
         if first is None or second is None or steps[after].exit_edge is None:
             continue
-        if abs(_sine(first, second)) <= BEND:
+        if abs(turn_sine(first, second)) <= BEND:
             continue
         shared = set(abstraction.triangles[steps[before].triangle].tolist())
         for vertex in abstraction.triangles[steps[after].triangle].tolist():
@@ -517,7 +511,7 @@ def _deviation(direction: float, arc: _Arc | None) -> float:
     return min(ahead - width, _TAU - ahead)
 
 
-def _sine(first: Guide, second: Guide) -> float:
+def turn_sine(first: Guide, second: Guide) -> float:
     """The sine of the angle from the direction of ``first`` to that of ``second`` (0 when
     either piece is a point)."""
     ax, ay = first.exit[0] - first.entry[0], first.exit[1] - first.entry[1]

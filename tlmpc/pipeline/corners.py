@@ -21,8 +21,10 @@ import numpy as np
 from tlmpc.abstraction.corner import RING_FRACTION, ring_corners, ring_inradius
 from tlmpc.abstraction.model import Abstraction, triangle_inradius
 from tlmpc.base.errors import TlmpcError
-from tlmpc.control.channel import LABEL_INSET, Guide
-from tlmpc.control.clearance import exposed_vertices
+from tlmpc.control.channel import LABEL_INSET, Guide, label_clearance
+from tlmpc.control.clearance import exposed_vertices, label_boundary
+from tlmpc.control.follow import path_guides, turn_sine
+from tlmpc.control.synthesize import plan_steps
 from tlmpc.mission.model import Mission
 from tlmpc.planning.mission import Planned, replan
 from tlmpc.planning.product import SLOTS, move_lengths
@@ -45,10 +47,6 @@ def corner_candidate(mission: Mission, planned: Planned) -> Planned | None:
     their midpoint lengths and the others :data:`CORRIDOR` times theirs (so the plan keeps to
     its channel, now cut finer); None when it bends round no corner that takes a ring, or
     the plan fails."""
-    from tlmpc.control.channel import label_clearance
-    from tlmpc.control.follow import path_guides
-    from tlmpc.control.synthesize import plan_steps
-
     mesh = planned.abstraction
     start = mission.robot.start
     try:
@@ -100,11 +98,8 @@ def ring_counts(
       with it).
 
     A corner where not even one ring fits is left out."""
-    letters = mesh.letter_of
-    boundary = [
-        v for v in corners if len(set(letters[np.nonzero(mesh.triangles == v)[0]].tolist())) > 1
-    ]
-    exposed = exposed_vertices(mesh, boundary)
+    boundary = label_boundary(mesh)
+    exposed = exposed_vertices(mesh, (v for v in corners if boundary[v]))
     counts: dict[int, int] = {}
     for v in dict.fromkeys(corners):
         kept = math.inf
@@ -143,12 +138,7 @@ def bend_corners(
         first, second = guides[before], guides[after]
         if edge is None or first is None or second is None:
             continue
-        ax, ay = first.exit[0] - first.entry[0], first.exit[1] - first.entry[1]
-        bx, by = second.exit[0] - second.entry[0], second.exit[1] - second.entry[1]
-        norms = math.hypot(ax, ay) * math.hypot(bx, by)
-        if norms == 0.0:
-            continue
-        turn = (ax * by - ay * bx) / norms
+        turn = turn_sine(first, second)  # (0 where either piece is a point)
         if abs(turn) <= TURN:
             continue
         corners = mesh.triangles[triangle].tolist()

@@ -144,15 +144,23 @@ def plan_minimum_time(
     return replace(chosen, witness=replace(chosen.witness, metric="time", stats=stats))
 
 
-def measure(mission: Mission, planned: Planned) -> Measured:
-    """Synthesise ``planned``'s controllers, simulate them exactly and time every step."""
+def simulated(
+    mission: Mission, planned: Planned, *, max_gap: float | None = None
+) -> tuple[Controllers, Trace]:
+    """``planned``'s controllers, synthesised, and their exact trajectory (samples at most
+    ``max_gap`` apart in time when given: :func:`tlmpc.simulate.simulate`)."""
     from tlmpc.control import synthesize
     from tlmpc.simulate import simulate
 
     controllers = synthesize(
         planned.abstraction, planned.witness, mission.robot, source=mission.source
     )
-    trace = simulate(planned.abstraction, controllers, mission)
+    return controllers, simulate(planned.abstraction, controllers, mission, max_gap=max_gap)
+
+
+def measure(mission: Mission, planned: Planned) -> Measured:
+    """Synthesise ``planned``'s controllers, simulate them exactly and time every step."""
+    controllers, trace = simulated(mission, planned)
     found = step_times(planned.abstraction, controllers, trace, planned.witness.beta)
     if not bounded_operators(mission.formula):
         return found

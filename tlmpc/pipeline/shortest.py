@@ -379,8 +379,6 @@ def tour_order(planned: Planned) -> tuple[int, ...] | None:
     and the distance between two sets the shortest walk between their triangles from
     centroid to centroid (one multi-source search per set); None past
     :data:`MAX_TOUR_SETS` sets."""
-    import numpy as np
-
     from tlmpc.automata.degeneralize import acceptance_orders
     from tlmpc.automata.guards import guard_holds
     from tlmpc.planning.search import Graph, distances
@@ -435,19 +433,15 @@ def _run(mission: Mission, planned: Planned, *, verified: bool) -> tuple[float, 
     controllers or simulation fail or (``verified``) its trace does not satisfy the task
     (the self-check's verifier: a plan on a split mesh is checked before it can replace one
     made on the mesh as built)."""
-    from tlmpc.control import synthesize
-    from tlmpc.pipeline.mintime import step_times
-    from tlmpc.simulate import simulate, trace_to_json
+    from tlmpc.pipeline.mintime import simulated, step_times
+    from tlmpc.simulate import trace_to_json
     from tlmpc.verify import verdict_to_json, verify_document
 
     vertices = planned.abstraction.vertices
     extent = float(np.hypot(*(vertices.max(axis=0) - vertices.min(axis=0))))
     gap = extent / LENGTH_SAMPLES / mission.robot.max_speed
     try:
-        controllers = synthesize(
-            planned.abstraction, planned.witness, mission.robot, source=mission.source
-        )
-        trace = simulate(planned.abstraction, controllers, mission, max_gap=gap)
+        controllers, trace = simulated(mission, planned, max_gap=gap)
     except TlmpcError:
         return math.inf, math.inf
     if verified:
