@@ -22,13 +22,20 @@ def _mesh(name: str) -> Abstraction:
     return build_abstraction(load_mission(SPECS / name))
 
 
-def _by_definition(abstraction: Abstraction, candidates: list[int]) -> frozenset[int]:
+def _by_definition(
+    abstraction: Abstraction, candidates: list[int], relevant: set[str] | None = None
+) -> frozenset[int]:
     """Each candidate whose distance to the boundary of a region labelling a triangle around
-    a candidate is within TOUCH of the mesh's extent (shapely's distance, one point at a
-    time)."""
+    a candidate (one of ``relevant``) is within TOUCH of the mesh's extent (shapely's
+    distance, one point at a time)."""
     extent = float(np.ptp(abstraction.vertices, axis=0).max())
     around = np.flatnonzero(np.isin(abstraction.triangles, candidates).any(axis=1))
-    names = {n for t in around.tolist() for n in abstraction.labels(t)}
+    names = {
+        n
+        for t in around.tolist()
+        for n in abstraction.labels(t)
+        if relevant is None or n in relevant
+    }
     outlines = shapely.MultiLineString(
         [
             shapely.Polygon(abstraction.regions[n]).exterior
@@ -37,6 +44,8 @@ def _by_definition(abstraction: Abstraction, candidates: list[int]) -> frozenset
         ]
     )
     found = set()
+    if not names:
+        return frozenset()
     for vertex in candidates:
         point = shapely.Point(abstraction.vertices[vertex])
         if shapely.distance(point, outlines) <= TOUCH * extent:
@@ -67,3 +76,18 @@ def test_any_vertices_of_example1(picks: list[int]) -> None:
     mesh = _mesh("example1.yaml")
     candidates = sorted({p % len(mesh.vertices) for p in picks})
     assert exposed_vertices(mesh, candidates) == _by_definition(mesh, candidates)
+
+
+@settings(max_examples=max(10, settings().max_examples // 5), deadline=None)
+@given(st.lists(st.integers(0, 10**6), min_size=1, max_size=60), st.sets(st.integers(0, 3)))
+def test_only_the_regions_a_task_names_expose_their_boundary(
+    picks: list[int], named: set[int]
+) -> None:
+    """Example 1's four regions, of which a random subset is named: a vertex on the boundary
+    of an unnamed region only is not exposed."""
+    mesh = _mesh("example1.yaml")
+    candidates = sorted({p % len(mesh.vertices) for p in picks})
+    relevant = {f"p{k + 1}" for k in named}
+    assert exposed_vertices(mesh, candidates, relevant) == _by_definition(
+        mesh, candidates, relevant
+    )

@@ -114,7 +114,7 @@ def test_where_the_solver_misses_a_sliver_the_best_push_field_holds(
     # split where sharing turns a field off the path give it a velocity of its own, which the
     # solver then meets: keep the shared run, so the fallback is what is tested here.
     monkeypatch.setattr("tlmpc.control.follow.DEFLECTION", math.inf)
-    mission = _needle("left", "patrol b and c", (2.772895461972917, 0.08322334781304659))
+    mission = _needle("left", "patrol b and c", (6.206914919437319, 0.3022861080732805))
     mission["regions"]["b"] = SLIVER
     compiled = tlmpc.compile(mission, until="verify")
     assert compiled.summary["verdict"]["satisfied"] is True

@@ -33,14 +33,18 @@ def _without_timings(document: Any) -> Any:
     return document
 
 
-# (not the missions whose plan refines the mesh where its path touches a region, Example 6
-# and reach-avoid: their abstraction.json is the plan stage's refined mesh; the deadline
-# mission has reach-avoid's map and holes)
-@pytest.mark.parametrize("spec", ["example1.yaml", "patrol.yaml", "deadline.yaml"])
+#: The plan stage's own refinements of the mesh: then abstraction.json is its mesh, which
+#: the abstraction stage alone does not make, and the plan stage alone plans on that mesh
+#: (not on the one it refined): both are left out, the later stages compared.
+REFINED = ("split_for_u_turns", "split_for_touches", "rings_at_corners", "corridor_refinements")
+
+
+@pytest.mark.parametrize("spec", ["example1.yaml", "example8.yaml", "patrol.yaml", "deadline.yaml"])
 def test_every_stage_reproduces_its_artifacts_from_its_inputs(tmp_path: Path, spec: str) -> None:
     whole = compile_mission(ROOT / "specs" / spec, until="verify")
     write_artifacts(tmp_path, whole.artifacts)
     mission = whole.compilation.get(MISSION)
+    refined = any(key in whole.artifacts["abstraction.json"]["stats"] for key in REFINED)
     # the verify stage samples a trace again when that makes its certificate hold (the
     # deadline spec's): the simulate stage's own trace.json is the one it wrote before
     simulated = compile_mission(ROOT / "specs" / spec, until="simulate").artifacts
@@ -48,6 +52,14 @@ def test_every_stage_reproduces_its_artifacts_from_its_inputs(tmp_path: Path, sp
         if not stage.requires or stage.name == "plot" or world_of(mission) not in stage.worlds:
             continue
         alone = run_stage_from_artifacts(stage.name, tmp_path)
+        if stage.name == "abstraction" and refined:
+            assert (
+                alone.artifacts["abstraction.json"]["stats"]["triangles"]
+                < (whole.artifacts["abstraction.json"]["stats"]["triangles"])
+            )
+            continue
+        if stage.name == "plan" and refined:
+            continue
         assert alone.artifacts, stage.name
         wrote = simulated if stage.name == "simulate" else whole.artifacts
         for name, document in alone.artifacts.items():

@@ -296,3 +296,44 @@ def test_a_laps_trajectory_length_weighs_the_lap_by_beta() -> None:
     prefix = along(0, crossings[loop - 1])
     lap = along(crossings[steps - 1], crossings[-1])
     assert found.exact_length == pytest.approx(prefix + 0.5 * lap, rel=1e-9)
+
+
+def test_example_7_keeps_a_shorter_trajectory_on_its_corridor_meshed_finer() -> None:
+    """Example 7's mesh is a few large triangles: the corridor candidate meshes the kept
+    plan's corridor finer, is kept, its trace is shorter until the task is met than with the
+    ring candidate alone, it verifies, and it is not slower than the midpoint plan."""
+    path = str(ROOT / "specs" / "example7.yaml")
+    result = compile_mission(path)
+    original = corners.corner_candidate
+
+    def rings_only(mission: Any, planned: Planned, *, refine: bool = False) -> Planned | None:
+        return None if refine else original(mission, planned)
+
+    with mock.patch.object(shortest, "corner_candidate", side_effect=rings_only):
+        plain = compile_mission(path)
+    stats = result.compilation.get(WITNESS).stats
+    assert "corridor_time" in stats
+    assert result.artifacts["abstraction.json"]["stats"]["corridor_refinements"] > 0
+    assert "corridor_refinements" not in plain.artifacts["abstraction.json"]["stats"]
+
+    def goals(compiled: CompileResult) -> list[str]:
+        # r2, then r1, then r3, r4 and r5 in the order the trace first enters them
+        mission = compiled.compilation.get(MISSION)
+        shapes = {r.name: shapely.Polygon(r.polygon) for r in mission.regions}
+        points = np.asarray(compiled.artifacts["trace.json"]["points"], dtype=np.float64)
+        entered = {
+            name: next(
+                k for k, p in enumerate(points[:, 1:]) if shapes[name].covers(shapely.Point(p))
+            )
+            for name in ("r3", "r4", "r5")
+        }
+        return ["r2", "r1", *sorted(entered, key=entered.__getitem__)]
+
+    assert _length_until_last_goal(result, goals(result)) < 0.98 * _length_until_last_goal(
+        plain, goals(plain)
+    )
+    assert result.summary()["verdict"]["satisfied"] is True
+    with mock.patch.object(shortest, "plan_shortest", side_effect=lambda _m, p: p):
+        first = compile_mission(path)
+    mission = result.compilation.get(MISSION)
+    assert stats["corridor_time"] <= measure(mission, _planned(first)).exact_time

@@ -453,7 +453,6 @@ def test_a_round_that_meets_the_bounds_is_preferred_to_a_faster_one(
     compilation = result.compilation
     mission, mesh = compilation.get(MISSION), compilation.get(ABSTRACTION)
     rounds = iter([(10.0, False), (12.0, True), (11.0, True), (9.0, False)])
-    base = compilation.get(WITNESS).prefix
     marks = iter(range(1, 10))
 
     def fake_measure(_: Mission, planned: Any) -> mintime.Measured:
@@ -464,7 +463,7 @@ def test_a_round_that_meets_the_bounds_is_preferred_to_a_faster_one(
         mark = next(marks)
         if mark == 3:  # the third re-plan repeats the second plan
             mark = 2
-        first = planned.witness.prefix[: len(base)]
+        first = tuple(t for t in planned.witness.prefix if t >= 0)
         # a plan of its own: the first plan's prefix and a mark in its shape
         witness = dataclasses.replace(planned.witness, prefix=(*first, -mark), stats={"mark": mark})
         return dataclasses.replace(planned, witness=witness)

@@ -191,7 +191,9 @@ def test_a_push_past_the_goal_replans_from_the_tracked_automaton_state() -> None
     dt = default_dt(executor.plan, 1.0)
     run = run_closed_loop(executor, _kick(0.0, dt, target), bound=0.0, dt=dt)
     kinds = [r.kind for r in run.recoveries]
-    assert kinds == ["replan"]
+    # (the push crosses several plan triangles past ``a`` in one sample: one re-plan each)
+    assert kinds
+    assert set(kinds) == {"replan"}
     assert run.progress.visits["a"] >= 1
     verdict = verify_document(run.trace)
     assert verdict.satisfied, verdict.violations
@@ -206,7 +208,9 @@ def test_a_robot_found_past_the_goal_after_losing_track_replans_instead_of_reent
     steps = executor.plan.steps
     first_a = next(i for i, s in enumerate(steps) if "a" in labels(s.triangle))
     before = {s.triangle for s in steps[: first_a + 1]}
-    after = next(s for s in steps[first_a + 1 :] if s.triangle not in before)
+    after = next(
+        s for s in steps[first_a + 1 :] if s.triangle not in before and not labels(s.triangle)
+    )
     executor.command(executor.mission.robot.start, 0.0)
     executor.command((-5.0, -5.0), 0.1)
     lost = executor.progress

@@ -14,7 +14,9 @@ the body's clearance.
 Each portal is first shrunk toward its midpoint by :data:`PORTAL_INSET` of its length at both
 ends: an affine field's vertex conditions push every vertex of a portal across it, so a flow
 line can only cross a portal strictly between its ends, and a little away from them the
-controller has room to follow the path (see docs/control.md).
+controller has room to follow the path (see docs/control.md).  The insets are then widened,
+and the string pulled again, where a piece could not be a flow line (:func:`_reachable`) or
+passes a region's own corner closer than its clearance (:func:`_cleared`).
 """
 
 from __future__ import annotations
@@ -230,6 +232,7 @@ def channel_pieces(
             _reachable(steps[i], insets[k], start if k == 0 else crossings[k - 1], crossings[k])
             for k, i in enumerate(moving)
         ]
+        wider = _cleared(steps, moving, wider, start, crossings)
         if wider == insets:
             break
         insets = wider
@@ -253,8 +256,10 @@ def channel_pieces(
     return guides
 
 
-#: Rounds of widening the exit insets where the path, as pulled, could not be followed.
-REACH_ROUNDS = 3
+#: Rounds of widening the exit insets where the path, as pulled, could not be followed, or
+#: passes a region's corner closer than its clearance (:func:`_cleared`; three rounds left a
+#: visit across a corner a few per cent short of it).
+REACH_ROUNDS = 6
 #: The inset asked where a piece heads toward a kept facet's line at the sine σ of its angle
 #: to it: this times σ.
 REACH_GAIN = 0.5
@@ -393,3 +398,84 @@ def _reachable(
         if REACH_GAIN * sigma > widened[side]:
             widened[side] = min(REACH_CAP, REACH_GAIN * sigma)
     return (widened[0], widened[1])
+
+
+#: A widening for the clearance asks this much more than the shortfall's ratio (the path moves
+#: when the insets do; without it the rounds end a hair short of the clearance).
+CLEARANCE_SLACK = 1.01
+
+
+def _cleared(
+    steps: Sequence[ChannelStep],
+    moving: Sequence[int],
+    insets: Sequence[tuple[float, float]],
+    start: Point,
+    crossings: Sequence[Point],
+) -> list[tuple[float, float]]:
+    """``insets`` widened where a piece passes a region's own corner (an exposed end of its
+    entry or exit portal) closer than its step's clearance, or, entering a region and leaving
+    it across one corner, goes less than that deep: the piece's ends on portals through that
+    corner are kept from it by the shortfall's ratio (times :data:`CLEARANCE_SLACK`) times
+    where they cross now, at most :data:`REACH_CAP` of the portal."""
+    widened = [list(pair) for pair in insets]
+    for k, i in enumerate(moving):
+        step = steps[i]
+        if step.through is not None or step.exit_edge is None:
+            continue
+        entry = start if k == 0 else crossings[k - 1]
+        exit_ = crossings[k]
+        e = step.exit_edge
+        before = steps[moving[k - 1]] if k > 0 else None
+        # the entry portal's ends (the step before's exit portal)
+        entry_ends: tuple[Point, ...] = ()
+        if before is not None and before.through is None and before.exit_edge is not None:
+            ends = exit_portal(before)
+            entry_ends = (ends.left, ends.right)
+        for side, corner in enumerate(((e + 2) % 3, (e + 1) % 3)):
+            if not step.labelled[corner]:
+                continue
+            vertex = step.corners[corner]
+            reached = _segment_distance(vertex, entry, exit_)
+            # a region entered in its corner triangle and left at once: the corner both
+            # portals share
+            if step.entered and all(step.labelled) and vertex in entry_ends:
+                reached = min(reached, _tip_depth(step, corner, entry, exit_))
+            if not 0.0 < reached < step.clearance:
+                continue
+            # the piece's ends move away from the corner along their portals by the
+            # shortfall's ratio (the distance and the depth grow in proportion)
+            factor = CLEARANCE_SLACK * step.clearance / reached
+            out = exit_portal(step)
+            along = math.dist(vertex, exit_) / math.dist(out.left, out.right)
+            widened[k][side] = min(REACH_CAP, max(widened[k][side], along * factor))
+            if vertex in entry_ends:
+                other = entry_ends.index(vertex)
+                along = math.dist(vertex, entry) / math.dist(*entry_ends)
+                widened[k - 1][other] = min(REACH_CAP, max(widened[k - 1][other], along * factor))
+    return [(pair[0], pair[1]) for pair in widened]
+
+
+def _segment_distance(point: Point, a: Point, b: Point) -> float:
+    """The distance from ``point`` to the segment a b."""
+    return math.dist(point, _nearest_on(Portal(a, b), point))
+
+
+def _tip_depth(step: ChannelStep, corner: int, entry: Point, exit_: Point) -> float:
+    """How deep the piece entry -> exit goes into the corner of its triangle at ``corner``
+    between the triangle's two edges there: the largest, along the piece, of the smaller
+    distance to the two edges' lines (each is linear along it)."""
+    vertex = step.corners[corner]
+    others = [step.corners[(corner + 1) % 3], step.corners[(corner + 2) % 3]]
+
+    def line_distance(point: Point, towards: Point) -> float:
+        length = math.dist(vertex, towards)
+        return abs(_cross(vertex, towards, point)) / length if length > 0.0 else 0.0
+
+    # the entry lies on one of the edges at the corner, the exit on the other (else no tip)
+    on_entry = min(others, key=lambda w: line_distance(entry, w))
+    on_exit = others[1] if on_entry is others[0] else others[0]
+    far_exit = line_distance(exit_, on_entry)
+    far_entry = line_distance(entry, on_exit)
+    if far_exit + far_entry == 0.0:
+        return 0.0
+    return far_exit * far_entry / (far_exit + far_entry)

@@ -19,7 +19,7 @@ too, which only keeps an inset that was not needed).
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Collection, Iterable
 
 import numpy as np
 import shapely
@@ -44,16 +44,29 @@ def label_boundary(abstraction: Abstraction) -> list[bool]:
     return boundary
 
 
-def exposed_vertices(abstraction: Abstraction, candidates: Iterable[int]) -> frozenset[int]:
+def exposed_vertices(
+    abstraction: Abstraction,
+    candidates: Iterable[int],
+    relevant: Collection[str] | None = None,
+) -> frozenset[int]:
     """Those of ``candidates`` (mesh vertices on a label boundary) that lie on the boundary
-    of a region itself (see the module doc)."""
+    of a region itself (see the module doc); with ``relevant``, of one of those regions only
+    (the task's propositions: the boundary of a region the task does not name never decides
+    the verdict)."""
     chosen = np.asarray(sorted(set(candidates)), dtype=np.int64)
     if len(chosen) == 0 or not abstraction.regions:
         return frozenset()
     # the regions that label a triangle around a candidate: only their edges are measured
     around = np.isin(abstraction.triangles, chosen).any(axis=1)
     letters = np.unique(abstraction.letter_of[around]).tolist()
-    names = sorted({name for k in letters for name in abstraction.letters[k]})
+    names = sorted(
+        {
+            name
+            for k in letters
+            for name in abstraction.letters[k]
+            if relevant is None or name in relevant
+        }
+    )
     rings = [
         np.asarray(abstraction.regions[name], dtype=np.float64).reshape(-1, 2)
         for name in names

@@ -34,7 +34,7 @@ and the re-check after solving is the same.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -312,6 +312,7 @@ def path_guides(
     *,
     clearance: float,
     passages: bool = False,
+    relevant: Collection[str] | None = None,
 ) -> list[Guide | None]:
     """The channel's shortest path, one straight piece per step (None for a vertex
     passage, unless ``passages``: then its piece to the corner), with the portal insets of
@@ -326,7 +327,9 @@ def path_guides(
     # workspace; pushed past the declared disturbance, runs then left it).
     corners = [abstraction.triangles[step.triangle].tolist() for step in steps]
     boundary = label_boundary(abstraction)
-    exposed = exposed_vertices(abstraction, (v for c in corners for v in c if boundary[v]))
+    exposed = exposed_vertices(
+        abstraction, (v for c in corners for v in c if boundary[v]), relevant
+    )
     on_wall = np.zeros(len(abstraction.vertices), dtype=bool)
     rows, sides = np.nonzero(abstraction.neighbors < 0)  # edge i is opposite corner i
     for shift in (1, 2):

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Mapping
+from collections.abc import Collection, Mapping
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -652,13 +652,16 @@ def synthesize(
     *,
     source: str | None = None,
     follow: bool = True,
+    relevant: Collection[str] | None = None,
 ) -> Controllers:
     """One affine field per plan step realising ``witness`` under ``robot.max_speed``, robust
     to any additive velocity disturbance up to ``robot.disturbance``.
 
     ``source`` names the mission file in diagnostics.  With ``follow`` (the default) the
     fields are chosen so that their flow follows the shortest path through the plan's
-    channel (:mod:`tlmpc.control.follow`), under the vertex program's constraints.
+    channel (:mod:`tlmpc.control.follow`), under the vertex program's constraints, keeping
+    the label clearance from the boundaries of the ``relevant`` regions (all when None; a
+    compile passes the task's propositions).
     """
     if on_cells(witness):
         # a plan made on convex cells: its steps are cell steps (tlmpc.control.cells)
@@ -693,6 +696,7 @@ def synthesize(
             loop_start,
             robot.start,
             clearance=label_clearance(robot.max_speed),
+            relevant=relevant,
         )
         if follow
         else None

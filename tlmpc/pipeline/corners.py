@@ -7,18 +7,22 @@ needs as much), so on a fan of long edges the robot swings wide of the corner.  
 kept plan's path is pulled, every corner it bends round is cut into rings of smaller
 triangles (:func:`tlmpc.abstraction.corner.ring_corners`), and the mission is planned
 again on that mesh: one more candidate for :func:`tlmpc.pipeline.shortest.plan_shortest`,
-kept when its trajectory is shorter and it is not slower than the midpoint plan.
+kept when its trajectory is shorter and it is not slower than the midpoint plan.  A second
+candidate first meshes the route's corridor finer
+(:func:`tlmpc.abstraction.corridor.refine_corridor`: on a mesh of large triangles the
+fields stray from the path everywhere, not only round its corners) and then cuts its rings.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 from dataclasses import replace
 
 import numpy as np
 
 from tlmpc.abstraction.corner import RING_FRACTION, ring_corners, ring_inradius
+from tlmpc.abstraction.corridor import refine_corridor
 from tlmpc.abstraction.model import Abstraction, triangle_inradius
 from tlmpc.base.errors import TlmpcError
 from tlmpc.control.channel import LABEL_INSET, Guide, label_clearance
@@ -39,14 +43,22 @@ RINGS = 3
 #: The re-plan on the cut mesh weighs moves outside the kept plan's triangles this many
 #: times their midpoint length (it keeps to the kept channel, now cut finer).
 CORRIDOR = 1.5
+#: The refined corridor's triangles have edges about this fraction of the kept plan's path
+#: (prefix and one lap) long.
+ROUTE_SHARE = 0.06
 
 
-def corner_candidate(mission: Mission, planned: Planned) -> Planned | None:
+def corner_candidate(mission: Mission, planned: Planned, *, refine: bool = False) -> Planned | None:
     """``planned`` planned again on its mesh cut into rings about the corners its path bends
     round (:func:`ring_counts` of them each), the moves in its own triangles' pieces weighing
     their midpoint lengths and the others :data:`CORRIDOR` times theirs (so the plan keeps to
     its channel, now cut finer); None when it bends round no corner that takes a ring, or
-    the plan fails."""
+    the plan fails.
+
+    With ``refine`` the route's corridor is first meshed again into triangles of edges about
+    :data:`ROUTE_SHARE` of the path's length
+    (:func:`tlmpc.abstraction.corridor.refine_corridor`), none thinner than the label
+    clearance unless the plan's own triangles are; None when it is not refined."""
     mesh = planned.abstraction
     start = mission.robot.start
     try:
@@ -54,16 +66,39 @@ def corner_candidate(mission: Mission, planned: Planned) -> Planned | None:
     except TlmpcError:
         return None
     clearance = label_clearance(mission.robot.max_speed)
-    guides = path_guides(mesh, steps, loop_start, start, passages=True, clearance=clearance)
+    relevant = mission.formula.props()
+    guides = path_guides(
+        mesh, steps, loop_start, start, passages=True, clearance=clearance, relevant=relevant
+    )
     corners = bend_corners(mesh, [(s.triangle, s.exit_edge) for s in steps], guides, loop_start)
-    if not corners:
-        return None
     route = {*planned.witness.prefix, *planned.witness.cycle}
     floor = min(triangle_inradius(mesh.corners(t)) for t in route)
-    refined, parents = ring_corners(mesh, ring_counts(mesh, corners, clearance, floor), start)
+    base, parent_of = mesh, list(range(mesh.num_triangles))
+    if refine:
+        # A piece as thin as the clearance is finer than anything the labels promise; the
+        # runtime's default sample period, a tenth of the smallest inradius over the speed,
+        # stays at least a hundredth of a second.
+        floor = min(floor, clearance)
+        length = sum(math.dist(g.entry, g.exit) for g in guides if g is not None)
+        # A plan ending by staying keeps the triangles of its stay's label whole: the plan on
+        # the finer mesh would stay in a piece by the goal's edge (the cost ends where the
+        # stay triangle is entered), and the robot converge there, not inside the goal.
+        stay: list[int] = []
+        if planned.witness.is_stay:
+            letter = mesh.letter_of[planned.witness.cycle[0]]
+            stay = np.flatnonzero(mesh.letter_of == letter).tolist()
+        base, finer = refine_corridor(
+            mesh, route, start, size=ROUTE_SHARE * length, floor=floor, keep=stay
+        )
+        if base is mesh:
+            return None
+        parent_of += finer
+    refined, parents = ring_corners(
+        base, ring_counts(base, corners, clearance, floor, relevant), start
+    )
     if refined is mesh:
         return None
-    parent_of = list(range(mesh.num_triangles)) + parents
+    parent_of += [parent_of[p] for p in parents]
     corridor = [t for t in range(refined.num_triangles) if parent_of[t] in route]
     lengths = move_lengths(refined, start)
     measured = {
@@ -80,7 +115,11 @@ def corner_candidate(mission: Mission, planned: Planned) -> Planned | None:
 
 
 def ring_counts(
-    mesh: Abstraction, corners: Sequence[int], clearance: float, floor: float
+    mesh: Abstraction,
+    corners: Sequence[int],
+    clearance: float,
+    floor: float,
+    relevant: Collection[str] | None = None,
 ) -> dict[int, int]:
     """How many rings to cut about each of ``corners``: at most :data:`RINGS`, and
 
@@ -89,8 +128,8 @@ def ring_counts(
       kept plan's triangles: the runtime's default sample period,
       :func:`tlmpc.runtime.closed_loop.default_dt`, is a fraction of it, so the rings never
       make a run take more samples, nor a robot's controller switch fields faster, than the
-      plan's own triangles do);
-    * about a corner on a region's own boundary
+      plan's own triangles do; on a refined corridor, at most the label clearance);
+    * about a corner on the own boundary of a ``relevant`` region (all when None)
       (:func:`tlmpc.control.clearance.exposed_vertices`) no more than keep its edges long
       enough for the path to keep ``clearance`` from it (an end there keeps at most
       :data:`tlmpc.control.channel.LABEL_INSET` of its portal: more rings would bring the
@@ -99,7 +138,7 @@ def ring_counts(
 
     A corner where not even one ring fits is left out."""
     boundary = label_boundary(mesh)
-    exposed = exposed_vertices(mesh, (v for v in corners if boundary[v]))
+    exposed = exposed_vertices(mesh, (v for v in corners if boundary[v]), relevant)
     counts: dict[int, int] = {}
     for v in dict.fromkeys(corners):
         kept = math.inf

@@ -153,7 +153,11 @@ def simulated(
     from tlmpc.simulate import simulate
 
     controllers = synthesize(
-        planned.abstraction, planned.witness, mission.robot, source=mission.source
+        planned.abstraction,
+        planned.witness,
+        mission.robot,
+        source=mission.source,
+        relevant=mission.formula.props(),
     )
     return controllers, simulate(planned.abstraction, controllers, mission, max_gap=max_gap)
 

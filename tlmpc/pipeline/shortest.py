@@ -166,9 +166,14 @@ def plan_shortest(mission: Mission, planned: Planned) -> Planned:
     spent = rounds.run(MAX_REPLANS, spent, check)
     # The kept plan planned again on its mesh cut into rings where its path bends round a
     # corner (tlmpc.pipeline.corners), and re-planned there as above: the shortest path
-    # pulled on that mesh is kept when its trajectory is shorter.
-    if spent + 2 * _nodes(kept.planned) <= NODE_BUDGET:
-        ringed = corner_candidate(mission, kept.planned)
+    # pulled on that mesh is kept when its trajectory is shorter.  First on the mesh as it
+    # is, then, where the budget still allows, with the route's corridor meshed finer, each
+    # judged against the plan kept so far.
+    base_plan = kept.planned
+    for refine in (False, True):
+        if spent + 2 * _nodes(base_plan) > NODE_BUDGET:
+            break
+        ringed = corner_candidate(mission, base_plan, refine=refine)
         found_ring = None if ringed is None else _pulled(mission, ringed)
         if ringed is not None and found_ring is not None:
             spent += _nodes(ringed)
@@ -182,11 +187,12 @@ def plan_shortest(mission: Mission, planned: Planned) -> Planned:
                 best=(ringed, found_ring),
             )
             spent = ring_rounds.run(MAX_RING_REPLANS, spent)
-            extra["ring_lengths"] = ring_rounds.history
+            kind = "corridor" if refine else "ring"
+            extra[f"{kind}_lengths"] = ring_rounds.history
             assert ring_rounds.best is not None
             time = kept.offer_trajectory(*ring_rounds.best)
             if time is not None:
-                extra["ring_time"] = time
+                extra[f"{kind}_time"] = time
     best = kept.planned
     stats: dict[str, Any] = {
         **best.witness.stats,
@@ -477,7 +483,13 @@ def pull(mission: Mission, planned: Planned) -> Pulled:
     steps, loop_start = plan_steps(abstraction, witness)
     clearance = label_clearance(mission.robot.max_speed)
     pieces = path_guides(
-        abstraction, steps, loop_start, mission.robot.start, passages=True, clearance=clearance
+        abstraction,
+        steps,
+        loop_start,
+        mission.robot.start,
+        passages=True,
+        clearance=clearance,
+        relevant=mission.formula.props(),
     )
     lengths = [0.0 if p is None else math.dist(p.entry, p.exit) for p in pieces]
     neighbors = abstraction.neighbors

@@ -320,7 +320,13 @@ def _control(c: Compilation) -> StageResult:
     mission = c.get(MISSION)
     abstraction = c.get(ABSTRACTION)
     witness = c.get(WITNESS)
-    controllers = synthesize(abstraction, witness, mission.robot, source=mission.source)
+    controllers = synthesize(
+        abstraction,
+        witness,
+        mission.robot,
+        source=mission.source,
+        relevant=mission.formula.props(),
+    )
     document = controllers_to_json(controllers)
     return StageResult(
         products=provide(CONTROLLERS, controllers),

@@ -496,7 +496,12 @@ class Executor:
                     resume=self._states,
                     start_point=(float(point[0]), float(point[1])),
                 )
-                controllers = synthesize(planned.abstraction, planned.witness, self.mission.robot)
+                controllers = synthesize(
+                    planned.abstraction,
+                    planned.witness,
+                    self.mission.robot,
+                    relevant=self.mission.formula.props(),
+                )
         except (NoPlanError, SolverError, InvalidInputError):
             self._stop("no_plan", triangle)
             return
