@@ -220,17 +220,20 @@ def _tiles(
 ) -> bool:
     """Whether the pieces tile their triangles: counter-clockwise, and the areas of each
     triangle's pieces sum to its own."""
-    corners = made[pieces]
-    u, w = corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]
-    areas = (u[:, 0] * w[:, 1] - u[:, 1] * w[:, 0]) / 2.0
+    areas = _signed_areas(made[pieces])
     if (areas <= 0.0).any():
         return False
     sums = np.zeros(len(corridor))
     np.add.at(sums, owner, areas)
-    old = abstraction.vertices[abstraction.triangles[corridor]]
-    u, w = old[:, 1] - old[:, 0], old[:, 2] - old[:, 0]
-    expected = (u[:, 0] * w[:, 1] - u[:, 1] * w[:, 0]) / 2.0
+    expected = _signed_areas(abstraction.vertices[abstraction.triangles[corridor]])
     return bool(np.allclose(sums, expected, rtol=1e-9, atol=0.0))
+
+
+def _signed_areas(corners: FloatArray) -> FloatArray:
+    """Each triangle's area, (k, 3, 2) corners: positive when counter-clockwise."""
+    u, w = corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]
+    areas: FloatArray = (u[:, 0] * w[:, 1] - u[:, 1] * w[:, 0]) / 2.0
+    return areas
 
 
 def _neighbors(triangles: np.ndarray) -> np.ndarray:
