@@ -244,6 +244,7 @@ def main(
     safe_err = typing.cast(TextIO, TerminalText(raw_err, "standard error"))
     _RECEIVED.clear()
     settled.begin()
+    enclosing = _held_outputs()
     handlers = _RunHandlers()
     # Every moment between installing the handlers and restoring them lies inside this outer
     # ``try``: a signal there, in the inner handlers or in the restoring itself, ends the run
@@ -269,13 +270,30 @@ def main(
                 raise
             code = _ended_by(disguised, safe_err)
         handlers.restore()
+        _release_leftovers(enclosing)
         return code
     except (KeyboardInterrupt, _Terminated) as signalled:
         handlers.restore()
+        _release_leftovers(enclosing)
         return _ended_by(signalled, safe_err)
     except BaseException:
         handlers.restore()
+        _release_leftovers(enclosing)
         raise
+
+
+def _held_outputs() -> frozenset[Any]:
+    """The lock files and staging folders held before this run (by a caller's run)."""
+    writer = sys.modules.get("tlmpc.io.outdir")
+    return frozenset() if writer is None else frozenset(writer.held())
+
+
+def _release_leftovers(enclosing: frozenset[Any]) -> None:
+    """Remove the lock files and staging folders of this run that a signal cut a ``finally``
+    short of removing (only a run that wrote output, and so imported the writer, has any)."""
+    writer = sys.modules.get("tlmpc.io.outdir")
+    if writer is not None:
+        writer.release_leftovers(enclosing)
 
 
 class _RunHandlers:

@@ -184,6 +184,92 @@ def test_a_signal_during_the_swap_waits_until_out_is_whole(
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]
 
 
+@pytest.mark.parametrize("removal", ["_release_lock", "_remove_staging"])
+def test_a_second_signal_before_a_removal_leaves_nothing_behind(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, removal: str
+) -> None:
+    # SIGTERM before the commit, and a second one landing in the ``finally`` that removes the
+    # lock (or the staging folder), just before the removal: the run still ends 143 with
+    # nothing of its own left beside OUT
+    real = getattr(output, removal)
+    calls: list[Path] = []
+
+    def cut_short(path: Path, *rest: int) -> None:
+        calls.append(path)
+        if len(calls) == 1:
+            signal.raise_signal(signal.SIGTERM)
+        real(path, *rest)
+
+    def terminated(*arguments: object, **keywords: object) -> None:
+        signal.raise_signal(signal.SIGTERM)
+
+    monkeypatch.setattr(output, removal, cut_short)
+    monkeypatch.setattr(output, "commit", terminated)
+    out = tmp_path / "out"
+    code, _, err = compile_to(out)
+    assert (code, err) == (143, "tlmpc: terminated\n")
+    assert len(calls) == 2  # the cut-short removal, then the one after the run
+    assert list(tmp_path.iterdir()) == []
+    assert output.held() == frozenset()
+
+
+def test_the_redelivery_alarm_while_the_lock_is_taken_leaves_no_lock(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # The command line delivers again, by SIGALRM a moment later, a signal whose exception a
+    # finaliser swallowed; that alarm once landed just after the lock file was opened, before
+    # the run knew it held the lock, and the lock file outlived the run.
+    real = output._take_lock
+
+    def alarm_at_once(out: Path, lock: Path) -> int:
+        descriptor = real(out, lock)
+        signal.raise_signal(signal.SIGALRM)
+        return descriptor
+
+    monkeypatch.setattr(output, "_take_lock", alarm_at_once)
+    code, _, err = compile_to(tmp_path / "out")
+    assert (code, err) == (130, "tlmpc: interrupted\n")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_run_inside_a_run_leaves_the_enclosing_lock_held(tmp_path: Path) -> None:
+    # the run after a signal removes what it left, never what its caller still holds
+    out, other = tmp_path / "out", tmp_path / "other"
+    with output_lock(out):
+        held = output.held()
+        with staging_directory(out) as staging:
+            code, _, err = compile_to(other)
+            assert code == 0, err
+            assert output.held() == held | {staging}
+    assert output.held() == frozenset()
+
+
+def test_the_redelivery_alarm_waits_until_a_deferred_block_ends(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # the command line's alarm re-raises a signal a finaliser swallowed; inside a block that
+    # takes the lock or makes the staging folder it must wait like the signal itself
+    class Alarm(Exception):
+        pass
+
+    def ring(number: int, frame: object) -> None:
+        raise Alarm
+
+    def block_and_ring(finished: list[bool]) -> None:
+        with output._signals_blocked():
+            signal.raise_signal(signal.SIGALRM)
+            finished.append(True)
+
+    previous = signal.signal(signal.SIGALRM, ring)
+    finished: list[bool] = []
+    try:
+        with pytest.raises(Alarm):
+            block_and_ring(finished)
+    finally:
+        signal.signal(signal.SIGALRM, previous)
+    assert finished == [True]
+
+
 def test_outputs_get_umask_permissions(tmp_path: Path) -> None:
     previous = os.umask(0o022)
     try:

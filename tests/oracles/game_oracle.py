@@ -82,6 +82,23 @@ def evaluate(expr: Expr, now: State, nxt: State | None = None) -> bool:
     return (not left or right) if expr.op == "->" else left == right
 
 
+def mentioned(expr: Expr) -> set[tuple[str, bool]]:
+    """The variables ``expr`` reads, each with whether it reads its next value: its truth
+    depends on no other (:func:`evaluate` reads these and only these)."""
+    if isinstance(expr, Const):
+        return set()
+    if isinstance(expr, Atom | Compare):
+        return {(expr.name, expr.primed)}
+    if isinstance(expr, Linear):
+        return {(name, primed) for _, name, primed in expr.terms}
+    if isinstance(expr, Not):
+        return mentioned(expr.arg)
+    if isinstance(expr, Nary):
+        return set().union(*(mentioned(a) for a in expr.args))
+    assert isinstance(expr, Binary)
+    return mentioned(expr.left) | mentioned(expr.right)
+
+
 def valuations(variables: tuple[Variable, ...]) -> Iterator[dict[str, Value]]:
     """Every valuation of ``variables`` within their domains."""
     domains: list[list[Value]] = []

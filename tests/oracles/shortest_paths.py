@@ -99,18 +99,22 @@ class VisibilityOracle:
         ).tocsr()
         return graph, count
 
-    def path_length(self) -> float:
-        """The shortest path from the start touching every target in order."""
-        k = len(self.targets)
-        graph, count = self._layered(k + 1, list(range(k)))
+    def path_length(self, order: Sequence[int] | None = None) -> float:
+        """The shortest path from the start touching every target in order (or the targets
+        of the indices ``order``, in that order: one visibility graph serves every order)."""
+        order = list(range(len(self.targets))) if order is None else list(order)
+        k = len(order)
+        graph, count = self._layered(k + 1, order)
         dist = dijkstra(graph, indices=0)
         return float(dist[k * count : (k + 1) * count].min())
 
-    def tour_length(self) -> float:
-        """The shortest closed tour touching every target in cyclic order (start ignored)."""
-        k = len(self.targets)
-        graph, count = self._layered(k, list(range(1, k)))
-        sources = np.flatnonzero(self.touches[0])
+    def tour_length(self, order: Sequence[int] | None = None) -> float:
+        """The shortest closed tour touching every target in cyclic order (start ignored),
+        or the targets of the indices ``order``."""
+        order = list(range(len(self.targets))) if order is None else list(order)
+        k = len(order)
+        graph, count = self._layered(k, order[1:])
+        sources = np.flatnonzero(self.touches[order[0]])
         dist = dijkstra(graph, indices=sources)
         back = dist[np.arange(len(sources)), (k - 1) * count + sources]
         return float(back.min())

@@ -56,12 +56,13 @@ def _cyclic_order(witness: Any, names: tuple[str, ...]) -> tuple[str, ...]:
 def _tour_oracle(mission: Any) -> Callable[[tuple[str, ...]], float]:
     """The closed tour from the start through the named regions in a given order, on the
     visibility-graph oracle (shapely geometry of the mission's free space)."""
-    shapes = {r.name: shapely.Polygon(r.polygon) for r in mission.regions}
+    names = [r.name for r in mission.regions]
     free = workspace_free_space(mission)
     start = (float(mission.robot.start[0]), float(mission.robot.start[1]))
+    oracle = VisibilityOracle(free, [shapely.Polygon(r.polygon) for r in mission.regions], start)
 
     def tour(order: tuple[str, ...]) -> float:
-        return VisibilityOracle(free, [shapes[n] for n in order], start).tour_length()
+        return oracle.tour_length([names.index(n) for n in order])
 
     return tour
 

@@ -130,7 +130,11 @@ def _spot_realizable(mission: Mission, abstraction: Abstraction) -> bool:
         f"((G({env_step}) & {fairness}" + "".join(f" & {a}" for a in assumed) + f") -> {task})"
     )
     outputs = [*g, *mission.reactive.actions]
-    game = spot.ltl_to_game(spot.formula(formula), outputs, spot.synthesis_info())
+    # determinize, then split (``ltlsynt --algo=ds``): as complete as the default (LAR), and on
+    # these one-hot face encodings some 200 times faster (0.05 s a formula against 10 s)
+    info = spot.synthesis_info()
+    info.s = spot.synthesis_info.algo_DET_SPLIT
+    game = spot.ltl_to_game(spot.formula(formula), outputs, info)
     return bool(spot.solve_game(game))
 
 

@@ -15,6 +15,9 @@ Safety rules, each of which guards a way user data was once lost:
   itself is missing, since it is the previous output).
 * The swap is one ``renameat2(RENAME_EXCHANGE)`` on Linux; elsewhere two renames with SIGINT,
   SIGTERM and SIGHUP deferred in between, so Ctrl-C cannot strand ``OUT`` half-way.
+* A signal that lands in the ``finally`` removing the lock or the staging folder, before the
+  removal, cannot strand them either: both are on record from the moment they exist, and the
+  command line removes what is still on record once its run is over.
 * ``-o`` must not be a symbolic link or anything but a directory; files written by ``export -o``
   and ``plot`` must be regular files (or not exist yet).
 * Every operating-system error on the output path becomes a U033 diagnostic with a hint.
@@ -203,16 +206,27 @@ def output_lock(out: Path) -> Iterator[None]:
     lock = _lock_name(out)
     fd: int | None = None
     try:
-        # a signal while the lock is taken is delivered once ``fd`` says whether we hold it,
-        # so the lock file never outlives a run that Ctrl-C or SIGTERM ended
+        # a signal while the lock is taken is delivered once ``fd`` says whether we hold it
+        # and the lock is on record, so the lock file never outlives a run that Ctrl-C or
+        # SIGTERM ended (should the signal cut the ``finally`` short, the command line
+        # releases what is on record: :func:`release_leftovers`)
         with _signals_blocked():
             fd = _take_lock(out, lock)
+            _hold(_HELD_LOCKS, lock, fd)
         yield
     finally:
         if fd is not None:
-            with contextlib.suppress(OSError):
-                os.unlink(lock)
-            os.close(fd)
+            _release_lock(lock, fd)
+
+
+def _release_lock(lock: Path, fd: int) -> None:
+    """Remove ``lock`` if it is still the file ``fd`` locked, then close ``fd``."""
+    with contextlib.suppress(OSError):
+        if os.path.samestat(os.fstat(fd), os.stat(lock, follow_symlinks=False)):
+            os.unlink(lock)
+    # off the record before the close: a descriptor number is never closed twice
+    _HELD_LOCKS.pop(lock, None)
+    os.close(fd)
 
 
 def _take_lock(out: Path, lock: Path) -> int:
@@ -310,10 +324,16 @@ def staging_directory(out: Path) -> Iterator[Path]:
         # a signal while the folder is made is delivered once ``staging`` names it
         with _signals_blocked():
             staging = _new_staging(out)
+            _hold(_HELD_STAGING, staging, None)
         yield staging
     finally:
         if staging is not None:
-            shutil.rmtree(staging, ignore_errors=True)
+            _remove_staging(staging)
+
+
+def _remove_staging(staging: Path) -> None:
+    shutil.rmtree(staging, ignore_errors=True)
+    _HELD_STAGING.pop(staging, None)
 
 
 def _new_staging(out: Path) -> Path:
@@ -379,9 +399,49 @@ def _exchange(a: Path, b: Path) -> bool:
     raise OSError(code, os.strerror(code), str(b))
 
 
+#: The lock files (with their descriptors) and staging folders the main thread holds.  Each
+#: is put on record in the same signal-deferred block that makes it, and removed by the
+#: ``finally`` of the block that made it; but no ``finally`` can keep a signal from landing
+#: before its first line, so what a signal left on record is released by
+#: :func:`release_leftovers` once the run's handlers no longer raise.  Other threads keep
+#: nothing on record: signal handlers run only in the main thread, so a ``finally`` there
+#: always runs whole.
+_HELD_LOCKS: dict[Path, int] = {}
+_HELD_STAGING: dict[Path, None] = {}
+
+
+def _hold(record: dict[Path, Any], path: Path, value: Any) -> None:
+    import threading
+
+    if threading.current_thread() is threading.main_thread():
+        record[path] = value
+
+
+def held() -> frozenset[Path]:
+    """The lock files and staging folders on record now (those of enclosing runs)."""
+    return frozenset(_HELD_LOCKS) | frozenset(_HELD_STAGING)
+
+
+def release_leftovers(keep: frozenset[Path] = frozenset()) -> None:
+    """Remove the staging folders and lock files a signal kept their blocks from removing,
+    all but ``keep`` (what :func:`held` said before the run: an enclosing run's, still held).
+
+    Call it when the run is over and signals no longer raise (the command line does, after
+    giving back its handlers); it does nothing when nothing was left.
+    """
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        return
+    for staging in [path for path in _HELD_STAGING if path not in keep]:
+        _remove_staging(staging)
+    for lock, fd in [(path, fd) for path, fd in _HELD_LOCKS.items() if path not in keep]:
+        _release_lock(lock, fd)
+
+
 @contextlib.contextmanager
 def _signals_blocked() -> Iterator[None]:
-    """Defer SIGINT, SIGTERM and SIGHUP until the block ends, then deliver them.
+    """Defer SIGINT, SIGTERM, SIGHUP and SIGALRM until the block ends, then deliver them.
 
     Python-level handlers run only in the main thread between bytecodes, so swapping them
     for a recorder defers the signal whichever thread the kernel delivered it to.
@@ -392,7 +452,8 @@ def _signals_blocked() -> Iterator[None]:
         yield
         return
     received: list[int] = []
-    kinds = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+    # SIGALRM too: the command line's alarm delivers again a signal a finaliser swallowed
+    kinds = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP, signal.SIGALRM)
     previous = {kind: signal.getsignal(kind) for kind in kinds}
     for kind in kinds:
         signal.signal(kind, lambda number, frame: received.append(number))
