@@ -96,7 +96,9 @@ def _outcome(number: int, code: int, err: str, folder: Path, whole: set[str]) ->
         return "before the interpreter ran"
     frames = FRAME.findall(err)
     assert number == signal.SIGINT, (code, err)
-    assert err.rstrip().endswith("KeyboardInterrupt"), (code, err)
+    # "KeyboardInterrupt", or "KeyboardInterrupt: " when it came while the interpreter set
+    # ``__main__.__loader__`` (it says so on the line before, and exits 1)
+    assert re.search(r"KeyboardInterrupt:?$", err.rstrip()), (code, err)
     assert all(_before_the_guard(file, int(line)) for file, line in frames), err
     return "in the interpreter's start-up"
 
