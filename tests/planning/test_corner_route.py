@@ -306,8 +306,10 @@ def test_example_7_keeps_a_shorter_trajectory_on_its_corridor_meshed_finer() -> 
     result = compile_mission(path)
     original = corners.corner_candidate
 
-    def rings_only(mission: Any, planned: Planned, *, refine: bool = False) -> Planned | None:
-        return None if refine else original(mission, planned)
+    def rings_only(
+        mission: Any, planned: Planned, bends: Any, *, refine: bool = False
+    ) -> Planned | None:
+        return None if refine else original(mission, planned, bends)
 
     with mock.patch.object(shortest, "corner_candidate", side_effect=rings_only):
         plain = compile_mission(path)

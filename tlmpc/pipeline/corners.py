@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Collection, Sequence
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -48,12 +48,49 @@ CORRIDOR = 1.5
 ROUTE_SHARE = 0.06
 
 
-def corner_candidate(mission: Mission, planned: Planned, *, refine: bool = False) -> Planned | None:
-    """``planned`` planned again on its mesh cut into rings about the corners its path bends
-    round (:func:`ring_counts` of them each), the moves in its own triangles' pieces weighing
-    their midpoint lengths and the others :data:`CORRIDOR` times theirs (so the plan keeps to
-    its channel, now cut finer); None when it bends round no corner that takes a ring, or
-    the plan fails.
+@dataclass(frozen=True, slots=True)
+class Bends:
+    """A plan's path as its fields follow it, read once for both of its candidates."""
+
+    #: The pulled path's pieces, one per plan step (None where a step has none).
+    guides: tuple[Guide | None, ...]
+    #: The mesh vertices the path bends round (:func:`tlmpc.control.follow.bend_corners`).
+    corners: tuple[int, ...]
+    #: The plan's triangles, and the smallest inradius among them.
+    route: frozenset[int]
+    floor: float
+
+
+def plan_bends(mission: Mission, planned: Planned) -> Bends | None:
+    """``planned``'s path as its fields follow it (None when its steps cannot be read)."""
+    mesh = planned.abstraction
+    try:
+        steps, loop_start = plan_steps(mesh, planned.witness)
+    except TlmpcError:
+        return None
+    guides = path_guides(
+        mesh,
+        steps,
+        loop_start,
+        mission.robot.start,
+        passages=True,
+        clearance=label_clearance(mission.robot.max_speed),
+        relevant=mission.formula.props(),
+    )
+    corners = bend_corners(mesh, [(s.triangle, s.exit_edge) for s in steps], guides, loop_start)
+    route = frozenset({*planned.witness.prefix, *planned.witness.cycle})
+    floor = min(triangle_inradius(mesh.corners(t)) for t in route)
+    return Bends(tuple(guides), tuple(corners), route, floor)
+
+
+def corner_candidate(
+    mission: Mission, planned: Planned, bends: Bends, *, refine: bool = False
+) -> Planned | None:
+    """``planned`` planned again on its mesh cut into rings about the corners its path
+    (``bends``, :func:`plan_bends`) bends round (:func:`ring_counts` of them each), the moves
+    in its own triangles' pieces weighing their midpoint lengths and the others
+    :data:`CORRIDOR` times theirs (so the plan keeps to its channel, now cut finer); None
+    when it bends round no corner that takes a ring, or the plan fails.
 
     With ``refine`` the route's corridor is first meshed again into triangles of edges about
     :data:`ROUTE_SHARE` of the path's length
@@ -61,25 +98,16 @@ def corner_candidate(mission: Mission, planned: Planned, *, refine: bool = False
     clearance unless the plan's own triangles are; None when it is not refined."""
     mesh = planned.abstraction
     start = mission.robot.start
-    try:
-        steps, loop_start = plan_steps(mesh, planned.witness)
-    except TlmpcError:
-        return None
     clearance = label_clearance(mission.robot.max_speed)
     relevant = mission.formula.props()
-    guides = path_guides(
-        mesh, steps, loop_start, start, passages=True, clearance=clearance, relevant=relevant
-    )
-    corners = bend_corners(mesh, [(s.triangle, s.exit_edge) for s in steps], guides, loop_start)
-    route = {*planned.witness.prefix, *planned.witness.cycle}
-    floor = min(triangle_inradius(mesh.corners(t)) for t in route)
+    route, floor, corners = bends.route, bends.floor, bends.corners
     base, parent_of = mesh, list(range(mesh.num_triangles))
     if refine:
         # A piece as thin as the clearance is finer than anything the labels promise; the
         # runtime's default sample period, a tenth of the smallest inradius over the speed,
         # stays at least a hundredth of a second.
         floor = min(floor, clearance)
-        length = sum(math.dist(g.entry, g.exit) for g in guides if g is not None)
+        length = sum(math.dist(g.entry, g.exit) for g in bends.guides if g is not None)
         # A plan ending by staying keeps the triangles of its stay's label whole: the plan on
         # the finer mesh would stay in a piece by the goal's edge (the cost ends where the
         # stay triangle is entered), and the robot converge there, not inside the goal.

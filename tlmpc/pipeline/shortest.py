@@ -54,7 +54,7 @@ import numpy as np
 
 from tlmpc.base.errors import TlmpcError
 from tlmpc.mission.model import Mission
-from tlmpc.pipeline.corners import corner_candidate
+from tlmpc.pipeline.corners import corner_candidate, plan_bends
 from tlmpc.pipeline.touches import touch_candidate
 from tlmpc.planning.mission import Planned, replan
 from tlmpc.planning.product import START_SLOT, STUTTER_COST
@@ -170,10 +170,14 @@ def plan_shortest(mission: Mission, planned: Planned) -> Planned:
     # is, then, where the budget still allows, with the route's corridor meshed finer, each
     # judged against the plan kept so far.
     base_plan = kept.planned
+    bends = None
     for refine in (False, True):
         if spent + 2 * _nodes(base_plan) > NODE_BUDGET:
             break
-        ringed = corner_candidate(mission, base_plan, refine=refine)
+        bends = bends or plan_bends(mission, base_plan)
+        ringed = (
+            None if bends is None else corner_candidate(mission, base_plan, bends, refine=refine)
+        )
         found_ring = None if ringed is None else _pulled(mission, ringed)
         if ringed is not None and found_ring is not None:
             spent += _nodes(ringed)
