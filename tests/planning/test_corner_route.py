@@ -20,10 +20,8 @@ import shapely
 
 from tlmpc.abstraction.corner import RING_FRACTION, ring_corners
 from tlmpc.control.channel import LABEL_INSET, label_clearance
-from tlmpc.control.follow import path_guides
 from tlmpc.control.synthesize import plan_steps
 from tlmpc.pipeline import corners, shortest
-from tlmpc.pipeline.corners import bend_corners
 from tlmpc.pipeline.mintime import measure
 from tlmpc.pipeline.stages import MISSION, WITNESS, CompileResult, compile_mission
 from tlmpc.planning.mission import Planned
@@ -105,15 +103,9 @@ def test_every_corner_is_an_end_of_a_portal_the_path_turns_across(spec: str) -> 
     mission = result.compilation.get(MISSION)
     mesh = planned.abstraction
     steps, loop_start = plan_steps(mesh, planned.witness)
-    guides = path_guides(
-        mesh,
-        steps,
-        loop_start,
-        mission.robot.start,
-        passages=True,
-        clearance=label_clearance(mission.robot.max_speed),
-    )
-    found = bend_corners(mesh, [(s.triangle, s.exit_edge) for s in steps], guides, loop_start)
+    bends = corners.plan_bends(mission, planned)
+    assert bends is not None
+    guides, found = bends.guides, list(bends.corners)
     expected = []
     moving = [k for k, s in enumerate(steps) if s.exit_edge is not None]
     sines = _turns([guides[k] for k in range(len(steps))])
