@@ -27,7 +27,7 @@ from tlmpc.abstraction.model import Abstraction, triangle_inradius
 from tlmpc.base.errors import TlmpcError
 from tlmpc.control.channel import LABEL_INSET, Guide, label_clearance
 from tlmpc.control.clearance import exposed_vertices, label_boundary
-from tlmpc.control.follow import path_guides, turn_sine
+from tlmpc.control.follow import PlanStep, path_guides, turn_sine
 from tlmpc.control.synthesize import plan_steps
 from tlmpc.mission.model import Mission
 from tlmpc.planning.mission import Planned, replan
@@ -61,15 +61,18 @@ class Bends:
     floor: float
 
 
-def plan_bends(mission: Mission, planned: Planned) -> Bends | None:
-    """``planned``'s path as its fields follow it (None when its steps cannot be read)."""
-    mesh = planned.abstraction
-    try:
-        steps, loop_start = plan_steps(mesh, planned.witness)
-    except TlmpcError:
-        return None
-    guides = path_guides(
-        mesh,
+def followed_path(
+    mission: Mission,
+    planned: Planned,
+    steps: Sequence[PlanStep],
+    loop_start: int | None,
+) -> list[Guide | None]:
+    """The shortest path through ``planned``'s channel (its ``steps``,
+    :func:`tlmpc.control.synthesize.plan_steps`) as the mission's controllers follow it: the
+    label clearance of its max_speed kept from the regions its task names, a vertex
+    passage's piece to its corner included."""
+    return path_guides(
+        planned.abstraction,
         steps,
         loop_start,
         mission.robot.start,
@@ -77,6 +80,16 @@ def plan_bends(mission: Mission, planned: Planned) -> Bends | None:
         clearance=label_clearance(mission.robot.max_speed),
         relevant=mission.formula.props(),
     )
+
+
+def plan_bends(mission: Mission, planned: Planned) -> Bends | None:
+    """``planned``'s path as its fields follow it (None when its steps cannot be read)."""
+    mesh = planned.abstraction
+    try:
+        steps, loop_start = plan_steps(mesh, planned.witness)
+    except TlmpcError:
+        return None
+    guides = followed_path(mission, planned, steps, loop_start)
     corners = bend_corners(mesh, [(s.triangle, s.exit_edge) for s in steps], guides, loop_start)
     route = frozenset({*planned.witness.prefix, *planned.witness.cycle})
     floor = min(triangle_inradius(mesh.corners(t)) for t in route)

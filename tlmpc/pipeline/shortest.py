@@ -54,7 +54,7 @@ import numpy as np
 
 from tlmpc.base.errors import TlmpcError
 from tlmpc.mission.model import Mission
-from tlmpc.pipeline.corners import corner_candidate, plan_bends
+from tlmpc.pipeline.corners import Bends, corner_candidate, followed_path, plan_bends
 from tlmpc.pipeline.touches import touch_candidate
 from tlmpc.planning.mission import Planned, replan
 from tlmpc.planning.product import START_SLOT, STUTTER_COST
@@ -170,14 +170,15 @@ def plan_shortest(mission: Mission, planned: Planned) -> Planned:
     # is, then, where the budget still allows, with the route's corridor meshed finer, each
     # judged against the plan kept so far.
     base_plan = kept.planned
-    bends = None
+    bends: Bends | None = None
     for refine in (False, True):
         if spent + 2 * _nodes(base_plan) > NODE_BUDGET:
             break
-        bends = bends or plan_bends(mission, base_plan)
-        ringed = (
-            None if bends is None else corner_candidate(mission, base_plan, bends, refine=refine)
-        )
+        if bends is None:
+            bends = plan_bends(mission, base_plan)
+            if bends is None:
+                break  # its steps cannot be read (the control stage will say why)
+        ringed = corner_candidate(mission, base_plan, bends, refine=refine)
         found_ring = None if ringed is None else _pulled(mission, ringed)
         if ringed is not None and found_ring is not None:
             spent += _nodes(ringed)
@@ -479,22 +480,11 @@ def pull(mission: Mission, planned: Planned) -> Pulled:
     (:func:`tlmpc.control.follow.path_guides`): its length (see the module doc) and the
     length of each of D's moves on it, keyed by :func:`~tlmpc.planning.timing.move_key`
     (plus the weights' stutter cost)."""
-    from tlmpc.control.channel import label_clearance
-    from tlmpc.control.follow import path_guides
     from tlmpc.control.synthesize import plan_steps
 
     abstraction, witness = planned.abstraction, planned.witness
     steps, loop_start = plan_steps(abstraction, witness)
-    clearance = label_clearance(mission.robot.max_speed)
-    pieces = path_guides(
-        abstraction,
-        steps,
-        loop_start,
-        mission.robot.start,
-        passages=True,
-        clearance=clearance,
-        relevant=mission.formula.props(),
-    )
+    pieces = followed_path(mission, planned, steps, loop_start)
     lengths = [0.0 if p is None else math.dist(p.entry, p.exit) for p in pieces]
     neighbors = abstraction.neighbors
     moves: dict[MoveKey, float] = {}
