@@ -18,6 +18,7 @@ the other targets, back to itself.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 from typing import Any
@@ -78,6 +79,7 @@ class VisibilityOracle:
         self.lengths = np.hypot(*(self.nodes[self.i] - self.nodes[self.j]).T)
         touches = [shapely.covers(t.buffer(1e-9), shapely.points(self.nodes)) for t in self.targets]
         self.touches = touches
+        self._touching_distances: tuple[np.ndarray, np.ndarray] | None = None
 
     def _layered(self, layers: int, targets: Sequence[int]) -> tuple[Any, int]:
         """The layered graph: layer k -> k + 1 where a node touches ``targets[k]``."""
@@ -110,7 +112,41 @@ class VisibilityOracle:
 
     def tour_length(self, order: Sequence[int] | None = None) -> float:
         """The shortest closed tour touching every target in cyclic order (start ignored),
-        or the targets of the indices ``order``."""
+        or the targets of the indices ``order``.
+
+        A tour is a cycle of touching nodes, one per target, joined by shortest paths: the
+        distances between every two touching nodes are found once (one Dijkstra from each),
+        and each order is then a min-plus product of its legs round the cycle."""
+        order = list(range(len(self.targets))) if order is None else list(order)
+        if len(order) == 1:
+            return 0.0
+        between, row = self._between_touching()
+        sets = [np.flatnonzero(self.touches[t]) for t in order]
+
+        if any(len(nodes) == 0 for nodes in sets):
+            return math.inf
+
+        def legs(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+            distances: np.ndarray = between[np.ix_(row[a], b)]
+            return distances
+
+        best = math.inf
+        # a block of first nodes at a time keeps the products' arrays small
+        block = max(1, 2_000_000 // max(len(a) * len(b) for a, b in itertools.pairwise(sets)))
+        for start in range(0, len(sets[0]), block):
+            first = sets[0][start : start + block]
+            # reach[s, t]: the shortest path from s (touching the first target) touching each
+            # target so far in order, ending at t (touching the latest one)
+            reach = legs(first, sets[1])
+            for here, there in itertools.pairwise(sets[1:]):
+                reach = (reach[:, :, None] + legs(here, there)[None, :, :]).min(axis=1)
+            back = legs(sets[-1], first)  # back[t, s]
+            best = min(best, float((reach + back.T).min()))
+        return best
+
+    def layered_tour_length(self, order: Sequence[int] | None = None) -> float:
+        """:meth:`tour_length` by a Dijkstra from every touching node of the first target in
+        a layered graph (a second reading of the same definition, slower)."""
         order = list(range(len(self.targets))) if order is None else list(order)
         k = len(order)
         graph, count = self._layered(k, order[1:])
@@ -118,6 +154,17 @@ class VisibilityOracle:
         dist = dijkstra(graph, indices=sources)
         back = dist[np.arange(len(sources)), (k - 1) * count + sources]
         return float(back.min())
+
+    def _between_touching(self) -> tuple[np.ndarray, np.ndarray]:
+        """Shortest distances from every node touching some target to every node, and each
+        node's row in them (-1 where it touches none)."""
+        if self._touching_distances is None:
+            touching = np.flatnonzero(np.any(self.touches, axis=0))
+            graph, _count = self._layered(1, [])
+            row = np.full(len(self.nodes), -1)
+            row[touching] = np.arange(len(touching))
+            self._touching_distances = (dijkstra(graph, indices=touching), row)
+        return self._touching_distances
 
 
 def geodesic(free: Any, start: tuple[float, float], target: Any) -> float:

@@ -57,14 +57,28 @@ def _tour_oracle(mission: Any) -> Callable[[tuple[str, ...]], float]:
     """The closed tour from the start through the named regions in a given order, on the
     visibility-graph oracle (shapely geometry of the mission's free space)."""
     names = [r.name for r in mission.regions]
-    free = workspace_free_space(mission)
-    start = (float(mission.robot.start[0]), float(mission.robot.start[1]))
-    oracle = VisibilityOracle(free, [shapely.Polygon(r.polygon) for r in mission.regions], start)
+    oracle = _visibility_oracle(mission)
 
     def tour(order: tuple[str, ...]) -> float:
         return oracle.tour_length([names.index(n) for n in order])
 
     return tour
+
+
+def _visibility_oracle(mission: Any) -> VisibilityOracle:
+    free = workspace_free_space(mission)
+    start = (float(mission.robot.start[0]), float(mission.robot.start[1]))
+    return VisibilityOracle(free, [shapely.Polygon(r.polygon) for r in mission.regions], start)
+
+
+def test_the_tour_oracles_two_readings_agree() -> None:
+    """The tour as a min-plus product over the touching nodes' distances is the tour as a
+    Dijkstra in the layered graph from every touching node of the first target."""
+    mission = compile_mission("five.yaml", text=_five(tuple(FIVE)), until="mission")
+    oracle = _visibility_oracle(mission.compilation.get(MISSION))
+    for order in [(0, 1, 2, 3, 4), (0, 3, 1, 4, 2), (4, 2, 0, 1, 3), (2, 0), (1, 4, 3), (3,)]:
+        product, layered = oracle.tour_length(order), oracle.layered_tour_length(order)
+        assert math.isclose(product, layered, rel_tol=1e-9), (order, product, layered)
 
 
 @pytest.mark.parametrize(
