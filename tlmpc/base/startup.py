@@ -12,8 +12,9 @@ A library user's ``import tlmpc`` changes no signal handler: the guard recognise
 how the interpreter was started (the ``tlmpc`` console script, or ``python -m tlmpc``).
 
 The interpreter's own start-up, before the first line of tlmpc runs, is out of any program's
-reach: a SIGTERM then kills the process by the signal (the shell reports 143), and a Ctrl-C
-while Python's ``site`` module runs gets Python's own message.
+reach: a SIGTERM then kills the process by the signal (the shell reports 143), a Ctrl-C
+while Python's ``site`` module runs gets Python's own message, and one raised in a callback of
+its import machinery is dropped by Python ("Exception ignored"), the run going on.
 """
 
 from __future__ import annotations
