@@ -153,6 +153,34 @@ def test_a_signal_at_any_moment_ends_cleanly(
     assert seen.get("clean", 0) >= len(FRACTIONS) // 2, seen
 
 
+@pytest.mark.parametrize(
+    ("frame", "number", "accepted"),
+    [
+        ('"<frozen importlib._bootstrap>", line 198, in cb', signal.SIGINT, True),
+        (f'"{PACKAGE / "__init__.py"}", line {GUARD_LINE}, in <module>', signal.SIGINT, True),
+        (f'"{PACKAGE / "cli.py"}", line 40, in main', signal.SIGINT, False),
+        (f'"{PACKAGE / "__init__.py"}", line {GUARD_LINE + 1}, in <module>', signal.SIGINT, False),
+        ('"<frozen importlib._bootstrap>", line 198, in cb', signal.SIGTERM, False),
+    ],
+)
+def test_only_a_ctrl_c_dropped_before_the_guard_is_python_s_own(
+    frame: str, number: signal.Signals, accepted: bool
+) -> None:
+    """The run that finished after Python dropped a Ctrl-C is accepted only when the dropped
+    exception's frames all ran before the guard, and only for Ctrl-C."""
+    report = (
+        "Exception ignored in: <function _get_module_lock.<locals>.cb at 0x7f>\n"
+        f"Traceback (most recent call last):\n  File {frame}\nKeyboardInterrupt: \n"
+    )
+    err = report + "[1/8] load           0.096 s  regions 4\n"
+    if accepted:
+        assert _ignored_in_the_start_up(number, err) == (True, err[len(report) :])
+    else:
+        with pytest.raises(AssertionError):
+            _ignored_in_the_start_up(number, err)
+    assert _ignored_in_the_start_up(number, "[1/8] load\n") == (False, "[1/8] load\n")
+
+
 def test_a_library_import_installs_no_handler() -> None:
     code = (
         "import signal\n"
