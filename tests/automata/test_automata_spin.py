@@ -21,16 +21,10 @@ from tlmpc.automata import guard_holds, translate
 from tlmpc.automata.model import Automaton
 from tlmpc.ltl import parse_ltl, to_spin
 from tlmpc.ltl.ast import (
-    And,
-    Const,
-    Equiv,
     Eventually,
     Formula,
     Globally,
-    Implies,
     Not,
-    Or,
-    Prop,
     Release,
     StrongRelease,
     Until,
@@ -144,27 +138,14 @@ def test_claim_parser_sanity() -> None:
     assert intersection_empty(aut, spin_claim("<> [] !a"), ["a"])
 
 
+#: The temporal operators of the benchmark's language.
+TEMPORAL = (Until, Release, WeakUntil, StrongRelease, Eventually, Globally)
+
+
 def temporal_depth(formula: Formula) -> int:
     """How deeply temporal operators nest in ``formula``."""
-    match formula:
-        case Const() | Prop():
-            return 0
-        case Not(arg):
-            return temporal_depth(arg)
-        case And(args) | Or(args):
-            return max(temporal_depth(a) for a in args)
-        case Implies(left, right) | Equiv(left, right):
-            return max(temporal_depth(left), temporal_depth(right))
-        case (
-            Until(left, right)
-            | Release(left, right)
-            | WeakUntil(left, right)
-            | StrongRelease(left, right)
-        ):
-            return 1 + max(temporal_depth(left), temporal_depth(right))
-        case Eventually(arg) | Globally(arg):
-            return 1 + temporal_depth(arg)
-    raise AssertionError(f"not in the benchmark's language: {formula!r}")
+    below = max((temporal_depth(child) for child in formula.children()), default=0)
+    return below + (1 if isinstance(formula, TEMPORAL) else 0)
 
 
 # The explicit product enumerates every letter: formulas over more than 5 propositions are
