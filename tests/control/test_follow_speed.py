@@ -180,11 +180,13 @@ def test_the_weakest_step_keeps_the_vertex_programs_floor_up_to_the_cap(
     assert float(followed.stats["min_exit_speed"]) >= floor * (1.0 - 1e-5)
 
 
-def test_the_following_solve_rewards_the_floor_up_to_the_cap_only() -> None:
-    """Solved on Example 8's plan, the following program's floor variable (the smallest
+@pytest.mark.parametrize("name", ["example8", "example1"])
+def test_the_following_solve_rewards_the_floor_up_to_the_cap_only(name: str) -> None:
+    """Solved on a shipped plan, the following program's floor variable (the smallest
     guaranteed speed it rewards) is at most the cap of a robot without a disturbance
     (FREE_FLOOR_CAP), while the vertex program alone puts it higher on the same runs (so the
-    cap is what holds it)."""
+    cap is what holds it); and it reaches the cap (on Example 1's plan, following its path
+    would lower the floor were it weighed like the mean guaranteed speed)."""
     from pathlib import Path
 
     from tlmpc.control.synthesize import (
@@ -195,7 +197,7 @@ def test_the_following_solve_rewards_the_floor_up_to_the_cap_only() -> None:
     )
     from tlmpc.pipeline.stages import ABSTRACTION, MISSION, WITNESS, compile_mission
 
-    source = Path(__file__).resolve().parents[2] / "specs" / "example8.yaml"
+    source = Path(__file__).resolve().parents[2] / "specs" / f"{name}.yaml"
     compilation = compile_mission(source, until="plan").compilation
     mission, abstraction = compilation.get(MISSION), compilation.get(ABSTRACTION)
     steps, loop_start = plan_steps(abstraction, compilation.get(WITNESS))
