@@ -129,3 +129,37 @@ def test_a_disturbance_no_field_can_reject_is_located() -> None:
     with pytest.raises(tlmpc.InvalidInputError) as too_strong:
         _compile(1.0)
     assert too_strong.value.diagnostics[0].code == "C033"
+
+
+@pytest.mark.parametrize("disturbance", [0.05, 0.15])
+def test_the_vertex_programs_own_fields_reject_the_disturbance(disturbance: float) -> None:
+    """The vertex program's solution itself meets every vertex condition with the
+    disturbance's margin and the speed bound: the re-check after the solve, which rebuilds a
+    failing field from its triangle alone, is a safety net, not what makes the fields robust."""
+    from tlmpc.control.synthesize import (
+        RECHECK_TOLERANCE,
+        _affine_controller,
+        _assign_runs,
+        _violated_condition,
+        plan_steps,
+        solve_vertex_program,
+        vertex_program,
+    )
+    from tlmpc.pipeline.stages import ABSTRACTION, MISSION, WITNESS, compile_mission
+
+    document = yaml.safe_load((ROOT / "specs" / "example1.yaml").read_text())
+    document["robot"]["disturbance"] = disturbance
+    built = compile_mission("example1.yaml", text=yaml.safe_dump(document), until="plan")
+    mission, abstraction = built.compilation.get(MISSION), built.compilation.get(ABSTRACTION)
+    robot = mission.robot
+    steps, loop_start = plan_steps(abstraction, built.compilation.get(WITNESS))
+    push = disturbance * (1.0 + RECHECK_TOLERANCE) + RECHECK_TOLERANCE * robot.max_speed
+    _assign_runs(abstraction, steps, loop_start, push=push, max_speed=robot.max_speed)
+    affine = [step for step in steps if step.through is None]
+    program, column = vertex_program(affine, robot.max_speed, disturbance)
+    velocities, _speeds = solve_vertex_program(program)
+    for index, step in enumerate(steps):
+        if step.through is not None:
+            continue
+        field = _affine_controller(index, step, velocities[[column[r] for r in step.runs]], robot)
+        assert _violated_condition(field, robot.max_speed, disturbance) is None, index

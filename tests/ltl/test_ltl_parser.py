@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import pytest
-from hypothesis import given
+from hypothesis import example, given
 from lasso_ltl import holds
 from strategies import formulas, lassos
 
@@ -121,6 +121,9 @@ def test_print_then_parse_is_the_identity(formula: object) -> None:
 
 
 @given(formulas(), lassos())
+# a negated F and G, where their duals and the operators with the negation pushed in differ
+@example(Not(Eventually(Prop("a"))), ([frozenset({"a"}), frozenset()], 0))
+@example(Not(Globally(Prop("a"))), ([frozenset(), frozenset({"a"})], 1))
 def test_nnf_preserves_meaning(formula: object, lasso: tuple[list[frozenset[str]], int]) -> None:
     word, loop = lasso
     normal = nnf(formula)  # type: ignore[arg-type]
