@@ -93,6 +93,12 @@ def run_mutant(mutant: Mutant, files: list[str], timeout: float) -> Outcome:
         copy_tree(files, copy)
         (copy / mutant.file).write_text(source.replace(mutant.find, mutant.replace), "utf-8")
         env = dict(os.environ, PYTHONPATH=str(copy), PYTHONDONTWRITEBYTECODE="1")
+        # The copy has no ``../shared`` beside it: its tests read the repository's (else the
+        # tests that need the benchmark suites or the robot data skip, and a mutant only
+        # they catch survives).
+        shared = ROOT.parent / "shared"
+        env.setdefault("TLMPC_SHARED_BENCHMARKS", str(shared / "benchmarks"))
+        env.setdefault("TLMPC_SHARED_DATA", str(shared / "data"))
         command = [
             sys.executable, "-m", "pytest", "-x", "-q", "-n", "0",
             "-p", "no:cacheprovider", *mutant.tests,
