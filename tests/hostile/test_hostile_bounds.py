@@ -180,3 +180,23 @@ def test_a_signal_disguised_by_c_code_still_ends_the_run(
 
     monkeypatch.setattr("tlmpc.commands.automaton.run", disguised)
     assert tlmpc.cli.main(["automaton", "G a"]) == code
+
+
+@pytest.mark.parametrize(("number", "code"), [(signal.SIGTERM, 143), (signal.SIGINT, 130)])
+def test_code_that_handles_errors_does_not_catch_a_signal(
+    monkeypatch: pytest.MonkeyPatch, number: signal.Signals, code: int
+) -> None:
+    # a signal ends the run where it lands: an ``except Exception`` on the way (a reader's or
+    # a library's error handling) does not swallow it and carry on
+    carried_on: list[str] = []
+
+    def handles_errors(*args: object) -> int:
+        try:
+            signal.raise_signal(number)
+        except Exception:
+            carried_on.append("caught as an error")
+        return 0
+
+    monkeypatch.setattr("tlmpc.commands.automaton.run", handles_errors)
+    assert tlmpc.cli.main(["automaton", "G a"]) == code
+    assert carried_on == []

@@ -22,7 +22,7 @@ from hypothesis import strategies as st
 
 import tlmpc
 from tlmpc.base.errors import InvalidInputError, NoPlanError, TlmpcError
-from tlmpc.mission.body import body_radius
+from tlmpc.mission.body import ARC_SEGMENTS, body_radius, conservative_offset
 from tlmpc.mission.load import check_text
 from tlmpc.mission.model import Robot
 
@@ -486,3 +486,25 @@ def test_margin_is_kept_where_the_geometry_allows(
     assert ("R006" in codes) == (clearance < margin * (1 - 1e-9))
     assert ("R007" in codes) == (depth < wanted * (1 - 1e-9))
     assert _body_clearance(mission, trace) >= radius * (1 - 1e-9)
+
+
+@given(
+    corners=st.lists(st.tuples(st.floats(-5.0, 5.0), st.floats(-5.0, 5.0)), min_size=3, max_size=7),
+    distance=st.floats(0.01, 2.0),
+    grow=st.booleans(),
+)
+def test_a_conservative_offset_keeps_the_whole_distance_despite_the_chords(
+    corners: list[tuple[float, float]], distance: float, grow: bool
+) -> None:
+    """Shapely draws an offset's arcs as chords, whose middles dip towards the shape: buffered
+    (or eroded) by :func:`conservative_offset`, every point of the result's boundary, a
+    chord's middle included, is at least the distance from the shape's boundary."""
+    shape = shapely.convex_hull(shapely.MultiPoint(corners))
+    assume(isinstance(shape, shapely.Polygon) and shape.area > 0.5)
+    reach = conservative_offset(distance)
+    offset = shape.buffer(reach if grow else -reach, quad_segs=ARC_SEGMENTS)
+    assume(not offset.is_empty)
+    boundary = shapely.segmentize(offset.boundary, distance / 50.0)
+    points = shapely.points(shapely.get_coordinates(boundary))
+    nearest = float(shapely.distance(shape.boundary, points).min())
+    assert nearest >= distance * (1.0 - 1e-9), (nearest, distance)
