@@ -20,16 +20,7 @@ from test_automata_formats import benchmark
 from tlmpc.automata import guard_holds, translate
 from tlmpc.automata.model import Automaton
 from tlmpc.ltl import parse_ltl, to_spin
-from tlmpc.ltl.ast import (
-    Eventually,
-    Formula,
-    Globally,
-    Not,
-    Release,
-    StrongRelease,
-    Until,
-    WeakUntil,
-)
+from tlmpc.ltl.ast import Formula, Not, is_temporal
 
 pytestmark = oracle_required(shutil.which("spin") is not None, "spin")
 
@@ -138,14 +129,10 @@ def test_claim_parser_sanity() -> None:
     assert intersection_empty(aut, spin_claim("<> [] !a"), ["a"])
 
 
-#: The temporal operators of the benchmark's language.
-TEMPORAL = (Until, Release, WeakUntil, StrongRelease, Eventually, Globally)
-
-
 def temporal_depth(formula: Formula) -> int:
     """How deeply temporal operators nest in ``formula``."""
     below = max((temporal_depth(child) for child in formula.children()), default=0)
-    return below + (1 if isinstance(formula, TEMPORAL) else 0)
+    return below + (1 if is_temporal(formula) else 0)
 
 
 # The explicit product enumerates every letter: formulas over more than 5 propositions are
