@@ -137,11 +137,11 @@ def test_the_vertex_programs_own_fields_reject_the_disturbance(disturbance: floa
     disturbance's margin and the speed bound: the re-check after the solve, which rebuilds a
     failing field from its triangle alone, is a safety net, not what makes the fields robust."""
     from tlmpc.control.synthesize import (
-        RECHECK_TOLERANCE,
         _affine_controller,
         _assign_runs,
         _violated_condition,
         plan_steps,
+        run_push,
         solve_vertex_program,
         vertex_program,
     )
@@ -153,8 +153,7 @@ def test_the_vertex_programs_own_fields_reject_the_disturbance(disturbance: floa
     mission, abstraction = built.compilation.get(MISSION), built.compilation.get(ABSTRACTION)
     robot = mission.robot
     steps, loop_start = plan_steps(abstraction, built.compilation.get(WITNESS))
-    push = disturbance * (1.0 + RECHECK_TOLERANCE) + RECHECK_TOLERANCE * robot.max_speed
-    _assign_runs(abstraction, steps, loop_start, push=push, max_speed=robot.max_speed)
+    _assign_runs(abstraction, steps, loop_start, push=run_push(robot), max_speed=robot.max_speed)
     affine = [step for step in steps if step.through is None]
     program, column = vertex_program(affine, robot.max_speed, disturbance)
     velocities, _speeds = solve_vertex_program(program)

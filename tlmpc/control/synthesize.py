@@ -462,6 +462,15 @@ def solve_vertex_program(program: VertexProgram) -> tuple[FloatArray, FloatArray
 RECHECK_TOLERANCE = 1e-9
 
 
+def run_push(robot: Robot) -> float:
+    """How hard a velocity shared along a vertex run must push along every facet the run
+    collects: harder than the disturbance (as the re-check demands), or, without one, merely
+    positively (0)."""
+    if robot.disturbance > 0.0:
+        return robot.disturbance * (1.0 + RECHECK_TOLERANCE) + RECHECK_TOLERANCE * robot.max_speed
+    return 0.0
+
+
 def _violated_condition(
     controller: StepController,
     max_speed: float,
@@ -682,13 +691,7 @@ def synthesize(
             None if supported is None else float(supported),
             None if cells_bound is None else float(cells_bound),
         )
-    # A velocity shared along a vertex run must push harder than the disturbance along every
-    # facet the run collects (without one, merely positive along each: push 0).
-    push = (
-        robot.disturbance * (1.0 + RECHECK_TOLERANCE) + RECHECK_TOLERANCE * robot.max_speed
-        if robot.disturbance > 0.0
-        else 0.0
-    )
+    push = run_push(robot)
     guides = (
         path_guides(
             abstraction,
