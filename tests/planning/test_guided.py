@@ -398,6 +398,15 @@ rects = st.tuples(st.integers(0, 8), st.integers(0, 6), st.integers(1, 3), st.in
     "right",
     False,
 )
+@example(  # a lasso it holds on the way costs more than the optimum, by less than 25 %
+    "visit b while avoiding c",
+    [(2, 4, 1, 1), (4, 6, 2, 2), (6, 1, 3, 1)],
+    True,
+    "length",
+    0.5,
+    "closed",
+    False,
+)
 def test_guided_lasso_costs_what_the_built_product_gives(
     task: str,
     regions: list[tuple[int, int, int, int]],

@@ -24,6 +24,7 @@ from tlmpc.mission.load import load_mission_text
 from tlmpc.mission.model import Mission
 from tlmpc.reactive.synthesize import strategy_to_json, synthesize
 from tlmpc.runtime.environments import (
+    FAIRNESS_BOUND,
     AdversarialEnvironment,
     Change,
     Environment,
@@ -302,6 +303,40 @@ def test_a_constant_environment_still_gets_a_patrol(guard: Compiled) -> None:
     letters = word(run.trace)
     assert sum("home" in letter for letter in letters) >= 3
     assert sum("post" in letter for letter in letters) >= 3
+    check_run(run.trace, guard[2])
+
+
+class _StarvingEnvironment(AdversarialEnvironment):
+    """An adversary whose own choice is always a person in view: only the generated
+    environments' shared fairness bookkeeping can make it give ``G F !person``."""
+
+    def _worst(
+        self,
+        executor: ReactiveExecutor,
+        options: list[dict[str, bool]],
+        *,
+        moved: bool = False,
+        first: bool = False,
+    ) -> dict[str, bool]:
+        seen = [reading for reading in options if reading["person"]]
+        return super()._worst(executor, seen or options, moved=moved, first=first)
+
+
+def test_a_starving_environment_is_made_to_meet_the_fairness_assumption(
+    guard: Compiled,
+) -> None:
+    """An environment that would keep ``person`` on forever gives ``!person`` within
+    :data:`FAIRNESS_BOUND` events, and the run keeps the assumptions and the task."""
+    executor = executor_of(guard)
+    starving = _StarvingEnvironment(executor.machine.sensors, 0, time_scale(executor))
+    run = run_reactive(executor, starving, events=80)
+    longest = stretch = 0
+    for event in run.executor.events:
+        stretch = stretch + 1 if event.sensors["person"] else 0
+        longest = max(longest, stretch)
+    # it does starve until forced (not vacuous), and never past the bound
+    assert FAIRNESS_BOUND - 1 <= longest <= FAIRNESS_BOUND
+    assert any(not event.sensors["person"] for event in run.executor.events[1:])
     check_run(run.trace, guard[2])
 
 
