@@ -56,6 +56,9 @@ class Browser:
             stdout=subprocess.DEVNULL,
             stderr=subprocess.DEVNULL,
             start_new_session=True,  # its helper processes share our browser's process group
+            # its shared-memory files (--disable-dev-shm-usage) go to TMPDIR: in the profile,
+            # removed with it, not left behind in /tmp by every run
+            env={**os.environ, "TMPDIR": self.profile.name},
         )
         self.errors: list[str] = []
         self.requests: list[str] = []
