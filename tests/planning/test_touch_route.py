@@ -56,3 +56,24 @@ task: ["visit goal"]
     result = compile_mission("straight.yaml", text=text)
     stats = result.compilation.get(WITNESS).stats
     assert "touch_length" not in stats
+
+
+def test_the_patrol_touches_the_goal_its_lap_crossed() -> None:
+    """The shipped patrol's lap crossed `charlie`'s core, one triangle, from one base corner
+    to the other; split where the lap touches it (the visit candidate), the kept path is
+    shorter, its trace verifies, and its lap is nearer the best tour (the independent tour
+    oracle) than without the candidate."""
+    from test_shortest_route import _lap_over_best_tour
+
+    spec = ROOT / "specs" / "patrol.yaml"
+    result = compile_mission(spec)
+    with mock.patch.object(shortest, "visit_touch_candidate", return_value=None):
+        plain = compile_mission(spec)
+    stats = result.compilation.get(WITNESS).stats
+    plain_stats = plain.compilation.get(WITNESS).stats
+    assert "visit_lengths" not in plain_stats
+    assert stats["path_length"] == min(stats["visit_lengths"])
+    assert stats["path_length"] < plain_stats["path_length"] * (1.0 - shortest.MIN_GAIN)
+    assert result.artifacts["abstraction.json"]["stats"]["split_for_touches"] > 0
+    assert result.summary()["verdict"]["satisfied"] is True
+    assert _lap_over_best_tour(result) < _lap_over_best_tour(plain) - 0.01

@@ -33,7 +33,9 @@ into rings where its path bends round a corner (:mod:`tlmpc.pipeline.corners`), 
 there the same way (:class:`_Rounds`), and the shortest path pulled there is kept when its
 **trajectory** is shorter, its path no longer and its exact time no longer than the midpoint
 plan's (:meth:`_Kept.offer_trajectory`): the cut is for the fields to follow the path closer,
-which the path's length does not see.
+which the path's length does not see.  Last, the kept plan's visits are touched rather than
+crossed where that is shorter (:func:`tlmpc.pipeline.touches.visit_touch_candidate`), re-planned
+there and kept on the re-plans' terms.
 
 Every round is deterministic (operations are counted, no clock is read).  What is promised
 (docs/planning.md): the kept plan's path is never longer, and its trajectory never slower,
@@ -55,7 +57,7 @@ import numpy as np
 from tlmpc.base.errors import TlmpcError
 from tlmpc.mission.model import Mission
 from tlmpc.pipeline.corners import Bends, corner_candidate, followed_path, plan_bends
-from tlmpc.pipeline.touches import touch_candidate
+from tlmpc.pipeline.touches import touch_candidate, visit_touch_candidate
 from tlmpc.planning.mission import Planned, replan
 from tlmpc.planning.product import START_SLOT, STUTTER_COST
 from tlmpc.planning.timing import MoveKey, MoveTimes, move_key
@@ -97,7 +99,10 @@ def plan_shortest(mission: Mission, planned: Planned) -> Planned:
     ``order_lengths`` (each order's path length, the first plan's order first); and where a
     plan with U-turns gave a touch candidate (:mod:`tlmpc.pipeline.touches`)
     ``touch_length`` (its path length) and, when that was short enough to simulate,
-    ``touch_time`` (its exact time).
+    ``touch_time`` (its exact time); the ring and corridor candidates' ``ring_lengths``,
+    ``ring_time``, ``corridor_lengths`` and ``corridor_time``; and where the kept plan's visits
+    gave one (:func:`~tlmpc.pipeline.touches.visit_touch_candidate`) ``visit_lengths`` (its
+    rounds' path lengths) and, when it was simulated, ``visit_time``.
     """
     spent = _nodes(planned)  # product nodes of the plans made so far
     if mission.options.cost != "length" or spent + spent > NODE_BUDGET:
@@ -198,6 +203,34 @@ def plan_shortest(mission: Mission, planned: Planned) -> Planned:
             time = kept.offer_trajectory(*ring_rounds.best)
             if time is not None:
                 extra[f"{kind}_time"] = time
+    # The kept plan's visits touched rather than crossed (tlmpc.pipeline.touches): its mesh
+    # split where its path would touch a label it visits, re-planned there as above, kept
+    # on the re-plans' terms.
+    if spent + 2 * _nodes(kept.planned) <= NODE_BUDGET:
+        now = plan_bends(mission, kept.planned)
+        visiting = (
+            None
+            if now is None
+            else visit_touch_candidate(mission, kept.planned, now.guides, now.floor)
+        )
+        found_visit = None if visiting is None else _pulled(mission, visiting)
+        if visiting is not None and found_visit is not None:
+            spent += _nodes(visiting)
+            visit_rounds = _Rounds(
+                mission,
+                visiting,
+                ratio,
+                measured=dict(found_visit.moves),
+                seen={visiting.route()},
+                history=[found_visit.length],
+                best=(visiting, found_visit),
+            )
+            spent = visit_rounds.run(MAX_RING_REPLANS, spent)
+            extra["visit_lengths"] = visit_rounds.history
+            assert visit_rounds.best is not None
+            time = kept.offer(*visit_rounds.best, verified=True)
+            if time is not None:
+                extra["visit_time"] = time
     best = kept.planned
     stats: dict[str, Any] = {
         **best.witness.stats,
