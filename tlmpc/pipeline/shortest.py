@@ -184,23 +184,10 @@ def plan_shortest(mission: Mission, planned: Planned) -> Planned:
             if bends is None:
                 break  # its steps cannot be read (the control stage will say why)
         ringed = corner_candidate(mission, base_plan, bends, refine=refine)
-        found_ring = None if ringed is None else _pulled(mission, ringed)
-        if ringed is not None and found_ring is not None:
-            spent += _nodes(ringed)
-            ring_rounds = _Rounds(
-                mission,
-                ringed,
-                ratio,
-                measured=dict(found_ring.moves),
-                seen={ringed.route()},
-                history=[found_ring.length],
-                best=(ringed, found_ring),
-            )
-            spent = ring_rounds.run(MAX_RING_REPLANS, spent)
-            kind = "corridor" if refine else "ring"
-            extra[f"{kind}_lengths"] = ring_rounds.history
-            assert ring_rounds.best is not None
-            time = kept.offer_trajectory(*ring_rounds.best)
+        kind = "corridor" if refine else "ring"
+        ring_best, spent = _candidate_rounds(mission, ringed, ratio, spent, extra, kind)
+        if ring_best is not None:
+            time = kept.offer_trajectory(*ring_best)
             if time is not None:
                 extra[f"{kind}_time"] = time
     # The kept plan's visits touched rather than crossed (tlmpc.pipeline.touches): its mesh
@@ -208,27 +195,10 @@ def plan_shortest(mission: Mission, planned: Planned) -> Planned:
     # on the re-plans' terms.
     if spent + 2 * _nodes(kept.planned) <= NODE_BUDGET:
         now = plan_bends(mission, kept.planned)
-        visiting = (
-            None
-            if now is None
-            else visit_touch_candidate(mission, kept.planned, now.guides, now.floor)
-        )
-        found_visit = None if visiting is None else _pulled(mission, visiting)
-        if visiting is not None and found_visit is not None:
-            spent += _nodes(visiting)
-            visit_rounds = _Rounds(
-                mission,
-                visiting,
-                ratio,
-                measured=dict(found_visit.moves),
-                seen={visiting.route()},
-                history=[found_visit.length],
-                best=(visiting, found_visit),
-            )
-            spent = visit_rounds.run(MAX_RING_REPLANS, spent)
-            extra["visit_lengths"] = visit_rounds.history
-            assert visit_rounds.best is not None
-            time = kept.offer(*visit_rounds.best, verified=True)
+        visiting = None if now is None else visit_touch_candidate(mission, kept.planned, now.guides)
+        visit_best, spent = _candidate_rounds(mission, visiting, ratio, spent, extra, "visit")
+        if visit_best is not None:
+            time = kept.offer(*visit_best, verified=True)
             if time is not None:
                 extra["visit_time"] = time
     best = kept.planned
@@ -242,6 +212,36 @@ def plan_shortest(mission: Mission, planned: Planned) -> Planned:
         **extra,
     }
     return replace(best, witness=replace(best.witness, stats=stats))
+
+
+def _candidate_rounds(
+    mission: Mission,
+    candidate: Planned | None,
+    ratio: float,
+    spent: int,
+    extra: dict[str, Any],
+    kind: str,
+) -> tuple[tuple[Planned, Pulled] | None, int]:
+    """A candidate on another mesh pulled and re-planned there (up to
+    :data:`MAX_RING_REPLANS` rounds within the budget): its shortest plan and path (None
+    when there is no candidate or its path cannot be pulled) and the nodes ``spent`` after
+    it; its rounds' path lengths recorded in ``extra`` as ``{kind}_lengths``."""
+    found = None if candidate is None else _pulled(mission, candidate)
+    if candidate is None or found is None:
+        return None, spent
+    spent += _nodes(candidate)
+    rounds = _Rounds(
+        mission,
+        candidate,
+        ratio,
+        measured=dict(found.moves),
+        seen={candidate.route()},
+        history=[found.length],
+        best=(candidate, found),
+    )
+    spent = rounds.run(MAX_RING_REPLANS, spent)
+    extra[f"{kind}_lengths"] = rounds.history
+    return rounds.best, spent
 
 
 class _Rounds:

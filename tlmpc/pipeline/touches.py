@@ -187,17 +187,15 @@ def _centroid(mesh: Abstraction, triangle: int) -> Point:
 
 
 def visit_touch_candidate(
-    mission: Mission,
-    planned: Planned,
-    guides: Sequence[Guide | None],
-    floor: float,
+    mission: Mission, planned: Planned, guides: Sequence[Guide | None]
 ) -> Planned | None:
     """``planned`` planned again on its mesh split where its path could touch the labels it
-    visits instead of crossing into them (:func:`visit_touches`), the split points cut into
-    rings (:func:`tlmpc.pipeline.corners.ring_counts`, none thinner than ``floor``) so that
-    the moves round them weigh little on the midpoint lengths; None when no visit gains or
-    the plan fails.  ``guides``: ``planned``'s path as its fields follow it, one piece per
-    plan step."""
+    visits instead of crossing into them (:func:`visit_touches`), the moves of the triangles
+    round each split point weighing their pieces of the touching path (:func:`_pieces`; on
+    the midpoint lengths the new spoke's middle, half way to the label's far corner, hides
+    the touch) and the others their midpoint lengths; None when no visit gains or the plan
+    fails.  ``guides``: ``planned``'s path as its fields follow it, one piece per plan
+    step."""
     from tlmpc.control.synthesize import plan_steps
 
     mesh = planned.abstraction
@@ -212,8 +210,6 @@ def visit_touch_candidate(
     refined = split_edges(mesh, [(t, edge, u) for t, edge, u, _, _ in touches], start)
     if refined is mesh:
         return None
-    # the moves round each split point weigh their pieces of the path touching it (on the
-    # midpoint lengths the spoke's middle, half way to the label's far corner, hides it)
     measured: dict[MoveKey, float] = {}
     for vertex in range(len(mesh.vertices), len(refined.vertices)):
         p = _point(refined, vertex)
