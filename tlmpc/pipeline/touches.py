@@ -40,7 +40,8 @@ import numpy as np
 from tlmpc.abstraction.model import Abstraction
 from tlmpc.abstraction.touch import EDGE_MARGIN, split_edges
 from tlmpc.base.errors import TlmpcError
-from tlmpc.control.channel import Guide, Point, Portal, funnel
+from tlmpc.control.channel import Guide, Point, Portal, _cross, funnel
+from tlmpc.control.follow import turn_sine
 from tlmpc.mission.model import Mission
 from tlmpc.planning.mission import Planned, again, replan
 from tlmpc.planning.product import STUTTER_COST
@@ -233,7 +234,7 @@ def _close(p: Point, touch: tuple[int, int, float, Point, Point], mesh: Abstract
     corners = mesh.triangles[t].tolist()
     a, b = _point(mesh, corners[(edge + 1) % 3]), _point(mesh, corners[(edge + 2) % 3])
     scale = math.dist(a, b)
-    return abs(_side(a, b, p)) <= 1e-9 * scale * scale
+    return abs(_cross(a, b, p)) <= 1e-9 * scale * scale
 
 
 def _pieces(mesh: Abstraction, vertex: int, x: Point, y: Point) -> dict[MoveKey, float]:
@@ -296,7 +297,7 @@ def _along(path: Sequence[Point], distance: float) -> Point:
 
 def _inside(corners: Sequence[Point], point: Point) -> bool:
     """Whether ``point`` lies in the triangle (either orientation)."""
-    sides = [_side(corners[k], corners[(k + 1) % 3], point) for k in range(3)]
+    sides = [_cross(corners[k], corners[(k + 1) % 3], point) for k in range(3)]
     return all(side >= 0.0 for side in sides) or all(side <= 0.0 for side in sides)
 
 
@@ -385,14 +386,12 @@ def visit_touches(
 
 def _bend_indices(points: Sequence[Point]) -> list[int]:
     """The inner points of a polyline where it turns by more than :data:`VISIT_BEND`."""
-    bends = []
-    for i in range(1, len(points) - 1):
-        a, b, c = points[i - 1], points[i], points[i + 1]
-        ax, ay, bx, by = b[0] - a[0], b[1] - a[1], c[0] - b[0], c[1] - b[1]
-        norms = math.hypot(ax, ay) * math.hypot(bx, by)
-        if norms > 0.0 and abs(ax * by - ay * bx) / norms > VISIT_BEND:
-            bends.append(i)
-    return bends
+    return [
+        i
+        for i in range(1, len(points) - 1)
+        if abs(turn_sine(Guide(points[i - 1], points[i]), Guide(points[i], points[i + 1])))
+        > VISIT_BEND
+    ]
 
 
 def _index_of(points: Sequence[Point], point: Point, after: int = 0) -> int | None:
@@ -450,8 +449,8 @@ def _best_touch(
             a = _point(mesh, corners[(edge + 1) % 3])
             b = _point(mesh, corners[(edge + 2) % 3])
             inside = _point(mesh, corners[edge])
-            side = _side(a, b, inside)
-            if _side(a, b, x) * side >= 0.0 or _side(a, b, y) * side >= 0.0:
+            side = _cross(a, b, inside)
+            if _cross(a, b, x) * side >= 0.0 or _cross(a, b, y) * side >= 0.0:
                 continue  # x or y not across the edge from the label
             u = min(1.0 - EDGE_MARGIN, max(EDGE_MARGIN, _touch(a, b, x, y)))
             p = (a[0] + u * (b[0] - a[0]), a[1] + u * (b[1] - a[1]))
@@ -459,7 +458,3 @@ def _best_touch(
             if best is None or length < best[0]:
                 best = (length, t, edge, u)
     return best
-
-
-def _side(a: Point, b: Point, c: Point) -> float:
-    return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
