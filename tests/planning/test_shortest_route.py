@@ -265,7 +265,8 @@ def test_other_metrics_are_left_alone() -> None:
 @given(missions())
 def test_random_missions_keep_the_shorter_route(document: dict[str, Any]) -> None:
     """On random missions: the kept route's path is never longer than the midpoint plan's,
-    and a plan kept is one the loop pulled (a round's, or the touch candidate's)."""
+    and a plan kept is one the loop pulled (a round's, or a candidate's: the touch, ring,
+    corridor or visit candidate)."""
     try:
         result, first = _compiled(yaml.safe_dump(document))
     except TlmpcError:
@@ -282,6 +283,7 @@ def test_random_missions_keep_the_shorter_route(document: dict[str, Any]) -> Non
         witness.stats.get("touch_length"),
         *witness.stats.get("ring_lengths", ()),
         *witness.stats.get("corridor_lengths", ()),
+        *witness.stats.get("visit_lengths", ()),
     ]
     assert witness.stats["path_length"] in pulled
 
