@@ -192,11 +192,13 @@ def plan_shortest(mission: Mission, planned: Planned) -> Planned:
                 extra[f"{kind}_time"] = time
     # The kept plan's visits touched rather than crossed (tlmpc.pipeline.touches): its mesh
     # split where its path would touch a label it visits, re-planned there as above, kept
-    # on the re-plans' terms.
-    if spent + 2 * _nodes(kept.planned) <= NODE_BUDGET:
+    # on the re-plans' terms.  Its own budget, as the touch candidate's (what the rounds
+    # above spent does not count: run last, it would otherwise rarely run at all).
+    if 2 * _nodes(kept.planned) <= NODE_BUDGET:
         now = plan_bends(mission, kept.planned)
         visiting = None if now is None else visit_touch_candidate(mission, kept.planned, now.guides)
-        visit_best, spent = _candidate_rounds(mission, visiting, ratio, spent, extra, "visit")
+        own = _nodes(kept.planned)  # the nodes its budget has spent: the kept plan's
+        visit_best, _ = _candidate_rounds(mission, visiting, ratio, own, extra, "visit")
         if visit_best is not None:
             time = kept.offer(*visit_best, verified=True)
             if time is not None:
