@@ -14,7 +14,9 @@ how the interpreter was started (the ``tlmpc`` console script, or ``python -m tl
 The interpreter's own start-up, before the first line of tlmpc runs, is out of any program's
 reach: a SIGTERM then kills the process by the signal (the shell reports 143), a Ctrl-C
 while Python's ``site`` module runs gets Python's own message, and one raised in a callback of
-its import machinery is dropped by Python ("Exception ignored"), the run going on.
+its import machinery, or while it checks whether a script's path is an import path entry, is
+dropped by Python ("Exception ignored", "Failed checking if argv[0] is an import path entry"),
+the run going on.
 """
 
 from __future__ import annotations
