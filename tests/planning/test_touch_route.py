@@ -6,7 +6,9 @@ verdict), the mesh checked for conformity by the abstraction tests' own checker.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
+from typing import Any
 from unittest import mock
 
 from tlmpc.pipeline import shortest
@@ -82,12 +84,44 @@ def test_the_patrol_touches_the_goal_its_lap_crossed() -> None:
     assert _lap_over_best_tour(result) < _lap_over_best_tour(plain) - 0.01
 
 
-def test_example6s_visits_are_touched_after_its_touch_candidate() -> None:
-    """On Example 6 the visit candidate runs on the touch candidate's split mesh, within a
-    budget of its own (the rounds before it spent the shared one), and its shorter path is
-    kept: the trace verifies."""
-    result = compile_mission(str(ROOT / "specs" / "example6.yaml"))
-    stats = result.compilation.get(WITNESS).stats
-    assert stats["path_length"] == min(stats["visit_lengths"])
-    assert stats["path_length"] < stats["touch_length"] * (1.0 - shortest.MIN_GAIN)
-    assert result.summary()["verdict"]["satisfied"] is True
+def test_each_split_point_weighs_the_path_of_its_own_visit() -> None:
+    """Example 6's visits touch goal cores whose edges lie on common lines (the rooms stand
+    in rows): the moves round each split point weigh the path x -> p -> y of the visit that
+    split there, not that of another visit whose edge lies on the same line."""
+    from tlmpc.pipeline import touches
+
+    meshes: list[Any] = []
+    found: list[Any] = []
+    weighed: list[tuple[tuple[float, float], Any, Any]] = []
+    visit_touches, pieces = touches.visit_touches, touches._pieces
+
+    def recorded_touches(mesh: Any, *rest: Any) -> Any:
+        meshes.append(mesh)
+        found[:] = visit_touches(mesh, *rest)
+        return found
+
+    def recorded_pieces(mesh: Any, vertex: int, x: Any, y: Any) -> Any:
+        weighed.append(((float(mesh.vertices[vertex, 0]), float(mesh.vertices[vertex, 1])), x, y))
+        return pieces(mesh, vertex, x, y)
+
+    with (
+        mock.patch.object(touches, "visit_touches", recorded_touches),
+        mock.patch.object(touches, "_pieces", recorded_pieces),
+    ):
+        compile_mission(str(ROOT / "specs" / "example6.yaml"), until="plan")
+    mesh = meshes[-1]
+
+    def split_point(t: int, edge: int, u: float) -> tuple[float, float]:
+        corners = mesh.vertices[mesh.triangles[t]]
+        a, b = corners[(edge + 1) % 3], corners[(edge + 2) % 3]
+        return (float(a[0] + u * (b[0] - a[0])), float(a[1] + u * (b[1] - a[1])))
+
+    points = [split_point(t, edge, u) for t, edge, u, _, _ in found]
+    # (split_edges skips a split whose triangles an earlier one cut)
+    assert 1 <= len(weighed) <= len(found)
+    lines = {round(point[1], 6) for point, _, _ in weighed}
+    assert len(lines) < len(weighed)  # two split points on one line at least
+    for point, x, y in weighed:
+        mine = [k for k, touch in enumerate(found) if (touch[3], touch[4]) == (x, y)]
+        assert len(mine) == 1
+        assert math.dist(point, points[mine[0]]) < 1e-9

@@ -195,8 +195,7 @@ def plan_shortest(mission: Mission, planned: Planned) -> Planned:
     # on the re-plans' terms.  Its own budget, as the touch candidate's (what the rounds
     # above spent does not count: run last, it would otherwise rarely run at all).
     if 2 * _nodes(kept.planned) <= NODE_BUDGET:
-        now = plan_bends(mission, kept.planned)
-        visiting = None if now is None else visit_touch_candidate(mission, kept.planned, now.guides)
+        visiting = visit_touch_candidate(mission, kept.planned)
         own = _nodes(kept.planned)  # the nodes its budget has spent: the kept plan's
         visit_best, _ = _candidate_rounds(mission, visiting, ratio, own, extra, "visit")
         if visit_best is not None:

@@ -187,17 +187,15 @@ def _centroid(mesh: Abstraction, triangle: int) -> Point:
     return (float(x), float(y))
 
 
-def visit_touch_candidate(
-    mission: Mission, planned: Planned, guides: Sequence[Guide | None]
-) -> Planned | None:
-    """``planned`` planned again on its mesh split where its path could touch the labels it
-    visits instead of crossing into them (:func:`visit_touches`), the moves of the triangles
-    round each split point weighing their pieces of the touching path (:func:`_pieces`; on
-    the midpoint lengths the new spoke's middle, half way to the label's far corner, hides
-    the touch) and the others their midpoint lengths; None when no visit gains or the plan
-    fails.  ``guides``: ``planned``'s path as its fields follow it, one piece per plan
-    step."""
+def visit_touch_candidate(mission: Mission, planned: Planned) -> Planned | None:
+    """``planned`` planned again on its mesh split where its path (as its fields follow it,
+    :func:`tlmpc.pipeline.corners.followed_path`) could touch the labels it visits instead
+    of crossing into them (:func:`visit_touches`), the moves of the triangles round each
+    split point weighing their pieces of the touching path (:func:`_pieces`; on the midpoint
+    lengths the new spoke's middle, half way to the label's far corner, hides the touch) and
+    the others their midpoint lengths; None when no visit gains or the plan fails."""
     from tlmpc.control.synthesize import plan_steps
+    from tlmpc.pipeline.corners import followed_path
 
     mesh = planned.abstraction
     start = mission.robot.start
@@ -205,19 +203,21 @@ def visit_touch_candidate(
         steps, loop_start = plan_steps(mesh, planned.witness)
     except TlmpcError:
         return None
+    guides = followed_path(mission, planned, steps, loop_start)
     touches = visit_touches(mesh, [s.triangle for s in steps], guides, loop_start)
     if not touches:
         return None
     refined = split_edges(mesh, [(t, edge, u) for t, edge, u, _, _ in touches], start)
     if refined is mesh:
         return None
+    # split_edges appends one point per split it makes (it may skip some): each is paired
+    # with the touch whose point of its edge it is
+    wanted = [(_split_point(mesh, touch), touch[3], touch[4]) for touch in touches]
     measured: dict[MoveKey, float] = {}
     for vertex in range(len(mesh.vertices), len(refined.vertices)):
         p = _point(refined, vertex)
-        near = [ends for ends in touches if _close(p, ends, mesh)]
-        if near:
-            _, _, _, x, y = near[0]
-            measured.update(_pieces(refined, vertex, x, y))
+        _, x, y = min(wanted, key=lambda w: math.dist(w[0], p))
+        measured.update(_pieces(refined, vertex, x, y))
     try:
         return replan(
             mission,
@@ -228,13 +228,12 @@ def visit_touch_candidate(
         return None
 
 
-def _close(p: Point, touch: tuple[int, int, float, Point, Point], mesh: Abstraction) -> bool:
-    """Whether split point ``p`` lies on ``touch``'s edge of ``mesh``."""
-    t, edge, _, _, _ = touch
+def _split_point(mesh: Abstraction, touch: tuple[int, int, float, Point, Point]) -> Point:
+    """The point of ``mesh`` where ``touch`` splits its edge."""
+    t, edge, u, _, _ = touch
     corners = mesh.triangles[t].tolist()
     a, b = _point(mesh, corners[(edge + 1) % 3]), _point(mesh, corners[(edge + 2) % 3])
-    scale = math.dist(a, b)
-    return abs(_cross(a, b, p)) <= 1e-9 * scale * scale
+    return (a[0] + u * (b[0] - a[0]), a[1] + u * (b[1] - a[1]))
 
 
 def _pieces(mesh: Abstraction, vertex: int, x: Point, y: Point) -> dict[MoveKey, float]:
