@@ -357,7 +357,12 @@ def _output_lost(lost: _OutputLost, raw_out: TextIO, raw_err: TextIO, err: TextI
 
 
 def _ended_by(signalled: BaseException, err: TextIO) -> int:
-    """Say that Ctrl-C or SIGTERM ended the run; its exit code (130 or 143)."""
+    """Say that Ctrl-C or SIGTERM ended the run; its exit code (130 or 143).
+
+    The run's result is final from here: a signal still on its way (a swallowed one's
+    redelivery, armed a moment before) is late, and the run is not ended, nor said to be,
+    twice."""
+    settled.settle()
     terminated = isinstance(signalled, _Terminated)
     with contextlib.suppress(Exception):
         err.write("tlmpc: terminated\n" if terminated else "tlmpc: interrupted\n")

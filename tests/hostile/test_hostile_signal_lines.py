@@ -155,3 +155,27 @@ def test_a_sigterm_at_every_point_of_the_run_ends_it_cleanly(
     assert endings["late"], endings
     assert max(endings["guard"], default=0) < min(endings["terminated"]), endings
     assert max(endings["terminated"]) < min(endings["late"]), endings
+
+
+@pytest.mark.parametrize("signalled", ["terminated", "interrupted"])
+def test_a_signal_redelivered_after_the_run_ended_by_one_is_late(signalled: str) -> None:
+    """A run ended by a signal whose exception a finaliser had swallowed arms a redelivery
+    (SIGALRM a moment later): once the run is said to have ended, that redelivery is late,
+    neither raising again nor saying "tlmpc: terminated" twice (the exact-point test above
+    met it under load, the alarm landing before the handlers were given back)."""
+    import tlmpc.cli as cli
+    from tlmpc.base import settled
+
+    exception = cli._Terminated() if signalled == "terminated" else KeyboardInterrupt()
+    err = io.StringIO()
+    settled.begin()
+    cli._RECEIVED[:] = [signal.SIGTERM if signalled == "terminated" else signal.SIGINT]
+    try:
+        assert cli._ended_by(exception, err) == (143 if signalled == "terminated" else 130)
+        cli._on_redelivery(signal.SIGALRM, None)  # late: returns, raises nothing
+        cli._on_sigterm(signal.SIGTERM, None)
+        cli._on_sigint(signal.SIGINT, None)
+    finally:
+        cli._RECEIVED.clear()
+        settled.begin()
+    assert err.getvalue() == f"tlmpc: {signalled}\n"
