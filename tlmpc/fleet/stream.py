@@ -40,7 +40,9 @@ import numpy.typing as npt
 from tlmpc.base.errors import Diagnostic, UsageError
 from tlmpc.verify import Verdict, declare_ending, from_document, verify_trace
 from tlmpc.verify.model import Certificate
+from tlmpc.verify.robustness import speed_excess
 from tlmpc.verify.samples import MAX_PER_KIND, sample_diagnostics
+from tlmpc.verify.trace_input import certifying_speed
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -50,9 +52,6 @@ MARGIN = 1e-9
 
 #: Samples per chunk of a bag (read whole by its reader, then streamed like a CSV).
 BAG_CHUNK = 100_000
-
-#: Relative slack on the speed check (the verifier's own).
-SPEED_SLACK = 1e-9
 
 
 def _rings(document: Mapping[str, Any]) -> tuple[list[FloatArray], list[FloatArray]]:
@@ -328,7 +327,9 @@ def _verify_log(
     reducer = Reducer(document, pin_time=loop_from)
     top_speed = 0.0
     max_gap = 0.0
-    where: tuple[float, float] | None = None
+    limit = certifying_speed(document.get("max_speed"))
+    # the fastest gap beyond what max_speed allows (the verifier's speed check), and where
+    violation: tuple[float, tuple[float, float]] | None = None
     last: FloatArray | None = None
     chunks = _log_chunks(
         path,
@@ -344,10 +345,13 @@ def _verify_log(
         if len(joined) > 1:
             max_gap = max(max_gap, float(np.diff(joined[:, 0]).max()))
             steps = np.hypot(np.diff(joined[:, 1]), np.diff(joined[:, 2])) / np.diff(joined[:, 0])
-            index = int(np.argmax(steps))
-            if steps[index] > top_speed:
-                top_speed = float(steps[index])
-                where = (float(joined[index, 0]), float(joined[index + 1, 0]))
+            top_speed = max(top_speed, float(steps.max()))
+            excess = None if limit is None else speed_excess(joined[:, 0], joined[:, 1:], limit)
+            if excess is not None and excess.any():
+                index = int(np.argmax(np.where(excess > 0.0, steps, -np.inf)))
+                if violation is None or steps[index] > violation[0]:
+                    where = (float(joined[index, 0]), float(joined[index + 1, 0]))
+                    violation = (float(steps[index]), where)
         if len(samples):
             last = samples[-1:].copy()
         reducer.feed(samples)
@@ -358,7 +362,7 @@ def _verify_log(
     verdict = dataclasses.replace(
         verdict,
         certificate=_raw_speed(
-            dataclasses.replace(verdict.certificate, max_gap=max_gap), top_speed, where
+            dataclasses.replace(verdict.certificate, max_gap=max_gap), top_speed, violation
         ),
         stats={**verdict.stats, "samples": reducer.count, "kept_samples": len(kept)},
     )
@@ -368,20 +372,21 @@ def _verify_log(
 
 
 def _raw_speed(
-    certificate: Certificate, observed: float, where: tuple[float, float] | None
+    certificate: Certificate, observed: float, violation: tuple[float, tuple[float, float]] | None
 ) -> Certificate:
-    """The certificate with the log's own top speed (every sample, not only the kept ones)."""
-    speed = certificate.max_speed
-    if speed is None or where is None or observed <= speed * (1 + SPEED_SLACK):
-        return dataclasses.replace(
-            certificate, observed_speed=max(observed, certificate.observed_speed)
-        )
+    """The certificate with the log's own top speed (every sample, not only the kept ones),
+    refused where some gap moves faster than max_speed allows (``violation``: its speed and
+    its times)."""
+    observed = max(observed, certificate.observed_speed)
+    if certificate.max_speed is None or violation is None:
+        return dataclasses.replace(certificate, observed_speed=observed)
+    fastest, (begin, end) = violation
     return dataclasses.replace(
         certificate,
         certified=False,
         observed_speed=observed,
         margin=None,
-        reason=f"the log moves at {observed:.4g} m/s between t={where[0]:.4g} s and "
-        f"t={where[1]:.4g} s, faster than max_speed {speed:.4g}: the certificate's assumption "
-        "does not hold",
+        reason=f"the log moves at {fastest:.4g} m/s between t={begin:.4g} s and "
+        f"t={end:.4g} s, faster than max_speed {certificate.max_speed:.4g}: the certificate's "
+        "assumption does not hold",
     )

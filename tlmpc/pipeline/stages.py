@@ -393,11 +393,7 @@ def _verify(c: Compilation) -> StageResult:
         )
     certificate = verdict_json["certificate"]
     bound = certificate["max_speed"]
-    if (
-        bound is not None
-        and certificate["observed_speed"] > bound * (1.0 + 1e-6)
-        and _outruns(document, bound)
-    ):
+    if bound is not None and _outruns(document, bound):
         # The controllers promise |u| <= max_speed; a faster trace breaks the guarantee too.
         raise SelfCheckError(
             error(
@@ -446,7 +442,7 @@ def _sampled_for_certificate(
         not verdict["satisfied"]
         or certificate["certified"]
         or speed is None
-        or certificate["observed_speed"] > speed  # (denser samples would not mend that)
+        or _outruns(document, speed)  # (denser samples would not mend that)
         or not isinstance(robustness, float)
         or not robustness > 0.0
     ):
@@ -468,17 +464,14 @@ def _sampled_for_certificate(
 
 
 def _outruns(trace: Mapping[str, Any], speed: float) -> bool:
-    """Whether some chord between consecutive samples is longer than ``speed`` times its time
-    by more than the floating-point rounding of its ends: crossing a sliver 1e-8 wide takes
-    1e-8 s, and the rounding of t ~ 10 and x ~ 5 alone is then 1e-7 of the ratio."""
+    """Whether some chord between consecutive samples is longer than ``speed`` allows over
+    its time (the verifier's speed check, :func:`tlmpc.verify.robustness.speed_excess`)."""
     import numpy as np
 
+    from tlmpc.verify.robustness import speed_excess
+
     samples = np.asarray(trace["points"], dtype=np.float64).reshape(-1, 3)
-    ends = np.abs(samples[:-1]) + np.abs(samples[1:])
-    rounding = 8 * np.finfo(np.float64).eps * (ends[:, 1] + ends[:, 2] + speed * ends[:, 0])
-    chords = np.hypot(*np.diff(samples[:, 1:], axis=0).T)
-    allowed = speed * np.diff(samples[:, 0]) * (1.0 + 1e-6) + rounding
-    return bool((chords > allowed).any())
+    return bool(speed_excess(samples[:, 0], samples[:, 1:], speed).any())
 
 
 def _synthesize(c: Compilation) -> StageResult:

@@ -143,6 +143,26 @@ def piece_atoms(
     return atom
 
 
+#: Relative slack on the speed check, beyond the rounding of the samples' own numbers.
+SPEED_SLACK = 1e-9
+
+
+def speed_excess(times: FloatArray, points: FloatArray, max_speed: float) -> FloatArray:
+    """Per gap between consecutive samples, how much longer its chord is than ``max_speed``
+    allows over its time, beyond :data:`SPEED_SLACK` and the floating-point rounding of its
+    ends (0 where it is not): the speed check of the certificate, of a streamed log and of
+    the compile's self-check.  The rounding matters across slivers: a chord 1e-8 long takes
+    1e-8 s, and the rounding of t ~ 10 and x ~ 5 alone is 1e-7 of its speed."""
+    gaps = np.diff(times)
+    chords = np.hypot(*np.diff(points, axis=0).T)
+    ends = np.abs(points[:-1]) + np.abs(points[1:])
+    spans = np.abs(times[:-1]) + np.abs(times[1:])
+    rounding = 8.0 * np.finfo(np.float64).eps * (ends[:, 0] + ends[:, 1] + max_speed * spans)
+    allowed = max_speed * gaps * (1.0 + SPEED_SLACK) + rounding
+    excess: FloatArray = np.maximum(chords - allowed, 0.0)
+    return excess
+
+
 def tube_radii(times: FloatArray, max_speed: float) -> FloatArray:
     """How far the robot may be from each sample while that sample is the nearest in time."""
     gaps = np.diff(times)

@@ -124,7 +124,7 @@ def _samples(rows: Any, file: str | None, lines: list[int] | None = None) -> Flo
     return array
 
 
-def _certifying_speed(speed: Any) -> float | None:
+def certifying_speed(speed: Any) -> float | None:
     """``max_speed`` when it can back the robustness certificate, else None.
 
     The certificate assumes the robot moves at most ``max_speed`` between samples: a speed
@@ -296,7 +296,7 @@ def from_document(
         components=components if boundary else (),
         convention=chosen,
         ending=ending,
-        max_speed=_certifying_speed(speed),
+        max_speed=certifying_speed(speed),
         source=file,
         radius=_radius(document.get("radius"), file),
         **reactive,

@@ -29,7 +29,7 @@ from tlmpc.verify.model import (
 )
 from tlmpc.verify.pieces import Pieces, build_pieces, merge_pieces, region_membership
 from tlmpc.verify.progress import Timeline, conjunct_reports, runs, timed_progress
-from tlmpc.verify.robustness import piece_atoms, tube_atoms, tube_radii
+from tlmpc.verify.robustness import piece_atoms, speed_excess, tube_atoms, tube_radii
 from tlmpc.verify.semantics import PieceEnding, Semantics, Timing
 from tlmpc.verify.signals import change_times, signal_labels, with_cuts
 from tlmpc.verify.time_robustness import horizon, reach, time_robustness
@@ -37,9 +37,6 @@ from tlmpc.verify.trace_input import TraceInput
 
 FloatArray = npt.NDArray[np.float64]
 BoolArray = npt.NDArray[np.bool_]
-
-#: Relative slack on the speed check (rounding of time stamps and positions).
-SPEED_SLACK = 1e-9
 
 
 def _conjuncts(formula: Formula) -> list[Formula]:
@@ -371,12 +368,13 @@ def certify(trace: TraceInput, regions: dict[str, FloatArray], outcome: Outcome)
 
     if speed is None:
         return refuse("no max_speed is known, so nothing bounds the motion between samples")
-    if observed > speed * (1 + SPEED_SLACK):
-        index = int(np.argmax(speeds))
+    excess = speed_excess(times, points, speed)
+    if excess.any():
+        index = int(np.argmax(np.where(excess > 0.0, speeds, -np.inf)))
         origin = float(times[0])
         begin, end = at(float(times[index]), origin), at(float(times[index + 1]), origin)
         return refuse(
-            f"the log moves at {observed:.4g} m/s between {begin} and {end}, "
+            f"the log moves at {float(speeds[index]):.4g} m/s between {begin} and {end}, "
             f"faster than max_speed {speed:.4g}: the "
             "certificate's assumption does not hold"
         )
