@@ -303,3 +303,25 @@ def test_first_violation_is_the_earliest(tmp_path: Path) -> None:
     assert first["conjunct"] == "G !hazard"
     assert first["t"] == pytest.approx(18.0 + 8.0 / 9.0)
     assert (first["x"], first["y"]) == (8.0, 2.0)
+
+
+def test_a_cached_error_names_its_own_log(tmp_path: Path) -> None:
+    # two logs with the same bytes, one bad sample: each record is told about its own file,
+    # from the cache or not
+    write_missions(tmp_path)  # (its missions: avoid.yaml among them)
+    logs = tmp_path / "logs"
+    logs.mkdir()
+    for name in ("first.csv", "second.csv"):
+        (logs / name).write_text("t,x,y\n0,1,1\n1,nan,1\n", encoding="utf-8")
+    argv = ("verify", str(logs), "--mission", str(tmp_path / "avoid.yaml"), "--jobs", "1")
+    cache = ("--cache", str(tmp_path / "cache"))
+    for run in range(2):
+        results = tmp_path / f"run{run}.jsonl"
+        code, _, _ = run_cli(*argv, *cache, "--results", str(results))
+        assert code == 2
+        rows = records(results)
+        assert [Path(r["log"]).name for r in rows] == ["first.csv", "second.csv"]
+        for row in rows:
+            assert row["verdict"] == "error"
+            assert row["error"]["message"].startswith(row["log"] + ":"), row
+        assert [r["cached"] for r in rows] == [run == 1, run == 1]

@@ -101,3 +101,56 @@ def test_a_refused_write_leaves_no_temporary_file(compiled: Path, work: Path) ->
     assert result.code == 2
     assert result.codes() == ["U083"]
     assert sorted(p.name for p in work.iterdir()) == ["out", "trace.json"]
+
+
+def _fleet(work: Path) -> tuple[Path, Path, Path]:
+    """Two logs and a mission mapping naming the mission file, inside ``work``."""
+    logs = work / "logs"
+    logs.mkdir()
+    for name, x in (("one.csv", 2.0), ("two.csv", 2.5)):
+        (logs / name).write_text(f"t,x,y\n0,{x},5\n1,{x + 0.5},5\n")
+    mission = work / "patrol.yaml"
+    mission.write_bytes((ROOT / "specs" / "patrol.yaml").read_bytes())
+    mapping = work / "missions.yaml"
+    mapping.write_text(
+        "format: tlmpc.fleet-missions/1\nmissions:\n  - {logs: '*.csv', mission: patrol.yaml}\n"
+    )
+    return logs / "one.csv", mission, mapping
+
+
+@pytest.mark.parametrize("flag", ["--results", "--report"])
+@pytest.mark.parametrize("target", ["logs/one.csv", "patrol.yaml", "missions.yaml"])
+def test_a_batch_never_writes_over_its_logs_or_missions(work: Path, flag: str, target: str) -> None:
+    _fleet(work)
+    result = run_hostile(
+        work, "verify", "logs", "--mission", "missions.yaml", "--no-cache", flag, target
+    )
+    assert result.code == 2
+    assert result.codes() == ["U043"]
+    assert result.out == ""  # refused before any log is verified
+
+
+def test_a_batchs_results_and_report_are_two_files(work: Path) -> None:
+    _fleet(work)
+    argv = ("verify", "logs", "--mission", "patrol.yaml", "--no-cache")
+    result = run_hostile(work, *argv, "--results", "r.out", "--report", "./r.out")
+    assert result.code == 2
+    assert result.codes() == ["U043"]
+
+
+def test_a_batch_never_replaces_a_fifo_and_keeps_a_files_mode(work: Path) -> None:
+    _fleet(work)
+    argv = ("verify", "logs", "--mission", "patrol.yaml", "--no-cache")
+    os.mkfifo(work / "pipe")
+    result = run_hostile(work, *argv, "--results", "pipe")
+    assert result.code == 2
+    assert result.codes() == ["F007"]
+    written = run_hostile(work, *argv, "--results", "r.jsonl", may_write=["r.jsonl"])
+    assert written.code in (0, 1, 4), written.err
+    umask = os.umask(0)
+    os.umask(umask)
+    assert (work / "r.jsonl").stat().st_mode & 0o777 == 0o666 & ~umask
+    (work / "r.jsonl").chmod(0o640)
+    again = run_hostile(work, *argv, "--results", "r.jsonl", may_write=["r.jsonl"])
+    assert again.code == written.code
+    assert (work / "r.jsonl").stat().st_mode & 0o777 == 0o640

@@ -11,19 +11,19 @@ import re
 from pathlib import Path
 from typing import Any
 
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from robot_data import require_shared
 
 from tlmpc.cli import main
 from tlmpc.verify import verdict_to_json, verify_document
-from tlmpc.verify.clock import at
+from tlmpc.verify.clock import at, seconds
 
 A = [[0.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0]]
 B = [[6.0, 0.0], [8.0, 0.0], [8.0, 2.0], [6.0, 2.0]]
 HAZARD = [[3.5, -1.0], [4.5, -1.0], [4.5, 3.0], [3.5, 3.0]]
 STAMP = re.compile(r" \(stamp ([0-9.e+-]+)\)")
-RELATIVE = re.compile(r"t=([0-9.e+-]+) s")
+STAMPED = re.compile(r"t=([0-9.e+-]+) s \(stamp ([0-9.e+-]+)\)")
 
 
 def _log(points: list[list[float]], ltl: str) -> dict[str, Any]:
@@ -62,15 +62,27 @@ def test_at_writes_the_stamp_only_for_a_log_not_starting_at_zero() -> None:
         max_size=8,
     ),
     shift=st.sampled_from([47.5, 2.0**30, 1432235500.0]),
+    ltl=st.sampled_from(
+        [
+            "F b & G !hazard & G F a",
+            # time bounds: a deadline met or missed, a bounded stay, a response's stretches
+            "F[0,6] b & G[0,3] !hazard & G(a -> F[0,1] !a)",
+            "F[2,99999999999999999999] b & G(hazard -> F[0,0.5] !hazard)",
+        ]
+    ),
+)
+@example(  # a stretch starting at a crossing: placed where the piece is, not interpolated
+    steps=[(9.75, -1.0), (7.25, 3.25), (3.75, 8.25), (1.75, 4.0)],
+    shift=47.5,
+    ltl="F[0,6] b & G[0,3] !hazard & G(a -> F[0,1] !a)",
 )
 @settings(max_examples=40, deadline=None)
 def test_messages_are_relative_to_the_first_sample(
-    steps: list[tuple[float, float]], shift: float
+    steps: list[tuple[float, float]], shift: float, ltl: str
 ) -> None:
     points = [[0.0, 1.0, 1.0]]
     for gap, x in steps:
         points.append([points[-1][0] + gap, x, 1.0])
-    ltl = "F b & G !hazard & G F a"
     at_zero = verdict_to_json(verify_document(_log(points, ltl)))
     shifted_points = [[t + shift, x, y] for t, x, y in points]
     shifted = verdict_to_json(verify_document(_log(shifted_points, ltl)))
@@ -81,11 +93,44 @@ def test_messages_are_relative_to_the_first_sample(
         assert "stamp" not in plain
         assert STAMP.sub("", stamped) == plain
         # each stamp is its relative time plus the log's start
-        for relative, stamp in zip(RELATIVE.findall(stamped), STAMP.findall(stamped), strict=True):
+        # (a time bound, "deadline t=6 s", is relative and has no stamp)
+        for relative, stamp in STAMPED.findall(stamped):
             assert (
                 abs(float(stamp) - (float(relative) + shift))
                 <= 1e-3 * max(1.0, float(relative)) + 1e-12 * shift
             )
+
+
+def test_times_hours_into_a_log_are_written_to_the_tenth() -> None:
+    assert seconds(12.25) == "12.25"
+    assert seconds(999.94) == "999.9"
+    assert seconds(43210.5) == "43210.5"
+    assert seconds(-1234.56) == "-1234.6"
+    assert seconds(1e23) == "1e+23"  # beyond any log: a bound, in its own form
+    assert at(43210.5, 0.0) == "t=43210.5 s"
+    # a log twelve hours long: the entry into b is found in it to the tenth of a second
+    points = [[0.0, 1.0, 1.0], [43200.0, 1.0, 1.0], [43210.0, 6.0, 1.0], [43220.0, 7.0, 1.0]]
+    verdict = verdict_to_json(verify_document(_log(points, "G !b & F[0,43300] b")))
+    assert any("entered b at t=43210.0 s" in text for text in _texts(verdict))
+    assert any("done at t=43210.0 s, 90 s before the deadline" in text for text in _texts(verdict))
+
+
+def test_a_deadline_far_away_is_met_at_its_own_time() -> None:
+    # the time robustness is the deadline less the instant: 1e20 - 10 is 1e20 in floats
+    points = [[0.0, 1.0, 1.0], [10.0, 6.0, 1.0], [20.0, 7.0, 1.0]]
+    verdict = verdict_to_json(verify_document(_log(points, "F[0,1e20] b")))
+    assert verdict["conjuncts"][0]["progress"].startswith("done at t=10 s, ")
+
+
+def test_every_stretch_of_a_timed_g_is_listed() -> None:
+    # in and out of a fifty times, two seconds each: each stay breaks `a -> F[0,1] !a`
+    points = []
+    for k in range(50):
+        points += [[4.0 * k, 3.0, 1.0], [4.0 * k + 1, 1.0, 1.0], [4.0 * k + 3, 1.0, 1.0]]
+    verdict = verdict_to_json(verify_document(_log(points, "G(a -> F[0,1] !a)")))
+    assert verdict["verdict"] == "violated"
+    assert len(verdict["violations"]) == 50
+    assert len({v["time"] for v in verdict["violations"]}) == 50
 
 
 def test_loop_from_counts_from_the_log_start(tmp_path: Path) -> None:

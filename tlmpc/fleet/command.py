@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 import os
 import time
+from collections.abc import Sequence
+from pathlib import Path
 from typing import Any, TextIO
 
 from tlmpc.base.errors import UsageError, error
@@ -77,7 +79,9 @@ def run_batch(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     if not logs:
         raise no_logs(args.trace)
     cache = None if args.no_cache else (args.cache or default_cache_dir())
-    jobs, failed = make_jobs(logs, missions_for(logs, args.mission), options, cache)
+    missions = missions_for(logs, args.mission)
+    _refuse_overwriting(args.results, args.report, [*logs, args.mission, *missions.values()])
+    jobs, failed = make_jobs(logs, missions, options, cache)
     client = dask_client(args.dask) if args.dask is not None else None
     began = time.perf_counter()
     records: list[dict[str, Any]] = []
@@ -103,3 +107,25 @@ def run_batch(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
 
     result = {"format": "tlmpc.fleet/1", "summary": numbers, "logs": finite(rows)}
     return report.finish(code, result, text)
+
+
+def _refuse_overwriting(
+    results: Path | None, report: Path | None, inputs: Sequence[Path | None]
+) -> None:
+    """Refuse (U043), before any log is verified, a results file or a report that names one
+    of the batch's inputs (a log, the mission, a mission the mapping names) or each other."""
+    from tlmpc.io.outputs import plain_name, refuse_input_as_output, same_file
+
+    for flag, path in (("--results", results), ("--report", report)):
+        if path is not None:
+            refuse_input_as_output(path, inputs, flag)
+    if results is not None and report is not None and same_file(results, report):
+        raise UsageError(
+            error(
+                "U043",
+                f"--report {plain_name(str(report))} is also the --results file; one would "
+                "overwrite the other",
+                hint="choose two different files",
+                file=str(report),
+            )
+        )

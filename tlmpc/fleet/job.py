@@ -47,8 +47,10 @@ class Job:
     cache: str | None = None
 
 
-def job_key(job: Job, log_digest: str) -> str:
-    """The cache key: the log's bytes, the mission as read, the options and tlmpc's version."""
+def job_key(job: Job, log_digest: str, *, named: bool = False) -> str:
+    """The cache key: the log's bytes, the mission as read, the options and tlmpc's version;
+    ``named``: the log's path too (the key of an error record, whose messages name the log:
+    another log with the same bytes must not be told about this one)."""
     import hashlib
 
     payload = json.dumps(
@@ -57,6 +59,7 @@ def job_key(job: Job, log_digest: str) -> str:
             "mission": job.document,
             "options": asdict(job.options),
             "log": log_digest,
+            **({"path": job.log} if named else {}),
         },
         sort_keys=True,
         separators=(",", ":"),
@@ -148,19 +151,21 @@ def run_job(job: Job) -> dict[str, Any]:
     were verified before, else verified now (and stored)."""
     began = time.perf_counter()
     cache = Cache(Path(job.cache)) if job.cache is not None else None
-    key = None
+    digest = None
     if cache is not None:
         try:
-            key = job_key(job, content_digest(Path(job.log)))
+            digest = content_digest(Path(job.log))
         except OSError:
-            key = None  # unreadable: verify_job says why
-        stored = cache.get(key) if key is not None else None
-        if stored is not None:
-            return {"log": job.log, "mission": job.mission, **stored, "cached": True}
+            digest = None  # unreadable: verify_job says why
+        if digest is not None:
+            # a verdict is the same for every log with these bytes; an error names its log
+            stored = cache.get(job_key(job, digest)) or cache.get(job_key(job, digest, named=True))
+            if stored is not None:
+                return {"log": job.log, "mission": job.mission, **stored, "cached": True}
     record = verify_job(job)
     record["seconds"] = time.perf_counter() - began
-    if cache is not None and key is not None:
-        cache.put(key, record)
+    if cache is not None and digest is not None:
+        cache.put(job_key(job, digest, named=record["verdict"] == "error"), record)
     return {"log": job.log, "mission": job.mission, **record, "cached": False}
 
 

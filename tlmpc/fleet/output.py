@@ -3,15 +3,14 @@
 from __future__ import annotations
 
 import json
-import os
-import tempfile
 from collections import Counter
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any, TextIO
 
 from tlmpc.base.errors import UsageError, error
 from tlmpc.fleet.job import finite
+from tlmpc.verify.clock import seconds
 
 #: The fields of a results row, in order (JSON lines and Parquet alike).
 FIELDS = (
@@ -43,7 +42,7 @@ def line(record: Mapping[str, Any]) -> str:
     text = f"{record['log']}: {STATUS[record['verdict']]}"
     first = record.get("first_violation")
     if first is not None:
-        when = "" if first["t"] is None else f" at t={first['t']:.4g} s"
+        when = "" if first["t"] is None else f" at t={seconds(first['t'])} s"
         where = "" if first["x"] is None else f" at ({first['x']:.4g}, {first['y']:.4g})"
         text += f": {first['conjunct']}{when}{where}"
     if record["verdict"] == "error":
@@ -98,27 +97,26 @@ def summary_table(numbers: Mapping[str, Any]) -> str:
     return "".join(f"  {name:<{width}}  {value:>10}\n" for name, value in rows)
 
 
-def write_atomically(path: Path, write: Callable[[Path], None]) -> None:
-    """Write through a temporary file in the same folder, renamed into place."""
+def write_atomically(path: Path, data: bytes) -> None:
+    """Replace ``path`` with ``data`` as every output is replaced
+    (:func:`tlmpc.io.outdir.replace_file`: whole or not at all, never over a link, a device
+    or a FIFO, a replaced file's permissions kept), its folder made first; any refusal is
+    F007, this command's code for an output it cannot write."""
+    from tlmpc.io.outdir import replace_file
+
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.")
-        os.close(handle)
     except OSError as exc:
         raise UsageError(
             error("F007", f"cannot write {path}: {exc.strerror or exc}", file=str(path))
         ) from None
     try:
-        write(Path(temporary))
-        os.replace(temporary, path)
-    except OSError as exc:
-        Path(temporary).unlink(missing_ok=True)
+        replace_file(path, data)
+    except UsageError as exc:
+        refused = exc.diagnostics[0]
         raise UsageError(
-            error("F007", f"cannot write {path}: {exc.strerror or exc}", file=str(path))
+            error("F007", refused.message, hint=refused.hint, file=str(path))
         ) from None
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise
 
 
 def write_results(path: Path, rows: Sequence[Mapping[str, Any]]) -> None:
@@ -138,15 +136,12 @@ def write_results(path: Path, rows: Sequence[Mapping[str, Any]]) -> None:
                 )
             ) from None
         table = pa.Table.from_pylist([dict(_parquet_row(r)) for r in rows], schema=_schema(pa))
-        write_atomically(path, lambda temporary: pq.write_table(table, temporary))
+        buffer = pa.BufferOutputStream()
+        pq.write_table(table, buffer)
+        write_atomically(path, buffer.getvalue().to_pybytes())
         return
-
-    def write(temporary: Path) -> None:
-        with open(temporary, "w", encoding="utf-8") as stream:
-            for row in rows:
-                stream.write(json.dumps(finite(dict(row)), sort_keys=False) + "\n")
-
-    write_atomically(path, write)
+    text = "".join(json.dumps(finite(dict(row)), sort_keys=False) + "\n" for row in rows)
+    write_atomically(path, text.encode("utf-8"))
 
 
 def _parquet_row(row: Mapping[str, Any]) -> dict[str, Any]:

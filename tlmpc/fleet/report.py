@@ -17,7 +17,7 @@ import html
 import math
 import re
 from collections import Counter, defaultdict
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path, PurePosixPath
 from typing import Any
 
@@ -244,13 +244,6 @@ def _heat_map(mission: str, document: Mapping[str, Any], rows: Sequence[Mapping[
     )
 
 
-def _text_writer(text: str) -> Callable[[Path], None]:
-    def write(target: Path) -> None:
-        target.write_text(text, encoding="utf-8")
-
-    return write
-
-
 def _views(rows: Sequence[Mapping[str, Any]], folder: Path, link_base: str) -> dict[str, str]:
     """Write each log's own view (violated first, at most :data:`VIEW_LIMIT`); the link of each
     one written, by log."""
@@ -269,7 +262,7 @@ def _views(rows: Sequence[Mapping[str, Any]], folder: Path, link_base: str) -> d
             continue  # too large for a view (a streamed log): the command is shown instead
         name = f"{index:05d}-{re.sub(r'[^A-Za-z0-9._-]+', '_', Path(row['log']).stem)[:60]}.html"
         folder.mkdir(parents=True, exist_ok=True)
-        write_atomically(folder / name, _text_writer(page))
+        write_atomically(folder / name, page.encode("utf-8"))
         links[row["log"]] = f"{link_base}/{name}"
     return links
 
@@ -350,4 +343,4 @@ def write_report(
     folder = path.with_name(path.stem + ".views")
     links = _views(rows, folder, folder.name)
     page = render_report(rows, documents, group=group, links=links)
-    write_atomically(path, _text_writer(page))
+    write_atomically(path, page.encode("utf-8"))

@@ -39,6 +39,7 @@ import numpy.typing as npt
 
 from tlmpc.base.errors import Diagnostic, UsageError
 from tlmpc.verify import Verdict, declare_ending, from_document, verify_trace
+from tlmpc.verify.clock import seconds
 from tlmpc.verify.model import Certificate
 from tlmpc.verify.robustness import speed_excess
 from tlmpc.verify.samples import MAX_PER_KIND, sample_diagnostics
@@ -386,7 +387,7 @@ def _raw_speed(
         certified=False,
         observed_speed=observed,
         margin=None,
-        reason=f"the log moves at {fastest:.4g} m/s between t={begin:.4g} s and "
-        f"t={end:.4g} s, faster than max_speed {certificate.max_speed:.4g}: the certificate's "
+        reason=f"the log moves at {fastest:.4g} m/s between t={seconds(begin)} s and "
+        f"t={seconds(end)} s, faster than max_speed {certificate.max_speed:.4g}: the certificate's "
         "assumption does not hold",
     )

@@ -47,7 +47,9 @@ def csv_cell(text: str) -> str:
     return cell
 
 
-def _same_file(a: Path, b: Path) -> bool:
+def same_file(a: Path, b: Path) -> bool:
+    """Whether ``a`` and ``b`` name one file (through any path or link; by their absolute
+    paths when either is missing)."""
     try:
         return os.path.samefile(a, b)
     except OSError:
@@ -60,7 +62,7 @@ def refuse_input_as_output(output: Path, inputs: Iterable[Path | None], flag: st
     for source in inputs:
         if source is None:
             continue
-        if _same_file(output, source):
+        if same_file(output, source):
             raise UsageError(
                 error(
                     "U043",

@@ -9,6 +9,22 @@ absolute stamps (``time`` fields) and give the log's start as ``stats.start_time
 
 from __future__ import annotations
 
+import math
+
+#: Below this many seconds a time is written to four significant digits, from it on to the
+#: tenth of a second (``t=43210.5 s``, not ``t=4.321e+04 s``), up to :data:`PLAIN_LIMIT`.
+TENTHS_FROM = 1000.0
+PLAIN_LIMIT = 1e9
+
+
+def seconds(value: float) -> str:
+    """A time or a duration in seconds as text (without the unit): four significant digits
+    below :data:`TENTHS_FROM`, to the tenth of a second beyond, so that a moment hours into a
+    log can be found in the log itself."""
+    if math.isfinite(value) and TENTHS_FROM <= abs(value) < PLAIN_LIMIT:
+        return f"{value:.1f}"
+    return f"{value:.4g}"
+
 
 def at(time: float, start: float) -> str:
     """``t=REL s`` of the absolute ``time`` in a log whose first sample is at ``start``,
@@ -17,9 +33,9 @@ def at(time: float, start: float) -> str:
     if relative == 0.0:
         relative = 0.0  # no "-0"
     if start == 0.0:
-        return f"t={relative:.4g} s"
+        return f"t={seconds(relative)} s"
     stamp = f"{time:.3f}".rstrip("0").rstrip(".")  # to the millisecond, as bags are read
-    return f"t={relative:.4g} s (stamp {stamp})"
+    return f"t={seconds(relative)} s (stamp {stamp})"
 
 
 def elapsed(time: float, start: float) -> float:

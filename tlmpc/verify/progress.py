@@ -22,7 +22,7 @@ from tlmpc.ltl.ast import (
     Until,
 )
 from tlmpc.ltl.printer import to_text
-from tlmpc.verify.clock import at
+from tlmpc.verify.clock import at, seconds
 from tlmpc.verify.evaluate import Value
 from tlmpc.verify.model import ConjunctReport, Outcome, Violation
 
@@ -251,7 +251,7 @@ def conjunct_reports(
 
 
 def _seconds(value: float) -> str:
-    return f"{value:.4g} s"
+    return f"{seconds(value)} s"
 
 
 def _response(inner: Formula) -> tuple[Formula, Formula, float] | None:
@@ -266,30 +266,43 @@ def _response(inner: Formula) -> tuple[Formula, Formula, float] | None:
 
 
 def timed_progress(
-    conjunct: Formula, outcome: Outcome, slack: float | None, first_broken: float | None
+    conjunct: Formula,
+    outcome: Outcome,
+    slack: float | None,
+    first_broken: float | None,
+    *,
+    first_done: float | None = None,
+    origin: float = 0.0,
 ) -> str | None:
-    """Progress of a conjunct with time bounds, from its time robustness ``slack``.
+    """Progress of a conjunct with time bounds, from its time robustness ``slack``;
+    ``first_broken`` (the first instant its ``G`` is broken) and ``first_done`` (a deadline's
+    first instant done) are the log's own times, written from its first sample at ``origin``.
 
     None when the conjunct has no time bound or no time robustness.
     """
     if outcome == "inconclusive":
         if isinstance(conjunct, BoundedEventually):
-            return f"pending: deadline t={conjunct.interval.high:.4g} s"
-        return "pending" if first_broken is None else f"pending (broken at t={first_broken:.4g} s)"
+            return f"pending: deadline t={seconds(conjunct.interval.high)} s"
+        return (
+            "pending" if first_broken is None else f"pending (broken at {at(first_broken, origin)})"
+        )
     if slack is None:
         return None
-    at = f" at t={first_broken:.4g} s" if first_broken is not None else ""
+    where = f" at {at(first_broken, origin)}" if first_broken is not None else ""
     if math.isinf(slack):
         return "holds at any bound" if slack > 0 else "fails at any bound"
     match conjunct:
         case BoundedEventually(_, interval) if math.isfinite(interval.high):
             deadline = interval.high
             if slack >= 0:
+                # from the instant itself where it is known: deadline - slack cancels to
+                # nothing when the deadline is far
+                done = deadline - slack if first_done is None else first_done - origin
                 return (
-                    f"done at t={deadline - slack:.4g} s, {_seconds(slack)} before the "
-                    f"deadline t={deadline:.4g} s"
+                    f"done at t={seconds(done)} s, {_seconds(deadline - done)} before the "
+                    f"deadline t={seconds(deadline)} s"
                 )
-            return f"deadline t={deadline:.4g} s missed by {_seconds(-slack)}"
+            return f"deadline t={seconds(deadline)} s missed by {_seconds(-slack)}"
         case Globally(BoundedEventually(goal, interval)) if interval.low == 0:
             gap = interval.high - slack
             return (
@@ -316,8 +329,8 @@ def timed_progress(
                     f"longest wait for `{to_text(goal)}` after `{to_text(trigger)}` "
                     f"{_seconds(bound - slack)} (within {bound:.4g} s)"
                 )
-            return f"deadline missed by {_seconds(-slack)}{at}"
+            return f"deadline missed by {_seconds(-slack)}{where}"
         case _:
             if slack >= 0:
                 return f"holds with {_seconds(slack)} to spare"
-            return f"fails by {_seconds(-slack)}{at}"
+            return f"fails by {_seconds(-slack)}{where}"

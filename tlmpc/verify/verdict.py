@@ -12,7 +12,7 @@ import numpy as np
 import numpy.typing as npt
 import shapely
 
-from tlmpc.ltl.ast import And, Formula, Globally, bounded_operators
+from tlmpc.ltl.ast import And, BoundedEventually, Formula, Globally, bounded_operators
 from tlmpc.ltl.printer import to_text
 from tlmpc.verify.blame import Prefixes, assume_guarantee
 from tlmpc.verify.clock import at, elapsed
@@ -162,7 +162,17 @@ def _with_time_robustness(
         broken = np.flatnonzero(truth(conjunct.arg)[1][: line.size] < 0)
         if len(broken):
             first_broken = float(line.starts[int(broken[0])])
-    progress = timed_progress(conjunct, report.outcome, slack, first_broken)
+    first_done = None
+    if isinstance(conjunct, BoundedEventually) and report.outcome == "satisfied":
+        # the first piece where the goal holds that reaches the bound's low end
+        low = line.origin + conjunct.interval.low
+        held = truth(conjunct.arg)[0][: line.size] > 0
+        reaching = held & ((line.ends > low) | (line.starts >= low))
+        if reaching.any():
+            first_done = max(float(line.starts[int(np.argmax(reaching))]), low)
+    progress = timed_progress(
+        conjunct, report.outcome, slack, first_broken, first_done=first_done, origin=line.origin
+    )
     return dataclasses.replace(
         report, time_robustness=slack, progress=progress if progress else report.progress
     )
@@ -174,9 +184,11 @@ def _timed_violations(
     found: list[Violation],
     truth: Semantics,
     trace: TraceInput,
+    line: Timeline,
 ) -> list[Violation]:
     """The violations of conjuncts with time bounds, in dense time: for ``G x``, each maximal
-    stretch of instants where ``x`` fails (exact ends); for the others, their progress."""
+    stretch of instants where ``x`` fails (exact ends), where it starts; for the others, their
+    progress."""
     timed = {
         to_text(c): (c, r)
         for c, r in zip(conjuncts, reports, strict=True)
@@ -195,11 +207,12 @@ def _timed_violations(
             continue
         signal = truth.dense().signal(conjunct.arg)
         stretches = _failing_stretches(signal.times, signal.hi, truth.dense().domain.end)
-        for start, end in stretches[:MAX_STRETCHES]:
-            x = float(np.interp(start, trace.times, trace.points[:, 0]))
-            y = float(np.interp(start, trace.times, trace.points[:, 1]))
+        for start, end in stretches:
+            x, y = _position(line, trace, start)
             when = (
-                f"at t={start:.4g} s" if end == start else f"from t={start:.4g} s to t={end:.4g} s"
+                f"at {at(start, trace.start)}"
+                if end == start
+                else f"from {at(start, trace.start)} to {at(end, trace.start)}"
             )
             kept.append(
                 Counterexample(
@@ -213,8 +226,17 @@ def _timed_violations(
     return kept
 
 
-#: At most this many failing stretches are listed per conjunct.
-MAX_STRETCHES = 20
+def _position(line: Timeline, trace: TraceInput, time: float) -> tuple[float, float]:
+    """Where the robot is at ``time``: the piece's own position where a piece starts then (a
+    sample or a crossing, as every other message places it), else between the samples."""
+    k = int(np.searchsorted(line.starts, time))
+    if k < line.size and line.starts[k] == time:
+        x, y = line.positions[k].tolist()
+        return float(x), float(y)
+    return (
+        float(np.interp(time, trace.times, trace.points[:, 0])),
+        float(np.interp(time, trace.times, trace.points[:, 1])),
+    )
 
 
 def _failing_stretches(
@@ -549,7 +571,7 @@ def verify_trace(trace: TraceInput) -> Verdict:
         _with_time_robustness(report, conjunct, outcome_of, truth, line, duration)
         for report, conjunct in zip(reports, conjuncts, strict=True)
     ]
-    violations = _timed_violations(conjuncts, reports, violations, truth, trace)
+    violations = _timed_violations(conjuncts, reports, violations, truth, trace, line)
     if len(reports) == 1:
         task_slack = reports[0].time_robustness  # the task is its one conjunct
     else:
