@@ -40,6 +40,7 @@ from tlmpc.importers.polygonize import (
     polygons,
     to_world,
 )
+from tlmpc.io.schema_check import MISSION_COORDINATE_LIMIT
 
 Point = tuple[float, float]
 Ring = tuple[Point, ...]
@@ -351,6 +352,34 @@ def _check_settings(settings: ImportSettings, file: str) -> None:
         raise _fail("M018", f"the start must be finite, got {settings.start}", file)
 
 
+def _check_reach(grid: OccupancyGrid, shapes: list[Polygon]) -> None:
+    """Refuse (M007) a map whose imported coordinates lie beyond the mission format's limit:
+    the mission written from it, or loaded with it, would be one ``tlmpc check`` rejects."""
+    coordinates = shapely.get_coordinates(shapes)
+    if not coordinates.size or np.abs(coordinates).max() <= MISSION_COORDINATE_LIMIT:
+        return
+    row, axis = np.unravel_index(int(np.argmax(np.abs(coordinates))), coordinates.shape)
+    value = float(coordinates[row, axis])
+    ox, oy, _ = grid.origin
+    # the origin alone out of range is the origin's fault; else the cells carry it there
+    key = "origin" if max(abs(ox), abs(oy)) > MISSION_COORDINATE_LIMIT else "resolution"
+    rows, cols = grid.shape
+    place = grid.places.get(key)
+    raise UsageError(
+        error(
+            "M007",
+            f"the imported map reaches {'xy'[int(axis)]} = {value:g}, beyond the "
+            f"±{MISSION_COORDINATE_LIMIT:g} a mission's coordinates may have",
+            hint=f"the map is {cols}x{rows} cells of {grid.resolution:g} m "
+            f"({cols * grid.resolution:g} m x {rows * grid.resolution:g} m) from the origin "
+            f"({ox:g}, {oy:g}): check `origin` and `resolution` (metres per cell)",
+            file=grid.source,
+            line=place[0] if place else None,
+            col=place[1] if place else None,
+        )
+    )
+
+
 def import_map(
     map_path: Path,
     settings: ImportSettings = ImportSettings(),
@@ -438,6 +467,7 @@ def import_map(
                 groups[group] = tuple(names)
     world = [to_world(p, grid.resolution, grid.origin) for p in kept_cells]
     assert all(isinstance(p, Polygon) for p in world)
+    _check_reach(grid, [*world, *(Polygon(ring) for ring in regions.values())])
     workspace = world[0]
     free_cells = float(np.count_nonzero(grid.values == FREE)) * grid.cell_area()
     return ImportedMap(

@@ -19,6 +19,8 @@ from __future__ import annotations
 
 import math
 import os
+import re
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -63,6 +65,8 @@ class OccupancyGrid:
     source: str
     #: the image file the cells were read from
     image: str = ""
+    #: where each key's value is written in the map YAML: (line, column), 1-based
+    places: Mapping[str, tuple[int, int]] = field(default_factory=dict, compare=False)
 
     @property
     def shape(self) -> tuple[int, int]:
@@ -82,11 +86,53 @@ class OccupancyGrid:
         return ox + c * gx - s * gy, oy + s * gx + c * gy
 
 
-def _fail(code: str, message: str, file: str, hint: str | None = None) -> UsageError:
-    return UsageError(error(code, message, hint=hint, file=file))
+def _fail(
+    code: str,
+    message: str,
+    file: str,
+    hint: str | None = None,
+    at: tuple[int, int] | None = None,
+) -> UsageError:
+    line, col = at if at is not None else (None, None)
+    return UsageError(error(code, message, hint=hint, file=file, line=line, col=col))
 
 
-def _number(meta: dict[str, Any], key: str, file: str, default: float | None = None) -> float:
+@dataclass(frozen=True, slots=True)
+class _Written:
+    """Where a key's value is written in the map YAML, and whether it is a quoted scalar."""
+
+    line: int
+    col: int
+    quoted: bool
+
+
+def _written(text: str) -> dict[str, _Written]:
+    """Each top-level key's value as written (the last of a repeated key, as the data has it).
+
+    Only called on text that ``load_small_yaml`` read, so it is small and within the limits."""
+    import yaml
+
+    try:
+        root = yaml.compose(text, Loader=yaml.SafeLoader)
+    except yaml.YAMLError:  # pragma: no cover - the text was just read as YAML
+        return {}
+    found: dict[str, _Written] = {}
+    if isinstance(root, yaml.MappingNode):
+        for key, value in root.value:
+            if isinstance(key, yaml.ScalarNode):
+                mark = value.start_mark
+                quoted = isinstance(value, yaml.ScalarNode) and value.style in ("'", '"')
+                found[key.value] = _Written(mark.line + 1, mark.column + 1, quoted)
+    return found
+
+
+def _number(
+    meta: dict[str, Any],
+    key: str,
+    file: str,
+    written: Mapping[str, _Written],
+    default: float | None = None,
+) -> float:
     value = meta.get(key, default)
     if value is None:
         raise _fail(
@@ -96,18 +142,43 @@ def _number(meta: dict[str, Any], key: str, file: str, default: float | None = N
             hint="a map_server map needs image, resolution, origin, occupied_thresh, free_thresh",
         )
     if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        place = written.get(key)
         hint = None
-        if isinstance(value, str):
-            try:
-                float(value)
-                hint = (
-                    "YAML 1.1 reads this as text: write it with a decimal point and a signed "
-                    "exponent, e.g. 1.0e-3"
-                )
-            except ValueError:
-                pass
-        raise _fail("M004", f"`{key}` is not a finite number: {brief(value)}", file, hint=hint)
+        finite = isinstance(value, str) and _finite_text(value)
+        if finite and place is not None and place.quoted:
+            hint = (
+                "the value is in quotes, so YAML reads it as text: write the number without "
+                f"quotes, {key}: {_yaml_number(float(value))}"
+            )
+        elif finite:
+            hint = (
+                "YAML 1.1 reads this as text: write it with a decimal point and a signed "
+                "exponent, e.g. 1.0e-3"
+            )
+        raise _fail(
+            "M004",
+            f"`{key}` is not a finite number: {brief(value)}",
+            file,
+            hint=hint,
+            at=None if place is None else (place.line, place.col),
+        )
     return float(value)
+
+
+def _finite_text(text: str) -> bool:
+    """Whether ``text`` reads as a finite number."""
+    try:
+        return math.isfinite(float(text))
+    except ValueError:
+        return False
+
+
+def _yaml_number(value: float) -> str:
+    """``value`` written so that YAML 1.1 reads it as a number (``1e-12`` is text there: its
+    floats need a decimal point)."""
+    text = repr(value)
+    mantissa, e, exponent = text.partition("e")
+    return f"{mantissa}.0e{exponent}" if e and "." not in mantissa else text
 
 
 def read_metadata(path: Path) -> dict[str, Any]:
@@ -122,10 +193,16 @@ def read_metadata(path: Path) -> dict[str, Any]:
             file,
             hint="expected keys image, resolution, origin, occupied_thresh, free_thresh",
         )
+    written = _written(text)
+
+    def at(key: str) -> tuple[int, int] | None:
+        place = written.get(key)
+        return None if place is None else (place.line, place.col)
+
     image = meta.get("image")
     if not isinstance(image, str) or not image:
         raise _fail("M003", "the map has no `image`", file, hint="image: map.pgm")
-    resolution = _number(meta, "resolution", file)
+    resolution = _number(meta, "resolution", file, written)
     if not MIN_RESOLUTION <= resolution <= MAX_RESOLUTION:
         raise _fail(
             "M004",
@@ -133,6 +210,7 @@ def read_metadata(path: Path) -> dict[str, Any]:
             f"(metres per cell), got {resolution:g}",
             file,
             hint="resolution is the size of one cell, e.g. 0.05",
+            at=at("resolution"),
         )
     origin = meta.get("origin")
     if (
@@ -151,9 +229,10 @@ def read_metadata(path: Path) -> dict[str, Any]:
             f"`origin` must be [x, y, yaw] of finite numbers (at most {MAX_COORDINATE:g} "
             f"in size), got {brief(origin)}",
             file,
+            at=at("origin"),
         )
-    occupied = _number(meta, "occupied_thresh", file)
-    free = _number(meta, "free_thresh", file)
+    occupied = _number(meta, "occupied_thresh", file, written)
+    free = _number(meta, "free_thresh", file, written)
     negate = meta.get("negate", 0)
     if negate not in (0, 1, True, False):
         raise _fail("M004", f"`negate` must be 0 or 1, got {brief(negate)}", file)
@@ -177,6 +256,7 @@ def read_metadata(path: Path) -> dict[str, Any]:
         "free_thresh": free,
         "negate": bool(negate),
         "mode": mode,
+        "places": {key: (place.line, place.col) for key, place in written.items()},
     }
 
 
@@ -227,8 +307,26 @@ def _pixels(path: Path, file: str) -> tuple[npt.NDArray[np.float64], npt.NDArray
             file,
             hint="crop or downsample the map",
         ) from None
-    except (OSError, UnidentifiedImageError, ValueError, SyntaxError, MemoryError) as exc:
-        raise _fail("M006", f"cannot read the map image {path}: {brief(str(exc))}", file) from None
+    except UnidentifiedImageError:
+        # Pillow's message names the open stream object, which tells the reader nothing.
+        raise _fail(
+            "M006",
+            f"cannot read the map image {path}: it is not in an image format Pillow knows, "
+            "or its header is malformed (a negative or missing size, say)",
+            file,
+            hint=_IMAGE_HINT,
+        ) from None
+    except MemoryError:
+        raise _fail(
+            "M006",
+            f"cannot read the map image {path}: not enough memory to decode it",
+            file,
+            hint="crop or downsample the map",
+        ) from None
+    except (OSError, ValueError, SyntaxError) as exc:
+        raise _fail(
+            "M006", f"cannot read the map image {path}: {_reason(exc)}", file, hint=_IMAGE_HINT
+        ) from None
     if mode == "1":
         return array.astype(np.float64), None
     if mode in ("I;16", "I;16B", "I;16L", "I"):
@@ -246,6 +344,20 @@ def _pixels(path: Path, file: str) -> tuple[npt.NDArray[np.float64], npt.NDArray
     else:
         shade = array.astype(np.float64) / top
     return shade, alpha
+
+
+_IMAGE_HINT = (
+    "a map image is a greyscale (or RGB) PGM, PNG or BMP file as map_saver writes it; "
+    "open it in an image viewer and save it again as an 8-bit greyscale PGM or PNG"
+)
+#: An object's repr inside a decoder's message (``<_io.BufferedReader name=3>``).
+_OBJECT_REPR = re.compile(r"\s*<[^<>]*>")
+
+
+def _reason(exc: BaseException) -> str:
+    """A decoder's whole message, on one line, without object reprs."""
+    text = " ".join(_OBJECT_REPR.sub("", str(exc)).split())
+    return text or f"the decoder failed ({type(exc).__name__})"
 
 
 def cell_values(
@@ -304,4 +416,5 @@ def read_map(path: Path) -> OccupancyGrid:
         mode=meta["mode"],
         source=str(path),
         image=str(image_path),
+        places=meta["places"],
     )

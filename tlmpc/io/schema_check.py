@@ -27,6 +27,11 @@ _ANNOTATIONS = frozenset(
 
 Check = Callable[[Any], bool]
 
+#: The largest size of a mission coordinate: the mission schema's ``coordinate`` bound (S010).
+#: The loader's quick shape checks and the map importer apply it too, so a mission written
+#: from a map is one ``tlmpc check`` accepts (a test keeps it equal to the schema's).
+MISSION_COORDINATE_LIMIT = 1e9
+
 
 class _Unsupported(Exception):
     """The schema uses a keyword this checker does not implement."""

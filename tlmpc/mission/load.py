@@ -15,7 +15,7 @@ from pathlib import Path as FilePath
 from typing import TYPE_CHECKING, Any
 
 from tlmpc.base.errors import Diagnostic, InvalidInputError, best_first, error
-from tlmpc.io.schema_check import is_valid, load_schema
+from tlmpc.io.schema_check import MISSION_COORDINATE_LIMIT, is_valid, load_schema
 from tlmpc.ltl.ast import Formula, Prop, bounded_operators, conjoin
 from tlmpc.ltl.keywords import KEYWORDS
 from tlmpc.ltl.transform import substitute
@@ -52,11 +52,15 @@ Pieces = list[tuple[CheckedShape, list[CheckedShape]]]
 
 #: The types of the numbers YAML reads (``bool`` is an ``int`` but no number here).
 _NUMBER_TYPES = frozenset((int, float))
-_AT_MOST_1E9 = (1e9).__ge__
+_WITHIN_LIMIT = MISSION_COORDINATE_LIMIT.__ge__
 
 
 def _number(value: Any) -> bool:
-    return isinstance(value, int | float) and not isinstance(value, bool) and abs(value) <= 1e9
+    return (
+        isinstance(value, int | float)
+        and not isinstance(value, bool)
+        and abs(value) <= MISSION_COORDINATE_LIMIT
+    )
 
 
 def _plain_shape(value: Any) -> bool:
@@ -69,18 +73,18 @@ def _plain_shape(value: Any) -> bool:
             and isinstance(rect, list)
             and len(rect) == 4
             and not set(map(type, rect)) - _NUMBER_TYPES
-            and all(map(_AT_MOST_1E9, map(abs, rect)))  # NaN is no number either
+            and all(map(_WITHIN_LIMIT, map(abs, rect)))  # NaN is no number either
         )
     if not isinstance(value, list) or len(value) < 3:
         return False
     # Type by type at C speed (a boundary may have a million points): every point a list of
-    # two ints or floats (not bools), each at most 1e9 in size.
+    # two ints or floats (not bools), each within the coordinate limit.
     if set(map(type, value)) != {list} or set(map(len, value)) != {2}:
         return False
     coordinates = list(chain.from_iterable(value))
     if not set(map(type, coordinates)) <= {int, float}:
         return False
-    return all(abs(c) <= 1e9 for c in coordinates)  # NaN is no coordinate either
+    return all(map(_WITHIN_LIMIT, map(abs, coordinates)))  # NaN is no coordinate either
 
 
 _STAND_IN = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]
@@ -325,7 +329,14 @@ def _check_task(
         positions = [_ltl_position(doc, ("task", i)) for i in range(len(phrases))]
         try:
             parts.append(
-                compile_phrases(phrases, groups=groups, file=file, positions=positions, kinds=kinds)
+                compile_phrases(
+                    phrases,
+                    groups=groups,
+                    file=file,
+                    positions=positions,
+                    kinds=kinds,
+                    declared=kinds or NameKinds(regions=frozenset(names), groups=frozenset(groups)),
+                )
             )
         except InvalidInputError as exc:
             problems.extend(exc.diagnostics)

@@ -99,7 +99,7 @@ def map_shapes(
             [
                 error(
                     d.code,
-                    f"{d.file}: {d.message}" if d.file and d.file != file else d.message,
+                    f"{d.location()}: {d.message}" if d.file and d.file != file else d.message,
                     hint=d.hint,
                     file=file,
                     line=line,

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import difflib
 import functools
+import itertools
 import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -34,7 +35,7 @@ from tlmpc.ltl.ast import (
     conjoin,
     disjoin,
 )
-from tlmpc.tasks.phrases import Node, Word, parse_plain
+from tlmpc.tasks.phrases import KEYWORDS, Node, Word, parse_plain
 
 if TYPE_CHECKING:
     from lark import Lark
@@ -491,6 +492,86 @@ def _unknown_phrase(phrase: str, file: str | None, line: int, col: int, at: int)
     )
 
 
+_IDENTIFIER = re.compile(r"(?<![A-Za-z0-9_])[A-Za-z_][A-Za-z0-9_]*")
+#: Reserved words a phrase may name in its declared names before the rest is tried: each
+#: subset of them is parsed once, so a phrase naming more is left to T001.
+_MAX_RESERVED = 6
+
+
+def _kind(name: str, groups: Mapping[str, Sequence[str]], kinds: NameKinds | None) -> str | None:
+    found = kinds.kind_of(name) if kinds is not None else None
+    return found or ("group" if name in groups else None)
+
+
+def _reserved_names(
+    phrase: str, groups: Mapping[str, Sequence[str]], kinds: NameKinds | None
+) -> list[Word]:
+    """The words of ``phrase`` that the mission declares as names but that the phrase
+    grammar reserves as keywords (its ``NAME`` refuses them), with their places."""
+    found: list[Word] = []
+    for match in _IDENTIFIER.finditer(phrase):
+        text = match.group()
+        if text.lower() in KEYWORDS and _kind(text, groups, kinds) is not None:
+            start = match.start()
+            line = phrase.count("\n", 0, start) + 1
+            found.append(Word(text, line, start - (phrase.rfind("\n", 0, start) + 1) + 1))
+    return found
+
+
+def _repair(phrase: str, words: list[Word]) -> list[Word]:
+    """The fewest of ``words`` that, read as names, make ``phrase`` parse (none: none do).
+
+    A reserved word a mission uses as a name may also stand in the phrase as the keyword
+    (``visit then then b``): only the occurrences whose renaming makes the phrase parse are
+    the ones meant as names."""
+    if len(words) > _MAX_RESERVED:
+        return []
+    starts = [_place(phrase, w) for w in words]
+    taken = {m.group().lower() for m in _IDENTIFIER.finditer(phrase)}
+    stand_in = next(f"name{i}" for i in itertools.count() if f"name{i}" not in taken)
+    for size in range(1, len(words) + 1):
+        for chosen in itertools.combinations(range(len(words)), size):
+            text = phrase
+            for index in sorted(chosen, key=lambda i: -starts[i]):
+                start = starts[index]
+                text = text[:start] + stand_in + text[start + len(words[index]) :]
+            try:
+                parse_tree(text)
+            except PhraseSyntaxError:
+                continue
+            return [words[i] for i in chosen]
+    return []
+
+
+def _place(phrase: str, word: Word) -> int:
+    """The offset in ``phrase`` of ``word`` (its line and column are 1-based)."""
+    offset = 0
+    for _ in range(word.line - 1):
+        offset = phrase.index("\n", offset) + 1
+    return offset + word.column - 1
+
+
+def _reserved(
+    word: Word,
+    lowering: _Lowering,
+    groups: Mapping[str, Sequence[str]] | None,
+    kinds: NameKinds | None,
+) -> Diagnostic:
+    kind = _kind(str(word), groups or {}, kinds) or "name"
+    line, col = lowering._where(word)
+    return error(
+        "T003",
+        f"{str(word)!r} is a {kind} of the mission, but task phrases read "
+        f"`{word.lower()}` as a keyword, so no phrase can name it",
+        # the kind first: a name that begins with a keyword (`visit_region`) can be split
+        hint=f"rename the {kind} (say `{kind}_{word}`), or state this part of the task "
+        f"under `ltl:`, where {str(word)!r} is an ordinary name",
+        file=lowering.file,
+        line=line,
+        col=col,
+    )
+
+
 def compile_phrase(
     phrase: str,
     *,
@@ -499,12 +580,17 @@ def compile_phrase(
     line: int = 1,
     col: int = 1,
     kinds: NameKinds | None = None,
+    declared: NameKinds | None = None,
 ) -> Formula:
     """Compile one phrase to LTL (raises :class:`InvalidInputError` with T-codes).
 
     With ``kinds`` (the mission's names by kind), a name used as the wrong kind — a region
-    where a sensor belongs, say — is reported (T020)."""
-    return _compile(phrase, groups=groups, file=file, line=line, col=col, kinds=kinds)[0]
+    where a sensor belongs, say — is reported (T020).  ``declared`` (default ``kinds``) are
+    the mission's names, to explain a phrase that fails because it names a word the phrases
+    reserve (T003)."""
+    return _compile(
+        phrase, groups=groups, file=file, line=line, col=col, kinds=kinds, declared=declared
+    )[0]
 
 
 def avoid_scopes(phrase: str, *, groups: Mapping[str, Sequence[str]] | None = None) -> list[str]:
@@ -520,6 +606,7 @@ def _compile(
     line: int,
     col: int,
     kinds: NameKinds | None = None,
+    declared: NameKinds | None = None,
 ) -> tuple[Formula, list[str]]:
     if not isinstance(phrase, str) or not phrase.strip():
         raise InvalidInputError(
@@ -532,12 +619,30 @@ def _compile(
                 col=col,
             )
         )
+    lowering = _Lowering(groups or {}, file, line, col, kinds)
     try:
         tree = parse_tree(phrase)
     except PhraseSyntaxError as exc:
+        known = declared or kinds
+        words = _reserved_names(phrase, groups or {}, known)
+        repaired = _repair(phrase, words)
+        if repaired:
+            found = [_reserved(w, lowering, groups, known) for w in repaired]
+            raise InvalidInputError(found) from None
         at = exc.column - 1
-        raise InvalidInputError(_unknown_phrase(phrase, file, line, col, max(at, 0))) from None
-    lowering = _Lowering(groups or {}, file, line, col, kinds)
+        problem = _unknown_phrase(phrase, file, line, col, max(at, 0))
+        if words:
+            names = ", ".join(sorted({repr(str(w)) for w in words}))
+            note = f"note: {names} cannot be named in a task phrase (a keyword there); "
+            problem = error(
+                problem.code,
+                problem.message,
+                hint=note + (problem.hint or ""),
+                file=file,
+                line=problem.line,
+                col=problem.col,
+            )
+        raise InvalidInputError(problem) from None
     formula = lowering.lower(tree.children[0])  # type: ignore[arg-type]
     if lowering.problems:
         raise InvalidInputError(lowering.problems)
@@ -551,6 +656,7 @@ def compile_phrases(
     file: str | None = None,
     positions: Sequence[tuple[int, int]] | None = None,
     kinds: NameKinds | None = None,
+    declared: NameKinds | None = None,
 ) -> Formula:
     """Compile every phrase and conjoin them; report the problems of all phrases at once.
 
@@ -560,6 +666,8 @@ def compile_phrases(
         file: the file name for diagnostics.
         positions: (line, col) where each phrase starts in ``file``.
         kinds: the mission's names by kind, to report a name used as the wrong kind.
+        declared: the mission's names by kind (default ``kinds``), to report a phrase that
+            names a word the phrases reserve as a keyword (T003).
     """
     formulas: list[Formula] = []
     problems: list[Diagnostic] = []
@@ -567,7 +675,15 @@ def compile_phrases(
         line, col = positions[index] if positions is not None else (1, 1)
         try:
             formulas.append(
-                compile_phrase(phrase, groups=groups, file=file, line=line, col=col, kinds=kinds)
+                compile_phrase(
+                    phrase,
+                    groups=groups,
+                    file=file,
+                    line=line,
+                    col=col,
+                    kinds=kinds,
+                    declared=declared,
+                )
             )
         except InvalidInputError as exc:
             problems.extend(exc.diagnostics)
