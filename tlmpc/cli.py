@@ -25,6 +25,7 @@ from types import ModuleType
 from typing import Any, TextIO
 
 from tlmpc.base import settled, startup
+from tlmpc.base.depth import nesting_room
 from tlmpc.base.errors import EXIT_INTERNAL, EXIT_USAGE, TlmpcError, error, printable
 from tlmpc.base.startup import EXIT_INTERRUPTED, EXIT_TERMINATED
 from tlmpc.base.version import __version__
@@ -369,6 +370,18 @@ def _ended_by(signalled: BaseException, err: TextIO) -> int:
     return EXIT_TERMINATED if terminated else EXIT_INTERRUPTED
 
 
+def _input_file(args: argparse.Namespace) -> str | None:
+    """The file a command reads its input from, where it takes one (a mission, a spec, a
+    map, a trace)."""
+    for name in ("mission", "spec", "map", "trace"):
+        value = getattr(args, name, None)
+        if isinstance(value, list) and len(value) == 1:
+            value = value[0]
+        if isinstance(value, os.PathLike):
+            return str(os.fspath(value))
+    return None
+
+
 def _main(argv: Sequence[str] | None, out: TextIO, err: TextIO) -> int:
     arguments = list(sys.argv[1:] if argv is None else argv)
     parser = build_parser(only=next((w for w in arguments if not w.startswith("-")), None))
@@ -389,7 +402,8 @@ def _main(argv: Sequence[str] | None, out: TextIO, err: TextIO) -> int:
             # Floating-point overflow on extreme inputs is numpy's and shapely's business: the
             # inputs are checked and refused with diagnostics, never with a screen of warnings.
             warnings.filterwarnings("ignore", category=RuntimeWarning)
-            result: int = args._run(args, out, err)
+            with nesting_room():
+                result: int = args._run(args, out, err)
         return result
     except TlmpcError as exc:
         return reporter.fail(exc)
@@ -406,6 +420,7 @@ def _main(argv: Sequence[str] | None, out: TextIO, err: TextIO) -> int:
                         "U036",
                         "the input is nested too deeply to process",
                         hint="flatten the input (no real mission or trace nests this deep)",
+                        file=_input_file(args),
                     )
                 ]
             )

@@ -29,7 +29,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Check every file; report all problems of all files."""
-    from tlmpc.base.errors import EXIT_NEGATIVE, EXIT_OK, EXIT_USAGE, UsageError
+    from tlmpc.base.errors import EXIT_NEGATIVE, EXIT_OK, EXIT_USAGE, UsageError, error
     from tlmpc.io.report import Reporter
     from tlmpc.ltl.printer import to_text
     from tlmpc.mission.load import inspect_file
@@ -42,35 +42,47 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         notices: list[Any] = []
         entry: dict[str, Any] = {"file": str(path), "ok": False, "diagnostics": [], "ltl": None}
         try:
-            mission, diagnostics = inspect_file(path)
-        except UsageError as exc:
-            unreadable += 1
-            diagnostics = list(exc.diagnostics)
-        else:
-            if mission is not None and not diagnostics:
-                diagnostics = _contradictions(path, mission)
-                if not diagnostics and mission.reactive is not None:
-                    diagnostics, entry["gr1"] = _gr1_reading(mission)
-                if not diagnostics:
-                    from tlmpc.mission.body import body_radius
-                    from tlmpc.mission.holes import workspace_notes
-
-                    merged, notices = workspace_notes(mission)
-                    if body_radius(mission.robot) > 0.0:  # shapely only for a body
-                        from tlmpc.mission.cspace import body_diagnostics
-
-                        body = body_diagnostics(merged)
-                        diagnostics = [d for d in body if d.severity == "error"]
-                        notices += [d for d in body if d.severity != "error"]
-                    if not diagnostics:
-                        diagnostics = _subgrid(merged)
-            if diagnostics:
-                invalid += 1
+            try:
+                mission, diagnostics = inspect_file(path)
+            except UsageError as exc:
+                unreadable += 1
+                diagnostics = list(exc.diagnostics)
             else:
-                entry["ok"] = True
-                if mission is not None:
-                    entry["ltl"] = to_text(mission.formula)
-                    entry["avoid_scopes"] = _scopes(mission)
+                if mission is not None and not diagnostics:
+                    diagnostics = _contradictions(path, mission)
+                    if not diagnostics and mission.reactive is not None:
+                        diagnostics, entry["gr1"] = _gr1_reading(mission)
+                    if not diagnostics:
+                        from tlmpc.mission.body import body_radius
+                        from tlmpc.mission.holes import workspace_notes
+
+                        merged, notices = workspace_notes(mission)
+                        if body_radius(mission.robot) > 0.0:  # shapely only for a body
+                            from tlmpc.mission.cspace import body_diagnostics
+
+                            body = body_diagnostics(merged)
+                            diagnostics = [d for d in body if d.severity == "error"]
+                            notices += [d for d in body if d.severity != "error"]
+                        if not diagnostics:
+                            diagnostics = _subgrid(merged)
+                if diagnostics:
+                    invalid += 1
+                else:
+                    entry["ok"] = True
+                    if mission is not None:
+                        entry["ltl"] = to_text(mission.formula)
+                        entry["avoid_scopes"] = _scopes(mission)
+        except RecursionError:  # deeper than any stage handles: this file, not the batch
+            unreadable += 1
+            notices = []
+            diagnostics = [
+                error(
+                    "U036",
+                    "the mission is nested too deeply to process",
+                    hint="flatten it (split a long sequence of steps, or nest fewer formulas)",
+                    file=str(path),
+                )
+            ]
         entry["diagnostics"] = [d.to_json() for d in [*diagnostics, *notices]]
         results.append(entry)
         report.diagnose([*diagnostics, *notices])

@@ -27,6 +27,7 @@ from lark.exceptions import (
     VisitError,
 )
 
+from tlmpc.base.depth import NESTING_LIMIT
 from tlmpc.base.errors import Diagnostic, InvalidInputError, error
 from tlmpc.ltl.ast import (
     And,
@@ -53,7 +54,7 @@ from tlmpc.ltl.grammar_cache import lalr_parser
 from tlmpc.ltl.keywords import KEYWORDS  # re-exported: words that cannot name a region
 
 #: Nesting deeper than this is refused (L005) instead of exhausting the Python stack.
-MAX_DEPTH = 400
+MAX_DEPTH = NESTING_LIMIT
 
 _NEXT_HINT = (
     "Next (X) has no meaning in continuous time: a robot has no 'next instant'. tlmpc keeps "
