@@ -136,24 +136,19 @@ def test_robot_and_day(log: str, group: str | None, expected: tuple[str, str]) -
     assert robot_and_day(log, PurePosixPath("fleet"), pattern) == expected
 
 
-def test_a_bad_group_fails_before_verifying(tmp_path: Path) -> None:
+@pytest.mark.parametrize("report", [True, False])
+def test_a_bad_group_fails_before_verifying(tmp_path: Path, report: bool) -> None:
     generate(tmp_path / "logs", 2)
     mapping = write_missions(tmp_path)
-    err = io.StringIO()
+    err, out = io.StringIO(), io.StringIO()
+    page = ["--report", str(tmp_path / "r.html")] if report else []
+    argv = ["verify", str(tmp_path / "logs"), "--mission", str(mapping), *page]
     code = main(
-        [
-            "verify",
-            str(tmp_path / "logs"),
-            "--mission",
-            str(mapping),
-            "--report",
-            str(tmp_path / "r.html"),
-            "--group",
-            "(unclosed",
-        ],
-        out=io.StringIO(),
+        [*argv, "--group", "(unclosed"],
+        out=out,
         err=err,
     )
     assert code == 2
     assert "F009" in err.getvalue()
+    assert out.getvalue() == ""  # not one log verified
     assert not (tmp_path / "r.html").exists()

@@ -192,3 +192,42 @@ def test_a_time_bound_is_refused_with_f010(tmp_path: Path) -> None:
     code, _, err = run_cli("monitor", "--mission", str(mission), stdin="t,x,y\n0,1,1\n")
     assert code == 2
     assert "F010" in err
+
+
+@pytest.mark.parametrize(
+    "rows",
+    [
+        "0,1,1\n1,nan,1\n",  # V003
+        "0,1,1\n1e13,1,1\n",  # V024: a time beyond any log
+        "0,1,1\n1,5e12,1\n",  # V024: a coordinate
+        "0,1,1\n2,1,1\n1,1,1\n",  # V005
+        "0,1,1\n1,1,1\n1,2,1\n",  # V020
+    ],
+)
+def test_a_pose_the_verifier_refuses_is_refused_alike(tmp_path: Path, rows: str) -> None:
+    mission = str(ROOT / "specs" / "reach-avoid.yaml")
+    log = tmp_path / "log.csv"
+    log.write_text("t,x,y\n" + rows, encoding="utf-8")
+    verified, _, offline = run_cli("verify", str(log), "--mission", mission)
+    monitored, _, live = run_cli("monitor", str(log), "--mission", mission)
+    codes = [part.split("]")[0] for part in offline.split("error[")[1:]]
+    assert verified == monitored == 2
+    assert codes
+    assert f"error[{codes[0]}]" in live, live
+
+
+@pytest.mark.parametrize("pose", ['{"t": 0, "x": "5", "y": 1}', '{"t": true, "x": 1, "y": 1}'])
+def test_a_json_pose_of_text_or_truth_values_is_refused(pose: str) -> None:
+    mission = str(ROOT / "specs" / "reach-avoid.yaml")
+    code, _, err = run_cli("monitor", "--mission", mission, stdin=pose + "\n")
+    assert code == 2
+    assert "M053" in err
+
+
+def test_a_time_bound_is_refused_at_the_mission(tmp_path: Path) -> None:
+    mission = tmp_path / "timed.yaml"
+    text = (ROOT / "specs" / "reach-avoid.yaml").read_text(encoding="utf-8")
+    mission.write_text(text.replace("- avoid hazard", "- visit dock within 60 s"), encoding="utf-8")
+    code, _, err = run_cli("monitor", "--mission", str(mission), stdin="t,x,y\n0,1,1\n")
+    assert code == 2
+    assert err.startswith(f"{mission}: error[F010]"), err

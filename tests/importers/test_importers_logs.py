@@ -101,6 +101,7 @@ def test_columns_choose_by_name_and_number(tmp_path: Path) -> None:
         ("0,1,2,3\n", None, "4 columns", 1),
         ("time,a,b\n0,1,2\n", None, "no x column", 1),
         ("t,x,y\n0,1,2\n1,oops,3\n", None, "not a number", 3),
+        ("t,x,y\n0,1,2\n1_0,1,3\n", None, "not a number", 3),  # Python's float takes it
         ("t,x,y\n0,1\n", None, "expected at least 3", 2),
         ("t,x,y\n0,1,2\n", ("t", "x", "z"), "no column named 'z'", 1),
         ("0,1,2\n", ("t", "x", "y"), "must give column numbers", 1),

@@ -104,7 +104,15 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
 
     report = Reporter.for_args(args, out, err)
     name = "<stdin>" if args.log == "-" else args.log
-    monitor = Monitor(mission_document(Path(name), args.mission), convention=args.boundary)
+    try:
+        monitor = Monitor(mission_document(Path(name), args.mission), convention=args.boundary)
+    except UsageError as exc:  # what the mission asks that the monitor cannot: the mission's
+        raise UsageError(
+            [
+                d if d.file else dataclasses.replace(d, file=str(args.mission))
+                for d in exc.diagnostics
+            ]
+        ) from None
     columns = parse_columns(args.columns) if args.columns else None
     transform = parse_transform(args.transform) if args.transform else None
     csv = CsvLines(name, columns)
@@ -156,7 +164,11 @@ def _json_pose(text: str, name: str, number: int) -> tuple[float, float, float]:
 
     try:
         record = json.loads(text)
-        return float(record["t"]), float(record["x"]), float(record["y"])
+        values = (record["t"], record["x"], record["y"])
+        # numbers only: float() would also take "5", true and "1_0"
+        if not all(isinstance(v, int | float) and not isinstance(v, bool) for v in values):
+            raise TypeError
+        return float(values[0]), float(values[1]), float(values[2])
     except (ValueError, KeyError, TypeError):
         raise UsageError(
             error(

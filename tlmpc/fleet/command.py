@@ -54,7 +54,7 @@ def run_batch(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             )
         )
     workers = _workers(args)
-    if args.report is not None:
+    if args.report is not None or args.group is not None:
         from tlmpc.fleet.report import group_pattern
 
         group_pattern(args.group)  # a bad --group fails before any log is verified

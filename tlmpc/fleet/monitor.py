@@ -35,6 +35,7 @@ from tlmpc.ltl.ast import And, Formula, bounded_operators
 from tlmpc.ltl.printer import to_text
 from tlmpc.verify import TraceInput, from_document, verify_trace
 from tlmpc.verify.pieces import boundary_membership, build_pieces, region_membership
+from tlmpc.verify.samples import sample_diagnostics
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -83,6 +84,7 @@ class Monitor:
         self.workspace = self.trace.boundary_polygon is not None
         self.last: FloatArray | None = None  # the last kept sample, pieces progressed to it
         self.previous_time: float | None = None
+        self.last_pose: tuple[float, float, float, int | None] | None = None
         self.origin: float | None = None
         self.verdicts: dict[str, str] = {}
         self.excursion: Change | None = None
@@ -92,23 +94,26 @@ class Monitor:
     # -- input --------------------------------------------------------------------------------
 
     def add(self, t: float, x: float, y: float, *, line: int | None = None) -> None:
-        """The next pose; V003/V005/V020 (exit 2) for a pose the verifier would refuse."""
-        where = f"sample {self.samples}" + (f" (line {line})" if line is not None else "")
-        if not (np.isfinite(t) and np.isfinite(x) and np.isfinite(y)):
-            raise UsageError(error("V003", f"{where} is not finite (NaN or infinity)", line=line))
-        if self.previous_time is not None and t <= self.previous_time:
-            code = "V005" if t < self.previous_time else "V020"
-            raise UsageError(
-                error(
-                    code,
-                    f"{where}: t = {t:g} after t = {self.previous_time:g}",
-                    hint="a live log's time stamps must increase",
-                    line=line,
-                )
-            )
+        """The next pose; the verifier's own sample checks (V003, V005, V020, V024; exit 2)
+        refuse a pose it would refuse."""
+        # with the pose before it: the order checks need both (that one passed already)
+        poses = [(t, x, y, line)] if self.last_pose is None else [self.last_pose, (t, x, y, line)]
+        numbers = np.array([pose[:3] for pose in poses], dtype=np.float64)
+        lines = [pose[3] for pose in poses]
+        found = sample_diagnostics(
+            numbers[:, 0],
+            numbers[:, 1],
+            numbers[:, 2],
+            file=None,
+            lines=None if None in lines else [int(n) for n in lines if n is not None],
+            first=self.samples - (len(poses) - 1),
+        )
+        if found:
+            raise UsageError(found)
         if self.previous_time is None:
             self.origin = t  # times in messages count from the first pose
         self.previous_time = t
+        self.last_pose = (t, x, y, line)
         self.samples += 1
         before = len(self.reducer.kept)
         self.reducer.feed(np.array([[t, x, y]]))

@@ -141,9 +141,17 @@ def _split(line: str, separator: str | None) -> list[str]:
     return [c.strip().strip('"').strip("'").strip() for c in cells]
 
 
+def _number(cell: str) -> float:
+    """``cell`` as a number, as numpy's reader takes it (ValueError otherwise): Python's
+    ``float`` alone would also read ``1_0`` as 10."""
+    if "_" in cell:
+        raise ValueError(cell)
+    return float(cell)
+
+
 def _is_number(cell: str) -> bool:
     try:
-        float(cell)
+        _number(cell)
     except ValueError:
         return False
     return True
@@ -256,7 +264,7 @@ def _row(cells: list[str], indices: tuple[int, int, int], file: str, number: int
             line=number,
         )
     try:
-        return [float(cells[i]) for i in indices]
+        return [_number(cells[i]) for i in indices]
     except ValueError:
         bad = next(cells[i] for i in indices if not _is_number(cells[i]))
         raise _fail("M053", f"not a number: {bad!r}", file, line=number) from None

@@ -26,10 +26,10 @@ MAX_PER_KIND = 3
 MAX_MAGNITUDE = 1e12
 
 
-def _where(index: int, lines: Sequence[int] | None) -> tuple[str, int | None]:
+def _where(index: int, lines: Sequence[int] | None, first: int) -> tuple[str, int | None]:
     if lines is not None and index < len(lines):
-        return f"sample {index} (line {lines[index]})", lines[index]
-    return f"sample {index}", None
+        return f"sample {first + index} (line {lines[index]})", lines[index]
+    return f"sample {first + index}", None
 
 
 def sample_diagnostics(
@@ -39,8 +39,11 @@ def sample_diagnostics(
     *,
     file: str | None,
     lines: Sequence[int] | None = None,
+    first: int = 0,
 ) -> list[Diagnostic]:
-    """Every problem with the samples ``(t[i], x[i], y[i])`` (empty list: they are usable)."""
+    """Every problem with the samples ``(t[i], x[i], y[i])`` (empty list: they are usable);
+    ``first``: the number of the first of them in its log (a live log's samples come one by
+    one)."""
     found: list[Diagnostic] = []
     if len(t) == 0:
         return [
@@ -54,7 +57,7 @@ def sample_diagnostics(
     values = np.column_stack([t, x, y])
     bad = np.flatnonzero(~np.all(np.isfinite(values), axis=1))
     for index in bad[:MAX_PER_KIND].tolist():
-        what, line = _where(index, lines)
+        what, line = _where(index, lines, first)
         columns = [
             n for n, v in zip("txy", values[index].tolist(), strict=True) if not np.isfinite(v)
         ]
@@ -71,7 +74,7 @@ def sample_diagnostics(
         return found  # order checks on NaN times would only repeat the same rows
     far = np.flatnonzero(np.any(np.abs(values) > MAX_MAGNITUDE, axis=1))
     for index in far[:MAX_PER_KIND].tolist():
-        what, line = _where(index, lines)
+        what, line = _where(index, lines, first)
         found.append(
             error(
                 "V024",
@@ -87,7 +90,7 @@ def sample_diagnostics(
         return found  # differences of such values overflow
     steps = np.diff(t)
     for index in (np.flatnonzero(steps < 0)[:MAX_PER_KIND] + 1).tolist():
-        what, line = _where(index, lines)
+        what, line = _where(index, lines, first)
         found.append(
             error(
                 "V005",
@@ -99,7 +102,7 @@ def sample_diagnostics(
         )
     repeated = np.flatnonzero(steps == 0) + 1
     for index in repeated[:MAX_PER_KIND].tolist():
-        what, line = _where(index, lines)
+        what, line = _where(index, lines, first)
         same = bool(x[index] == x[index - 1] and y[index] == y[index - 1])
         found.append(
             error(
