@@ -54,7 +54,7 @@ def test_artifact_names_alone_do_not_make_an_output(tmp_path: Path) -> None:
     before = snapshot(out)
     code, _, err = compile_to(out)
     assert code == 2
-    assert "error[U012]" in err
+    assert err.startswith(f"{out}: error[U012]"), err  # placed at the -o path
     assert snapshot(out) == before
 
 
@@ -344,10 +344,10 @@ def test_unwritable_places_are_u_codes(tmp_path: Path) -> None:
     assert "error[U03" in err
     code, _, err = compile_to(Path("/"))
     assert code == 2
-    assert "error[U011]" in err
+    assert err.startswith("/: error[U011]"), err
     code, _, err = compile_to(tmp_path / "missing" / "out")
     assert code == 2
-    assert "error[U010]" in err
+    assert err.startswith(f"{tmp_path / 'missing' / 'out'}: error[U010]"), err
 
 
 def test_check_destination_rejects_files(tmp_path: Path) -> None:

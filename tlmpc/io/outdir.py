@@ -68,7 +68,7 @@ def io_error(exc: OSError, path: Path, action: str) -> UsageError:
     """A U033 diagnostic for an operating-system error while writing output at ``path``."""
     reason = exc.strerror or str(exc)
     hint = _HINTS.get(exc.errno or 0, "check the path, its permissions and the free space")
-    return UsageError(error("U033", f"cannot {action} {path}: {reason}", hint=hint))
+    return UsageError(error("U033", f"cannot {action} {path}: {reason}", hint=hint, file=str(path)))
 
 
 def _umask() -> int:
@@ -111,11 +111,17 @@ def check_destination(out: Path, *, force: bool) -> None:
                 "U030",
                 f"{out} is a symbolic link; refusing to write through it or replace it",
                 hint="pass the directory it points to, or choose another -o",
+                file=str(out),
             )
         )
     if out.parent == out:
         raise UsageError(
-            error("U011", f"{out} cannot be an output directory", hint="choose another -o")
+            error(
+                "U011",
+                f"{out} cannot be an output directory",
+                hint="choose another -o",
+                file=str(out),
+            )
         )
     if not out.exists():
         if not out.parent.is_dir():
@@ -124,12 +130,18 @@ def check_destination(out: Path, *, force: bool) -> None:
                     "U010",
                     f"the parent directory of {out} does not exist",
                     hint="create it first, or choose another -o",
+                    file=str(out),
                 )
             )
         return
     if not out.is_dir():
         raise UsageError(
-            error("U011", f"{out} exists and is not a directory", hint="choose another -o")
+            error(
+                "U011",
+                f"{out} exists and is not a directory",
+                hint="choose another -o",
+                file=str(out),
+            )
         )
     if not force and not is_tlmpc_output(out):
         raise UsageError(
@@ -138,6 +150,7 @@ def check_destination(out: Path, *, force: bool) -> None:
                 f"{out} is not empty and is not a tlmpc output (it has no {MARKER} file)",
                 hint="choose another -o, or pass --force to add the artifacts to it "
                 "(other files in it are kept)",
+                file=str(out),
             )
         )
 
@@ -243,6 +256,7 @@ def _take_lock(out: Path, lock: Path) -> int:
                         "U010",
                         f"the parent directory of {out} does not exist",
                         hint="create it first, or choose another -o",
+                        file=str(out),
                     )
                 ) from None
             raise io_error(exc, lock, "create the lock file") from None
@@ -481,10 +495,14 @@ def commit(staging: Path, out: Path, *, force: bool) -> None:
 
 def _commit(staging: Path, out: Path, *, force: bool) -> None:
     if out.is_symlink():
-        raise UsageError(error("U030", f"{out} became a symbolic link; nothing was written"))
+        raise UsageError(
+            error("U030", f"{out} became a symbolic link; nothing was written", file=str(out))
+        )
     if out.exists() and not is_tlmpc_output(out):
         if not force:  # checked before compiling too; a race must not lose user files
-            raise UsageError(error("U012", f"{out} changed and is no longer a tlmpc output"))
+            raise UsageError(
+                error("U012", f"{out} changed and is no longer a tlmpc output", file=str(out))
+            )
         refuse_overwriting(out, [p.name for p in staging.iterdir() if p.name != MARKER])
         with _signals_blocked():  # the files arrive all together, like a swapped output
             for item in staging.iterdir():
@@ -538,6 +556,7 @@ def replace_file(path: Path, data: bytes) -> None:
                 "U034",
                 f"{path} is {kind}; refusing to replace it",
                 hint="choose another output file",
+                file=str(path),
             )
         )
     mode = stat.S_IMODE(info.st_mode) if info is not None else 0o666 & ~_umask()
