@@ -255,3 +255,43 @@ def test_a_sample_on_the_boundary_is_not_certified() -> None:
     assert not verdict.certified
     motion = [*samples[:3], [2.2, 4.2, 5.0], samples[3]]
     assert verify_document(document(motion, "G[0,3] !a", max_speed=1.0)).outcome == "violated"
+
+
+def test_the_time_robustness_search_keeps_no_variant_in_the_memo(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # each step of the search tightens the bounds, a new formula for the memo: kept, a long
+    # log's variants took gigabytes; what the verdict needs stays memoised
+    import tlmpc.verify.verdict as verdict_module
+    from tlmpc.ltl.ast import Formula
+    from tlmpc.verify import from_document
+
+    found: list[Any] = []
+    original = verdict_module._truth_of
+
+    def recorded(trace: Any) -> Any:
+        found.append(original(trace))
+        return found[-1]
+
+    monkeypatch.setattr(verdict_module, "_truth_of", recorded)
+    points = [[float(t), 1.0 + (t % 7), 1.0] for t in range(60)]
+    document = {
+        "format": "tlmpc.trace/1",
+        "ltl": "G F[0,9] a & G(b -> F[0,1.5] !b)",
+        "regions": {"a": [[0, 0], [2, 0], [2, 2], [0, 2]], "b": [[6, 0], [8, 0], [8, 2], [6, 2]]},
+        "workspace": {"boundary": [[-1, -1], [10, -1], [10, 10], [-1, 10]]},
+        "boundary": "right",
+        "max_speed": 10.0,
+        "points": points,
+        "loop_start": None,
+    }
+    verdict = verify_document(document, assume_stay=True)
+    assert any(c.time_robustness is not None for c in verdict.conjuncts)  # a search ran
+    truth = found[-1].truth
+
+    def subformulas(formula: Formula) -> set[Formula]:
+        return {formula}.union(*(subformulas(c) for c in formula.children()))
+
+    asked = subformulas(from_document(document).formula)
+    assert set(truth.cache) <= asked
+    assert set(truth.dense().cache) <= asked

@@ -31,7 +31,7 @@ each end is computed on its own.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, MutableMapping
 from dataclasses import dataclass
 from typing import Literal, assert_never
 
@@ -180,7 +180,7 @@ class DenseSemantics:
             self.domain = Domain(float(starts[0]), float(starts[ending]), float(timing.end))
         else:
             self.domain = Domain(float(starts[0]), None, float(starts[-1]))
-        self.cache: dict[Formula, Signal] = {}
+        self.cache: MutableMapping[Formula, Signal] = {}
 
     # -- signals ------------------------------------------------------------------------------
 

@@ -22,7 +22,9 @@ the hull of their values; the first piece, an instant, is always read exactly).
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections import ChainMap
+from collections.abc import Callable, Iterator, MutableMapping
+from contextlib import contextmanager
 
 import numpy as np
 import numpy.typing as npt
@@ -58,7 +60,7 @@ class Semantics:
         self.timing = timing
         self._untimed = self._lasso()
         self._dense: DenseSemantics | None = None
-        self.cache: dict[Formula, Value] = {}
+        self.cache: MutableMapping[Formula, Value] = {}
 
     def _lasso(self) -> IntervalEvaluator:
         atoms, size, ending, is_point = self.atoms, self.size, self.ending, self.is_point
@@ -80,6 +82,23 @@ class Semantics:
                 raise ValueError("a formula with time bounds needs the pieces' times")
             self._dense = DenseSemantics(self.atoms, self.size, self.ending, self.timing)
         return self._dense
+
+    @contextmanager
+    def scratch(self) -> Iterator[None]:
+        """Values computed in the block are forgotten after it (those known before are kept,
+        and used): a search that evaluates many variants of one formula, each a new key of
+        the memo, then holds one variant's signals at a time instead of all of them."""
+        dense = self.dense() if self.timing is not None else None
+        kept, dense_kept = self.cache, None if dense is None else dense.cache
+        self.cache = ChainMap({}, kept)
+        if dense is not None and dense_kept is not None:
+            dense.cache = ChainMap({}, dense_kept)
+        try:
+            yield
+        finally:
+            self.cache = kept
+            if dense is not None and dense_kept is not None:
+                dense.cache = dense_kept
 
     def __call__(self, formula: Formula) -> Value:
         """``(lo, hi)`` of ``formula`` at each piece."""

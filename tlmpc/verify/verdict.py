@@ -467,7 +467,8 @@ class _Truth:
             # up to its reach: the searches for time robustness evaluate only that prefix.
             cut = _prefix_end(times, reach(formula))
             if cut is None:
-                return _outcome(*truth.at_start(formula))
+                with truth.scratch():  # (the searches ask for many tightened variants)
+                    return _outcome(*truth.at_start(formula))
             return prefixes.outcome(formula, cut)
 
         return outcome_of
