@@ -223,6 +223,32 @@ def test_a_strategy_of_another_mission_is_refused(guard: Path, tmp_path: Path) -
     assert "error[Q123]" in err
 
 
+def test_an_unrealizable_mission_has_nothing_to_simulate(tmp_path: Path) -> None:
+    """Its folder holds the mission and the counterstrategy but no strategy: simulate says
+    so (Q123), with or without the reactive flags."""
+    mission = tmp_path / "lost.yaml"
+    mission.write_text(
+        "version: 1\n"
+        "workspace: {boundary: {rect: [0, 0, 3, 2]}}\n"
+        "regions:\n  r0: {rect: [0, 0, 1, 2]}\n  r1: {rect: [2, 0, 3, 2]}\n"
+        "sensors: {s: null}\n"
+        "robot: {start: [1.5, 1]}\n"
+        "task:\n  - visit r1 infinitely often\n  - never enter r1 while s\n"
+    )
+    out = tmp_path / "out"
+    code, _, err = run("compile", str(mission), "-o", str(out))
+    assert code == 1, err
+    assert "error[Q110]" in err
+    assert (out / "counterstrategy.json").is_file()
+    for flags in (("--sensors", "random"), ("--events", "5"), ()):
+        status, printed, err = run("simulate", str(out), *flags)
+        assert status == 2, flags
+        assert printed == ""
+        assert f"{out}: error[Q123]" in err, (flags, err)
+        assert "unrealizable reactive mission" in err
+        assert "hint: tlmpc view" in err
+
+
 def test_an_assumption_no_environment_can_keep_stops_the_run(tmp_path: Path) -> None:
     """ "G !r1" promises the robot is never in r1; the robot, asked to visit r1, wins the
     game vacuously (the environment cannot keep both that and the robot's arrival), but a

@@ -127,6 +127,15 @@ def test_all_init_changes_the_answer(tmp_path: Path) -> None:
         ("f.slugsin", "[INPUT]\nx\n[OUTPUT]\ny\n[SYS_TRANS]\n& x\n", ":6:4:", "Q030"),
         ("g.slugsin", "[INPUT]\nx\n[OUTPUT]\ny\n[ENV_TRANS]\n| x y'\n", ":6:5:", "Q035"),
         ("h.slugsin", "[INPUT]\nx\n[SYS_INIT]\n$ 2 ? 1 x\n", ":4:5:", "Q033"),
+        # a buffer announcing more formulas than its line holds ends early at its '$'
+        ("h2.slugsin", "[INPUT]\nx\n[SYS_INIT]\n& x $ 4 x ? 0\n", ":4:5:", "Q030"),
+        ("h3.slugsin", "[INPUT]\nx\n[SYS_INIT]\n$ 99999999999999 x\n", ":4:1:", "Q030"),
+        # longer than int() reads
+        ("h4.slugsin", f"[INPUT]\nx\n[SYS_INIT]\n$ 2 x ? {'9' * 5000}\n", ":4:7:", "Q033"),
+        ("h5.slugsin", f"[INPUT]\nx\n[SYS_INIT]\n$ {'9' * 5000} x\n", ":4:1:", "Q030"),
+        # 0 and 1 are the constants in a formula: such a variable could never be read
+        ("h6.slugsin", "[INPUT]\nx\n[OUTPUT]\n1\n[SYS_LIVENESS]\n! 1\n", ":4:1:", "Q032"),
+        ("h7.slugsin", "[INPUT]\n0\n[SYS_LIVENESS]\n0\n", ":2:1:", "Q032"),
         (
             "i.tlsf",
             "INFO { SEMANTICS: Mealy,Strict; }\nMAIN { INPUTS { a; } OUTPUTS { b; }\n"
@@ -146,6 +155,23 @@ def test_all_init_changes_the_answer(tmp_path: Path) -> None:
             "REQUIRE { a -> X a; } ASSERT { b -> X b; } }\n",
             ":3:11:",
             "Q047",
+        ),
+        # no MAIN (an empty file is not the trivial game), no SEMANTICS (strict or not?)
+        ("l.tlsf", "", ":1:1:", "Q041"),
+        ("m.tlsf", "// only a comment\n", ":2:1:", "Q041"),
+        ("n.tlsf", "INFO { SEMANTICS: Mealy,Strict }\n", ":2:1:", "Q041"),
+        (
+            "o.tlsf",
+            "MAIN { INPUTS { a; } OUTPUTS { b; }\nREQUIRE { a; } ASSERT { b; } }\n",
+            ":1:1:",
+            "Q041",
+        ),
+        (
+            "p.tlsf",
+            'INFO { TITLE: "t" }\nMAIN { INPUTS { a; } OUTPUTS { b; }\n'
+            "REQUIRE { a; } ASSERT { b; } }\n",
+            ":1:1:",
+            "Q041",
         ),
     ],
 )

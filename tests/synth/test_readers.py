@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import pytest
+
+from tlmpc.base.errors import UsageError
 from tlmpc.synth.readers.gr1c import parse_gr1c
 from tlmpc.synth.readers.slugsin import parse_slugsin
 from tlmpc.synth.readers.tlsf import parse_tlsf
@@ -54,6 +57,25 @@ def _tlsf(semantics: str, body: str) -> str:
     )
 
 
+def test_slugs_buffer_size_is_bounded_by_its_line() -> None:
+    """``$ N`` with N far beyond the line's words is refused before any room for N formulas
+    is set aside."""
+    import tracemalloc
+
+    text = "[INPUT]\nx\n[OUTPUT]\ny\n[SYS_TRANS]\n$ 100000000 y\n"
+    tracemalloc.start()
+    try:
+        with pytest.raises(UsageError) as caught:
+            parse_slugsin(text, file="big.slugsin")
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    found = caught.value.diagnostics[0]
+    assert (found.code, found.line, found.col) == ("Q030", 6, 1)
+    assert "ends early" in found.message
+    assert peak < 10_000_000
+
+
 def test_tlsf_sections_become_parts_of_the_right_player() -> None:
     spec = parse_tlsf(
         _tlsf(
@@ -100,6 +122,23 @@ def test_tlsf_strict_safety_ends_when_the_environment_breaks_its_own() -> None:
         _tlsf("Mealy,Strict", "INITIALLY { !r; }\nPRESET { !g; }\nASSERT { X g <-> r; !g; }")
     )
     assert not solve(Game.build(unguarded)).realizable
+
+
+def test_tlsf_without_main_or_semantics_says_what_is_missing() -> None:
+    main = "MAIN { INPUTS { r; } OUTPUTS { g; } REQUIRE { r; } ASSERT { g; } }\n"
+    cases = {
+        "": "neither an INFO nor a MAIN section",
+        "/* nothing */\n": "neither an INFO nor a MAIN section",
+        "INFO { SEMANTICS: Mealy,Strict }\n": "no MAIN section",
+        main: "SEMANTICS is missing",
+        'INFO { TITLE: "t" }\n' + main: "SEMANTICS is missing",
+    }
+    for text, message in cases.items():
+        with pytest.raises(UsageError) as caught:
+            parse_tlsf(text, file="t.tlsf")
+        found = caught.value.diagnostics[0]
+        assert found.code == "Q041", text
+        assert message in found.message, (text, found.message)
 
 
 def test_gr1c_one_side_init() -> None:

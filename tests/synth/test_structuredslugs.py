@@ -11,6 +11,7 @@ whole specification must get the same answer.
 from __future__ import annotations
 
 import itertools
+import operator
 import subprocess
 import sys
 from collections.abc import Callable
@@ -24,9 +25,9 @@ from hypothesis import strategies as st
 from tlmpc.base.errors import UsageError
 from tlmpc.synth.readers import read_spec
 from tlmpc.synth.readers.slugsin import parse_slugsin
-from tlmpc.synth.readers.structuredslugs import parse_structuredslugs
+from tlmpc.synth.readers.structuredslugs import CompareOp, parse_structuredslugs
 from tlmpc.synth.solver import Game, solve
-from tlmpc.synth.spec import Expr, GameSpec, Part
+from tlmpc.synth.spec import Compare, Expr, GameSpec, Linear, Part, Variable
 
 HERE = Path(__file__).resolve().parent / "slugs"
 #: every example but basicEvasion (a 24 x 8 grid with a moving obstacle: realizable, but its
@@ -290,3 +291,85 @@ def test_arithmetic_lines_mean_exact_sums() -> None:
                 assert evaluate(part.formula, now, after) == truth, (part.text, now, after)
                 bits = {**_assignment(enc, now, False), **_assignment(enc, after, True)}
                 assert (enc.bdd.let(bits, u) == enc.bdd.true) == truth, (part.text, now, after)
+
+
+# --- integer comparisons on the bits --------------------------------------------------------
+
+#: odd lows, a range of one value, a range that fills its bits and one that does not
+_LINEAR_VARS = (
+    Variable("p", "env", 3, 8),
+    Variable("q", "sys", 0, 7),
+    Variable("r", "sys", 5, 5),
+    Variable("s", "env", 2, 4),
+)
+_OPS = ["=", "!=", "<", "<=", ">", ">="]
+_terms = st.lists(
+    st.tuples(
+        st.integers(-3, 3).filter(bool),
+        st.sampled_from([v.name for v in _LINEAR_VARS]),
+        st.booleans(),
+    ),
+    min_size=0,
+    max_size=3,
+)
+
+
+@settings(max_examples=120, deadline=None)
+@given(terms=_terms, op=st.sampled_from(_OPS), value=st.integers(-30, 30))
+def test_linear_comparisons_match_brute_force(
+    terms: list[tuple[int, str, bool]], op: CompareOp, value: int
+) -> None:
+    """Every bit pattern of the variables read (out-of-range ones included) against Python's
+    arithmetic, for sums and for gr1c's single-variable comparisons."""
+    from tlmpc.synth.symbolic import Encoding
+
+    spec = GameSpec(_LINEAR_VARS, (), "forall_env_exists_sys", "structuredslugs", "t")
+    enc = Encoding(spec)
+    nodes: list[Expr] = [Linear(tuple(terms), op, value)]
+    if len(terms) == 1 and terms[0][0] == 1:
+        nodes.append(Compare(terms[0][1], op, value, terms[0][2]))
+    test = {
+        "=": operator.eq,
+        "!=": operator.ne,
+        "<": operator.lt,
+        "<=": operator.le,
+        ">": operator.gt,
+        ">=": operator.ge,
+    }[op]
+    ranges = {v.name: (v.low or 0, v.high or 0) for v in _LINEAR_VARS}
+    read = sorted({(name, primed) for _, name, primed in terms})
+    bits = [(enc.next_bits if primed else enc.bits)[name] for name, primed in read]
+    for node in nodes:
+        u = enc.expr(node)
+        for offsets in itertools.product(*(range(1 << len(b)) for b in bits)):
+            values = {
+                key: ranges[key[0]][0] + offset for key, offset in zip(read, offsets, strict=True)
+            }
+            inside = all(values[name, primed] <= ranges[name][1] for name, primed in read)
+            total = sum(coef * values[name, primed] for coef, name, primed in terms)
+            assignment = {
+                bit: bool((offset >> k) & 1)
+                for names, offset in zip(bits, offsets, strict=True)
+                for k, bit in enumerate(names)
+            }
+            holds = enc.bdd.let(assignment, u) == enc.bdd.true
+            assert holds == (inside and test(total, value)), (node, values)
+
+
+def test_comparisons_over_huge_ranges_are_built_on_the_bits() -> None:
+    """Ranges of a trillion values: the number of solutions is known, and the game of a
+    counter that must visit 7 is realizable (a loop over the values would never finish)."""
+    from tlmpc.synth.symbolic import Encoding
+
+    big = 10**12
+    text = f"[INPUT]\nx\n[OUTPUT]\nn: 0...{big}\nm: 0...{big}\n[SYS_LIVENESS]\nn = 7\n"
+    spec = parse_structuredslugs(text, file="big.structuredslugs")
+    assert solve(Game.build(spec)).realizable
+    enc = Encoding(spec)
+    width = 2 * len(enc.bits["n"])
+    pairs = enc.expr(Linear(((1, "n", False), (1, "m", False)), "=", big + 1))
+    assert enc.bdd.count(pairs, nvars=width) == big
+    thirds = enc.expr(Linear(((3, "n", False),), "<=", big))
+    assert enc.bdd.count(thirds, nvars=width // 2) == big // 3 + 1
+    above = enc.expr(Compare("m", ">", big - 5))
+    assert enc.bdd.count(above, nvars=width // 2) == 5

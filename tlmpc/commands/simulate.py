@@ -88,12 +88,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Simulate, verify and report."""
     from tlmpc.base.errors import EXIT_NEGATIVE
-    from tlmpc.commands.simulate_reactive import check_seed
+    from tlmpc.commands.simulate_reactive import check_seed, is_reactive_output
     from tlmpc.io.report import OUTCOME_EXIT, Reporter
     from tlmpc.runtime import Executor, make_disturbance, run_closed_loop
     from tlmpc.verify import verify_document
 
-    if args.sensors is not None or args.events is not None or (args.out / "strategy.json").exists():
+    if args.sensors is not None or args.events is not None or is_reactive_output(args.out):
         from tlmpc.commands.simulate_reactive import run_reactive_command
 
         return run_reactive_command(args, out, err)

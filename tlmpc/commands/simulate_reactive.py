@@ -54,6 +54,22 @@ def check_seed(seed: int, drawn: str) -> None:
         )
 
 
+def is_reactive_output(folder: Path) -> bool:
+    """Whether ``folder`` holds a reactive mission's compilation: its ``strategy.json``, or
+    (an unrealizable mission has none) a ``mission.json`` with sensors.  An unreadable
+    ``mission.json`` counts as static: the static run then reports it."""
+    from tlmpc.base.errors import TlmpcError
+    from tlmpc.io.artifacts import read_artifacts
+
+    if (folder / "strategy.json").exists():
+        return True
+    try:
+        mission = read_artifacts(folder, ("mission.json",)).get("mission.json")
+    except TlmpcError:
+        return False
+    return mission is not None and mission.get("reactive") is not None
+
+
 def run_reactive_command(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Run a reactive mission's strategy against an environment and report."""
     from tlmpc.base.errors import EXIT_NEGATIVE, EXIT_OK
@@ -71,7 +87,7 @@ def run_reactive_command(args: argparse.Namespace, out: TextIO, err: TextIO) -> 
     from tlmpc.verify import verify_document
 
     events = _events(args.events)
-    if not (args.out / "strategy.json").exists():
+    if not is_reactive_output(args.out):
         raise UsageError(
             error(
                 "U100",

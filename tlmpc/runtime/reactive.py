@@ -156,6 +156,19 @@ class ReactiveExecutor:
         else:
             folder, artifacts = Path(output.source), output.artifacts
         missing = [name for name in REACTIVE_ARTIFACTS if name not in artifacts]
+        lost = "counterstrategy.json" in artifacts or (folder / "counterstrategy.json").is_file()
+        if missing == ["strategy.json"] and lost:
+            raise UsageError(
+                error(
+                    "Q123",
+                    f"{folder} is the compilation of an unrealizable reactive mission: the "
+                    "environment can defeat every robot strategy (counterstrategy.json), so "
+                    "there is no strategy.json to simulate",
+                    hint=f"tlmpc view {folder} (or tlmpc plot) draws how the environment wins; "
+                    "weaken the task or add assumptions until tlmpc compile finds a strategy",
+                    file=str(folder),
+                )
+            )
         if missing:
             raise UsageError(
                 error(

@@ -43,6 +43,12 @@ _COMPARE: dict[str, Callable[[int, int], bool]] = {
 }
 
 
+def _carried(total: int, odd: bool) -> tuple[int, bool]:
+    """A column's total written down: its low bit joins the rest, the others carry over
+    (floor division, so a negative total carries correctly)."""
+    return total >> 1, odd or bool(total & 1)
+
+
 def bit_width(variable: Variable) -> int:
     """How many bits encode ``variable``."""
     if variable.is_bool:
@@ -171,12 +177,7 @@ class Encoding:
                 inside = variable.low <= node.value <= variable.high
                 cube = self.value_cube(variable, node.value, node.primed) if inside else bdd.false
                 return cube if node.op == "=" else ~cube & self._in_range(variable, node.primed)
-            test = _COMPARE[node.op]
-            result = bdd.false
-            for value in range(variable.low, variable.high + 1):
-                if test(value, node.value):
-                    result |= self.value_cube(variable, value, node.primed)
-            return result
+            return self._linear(Linear(((1, node.name, node.primed),), node.op, node.value))
         if isinstance(node, Linear):
             return self._linear(node)
         if isinstance(node, Not):
@@ -203,28 +204,64 @@ class Encoding:
         return bdd.apply("equiv", left, right)
 
     def _linear(self, node: Linear) -> Function:
-        """``sum(coef * var) op value``: the partial sums, one variable at a time, each with
-        the BDD of the values that give it (exact integers; the sums stay few because the
-        ranges are small)."""
+        """``sum(coef * var) op value`` (with every variable in its range), built bit by bit.
+
+        A loop over the values would cost the size of the ranges (a million and more for a
+        counter); instead the bits are added column by column, least significant first, like a
+        written sum.  With ``D = sum(coef * offset) - (value - sum(coef * low))``, the state
+        after column k is ``(carry, odd)`` such that ``D = 2^k * (carry + the columns still to
+        add) + rest`` with ``0 <= rest < 2^k`` and ``odd`` telling whether ``rest > 0``; at the
+        end the sign of D is that of the carry, or of ``rest`` when the carry is 0.  The carries
+        stay within the sum of the coefficients, so the cost grows with the number of bits.
+        """
         bdd = self.bdd
-        test = _COMPARE[node.op]
-        partial: dict[int, Function] = {0: bdd.true}
+        target = node.value
+        in_range = bdd.true
+        columns: list[list[tuple[int, str]]] = []
         for coef, name, primed in node.terms:
             variable = self.spec.variable(name)
             assert variable.low is not None
-            assert variable.high is not None
-            grown: dict[int, Function] = {}
-            for value in range(variable.low, variable.high + 1):
-                cube = self.value_cube(variable, value, primed)
-                for total, reached in partial.items():
-                    key = total + coef * value
-                    grown[key] = grown.get(key, bdd.false) | (reached & cube)
-            partial = grown
-        result = bdd.false
-        for total, reached in partial.items():
-            if test(total, node.value):
-                result |= reached
-        return result
+            target -= coef * variable.low
+            in_range &= self._in_range(variable, primed)
+            bits = (self.next_bits if primed else self.bits)[name]
+            columns.extend([] for _ in range(len(bits) - len(columns)))
+            for k, bit in enumerate(bits):
+                columns[k].append((coef, bit))
+        # a bit adds its coefficient to the column's total; None carries the total over
+        steps: list[tuple[int, str] | None] = []
+        for column in columns:
+            steps.extend(column)
+            steps.append(None)
+        start = (-target, False)
+        layers: list[set[tuple[int, bool]]] = [{start}]
+        for step in steps:
+            layers.append(
+                {
+                    after
+                    for total, odd in layers[-1]
+                    for after in (
+                        [_carried(total, odd)]
+                        if step is None
+                        else [(total, odd), (total + step[0], odd)]
+                    )
+                }
+            )
+        test = _COMPARE[node.op]
+        later: dict[tuple[int, bool], Function] = {}
+        for carry, odd in layers[-1]:
+            sign = -1 if carry < 0 else int(carry > 0 or odd)
+            later[carry, odd] = bdd.true if test(sign, 0) else bdd.false
+        for step, layer in zip(reversed(steps), reversed(layers[:-1]), strict=True):
+            here: dict[tuple[int, bool], Function] = {}
+            for total, odd in layer:
+                if step is None:
+                    here[total, odd] = later[_carried(total, odd)]
+                else:
+                    coef, bit = step
+                    high, low = later[total + coef, odd], later[total, odd]
+                    here[total, odd] = bdd.ite(bdd.var(bit), high, low)
+            later = here
+        return later[start] & in_range
 
     def part(self, part: Part) -> Function:
         """The BDD of one part (cached)."""

@@ -125,13 +125,16 @@ def parse_slugsin(
     ):
         if what == "vars":
             name = stripped
-            if name in variables or any(ch.isspace() for ch in name) or name.endswith("'"):
+            # a formula reads 0 and 1 as the constants, so such a variable could not be used
+            malformed = any(ch.isspace() for ch in name) or name.endswith("'")
+            if name in variables or malformed or name in ("0", "1"):
                 problem = "is declared twice" if name in variables else "is not a variable name"
                 raise source.fail(
                     "Q032",
                     f"{name!r} {problem}",
                     start,
-                    "one variable per line, each name once, without spaces or a trailing '",
+                    "one variable per line, each name once, without spaces or a trailing ', "
+                    "and not 0 or 1 (the constants)",
                 )
             variables[name] = Variable(name, owner)
             continue
@@ -169,7 +172,7 @@ def _allowed(variable: Variable, primed: bool, owner: Owner, kind: PartKind) -> 
 
 def _formula(
     line: _Line,
-    memory: list[Expr | None],
+    memory: list[Expr],
     variables: dict[str, Variable],
     owner: Owner,
     kind: PartKind,
@@ -186,35 +189,45 @@ def _formula(
         return Const(word == "1")
     if word in ("$", "?"):
         count_word, count_where = line.next("a number")
-        if not count_word.isdigit():
+        if not (count_word.isascii() and count_word.isdigit()):
             raise source.fail(
                 "Q033",
                 f"expected a number after {word!r}, found {count_word!r}",
                 count_where,
                 "write '$ N' followed by N formulas, and '? i' to recall formula i",
             )
-        count = int(count_word)
+        # every formula takes a word of the line, so a number with more digits than the count
+        # of its words (even one too long for int()) is too large for '$' and '?' alike
+        too_large = len(line.tokens) + 1
+        digits = count_word.lstrip("0")
+        count = int(digits or "0") if len(digits) <= len(str(too_large)) else too_large
+        shown = f"{word} {count_word}" if len(count_word) <= 20 else f"{word} {count_word[:20]}..."
         if word == "$":
             if count == 0:
                 raise source.fail(
                     "Q033", "an empty memory buffer '$ 0'", where, "a buffer holds N >= 1 formulas"
                 )
-            buffer: list[Expr | None] = [None] * count
-            for index in range(count):
-                buffer[index] = _formula(line, buffer, variables, owner, kind)
-            result = buffer[-1]
-            assert result is not None
-            return result
-        if count >= len(memory) or memory[count] is None:
+            words_left = len(line.tokens) - line.pos
+            if count > words_left:
+                raise source.fail(
+                    "Q030",
+                    f"the formula ends early: '{shown}' announces more formulas "
+                    f"than the {words_left} word(s) after it on the line",
+                    where,
+                    "'$ N' is followed by exactly N formulas, the last one being its value",
+                )
+            buffer: list[Expr] = []
+            while len(buffer) < count:
+                buffer.append(_formula(line, buffer, variables, owner, kind))
+            return buffer[-1]
+        if count >= len(memory):
             raise source.fail(
                 "Q033",
-                f"'? {count}' recalls a formula that is not stored yet",
+                f"'{shown}' recalls a formula that is not stored yet",
                 where,
                 "inside '$ N ...', '? i' may recall only the formulas before it",
             )
-        recalled = memory[count]
-        assert recalled is not None
-        return recalled
+        return memory[count]
     primed = word.endswith("'")
     name = word[:-1] if primed else word
     if name not in variables:

@@ -186,12 +186,15 @@ class _Parser:
     # --- the file ------------------------------------------------------------------------
 
     def parse(self) -> tuple[str, list[tuple[str, Token]], list[tuple[str, Node]]]:
-        semantics = "Mealy"
+        semantics: str | None = None
+        info: Token | None = None
+        main: Token | None = None
         signals: list[tuple[str, Token]] = []
         formulas: list[tuple[str, Node]] = []
         while self.token.kind != "eof":
             head = self.advance()
             if head.text == "INFO":
+                info = head
                 semantics = self.info()
             elif head.text == "GLOBAL":
                 self.expect("{", "GLOBAL { ... }")
@@ -204,6 +207,7 @@ class _Parser:
                     )
                 self.advance()
             elif head.text == "MAIN":
+                main = head
                 self.main(signals, formulas)
             else:
                 raise self.source.fail(
@@ -212,11 +216,30 @@ class _Parser:
                     head.start,
                     "a TLSF file is INFO { ... } GLOBAL { ... } MAIN { ... }",
                 )
+        # the game's meaning hangs on SEMANTICS (strict or not), and an empty file would
+        # otherwise read as the trivially realizable game
+        if main is None:
+            missing = "neither an INFO nor a MAIN section" if info is None else "no MAIN section"
+            raise self.source.fail(
+                "Q041",
+                f"the file has {missing}",
+                self.token.start,
+                "a TLSF file is INFO { SEMANTICS: Mealy,Strict } MAIN { INPUTS { ... } ... }",
+            )
+        if semantics is None:
+            where = "INFO does not declare it" if info is not None else "the file has no INFO"
+            raise self.source.fail(
+                "Q041",
+                f"SEMANTICS is missing: {where}",
+                main.start if info is None else info.start,
+                "declare INFO { SEMANTICS: Mealy,Strict } before MAIN (plain Mealy is the "
+                "non-strict reading)",
+            )
         return semantics, signals, formulas
 
-    def info(self) -> str:
+    def info(self) -> str | None:
         self.expect("{", "INFO { TITLE: ... SEMANTICS: ... }")
-        semantics = "Mealy"
+        semantics: str | None = None
         while self.token.text != "}":
             key = self.advance()
             if key.kind == "eof":
