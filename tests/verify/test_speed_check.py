@@ -55,16 +55,21 @@ def runs(draw: st.DrawFn, *, shortest_gap: float, factor: float) -> tuple[np.nda
     return np.column_stack([times, points]), speed
 
 
-def _refusals(samples: np.ndarray, speed: float) -> list[bool]:
-    """Whether each of the three checks says the samples move faster than ``speed``."""
-    document = _document(samples, speed)
-    whole = verify_document(document, assume_stay=True).certificate
+def _streamed(samples: np.ndarray, document: dict[str, Any]) -> Any:
+    """The streamed verifier's answer on ``samples`` written as a CSV log."""
     with tempfile.TemporaryDirectory() as folder:
         path = Path(folder) / "log.csv"
         with open(path, "w", encoding="utf-8") as stream:
             stream.write("t,x,y\n")
             np.savetxt(stream, samples, fmt="%.17g", delimiter=",")
-        streamed = verify_log(path, {**document, "points": []}, assume_stay=True)
+        return verify_log(path, {**document, "points": []}, assume_stay=True)
+
+
+def _refusals(samples: np.ndarray, speed: float) -> list[bool]:
+    """Whether each of the three checks says the samples move faster than ``speed``."""
+    document = _document(samples, speed)
+    whole = verify_document(document, assume_stay=True).certificate
+    streamed = _streamed(samples, document)
     return [
         "faster than max_speed" in whole.reason,
         "faster than max_speed" in streamed.verdict.certificate.reason,
@@ -111,13 +116,7 @@ def test_a_streamed_log_is_checked_on_every_sample_not_only_the_kept_ones() -> N
     times = np.array([0.0, 1.0, 2.0, 2.5, 3.5, 4.5])
     xs = np.array([0.0, 0.5, 1.0, 2.0, 2.5, 3.0])
     samples = np.column_stack([times, xs, np.zeros_like(xs)])
-    document = _document(samples, 1.0)
-    with tempfile.TemporaryDirectory() as folder:
-        path = Path(folder) / "log.csv"
-        with open(path, "w", encoding="utf-8") as stream:
-            stream.write("t,x,y\n")
-            np.savetxt(stream, samples, fmt="%.17g", delimiter=",")
-        streamed = verify_log(path, {**document, "points": []}, assume_stay=True)
+    streamed = _streamed(samples, _document(samples, 1.0))
     assert streamed.kept < streamed.samples
     assert "faster than max_speed" in streamed.verdict.certificate.reason
     assert "between t=2 s and t=2.5 s" in streamed.verdict.certificate.reason
