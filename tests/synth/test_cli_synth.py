@@ -191,3 +191,22 @@ def test_all_init_is_refused_for_tlsf(tmp_path: Path) -> None:
     code, _, err = run("synth", str(spec), "--all-init")
     assert code == 2
     assert "error[Q063]" in err
+
+
+def test_a_counterstrategy_too_large_to_show_keeps_the_answer(tmp_path: Path) -> None:
+    # the environment never gives x: unrealizable, and the counterstrategy visits each of the
+    # 25,001 values of n, more than are shown; the answer and the core still stand
+    spec = tmp_path / "wide.structuredslugs"
+    spec.write_text("[INPUT]\nx\n[OUTPUT]\nn: 0...25000\n[SYS_LIVENESS]\nx\n")
+    code, out, err = run("synth", str(spec))
+    assert code == 1, err
+    assert out.startswith("unrealizable\ncore: this guarantee is unrealizable")
+    assert f"{spec}:6:1: sys liveness: x" in out
+    assert err.startswith(f"{spec}: note[Q062]"), err
+    code, out, _ = run("synth", str(spec), "--json")
+    assert code == 1
+    document = json.loads(out)
+    jsonschema.validate(document, load_schema("cli-output"))
+    assert document["result"]["realizable"] is False
+    assert "counterstrategy" not in document["result"]
+    assert [d["code"] for d in document["diagnostics"]] == ["Q062"]

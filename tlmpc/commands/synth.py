@@ -7,6 +7,7 @@ counterstrategy), 2 when the specification cannot be read.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TextIO
 
@@ -183,7 +184,14 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
 
         core = minimal_core(spec, game.enc)
         core_spec = spec.with_parts(tuple(p for p in spec.parts if p.owner == "env") + core.parts)
-        counter = extract_counterstrategy(solve(Game.build(core_spec, game.enc)))
+        counter: CounterStrategy | None = None
+        try:
+            counter = extract_counterstrategy(solve(Game.build(core_spec, game.enc)))
+        except UsageError as exc:
+            if exc.diagnostics[0].code != "Q062":
+                raise
+            # too large to show: the answer and the core still stand (a note, not a failure)
+            reporter.diagnose(dataclasses.replace(d, severity="note") for d in exc.diagnostics)
         result["core"] = [
             {
                 "file": p.location.file,
@@ -194,7 +202,8 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             }
             for p in core.parts
         ]
-        result["counterstrategy"] = _counter_json(counter)
+        if counter is not None:
+            result["counterstrategy"] = _counter_json(counter)
         text += _explain(spec, core, counter)
     return reporter.finish(EXIT_NEGATIVE, result, text)
 
@@ -215,7 +224,7 @@ def _shorten(text: str, width: int = 90) -> str:
     return text if len(text) <= width else text[: width - 3] + "..."
 
 
-def _explain(spec: GameSpec, core: Core, counter: CounterStrategy) -> str:
+def _explain(spec: GameSpec, core: Core, counter: CounterStrategy | None) -> str:
     inputs = [v.name for v in spec.owned("env")]
     outputs = [v.name for v in spec.owned("sys")]
     count = len(core.parts)
@@ -225,6 +234,8 @@ def _explain(spec: GameSpec, core: Core, counter: CounterStrategy) -> str:
     ]
     for part in core.parts:
         lines.append(f"  {part.location}: {part.label}: {_shorten(part.text)}")
+    if counter is None:
+        return "\n".join(lines) + "\n"
     lines.append(f"counterstrategy ({len(counter.states)} nodes): the environment plays")
     if counter.initial_inputs is not None:
         lines.append(f"  first inputs: {_values(counter.initial_inputs)}")
