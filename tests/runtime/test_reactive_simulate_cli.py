@@ -177,6 +177,9 @@ def test_sensor_files_in_both_layouts(guard: Path, tmp_path: Path, text: str) ->
         ("t,person,alarm\n0,false,false\n5,true,false\n3,true,false\n", "U104", 4, 1),
         ("t,person,alarm\n1,false,false\n", "U104", 2, 1),
         ("t,sensor,value\n0,person,false\n", "U104", 2, 1),
+        # one instant, two values of one sensor: long and wide
+        ("t,sensor,value\n0,person,false\n0,alarm,false\n0,person,true\n", "U104", 4, 1),
+        ("t,person,alarm\n0,false,false\n1,true,false\n1,false,true\n", "U104", 4, 1),
         ("t,person,alarm\n0,false\n", "U103", 2, 1),
         # the initial assumption !alarm
         ("t,person,alarm\n0,false,true\n", "Q120", 2, 1),

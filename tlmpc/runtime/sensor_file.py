@@ -208,8 +208,27 @@ def _instants(timed: Timed, sensors: Sequence[str], name: str) -> list[Change]:
     problems: list[Diagnostic] = []
     changes: list[Change] = []
     current: dict[str, bool] = {}
+    read_now: dict[str, tuple[bool, int]] = {}  # this instant's readings, and their lines
     last = -math.inf
     for t, line, sensor, value in timed:
+        if t != last:
+            read_now = {}
+        earlier = read_now.get(sensor)
+        if earlier is not None and earlier[0] != value:
+            problems.append(
+                error(
+                    "U104",
+                    f"sensor {sensor!r} reads {str(earlier[0]).lower()} (line {earlier[1]}) and "
+                    f"{str(value).lower()} at one instant, t={t:g}",
+                    hint="one instant has one value per sensor: drop one reading, or give "
+                    "the later one its own time",
+                    file=name,
+                    line=line,
+                    col=1,
+                )
+            )
+            break
+        read_now[sensor] = (value, line)
         if t < last:
             problems.append(
                 error(
