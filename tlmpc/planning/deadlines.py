@@ -96,11 +96,22 @@ class DeadlineBound:
     @property
     def message(self) -> str:
         """The proof in words."""
+        earliest, deadline = _apart(self.earliest, self.deadline)
         return (
             f"no plan meets the deadline of `{self.conjunct}`: {self.what} takes at least "
-            f"{self.earliest:.4g} s > {self.deadline:.4g} s (a path of at least "
+            f"{earliest} s > {deadline} s (a path of at least "
             f"{self.distance:.4g} at speed {self.speed:g})"
         )
+
+
+def _apart(larger: float, smaller: float) -> tuple[str, str]:
+    """Two times written with the fewest significant digits (four at least) that show them
+    apart: a bound of 16.8231 s over a deadline of 16.82 s is not '16.82 s > 16.82 s'."""
+    for digits in range(4, 17):
+        texts = (f"{larger:.{digits}g}", f"{smaller:.{digits}g}")
+        if texts[0] != texts[1]:
+            return texts
+    return f"{larger!r}", f"{smaller!r}"
 
 
 @dataclass(frozen=True, slots=True)
