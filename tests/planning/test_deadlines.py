@@ -616,3 +616,23 @@ def test_a_proof_shows_its_two_times_apart() -> None:
         conjunct="F[0,3] a", what="w", deadline=3.0, earliest=12.5, distance=12.5, speed=1.0
     )
     assert "takes at least 12.5 s > 3 s" in far.message
+
+
+@pytest.mark.parametrize("disturbance", [0.0, 0.1])
+def test_bounds_met_undisturbed_are_flagged_under_a_disturbance(disturbance: float) -> None:
+    # met by the undisturbed trajectory, missed under the adversarial push of 0.1
+    import tlmpc
+
+    mission = {
+        "version": 1,
+        "workspace": {"boundary": {"rect": [0, 0, 20, 10]}},
+        "regions": {"a": {"rect": [15, 4, 17, 6]}},
+        "robot": {"start": [1, 5], "max_speed": 1.0, "disturbance": disturbance},
+        "task": ["visit a within 15.3 s"],
+    }
+    compiled = tlmpc.compile(mission)
+    flagged = [w for w in compiled.warnings if w.code == "R009"]
+    assert len(flagged) == (1 if disturbance else 0)
+    for warning in flagged:
+        assert warning.path == "$.robot.disturbance"
+        assert "disturbance 0.1" in warning.message

@@ -21,6 +21,7 @@ from typing import Any
 
 from tlmpc.abstraction.model import Abstraction
 from tlmpc.base.errors import EXIT_INCONCLUSIVE, Diagnostic, NoPlanError, TlmpcError
+from tlmpc.control.model import Controllers
 from tlmpc.ltl.ast import (
     And,
     BoundedEventually,
@@ -257,6 +258,30 @@ def _bounds(mission: Mission, abstraction: Abstraction) -> tuple[DeadlineBound, 
     )
     mesh = abstraction if exact else abstraction_for(proof_mission(mission), 0.0, deep=False)
     return deadline_bounds(mission, mesh)
+
+
+def disturbed_bounds(mission: Mission, controllers: Controllers) -> Diagnostic:
+    """R009: the task's time bounds were checked on the undisturbed trajectory, and a push of
+    up to ``robot.disturbance`` may delay it past them: the controllers guarantee that every
+    step is left (within its exit-time bound), not when the undisturbed run leaves it."""
+    steps = controllers.steps
+    first_pass = steps if controllers.loop_start is None else steps[: controllers.loop_start]
+    guaranteed = sum(
+        s.exit_time_bound for s in first_pass if not s.is_stay and math.isfinite(s.exit_time_bound)
+    )
+    return Diagnostic(
+        code="R009",
+        severity="warning",
+        message="the task's time bounds hold on the undisturbed trajectory; a push of up to "
+        f"robot.disturbance {mission.robot.disturbance:g} may delay it past them (the "
+        "controllers guarantee each step's exit, within its exit-time bound: the plan's "
+        f"{'prefix' if controllers.loop_start is not None else 'steps'} within "
+        f"{guaranteed:.4g} s at the latest, not the undisturbed times)",
+        hint="leave the bounds slack for the push, and check runs under it with `tlmpc "
+        "simulate OUT --model-disturbance adversarial`",
+        file=mission.source,
+        path="$.robot.disturbance",
+    )
 
 
 def proof_mission(mission: Mission) -> Mission:

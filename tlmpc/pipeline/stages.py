@@ -345,17 +345,20 @@ def _simulate(c: Compilation) -> StageResult:
     document = trace_to_json(trace, mission)
     points: list[list[float]] = document["points"]  # type: ignore[assignment]
     clearance, margin = _clearance(document, mission)
-    from tlmpc.pipeline.deadlines import check_time_bounds
+    from tlmpc.pipeline.deadlines import check_time_bounds, disturbed_bounds
     from tlmpc.verify.clearance import margin_warnings
 
     # Every time bound checked on the exact trajectory (P050/P051 when one is missed).
     bounds = check_time_bounds(mission, document, abstraction)
+    warnings = list(margin_warnings(clearance, margin, mission.source))
+    if bounds is not None and mission.robot.disturbance > 0.0:
+        warnings.append(disturbed_bounds(mission, controllers))
 
     return StageResult(
         products=provide(TRACE, document),
         artifacts={"trace.json": document},
         sizes={"samples": len(points), "duration": round(float(points[-1][0]), 3)},
-        warnings=tuple(margin_warnings(clearance, margin, mission.source)),
+        warnings=tuple(warnings),
         summary={"clearance": clearance.to_json(margin), **(bounds or {})},
     )
 
