@@ -58,6 +58,14 @@ def _expect(value: Any, kinds: tuple[type, ...], what: str, function: str) -> No
 _PATH = (str, os.PathLike)
 
 
+def _expect_path(value: Any, what: str, function: str) -> None:
+    """:func:`_expect` a path, and refuse (U075) one holding a NUL character (the operating
+    system cannot name such a file; Python would raise a bare ValueError)."""
+    _expect(value, _PATH, what, function)
+    if "\x00" in os.fspath(value):
+        raise UsageError(error("U075", f"tlmpc.{function}: the path holds a NUL character"))
+
+
 def _mission_text(mission: MissionSource, function: str) -> tuple[str | None, Path]:
     """(YAML text or None when ``mission`` is a file, the path diagnostics will name)."""
     _expect(mission, (*_PATH, Mapping), "the mission must be a path, YAML text or a dict", function)
@@ -144,7 +152,7 @@ class Compiled:
         """Write every artifact (and the figure, when drawn) into ``out`` atomically."""
         from tlmpc.io.outdir import check_destination, commit, staging_directory, write_artifacts
 
-        _expect(out, _PATH, "out must be a path", "Compiled.write")
+        _expect_path(out, "out must be a path", "Compiled.write")
         destination = Path(out)
         check_destination(destination, force=force)
         with staging_directory(destination) as staging:
@@ -231,7 +239,7 @@ def read_output(directory: str | os.PathLike[str]) -> Compiled:
     """
     from tlmpc.io.artifacts import ARTIFACT_SCHEMAS, cross_check, read_artifact
 
-    _expect(directory, _PATH, "directory must be a path", "read_output")
+    _expect_path(directory, "directory must be a path", "read_output")
     root = Path(directory)
     artifacts: dict[str, Any] = {}
     for name, (_, schema) in ARTIFACT_SCHEMAS.items():
@@ -276,7 +284,7 @@ def verify_trace(
         "verify_trace",
     )
     if mission is not None:
-        _expect(mission, _PATH, "mission must be a path", "verify_trace")
+        _expect_path(mission, "mission must be a path", "verify_trace")
     if boundary is not None:
         _expect(boundary, (str,), "boundary must be 'right' or 'closed'", "verify_trace")
     if isinstance(trace, Compiled):

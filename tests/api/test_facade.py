@@ -76,6 +76,27 @@ def test_errors_are_typed_and_carry_diagnostics(tmp_path: Path) -> None:
         tlmpc.compile(_mission(), until="no-such-stage")
 
 
+def test_a_trace_or_a_path_python_cannot_take_is_a_diagnostic(tmp_path: Path) -> None:
+    compiled = tlmpc.compile(_mission())
+    trace = compiled.artifacts["trace.json"]
+    for changed, code in (
+        ({"workspace": "x"}, "V004"),
+        ({"workspace": [[1]]}, "V004"),
+        ({"points": [[0, 10**400, 1], [2, 1, 1]]}, "V024"),  # too large for a float
+        ({"regions": {"a": [[0, 0], [10**400, 0], [0, 1]]}}, "V004"),
+    ):
+        with pytest.raises(tlmpc.UsageError) as caught:
+            tlmpc.verify_trace({**trace, **changed})
+        assert caught.value.diagnostics[0].code == code, changed
+    for call in (
+        lambda: compiled.write(tmp_path / "a\x00b"),
+        lambda: tlmpc.read_output("a\x00b"),
+    ):
+        with pytest.raises(tlmpc.UsageError) as refused:
+            call()
+        assert refused.value.diagnostics[0].code == "U075"
+
+
 def test_impossible_mission_raises_no_plan() -> None:
     mission = _mission()
     mission["task"] = ["visit dock", "avoid dock"]

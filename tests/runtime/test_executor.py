@@ -391,10 +391,21 @@ def test_the_executor_needs_the_control_stage() -> None:
         ((1.0,), {}),
         ((float("nan"), 1.0), {}),
         ((1.0, 1.0), {"model": "unicycle", "offset": 0.2}),
+        (None, {}),  # not numbers at all: still R023, not Python's own errors
+        (("a", "b"), {}),
+        ((10**400, 1), {}),
     ],
 )
-def test_a_malformed_pose_is_R023(pose: tuple[float, ...], robot: dict[str, Any]) -> None:
+def test_a_malformed_pose_is_R023(pose: Any, robot: dict[str, Any]) -> None:
     executor = tlmpc.executor(_compiled("visit a then b", **robot))
     with pytest.raises(tlmpc.UsageError) as caught:
         executor.command(pose, 0.0)
+    assert caught.value.diagnostics[0].code == "R023"
+
+
+@pytest.mark.parametrize("t", [None, "now", 10**400])
+def test_a_malformed_time_is_R023(t: Any) -> None:
+    executor = tlmpc.executor(_compiled("visit a then b"))
+    with pytest.raises(tlmpc.UsageError) as caught:
+        executor.command((1.0, 1.0), t)
     assert caught.value.diagnostics[0].code == "R023"

@@ -262,13 +262,13 @@ class Executor:
         """The command for ``pose`` at time ``t``: ``(vx, vy)``, or ``(v, omega)`` for a
         unicycle.  Updates the plan step, the task progress and recovers when needed."""
         expected = 3 if self.is_unicycle else 2
-        if len(pose) != expected or not all(math.isfinite(float(v)) for v in (*pose, t)):
+        if not _finite_numbers(pose, expected, t):
             shape = "(x, y, theta)" if self.is_unicycle else "(x, y)"
             raise UsageError(
                 error(
                     "R023",
                     f"a pose of this {self.mission.robot.model} robot is {shape} of finite "
-                    f"numbers with a finite time, not {tuple(pose)!r} at t={t!r}",
+                    f"numbers with a finite time, not {repr(pose)[:60]} at t={repr(t)[:30]}",
                     hint="pass the measured pose in the mission's frame",
                 )
             )
@@ -532,3 +532,13 @@ class Executor:
                 step_after=step_after,
             )
         )
+
+
+def _finite_numbers(pose: Any, expected: int, t: Any) -> bool:
+    """Whether ``pose`` is ``expected`` finite numbers and ``t`` a finite number (anything
+    else, None or text or an integer too large for a float, is not)."""
+    try:
+        values = [float(v) for v in (*pose, t)]
+        return len(pose) == expected and all(math.isfinite(v) for v in values)
+    except (TypeError, ValueError, OverflowError):
+        return False

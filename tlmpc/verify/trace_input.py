@@ -19,7 +19,7 @@ import numpy.typing as npt
 from tlmpc.base.errors import UsageError, error
 from tlmpc.ltl.ast import Formula
 from tlmpc.verify.model import Ending
-from tlmpc.verify.samples import check_samples
+from tlmpc.verify.samples import MAX_MAGNITUDE, check_samples
 from tlmpc.verify.signals import Signal, signals_of_document
 
 if TYPE_CHECKING:
@@ -79,6 +79,8 @@ def _fail(
 def _polygon(value: Any, what: str, file: str | None) -> FloatArray:
     try:
         array = np.asarray(value, dtype=np.float64)
+    except OverflowError:  # an integer too large for a float
+        raise _fail("V004", f"{what} has a non-finite coordinate", file) from None
     except (TypeError, ValueError):
         raise _fail("V004", f"{what} is not a list of [x, y] points", file) from None
     if array.ndim != 2 or array.shape[1] != 2 or array.shape[0] < 3:
@@ -103,7 +105,7 @@ def _polygons(named: Mapping[str, Any], file: str | None) -> dict[str, FloatArra
             and min(lengths, default=3) >= 3
             and bool(np.isfinite(flat).all())
         )
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         fine = False
     if not fine:
         return {str(k): _polygon(v, f"region {k!r}", file) for k, v in named.items()}
@@ -116,6 +118,13 @@ def _polygons(named: Mapping[str, Any], file: str | None) -> dict[str, FloatArra
 def _samples(rows: Any, file: str | None, lines: list[int] | None = None) -> FloatArray:
     try:
         array = np.asarray(rows, dtype=np.float64)
+    except OverflowError:  # an integer too large for a float: beyond any time or place
+        raise _fail(
+            "V024",
+            f"a sample has a time or coordinate beyond {MAX_MAGNITUDE:g} (an integer too "
+            "large for a number)",
+            file,
+        ) from None
     except (TypeError, ValueError):
         raise _fail("V002", "points must be rows of three numbers [t, x, y]", file) from None
     if array.ndim != 2 or array.shape[1] != 3:
@@ -242,6 +251,8 @@ def from_document(
     ):
         raise _fail("V008", f"loop_start {loop!r} is not a sample index", file)
     workspace = document.get("workspace") or {}
+    if not isinstance(workspace, dict):
+        raise _fail("V004", "the trace's `workspace` is not a mapping {boundary, holes}", file)
     boundary = workspace.get("boundary")
     holes = tuple(
         _polygon(h, f"hole {i}", file) for i, h in enumerate(workspace.get("holes") or [])
