@@ -77,6 +77,9 @@ TAMPERINGS: dict[str, Callable[[Path], None]] = {
     "formula region": edit("mission.json", set_key("formula", "F zzz")),
     "formula type": edit("mission.json", set_key("formula", 42)),
     "witness index": edit("witness.json", lambda d: d["prefix"].append(10**7)),
+    "witness prefix emptied": edit("witness.json", set_key("prefix", [])),
+    "witness word cut": edit("witness.json", lambda d: d["word"].pop()),
+    "witness states cut": edit("witness.json", lambda d: d["prefix_states"].pop()),
     "trace NaN": write(
         "trace.json",
         (ROOT / "specs" / "example1.yaml").read_text()
@@ -104,7 +107,7 @@ def test_tampered_output_is_rejected(compiled: Path, tmp_path: Path, tampering: 
     picture = (copy / "plan.svg").read_bytes()
     for argv in (("plot", str(copy)), *(("export", str(copy), "--format", f) for f in FORMATS)):
         code, out, err = run_cli(*argv)
-        if tampering in ("witness index", "trace NaN") and argv[0] == "export":
+        if tampering.startswith(("witness", "trace NaN")) and argv[0] == "export":
             assert code == 0, err  # export does not read the witness or the trace
             continue
         assert code == 2, (argv, err)
@@ -131,3 +134,20 @@ def test_mathtext_in_the_mission_name_is_drawn_literally(compiled: Path, tmp_pat
     edit("mission.json", set_key("name", r"$\foo$ and $x^{$"))(copy)
     code, _, err = run_cli("plot", str(copy))
     assert code == 0, err
+
+
+def test_stage_verify_of_an_edited_trace_that_fails_is_the_folders_answer(
+    compiled: Path, tmp_path: Path
+) -> None:
+    # cut to its first samples and declared to stay there: a trajectory that never gets done
+    copy = tmp_path / "out"
+    shutil.copytree(compiled, copy)
+    trace = json.loads((copy / "trace.json").read_text())
+    trace["points"] = trace["points"][:5]
+    trace["loop_start"] = None
+    (copy / "trace.json").write_text(json.dumps(trace))
+    code, _, err = run_cli("stage", "verify", str(copy))
+    assert code == 1, err  # a no, as `tlmpc verify` answers it; not an internal error
+    assert err.startswith(f"{copy / 'trace.json'}: error[U077]: the trajectory in trace.json"), err
+    assert "{" not in err.splitlines()[0]  # the verifier's words, not a raw record
+    assert "Traceback" not in err

@@ -483,6 +483,22 @@ def cross_check(directory: Path, documents: Mapping[str, Mapping[str, Any]]) -> 
                 path, f"the formula names regions the output does not have: {', '.join(unknown)}"
             )
     witness = documents.get("witness.json")
+    if witness is not None:
+        # a run of the product: one automaton state and one letter per plan step
+        steps = {"prefix": len(witness["prefix"]), "cycle": len(witness["cycle"])}
+        for key, count in steps.items():
+            states = witness.get(f"{key}_states")
+            if states is not None and len(states) != count:
+                raise _tampered(
+                    directory / "witness.json",
+                    f"witness.json: {key}_states has {len(states)} states for {count} steps",
+                )
+        word = witness.get("word")
+        if word is not None and len(word) != sum(steps.values()):
+            raise _tampered(
+                directory / "witness.json",
+                f"witness.json: the word has {len(word)} letters for {sum(steps.values())} steps",
+            )
     if witness is not None and abstraction is not None:
         for key in ("prefix", "cycle"):
             if not _indices(witness[key], triangles):

@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
-from tlmpc.base.errors import TlmpcError, error
+from tlmpc.base.errors import InvalidInputError, TlmpcError, error
 from tlmpc.base.memo import current_memo, memo_scope
 from tlmpc.base.pages import plain_pages
 from tlmpc.base.progress import heartbeat
@@ -390,7 +390,7 @@ def _verify(c: Compilation) -> StageResult:
             error(
                 "I001",
                 "the compiled trajectory does not satisfy the task (self-check failed): "
-                + str(verdict_json.get("counterexample")),
+                + _counterexample_text(verdict_json.get("counterexample")),
                 hint="please report this mission; the artifacts were not written",
             )
         )
@@ -464,6 +464,13 @@ def _sampled_for_certificate(
     if not (dense_verdict["satisfied"] and dense_verdict["certificate"]["certified"]):
         return None
     return denser, dense_verdict
+
+
+def _counterexample_text(counterexample: Any) -> str:
+    """The verifier's counterexample in words (its message), else as it is."""
+    if isinstance(counterexample, Mapping) and isinstance(counterexample.get("message"), str):
+        return str(counterexample["message"])
+    return str(counterexample)
 
 
 def _outruns(trace: Mapping[str, Any], speed: float) -> bool:
@@ -850,4 +857,22 @@ def run_stage_from_artifacts(
                 file=str(directory / MISSION.artifact),
             )
         )
-    return run_stages([stage], compilation, progress=progress)
+    try:
+        return run_stages([stage], compilation, progress=progress)
+    except SelfCheckError as exc:
+        # artifacts read from a folder may have been edited by hand: a trace that fails its
+        # re-check is the folder's answer (as `tlmpc verify` gives it), not a compiler bug
+        raise InvalidInputError(
+            [
+                error(
+                    "U077",
+                    d.message.replace(" (self-check failed)", "").replace(
+                        "the compiled trajectory", "the trajectory in " + TRACE.artifact
+                    ),
+                    hint=f"compare with `tlmpc verify {directory / TRACE.artifact}`; compile "
+                    "the mission again for a trajectory that meets it",
+                    file=str(directory / TRACE.artifact),
+                )
+                for d in exc.diagnostics
+            ]
+        ) from None
