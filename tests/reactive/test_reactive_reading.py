@@ -8,7 +8,9 @@ getting stuck and taking every acceptance set infinitely often).
 
 from __future__ import annotations
 
+import io
 import itertools
+from pathlib import Path
 
 import pytest
 from hypothesis import given, settings
@@ -16,6 +18,7 @@ from hypothesis import strategies as st
 
 from tlmpc.automata.guards import holds
 from tlmpc.base.errors import InvalidInputError
+from tlmpc.cli import main
 from tlmpc.ltl import parse_ltl, to_text
 from tlmpc.ltl.ast import Formula
 from tlmpc.mission import load_mission_text
@@ -256,3 +259,16 @@ def test_the_subset_construction_determinises_a_guessing_safety_automaton() -> N
         for state in range(piece.automaton.num_states):
             out = [e for e in piece.automaton.edges if e.src == state and holds(e.guard, letter)]
             assert len(out) <= 1
+
+
+def test_a_time_bound_in_a_reactive_mission_is_refused_at_its_part(tmp_path: Path) -> None:
+    # the game has no clocks: refused where the bound is written, with a hint that fits
+    path = tmp_path / "m.yaml"
+    path.write_text(_mission(["visit a", "visit b within 30 s"]))
+    err = io.StringIO()
+    code = main(["check", str(path)], out=io.StringIO(), err=err)
+    assert code == 1
+    err_text = err.getvalue()
+    line = path.read_text().splitlines().index("  - visit b within 30 s") + 1
+    assert err_text.startswith(f"{path}:{line}:5: error[L045]: a reactive mission cannot take")
+    assert "compile plans a bounded task" not in err_text

@@ -33,6 +33,7 @@ from tlmpc.ltl.ast import (
     Globally,
     Not,
     Prop,
+    bounded_operators,
     conjoin,
     disjoin,
     is_propositional,
@@ -87,6 +88,20 @@ def _wrapped(text: str) -> str:
 
 def pieces(part: TaskPart, owner: Owner, file: str | None = None) -> list[Piece]:
     """The GR(1) pieces of one part; raises :class:`NotGr1` when a conjunct has none."""
+    timed = bounded_operators(part.formula)
+    if timed:  # (the game has no clocks: no automaton reads a time bound)
+        raise NotGr1(
+            error(
+                "L045",
+                f"a reactive mission cannot take the time bound of `{to_text(timed[0])}`: "
+                "its task is synthesised as a game, which has no clocks",
+                hint="state this part without the bound (visit, not visit within); `tlmpc "
+                "verify LOG --mission MISSION` checks a bound on a run's log",
+                file=file,
+                line=part.line,
+                col=part.col,
+            )
+        )
     found: list[Piece] = []
     for conjunct in _conjuncts(part.formula):
         found.append(_piece(conjunct, part, owner, file))
