@@ -355,3 +355,18 @@ def test_a_strategy_written_only_symbolically_runs(tmp_path: Path, kind: str) ->
     # the run changed sensors and moved the robot between faces
     assert any(len(points) > 1 for points in trace["signals"].values())
     assert len({(round(x, 6), round(y, 6)) for _, x, y in trace["points"]}) > 10
+
+
+@pytest.mark.parametrize("fmt", ["promela", "smv", "dot"])
+def test_export_of_a_reactive_output_says_why_a_model_cannot_be_written(
+    guard: Path, fmt: str
+) -> None:
+    code, out, err = run("export", str(guard), "--format", fmt)
+    if fmt == "dot":  # the transition system alone: no task in it
+        assert code == 0, err
+        assert out.startswith("graph")
+        return
+    assert code == 2
+    assert err.startswith(f"{guard / 'mission.json'}: error[U078]"), err
+    assert "alarm, camera, person" in err
+    assert "different compiles" not in err

@@ -66,6 +66,20 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     mission = documents["mission.json"]
     formula = parse_ltl(mission["formula"])
     title = str(mission.get("name", "mission"))
+    reactive = mission.get("reactive") or {}
+    if args.format in ("promela", "smv") and reactive:
+        signals = sorted({*reactive.get("sensors", {}), *reactive.get("actions", [])})
+        raise UsageError(
+            error(
+                "U078",
+                f"{directory} is a reactive mission's output: its task reads sensors and "
+                f"actions ({', '.join(signals)}), which a {args.format} model of the "
+                "transition system has no variables for",
+                hint="--format dot draws the transition system alone; the robot's strategy "
+                f"is {directory / 'strategy.json'}",
+                file=str(directory / "mission.json"),
+            )
+        )
     if args.format in ("promela", "smv"):
         from tlmpc.ltl.bounds import refuse_bounds
 
