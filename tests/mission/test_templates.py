@@ -11,7 +11,8 @@ from urllib.parse import unquote, urlparse
 import numpy as np
 import pytest
 import yaml
-from robot_data import image_from_free, write_map
+from PIL import Image
+from robot_data import image_from_free
 
 from tlmpc.cli import main
 from tlmpc.commands.new import TEMPLATES
@@ -25,13 +26,12 @@ def _run(*argv: str) -> tuple[int, str, str]:
 
 
 @pytest.mark.parametrize("template", TEMPLATES)
-def test_every_template_is_a_mission_that_compiles(tmp_path: Path, template: str) -> None:
-    if template == "map":
-        free = np.ones((40, 40), dtype=bool)
-        free[[0, -1], :] = False
-        free[:, [0, -1]] = False
-        write_map(tmp_path, "map", image_from_free(free), resolution=0.1, origin=(-1.0, -1.0, 0.0))
-    mission = tmp_path / f"mission-{template}.yaml"
+@pytest.mark.parametrize("name", ["mission.yaml", "map.yaml", "my mission: v2.yaml"])
+def test_every_template_is_a_mission_that_compiles(
+    tmp_path: Path, template: str, name: str
+) -> None:
+    # a fresh folder: whatever the mission needs (the map template's map), `new` writes
+    mission = tmp_path / name
     code, _, err = _run("new", template, "-o", str(mission))
     assert code == 0, err
     text = mission.read_text()
@@ -55,3 +55,35 @@ def test_new_prints_without_o_and_never_overwrites(tmp_path: Path) -> None:
     assert code == 2
     assert "error[U094]" in err
     assert target.read_text() == "my own mission\n"
+
+
+def test_the_map_template_writes_its_map_beside_the_mission(tmp_path: Path) -> None:
+    mission = tmp_path / "site.yaml"
+    assert _run("new", "map", "-o", str(mission))[0] == 0
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "site-map.pgm",
+        "site-map.yaml",
+        "site.yaml",
+    ]
+    assert yaml.safe_load(mission.read_text())["workspace"] == {"map": "site-map.yaml"}
+    assert yaml.safe_load((tmp_path / "site-map.yaml").read_text())["image"] == "site-map.pgm"
+    # the room: 40 x 40 cells, walls one cell thick, free inside
+    with Image.open(tmp_path / "site-map.pgm") as image:
+        pixels = np.asarray(image)
+    assert pixels.shape == (40, 40)
+    free = np.ones((40, 40), dtype=bool)
+    free[[0, -1], :] = False
+    free[:, [0, -1]] = False
+    assert np.array_equal(pixels, image_from_free(free))
+
+
+@pytest.mark.parametrize("existing", ["site-map.yaml", "site-map.pgm"])
+def test_the_map_template_never_overwrites_a_map(tmp_path: Path, existing: str) -> None:
+    (tmp_path / existing).write_text("my own map\n")
+    code, _, err = _run("new", "map", "-o", str(tmp_path / "site.yaml"))
+    assert code == 2
+    assert "error[U094]" in err
+    assert existing in err
+    # nothing written: the refusal comes before the first file
+    assert [p.name for p in tmp_path.iterdir()] == [existing]
+    assert (tmp_path / existing).read_text() == "my own map\n"

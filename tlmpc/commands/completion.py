@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import shlex
+from dataclasses import dataclass
 from typing import TextIO
 
 NAME = "completion"
@@ -16,8 +17,9 @@ knows every command, flag and choice of this version):
   zsh:   tlmpc completion zsh > "${fpath[1]}/_tlmpc"
   fish:  tlmpc completion fish > "$HOME/.config/fish/completions/tlmpc.fish"
 
-Commands complete after `tlmpc`, flags after `-`, a flag's choices (compile --until, plot
---format ...) after the flag, and file names elsewhere."""
+Commands complete after `tlmpc`, flags after `-` (tlmpc's own --help and --version too), a
+flag's choices (compile --until, plot --format ...) after the flag, an argument with fixed
+choices (new's templates, stage's names) to those choices only, and file names elsewhere."""
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -25,63 +27,191 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("shell", choices=("bash", "zsh", "fish"), help="the shell")
 
 
-Commands = dict[str, tuple[str, list[str], dict[str, list[str]], list[str]]]
+@dataclass(frozen=True)
+class Command:
+    """What completion needs to know of one command.
+
+    ``values`` counts the words each flag that takes a value consumes (so that a flag's value
+    is not taken for a positional argument); ``slots`` holds each positional argument's
+    choices, empty for a file name; ``repeats`` says the last slot takes any number of words.
+    """
+
+    help: str
+    flags: list[str]
+    choices: dict[str, list[str]]
+    values: dict[str, int]
+    slots: list[list[str]]
+    repeats: bool
+
+
+@dataclass(frozen=True)
+class Commands:
+    """tlmpc's own flags (``--help``, ``--version``) and every command, by name."""
+
+    flags: list[str]
+    commands: dict[str, Command]
+
+
+def _value_count(action: argparse.Action) -> int:
+    """How many words after the flag are its value (an optional value is taken as absent)."""
+    if isinstance(action.nargs, int):
+        return action.nargs
+    return 0 if action.nargs in (argparse.OPTIONAL, argparse.ZERO_OR_MORE) else 1
 
 
 def _commands(parser: argparse.ArgumentParser) -> Commands:
-    """Each command: its help, its flags, each flag's choices and its positionals' choices."""
+    """tlmpc's own flags, and each command's help, flags, flags' choices and positionals."""
     sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
     helps = {action.dest: action.help or "" for action in sub._choices_actions}
     found = {}
     for name, command in sub.choices.items():
         flags: list[str] = []
         choices: dict[str, list[str]] = {}
-        positional: list[str] = []
+        values: dict[str, int] = {}
+        slots: list[list[str]] = []
+        repeats = False
         for action in command._actions:
-            values = [str(c) for c in action.choices] if action.choices else []
+            words = [str(c) for c in action.choices] if action.choices else []
             if action.option_strings:
                 flags.extend(action.option_strings)
                 for flag in action.option_strings:
-                    if values:
-                        choices[flag] = values
+                    if words:
+                        choices[flag] = words
+                    if _value_count(action):
+                        values[flag] = _value_count(action)
             else:
-                positional.extend(values)
-        found[name] = (helps.get(name, ""), flags, choices, positional)
-    return found
+                count = action.nargs if isinstance(action.nargs, int) else 1
+                slots.extend([words] * count)
+                repeats = action.nargs in (argparse.ONE_OR_MORE, argparse.ZERO_OR_MORE)
+        found[name] = Command(helps.get(name, ""), flags, choices, values, slots, repeats)
+    own = [
+        s
+        for a in parser._actions
+        if not isinstance(a, argparse._SubParsersAction)
+        for s in a.option_strings
+    ]
+    return Commands(own, found)
+
+
+# Helpers shared by every generated script.  Candidates are read one per line into COMPREPLY:
+# `COMPREPLY=($(compgen ...))` would split a file named `my mission.yaml` in two (and
+# glob-expand a name with `*`).  `mapfile` would do the same in bash, but zsh runs this script
+# through bashcompinit, which has no `mapfile`, so a `read` loop serves both.
+_BASH_HELPERS = r"""_tlmpc_reply() {
+  local line
+  while IFS= read -r line; do
+    [ -n "$line" ] && COMPREPLY+=("$line")
+  done <<< "$1"
+}
+_tlmpc_words() {
+  _tlmpc_reply "$(compgen -W "$1" -- "$2")"
+  # fixed words, not file names: no slash after one that happens to name a directory
+  if [ -n "${BASH_VERSION-}" ]; then compopt +o filenames 2>/dev/null; fi
+}
+_tlmpc_files() {
+  _tlmpc_reply "$(compgen -f -- "$1")"
+  if [ -n "${ZSH_VERSION-}" ]; then
+    # zsh's bashcompinit inserts candidates unquoted (bash quotes them itself: -o filenames)
+    local name
+    local -a quoted
+    for name in "${COMPREPLY[@]}"; do quoted+=("$(printf '%q' "$name")"); done
+    COMPREPLY=("${quoted[@]}")
+  fi
+}"""
+
+
+def _pattern(*words: str) -> str:
+    """A bash ``case`` pattern matching the words joined by a space, literally."""
+    return shlex.quote(" ".join(words))
 
 
 def bash_script(commands: Commands) -> str:
     """The bash completion function (zsh loads it through bashcompinit)."""
+    table = commands.commands
     lines = [
         "# tlmpc completion for bash (generated by `tlmpc completion bash`)",
+        _BASH_HELPERS,
         "_tlmpc() {",
         '  local cur="${COMP_WORDS[COMP_CWORD]}" prev="${COMP_WORDS[COMP_CWORD-1]}"',
-        '  local cmd="${COMP_WORDS[1]}" words=""',
+        '  local cmd="" i=1 n=0 skip=0 options=1 w',
         "  COMPREPLY=()",
-        '  if [ "$COMP_CWORD" -eq 1 ]; then',
-        f'    COMPREPLY=($(compgen -W {shlex.quote(" ".join(commands))} -- "$cur"))',
+        "  # the command is the first word that is not a flag (tlmpc's own flags take no value)",
+        '  while [ "$i" -lt "$COMP_CWORD" ]; do',
+        '    w="${COMP_WORDS[i]}"',
+        "    i=$((i + 1))",
+        '    case "$w" in -*) ;; *) cmd="$w"; break;; esac',
+        "  done",
+        '  if [ -z "$cmd" ]; then',
+        '    case "$cur" in',
+        f'      -*) _tlmpc_words {shlex.quote(" ".join(commands.flags))} "$cur";;',
+        f'      *) _tlmpc_words {shlex.quote(" ".join(table))} "$cur";;',
+        "    esac",
         "    return",
         "  fi",
         '  case "$cmd $prev" in',
     ]
-    for name, (_, _, choices, _) in commands.items():
-        for flag, values in choices.items():
+    for name, command in table.items():
+        for flag, values in command.choices.items():
             lines.append(
-                f"    {shlex.quote(f'{name} {flag}')}) "
-                f'COMPREPLY=($(compgen -W {shlex.quote(" ".join(values))} -- "$cur")); return;;'
+                f"    {_pattern(name, flag)}) _tlmpc_words {shlex.quote(' '.join(values))} "
+                '"$cur"; return;;'
             )
-    lines += ["  esac", '  case "$cmd" in']
-    for name, (_, flags, _, positional) in commands.items():
-        lines.append(
-            f"    {shlex.quote(name)}) words={shlex.quote(' '.join(flags + positional))};;"
-        )
     lines += [
         "  esac",
-        '  if [[ "$cur" == -* ]]; then',
-        '    COMPREPLY=($(compgen -W "$words" -- "$cur"))',
-        "  else",
-        '    COMPREPLY=($(compgen -W "$words" -- "$cur" | grep -v "^-") $(compgen -f -- "$cur"))',
+        "  # which positional argument the current word is: flags and their values do not count",
+        '  while [ "$i" -lt "$COMP_CWORD" ]; do',
+        '    w="${COMP_WORDS[i]}"',
+        "    i=$((i + 1))",
+        '    if [ "$skip" -gt 0 ]; then skip=$((skip - 1)); continue; fi',
+        '    if [ "$options" = 1 ]; then',
+        '      case "$w" in',
+        "        --) options=0; continue;;",
+        '        -?*) case "$cmd $w" in',
+    ]
+    for name, command in table.items():
+        by_count: dict[int, list[str]] = {}
+        for flag, count in command.values.items():
+            by_count.setdefault(count, []).append(_pattern(name, flag))
+        for count, patterns in sorted(by_count.items()):
+            lines.append(f"            {'|'.join(patterns)}) skip={count};;")
+    lines += [
+        "          esac",
+        "          continue;;",
+        "      esac",
+        "    fi",
+        "    n=$((n + 1))",
+        "  done",
+        "  # the current word is a flag's value (a flag with choices was answered above)",
+        '  if [ "$skip" -gt 0 ]; then _tlmpc_files "$cur"; return; fi',
+        '  if [ "$options" = 1 ]; then',
+        '    case "$cur" in',
+        '      -*) case "$cmd" in',
+    ]
+    for name, command in table.items():
+        lines.append(
+            f"          {shlex.quote(name)}) _tlmpc_words {shlex.quote(' '.join(command.flags))} "
+            '"$cur";;'
+        )
+    lines += [
+        "        esac",
+        "        return;;",
+        "    esac",
         "  fi",
+        "  # an argument with fixed choices takes nothing else; any other is a file",
+        '  case "$cmd $n" in',
+    ]
+    for name, command in table.items():
+        for index, values in enumerate(command.slots):
+            if values:
+                pattern = _pattern(name, str(index))
+                if command.repeats and index == len(command.slots) - 1:
+                    pattern = _pattern(name, "") + "*"
+                lines.append(
+                    f'    {pattern}) _tlmpc_words {shlex.quote(" ".join(values))} "$cur"; return;;'
+                )
+    lines += [
+        "  esac",
+        '  _tlmpc_files "$cur"',
         "}",
         "complete -o filenames -F _tlmpc tlmpc",
     ]
@@ -99,21 +229,41 @@ def zsh_script(commands: Commands) -> str:
 def fish_script(commands: Commands) -> str:
     """``complete`` lines for fish."""
     lines = ["# tlmpc completion for fish (generated by `tlmpc completion fish`)"]
-    names = " ".join(commands)
-    for name, (help_text, flags, choices, positional) in commands.items():
+    names = " ".join(commands.commands)
+    before = f"-n 'not __fish_seen_subcommand_from {names}'"
+    for flag in commands.flags:
+        lines.append(f"complete -c tlmpc {before} {_fish_option(flag)}")
+    for name, command in commands.commands.items():
         lines.append(
-            f"complete -c tlmpc -f -n 'not __fish_seen_subcommand_from {names}' "
-            f"-a {shlex.quote(name)} -d {shlex.quote(help_text)}"
+            f"complete -c tlmpc -f {before} -a {shlex.quote(name)} -d {shlex.quote(command.help)}"
         )
         seen = f"-n '__fish_seen_subcommand_from {name}'"
-        for flag in flags:
-            option = f"-l {flag[2:]}" if flag.startswith("--") else f"-s {flag[1:]}"
-            values = choices.get(flag)
-            extra = f" -xa {shlex.quote(' '.join(values))}" if values else ""
-            lines.append(f"complete -c tlmpc {seen} {option}{extra}")
-        if positional:
-            lines.append(f"complete -c tlmpc {seen} -a {shlex.quote(' '.join(positional))}")
+        for flag in command.flags:
+            values = command.choices.get(flag)
+            if values:
+                extra = f" -xa {shlex.quote(' '.join(values))}"
+            else:
+                # -r: the next word is the flag's value (a file), not a positional argument
+                extra = " -r" if flag in command.values else ""
+            lines.append(f"complete -c tlmpc {seen} {_fish_option(flag)}{extra}")
+        for index, values in enumerate(command.slots):
+            if not values:
+                continue
+            words = " ".join(values)
+            if index == 0:
+                # only these words (-f: no file names) until one of them is given
+                lines.append(
+                    f"complete -c tlmpc -f -n '__fish_seen_subcommand_from {name}; "
+                    f"and not __fish_seen_subcommand_from {words}' -a {shlex.quote(words)}"
+                )
+            else:  # fish cannot count positional arguments: offer the words beside files
+                lines.append(f"complete -c tlmpc {seen} -a {shlex.quote(words)}")
     return "\n".join(lines) + "\n"
+
+
+def _fish_option(flag: str) -> str:
+    """A flag as fish's ``complete`` names it (``-l long`` or ``-s x``)."""
+    return f"-l {flag[2:]}" if flag.startswith("--") else f"-s {flag[1:]}"
 
 
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:

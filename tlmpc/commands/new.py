@@ -14,7 +14,9 @@ without entering a region, come back), patrol (visit places again and again) or 
 on a ROS occupancy-grid map).  The file starts with a yaml-language-server line naming the
 mission schema installed with tlmpc, so editors with a YAML language server (VS Code's YAML
 extension, Neovim, Helix ...) complete and check the keys as you type.  Without -o the mission
-is printed.  An existing file is never overwritten (exit 2)."""
+is printed.  With -o, map also writes the map it names beside the mission (an empty room,
+FILE-map.yaml and FILE-map.pgm after FILE's name, to replace with your own), so the mission
+compiles as written.  An existing file is never overwritten (exit 2)."""
 
 TEMPLATES = ("reach-avoid", "patrol", "map")
 
@@ -32,12 +34,62 @@ def schema_line() -> str:
     return f"# yaml-language-server: $schema={(schema_dir() / 'mission.schema.json').as_uri()}\n"
 
 
-def template_text(name: str) -> str:
-    """The template ``name`` with the schema line on top."""
+# The map template's own line naming its map: the one line `tlmpc new map -o FILE` rewrites
+# to the map it writes beside FILE.
+MAP_LINE = "workspace: {map: map.yaml}\n"
+
+# The map written beside the map template: a 4 m x 4 m room (40 x 40 cells of 0.1 m, walls one
+# cell thick) with its lower-left corner at (-1, -1), around the template's start (0, 0) and
+# dock [1, 2] x [1, 2].
+_CELLS = 40
+_RESOLUTION = 0.1
+_ORIGIN = (-1.0, -1.0, 0.0)
+
+
+def template_text(name: str, map_name: str | None = None) -> str:
+    """The template ``name`` with the schema line on top; ``map_name``, for the map template,
+    is the map file the mission names instead of ``map.yaml``."""
+    import json
     from importlib import resources
 
     body = (resources.files("tlmpc.templates") / f"{name}.yaml").read_text(encoding="utf-8")
+    if map_name is not None:
+        # a JSON string is a YAML scalar, so a name with spaces or colons reads back as written
+        body = body.replace(MAP_LINE, f"workspace: {{map: {json.dumps(map_name)}}}\n")
     return schema_line() + body
+
+
+def map_files(mission: Path) -> tuple[Path, Path]:
+    """The map YAML and image that ``tlmpc new map -o mission`` writes beside ``mission``:
+    named after it, so two missions in one folder get a map each."""
+    stem = mission.stem or mission.name
+    return mission.with_name(f"{stem}-map.yaml"), mission.with_name(f"{stem}-map.pgm")
+
+
+def map_image() -> bytes:
+    """The room's occupancy grid as a binary PGM: 254 free, 0 occupied (walls at the edge)."""
+    rows = []
+    for row in range(_CELLS):
+        edge = row in (0, _CELLS - 1)
+        cells = [0 if edge or col in (0, _CELLS - 1) else 254 for col in range(_CELLS)]
+        rows.append(bytes(cells))
+    return f"P5\n{_CELLS} {_CELLS}\n255\n".encode("ascii") + b"".join(rows)
+
+
+def map_metadata(image: Path) -> str:
+    """The map_server YAML of the room, naming ``image`` (beside it)."""
+    import json
+
+    x, y, yaw = _ORIGIN
+    return (
+        "# The map of `tlmpc new map`: an empty room to replace with your robot's map.\n"
+        f"image: {json.dumps(image.name)}\n"
+        f"resolution: {_RESOLUTION}\n"
+        f"origin: [{x}, {y}, {yaw}]\n"
+        "negate: 0\n"
+        "occupied_thresh: 0.65\n"
+        "free_thresh: 0.196\n"
+    )
 
 
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
@@ -46,20 +98,32 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     from tlmpc.io.outdir import replace_file
     from tlmpc.io.report import Reporter
 
-    text = template_text(args.template)
     reporter = Reporter.for_args(args, out, err)
     if args.output is None:
-        return reporter.finish(EXIT_OK, text=text)
+        return reporter.finish(EXIT_OK, text=template_text(args.template))
     target: Path = args.output
-    if target.exists() or target.is_symlink():
-        raise UsageError(
-            error(
-                "U094",
-                f"{target} exists: tlmpc new never overwrites a file",
-                hint="choose another name with -o, or remove the file first",
-                file=str(target),
+    written: dict[Path, bytes]
+    if args.template == "map":
+        # the mission names a map: write one beside it, or the mission does not compile
+        map_yaml, image = map_files(target)
+        written = {
+            image: map_image(),
+            map_yaml: map_metadata(image).encode("utf-8"),
+            target: template_text("map", map_yaml.name).encode("utf-8"),
+        }
+    else:
+        written = {target: template_text(args.template).encode("utf-8")}
+    # every file checked before any is written (the mission first, the name the user gave)
+    for path in sorted(written, key=lambda p: p != target):
+        if path.exists() or path.is_symlink():
+            raise UsageError(
+                error(
+                    "U094",
+                    f"{path} exists: tlmpc new never overwrites a file",
+                    hint="choose another name with -o, or remove the file first",
+                    file=str(path),
+                )
             )
-        )
     if not target.parent.is_dir():
         raise UsageError(
             error(
@@ -69,6 +133,9 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
                 file=str(target),
             )
         )
-    replace_file(target, text.encode("utf-8"))
+    for path, data in written.items():  # the mission last: it names the others
+        replace_file(path, data)
+    if len(written) > 1:
+        reporter.note(f"wrote the map {', '.join(str(p) for p in written if p != target)}")
     reporter.note(f"wrote {target}: edit it, then `tlmpc check {target}`")
     return reporter.finish(EXIT_OK)
