@@ -14,7 +14,7 @@ Print a completion script for SHELL, generated from tlmpc's own command-line par
 knows every command, flag and choice of this version):
 
   bash:  tlmpc completion bash > "$HOME/.local/share/bash-completion/completions/tlmpc"
-  zsh:   tlmpc completion zsh > "${fpath[1]}/_tlmpc"
+  zsh:   echo 'eval "$(tlmpc completion zsh)"' >> "$HOME/.zshrc"
   fish:  tlmpc completion fish > "$HOME/.config/fish/completions/tlmpc.fish"
 
 Commands complete after `tlmpc`, flags after `-` (tlmpc's own --help and --version too), a
