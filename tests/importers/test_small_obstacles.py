@@ -22,6 +22,7 @@ from robot_data import image_from_free, write_map
 from shapely.geometry import Point, Polygon
 
 from tlmpc.cli import main
+from tlmpc.importers import maps
 from tlmpc.importers.maps import ImportSettings, _obstacles_kept, import_map
 
 Cells = frozenset[tuple[int, int]]
@@ -189,3 +190,42 @@ def test_an_obstacle_lost_to_simplification_is_noticed() -> None:
     assert not _obstacles_kept(room, [Polygon([(7, 7), (8, 7), (8, 8)])])
     assert not _obstacles_kept(room, [Polygon([(6, 6), (7, 6), (7, 7)])])  # touching only
     assert _obstacles_kept(Polygon(room.exterior), [])
+
+
+def test_a_free_pocket_inside_an_obstacle_is_not_taken_for_the_main_piece(tmp_path: Path) -> None:
+    """The pocket's bounding box lies inside the room's: each exact piece must be matched to
+    the simplified piece it overlaps most, not merely to one near it."""
+    free = np.zeros((10, 10), dtype=bool)
+    free[1:9, 1:9] = True  # the room
+    free[2:8, 2:8] = False  # a block of shelving
+    free[4, 4:6] = free[5, 5:7] = True  # a pocket of 4 free cells inside it
+    path = write_map(tmp_path, "p", image_from_free(free), resolution=1.0)
+    imported = import_map(path)
+    assert Polygon(imported.boundary).equals(shapely.box(1, 1, 9, 9))
+    assert len(imported.holes) == 1
+    assert len(imported.components) == 1
+    assert Polygon(imported.components[0][0]).within(shapely.box(4, 4, 7, 6))
+
+
+def test_an_obstacle_whose_simplified_hole_moved_off_it_keeps_its_exact_shape(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Simplification within the tolerance does not do this, but should a simplified hole end
+    up over free cells it would be labelled free: the import then keeps the exact faces."""
+    free = np.ones((12, 12), dtype=bool)
+    free[[0, -1], :] = free[:, [0, -1]] = False
+    free[6, 5:8] = free[5, 6] = False  # a T of 4 cells
+    exact_simplified = maps._simplified
+
+    def moved(noded: shapely.Geometry, tolerance: float, rounds: int = 8) -> shapely.Geometry:
+        chains = list(exact_simplified(noded, tolerance, rounds).geoms)
+        hole = min(range(len(chains)), key=lambda k: chains[k].length)
+        chains[hole] = shapely.LineString([(2, 2), (3, 2), (2, 3), (2, 2)])  # over free cells
+        return shapely.MultiLineString(chains)
+
+    monkeypatch.setattr(maps, "_simplified", moved)
+    path = write_map(tmp_path, "t", image_from_free(free), resolution=1.0)
+    imported = import_map(path)
+    assert len(imported.holes) == 1
+    obstacle = shapely.affinity.translate(_squares(~free[1:-1, 1:-1]), 1, 1)
+    assert Polygon(imported.holes[0]).equals(obstacle)

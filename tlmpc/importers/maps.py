@@ -80,6 +80,7 @@ class ImportedMap:
     resolution: float
     tolerance: float
     source: str
+    #: obstacle specks filled: holes smaller than ``min_area`` by their exact cell area
     speckles_dropped: int = 0
     #: every file read: the map YAML, its image, and those of the masks
     inputs: tuple[str, ...] = ()
@@ -284,7 +285,9 @@ def _coverage(
         kept_area = sum(f.area for f, lab in zip(simple, matched, strict=True) if lab is not None)
         # Each edge moved by at most the tolerance, so the area cannot change by more than
         # tolerance x total edge length; more means the simplified linework lost a junction.
-        if abs(kept_area - workspace.area) <= tolerance * workspace.length + 1e-9:
+        area_kept = abs(kept_area - workspace.area) <= tolerance * workspace.length + 1e-9
+        holes = [f for f, lab in zip(simple, matched, strict=True) if lab is None]
+        if area_kept and _obstacles_kept(workspace, holes):
             faces, face_labels = simple, matched
     kept = [f for f, lab in zip(faces, face_labels, strict=True) if lab is not None]
     merged = polygons(shapely.union_all(kept))
@@ -295,6 +298,24 @@ def _coverage(
         if face_label is not None:
             by_label.setdefault(face_label, []).append(face)
     return merged, by_label
+
+
+def _obstacles_kept(workspace: BaseGeometry, simple_holes: list[Polygon]) -> bool:
+    """Whether every hole of ``workspace`` (an obstacle) overlaps one of ``simple_holes``, the
+    simplified faces matched to no free face.
+
+    Simplified faces take the label of the exact face they overlap most, so a hole simplified
+    into a sliver lying mostly over free cells would be labelled free and the obstacle would
+    vanish from the map: then the import keeps the exact faces instead.
+    """
+    exact_holes = [Polygon(ring) for piece in polygons(workspace) for ring in piece.interiors]
+    if not exact_holes:
+        return True
+    tree = shapely.STRtree(simple_holes)
+    return all(
+        any(hole.intersection(simple_holes[int(k)]).area > 0 for k in tree.query(hole))
+        for hole in exact_holes
+    )
 
 
 def _simple_parts(piece: Polygon, free: BaseGeometry, members: BaseGeometry) -> list[Polygon]:
@@ -326,10 +347,21 @@ def _simple_parts(piece: Polygon, free: BaseGeometry, members: BaseGeometry) -> 
 
 def _exact_free(
     grid: OccupancyGrid, settings: ImportSettings, min_area_cells: float
-) -> tuple[Polygon, list[Polygon]]:
+) -> tuple[Polygon, list[Polygon], int]:
+    """The free pieces in grid units before simplification, with their specks decided: the
+    main piece, the other pieces of at least ``min_area_cells``, and how many holes smaller
+    than that were filled.
+
+    Specks are judged here, on the exact cell areas, and only here: simplification within
+    one cell can take a 4-cell L, S or T obstacle to a triangle of 3 cells or less, which
+    would then count as a speck and turn real occupied cells into free space.
+    """
     main, others = _free_pieces(grid, settings.radius, settings.start, min_area_cells)
     holes = 0.0 if settings.keep_obstacles else min_area_cells
-    return drop_small_holes(main, holes), [drop_small_holes(p, holes) for p in others]
+    pieces = [main, *others]
+    filled = [drop_small_holes(p, holes) for p in pieces]
+    dropped = sum(len(a.interiors) - len(b.interiors) for a, b in zip(pieces, filled, strict=True))
+    return filled[0], filled[1:], dropped
 
 
 def _check_settings(settings: ImportSettings, file: str) -> None:
@@ -395,7 +427,7 @@ def import_map(
         DEFAULT_MIN_CELLS * grid.cell_area() if settings.min_area is None else settings.min_area
     )
     cell_area = grid.cell_area()
-    exact_main, exact_others = _exact_free(grid, settings, min_area / cell_area)
+    exact_main, exact_others, dropped = _exact_free(grid, settings, min_area / cell_area)
     mask_grids: list[tuple[str, Path, OccupancyGrid]] = []
     for prefix, path in (("keepout", keepout), ("speed", speed)):
         if path is None:
@@ -419,16 +451,18 @@ def import_map(
     labels = _labels(grid, layers)
     exact = MultiPolygon([exact_main, *exact_others]) if exact_others else exact_main
     simplified, pieces = _coverage(exact, labels, tolerance / grid.resolution)
-    # the main piece is the simplified one overlapping the exact main piece most
-    main = max(simplified, key=lambda p: (p.intersection(exact_main).area, p.area))
-    others = [p for p in simplified if p is not main and p.area >= min_area / cell_area]
+    # Each exact piece, its specks already decided on exact areas, is the simplified piece
+    # overlapping it most; their holes are the exact holes kept, however small simplified.
+    tree = shapely.STRtree(simplified)
+
+    def counterpart(piece: Polygon) -> Polygon:
+        near = [simplified[int(k)] for k in tree.query(piece)] or simplified
+        return max(near, key=lambda p: (p.intersection(piece).area, p.area))
+
+    main = counterpart(exact_main)
+    others = list({id(p): p for p in map(counterpart, exact_others) if p is not main}.values())
     others.sort(key=lambda p: (-p.area, p.bounds))
-    hole_cells = 0.0 if settings.keep_obstacles else min_area / cell_area
-    kept_cells = [drop_small_holes(p, hole_cells) for p in (main, *others)]
-    dropped = sum(
-        len(a.interiors) - len(b.interiors)
-        for a, b in zip((main, *others), kept_cells, strict=True)
-    )
+    kept_cells = [main, *others]
     outer_cells = shapely.union_all([Polygon(p.exterior) for p in kept_cells])
     shapely.prepare(outer_cells)
     free_union = shapely.union_all(kept_cells)
