@@ -214,6 +214,34 @@ def test_verifier_checks_the_body_against_obstacles() -> None:
     assert verdict.robustness < 0
 
 
+def test_the_first_workspace_violation_is_the_bodys_first_contact() -> None:
+    # the body (0.5) reaches the outer wall y = 0 at t = 1.5 / 1.8 s, then the point enters the
+    # hole at t = 2 + 2/3 s: the contact comes first, though the path only leaves later
+    trace = {
+        "format": "tlmpc.trace/1",
+        "ltl": "F a",
+        "regions": {"a": [[8, 8], [9, 8], [9, 9], [8, 9]]},
+        "workspace": {
+            "boundary": [[0, 0], [10, 0], [10, 10], [0, 10]],
+            "holes": [[[4, 4], [6, 4], [6, 6], [4, 6]]],
+        },
+        "points": [[0, 2, 2], [1, 2, 0.2], [2, 2, 2], [3, 5, 5], [4, 2, 2]],
+        "loop_start": None,
+        "end": "stay",
+        "radius": 0.5,
+    }
+    verdict = tlmpc.verify_trace(trace)
+    first = verdict.workspace_violation
+    assert first is not None
+    assert first.time is not None
+    assert first.position is not None
+    assert first.time == pytest.approx(1.5 / 1.8, abs=1e-6)
+    assert first.position == pytest.approx((2.0, 0.5), abs=1e-6)
+    assert "body" in first.message
+    entries = [v for v in verdict.violations if v.conjunct == "workspace"]
+    assert [round(v.time or 0.0, 6) for v in entries] == [round(1.5 / 1.8, 6), round(8 / 3, 6)]
+
+
 @st.composite
 def _rooms(draw: st.DrawFn) -> tuple[Mission, float]:
     radius = draw(st.floats(0.05, 0.6))

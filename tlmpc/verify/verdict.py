@@ -283,16 +283,30 @@ def _body_contacts(trace: TraceInput, distances: FloatArray) -> list[Violation]:
     segment = points[index : index + 2]
     free = _free_space(trace)
     assert free is not None
-    offsets = np.asarray(shapely.distance(free.boundary, shapely.points(segment)), dtype=np.float64)
-    closest = segment[int(np.argmin(offsets))]
-    time = float(trace.times[min(index + int(np.argmin(offsets)), len(points) - 1)])
-    x, y = float(closest[0]), float(closest[1])
+    # where the segment first comes within the radius: its first point outside the free space
+    # shrunk by the radius (a fine polygon of it; the sample nearest the wall if none is found)
+    inner = free.buffer(-trace.radius, quad_segs=64)
+    line = shapely.LineString(segment) if len(segment) == 2 else shapely.Point(segment[0])
+    near = shapely.get_coordinates(shapely.difference(line, inner))
+    if len(near) and len(segment) == 2:
+        along = np.linalg.norm(near - segment[0], axis=1)
+        first = near[int(np.argmin(along))]
+        length = float(np.linalg.norm(segment[1] - segment[0]))
+        fraction = float(np.min(along)) / length if length > 0.0 else 0.0
+        time = float(trace.times[index] + fraction * (trace.times[index + 1] - trace.times[index]))
+    else:
+        offsets = np.asarray(
+            shapely.distance(free.boundary, shapely.points(segment)), dtype=np.float64
+        )
+        first = segment[int(np.argmin(offsets))]
+        time = float(trace.times[min(index + int(np.argmin(offsets)), len(points) - 1)])
+    x, y = float(first[0]), float(first[1])
     return [
         Counterexample(
             conjunct="workspace",
             time=time,
             position=(x, y),
-            message=f"the robot's body (radius {trace.radius:g}) touches an obstacle near "
+            message=f"the robot's body (radius {trace.radius:g}) touches an obstacle from "
             f"{at(time, trace.start)} at ({x:.4g}, {y:.4g}): the path passes "
             f"{float(distances[index]):.4g} from it",
         )
@@ -365,6 +379,12 @@ def workspace_violations(trace: TraceInput) -> tuple[list[Violation], float | No
                 message=f"the trajectory {where} at {at(time, trace.start)} at ({x:.4g}, {y:.4g})",
             )
         )
+    if trace.radius > 0.0:
+        # the body may meet an obstacle where the point stays inside, before it leaves
+        distances = np.full(len(segments), np.inf)
+        distances[inside] = shapely.distance(free.boundary, segments[inside])
+        found.extend(_body_contacts(trace, distances))
+        found.sort(key=lambda v: math.inf if v.time is None else v.time)
     return found, -depth
 
 
