@@ -94,3 +94,22 @@ def test_task_phrases_are_located_at_their_phrase(tmp_path: Path) -> None:
     assert "region 'c'" not in first.message + (first.hint or ""), "c is only forbidden"
     assert "region 'b' can only be reached through regions the task forbids" in (first.hint or "")
     assert (first.line, first.col) == (len(lines) - 1, _col(lines, len(lines) - 1, "avoid c"))
+
+
+@pytest.mark.parametrize("task", ["visit corner", "visit a then corner"])
+def test_a_region_the_body_cannot_enter_is_named_not_an_overlap(tmp_path: Path, task: str) -> None:
+    # a corner region 0.1 wide, within a 0.3 body's radius of both walls: no triangle of the
+    # planner's space holds it, so the automaton over the map's letters has no edge
+    text = (
+        "version: 1\nworkspace:\n  boundary: {rect: [0, 0, 10, 10]}\nregions:\n"
+        "  a: {rect: [1, 1, 3, 3]}\n  corner: {rect: [9.9, 9.9, 10, 10]}\n"
+        f"robot: {{start: [5, 5], radius: 0.3}}\ntask: [{task}]\n"
+    )
+    path = tmp_path / "m.yaml"
+    path.write_text(text)
+    with pytest.raises(NoPlanError) as raised:
+        compile_mission(path, until="plan")
+    first = raised.value.diagnostics[0]
+    assert first.code == "P010"
+    assert "region 'corner' has no free space the robot can be in" in (first.hint or "")
+    assert "overlap" not in first.message + (first.hint or "")

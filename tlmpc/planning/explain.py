@@ -118,6 +118,21 @@ def explain_no_plan(
             )
         ]
     if not automaton.edges:
+        # a needed region with no triangle at all (in holes, or within the body's radius of
+        # obstacles) empties the automaton too: that, not an overlap, is the reason
+        held = {name for letter in abstraction.letters for name in letter}
+        missing = [name for name in _positive_props(formula) if name not in held]
+        if missing:
+            return [
+                error(
+                    "P004",
+                    f"region {name!r} has no free space the robot can be in: it lies in "
+                    "holes, or within the body's radius of obstacles",
+                    hint="move or enlarge the region, or the holes (R003 says when the body "
+                    "is what keeps the robot out)",
+                )
+                for name in sorted(missing)
+            ]
         return [
             error(
                 "P006",
@@ -270,8 +285,10 @@ def _region_facts(
             facts.append(
                 error(
                     "P004",
-                    f"region {name!r} has no free space: it lies in holes",
-                    hint="move the region or the holes",
+                    f"region {name!r} has no free space the robot can be in: it lies in "
+                    "holes, or within the body's radius of obstacles",
+                    hint="move or enlarge the region, or the holes (R003 says when the body "
+                    "is what keeps the robot out)",
                     **where,
                 )
             )
