@@ -157,3 +157,13 @@ def test_spin_syntax_expands_weak_until_and_strong_release() -> None:
     assert to_spin(parse_ltl("a W b")) == "((b) V ((a) || (b)))"
     assert to_spin(parse_ltl("a M b")) == "((b) U ((a) && (b)))"
     assert to_spin(parse_ltl("G(a -> F b)")) == "[](((a) -> (<>(b))))"
+
+
+def test_brackets_inside_a_quoted_name_are_not_nesting() -> None:
+    # a quoted name may hold any character: 401 brackets in it are a name, not 401 levels
+    name = "(" * 401 + '\\"' + ")" * 3
+    formula = parse_ltl(f'F "{name}"')
+    assert formula == parse_ltl(f'F("{name}")')
+    with pytest.raises(InvalidInputError) as caught:  # and the limit still holds outside
+        parse_ltl("F " + "(" * 401 + f'"{name}"' + ")" * 401)
+    assert caught.value.diagnostics[0].code == "L005"

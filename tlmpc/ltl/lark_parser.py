@@ -358,9 +358,22 @@ def _tree_depth(tree: Tree[Token]) -> int:
 
 
 def _max_depth(text: str) -> int:
+    """The deepest nesting of brackets in ``text``, outside double-quoted names (a name may
+    hold any character, brackets too)."""
     depth = deepest = 0
+    quoted = escaped = False
     for char in text:
-        if char == "(":
+        if quoted:
+            if escaped:
+                escaped = False
+            elif char == "\\":
+                escaped = True
+            elif char == '"':
+                quoted = False
+            continue
+        if char == '"':
+            quoted = True
+        elif char == "(":
             depth += 1
             deepest = max(deepest, depth)
         elif char == ")":
