@@ -89,6 +89,18 @@ def _positive_props(formula: Formula) -> list[str]:
     return [p for p in dict.fromkeys(names) if p in positive]
 
 
+def _no_free_space(name: str, **where: Any) -> Diagnostic:
+    """P004: region ``name`` has no triangle the robot can be in."""
+    return error(
+        "P004",
+        f"region {name!r} has no free space the robot can be in: it lies in holes, or within "
+        "the body's radius of obstacles",
+        hint="move or enlarge the region, or the holes (R003 says when the body is what keeps "
+        "the robot out)",
+        **where,
+    )
+
+
 def explain_no_plan(
     abstraction: Abstraction,
     automaton: Automaton,
@@ -123,16 +135,7 @@ def explain_no_plan(
         held = {name for letter in abstraction.letters for name in letter}
         missing = [name for name in _positive_props(formula) if name not in held]
         if missing:
-            return [
-                error(
-                    "P004",
-                    f"region {name!r} has no free space the robot can be in: it lies in "
-                    "holes, or within the body's radius of obstacles",
-                    hint="move or enlarge the region, or the holes (R003 says when the body "
-                    "is what keeps the robot out)",
-                )
-                for name in sorted(missing)
-            ]
+            return [_no_free_space(name) for name in sorted(missing)]
         return [
             error(
                 "P006",
@@ -282,16 +285,7 @@ def _region_facts(
         with_region = np.array([name in letter for letter in abstraction.letters], dtype=bool)
         triangles = with_region[abstraction.letter_of]
         if not triangles.any():
-            facts.append(
-                error(
-                    "P004",
-                    f"region {name!r} has no free space the robot can be in: it lies in "
-                    "holes, or within the body's radius of obstacles",
-                    hint="move or enlarge the region, or the holes (R003 says when the body "
-                    "is what keeps the robot out)",
-                    **where,
-                )
-            )
+            facts.append(_no_free_space(name, **where))
         elif not (triangles & reachable_ok).any():
             if (triangles & reachable_any).any():
                 forbidden = ", ".join(f"`G {to_text(p)}`" for p in invariants(formula))
