@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
-from tlmpc.base.errors import InvalidInputError, TlmpcError, error
+from tlmpc.base.errors import Diagnostic, InvalidInputError, TlmpcError, error
 from tlmpc.base.memo import current_memo, memo_scope
 from tlmpc.base.pages import plain_pages
 from tlmpc.base.progress import heartbeat
@@ -27,7 +27,6 @@ from tlmpc.base.version import __version__
 if TYPE_CHECKING:
     from tlmpc.abstraction.model import Abstraction
     from tlmpc.automata.model import Automaton
-    from tlmpc.base.errors import Diagnostic
     from tlmpc.control.model import Controllers
     from tlmpc.mission.model import Mission
     from tlmpc.planning.model import Witness
@@ -386,25 +385,28 @@ def _verify(c: Compilation) -> StageResult:
     verdict_json = verdict_to_json(verdict)
     if not verdict_json["satisfied"]:
         # The compiler's guarantee failed: that is a bug in tlmpc, never the user's fault.
+        counterexample = _counterexample_text(verdict_json.get("counterexample"))
         raise SelfCheckError(
             error(
                 "I001",
-                "the compiled trajectory does not satisfy the task (self-check failed): "
-                + _counterexample_text(verdict_json.get("counterexample")),
+                f"the compiled trajectory does not satisfy the task (self-check failed): "
+                f"{counterexample}",
                 hint="please report this mission; the artifacts were not written",
-            )
+            ),
+            reason=f"does not satisfy the task: {counterexample}",
         )
     certificate = verdict_json["certificate"]
     bound = certificate["max_speed"]
     if bound is not None and _outruns(document, bound):
         # The controllers promise |u| <= max_speed; a faster trace breaks the guarantee too.
+        speeds = f"moves at {certificate['observed_speed']:.6g}, faster than max_speed {bound:.6g}"
         raise SelfCheckError(
             error(
                 "I001",
-                f"the compiled trajectory moves at {certificate['observed_speed']:.6g}, faster "
-                f"than max_speed {bound:.6g} (self-check failed)",
+                f"the compiled trajectory {speeds} (self-check failed)",
                 hint="please report this mission; the artifacts were not written",
-            )
+            ),
+            reason=speeds,
         )
     # (after the self-checks: a trace faster than max_speed is not certified either, and no
     # denser sampling mends that)
@@ -536,9 +538,14 @@ def _plot(c: Compilation) -> StageResult:
 
 
 class SelfCheckError(TlmpcError):
-    """The verifier rejected a trace the compiler produced (an internal error, exit 3)."""
+    """The verifier rejected a trace the compiler produced (an internal error, exit 3);
+    ``reason`` says what is wrong with the trajectory, whoever made it."""
 
     exit_code = 3
+
+    def __init__(self, diagnostic: Diagnostic, *, reason: str) -> None:
+        super().__init__(diagnostic)
+        self.reason = reason
 
 
 _STATIC: frozenset[World] = frozenset({"static"})
@@ -863,16 +870,11 @@ def run_stage_from_artifacts(
         # artifacts read from a folder may have been edited by hand: a trace that fails its
         # re-check is the folder's answer (as `tlmpc verify` gives it), not a compiler bug
         raise InvalidInputError(
-            [
-                error(
-                    "U077",
-                    d.message.replace(" (self-check failed)", "").replace(
-                        "the compiled trajectory", "the trajectory in " + TRACE.artifact
-                    ),
-                    hint=f"compare with `tlmpc verify {directory / TRACE.artifact}`; compile "
-                    "the mission again for a trajectory that meets it",
-                    file=str(directory / TRACE.artifact),
-                )
-                for d in exc.diagnostics
-            ]
+            error(
+                "U077",
+                f"the trajectory in {TRACE.artifact} {exc.reason}",
+                hint=f"compare with `tlmpc verify {directory / TRACE.artifact}`; compile "
+                "the mission again for a trajectory that meets it",
+                file=str(directory / TRACE.artifact),
+            )
         ) from None
