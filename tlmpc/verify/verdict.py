@@ -271,8 +271,11 @@ def _segments(points: FloatArray) -> npt.NDArray[np.object_]:
     return np.asarray(shapely.linestrings(np.stack([points[:-1], points[1:]], axis=1)))
 
 
-def _body_contacts(trace: TraceInput, distances: FloatArray) -> list[Violation]:
-    """Where the body (a disc of ``trace.radius`` around the point) first meets an obstacle."""
+def _body_contacts(
+    trace: TraceInput, free: shapely.Geometry, distances: FloatArray
+) -> list[Violation]:
+    """Where the body (a disc of ``trace.radius`` around the point) first meets an obstacle
+    of ``free`` (the trace's free space), given each segment's ``distances`` to its boundary."""
     assert trace.boundary_polygon is not None
     size = float(np.ptp(trace.boundary_polygon, axis=0).max())
     touching = np.flatnonzero(distances < trace.radius - 1e-9 * size)
@@ -281,8 +284,6 @@ def _body_contacts(trace: TraceInput, distances: FloatArray) -> list[Violation]:
     index = int(touching[0])
     points = trace.points
     segment = points[index : index + 2]
-    free = _free_space(trace)
-    assert free is not None
     # where the segment first comes within the radius: its first point outside the free space
     # shrunk by the radius (a fine polygon of it; the sample nearest the wall if none is found)
     inner = free.buffer(-trace.radius, quad_segs=64)
@@ -329,7 +330,7 @@ def workspace_violations(trace: TraceInput) -> tuple[list[Violation], float | No
         distances = np.asarray(shapely.distance(free.boundary, segments), dtype=np.float64)
         clearance = float(np.min(distances))
         if trace.radius > 0.0:
-            return _body_contacts(trace, distances), clearance - trace.radius
+            return _body_contacts(trace, free, distances), clearance - trace.radius
         return [], clearance
     found: list[Violation] = []
     depth = 0.0
@@ -383,7 +384,7 @@ def workspace_violations(trace: TraceInput) -> tuple[list[Violation], float | No
         # the body may meet an obstacle where the point stays inside, before it leaves
         distances = np.full(len(segments), np.inf)
         distances[inside] = shapely.distance(free.boundary, segments[inside])
-        found.extend(_body_contacts(trace, distances))
+        found.extend(_body_contacts(trace, free, distances))
         found.sort(key=lambda v: math.inf if v.time is None else v.time)
     return found, -depth
 
