@@ -8,8 +8,10 @@ stack in the printer, and a long sequence of task steps (two levels each) with i
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
+import pytest
 from hostile_harness import run_hostile, work_fixture  # noqa: F401 (fixture, by its name)
 
 from tlmpc.base.depth import NESTING_LIMIT
@@ -72,3 +74,22 @@ def test_a_spec_nested_beyond_it_is_refused_at_its_file(work: Path) -> None:
     result = run_hostile(work, "synth", "deeper.spc", located=False)
     assert result.code == 2
     assert result.err.startswith("deeper.spc:"), result.err
+
+
+def test_a_file_refused_for_its_depth_is_never_reported_valid(
+    work: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # loaded whole, then too deep for the last step (printing its formula): the JSON entry
+    # must not keep the 'ok' it had before
+    import tlmpc.ltl.printer
+
+    def too_deep(formula: object) -> str:
+        raise RecursionError
+
+    monkeypatch.setattr(tlmpc.ltl.printer, "to_text", too_deep)
+    (work / "steps.yaml").write_text(MISSION.format(task=_steps(3)))
+    result = run_hostile(work, "check", "--json", "steps.yaml", located=False)
+    assert result.code == 2
+    (entry,) = json.loads(result.out)["result"]["files"]
+    assert entry["ok"] is False
+    assert [d["code"] for d in entry["diagnostics"]] == ["U036"]

@@ -29,52 +29,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Check every file; report all problems of all files."""
-    from tlmpc.base.errors import EXIT_NEGATIVE, EXIT_OK, EXIT_USAGE, UsageError, error
+    from tlmpc.base.errors import EXIT_NEGATIVE, EXIT_OK, EXIT_USAGE, error
     from tlmpc.io.report import Reporter
-    from tlmpc.ltl.printer import to_text
-    from tlmpc.mission.load import inspect_file
 
     report = Reporter.for_args(args, out, err)
     results: list[dict[str, Any]] = []
     explained: list[str] = []
     unreadable = invalid = 0
     for path in args.files:
-        notices: list[Any] = []
-        entry: dict[str, Any] = {"file": str(path), "ok": False, "diagnostics": [], "ltl": None}
         try:
-            try:
-                mission, diagnostics = inspect_file(path)
-            except UsageError as exc:
-                unreadable += 1
-                diagnostics = list(exc.diagnostics)
-            else:
-                if mission is not None and not diagnostics:
-                    diagnostics = _contradictions(path, mission)
-                    if not diagnostics and mission.reactive is not None:
-                        diagnostics, entry["gr1"] = _gr1_reading(mission)
-                    if not diagnostics:
-                        from tlmpc.mission.body import body_radius
-                        from tlmpc.mission.holes import workspace_notes
-
-                        merged, notices = workspace_notes(mission)
-                        if body_radius(mission.robot) > 0.0:  # shapely only for a body
-                            from tlmpc.mission.cspace import body_diagnostics
-
-                            body = body_diagnostics(merged)
-                            diagnostics = [d for d in body if d.severity == "error"]
-                            notices += [d for d in body if d.severity != "error"]
-                        if not diagnostics:
-                            diagnostics = _subgrid(merged)
-                if diagnostics:
-                    invalid += 1
-                else:
-                    entry["ok"] = True
-                    if mission is not None:
-                        entry["ltl"] = to_text(mission.formula)
-                        entry["avoid_scopes"] = _scopes(mission)
+            entry, diagnostics, notices, status = _check_file(path)
         except RecursionError:  # deeper than any stage handles: this file, not the batch
-            unreadable += 1
-            notices = []
+            entry, notices, status = _entry(path), [], "unreadable"
             diagnostics = [
                 error(
                     "U036",
@@ -83,6 +49,8 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
                     file=str(path),
                 )
             ]
+        unreadable += status == "unreadable"
+        invalid += status == "invalid"
         entry["diagnostics"] = [d.to_json() for d in [*diagnostics, *notices]]
         results.append(entry)
         report.diagnose([*diagnostics, *notices])
@@ -102,6 +70,50 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             summary += f", {unreadable} unreadable"
         report.note(summary)
     return code
+
+
+def _entry(path: Path) -> dict[str, Any]:
+    """A file's entry in the JSON result, before it is checked."""
+    return {"file": str(path), "ok": False, "diagnostics": [], "ltl": None}
+
+
+def _check_file(path: Path) -> tuple[dict[str, Any], list[Any], list[Any], str]:
+    """One file's entry, its problems and its notes, and whether it is ``"valid"``,
+    ``"invalid"`` or ``"unreadable"``."""
+    from tlmpc.base.errors import UsageError
+    from tlmpc.ltl.printer import to_text
+    from tlmpc.mission.load import inspect_file
+
+    entry = _entry(path)
+    notices: list[Any] = []
+    try:
+        mission, diagnostics = inspect_file(path)
+    except UsageError as exc:
+        return entry, list(exc.diagnostics), notices, "unreadable"
+    if mission is not None and not diagnostics:
+        diagnostics = _contradictions(path, mission)
+        if not diagnostics and mission.reactive is not None:
+            diagnostics, entry["gr1"] = _gr1_reading(mission)
+        if not diagnostics:
+            from tlmpc.mission.body import body_radius
+            from tlmpc.mission.holes import workspace_notes
+
+            merged, notices = workspace_notes(mission)
+            if body_radius(mission.robot) > 0.0:  # shapely only for a body
+                from tlmpc.mission.cspace import body_diagnostics
+
+                body = body_diagnostics(merged)
+                diagnostics = [d for d in body if d.severity == "error"]
+                notices += [d for d in body if d.severity != "error"]
+            if not diagnostics:
+                diagnostics = _subgrid(merged)
+    if diagnostics:
+        return entry, diagnostics, notices, "invalid"
+    entry["ok"] = True
+    if mission is not None:
+        entry["ltl"] = to_text(mission.formula)
+        entry["avoid_scopes"] = _scopes(mission)
+    return entry, diagnostics, notices, "valid"
 
 
 def _subgrid(mission: Any) -> list[Any]:
