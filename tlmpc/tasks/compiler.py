@@ -379,14 +379,10 @@ class _Lowering:
             [Until(guard, s) if guard is not None else Eventually(s) for s in steps[-1]]
         )
         for index in range(len(steps) - 2, -1, -1):
-            parts: list[Formula] = []
-            for prop in steps[index]:
-                after: Formula = formula
-                if index == len(steps) - 2 and self._members(prop.name) & leaving:
-                    # leaving an avoided region: stay in it until the avoidance starts
-                    after = Until(prop, formula)
-                parts.append(Eventually(And((prop, after))))
-            formula = conjoin(parts)
+            if index == len(steps) - 2 and guard is not None:
+                formula = self._last_leg(steps[index], formula, leaving)
+                continue
+            formula = conjoin([Eventually(And((prop, formula))) for prop in steps[index]])
         self._scope(always, "always (the phrase never visits {it})")
         if last_leg:
             before = steps[-2] if len(steps) > 1 else []
@@ -397,6 +393,25 @@ class _Lowering:
                 "(the phrase visits {it} earlier)",
             )
         return conjoin([formula, *[Globally(Not(p)) for p in always]])
+
+    def _last_leg(self, step: list[Prop], leg: Formula, leaving: set[str]) -> Formula:
+        """Visit every region of ``step`` (in any order), then ``leg`` from the last visit.
+
+        From a visit of an avoided region the leg starts when the robot leaves it.  With one
+        region that is ``F(s & leg)``.  With several, the leg must start at a visit of the
+        step made after all of them: ``⋀_s F(s & F P)`` with ``P = ⋁_s (s & leg)``.  (Each
+        conjunct finds a ``P`` after its own region; the latest of those comes after all of
+        them.  ``⋀_s F(s & leg)`` would demand the leg after *every* region's visit, so a
+        region of the step visited after another would break the other's avoidance.)
+        """
+        starts: list[Formula] = []
+        for prop in step:
+            after = Until(prop, leg) if self._members(prop.name) & leaving else leg
+            starts.append(And((prop, after)))
+        if len(starts) == 1:
+            return Eventually(starts[0])
+        start = disjoin(starts)
+        return conjoin([Eventually(And((prop, Eventually(start)))) for prop in step])
 
     def _avoid_final(self, prop: Prop, final: list[Prop]) -> None:
         line, col = (prop.span.line, prop.span.col) if prop.span else (self.line, self.col)
