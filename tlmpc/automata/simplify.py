@@ -286,32 +286,28 @@ def _drop_implied_sets(
 def _merge_states(automaton: Automaton, letters: Sequence[frozenset[str]] | None) -> Automaton:
     """Quotient by the coarsest partition where equivalent states have equal signatures."""
     n = automaton.num_states
-    out: dict[int, list[Edge]] = defaultdict(list)
+    # Each edge as (label, marks, target): the label is an interned guard, or with letters
+    # every letter that enables the edge, so that a refinement round hashes small integers
+    # and not formulas.  A signature is the set of (label, marks, target block) triples: it
+    # tells the same states apart as grouping the labels by (marks, target block).
+    labels: dict[Formula, int] = {}
+    mark_ids: dict[frozenset[int], int] = {}
+    out: list[list[tuple[int, int, int]]] = [[] for _ in range(n)]
     for edge in automaton.edges:
-        out[edge.src].append(edge)
-    enabled: dict[int, frozenset[int]] = {}
-    if letters is not None:
-        for index, edge in enumerate(automaton.edges):
-            enabled[index] = frozenset(
-                i for i, letter in enumerate(letters) if holds(edge.guard, letter)
-            )
-    edge_index = {id(e): i for i, e in enumerate(automaton.edges)}
+        marks = mark_ids.setdefault(edge.marks, len(mark_ids))
+        if letters is None:
+            label = labels.setdefault(edge.guard, len(labels))
+            out[edge.src].append((label, marks, edge.dst))
+        else:
+            for i, letter in enumerate(letters):
+                if holds(edge.guard, letter):
+                    out[edge.src].append((i, marks, edge.dst))
     block = [0] * n
     while True:
         signatures: dict[object, int] = {}
         new_block = [0] * n
         for state in range(n):
-            if letters is not None:
-                per_letter: dict[int, set[tuple[frozenset[int], int]]] = defaultdict(set)
-                for edge in out[state]:
-                    for letter in enabled[edge_index[id(edge)]]:
-                        per_letter[letter].add((edge.marks, block[edge.dst]))
-                signature: object = frozenset((k, frozenset(v)) for k, v in per_letter.items())
-            else:
-                grouped: dict[tuple[frozenset[int], int], set[Formula]] = defaultdict(set)
-                for edge in out[state]:
-                    grouped[(edge.marks, block[edge.dst])].add(edge.guard)
-                signature = frozenset((k, frozenset(v)) for k, v in grouped.items())
+            signature = frozenset((label, marks, block[dst]) for label, marks, dst in out[state])
             key = (block[state], signature)
             new_block[state] = signatures.setdefault(key, len(signatures))
         if len(set(new_block)) == len(set(block)):

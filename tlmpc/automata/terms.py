@@ -539,6 +539,15 @@ def restrict_letters(letters: list[frozenset[str]] | None) -> list[frozenset[str
     return previous
 
 
+#: At most this many expansion terms in one formula's or one state's expansion (each becomes
+#: an edge of the automaton before reduction: see :data:`tlmpc.automata.translate.MAX_RAW_EDGES`).
+MAX_TERMS = 100_000
+
+
+class TooManyTerms(Exception):
+    """An expansion would have more than :data:`MAX_TERMS` terms."""
+
+
 def _combine(left: Iterable[Expansion], right: Iterable[Expansion]) -> list[Expansion]:
     out: list[Expansion] = []
     right = list(right)
@@ -549,6 +558,8 @@ def _combine(left: Iterable[Expansion], right: Iterable[Expansion]) -> list[Expa
             if not cube_allowed(pos, neg):
                 continue
             out.append(Expansion(pos, neg, lx | rx, lprom | rprom))
+        if len(out) > MAX_TERMS:
+            raise TooManyTerms
     return out
 
 

@@ -21,7 +21,9 @@ from tlmpc.automata.nnf import FALSE, Node
 from tlmpc.automata.rewrite import MAX_SEMANTIC_APS, rewrite
 from tlmpc.automata.simplify import postprocess
 from tlmpc.automata.terms import (
+    MAX_TERMS,
     Expansion,
+    TooManyTerms,
     cube_allowed,
     eventualities,
     expand,
@@ -32,6 +34,7 @@ from tlmpc.automata.terms import (
 )
 from tlmpc.automata.wdba import is_obligation
 from tlmpc.automata.work import OutOfBudget
+from tlmpc.base.errors import UsageError, error
 from tlmpc.base.graphs import csr, strong_components
 from tlmpc.ltl.ast import Formula, Not, Prop, conjoin
 from tlmpc.ltl.bounds import refuse_bounds
@@ -47,6 +50,16 @@ DEFAULT_BUDGET = 2_000_000
 PLANNER_START_SHARE = 0.5
 #: At most this much work for the language-containment simplification of the formula.
 CONTAINMENT_BUDGET = 800_000
+
+#: The work units of building and rewriting the internal form of a formula, per node of its
+#: negation normal form, in the emptiness checks of the containment simplification (measured:
+#: 20-70 µs a node, on formulas of 10 to 5,000 nodes).
+UNITS_PER_NODE = 100
+
+#: The translation refuses (P041) a formula whose automaton, before any reduction, has more
+#: edges than this (each takes about 2.5 KiB until the reductions are done: about 750 MiB), or
+#: a state more than :data:`~tlmpc.automata.terms.MAX_TERMS` expansion terms.
+MAX_RAW_EDGES = 300_000
 
 #: Emptiness checks of the rewriting give up (answer "not shown empty") past this many states.
 MAX_EMPTINESS_STATES = 400
@@ -72,9 +85,7 @@ def cube_formula(pos: Iterable[str], neg: Iterable[str]) -> Formula:
     return conjoin(literals)
 
 
-def _dominated(
-    terms: list[tuple[Cube, State, frozenset[int]]], num_acc: int
-) -> list[tuple[Cube, State, frozenset[int]]]:
+def _dominated(terms: list[tuple[Cube, State, int]], num_acc: int) -> list[tuple[Cube, State, int]]:
     """Drop every term that another term dominates.
 
     Term A dominates B when A is enabled whenever B is (weaker cube), leaves a weaker
@@ -92,6 +103,7 @@ def _dominated(
     width = len(names)
     # Term A dominates B iff key(A) is a bit subset of key(B) and A's target a subset of B's:
     # key = positive literals | negative literals | marks *not* carried.
+    every = (1 << num_acc) - 1
     keys = []
     for (pos, neg), _target, marks in unique:
         key = 0
@@ -99,11 +111,7 @@ def _dominated(
             key |= bit[p]
         for n in neg:
             key |= bit[n] << width
-        missing = 0
-        for m in range(num_acc):
-            if m not in marks:
-                missing |= 1 << m
-        keys.append(key | missing << (2 * width))
+        keys.append(key | (every & ~marks) << (2 * width))
     kept = []
     # Distinct terms cannot dominate each other both ways, so "any other term" is safe.
     for i, term in enumerate(unique):
@@ -144,6 +152,11 @@ def translate(
             optional reductions (simulation) stop and the automaton reduced so far, which is
             always correct, is returned; None = no limit.
         containment: simplify the formula by language containment first.
+
+    Raises:
+        UsageError: P041, the automaton is beyond the translation's budget before any
+            reduction (:data:`MAX_RAW_EDGES` edges, or a state of
+            :data:`~tlmpc.automata.terms.MAX_TERMS` terms).
     """
     refuse_bounds(formula, purpose="the automaton translation")
     return _translate(
@@ -246,11 +259,14 @@ def _explore(
 ) -> Automaton:
     """The raw TGBA: states reached from ``initial`` by the expansion terms letters allow
     (:class:`~tlmpc.automata.work.OutOfBudget` once the work count passes ``deadline``, when
-    given)."""
+    given).  Past :data:`MAX_RAW_EDGES` edges or :data:`~tlmpc.automata.terms.MAX_TERMS`
+    terms in a state: :class:`~tlmpc.base.errors.UsageError` (P041), or with a ``deadline``
+    (an optional check) :class:`~tlmpc.automata.work.OutOfBudget`."""
     event_index = {e: i for i, e in enumerate(events)}
+    every = (1 << len(events)) - 1
     states: dict[State, int] = {}
     names: list[str] = []
-    raw_edges: list[tuple[int, int, Cube, frozenset[int]]] = []
+    raw_edges: list[tuple[int, int, Cube, int]] = []
     if initial is not None:
         states[initial] = 0
         names.append(_state_name(initial))
@@ -258,24 +274,37 @@ def _explore(
         while queue:
             state = queue.pop()
             source = states[state]
-            expansion = _state_terms(state)
+            try:
+                expansion = _state_terms(state)
+            except TooManyTerms:
+                if deadline is not None:  # an optional check: it gives up
+                    raise OutOfBudget from None
+                raise _too_large(text, len(states), per_state=True) from None
             if deadline is not None:
-                work.charge(deadline, 1 + len(expansion))
-            terms: list[tuple[Cube, State, frozenset[int]]] = []
+                work.charge(deadline, _expansion_units(expansion))
+            terms: list[tuple[Cube, State, int]] = []
             for pos, neg, nxt, promises in expansion:
                 target = simplify_state(nxt)
                 if target is None or not _letter_ok((pos, neg), letter_sets):
                     continue
-                marks = frozenset(i for e, i in event_index.items() if e not in promises)
-                terms.append(((pos, neg), target, marks))
+                terms.append(((pos, neg), target, _kept_marks(promises, event_index, every)))
             for cube, target, marks in _dominated(terms, len(events)):
                 if target not in states:
                     states[target] = len(states)
                     names.append(_state_name(target))
                     queue.append(target)
                 raw_edges.append((source, states[target], cube, marks))
+            if len(raw_edges) > MAX_RAW_EDGES:
+                if deadline is not None:
+                    raise OutOfBudget
+                raise _too_large(text, len(states))
     edges = tuple(
-        Edge(src=s, dst=d, guard=cube_formula(*cube), marks=marks)
+        Edge(
+            src=s,
+            dst=d,
+            guard=cube_formula(*cube),
+            marks=frozenset(i for i in range(marks.bit_length()) if marks >> i & 1),
+        )
         for s, d, cube, marks in raw_edges
     )
     return Automaton(
@@ -290,8 +319,13 @@ def _explore(
 
 
 def _is_empty(formula: Formula, deadline: float = float("inf")) -> bool:
-    """No word satisfies ``formula`` (see :func:`_is_empty_term`)."""
-    return _is_empty_term(rewrite(from_ast(nnf(formula))), deadline)
+    """No word satisfies ``formula`` (see :func:`_is_empty_term`); not shown empty (False)
+    when the work of bringing it to the internal form, :data:`UNITS_PER_NODE` for each of
+    its nodes, would pass ``deadline``."""
+    normal = nnf(formula)
+    if work.over(deadline, UNITS_PER_NODE * sum(1 for _ in normal.walk())):
+        return False
+    return _is_empty_term(rewrite(from_ast(normal)), deadline)
 
 
 def _is_empty_term(root: Node, deadline: float = float("inf")) -> bool:
@@ -318,24 +352,23 @@ def _is_empty_term(root: Node, deadline: float = float("inf")) -> bool:
                 return False
             state = queue.pop()
             source = states[state]
-            expansion = _state_terms(state)
-            if work.over(deadline, 1 + len(expansion)):
+            try:
+                expansion = _state_terms(state)
+            except TooManyTerms:
                 return False
-            terms: list[tuple[Cube, State, frozenset[int]]] = []
+            if work.over(deadline, _expansion_units(expansion)):
+                return False
+            terms: list[tuple[Cube, State, int]] = []
             for pos, neg, nxt, promises in expansion:
                 target = simplify_state(nxt)
                 if target is None:
                     continue
-                marks = frozenset(i for e, i in event_index.items() if e not in promises)
-                terms.append(((pos, neg), target, marks))
+                terms.append(((pos, neg), target, _kept_marks(promises, event_index, every)))
             for _cube, target, marks in _dominated(terms, len(events)):
                 if target not in states:
                     states[target] = len(states)
                     queue.append(target)
-                bits = 0
-                for mark in marks:
-                    bits |= 1 << mark
-                graph.append((source, states[target], bits))
+                graph.append((source, states[target], marks))
     finally:
         restrict_letters(previous)
     succ: list[list[int]] = [[] for _ in range(len(states))]
@@ -349,7 +382,49 @@ def _is_empty_term(root: Node, deadline: float = float("inf")) -> bool:
     return not any(bits == every for bits in seen.values())
 
 
+def _kept_marks(promises: frozenset[Node], event_index: dict[Node, int], every: int) -> int:
+    """The acceptance sets (bit ``i`` for eventuality ``i``) of a term postponing
+    ``promises``: every eventuality it does not postpone."""
+    postponed = 0
+    for promise in promises:
+        index = event_index.get(promise)
+        if index is not None:
+            postponed |= 1 << index
+    return every & ~postponed
+
+
+def _expansion_units(expansion: list[Expansion]) -> int:
+    """The work units of one explored state: its terms, each with its obligations and
+    promises, and their pairwise domination check."""
+    terms = len(expansion)
+    sizes = sum(len(term.next) + len(term.promises) for term in expansion)
+    return 1 + terms + sizes + min(terms, MAX_DOMINATION_TERMS) ** 2
+
+
+def _too_large(text: str, states: int, *, per_state: bool = False) -> UsageError:
+    too_many = (
+        f"a state with more than {MAX_TERMS:,} edges"
+        if per_state
+        else f"more than {MAX_RAW_EDGES:,} edges"
+    )
+    return UsageError(
+        error(
+            "P041",
+            f"the automaton of {_shortened(text)} has {too_many} before reduction "
+            f"({states:,} state{'' if states == 1 else 's'} so far), more than the "
+            "translation's budget",
+            hint="split the task into smaller missions, or write fewer independent goals in "
+            "one formula (each `F a` or `G F a` beside the others can double the automaton)",
+        )
+    )
+
+
+def _shortened(text: str, limit: int = 120) -> str:
+    return repr(text) if len(text) <= limit else repr(text[: limit - 1] + "…")
+
+
 def _state_terms(state: State) -> list[Expansion]:
+    """The expansion terms of ``state`` (:class:`TooManyTerms` past :data:`MAX_TERMS`)."""
     terms: list[Expansion] = [Expansion(frozenset(), frozenset(), frozenset(), frozenset())]
     for part in sorted(state, key=repr):
         combined: list[Expansion] = []
@@ -360,6 +435,8 @@ def _state_terms(state: State) -> list[Expansion]:
                 if not cube_allowed(p, n):
                     continue
                 combined.append(Expansion(p, n, nxt | x2, prom | pr2))
+            if len(combined) > MAX_TERMS:
+                raise TooManyTerms
         terms = _undominated_partial(combined)
         if not terms:
             break
