@@ -82,6 +82,8 @@ def test_operator_keywords_are_not_names(text: str, cols: list[int]) -> None:
     assert [d.col for d in diagnostics] == [10 + c - 1 for c in cols]
     assert all(d.line == 4 and d.file == "m.yaml" for d in diagnostics)
     assert all(d.hint and "double quotes" in d.hint for d in diagnostics)
+    # quoting names a proposition, never a mission's region (S008 refuses keyword names)
+    assert all(d.hint and "a mission cannot name a region" in d.hint for d in diagnostics)
 
 
 def test_quoted_keywords_are_names() -> None:

@@ -86,6 +86,30 @@ def test_spans_are_shifted_into_the_file() -> None:
     assert (formula.arg.span.line, formula.arg.span.col) == (7, 13)
 
 
+@pytest.mark.parametrize(
+    ("text", "cols"),
+    [
+        ("GF a", [1, 2]),
+        ("b & FGF a", [5, 6, 7]),
+        ("GF[0,40] a", [1, 2]),
+        ("GGF[2,4] a", [1, 2, 3]),
+        ("<> a", [1]),
+        ("[] a", [1]),
+    ],
+)
+def test_each_letter_of_an_operator_chain_is_located_at_itself(text: str, cols: list[int]) -> None:
+    node = parse_ltl(text, file="m.yaml", line=7, col=10)
+    if isinstance(node, And):
+        node = node.args[1]
+    found = []
+    while not isinstance(node, Prop):
+        assert node.span is not None
+        found.append(node.span.col)
+        assert (node.span.line, node.span.end_col) == (7, 10 + len(text))
+        node = node.children()[0]
+    assert found == [10 + c - 1 for c in cols]
+
+
 @pytest.mark.parametrize("text", ["X p1", "G X a", "F(a & X b)", "N a"])
 def test_next_is_rejected_with_an_explanation(text: str) -> None:
     with pytest.raises(InvalidInputError) as caught:

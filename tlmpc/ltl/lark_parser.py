@@ -186,7 +186,9 @@ class _ToAst(Transformer[Token, Formula]):
                 error(
                     "L030",
                     f"{name!r} is an operator of the language, not a proposition name",
-                    hint=f'write "{name}" in double quotes to name a region {name}',
+                    hint=f'an operator cannot stand here; write "{name}" in double quotes for '
+                    f"a proposition named {name} (a mission cannot name a region after an "
+                    "operator)",
                     file=self.file,
                     line=span.line,
                     col=span.col,
@@ -202,20 +204,29 @@ class _ToAst(Transformer[Token, Formula]):
     def not_op(self, meta: Any, children: list[Any]) -> Formula:
         return Not(children[1], span=self._span(meta))
 
+    def _letter_span(self, meta: Any, chain: Token, index: int) -> Span | None:
+        """From the ``index``-th letter of an operator chain (``GF``: one token) to the end of
+        the formula it applies to: each letter's own subformula."""
+        if getattr(meta, "empty", True):
+            return None
+        column = (chain.column or meta.column) + index
+        return self.pos.span(chain.line or meta.line, column, meta.end_line, meta.end_column)
+
     @v_args(meta=True)
     def unary_op(self, meta: Any, children: list[Any]) -> Formula:
-        operators, operand = str(children[0]), children[1]
-        if operators == "<>":
-            operators = "F"
-        elif operators == "[]":
-            operators = "G"
+        token, operand = children[0], children[1]
+        operators = str(token)
+        if operators in ("<>", "[]"):
+            # one operator of two characters: its span starts at the first
+            operators = "F" if operators == "<>" else "G"
         result: Formula = operand
-        for symbol in reversed(operators):
+        for index in range(len(operators) - 1, -1, -1):
             # X/N were rejected before the transformation; only F and G reach here.
+            span = self._letter_span(meta, token, index)
             result = (
-                Eventually(result, span=self._span(meta))
-                if symbol == "F"
-                else Globally(result, span=self._span(meta))
+                Eventually(result, span=span)
+                if operators[index] == "F"
+                else Globally(result, span=span)
             )
         return result
 
@@ -231,19 +242,22 @@ class _ToAst(Transformer[Token, Formula]):
 
     @v_args(meta=True)
     def bounded_unary_op(self, meta: Any, children: list[Any]) -> Formula:
-        chain, token, operand = str(children[0]), children[1], children[2]
+        letters, token, operand = children[0], children[1], children[2]
+        chain = str(letters)
         interval = self._interval(token)
         # The bound belongs to the last letter of a chain: `GF[0,10] a` is `G F[0,10] a`.
+        last = self._letter_span(meta, letters, len(chain) - 1)
         result: Formula = (
-            BoundedEventually(operand, interval, span=self._span(meta))
+            BoundedEventually(operand, interval, span=last)
             if chain[-1] == "F"
-            else BoundedGlobally(operand, interval, span=self._span(meta))
+            else BoundedGlobally(operand, interval, span=last)
         )
-        for symbol in reversed(chain[:-1]):
+        for index in range(len(chain) - 2, -1, -1):
+            span = self._letter_span(meta, letters, index)
             result = (
-                Eventually(result, span=self._span(meta))
-                if symbol == "F"
-                else Globally(result, span=self._span(meta))
+                Eventually(result, span=span)
+                if chain[index] == "F"
+                else Globally(result, span=span)
             )
         return result
 

@@ -219,9 +219,11 @@ class _Reader:
             raise _Unsure
         operand = self._unary()
         self.depth -= len(operators)
-        span = self._span(token.start, operand.end)
         formula = operand.formula
-        for symbol in reversed(operators):
+        for index in range(len(operators) - 1, -1, -1):
+            # each letter of a chain (`GF`, one token) spans its own subformula
+            symbol = operators[index]
+            span = self._span((token.start[0], token.start[1] + index), operand.end)
             if symbol == "!":
                 formula = Not(formula, span=span)
             elif symbol == "F":
