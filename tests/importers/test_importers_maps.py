@@ -236,6 +236,17 @@ def test_specks_are_filled_by_the_area_threshold(tmp_path: Path) -> None:
     assert sorted(Polygon(h).area for h in filled.holes) == pytest.approx([4 * 0.25, 9 * 0.25])
 
 
+def test_an_area_of_whole_cells_is_that_many_cells(tmp_path: Path) -> None:
+    # 0.0054 m² is 6 cells of 0.03 m; divided in floats it is 6.000000000000001
+    free = np.ones((20, 20), dtype=bool)
+    free[0, :] = free[-1, :] = free[:, 0] = free[:, -1] = False
+    free[5:7, 5:8] = False  # a 6-cell post: exactly the threshold, so kept
+    free[12, 12] = False  # a one-cell speck, filled
+    path = write_map(tmp_path, "m", image_from_free(free), resolution=0.03)
+    imported = import_map(path, ImportSettings(tolerance=0.0, min_area=0.0054))
+    assert [Polygon(h).area for h in imported.holes] == pytest.approx([6 * 0.03 * 0.03])
+
+
 def test_radius_erodes_free_space(tmp_path: Path) -> None:
     free = np.zeros((30, 30), dtype=bool)
     free[2:28, 2:28] = True

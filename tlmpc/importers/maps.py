@@ -412,6 +412,14 @@ def _check_reach(grid: OccupancyGrid, shapes: list[Polygon]) -> None:
     )
 
 
+def _in_cells(area: float, cell_area: float) -> float:
+    """``area`` in cells, a whole number of cells when it is one up to rounding: 0.0054 m² at
+    0.03 m is 6 cells, not 6.000000000000001 (which would drop 6-cell obstacles)."""
+    cells = area / cell_area
+    whole = round(cells)
+    return float(whole) if abs(cells - whole) <= 1e-9 * max(1.0, cells) else cells
+
+
 def import_map(
     map_path: Path,
     settings: ImportSettings = ImportSettings(),
@@ -427,7 +435,8 @@ def import_map(
         DEFAULT_MIN_CELLS * grid.cell_area() if settings.min_area is None else settings.min_area
     )
     cell_area = grid.cell_area()
-    exact_main, exact_others, dropped = _exact_free(grid, settings, min_area / cell_area)
+    min_cells = _in_cells(min_area, cell_area)
+    exact_main, exact_others, dropped = _exact_free(grid, settings, min_cells)
     mask_grids: list[tuple[str, Path, OccupancyGrid]] = []
     for prefix, path in (("keepout", keepout), ("speed", speed)):
         if path is None:
@@ -488,7 +497,7 @@ def import_map(
             outers = [
                 simple
                 for p in merged
-                if p.area >= min_area / cell_area
+                if p.area >= min_cells
                 and outer_cells.covers(p)
                 and p.intersection(free_union).area > 0
                 for simple in _simple_parts(p, free_union, covered)
