@@ -71,6 +71,18 @@ def test_the_stream_is_the_whole_reader_in_chunks(
     assert np.array_equal(streamed, expected)
 
 
+@pytest.mark.parametrize("chunk", [1, 2, 3, 50])
+def test_a_streams_stamps_a_nanosecond_apart_stay_apart(tmp_path: Path, chunk: int) -> None:
+    # at a real epoch a float second's step is 238 ns: ns / 1e9 would make these one time,
+    # and a chunk's first stamp must stay after the chunk before's last
+    epoch = 1_700_000_000 * 1_000_000_000
+    rows = [(epoch + k, 2.0 + 0.01 * k, 5.0) for k in range(7)]
+    bag = write_bag(tmp_path / "log.mcap", "mcap", {"/odom": ("nav_msgs/msg/Odometry", rows)})
+    streamed = np.vstack(list(iter_bag_chunks(bag, chunk=chunk)))
+    assert np.all(np.diff(streamed[:, 0]) > 0)
+    assert np.array_equal(streamed, read_bag(bag).samples)
+
+
 def _peak(bag: Path) -> int:
     tracemalloc.start()
     try:

@@ -8,13 +8,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from robot_data import require_shared, write_bag
 
 from tlmpc.base.errors import UsageError
 from tlmpc.cli import main
-from tlmpc.importers.logs import read_log
+from tlmpc.importers.logs import read_log, stamp_seconds
 from tlmpc.verify.samples import check_samples
 
 POSE_TYPES = (
@@ -209,6 +209,74 @@ def test_stamps_are_sorted_and_repeats_refused_like_csv(tmp_path: Path, kind: st
         assert [d.code for d in caught.value.diagnostics] == ["V020"]
 
 
+#: A real epoch in nanoseconds (2023): a float second's step there is 238 ns.
+EPOCH = 1_700_000_000 * 1_000_000_000
+
+
+@pytest.mark.parametrize("kind", KINDS)
+@pytest.mark.parametrize("clock", ["header stamp", "log time"])
+def test_stamps_a_nanosecond_apart_stay_apart(tmp_path: Path, kind: str, clock: str) -> None:
+    # Distinct integer stamps 1 ns apart, which ns / 1e9 rounds to one float: not repeated.
+    # "log time": the header stamps are zero, so each pose takes its log (receive) time.
+    stamps = [EPOCH + i for i in range(5)] + [EPOCH + 1_000_000_000]
+    rows = [(ns if clock == "header stamp" else 0, 0.1 * i, 0.0) for i, ns in enumerate(stamps)]
+    path = write_bag(
+        bag_path(tmp_path, kind), kind, {"/odom": (POSE_TYPES[0], rows)}, {"/odom": stamps}
+    )
+    samples = read_log(path).samples
+    assert np.all(np.diff(samples[:, 0]) > 0)  # in the stamps' order, each its own time
+    check_samples(samples[:, 0], samples[:, 1], samples[:, 2], file="log")  # no V020
+    assert samples[0, 0] == EPOCH / 1e9
+    assert samples[-1, 0] == (EPOCH + 1_000_000_000) / 1e9  # far apart: as a CSV has it
+    # each a float step after the one before (238 ns: as close as float seconds can be)
+    assert np.array_equal(np.diff(samples[:5, 0]), np.full(4, np.spacing(EPOCH / 1e9)))
+    # a stamp that is truly repeated is still refused
+    twice = [*rows[:3], (rows[2][0], 9.0, 9.0)]
+    repeated = write_bag(
+        bag_path(tmp_path, kind, "twice"),
+        kind,
+        {"/odom": (POSE_TYPES[0], twice)},
+        {"/odom": [*stamps[:3], stamps[2]]},
+    )
+    log = read_log(repeated).samples
+    with pytest.raises(UsageError) as caught:
+        check_samples(log[:, 0], log[:, 1], log[:, 2], file="log")
+    assert [d.code for d in caught.value.diagnostics] == ["V020"]
+
+
+@settings(max_examples=200, deadline=None)
+@example(start=EPOCH, gaps=[1, 0, 1, 300, 1, 10**9], cut=2)
+@given(
+    start=st.integers(-(2**62), 2**62) | st.integers(10**18, 4 * 10**18),  # ROS epochs
+    gaps=st.lists(st.integers(0, 400) | st.integers(0, 10**10), max_size=40),
+    cut=st.integers(0, 40),
+)
+def test_stamp_seconds_keep_the_stamps_order_and_ties(
+    start: int, gaps: list[int], cut: int
+) -> None:
+    stamps = np.array([start + sum(gaps[:k]) for k in range(len(gaps) + 1)], dtype=np.int64)
+    seconds = stamp_seconds(stamps)
+    steps = np.diff(stamps)
+    assert np.array_equal(np.diff(seconds) > 0, steps > 0)  # later stamps later, ties tied
+    assert np.array_equal(np.diff(seconds) == 0, steps == 0)
+    naive = stamps / 1e9
+    if np.array_equal(np.diff(naive) > 0, steps > 0):
+        assert np.array_equal(seconds, naive)  # nothing collapsed: exactly ns / 1e9
+    # the oracle, one stamp at a time: a tie keeps the time before, a later stamp gets its
+    # ns / 1e9, or the next float after the time before when that is not later
+    oracle = [float(naive[0])] if len(stamps) else []
+    for step, value in zip(steps.tolist(), naive[1:].tolist(), strict=True):
+        after = float(np.nextafter(oracle[-1], np.inf))
+        oracle.append(oracle[-1] if step == 0 else max(value, after))
+    assert seconds.tolist() == oracle
+    # a stream's chunks, each after the one before, give the same seconds
+    cut = min(cut, len(stamps))
+    head = stamp_seconds(stamps[:cut])
+    previous = (int(stamps[cut - 1]), float(head[-1])) if cut else None
+    tail = stamp_seconds(stamps[cut:], previous)
+    assert np.array_equal(np.concatenate([head, tail]), seconds)
+
+
 def test_transform_maps_the_log_frame(tmp_path: Path) -> None:
     path = write_bag(bag_path(tmp_path, "mcap"), "mcap", {"/odom": (POSE_TYPES[0], ROWS)})
     moved = read_log(path, transform=(1.0, -2.0, np.pi / 2)).samples
@@ -254,6 +322,68 @@ def test_a_corrupt_bag_gets_a_diagnostic_not_a_traceback(tmp_path: Path, suffix:
     assert code == 2
     assert "error[M060]" in err
     assert "Traceback" not in err
+
+
+@pytest.mark.parametrize(
+    ("form", "keep", "expected"),
+    [
+        # ends right after its magic, where rosbags' reader raised a bare TypeError (ord())
+        ("mcap file", 8, "is truncated: it ends at byte 8, where record 1 should begin"),
+        ("mcap file", 20, "truncated or corrupt: record 1 (header, at byte 8) declares 26 bytes"),
+        ("mcap file", 100, "is truncated or corrupt: record 2 (chunk, at byte"),
+        ("mcap bag", 8, "the file (log.mcap) is truncated: it ends at byte 8"),
+        ("ros1", 4000, "is truncated or corrupt: record 1 (bag header, at byte 13) declares"),
+        ("ros1", -20, "is truncated"),
+    ],
+)
+def test_a_truncated_bag_says_where_it_ends(
+    tmp_path: Path, form: str, keep: int, expected: str
+) -> None:
+    kind = form.split()[0]
+    bag = write_bag(bag_path(tmp_path, kind), kind, {"/odom": (POSE_TYPES[0], ROWS)})
+    data = next(iter(bag.glob("*.mcap"))) if form.startswith("mcap") else bag
+    data.write_bytes(data.read_bytes()[:keep])
+    path = data if form == "mcap file" else bag
+    with pytest.raises(UsageError) as caught:
+        read_log(path)
+    diagnostic = caught.value.diagnostics[0]
+    assert diagnostic.code == "M060"
+    assert expected in diagnostic.message
+    assert "Error" not in diagnostic.message  # no Python exception's name or text
+    assert diagnostic.hint is not None
+    assert "cut short" in diagnostic.hint
+
+
+def test_a_symbolic_link_loop_is_named_as_one(tmp_path: Path) -> None:
+    mission = tmp_path / "m.yaml"
+    mission.write_text(MISSION)
+    loop = tmp_path / "self.bag"
+    loop.symlink_to(loop.name)  # a link to itself
+    code, _, err = run("verify", str(loop), "--mission", str(mission))
+    assert code == 2
+    assert "error[M050]" in err
+    assert "it is a symbolic link loop" in err
+    assert "no such file" not in err
+    # a folder of logs that is a link loop: no "artifact", no bare strerror
+    folder = tmp_path / "logs"
+    folder.symlink_to(folder.name)
+    code, _, err = run("verify", str(folder), "--mission", str(mission))
+    assert code == 2
+    assert "error[U001]" in err
+    assert "it is a symbolic link loop" in err
+    assert "artifact" not in err
+    # verified with others, each says so in its line
+    code, out, _ = run("verify", str(folder), str(loop), "--mission", str(mission), "--no-cache")
+    assert code == 2
+    assert out.count("it is a symbolic link loop") == 2
+    # a link to nothing, and a plain missing file
+    dangling = tmp_path / "gone.mcap"
+    dangling.symlink_to("nowhere.mcap")
+    code, _, err = run("verify", str(dangling), "--mission", str(mission))
+    assert "symbolic link to nowhere.mcap, which does not exist" in err
+    code, _, err = run("verify", str(tmp_path / "missing.bag"), "--mission", str(mission))
+    assert "error[M050]" in err
+    assert "no such file or directory" in err
 
 
 def test_verify_gives_identical_verdicts_for_every_form(tmp_path: Path) -> None:

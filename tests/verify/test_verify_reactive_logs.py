@@ -241,6 +241,28 @@ def test_bag_topics_drive_the_verdict(tmp_path: Path, kind: str) -> None:
     assert verify("--mission", str(bound), str(other), "--assume-stay")[0] == 0
 
 
+def test_bag_sensor_stamps_a_nanosecond_apart_are_not_repeated(tmp_path: Path) -> None:
+    # At a real epoch ns / 1e9 rounds stamps 1 ns apart to one float (a float second's step
+    # is 238 ns there): two samples of the alarm must stay two times, not a repeat (V031).
+    # Bool messages have no header: their log times stamp them.
+    pytest.importorskip("rosbags")
+    epoch = 1_700_000_000 * SECOND
+    poses = [(epoch + ns, x, y) for ns, x, y in POSES]
+    alarm = [(epoch, False), (epoch + 3 * SECOND, False), (epoch + 3 * SECOND + 1, True)]
+    bag = write_bag(tmp_path / "run.bag", "ros1", poses, {"/alarm": alarm})
+    path = mission(tmp_path, sensors="  alarm: null")
+    status, data = result("--mission", str(path), str(bag))
+    assert status == 1  # the alarm is on from t = 3 s, and the robot enters the lab at 4 s
+    assert data["reactive"]["robot"]["elapsed"] == pytest.approx(4.0)
+    # a stamp truly repeated is still refused
+    twice = write_bag(
+        tmp_path / "twice.bag", "ros1", poses, {"/alarm": [*alarm, (epoch + 3 * SECOND + 1, True)]}
+    )
+    status, out, _ = verify("--mission", str(path), str(twice), "--json")
+    assert status == 2
+    assert json.loads(out)["diagnostics"][0]["code"] == "V031"
+
+
 def test_bag_hostile_values_and_missing_topics(tmp_path: Path) -> None:
     pytest.importorskip("rosbags")
     unbound = mission(tmp_path, sensors="  alarm: null")

@@ -10,8 +10,9 @@
   with the pure-Python ``rosbags``: the pose of ``nav_msgs/Odometry``,
   ``geometry_msgs/PoseStamped`` or ``geometry_msgs/PoseWithCovarianceStamped`` messages on
   ``topic`` (needed only when several topics carry poses), stamped with the message header
-  (the log time when the header stamp is zero).  Samples are sorted by time; a repeated
-  stamp is kept, for the verifier to refuse (V020) as in a CSV log.  At most
+  (the log time when the header stamp is zero).  Samples are sorted by the integer stamps,
+  then converted to seconds keeping distinct stamps distinct (:func:`stamp_seconds`); a
+  repeated stamp is kept, for the verifier to refuse (V020) as in a CSV log.  At most
   :data:`MAX_LOG_SAMPLES` samples are read (M066).
 
 An optional rigid ``transform`` ``(x, y, yaw)`` maps the log's frame into the mission's
@@ -38,6 +39,7 @@ import numpy.typing as npt
 
 from tlmpc.base.errors import UsageError, error
 from tlmpc.base.extras import require
+from tlmpc.importers.bag_damage import reader_failure
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -78,6 +80,38 @@ def _fail(
     return UsageError(error(code, message, hint=hint, file=file, line=line))
 
 
+def path_problem(path: Path) -> str | None:
+    """Why ``path`` names nothing to read (None: it names a file or a folder), in words: no
+    such file, a symbolic link loop (``ELOOP``, which :meth:`Path.exists` takes for a missing
+    file), a link to nothing, or the system's reason."""
+    import errno
+    import os
+
+    try:
+        os.stat(path)
+    except OSError as exc:
+        if exc.errno == errno.ELOOP and path.is_symlink():
+            return "it is a symbolic link loop (its links lead back to themselves)"
+        if exc.errno == errno.ELOOP:
+            return "its path runs into a symbolic link loop (links leading back to themselves)"
+        if exc.errno == errno.ENOENT and path.is_symlink():
+            with contextlib.suppress(OSError):
+                return f"it is a symbolic link to {os.readlink(path)}, which does not exist"
+        if exc.errno == errno.ENOENT:
+            return "no such file or directory"
+        return str(exc.strerror or exc)
+    except ValueError as exc:  # a NUL in the path
+        return str(exc)
+    return None
+
+
+def _path_hint(path: Path) -> str | None:
+    """The hint for :func:`path_problem`: where the path is a link, to mend it."""
+    if path.is_symlink():
+        return "point the link at the log file or the bag directory"
+    return None
+
+
 def _apply(samples: FloatArray, transform: tuple[float, float, float] | None) -> FloatArray:
     if transform is None or len(samples) == 0:
         return samples
@@ -100,8 +134,9 @@ def read_log(
     """Read a CSV log or a ROS bag; raise :class:`UsageError` (M050–M079, M102–M106) on bad
     input.  ``frame`` (bags): express the poses in that frame through the bag's tf."""
     file = str(path)
-    if not path.exists():
-        raise _fail("M050", f"cannot read {file}: no such file or directory", file)
+    problem = path_problem(path)
+    if problem is not None:
+        raise _fail("M050", f"cannot read {file}: {problem}", file, hint=_path_hint(path))
     if frame is not None and transform is not None:
         raise _fail(
             "M105",
@@ -509,16 +544,19 @@ def iter_bag_chunks(
     recording whose header stamps disagree with its log times); the diagnostics and the
     message limit (M060–M066, M102–M106) are :func:`read_bag`'s.
     """
-    last = -(2**63)
+    previous: tuple[int, float] | None = None  # the last stamp and its seconds
     with _opened_bag(path, topic) as (reader, chosen, _):
         for stamps, xs, ys in _pose_chunks(reader, chosen, frame, str(path), chunk):
             ordered = np.asarray(stamps, dtype=np.int64)
-            if len(ordered) and (ordered[0] < last or np.any(np.diff(ordered) < 0)):
+            if len(ordered) and (
+                (previous is not None and ordered[0] < previous[0]) or np.any(np.diff(ordered) < 0)
+            ):
                 raise BagOutOfOrder(str(path))
+            seconds = stamp_seconds(ordered, previous)
             if len(ordered):
-                last = int(ordered[-1])
+                previous = int(ordered[-1]), float(seconds[-1])
             yield np.column_stack(
-                [ordered / 1e9, np.asarray(xs, dtype=np.float64), np.asarray(ys, dtype=np.float64)]
+                [seconds, np.asarray(xs, dtype=np.float64), np.asarray(ys, dtype=np.float64)]
             ).reshape(-1, 3)
 
 
@@ -538,11 +576,13 @@ def _opened_bag(
         reader = AnyReader([_bag_paths(path)], default_typestore=get_typestore(Stores.ROS2_HUMBLE))
         reader.open()
     except Exception as exc:
+        problem, hint = reader_failure(exc, path)
         raise _fail(
             "M060",
-            f"cannot open the bag: {type(exc).__name__}: {exc}",
+            f"cannot open the bag: {problem}",
             file,
-            hint="expected a ROS 1 .bag, a ROS 2 bag directory (sqlite3 or MCAP) or a .mcap file",
+            hint=hint
+            or "expected a ROS 1 .bag, a ROS 2 bag directory (sqlite3 or MCAP) or a .mcap file",
         ) from None
     try:
         chosen, topic = _chosen_connections(reader, topic, file)
@@ -636,9 +676,8 @@ def _pose_chunks(
     except UsageError:
         raise
     except Exception as exc:
-        raise _fail(
-            "M065", f"cannot read the bag's messages: {type(exc).__name__}: {exc}", file
-        ) from None
+        problem, hint = reader_failure(exc, Path(file))
+        raise _fail("M065", f"cannot read the bag's messages: {problem}", file, hint=hint) from None
 
 
 def _emit(
@@ -686,8 +725,9 @@ def _check_bag_path(path: Path, file: str) -> None:
 
     try:
         mode = os.stat(path).st_mode
-    except OSError as exc:
-        raise _fail("M050", f"cannot read {file}: {exc.strerror or exc}", file) from None
+    except OSError:
+        problem = path_problem(path) or "it cannot be looked at"
+        raise _fail("M050", f"cannot read {file}: {problem}", file, hint=_path_hint(path)) from None
     if not (stat.S_ISREG(mode) or stat.S_ISDIR(mode)):
         raise _fail(
             "M060",
@@ -738,10 +778,49 @@ def _sorted_samples(stamps: array[int], xs: array[float], ys: array[float]) -> F
     nanoseconds = np.frombuffer(stamps, dtype=np.int64) if len(stamps) else np.zeros(0, np.int64)
     order = np.argsort(nanoseconds, kind="stable")
     samples = np.empty((len(stamps), 3), dtype=np.float64)
-    samples[:, 0] = nanoseconds[order] / 1e9
+    samples[:, 0] = stamp_seconds(nanoseconds[order])
     samples[:, 1] = np.frombuffer(xs, dtype=np.float64)[order] if len(xs) else 0.0
     samples[:, 2] = np.frombuffer(ys, dtype=np.float64)[order] if len(ys) else 0.0
     return samples
+
+
+#: The bits of a float64 below its sign (see :func:`stamp_seconds`).
+_MAGNITUDE = np.int64(0x7FFF_FFFF_FFFF_FFFF)
+
+
+def _ordered(keys: npt.NDArray[np.int64]) -> npt.NDArray[np.int64]:
+    """Float64 bit patterns to integers in the floats' order, and back (its own inverse):
+    consecutive floats are consecutive integers."""
+    return keys ^ ((keys >> 63) & _MAGNITUDE)
+
+
+def stamp_seconds(
+    nanoseconds: npt.NDArray[np.int64], previous: tuple[int, float] | None = None
+) -> FloatArray:
+    """Seconds of integer-nanosecond stamps in non-decreasing order, distinct where they are.
+
+    Each is ``ns / 1e9``, as a CSV written from the log has it.  But a float64 second has a
+    step of 238 ns at a ROS epoch (1.7e9 s), so stamps closer than that would round to one
+    time, which the verifier refuses as a repeated stamp (V020): where a stamp is later than
+    the one before and its seconds are not, they become the next float above the seconds
+    before (off by a fraction of a microsecond, in the stamps' order).  Equal stamps stay
+    equal.  ``previous``: the last stamp and seconds before these (a stream's chunk before).
+    """
+    stamps = np.asarray(nanoseconds, dtype=np.int64)
+    if previous is not None:
+        stamps = np.concatenate([np.asarray([previous[0]], dtype=np.int64), stamps])
+    seconds = stamps / 1e9
+    if previous is not None:
+        seconds[0] = previous[1]
+    rises = np.diff(stamps) > 0
+    if np.any(rises & (np.diff(seconds) <= 0)):
+        # k'[i] = max(k[i], k'[i-1] + rise[i]) on the ordered bit patterns k, in closed form:
+        # with c the running count of rises, k'[i] = c[i] + max over j <= i of (k[j] - c[j]).
+        count = np.concatenate([np.zeros(1, dtype=np.int64), np.cumsum(rises, dtype=np.int64)])
+        keys = _ordered(seconds.view(np.int64))
+        keys = count + np.maximum.accumulate(keys - count)
+        seconds = _ordered(keys).view(np.float64)
+    return seconds[1:] if previous is not None else seconds
 
 
 _TRANSFORM = re.compile(r"^\s*(\S+)\s*,\s*(\S+)\s*,\s*(\S+)\s*$")

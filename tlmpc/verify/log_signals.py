@@ -19,6 +19,8 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from tlmpc.base.errors import UsageError, error
 from tlmpc.verify.signals import Signal, Where, make_signal
 
@@ -138,7 +140,8 @@ def _bag_signals(path: Path, reactive: Reactive) -> dict[str, Signal]:
     from rosbags.highlevel import AnyReader
     from rosbags.typesys import Stores, get_typestore
 
-    from tlmpc.importers.logs import MAX_LOG_SAMPLES, _bag_paths
+    from tlmpc.importers.bag_damage import reader_failure
+    from tlmpc.importers.logs import MAX_LOG_SAMPLES, _bag_paths, stamp_seconds
 
     file = str(path)
     reader = AnyReader([_bag_paths(path)], default_typestore=get_typestore(Stores.ROS2_HUMBLE))
@@ -192,17 +195,19 @@ def _bag_signals(path: Path, reactive: Reactive) -> dict[str, Signal]:
                     ) from None
                 samples.append((_stamp(message, log_time), value))
             samples.sort(key=lambda sample: sample[0])  # stable: repeated stamps stay, refused
+            stamps = np.asarray([stamp for stamp, _ in samples], dtype=np.int64)
             found[name] = make_signal(
                 name,
-                [stamp / 1e9 for stamp, _ in samples],
+                stamp_seconds(stamps).tolist(),  # stamps 1 ns apart stay apart, as poses do
                 [value for _, value in samples],
                 Where(file, path=topic),
             )
     except UsageError:
         raise
     except Exception as exc:
+        problem, hint = reader_failure(exc, path)
         raise UsageError(
-            error("M065", f"cannot read the bag's messages: {type(exc).__name__}: {exc}", file=file)
+            error("M065", f"cannot read the bag's messages: {problem}", hint=hint, file=file)
         ) from None
     finally:
         reader.close()

@@ -416,7 +416,7 @@ def read_trace(
     against ``mission`` (a mission file, or a mission already loaded) for its regions and task.
     ``tlmpc verify``, ``tlmpc plot --log`` and ``tlmpc view --log`` all read through here, so
     they take the same formats."""
-    from tlmpc.importers.logs import is_log
+    from tlmpc.importers.logs import is_log, path_problem
 
     if is_log(path):
         if mission is None:
@@ -428,6 +428,13 @@ def read_trace(
         if isinstance(mission, Path):
             mission = _load_mission(mission)
         return _log_trace(path, mission, convention, options)
+    if path.is_symlink() and not path.exists():  # a link loop (meant as a folder?) or to nothing
+        raise _fail(
+            "U001",
+            f"cannot read {path}: {path_problem(path)}",
+            str(path),
+            hint="point the link at a trace.json, a log or a folder of logs",
+        )
     from tlmpc.io.artifacts import read_json
 
     # non-finite numbers are read, so that the verifier reports the sample where it is

@@ -1,0 +1,183 @@
+"""Why a robot log the bag reader failed on cannot be read, in words.
+
+The reader (``rosbags``) fails deep inside on a recording cut short or garbled, with a Python
+error that names no place in the file.  Walking the file's own record layout (ROS 1 bags and
+MCAP files) finds where it ends or breaks ("record 2 (chunk, at byte 43) declares 8,451 bytes,
+but the file ends 57 bytes into it"); otherwise the reader's own message is kept when it is
+worded for people.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+_MCAP_MAGIC = b"\x89MCAP0\r\n"
+_MCAP_RECORDS = {
+    0x01: "header",
+    0x02: "footer",
+    0x03: "schema",
+    0x04: "channel",
+    0x05: "message",
+    0x06: "chunk",
+    0x07: "message index",
+    0x08: "chunk index",
+    0x09: "attachment",
+    0x0A: "attachment index",
+    0x0B: "statistics",
+    0x0C: "metadata",
+    0x0D: "metadata index",
+    0x0E: "summary offset",
+    0x0F: "data end",
+}
+_ROS1_MAGIC = b"#ROSBAG V2.0\n"
+_ROS1_RECORDS = {
+    0x02: "message data",
+    0x03: "bag header",
+    0x04: "index data",
+    0x05: "chunk",
+    0x06: "chunk info",
+    0x07: "connection",
+}
+#: Records looked at by :func:`_damage` at most (it runs only after the reader failed).
+_SCAN_RECORDS = 4_000_000
+
+
+def reader_failure(exc: BaseException, path: Path) -> tuple[str, str | None]:
+    """Why the bag reader failed on ``path``, as a sentence, and a hint (or None).
+
+    A recording cut short is said to be (with the record where it ends), found by walking the
+    file's records (ROS 1 bags and MCAP files); else the reader's own message (``rosbags``
+    and SQLite word theirs for people), or, for a Python error from deep inside the reader
+    (a garbled length or name: ``TypeError``, ``KeyError``, ...), that the file is corrupt.
+    """
+    import errno
+    import sqlite3
+
+    damage = _damage(path)
+    if damage is not None:
+        return damage
+    if type(exc).__module__.startswith("rosbags") or isinstance(exc, sqlite3.Error):
+        text = " ".join(str(exc).split())  # one line (a type error quotes a definition)
+        return (text if len(text) <= 200 else text[:199] + "…") or type(exc).__name__, None
+    if isinstance(exc, OSError) and exc.strerror and exc.errno != errno.EINVAL:
+        return exc.strerror, None  # EINVAL: a seek to a garbled offset
+    return (
+        "the file is corrupt (its contents do not parse as a bag)",
+        "it may have been damaged in a copy: compare it with the robot's own",
+    )
+
+
+def _damage(path: Path) -> tuple[str, str] | None:
+    """Where the ROS 1 bag or MCAP file ``path`` (or a bag directory's MCAP file) is cut
+    short, with a hint; None when its records are whole (or it is neither)."""
+    import os
+
+    try:
+        files = sorted(path.iterdir()) if path.is_dir() else [path]
+        for file in files:
+            if not file.is_file():
+                continue
+            with open(file, "rb") as stream:
+                size = os.fstat(stream.fileno()).st_size
+                start = stream.read(len(_ROS1_MAGIC))
+                if start.startswith(_MCAP_MAGIC):
+                    stream.seek(len(_MCAP_MAGIC))
+                    found = _mcap_damage(stream, size)
+                    tool = "`mcap recover`"
+                elif start == _ROS1_MAGIC:
+                    found = _ros1_damage(stream, size)
+                    tool = "`rosbag reindex`"
+                else:
+                    continue
+            if found is not None:
+                inside = f" ({file.name})" if file != path else ""
+                state = "truncated" if found.startswith("it ends") else "truncated or corrupt"
+                return (
+                    f"the file{inside} is {state}: {found}",
+                    f"a recording cut short (the recorder stopped, or the disk filled); {tool} "
+                    "may salvage its whole records",
+                )
+    except OSError:
+        return None
+    return None
+
+
+def _mcap_damage(stream: Any, size: int) -> str | None:
+    """Where an MCAP file ends early: its records are opcode (1 byte), length (8 bytes,
+    little-endian) and body, up to the footer and the closing magic."""
+    offset = len(_MCAP_MAGIC)
+    for number in range(1, _SCAN_RECORDS):
+        head = stream.read(9)
+        if not head:
+            return f"it ends at byte {size}, where record {number} should begin"
+        kind = _MCAP_RECORDS.get(head[0], f"opcode 0x{head[0]:02x}")
+        where = f"record {number} ({kind}, at byte {offset})"
+        if len(head) < 9:
+            return f"it ends at byte {size}, inside the length of {where}"
+        length = int.from_bytes(head[1:], "little")
+        if offset + 9 + length > size:
+            return (
+                f"{where} declares {length:,} bytes, but the file ends "
+                f"{size - offset - 9:,} bytes into it"
+            )
+        offset += 9 + length
+        stream.seek(offset)
+        if head[0] == 0x02:  # the footer: the closing magic follows
+            if size - offset < len(_MCAP_MAGIC):
+                return f"it ends at byte {size}, inside the closing magic after the footer"
+            return None
+    return None
+
+
+def _ros1_damage(stream: Any, size: int) -> str | None:
+    """Where a ROS 1 bag ends early: its records are a header (length, 4 bytes, then fields)
+    and data (length, 4 bytes, then bytes); the bag header record says where the index is."""
+    offset = len(_ROS1_MAGIC)
+    index = None
+    for number in range(1, _SCAN_RECORDS):
+        if offset == size:
+            if index is not None and index > size:
+                return f"it ends at byte {size}, before its index (at byte {index:,})"
+            return None
+        head = stream.read(4)
+        if len(head) < 4:
+            return f"it ends at byte {size}, inside the header length of record {number}"
+        header_length = int.from_bytes(head, "little")
+        if offset + 4 + header_length > size:
+            return (
+                f"record {number} (at byte {offset}) declares a header of {header_length:,} "
+                f"bytes, but the file ends {size - offset - 4:,} bytes into it"
+            )
+        header = stream.read(header_length)
+        fields = _ros1_fields(header)
+        op = fields.get("op", b"")
+        kind = _ROS1_RECORDS.get(op[0], "unknown") if len(op) == 1 else "unknown"
+        if kind == "bag header" and len(fields.get("index_pos", b"")) == 8:
+            index = int.from_bytes(fields["index_pos"], "little")
+        head = stream.read(4)
+        where = f"record {number} ({kind}, at byte {offset})"
+        if len(head) < 4:
+            return f"it ends at byte {size}, inside the data length of {where}"
+        data_length = int.from_bytes(head, "little")
+        end = offset + 8 + header_length + data_length
+        if end > size:
+            return (
+                f"{where} declares {data_length:,} bytes of data, but the file ends "
+                f"{size - (offset + 8 + header_length):,} bytes into them"
+            )
+        offset = end
+        stream.seek(offset)
+    return None
+
+
+def _ros1_fields(header: bytes) -> dict[str, bytes]:
+    """A ROS 1 record header's ``name=value`` fields (each after its 4-byte length)."""
+    fields: dict[str, bytes] = {}
+    at = 0
+    while at + 4 <= len(header):
+        length = int.from_bytes(header[at : at + 4], "little")
+        name, _, value = header[at + 4 : at + 4 + length].partition(b"=")
+        fields[name.decode("latin-1")] = value
+        at += 4 + length
+    return fields
