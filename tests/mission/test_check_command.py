@@ -8,6 +8,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 from tlmpc.cli import main
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -172,3 +174,90 @@ def run_main(*argv: str) -> tuple[int, str, str]:
     out, err = io.StringIO(), io.StringIO()
     code = main(list(argv), out, err)
     return code, out.getvalue(), err.getvalue()
+
+
+# --- positions inside task phrases and formulas written over several YAML lines ---------------
+
+POSITIONED = """\
+version: 1
+name: positions
+workspace: {boundary: {rect: [0, 0, 10, 10]}}
+regions:
+  a: {rect: [1, 1, 2, 2]}
+  b: {rect: [4, 1, 5, 2]}
+  c: {rect: [7, 1, 8, 2]}
+robot: {start: [0.5, 0.5], max_speed: 1.0}
+"""
+
+#: (the task as written, the code, a piece of the raw text that occurs once, and where in that
+#: piece the diagnostic must point): every YAML form a phrase or a formula can take.
+LAYOUTS = [
+    (
+        "folded",
+        "task:\n  - >-\n    visit a then b\n    while avoiding b\n",
+        "T010",
+        "avoiding b",
+        9,
+    ),
+    ("plain", "task:\n  - visit a then\n    b while avoiding qq\n", "L010", "qq", 0),
+    ("single", "task:\n  - 'visit a then\n    b while avoiding b'\n", "T010", "avoiding b", 9),
+    (
+        "double",
+        'task:\n  - "visit a then \\\n    c while avoiding c"\n',
+        "T010",
+        "avoiding c",
+        9,
+    ),
+    ("literal", "task:\n  - |\n    visit a then\n    b while avoiding zz\n", "L010", "zz", 0),
+    ("literal-one-line", "task:\n  - |-\n    visit a then b while avoiding zz\n", "L010", "zz", 0),
+    ("ltl-literal", "ltl: |\n  F a &\n    G !zz\n", "L010", "zz", 0),
+    ("ltl-folded", "ltl: >-\n  F a &\n   G (b | zz)\n", "L010", "zz", 0),
+    ("ltl-plain", "ltl: F a\n  & G !zz\n", "L010", "zz", 0),
+    ("ltl-single", "ltl: 'F a &\n\n     G !zz'\n", "L010", "zz", 0),
+    ("ltl-double", 'ltl: "F a & \\\n     G !\\"zz\\""\n', "L010", '\\"zz', 0),
+    ("ltl-syntax", "ltl: |\n  F a &\n    G $ b\n", "L001", "$", 0),
+    ("ltl-next", "ltl: >\n  F a &\n    X b\n", "L004", "X", 0),
+    ("ltl-ends-early", "ltl: |\n  F (a &\n    b\n", "L002", "    b\n", 5),
+    ("ltl-doubled-quote", "ltl: 'F \"it''s\" &\n   G !zz'\n", "L010", "zz", 0),
+    # a file with Windows line ends (the whole mission is written with them)
+    (
+        "crlf-literal",
+        "task:\r\n  - |\r\n    visit a then\r\n    b while avoiding zz\r\n",
+        "L010",
+        "zz",
+        0,
+    ),
+    (
+        "crlf-double",
+        'task:\r\n  - "visit a then \\\r\n    c while avoiding zz"\r\n',
+        "L010",
+        "zz",
+        0,
+    ),
+]
+
+
+def _expected(text: str, piece: str, offset: int) -> tuple[int, int]:
+    """The 1-based line and column of ``piece`` (which occurs once) plus ``offset``."""
+    assert text.count(piece) == 1, piece
+    index = text.index(piece) + offset
+    return text.count("\n", 0, index) + 1, index - (text.rfind("\n", 0, index) + 1) + 1
+
+
+@pytest.mark.parametrize("command", ["check", "compile"])
+@pytest.mark.parametrize(
+    ("task", "code_", "piece", "offset"),
+    [case[1:] for case in LAYOUTS],
+    ids=[case[0] for case in LAYOUTS],
+)
+def test_positions_in_strings_over_several_yaml_lines(
+    tmp_path: Path, command: str, task: str, code_: str, piece: str, offset: int
+) -> None:
+    mission = tmp_path / "m.yaml"
+    text = POSITIONED.replace("\n", "\r\n") + task if "\r" in task else POSITIONED + task
+    mission.write_bytes(text.encode("utf-8"))
+    argv = [command, str(mission)] + (["-o", str(tmp_path / "out")] if command == "compile" else [])
+    code, _, err = run_main(*argv)
+    assert code == 1, err
+    line, col = _expected(text, piece, offset)
+    assert f"{mission}:{line}:{col}: error[{code_}]" in err, err

@@ -7,6 +7,7 @@ by inclusion, never by their text.
 from __future__ import annotations
 
 import itertools
+import re
 from collections.abc import Callable
 
 import pytest
@@ -88,10 +89,80 @@ def test_avoiding_the_final_target_is_an_error() -> None:
     assert (diagnostic.line, diagnostic.col) == (4, 5 + len("visit a then b while avoiding "))
 
 
+def _expand(formula: str) -> str:
+    """The formula with each group's name read as any of its regions (as a mission does)."""
+    for group, members in GROUPS.items():
+        formula = re.sub(rf"\b{group}\b", "(" + " | ".join(members) + ")", formula)
+    return formula
+
+
+@pytest.mark.parametrize(
+    ("phrase", "expected"),
+    [
+        # `visit exhibits` is any one exhibit: e1 need not be visited, so it is avoided always
+        ("visit exhibits then d while avoiding e1", "G !e1 & F((e1 | e2 | e3) & F d)"),
+        ("visit d then exhibits while avoiding e1", "G !e1 & F(d & F(e1 | e2 | e3))"),
+        ("visit exhibits while avoiding e1, e2", "G !e1 & G !e2 & F e3"),
+        # a step inside the avoided group: visited, so avoided on the last leg
+        ("visit e1 then d while avoiding exhibits", "F(e1 & (e1 U ((!e1 & !e2 & !e3) U d)))"),
+        ("visit x then exhibits then d while avoiding x", "F(x & F((e1 | e2 | e3) & (!x U d)))"),
+    ],
+)
+def test_a_group_step_is_any_one_of_its_regions(phrase: str, expected: str) -> None:
+    mine = _expand(to_text(compile_phrase(phrase, groups=GROUPS)))
+    assert _same_language(mine, expected), mine
+
+
+@pytest.mark.parametrize(
+    "phrase",
+    [
+        "visit d then all exhibits while avoiding e1",
+        "visit d then e1 while avoiding exhibits",
+        "visit d then exhibits while avoiding exhibits",
+    ],
+)
+def test_avoiding_what_holds_every_final_target_is_an_error(phrase: str) -> None:
+    with pytest.raises(InvalidInputError) as caught:
+        compile_phrase(phrase, groups=GROUPS)
+    assert [d.code for d in caught.value.diagnostics] == ["T010"]
+
+
+SAME_CONDITION = "G(s & t -> F(!(s & t) | a)) & G(s & t & a -> (a W !(s & t)))"
+
+
+@pytest.mark.parametrize(
+    ("phrase", "expected"),
+    [
+        ("when all of s and t, go to a and stay there while all of t and s", SAME_CONDITION),
+        ("when all of s, t, go to a and stay there while all of t, s and t", SAME_CONDITION),
+        (
+            "when any of s, t, go to a and stay there while any of t, s",
+            "G(s | t -> F(!(s | t) | a)) & G((s | t) & a -> (a W !(s | t)))",
+        ),
+    ],
+)
+def test_stay_there_while_the_same_condition_in_another_order(phrase: str, expected: str) -> None:
+    assert _same_language(to_text(compile_phrase(phrase)), expected)
+
+
+@pytest.mark.parametrize(
+    "phrase",
+    [
+        "when all of s and t, go to a and stay there while any of t and s",
+        "when s, go to a and stay there while all of s, t",
+        "when any of s, t, go to a and stay there while any of s, u",
+    ],
+)
+def test_stay_there_while_another_condition_is_t021(phrase: str) -> None:
+    with pytest.raises(InvalidInputError) as caught:
+        compile_phrase(phrase)
+    assert [d.code for d in caught.value.diagnostics] == ["T021"]
+
+
 def test_scopes_are_stated_in_words() -> None:
     scopes = avoid_scopes("visit p then q then return to h while avoiding p, lane")
     assert scopes == [
-        "avoid lane: always (the phrase never visits it)",
+        "avoid lane: always (the phrase need not visit it)",
         "avoid p: on the last leg only, after the last visit, from q until h "
         "(the phrase visits it earlier)",
     ]

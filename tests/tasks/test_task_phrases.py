@@ -95,3 +95,32 @@ def test_the_documentation_table_is_true() -> None:
     assert len(rows) >= len(TABLE)
     for phrase, ltl in rows:
         assert compile_phrase(phrase, groups=GROUPS) == parse_ltl(ltl.replace("\\|", "|")), phrase
+
+
+WITHOUT_SENSORS = """\
+version: 1
+workspace: {boundary: {rect: [0, 0, 10, 10]}}
+regions:
+  dock: {rect: [1, 1, 2, 2]}
+  lab: {rect: [4, 1, 5, 2]}
+groups: {both: [dock, lab]}
+robot: {start: [0.5, 0.5], max_speed: 1.0}
+task:
+"""
+
+
+def test_names_of_the_wrong_kind_are_reported_without_sensors() -> None:
+    # no `sensors:`, `actions:` or `assumptions:`: a region is still no condition or action
+    from tlmpc.mission import load_mission_text
+
+    task = "  - if you sense dock then do lab\n  - never enter lab while both\n"
+    with pytest.raises(InvalidInputError) as caught:
+        load_mission_text(WITHOUT_SENSORS + task, "m.yaml")
+    found = [(d.code, d.line, d.col, d.message) for d in caught.value.diagnostics]
+    assert found == [
+        ("T020", 9, 18, "'dock' is a region, not a sensor"),
+        ("T020", 9, 31, "'lab' is a region, not an action"),
+        ("T020", 10, 27, "'both' is a group, not a sensor"),
+    ]
+    mission = load_mission_text(WITHOUT_SENSORS + "  - whenever dock, visit both\n", "m.yaml")
+    assert to_text(mission.formula) == "G(dock -> F(dock | lab))"

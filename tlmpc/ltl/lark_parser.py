@@ -5,8 +5,10 @@ tries a lark-free reader first (see :mod:`tlmpc.ltl.reader`).
 
 ``parse_ltl(text, file=..., line=..., col=...)`` takes the position where ``text`` starts in
 its file (an LTL string inside a YAML mission), so every diagnostic and every node's span
-points into the user's file.  Problems raise :class:`~tlmpc.base.errors.InvalidInputError` with
-L-coded diagnostics; no input, however malformed, produces a traceback.
+points into the user's file; ``place=`` places every character itself (a YAML string over
+several lines, quoted or a block: :mod:`tlmpc.io.scalar_places`).  Problems raise
+:class:`~tlmpc.base.errors.InvalidInputError` with L-coded diagnostics; no input, however
+malformed, produces a traceback.
 """
 
 from __future__ import annotations
@@ -114,11 +116,16 @@ def _parser() -> Lark:
 class _Positions:
     """Shifts lark's 1-based positions (relative to the text) into the user's file."""
 
-    def __init__(self, line: int, col: int) -> None:
+    def __init__(
+        self, line: int, col: int, place: Callable[[int, int], tuple[int, int]] | None = None
+    ) -> None:
         self.line = line
         self.col = col
+        self.place = place
 
     def at(self, line: int, col: int) -> tuple[int, int]:
+        if self.place is not None:
+            return self.place(line, col)
         if line == 1:
             return self.line, self.col + col - 1
         return self.line + line - 1, col
@@ -470,7 +477,14 @@ def _next_operators(tokens: list[Token], pos: _Positions, file: str | None) -> l
     return found
 
 
-def parse_ltl(text: str, *, file: str | None = None, line: int = 1, col: int = 1) -> Formula:
+def parse_ltl(
+    text: str,
+    *,
+    file: str | None = None,
+    line: int = 1,
+    col: int = 1,
+    place: Callable[[int, int], tuple[int, int]] | None = None,
+) -> Formula:
     """Parse ``text`` (LTL without Next) into an AST.
 
     Args:
@@ -478,11 +492,13 @@ def parse_ltl(text: str, *, file: str | None = None, line: int = 1, col: int = 1
         file: the file name to put in diagnostics.
         line: the 1-based line where ``text`` starts in ``file``.
         col: the 1-based column where ``text`` starts in ``file``.
+        place: when given, where the character at a 1-based line and column of ``text``
+            is written in ``file`` (``line``/``col`` then only place the whole formula).
 
     Raises:
         InvalidInputError: with L-coded diagnostics (syntax errors, Next, nesting too deep).
     """
-    pos = _Positions(line, col)
+    pos = _Positions(line, col, place)
     if not isinstance(text, str):
         raise InvalidInputError(
             error("L003", "an LTL formula must be a string", file=file, line=line, col=col)

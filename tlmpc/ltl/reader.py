@@ -253,11 +253,19 @@ class _Reader:
         return _Part(Prop(token.text, span=span), token.start, token.end)
 
 
-def read_plain_ltl(text: str, line: int = 1, col: int = 1) -> Formula | None:
-    """The formula of ``text`` (starting at ``line``:``col`` of its file) when it is plain
-    LTL this reader decides; None to leave it to the lark parser."""
+def read_plain_ltl(
+    text: str,
+    line: int = 1,
+    col: int = 1,
+    place: Callable[[int, int], tuple[int, int]] | None = None,
+) -> Formula | None:
+    """The formula of ``text`` (starting at ``line``:``col`` of its file, or with each
+    character where ``place`` says) when it is plain LTL this reader decides; None to leave
+    it to the lark parser."""
 
     def shift(position: tuple[int, int]) -> tuple[int, int]:
+        if place is not None:
+            return place(*position)
         if position[0] == 1:
             return line, col + position[1] - 1
         return line + position[0] - 1, position[1]

@@ -15,6 +15,7 @@ from pathlib import Path as FilePath
 from typing import TYPE_CHECKING, Any
 
 from tlmpc.base.errors import Diagnostic, InvalidInputError, best_first, error
+from tlmpc.io.scalar_places import ScalarPlaces
 from tlmpc.io.schema_check import MISSION_COORDINATE_LIMIT, is_valid, load_schema
 from tlmpc.ltl.ast import Formula, Prop, bounded_operators, conjoin
 from tlmpc.ltl.keywords import KEYWORDS
@@ -306,6 +307,10 @@ def _describe(
 
 
 def _ltl_position(doc: PositionedDocument, path: Path) -> tuple[int, int]:
+    """Where the text of the string at ``path`` starts (its first character)."""
+    places = doc.places(path)
+    if places is not None:
+        return places.at_offset(0)
     line, col = doc.value_at(path)
     if doc.quoted.get(path):
         col += 1
@@ -334,8 +339,9 @@ def _check_task(
                     groups=groups,
                     file=file,
                     positions=positions,
-                    kinds=kinds,
-                    declared=kinds or NameKinds(regions=frozenset(names), groups=frozenset(groups)),
+                    places=[doc.places(("task", i)) for i in range(len(phrases))],
+                    # without sensors or actions too: a region is no condition (T020)
+                    kinds=kinds or NameKinds(regions=frozenset(names), groups=frozenset(groups)),
                 )
             )
         except InvalidInputError as exc:
@@ -358,8 +364,9 @@ def _check_task(
         from tlmpc.ltl.parser import parse_ltl  # lark: only for missions with `ltl`
 
         line, col = _ltl_position(doc, ("ltl",))
+        place = doc.places(("ltl",))
         try:
-            parts.append(parse_ltl(ltl, file=file, line=line, col=col))
+            parts.append(parse_ltl(ltl, file=file, line=line, col=col, place=place))
         except InvalidInputError as exc:
             problems.extend(exc.diagnostics)
     signals = set(kinds.sensors | kinds.actions) if kinds is not None else set()
@@ -445,8 +452,9 @@ def _reactive(
         from tlmpc.ltl.parser import parse_ltl  # lark: only for missions with assumptions
 
         line, col = _ltl_position(doc, ("assumptions", index))
+        place = doc.places(("assumptions", index))
         try:
-            formula = parse_ltl(text, file=file, line=line, col=col)
+            formula = parse_ltl(text, file=file, line=line, col=col, place=place)
         except InvalidInputError as exc:
             problems.extend(exc.diagnostics)
             continue
@@ -493,6 +501,18 @@ def _task_positions(
     if isinstance(ltl, str) and ltl.strip():
         positions.append(_ltl_position(doc, ("ltl",)))
     return tuple(positions)
+
+
+def _task_places(
+    data: Mapping[str, Any], doc: PositionedDocument
+) -> tuple[ScalarPlaces | None, ...]:
+    """Where each character of each task phrase, then of the ``ltl`` string, is written (None
+    for a one-line plain string: its start and the offset place it)."""
+    places = [doc.places(("task", i)) for i in range(len(data.get("task") or []))]
+    ltl = data.get("ltl")
+    if isinstance(ltl, str) and ltl.strip():
+        places.append(doc.places(("ltl",)))
+    return tuple(places)
 
 
 def _shapes(
@@ -756,6 +776,7 @@ def _load_data(text: str, file: str, stem: str) -> tuple[Mission | None, list[Di
         ),
         source=file,
         task_positions=_task_positions(data, doc),
+        task_places=_task_places(data, doc),
         reactive=reactive,
     )
     return mission, []

@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 from typing import Any, Literal
 
 from tlmpc.base.memo import Slot, recall
+from tlmpc.io.scalar_places import ScalarPlaces
 from tlmpc.ltl.ast import Formula
 
 Point = tuple[float, float]
@@ -239,6 +240,9 @@ class Mission:
     source: str | None = None
     #: (line, col) of each task phrase, then of the ``ltl`` string (see :mod:`.parts`).
     task_positions: tuple[tuple[int, int], ...] = ()
+    #: ... and where each of their characters is written, when the string is quoted, a block
+    #: or over several lines (None for a one-line plain string: its position and the offset)
+    task_places: tuple[ScalarPlaces | None, ...] = field(default=(), compare=False, repr=False)
     #: sensors, actions and assumptions; None for a mission in a world that never changes
     reactive: Reactive | None = None
 

@@ -31,11 +31,16 @@ def task_parts(mission: Mission) -> tuple[TaskPart, ...]:
     expand = group_expansion(mission.groups)
     groups = {g: list(members) for g, members in mission.groups.items()}
     positions = list(mission.task_positions)
+    places = list(mission.task_places)
     parts: list[TaskPart] = []
     for index, phrase in enumerate(mission.task):
         line, col = positions[index] if index < len(positions) else (1, 1)
         formula = compile_phrases(
-            [phrase], groups=groups, file=mission.source, positions=[(line, col)]
+            [phrase],
+            groups=groups,
+            file=mission.source,
+            positions=[(line, col)],
+            places=[places[index] if index < len(places) else None],
         )
         parts.append(TaskPart(text=phrase, formula=substitute(formula, expand), line=line, col=col))
     if mission.ltl and mission.ltl.strip():
@@ -43,7 +48,8 @@ def task_parts(mission: Mission) -> tuple[TaskPart, ...]:
 
         index = len(mission.task)
         line, col = positions[index] if index < len(positions) else (1, 1)
-        whole = parse_ltl(mission.ltl, file=mission.source, line=line, col=col)
+        place = places[index] if index < len(places) else None
+        whole = parse_ltl(mission.ltl, file=mission.source, line=line, col=col, place=place)
         for conjunct in whole.args if isinstance(whole, And) else (whole,):
             span = getattr(conjunct, "span", None)
             parts.append(

@@ -17,6 +17,7 @@ from typing import Any
 import yaml
 
 from tlmpc.base.errors import Diagnostic, error
+from tlmpc.io.scalar_places import ScalarPlaces, line_starts, scalar_places
 from tlmpc.mission.bulk import STEM, BulkList, cut_out
 
 Path = tuple[str | int, ...]
@@ -47,6 +48,13 @@ class PositionedDocument:
     unplaced: set[Path] = field(default_factory=set)
     #: ... and how to read the whole document again with every position, when one is asked.
     reread: Callable[[], PositionedDocument | None] | None = None
+    #: The YAML text, and for each string that is quoted, a block or over several lines:
+    #: (value, style, 0-based start and end marks), to place its characters (see places).
+    source: str = ""
+    scalars: dict[Path, tuple[str, str | None, tuple[int, int], tuple[int, int]]] = field(
+        default_factory=dict
+    )
+    _lines: list[int] | None = None
 
     def value_at(self, path: Path) -> tuple[int, int]:
         """Position of the value at ``path``, or of its deepest known ancestor."""
@@ -77,6 +85,17 @@ class PositionedDocument:
         ):
             self._place_all()
         return self.keys.get(path) or self.value_at(path)
+
+    def places(self, path: Path) -> ScalarPlaces | None:
+        """Where each character of the string at ``path`` is written; None for a one-line
+        plain string (its start plus the offset is exact) or one whose text is not followed."""
+        marks = self.scalars.get(path)
+        if marks is None or not self.source:
+            return None
+        if self._lines is None:
+            self._lines = line_starts(self.source)
+        value, style, start, end = marks
+        return scalar_places(self.source, value, style, start, end, self._lines)
 
 
 def json_path(path: Path) -> str:
@@ -375,6 +394,19 @@ class _Converter:
                 self.doc.quoted[path] = event.style in ("'", '"')
                 self.doc.block[path] = event.style in ("|", ">")
                 value = self.scalar(event, path)
+                start, end = event.start_mark, event.end_mark
+                if (
+                    isinstance(value, str)
+                    and start is not None
+                    and end is not None
+                    and (event.style or start.line != end.line)
+                ):
+                    self.doc.scalars[path] = (
+                        value,
+                        event.style,
+                        (start.line, start.column),
+                        (end.line, end.column),
+                    )
                 if event.anchor is not None:
                     self.anchors[event.anchor] = (value, 1)
                 self._store(parent, value, 1)
@@ -491,6 +523,8 @@ def load_positioned(
     on large maps); the first question about one reads the text again with every position.
     """
     doc, problems = _load_positioned(text, file, lazy)
+    if doc is not None:
+        doc.source = text
     if doc is not None and doc.unplaced:
         doc.reread = lambda: _load_positioned(text, file, False)[0]
     return doc, problems

@@ -12,7 +12,7 @@ import difflib
 import functools
 import itertools
 import re
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -148,17 +148,23 @@ class _Lowering:
         line: int,
         col: int,
         kinds: NameKinds | None = None,
+        place: Callable[[int, int], tuple[int, int]] | None = None,
     ) -> None:
         self.groups = groups
         self.kinds = kinds
         self.file = file
         self.line = line
         self.col = col
+        #: where the phrase's character at a 1-based line and column is written in ``file``
+        #: (a YAML string over several lines, quoted or a block); None: ``line``/``col`` + offset
+        self.place = place
         self.problems: list[Diagnostic] = []
         #: each avoidance's scope in words, for ``tlmpc check --explain``
         self.scopes: list[str] = []
 
     def _where(self, token: Word) -> tuple[int, int]:
+        if self.place is not None:
+            return self.place(token.line or 1, token.column or 1)
         if (token.line or 1) > 1:  # a phrase spread over several lines (a YAML block scalar)
             return self.line + (token.line or 1) - 1, token.column or 1
         return self.line, self.col + (token.column or 1) - 1
@@ -271,8 +277,8 @@ class _Lowering:
         # sense_stay: reach the place while the condition lasts, then stay while it lasts
         sensed = self._condition(children[0])
         (place,) = self._expect([self.name(children[1])], "region")
-        lasting = self._condition(children[2])
-        if lasting != sensed:
+        self._condition(children[2])  # its names are checked; the same condition as `when`
+        if _condition_key(children[2]) != _condition_key(children[0]):
             self._report(
                 "T021",
                 children[2],
@@ -310,7 +316,7 @@ class _Lowering:
                     self.problems.append(
                         error(
                             "T020",
-                            f"{prop.name!r} is a {found}, not a {kind}",
+                            f"{prop.name!r} is {_a(found)}, not {_a(kind)}",
                             hint=_KIND_HINTS[kind],
                             file=self.file,
                             line=line,
@@ -350,26 +356,25 @@ class _Lowering:
         region of the previous step (a later visit of a step's region serves all of it).
 
         ``while avoiding X`` never weakens into something a reader would not expect: a name the
-        phrase never visits is avoided always (``G !X``); a name the phrase must visit is
+        phrase need not visit is avoided always (``G !X``); a name the phrase must visit is
         avoided on the last leg — after the last intermediate visit, until the final target
         (the paper's "finally, return to p1 while avoiding p2 and p3").  Avoiding a final
         target is a contradiction and is reported (T010).
         """
         avoiding = children[-1] if children[-1].data == "avoiding" else None
         steps = [self._step(s) for s in (children[:-1] if avoiding is not None else children)]
-        visited: set[str] = set()
-        for step in steps:
-            for prop in step:
-                visited |= self._members(prop.name)
+        # the phrase must visit X when a step names something inside X (a group named as a
+        # step is one of its members, any one: ``visit rooms`` need not visit r1)
+        visited = [self._members(prop.name) for step in steps for prop in step]
         always: list[Prop] = []
         last_leg: list[Prop] = []
         if avoiding is not None:
-            final = {m for p in steps[-1] for m in self._members(p.name)}
+            final = [self._members(p.name) for p in steps[-1]]
             for prop in self._avoided_names(avoiding):
                 members = self._members(prop.name)
-                if members & final:
+                if any(target <= members for target in final):
                     self._avoid_final(prop, steps[-1])
-                elif members & visited:
+                elif any(step <= members for step in visited):
                     last_leg.append(prop)
                 else:
                     always.append(prop)
@@ -383,7 +388,7 @@ class _Lowering:
                 formula = self._last_leg(steps[index], formula, leaving)
                 continue
             formula = conjoin([Eventually(And((prop, formula))) for prop in steps[index]])
-        self._scope(always, "always (the phrase never visits {it})")
+        self._scope(always, "always (the phrase need not visit {it})")
         if last_leg:
             before = steps[-2] if len(steps) > 1 else []
             start = "after the last visit, from " + _listing(before) if before else "from the start"
@@ -486,6 +491,18 @@ def _duration(tree: Node) -> float:
     return float(found.group(1)) * _UNITS[found.group(2).lower()]
 
 
+def _condition_key(tree: Node) -> tuple[str, frozenset[str]]:
+    """What a condition tests: ``any``/``all`` of a set of sensors (one sensor is either), so
+    ``all of s and t`` and ``all of t, s`` are the same condition."""
+    sensors = frozenset(str(w) for w in _words(tree))
+    return ("one" if len(sensors) == 1 else tree.data, sensors)
+
+
+def _a(kind: str) -> str:
+    """``kind`` with its article: ``a sensor``, ``an action``."""
+    return ("an " if kind[0] in "aeiou" else "a ") + kind
+
+
 def _listing(props: Sequence[Prop]) -> str:
     names = [p.name for p in props]
     return names[0] if len(names) == 1 else ", ".join(names[:-1]) + " and " + names[-1]
@@ -578,7 +595,7 @@ def _reserved(
         "T003",
         f"{str(word)!r} is a {kind} of the mission, but task phrases read "
         f"`{word.lower()}` as a keyword, so no phrase can name it",
-        # the kind first: a name that begins with a keyword (`visit_region`) can be split
+        # any longer word is a name (a keyword is a whole word): `region_then`
         hint=f"rename the {kind} (say `{kind}_{word}`), or state this part of the task "
         f"under `ltl:`, where {str(word)!r} is an ordinary name",
         file=lowering.file,
@@ -596,15 +613,25 @@ def compile_phrase(
     col: int = 1,
     kinds: NameKinds | None = None,
     declared: NameKinds | None = None,
+    place: Callable[[int, int], tuple[int, int]] | None = None,
 ) -> Formula:
     """Compile one phrase to LTL (raises :class:`InvalidInputError` with T-codes).
 
     With ``kinds`` (the mission's names by kind), a name used as the wrong kind — a region
     where a sensor belongs, say — is reported (T020).  ``declared`` (default ``kinds``) are
     the mission's names, to explain a phrase that fails because it names a word the phrases
-    reserve (T003)."""
+    reserve (T003).  The phrase starts at ``line``:``col`` of ``file``; ``place``, when
+    given, says where its character at a 1-based line and column is written (a YAML string
+    over several lines, quoted or a block: :mod:`tlmpc.io.scalar_places`)."""
     return _compile(
-        phrase, groups=groups, file=file, line=line, col=col, kinds=kinds, declared=declared
+        phrase,
+        groups=groups,
+        file=file,
+        line=line,
+        col=col,
+        kinds=kinds,
+        declared=declared,
+        place=place,
     )[0]
 
 
@@ -622,6 +649,7 @@ def _compile(
     col: int,
     kinds: NameKinds | None = None,
     declared: NameKinds | None = None,
+    place: Callable[[int, int], tuple[int, int]] | None = None,
 ) -> tuple[Formula, list[str]]:
     if not isinstance(phrase, str) or not phrase.strip():
         raise InvalidInputError(
@@ -634,7 +662,7 @@ def _compile(
                 col=col,
             )
         )
-    lowering = _Lowering(groups or {}, file, line, col, kinds)
+    lowering = _Lowering(groups or {}, file, line, col, kinds, place)
     try:
         tree = parse_tree(phrase)
     except PhraseSyntaxError as exc:
@@ -672,6 +700,7 @@ def compile_phrases(
     positions: Sequence[tuple[int, int]] | None = None,
     kinds: NameKinds | None = None,
     declared: NameKinds | None = None,
+    places: Sequence[Callable[[int, int], tuple[int, int]] | None] | None = None,
 ) -> Formula:
     """Compile every phrase and conjoin them; report the problems of all phrases at once.
 
@@ -683,6 +712,8 @@ def compile_phrases(
         kinds: the mission's names by kind, to report a name used as the wrong kind.
         declared: the mission's names by kind (default ``kinds``), to report a phrase that
             names a word the phrases reserve as a keyword (T003).
+        places: per phrase, None or where its character at a 1-based line and column is
+            written in ``file`` (a YAML string over several lines, quoted or a block).
     """
     formulas: list[Formula] = []
     problems: list[Diagnostic] = []
@@ -698,6 +729,7 @@ def compile_phrases(
                     col=col,
                     kinds=kinds,
                     declared=declared,
+                    place=places[index] if places is not None else None,
                 )
             )
         except InvalidInputError as exc:

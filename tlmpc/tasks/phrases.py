@@ -2,14 +2,15 @@
 
 ``tasks.lark`` stays the definition of the phrase language: it is parsed with lark's Earley
 parser (dynamic lexer, ``ambiguity="resolve"``), which costs a tenth of a second to build on
-every start and milliseconds per phrase.  Nearly every real phrase is made of whole words —
-keywords and region names that do not begin with a keyword — where the grammar is
-unambiguous and one token of look-ahead decides every choice.  :func:`parse_plain` reads
-exactly those phrases and returns the tree the Earley parser would return; for anything else
-(a name such as ``visitor`` that the dynamic lexer could split into ``visit`` + ``or``, an
-unusual character, a phrase that does not parse) it returns ``None`` and the caller asks the
-Earley parser, which then also words every error message.  A differential test draws phrases
-from the whole grammar, with adversarial names, and checks both parsers agree.
+every start and milliseconds per phrase.  Nearly every real phrase is made of words —
+keywords and names; a keyword is a whole word there (the grammar's keywords end at a word's
+end, so ``visitor`` is a name, never ``visit`` + ``or``) — where the grammar is unambiguous
+and one token of look-ahead decides every choice.  :func:`parse_plain` reads exactly those
+phrases and returns the tree the Earley parser would return; for anything else (an unusual
+character, a time-bounded or reactive phrase, a phrase that does not parse) it returns
+``None`` and the caller asks the Earley parser, which then also words every error message.
+A differential test draws phrases from the whole grammar, with adversarial names, and checks
+both parsers agree.
 """
 
 from __future__ import annotations
@@ -78,17 +79,7 @@ KEYWORDS = frozenset(
         "of",
     }
 )
-#: Keywords of the reactive phrases only, which this reader never reads (it leaves every
-#: phrase that uses them to the Earley parser).
-REACTIVE_KEYWORDS = frozenset(
-    {"if", "you", "sense", "see", "when", "there", "unless", "enter", "do", "of"}
-)
-#: A name starting with one of these could be split by the Earley parser's dynamic lexer
-#: (``visitor`` = ``visit`` + ``or``): such phrases go to the Earley parser.  A reactive
-#: keyword cannot split a name in the phrases read here (the parser expects none of them
-#: where a name stands), so ``dock`` and ``office`` stay plain.
-_SPLITTABLE = tuple(sorted(KEYWORDS - REACTIVE_KEYWORDS))
-#: ``one of`` and ``come back`` are keywords only as a pair, one space apart.
+#: ``one of``, ``come back`` and ``go to`` are keywords only as a pair, one space apart.
 _PAIR_SECOND = {"one": "of", "come": "back", "go": "to"}
 _NOUNS = frozenset({"area", "areas", "region", "regions", "room", "rooms"})
 
@@ -302,26 +293,11 @@ class _Reader:
         raise _NotPlain
 
 
-def _splittable(tokens: list[_Token]) -> bool:
-    """Whether some name could be read by the dynamic lexer as a keyword and a shorter name."""
-    previous = ""
-    for token in tokens:
-        word = token.lower
-        if token.kind == _WORD and word not in KEYWORDS:
-            if word.startswith(_SPLITTABLE):
-                return True
-            second = _PAIR_SECOND.get(previous, "")
-            if second and word != second and word.startswith(second):
-                return True
-        previous = word
-    return False
-
-
 def parse_plain(phrase: str) -> Node | None:
     """The phrase's tree (rule ``start``), or None when the Earley parser must decide."""
     try:
         tokens = _tokens(phrase)
-        if not tokens or _splittable(tokens):
+        if not tokens:
             return None
         reader = _Reader(phrase, tokens)
         tree = reader.phrase_()
