@@ -46,10 +46,11 @@ def _spin_seconds(formula: str, timeout: float) -> float | None:
 
 def _clear_caches() -> None:
     # The translator memoizes expansions across calls; time cold translations.
-    from tlmpc.automata import terms
+    from tlmpc.automata import rewrite, terms
 
     terms.expand.cache_clear()
     terms.implies.cache_clear()
+    rewrite.negate.cache_clear()
 
 
 def run(

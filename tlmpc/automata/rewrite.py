@@ -39,6 +39,7 @@ fulfilled at once or never needed ``a``; with ¬a ⇒ b every position before th
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 from typing import assert_never
 
@@ -81,8 +82,12 @@ _DUAL: dict[BinaryKind, BinaryKind] = {"U": "R", "R": "U", "W": "M", "M": "W"}
 _TEMPORAL = Finally | Always | Binary
 
 
+@functools.lru_cache(maxsize=1 << 16)
 def negate(f: Node) -> Node:
-    """The negation normal form of ``!f`` (rebuilt through the simplifying constructors)."""
+    """The negation normal form of ``!f`` (rebuilt through the simplifying constructors).
+
+    Memoized: the pairwise checks of a junction negate the same operands again and again, and
+    a nest of ``<->`` doubles its operands at each level."""
     match f:
         case Top():
             return FALSE
