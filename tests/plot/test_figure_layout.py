@@ -17,12 +17,16 @@ from hypothesis import strategies as st
 
 from tlmpc.render.layout import (
     LABEL_HALO,
+    LABEL_PX,
     PNG_PIXELS_PER_FIGURE_PIXEL,
+    SMALL_PX,
+    TITLE_PX,
     Box,
     Canvas,
     layout,
     place_labels,
     text_width,
+    wrap,
 )
 from tlmpc.render.plot import figure_of, png_style
 from tlmpc.render.scene import Region, Scene, build_scene
@@ -255,3 +259,71 @@ def test_placement_never_overlaps(rectangles: list[tuple[float, float, float, fl
     assert sorted([label.name for label in placed] + list(hidden)) == sorted(
         r.name for r in regions
     )
+
+
+def _reference_wrap(text: str, font_px: float, width: float, lines: int) -> list[str]:
+    """The wrapping :func:`wrap` promises, written the slow and obvious way: every word cut
+    into the longest prefixes that fit (at least one character; two when any longer cut is
+    tried), greedy lines, the tail past ``lines`` cut and ended with an ellipsis."""
+
+    def fits(piece: str) -> bool:
+        return not text_width(piece, font_px) > width
+
+    words: list[str] = []
+    for word in text.split():
+        while not fits(word) and len(word) > 1:
+            fitting = [c for c in range(2, len(word)) if fits(word[:c])]
+            cut = max(fitting, default=1)
+            words.append(word[:cut])
+            word = word[cut:]
+        words.append(word)
+    out: list[str] = []
+    for word in words:
+        if out and fits(f"{out[-1]} {word}"):
+            out[-1] = f"{out[-1]} {word}"
+        else:
+            out.append(word)
+    if len(out) > lines:
+        last = out[lines - 1]
+        while last and not fits(last + " …"):
+            last = last[:-1]
+        out = [*out[: lines - 1], last.rstrip() + " …"]
+    return out
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    text=st.text(alphabet="aWil.M –é\u6f22\n", max_size=120),
+    font_px=st.sampled_from([SMALL_PX, LABEL_PX, TITLE_PX, 3.7]),
+    width=st.sampled_from([0.0, 4.0, 12.0, 40.0, 120.0, 204.0]),
+    lines=st.integers(1, 5),
+)
+def test_wrap_equals_the_reference_wrapping(
+    text: str, font_px: float, width: float, lines: int
+) -> None:
+    assert wrap(text, font_px, width, lines) == _reference_wrap(text, font_px, width, lines)
+
+
+@pytest.mark.parametrize("text", ["x" * 200_000, "word " * 40_000, "\u6f22" * 200_000])
+def test_a_huge_text_wraps_with_few_measurements(
+    text: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A 200,000-character title or name is measured a bounded number of times, on short
+    texts only (the old cut re-measured every prefix: cubic, hours for this text)."""
+    from tlmpc.render import layout
+
+    measured: list[int] = []
+
+    def counting(piece: str, font_px: float) -> float:
+        measured.append(len(piece))
+        # fail at once rather than measure for hours
+        assert len(measured) < 2_000
+        assert sum(measured) < 50_000
+        return text_width(piece, font_px)
+
+    monkeypatch.setattr(layout, "text_width", counting)
+    title = wrap(text, TITLE_PX, 1100.0, lines=1)
+    legend = wrap(text, SMALL_PX, 194.0)
+    assert len(title) == 1
+    assert len(legend) == 4
+    assert legend[-1].endswith(" …")

@@ -139,3 +139,20 @@ def test_the_simulated_trace_describes_the_mission_as_the_compiled_one_does(
     assert simulated["radius"] == 0.05
     for key in ("ltl", "regions", "workspace", "boundary", "radius"):
         assert simulated[key] == compiled[key], key
+
+
+def test_an_output_whose_mission_has_no_source_simulates(patrol: Path, tmp_path: Path) -> None:
+    """``source`` (the mission file, named in diagnostics) is optional in the mission
+    artifact's schema: simulate and stage read such a folder (they raised KeyError, exit 3)."""
+    import shutil
+
+    out = tmp_path / "no-source"
+    shutil.copytree(patrol, out)
+    mission = json.loads((out / "mission.json").read_text())
+    del mission["source"]
+    (out / "mission.json").write_text(json.dumps(mission))
+    code, text, err = run("simulate", str(out), "--cycles", "1")
+    assert code == 0, text + err
+    assert ": satisfied:" in text
+    code, text, err = run("stage", "control", str(out))
+    assert code == 0, text + err

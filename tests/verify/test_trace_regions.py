@@ -15,7 +15,17 @@ from tlmpc.base.errors import UsageError
 from tlmpc.verify.trace_input import from_document
 
 coordinate = st.floats(-1e6, 1e6, allow_nan=False)
-polygon = st.lists(st.tuples(coordinate, coordinate).map(list), min_size=3, max_size=7)
+size = st.floats(1.0, 1e3)
+
+
+def _rectangle(r: tuple[float, float, float, float, int]) -> list[list[float]]:
+    x, y, w, h, first = r
+    corners = [[x, y], [x + w, y], [x + w, y + h], [x, y + h]]
+    return corners[first:] + corners[:first]
+
+
+#: Simple polygons (a trace's regions must be, as a mission's): rectangles, from any corner.
+polygon = st.tuples(coordinate, coordinate, size, size, st.integers(0, 3)).map(_rectangle)
 
 
 def _document(regions: dict[str, Any]) -> dict[str, Any]:
@@ -73,3 +83,51 @@ def test_a_last_point_on_a_region_boundary(end: str, outcome: str) -> None:
         "end": end,
     }
     assert verify_document(document).outcome == outcome
+
+
+BOWTIE = [[0, 0], [12, 8], [12, 0], [0, 8]]  # its edges cross at (6, 4)
+SQUARE = [[0, 0], [12, 0], [12, 8], [0, 8]]
+
+
+@pytest.mark.parametrize(
+    ("workspace", "regions", "what"),
+    [
+        ({"boundary": BOWTIE}, {"a": [[1, 1], [2, 1], [2, 2]]}, "workspace boundary"),
+        ({"boundary": SQUARE}, {"a": [[0, 0], [2, 2], [2, 0], [0, 2]]}, "region 'a'"),
+        ({"boundary": SQUARE, "holes": [[[3, 3], [5, 5], [5, 3], [3, 5]]]}, {}, "hole 0"),
+        (
+            {"boundary": SQUARE, "components": [{"boundary": BOWTIE, "holes": []}]},
+            {},
+            "boundary of component 0",
+        ),
+        ({"boundary": SQUARE}, {"a": [[1, 1], [2, 2], [3, 3]]}, "region 'a'"),  # zero area
+    ],
+)
+def test_a_self_intersecting_or_flat_polygon_is_V004(
+    workspace: dict[str, Any], regions: dict[str, Any], what: str
+) -> None:
+    """A trace takes the shapes a mission takes: a bow-tie workspace made shapely's overlay
+    raise (exit 3), a bow-tie region was silently certified."""
+    document = {**_document(regions), "workspace": workspace}
+    with pytest.raises(UsageError) as caught:
+        from_document(document)
+    (diagnostic,) = caught.value.diagnostics
+    assert diagnostic.code == "V004"
+    assert diagnostic.message.startswith(f"{what}: the polygon ")
+
+
+def test_verify_refuses_a_bowtie_workspace_with_exit_2(tmp_path: Any) -> None:
+    import io
+    import json
+
+    from tlmpc.cli import main
+
+    trace = tmp_path / "trace.json"
+    document = {**_document({"a": [[1, 1], [2, 1], [2, 2]]}), "workspace": {"boundary": BOWTIE}}
+    trace.write_text(json.dumps(document))
+    err = io.StringIO()
+    assert main(["verify", str(trace)], out=io.StringIO(), err=err) == 2
+    assert f"{trace}: error[V004]: workspace boundary: the polygon is self-intersecting" in (
+        err.getvalue()
+    )
+    assert "Traceback" not in err.getvalue()

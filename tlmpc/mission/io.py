@@ -72,7 +72,7 @@ def mission_from_json(document: Mapping[str, Any]) -> Mission:
             margin=options.get("margin"),
             goal_depth=options.get("goal_depth"),
         ),
-        source=document["source"],
+        source=document.get("source"),  # optional in the schema: the file, for diagnostics
         reactive=_reactive(document.get("reactive")),
     )
 

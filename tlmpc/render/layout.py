@@ -15,8 +15,9 @@ font's widest glyph, so a box is never narrower than the text drawn in it.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
+from itertools import accumulate
 
 from tlmpc.render.scene import Point, Region, Scene, label_priority
 
@@ -57,11 +58,15 @@ _LINE_EM = 1.164
 _ASCENT_EM = 0.928
 
 
+def _advances(text: str) -> list[int]:
+    """The advance width of each character of ``text``, in font units."""
+    return [_ADVANCE[ord(c) - 32] if 32 <= ord(c) < 127 else _MAX_ADVANCE for c in text]
+
+
 def text_width(text: str, font_px: float) -> float:
     """The width of ``text`` in DejaVu Sans at ``font_px`` (at most: a non-ASCII character
     counts as the widest glyph)."""
-    units = sum(_ADVANCE[ord(c) - 32] if 32 <= ord(c) < 127 else _MAX_ADVANCE for c in text)
-    return units * font_px / _UNITS_PER_EM
+    return sum(_advances(text)) * font_px / _UNITS_PER_EM
 
 
 def text_height(font_px: float) -> float:
@@ -250,27 +255,56 @@ def place_labels(
     return tuple(placed), tuple(sorted(hidden))
 
 
+def _pieces(word: str, font_px: float, width: float) -> Iterator[str]:
+    """``word`` cut into pieces no wider than ``width`` pixels, each as long as fits (a piece
+    of one character may be wider); a word that fits is its only piece.
+
+    The widths come from running sums of the characters' advances, and each cut point is
+    found by bisection, so a long word costs time linear in its length (measuring every
+    prefix anew would be cubic).  A prefix's width is computed exactly as :func:`text_width`
+    computes it (an integer sum of advances, scaled), so the pieces are the same.
+    """
+    ends = list(accumulate(_advances(word), initial=0))
+    start, size = 0, len(word)
+
+    def too_wide(end: int) -> bool:
+        return (ends[end] - ends[start]) * font_px / _UNITS_PER_EM > width
+
+    while too_wide(size) and size - start > 1:
+        # the longest prefix of at least 2 characters (and not all) that fits, else 1
+        low, high = 1, size - start - 1
+        while low < high:
+            middle = (low + high + 1) // 2
+            if too_wide(start + middle):
+                high = middle - 1
+            else:
+                low = middle
+        yield word[start : start + low]
+        start += low
+    yield word[start:]
+
+
 def wrap(text: str, font_px: float, width: float, lines: int = 4) -> list[str]:
     """``text`` broken on spaces into at most ``lines`` lines no wider than ``width`` pixels
-    (a word longer than a line is cut); a cut tail ends in an ellipsis."""
-    words: list[str] = []
-    for word in text.split():
-        while text_width(word, font_px) > width and len(word) > 1:
-            cut = len(word) - 1
-            while cut > 1 and text_width(word[:cut], font_px) > width:
-                cut -= 1
-            words.append(word[:cut])
-            word = word[cut:]
-        words.append(word)
+    (a word longer than a line is cut); a cut tail ends in an ellipsis.
+
+    Only the first ``lines`` + 1 lines are ever built, so a very long text costs little more
+    than splitting it.
+    """
     out: list[str] = []
     current = ""
-    for word in words:
-        candidate = f"{current} {word}" if current else word
-        if current and text_width(candidate, font_px) > width:
-            out.append(current)
-            current = word
-        else:
-            current = candidate
+    for word in text.split():
+        for piece in _pieces(word, font_px, width):
+            candidate = f"{current} {piece}" if current else piece
+            if current and text_width(candidate, font_px) > width:
+                out.append(current)
+                current = piece
+            else:
+                current = candidate
+            if len(out) > lines:
+                break
+        if len(out) > lines:
+            break
     if current:
         out.append(current)
     if len(out) > lines:

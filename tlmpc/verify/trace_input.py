@@ -90,6 +90,17 @@ def _polygon(value: Any, what: str, file: str | None) -> FloatArray:
     return array
 
 
+def _check_simple(polygon: FloatArray, what: str, file: str | None) -> None:
+    """Refuse (V004) a polygon a mission would refuse: fewer than 3 distinct points, zero
+    area, or edges that cross or touch — by the mission loader's own check, so a trace takes
+    the shapes a mission takes (shapely's overlays fail on a self-intersecting workspace)."""
+    from tlmpc.mission.geometry import check_shape
+
+    _, problems = check_shape(polygon.tolist(), (), what, file or "<input>", lambda _: (0, 0))
+    if problems:
+        raise _fail("V004", problems[0].message, file, hint=problems[0].hint)
+
+
 def _polygons(named: Mapping[str, Any], file: str | None) -> dict[str, FloatArray]:
     """``_polygon`` of every region, converted in one array when all are well formed (a map
     of many regions would spend most of its reading here); any doubt: one by one, for the
@@ -244,6 +255,8 @@ def from_document(
     if not isinstance(regions_doc, dict):
         raise _fail("V004", "the trace has no `regions`", file)
     regions = _polygons(regions_doc, file)
+    for name, polygon in regions.items():
+        _check_simple(polygon, f"region {name!r}", file)
     samples = _samples(document.get("points"), file)
     loop = document.get("loop_start")
     if loop is not None and (
@@ -254,6 +267,7 @@ def from_document(
     if not isinstance(workspace, dict):
         raise _fail("V004", "the trace's `workspace` is not a mapping {boundary, holes}", file)
     boundary = workspace.get("boundary")
+    boundary_polygon = _polygon(boundary, "workspace boundary", file) if boundary else None
     holes = tuple(
         _polygon(h, f"hole {i}", file) for i, h in enumerate(workspace.get("holes") or [])
     )
@@ -272,6 +286,14 @@ def from_document(
         )
         for k, c in enumerate(components_doc)
     )
+    if boundary_polygon is not None:
+        _check_simple(boundary_polygon, "workspace boundary", file)
+    for i, hole in enumerate(holes):
+        _check_simple(hole, f"hole {i}", file)
+    for k, (outer, inner) in enumerate(components):
+        _check_simple(outer, f"boundary of component {k}", file)
+        for i, hole in enumerate(inner):
+            _check_simple(hole, f"hole {i} of component {k}", file)
     chosen = convention or document.get("boundary") or "right"
     if chosen not in ("right", "closed"):
         raise _fail(
@@ -302,7 +324,7 @@ def from_document(
         loop_start=loop,
         formula=_formula(document.get("ltl"), propositions, file),
         regions=regions,
-        boundary_polygon=_polygon(boundary, "workspace boundary", file) if boundary else None,
+        boundary_polygon=boundary_polygon,
         holes=holes,
         components=components if boundary else (),
         convention=chosen,
