@@ -717,3 +717,28 @@ def test_a_task_naming_an_unknown_region_fails_at_the_flag(
     assert err.startswith(where), err
     assert "error[L010]: unknown region" in err
     assert not out.exists()
+
+
+@pytest.mark.parametrize("region", [True, False])
+@pytest.mark.parametrize(
+    ("flags", "expected"),
+    [
+        (["--ltl", "G("], "--ltl 'G(':1:3: error[L002]: the LTL formula ends too early"),
+        (["--task", "visit"], "--task 'visit':1:1: error[T001]"),
+        (["--task", "visit goal", "--ltl", "F & goal"], "--ltl 'F & goal':1:3: error[L"),
+    ],
+)
+def test_a_task_that_does_not_parse_fails_at_the_flag(
+    tmp_path: Path, flags: list[str], expected: str, region: bool
+) -> None:
+    # located in the flag's own text, not at a line of the mission that is never written;
+    # a syntax error is refused even when the mission has no regions yet
+    free = np.ones((20, 20), dtype=bool)
+    path = write_map(tmp_path, "m", image_from_free(free), resolution=0.1)
+    out = tmp_path / "mission.yaml"
+    regions = ["--region", "goal", "0.1", "0.1", "0.3", "0.3"] if region else []
+    code, _, err = run("import-map", str(path), *regions, *flags, "-o", str(out))
+    assert code == 1, err
+    assert err.startswith(expected), err
+    assert "mission.yaml" not in err
+    assert not out.exists()

@@ -261,3 +261,68 @@ def test_positions_in_strings_over_several_yaml_lines(
     assert code == 1, err
     line, col = _expected(text, piece, offset)
     assert f"{mission}:{line}:{col}: error[{code_}]" in err, err
+
+
+# --- values that pass the schema but that the compiler's later stages cannot carry -------------
+
+SLOW = """\
+version: 1
+name: slow
+workspace: {boundary: {rect: [0, 0, 12, 8]}}
+regions:
+  home: {rect: [0.5, 0.5, 2.0, 2.0]}
+  dock: {rect: [10.0, 6.0, 11.5, 7.5]}
+robot: {start: [1.0, 1.0], max_speed: SPEED}
+task:
+  - avoid home
+  - PHRASE
+"""
+
+
+@pytest.mark.parametrize("command", ["check", "compile"])
+@pytest.mark.parametrize("speed", ["1.0e-12", "1.0e-320", "1.4e-9"])
+def test_a_max_speed_too_small_to_cross_the_workspace_is_refused(
+    tmp_path: Path, command: str, speed: str
+) -> None:
+    # 14.42 across (the rectangle's diagonal) at under 1.442e-9 takes more than 1e10 s; compile
+    # used to fail at exit 3 (C010, C031) or exit 2 with a V024 about its own trace
+    mission = tmp_path / "m.yaml"
+    mission.write_text(SLOW.replace("SPEED", speed).replace("PHRASE", "visit dock"))
+    argv = [command, str(mission)] + (["-o", str(tmp_path / "out")] if command == "compile" else [])
+    code, _, err = run_main(*argv)
+    assert code == 1, err
+    assert err.startswith(f"{mission}:7:39: error[S010]: $.robot.max_speed: "), err
+    assert "hint: give a max_speed of at least 1.44e-09" in err
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_max_speed_just_fast_enough_is_valid(tmp_path: Path) -> None:
+    mission = tmp_path / "m.yaml"
+    mission.write_text(SLOW.replace("SPEED", "1.5e-9").replace("PHRASE", "visit dock"))
+    assert run_main("check", str(mission))[0] == 0
+
+
+@pytest.mark.parametrize("command", ["check", "compile"])
+def test_a_then_chain_nested_beyond_the_readers_limit_is_refused_at_its_phrase(
+    tmp_path: Path, command: str
+) -> None:
+    # 200 `then`s nest 402 levels (403 in the conjunction with `avoid home`), more than the
+    # LTL reader's 400 (L005): compile used to
+    # spend a minute in the automaton stage, then fail at <input>:1:1 with exit 2
+    mission = tmp_path / "m.yaml"
+    chain = "visit dock then " * 200 + "visit home"
+    mission.write_text(SLOW.replace("SPEED", "1.0").replace("PHRASE", chain))
+    argv = [command, str(mission)] + (["-o", str(tmp_path / "out")] if command == "compile" else [])
+    code, _, err = run_main(*argv)
+    assert code == 1, err
+    assert err.startswith(
+        f"{mission}:10:5: error[L005]: the LTL formula is nested more than 400 levels deep "
+        "(403 with task phrase 2)"
+    ), err
+    assert not (tmp_path / "out").exists()
+    # one `then` fewer: 401 levels with the conjunction, refused at the same phrase
+    mission.write_text(SLOW.replace("SPEED", "1.0").replace("PHRASE", chain[16:]))
+    assert f"{mission}:10:5: error[L005]" in run_main("check", str(mission))[2]
+    # 198 `then`s: 399 levels, within the limit
+    mission.write_text(SLOW.replace("SPEED", "1.0").replace("PHRASE", chain[32:]))
+    assert run_main("check", str(mission))[0] == 0

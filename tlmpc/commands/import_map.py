@@ -92,6 +92,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         from tlmpc.io.outputs import refuse_input_as_output
 
         refuse_input_as_output(args.output, [Path(name) for name in imported.inputs])
+    _check_flags(args, document.get("groups") or {})
     text = mission_yaml(document)
     missing = unfinished(document)
     if not missing:
@@ -114,6 +115,30 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             f"{args.output} (see its first lines), then run `tlmpc check {args.output}`"
         )
     return reporter.finish(EXIT_OK)
+
+
+def _check_flags(args: argparse.Namespace, groups: dict[str, list[str]]) -> None:
+    """Read every --task phrase and the --ltl formula on their own, located at the flag
+    (`--ltl 'G(':1:3`): a syntax error is the command's error (exit 1, nothing written) even
+    when the mission has no regions yet; unknown names are checked with the whole mission."""
+    from tlmpc.base.errors import Diagnostic, InvalidInputError
+    from tlmpc.tasks.compiler import compile_phrase
+
+    problems: list[Diagnostic] = []
+    for phrase in args.task or []:
+        try:
+            compile_phrase(phrase, groups=groups, file=f"--task {phrase!r}")
+        except InvalidInputError as exc:
+            problems.extend(exc.diagnostics)
+    if args.ltl is not None:
+        from tlmpc.ltl.parser import parse_ltl
+
+        try:
+            parse_ltl(args.ltl, file=f"--ltl {args.ltl!r}")
+        except InvalidInputError as exc:
+            problems.extend(exc.diagnostics)
+    if problems:
+        raise InvalidInputError(problems)
 
 
 def _check_task(text: str, args: argparse.Namespace) -> None:

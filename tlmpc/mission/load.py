@@ -8,12 +8,14 @@ from __future__ import annotations
 
 import difflib
 import gc
+import math
 import re
 from collections.abc import Mapping
 from itertools import chain
 from pathlib import Path as FilePath
 from typing import TYPE_CHECKING, Any
 
+from tlmpc.base.depth import NESTING_LIMIT
 from tlmpc.base.errors import Diagnostic, InvalidInputError, best_first, error
 from tlmpc.io.scalar_places import ScalarPlaces
 from tlmpc.io.schema_check import MISSION_COORDINATE_LIMIT, is_valid, load_schema
@@ -34,9 +36,9 @@ from tlmpc.mission.model import (
     Workspace,
 )
 from tlmpc.mission.parts import group_expansion
-from tlmpc.mission.shapes import CheckedShape
+from tlmpc.mission.shapes import CheckedShape, shapely_polygon
 from tlmpc.mission.yamlpos import Path, PositionedDocument, json_path, load_positioned
-from tlmpc.tasks.compiler import NameKinds, compile_phrases
+from tlmpc.tasks.compiler import NameKinds, compile_phrase, compile_phrases
 
 if TYPE_CHECKING:
     from jsonschema.exceptions import ValidationError
@@ -373,7 +375,62 @@ def _check_task(
     problems.extend(_unknown_names(parts, names | set(groups) | signals, file, bool(signals)))
     if problems or not parts:
         return None, problems
-    return substitute(conjoin(parts), group_expansion(groups)), []
+    formula = substitute(conjoin(parts), group_expansion(groups))
+    if _depth(formula) > NESTING_LIMIT:
+        ltl_part = parts[-1] if isinstance(ltl, str) else None
+        return None, [_too_deep(formula, ltl_part, data, doc, file, groups, kinds, names)]
+    return formula, []
+
+
+def _depth(formula: Formula) -> int:
+    """How many levels deep ``formula`` is nested: the depth the LTL reader counts (L005)."""
+    deepest = 0
+    stack = [(formula, 1)]
+    while stack:
+        node, depth = stack.pop()
+        deepest = max(deepest, depth)
+        stack.extend((child, depth + 1) for child in node.children())
+    return deepest
+
+
+def _too_deep(
+    formula: Formula,
+    ltl: Formula | None,
+    data: Mapping[str, Any],
+    doc: PositionedDocument,
+    file: str,
+    groups: Mapping[str, list[str]],
+    kinds: NameKinds | None,
+    names: set[str],
+) -> Diagnostic:
+    """L005 for a task whose formula is nested deeper than the LTL reader accepts (a long
+    ``then`` chain), placed at its deepest phrase (or at ``ltl``): every later stage reads
+    the formula back, so the mission is refused before them."""
+    expansion = group_expansion(groups)
+    where: Path = ("ltl",)
+    what = "`ltl`"
+    deepest = -1 if ltl is None else _depth(substitute(ltl, expansion))
+    for index, phrase in enumerate(data.get("task") or ()):
+        part = compile_phrase(
+            phrase,
+            groups=groups,
+            kinds=kinds or NameKinds(regions=frozenset(names), groups=frozenset(groups)),
+        )
+        depth = _depth(substitute(part, expansion))
+        if depth > deepest:
+            where, what, deepest = ("task", index), f"task phrase {index + 1}", depth
+    line, col = _ltl_position(doc, where)
+    return error(
+        "L005",
+        f"the LTL formula is nested more than {NESTING_LIMIT} levels deep "
+        f"({_depth(formula)} with {what})",
+        hint="each `then` nests two levels: shorten the chain, or split the task into "
+        "several phrases or conjuncts",
+        file=file,
+        line=line,
+        col=col,
+        path=json_path(where),
+    )
 
 
 def _unknown_names(
@@ -638,6 +695,61 @@ def _body(
     return (radius, footprint), problems
 
 
+#: The longest time, in seconds, the robot may take to cross the workspace's bounding box at
+#: ``robot.max_speed`` (S010 below): the compiler's traces hold times up to 1e12 (V024), and
+#: a plan takes many such crossings; a map at the coordinates' bound (2.8e9 across) still
+#: checks at the default speed of 1.
+MAX_CROSSING_SECONDS = 1e10
+
+
+def _speed(
+    data: Mapping[str, Any],
+    doc: PositionedDocument,
+    file: str,
+    boundary: CheckedShape | None,
+    components: Pieces,
+) -> list[Diagnostic]:
+    """S010 for a ``robot.max_speed`` so small that crossing the workspace's bounding box
+    would take longer than MAX_CROSSING_SECONDS (a positive 1e-12, or a subnormal 1e-320)."""
+    robot = data["robot"]
+    if boundary is None or "max_speed" not in robot:
+        return []
+    speed = float(robot["max_speed"])
+    if speed * MAX_CROSSING_SECONDS >= 3 * MISSION_COORDINATE_LIMIT:
+        return []  # no workspace within the coordinates' bound is that wide
+    bounds = [_bounds(shape) for shape in (boundary, *(piece for piece, _ in components))]
+    width = max(b[2] for b in bounds) - min(b[0] for b in bounds)
+    height = max(b[3] for b in bounds) - min(b[1] for b in bounds)
+    diagonal = math.hypot(width, height)
+    if diagonal <= speed * MAX_CROSSING_SECONDS:
+        return []
+    line, col = doc.value_at(("robot", "max_speed"))
+    return [
+        error(
+            "S010",
+            f"$.robot.max_speed: {speed:g} is too small: crossing the workspace "
+            f"({diagonal:g} across) would take more than {MAX_CROSSING_SECONDS:g} s",
+            hint=f"give a max_speed of at least {diagonal / MAX_CROSSING_SECONDS:.3g} "
+            f"(the workspace's bounding-box diagonal / {MAX_CROSSING_SECONDS:g} s), "
+            "or check its units",
+            file=file,
+            line=line,
+            col=col,
+            path="$.robot.max_speed",
+        )
+    ]
+
+
+def _bounds(shape: CheckedShape) -> tuple[float, float, float, float]:
+    """The shape's bounding box, from its shapely polygon when one was built (a large map's),
+    else in plain Python (a small mission's check loads no geometry library)."""
+    if shape.polygon is not None:
+        return shapely_polygon(shape).bounds  # type: ignore[no-any-return]
+    xs = [float(point[0]) for point in shape.points]
+    ys = [float(point[1]) for point in shape.points]
+    return min(xs), min(ys), max(xs), max(ys)
+
+
 def _groups(
     data: Mapping[str, Any], doc: PositionedDocument, file: str, names: set[str]
 ) -> tuple[dict[str, list[str]], list[Diagnostic]]:
@@ -725,6 +837,7 @@ def _load_data(text: str, file: str, stem: str) -> tuple[Mission | None, list[Di
     )
     body, found = _body(data, doc, file)
     problems.extend(found)
+    problems.extend(_speed(data, doc, file, boundary, components))
     names = set(regions) | set(data["regions"])
     groups, found = _groups(data, doc, file, names)
     problems.extend(found)
