@@ -210,3 +210,13 @@ def test_command_bad_formula() -> None:
     with pytest.raises(InvalidInputError) as info:
         run_command("F (a &")
     assert info.value.diagnostics[0].code.startswith("L")
+
+
+def test_state_names_read_back_as_formulas_over_the_same_names() -> None:
+    # names that need quotes: a constant's word, an operator, empty, a space, a quote
+    text = 'F "true" & G F "U" & F "" & F "a b" & F "q\\"x" & G(plain -> F !"true")'
+    formula = parse_ltl(text)
+    automaton = translate(formula)
+    for name in automaton.state_names:
+        assert parse_ltl(name).props() <= formula.props(), name
+    assert any('"a b"' in name for name in automaton.state_names)

@@ -46,6 +46,7 @@ from tlmpc.ltl.ast import (
     StrongRelease,
     Until,
     WeakUntil,
+    proposition_text,
 )
 from tlmpc.ltl.transform import nnf
 
@@ -682,16 +683,18 @@ def props(f: Node) -> frozenset[str]:
 
 
 def to_text(f: Node) -> str:
-    """Readable form of an internal formula (state names)."""
+    """Readable form of an internal formula (state names), which the LTL reader reads back:
+    names are written as :func:`~tlmpc.ltl.ast.proposition_text` writes them (``"true"``,
+    ``"a b"``, ``""`` quoted)."""
     match f:
         case Top():
             return "true"
         case Bottom():
             return "false"
         case Pos(name=name):
-            return name
+            return proposition_text(name)
         case Neg(name=name):
-            return "!" + name
+            return "!" + proposition_text(name)
         case Conj(args=args):
             return "(" + " & ".join(to_text(a) for a in args) + ")"
         case Disj(args=args):
