@@ -280,11 +280,11 @@ task:
 
 
 @pytest.mark.parametrize("command", ["check", "compile"])
-@pytest.mark.parametrize("speed", ["1.0e-12", "1.0e-320", "1.4e-9"])
+@pytest.mark.parametrize("speed", ["1.0e-12", "1.0e-320", "1.4e-11"])
 def test_a_max_speed_too_small_to_cross_the_workspace_is_refused(
     tmp_path: Path, command: str, speed: str
 ) -> None:
-    # 14.42 across (the rectangle's diagonal) at under 1.442e-9 takes more than 1e10 s; compile
+    # 14.42 across (the rectangle's diagonal) at under 1.442e-11 takes more than 1e12 s; compile
     # used to fail at exit 3 (C010, C031) or exit 2 with a V024 about its own trace
     mission = tmp_path / "m.yaml"
     mission.write_text(SLOW.replace("SPEED", speed).replace("PHRASE", "visit dock"))
@@ -292,13 +292,13 @@ def test_a_max_speed_too_small_to_cross_the_workspace_is_refused(
     code, _, err = run_main(*argv)
     assert code == 1, err
     assert err.startswith(f"{mission}:7:39: error[S010]: $.robot.max_speed: "), err
-    assert "hint: give a max_speed of at least 1.44e-09" in err
+    assert "hint: give a max_speed of at least 1.44e-11" in err
     assert not (tmp_path / "out").exists()
 
 
 def test_a_max_speed_just_fast_enough_is_valid(tmp_path: Path) -> None:
     mission = tmp_path / "m.yaml"
-    mission.write_text(SLOW.replace("SPEED", "1.5e-9").replace("PHRASE", "visit dock"))
+    mission.write_text(SLOW.replace("SPEED", "1.5e-11").replace("PHRASE", "visit dock"))
     assert run_main("check", str(mission))[0] == 0
 
 

@@ -696,10 +696,10 @@ def _body(
 
 
 #: The longest time, in seconds, the robot may take to cross the workspace's bounding box at
-#: ``robot.max_speed`` (S010 below): the compiler's traces hold times up to 1e12 (V024), and
-#: a plan takes many such crossings; a map at the coordinates' bound (2.8e9 across) still
-#: checks at the default speed of 1.
-MAX_CROSSING_SECONDS = 1e10
+#: ``robot.max_speed`` (S010 below): a trace holds times up to 1e12 (V024), so a slower robot
+#: could not even cross once in one (1e-11 over 14 m compiled to a trace V024 refused; 1e-10
+#: compiles).  A map at the coordinates' bound (2.8e9 across) checks at the default speed.
+MAX_CROSSING_SECONDS = 1e12
 
 
 def _speed(
@@ -710,7 +710,8 @@ def _speed(
     components: Pieces,
 ) -> list[Diagnostic]:
     """S010 for a ``robot.max_speed`` so small that crossing the workspace's bounding box
-    would take longer than MAX_CROSSING_SECONDS (a positive 1e-12, or a subnormal 1e-320)."""
+    would take longer than MAX_CROSSING_SECONDS (a positive 1e-12 over 14 m, or a subnormal
+    1e-320)."""
     robot = data["robot"]
     if boundary is None or "max_speed" not in robot:
         return []
