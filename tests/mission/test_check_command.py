@@ -213,6 +213,10 @@ LAYOUTS = [
     ("ltl-literal", "ltl: |\n  F a &\n    G !zz\n", "L010", "zz", 0),
     ("ltl-folded", "ltl: >-\n  F a &\n   G (b | zz)\n", "L010", "zz", 0),
     ("ltl-plain", "ltl: F a\n  & G !zz\n", "L010", "zz", 0),
+    # a phrase that does not parse: where the parser stopped
+    ("t001-folded", "task:\n  - >-\n    visit a then\n    b qq\n", "T001", "qq", 0),
+    ("t001-literal", "task:\n  - |\n    visit a then\n    b qq\n", "T001", "qq", 0),
+    ("t001-plain", "task:\n  - visit a then\n    b qq\n", "T001", "qq", 0),
     ("ltl-single", "ltl: 'F a &\n\n     G !zz'\n", "L010", "zz", 0),
     ("ltl-double", 'ltl: "F a & \\\n     G !\\"zz\\""\n', "L010", '\\"zz', 0),
     ("ltl-syntax", "ltl: |\n  F a &\n    G $ b\n", "L001", "$", 0),

@@ -112,11 +112,13 @@ def _from_lark(tree: Any) -> Node:
 
 
 class PhraseSyntaxError(Exception):
-    """The phrase is not in the language; ``column`` (1-based) is where the parser stopped."""
+    """The phrase is not in the language; ``line`` and ``column`` (1-based, in the phrase) are
+    where the parser stopped."""
 
-    def __init__(self, column: int) -> None:
+    def __init__(self, column: int, line: int = 1) -> None:
         super().__init__(column)
         self.column = column
+        self.line = line
 
 
 @functools.lru_cache(maxsize=4096)  # trees are immutable; a check compiles each phrase thrice
@@ -135,7 +137,12 @@ def parse_tree(phrase: str) -> Node:
     try:
         return _from_lark(_parser().parse(phrase))
     except LarkError as exc:
-        raise PhraseSyntaxError(int(getattr(exc, "column", 1) or 1)) from None
+        line = getattr(exc, "line", 1)
+        column = getattr(exc, "column", 1)
+        raise PhraseSyntaxError(
+            column if isinstance(column, int) and column > 0 else 1,
+            line if isinstance(line, int) and line > 0 else 1,
+        ) from None
 
 
 class _Lowering:
@@ -162,12 +169,16 @@ class _Lowering:
         #: each avoidance's scope in words, for ``tlmpc check --explain``
         self.scopes: list[str] = []
 
-    def _where(self, token: Word) -> tuple[int, int]:
+    def at(self, line: int, column: int) -> tuple[int, int]:
+        """Where the phrase's character at ``line``:``column`` (1-based) is in the file."""
         if self.place is not None:
-            return self.place(token.line or 1, token.column or 1)
-        if (token.line or 1) > 1:  # a phrase spread over several lines (a YAML block scalar)
-            return self.line + (token.line or 1) - 1, token.column or 1
-        return self.line, self.col + (token.column or 1) - 1
+            return self.place(line, column)
+        if line > 1:  # a phrase spread over several lines (a YAML block scalar)
+            return self.line + line - 1, column
+        return self.line, self.col + column - 1
+
+    def _where(self, token: Word) -> tuple[int, int]:
+        return self.at(token.line or 1, token.column or 1)
 
     def name(self, tree: Node) -> Prop:
         token = tree.children[0]
@@ -508,7 +519,7 @@ def _listing(props: Sequence[Prop]) -> str:
     return names[0] if len(names) == 1 else ", ".join(names[:-1]) + " and " + names[-1]
 
 
-def _unknown_phrase(phrase: str, file: str | None, line: int, col: int, at: int) -> Diagnostic:
+def _unknown_phrase(phrase: str, file: str | None, line: int, col: int) -> Diagnostic:
     first = phrase.strip().split(" ", 1)[0].lower() if phrase.strip() else ""
     close = difflib.get_close_matches(first, _LEADING_WORDS, n=1)
     hint = "known phrases: " + "; ".join(KNOWN_PHRASES)
@@ -520,7 +531,7 @@ def _unknown_phrase(phrase: str, file: str | None, line: int, col: int, at: int)
         hint=hint,
         file=file,
         line=line,
-        col=col + at,
+        col=col,
     )
 
 
@@ -672,8 +683,7 @@ def _compile(
         if repaired:
             found = [_reserved(w, lowering, groups, known) for w in repaired]
             raise InvalidInputError(found) from None
-        at = exc.column - 1
-        problem = _unknown_phrase(phrase, file, line, col, max(at, 0))
+        problem = _unknown_phrase(phrase, file, *lowering.at(exc.line, exc.column))
         if words:
             names = ", ".join(sorted({repr(str(w)) for w in words}))
             note = f"note: {names} cannot be named in a task phrase (a keyword there); "
