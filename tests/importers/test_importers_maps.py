@@ -742,3 +742,18 @@ def test_a_task_that_does_not_parse_fails_at_the_flag(
     assert err.startswith(expected), err
     assert "mission.yaml" not in err
     assert not out.exists()
+
+
+def test_a_max_speed_too_small_for_the_map_fails_at_the_flag(tmp_path: Path) -> None:
+    # 2 m across at 1e-12 takes 2.8e12 s to cross, more than a trace holds (S010)
+    free = np.ones((20, 20), dtype=bool)
+    path = write_map(tmp_path, "m", image_from_free(free), resolution=0.1)
+    out = tmp_path / "mission.yaml"
+    code, _, err = run(
+        "import-map", str(path), "--region", "goal", "0.1", "0.1", "0.3", "0.3",
+        "--task", "visit goal", "--max-speed", "1e-12", "-o", str(out),
+    )  # fmt: skip
+    assert code == 1, err
+    assert err.startswith("--max-speed 1e-12: error[S010]: $.robot.max_speed: 1e-12 is too small")
+    assert "mission.yaml" not in err
+    assert not out.exists()

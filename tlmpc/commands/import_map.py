@@ -143,8 +143,8 @@ def _check_flags(args: argparse.Namespace, groups: dict[str, list[str]]) -> None
 
 def _check_task(text: str, args: argparse.Namespace) -> None:
     """Load the mission about to be written; its errors (an unknown region in a --task, an
-    --ltl that does not parse) are the command's, located at the flag (exit 1, nothing
-    written)."""
+    --ltl that does not parse, a --max-speed too small to cross the map) are the command's,
+    located at the flag (exit 1, nothing written)."""
     import dataclasses
 
     from tlmpc.base.errors import InvalidInputError
@@ -158,6 +158,13 @@ def _check_task(text: str, args: argparse.Namespace) -> None:
         located = []
         for problem in exc.diagnostics:
             if problem.severity != "error":
+                continue
+            if problem.path == "$.robot.max_speed":  # S010: the speed comes from the flag
+                located.append(
+                    dataclasses.replace(
+                        problem, file=f"--max-speed {args.max_speed:g}", line=None, col=None
+                    )
+                )
                 continue
             row = lines[problem.line - 1] if problem.line and problem.line <= len(lines) else ""
             flag = _flag_at(row, problem.col, args)
