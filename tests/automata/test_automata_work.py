@@ -157,7 +157,7 @@ def test_one_states_expansion_stops_at_the_budget(monkeypatch: pytest.MonkeyPatc
     # F p0 & ... & F p10: its first state has 11 conjuncts, two terms each, 2^11 together
     formula = parse_ltl(" & ".join(f"F p{i}" for i in range(11)))
     monkeypatch.setattr(translate_module, "MAX_RAW_EDGES", 10**9)
-    monkeypatch.setattr(translate_module, "MAX_TERMS", 2**11 - 1)
+    monkeypatch.setattr(terms, "MAX_TERMS", 2**11 - 1)
     with pytest.raises(UsageError) as refused:
         translate(formula, containment=False)
     assert "a state with more than 2,047 edges" in refused.value.diagnostics[0].message

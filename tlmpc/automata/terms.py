@@ -546,10 +546,17 @@ MAX_TERMS = 100_000
 
 
 class TooManyTerms(Exception):
-    """An expansion would have more than :data:`MAX_TERMS` terms."""
+    """An expansion would have more than ``limit`` (:data:`MAX_TERMS`) terms."""
+
+    def __init__(self, limit: int) -> None:
+        super().__init__(limit)
+        self.limit = limit
 
 
-def _combine(left: Iterable[Expansion], right: Iterable[Expansion]) -> list[Expansion]:
+def combine(left: Iterable[Expansion], right: Iterable[Expansion]) -> list[Expansion]:
+    """Every pair of a ``left`` and a ``right`` term a letter allows, as one term: the union
+    of their literals, obligations and promises (:class:`TooManyTerms` past
+    :data:`MAX_TERMS` of them)."""
     out: list[Expansion] = []
     right = list(right)
     for lp, ln, lx, lprom in left:
@@ -560,7 +567,7 @@ def _combine(left: Iterable[Expansion], right: Iterable[Expansion]) -> list[Expa
                 continue
             out.append(Expansion(pos, neg, lx | rx, lprom | rprom))
         if len(out) > MAX_TERMS:
-            raise TooManyTerms
+            raise TooManyTerms(MAX_TERMS)
     return out
 
 
@@ -608,7 +615,7 @@ def expand(f: Node) -> tuple[Expansion, ...]:
         case Conj(args=args):
             result = [_NOTHING]
             for arg in args:
-                result = _combine(result, expand(arg))
+                result = combine(result, expand(arg))
             return tuple(result)
         case Disj(args=args):
             # Literal disjuncts make the other disjuncts' terms exclusive: where a literal
@@ -619,21 +626,21 @@ def expand(f: Node) -> tuple[Expansion, ...]:
         case Finally(arg=arg):  # b | (!b & P & N(F b)) -- `!b` only when b is a literal
             return (*expand(arg), *_unless([promise], [arg]))
         case Always(arg=arg):  # a & N(G a)
-            return tuple(_combine(expand(arg), [later]))
+            return tuple(combine(expand(arg), [later]))
         case Binary(kind="U", left=a, right=b):  # b | (a & P & N(a U b))
-            return (*expand(b), *_unless(_combine(expand(a), [promise]), [b]))
+            return (*expand(b), *_unless(combine(expand(a), [promise]), [b]))
         case Binary(kind="M", left=a, right=b):  # (a & b) | (b & P & N(a M b))
             return (
-                *_combine(expand(a), expand(b)),
-                *_unless(_combine(expand(b), [promise]), [a]),
+                *combine(expand(a), expand(b)),
+                *_unless(combine(expand(b), [promise]), [a]),
             )
         case Binary(kind="R", left=a, right=b):  # (a & b) | (b & N(a R b))
             return (
-                *_combine(expand(a), expand(b)),
-                *_unless(_combine(expand(b), [later]), [a]),
+                *combine(expand(a), expand(b)),
+                *_unless(combine(expand(b), [later]), [a]),
             )
         case Binary(kind="W", left=a, right=b):  # b | (a & N(a W b))
-            return (*expand(b), *_unless(_combine(expand(a), [later]), [b]))
+            return (*expand(b), *_unless(combine(expand(a), [later]), [b]))
         case Binary():
             raise ValueError(f"unknown binary operator {f.kind!r}")
         case _:

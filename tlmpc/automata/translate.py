@@ -21,10 +21,9 @@ from tlmpc.automata.nnf import FALSE, Node
 from tlmpc.automata.rewrite import MAX_SEMANTIC_APS, rewrite
 from tlmpc.automata.simplify import postprocess
 from tlmpc.automata.terms import (
-    MAX_TERMS,
     Expansion,
     TooManyTerms,
-    cube_allowed,
+    combine,
     eventualities,
     expand,
     from_ast,
@@ -276,10 +275,10 @@ def _explore(
             source = states[state]
             try:
                 expansion = _state_terms(state)
-            except TooManyTerms:
+            except TooManyTerms as exc:
                 if deadline is not None:  # an optional check: it gives up
                     raise OutOfBudget from None
-                raise _too_large(text, len(states), per_state=True) from None
+                raise _too_large(text, len(states), state_limit=exc.limit) from None
             if deadline is not None:
                 work.charge(deadline, _expansion_units(expansion))
             terms: list[tuple[Cube, State, int]] = []
@@ -401,11 +400,11 @@ def _expansion_units(expansion: list[Expansion]) -> int:
     return 1 + terms + sizes + min(terms, MAX_DOMINATION_TERMS) ** 2
 
 
-def _too_large(text: str, states: int, *, per_state: bool = False) -> UsageError:
+def _too_large(text: str, states: int, *, state_limit: int | None = None) -> UsageError:
     too_many = (
-        f"a state with more than {MAX_TERMS:,} edges"
-        if per_state
-        else f"more than {MAX_RAW_EDGES:,} edges"
+        f"more than {MAX_RAW_EDGES:,} edges"
+        if state_limit is None
+        else f"a state with more than {state_limit:,} edges"
     )
     return UsageError(
         error(
@@ -424,20 +423,11 @@ def _shortened(text: str, limit: int = 120) -> str:
 
 
 def _state_terms(state: State) -> list[Expansion]:
-    """The expansion terms of ``state`` (:class:`TooManyTerms` past :data:`MAX_TERMS`)."""
+    """The expansion terms of ``state`` (:class:`TooManyTerms` past
+    :data:`~tlmpc.automata.terms.MAX_TERMS`)."""
     terms: list[Expansion] = [Expansion(frozenset(), frozenset(), frozenset(), frozenset())]
     for part in sorted(state, key=repr):
-        combined: list[Expansion] = []
-        for pos, neg, nxt, prom in terms:
-            for p2, n2, x2, pr2 in expand(part):
-                p = pos | p2
-                n = neg | n2
-                if not cube_allowed(p, n):
-                    continue
-                combined.append(Expansion(p, n, nxt | x2, prom | pr2))
-            if len(combined) > MAX_TERMS:
-                raise TooManyTerms
-        terms = _undominated_partial(combined)
+        terms = _undominated_partial(combine(terms, expand(part)))
         if not terms:
             break
     return terms
