@@ -331,6 +331,8 @@ def _check_task(
 ) -> tuple[Formula | None, list[Diagnostic]]:
     problems: list[Diagnostic] = []
     parts: list[Formula] = []
+    # without sensors or actions too: a region is no condition (T020)
+    known = kinds or NameKinds(regions=frozenset(names), groups=frozenset(groups))
     phrases = data.get("task")
     if isinstance(phrases, list) and phrases and all(isinstance(p, str) for p in phrases):
         positions = [_ltl_position(doc, ("task", i)) for i in range(len(phrases))]
@@ -342,8 +344,7 @@ def _check_task(
                     file=file,
                     positions=positions,
                     places=[doc.places(("task", i)) for i in range(len(phrases))],
-                    # without sensors or actions too: a region is no condition (T020)
-                    kinds=kinds or NameKinds(regions=frozenset(names), groups=frozenset(groups)),
+                    kinds=known,
                 )
             )
         except InvalidInputError as exc:
@@ -378,7 +379,7 @@ def _check_task(
     formula = substitute(conjoin(parts), group_expansion(groups))
     if _depth(formula) > NESTING_LIMIT:
         ltl_part = parts[-1] if isinstance(ltl, str) else None
-        return None, [_too_deep(formula, ltl_part, data, doc, file, groups, kinds, names)]
+        return None, [_too_deep(formula, ltl_part, data, doc, file, groups, known)]
     return formula, []
 
 
@@ -400,8 +401,7 @@ def _too_deep(
     doc: PositionedDocument,
     file: str,
     groups: Mapping[str, list[str]],
-    kinds: NameKinds | None,
-    names: set[str],
+    kinds: NameKinds,
 ) -> Diagnostic:
     """L005 for a task whose formula is nested deeper than the LTL reader accepts (a long
     ``then`` chain), placed at its deepest phrase (or at ``ltl``): every later stage reads
@@ -411,11 +411,7 @@ def _too_deep(
     what = "`ltl`"
     deepest = -1 if ltl is None else _depth(substitute(ltl, expansion))
     for index, phrase in enumerate(data.get("task") or ()):
-        part = compile_phrase(
-            phrase,
-            groups=groups,
-            kinds=kinds or NameKinds(regions=frozenset(names), groups=frozenset(groups)),
-        )
+        part = compile_phrase(phrase, groups=groups, kinds=kinds)
         depth = _depth(substitute(part, expansion))
         if depth > deepest:
             where, what, deepest = ("task", index), f"task phrase {index + 1}", depth

@@ -55,6 +55,7 @@ class PositionedDocument:
         default_factory=dict
     )
     _lines: list[int] | None = None
+    _places: dict[Path, ScalarPlaces | None] = field(default_factory=dict)
 
     def value_at(self, path: Path) -> tuple[int, int]:
         """Position of the value at ``path``, or of its deepest known ancestor."""
@@ -89,13 +90,17 @@ class PositionedDocument:
     def places(self, path: Path) -> ScalarPlaces | None:
         """Where each character of the string at ``path`` is written; None for a one-line
         plain string (its start plus the offset is exact) or one whose text is not followed."""
+        if path in self._places:  # a phrase is placed by check, by load and by its parts
+            return self._places[path]
         marks = self.scalars.get(path)
-        if marks is None or not self.source:
-            return None
-        if self._lines is None:
-            self._lines = line_starts(self.source)
-        value, style, start, end = marks
-        return scalar_places(self.source, value, style, start, end, self._lines)
+        found = None
+        if marks is not None and self.source:
+            if self._lines is None:
+                self._lines = line_starts(self.source)
+            value, style, start, end = marks
+            found = scalar_places(self.source, value, style, start, end, self._lines)
+        self._places[path] = found
+        return found
 
 
 def json_path(path: Path) -> str:
