@@ -54,6 +54,7 @@ from tlmpc.ltl.ast import (
 )
 from tlmpc.ltl.grammar_cache import lalr_parser
 from tlmpc.ltl.keywords import KEYWORDS  # re-exported: words that cannot name a region
+from tlmpc.ltl.places import Place, placed
 
 #: Nesting deeper than this is refused (L005) instead of exhausting the Python stack.
 MAX_DEPTH = NESTING_LIMIT
@@ -116,19 +117,13 @@ def _parser() -> Lark:
 class _Positions:
     """Shifts lark's 1-based positions (relative to the text) into the user's file."""
 
-    def __init__(
-        self, line: int, col: int, place: Callable[[int, int], tuple[int, int]] | None = None
-    ) -> None:
+    def __init__(self, line: int, col: int, place: Place | None = None) -> None:
         self.line = line
         self.col = col
         self.place = place
 
     def at(self, line: int, col: int) -> tuple[int, int]:
-        if self.place is not None:
-            return self.place(line, col)
-        if line == 1:
-            return self.line, self.col + col - 1
-        return self.line + line - 1, col
+        return placed(line, col, (self.line, self.col), self.place)
 
     def span(self, line: int, col: int, end_line: int, end_col: int) -> Span:
         start = self.at(line, col)
@@ -483,7 +478,7 @@ def parse_ltl(
     file: str | None = None,
     line: int = 1,
     col: int = 1,
-    place: Callable[[int, int], tuple[int, int]] | None = None,
+    place: Place | None = None,
 ) -> Formula:
     """Parse ``text`` (LTL without Next) into an AST.
 

@@ -14,10 +14,9 @@ everything else, and every diagnostic, comes from the lark parser
 
 from __future__ import annotations
 
-from collections.abc import Callable
-
 from tlmpc.ltl.ast import Formula
 from tlmpc.ltl.keywords import KEYWORDS  # re-exported: words that cannot name a region
+from tlmpc.ltl.places import Place
 from tlmpc.ltl.reader import read_plain_ltl
 
 __all__ = ["KEYWORDS", "parse_ltl"]
@@ -29,7 +28,7 @@ def parse_ltl(
     file: str | None = None,
     line: int = 1,
     col: int = 1,
-    place: Callable[[int, int], tuple[int, int]] | None = None,
+    place: Place | None = None,
 ) -> Formula:
     """Parse ``text`` (LTL without Next) into an AST.
 

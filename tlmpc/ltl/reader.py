@@ -37,6 +37,7 @@ from tlmpc.ltl.ast import (
     WeakUntil,
 )
 from tlmpc.ltl.keywords import KEYWORDS
+from tlmpc.ltl.places import Place, placed
 
 #: Formulas nested deeper than this are left to the lark parser (which refuses > 400 with
 #: L005); far below Python's recursion limit at a handful of frames per level.
@@ -257,18 +258,14 @@ def read_plain_ltl(
     text: str,
     line: int = 1,
     col: int = 1,
-    place: Callable[[int, int], tuple[int, int]] | None = None,
+    place: Place | None = None,
 ) -> Formula | None:
     """The formula of ``text`` (starting at ``line``:``col`` of its file, or with each
     character where ``place`` says) when it is plain LTL this reader decides; None to leave
     it to the lark parser."""
 
     def shift(position: tuple[int, int]) -> tuple[int, int]:
-        if place is not None:
-            return place(*position)
-        if position[0] == 1:
-            return line, col + position[1] - 1
-        return line + position[0] - 1, position[1]
+        return placed(*position, (line, col), place)
 
     try:
         tokens = _tokens(text)

@@ -12,7 +12,7 @@ import difflib
 import functools
 import itertools
 import re
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -35,6 +35,7 @@ from tlmpc.ltl.ast import (
     conjoin,
     disjoin,
 )
+from tlmpc.ltl.places import Place, placed
 from tlmpc.tasks.phrases import KEYWORDS, Node, Word, parse_plain
 
 if TYPE_CHECKING:
@@ -155,7 +156,7 @@ class _Lowering:
         line: int,
         col: int,
         kinds: NameKinds | None = None,
-        place: Callable[[int, int], tuple[int, int]] | None = None,
+        place: Place | None = None,
     ) -> None:
         self.groups = groups
         self.kinds = kinds
@@ -171,11 +172,7 @@ class _Lowering:
 
     def at(self, line: int, column: int) -> tuple[int, int]:
         """Where the phrase's character at ``line``:``column`` (1-based) is in the file."""
-        if self.place is not None:
-            return self.place(line, column)
-        if line > 1:  # a phrase spread over several lines (a YAML block scalar)
-            return self.line + line - 1, column
-        return self.line, self.col + column - 1
+        return placed(line, column, (self.line, self.col), self.place)
 
     def _where(self, token: Word) -> tuple[int, int]:
         return self.at(token.line or 1, token.column or 1)
@@ -624,7 +621,7 @@ def compile_phrase(
     col: int = 1,
     kinds: NameKinds | None = None,
     declared: NameKinds | None = None,
-    place: Callable[[int, int], tuple[int, int]] | None = None,
+    place: Place | None = None,
 ) -> Formula:
     """Compile one phrase to LTL (raises :class:`InvalidInputError` with T-codes).
 
@@ -660,7 +657,7 @@ def _compile(
     col: int,
     kinds: NameKinds | None = None,
     declared: NameKinds | None = None,
-    place: Callable[[int, int], tuple[int, int]] | None = None,
+    place: Place | None = None,
 ) -> tuple[Formula, list[str]]:
     if not isinstance(phrase, str) or not phrase.strip():
         raise InvalidInputError(
@@ -710,7 +707,7 @@ def compile_phrases(
     positions: Sequence[tuple[int, int]] | None = None,
     kinds: NameKinds | None = None,
     declared: NameKinds | None = None,
-    places: Sequence[Callable[[int, int], tuple[int, int]] | None] | None = None,
+    places: Sequence[Place | None] | None = None,
 ) -> Formula:
     """Compile every phrase and conjoin them; report the problems of all phrases at once.
 
