@@ -17,6 +17,8 @@ from typing import Any
 import numpy as np
 import pytest
 import shapely
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import tlmpc
 from tlmpc.base.errors import TlmpcError
@@ -82,6 +84,29 @@ def test_a_doorway_wider_than_the_body_is_no_r002() -> None:
 def test_a_start_exactly_the_radius_from_a_wall_is_legal(start: tuple[float, float]) -> None:
     radius = 0.5
     mission = _door(radius, 2.0, start)
+    compiled = tlmpc.compile(mission)
+    trace = compiled.artifacts["trace.json"]
+    assert trace["points"][0][1:] == list(start)
+    assert _clearance(trace) >= radius - 1e-9 * 10.0
+
+
+@settings(max_examples=max(4, settings().max_examples // 20), deadline=None)
+@given(
+    st.floats(math.pi / 2, math.pi),
+    st.sampled_from([0.0, 1e-12, 1e-10, 3e-10, 1e-9]),
+    st.sampled_from([0.0, 0.3]),
+)
+def test_a_start_the_radius_from_a_corner_in_any_direction_is_legal(
+    angle: float, spare: float, margin: float
+) -> None:
+    """Off the grid, and beside a corner (where the configuration space is round): the start
+    must stay in the snapped mesh, and the path keep the radius but for a snapping step."""
+    radius = 0.5
+    corner = (4.5, 2.0)  # the lower hole's top left corner, the start above and left of it
+    away = radius + spare
+    start = (corner[0] + away * math.cos(angle), corner[1] + away * math.sin(angle))
+    mission = _door(radius, 2.0, start)
+    mission["options"] = {"margin": margin}
     compiled = tlmpc.compile(mission)
     trace = compiled.artifacts["trace.json"]
     assert trace["points"][0][1:] == list(start)

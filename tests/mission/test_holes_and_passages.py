@@ -15,7 +15,7 @@ from shapely import Polygon, union_all
 from tlmpc.base.progress import heartbeat
 from tlmpc.cli import main
 from tlmpc.mission import load_mission_text
-from tlmpc.mission.holes import merge_holes, narrow_passages, workspace_notes
+from tlmpc.mission.holes import merge_holes, narrow_passages, obstacle, workspace_notes
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -94,6 +94,67 @@ def test_overlapping_holes_compile_with_a_note(tmp_path: Path) -> None:
     assert len(holes) == 2
     assert Polygon(holes[0]).area == 4 + 4 - 1
     assert json.loads((out / "verdict.json").read_text())["satisfied"] is True
+
+
+@given(st.lists(rects, min_size=1, max_size=7))
+def test_the_checked_obstacle_is_the_compiled_one(
+    holes: list[tuple[tuple[float, float], ...]],
+) -> None:
+    """``tlmpc check`` refuses a region or start by the obstacle the compile triangulates."""
+    checked = obstacle([Polygon(h) for h in holes])
+    compiled = union_all([Polygon(h) for h in merge_holes(holes).holes])
+    assert checked.symmetric_difference(compiled).area == 0
+
+
+RING = [
+    "{rect: [2, 2, 8, 3]}",
+    "{rect: [7, 2, 8, 8]}",
+    "{rect: [2, 7, 8, 8]}",
+    "{rect: [2, 2, 3, 8]}",
+]
+
+
+@pytest.mark.parametrize(
+    ("goal", "start", "code", "line"),
+    [("[4, 4, 6, 6]", "[0.5, 0.5]", "G008", 10), ("[8, 8, 9, 9]", "[5, 5]", "G010", 11)],
+)
+def test_a_region_or_start_in_a_pocket_of_overlapping_holes_is_refused_by_check(
+    tmp_path: Path, goal: str, start: str, code: str, line: int
+) -> None:
+    path = _mission(tmp_path, RING)
+    text = path.read_text()
+    text = text.replace("[8, 8, 9, 9]", goal).replace("[0.5, 0.5]", start)
+    path.write_text(text)
+    err = io.StringIO()
+    assert main(["check", str(path)], out=io.StringIO(), err=err) == 1
+    assert f"{path}:{line}:" in err.getvalue()
+    assert f"error[{code}]" in err.getvalue()
+
+
+def test_a_region_in_a_pocket_of_a_second_pieces_overlapping_holes_is_g008(
+    tmp_path: Path,
+) -> None:
+    """The same rule in every piece of a workspace with components."""
+    holes = ", ".join(
+        f"{{rect: [{x0 + 20}, {y0}, {x1 + 20}, {y1}]}}"
+        for x0, y0, x1, y1 in [(2, 2, 8, 3), (7, 2, 8, 8), (2, 7, 8, 8), (2, 2, 3, 8)]
+    )
+    path = tmp_path / "pieces.yaml"
+    path.write_text(
+        "version: 1\n"
+        "workspace:\n"
+        "  boundary: {rect: [0, 0, 10, 10]}\n"
+        f"  components: [{{boundary: {{rect: [20, 0, 30, 10]}}, holes: [{holes}]}}]\n"
+        "regions:\n"
+        "  goal: {rect: [24, 4, 26, 6]}\n"
+        "robot: {start: [0.5, 0.5]}\n"
+        "task:\n"
+        "  - visit goal\n"
+    )
+    err = io.StringIO()
+    assert main(["check", str(path)], out=io.StringIO(), err=err) == 1
+    assert f"{path}:6:" in err.getvalue()
+    assert "error[G008]" in err.getvalue()
 
 
 def test_holes_that_only_touch_are_kept() -> None:

@@ -174,7 +174,13 @@ def planning_layout(
         half = reach + 2.0 * radius
         window = raw.intersection(shapely.box(x - half, y - half, x + half, y + half))
         exact = erode(window, radius, through=mission.robot.start)
-        free = shapely.make_valid(shapely.union(free, exact.intersection(near_start)))
+        # Snapping moves the free space's vertices by up to a step's half diagonal: a start
+        # less than that inside (off the grid, a hair more than the radius from a slanted wall
+        # or a corner) would fall out of the snapped mesh.  A disc of one step round it keeps
+        # it in; it reaches at most a step closer to an obstacle than the start itself is.
+        keep_start = start.buffer(grid, quad_segs=ARC_SEGMENTS)
+        kept = shapely.union(exact.intersection(near_start), keep_start)
+        free = shapely.make_valid(shapely.union(free, kept))
     signs = polarities(mission.formula) if margin > 0.0 or deep else {}
     shapes: list[Any] = []
     for region in mission.regions:

@@ -15,6 +15,7 @@ import shapely
 from shapely.geometry import Point as ShapelyPoint
 
 from tlmpc.base.errors import Diagnostic, error
+from tlmpc.mission.holes import obstacle
 from tlmpc.mission.shapes import AREA_TOLERANCE, CheckedShape, shapely_polygon
 from tlmpc.mission.yamlpos import Path, json_path
 
@@ -58,7 +59,7 @@ def check_pieces(
                         "holes must lie inside the boundary of their own piece; clip the hole",
                     )
                 )
-        cut = shapely.union_all([shapely_polygon(h) for h in holes]) if holes else None
+        cut = obstacle([shapely_polygon(h) for h in holes])
         free.append(outer.difference(cut) if cut is not None else outer)
     tree = shapely.STRtree(free)
     left, right = tree.query(free, predicate="intersects")

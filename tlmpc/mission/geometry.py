@@ -14,6 +14,7 @@ from typing import Any
 
 from tlmpc.base.errors import Diagnostic, error
 from tlmpc.mission import plain_geometry
+from tlmpc.mission.holes import obstacle
 from tlmpc.mission.model import Polygon
 from tlmpc.mission.shapes import AREA_TOLERANCE, CheckedShape, shapely_polygon
 from tlmpc.mission.yamlpos import Path, json_path
@@ -316,7 +317,7 @@ def check_layout(
     # Near-linear on large inputs: the boundary is prepared once (an indexed edge set, so each
     # containment test is logarithmic in its vertices), and overlap tests run only on pairs a
     # spatial index reports as candidates, never on all pairs.
-    hole_union = shapely.union_all([shapely_polygon(h) for h in holes]) if holes else None
+    hole_union = obstacle([shapely_polygon(h) for h in holes])
     if hole_union is not None:
         shapely.prepare(hole_union)
     if boundary is not None:
@@ -342,7 +343,8 @@ def check_layout(
                         "regions must lie inside the boundary; clip the region",
                     )
                 )
-    # overlapping or touching holes are merged later, with a note (tlmpc.mission.holes)
+    # overlapping holes are merged later, with a note (tlmpc.mission.holes); what they
+    # enclose is part of the obstacle already
     if hole_union is not None:
         for name, region in regions.items():
             if not hole_union.intersects(shapely_polygon(region)):

@@ -18,6 +18,7 @@ import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from tlmpc.base.errors import Diagnostic
 from tlmpc.mission.model import Mission, Point, Polygon
@@ -43,12 +44,11 @@ def _ring(coords: Sequence[tuple[float, ...]]) -> Polygon:
     return tuple(points)
 
 
-def merge_holes(holes: Sequence[Polygon]) -> MergedHoles:
-    """Merge holes whose interiors overlap (transitively); keep the others exactly as given."""
-    from shapely import Polygon as ShapelyPolygon
-    from shapely import STRtree, union_all
+def _overlap_groups(shapes: Sequence[Any]) -> list[list[int]]:
+    """The holes (shapely polygons) grouped by overlapping interiors (transitively), each
+    group in file order and the groups by their first hole."""
+    from shapely import STRtree
 
-    shapes = [ShapelyPolygon(h) for h in holes]
     parent = list(range(len(shapes)))
 
     def find(i: int) -> int:
@@ -67,25 +67,59 @@ def merge_holes(holes: Sequence[Polygon]) -> MergedHoles:
             overlap = shape.intersection(shapes[j]).area
             if overlap > AREA_TOLERANCE * max(shape.area, shapes[j].area):
                 parent[find(j)] = find(i)
-    clusters: dict[int, list[int]] = {}
+    groups: dict[int, list[int]] = {}
     for i in range(len(shapes)):
-        clusters.setdefault(find(i), []).append(i)
+        groups.setdefault(find(i), []).append(i)
+    return sorted(groups.values())
+
+
+def _group_union(group: Sequence[Any]) -> Any:
+    """The union of one group of overlapping holes (one polygon: the group is connected)."""
+    from shapely import union_all
+
+    union = union_all(group)
+    if union.geom_type != "Polygon":  # pragma: no cover - groups are connected by area
+        union = max(union.geoms, key=lambda g: g.area)
+    return union
+
+
+def merge_holes(holes: Sequence[Polygon]) -> MergedHoles:
+    """Merge holes whose interiors overlap (transitively); keep the others exactly as given.
+    A merged hole is its union's outer ring: the free space it encloses is unreachable."""
+    from shapely import Polygon as ShapelyPolygon
+
+    shapes = [ShapelyPolygon(h) for h in holes]
     merged: list[Polygon] = []
     sources: list[tuple[int, ...]] = []
     enclosed: list[bool] = []
-    for members in sorted(clusters.values()):
+    for members in _overlap_groups(shapes):
         if len(members) == 1:
             merged.append(tuple(holes[members[0]]))
             sources.append((members[0],))
             enclosed.append(False)
             continue
-        union = union_all([shapes[i] for i in members])
-        if union.geom_type != "Polygon":  # pragma: no cover - clusters are connected by area
-            union = max(union.geoms, key=lambda g: g.area)
+        union = _group_union([shapes[i] for i in members])
         merged.append(_ring(list(union.exterior.coords)))
         sources.append(tuple(members))
         enclosed.append(len(union.interiors) > 0)
     return MergedHoles(holes=tuple(merged), sources=tuple(sources), enclosed=tuple(enclosed))
+
+
+def obstacle(holes: Sequence[Any]) -> Any:
+    """What the holes (shapely polygons) take from the free space once merged: their union,
+    with the free space that overlapping holes enclose filled (as :func:`merge_holes` makes
+    it); None without holes.  The checks of regions and the start use it, so that a region or
+    start in an enclosed pocket is refused by ``tlmpc check`` as by the compile."""
+    from shapely import Polygon as ShapelyPolygon
+    from shapely import union_all
+
+    if not holes:
+        return None
+    pieces = []
+    for members in _overlap_groups(holes):
+        group = [holes[i] for i in members]
+        pieces.append(group[0] if len(group) == 1 else ShapelyPolygon(_group_union(group).exterior))
+    return union_all(pieces)
 
 
 def merge_notes(
