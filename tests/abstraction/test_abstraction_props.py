@@ -190,6 +190,7 @@ def test_start_outside_is_an_error() -> None:
     with pytest.raises(InvalidInputError) as caught:
         build_abstraction(mission)
     assert caught.value.diagnostics[0].code == "A002"
+    assert caught.value.diagnostics[0].path == "$.robot.start"  # placed at it in the file
 
 
 def test_unreachable_region_is_reported() -> None:

@@ -171,6 +171,7 @@ def build_abstraction(
                 f"the start point {mission.robot.start} is not in the free workspace",
                 hint="start the robot inside the boundary and outside every hole",
                 file=mission.source,
+                path="$.robot.start",
             )
         )
     component = connected_components(neighbors)
