@@ -6,10 +6,11 @@ containment test asked only inside a region's bounding box is shapely's on every
 from __future__ import annotations
 
 import numpy as np
-from hypothesis import given
+import shapely
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from tlmpc.verify.robustness import _ring_distance
+from tlmpc.verify.robustness import INDEXED_EDGES, _indexed_ring_distance, _ring_distance
 
 FloatArray = np.ndarray
 
@@ -100,3 +101,28 @@ def test_ring_distance_across_block_boundaries_is_the_row_wise_definition() -> N
     for count in (1, RING_BLOCK - 1, RING_BLOCK, RING_BLOCK + 1, 3 * RING_BLOCK + 5):
         points = rng.uniform(-20.0, 20.0, (count, 2))
         assert _ring_distance(ring, points).tobytes() == _row_wise(ring, points).tobytes()
+
+
+@settings(max_examples=max(10, settings().max_examples // 5), deadline=None)
+@given(
+    st.integers(INDEXED_EDGES + 1, 3 * INDEXED_EDGES),
+    st.integers(0, 2**32 - 1),
+    st.floats(0.0, 0.9),
+)
+def test_a_large_ring_through_its_index_is_geos_distance_bit_for_bit(
+    corners: int, seed: int, jagged: float
+) -> None:
+    """Star-shaped rings of many corners (jagged: radii that vary), probed inside, outside,
+    on their corners and on their edges: the index finds GEOS's own distance to the ring."""
+    rng = np.random.default_rng(seed)
+    angles = np.sort(rng.uniform(0.0, 2.0 * np.pi, corners))
+    radii = 2.0 * (1.0 - jagged * rng.uniform(0.0, 1.0, corners))
+    ring = np.stack([5.0 + radii * np.cos(angles), 5.0 + radii * np.sin(angles)], axis=1)
+    polygon = shapely.Polygon(ring)
+    if not polygon.is_valid:
+        return
+    halfway = (ring + np.roll(ring, -1, axis=0)) / 2.0
+    probes = np.concatenate([rng.uniform(0.0, 10.0, (2000, 2)), ring[::7], halfway[::5]])
+    geoms = shapely.points(probes)
+    expected = shapely.distance(polygon.exterior, geoms)
+    assert np.array_equal(_indexed_ring_distance(polygon.exterior, geoms), expected)

@@ -85,6 +85,37 @@ def _ring_distance(polygon: FloatArray, points: FloatArray) -> FloatArray:
     return best
 
 
+#: Polygons with more edges than this get their distances through an index over pieces of
+#: their ring (:func:`_indexed_ring_distance`): GEOS measures a point against every edge, and
+#: a finely drawn region (thousands of vertices) against a densely resampled trace (10^5
+#: samples) took minutes.  Below it the index costs more than it saves (measured: even at
+#: about 600 edges, 1.6 x faster at 1,000, 4.5 x at 6,000).
+INDEXED_EDGES = 1000
+
+#: Consecutive edges per piece of the ring in the index: fewer pieces to search, each a short
+#: run of edges measured at C speed.
+EDGES_PER_PIECE = 16
+
+
+def _indexed_ring_distance(ring: shapely.LinearRing, geoms: npt.NDArray[np.object_]) -> FloatArray:
+    """GEOS's distance from each point to ``ring``, the same numbers, found through an
+    R-tree over runs of :data:`EDGES_PER_PIECE` edges: the distance to a line is the least
+    over its edges, and the tree's nearest piece holds the nearest edge."""
+    coords = shapely.get_coordinates(ring)
+    edges = len(coords) - 1
+    firsts = np.arange(0, edges, EDGES_PER_PIECE)
+    lasts = np.minimum(firsts + EDGES_PER_PIECE, edges)
+    sizes = lasts - firsts + 1  # a piece's vertices, its last shared with the next piece
+    take = np.repeat(firsts - np.cumsum(sizes) + sizes, sizes) + np.arange(int(sizes.sum()))
+    pieces = shapely.linestrings(coords[take], indices=np.repeat(np.arange(len(sizes)), sizes))
+    (which, _), distance = shapely.STRtree(pieces).query_nearest(
+        geoms, return_distance=True, all_matches=False
+    )
+    result: FloatArray = np.empty(len(geoms), dtype=np.float64)
+    result[which] = distance
+    return result
+
+
 def _contains(shape: shapely.Polygon, corners: FloatArray, points: FloatArray) -> BoolArray:
     """``shapely.contains_xy`` of each point: asked only of the points in the polygon's
     (closed) bounding box, since no point outside it lies in the polygon's interior (a region
@@ -112,7 +143,10 @@ def signed_distance(
     else:
         if geoms is None:
             geoms = shapely.points(points)
-        distance = np.asarray(shapely.distance(shape.exterior, geoms), dtype=np.float64)
+        if len(polygon) > INDEXED_EDGES:
+            distance = _indexed_ring_distance(shape.exterior, geoms)
+        else:
+            distance = np.asarray(shapely.distance(shape.exterior, geoms), dtype=np.float64)
     inside = _contains(shape, corners, points)
     result: FloatArray = np.where(inside, distance, -distance)
     return result
