@@ -757,3 +757,72 @@ def test_a_max_speed_too_small_for_the_map_fails_at_the_flag(tmp_path: Path) -> 
     assert err.startswith("--max-speed 1e-12: error[S010]: $.robot.max_speed: 1e-12 is too small")
     assert "mission.yaml" not in err
     assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("regions", "expected"),
+    [
+        pytest.param(
+            ["dock", "0.1", "0.1", "0.5", "0.5", "dock", "1", "1", "1.5", "1.5"],
+            "--region dock 1 1 1.5 1.5: error[M017]: the region 'dock' is already given by "
+            "`--region dock 0.1 0.1 0.5 0.5`",
+            id="a name twice",
+        ),
+        pytest.param(
+            [
+                *("dock", "0.1", "0.1", "0.5", "0.5"),
+                *("pier", "1", "1", "1.5", "1.5"),
+                *("dock", "0.1", "0.1", "0.5", "0.5"),
+            ],
+            "--region dock 0.1 0.1 0.5 0.5: error[M017]: the region 'dock' is already given",
+            id="the same rectangle again",
+        ),
+        pytest.param(
+            ["dock", "0", "0", "x", "1"],
+            "--region dock 0 0 x 1: error[M017]: the bounds must be numbers",
+            id="bounds not numbers",
+        ),
+        pytest.param(
+            ["my dock", "0", "0", "1", "1"],
+            "--region 'my dock' 0 0 1 1: error[M017]: 'my dock' is not a usable region name",
+            id="not an identifier",
+        ),
+        pytest.param(
+            ["dock", "1", "1", "0.5", "0.5"],
+            "--region dock 1 1 0.5 0.5: error[M017]: need finite bounds",
+            id="corners swapped",
+        ),
+        pytest.param(
+            ["dock", "10", "10", "11", "11"],
+            "--region dock 10 10 11 11: error[M017]: the rectangle has no free space",
+            id="off the map",
+        ),
+    ],
+)
+def test_a_region_flag_that_cannot_be_used_is_refused_at_the_flag(
+    tmp_path: Path, regions: list[str], expected: str
+) -> None:
+    # a name given twice would otherwise silently keep the last rectangle only
+    free = np.ones((20, 20), dtype=bool)
+    path = write_map(tmp_path, "m", image_from_free(free), resolution=0.1)
+    out = tmp_path / "mission.yaml"
+    flags = [w for k in range(0, len(regions), 5) for w in ("--region", *regions[k : k + 5])]
+    code, _, err = run("import-map", str(path), *flags, "--task", "visit dock", "-o", str(out))
+    assert code == 2, err
+    assert err.startswith(expected), err
+    assert "\n  hint: " in err
+    assert not out.exists()
+
+
+def test_regions_of_distinct_names_are_all_written(tmp_path: Path) -> None:
+    free = np.ones((20, 20), dtype=bool)
+    path = write_map(tmp_path, "m", image_from_free(free), resolution=0.1)
+    out = tmp_path / "mission.yaml"
+    code, _, err = run(
+        "import-map", str(path), "--region", "dock", "0.1", "0.1", "0.5", "0.5",
+        "--region", "pier", "1", "1", "1.5", "1.5", "--task", "visit dock", "-o", str(out),
+    )  # fmt: skip
+    assert code == 0, err
+    mission = load_mission(out)
+    assert Polygon(mission.region("dock").polygon).equals(box(0.1, 0.1, 0.5, 0.5))
+    assert Polygon(mission.region("pier").polygon).equals(box(1, 1, 1.5, 1.5))

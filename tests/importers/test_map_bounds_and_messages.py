@@ -5,6 +5,7 @@ from __future__ import annotations
 import io
 import math
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -154,3 +155,85 @@ def test_a_resolution_that_is_text_gets_a_hint_that_fits(
     assert f"{path}:{_line_of(path, 'resolution')}:13: error[M004]" in message
     assert suggested in hint
     assert wrong not in hint
+
+
+# --- every map-YAML diagnostic is located and has a hint (M002-M006, M013) ------------------
+
+GOOD_MAP = (
+    "# a map_server map\nimage: m.pgm\nresolution: 0.1\norigin: [0.0, 0.0, 0.0]\nnegate: 0\n"
+    "occupied_thresh: 0.65\nfree_thresh: 0.196\n"
+)
+
+
+def _written_at(text: str, key: str) -> tuple[int, int]:
+    """Where ``key: VALUE`` writes its value (one space after the colon), 1-based."""
+    for number, line in enumerate(text.splitlines(), 1):
+        if line.startswith(f"{key}:"):
+            return number, len(key) + 3
+    raise AssertionError(f"{key} is not in the map")
+
+
+def _without(key: str) -> str:
+    return "".join(f"{line}\n" for line in GOOD_MAP.splitlines() if not line.startswith(f"{key}:"))
+
+
+# (the map's text, the code, the key whose value is blamed, or None: the mapping, at its first key)
+DEFECTS = [
+    pytest.param(_without("origin"), "M003", None, id="no origin"),
+    pytest.param(_without("image"), "M003", None, id="no image"),
+    pytest.param(_without("resolution"), "M003", None, id="no resolution"),
+    pytest.param(_without("occupied_thresh"), "M003", None, id="no occupied_thresh"),
+    pytest.param(_without("free_thresh"), "M003", None, id="no free_thresh"),
+    pytest.param(GOOD_MAP.replace("[0.0, 0.0, 0.0]", "~"), "M003", "origin", id="origin null"),
+    pytest.param(GOOD_MAP.replace("0.0, 0.0, 0.0", "0.0, 0.0"), "M004", "origin", id="origin"),
+    pytest.param(GOOD_MAP.replace("image: m.pgm", "image: 5"), "M004", "image", id="image 5"),
+    pytest.param(GOOD_MAP.replace("0.1\n", "0.0\n"), "M004", "resolution", id="resolution 0"),
+    pytest.param(GOOD_MAP.replace("negate: 0", "negate: 2"), "M004", "negate", id="negate 2"),
+    pytest.param(GOOD_MAP + "mode: fancy\n", "M004", "mode", id="mode"),
+    pytest.param(
+        GOOD_MAP.replace("0.65", "0.1").replace("0.196", "0.9"),
+        "M004",
+        "free_thresh",
+        id="thresholds swapped",
+    ),
+    pytest.param(GOOD_MAP.replace("0.65", "1.5"), "M004", "occupied_thresh", id="occupied 1.5"),
+    pytest.param(GOOD_MAP.replace("0.196", "-0.1"), "M004", "free_thresh", id="free -0.1"),
+    pytest.param(GOOD_MAP.replace("0.65", "high"), "M004", "occupied_thresh", id="occupied text"),
+    pytest.param(GOOD_MAP.replace("m.pgm", "gone.pgm"), "M005", "image", id="no image file"),
+    pytest.param("# a list\n- image\n- m.pgm\n", "M002", None, id="not a mapping"),
+]
+
+
+@pytest.mark.parametrize(("text", "code", "key"), DEFECTS)
+def test_a_map_yaml_diagnostic_is_located_and_has_a_hint(
+    tmp_path: Path, text: str, code: str, key: str | None
+) -> None:
+    path = _free_map(tmp_path, 0.1, (0.0, 0.0, 0.0))
+    path.write_text(text)
+    line, col = (2, 1) if key is None else _written_at(text, key)  # line 1 is a comment
+    code_, _, err = run("import-map", str(path), "-o", str(tmp_path / "out.yaml"))
+    assert code_ == 2, err
+    assert err.startswith(f"{path}:{line}:{col}: error[{code}]: "), err
+    message, _, hint = err.partition("\n  hint: ")
+    assert hint.strip(), err
+    assert "None" not in message
+
+
+@pytest.mark.parametrize(
+    ("change", "key"),
+    [
+        (lambda t: t.replace("resolution: 0.1", "resolution: 0.2"), "resolution"),
+        (lambda t: t.replace("[0.0, 0.0, 0.0]", "[1.0, 0.0, 0.0]"), "origin"),
+    ],
+)
+def test_a_mask_that_does_not_fit_the_map_is_refused_at_its_key(
+    tmp_path: Path, change: Any, key: str
+) -> None:
+    path = _free_map(tmp_path, 0.1, (0.0, 0.0, 0.0))
+    mask = write_map(tmp_path, "k", image_from_free(np.ones((CELLS, CELLS), dtype=bool)))
+    mask.write_text(change(mask.read_text()))
+    code, _, err = run("import-map", str(path), "--keepout", str(mask))
+    assert code == 2, err
+    assert err.startswith(f"{mask}:{_line_of(mask, key)}:"), err
+    assert "error[M013]" in err
+    assert "\n  hint: " in err

@@ -10,8 +10,9 @@ NAME = "import-map"
 HELP = "write a mission from a ROS map_server / nav2 map (and keepout / speed masks)"
 DESCRIPTION = """\
 Turn an occupancy-grid map (map.yaml + image, map_server conventions) into a mission with
-explicit polygons: free cells become the workspace (unknown space is not free), eroded by
---radius (configuration space of a disc robot), simplified within --tolerance; a keepout mask
+explicit polygons: free cells become the workspace (unknown space is not free), simplified
+within --tolerance; with --radius eroded by the radius plus that tolerance (the configuration
+space of a disc robot, kept however the simplification moves the boundary); a keepout mask
 becomes regions keepout_K (group keepout), a speed mask regions speed_V_K (groups speed_V).
 The task defaults to `avoid keepout` when a keepout mask is given.  See docs/robot-data.md."""
 
@@ -23,7 +24,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--keepout", type=Path, help="a nav2 keepout mask YAML")
     parser.add_argument("--speed", type=Path, help="a nav2 speed mask YAML")
     parser.add_argument(
-        "--radius", type=float, default=0.0, help="robot radius: erode free space by it"
+        "--radius",
+        type=float,
+        default=0.0,
+        help="robot radius: erode free space by it, plus the tolerance (so the simplified "
+        "workspace keeps the radius from obstacles)",
     )
     parser.add_argument(
         "--tolerance", type=float, help="simplification tolerance (default: one cell)"
@@ -54,7 +59,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         action="append",
         nargs=5,
         metavar=("NAME", "XMIN", "YMIN", "XMAX", "YMAX"),
-        help="add a rectangular region, clipped to the workspace boundary (repeatable)",
+        help="add a rectangular region, clipped to the workspace boundary (repeatable, each "
+        "with its own name)",
     )
 
 
@@ -71,12 +77,15 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         tolerance=args.tolerance,
         min_area=args.min_area,
         start=tuple(args.start) if args.start else None,
+        # a robot with a body can hit an obstacle of a few cells: none is filled as a speck
+        keep_obstacles=args.radius > 0,
     )
     import contextlib
     import sys
 
     from tlmpc.base.progress import heartbeat
 
+    rects, flags = _rects(args.region or [])
     with contextlib.nullcontext() if args.quiet else heartbeat("import-map", sys.stderr):
         imported = import_map(args.map, settings, keepout=args.keepout, speed=args.speed)
     document = mission_document(
@@ -86,7 +95,8 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         task=args.task,
         ltl=args.ltl,
         max_speed=args.max_speed,
-        rects=_rects(args.region or []),
+        rects=rects,
+        flags=flags,
     )
     if args.output is not None:
         from tlmpc.io.outputs import refuse_input_as_output
@@ -103,6 +113,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         f"{100 * ratio:.2f}%), {len(imported.boundary)} boundary vertices, "
         f"{len(imported.holes)} holes, {len(imported.components)} further free components, "
         f"{len(imported.regions)} mask regions"
+        + (f", free space eroded by {imported.erosion:g}" if imported.erosion else "")
     )
     reporter = Reporter.for_args(args, out, err)
     if args.output is None:
@@ -176,19 +187,38 @@ def _check_task(text: str, args: argparse.Namespace) -> None:
         raise InvalidInputError(located or list(exc.diagnostics)) from None
 
 
-def _rects(values: list[list[str]]) -> dict[str, tuple[float, float, float, float]]:
-    from tlmpc.base.errors import UsageError, error
+def _rects(
+    values: list[list[str]],
+) -> tuple[dict[str, tuple[float, float, float, float]], dict[str, str]]:
+    """The ``--region`` rectangles by name, and each one's flag as given (where its
+    diagnostics are located).  Refused (M017, at the flag): bounds that are not numbers, and
+    a name an earlier ``--region`` gave, whose rectangle would otherwise be silently lost."""
+    import shlex
+
+    from tlmpc.importers.mission import region_error
 
     rects: dict[str, tuple[float, float, float, float]] = {}
-    for name, *numbers in values:
+    flags: dict[str, str] = {}
+    for words in values:
+        name, *numbers = words
+        flag = shlex.join(["--region", *words])
+        if name in flags:
+            raise region_error(
+                flag,
+                f"the region {name!r} is already given by `{flags[name]}`",
+                "give each --region its own name (a group of the mission can then name several)",
+            )
         try:
             x0, y0, x1, y1 = (float(v) for v in numbers)
         except ValueError:
-            raise UsageError(
-                error("M017", f"--region {name}: the bounds must be numbers, got {numbers}")
+            raise region_error(
+                flag,
+                f"the bounds must be numbers, got {' '.join(numbers)}",
+                "--region NAME XMIN YMIN XMAX YMAX, in map units",
             ) from None
         rects[name] = (x0, y0, x1, y1)
-    return rects
+        flags[name] = flag
+    return rects, flags
 
 
 def _flag_at(row: str, col: int | None, args: argparse.Namespace) -> tuple[str, int] | None:

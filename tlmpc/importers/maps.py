@@ -2,7 +2,8 @@
 
 * Free space is the cells of value 0 (unknown space is *not* free), as the exact union of their
   squares (:mod:`tlmpc.importers.polygonize`).
-* ``radius`` erodes free space by the robot's radius (configuration space of a disc robot).
+* ``radius`` erodes free space by the robot's radius (configuration space of a disc robot),
+  plus the margin the simplification may take back (see :func:`erosion`).
 * The workspace's main piece is the free piece containing ``start`` (else the largest); its
   outer ring is the boundary, its inner rings the holes.  Every other free piece of at least
   ``min_area`` becomes a further workspace component; holes and pieces smaller than
@@ -34,6 +35,7 @@ from shapely.ops import split
 from tlmpc.base.errors import UsageError, error
 from tlmpc.importers.occupancy import FREE, OCCUPIED, OccupancyGrid, read_map
 from tlmpc.importers.polygonize import (
+    ARC_CLEARANCE,
     cells_to_geometry,
     drop_small_holes,
     erode,
@@ -80,6 +82,8 @@ class ImportedMap:
     resolution: float
     tolerance: float
     source: str
+    #: how far free space was eroded (:func:`erosion` of the radius and the tolerance)
+    erosion: float = 0.0
     #: obstacle specks filled: holes smaller than ``min_area`` by their exact cell area
     speckles_dropped: int = 0
     #: every file read: the map YAML, its image, and those of the masks
@@ -108,21 +112,39 @@ def _to_grid(grid: OccupancyGrid, point: Point) -> Point:
     return (c * dx + s * dy) / grid.resolution, (-s * dx + c * dy) / grid.resolution
 
 
+def erosion(radius: float, tolerance: float) -> float:
+    """How far free space is eroded for a disc robot of ``radius`` whose workspace is then
+    simplified within ``tolerance``: ``radius + tolerance / ARC_CLEARANCE`` (0 without a radius).
+
+    The erosion keeps ``ARC_CLEARANCE`` of its depth from every non-free cell (its arcs are
+    chords), and the simplification moves the boundary by at most ``tolerance``, toward the
+    obstacles too; eroding by the radius alone would leave the robot up to ``tolerance`` closer
+    to them than its radius.  With the margin every point of the written workspace is at least
+    ``radius * ARC_CLEARANCE`` from every non-free cell.
+    """
+    return radius + tolerance / ARC_CLEARANCE if radius > 0 else 0.0
+
+
 def _free_pieces(
-    grid: OccupancyGrid, radius: float, start: Point | None, min_cells: float
+    grid: OccupancyGrid, depth: float, start: Point | None, min_cells: float
 ) -> tuple[Polygon, list[Polygon]]:
-    """The eroded free pieces in grid units: the one containing ``start`` (else the largest),
-    and every other piece of at least ``min_cells`` cells (smaller ones are specks)."""
-    free = erode(cells_to_geometry(grid.values == FREE), radius / grid.resolution)
+    """The free pieces eroded by ``depth`` (map units), in grid units: the one containing
+    ``start`` (else the largest), and every other piece of at least ``min_cells`` cells
+    (smaller ones are specks)."""
+    free = erode(cells_to_geometry(grid.values == FREE), depth / grid.resolution)
     pieces = polygons(free)
     if not pieces:
         raise _fail(
             "M010",
             "the map has no free space"
-            + (f" left after eroding by the radius {radius:g}" if radius else ""),
+            + (
+                f" left after eroding by {depth:g} (the radius plus the simplification tolerance)"
+                if depth
+                else ""
+            ),
             grid.source,
             hint="free cells are those with occupancy below free_thresh; "
-            "check negate, the thresholds and the radius",
+            "check negate, the thresholds, the radius and the tolerance",
         )
     chosen: Polygon | None = None
     if start is not None:
@@ -346,17 +368,17 @@ def _simple_parts(piece: Polygon, free: BaseGeometry, members: BaseGeometry) -> 
 
 
 def _exact_free(
-    grid: OccupancyGrid, settings: ImportSettings, min_area_cells: float
+    grid: OccupancyGrid, settings: ImportSettings, depth: float, min_area_cells: float
 ) -> tuple[Polygon, list[Polygon], int]:
-    """The free pieces in grid units before simplification, with their specks decided: the
-    main piece, the other pieces of at least ``min_area_cells``, and how many holes smaller
-    than that were filled.
+    """The free pieces eroded by ``depth``, in grid units before simplification, with their
+    specks decided: the main piece, the other pieces of at least ``min_area_cells``, and how
+    many holes smaller than that were filled.
 
     Specks are judged here, on the exact cell areas, and only here: simplification within
     one cell can take a 4-cell L, S or T obstacle to a triangle of 3 cells or less, which
     would then count as a speck and turn real occupied cells into free space.
     """
-    main, others = _free_pieces(grid, settings.radius, settings.start, min_area_cells)
+    main, others = _free_pieces(grid, depth, settings.start, min_area_cells)
     holes = 0.0 if settings.keep_obstacles else min_area_cells
     pieces = [main, *others]
     filled = [drop_small_holes(p, holes) for p in pieces]
@@ -436,7 +458,8 @@ def import_map(
     )
     cell_area = grid.cell_area()
     min_cells = _in_cells(min_area, cell_area)
-    exact_main, exact_others, dropped = _exact_free(grid, settings, min_cells)
+    depth = erosion(settings.radius, tolerance)
+    exact_main, exact_others, dropped = _exact_free(grid, settings, depth, min_cells)
     mask_grids: list[tuple[str, Path, OccupancyGrid]] = []
     for prefix, path in (("keepout", keepout), ("speed", speed)):
         if path is None:
@@ -447,13 +470,26 @@ def import_map(
             or mask.resolution != grid.resolution
             or mask.origin != grid.origin
         ):
-            raise _fail(
-                "M013",
-                f"the mask is {mask.shape[1]}x{mask.shape[0]} cells at {mask.resolution:g} "
-                f"from origin {list(mask.origin)}, the map {grid.shape[1]}x{grid.shape[0]} "
-                f"at {grid.resolution:g} from {list(grid.origin)}",
-                str(path),
-                hint="a mask must have the map's size, resolution and origin",
+            # at the mask's first key that differs from the map's (its image for the size)
+            key = (
+                "image"
+                if mask.shape != grid.shape
+                else "resolution"
+                if mask.resolution != grid.resolution
+                else "origin"
+            )
+            line, col = mask.places.get(key, (None, None))
+            raise UsageError(
+                error(
+                    "M013",
+                    f"the mask is {mask.shape[1]}x{mask.shape[0]} cells at {mask.resolution:g} "
+                    f"from origin {list(mask.origin)}, the map {grid.shape[1]}x{grid.shape[0]} "
+                    f"at {grid.resolution:g} from {list(grid.origin)}",
+                    hint="a mask must have the map's size, resolution and origin",
+                    file=str(path),
+                    line=line,
+                    col=col,
+                )
             )
         mask_grids.append((prefix, path, mask))
     layers = [m.values for _, _, m in mask_grids]
@@ -526,6 +562,7 @@ def import_map(
         resolution=grid.resolution,
         tolerance=tolerance,
         source=str(map_path),
+        erosion=depth,
         speckles_dropped=dropped,
         inputs=tuple(
             name for g in (grid, *(m for _, _, m in mask_grids)) for name in (g.source, g.image)

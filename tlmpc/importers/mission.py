@@ -42,18 +42,27 @@ def default_start(imported: ImportedMap) -> Point:
     return float(point.x), float(point.y)
 
 
-def _check_rect(imported: ImportedMap, name: str, rect: tuple[float, float, float, float]) -> None:
+def region_error(flag: str, message: str, hint: str) -> UsageError:
+    """M017 about a ``--region``, located at the flag as it was given (``flag``)."""
+    return UsageError(error("M017", message, hint=hint, file=flag))
+
+
+def _check_rect(
+    imported: ImportedMap, name: str, rect: tuple[float, float, float, float], flag: str
+) -> None:
     if not _NAME.match(name) or name in _KEYWORDS or name in imported.regions:
-        raise UsageError(
-            error(
-                "M017",
-                f"--region {name}: not a usable region name",
-                hint="an identifier, not an LTL keyword and not an imported region's name",
-            )
+        raise region_error(
+            flag,
+            f"{name!r} is not a usable region name",
+            "an identifier, not an LTL keyword and not an imported region's name",
         )
     x0, y0, x1, y1 = rect
     if not (x0 < x1 and y0 < y1 and all(math.isfinite(v) for v in rect)):
-        raise UsageError(error("M017", f"--region {name}: need XMIN < XMAX and YMIN < YMAX"))
+        raise region_error(
+            flag,
+            "need finite bounds with XMIN < XMAX and YMIN < YMAX",
+            "--region NAME XMIN YMIN XMAX YMAX: the rectangle's lower-left and upper-right corners",
+        )
 
 
 def _nearest_on_segment(p: Point, a: Point, b: Point) -> tuple[float, float]:
@@ -92,10 +101,13 @@ def snap_to_rings(
 
 
 def _clip_rects(
-    imported: ImportedMap, rects: Mapping[str, tuple[float, float, float, float]]
+    imported: ImportedMap,
+    rects: Mapping[str, tuple[float, float, float, float]],
+    flags: Mapping[str, str],
 ) -> tuple[Ring, tuple[Ring, ...], dict[str, list[list[float]]]]:
     """Each rectangle clipped to the workspace's outer boundary, and the boundary and holes
-    noded with the clipped regions.
+    noded with the clipped regions; a rectangle's problems are located at its flag in
+    ``flags`` (else at ``--region NAME``).
 
     A clipped region's vertices on the boundary are the boundary's own: the boundary
     vertices it follows are copied exactly, and each point where a rectangle's edge crosses a
@@ -112,13 +124,17 @@ def _clip_rects(
     tolerance = 1e-9 * size
     regions: dict[str, list[list[float]]] = {}
     for name, rect in rects.items():
-        _check_rect(imported, name, rect)
+        flag = flags.get(name, f"--region {name}")
+        _check_rect(imported, name, rect, flag)
         free = Polygon(rings[0], rings[1:])
         clipped = polygons(box(*rect).intersection(Polygon(rings[0])))
         usable = [p for p in clipped if p.intersection(free).area > 0]
         if not usable:
-            raise UsageError(
-                error("M017", f"--region {name} has no free space in the imported workspace")
+            raise region_error(
+                flag,
+                "the rectangle has no free space in the imported workspace",
+                f"the workspace spans x {minx:g} to {maxx:g}, y {miny:g} to {maxy:g}; a "
+                "region must overlap its free space",
             )
         largest = max(usable, key=lambda p: p.area)
         ring: list[Point] = []
@@ -143,9 +159,12 @@ def mission_document(
     ltl: str | None = None,
     max_speed: float = 1.0,
     rects: Mapping[str, tuple[float, float, float, float]] | None = None,
+    flags: Mapping[str, str] | None = None,
 ) -> dict[str, Any]:
     """A ``version: 1`` mission with the imported workspace, regions and groups.
 
+    ``rects`` are rectangular regions to add, each clipped to the workspace; ``flags`` says
+    where each was given (its ``--region`` flag), where its problems (M017) are located.
     Refuses (M018) what ``tlmpc check`` would reject in the written mission: a start that is
     not a finite point of the free workspace, a speed that is not a positive finite number."""
     if not (math.isfinite(max_speed) and max_speed > 0):
@@ -171,7 +190,7 @@ def mission_document(
                 )
             )
     regions: dict[str, Any] = {n: _points(r) for n, r in imported.regions.items()}
-    boundary, holes, clipped = _clip_rects(imported, rects or {})
+    boundary, holes, clipped = _clip_rects(imported, rects or {}, flags or {})
     regions.update(clipped)
     phrases = list(task or [])
     if not phrases and not ltl and "keepout" in imported.groups:

@@ -53,6 +53,13 @@ MAX_RESOLUTION = 1e9
 #: Origins farther out than this put the map beyond where a float resolves a cell.
 MAX_COORDINATE = 1e12
 
+#: The hint of a diagnostic about either threshold.
+_THRESHOLDS_HINT = (
+    "free_thresh and occupied_thresh are occupancies from 0 to 1: a cell is free below "
+    "free_thresh and occupied above occupied_thresh, so free_thresh <= occupied_thresh "
+    "(nav2's map_saver writes free_thresh: 0.25, occupied_thresh: 0.65)"
+)
+
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class OccupancyGrid:
@@ -106,7 +113,43 @@ class _Written:
     quoted: bool
 
 
-def _written(text: str) -> dict[str, _Written]:
+#: What each key of a map YAML holds, as the hint of a diagnostic about its value.
+_KEY_HINTS = {
+    "image": "image is the map image's file name, relative to this YAML file, e.g. map.pgm",
+    "resolution": "resolution is the size of one cell in metres, e.g. 0.05",
+    "origin": "origin is the pose of the map's lower-left corner, [x, y, yaw] in metres and "
+    "radians, e.g. [-10.0, -10.0, 0.0]",
+    "occupied_thresh": _THRESHOLDS_HINT,
+    "free_thresh": _THRESHOLDS_HINT,
+    "negate": "negate: 0 when white pixels are free (as map_saver writes), 1 when black ones are",
+    "mode": "use trinary, scale or raw",
+}
+
+#: A value to write for each required key, for the hint of a map that lacks it.
+_KEY_EXAMPLES = {
+    "image": "map.pgm",
+    "resolution": "0.05",
+    "origin": "[0.0, 0.0, 0.0]",
+    "occupied_thresh": "0.65",
+    "free_thresh": "0.25",
+}
+
+
+@dataclass(frozen=True, slots=True)
+class _MapText:
+    """Where the map YAML writes its mapping and each top-level key's value."""
+
+    values: Mapping[str, _Written]
+    #: where the mapping starts: the place of a diagnostic about a key it lacks
+    mapping: tuple[int, int]
+
+    def at(self, key: str) -> tuple[int, int]:
+        """Where ``key``'s value is written, else where the mapping starts."""
+        place = self.values.get(key)
+        return self.mapping if place is None else (place.line, place.col)
+
+
+def _written(text: str) -> _MapText:
     """Each top-level key's value as written (the last of a repeated key, as the data has it).
 
     Only called on text that ``load_small_yaml`` read, so it is small and within the limits."""
@@ -115,7 +158,9 @@ def _written(text: str) -> dict[str, _Written]:
     try:
         root = yaml.compose(text, Loader=yaml.SafeLoader)
     except yaml.YAMLError:  # pragma: no cover - the text was just read as YAML
-        return {}
+        return _MapText({}, (1, 1))
+    if root is None:  # an empty document
+        return _MapText({}, (1, 1))
     found: dict[str, _Written] = {}
     if isinstance(root, yaml.MappingNode):
         for key, value in root.value:
@@ -123,27 +168,28 @@ def _written(text: str) -> dict[str, _Written]:
                 mark = value.start_mark
                 quoted = isinstance(value, yaml.ScalarNode) and value.style in ("'", '"')
                 found[key.value] = _Written(mark.line + 1, mark.column + 1, quoted)
-    return found
+    return _MapText(found, (root.start_mark.line + 1, root.start_mark.column + 1))
 
 
-def _number(
-    meta: dict[str, Any],
-    key: str,
-    file: str,
-    written: Mapping[str, _Written],
-    default: float | None = None,
-) -> float:
-    value = meta.get(key, default)
+def _missing(key: str, file: str, written: _MapText) -> UsageError:
+    """M003: the map lacks ``key`` (or gives it no value), at the mapping (or the empty value)."""
+    return _fail(
+        "M003",
+        f"the map has no `{key}`",
+        file,
+        hint="a map_server map needs image, resolution, origin, occupied_thresh and "
+        f"free_thresh: add `{key}: {_KEY_EXAMPLES[key]}`",
+        at=written.at(key),
+    )
+
+
+def _number(meta: dict[str, Any], key: str, file: str, written: _MapText) -> float:
+    value = meta.get(key)
     if value is None:
-        raise _fail(
-            "M003",
-            f"the map has no `{key}`",
-            file,
-            hint="a map_server map needs image, resolution, origin, occupied_thresh, free_thresh",
-        )
+        raise _missing(key, file, written)
     if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        place = written.get(key)
-        hint = None
+        place = written.values.get(key)
+        hint = _KEY_HINTS[key]
         finite = isinstance(value, str) and _finite_text(value)
         if finite and place is not None and place.quoted:
             hint = (
@@ -160,7 +206,7 @@ def _number(
             f"`{key}` is not a finite number: {brief(value)}",
             file,
             hint=hint,
-            at=None if place is None else (place.line, place.col),
+            at=written.at(key),
         )
     return float(value)
 
@@ -186,33 +232,35 @@ def read_metadata(path: Path) -> dict[str, Any]:
     file = str(path)
     text = read_text(path, limit=MAX_MAP_YAML_BYTES, code="M001", what="map")
     meta = load_small_yaml(text, file, code="M002")
+    written = _written(text)
     if not isinstance(meta, dict):
         raise _fail(
             "M002",
             "the map file is not a map_server YAML mapping",
             file,
             hint="expected keys image, resolution, origin, occupied_thresh, free_thresh",
+            at=written.mapping,
         )
-    written = _written(text)
 
-    def at(key: str) -> tuple[int, int] | None:
-        place = written.get(key)
-        return None if place is None else (place.line, place.col)
+    def bad(key: str, message: str) -> UsageError:
+        """M004 at ``key``'s value, with what the key holds as the hint."""
+        return _fail("M004", message, file, hint=_KEY_HINTS[key], at=written.at(key))
 
     image = meta.get("image")
+    if image is None:
+        raise _missing("image", file, written)
     if not isinstance(image, str) or not image:
-        raise _fail("M003", "the map has no `image`", file, hint="image: map.pgm")
+        raise bad("image", f"`image` must be the image's file name, got {brief(image)}")
     resolution = _number(meta, "resolution", file, written)
     if not MIN_RESOLUTION <= resolution <= MAX_RESOLUTION:
-        raise _fail(
-            "M004",
+        raise bad(
+            "resolution",
             f"`resolution` must be between {MIN_RESOLUTION:g} and {MAX_RESOLUTION:g} "
             f"(metres per cell), got {resolution:g}",
-            file,
-            hint="resolution is the size of one cell, e.g. 0.05",
-            at=at("resolution"),
         )
     origin = meta.get("origin")
+    if origin is None:
+        raise _missing("origin", file, written)
     if (
         not isinstance(origin, list)
         or len(origin) != 3
@@ -224,30 +272,32 @@ def read_metadata(path: Path) -> dict[str, Any]:
             for v in origin
         )
     ):
-        raise _fail(
-            "M004",
+        raise bad(
+            "origin",
             f"`origin` must be [x, y, yaw] of finite numbers (at most {MAX_COORDINATE:g} "
             f"in size), got {brief(origin)}",
-            file,
-            at=at("origin"),
         )
     occupied = _number(meta, "occupied_thresh", file, written)
     free = _number(meta, "free_thresh", file, written)
     negate = meta.get("negate", 0)
     if negate not in (0, 1, True, False):
-        raise _fail("M004", f"`negate` must be 0 or 1, got {brief(negate)}", file)
+        raise bad("negate", f"`negate` must be 0 or 1, got {brief(negate)}")
     if not 0.0 <= free <= occupied <= 1.0:
-        raise _fail(
-            "M004",
+        # the value outside 0..1; when both lie inside it (in the wrong order), free_thresh
+        outside = [
+            key
+            for key, v in (("free_thresh", free), ("occupied_thresh", occupied))
+            if not 0.0 <= v <= 1.0
+        ]
+        culprit = outside[0] if outside else "free_thresh"
+        raise bad(
+            culprit,
             f"thresholds must satisfy 0 <= free_thresh <= occupied_thresh <= 1, "
             f"got free {free:g}, occupied {occupied:g}",
-            file,
         )
     mode = meta.get("mode", "trinary")
     if mode not in MODES:
-        raise _fail(
-            "M004", f"unknown map mode {brief(mode)}", file, hint="use trinary, scale or raw"
-        )
+        raise bad("mode", f"unknown map mode {brief(mode)}")
     return {
         "image": image,
         "resolution": resolution,
@@ -256,21 +306,27 @@ def read_metadata(path: Path) -> dict[str, Any]:
         "free_thresh": free,
         "negate": bool(negate),
         "mode": mode,
-        "places": {key: (place.line, place.col) for key, place in written.items()},
+        "places": {key: (place.line, place.col) for key, place in written.values.items()},
     }
 
 
-def _pixels(path: Path, file: str) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.bool_] | None]:
-    """Shade in [0, 1] per pixel (mean of colour channels) and, if any, opacity per pixel."""
+def _pixels(
+    path: Path, file: str, at: tuple[int, int] | None = None
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.bool_] | None]:
+    """Shade in [0, 1] per pixel (mean of colour channels) and, if any, opacity per pixel.
+
+    Problems are reported in the map YAML ``file``, at ``at`` (where it names the image)."""
     import warnings
 
     from PIL import Image, UnidentifiedImageError
 
+    def fail(code: str, message: str, hint: str) -> UsageError:
+        return _fail(code, message, file, hint=hint, at=at)
+
     if not path.exists():
-        raise _fail(
+        raise fail(
             "M005",
             f"the map image {path} does not exist",
-            file,
             hint="`image` is relative to the map YAML file",
         )
     try:
@@ -282,50 +338,53 @@ def _pixels(path: Path, file: str) -> tuple[npt.NDArray[np.float64], npt.NDArray
             # "decompression bomb" check (a warning, then an error) is ours to report.
             warnings.simplefilter("ignore", Image.DecompressionBombWarning)
             if os.fstat(stream.fileno()).st_size > MAX_IMAGE_BYTES:
-                raise _fail(
-                    "M006", f"the map image {path} is larger than {MAX_IMAGE_BYTES >> 20} MiB", file
+                raise fail(
+                    "M006",
+                    f"the map image {path} is larger than {MAX_IMAGE_BYTES >> 20} MiB",
+                    hint="crop or downsample the map",
                 )
             with Image.open(stream) as image:
                 if image.width * image.height > MAX_CELLS:
-                    raise _fail(
+                    raise fail(
                         "M006",
                         f"the map image {path} is {image.width}x{image.height} pixels, more "
                         f"than {MAX_CELLS:,} cells",
-                        file,
                         hint="crop or downsample the map",
                     )
                 mode = image.mode
                 array = np.asarray(image)
     except UsageError as exc:
+        # open_regular's refusal names the image; it is reported in the map YAML, at `image`
+        line, col = at if at is not None else (None, None)
         raise UsageError(
-            [error(d.code, d.message, hint=d.hint, file=file) for d in exc.diagnostics]
+            [
+                error(d.code, d.message, hint=d.hint, file=file, line=line, col=col)
+                for d in exc.diagnostics
+            ]
         ) from None
     except Image.DecompressionBombError:
-        raise _fail(
+        raise fail(
             "M006",
             f"the map image {path} declares more than {MAX_CELLS:,} cells",
-            file,
             hint="crop or downsample the map",
         ) from None
     except UnidentifiedImageError:
         # Pillow's message names the open stream object, which tells the reader nothing.
-        raise _fail(
+        raise fail(
             "M006",
             f"cannot read the map image {path}: it is not in an image format Pillow knows, "
             "or its header is malformed (a negative or missing size, say)",
-            file,
             hint=_IMAGE_HINT,
         ) from None
     except MemoryError:
-        raise _fail(
+        raise fail(
             "M006",
             f"cannot read the map image {path}: not enough memory to decode it",
-            file,
             hint="crop or downsample the map",
         ) from None
     except (OSError, ValueError, SyntaxError) as exc:
-        raise _fail(
-            "M006", f"cannot read the map image {path}: {_reason(exc)}", file, hint=_IMAGE_HINT
+        raise fail(
+            "M006", f"cannot read the map image {path}: {_reason(exc)}", hint=_IMAGE_HINT
         ) from None
     if mode == "1":
         return array.astype(np.float64), None
@@ -333,7 +392,7 @@ def _pixels(path: Path, file: str) -> tuple[npt.NDArray[np.float64], npt.NDArray
         top = 65535.0 if mode != "I" else float(max(int(array.max(initial=0)), 1))
         return array.astype(np.float64) / top, None
     if mode == "P":
-        raise _fail("M006", "palette images are not supported", file, hint="save as greyscale")
+        raise fail("M006", "palette images are not supported", hint="save as greyscale")
     top = 255.0
     alpha: npt.NDArray[np.bool_] | None = None
     if array.ndim == 3:
@@ -398,9 +457,12 @@ def read_map(path: Path) -> OccupancyGrid:
     image_path = Path(meta["image"])
     if not image_path.is_absolute():
         image_path = path.parent / image_path
-    shade, opaque = _pixels(image_path, str(path))
+    named = meta["places"].get("image")
+    shade, opaque = _pixels(image_path, str(path), named)
     if shade.ndim != 2 or shade.size == 0:
-        raise _fail("M006", f"the map image {image_path} has no pixels", str(path))
+        raise _fail(
+            "M006", f"the map image {image_path} has no pixels", str(path), _IMAGE_HINT, named
+        )
     values = cell_values(
         shade,
         opaque,

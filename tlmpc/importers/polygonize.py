@@ -11,12 +11,22 @@ simplified within a stated tolerance.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import numpy.typing as npt
 import shapely
 from shapely import affinity
 from shapely.geometry import MultiPolygon, Polygon
 from shapely.geometry.base import BaseGeometry
+
+#: Chords per quarter circle of an eroded corner's arc.
+QUARTER_SEGMENTS = 8
+
+#: The fraction of the radius an erosion keeps everywhere: its arcs are chords with their
+#: vertices on the arc, whose midpoints lie ``cos(pi / (4 * QUARTER_SEGMENTS))`` of the radius
+#: from the corner.
+ARC_CLEARANCE = math.cos(math.pi / (4 * QUARTER_SEGMENTS))
 
 
 def cells_to_geometry(mask: npt.NDArray[np.bool_]) -> BaseGeometry:
@@ -136,12 +146,12 @@ def simplify(polygon: Polygon, tolerance: float) -> Polygon | None:
 def erode(geometry: BaseGeometry, radius: float) -> BaseGeometry:
     """Free space shrunk by ``radius``: the configuration space of a disc robot.
 
-    Arcs are approximated by 8 chords per quarter circle with vertices on the arc, so the
-    clearance kept is at least ``radius * cos(pi / 32)`` (99.5%).
+    Arcs are approximated by ``QUARTER_SEGMENTS`` chords per quarter circle with vertices on
+    the arc, so the clearance kept is at least ``radius * ARC_CLEARANCE`` (99.5%).
     """
     if radius <= 0:
         return geometry
-    return geometry.buffer(-radius, quad_segs=8)
+    return geometry.buffer(-radius, quad_segs=QUARTER_SEGMENTS)
 
 
 def drop_small_holes(polygon: Polygon, min_area: float) -> Polygon:
