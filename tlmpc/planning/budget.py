@@ -7,6 +7,10 @@ graph, plus the search's arrays per node.  A product within the budget is built;
 is searched as it is expanded (:mod:`tlmpc.planning.guided`), which stores per node only the
 searches' arrays (50 bytes), so only a product with more nodes than that search allows stops
 with a diagnostic (P040) instead of exhausting the machine's memory.
+
+Vertex passages (:mod:`tlmpc.planning.passages`) add edges that grow with the square of the
+number of triangles around a vertex; they are estimated from those counts before any passage
+is listed, and refused (P060) beyond :data:`MAX_PASSAGE_EDGES`.
 """
 
 from __future__ import annotations
@@ -24,6 +28,12 @@ MAX_PRODUCT_NODES = 40_000_000
 MAX_PRODUCT_EDGES = 160_000_000
 #: The most nodes the guided search handles: two searches' arrays, 50 bytes a node.
 MAX_GUIDED_NODES = 32_000_000
+
+#: The most product edges vertex passages may add.  Building them takes about 130 bytes and
+#: half a microsecond of CPU per edge (the moves, their letters and the edge batches, then the
+#: graph merged with them), so the budget keeps them near 2.6 GB; a mesh of good shape has a
+#: few triangles around each vertex and needs a tiny fraction of it.
+MAX_PASSAGE_EDGES = 20_000_000
 
 SLOTS = 4  # as in tlmpc.planning.product: three entry edges and the start
 MOVES_PER_NODE = 4  # leave through one of three edges (two after entering) or stutter
@@ -89,5 +99,27 @@ def passages_too_large(abstraction: Abstraction, automaton: Automaton) -> UsageE
             f"{MAX_PRODUCT_EDGES:,} edges)",
             hint="use a coarser mesh (a larger options.max_area), or widen the passage the "
             "plan must take so that it runs through an edge",
+        )
+    )
+
+
+def check_passage_edges(edges: int, *, widest_fan: int, at: tuple[float, float]) -> None:
+    """Raises :class:`UsageError` (P060) when vertex passages would add more than
+    :data:`MAX_PASSAGE_EDGES` edges to the product (``edges``: the estimate); ``widest_fan``
+    triangles lie around the vertex ``at``, the most around any contact vertex."""
+    if edges <= MAX_PASSAGE_EDGES:
+        return
+    x, y = at
+    raise UsageError(
+        error(
+            "P060",
+            "no plan exists along the mesh's edges, and the search through mesh vertices "
+            f"would add up to {edges:,} product edges, more than the planner's budget "
+            f"({MAX_PASSAGE_EDGES:,}): they grow with the square of the triangles around a "
+            f"vertex, and {widest_fan:,} lie around ({x:.6g}, {y:.6g})",
+            hint="widen the passage the plan must take so that it runs through an edge; "
+            "dozens of triangles or more around one vertex are a sliver the mesh had to fill "
+            "(move the features near it apart, or exactly together), many contact vertices "
+            "a fine mesh (a larger options.max_area)",
         )
     )

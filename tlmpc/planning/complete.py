@@ -8,6 +8,10 @@
    (:func:`tlmpc.abstraction.refine.split_triangles`), and the no-bounce planner runs again on
    the refined mesh, where the fan lets the robot circle back; the returned abstraction is the
    refined one, and the controllers, simulation and self-check all use it.
+
+Every mesh planned on, the refined ones too, is charged against the planner's budget before
+its product is built (:func:`tlmpc.planning.budget.check_product_size`, P040): a round of
+refinement may triple a mesh (two triangles more per triangle of the lasso).
 """
 
 from __future__ import annotations
@@ -22,6 +26,7 @@ from tlmpc.base.errors import NoPlanError, TlmpcError, error
 from tlmpc.ltl.ast import Formula
 from tlmpc.mission.model import Options, TaskPart
 from tlmpc.planning.boundary import start_cells, task_formula, task_letters
+from tlmpc.planning.budget import check_product_size
 from tlmpc.planning.explain import explain_infeasible
 from tlmpc.planning.model import Witness
 from tlmpc.planning.passages import passage_turns
@@ -91,6 +96,7 @@ def plan_complete(
     """
 
     def attempt(mesh: Abstraction, *, bounces: bool = False, passages: bool = False) -> Witness:
+        check_product_size(mesh, automaton)
         return plan(
             mesh,
             automaton,

@@ -21,6 +21,11 @@ vertices where the labels of the triangles around differ get passages: around an
 vertex every triangle lies in one face, and a passage would add no run the edge moves lack.
 Plans use passages only when no plan exists without them (see
 :func:`tlmpc.planning.complete.plan_complete`).
+
+A vertex with ``g`` triangles around it gives about ``g**2`` passages: their product edges are
+bounded from the corners' counts alone (:func:`estimate_passage_edges`) and charged against
+the planner's budget (:func:`tlmpc.planning.budget.check_passage_edges`, P060) before any
+passage is listed.
 """
 
 from __future__ import annotations
@@ -33,6 +38,7 @@ from tlmpc.abstraction.model import Abstraction, FloatArray, IntArray
 from tlmpc.automata.guards import successor_table
 from tlmpc.automata.model import Automaton
 from tlmpc.base.content import ContentEquality
+from tlmpc.planning import budget
 from tlmpc.planning.boundary import StartCell, crossing_letter
 from tlmpc.planning.contacts import contact_vertices, vertex_point_letters
 from tlmpc.planning.model import Witness
@@ -83,10 +89,21 @@ def add_vertex_passages(
     entered through an edge that holds the vertex, and an arrival may leave through such an
     edge: :func:`passage_turns` names those triangles, which refinement splits.  Built with
     numpy over all corners at once, as the product is.
+
+    Raises :class:`~tlmpc.base.errors.UsageError` (P060) before listing any passage when
+    :func:`estimate_passage_edges` exceeds the planner's budget.
     """
     nq = automaton.num_states
     base = abstraction.num_triangles * SLOTS * nq
     corners = _ArrivalCorners.around_contacts(abstraction, allowed)
+    corners.charge(
+        abstraction,
+        automaton,
+        allowed=allowed,
+        starts=starts,
+        bounces=bounces,
+        closed=convention == "closed",
+    )
     cells_info = PassageCells(
         base=base, triangle=corners.triangle.astype(np.int64), vertex=corners.vertex
     )
@@ -161,6 +178,77 @@ class _ArrivalCorners:
             group_size=group_size,
         )
 
+    def move_count(
+        self,
+        abstraction: Abstraction,
+        *,
+        allowed: BoolArray,
+        starts: tuple[StartCell, ...],
+        bounces: bool,
+    ) -> int:
+        """How many passage moves into and out of these corners' arrival cells
+        :func:`add_vertex_passages` makes, from the group sizes and each corner's edges
+        (a start on an edge through the vertex counted as if it were off it)."""
+        # Each triangle holds a vertex once: a corner in a group of g is the source of g
+        # passages, one of them back into its own triangle (a U-turn, only with bounces).
+        targets = np.repeat(self.group_size.astype(np.int64), self.group_size)
+        if not bounces:
+            targets -= 1
+        # The edge opposite the vertex; with bounces the two through it as well.
+        turns = (0, 1, 2) if bounces else (0,)
+        sides = self.corner[:, None] + np.asarray(turns)[None, :]
+        across = abstraction.neighbors[self.triangle[:, None], sides % 3]
+        entered = (across >= 0).sum(axis=1)
+        left = ((across >= 0) & allowed[np.maximum(across, 0)]).sum(axis=1)
+        start_triangles = np.unique([cell.triangle for cell in starts])
+        from_start = np.isin(self.triangle, start_triangles)
+        return int((entered * targets).sum() + targets[from_start].sum() + left.sum())
+
+    def edge_bound(
+        self,
+        abstraction: Abstraction,
+        automaton: Automaton,
+        *,
+        allowed: BoolArray,
+        starts: tuple[StartCell, ...],
+        bounces: bool,
+        closed: bool,
+    ) -> int:
+        """An upper bound on the product edges of these corners' passages (see
+        :func:`estimate_passage_edges`)."""
+        moves = self.move_count(abstraction, allowed=allowed, starts=starts, bounces=bounces)
+        one_letter, two_letters = _successor_bounds(automaton)
+        word = two_letters if closed else one_letter
+        return moves * word + len(self.triangle) * one_letter  # and the cells' stutter steps
+
+    def charge(
+        self,
+        abstraction: Abstraction,
+        automaton: Automaton,
+        *,
+        allowed: BoolArray,
+        starts: tuple[StartCell, ...],
+        bounces: bool,
+        closed: bool,
+    ) -> None:
+        """Raises P060 when :meth:`edge_bound` is beyond the planner's budget."""
+        if len(self.group_size) == 0:
+            return
+        widest = int(np.argmax(self.group_size))
+        x, y = abstraction.vertices[self.vertex[self.group_start[widest]]].tolist()
+        budget.check_passage_edges(
+            self.edge_bound(
+                abstraction,
+                automaton,
+                allowed=allowed,
+                starts=starts,
+                bounces=bounces,
+                closed=closed,
+            ),
+            widest_fan=int(self.group_size[widest]),
+            at=(float(x), float(y)),
+        )
+
     def pairs(self, *, bounces: bool) -> tuple[IntArray, IntArray]:
         """Every (source corner, target cell) around one vertex; the same triangle on both
         sides only with ``bounces`` (a U-turn at the vertex)."""
@@ -174,6 +262,48 @@ class _ArrivalCorners:
             distinct = self.triangle[source] != self.triangle[target]
             source, target = source[distinct], target[distinct]
         return source, target
+
+
+def _successor_bounds(automaton: Automaton) -> tuple[int, int]:
+    """Upper bounds, summed over the automaton's states, on the successor states after a word
+    of one letter and of two letters: a letter enables at most a state's out-edges, and no
+    state has more than ``num_states`` successors."""
+    states = automaton.num_states
+    out_degree = np.bincount(
+        np.fromiter((edge.src for edge in automaton.edges), dtype=np.int64),
+        minlength=states,
+    )
+    then = sum(int(out_degree[edge.dst]) for edge in automaton.edges)
+    return min(len(automaton.edges), states * states), min(then, states * states)
+
+
+def estimate_passage_edges(
+    abstraction: Abstraction,
+    automaton: Automaton,
+    *,
+    allowed: BoolArray,
+    starts: tuple[StartCell, ...],
+    convention: str,
+    bounces: bool = False,
+) -> int:
+    """An upper bound on the edges :func:`add_vertex_passages` adds to the product (same
+    arguments), from the allowed triangles around each contact vertex and their neighbours
+    alone (no passage is listed).
+
+    Per passage source: the edges it may be entered by (the one opposite the vertex, any of
+    its three with ``bounces``) times the cells around its vertex (its own only with
+    ``bounces``), and as many again from a start triangle; per cell, its exits into allowed
+    triangles and its stutter steps.  Each move gives at most as many edges as the automaton
+    has successors over the word it reads (two letters under the closed convention).
+    """
+    return _ArrivalCorners.around_contacts(abstraction, allowed).edge_bound(
+        abstraction,
+        automaton,
+        allowed=allowed,
+        starts=starts,
+        bounces=bounces,
+        closed=convention == "closed",
+    )
 
 
 class _LetterIds:
