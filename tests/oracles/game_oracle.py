@@ -134,7 +134,14 @@ def check_strategy(spec: GameSpec, machine: MealyMachine) -> None:
                 match = [s for s in starts if all(s[k] == x[k] for k in x)]
                 assert match, f"no initial node for inputs {x}"
                 assert all(holds(sys_init, s) for s in match)
-    elif spec.init_mode == "all_init":
+    elif spec.init_mode == "one_side" and sys_init:
+        # gr1c: "If SYSINIT: f; then the strategy need only choose one initial state
+        # satisfying f"
+        assert starts, "no initial node"
+        assert all(holds(sys_init, s) for s in starts), "an initial node breaks SYSINIT"
+    else:
+        # ALL_INIT: any state satisfying ENVINIT and SYSINIT; ONE_SIDE_INIT with ENVINIT: f
+        # (or neither, "equivalent to ENVINIT: True"): any state satisfying f
         for s in valuations(inputs + outputs):
             if holds(env_init, s) and holds(sys_init, s):
                 assert any(dict(t) == s for t in starts), f"initial state {s} not served"
@@ -195,8 +202,12 @@ def check_counterstrategy(spec: GameSpec, counter: CounterStrategy) -> None:
         assert starts
         for s in starts:
             assert holds(env_init, s)
-            if spec.init_mode == "all_init":
-                assert holds(sys_init, s)
+            assert holds(sys_init, s)
+        if spec.init_mode == "one_side" and sys_init:
+            # the system picks its start: the environment must defeat every one it may pick
+            for s in valuations(spec.owned("env") + outputs):
+                if holds(sys_init, s):
+                    assert any(dict(t) == s for t in starts), f"start {s} not covered"
     # the environment's moves keep its safety; every allowed system answer is covered
     edges: list[tuple[int, int]] = []
     for node, state in enumerate(states):
@@ -252,24 +263,70 @@ def ltl(expr: Expr) -> str:
     return f"(({ltl(expr.left)}) {expr.op} ({ltl(expr.right)}))"
 
 
-def strict_ltl_of(spec: GameSpec) -> str:
-    """The LTL formula the GR(1) game decides (strict reading, Mealy, gr1c's default initial
-    quantification): ``theta_e -> (theta_s /\\ (rho_s W ~rho_e) /\\ ((G rho_e /\\ GF J^e) ->
-    GF J^s))``."""
+def _conj(parts: tuple[Part, ...]) -> str:
+    return " & ".join(f"({ltl(p.formula)})" for p in parts) or "1"
 
-    def conj(parts: tuple[Part, ...]) -> str:
-        return " & ".join(f"({ltl(p.formula)})" for p in parts) or "1"
 
-    env_safety = conj(spec.select("env", "safety"))
-    sys_safety = conj(spec.select("sys", "safety"))
+def strict_body(spec: GameSpec) -> str:
+    r"""The strict reading after the first state: ``(rho_s W ~rho_e) /\ ((G rho_e /\ GF J^e)
+    -> GF J^s)``."""
+    env_safety = _conj(spec.select("env", "safety"))
+    sys_safety = _conj(spec.select("sys", "safety"))
     env_goals = [f"G F({ltl(p.formula)})" for p in spec.select("env", "liveness")]
     sys_goals = [f"G F({ltl(p.formula)})" for p in spec.select("sys", "liveness")]
     assumption = " & ".join([f"G({env_safety})", *env_goals])
     guarantee = " & ".join(sys_goals) or "1"
+    return f"(({sys_safety}) W !({env_safety})) & (({assumption}) -> ({guarantee}))"
+
+
+def strict_ltl_of(spec: GameSpec) -> str:
+    r"""The LTL formula the GR(1) game decides (strict reading, Mealy, gr1c's default initial
+    quantification): ``theta_e -> (theta_s /\ (rho_s W ~rho_e) /\ ((G rho_e /\ GF J^e) ->
+    GF J^s))``."""
     return (
-        f"({conj(spec.select('env', 'init'))}) -> (({conj(spec.select('sys', 'init'))}) & "
-        f"(({sys_safety}) W !({env_safety})) & (({assumption}) -> ({guarantee})))"
+        f"({_conj(spec.select('env', 'init'))}) -> (({_conj(spec.select('sys', 'init'))}) & "
+        f"{strict_body(spec)})"
     )
+
+
+def spot_realizable(formula: str, outputs: list[str]) -> bool:
+    """Spot's verdict on ``formula`` (Mealy: the outputs answer the inputs of the same step)."""
+    import spot
+
+    arena = spot.ltl_to_game(spot.formula(formula), outputs, spot.synthesis_info())
+    return bool(spot.solve_game(arena))
+
+
+def spot_verdict(spec: GameSpec) -> bool:
+    r"""Whether the game is realizable under its initial quantification, decided by Spot (only
+    Boolean variables), the quantification read from gr1c's documentation, not from tlmpc:
+
+    * ALL_ENV_EXIST_SYS_INIT: the strict formula with both initial conditions;
+    * ALL_INIT: the system wins from every state satisfying ENVINIT and SYSINIT;
+    * ONE_SIDE_INIT: with SYSINIT (and no ENVINIT), from some state satisfying it; else from
+      every state satisfying ENVINIT (none: ``ENVINIT: True``).
+
+    The system wins from a state when it wins ``(inputs = v) -> (outputs = v /\ body)``: the
+    environment's first inputs are the state's, and the system must answer with its outputs.
+    """
+    outputs = [v.name for v in spec.owned("sys")]
+    if spec.init_mode == "forall_env_exists_sys":
+        return spot_realizable(strict_ltl_of(spec), outputs)
+    env_init, sys_init = spec.select("env", "init"), spec.select("sys", "init")
+    body = strict_body(spec)
+
+    def wins_from(state: dict[str, Value]) -> bool:
+        def literals(variables: tuple[Variable, ...]) -> str:
+            return " & ".join(f"{'' if state[v.name] else '!'}{v.name}" for v in variables) or "1"
+
+        formula = f"({literals(spec.owned('env'))}) -> (({literals(spec.owned('sys'))}) & {body})"
+        return spot_realizable(formula, outputs)
+
+    states = list(valuations(spec.owned("env") + spec.owned("sys")))
+    if spec.init_mode == "one_side" and sys_init:
+        assert not env_init, "ONE_SIDE_INIT takes at most one initial condition"
+        return any(wins_from(s) for s in states if holds(sys_init, s))
+    return all(wins_from(s) for s in states if holds(env_init + sys_init, s))
 
 
 def explore(spec: GameSpec, strategy: SymbolicStrategy) -> MealyMachine:

@@ -153,7 +153,7 @@ def test_all_init_changes_the_answer(tmp_path: Path) -> None:
             "k.tlsf",
             "INFO { SEMANTICS: Mealy; }\nMAIN { INPUTS { a; } OUTPUTS { b; }\n"
             "REQUIRE { a -> X a; } ASSERT { b -> X b; } }\n",
-            ":3:11:",
+            ":3:32:",
             "Q047",
         ),
         # no MAIN (an empty file is not the trivial game), no SEMANTICS (strict or not?)
@@ -184,6 +184,30 @@ def test_a_refusal_is_located_and_exits_2(
     assert out == ""
     assert f"{spec}{where} error[{code}]" in err
     assert "hint:" in err
+
+
+def test_one_side_init_refuses_both_initial_conditions(tmp_path: Path) -> None:
+    spec = write(tmp_path, "both.spc", "ENV: e;\nSYS: s;\nENVINIT: e;\nSYSINIT: s;\n")
+    code, out, err = run("synth", str(spec), "--one-side-init")
+    assert (code, out) == (2, "")
+    assert f"{spec}:4:10: error[Q016]" in err
+
+
+def test_a_tlsf_core_names_whole_conjuncts(tmp_path: Path) -> None:
+    spec = write(
+        tmp_path,
+        "core.tlsf",
+        "INFO { SEMANTICS: Mealy,Strict }\nMAIN { INPUTS { r; } OUTPUTS { g; }\n"
+        "ASSERT { (g && r) || (!g && !r) -> X(!g); }\n"
+        "GUARANTEE { G F ((g || r) && (g || !r)); }\n}\n",
+    )
+    code, out, _ = run("synth", str(spec), "--json")
+    assert code == 1
+    core = json.loads(out)["result"]["core"]
+    assert [(p["line"], p["col"], p["text"]) for p in core] == [
+        (3, 10, "(g && r) || (!g && !r) -> X(!g)"),
+        (4, 17, "((g || r) && (g || !r))"),
+    ]
 
 
 def test_all_init_is_refused_for_tlsf(tmp_path: Path) -> None:

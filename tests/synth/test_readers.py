@@ -2,14 +2,17 @@
 
 from __future__ import annotations
 
+import itertools
+
 import pytest
+from game_oracle import evaluate
 
 from tlmpc.base.errors import UsageError
 from tlmpc.synth.readers.gr1c import parse_gr1c
 from tlmpc.synth.readers.slugsin import parse_slugsin
 from tlmpc.synth.readers.tlsf import parse_tlsf
 from tlmpc.synth.solver import Game, solve
-from tlmpc.synth.spec import Atom, Binary, Nary, Not
+from tlmpc.synth.spec import Atom, Binary, Nary, Not, Part
 
 
 def test_gr1c_and_or_share_a_level_and_group_left() -> None:
@@ -81,7 +84,7 @@ def test_tlsf_sections_become_parts_of_the_right_player() -> None:
         _tlsf(
             "Mealy,Strict",
             "INITIALLY { !r; }\nPRESET { !g; }\nREQUIRE { g -> X !r; }\n"
-            "ASSERT { X g <-> r; }\nASSUME { G F r; }\nGUARANTEE { G F g && G (r -> g); }",
+            "ASSERT { X g <-> r; }\nASSUME { G F r; }\nGUARANTEE { G F g; }",
         )
     )
     kinds = [(p.owner, p.kind) for p in spec.parts]
@@ -92,11 +95,22 @@ def test_tlsf_sections_become_parts_of_the_right_player() -> None:
         ("sys", "safety"),
         ("env", "liveness"),
         ("sys", "liveness"),
+    ]
+    # a G in ASSUME is environment safety, a G in GUARANTEE system safety (each where the game
+    # decides the file's meaning: see test_tlsf_meaning)
+    assumed = parse_tlsf(_tlsf("Mealy,Strict", "ASSUME { G F r && G (r -> X !r); }"))
+    assert [(p.owner, p.kind) for p in assumed.parts] == [("env", "liveness"), ("env", "safety")]
+    unconditioned = parse_tlsf(
+        _tlsf("Mealy,Strict", "PRESET { !g; }\nASSERT { X g <-> r; }\nGUARANTEE { G (r -> g); }")
+    )
+    assert [(p.owner, p.kind) for p in unconditioned.parts] == [
+        ("sys", "init"),
+        ("sys", "safety"),
         ("sys", "safety"),
     ]
-    # g follows r one step late, so the first r (allowed while g is low) finds g low and
-    # breaks G (r -> g): unrealizable
-    assert not solve(Game.build(spec)).realizable
+    # g follows r one step late, so the first r finds g low and breaks G (r -> g):
+    # unrealizable
+    assert not solve(Game.build(unconditioned)).realizable
 
 
 def test_tlsf_mealy_lets_the_system_see_the_inputs_of_the_step() -> None:
@@ -151,3 +165,47 @@ def test_gr1c_one_side_init() -> None:
     assert not solve(Game.build(env_side)).realizable
     env_side_ok = parse_gr1c(frozen + "ENVINIT: y;\n", init_mode="one_side")
     assert solve(Game.build(env_side_ok)).realizable
+
+
+def _same_function(left: Part, right: Part) -> bool:
+    """Whether two parts' formulas agree on every valuation of r, g and their next values."""
+    names = [("r", False), ("g", False), ("r", True), ("g", True)]
+    for bits in itertools.product([False, True], repeat=len(names)):
+        values = dict(zip(names, bits, strict=True))
+        now = {name: v for (name, primed), v in values.items() if not primed}
+        nxt = {name: v for (name, primed), v in values.items() if primed}
+        if evaluate(left.formula, now, nxt) != evaluate(right.formula, now, nxt):
+            return False
+    return True
+
+
+@pytest.mark.parametrize(
+    ("section", "formula", "text"),
+    [
+        ("ASSERT", "(g && r) || (!g && !r) -> X(!g)", "(g && r) || (!g && !r) -> X(!g)"),
+        ("ASSERT", "G ((g))", "((g))"),
+        ("REQUIRE", "(!r) -> X (r)", "(!r) -> X (r)"),
+        ("REQUIRE", "X !r || g", "X !r || g"),
+        ("ASSERT", "!g && X (g || r)", "!g && X (g || r)"),
+        ("GUARANTEE", "G F ((g || r) && (g || !r))", "((g || r) && (g || !r))"),
+        ("GUARANTEE", "(G (g -> X r)) && G F (g)", "(g -> X r)"),
+        ("ASSUME", "G F r && (G F (!r))", "r"),
+        ("PRESET", "((g) && (r || !g))", "((g) && (r || !g))"),
+    ],
+)
+def test_tlsf_part_is_its_whole_conjunct_as_written(section: str, formula: str, text: str) -> None:
+    """A part's location is where its conjunct starts and its text the conjunct as written
+    (parentheses included): read back in the same section, the text is the same formula."""
+    body = f"{section} {{ {formula}; }}"
+    source = _tlsf("Mealy,Strict", body)
+    spec = parse_tlsf(source)
+    first = spec.parts[0]
+    assert first.text == text
+    line = source.splitlines()[first.location.line - 1]
+    assert line[first.location.col - 1 :].startswith(text)
+    for part in spec.parts:
+        again = part.text if part.kind != "liveness" else f"G F {part.text}"
+        if section in ("ASSUME", "GUARANTEE") and part.kind == "safety":
+            again = f"G {part.text}"
+        (reread,) = parse_tlsf(_tlsf("Mealy,Strict", f"{section} {{ {again}; }}")).parts
+        assert _same_function(part, reread), (part.text, again)

@@ -183,10 +183,9 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         from tlmpc.synth.counter import extract_counterstrategy
 
         core = minimal_core(spec, game.enc)
-        core_spec = spec.with_parts(tuple(p for p in spec.parts if p.owner == "env") + core.parts)
         counter: CounterStrategy | None = None
         try:
-            counter = extract_counterstrategy(solve(Game.build(core_spec, game.enc)))
+            counter = extract_counterstrategy(solve(core.game(game.enc)))
         except UsageError as exc:
             if exc.diagnostics[0].code != "Q062":
                 raise

@@ -1,7 +1,8 @@
 """Solve a reactive mission: its GR(1) game, realizability, and a core when it is not.
 
-The core is the smallest set of task parts (deletion-minimal) that no robot strategy can
-meet under all of the mission's assumptions: every one of them is needed for the conflict.
+The core is a set of task parts that no robot strategy can meet under all of the mission's
+assumptions, from which no part can be dropped (deletion-minimal: every one of them is needed
+for the conflict); a smaller core of other parts may exist.
 Assumptions stay in the game while the core is sought (taking one away only makes the robot's
 task harder, so none would ever be needed).
 """

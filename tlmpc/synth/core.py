@@ -1,10 +1,21 @@
 """Unrealizability cores: a minimal set of system guarantees that is already unrealizable.
 
-Deletion-based: parts are dropped (in chunks that halve down to single parts) while the game
-stays unrealizable; the parts left are a core in which dropping any one part makes the game
-realizable.  Every environment assumption stays: dropping an assumption only frees the
-environment, so it can never turn an unrealizable game realizable, and an assumption is
-therefore never needed in, nor removable from, the explanation.
+Deletion-based: guarantees are dropped (in chunks that halve down to single parts) while the
+game stays unrealizable; the guarantees left are a core in which dropping any one makes the
+game realizable.  That last pass proves it only because dropping a guarantee can never make
+the game harder (monotonicity): a guarantee needed when it was tested is still needed once
+others are gone.  So the parts whose removal *can* make the game harder are held in every
+trial and are never in a core:
+
+* the environment's assumptions (dropping one frees the environment);
+* the system's initial condition when every state it allows must be won (``every_state``:
+  gr1c's ALL_INIT, slugs' robotics semantics): there it narrows the starts the environment may
+  pick, like an assumption.
+
+Every trial also keeps the start rule of the whole specification
+(:func:`~tlmpc.synth.solver.start_rule`): under gr1c's ONE_SIDE_INIT, dropping the last
+SYSINIT conjunct reads it as ``SYSINIT: True`` (the system still picks the start), not as an
+empty section, which would ask every state to win.
 """
 
 from __future__ import annotations
@@ -12,17 +23,34 @@ from __future__ import annotations
 from collections.abc import Callable, Hashable
 from dataclasses import dataclass
 
-from tlmpc.synth.solver import Game, solve
+from tlmpc.synth.solver import Game, StartRule, solve, start_rule
 from tlmpc.synth.spec import GameSpec, Part
 from tlmpc.synth.symbolic import Encoding
 
 
 @dataclass(frozen=True)
 class Core:
-    """A minimal unrealizable set of guarantees (``parts``) and the solves it took."""
+    """A minimal unrealizable set of guarantees (``parts``) and the solves it took.
+
+    ``spec`` is the core's game: the parts held in every trial (``held``) and ``parts``, in
+    the specification's order, read with the whole specification's ``start`` rule."""
 
     parts: tuple[Part, ...]
+    held: tuple[Part, ...]
+    spec: GameSpec
+    start: StartRule
     solves: int
+
+    def game(self, enc: Encoding | None = None) -> Game:
+        """The core's game (unrealizable), for its counterstrategy."""
+        return Game.build(self.spec, enc, start=self.start)
+
+
+def held_parts(spec: GameSpec, start: StartRule) -> tuple[Part, ...]:
+    """The parts a core search never drops: those whose removal can make the game harder."""
+    return tuple(
+        p for p in spec.parts if p.owner == "env" or (p.kind == "init" and start == "every_state")
+    )
 
 
 def minimal_core(
@@ -39,35 +67,47 @@ def minimal_core(
     """
     enc = enc or Encoding(spec)
     key = group or id
-    assumptions = tuple(p for p in spec.parts if p.owner == "env")
-    fixed = tuple(p for p in spec.parts if p.owner == "sys" and key(p) is None)
+    start = start_rule(spec)
+    held = held_parts(spec, start)
+    held_ids = {id(p) for p in held}
+    fixed = tuple(p for p in spec.parts if id(p) not in held_ids and key(p) is None)
     members: dict[Hashable, list[Part]] = {}
     for part in spec.parts:
-        if part.owner == "sys" and key(part) is not None:
+        if id(part) not in held_ids and key(part) is not None:
             members.setdefault(key(part), []).append(part)
     kept = list(members)
     solves = 0
 
+    def trial_spec(groups: list[Hashable]) -> GameSpec:
+        chosen = held_ids | {id(p) for p in fixed} | {id(p) for g in groups for p in members[g]}
+        return spec.with_parts(tuple(p for p in spec.parts if id(p) in chosen))
+
     def unrealizable(groups: list[Hashable]) -> bool:
         nonlocal solves
         solves += 1
-        guarantees = tuple(p for g in groups for p in members[g])
-        trial = spec.with_parts(assumptions + fixed + guarantees)
-        return not solve(Game.build(trial, enc), keep_layers=False).realizable
+        trial = Game.build(trial_spec(groups), enc, start=start)
+        return not solve(trial, keep_layers=False).realizable
 
     if not unrealizable(kept):
         raise ValueError("the specification is realizable: it has no unrealizability core")
     chunk = max(1, len(kept) // 2)
     while True:
-        start = 0
-        while start < len(kept):
-            trial = kept[:start] + kept[start + chunk :]
+        index = 0
+        while index < len(kept):
+            trial = kept[:index] + kept[index + chunk :]
             if unrealizable(trial):
                 kept = trial
             else:
-                start += chunk
+                index += chunk
         if chunk == 1:
             break
         chunk = max(1, chunk // 2)
     enc.spec = spec
-    return Core(parts=tuple(p for g in kept for p in members[g]), solves=solves)
+    core_spec = trial_spec(kept)
+    return Core(
+        parts=tuple(p for g in kept for p in members[g]),
+        held=held,
+        spec=core_spec,
+        start=start,
+        solves=solves,
+    )

@@ -165,13 +165,12 @@ def extract_counterstrategy(solution: Solution, *, max_nodes: int = MAX_NODES) -
             queue.append(found)
         return found
 
-    env_start = game.env_init & enc.domain("env", False)
-    sys_start = game.sys_init & enc.domain("sys", False)
-    mode = game.spec.init_mode
     initial_inputs: dict[str, Value] | None = None
     starts: list[dict[str, Value]] = []
-    if mode == "forall_env_exists_sys":
+    if game.start == "each_input":
         # an initial input from which every allowed initial output loses
+        env_start = game.env_init & enc.domain("env", False)
+        sys_start = game.sys_init & enc.domain("sys", False)
         bad = env_start & bdd.forall(outputs, ~sys_start | losing)
         x = smallest(enc, bdd.exist(outputs, bad), ordered_bits(enc, "env", False))
         assert x is not None, "unrealizable, yet every initial input has a winning answer"
@@ -180,15 +179,13 @@ def extract_counterstrategy(solution: Solution, *, max_nodes: int = MAX_NODES) -
         for y in all_assignments(enc, answers, ordered_bits(enc, "sys", False)):
             starts.append(enc.decode({**x, **y}, None, False))
     else:
-        if mode == "all_init":
-            start = env_start & sys_start & losing
-        elif game.spec.select("env", "init") or not game.spec.select("sys", "init"):
-            start = env_start & losing
-        else:  # one side, system's: every start the system may pick loses
-            start = sys_start & env_start & domain
+        # every_state: one losing state the play may start in; some_state: every start the
+        # system may pick (all of them lose)
+        first = game.first_states()
+        start = first & losing if game.start == "every_state" else first
         for s in all_assignments(enc, start, ordered_bits(enc, None, False)):
             starts.append(enc.decode(s, None, False))
-            if mode != "one_side" or game.spec.select("env", "init"):
+            if game.start == "every_state":
                 break
     initial = tuple(node(s, 0, 0) for s in sorted(starts, key=_key))
     moves: list[dict[str, Value]] = []

@@ -20,11 +20,36 @@ Mealy machine in :mod:`tlmpc.synth.strategy` is built from them.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Literal
 
 from dd import cudd
 
-from tlmpc.synth.spec import GameSpec, InitMode
+from tlmpc.synth.spec import GameSpec
 from tlmpc.synth.symbolic import Encoding, Function
+
+#: Who picks the first state, the one reading of the initial conditions that the verdict, the
+#: strategies and the counterstrategy share (:func:`start_rule` decides it): ``each_input``,
+#: for every first input the environment's initial condition allows the system answers with
+#: first outputs its own allows; ``every_state``, any state both allow may be the first;
+#: ``some_state``, the system picks one first state its initial condition allows.
+StartRule = Literal["each_input", "every_state", "some_state"]
+
+
+def start_rule(spec: GameSpec) -> StartRule:
+    """How ``spec``'s initial conditions are read under its initial-state quantification.
+
+    gr1c's ONE_SIDE_INIT takes at most one non-empty initial condition (the readers refuse
+    both): the system's alone is ``some_state``; the environment's alone, or none (which is
+    ``ENVINIT: True``), is ``every_state``.  Raises ValueError for both under ONE_SIDE_INIT.
+    """
+    if spec.init_mode == "forall_env_exists_sys":
+        return "each_input"
+    if spec.init_mode == "all_init":
+        return "every_state"
+    has_env, has_sys = bool(spec.select("env", "init")), bool(spec.select("sys", "init"))
+    if has_env and has_sys:
+        raise ValueError("gr1c's ONE_SIDE_INIT takes at most one non-empty initial condition")
+    return "some_state" if has_sys else "every_state"
 
 
 @dataclass
@@ -39,10 +64,16 @@ class Game:
     sys_safety: Function
     env_goals: list[Function]
     sys_goals: list[Function]
+    #: who picks the first state (:func:`start_rule` of the spec, unless given)
+    start: StartRule
 
     @classmethod
-    def build(cls, spec: GameSpec, enc: Encoding | None = None) -> Game:
-        """Translate ``spec`` (reusing ``enc``'s BDDs of parts when given)."""
+    def build(
+        cls, spec: GameSpec, enc: Encoding | None = None, *, start: StartRule | None = None
+    ) -> Game:
+        """Translate ``spec`` (reusing ``enc``'s BDDs of parts when given).  ``start``
+        overrides the spec's own :func:`start_rule` (an unrealizability core keeps the rule of
+        the whole specification while it drops parts)."""
         if enc is None:
             enc = Encoding(spec)
         else:
@@ -59,7 +90,13 @@ class Game:
             sys_safety=enc.conjoin(spec.select("sys", "safety")) & enc.domain("sys", True),
             env_goals=env_goals,
             sys_goals=sys_goals,
+            start=start or start_rule(spec),
         )
+
+    def first_states(self) -> Function:
+        """The states both initial conditions allow (within the variables' domains): under
+        ``every_state`` each may be the first, under ``some_state`` the system picks one."""
+        return self.env_init & self.sys_init & self.enc.domain(None, False)
 
 
 @dataclass
@@ -184,29 +221,23 @@ def solve(game: Game, *, keep_layers: bool = True) -> Solution:
     return Solution(
         game=game,
         winning=z,
-        realizable=initially_winning(game, z, game.spec.init_mode),
+        realizable=initially_winning(game, z),
         layers=layers,
         cpre_count=cpre.count,
     )
 
 
-def initially_winning(game: Game, winning: Function, mode: InitMode) -> bool:
-    """Whether the initial condition is met from ``winning`` under ``mode``."""
+def initially_winning(game: Game, winning: Function) -> bool:
+    """Whether the initial condition is met from ``winning`` under the game's start rule."""
     enc = game.enc
     bdd = enc.bdd
     inputs = enc.names("env", False)
     outputs = enc.names("sys", False)
-    domain = enc.domain(None, False)
-    if mode == "forall_env_exists_sys":
-        answer = bdd.exist(outputs, winning & game.sys_init & domain)
+    if game.start == "each_input":
+        answer = bdd.exist(outputs, winning & game.first_states())
         result = bdd.forall(inputs, ~game.env_init | answer)
-    elif mode == "all_init":
-        result = bdd.forall(inputs | outputs, ~(game.env_init & game.sys_init & domain) | winning)
-    else:  # gr1c's ONE_SIDE_INIT
-        has_sys = bool(game.spec.select("sys", "init"))
-        has_env = bool(game.spec.select("env", "init"))
-        if has_sys and not has_env:
-            result = bdd.exist(inputs | outputs, game.sys_init & domain & winning)
-        else:
-            result = bdd.forall(inputs | outputs, ~(game.env_init & domain) | winning)
+    elif game.start == "every_state":
+        result = bdd.forall(inputs | outputs, ~game.first_states() | winning)
+    else:
+        result = bdd.exist(inputs | outputs, game.first_states() & winning)
     return bool(result == bdd.true)

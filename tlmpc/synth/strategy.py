@@ -145,31 +145,40 @@ def _key(values: dict[str, Value]) -> tuple[Value, ...]:
     return tuple(values[k] for k in sorted(values))
 
 
+def picked_start(solution: Solution) -> dict[str, bool]:
+    """The first state the system picks where it picks one (``some_state``): the
+    lexicographically first winning state its initial condition allows, as bits."""
+    game = solution.game
+    enc = game.enc
+    bits = ordered_bits(enc, "env", False) + ordered_bits(enc, "sys", False)
+    start = smallest(enc, game.first_states() & solution.winning, bits)
+    assert start is not None, "realizable, yet no first state is winning"
+    return start
+
+
 def initial_states(solution: Solution) -> list[dict[str, Value]]:
-    """The initial states the machine must serve, under the spec's quantification."""
+    """The initial states the machine must serve, under the game's start rule: the first
+    winning answer to each first input (``each_input``), every state both initial conditions
+    allow (``every_state``: the verdict asked them all to be winning), or the first winning
+    one the system picks (``some_state``)."""
     game = solution.game
     enc = game.enc
     bdd = enc.bdd
     outputs = enc.names("sys", False)
-    env_start = game.env_init & enc.domain("env", False)
-    sys_start = game.sys_init & enc.domain("sys", False)
-    mode = game.spec.init_mode
     states: list[dict[str, Value]] = []
     input_bits = ordered_bits(enc, "env", False)
     output_bits = ordered_bits(enc, "sys", False)
-    if mode == "forall_env_exists_sys":
+    if game.start == "each_input":
+        env_start = game.env_init & enc.domain("env", False)
         for x in all_assignments(enc, bdd.exist(outputs, env_start), input_bits):
-            answer = restrict(enc, x, sys_start & solution.winning)
+            answer = restrict(enc, x, game.first_states() & solution.winning)
             y = smallest(enc, answer, output_bits)
             assert y is not None, "realizable, yet an initial input has no winning answer"
             states.append(enc.decode({**x, **y}, None, False))
-    elif mode == "one_side" and not game.spec.select("env", "init"):
-        start = smallest(enc, sys_start & env_start & solution.winning, input_bits + output_bits)
-        assert start is not None
-        states.append(enc.decode(start, None, False))
+    elif game.start == "some_state":
+        states.append(enc.decode(picked_start(solution), None, False))
     else:
-        both = env_start & sys_start if mode == "all_init" else env_start & enc.domain(None, False)
-        for s in all_assignments(enc, both, input_bits + output_bits):
+        for s in all_assignments(enc, game.first_states(), input_bits + output_bits):
             states.append(enc.decode(s, None, False))
     return sorted(states, key=_key)
 

@@ -35,7 +35,7 @@ from tlmpc.synth.strategy import (
     Value,
     goal_strategies,
     ordered_bits,
-    smallest,
+    picked_start,
     variable_from_json,
     variable_json,
 )
@@ -214,20 +214,11 @@ def _starting_set(solution: Solution) -> Function:
     """The first states the strategy serves (the explicit machine's initial states)."""
     game = solution.game
     enc = game.enc
-    env_start = game.env_init & enc.domain("env", False)
-    sys_start = game.sys_init & enc.domain("sys", False)
-    mode = game.spec.init_mode
-    if mode == "forall_env_exists_sys":
-        return env_start & sys_start & solution.winning
-    if mode == "one_side" and not game.spec.select("env", "init"):
-        # the system picks one start: the lexicographically first winning one
-        bits = ordered_bits(enc, "env", False) + ordered_bits(enc, "sys", False)
-        start = smallest(enc, sys_start & env_start & solution.winning, bits)
-        assert start is not None
-        return enc.bdd.cube(start)
-    if mode == "all_init":
-        return env_start & sys_start
-    return env_start & enc.domain(None, False)
+    if game.start == "each_input":
+        return game.first_states() & solution.winning
+    if game.start == "some_state":
+        return enc.bdd.cube(picked_start(solution))
+    return game.first_states()
 
 
 def symbolic_strategy(solution: Solution) -> SymbolicStrategy:
@@ -362,7 +353,7 @@ def reachable_size(solution: Solution, strategy: SymbolicStrategy | None = None)
     goals = len(game.sys_goals)
     reached = [bdd.false] * goals
     reached[0] = _starting_set(solution)
-    if game.spec.init_mode == "forall_env_exists_sys":
+    if game.start == "each_input":
         # the explicit machine serves each first input with the first winning answer
         outputs = ordered_bits(enc, "sys", False)
         pick = bdd.true

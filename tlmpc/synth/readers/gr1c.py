@@ -10,7 +10,8 @@ right after it.  Each conjunct is one part of the game (for unrealizability core
 
 Initial conditions follow gr1c's ``-n`` option: ``forall_env_exists_sys`` (gr1c's default
 ``ALL_ENV_EXIST_SYS_INIT``: ENVINIT only over environment variables, SYSINIT only over system
-ones), ``all_init`` (``ALL_INIT``) or ``one_side`` (``ONE_SIDE_INIT``).
+ones), ``all_init`` (``ALL_INIT``) or ``one_side`` (``ONE_SIDE_INIT``: at most one of ENVINIT
+and SYSINIT, both is refused, Q016).
 """
 
 from __future__ import annotations
@@ -119,7 +120,8 @@ class _Parser:
         self.init_mode = init_mode
         self.variables: dict[str, Variable] = {}
         self.parts: list[Part] = []
-        self.seen_sections: set[str] = set()
+        #: where each player's initial condition starts (ONE_SIDE_INIT takes only one)
+        self.init_starts: dict[Owner, int] = {}
 
     # --- token helpers --------------------------------------------------------------------
 
@@ -169,6 +171,15 @@ class _Parser:
                 "no variables are declared",
                 0,
                 "declare at least one variable in ENV: or SYS: (gr1c requires one)",
+            )
+        if self.init_mode == "one_side" and "env" in self.init_starts and "sys" in self.init_starts:
+            raise self.source.fail(
+                "Q016",
+                "SYSINIT beside ENVINIT: gr1c's ONE_SIDE_INIT takes at most one of them",
+                self.init_starts["sys"],
+                "keep ENVINIT (every state it allows may be the first) or SYSINIT (the system "
+                "picks a first state it allows), or read with --all-init (every state both "
+                "allow may be the first)",
             )
         return GameSpec(
             variables=tuple(self.variables.values()),
@@ -273,6 +284,8 @@ class _Parser:
 
     def add_part(self, owner: Owner, kind: PartKind, formula: Expr, start: int) -> None:
         end = self.tokens[self.pos - 1].end
+        if kind == "init":
+            self.init_starts.setdefault(owner, start)
         used = support(formula)
         for name, primed in sorted(used):
             variable = self.variables[name]

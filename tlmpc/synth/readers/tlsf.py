@@ -13,13 +13,15 @@ GR(1) translation does (the one SYNTCOMP feeds GR(1) tools with):
 * ``ASSUME`` / ``GUARANTEE``: conjunctions of ``G F b`` (liveness) and ``G s`` (safety).
 
 Anything else is outside GR(1) and refused with a diagnostic saying why and how to rewrite it.
+So is a file whose meaning the game would not decide exactly (Q047, :func:`_undecided`: e.g.
+non-strict system safety beside assumptions, or a ``G s`` in GUARANTEE under ASSUME).
 Parametric TLSF (a non-empty ``GLOBAL``) and Moore semantics are refused as well.
 """
 
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from tlmpc.base.errors import UsageError
 from tlmpc.synth.readers.source import Source
@@ -67,11 +69,16 @@ class Token:
 @dataclass(frozen=True, eq=False)
 class Node:
     """A TLSF formula node: ``op`` is ``ap``, ``const``, ``!``, ``&&``, ``||``, ``->``,
-    ``<->``, ``X``, ``G``, ``F``, ``U``, ``W`` or ``R``."""
+    ``<->``, ``X``, ``G``, ``F``, ``U``, ``W`` or ``R``.
+
+    ``start`` is where the node's operator (or atom) is written, the place of a diagnostic
+    about it; ``span`` the offsets of the whole formula as written, from its first to the end
+    of its last token, parentheses around it included (a part's location and text)."""
 
     op: str
     args: tuple[Node, ...]
     start: int
+    span: tuple[int, int]
     name: str = ""
     value: bool = False
 
@@ -138,25 +145,28 @@ class _Parser:
             right_assoc = op.text != "R" and op.text not in ("&&", "||")
             if right_assoc:
                 right = self.formula(level)
-                return Node(op.text, (left, right), op.start)
+                return Node(op.text, (left, right), op.start, (left.span[0], right.span[1]))
             right = self.formula(level + 1)
-            left = Node(op.text, (left, right), op.start)
+            left = Node(op.text, (left, right), op.start, (left.span[0], right.span[1]))
             while self.token.text in ops and self.token.kind in ("op", "ident"):
                 op = self.advance()
                 right = self.formula(level + 1)
-                left = Node(op.text, (left, right), op.start)
+                left = Node(op.text, (left, right), op.start, (left.span[0], right.span[1]))
         return left
 
     def unary(self) -> Node:
         token = self.advance()
         if token.text in _UNARY and token.kind in ("op", "ident"):
-            return Node(token.text, (self.unary(),), token.start)
+            operand = self.unary()
+            return Node(token.text, (operand,), token.start, (token.start, operand.span[1]))
         if token.text == "(" and token.kind == "op":
             inner = self.formula()
-            self.expect(")", "close the parenthesis")
-            return inner
+            close = self.expect(")", "close the parenthesis")
+            return replace(inner, span=(token.start, close.end))
         if token.kind == "ident" and token.text in ("true", "false"):
-            return Node("const", (), token.start, value=token.text == "true")
+            return Node(
+                "const", (), token.start, (token.start, token.end), value=token.text == "true"
+            )
         if token.kind == "ident" and token.text not in _BINARY_TEMPORAL:
             if self.token.text == "[" or self.token.text == "(":
                 raise self.source.fail(
@@ -166,7 +176,7 @@ class _Parser:
                     "only basic TLSF is read: expand parametric TLSF first "
                     "(syfco -f basic spec.tlsf)",
                 )
-            return Node("ap", (), token.start, name=token.text)
+            return Node("ap", (), token.start, (token.start, token.end), name=token.text)
         if token.kind == "other":
             raise self.source.fail(
                 "Q040",
@@ -487,31 +497,18 @@ def parse_tlsf(
         variables[token.text] = Variable(token.text, "env" if section == "INPUTS" else "sys")
     lowering = _Lowering(source, variables)
     parts: list[Part] = []
+    roles: dict[str, list[tuple[Node, Node]]] = {}
     for section, node in formulas:
         for owner, kind, expr, origin in lowering.parts(section, node):
-            end = _end_offset(parser, origin)
+            start, end = origin.span
             parts.append(
-                Part(
-                    owner,
-                    kind,
-                    expr,
-                    source.location(_start_offset(origin)),
-                    source.excerpt(_start_offset(origin), end),
-                )
+                Part(owner, kind, expr, source.location(start), source.excerpt(start, end))
             )
-    strict = "Strict" in semantics.split(",")
-    has_env_safety = any(p.owner == "env" and p.kind == "safety" for p in parts)
-    has_sys_safety = any(p.owner == "sys" and p.kind == "safety" for p in parts)
-    if not strict and has_env_safety and has_sys_safety:
-        first = next(p for p in parts if p.owner == "env" and p.kind == "safety")
-        raise source.fail(
-            "Q047",
-            "non-strict semantics with safety on both sides: G REQUIRE -> G ASSERT is an "
-            "implication the GR(1) game does not decide",
-            _offset_of(source, first.location.line, first.location.col),
-            "declare SEMANTICS: Mealy,Strict (the system keeps its safety until the environment "
-            "breaks its own), the reading GR(1) tools use",
-        )
+            roles.setdefault(_role(section, kind), []).append((node, origin))
+    undecided = _undecided("Strict" in semantics.split(","), roles)
+    if undecided is not None:
+        where, message, hint = undecided
+        raise source.fail("Q047", message, where.span[0], hint)
     return GameSpec(
         variables=tuple(variables.values()),
         parts=tuple(parts),
@@ -521,33 +518,83 @@ def parse_tlsf(
     )
 
 
-def _start_offset(node: Node) -> int:
-    return min([node.start, *(_start_offset(a) for a in node.args)])
+def _role(section: str, kind: PartKind) -> str:
+    """A part's place in TLSF's meaning: its section, and for ASSUME and GUARANTEE whether it
+    is a ``G`` (safety) or a ``G F`` (goal) conjunct."""
+    section = {"INVARIANTS": "ASSERT", "ASSUMPTIONS": "ASSUME", "GUARANTEES": "GUARANTEE"}.get(
+        section, section
+    )
+    if section in ("ASSUME", "GUARANTEE"):
+        return f"{section} {'G F' if kind == 'liveness' else 'G'}"
+    return section
 
 
-def _end_offset(parser: _Parser, node: Node) -> int:
-    """The end of the last token of ``node`` (the token before the next ';' or '}')."""
-    last = max([node.start, *(_end_start(a) for a in node.args)])
-    index = next(i for i, t in enumerate(parser.tokens) if t.start >= last)
-    depth = 0
-    while index < len(parser.tokens) - 1:
-        token = parser.tokens[index]
-        if token.text == "(":
-            depth += 1
-        elif token.text == ")":
-            if depth == 0:
-                break
-            depth -= 1
-        elif token.text in (";", "}") and depth == 0:
-            break
-        index += 1
-    return parser.tokens[index - 1].end
+def _undecided(
+    strict: bool, roles: dict[str, list[tuple[Node, Node]]]
+) -> tuple[Node, str, str] | None:
+    """Where the GR(1) game would decide something else than the TLSF file means: the part to
+    blame, why, and the rewrite; None when the game decides exactly the file's meaning.
 
+    TLSF means (syfco's ``merge``, the formulas as written, empty conjunctions true)
+    ``INITIALLY -> (PRESET && ((G REQUIRE && ASSUME) -> (G ASSERT && GUARANTEE)))``, and under
+    strict semantics ``INITIALLY -> (PRESET && (ASSERT W !REQUIRE) && ((G REQUIRE && ASSUME)
+    -> GUARANTEE))``.  The game decides ``INITIALLY -> (PRESET && (S W !E) && ((G E && G F
+    a...) -> G F g...))`` with E = REQUIRE and ASSUME's ``G`` parts, S = ASSERT and
+    GUARANTEE's ``G`` parts.  Term by term the two agree exactly when
 
-def _end_start(node: Node) -> int:
-    return max([node.start, *(_end_start(a) for a in node.args)])
+    * non-strict: S is empty, or nothing conditions it (no REQUIRE, no ASSUME);
+    * strict: GUARANTEE's ``G`` parts are conditioned by nothing (no REQUIRE, no ASSUME),
+      ASSUME's ``G`` parts release no ASSERT (there is none), and ``ASSERT W !REQUIRE`` is
+      ``a W !r`` of the steps' formulas (no ``G`` on top of either side when both are there).
 
+    Otherwise the file's meaning is an implication between safety and the other side's
+    assumptions, which a GR(1) game does not decide in general, and the file is refused.
+    """
 
-def _offset_of(source: Source, line: int, col: int) -> int:
-    lines = source.text.split("\n")
-    return sum(len(text) + 1 for text in lines[: line - 1]) + col - 1
+    def first(*names: str) -> Node | None:
+        found = [origin for name in names for _, origin in roles.get(name, ())]
+        return min(found, key=lambda n: n.span[0]) if found else None
+
+    conditions = first("REQUIRE", "ASSUME G", "ASSUME G F")
+    if not strict:
+        safety = first("ASSERT", "GUARANTEE G")
+        if safety is not None and conditions is not None:
+            return (
+                safety,
+                "non-strict semantics: the system's safety must hold only while the "
+                "environment keeps REQUIRE and ASSUME (G REQUIRE && ASSUME -> G ASSERT && "
+                "GUARANTEE), an implication the GR(1) game does not decide",
+                "declare SEMANTICS: Mealy,Strict and write the system's safety in ASSERT: it "
+                "then holds until the environment breaks REQUIRE, the reading GR(1) tools use",
+            )
+        return None
+    guarantee_safety = first("GUARANTEE G")
+    if guarantee_safety is not None and conditions is not None:
+        return (
+            guarantee_safety,
+            "G in GUARANTEE must hold only while the environment keeps REQUIRE and ASSUME "
+            "(G REQUIRE && ASSUME -> GUARANTEE), an implication the GR(1) game does not decide",
+            "write it in ASSERT: it then holds until the environment breaks REQUIRE, the "
+            "reading GR(1) tools use",
+        )
+    assume_safety = first("ASSUME G")
+    if assume_safety is not None and "ASSERT" in roles:
+        return (
+            assume_safety,
+            "G in ASSUME beside ASSERT: ASSERT must hold until REQUIRE is broken, whatever "
+            "ASSUME's safety does, and the GR(1) game would release it when ASSUME's safety "
+            "is broken",
+            "write the environment's safety in REQUIRE: ASSERT then holds until it is broken",
+        )
+    if "ASSERT" in roles and "REQUIRE" in roles:
+        for name in ("REQUIRE", "ASSERT"):
+            for formula, _ in roles[name]:
+                if formula.op == "G":
+                    return (
+                        formula,
+                        f"G on top of a {name} formula: strict semantics reads ASSERT W "
+                        "!REQUIRE with the formulas as written, and (G a) W !r, a W !(G r) "
+                        "are not the step-by-step a W !r the GR(1) game decides",
+                        f"drop the G: a {name} formula holds in every step by itself",
+                    )
+    return None
