@@ -25,7 +25,7 @@ import numpy.typing as npt
 
 from tlmpc.ltl.ast import Formula, bounded_operators
 from tlmpc.ltl.printer import to_text
-from tlmpc.verify.clock import at
+from tlmpc.verify.clock import Clock
 from tlmpc.verify.evaluate import Value
 from tlmpc.verify.model import AssumeGuarantee, Blame, Outcome, PartVerdict
 from tlmpc.verify.semantics import PieceEnding, Semantics, Timing
@@ -56,7 +56,8 @@ def _prefix_atoms(atoms: Callable[[str], Value], cut: int) -> Callable[[str], Va
 
 class Prefixes:
     """The open (three-valued) verdicts of the run's first ``cut`` pieces, one evaluator per
-    cut: what was known of a formula at the first instant of piece ``cut - 1``."""
+    cut: what was known of a formula at the first instant of piece ``cut - 1`` (``starts``:
+    seconds from the first sample)."""
 
     def __init__(
         self, atoms: Callable[[str], Value], starts: FloatArray, is_point: BoolArray | None
@@ -92,7 +93,8 @@ def breaking_time(
     prefixes: Prefixes,
     ending: PieceEnding,
 ) -> float | None:
-    """The earliest piece start at which the run's prefix is bad for ``formula``.
+    """The earliest piece start (seconds from the first sample) at which the run's prefix is
+    bad for ``formula``.
 
     Bad prefixes stay bad when the run goes on (the evaluator refines the unknown future),
     so the earliest is found by bisection over the cuts.  A time-bounded formula is cut only
@@ -183,12 +185,14 @@ def assume_guarantee(
 
 
 def blame_lines(judged: AssumeGuarantee, start: float) -> list[str]:
-    """The text report's lines on who broke what (indented, no newlines)."""
+    """The text report's lines on who broke what (indented, no newlines); ``start``: the
+    stamp of the log's first sample."""
+    clock = Clock(start, start)
 
     def when(part: PartVerdict) -> str:
         if part.broken is None:
             return "in the limit (on the repeating part, at no single instant)"
-        return "at " + at(part.broken, start)
+        return "at " + clock.at(part.broken)
 
     lines: list[str] = []
     environment, robot = judged.environment, judged.robot

@@ -1,5 +1,9 @@
 """Dense-time evaluation of formulas with time bounds (MTL over continuous time).
 
+Times are seconds from the trace's first instant, ``T_0 = 0`` (the log's stamps less its first
+one): at an epoch of 1.7e9 s a stamp is rounded to 2.4e-7 s, and a window end ``T_j - b``
+taken in stamps would land on an instant nearby.
+
 Every sub-formula's value is a **signal**: piecewise constant between the instants of its
 grid ``T_0 < T_1 < ... < T_m``, with a value at each instant (a *point* position) and one on
 each open stretch after it (an *open* position): positions ``2i`` (the instant ``T_i``) and
@@ -19,13 +23,16 @@ each end is computed on its own.
   evaluated exactly at each of them and at the middle of each stretch between them, with the
   comparisons made in shifted time (``t <= T_j - a`` rather than ``t + a <= T_j``, so that
   a window end falling on an instant is decided the same way each time it is computed).
+* Every result drops the instants where its value does not change (but the trace's own): the
+  grids stay as large as the values are varied, however deeply bounds are nested.
 * ``x U[a,b] y = G[0,a) x & F[a,a] (x U[0,b-a] y)`` (for ``a > 0``) and
   ``x U[0,c] y = (x U y) & F[0,c] y``: exact identities of the non-strict until (by cases on
   the witness, for every threshold of the real-valued reading).
 * A loop repeats with its period ``P``: windows are evaluated on the trace unrolled far
-  enough; a window longer than ``a + P + (loop start - T_0)`` meets nothing new and is cut
-  there (so ``b = inf`` needs finitely many copies).  A stay or an open log: the tail takes
-  part in every window that reaches past the last instant.
+  enough, from the copy ``a`` reaches; a window longer than ``a + P + (loop start - T_0)``
+  meets nothing new and is cut there (so ``b = inf`` needs finitely many copies).  A window
+  meeting more than :data:`MAX_UNROLLED` pieces of the copies is refused.  A stay or an open
+  log: the tail takes part in every window that reaches past the last instant.
 """
 
 from __future__ import annotations
@@ -65,10 +72,29 @@ IntArray = npt.NDArray[np.int64]
 #: What follows the last piece: the loop's first piece, ``stay`` or ``open``.
 PieceEnding = int | Literal["stay", "open"]
 
+#: A window on a loop lays out at most this many pieces of the loop's copies (refused beyond,
+#: :class:`UnrollTooLong`): a window ``[t + a, t + b]`` sliding over the whole trace meets
+#: about (length of the trace + b - a) / period copies, millions when a long log ends in a
+#: loop of a few milliseconds, and then that many instants in its result.
+MAX_UNROLLED = 1 << 21
+
+
+class UnrollTooLong(ValueError):
+    """A window on a loop would lay out more than :data:`MAX_UNROLLED` pieces of its copies."""
+
+    def __init__(self, low: float, high: float, period: float, pieces: int) -> None:
+        super().__init__(
+            f"a window [t + {low:g}, t + {high:g}] on a loop of period {period:g} s meets "
+            f"{pieces:,} pieces of its copies, more than the {MAX_UNROLLED:,} the verifier lays "
+            "out"
+        )
+        self.pieces = pieces
+
 
 @dataclass(frozen=True, slots=True)
 class Timing:
-    """When each piece starts, and when the last one ends (a loop: the wrap instant).
+    """When each piece starts, and when the last one ends (a loop: the wrap instant), in
+    seconds from the first piece's instant (0): the log's stamps less its first one.
 
     Pieces alternate: an instant (a point piece) at each even index, the open stretch up to
     the next instant at each odd one.
@@ -167,6 +193,10 @@ class DenseSemantics:
         starts = np.asarray(timing.starts, dtype=np.float64)
         if len(starts) != size:
             raise ValueError("one start time per piece")
+        if starts[0] != 0.0:
+            # a window end t + b is decided on exact differences of the stamps, never on a
+            # stamp of 1.7e9 s, whose rounding (2e-7 s) would move it onto an instant nearby
+            raise ValueError("times count from the first piece's instant, 0")
         looping = isinstance(ending, int)
         if looping != (size % 2 == 0):
             raise ValueError("pieces alternate: a loop ends on an open piece, else on an instant")
@@ -222,6 +252,37 @@ class DenseSemantics:
             both = signal.lo[positions]
             return both, both
         return signal.lo[positions], signal.hi[positions]
+
+    def _compact(self, times: FloatArray, lo: FloatArray, hi: FloatArray) -> Signal:
+        """The signal of values ``lo``, ``hi`` on ``times`` without the instants where nothing
+        changes: an instant whose value is that of the stretches on both sides goes, its two
+        stretches becoming one (the trace's own instants stay: every signal is read there).
+
+        A bounded operator adds ``T_j - a`` and ``T_j - b`` for every instant of its operand;
+        kept, they would multiply with each level of nesting, while a window's value changes
+        only where the window takes in or lets go of a piece holding its maximum: at most
+        once per piece of the operand."""
+        count = len(times)
+        if count < 2:
+            return Signal(times, lo, hi)
+
+        def steady(values: FloatArray) -> npt.NDArray[np.bool_]:
+            # instant i (from 1): the stretch before (2i - 1), the instant (2i), after (2i + 1)
+            flat: npt.NDArray[np.bool_] = (values[1:-1:2] == values[2::2]) & (
+                values[2::2] == values[3::2]
+            )
+            return flat
+
+        keep = np.ones(count, dtype=bool)
+        keep[1:] = ~(steady(lo) if lo is hi else steady(lo) & steady(hi))
+        if keep.all():
+            return Signal(times, lo, hi)
+        keep[np.searchsorted(times, self.base_times)] = True
+        if keep.all():
+            return Signal(times, lo, hi)
+        positions = np.repeat(keep, 2)
+        kept_lo = lo[positions]
+        return Signal(times[keep], kept_lo, kept_lo if lo is hi else hi[positions])
 
     def _common(self, signals: list[Signal]) -> tuple[FloatArray, list[Value]]:
         times = signals[0].times
@@ -281,7 +342,7 @@ class DenseSemantics:
         times, values = self._common(operands)
         evaluator = self._lasso(times, lambda name: values[int(name[1:])])
         lo, hi = evaluator(shape)
-        return Signal(times, lo, hi)
+        return self._compact(times, lo, hi)
 
     def meet(self, first: Signal, second: Signal) -> Signal:
         """``first & second``."""
@@ -290,10 +351,11 @@ class DenseSemantics:
     # -- time bounds --------------------------------------------------------------------------
 
     def _extended(
-        self, signal: Signal, horizon: float
+        self, signal: Signal, low: float, high: float
     ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, npt.NDArray[np.bool_]]:
-        """Every piece of ``signal`` up to ``horizon`` past the domain's end: starts, ends,
-        lo, hi and whether it is an instant (a loop is unrolled; a tail runs to infinity)."""
+        """Every piece of ``signal`` a window ``[t + low, t + high]`` may meet: starts, ends,
+        lo, hi and whether it is an instant (a loop is unrolled up to ``high`` past the
+        domain's end, from the copy ``low`` reaches; a tail runs to infinity)."""
         times = signal.times
         count = 2 * len(times)
         starts = np.repeat(times, 2)
@@ -309,16 +371,25 @@ class DenseSemantics:
         ends[-1] = domain.end
         period = domain.period
         first = self._loop_position(times)
-        copies = math.ceil(horizon / period) + 1
-        shifts = np.repeat(np.arange(1, copies + 1, dtype=np.float64) * period, count - first)
-        starts = np.concatenate([starts, np.tile(starts[first:], copies) + shifts])
-        ends = np.concatenate([ends, np.tile(ends[first:], copies) + shifts])
-        lo = np.concatenate([signal.lo, np.tile(signal.lo[first:], copies)])
+        last_copy = math.ceil(high / period) + 1
+        # Copy k ends at ``end + k P``; one ending a period before ``low`` is met by no window
+        # (all start at or after ``low``), nor is anything before it.
+        first_copy = max(1, math.floor((low - domain.end) / period) - 1)
+        copies = last_copy - first_copy + 1
+        if copies * (count - first) > MAX_UNROLLED:
+            raise UnrollTooLong(low, high, period, copies * (count - first))
+        shifts = np.repeat(
+            np.arange(first_copy, last_copy + 1, dtype=np.float64) * period, count - first
+        )
+        keep = slice(0, count) if first_copy == 1 else slice(count, count)  # the trace itself
+        starts = np.concatenate([starts[keep], np.tile(starts[first:], copies) + shifts])
+        ends = np.concatenate([ends[keep], np.tile(ends[first:], copies) + shifts])
+        lo = np.concatenate([signal.lo[keep], np.tile(signal.lo[first:], copies)])
         if signal.lo is signal.hi:
             hi = lo
         else:
-            hi = np.concatenate([signal.hi, np.tile(signal.hi[first:], copies)])
-        is_point = np.concatenate([is_point, np.tile(is_point[first:], copies)])
+            hi = np.concatenate([signal.hi[keep], np.tile(signal.hi[first:], copies)])
+        is_point = np.concatenate([is_point[keep], np.tile(is_point[first:], copies)])
         return starts, ends, lo, hi, is_point
 
     def window(
@@ -332,7 +403,7 @@ class DenseSemantics:
             reach = low + domain.period + (domain.loop_time - domain.start)
             if high > reach:
                 high, right_closed = reach, True
-        starts, ends, lo, hi, is_point = self._extended(signal, high)
+        starts, ends, lo, hi, is_point = self._extended(signal, low, high)
         instants = starts[is_point]
         candidates = [signal.times, instants - low]
         if math.isfinite(high):
@@ -367,7 +438,7 @@ class DenseSemantics:
         if domain.loop_time is None:
             # On the tail the window lies wholly in it: its constant value.
             out_lo[-1], out_hi[-1] = signal.lo[-1], signal.hi[-1]
-        return Signal(grid, out_lo, out_hi)
+        return self._compact(grid, out_lo, out_hi)
 
     def bounded_until(self, left: Signal, right: Signal, low: float, high: float) -> Signal:
         """``left U[low,high] right``."""

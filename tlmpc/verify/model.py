@@ -75,8 +75,9 @@ class PartVerdict:
 
     part: str
     outcome: Outcome
-    #: the earliest instant (the log's clock) at which the run's prefix was bad for the part;
-    #: None when it never was (it holds, is undecided, or fails only in the limit)
+    #: the earliest instant (seconds from the log's first sample) at which the run's prefix was
+    #: bad for the part; None when it never was (it holds, is undecided, or fails only in the
+    #: limit)
     broken: float | None
 
 

@@ -22,7 +22,7 @@ from tlmpc.ltl.ast import (
     Until,
 )
 from tlmpc.ltl.printer import to_text
-from tlmpc.verify.clock import at, seconds
+from tlmpc.verify.clock import Clock, seconds
 from tlmpc.verify.evaluate import Value
 from tlmpc.verify.model import ConjunctReport, Outcome, Violation
 
@@ -32,14 +32,15 @@ FloatArray = npt.NDArray[np.float64]
 
 @dataclass(frozen=True, slots=True)
 class Timeline:
-    """The pieces in time: when each starts and ends, where it is, what it is labelled."""
+    """The pieces in time: when each starts and ends (seconds from the log's first sample),
+    where it is, what it is labelled."""
 
     starts: FloatArray
     ends: FloatArray
     positions: FloatArray
     labels: BoolArray
     names: list[str]
-    origin: float = 0.0  # the time of the log's first sample: times are reported from it
+    clock: Clock  # the log's stamps of these times, and how they are written
     #: the names that are sensors or actions, not regions (a reactive run's)
     signals: frozenset[str] = frozenset()
 
@@ -59,6 +60,7 @@ def runs(mask: BoolArray) -> list[tuple[int, int]]:
 
 
 def _at(line: Timeline, k: int) -> tuple[float, tuple[float, float]]:
+    """When piece ``k`` starts (from the first sample) and where."""
     x, y = line.positions[k].tolist()
     return float(line.starts[k]), (float(x), float(y))
 
@@ -98,10 +100,14 @@ def _globally_violations(
         time, position = _at(line, first)
         if isinstance(inner, Eventually):
             message = (
-                f"`{to_text(inner.arg)}` never holds again after {at(time, line.origin)} "
+                f"`{to_text(inner.arg)}` never holds again after {line.clock.at(time)} "
                 f"(from {_place(position)}), so `{text}` fails"
             )
-            found.append(Violation(conjunct=text, time=time, position=position, message=message))
+            found.append(
+                Violation(
+                    conjunct=text, time=line.clock.stamp(time), position=position, message=message
+                )
+            )
             continue
         true = [line.names[i] for i in np.flatnonzero(line.labels[first])]
         inside = [name for name in true if name not in line.signals]
@@ -111,19 +117,23 @@ def _globally_violations(
             if isinstance(n, Not) and isinstance(n.arg, Prop) and n.arg.name in true
         ]
         if forbidden and forbidden[0] in line.signals:
-            message = f"`{forbidden[0]}` is true at {at(time, line.origin)} at {_place(position)}"
+            message = f"`{forbidden[0]}` is true at {line.clock.at(time)} at {_place(position)}"
         elif forbidden:
-            message = f"entered {forbidden[0]} at {at(time, line.origin)} at {_place(position)}"
+            message = f"entered {forbidden[0]} at {line.clock.at(time)} at {_place(position)}"
         else:
             where = ", ".join(inside) if inside else "free space"
             message = (
-                f"`{to_text(inner)}` stops holding at {at(time, line.origin)} at "
+                f"`{to_text(inner)}` stops holding at {line.clock.at(time)} at "
                 f"{_place(position)} "
                 f"(in {where})"
             )
         duration = float(line.ends[last]) - time
         message += f" for {duration:.4g} s while `{text}` must hold"
-        found.append(Violation(conjunct=text, time=time, position=position, message=message))
+        found.append(
+            Violation(
+                conjunct=text, time=line.clock.stamp(time), position=position, message=message
+            )
+        )
     return found
 
 
@@ -149,9 +159,9 @@ def _other_violation(
                 time, position = _at(line, int(bad[0]))
                 return Violation(
                     conjunct=text,
-                    time=time,
+                    time=line.clock.stamp(time),
                     position=position,
-                    message=f"`{to_text(left)}` stops holding at {at(time, line.origin)} at "
+                    message=f"`{to_text(left)}` stops holding at {line.clock.at(time)} at "
                     f"{_place(position)} before `{to_text(right)}` holds",
                 )
             if right_never.all():
@@ -184,7 +194,7 @@ def _progress(
             count, last, gap = _visits(line, held(goal))
             if last is not None:  # visited at least once
                 progress = (
-                    f"visited {_times(count)}, last at {at(last, line.origin)}, "
+                    f"visited {_times(count)}, last at {line.clock.at(last)}, "
                     f"longest gap {gap:.4g} s"
                 )
             else:
@@ -194,14 +204,14 @@ def _progress(
                 outcome=outcome,
                 progress=progress,
                 visits=count,
-                last_visit=last,
+                last_visit=None if last is None else line.clock.stamp(last),
                 longest_gap=gap,
             )
         case Eventually(arg):
             found = runs(held(arg))
             if found:
                 time = float(line.starts[found[0][0]])
-                progress = f"done at {at(time, line.origin)}"
+                progress = f"done at {line.clock.at(time)}"
             else:
                 progress = "pending" if outcome == "inconclusive" else "never done"
             return ConjunctReport(
@@ -211,7 +221,7 @@ def _progress(
             broken = runs(value(arg)[1][:size] < 0)
             if broken:
                 time = float(line.starts[broken[0][0]])
-                progress = f"broken {_times(len(broken))}, first at {at(time, line.origin)}"
+                progress = f"broken {_times(len(broken))}, first at {line.clock.at(time)}"
             else:
                 progress = "held so far" if outcome == "inconclusive" else "held throughout"
             return ConjunctReport(conjunct=text, outcome=outcome, progress=progress)
@@ -219,7 +229,7 @@ def _progress(
             found = runs(held(right))
             if found and outcome == "satisfied":
                 reached = float(line.starts[found[0][0]])
-                progress = f"`{to_text(right)}` reached at {at(reached, line.origin)}"
+                progress = f"`{to_text(right)}` reached at {line.clock.at(reached)}"
             else:
                 progress = words[outcome]
             return ConjunctReport(conjunct=text, outcome=outcome, progress=progress)
@@ -272,11 +282,12 @@ def timed_progress(
     first_broken: float | None,
     *,
     first_done: float | None = None,
-    origin: float = 0.0,
+    clock: Clock,
 ) -> str | None:
     """Progress of a conjunct with time bounds, from its time robustness ``slack``;
     ``first_broken`` (the first instant its ``G`` is broken) and ``first_done`` (a deadline's
-    first instant done) are the log's own times, written from its first sample at ``origin``.
+    first instant done) are seconds from the log's first sample, as every bound is; ``clock``
+    writes them.
 
     None when the conjunct has no time bound or no time robustness.
     """
@@ -284,11 +295,11 @@ def timed_progress(
         if isinstance(conjunct, BoundedEventually):
             return f"pending: deadline t={seconds(conjunct.interval.high)} s"
         return (
-            "pending" if first_broken is None else f"pending (broken at {at(first_broken, origin)})"
+            "pending" if first_broken is None else f"pending (broken at {clock.at(first_broken)})"
         )
     if slack is None:
         return None
-    where = f" at {at(first_broken, origin)}" if first_broken is not None else ""
+    where = f" at {clock.at(first_broken)}" if first_broken is not None else ""
     if math.isinf(slack):
         return "holds at any bound" if slack > 0 else "fails at any bound"
     match conjunct:
@@ -297,7 +308,7 @@ def timed_progress(
             if slack >= 0:
                 # from the instant itself where it is known: deadline - slack cancels to
                 # nothing when the deadline is far
-                done = deadline - slack if first_done is None else first_done - origin
+                done = deadline - slack if first_done is None else first_done
                 return (
                     f"done at t={seconds(done)} s, {_seconds(deadline - done)} before the "
                     f"deadline t={seconds(deadline)} s"

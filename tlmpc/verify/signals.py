@@ -228,6 +228,15 @@ def with_cuts(
     return all_times[order], merged_points, where[: len(times)]
 
 
+def counted_from(signals: Mapping[str, Signal], zero: float) -> dict[str, Signal]:
+    """``signals`` with their times counted from ``zero`` (the log's first sample, as the
+    verifier counts every time)."""
+    return {
+        name: Signal(signal.name, signal.times - zero, signal.values)
+        for name, signal in signals.items()
+    }
+
+
 def change_times(signals: Mapping[str, Signal]) -> FloatArray:
     """Every instant at which some signal changes (its first point included: from unknown)."""
     if not signals:

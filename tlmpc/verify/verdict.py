@@ -3,19 +3,22 @@ robustness that agrees with the verdict, and the certificate for the real robot.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import math
-from collections.abc import Callable, Set
+from collections.abc import Callable, Iterator, Mapping, Set
 from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 import shapely
 
+from tlmpc.base.errors import UsageError, error
 from tlmpc.ltl.ast import And, BoundedEventually, Formula, Globally, bounded_operators
 from tlmpc.ltl.printer import to_text
 from tlmpc.verify.blame import Prefixes, assume_guarantee
-from tlmpc.verify.clock import at, elapsed
+from tlmpc.verify.clock import Clock, since_first
+from tlmpc.verify.dense import DenseSemantics, Domain, UnrollTooLong
 from tlmpc.verify.evaluate import Value, truth_atoms
 from tlmpc.verify.model import (
     AssumeGuarantee,
@@ -31,7 +34,7 @@ from tlmpc.verify.pieces import Pieces, build_pieces, merge_pieces, region_membe
 from tlmpc.verify.progress import Timeline, conjunct_reports, runs, timed_progress
 from tlmpc.verify.robustness import piece_atoms, speed_excess, tube_atoms, tube_radii
 from tlmpc.verify.semantics import PieceEnding, Semantics, Timing
-from tlmpc.verify.signals import change_times, signal_labels, with_cuts
+from tlmpc.verify.signals import Signal, change_times, counted_from, signal_labels, with_cuts
 from tlmpc.verify.time_robustness import horizon, reach, time_robustness
 from tlmpc.verify.trace_input import TraceInput
 
@@ -79,14 +82,19 @@ def _piece_ending(trace: TraceInput, pieces: Pieces) -> PieceEnding:
     return "stay"
 
 
+def _clock(trace: TraceInput) -> Clock:
+    """The log's stamps of the verifier's times (from its first sample), and where messages
+    count from."""
+    return Clock(float(trace.times[0]), trace.start)
+
+
 def _sample_cells(
-    trace: TraceInput, atoms: Callable[[str], Value]
+    trace: TraceInput, times: FloatArray, atoms: Callable[[str], Value]
 ) -> tuple[Callable[[str], Value], int, PieceEnding, Timing]:
-    """The samples as a dense-time signal: sample i's bounds hold from the middle of the gap
-    before it to the middle of the gap after it; at a middle instant both neighbours' bounds
-    hold (the robot is within each one's radius then), so their intersection is taken.  A
-    loop's last sample is the wrap back to its first."""
-    times = trace.times
+    """The samples (at ``times``, from the first) as a dense-time signal: sample i's bounds
+    hold from the middle of the gap before it to the middle of the gap after it; at a middle
+    instant both neighbours' bounds hold (the robot is within each one's radius then), so
+    their intersection is taken.  A loop's last sample is the wrap back to its first."""
     n = len(times)
     middles = (times[:-1] + times[1:]) / 2.0
     loop = trace.loop_start if trace.ending == "loop" else None
@@ -105,13 +113,15 @@ def _sample_cells(
             instants.append(float(times[i]))
             owners.append((i, i))
             loop_instant = len(instants) - 1
-    stretch.append(n - 1)
-    if loop is None:
+    if loop is not None:
+        stretch.append(n - 1)  # up to the wrap
+    elif n > 1:  # (a single sample is one instant)
+        stretch.append(n - 1)
         instants.append(float(times[-1]))
         owners.append((n - 1, n - 1))
     first = np.array([o[0] for o in owners])
     second = np.array([o[1] for o in owners])
-    stretch_of = np.array(stretch)
+    stretch_of = np.array(stretch, dtype=np.int64)
     size = len(instants) + len(stretch)
     starts = np.empty(size)
     starts[0::2] = instants
@@ -133,13 +143,13 @@ def _sample_cells(
 
 
 def _prefix_end(starts: FloatArray, span: float) -> int | None:
-    """How many pieces cover ``[T_0, T_0 + span]`` and end on an instant after it (None: the
-    trace is not longer than that)."""
+    """How many pieces (``starts``: from the first sample, 0) cover ``[0, span]`` and end on an
+    instant after it (None: the trace is not longer than that)."""
     if not math.isfinite(span):
         return None
     # pieces come in pairs (an instant and the stretch after it, with one start): an even count
     # ends on a stretch, closed by the instant at ``index``; an odd one is the whole trace
-    index = int(np.searchsorted(starts, starts[0] + span, side="right"))
+    index = int(np.searchsorted(starts, span, side="right"))
     if index % 2 or index >= len(starts):
         return None
     return index + 1
@@ -164,18 +174,30 @@ def _with_time_robustness(
             first_broken = float(line.starts[int(broken[0])])
     first_done = None
     if isinstance(conjunct, BoundedEventually) and report.outcome == "satisfied":
-        # the first piece where the goal holds that reaches the bound's low end
-        low = line.origin + conjunct.interval.low
-        held = truth(conjunct.arg)[0][: line.size] > 0
-        reaching = held & ((line.ends > low) | (line.starts >= low))
-        if reaching.any():
-            first_done = max(float(line.starts[int(np.argmax(reaching))]), low)
+        first_done = _first_done(truth.dense(), conjunct.arg, conjunct.interval.low)
     progress = timed_progress(
-        conjunct, report.outcome, slack, first_broken, first_done=first_done, origin=line.origin
+        conjunct, report.outcome, slack, first_broken, first_done=first_done, clock=line.clock
     )
     return dataclasses.replace(
         report, time_robustness=slack, progress=progress if progress else report.progress
     )
+
+
+def _first_done(dense: DenseSemantics, goal: Formula, low: float) -> float | None:
+    """When ``goal`` first holds at or after ``low`` (a deadline's goal done): an instant of its
+    signal, or the start of an open stretch reaching past ``low`` (from the signal, not the
+    pieces: a goal with bounds of its own may begin to hold inside a piece); None: not within
+    the trace."""
+    signal = dense.signal(goal)
+    times, domain = signal.times, dense.domain
+    ends = np.append(times[1:], np.inf if domain.loop_time is None else domain.end)
+    held = signal.lo > 0
+    reaching = np.empty(2 * len(times), dtype=bool)
+    reaching[0::2] = held[0::2] & (times >= low)
+    reaching[1::2] = held[1::2] & (ends > low)
+    if not reaching.any():
+        return None
+    return max(float(times[int(np.argmax(reaching)) // 2]), low)
 
 
 def _timed_violations(
@@ -184,11 +206,12 @@ def _timed_violations(
     found: list[Violation],
     truth: Semantics,
     trace: TraceInput,
+    times: FloatArray,
     line: Timeline,
 ) -> list[Violation]:
     """The violations of conjuncts with time bounds, in dense time: for ``G x``, each maximal
     stretch of instants where ``x`` fails (exact ends), where it starts; for the others, their
-    progress."""
+    progress (``times``: the samples', from the first)."""
     timed = {
         to_text(c): (c, r)
         for c, r in zip(conjuncts, reports, strict=True)
@@ -206,18 +229,19 @@ def _timed_violations(
             )
             continue
         signal = truth.dense().signal(conjunct.arg)
-        stretches = _failing_stretches(signal.times, signal.hi, truth.dense().domain.end)
+        stretches = _failing_stretches(signal.times, signal.hi, truth.dense().domain)
         for start, end in stretches:
-            x, y = _position(line, trace, start)
+            x, y = _position(line, times, trace.points, start)
+            clock = line.clock
             when = (
-                f"at {at(start, trace.start)}"
+                f"at {clock.at(start)}"
                 if end == start
-                else f"from {at(start, trace.start)} to {at(end, trace.start)}"
+                else f"from {clock.at(start)} to {clock.at(end)}"
             )
             kept.append(
                 Counterexample(
                     conjunct=text,
-                    time=start,
+                    time=clock.stamp(start),
                     position=(x, y),
                     message=f"`{to_text(conjunct.arg)}` fails {when}, starting at "
                     f"({x:.4g}, {y:.4g}), while `{text}` must hold",
@@ -226,25 +250,30 @@ def _timed_violations(
     return kept
 
 
-def _position(line: Timeline, trace: TraceInput, time: float) -> tuple[float, float]:
+def _position(
+    line: Timeline, times: FloatArray, points: FloatArray, time: float
+) -> tuple[float, float]:
     """Where the robot is at ``time``: the piece's own position where a piece starts then (a
-    sample or a crossing, as every other message places it), else between the samples."""
+    sample or a crossing, as every other message places it), else between the samples
+    (``points`` at ``times``; every time from the first sample)."""
     k = int(np.searchsorted(line.starts, time))
     if k < line.size and line.starts[k] == time:
         x, y = line.positions[k].tolist()
         return float(x), float(y)
     return (
-        float(np.interp(time, trace.times, trace.points[:, 0])),
-        float(np.interp(time, trace.times, trace.points[:, 1])),
+        float(np.interp(time, times, points[:, 0])),
+        float(np.interp(time, times, points[:, 1])),
     )
 
 
 def _failing_stretches(
-    times: FloatArray, hi: FloatArray, domain_end: float
+    times: FloatArray, hi: FloatArray, domain: Domain
 ) -> list[tuple[float, float]]:
-    """Maximal stretches ``[start, end]`` of a signal's positions where ``hi < 0`` (the last
-    open position, a tail, is left out: it is not part of the trace)."""
-    bad = hi[: 2 * len(times) - 1] < 0
+    """Maximal stretches ``[start, end]`` of a signal's positions where ``hi < 0``: a loop's
+    last open position runs to the wrap; a stay's or an open log's, its tail, is left out (it
+    is not part of the trace)."""
+    positions = 2 * len(times) - (1 if domain.loop_time is None else 0)
+    bad = hi[:positions] < 0
     stretches: list[tuple[float, float]] = []
     for first, last in runs(bad):
         start = float(times[first // 2])
@@ -252,7 +281,7 @@ def _failing_stretches(
         end = (
             float(times[last // 2])
             if last % 2 == 0
-            else float(times[last // 2 + 1] if last // 2 + 1 < len(times) else domain_end)
+            else float(times[last // 2 + 1] if last // 2 + 1 < len(times) else domain.end)
         )
         stretches.append((start, end))
     return stretches
@@ -282,7 +311,7 @@ def _body_contacts(
     if not len(touching):
         return []
     index = int(touching[0])
-    points = trace.points
+    points, times, clock = trace.points, since_first(trace.times), _clock(trace)
     segment = points[index : index + 2]
     # where the segment first comes within the radius: its first point outside the free space
     # shrunk by the radius (a fine polygon of it; the sample nearest the wall if none is found)
@@ -294,21 +323,21 @@ def _body_contacts(
         first = near[int(np.argmin(along))]
         length = float(np.linalg.norm(segment[1] - segment[0]))
         fraction = float(np.min(along)) / length if length > 0.0 else 0.0
-        time = float(trace.times[index] + fraction * (trace.times[index + 1] - trace.times[index]))
+        time = float(times[index] + fraction * (times[index + 1] - times[index]))
     else:
         offsets = np.asarray(
             shapely.distance(free.boundary, shapely.points(segment)), dtype=np.float64
         )
         first = segment[int(np.argmin(offsets))]
-        time = float(trace.times[min(index + int(np.argmin(offsets)), len(points) - 1)])
+        time = float(times[min(index + int(np.argmin(offsets)), len(points) - 1)])
     x, y = float(first[0]), float(first[1])
     return [
         Counterexample(
             conjunct="workspace",
-            time=time,
+            time=clock.stamp(time),
             position=(x, y),
             message=f"the robot's body (radius {trace.radius:g}) touches an obstacle from "
-            f"{at(time, trace.start)} at ({x:.4g}, {y:.4g}): the path passes "
+            f"{clock.at(time)} at ({x:.4g}, {y:.4g}): the path passes "
             f"{float(distances[index]):.4g} from it",
         )
     ]
@@ -335,6 +364,7 @@ def workspace_violations(trace: TraceInput) -> tuple[list[Violation], float | No
     found: list[Violation] = []
     depth = 0.0
     previous_bad = False
+    times, clock = since_first(trace.times), _clock(trace)
     for index in range(len(segments)):
         if inside[index]:
             previous_bad = False
@@ -362,10 +392,9 @@ def workspace_violations(trace: TraceInput) -> tuple[list[Violation], float | No
         if len(points) > 1:
             length = float(np.linalg.norm(points[index + 1] - start))
             fraction = float(np.linalg.norm(entry - start) / length) if length > 0 else 0.0
-            gap = trace.times[index + 1] - trace.times[index]
-            time = float(trace.times[index] + fraction * gap)
+            time = float(times[index] + fraction * (times[index + 1] - times[index]))
         else:
-            time = float(trace.times[0])
+            time = 0.0
         in_hole = any(
             shapely.Polygon(h).intersects(segments[index])
             for h in (*trace.holes, *(h for _, holes in trace.components for h in holes))
@@ -375,9 +404,9 @@ def workspace_violations(trace: TraceInput) -> tuple[list[Violation], float | No
         found.append(
             Counterexample(
                 conjunct="workspace",
-                time=time,
+                time=clock.stamp(time),
                 position=(x, y),
-                message=f"the trajectory {where} at {at(time, trace.start)} at ({x:.4g}, {y:.4g})",
+                message=f"the trajectory {where} at {clock.at(time)} at ({x:.4g}, {y:.4g})",
             )
         )
     if trace.radius > 0.0:
@@ -391,8 +420,8 @@ def workspace_violations(trace: TraceInput) -> tuple[list[Violation], float | No
 
 def certify(trace: TraceInput, regions: dict[str, FloatArray], outcome: Outcome) -> Certificate:
     """Check the speed assumption, then bound the robustness of every motion it allows."""
-    times, points = trace.times, trace.points
-    gaps = np.diff(times)
+    stamps, points = trace.times, trace.points
+    gaps = np.diff(stamps)
     max_gap = float(gaps.max()) if len(gaps) else 0.0
     speeds = np.linalg.norm(np.diff(points, axis=0), axis=1) / gaps if len(gaps) else np.zeros(0)
     observed = float(speeds.max()) if len(speeds) else 0.0
@@ -411,11 +440,13 @@ def certify(trace: TraceInput, regions: dict[str, FloatArray], outcome: Outcome)
 
     if speed is None:
         return refuse("no max_speed is known, so nothing bounds the motion between samples")
-    excess = speed_excess(times, points, speed)
+    # on the stamps as logged: the check allows for their rounding
+    excess = speed_excess(stamps, points, speed)
+    times = since_first(stamps)
     if excess.any():
         index = int(np.argmax(np.where(excess > 0.0, speeds, -np.inf)))
-        origin = float(times[0])
-        begin, end = at(float(times[index]), origin), at(float(times[index + 1]), origin)
+        clock = _clock(trace)
+        begin, end = clock.at(float(times[index])), clock.at(float(times[index + 1]))
         return refuse(
             f"the log moves at {float(speeds[index]):.4g} m/s between {begin} and {end}, "
             f"faster than max_speed {speed:.4g}: the "
@@ -427,7 +458,7 @@ def certify(trace: TraceInput, regions: dict[str, FloatArray], outcome: Outcome)
         return refuse("an inconclusive verdict has nothing to certify", bound)
     atoms = tube_atoms(regions, points, radii)
     if bounded_operators(trace.formula):
-        cells, size, ending, timing = _sample_cells(trace, atoms)
+        cells, size, ending, timing = _sample_cells(trace, times, atoms)
         tube = Semantics(cells, size, ending, timing=timing)
     else:
         samples: PieceEnding = "open"
@@ -464,8 +495,10 @@ def certify(trace: TraceInput, regions: dict[str, FloatArray], outcome: Outcome)
 @dataclasses.dataclass(frozen=True, slots=True)
 class _Truth:
     """The trace cut into pieces at the crossings of the regions its task mentions, and the
-    exact truth of formulas on them."""
+    exact truth of formulas on them; every time from the first sample (``times``: the
+    samples')."""
 
+    times: FloatArray
     pieces: Pieces
     regions: dict[str, FloatArray]
     names: list[str]
@@ -502,18 +535,21 @@ def _truth_of(trace: TraceInput) -> _Truth:
     regions = {n: p for n, p in trace.regions.items() if n in mentioned}
     names = list(regions)
     loop_start = trace.loop_start if trace.ending == "loop" else None
-    times, points, loop_sample = trace.times, trace.points, loop_start
-    if trace.signals:
+    # every time from the first sample: bounds are decided on exact differences of stamps
+    samples = since_first(trace.times)
+    signals = counted_from(trace.signals, float(trace.times[0]))
+    times, points, loop_sample = samples, trace.points, loop_start
+    if signals:
         # a sample at every signal change: the run is cut there as at a region crossing
-        times, points, moved = with_cuts(times, points, change_times(trace.signals))
+        times, points, moved = with_cuts(times, points, change_times(signals))
         loop_sample = None if loop_start is None else int(moved[loop_start])
     pieces = build_pieces(times, points, loop_sample, regions, trace.convention)
     unknown = _last_point_unknown(trace, pieces, regions)
-    pieces, unknown, names = _with_signals(trace, pieces, unknown, names, mentioned)
+    pieces, unknown, names = _with_signals(trace, signals, pieces, unknown, names, mentioned)
     size = len(pieces.is_point)
     ending = _piece_ending(trace, pieces)
     is_point = pieces.is_point if trace.convention == "closed" else None
-    timing = Timing(pieces.times, float(trace.times[-1]))
+    timing = Timing(pieces.times, float(samples[-1]))
     truth = Semantics(
         truth_atoms(pieces.labels, names, unknown),
         size,
@@ -522,7 +558,9 @@ def _truth_of(trace: TraceInput) -> _Truth:
         timing=timing,
     )
     prefixes = Prefixes(truth_atoms(pieces.labels, names, unknown), pieces.times, is_point)
-    return _Truth(pieces, regions, names, unknown, size, ending, is_point, timing, truth, prefixes)
+    return _Truth(
+        samples, pieces, regions, names, unknown, size, ending, is_point, timing, truth, prefixes
+    )
 
 
 @dataclasses.dataclass(frozen=True, slots=True)
@@ -535,13 +573,39 @@ class BoundSlack:
     slack: float | None
 
 
+@contextlib.contextmanager
+def _loop_limit(trace: TraceInput) -> Iterator[None]:
+    """Refuse (V040) a task whose windows would unroll the trace's loop past
+    :data:`~tlmpc.verify.dense.MAX_UNROLLED` pieces."""
+    try:
+        yield
+    except UnrollTooLong as exc:
+        raise UsageError(
+            error(
+                "V040",
+                f"{exc}: the loop is too short for the length of the trace before it",
+                hint="declare a longer loop (--loop-from earlier), or read the log's end as a "
+                "stay (--assume-stay) or open",
+                file=trace.source,
+            )
+        ) from None
+
+
 def bound_slacks(trace: TraceInput) -> tuple[Outcome, tuple[BoundSlack, ...]]:
     """The task's verdict on ``trace`` and the slack of each of its bounded operators
-    (pre-order): the time robustness of the task with that one bound moved."""
+    (pre-order): the time robustness of the task with that one bound moved.
+
+    Raises:
+        UsageError: V040, a window would unroll the trace's loop too far."""
+    with _loop_limit(trace):
+        return _bound_slacks(trace)
+
+
+def _bound_slacks(trace: TraceInput) -> tuple[Outcome, tuple[BoundSlack, ...]]:
     found = _truth_of(trace)
     outcome_of = found.outcome_function()
     outcome = _outcome(*found.truth.at_start(trace.formula))
-    span = horizon(trace.formula, float(trace.times[-1] - trace.times[0]))
+    span = horizon(trace.formula, float(found.times[-1]))
     slacks = tuple(
         BoundSlack(
             bound=to_text(node),
@@ -553,7 +617,15 @@ def bound_slacks(trace: TraceInput) -> tuple[Outcome, tuple[BoundSlack, ...]]:
 
 
 def verify_trace(trace: TraceInput) -> Verdict:
-    """Check ``trace`` against its task under its boundary convention and ending."""
+    """Check ``trace`` against its task under its boundary convention and ending.
+
+    Raises:
+        UsageError: V040, a window would unroll the trace's loop too far."""
+    with _loop_limit(trace):
+        return _verify_trace(trace)
+
+
+def _verify_trace(trace: TraceInput) -> Verdict:
     found = _truth_of(trace)
     pieces, regions, names, unknown = found.pieces, found.regions, found.names, found.unknown
     size, ending, is_point, timing = found.size, found.ending, found.is_point, found.timing
@@ -564,14 +636,14 @@ def verify_trace(trace: TraceInput) -> Verdict:
     outcomes = [_outcome(*truth.at_start(c)) for c in conjuncts]
     ends = np.append(pieces.times[1:], pieces.times[-1])
     if loop_start is not None and size:
-        ends[-1] = trace.times[-1]
+        ends[-1] = found.times[-1]
     line = Timeline(
         starts=pieces.times,
         ends=ends,
         positions=pieces.positions,
         labels=pieces.labels,
         names=names,
-        origin=trace.start,
+        clock=_clock(trace),
         signals=frozenset(trace.sensors) | frozenset(trace.actions),
     )
     reports, violations = conjunct_reports(conjuncts, outcomes, truth, line)
@@ -588,12 +660,12 @@ def verify_trace(trace: TraceInput) -> Verdict:
             ending,
         )
 
-    duration = float(trace.times[-1] - trace.times[0])
+    duration = float(found.times[-1])
     reports = [
         _with_time_robustness(report, conjunct, outcome_of, truth, line, duration)
         for report, conjunct in zip(reports, conjuncts, strict=True)
     ]
-    violations = _timed_violations(conjuncts, reports, violations, truth, trace, line)
+    violations = _timed_violations(conjuncts, reports, violations, truth, trace, found.times, line)
     if len(reports) == 1:
         task_slack = reports[0].time_robustness  # the task is its one conjunct
     else:
@@ -670,6 +742,7 @@ def _reactive_certificate(trace: TraceInput) -> Certificate:
 
 def _with_signals(
     trace: TraceInput,
+    signals: Mapping[str, Signal],
     pieces: Pieces,
     unknown: BoolArray | None,
     names: list[str],
@@ -677,11 +750,12 @@ def _with_signals(
 ) -> tuple[Pieces, BoolArray | None, list[str]]:
     """The pieces' labels with a column for each sensor and action the formulas mention: its
     value at the piece's first instant (unknown before the signal's first sample, and
-    throughout for an action the log does not carry)."""
+    throughout for an action the log does not carry); ``signals`` are the trace's, timed as
+    the pieces are."""
     signal_names = [n for n in (*trace.sensors, *trace.actions) if n in mentioned]
     if not signal_names:
         return pieces, unknown, names
-    values, unknown_signals = signal_labels(trace.signals, signal_names, pieces.times)
+    values, unknown_signals = signal_labels(signals, signal_names, pieces.times)
     labels = np.hstack([pieces.labels, values])
     if unknown is None and not unknown_signals.any():
         combined = None
@@ -745,13 +819,14 @@ def _part(part: PartVerdict | None, start: float) -> dict[str, Any] | None:
     return {
         "part": part.part,
         "verdict": part.outcome,
-        "broken_at": part.broken,
-        "elapsed": None if part.broken is None else elapsed(part.broken, start),
+        "broken_at": None if part.broken is None else start + part.broken,
+        "elapsed": part.broken,
     }
 
 
 def reactive_to_json(judged: AssumeGuarantee, start: float) -> dict[str, Any]:
-    """The ``reactive`` object of ``tlmpc.verdict/1``: blame, both times, every part."""
+    """The ``reactive`` object of ``tlmpc.verdict/1``: blame, both times, every part
+    (``start``: the stamp of the log's first sample)."""
     return {
         "verdict": judged.outcome,
         "blame": judged.blame,
