@@ -438,3 +438,25 @@ def test_a_refined_mesh_beyond_the_budget_is_p040_before_its_product(
     assert [d.code for d in refused.value.diagnostics] == ["P040"]
     assert sizes  # the input mesh was planned on, with and without bounces
     assert set(sizes) == {abstraction.num_triangles}
+
+
+def test_a_budget_refusal_names_the_mission_file(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The planner knows the mesh, not the file: the refusal still names the mission."""
+    from tlmpc.cli import main
+    from tlmpc.planning import budget
+
+    monkeypatch.setattr(budget, "MAX_GUIDED_NODES", 1)
+    monkeypatch.setattr(budget, "MAX_PRODUCT_NODES", 1)
+    path = tmp_path / "mission.yaml"
+    path.write_text(
+        "version: 1\n"
+        "workspace: {boundary: {rect: [0, 0, 10, 10]}}\n"
+        "regions: {goal: {rect: [8, 8, 9, 9]}}\n"
+        "robot: {start: [1, 1]}\n"
+        "task: [visit goal]\n"
+    )
+    err = io.StringIO()
+    assert main(["compile", str(path), "-o", str(tmp_path / "out"), "-q"], err=err) == 2
+    assert err.getvalue().startswith(f"{path}: error[P040]"), err.getvalue()

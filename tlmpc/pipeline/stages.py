@@ -783,10 +783,15 @@ def _placed(
     diagnostics: tuple[Diagnostic, ...], compilation: Compilation
 ) -> tuple[Diagnostic, ...]:
     """The stage's diagnostics of the mission file with the line and column of the value
-    their JSON path names (a later stage knows the value, not where it is written)."""
+    their JSON path names (a later stage knows the value, not where it is written); one that
+    names no file is about the mission compiled (a planner's budget, say), and names it."""
     from tlmpc.mission.placement import placed
 
-    return placed(diagnostics, str(compilation.source), compilation.text)
+    source = str(compilation.source)
+    named = tuple(
+        d if d.file is not None else dataclasses.replace(d, file=source) for d in diagnostics
+    )
+    return placed(named, source, compilation.text)
 
 
 def compile_mission(
