@@ -181,7 +181,8 @@ def test_bad_export_requests_get_diagnostics(compiled: Path, tmp_path: Path) -> 
     assert "error[M083]" in err
     code, _, err = run("export-plan", str(compiled), "--spacing", "-1")
     assert code == 2
-    assert "error[M082]" in err
+    assert "--spacing -1: error[M082]" in err
+    assert "hint: the least distance between kept waypoints" in err
     code, _, err = run("export-plan", str(compiled), "-o", str(tmp_path / "no" / "x.yaml"))
     assert code == 2
     assert "error[M083]" in err

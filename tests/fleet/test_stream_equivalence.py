@@ -117,10 +117,10 @@ def test_streamed_equals_whole(
         refused = [d.code for d in exc.diagnostics]
     if refused:
         with pytest.raises(UsageError) as caught:
-            verify_log(path, base, assume_stay=stay, loop_from=loop_from, block_chars=block)
+            verify_log(path, base, assume_stay=stay, loop_from=loop_from, block_bytes=block)
         assert [d.code for d in caught.value.diagnostics] == refused
         return
-    streamed = verify_log(path, base, assume_stay=stay, loop_from=loop_from, block_chars=block)
+    streamed = verify_log(path, base, assume_stay=stay, loop_from=loop_from, block_bytes=block)
     assert comparable(verdict_to_json(streamed.verdict)) == comparable(verdict_to_json(whole))
     assert streamed.samples == len(samples)
     # robustness keeps the sign of the verdict

@@ -112,3 +112,18 @@ def test_hostile_json_traces_are_diagnostics(tmp_path: Path, text: str) -> None:
 def test_a_robot_that_cannot_move_certifies_nothing() -> None:
     still = trace(points=[[0, 1, 1], [1, 1, 1], [2, 1, 1]], max_speed=0)
     assert from_document(still).max_speed is None
+
+
+@pytest.mark.parametrize(("x", "y", "clearance"), [(2.0, 0.0, 8.0), (2.0, -10.0, 0.0)])
+def test_a_step_a_hair_long_is_measured_without_a_warning(
+    x: float, y: float, clearance: float
+) -> None:
+    """A step of 3.6e-305 (its squared length underflows; the second lies along the wall):
+    the workspace robustness is the distance of the point it nearly is (the suite turns a
+    numpy warning into a failure)."""
+    from tlmpc.verify.verdict import workspace_violations
+
+    hair = trace(points=[[0, x, y], [1, x, y + 3.62409544e-305]])
+    violations, robustness = workspace_violations(from_document(hair))
+    assert violations == []
+    assert robustness == clearance

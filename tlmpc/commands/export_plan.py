@@ -61,7 +61,13 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
 
     if not math.isfinite(args.spacing) or args.spacing < 0:
         raise UsageError(
-            error("M082", f"--spacing must be a non-negative number, got {args.spacing:g}")
+            error(
+                "M082",
+                f"--spacing must be a non-negative number, got {args.spacing:g}",
+                hint="the least distance between kept waypoints, in map units (0: every "
+                "trajectory sample)",
+                file=f"--spacing {args.spacing:g}",
+            )
         )
     for flag, value in (("--frame-id", args.frame_id), ("--topic", args.topic)):
         if not value or has_unsafe_chars(value):

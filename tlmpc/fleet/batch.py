@@ -11,9 +11,11 @@
 
 from __future__ import annotations
 
+import contextlib
 import fnmatch
 import os
-from collections.abc import Iterator, Mapping, Sequence
+import signal
+from collections.abc import Generator, Iterator, Mapping, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from dataclasses import dataclass
 from pathlib import Path
@@ -40,7 +42,11 @@ def _is_bag_dir(path: Path) -> bool:
 
 def discover(paths: Sequence[Path]) -> list[Path]:
     """The logs the paths name: a file as it is; a folder (not a bag directory) searched
-    recursively for CSV and bag files and ROS 2 bag directories, sorted by path."""
+    recursively for CSV and bag files and ROS 2 bag directories, sorted by path.
+
+    Symbolic links to folders are followed (a robot's log folder linked in from another
+    disk is searched like any other); a folder already searched (a link loop, or a second
+    link to one folder) is searched once."""
     from tlmpc.importers.logs import CSV_SUFFIXES
 
     found: list[Path] = []
@@ -49,11 +55,17 @@ def discover(paths: Sequence[Path]) -> list[Path]:
             found.append(path)
             continue
         inside: list[Path] = []
-        for folder, names, files in os.walk(path):
+        searched: set[tuple[int, int]] = set()
+        _first_visit(path, searched)
+        for folder, names, files in os.walk(path, followlinks=True):
             here = Path(folder)
             bags = [n for n in names if _is_bag_dir(here / n)]
             inside.extend(here / n for n in bags)
-            names[:] = sorted(n for n in names if n not in bags and not n.startswith("."))
+            names[:] = [
+                n
+                for n in sorted(names)
+                if n not in bags and not n.startswith(".") and _first_visit(here / n, searched)
+            ]
             inside.extend(
                 here / f
                 for f in files
@@ -63,6 +75,27 @@ def discover(paths: Sequence[Path]) -> list[Path]:
         # (a .db3 file is read through its bag directory, found above)
         found.extend(sorted(inside, key=lambda p: p.as_posix()))
     return found
+
+
+def _identity(folder: Path) -> tuple[int, int] | None:
+    """The folder's device and inode (what a link to it shares), None when it cannot be
+    looked at."""
+    try:
+        info = folder.stat()
+    except OSError:
+        return None
+    return info.st_dev, info.st_ino
+
+
+def _first_visit(folder: Path, searched: set[tuple[int, int]]) -> bool:
+    """Whether ``folder`` was not searched yet (and is now counted as searched)."""
+    identity = _identity(folder)
+    if identity is None:
+        return True  # os.walk cannot list it either
+    if identity in searched:
+        return False
+    searched.add(identity)
+    return True
 
 
 @dataclass(frozen=True, slots=True)
@@ -124,7 +157,7 @@ def make_jobs(
 ) -> tuple[list[Job], list[dict[str, Any]]]:
     """A job per log, each mission read once; logs without a usable mission become error
     records right away."""
-    from tlmpc.verify.trace_input import mission_document
+    from tlmpc.verify.trace_input import load_log_mission, positions_document
 
     documents: dict[Path, dict[str, Any] | TlmpcError] = {}
     jobs: list[Job] = []
@@ -148,8 +181,9 @@ def make_jobs(
             )
             continue
         if mission not in documents:
+            # read once for all its logs, so its diagnostics name the mission, never a log
             try:
-                documents[mission] = mission_document(log, mission)
+                documents[mission] = positions_document(load_log_mission(mission))
             except TlmpcError as exc:
                 documents[mission] = exc
         document = documents[mission]
@@ -189,7 +223,7 @@ def _internal(job: Job, exc: BaseException) -> dict[str, Any]:
     return record
 
 
-def _local(jobs: Sequence[Job]) -> Iterator[dict[str, Any]]:
+def _local(jobs: Sequence[Job]) -> Generator[dict[str, Any], None, None]:
     for job in jobs:
         try:
             yield run_job(job)
@@ -197,16 +231,20 @@ def _local(jobs: Sequence[Job]) -> Iterator[dict[str, Any]]:
             yield _internal(job, exc)
 
 
-def _pool(jobs: Sequence[Job], workers: int) -> Iterator[dict[str, Any]]:
+def _pool(jobs: Sequence[Job], workers: int) -> Generator[dict[str, Any], None, None]:
     # At most a few jobs in flight per worker: a million logs never sit in memory as futures.
     limit = 4 * workers
     queue = iter(jobs)
-    with ProcessPoolExecutor(max_workers=workers) as pool:
+    pool = ProcessPoolExecutor(max_workers=workers, initializer=_worker_start)
+    finished = False
+    try:
         running: dict[Future[dict[str, Any]], Job] = {}
-        for job in queue:
-            running[pool.submit(run_job, job)] = job
-            if len(running) >= limit:
-                break
+        # the workers are forked by the first submit: they start with the signals held
+        with _signals_held():
+            for job in queue:
+                running[pool.submit(run_job, job)] = job
+                if len(running) >= limit:
+                    break
         while running:
             done, _ = wait(running, return_when=FIRST_COMPLETED)
             for future in done:
@@ -216,6 +254,47 @@ def _pool(jobs: Sequence[Job], workers: int) -> Iterator[dict[str, Any]]:
                 following = next(queue, None)
                 if following is not None:
                     running[pool.submit(run_job, following)] = following
+        finished = True
+    finally:
+        if not finished:  # interrupted, or the caller stopped early: no log is finished
+            _stop_workers(pool)
+        pool.shutdown(wait=True, cancel_futures=True)
+
+
+#: The signals that end a run: the parent's to handle, never a worker's.
+_ENDING = (signal.SIGINT, signal.SIGTERM)
+
+
+@contextlib.contextmanager
+def _signals_held() -> Iterator[None]:
+    """Hold Ctrl-C and SIGTERM in this thread (a process forked meanwhile starts with them
+    held); they are delivered when the block ends."""
+    held = signal.pthread_sigmask(signal.SIG_BLOCK, _ENDING)
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, held)
+
+
+def _worker_start() -> None:
+    """A pool worker's first act: Ctrl-C is ignored and SIGTERM ends it at once, quietly.
+
+    The parent ends the run and stops its workers (:func:`_stop_workers`); the handlers a
+    forked worker inherits would raise inside multiprocessing's loop instead, which prints
+    a traceback per worker."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, _ENDING)
+
+
+def _stop_workers(pool: ProcessPoolExecutor) -> None:
+    """End the pool's workers now (each would finish its log first)."""
+    # ProcessPoolExecutor has no public way to reach its processes before Python 3.14
+    # (terminate_workers); its map of them has kept this name since Python 3.2.
+    processes: Mapping[int, Any] = getattr(pool, "_processes", None) or {}
+    for process in list(processes.values()):
+        with contextlib.suppress(OSError, ValueError):
+            process.terminate()
 
 
 def dask_client(address: str) -> Any:
@@ -245,7 +324,7 @@ def dask_client(address: str) -> Any:
         ) from None
 
 
-def _dask(jobs: Sequence[Job], client: Any) -> Iterator[dict[str, Any]]:
+def _dask(jobs: Sequence[Job], client: Any) -> Generator[dict[str, Any], None, None]:
     from distributed import as_completed
 
     futures = {client.submit(run_job, job, pure=False): job for job in jobs}
@@ -257,9 +336,12 @@ def _dask(jobs: Sequence[Job], client: Any) -> Iterator[dict[str, Any]]:
             yield future.result()
 
 
-def run(jobs: Sequence[Job], *, workers: int = 1, client: Any = None) -> Iterator[dict[str, Any]]:
+def run(
+    jobs: Sequence[Job], *, workers: int = 1, client: Any = None
+) -> Generator[dict[str, Any], None, None]:
     """Each job's record as it finishes: on ``client`` (a ``distributed.Client``) when given,
-    else in this process (``workers`` 1) or a pool of ``workers`` processes."""
+    else in this process (``workers`` 1) or a pool of ``workers`` processes.  Closing the
+    generator before its end stops the pool's workers at once."""
     if client is not None:
         return _dask(jobs, client)
     if workers <= 1 or len(jobs) <= 1:

@@ -32,13 +32,18 @@ def default_cache_dir() -> Path:
 
 
 def content_digest(path: Path) -> str:
-    """SHA-256 of a log file's bytes, or of a bag directory's files (names and bytes)."""
+    """SHA-256 of a log file's bytes, or of a bag directory's files (names and bytes).
+
+    Regular files only, as every reader (:func:`tlmpc.io.inputs.open_regular`): a FIFO or a
+    device named like a log is refused (M050) at once, never waited on or read without end."""
+    from tlmpc.io.inputs import open_regular
+
     digest = hashlib.sha256()
     files = sorted(p for p in path.rglob("*") if p.is_file()) if path.is_dir() else [path]
     for file in files:
         if path.is_dir():
             digest.update(file.relative_to(path).as_posix().encode() + b"\0")
-        with open(file, "rb") as stream:
+        with open_regular(file, code="M050", what="log") as stream:
             while block := stream.read(READ_BLOCK):
                 digest.update(block)
     return digest.hexdigest()

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import itertools
 import os
 import time
 from collections.abc import Sequence
@@ -39,7 +40,14 @@ def run_batch(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     )
     from tlmpc.fleet.cache import default_cache_dir
     from tlmpc.fleet.job import Options
-    from tlmpc.fleet.output import line, ordered, summary, summary_table, write_results
+    from tlmpc.fleet.output import (
+        check_output,
+        line,
+        ordered,
+        summary,
+        summary_table,
+        write_results,
+    )
     from tlmpc.importers.logs import parse_columns, parse_transform
     from tlmpc.io.report import Reporter
 
@@ -81,15 +89,24 @@ def run_batch(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     cache = None if args.no_cache else (args.cache or default_cache_dir())
     missions = missions_for(logs, args.mission)
     _refuse_overwriting(args.results, args.report, [*logs, args.mission, *missions.values()])
+    # an output the batch could not write at its end is refused before any log is verified
+    if args.results is not None:
+        check_output(args.results)
+    if args.report is not None:
+        from tlmpc.fleet.report import check_report
+
+        check_report(args.report)
     jobs, failed = make_jobs(logs, missions, options, cache)
     client = dask_client(args.dask) if args.dask is not None else None
     began = time.perf_counter()
     records: list[dict[str, Any]] = []
+    results = run(jobs, workers=workers, client=client)
     try:
-        for record in [*failed, *run(jobs, workers=workers, client=client)]:
+        for record in itertools.chain(failed, results):  # each line as its log finishes
             records.append(record)
             report.stream(line(record))
     finally:
+        results.close()  # interrupted: the workers stop now, not after their logs
         if client is not None:
             client.close()
     wall = time.perf_counter() - began

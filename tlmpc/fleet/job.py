@@ -155,8 +155,8 @@ def run_job(job: Job) -> dict[str, Any]:
     if cache is not None:
         try:
             digest = content_digest(Path(job.log))
-        except OSError:
-            digest = None  # unreadable: verify_job says why
+        except (OSError, TlmpcError):
+            digest = None  # unreadable, or not a file to read: verify_job says why
         if digest is not None:
             # a verdict is the same for every log with these bytes; an error names its log
             stored = cache.get(job_key(job, digest)) or cache.get(job_key(job, digest, named=True))

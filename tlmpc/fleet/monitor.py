@@ -44,7 +44,11 @@ OUTCOMES = {1: "satisfied", 0: "inconclusive", -1: "violated"}
 
 @dataclass(frozen=True, slots=True)
 class Change:
-    """A verdict that changed: of a conjunct, of the whole ``task``, or of the ``workspace``."""
+    """A verdict that changed: of a conjunct, of the whole ``task``, or of the ``workspace``,
+    at ``time`` (the pose's own stamp).
+
+    A conjunct's or the task's ``satisfied`` or ``violated`` is final: no pose after it
+    changes it (the open log's verdict, LTL3).  The workspace is only ever ``violated``."""
 
     time: float
     subject: str
@@ -178,8 +182,9 @@ class Monitor:
         tail = self._tail()
         for conjunct, r in zip(self.conjuncts, self.residues, strict=True):
             self._set(time, to_text(conjunct), OUTCOMES[value(r, tail)])
-        task = OUTCOMES[value(self.task, tail)]
-        self._set(time, "task", "violated" if self.excursion is not None else task)
+        # the task's own verdict: final once satisfied or violated (LTL3); the workspace,
+        # which an open log can break at any time, is its own line (see :attr:`outcome`)
+        self._set(time, "task", OUTCOMES[value(self.task, tail)])
 
     def _set(self, time: float, subject: str, verdict: str, message: str | None = None) -> None:
         if self.verdicts.get(subject) != verdict:
@@ -206,8 +211,7 @@ class Monitor:
             first = found[0]
             when = float(first.time) if first.time is not None else float(stretch[0, 0])
             self.excursion = Change(when, "workspace", "violated", first.message)
-            self.pending.append(self.excursion)
-            self._set(when, "task", "violated")
+            self._set(when, "workspace", "violated", first.message)
 
     # -- output -------------------------------------------------------------------------------
 
@@ -225,6 +229,14 @@ class Monitor:
         return self.changes()
 
     @property
+    def start(self) -> float:
+        """The first pose's time, which the times of messages count from (0 before it)."""
+        return self.origin if self.origin is not None else 0.0
+
+    @property
     def outcome(self) -> str:
-        """The task's verdict so far (``violated`` after a workspace violation)."""
+        """The run's verdict so far, as ``tlmpc verify`` gives it: ``violated`` after a
+        workspace violation, else the task's."""
+        if self.excursion is not None:
+            return "violated"
         return self.verdicts.get("task", "inconclusive")

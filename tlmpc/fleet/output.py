@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import json
+import os
+import stat
 from collections import Counter
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -97,6 +99,54 @@ def summary_table(numbers: Mapping[str, Any]) -> str:
     return "".join(f"  {name:<{width}}  {value:>10}\n" for name, value in rows)
 
 
+def visible(text: str) -> str:
+    """``text`` with the bytes of a file name that are not UTF-8 shown as ``\\xNN``.
+
+    Python keeps such bytes in a path as lone surrogates (``\\udce9`` for the byte 0xE9),
+    which no UTF-8 file can hold: a report or a Parquet file shows the byte instead."""
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError:
+        return text.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
+    return text
+
+
+def _refused(path: Path, message: str, hint: str) -> UsageError:
+    return UsageError(error("F007", message, hint=hint, file=str(path)))
+
+
+def check_output(path: Path) -> None:
+    """Refuse (F007) an output file the batch could not write at its end, before any log
+    is verified: a link, a folder, a device or a FIFO at ``path`` (never replaced), or a
+    path whose folder is a file or cannot be written."""
+    try:
+        info: os.stat_result | None = os.lstat(path)
+    except FileNotFoundError:
+        info = None
+    except OSError as exc:
+        raise _refused(
+            path, f"cannot write {path}: {exc.strerror or exc}", "choose another file"
+        ) from None
+    if info is not None and not stat.S_ISREG(info.st_mode):
+        kind = {stat.S_IFLNK: "a symbolic link", stat.S_IFDIR: "a folder"}.get(
+            stat.S_IFMT(info.st_mode), "not a regular file"
+        )
+        raise _refused(path, f"{path} is {kind}; it is never replaced", "choose another file")
+    folder = Path(os.path.abspath(path)).parent
+    while not os.path.lexists(folder) and folder != folder.parent:
+        folder = folder.parent  # made when the file is written
+    if not folder.is_dir():
+        raise _refused(
+            path, f"cannot write {path}: {folder} is not a folder", "choose another file"
+        )
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise _refused(
+            path,
+            f"cannot write {path}: the folder {folder} is not writable",
+            "choose a folder you may write in",
+        )
+
+
 def write_atomically(path: Path, data: bytes) -> None:
     """Replace ``path`` with ``data`` as every output is replaced
     (:func:`tlmpc.io.outdir.replace_file`: whole or not at all, never over a link, a device
@@ -147,7 +197,18 @@ def write_results(path: Path, rows: Sequence[Mapping[str, Any]]) -> None:
 def _parquet_row(row: Mapping[str, Any]) -> dict[str, Any]:
     out = dict(row)
     out["error"] = None if row["error"] is None else row["error"]["message"]
-    return out
+    return {name: _visible_strings(value) for name, value in out.items()}
+
+
+def _visible_strings(value: Any) -> Any:
+    """``value`` with every string :func:`visible` (Parquet strings are UTF-8)."""
+    if isinstance(value, str):
+        return visible(value)
+    if isinstance(value, dict):
+        return {k: _visible_strings(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_visible_strings(v) for v in value]
+    return value
 
 
 def _schema(pa: Any) -> Any:

@@ -18,12 +18,14 @@ import math
 import re
 from collections import Counter, defaultdict
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 from typing import Any
+from urllib.parse import quote
 
-from tlmpc.base.errors import UsageError, error
+from tlmpc.base.errors import Diagnostic, UsageError, error
 from tlmpc.fleet.job import Job
-from tlmpc.fleet.output import write_atomically
+from tlmpc.fleet.output import check_output, visible, write_atomically
 
 DATE = re.compile(r"\d{4}-\d{2}-\d{2}")
 
@@ -117,7 +119,12 @@ def _common_root(logs: Sequence[str]) -> PurePosixPath:
 
 
 def _e(value: Any) -> str:
-    return html.escape(str(value), quote=True)
+    return html.escape(visible(str(value)), quote=True)
+
+
+def _href(link: str) -> str:
+    """A link to a file written beside the report, its name's bytes percent-encoded."""
+    return html.escape(quote(link, errors="surrogateescape"), quote=True)
 
 
 def _verdict(verdict: str) -> str:
@@ -244,9 +251,48 @@ def _heat_map(mission: str, document: Mapping[str, Any], rows: Sequence[Mapping[
     )
 
 
-def _views(rows: Sequence[Mapping[str, Any]], folder: Path, link_base: str) -> dict[str, str]:
-    """Write each log's own view (violated first, at most :data:`VIEW_LIMIT`); the link of each
-    one written, by log."""
+@dataclass(frozen=True, slots=True)
+class Views:
+    """The views written beside the report (their links, by log) and the logs that have
+    none because ``tlmpc view`` refuses them (its diagnostic, by log)."""
+
+    links: Mapping[str, str] = field(default_factory=dict)
+    refused: Mapping[str, Diagnostic] = field(default_factory=dict)
+
+
+def views_folder(report: Path) -> Path:
+    """The folder of the logs' views beside the report (``fleet.views/`` for ``fleet.html``)."""
+    return report.with_name(report.stem + ".views")
+
+
+def _check_views_folder(folder: Path) -> None:
+    """Refuse (F007) a views folder that is a link (never written through) or not a folder."""
+    if folder.is_symlink() or (folder.exists() and not folder.is_dir()):
+        what = (
+            "is a symbolic link (the report's views are never written through one)"
+            if folder.is_symlink()
+            else "exists and is not a folder (the report's views are written there)"
+        )
+        raise UsageError(
+            error(
+                "F007",
+                f"{folder} {what}",
+                hint="move it away, or choose another --report name (the views of NAME.html "
+                "go in NAME.views)",
+                file=str(folder),
+            )
+        )
+
+
+def check_report(path: Path) -> None:
+    """Refuse (F007), before any log is verified, a report or a views folder the batch
+    could not write at its end."""
+    check_output(path)
+    _check_views_folder(views_folder(path))
+
+
+def _views(rows: Sequence[Mapping[str, Any]], folder: Path, link_base: str) -> Views:
+    """Write each log's own view (violated first, at most :data:`VIEW_LIMIT`)."""
     from tlmpc.base.errors import TlmpcError
     from tlmpc.view import render_html, scene_from_log
 
@@ -255,16 +301,25 @@ def _views(rows: Sequence[Mapping[str, Any]], folder: Path, link_base: str) -> d
         key=lambda r: (r["verdict"] != "violated", r["verdict"] != "inconclusive"),
     )
     links: dict[str, str] = {}
+    refused: dict[str, Diagnostic] = {}
     for index, row in enumerate(order[:VIEW_LIMIT]):
         try:
             page = render_html(scene_from_log(Path(row["log"]), Path(row["mission"])))
-        except TlmpcError:
-            continue  # too large for a view (a streamed log): the command is shown instead
+        except TlmpcError as exc:  # too large for a view (a streamed log): the report says so
+            if exc.diagnostics:
+                refused[row["log"]] = exc.diagnostics[0]
+            continue
         name = f"{index:05d}-{re.sub(r'[^A-Za-z0-9._-]+', '_', Path(row['log']).stem)[:60]}.html"
-        folder.mkdir(parents=True, exist_ok=True)
+        _check_views_folder(folder)
+        try:
+            folder.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise UsageError(
+                error("F007", f"cannot write {folder}: {exc.strerror or exc}", file=str(folder))
+            ) from None
         write_atomically(folder / name, page.encode("utf-8"))
         links[row["log"]] = f"{link_base}/{name}"
-    return links
+    return Views(links, refused)
 
 
 def render_report(
@@ -272,11 +327,11 @@ def render_report(
     documents: Mapping[str, Mapping[str, Any]],
     *,
     group: str | None = None,
-    links: Mapping[str, str] | None = None,
+    views: Views | None = None,
 ) -> str:
     """The page for ``rows`` (the batch's records), ``documents`` the missions by path."""
     pattern = group_pattern(group)
-    links = links or {}
+    views = views or Views()
     root = _common_root([r["log"] for r in rows])
     places = {r["log"]: robot_and_day(r["log"], root, pattern) for r in rows}
     verdicts = Counter(r["verdict"] for r in rows)
@@ -294,9 +349,14 @@ def render_report(
     for row in rows:
         robot, day = places[row["log"]]
         first = row.get("first_violation") or {}
-        link = links.get(row["log"])
+        link = views.links.get(row["log"])
+        refused = views.refused.get(row["log"])
         if link is not None:
-            view = f'<a href="{_e(link)}">view</a>'
+            view = f'<a href="{_href(link)}">view</a>'
+        elif refused is not None:
+            view = f"no view: {_e(refused.message)}" + (
+                f"<br>{_e(refused.hint)}" if refused.hint else ""
+            )
         elif row.get("mission"):
             view = (
                 f'<span class="formula">tlmpc view --log {_e(row["log"])} '
@@ -340,7 +400,7 @@ def write_report(
 ) -> None:
     """Write the report at ``path`` and the logs' views in ``<path stem>.views/`` beside it."""
     documents = {job.mission: job.document for job in jobs}
-    folder = path.with_name(path.stem + ".views")
-    links = _views(rows, folder, folder.name)
-    page = render_report(rows, documents, group=group, links=links)
+    folder = views_folder(path)
+    views = _views(rows, folder, folder.name)
+    page = render_report(rows, documents, group=group, views=views)
     write_atomically(path, page.encode("utf-8"))

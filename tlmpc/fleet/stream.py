@@ -240,7 +240,7 @@ def _log_chunks(
     columns: Sequence[str] | None,
     transform: tuple[float, float, float] | None,
     frame: str | None,
-    block_chars: int,
+    block_bytes: int,
     whole_bag: bool,
 ) -> Iterator[tuple[FloatArray, tuple[int, ...]]]:
     from tlmpc.importers.logs import (
@@ -251,10 +251,11 @@ def _log_chunks(
         read_log,
     )
 
-    if path.suffix.lower() in CSV_SUFFIXES and path.is_file():
+    # chosen by name, as the whole reader chooses (a FIFO named .csv is a CSV log it refuses)
+    if path.suffix.lower() in CSV_SUFFIXES and not path.is_dir():
         if topic is not None or frame is not None:
             read_log(path, topic=topic, frame=frame)  # raises the reader's own diagnostic
-        for chunk in iter_csv_chunks(path, columns, block_chars):
+        for chunk in iter_csv_chunks(path, columns, block_bytes):
             yield apply_transform(chunk.samples, transform), chunk.lines
         return
     if columns is not None or (frame is not None and transform is not None):
@@ -281,10 +282,10 @@ def verify_log(
     frame: str | None = None,
     assume_stay: bool = False,
     loop_from: float | None = None,
-    block_chars: int = 1 << 22,
+    block_bytes: int = 1 << 22,
 ) -> StreamedVerdict:
     """Verify the log at ``path`` against ``document`` (a sample-less ``tlmpc.trace/1``, see
-    :func:`tlmpc.verify.trace_input.mission_document`), a CSV log ``block_chars`` characters at
+    :func:`tlmpc.verify.trace_input.mission_document`), a CSV log ``block_bytes`` bytes at
     a time, a bag a chunk of messages at a time (a bag whose stamps go back somewhere is
     verified again from the start, read whole and sorted)."""
     from tlmpc.importers.logs import BagOutOfOrder
@@ -300,7 +301,7 @@ def verify_log(
             frame=frame,
             assume_stay=assume_stay,
             loop_from=loop_from,
-            block_chars=block_chars,
+            block_bytes=block_bytes,
             whole_bag=whole_bag,
         )
 
@@ -321,7 +322,7 @@ def _verify_log(
     frame: str | None,
     assume_stay: bool,
     loop_from: float | None,
-    block_chars: int,
+    block_bytes: int,
     whole_bag: bool,
 ) -> StreamedVerdict:
     file = str(path)
@@ -338,7 +339,7 @@ def _verify_log(
         columns=columns,
         transform=transform,
         frame=frame,
-        block_chars=block_chars,
+        block_bytes=block_bytes,
         whole_bag=whole_bag,
     )
     for samples in _checked_chunks(chunks, file):

@@ -75,9 +75,14 @@ def is_log(path: Path) -> bool:
 
 
 def _fail(
-    code: str, message: str, file: str, hint: str | None = None, line: int | None = None
+    code: str,
+    message: str,
+    file: str,
+    hint: str | None = None,
+    line: int | None = None,
+    col: int | None = None,
 ) -> UsageError:
-    return UsageError(error(code, message, hint=hint, file=file, line=line))
+    return UsageError(error(code, message, hint=hint, file=file, line=line, col=col))
 
 
 def path_problem(path: Path) -> str | None:
@@ -112,6 +117,13 @@ def _path_hint(path: Path) -> str | None:
     return None
 
 
+def require_path(path: Path) -> None:
+    """Refuse (M050) a log path that names nothing to read (see :func:`path_problem`)."""
+    problem = path_problem(path)
+    if problem is not None:
+        raise _fail("M050", f"cannot read {path}: {problem}", str(path), hint=_path_hint(path))
+
+
 def _apply(samples: FloatArray, transform: tuple[float, float, float] | None) -> FloatArray:
     if transform is None or len(samples) == 0:
         return samples
@@ -134,9 +146,7 @@ def read_log(
     """Read a CSV log or a ROS bag; raise :class:`UsageError` (M050–M079, M102–M106) on bad
     input.  ``frame`` (bags): express the poses in that frame through the bag's tf."""
     file = str(path)
-    problem = path_problem(path)
-    if problem is not None:
-        raise _fail("M050", f"cannot read {file}: {problem}", file, hint=_path_hint(path))
+    require_path(path)
     if frame is not None and transform is not None:
         raise _fail(
             "M105",
@@ -164,6 +174,112 @@ def read_log(
     return Log(
         samples=_apply(log.samples, transform), lines=log.lines, source=log.source, topic=log.topic
     )
+
+
+# --- lines -----------------------------------------------------------------------------------
+
+#: The longest line a log may have, in characters: a pose line is a few dozen, a logger's
+#: widest row a few thousand; more is not a log (a file of NULs, a stray binary), and a reader
+#: that waits for its end would hold it whole.
+MAX_LINE_CHARS = 1 << 20
+
+
+def split_lines(text: str) -> list[str]:
+    """The lines of a log's text, split where an editor splits them: at ``\\n``, ``\\r\\n``
+    and ``\\r`` only.
+
+    :meth:`str.splitlines` also ends a line at a form feed, a record separator, U+2028 and
+    more; in a log those are stray bytes inside a line.  Every reader of a log (whole,
+    streamed, live) splits here, so they number its lines alike and read the same rows."""
+    lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
+    if lines[-1] == "":
+        lines.pop()
+    return lines
+
+
+def _complete(data: bytes) -> int:
+    """How many bytes of ``data`` are whole lines: up to its last ``\\n``, or its last
+    ``\\r`` when more follows (a ``\\r`` at the very end may be the first half of
+    ``\\r\\n``)."""
+    return max(data.rfind(b"\n"), data.rfind(b"\r", 0, len(data) - 1)) + 1
+
+
+class LogLines:
+    """The lines of a log whose bytes come a block at a time (a file read in blocks, a pipe,
+    a file that grows): split by :func:`split_lines`, decoded as UTF-8 with a byte-order mark
+    at the start skipped, numbered from 1.
+
+    A line that is not UTF-8 is refused (M050) at its line and column, a line longer than
+    :data:`MAX_LINE_CHARS` (M053) as soon as it is known to be: memory stays one block and
+    one line."""
+
+    def __init__(self, file: str) -> None:
+        self.file = file
+        #: the lines given so far (the next one is line ``count + 1``)
+        self.count = 0
+        #: the bytes of a line whose end has not come yet
+        self.rest = b""
+        self._offset = 0  # bytes of the log before ``rest``
+
+    def feed(self, data: bytes) -> list[str]:
+        """The lines ``data`` completes, in order (the last is line :attr:`count`)."""
+        data = self.rest + data if self.rest else data
+        cut = _complete(data)
+        self.rest = data[cut:]
+        lines = self._lines(data[:cut])
+        # Each character is at most 4 bytes: a rest longer than this is surely too long.
+        if len(self.rest) > 4 * MAX_LINE_CHARS:
+            raise self._too_long(self.count + 1)
+        return lines
+
+    def finish(self) -> list[str]:
+        """The last line, when the log does not end with a line break."""
+        rest, self.rest = self.rest, b""
+        return self._lines(rest)
+
+    def _lines(self, data: bytes) -> list[str]:
+        start = 3 if self._offset == 0 and data.startswith(b"\xef\xbb\xbf") else 0
+        try:
+            text = data[start:].decode("utf-8")
+        except UnicodeDecodeError as exc:
+            before = split_lines(data[start : start + exc.start].decode("utf-8") + "|")
+            raise _fail(
+                "M050",
+                f"the log {self.file} is not UTF-8 text ({exc.reason} at byte "
+                f"{self._offset + start + exc.start})",
+                self.file,
+                hint="save it as UTF-8 text",
+                line=self.count + len(before),
+                col=len(before[-1]),
+            ) from None
+        self._offset += len(data)
+        lines = split_lines(text)
+        if len(text) > MAX_LINE_CHARS:
+            for index, line in enumerate(lines):
+                if len(line) > MAX_LINE_CHARS:
+                    raise self._too_long(self.count + index + 1)
+        self.count += len(lines)
+        return lines
+
+    def _too_long(self, number: int) -> UsageError:
+        return _fail(
+            "M053",
+            f"line {number} is longer than {MAX_LINE_CHARS:,} characters: not a line of a log",
+            self.file,
+            hint="a log line holds one pose (t, x, y and a few more columns); is this the "
+            "right file?",
+            line=number,
+        )
+
+
+def read_log_lines(path: Path) -> list[str]:
+    """The lines of the CSV log at ``path``, read whole (at most :data:`MAX_CSV_BYTES`; a
+    regular file only, M050), as :class:`LogLines` reads them."""
+    from tlmpc.io.inputs import read_bytes
+
+    reader = LogLines(str(path))
+    data = read_bytes(path, limit=MAX_CSV_BYTES, code="M050", what="log")
+    return reader.feed(data) + reader.finish()
 
 
 # --- CSV -------------------------------------------------------------------------------------
@@ -290,46 +406,70 @@ def _layout(
     return False, (0, 1, 2)
 
 
-def _row(cells: list[str], indices: tuple[int, int, int], file: str, number: int) -> list[float]:
+def _cell_column(raw: str, separator: str | None, index: int) -> int:
+    """The 1-based column where cell ``index`` of the line ``raw`` (as :func:`_split` cuts
+    it) shows its first character (past spaces and quotes)."""
+    stripped = raw.strip()
+    start = len(raw) - len(raw.lstrip())
+    if separator:
+        start += sum(len(cell) + len(separator) for cell in stripped.split(separator)[:index])
+    else:
+        start += [m.start() for m in re.finditer(r"\S+", stripped)][index]
+    while start < len(raw) and (raw[start].isspace() or raw[start] in "\"'"):
+        start += 1
+    return start + 1
+
+
+def _row(
+    raw: str, separator: str | None, indices: tuple[int, int, int], file: str, number: int
+) -> list[float]:
+    """The ``t, x, y`` of the line ``raw`` (line ``number``); M053 for a short row or a cell
+    that is not a number, at that cell."""
+    cells = _split(raw.strip(), separator)
     if len(cells) <= max(indices):
         raise _fail(
             "M053",
             f"row has {len(cells)} columns, expected at least {max(indices) + 1}",
             file,
+            hint="every row needs the time and position columns; is the line cut short? "
+            "Complete or delete it",
             line=number,
         )
     try:
         return [_number(cells[i]) for i in indices]
     except ValueError:
-        bad = next(cells[i] for i in indices if not _is_number(cells[i]))
-        raise _fail("M053", f"not a number: {bad!r}", file, line=number) from None
+        bad = next(i for i in indices if not _is_number(cells[i]))
+        raise _fail(
+            "M053",
+            f"not a number: {cells[bad]!r}",
+            file,
+            hint="the time and position columns hold a number on every row; correct or "
+            "delete the line",
+            line=number,
+            col=_cell_column(raw, separator, bad),
+        ) from None
 
 
 def read_csv_log(path: Path, columns: Sequence[str] | None = None) -> Log:
     """A CSV/TSV/whitespace log; see the module docstring for the accepted forms."""
-    from tlmpc.io.inputs import read_text
-
     file = str(path)
-    text = read_text(path, limit=MAX_CSV_BYTES, code="M050", what="log", encoding="utf-8-sig")
     separator: str | None = None
     indices: tuple[int, int, int] | None = None
     rows: list[list[float]] = []
     lines: list[int] = []
     first = True
-    for number, raw in enumerate(text.splitlines(), start=1):
+    for number, raw in enumerate(read_log_lines(path), start=1):
         stripped = raw.strip()
         if not stripped or stripped.startswith("#"):
             continue
         if first:
-            separator = next((s for s in _SEPARATORS if s in stripped), None)
-        cells = _split(stripped, separator)
-        if first:
             first = False
-            header, indices = _layout(cells, columns, file, number)
+            separator = next((s for s in _SEPARATORS if s in stripped), None)
+            header, indices = _layout(_split(stripped, separator), columns, file, number)
             if header:
                 continue
         assert indices is not None
-        rows.append(_row(cells, indices, file, number))
+        rows.append(_row(raw, separator, indices, file, number))
         lines.append(number)
         if len(rows) > MAX_LOG_SAMPLES:
             raise _fail(
@@ -343,8 +483,8 @@ def read_csv_log(path: Path, columns: Sequence[str] | None = None) -> Log:
     return Log(samples=samples, lines=tuple(lines), source=file)
 
 
-#: Characters read at a time by :func:`iter_csv_chunks`.
-BLOCK_CHARS = 1 << 22
+#: Bytes read at a time by :func:`iter_csv_chunks`.
+BLOCK_BYTES = 1 << 22
 
 
 def _fast_rows(
@@ -368,34 +508,26 @@ def _fast_rows(
 
 
 def iter_csv_chunks(
-    path: Path, columns: Sequence[str] | None = None, block_chars: int = BLOCK_CHARS
+    path: Path, columns: Sequence[str] | None = None, block_bytes: int = BLOCK_BYTES
 ) -> Iterator[Log]:
-    """The samples of a CSV log, a block of text at a time, never the whole file.
+    """The samples of a CSV log, ``block_bytes`` bytes at a time, never the whole file.
 
     Accepts exactly what :func:`read_csv_log` accepts and gives the same samples and line
     numbers, in order; a problem is raised when its block is reached.
     """
+    from tlmpc.io.inputs import open_regular
+
     file = str(path)
+    require_path(path)
     separator: str | None = None
     indices: tuple[int, int, int] | None = None
-    number = 0  # lines before the current block
-    carry = ""
+    reader = LogLines(file)
     try:
-        with open(path, encoding="utf-8-sig") as stream:
+        with open_regular(path, code="M050", what="log") as stream:
             while True:
-                text = stream.read(block_chars)
-                end = text.rfind("\n") + 1 if text else len(carry)
-                if text and end == 0:
-                    carry += text
-                    continue
-                block, carry = carry + text[:end], text[end:] if text else ""
-                if not block:
-                    break
-                # splitlines, as read_csv_log splits the whole text (form feeds, ...); the
-                # block ends after a line break, so its lines are the file's lines.
-                lines = block.splitlines()
-                first_number = number + 1
-                number += len(lines)
+                data = stream.read(block_bytes)
+                lines = reader.feed(data) if data else reader.finish()
+                first_number = reader.count - len(lines) + 1
                 if indices is None:
                     for offset, raw in enumerate(lines):
                         stripped = raw.strip()
@@ -408,13 +540,15 @@ def iter_csv_chunks(
                         skip = offset + 1 if header else offset
                         lines, first_number = lines[skip:], first_number + skip
                         break
-                    else:
-                        continue
-                chunk = _chunk(lines, first_number, separator, indices, file, "#" not in block)
-                if len(chunk.samples):
-                    yield chunk
-    except (OSError, UnicodeDecodeError) as exc:
-        raise _fail("M050", f"cannot read {file}: {exc}", file) from None
+                if indices is not None and lines:
+                    plain = all(line and "#" not in line for line in lines)
+                    chunk = _chunk(lines, first_number, separator, indices, file, plain)
+                    if len(chunk.samples):
+                        yield chunk
+                if not data:
+                    return
+    except OSError as exc:  # a read that fails (a disk error): the system's reason
+        raise _fail("M050", f"cannot read {file}: {exc.strerror or exc}", file) from None
 
 
 def _chunk(
@@ -426,7 +560,7 @@ def _chunk(
     plain: bool,
 ) -> Log:
     """The samples of consecutive lines (the first is line ``first_number``); ``plain``: no
-    line is a comment (blank lines make the widths differ, which the fast parser refuses)."""
+    line is a comment or empty (for the fast parser)."""
     numbers = range(first_number, first_number + len(lines))
     samples = _fast_rows(lines, separator, indices) if plain and lines else None
     if samples is not None:
@@ -437,7 +571,7 @@ def _chunk(
         stripped = raw.strip()
         if not stripped or stripped.startswith("#"):
             continue
-        rows.append(_row(_split(stripped, separator), indices, file, number))
+        rows.append(_row(raw, separator, indices, file, number))
         kept.append(number)
     return Log(
         samples=np.asarray(rows, dtype=np.float64).reshape(-1, 3),
@@ -475,7 +609,7 @@ class CsvLines:
             )
             if header:
                 return None
-        t, x, y = _row(_split(stripped, self.separator), self.indices, self.file, number)
+        t, x, y = _row(raw, self.separator, self.indices, self.file, number)
         return t, x, y
 
 

@@ -52,14 +52,12 @@ def _missing(file: str, what: str, hint: str) -> UsageError:
 def _csv_signals(
     path: Path, reactive: Reactive, columns: Sequence[str] | None
 ) -> dict[str, Signal]:
-    from tlmpc.importers.logs import _SEPARATORS, MAX_CSV_BYTES, _layout, _split
-    from tlmpc.io.inputs import read_text
+    from tlmpc.importers.logs import _SEPARATORS, _layout, _split, read_log_lines
 
     file = str(path)
-    text = read_text(path, limit=MAX_CSV_BYTES, code="M050", what="log", encoding="utf-8-sig")
     rows = [
         (number, raw.strip())
-        for number, raw in enumerate(text.splitlines(), start=1)
+        for number, raw in enumerate(read_log_lines(path), start=1)
         if raw.strip() and not raw.strip().startswith("#")
     ]
     if not rows:

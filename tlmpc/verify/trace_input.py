@@ -406,7 +406,8 @@ def check_csv_file(path: Path) -> None:
             f"the CSV trace is too large (more than {MAX_CSV_ROWS:,} rows or "
             f"{MAX_CSV_BYTES // 2**20} MiB)",
             str(path),
-            hint="downsample the log (every k-th row) before verifying it",
+            hint="thin the log out (keep every k-th row) to view, plot or read it whole; "
+            "`tlmpc verify` streams a log of any length",
         )
     if longest > MAX_CSV_LINE:
         raise _fail(
@@ -448,7 +449,7 @@ def read_trace(
                 str(path),
             )
         if isinstance(mission, Path):
-            mission = _load_mission(mission)
+            mission = load_log_mission(mission)
         return _log_trace(path, mission, convention, options)
     if path.is_symlink() and not path.exists():  # a link loop (meant as a folder?) or to nothing
         raise _fail(
@@ -463,7 +464,8 @@ def read_trace(
     return from_document(read_json(path, finite=False), file=str(path), convention=convention)
 
 
-def _load_mission(mission_path: Path) -> Mission:
+def load_log_mission(mission_path: Path) -> Mission:
+    """The mission a log is checked against (its loader's diagnostics, exit 2)."""
     from tlmpc.base.errors import InvalidInputError
     from tlmpc.mission.load import load_mission
 
@@ -475,19 +477,27 @@ def _load_mission(mission_path: Path) -> Mission:
 
 def mission_document(path: Path, mission_path: Path | None) -> dict[str, Any]:
     """A ``tlmpc.trace/1`` document without samples: the task, regions, workspace, convention,
-    ``max_speed`` and body radius that ``mission_path`` gives the log at ``path``."""
+    ``max_speed`` and body radius that ``mission_path`` gives the log at ``path`` (see
+    :func:`positions_document`)."""
     if mission_path is None:
         raise _fail(
             "V010", "a CSV trace needs --mission MISSION.yaml for its regions and task", str(path)
         )
-    mission = _load_mission(mission_path)
+    return positions_document(load_log_mission(mission_path))
+
+
+def positions_document(mission: Mission) -> dict[str, Any]:
+    """``mission`` as a sample-less ``tlmpc.trace/1`` document for the readers that take
+    positions only (many logs at once, a streamed log, the live monitor): refused (U110, at
+    the mission file, whatever log it was meant for) when the mission is reactive."""
     if mission.reactive is not None:
+        name = mission.source or "the mission"
         raise _fail(
             "U110",
-            f"{mission_path} is a reactive mission: verifying many logs at once, streaming a "
+            f"{name} is a reactive mission: verifying many logs at once, streaming a "
             "long log and live monitoring read positions only, not sensor values",
-            str(path),
-            hint=f"verify each log on its own: tlmpc verify --mission {mission_path} LOG "
+            mission.source,
+            hint=f"verify each log on its own: tlmpc verify --mission {name} LOG "
             "(a log over the size limit: thin it out first)",
         )
     return _mission_fields(mission)
@@ -568,4 +578,4 @@ def from_csv(
             "V010", "a CSV trace needs --mission MISSION.yaml for its regions and task", str(path)
         )
     options = LogOptions(topic=topic, columns=columns, transform=transform, frame=frame)
-    return _log_trace(path, _load_mission(mission_path), convention, options)
+    return _log_trace(path, load_log_mission(mission_path), convention, options)

@@ -343,6 +343,16 @@ def _body_contacts(
     ]
 
 
+def _distances(shape: Any, others: Any) -> FloatArray:
+    """GEOS's distances from ``shape`` to each of ``others``.  A segment a hair long (3.6e-305)
+    has a squared length that underflows to 0, and GEOS divides by it (a projection beyond
+    the segment's end, or 0 / 0 beside a collinear edge) on its way to the right distance, the
+    one to the segment's end or 0; numpy's flags raised on the way are no warning for the
+    caller."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.asarray(shapely.distance(shape, others), dtype=np.float64)
+
+
 def workspace_violations(trace: TraceInput) -> tuple[list[Violation], float | None]:
     """Every excursion out of the workspace or into a hole, and the workspace robustness.
 
@@ -356,7 +366,7 @@ def workspace_violations(trace: TraceInput) -> tuple[list[Violation], float | No
     segments = _segments(points)
     inside = np.asarray(shapely.covers(free, segments), dtype=bool)
     if inside.all():
-        distances = np.asarray(shapely.distance(free.boundary, segments), dtype=np.float64)
+        distances = _distances(free.boundary, segments)
         clearance = float(np.min(distances))
         if trace.radius > 0.0:
             return _body_contacts(trace, free, distances), clearance - trace.radius
@@ -380,9 +390,7 @@ def workspace_violations(trace: TraceInput) -> tuple[list[Violation], float | No
             probes = np.vstack([coords, middles[None, :]])
             outside_probes = probes[~shapely.covers(free, shapely.points(probes))]
             if len(outside_probes):
-                depth = max(
-                    depth, float(np.max(shapely.distance(free, shapely.points(outside_probes))))
-                )
+                depth = max(depth, float(np.max(_distances(free, shapely.points(outside_probes)))))
         if previous_bad:
             continue
         previous_bad = True
