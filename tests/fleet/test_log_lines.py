@@ -4,16 +4,15 @@ the same refusals whichever blocks the bytes come in."""
 
 from __future__ import annotations
 
-import io
 import re
 from pathlib import Path
 
 import pytest
+from fleet_cli import run_cli
 from hypothesis import given
 from hypothesis import strategies as st
 
 from tlmpc.base.errors import UsageError
-from tlmpc.cli import main
 from tlmpc.importers.logs import MAX_LINE_CHARS, LogLines, iter_csv_chunks, split_lines
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -71,20 +70,6 @@ def test_an_endless_line_is_refused_before_it_is_held() -> None:
     with pytest.raises(UsageError) as raised:
         read_in_blocks(long, [])
     assert (raised.value.diagnostics[0].code, raised.value.diagnostics[0].line) == ("M053", 2)
-
-
-def run_cli(*argv: str, stdin: bytes | None = None) -> tuple[int, str, str]:
-    import sys
-
-    out, err = io.StringIO(), io.StringIO()
-    saved = sys.stdin
-    if stdin is not None:
-        sys.stdin = io.TextIOWrapper(io.BytesIO(stdin), encoding="utf-8")
-    try:
-        code = main(list(argv), out=out, err=err)
-    finally:
-        sys.stdin = saved
-    return code, out.getvalue(), err.getvalue()
 
 
 @pytest.mark.parametrize(

@@ -5,7 +5,6 @@ tracebacks or hangs, a followed log read line by complete line, and verdicts nev
 
 from __future__ import annotations
 
-import io
 import json
 import os
 import re
@@ -16,13 +15,13 @@ from typing import Any
 
 import numpy as np
 import pytest
+from fleet_cli import run_cli
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from strategies import formulas
 from test_stream_equivalence import document, walks
 
 from tlmpc.base.errors import UsageError
-from tlmpc.cli import main
 from tlmpc.fleet.monitor import Monitor
 from tlmpc.ltl.printer import to_text
 
@@ -30,20 +29,6 @@ ROOT = Path(__file__).resolve().parents[2]
 MISSION = str(ROOT / "specs" / "reach-avoid.yaml")
 #: Poses of specs/reach-avoid.yaml: home, then through the hazard (violated at the third).
 POSES = [(0.0, 1.0, 1.0), (10.0, 4.0, 2.0), (20.0, 8.5, 2.0), (30.0, 10.8, 6.8)]
-
-
-def run_cli(*argv: str, stdin: bytes | None = None) -> tuple[int, str, str]:
-    import sys
-
-    out, err = io.StringIO(), io.StringIO()
-    saved = sys.stdin
-    if stdin is not None:
-        sys.stdin = io.TextIOWrapper(io.BytesIO(stdin), encoding="utf-8")
-    try:
-        code = main(list(argv), out=out, err=err)
-    finally:
-        sys.stdin = saved
-    return code, out.getvalue(), err.getvalue()
 
 
 def csv_of(poses: list[tuple[float, float, float]], epoch: float = 0.0) -> str:
