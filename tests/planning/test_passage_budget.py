@@ -40,6 +40,7 @@ from tlmpc.planning.boundary import start_cells
 from tlmpc.planning.budget import estimate_product
 from tlmpc.planning.complete import plan_complete
 from tlmpc.planning.mission import automaton_for
+from tlmpc.planning.model import Witness
 from tlmpc.planning.passages import add_vertex_passages, estimate_passage_edges
 from tlmpc.planning.plan import plan
 from tlmpc.planning.product import build_product
@@ -171,33 +172,43 @@ def test_the_diagonal_gap_ends_within_a_small_budget(
     assert all(count <= small for count in listed.counts)
 
 
-def test_a_fan_beyond_the_budget_is_p060_before_any_pair_is_listed(
-    monkeypatch: pytest.MonkeyPatch,
-) -> None:
-    needles = fan(1000, labelled=500)
+def _fan_task(count: int, labelled: int) -> tuple[Abstraction, Automaton, tuple[float, float], int]:
+    """A fan of ``count`` needles round one vertex, ``labelled`` of them in ``a``: the mesh,
+    the automaton of ``F a``, the start (in the fan's start triangle) and the passage
+    estimate."""
+    needles = fan(count, labelled=labelled)
     automaton = translate(parse_ltl("F a"), letters=needles.letters)
-    options = Options()
     start = centroid(needles, needles.start)
-    allowed = np.ones(needles.num_triangles, dtype=bool)
     estimate = estimate_passage_edges(
         needles,
         automaton,
-        allowed=allowed,
+        allowed=np.ones(needles.num_triangles, dtype=bool),
         starts=start_cells(needles, start),
-        convention=options.boundary,
+        convention=Options().boundary,
     )
+    return needles, automaton, start, estimate
+
+
+def _plan_fan(needles: Abstraction, automaton: Automaton, start: tuple[float, float]) -> Witness:
+    return plan(
+        needles,
+        automaton,
+        formula=parse_ltl("F a"),
+        options=Options(),
+        start_point=start,
+        passages=True,
+    )
+
+
+def test_a_fan_beyond_the_budget_is_p060_before_any_pair_is_listed(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    needles, automaton, start, estimate = _fan_task(1000, labelled=500)
     assert estimate >= 1000 * 999  # every ordered pair of the fan's needles
     monkeypatch.setattr(budget, "MAX_PASSAGE_EDGES", estimate - 1)
     listed = PairsListed(monkeypatch, most=0)
     with pytest.raises(UsageError) as refused:
-        plan(
-            needles,
-            automaton,
-            formula=parse_ltl("F a"),
-            options=options,
-            start_point=start,
-            passages=True,
-        )
+        _plan_fan(needles, automaton, start)
     (diagnostic,) = refused.value.diagnostics
     assert diagnostic.code == "P060"
     assert "1,000 lie around (0, 0)" in diagnostic.message
@@ -209,26 +220,9 @@ def test_a_fan_within_the_budget_plans_through_its_centre(
 ) -> None:
     """At the budget exactly, the passages are built and the plan found (the estimate is the
     whole charge: nothing else refuses)."""
-    needles = fan(60, labelled=30)
-    automaton = translate(parse_ltl("F a"), letters=needles.letters)
-    options = Options()
-    start = centroid(needles, needles.start)
-    estimate = estimate_passage_edges(
-        needles,
-        automaton,
-        allowed=np.ones(needles.num_triangles, dtype=bool),
-        starts=start_cells(needles, start),
-        convention=options.boundary,
-    )
+    needles, automaton, start, estimate = _fan_task(60, labelled=30)
     monkeypatch.setattr(budget, "MAX_PASSAGE_EDGES", estimate)
-    witness = plan(
-        needles,
-        automaton,
-        formula=parse_ltl("F a"),
-        options=options,
-        start_point=start,
-        passages=True,
-    )
+    witness = _plan_fan(needles, automaton, start)
     assert witness.prefix
 
 

@@ -21,7 +21,7 @@ from typing import IO, TYPE_CHECKING, Any, TextIO
 if TYPE_CHECKING:
     from tlmpc.base.errors import Diagnostic
     from tlmpc.fleet.monitor import Change
-    from tlmpc.importers.logs import LogLines
+    from tlmpc.importers.logs import CsvLines, LogLines
     from tlmpc.mission.model import Mission
 
 NAME = "monitor"
@@ -237,7 +237,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
 
 def _pose(
     raw: str,
-    csv: Any,
+    csv: CsvLines,
     transform: tuple[float, float, float] | None,
     name: str,
     number: int,
