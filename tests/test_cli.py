@@ -39,6 +39,21 @@ def test_usage_errors_exit_2(argv: tuple[str, ...]) -> None:
     assert "usage:" in err
 
 
+@pytest.mark.parametrize(
+    ("argv", "prefix"),
+    [
+        (("monitor", "--mission", "m.yaml", "--json"), "--json"),
+        (("compile", "m.yaml", "--unt", "plan"), "--unt"),
+        (("verify", "trace.json", "--miss", "m.yaml"), "--miss"),
+    ],
+)
+def test_a_prefix_of_an_option_is_not_taken_for_it(argv: tuple[str, ...], prefix: str) -> None:
+    # `monitor --json` once ran as `--jsonl`: a prefix may name another option tomorrow
+    code, _, err = run(*argv)
+    assert code == 2
+    assert f"unrecognized arguments: {prefix}" in err
+
+
 def test_missing_mission_file_exits_2(tmp_path: object) -> None:
     code, _, err = run("compile", "/nonexistent/mission.yaml", "-o", "/tmp/tlmpc-never-written")
     assert code == 2

@@ -72,6 +72,7 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
         description="Temporal logic motion planning compiler and verifier.",
         epilog=EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
+        allow_abbrev=False,
     )
     parser.add_argument("--version", action="version", version=f"tlmpc {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
@@ -86,6 +87,9 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
             description=getattr(module, "DESCRIPTION", module.HELP),
             epilog=EPILOG,
             formatter_class=argparse.RawDescriptionHelpFormatter,
+            # a prefix that names one option today may name another tomorrow (`--json` was
+            # taken for `--jsonl`): options are spelled out in full
+            allow_abbrev=False,
         )
         if only is None or only == module.NAME:
             module.add_arguments(command_parser)
