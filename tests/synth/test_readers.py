@@ -155,6 +155,21 @@ def test_tlsf_without_main_or_semantics_says_what_is_missing() -> None:
         assert message in found.message, (text, found.message)
 
 
+@pytest.mark.parametrize("name", ["true", "false", "X", "G", "F", "U", "W", "R"])
+def test_tlsf_signal_named_like_a_keyword_is_refused_at_its_declaration(name: str) -> None:
+    """A formula reads such a name as the operator or constant, never as the signal: a
+    `true` input would vanish from ``G (true -> g)``."""
+    text = (
+        'INFO { TITLE: "t" SEMANTICS: Mealy TARGET: Mealy }\n'
+        f"MAIN {{\nINPUTS {{ r; {name}; }}\nOUTPUTS {{ g; }}\nGUARANTEE {{ G F g; }}\n}}\n"
+    )
+    with pytest.raises(UsageError) as caught:
+        parse_tlsf(text, file="t.tlsf")
+    found = caught.value.diagnostics[0]
+    assert (found.code, found.line, found.col) == ("Q041", 3, 13)
+    assert "keyword" in found.message
+
+
 def test_gr1c_one_side_init() -> None:
     """gr1c's ONE_SIDE_INIT: a SYSINIT alone needs one winning state; an ENVINIT alone needs
     every state it allows to win (y is frozen, and only y = True wins)."""

@@ -54,6 +54,7 @@ _TOKEN = re.compile(
 _WORD_OPS = {"NOT": "!", "AND": "&&", "OR": "||", "IMPLIES": "->", "EQUIV": "<->"}
 _UNARY = {"!", "X", "G", "F"}
 _BINARY_TEMPORAL = {"U", "W", "R"}
+_RESERVED = _UNARY.union(_BINARY_TEMPORAL, {"true", "false"}) - {"!"}
 
 
 @dataclass(frozen=True)
@@ -287,6 +288,14 @@ class _Parser:
                             f"expected a signal name, found {self.shown(signal)}",
                             signal.start,
                             f"{name} {{ a; b; }} (basic TLSF has no buses or enums)",
+                        )
+                    if signal.text in _RESERVED:
+                        # a formula would read the name as the operator or constant
+                        raise self.source.fail(
+                            "Q041",
+                            f"the signal name {signal.text!r} is a TLSF keyword",
+                            signal.start,
+                            "rename the signal (true, false, X, G, F, U, W and R are reserved)",
                         )
                     self.expect(";", "end each signal with ';'")
                     signals.append((name, signal))
