@@ -62,6 +62,8 @@ def test_bounded_operators_bind_like_their_namesakes() -> None:
         ("F[1] a", "L040", 2),
         ("F[1,2,3] a", "L040", 2),
         ("F[0,5s] a", "L040", 2),
+        ("F[0,1e309] a", "L040", 2),
+        ("G[2e308,inf] a", "L040", 2),
         ("a R[0,1] b", "L044", 3),
         ("a W[0,1] b", "L044", 3),
         ("F a & G[3,2] b", "L041", 8),

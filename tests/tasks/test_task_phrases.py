@@ -82,6 +82,18 @@ def test_unknown_group() -> None:
     assert "rooms" in (caught.value.diagnostics[0].hint or "")
 
 
+@pytest.mark.parametrize(
+    "duration", ["9" * 400 + " s", "2" + "0" * 307 + " minutes", "2" + "0" * 308 + ".5 seconds"]
+)
+def test_a_duration_past_the_float_range_is_refused_at_the_duration(duration: str) -> None:
+    # read as inf it would make "within" bound nothing
+    with pytest.raises(InvalidInputError) as caught:
+        compile_phrase(f"visit a within {duration}", file="m.yaml", line=3, col=5)
+    found = caught.value.diagnostics[0]
+    assert (found.code, found.line, found.col) == ("T004", 3, 20)
+    assert compile_phrase("visit a within 1" + "0" * 306 + " s") == parse_ltl("F[0,1e306] a")
+
+
 def test_names_keep_positions_inside_the_phrase() -> None:
     formula = compile_phrase("visit kitchen", file="m.yaml", line=9, col=5)
     prop = next(n for n in formula.walk() if hasattr(n, "name"))

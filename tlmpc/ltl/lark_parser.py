@@ -89,7 +89,16 @@ def _interval_problem(text: str) -> tuple[str, str, Interval | None]:
     bounds: list[float] = []
     for part in (p.strip() for p in parts):
         if _NUMBER.fullmatch(part):
-            bounds.append(float(part))
+            value = float(part)
+            if math.isinf(value):
+                # written finite, read unbounded: the window would change its meaning
+                return (
+                    "L040",
+                    f"the time bound {text}: {part} is too large for a float"
+                    " (inf is a window without end)",
+                    None,
+                )
+            bounds.append(value)
         elif _INFINITY.fullmatch(part):
             bounds.append(math.inf)
         elif _NOT_A_NUMBER.fullmatch(part):

@@ -11,6 +11,7 @@ from __future__ import annotations
 import difflib
 import functools
 import itertools
+import math
 import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -239,7 +240,23 @@ class _Lowering:
         if kind in _REACTIVE:
             return self._reactive(kind, children)
         if kind in _TIMED:
-            return self._timed(kind, children, _duration(tree))
+            seconds = _duration(tree)
+            if math.isinf(seconds):
+                # written finite, read unbounded: "within" would no longer bound anything
+                token = tree.children[-1]
+                assert isinstance(token, Word)
+                line, col = self._where(token)
+                self.problems.append(
+                    error(
+                        "T004",
+                        f"the duration {str(token)!r} is too large for a float",
+                        hint="write a duration below 1e308 s",
+                        file=self.file,
+                        line=line,
+                        col=col,
+                    )
+                )
+            return self._timed(kind, children, seconds)
         raise ValueError(f"unknown phrase kind {kind}")  # pragma: no cover - grammar is closed
 
     def _timed(self, kind: str, children: list[Node], seconds: float) -> Formula:
