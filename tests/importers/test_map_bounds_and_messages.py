@@ -220,6 +220,28 @@ def test_a_map_yaml_diagnostic_is_located_and_has_a_hint(
 
 
 @pytest.mark.parametrize(
+    ("text", "place", "hint"),
+    [
+        pytest.param(
+            GOOD_MAP.replace("0.0, 0.0]", "0.0, 0.0"), (5, 7), "brackets", id="unclosed list"
+        ),
+        pytest.param(GOOD_MAP + "  extra: 1\n", (8, 8), "indentation", id="indented key"),
+        pytest.param(GOOD_MAP + "\tmode: trinary\n", (8, 1), "tabs", id="tab"),
+    ],
+)
+def test_a_map_yaml_syntax_error_is_located_and_has_a_hint(
+    tmp_path: Path, text: str, place: tuple[int, int], hint: str
+) -> None:
+    path = _free_map(tmp_path, 0.1, (0.0, 0.0, 0.0))
+    path.write_text(text)
+    code_, _, err = run("import-map", str(path), "-o", str(tmp_path / "out.yaml"))
+    assert code_ == 2, err
+    line, col = place
+    assert err.startswith(f"{path}:{line}:{col}: error[M002]: YAML syntax error: "), err
+    assert hint in err.partition("\n  hint: ")[2], err
+
+
+@pytest.mark.parametrize(
     ("change", "key"),
     [
         (lambda t: t.replace("resolution: 0.1", "resolution: 0.2"), "resolution"),
@@ -237,3 +259,22 @@ def test_a_mask_that_does_not_fit_the_map_is_refused_at_its_key(
     assert err.startswith(f"{mask}:{_line_of(mask, key)}:"), err
     assert "error[M013]" in err
     assert "\n  hint: " in err
+
+
+def test_free_space_lost_in_simplification_is_blamed_on_the_map_with_a_hint(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The simplified coverage keeps the exact faces' area by construction; should it ever
+    come back empty, M011 names the map and says what to change."""
+    from tlmpc.importers import maps
+
+    def nothing_left(*_: object) -> tuple[list[object], dict[int, list[object]]]:
+        return [], {}
+
+    monkeypatch.setattr(maps, "_coverage", nothing_left)
+    path = _free_map(tmp_path, 0.1, (0.0, 0.0, 0.0))
+    code, _, err = run("import-map", str(path), "-o", str(tmp_path / "out.yaml"))
+    assert code == 2, err
+    assert err.startswith(f"{path}: error[M011]: "), err
+    assert "--tolerance" in err.partition("\n  hint: ")[2], err
+    assert not (tmp_path / "out.yaml").exists()

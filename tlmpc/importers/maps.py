@@ -313,8 +313,6 @@ def _coverage(
             faces, face_labels = simple, matched
     kept = [f for f, lab in zip(faces, face_labels, strict=True) if lab is not None]
     merged = polygons(shapely.union_all(kept))
-    if not merged:
-        raise _fail("M011", "the free space vanishes when simplified", "")
     by_label: dict[int, list[BaseGeometry]] = {}
     for face, face_label in zip(faces, face_labels, strict=True):
         if face_label is not None:
@@ -496,6 +494,14 @@ def import_map(
     labels = _labels(grid, layers)
     exact = MultiPolygon([exact_main, *exact_others]) if exact_others else exact_main
     simplified, pieces = _coverage(exact, labels, tolerance / grid.resolution)
+    if not simplified:
+        raise _fail(
+            "M011",
+            "the free space vanishes when simplified",
+            grid.source,
+            hint="lower the simplification tolerance (import-map --tolerance, or the map's"
+            " `tolerance` in a mission; 0 keeps the cells' own outline)",
+        )
     # Each exact piece, its specks already decided on exact areas, is the simplified piece
     # overlapping it most; their holes are the exact holes kept, however small simplified.
     tree = shapely.STRtree(simplified)

@@ -28,7 +28,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import IO, Any
 
-from tlmpc.base.errors import UsageError, error
+from tlmpc.base.errors import Diagnostic, UsageError, error
 
 #: Pieces in which files are read (a bounded read never asks for more than it may keep).
 CHUNK = 4 * 1024 * 1024
@@ -204,6 +204,30 @@ def _check_yaml_events(text: str, max_values: int, max_depth: int) -> None:
             )
 
 
+#: The longest YAML parser problem quoted in a message.
+MAX_YAML_PROBLEM = 200
+
+
+def yaml_syntax_error(exc: Any, code: str, file: str) -> Diagnostic:
+    """The diagnostic of a YAML parser's ``MarkedYAMLError``: at the parser's mark, its
+    problem as the message, a hint on what usually breaks YAML."""
+    mark = exc.problem_mark or exc.context_mark
+    problem = str(exc.problem or "invalid YAML")
+    if len(problem) > MAX_YAML_PROBLEM:  # it may quote the file
+        problem = problem[: MAX_YAML_PROBLEM - 1] + "…"
+    hint = "check indentation (spaces only, no tabs), quotes and brackets"
+    if "\t" in problem or "tab" in problem:
+        hint = "YAML does not allow tabs for indentation: use spaces"
+    return error(
+        code,
+        f"YAML syntax error: {problem}",
+        hint=hint,
+        file=file,
+        line=mark.line + 1 if mark is not None else 1,
+        col=mark.column + 1 if mark is not None else 1,
+    )
+
+
 def load_small_yaml(
     text: str,
     file: str,
@@ -214,7 +238,7 @@ def load_small_yaml(
 ) -> Any:
     """The data of a small YAML file (a map, a mask), refused (``code``) when it is not YAML
     or when it nests or expands past the limits; found while parsing, before any value is
-    built.  The YAML error's text is kept short (it may quote the file)."""
+    built."""
     import yaml
 
     try:
@@ -231,15 +255,6 @@ def load_small_yaml(
             )
         ) from None
     except yaml.MarkedYAMLError as exc:
-        mark = exc.problem_mark or exc.context_mark
-        raise UsageError(
-            error(
-                code,
-                f"not valid YAML: {brief(exc.problem or 'invalid YAML')}",
-                file=file,
-                line=mark.line + 1 if mark is not None else None,
-                col=mark.column + 1 if mark is not None else None,
-            )
-        ) from None
+        raise UsageError(yaml_syntax_error(exc, code, file)) from None
     except (yaml.YAMLError, RecursionError, ValueError) as exc:
         raise UsageError(error(code, f"not valid YAML: {brief(str(exc))}", file=file)) from None

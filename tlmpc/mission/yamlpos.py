@@ -17,6 +17,7 @@ from typing import Any
 import yaml
 
 from tlmpc.base.errors import Diagnostic, error
+from tlmpc.io.inputs import yaml_syntax_error
 from tlmpc.io.scalar_places import ScalarPlaces, line_starts, scalar_places
 from tlmpc.mission.bulk import STEM, BulkList, cut_out
 
@@ -642,16 +643,7 @@ def _result(
     if outcome is None:
         return None, converter.problems
     if isinstance(outcome, yaml.MarkedYAMLError):
-        mark = outcome.problem_mark or outcome.context_mark
-        line = mark.line + 1 if mark is not None else 1
-        col = mark.column + 1 if mark is not None else 1
-        problem = outcome.problem or "invalid YAML"
-        hint = "check indentation (spaces only, no tabs), quotes and brackets"
-        if "\t" in problem or "tab" in problem:
-            hint = "YAML does not allow tabs for indentation: use spaces"
-        return None, [
-            error("Y001", f"YAML syntax error: {problem}", hint=hint, file=file, line=line, col=col)
-        ]
+        return None, [yaml_syntax_error(outcome, "Y001", file)]
     if isinstance(outcome, yaml.YAMLError):
         return None, [error("Y001", f"YAML syntax error: {outcome}", file=file, line=1, col=1)]
     if not outcome or (converter.doc.data is None and not converter.problems):
