@@ -12,7 +12,7 @@ import yaml
 from tlmpc.base.extras import require
 from tlmpc.exports.georeference import Georeference, to_lon_lat
 from tlmpc.exports.plan import Plan, Ring, Waypoint
-from tlmpc.io.outputs import csv_cell
+from tlmpc.io.outputs import csv_cell, yaml_float
 
 
 def _quaternion(yaw: float) -> dict[str, float]:
@@ -44,24 +44,11 @@ def waypoints_yaml(
     for w in points:
         q = _quaternion(w.yaw)
         out.write(
-            f"- t: {_yaml_float(w.t)}\n  x: {_yaml_float(w.x)}\n  y: {_yaml_float(w.y)}\n"
-            f"  yaw: {_yaml_float(w.yaw)}\n  orientation: {{x: {_yaml_float(q['x'])}, "
-            f"y: {_yaml_float(q['y'])}, z: {_yaml_float(q['z'])}, w: {_yaml_float(q['w'])}}}\n"
+            f"- t: {yaml_float(w.t)}\n  x: {yaml_float(w.x)}\n  y: {yaml_float(w.y)}\n"
+            f"  yaw: {yaml_float(w.yaw)}\n  orientation: {{x: {yaml_float(q['x'])}, "
+            f"y: {yaml_float(q['y'])}, z: {yaml_float(q['z'])}, w: {yaml_float(q['w'])}}}\n"
         )
     return out.getvalue()
-
-
-def _yaml_float(value: float) -> str:
-    """A float as PyYAML's SafeRepresenter writes it (``repr``, with ``.0`` before a bare
-    exponent so that YAML 1.1 reads it back as a float)."""
-    if value != value:
-        return ".nan"
-    if value in (math.inf, -math.inf):
-        return ".inf" if value > 0 else "-.inf"
-    text = repr(float(value)).lower()
-    if "." not in text and "e" in text:
-        text = text.replace("e", ".0e", 1)
-    return text
 
 
 def waypoints_csv(plan: Plan, points: list[Waypoint], loop: int | None) -> str:

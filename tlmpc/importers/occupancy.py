@@ -30,6 +30,7 @@ import numpy.typing as npt
 
 from tlmpc.base.errors import UsageError, error
 from tlmpc.io.inputs import brief, load_small_yaml, open_regular, read_text
+from tlmpc.io.outputs import yaml_float
 
 MODES = ("trinary", "scale", "raw")
 UNKNOWN = -1
@@ -194,7 +195,7 @@ def _number(meta: dict[str, Any], key: str, file: str, written: _MapText) -> flo
         if finite and place is not None and place.quoted:
             hint = (
                 "the value is in quotes, so YAML reads it as text: write the number without "
-                f"quotes, {key}: {_yaml_number(float(value))}"
+                f"quotes, {key}: {yaml_float(float(value))}"
             )
         elif finite:
             hint = (
@@ -217,14 +218,6 @@ def _finite_text(text: str) -> bool:
         return math.isfinite(float(text))
     except ValueError:
         return False
-
-
-def _yaml_number(value: float) -> str:
-    """``value`` written so that YAML 1.1 reads it as a number (``1e-12`` is text there: its
-    floats need a decimal point)."""
-    text = repr(value)
-    mantissa, e, exponent = text.partition("e")
-    return f"{mantissa}.0e{exponent}" if e and "." not in mantissa else text
 
 
 def read_metadata(path: Path) -> dict[str, Any]:

@@ -13,6 +13,7 @@
 
 from __future__ import annotations
 
+import math
 import os
 from collections.abc import Iterable
 from pathlib import Path
@@ -45,6 +46,19 @@ def csv_cell(text: str) -> str:
     if any(ch in cell for ch in ",;\"'\t "):
         cell = '"' + cell.replace('"', '""') + '"'
     return cell
+
+
+def yaml_float(value: float) -> str:
+    """A float as PyYAML's SafeRepresenter writes it: ``repr``, with ``.0`` before a bare
+    exponent (YAML 1.1 reads ``1e-12`` as text: its floats need a decimal point)."""
+    if value != value:
+        return ".nan"
+    if value in (math.inf, -math.inf):
+        return ".inf" if value > 0 else "-.inf"
+    text = repr(float(value)).lower()
+    if "." not in text and "e" in text:
+        text = text.replace("e", ".0e", 1)
+    return text
 
 
 def same_file(a: Path, b: Path) -> bool:
