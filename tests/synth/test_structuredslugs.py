@@ -265,7 +265,7 @@ X(y = x + 2) | b
 def test_arithmetic_lines_mean_exact_sums() -> None:
     """Each line against Python's own arithmetic, and its BDD against the evaluator on every
     valuation (the encoding of sums by partial sums)."""
-    from tlmpc.synth.strategy import _assignment
+    from tlmpc.synth.strategy import bits_of
     from tlmpc.synth.symbolic import Encoding
 
     spec = parse_structuredslugs(ARITHMETIC, file="a.structuredslugs")
@@ -289,7 +289,7 @@ def test_arithmetic_lines_mean_exact_sums() -> None:
             for after in states:
                 truth = python(now, after)
                 assert evaluate(part.formula, now, after) == truth, (part.text, now, after)
-                bits = {**_assignment(enc, now, False), **_assignment(enc, after, True)}
+                bits = {**bits_of(enc, now, False), **bits_of(enc, after, True)}
                 assert (enc.bdd.let(bits, u) == enc.bdd.true) == truth, (part.text, now, after)
 
 

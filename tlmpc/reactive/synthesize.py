@@ -149,7 +149,7 @@ def counterstrategy_to_json(synthesis: Synthesis, abstraction: Abstraction) -> d
     assert synthesis.counter is not None
     game = synthesis.game
     letters = game.faces.letters
-    play = counter_play_steps(synthesis.counter, game)
+    play = counter_play_steps(synthesis.counter, game, synthesis.core)
     points = face_points(abstraction, game.faces)
     return {
         "format": "tlmpc.counterstrategy/1",
@@ -187,7 +187,7 @@ def unrealizable(synthesis: Synthesis, mission: Mission) -> list[Diagnostic]:
     names = "; ".join(part.text for part in core) or "the robot's motion alone"
     first = core[0] if core else None
     counter = synthesis.counter
-    play = counter_play(counter, synthesis.game) if counter is not None else []
+    play = counter_play(counter, synthesis.game, synthesis.core) if counter is not None else []
     found = [
         error(
             "Q110",

@@ -24,9 +24,9 @@ from tlmpc.base.errors import UsageError, error
 from tlmpc.synth.solver import Game, Solution
 from tlmpc.synth.strategy import (
     Value,
-    _assignment,
     _key,
     all_assignments,
+    bits_of,
     ordered_bits,
     restrict,
     smallest,
@@ -128,7 +128,7 @@ def extract_counterstrategy(solution: Solution, *, max_nodes: int = MAX_NODES) -
     losing = ~solution.winning & domain
 
     def rank(values: dict[str, Value]) -> int:
-        bits = _assignment(enc, values, False)
+        bits = bits_of(enc, values, False)
         for r, w in enumerate(layers.ranks):
             if restrict(enc, bits, w) == bdd.true:
                 return r
@@ -141,7 +141,7 @@ def extract_counterstrategy(solution: Solution, *, max_nodes: int = MAX_NODES) -
 
     def node(values: dict[str, Value], goal: int, env_goal: int) -> int:
         r = rank(values)
-        bits = _assignment(enc, values, False)
+        bits = bits_of(enc, values, False)
         if restrict(enc, bits, layers.v[r][goal]) != bdd.true:
             goal = next(j for j, v in enumerate(layers.v[r]) if restrict(enc, bits, v) == bdd.true)
             env_goal = 0
@@ -199,7 +199,7 @@ def extract_counterstrategy(solution: Solution, *, max_nodes: int = MAX_NODES) -
         values = states[current]
         goal, env_goal = memory[current]
         r = rank(values)
-        bits = _assignment(enc, values, False)
+        bits = bits_of(enc, values, False)
         u_ranks = layers.u[r][goal][env_goal]
         k = next(k for k, u in enumerate(u_ranks) if restrict(enc, bits, u) == bdd.true)
         lower = enc.prime(u_ranks[k - 1]) if k > 0 else bdd.false

@@ -88,7 +88,8 @@ def goal_strategies(solution: Solution) -> list[Function]:
     return result
 
 
-def _assignment(enc: Encoding, values: dict[str, Value], primed: bool) -> dict[str, bool]:
+def bits_of(enc: Encoding, values: dict[str, Value], primed: bool) -> dict[str, bool]:
+    """The BDD bits of a state's ``values`` (the next state's bits when ``primed``)."""
     bits: dict[str, bool] = {}
     table = enc.next_bits if primed else enc.bits
     for variable in enc.spec.variables:
@@ -226,7 +227,7 @@ def extract(
     while queue:
         source = queue.popleft()
         values, goal = states[source], node_goals[source]
-        current = _assignment(enc, values, False)
+        current = bits_of(enc, values, False)
         strategy = restrict(enc, current, strategies[goal])
         env_moves = restrict(enc, current, env_moves_all)
         done = restrict(enc, current, goals_done[goal])
