@@ -4,11 +4,13 @@ from __future__ import annotations
 
 import argparse
 import io
+import shlex
 import shutil
 import subprocess
 from pathlib import Path
 
 import pytest
+from ci_oracles import oracle_required
 
 from tlmpc.cli import COMMAND_MODULES, build_parser, main
 from tlmpc.commands import completion
@@ -121,18 +123,16 @@ def test_zsh_and_fish_scripts_keep_file_names_whole_and_offer_flags_and_choices(
     assert "COMPREPLY=($(" not in zsh
     assert "COMPREPLY=( $(" not in zsh
     assert "while IFS= read -r line" in zsh
-    assert "printf '%q'" in zsh
     fish = _script("fish")
-    names = " ".join(name.replace("_", "-") for name in COMMAND_MODULES)
-    before = f"-n 'not __fish_seen_subcommand_from {names}'"
+    before = "-n 'not __fish_tlmpc_command'"
     for option in ("-l version", "-l help", "-s h"):
         assert f"complete -c tlmpc {before} {option}\n" in fish
     # -f: the templates only, no file names, until one is given
     assert (
-        "complete -c tlmpc -f -n '__fish_seen_subcommand_from new; and not "
+        "complete -c tlmpc -f -n '__fish_tlmpc_using new; and not "
         "__fish_seen_subcommand_from reach-avoid patrol map' -a 'reach-avoid patrol map'\n"
     ) in fish
-    assert "complete -c tlmpc -n '__fish_seen_subcommand_from new' -l output -r\n" in fish
+    assert "complete -c tlmpc -n '__fish_tlmpc_using new' -l output -r\n" in fish
 
 
 def test_flag_values_and_repeated_choices_count_as_the_parser_counts(tmp_path: Path) -> None:
@@ -155,3 +155,137 @@ def test_flag_values_and_repeated_choices_count_as_the_parser_counts(tmp_path: P
     assert _complete(script, "pick", "--", "a", "x", "-") == []
     assert _complete(script, "take", "-") == ["-h", "--help"]
     assert _complete(script, "take", "--", "-") == ["-odd.yaml"]
+
+
+def test_a_flag_given_as_flag_equals_value_counts_as_the_parser_counts(tmp_path: Path) -> None:
+    # bash splits `--out=x` at the `=` (COMP_WORDBREAKS): the words the function sees
+    script = _bash_script(tmp_path)
+    (tmp_path / "mission.yaml").write_text("")
+    stages = _complete(script, "stage", "")
+    assert _complete(script, "stage", "--out", "=", "x", "") == stages
+    assert _complete(script, "stage", "-o", "=", "x", "pla") == ["plan"]
+    assert _complete(script, "plot", "--format", "=", "s") == ["svg"]
+    # the cursor right after the `=`: bash completes the empty word after it
+    assert _complete(script, "plot", "--format", "=") == ["svg", "png", "both"]
+    assert _complete(script, "compile", "--until", "=", "abs") == ["abstraction"]
+    assert _complete(script, "check", "--json", "--explain", "=", "mi") == ["mission.yaml"]
+    # a value holding `=` is still one flag's value
+    assert _complete(script, "stage", "--out", "=", "a", "=", "b", "pla") == ["plan"]
+    # `--` alone is not a flag to glue to
+    assert _complete(script, "new", "--", "p") == ["patrol"]
+
+
+ZSH = shutil.which("zsh")
+
+# Types each line into an interactive zsh (in a zpty), presses TAB, and prints the edit buffer:
+# what a user of the documented install sees.  zpty -r waits for the printed marker, so no
+# delay is guessed.
+_ZSH_DRIVER = r"""
+zmodload zsh/zpty || exit 3
+script=$1 dir=$2
+shift 2
+zpty tlmpc_z zsh -f -i
+zpty -w tlmpc_z "PS1='> '; unsetopt beep; LISTMAX=100000; cd ${(q)dir}"
+zpty -w tlmpc_z "autoload -U compinit && compinit -u -D && eval \"\$(<${(q)script})\""
+zpty -w tlmpc_z "tlmpc_dump() { zle -I; print -r -- \"@@[\$BUFFER]@@\"; BUFFER=''; }"
+zpty -w tlmpc_z "zle -N tlmpc_dump; bindkey '^X' tlmpc_dump; print tlmpc-ready-\$((6*7))"
+zpty -r tlmpc_z ignored '*tlmpc-ready-42*' || exit 3
+local out
+for line in "$@"; do
+  zpty -w -n tlmpc_z "$line"$'\t\C-x'
+  zpty -r tlmpc_z out '*@@\[*\]@@*' || exit 3
+  out=${out##*@@\[}
+  print -r -- "${out%\]@@*}"
+done
+zpty -d tlmpc_z
+"""
+
+
+def _zsh_buffers(directory: Path, *lines: str) -> list[str]:
+    """The command line after typing each of ``lines`` and TAB in a real zsh."""
+    assert ZSH is not None
+    script = directory / "tlmpc.zsh"
+    script.write_text(_script("zsh"))
+    driver = directory / "drive.zsh"
+    driver.write_text(_ZSH_DRIVER)
+    result = subprocess.run(
+        [ZSH, "-f", str(driver), str(script), str(directory), *lines],
+        capture_output=True,
+        text=True,
+        timeout=120,  # a guard against a hung pty, not a budget
+    )
+    if result.returncode == 3:
+        pytest.skip("zsh has no zpty module")
+    assert result.returncode == 0, result.stderr
+    return result.stdout.splitlines()
+
+
+@oracle_required(ZSH is not None, "zsh")
+def test_zsh_inserts_file_names_quoted_once(tmp_path: Path) -> None:
+    assert ZSH is not None
+    for name in ("zz file1", "a$b*c", "it's"):
+        (tmp_path / name).write_text("")
+    buffers = _zsh_buffers(
+        tmp_path,
+        "tlmpc plot zz",
+        "tlmpc check a",
+        "tlmpc view it",
+        "tlmpc plot --log=zz",
+        "tlmpc stage --out=x pla",
+        "tlmpc plot --format=s",
+        "tlmpc compile --until=abs",
+    )
+    # zsh reads each completed word back as the file's own name (an oracle independent of
+    # the script: zsh's own word splitting and quote removal)
+    words = [
+        subprocess.run(
+            [ZSH, "-f", "-c", "print -rl -- ${(Q)${(z)1}}", "zsh", line],
+            capture_output=True,
+            text=True,
+            check=True,
+        ).stdout.splitlines()
+        for line in buffers
+    ]
+    assert words[0] == ["tlmpc", "plot", "zz file1"]
+    assert words[1] == ["tlmpc", "check", "a$b*c"]
+    assert words[2] == ["tlmpc", "view", "it's"]
+    assert words[3] == ["tlmpc", "plot", "--log=zz file1"]
+    assert words[4] == ["tlmpc", "stage", "--out=x", "plan"]
+    assert words[5] == ["tlmpc", "plot", "--format=svg"]
+    assert words[6] == ["tlmpc", "compile", "--until=abstraction"]
+
+
+FISH = shutil.which("fish")
+
+
+def _fish_complete(directory: Path, line: str) -> list[str]:
+    assert FISH is not None
+    script = directory / "tlmpc.fish"
+    script.write_text(_script("fish"))
+    program = f"source {shlex.quote(str(script))}; complete -C {shlex.quote(line)}"
+    result = subprocess.run(
+        [FISH, "--no-config", "-c", program], capture_output=True, text=True, check=True
+    )
+    return sorted(entry.split("\t")[0] for entry in result.stdout.splitlines())
+
+
+@oracle_required(FISH is not None, "fish")
+def test_fish_offers_the_flags_of_the_command_word_only(tmp_path: Path) -> None:
+    parser = build_parser()
+    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+
+    def flags(name: str, start: str) -> list[str]:
+        found = {s for a in sub.choices[name]._actions for s in a.option_strings}
+        return sorted(s for s in found if s.startswith(start))
+
+    # `plot` and `verify` are stage names and command names; `verify` may name a file
+    assert _fish_complete(tmp_path, "tlmpc stage plot -") == flags("stage", "-")
+    assert _fish_complete(tmp_path, "tlmpc stage verify --") == flags("stage", "--")
+    assert _fish_complete(tmp_path, "tlmpc check verify --") == flags("check", "--")
+    assert _fish_complete(tmp_path, "tlmpc --help plot --f") == flags("plot", "--f")
+    assert _fish_complete(tmp_path, "tlmpc -") == sorted(
+        s
+        for a in parser._actions
+        if not isinstance(a, argparse._SubParsersAction)
+        for s in a.option_strings
+    )

@@ -8,7 +8,7 @@ name and the extent of every text in the PNG.
 from __future__ import annotations
 
 import itertools
-from typing import Any
+from typing import Any, cast
 from xml.etree import ElementTree
 
 import pytest
@@ -157,7 +157,7 @@ def test_png_draws_the_same_names_where_the_layout_puts_them() -> None:
         figure_layout.width * PNG_PIXELS_PER_FIGURE_PIXEL
     )
     labels = [(text, box) for gid, text, box in texts if gid == "label"]
-    assert [text for text, _ in labels] == [label.name for label in figure_layout.labels]
+    assert [text for text, _ in labels] == [label.text for label in figure_layout.labels]
     for (_, real), label in zip(labels, figure_layout.labels, strict=True):
         # real glyph metrics: the ink lies within the layout's box (its width estimate is an
         # upper bound) and is centred where the layout says
@@ -327,3 +327,44 @@ def test_a_huge_text_wraps_with_few_measurements(
     assert len(title) == 1
     assert len(legend) == 4
     assert legend[-1].endswith(" …")
+
+
+def _hostile_scene() -> Scene:
+    """The crowded scene with control, direction, noncharacter and surrogate characters in its
+    title, two region names and a violation message."""
+    mission = _crowded_mission()
+    mission["name"] = "\x01" * 200
+    regions = mission["regions"]
+    regions["keepout_0_0\x1b[31m\u202e"] = regions.pop("keepout_0_0")
+    regions["dock\uffff\ud800"] = regions.pop("keepout_5_4")
+    counterexample = dict(cast("dict[str, Any]", _VERDICT["counterexample"]))
+    counterexample["message"] = "entered \x07\x08 hazard\u2028at \ufffe\udfff " + "\x0b" * 80
+    verdict = {**_VERDICT, "counterexample": counterexample}
+    trace = {"format": "tlmpc.trace/1", "points": [[0, 1, 1], [5, 11.5, 10.6], [9, 29.9, 14.9]]}
+    return build_scene({"mission.json": mission, "trace.json": trace}, verdict=verdict)
+
+
+def test_unsafe_characters_are_escaped_before_the_layout_measures() -> None:
+    scene = _hostile_scene()
+    figure_layout = layout(scene)
+    svg = render_svg(scene)
+    root = ElementTree.fromstring(svg)  # the XML parser: well-formed, every character allowed
+    _, texts = _png_texts(scene)
+    # the SVG writes and the PNG draws the same texts: those the layout measured
+    svg_texts = [t.text for t in root.iter(f"{SVG}text") if t.text]
+    doubled = ("label", "violation-number")
+    assert sorted(svg_texts) == sorted(
+        [text for _, text, _ in texts] + [text for gid, text, _ in texts if gid in doubled]
+    )
+    title = next(text for gid, text, _ in texts if gid == "title")
+    assert title == figure_layout.title
+    assert title.startswith("\\x01\\x01")
+    assert title.endswith(" …")
+    assert all(ch.isprintable() for text in svg_texts for ch in text)
+    # the title, as written, fits the figure (measured by the layout's metric and by FreeType)
+    assert text_width(title, TITLE_PX) <= figure_layout.width - 2 * 14.0
+    page = Box(0.0, 0.0, figure_layout.width, figure_layout.height)
+    for gid, text, box in texts:
+        assert box.within(page.grown(0.5)), (gid, text, box)
+    drawn = {label.text for label in figure_layout.labels}
+    assert "keepout_0_0\\x1b[31m\\u202e" in drawn

@@ -24,6 +24,7 @@ Code prefixes, one per stage (the full list is in ``docs/errors.md``):
 
 from __future__ import annotations
 
+from bisect import bisect_right
 from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Any, Literal
@@ -45,28 +46,54 @@ _INVISIBLE = frozenset(
     "\u061c\u200e\u200f\u202a\u202b\u202c\u202d\u202e\u2066\u2067\u2068\u2069\u2028\u2029"
 )
 
+#: Code point ranges ``(first, last)``, in increasing order, of the characters no printed or
+#: exported name carries as they are: control characters (C0, DEL, C1), the invisible
+#: direction and line controls, lone surrogates (no UTF-8 file can hold one, yet an escaped
+#: ``\ud800`` in a JSON input reads back as one) and the Unicode noncharacters (U+FFFE and
+#: U+FFFF are not XML 1.0 characters: one makes a whole SVG unreadable).  The one rule behind
+#: :func:`is_unsafe_char` and :func:`printable`; the view's page escapes these same ranges.
+UNSAFE_RANGES: tuple[tuple[int, int], ...] = tuple(
+    sorted(
+        [
+            (0x00, 0x1F),
+            (0x7F, 0x9F),
+            *((ord(ch), ord(ch)) for ch in _INVISIBLE),
+            (0xD800, 0xDFFF),
+            (0xFDD0, 0xFDEF),
+            *((plane + 0xFFFE, plane + 0xFFFF) for plane in range(0, 0x110000, 0x10000)),
+        ]
+    )
+)
+_UNSAFE_FIRSTS = tuple(first for first, _ in UNSAFE_RANGES)
+
 
 def is_unsafe_char(ch: str) -> bool:
-    """Whether ``ch`` is a control character (C0, DEL, C1) or an invisible direction or line
-    control: the characters no exported or printed name may carry as they are."""
-    return "\x00" <= ch < " " or "\x7f" <= ch <= "\x9f" or ch in _INVISIBLE
+    """Whether ``ch`` is a control character (C0, DEL, C1), an invisible direction or line
+    control, a lone surrogate or a noncharacter (:data:`UNSAFE_RANGES`): the characters no
+    exported or printed name may carry as they are."""
+    code = ord(ch)
+    index = bisect_right(_UNSAFE_FIRSTS, code) - 1
+    return index >= 0 and code <= UNSAFE_RANGES[index][1]
 
 
 def printable(text: str, keep: str = "\n\t") -> str:
-    """``text`` with control characters (C0 but ``keep``, DEL, C1) and invisible direction and
-    line controls as ``\\xNN`` / ``\\uNNNN`` escapes.
+    """``text`` with control characters (C0 but ``keep``, DEL, C1), invisible direction and
+    line controls, lone surrogates and noncharacters as ``\\xNN`` / ``\\uNNNN`` /
+    ``\\UNNNNNNNN`` escapes.
 
     The one sanitiser of everything tlmpc prints (diagnostics, hints, status lines) and of
-    names written into exported text: a hostile name can neither forge a line, drive the
-    terminal, nor reorder what is shown."""
-    if text.isprintable():  # no control character at all (newlines and tabs included)
+    names written into exported text and pictures (SVG, PNG, HTML): a hostile name can neither
+    forge a line, drive the terminal, reorder what is shown, nor make a file unreadable."""
+    if text.isprintable():  # no unsafe character at all (newlines and tabs included)
         return text
     return "".join(ch if ch in keep or not is_unsafe_char(ch) else _escaped(ch) for ch in text)
 
 
 def _escaped(ch: str) -> str:
     code = ord(ch)
-    return f"\\x{code:02x}" if code < 0x100 else f"\\u{code:04x}"
+    if code < 0x100:
+        return f"\\x{code:02x}"
+    return f"\\u{code:04x}" if code < 0x10000 else f"\\U{code:08x}"
 
 
 @dataclass(frozen=True, slots=True, kw_only=True)

@@ -49,14 +49,26 @@ _ORIGIN = (-1.0, -1.0, 0.0)
 def template_text(name: str, map_name: str | None = None) -> str:
     """The template ``name`` with the schema line on top; ``map_name``, for the map template,
     is the map file the mission names instead of ``map.yaml``."""
-    import json
     from importlib import resources
 
     body = (resources.files("tlmpc.templates") / f"{name}.yaml").read_text(encoding="utf-8")
     if map_name is not None:
-        # a JSON string is a YAML scalar, so a name with spaces or colons reads back as written
-        body = body.replace(MAP_LINE, f"workspace: {{map: {json.dumps(map_name)}}}\n")
+        body = body.replace(MAP_LINE, f"workspace: {{map: {yaml_string(map_name)}}}\n")
     return schema_line() + body
+
+
+def yaml_string(text: str) -> str:
+    """``text`` as a double-quoted YAML scalar on one line that reads back as ``text`` exactly
+    (spaces, colons, quotes, control characters and characters beyond U+FFFF included).
+
+    PyYAML's own emitter writes it, so every escape is one YAML defines (``\\U0001F600``
+    for an emoji: a JSON string's surrogate pair ``\\ud83d\\ude00`` is not a YAML
+    character)."""
+    import math
+
+    import yaml
+
+    return yaml.safe_dump(text, default_style='"', allow_unicode=True, width=math.inf).rstrip("\n")
 
 
 def map_files(mission: Path) -> tuple[Path, Path]:
@@ -78,12 +90,10 @@ def map_image() -> bytes:
 
 def map_metadata(image: Path) -> str:
     """The map_server YAML of the room, naming ``image`` (beside it)."""
-    import json
-
     x, y, yaw = _ORIGIN
     return (
         "# The map of `tlmpc new map`: an empty room to replace with your robot's map.\n"
-        f"image: {json.dumps(image.name)}\n"
+        f"image: {yaml_string(image.name)}\n"
         f"resolution: {_RESOLUTION}\n"
         f"origin: [{x}, {y}, {yaw}]\n"
         "negate: 0\n"

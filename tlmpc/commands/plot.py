@@ -37,7 +37,8 @@ _INPUTS = {
 
 
 def parse_zoom(text: str) -> tuple[float, float, float, float]:
-    """``x0,y0,x1,y1`` -> a window with x0 < x1 and y0 < y1 (argparse type)."""
+    """``x0,y0,x1,y1`` -> a window with x0 < x1 and y0 < y1 and a finite width and height
+    (argparse type)."""
     import math
 
     try:
@@ -51,6 +52,11 @@ def parse_zoom(text: str) -> tuple[float, float, float, float]:
     x0, y0, x1, y1 = values
     if not (x0 < x1 and y0 < y1):
         raise argparse.ArgumentTypeError(f"empty window {text!r}: need x0 < x1 and y0 < y1")
+    # the picture's scale divides by the window's size: it must be a number too
+    if not (math.isfinite(x1 - x0) and math.isfinite(y1 - y0)):
+        raise argparse.ArgumentTypeError(
+            f"window {text!r} too large: its width and height must be finite numbers"
+        )
     return x0, y0, x1, y1
 
 

@@ -103,12 +103,20 @@ def visible(text: str) -> str:
     """``text`` with the bytes of a file name that are not UTF-8 shown as ``\\xNN``.
 
     Python keeps such bytes in a path as lone surrogates (``\\udce9`` for the byte 0xE9),
-    which no UTF-8 file can hold: a report or a Parquet file shows the byte instead."""
+    which no UTF-8 file can hold: a report or a Parquet file shows the byte instead.  Any
+    other lone surrogate (an escaped ``\\ud800`` read from JSON) is shown as ``\\uNNNN``."""
     try:
         text.encode("utf-8")
     except UnicodeEncodeError:
-        return text.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
+        return "".join(_visible_char(ch) for ch in text)
     return text
+
+
+def _visible_char(ch: str) -> str:
+    code = ord(ch)
+    if 0xDC80 <= code <= 0xDCFF:  # a file name's byte that is not UTF-8
+        return f"\\x{code - 0xDC00:02x}"
+    return f"\\u{code:04x}" if 0xD800 <= code <= 0xDFFF else ch
 
 
 def _refused(path: Path, message: str, hint: str) -> UsageError:

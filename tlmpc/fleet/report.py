@@ -8,7 +8,8 @@
   page, written beside the report).
 
 Robot and day come from each log's path (:func:`robot_and_day`).  Every piece of text from a
-log, a path or a mission is escaped; the page loads nothing (no script, no network).
+log, a path or a mission is escaped (HTML, and control and direction characters as
+visible escapes); the page loads nothing (no script, no network).
 """
 
 from __future__ import annotations
@@ -23,7 +24,7 @@ from pathlib import Path, PurePosixPath
 from typing import Any
 from urllib.parse import quote
 
-from tlmpc.base.errors import Diagnostic, UsageError, error
+from tlmpc.base.errors import Diagnostic, UsageError, error, printable
 from tlmpc.fleet.job import Job
 from tlmpc.fleet.output import check_output, visible, write_atomically
 
@@ -119,7 +120,9 @@ def _common_root(logs: Sequence[str]) -> PurePosixPath:
 
 
 def _e(value: Any) -> str:
-    return html.escape(visible(str(value)), quote=True)
+    """Text for the page: a file name's bytes that are not UTF-8 as ``\\xNN``, control and
+    direction characters escaped as everywhere else (:func:`printable`), then HTML-escaped."""
+    return html.escape(printable(visible(str(value)), keep=""), quote=True)
 
 
 def _href(link: str) -> str:

@@ -19,6 +19,7 @@ from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from itertools import accumulate
 
+from tlmpc.base.errors import printable
 from tlmpc.render.scene import Point, Region, Scene, label_priority
 
 #: Figure pixels for the map's width and height at most (it keeps its aspect ratio).
@@ -61,6 +62,13 @@ _ASCENT_EM = 0.928
 def _advances(text: str) -> list[int]:
     """The advance width of each character of ``text``, in font units."""
     return [_ADVANCE[ord(c) - 32] if 32 <= ord(c) < 127 else _MAX_ADVANCE for c in text]
+
+
+def shown(text: str) -> str:
+    """``text`` as every picture draws it: on one line, with control, direction and other
+    unsafe characters as visible escapes (:func:`~tlmpc.base.errors.printable`).  The layout
+    measures and wraps this text, so what is drawn is what was measured."""
+    return printable(text, keep="")
 
 
 def text_width(text: str, font_px: float) -> float:
@@ -156,6 +164,7 @@ class Label:
     """A region's name, centred on ``(x, y)`` (figure pixels), ``box`` around its ink."""
 
     name: str
+    text: str  # the name as drawn and measured (:func:`shown`)
     x: float
     y: float
     font_px: float
@@ -171,7 +180,7 @@ class LegendRow:
     """
 
     kind: str  # hole, region, task-region, mesh, plan, cycle, start, log, violation, text
-    text: str
+    text: str  # as drawn (:func:`shown`)
     x: float
     y: float
     font_px: float
@@ -184,7 +193,7 @@ class FigureLayout:
     width: float
     height: float
     canvas: Canvas
-    title: str
+    title: str  # as drawn (:func:`shown`), cut to one line
     labels: tuple[Label, ...]
     labels_hidden: tuple[str, ...]  # names with no free room on the map
     legend: tuple[LegendRow, ...]
@@ -222,7 +231,8 @@ def place_labels(
     hidden: list[str] = []
     height = text_height(font_px)
     for region in sorted((r for r in regions if r.labelled), key=_priority):
-        width = text_width(region.name, font_px)
+        text = shown(region.name)
+        width = text_width(text, font_px)
         pixels = [canvas.pixel(p) for p in region.polygon]
         left = min(p[0] for p in pixels)
         right = max(p[0] for p in pixels)
@@ -247,7 +257,7 @@ def place_labels(
             if not halo.within(area) or any(halo.overlaps(other) for other in taken):
                 continue
             taken.append(halo.grown(LABEL_GAP))
-            placed.append(Label(region.name, x, y, font_px, box, on_region))
+            placed.append(Label(region.name, text, x, y, font_px, box, on_region))
             break
         else:
             hidden.append(region.name)
@@ -349,7 +359,7 @@ def _legend(
         add("log", "recorded log")
     for number, violation in enumerate(scene.violations, start=1):
         add("violation", f"violation {number}")
-        for text in wrap(violation.message, SMALL_PX, LEGEND_TEXT_WIDTH):
+        for text in wrap(shown(violation.message), SMALL_PX, LEGEND_TEXT_WIDTH):
             rows.append(LegendRow("text", text, x + 30, row, SMALL_PX))
             row += 12
     bar = None
@@ -362,7 +372,7 @@ def _legend(
         row += 28
     if hidden:
         row += 12
-        text = f"not named (no room): {', '.join(hidden)}"
+        text = shown(f"not named (no room): {', '.join(hidden)}")
         for line in wrap(text, SMALL_PX, LEGEND_WIDTH - 6):
             rows.append(LegendRow("note", line, x, row, SMALL_PX))
             row += 12
@@ -397,11 +407,13 @@ def layout(scene: Scene) -> FigureLayout:
     height = max(extent_y + PAD, legend_bottom + PAD)
     x0, y0, x1, y1 = scene.view
     width = legend_x + LEGEND_WIDTH
+    # escaped first: the title is measured as it is drawn
+    title = wrap(shown(scene.title), TITLE_PX, width - 2 * PAD, lines=1)[0] if scene.title else ""
     return FigureLayout(
         width=width,
         height=math.ceil(height),
         canvas=canvas,
-        title=wrap(scene.title, TITLE_PX, width - 2 * PAD, lines=1)[0] if scene.title else "",
+        title=title,
         labels=labels,
         labels_hidden=hidden,
         legend=tuple(rows),

@@ -29,6 +29,7 @@ from tlmpc.render.layout import (
     FigureLayout,
     baseline_offset,
     layout,
+    shown,
 )
 from tlmpc.render.scene import Scene, build_scene, viridis
 from tlmpc.render.svg import PLAY_COLOUR
@@ -129,7 +130,7 @@ def figure_of(scene: Scene) -> Any:
         text(
             label.x,
             label.y + baseline_offset(label.font_px),
-            label.name,
+            label.text,
             label.font_px,
             "label",
             ha="center",
@@ -142,7 +143,7 @@ def figure_of(scene: Scene) -> Any:
         text(
             px + 8,
             py + 4,
-            mark.text,
+            shown(mark.text),
             FONT_PX,
             "play-text",
             va="baseline",

@@ -15,7 +15,6 @@ from html import escape as _html_escape
 from itertools import chain
 from typing import TYPE_CHECKING
 
-from tlmpc.base.errors import printable
 from tlmpc.render.layout import (
     FONT_PX,
     LABEL_HALO,
@@ -27,6 +26,7 @@ from tlmpc.render.layout import (
     FigureLayout,
     baseline_offset,
     layout,
+    shown,
 )
 from tlmpc.render.scene import Path, Point, Scene, viridis
 
@@ -42,9 +42,10 @@ PLAY_COLOUR = "#7b2cbf"
 
 
 def escape(text: str) -> str:
-    """Text for an SVG element: XML-escaped, with control characters (which XML 1.0 does not
-    allow at all), newlines and direction controls as visible escapes."""
-    return _html_escape(printable(text, keep=""))
+    """Text for an SVG element: XML-escaped, with control characters, noncharacters and lone
+    surrogates (which XML 1.0 and UTF-8 do not allow at all), newlines and direction controls
+    as visible escapes (:func:`~tlmpc.render.layout.shown`: the text the layout measured)."""
+    return _html_escape(shown(text))
 
 
 def _fmt(value: float) -> str:
@@ -314,7 +315,7 @@ def render_svg(scene: Scene) -> bytes:
         # A white halo under each name (drawn first: not every renderer knows paint-order).
         body = "".join(
             f'<text x="{_fmt(label.x)}" y="{_fmt(label.y + baseline_offset(label.font_px))}">'
-            f"{escape(label.name)}</text>"
+            f"{escape(label.text)}</text>"
             for label in figure.labels
         )
         parts.append(
