@@ -140,6 +140,35 @@ def _same(a: object, b: object) -> bool:
     return a == b and type(a) is type(b)
 
 
+_BIG_BOUNDARY = "[" + ", ".join(f"[{4 * i / 2000}, 0]" for i in range(2001)) + ", [4, 4], [0, 4]]"
+
+
+@pytest.mark.parametrize(
+    ("old", "new"),
+    [
+        ("rect: [0, 0, 4, 4]", "rect: [0, 0, 4e0, 4]"),
+        ("start: [3, 3]", "start: [3e0, 3]"),
+        ("{a: {rect: [1, 1, 2, 2]}}", "{a: [[1, 1], [2, 1], [2, 2e0]]}"),
+        ("{rect: [0, 0, 4, 4]}", _BIG_BOUNDARY.replace("[4, 4]", "[4, 4e0]")),
+    ],
+)
+def test_number_like_text_where_a_number_belongs_is_y010(old: str, new: str) -> None:
+    assert old in VALID
+    assert codes(VALID.replace(old, new)) == ["Y010"]
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        VALID + "name: 1e3\n",
+        VALID.replace("task: [visit a]", "task: [visit a]\nsensors: {s: {column: 2E5}}"),
+    ],
+)
+def test_number_like_text_where_text_belongs_is_no_problem(text: str) -> None:
+    # YAML 1.1 reads 1e3 as the text "1e3", which is what a name holds
+    assert codes(text) == []
+
+
 @pytest.mark.parametrize(("written", "suggested"), [("1e-6", "1.0e-6"), ("2E5", "2.0e+5")])
 def test_yaml_11_exponent_without_dot_is_y010(written: str, suggested: str) -> None:
     problems = check_text(VALID.replace("max_speed: 1.0", f"max_speed: {written}"))

@@ -37,7 +37,13 @@ from tlmpc.mission.model import (
 )
 from tlmpc.mission.parts import group_expansion
 from tlmpc.mission.shapes import CheckedShape, shapely_polygon
-from tlmpc.mission.yamlpos import Path, PositionedDocument, json_path, load_positioned
+from tlmpc.mission.yamlpos import (
+    NUMBER_LIKE_TEXT,
+    Path,
+    PositionedDocument,
+    json_path,
+    load_positioned,
+)
 from tlmpc.tasks.compiler import NameKinds, compile_phrase, compile_phrases
 
 if TYPE_CHECKING:
@@ -105,6 +111,17 @@ def _small_component(component: Any, path: Path, bad: list[Path]) -> Any:
     if isinstance(holes, list):
         small["holes"] = [_small(h, (*path, "holes", i), bad) for i, h in enumerate(holes)]
     return small
+
+
+def _number_like_where_refused(
+    number_like: list[Diagnostic], schema: list[Diagnostic]
+) -> list[Diagnostic]:
+    """The schema's diagnostics, each at a value YAML 1.1 read as text although it looks like a
+    number (``1e-6``) replaced by that finding, which says how to write the number.  Where
+    the schema takes the text (a name ``1e3``) it is no problem at all."""
+    at = {p.path: p for p in number_like}
+    found = [at.get(p.path, p) for p in schema]
+    return list(dict.fromkeys(found))  # one finding per value, in the schema's order
 
 
 def _schema_diagnostics(doc: PositionedDocument, file: str) -> list[Diagnostic]:
@@ -799,8 +816,11 @@ def _load_data(text: str, file: str, stem: str) -> tuple[Mission | None, list[Di
     doc, problems = load_positioned(text, file, lazy=True)
     if doc is None:
         return None, problems
-    if problems:  # non-finite numbers, duplicate keys: the schema would mislead after these
+    number_like = [p for p in problems if p.code == NUMBER_LIKE_TEXT]
+    if len(number_like) < len(problems):
+        # non-finite numbers, duplicate keys: the schema would mislead after these
         return None, problems
+    problems = []
     if not isinstance(doc.data, dict):
         return None, [
             error(
@@ -812,7 +832,7 @@ def _load_data(text: str, file: str, stem: str) -> tuple[Mission | None, list[Di
                 col=1,
             )
         ]
-    problems.extend(_schema_diagnostics(doc, file))
+    problems.extend(_number_like_where_refused(number_like, _schema_diagnostics(doc, file)))
     if problems:
         return None, problems
     data: dict[str, Any] = doc.data

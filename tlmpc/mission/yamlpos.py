@@ -118,6 +118,9 @@ def _mark(node: Any) -> tuple[int, int]:
 
 #: A plain scalar YAML 1.1 reads as text although it looks like a number (``1e-6``,
 #: ``1.5e3``: PyYAML's floats need a dot and a signed exponent).
+#: The code of a plain scalar YAML 1.1 reads as text although it looks like a number; the
+#: mission loader keeps it only where the schema refuses the text.
+NUMBER_LIKE_TEXT = "Y010"
 _NUMBER_LIKE = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)")
 
 
@@ -205,7 +208,7 @@ class _Converter:
         if tag == "tag:yaml.org,2002:str":
             if not event.style and _NUMBER_LIKE.fullmatch(event.value):
                 self.problem(
-                    "Y010",
+                    NUMBER_LIKE_TEXT,
                     f"{event.value!r} is text in YAML 1.1, not a number",
                     event,
                     path,
