@@ -91,3 +91,22 @@ def test_quoted_keywords_are_names() -> None:
     assert parse_ltl('"a\\"b"') == Prop('a"b')
     assert parse_ltl('"a\\\\b"') == Prop("a\\b")
     assert parse_ltl('"a\\nb"') == Prop("a\nb")
+
+
+@given(
+    st.text(st.characters(blacklist_characters='"\\\n'), max_size=5),
+    st.characters(blacklist_characters='"\\n\n'),
+    st.integers(0, 2),
+)
+def test_an_unknown_escape_in_a_quoted_name_is_refused_at_its_backslash(
+    before: str, letter: str, pairs: int
+) -> None:
+    # `"a\tb"` read as `atb` would name another region than the one meant; escaped
+    # backslashes before it do not hide it, an escaped backslash before the letter does
+    text = f'F "{before}{chr(92) * 2 * pairs}\\{letter}"'
+    with pytest.raises(InvalidInputError) as caught:
+        parse_ltl(text)
+    found = caught.value.diagnostics[0]
+    assert (found.code, found.line, found.col) == ("L031", 1, 4 + len(before) + 2 * pairs)
+    kept = f'F "{before}{chr(92) * 2 * (pairs + 1)}{letter}"'
+    assert parse_ltl(kept) == Eventually(Prop(f"{before}{chr(92) * (pairs + 1)}{letter}"))

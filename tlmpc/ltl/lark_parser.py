@@ -149,8 +149,13 @@ def _token_span(pos: _Positions, token: Token) -> Span:
     )
 
 
+#: An escape inside a quoted name other than ``\\"``, ``\\\\`` and ``\\n`` (group 1: the escape).
+_UNKNOWN_ESCAPE = re.compile(r'(?:^|[^\\])(?:\\\\)*(\\[^"\\n])')
+
+
 def unquote(token: str) -> str:
-    """The name inside a quoted proposition: ``\\n`` is a newline, ``\\x`` is ``x``."""
+    """The name inside a quoted proposition: ``\\n`` is a newline, ``\\"`` a quote and
+    ``\\\\`` a backslash (any other escape is refused by the parser, L031)."""
     body = token[1:-1]
     if "\\" not in body:
         return body
@@ -170,9 +175,9 @@ class _ToAst(Transformer[Token, Formula]):
         super().__init__()
         self.pos = pos
         self.file = file
-        #: Operator keywords used as bare proposition names (L030) and bad time bounds
-        #: (L040-L044), reported after the walk.
-        self.keyword_names: list[Diagnostic] = []
+        #: Operator keywords used as bare proposition names (L030), unknown escapes in quoted
+        #: names (L031) and bad time bounds (L040-L044), reported after the walk.
+        self.problems: list[Diagnostic] = []
 
     def _span(self, meta: Any) -> Span | None:
         if getattr(meta, "empty", True):
@@ -193,7 +198,7 @@ class _ToAst(Transformer[Token, Formula]):
         span = _token_span(self.pos, children[0])
         if name in KEYWORDS:
             # The contextual lexer reads `U` as a name where no operator can stand (`U U U`).
-            self.keyword_names.append(
+            self.problems.append(
                 error(
                     "L030",
                     f"{name!r} is an operator of the language, not a proposition name",
@@ -209,7 +214,23 @@ class _ToAst(Transformer[Token, Formula]):
 
     @v_args(meta=True)
     def quoted_prop(self, meta: Any, children: list[Token]) -> Formula:
-        return Prop(unquote(str(children[0])), span=_token_span(self.pos, children[0]))
+        token = children[0]
+        span = _token_span(self.pos, token)
+        unknown = _UNKNOWN_ESCAPE.search(str(token))
+        if unknown is not None:
+            # `"a\tb"` read as `atb` would name another region than the one meant
+            line, col = self.pos.at(token.line or 1, (token.column or 1) + unknown.start(1))
+            self.problems.append(
+                error(
+                    "L031",
+                    f"unknown escape `{unknown.group(1)}` in the quoted name {token!s}",
+                    hint='inside quotes \\" is a quote, \\\\ a backslash and \\n a newline',
+                    file=self.file,
+                    line=line,
+                    col=col,
+                )
+            )
+        return Prop(unquote(str(token)), span=span)
 
     @v_args(meta=True)
     def not_op(self, meta: Any, children: list[Any]) -> Formula:
@@ -246,7 +267,7 @@ class _ToAst(Transformer[Token, Formula]):
         if interval is not None:
             return interval
         span = _token_span(self.pos, token)
-        self.keyword_names.append(
+        self.problems.append(
             error(code, message, hint=_INTERVAL_HINT, file=self.file, line=span.line, col=span.col)
         )
         return Interval(0.0, 0.0)  # a placeholder: the parse fails with the diagnostic
@@ -278,7 +299,7 @@ class _ToAst(Transformer[Token, Formula]):
         interval = self._interval(token)
         if str(op) != "U":
             span = _token_span(self.pos, op)
-            self.keyword_names.append(
+            self.problems.append(
                 error(
                     "L044",
                     f"only U takes a time bound, not {op}",
@@ -556,8 +577,8 @@ def parse_ltl(
         formula = transformer.transform(tree)
     except (RecursionError, VisitError):
         raise InvalidInputError(too_deep) from None
-    if transformer.keyword_names:
-        raise InvalidInputError(transformer.keyword_names)
+    if transformer.problems:
+        raise InvalidInputError(transformer.problems)
     if not isinstance(formula, Formula):  # pragma: no cover - the grammar always yields one
         raise InvalidInputError(error("L003", "cannot parse LTL formula", file=file))
     return formula
