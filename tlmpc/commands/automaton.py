@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import time
+from collections.abc import Sequence
 from typing import TextIO
 
 from tlmpc.io.artifacts import json_text
@@ -67,8 +68,33 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     document = automaton_to_json(automaton)
     if args.format == "hoa":
         text = to_hoa(automaton)
+        if not args.json:
+            _refuse_unprintable_hoa(automaton.aps)
     elif args.format == "dot":
         text = to_dot(automaton)
     else:
         text = json_text(document)
     return report.finish(EXIT_OK, {"automaton": document}, text)
+
+
+def _refuse_unprintable_hoa(aps: Sequence[str]) -> None:
+    """Refuse (U079) HOA whose AP names hold characters tlmpc never prints as they are.
+
+    Everything printed has control and direction characters escaped (``\\u202e``), but an
+    HOA string has no such escapes: a reader would take the escape for other characters,
+    so the automaton would name other APs (two may even meet).  Newlines and tabs are
+    printed as they are, and HOA strings hold them."""
+    from tlmpc.base.errors import UsageError, error, printable
+
+    odd = [name for name in aps if printable(name) != name]
+    if odd:
+        shown = ", ".join(f"\"{printable(name)}\"" for name in odd)
+        raise UsageError(
+            error(
+                "U079",
+                f"the atomic propositions {shown} hold control or direction characters, "
+                "which tlmpc prints escaped and an HOA string cannot hold escaped",
+                hint="--format json (or --json) keeps these names exactly",
+                file="<formula>",
+            )
+        )

@@ -11,7 +11,7 @@ import yaml
 
 from tlmpc.base.extras import require
 from tlmpc.exports.georeference import Georeference, to_lon_lat
-from tlmpc.exports.plan import Plan, Ring, Waypoint
+from tlmpc.exports.plan import Plan, Waypoint
 from tlmpc.io.outputs import csv_cell, yaml_float
 
 
@@ -66,31 +66,47 @@ def waypoints_csv(plan: Plan, points: list[Waypoint], loop: int | None) -> str:
     return out.getvalue()
 
 
-def _closed(ring: Ring) -> list[list[float]]:
-    coords = [[x, y] for x, y in ring]
-    return [*coords, coords[0]]
+def _polygons(geometry: Any) -> list[Any]:
+    """The polygons of positive area of a shapely geometry (of any type)."""
+    from shapely.geometry import Polygon
+
+    parts = getattr(geometry, "geoms", [geometry])
+    return [part for part in parts if isinstance(part, Polygon) and part.area > 0]
 
 
-def _oriented(ring: Ring, ccw: bool) -> Ring:
-    area = sum(
-        x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in zip(ring, ring[1:] + ring[:1], strict=True)
-    )
-    return ring if (area > 0) == ccw else tuple(reversed(ring))
+def _free_space(plan: Plan) -> list[Any]:
+    """The workspace's free space as valid polygons (shapely), one per connected piece.
+
+    A mission's holes may touch the boundary and each other, along an edge too, but rings
+    that share an edge do not make a valid polygon (OGC Simple Features, whose geometries
+    GeoJSON's are): the holes are subtracted from the outer rings and the rings of the result
+    are written, a piece cut off by holes becoming a polygon of its own."""
+    import shapely
+    from shapely.geometry import Polygon
+
+    pieces = [
+        shapely.make_valid(Polygon(outer)).difference(
+            shapely.union_all([shapely.make_valid(Polygon(hole)) for hole in holes])
+        )
+        for outer, holes in ((plan.boundary, plan.holes), *plan.components)
+    ]
+    return _polygons(shapely.union_all(pieces))
 
 
-def _rings(boundary: Ring, holes: tuple[Ring, ...]) -> list[list[list[float]]]:
-    return [_closed(_oriented(boundary, True))] + [_closed(_oriented(h, False)) for h in holes]
+def _polygon_coordinates(polygon: Any) -> list[list[list[float]]]:
+    """GeoJSON rings of a shapely polygon, closed, with RFC 7946's right-hand rule (§3.1.6:
+    the outer ring counter-clockwise, holes clockwise)."""
+    from shapely.geometry.polygon import orient
+
+    oriented = orient(polygon, sign=1.0)
+    return [[[x, y] for x, y in ring.coords] for ring in (oriented.exterior, *oriented.interiors)]
 
 
-def _workspace_geometry(plan: Plan) -> dict[str, Any]:
-    """A Polygon, or a MultiPolygon when the workspace has further components."""
-    if not plan.components:
-        return {"type": "Polygon", "coordinates": _rings(plan.boundary, plan.holes)}
-    return {
-        "type": "MultiPolygon",
-        "coordinates": [_rings(plan.boundary, plan.holes)]
-        + [_rings(outer, inner) for outer, inner in plan.components],
-    }
+def _polygonal_geometry(polygons: list[Any]) -> dict[str, Any]:
+    """A Polygon, or a MultiPolygon of several (or no) pieces."""
+    if len(polygons) == 1:
+        return {"type": "Polygon", "coordinates": _polygon_coordinates(polygons[0])}
+    return {"type": "MultiPolygon", "coordinates": [_polygon_coordinates(p) for p in polygons]}
 
 
 def geojson(
@@ -102,14 +118,17 @@ def geojson(
     """A FeatureCollection: workspace, regions, trajectory, waypoints.
 
     Coordinates are the map frame's metres, or with ``georeference`` WGS 84 longitude and
-    latitude (RFC 7946 proper).  Rings follow RFC 7946's right-hand rule (outer
-    counter-clockwise, holes clockwise; a yaw or a mirror-free georeference keeps the turn).
+    latitude (RFC 7946 proper, geometries crossing the antimeridian cut there).  Rings follow
+    RFC 7946's right-hand rule (outer counter-clockwise, holes clockwise), in the coordinates
+    written.  The workspace is its free space as valid polygons (see :func:`_free_space`).
     """
+    from shapely.geometry import Polygon
+
     features: list[dict[str, Any]] = [
         {
             "type": "Feature",
             "properties": {"kind": "workspace", "name": plan.name},
-            "geometry": _workspace_geometry(plan),
+            "geometry": _polygonal_geometry(_free_space(plan)),
         }
     ]
     for name, ring in plan.regions.items():
@@ -117,7 +136,7 @@ def geojson(
             {
                 "type": "Feature",
                 "properties": {"kind": "region", "name": name},
-                "geometry": {"type": "Polygon", "coordinates": [_closed(_oriented(ring, True))]},
+                "geometry": _polygonal_geometry([Polygon(ring)]),
             }
         )
     samples = plan.samples
@@ -150,37 +169,132 @@ def geojson(
             "geometry": {"type": "MultiPoint", "coordinates": [[w.x, w.y] for w in points]},
         }
     )
-    collection: dict[str, Any] = {"type": "FeatureCollection", "features": features}
     if georeference is not None:
-        _georeferenced(collection, georeference)
+        for feature in features:
+            _georeferenced(feature, georeference)
+    collection: dict[str, Any] = {"type": "FeatureCollection", "features": features}
     # strict JSON: a non-finite number (only an edited output has one) is refused, not
     # written as the NaN no GeoJSON reader accepts
     return json.dumps(collection, indent=1, allow_nan=False) + "\n"
 
 
-def _georeferenced(collection: dict[str, Any], reference: Georeference) -> None:
-    """Every coordinate pair of ``collection`` mapped to ``[longitude, latitude]``."""
+def _sheet(longitude: float) -> int:
+    """Which copy of the globe an unwrapped longitude lies on: 0 for [-180, 180), 1 for
+    [180, 540), -1 for [-540, -180), ..."""
+    return math.floor((longitude + 180.0) / 360.0)
 
-    def convert(value: Any) -> Any:
-        if (
-            isinstance(value, list)
-            and len(value) == 2
-            and all(isinstance(v, float | int) for v in value)
-        ):
-            return list(to_lon_lat(reference, float(value[0]), float(value[1])))
-        if isinstance(value, list):
-            return [convert(v) for v in value]
-        return value
 
-    for feature in collection["features"]:
-        geometry = feature["geometry"]
-        geometry["coordinates"] = convert(geometry["coordinates"])
+def _georeferenced(feature: dict[str, Any], reference: Georeference) -> None:
+    """The feature's geometry in ``[longitude, latitude]``, cut at the antimeridian.
+
+    Each point is mapped by :func:`to_lon_lat` and its longitude unwrapped to within 180
+    degrees of the map origin's, so a geometry stays connected where the map crosses the
+    antimeridian; there RFC 7946 §3.1.9 asks for it to be cut in parts none of which crosses
+    it.  Polygons are cut along ±180 (a MultiPolygon), a trajectory becomes a
+    MultiLineString whose parts end and start on the antimeridian (its ``times`` then one
+    list per part, the crossing's time interpolated), and every longitude written is in
+    [-180, 180].  Rings are oriented again in longitude and latitude."""
+    geometry = feature["geometry"]
+    kind, coordinates = geometry["type"], geometry["coordinates"]
+
+    def unwrapped(x: float, y: float) -> tuple[float, float]:
+        longitude, latitude = to_lon_lat(reference, float(x), float(y))
+        return reference.longitude + math.remainder(longitude - reference.longitude, 360.0), (
+            latitude
+        )
+
+    def wrapped(longitude: float, latitude: float) -> list[float]:
+        return [longitude - 360.0 * _sheet(longitude), latitude]
+
+    if kind == "Point":
+        geometry["coordinates"] = wrapped(*unwrapped(*coordinates))
+    elif kind == "MultiPoint":
+        geometry["coordinates"] = [wrapped(*unwrapped(*p)) for p in coordinates]
+    elif kind == "LineString":
+        parts, times = _cut_line(
+            [unwrapped(*p) for p in coordinates], feature["properties"].get("times")
+        )
+        if len(parts) > 1:
+            geometry["type"], geometry["coordinates"] = "MultiLineString", parts
+            if times is not None:
+                feature["properties"]["times"] = times
+        else:
+            geometry["coordinates"] = parts[0]
+    else:
+        from shapely.geometry import Polygon
+
+        polygons = [coordinates] if kind == "Polygon" else coordinates
+        lon_lat = [
+            Polygon(
+                [unwrapped(*p) for p in rings[0]], [[unwrapped(*p) for p in r] for r in rings[1:]]
+            )
+            for rings in polygons
+        ]
+        feature["geometry"] = _polygonal_geometry(
+            [piece for polygon in lon_lat for piece in _cut_polygon(polygon)]
+        )
+
+
+def _cut_polygon(polygon: Any) -> list[Any]:
+    """The polygon (unwrapped longitudes) cut into pieces within [-180, 180] each, moved there
+    by whole turns; a polygon that does not cross the antimeridian is kept as it is."""
+    from shapely import affinity
+    from shapely.geometry import box
+
+    west, _, east, _ = polygon.bounds
+    if _sheet(west) == _sheet(east):
+        return [affinity.translate(polygon, -360.0 * _sheet(west)) if _sheet(west) else polygon]
+    pieces: list[Any] = []
+    for sheet in range(_sheet(west), _sheet(east) + 1):
+        low = -180.0 + 360.0 * sheet
+        window = box(low, -90.0, low + 360.0, 90.0)
+        pieces += [
+            affinity.translate(piece, -360.0 * sheet)
+            for piece in _polygons(polygon.intersection(window))
+        ]
+    return pieces
+
+
+def _cut_line(
+    points: list[tuple[float, float]], times: list[float] | None
+) -> tuple[list[list[list[float]]], list[list[float]] | None]:
+    """A polyline (unwrapped longitudes) cut where it crosses the antimeridian: its parts, in
+    [-180, 180] each, and the times of their points (``None`` without ``times``).
+
+    A map is far smaller than the Earth, so one step crosses at most one antimeridian."""
+    parts: list[list[list[float]]] = [[]]
+    part_times: list[list[float]] = [[]]
+    for index, (longitude, latitude) in enumerate(points):
+        sheet = _sheet(longitude)
+        if index > 0:
+            previous_longitude, previous_latitude = points[index - 1]
+            previous_sheet = _sheet(previous_longitude)
+            if sheet != previous_sheet:
+                boundary = -180.0 + 360.0 * max(sheet, previous_sheet)
+                share = (boundary - previous_longitude) / (longitude - previous_longitude)
+                crossing = previous_latitude + share * (latitude - previous_latitude)
+                parts[-1].append([boundary - 360.0 * previous_sheet, crossing])
+                parts.append([[boundary - 360.0 * sheet, crossing]])
+                if times is not None:
+                    at = times[index - 1] + share * (times[index] - times[index - 1])
+                    part_times[-1].append(at)
+                    part_times.append([at])
+        parts[-1].append([longitude - 360.0 * sheet, latitude])
+        if times is not None:
+            part_times[-1].append(times[index])
+    return parts, part_times if times is not None else None
 
 
 PATH_TYPE = "nav_msgs/msg/Path"
 
-#: A ROS ``builtin_interfaces/Time`` holds whole seconds in an unsigned 32-bit field.
-MAX_STAMP_SECONDS = 2**32
+#: A ROS 2 ``builtin_interfaces/msg/Time`` holds whole seconds in a signed 32-bit field
+#: (``int32 sec``): stamps reach 2^31 - 1 s and 999,999,999 ns.
+MAX_STAMP_SECONDS = 2**31
+
+
+def _stamp_nanoseconds(seconds: float) -> int:
+    """The time as the whole nanoseconds a stamp holds (rounded, as the stamp is written)."""
+    return round(seconds * 1e9)
 
 
 def path_mcap(
@@ -197,13 +311,16 @@ def path_mcap(
 
     from tlmpc.base.errors import UsageError, error
 
-    late = [w.t for w in points if not 0.0 <= w.t < MAX_STAMP_SECONDS]
+    # the stamp as written is compared (rounded to whole nanoseconds)
+    late = [
+        w.t for w in points if not 0 <= _stamp_nanoseconds(w.t) < MAX_STAMP_SECONDS * 1_000_000_000
+    ]
     if late:
         raise UsageError(
             error(
                 "M085",
-                f"a plan time ({late[0]:g} s) does not fit a ROS time stamp "
-                f"(0 to {MAX_STAMP_SECONDS:,} s)",
+                f"a plan time ({late[0]:g} s) does not fit a ROS 2 time stamp "
+                f"(0 to {MAX_STAMP_SECONDS - 1:,} s and 999,999,999 ns)",
                 hint="export this plan as waypoints-yaml, waypoints-csv or geojson",
             )
         )
@@ -218,7 +335,7 @@ def path_mcap(
     point_type, quat_type = types["geometry_msgs/msg/Point"], types["geometry_msgs/msg/Quaternion"]
 
     def stamp(seconds: float) -> Any:
-        nanoseconds = max(0, round(seconds * 1e9))
+        nanoseconds = _stamp_nanoseconds(seconds)
         return time_type(sec=nanoseconds // 1_000_000_000, nanosec=nanoseconds % 1_000_000_000)
 
     poses = [
@@ -244,7 +361,7 @@ def path_mcap(
         name=PATH_TYPE, encoding="ros2msg", data=definition.encode("utf-8")
     )
     channel = writer.register_channel(topic=topic, message_encoding="cdr", schema_id=schema)
-    log_time = max(0, round(first * 1e9))
+    log_time = _stamp_nanoseconds(first)
     writer.add_message(channel, log_time=log_time, data=data, publish_time=log_time, sequence=0)
     writer.finish()  # type: ignore[no-untyped-call]
     return buffer.getvalue()

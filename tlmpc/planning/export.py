@@ -9,19 +9,66 @@ trails can be shorter on maps where the shortest route bounces (see docs/model-c
 
 from __future__ import annotations
 
+import hashlib
 import re
+from collections.abc import Callable
+from typing import assert_never
 
 from tlmpc.abstraction.model import Abstraction
 from tlmpc.base.errors import UsageError, error
-from tlmpc.ltl.ast import TRUE, Formula, Prop
-from tlmpc.ltl.printer import to_spin
-from tlmpc.ltl.transform import nnf, substitute
+from tlmpc.ltl.ast import (
+    TRUE,
+    And,
+    BoundedEventually,
+    BoundedGlobally,
+    BoundedUntil,
+    Const,
+    Equiv,
+    Eventually,
+    Formula,
+    Globally,
+    Implies,
+    Not,
+    Or,
+    Prop,
+    Release,
+    StrongRelease,
+    Until,
+    WeakUntil,
+)
+from tlmpc.ltl.printer import to_spin, to_text
+from tlmpc.ltl.transform import substitute
 
-PREFIX = "p_"  # region macros get a prefix so no region name clashes with a keyword
+PREFIX = "p_"  # region propositions get a prefix so no region name clashes with a keyword
 
-#: The only names that may reach a model as identifiers: the mission language's own rule,
-#: which is also a subset of Promela's, NuSMV's and DOT's identifier grammars.
-IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,63}")
+#: The only names that may reach a model as identifiers: the mission language's own rule
+#: (no length limit), which is also a subset of Promela's, NuSMV's and DOT's identifier
+#: grammars (SPIN's length limit is met by :func:`promela_name`).
+IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+
+#: Prefix of the Promela tables ``r_<region>[t]`` (whether triangle ``t`` lies in the region);
+#: it differs from :data:`PREFIX`, so a table never has a proposition's name.
+TABLE_PREFIX = "r_"
+
+#: The longest region name a Promela identifier keeps whole.  SPIN's lexer overflows on
+#: identifiers of about 500 characters; a longer name is cut to this many characters and
+#: followed by ``_`` and 16 hex digits of the name's SHA-256, so it is longer than every name
+#: kept whole and distinct from every other cut name.
+PROMELA_NAME_LIMIT = 200
+
+
+def promela_name(region: str) -> str:
+    """The region's name as a Promela identifier's tail: itself, or cut and tagged with its
+    hash when it is longer than :data:`PROMELA_NAME_LIMIT` (deterministic)."""
+    if len(region) <= PROMELA_NAME_LIMIT:
+        return region
+    digest = hashlib.sha256(region.encode("utf-8")).hexdigest()[:16]
+    return f"{region[:PROMELA_NAME_LIMIT]}_{digest}"
+
+
+def _same_name(region: str) -> str:
+    return region
+
 
 #: Characters a user's text keeps in a model comment: none can open, close or end a comment
 #: (no ``*``, ``/``, ``--``, newline) or start a quoted string or escape in any of the formats.
@@ -65,8 +112,8 @@ def checked_regions(abstraction: Abstraction, formula: Formula) -> None:
         )
 
 
-def _prefixed(formula: Formula) -> Formula:
-    return substitute(formula, {p: Prop(PREFIX + p) for p in formula.props()})
+def _prefixed(formula: Formula, rename: Callable[[str], str] = _same_name) -> Formula:
+    return substitute(formula, {p: Prop(PREFIX + rename(p)) for p in formula.props()})
 
 
 def _members(abstraction: Abstraction) -> dict[str, list[int]]:
@@ -81,14 +128,20 @@ def _members(abstraction: Abstraction) -> dict[str, list[int]]:
 D_STEP_CHUNK = 1000
 
 
-def _adjacency_steps(abstraction: Abstraction) -> list[str]:
-    """``d_step`` blocks setting ``nb[3*t + i] = n`` for every neighbour ``n`` of every
-    triangle, a dozen assignments per line."""
+def _table_steps(abstraction: Abstraction) -> list[str]:
+    """``d_step`` blocks filling the ``hidden`` tables once: ``nb[3*t + i] = n`` for every
+    neighbour ``n`` of every triangle and ``r_<region>[t] = 1`` for every triangle of every
+    region, a dozen assignments per line."""
     assignments = [
         f"nb[{3 * triangle + i}] = {int(n)};"
         for triangle in range(abstraction.num_triangles)
         for i, n in enumerate(abstraction.neighbors[triangle].tolist())
         if n >= 0
+    ]
+    assignments += [
+        f"{TABLE_PREFIX}{promela_name(region)}[{triangle}] = 1;"
+        for region, triangles in _members(abstraction).items()
+        for triangle in triangles
     ]
     lines: list[str] = []
     for chunk in range(0, len(assignments), D_STEP_CHUNK):
@@ -106,10 +159,14 @@ def to_promela(
 
     The model moves ``t`` to a neighbour or stays (one step each), and never leaves a triangle
     through the edge it entered by (the variable ``prev``), as tlmpc's planner; ``bounce=True``
-    drops that rule and gives the paper's plain D.  Adjacency lives in a ``hidden`` array set
-    once by a few ``d_step`` blocks, so the model (and ``pan.c``) stays linear in the number
-    of triangles and the state vector holds only ``t`` and ``prev``.  Every move prints
-    ``tlmpc: t = N``, so ``spin -t`` replays a trail as a list of triangles.
+    drops that rule and gives the paper's plain D.  Adjacency and region membership live in
+    ``hidden`` tables set once by a few ``d_step`` blocks, so the model (and ``pan.c``) stays
+    linear in the number of triangles.  Each region's proposition is a ``bit`` that every move
+    sets from its table: the ``ltl`` text names only these bits, so it stays as short as the
+    task however many triangles a region has (SPIN expands macros into the ``ltl`` text, and
+    its LTL parser fails on a long one).  The state vector holds ``t``, ``prev`` and the bits,
+    which follow from ``t``, so they add no states.  Every move prints ``tlmpc: t = N``, so
+    ``spin -t`` replays a trail as a list of triangles.
     """
     checked_regions(abstraction, formula)
     m = abstraction.num_triangles
@@ -124,29 +181,78 @@ def to_promela(
     ]
     if not bounce:
         lines.append("int prev = -1;  /* the triangle t was entered from (no bounce) */")
+    updates = ""
     for region, triangles in _members(abstraction).items():
-        condition = " || ".join(f"t == {i}" for i in triangles) or "false"
-        lines.append(f"#define {PREFIX}{region} ({condition})")
-    lines += ["", "active proctype robot() {", *_adjacency_steps(abstraction), "  do"]
+        proposition, table = PREFIX + promela_name(region), TABLE_PREFIX + promela_name(region)
+        if not triangles:
+            lines.append(f"#define {proposition} false  /* a region with no triangle */")
+            continue
+        inside = int(abstraction.start in triangles)
+        lines += [
+            f"hidden byte {table}[{m}];  /* 1: the triangle lies in the region */",
+            f"bit {proposition} = {inside};  /* the robot is in the region */",
+        ]
+        updates += f"{proposition} = {table}[t]; "
+    lines += ["", "active proctype robot() {", *_table_steps(abstraction), "  do"]
     for i in range(3):
         k = f"3*t + {i}"
         guard = f"nb[{k}] >= 0" + ("" if bounce else f" && nb[{k}] != prev")
-        move = f'{entry}t = nb[{k}]; printf("tlmpc: t = %d\\n", t)'
+        move = f'{entry}t = nb[{k}]; {updates}printf("tlmpc: t = %d\\n", t)'
         lines.append(f"  :: d_step {{ {guard} -> {move} }}")
     lines += [
         "  :: t >= 0 -> skip  /* stutter (a bare skip would be an unconditional self-loop) */",
         "  od",
         "}",
         "",
-        f"ltl task {{ !({to_spin(_prefixed(formula))}) }}",
+        f"ltl task {{ !({to_spin(_prefixed(formula, promela_name))}) }}",
         "",
     ]
     return "\n".join(lines)
 
 
-def _smv(formula: Formula) -> str:
-    spin = to_spin(nnf(_prefixed(formula)))
-    return spin.replace("[]", "G ").replace("<>", "F ").replace("&&", "&").replace("||", "|")
+def to_nusmv(formula: Formula) -> str:
+    """The formula in NuSMV's LTL syntax (``G F U V ! & | -> <-> TRUE FALSE``), fully
+    parenthesised.
+
+    NuSMV's constants are upper case (``true`` is an identifier there, unlike in SPIN), and
+    it has no weak until or strong release: ``a W b`` is written ``b V (a | b)`` and ``a M b``
+    ``b U (a & b)``, as :func:`tlmpc.ltl.printer.to_spin` does for SPIN.
+    """
+    match formula:
+        case Const(value):
+            return "TRUE" if value else "FALSE"
+        case Prop(name):
+            return name
+        case Not(arg):
+            return f"!({to_nusmv(arg)})"
+        case Eventually(arg):
+            return f"F ({to_nusmv(arg)})"
+        case Globally(arg):
+            return f"G ({to_nusmv(arg)})"
+        case And(args):
+            return "(" + " & ".join(to_nusmv(a) for a in args) + ")"
+        case Or(args):
+            return "(" + " | ".join(to_nusmv(a) for a in args) + ")"
+        case Implies(left, right):
+            return f"(({to_nusmv(left)}) -> ({to_nusmv(right)}))"
+        case Equiv(left, right):
+            return f"(({to_nusmv(left)}) <-> ({to_nusmv(right)}))"
+        case Until(left, right):
+            return f"(({to_nusmv(left)}) U ({to_nusmv(right)}))"
+        case Release(left, right):
+            return f"(({to_nusmv(left)}) V ({to_nusmv(right)}))"
+        case WeakUntil(left, right):
+            a, b = to_nusmv(left), to_nusmv(right)
+            return f"(({b}) V (({a}) | ({b})))"
+        case StrongRelease(left, right):
+            a, b = to_nusmv(left), to_nusmv(right)
+            return f"(({b}) U (({a}) & ({b})))"
+        case BoundedEventually() | BoundedGlobally() | BoundedUntil():
+            raise ValueError(
+                f"NuSMV's LTL has no time bounds: {to_text(formula)} cannot be written for it"
+            )
+        case _:
+            assert_never(formula)
 
 
 def to_smv(
@@ -182,7 +288,7 @@ def to_smv(
     for region, triangles in _members(abstraction).items():
         members = ", ".join(str(i) for i in triangles)
         lines.append(f"  {PREFIX}{region} := {'t in {' + members + '}' if triangles else 'FALSE'};")
-    lines += [f"LTLSPEC !({_smv(formula)})", ""]
+    lines += [f"LTLSPEC !({to_nusmv(_prefixed(formula))})", ""]
     return "\n".join(lines)
 
 
