@@ -7,7 +7,7 @@ import io
 import pytest
 
 from tlmpc.base.version import __version__
-from tlmpc.cli import COMMAND_MODULES, _command, main
+from tlmpc.cli import COMMAND_MODULES, _command, build_parser, main
 
 
 def run(*argv: str) -> tuple[int, str, str]:
@@ -52,6 +52,27 @@ def test_a_prefix_of_an_option_is_not_taken_for_it(argv: tuple[str, ...], prefix
     code, _, err = run(*argv)
     assert code == 2
     assert f"unrecognized arguments: {prefix}" in err
+
+
+@pytest.mark.parametrize(
+    ("command", "argv", "dest", "value"),
+    [
+        (
+            "verify",
+            ["x.csv", "--mission", "m.yaml", "--transform", "-1,2,0"],
+            "transform",
+            "-1,2,0",
+        ),
+        ("plot", ["out", "--zoom", "-5,-5,5,5"], "zoom", (-5.0, -5.0, 5.0, 5.0)),
+        ("monitor", ["--mission", "m.yaml", "--transform", "-.5,0,0"], "transform", "-.5,0,0"),
+    ],
+)
+def test_a_value_starting_with_a_negative_number_is_a_value(
+    command: str, argv: list[str], dest: str, value: object
+) -> None:
+    # argparse before Python 3.13 took `-1,2,0` for an option
+    parsed = build_parser(command).parse_args([command, *argv])
+    assert getattr(parsed, dest) == value
 
 
 def test_missing_mission_file_exits_2(tmp_path: object) -> None:

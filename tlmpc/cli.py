@@ -15,6 +15,7 @@ import contextlib
 import importlib
 import io
 import os
+import re
 import signal
 import sys
 import threading
@@ -51,6 +52,10 @@ COMMAND_MODULES = (
 )
 
 EPILOG = exit_code_epilog()
+
+#: A command-line word that is a value although it starts with `-`: a negative number, or a
+#: list of numbers that starts with one (`-33.86,151.21`).
+_NEGATIVE_VALUE = re.compile(r"^-\.?\d")
 
 
 def _command(name: str) -> ModuleType:
@@ -91,6 +96,11 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
             # taken for `--jsonl`): options are spelled out in full
             allow_abbrev=False,
         )
+        # `--georeference -33.86,151.21`, `--transform -1,2,0`: argparse takes a word that
+        # starts with `-` for an option unless it looks like a negative number, and its test
+        # for one (before Python 3.13) refuses the comma.  No option of tlmpc looks like a
+        # number, so every word starting with `-` and a digit is a value, on any Python.
+        command_parser._negative_number_matcher = _NEGATIVE_VALUE
         if only is None or only == module.NAME:
             module.add_arguments(command_parser)
         # `_full_parser`: every command's flags (for `tlmpc completion`, which commands cannot

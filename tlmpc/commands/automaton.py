@@ -88,7 +88,7 @@ def _refuse_unprintable_hoa(aps: Sequence[str]) -> None:
 
     odd = [name for name in aps if printable(name) != name]
     if odd:
-        shown = ", ".join(f"\"{printable(name)}\"" for name in odd)
+        shown = ", ".join(f'"{printable(name)}"' for name in odd)
         raise UsageError(
             error(
                 "U079",

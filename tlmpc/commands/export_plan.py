@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import re
 from pathlib import Path
 from typing import TextIO
 
@@ -42,13 +41,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "to the map's x axis (degrees, counter-clockwise): coordinates become longitude, "
         "latitude (RFC 7946) instead of the map's metres",
     )
-
-
-    # `--georeference -33.86,151.21`: argparse takes a value starting with `-` for an option
-    # unless it looks like a negative number, and its test for one does not allow the comma.
-    # Every argument starting with `-` and a digit is a value here (this command has no flag
-    # that looks like a number), as Python 3.13's argparse reads it.
-    parser._negative_number_matcher = re.compile(r"^-\.?\d")
 
 
 def _georeference(text: str) -> object:

@@ -12,31 +12,15 @@ from __future__ import annotations
 import hashlib
 import re
 from collections.abc import Callable
-from typing import assert_never
 
 from tlmpc.abstraction.model import Abstraction
 from tlmpc.base.errors import UsageError, error
 from tlmpc.ltl.ast import (
     TRUE,
-    And,
-    BoundedEventually,
-    BoundedGlobally,
-    BoundedUntil,
-    Const,
-    Equiv,
-    Eventually,
     Formula,
-    Globally,
-    Implies,
-    Not,
-    Or,
     Prop,
-    Release,
-    StrongRelease,
-    Until,
-    WeakUntil,
 )
-from tlmpc.ltl.printer import to_spin, to_text
+from tlmpc.ltl.printer import to_nusmv, to_spin
 from tlmpc.ltl.transform import substitute
 
 PREFIX = "p_"  # region propositions get a prefix so no region name clashes with a keyword
@@ -208,51 +192,6 @@ def to_promela(
         "",
     ]
     return "\n".join(lines)
-
-
-def to_nusmv(formula: Formula) -> str:
-    """The formula in NuSMV's LTL syntax (``G F U V ! & | -> <-> TRUE FALSE``), fully
-    parenthesised.
-
-    NuSMV's constants are upper case (``true`` is an identifier there, unlike in SPIN), and
-    it has no weak until or strong release: ``a W b`` is written ``b V (a | b)`` and ``a M b``
-    ``b U (a & b)``, as :func:`tlmpc.ltl.printer.to_spin` does for SPIN.
-    """
-    match formula:
-        case Const(value):
-            return "TRUE" if value else "FALSE"
-        case Prop(name):
-            return name
-        case Not(arg):
-            return f"!({to_nusmv(arg)})"
-        case Eventually(arg):
-            return f"F ({to_nusmv(arg)})"
-        case Globally(arg):
-            return f"G ({to_nusmv(arg)})"
-        case And(args):
-            return "(" + " & ".join(to_nusmv(a) for a in args) + ")"
-        case Or(args):
-            return "(" + " | ".join(to_nusmv(a) for a in args) + ")"
-        case Implies(left, right):
-            return f"(({to_nusmv(left)}) -> ({to_nusmv(right)}))"
-        case Equiv(left, right):
-            return f"(({to_nusmv(left)}) <-> ({to_nusmv(right)}))"
-        case Until(left, right):
-            return f"(({to_nusmv(left)}) U ({to_nusmv(right)}))"
-        case Release(left, right):
-            return f"(({to_nusmv(left)}) V ({to_nusmv(right)}))"
-        case WeakUntil(left, right):
-            a, b = to_nusmv(left), to_nusmv(right)
-            return f"(({b}) V (({a}) | ({b})))"
-        case StrongRelease(left, right):
-            a, b = to_nusmv(left), to_nusmv(right)
-            return f"(({b}) U (({a}) & ({b})))"
-        case BoundedEventually() | BoundedGlobally() | BoundedUntil():
-            raise ValueError(
-                f"NuSMV's LTL has no time bounds: {to_text(formula)} cannot be written for it"
-            )
-        case _:
-            assert_never(formula)
 
 
 def to_smv(
