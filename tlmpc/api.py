@@ -89,9 +89,31 @@ def _mission_text(mission: MissionSource, function: str) -> tuple[str | None, Pa
         raise UsageError(
             error("U075", f"tlmpc.{function}: the mission text or path holds a NUL character")
         )
-    if "\n" in mission or (":" in mission and not Path(mission).exists()):
+    if _is_mission_text(mission):
         return mission, Path("<mission>")
     return None, Path(mission)
+
+
+def _is_mission_text(mission: str) -> bool:
+    """Whether the string ``mission`` is YAML text rather than a path: it spans lines, starts
+    with ``{`` (flow style or JSON, however long or broken: its diagnostics are the YAML
+    reader's), or is one line that YAML reads as a mapping (``name: x``) and names no existing
+    file.  Anything else is a path, so a missing or unreadable file is U001, whatever its
+    name holds (``C:/missions/a.yaml``)."""
+    if "\n" in mission or "\r" in mission or mission.lstrip().startswith("{"):
+        return True
+    import yaml
+
+    try:
+        mapping = isinstance(yaml.safe_load(mission), Mapping)
+    except (yaml.YAMLError, ValueError, RecursionError):
+        return False
+    if not mapping:
+        return False
+    try:
+        return not Path(mission).is_file()
+    except (OSError, ValueError):  # a name longer than the system allows is no file
+        return True
 
 
 @dataclass(frozen=True, repr=False)

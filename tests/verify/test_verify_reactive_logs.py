@@ -320,3 +320,23 @@ def test_bag_strings_and_repeated_stamps(tmp_path: Path) -> None:
     found = json.loads(out)["diagnostics"][0]
     assert found["code"] == "V031"
     assert "sample 2 at /alarm" in found["message"]
+
+
+def test_a_sensor_topic_missing_messages_is_refused(tmp_path: Path) -> None:
+    # a bag whose metadata declares more alarm messages than it holds: read as it is, the
+    # alarm would stay off where the robot logged it on
+    import yaml
+
+    pytest.importorskip("rosbags")
+    bag = write_bag(tmp_path / "run", "mcap", POSES, {"/alarm": [(0, False), (3 * SECOND, True)]})
+    metadata = bag / "metadata.yaml"
+    information = yaml.safe_load(metadata.read_text())
+    topics = information["rosbag2_bagfile_information"]["topics_with_message_count"]
+    (alarm,) = [t for t in topics if t["topic_metadata"]["name"] == "/alarm"]
+    alarm["message_count"] += 1
+    metadata.write_text(yaml.safe_dump(information))
+    path = mission(tmp_path, sensors="  alarm: null")
+    status, _, err = verify("--mission", str(path), str(bag))
+    assert status == 2, err
+    assert "error[M065]" in err
+    assert "declares 3 messages on /alarm (metadata.yaml), but 2 could be read" in err

@@ -39,7 +39,7 @@ import numpy.typing as npt
 
 from tlmpc.base.errors import Diagnostic, UsageError
 from tlmpc.verify import Verdict, declare_ending, from_document, verify_trace
-from tlmpc.verify.clock import seconds
+from tlmpc.verify.clock import at
 from tlmpc.verify.model import Certificate
 from tlmpc.verify.robustness import speed_excess
 from tlmpc.verify.samples import MAX_PER_KIND, sample_diagnostics
@@ -364,7 +364,10 @@ def _verify_log(
     verdict = dataclasses.replace(
         verdict,
         certificate=_raw_speed(
-            dataclasses.replace(verdict.certificate, max_gap=max_gap), top_speed, violation
+            dataclasses.replace(verdict.certificate, max_gap=max_gap),
+            top_speed,
+            violation,
+            trace.start,
         ),
         stats={**verdict.stats, "samples": reducer.count, "kept_samples": len(kept)},
     )
@@ -374,11 +377,15 @@ def _verify_log(
 
 
 def _raw_speed(
-    certificate: Certificate, observed: float, violation: tuple[float, tuple[float, float]] | None
+    certificate: Certificate,
+    observed: float,
+    violation: tuple[float, tuple[float, float]] | None,
+    start: float,
 ) -> Certificate:
     """The certificate with the log's own top speed (every sample, not only the kept ones),
     refused where some gap moves faster than max_speed allows (``violation``: its speed and
-    its times)."""
+    its stamps, written from the log's first sample at ``start`` as the verifier writes
+    times)."""
     observed = max(observed, certificate.observed_speed)
     if certificate.max_speed is None or violation is None:
         return dataclasses.replace(certificate, observed_speed=observed)
@@ -388,7 +395,7 @@ def _raw_speed(
         certified=False,
         observed_speed=observed,
         margin=None,
-        reason=f"the log moves at {fastest:.4g} m/s between t={seconds(begin)} s and "
-        f"t={seconds(end)} s, faster than max_speed {certificate.max_speed:.4g}: the certificate's "
+        reason=f"the log moves at {fastest:.4g} m/s between {at(begin, start)} and "
+        f"{at(end, start)}, faster than max_speed {certificate.max_speed:.4g}: the certificate's "
         "assumption does not hold",
     )

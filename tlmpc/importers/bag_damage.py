@@ -9,6 +9,7 @@ worded for people.
 
 from __future__ import annotations
 
+import contextlib
 from pathlib import Path
 from typing import Any
 
@@ -74,32 +75,166 @@ def _damage(path: Path) -> tuple[str, str] | None:
     import os
 
     try:
-        files = sorted(path.iterdir()) if path.is_dir() else [path]
-        for file in files:
-            if not file.is_file():
+        for file, kind in _storage_files(path):
+            if kind not in _SALVAGE:
                 continue
             with open(file, "rb") as stream:
                 size = os.fstat(stream.fileno()).st_size
-                start = stream.read(len(_ROS1_MAGIC))
-                if start.startswith(_MCAP_MAGIC):
+                if kind == "mcap":
                     stream.seek(len(_MCAP_MAGIC))
                     found = _mcap_damage(stream, size)
-                    tool = "`mcap recover`"
-                elif start == _ROS1_MAGIC:
-                    found = _ros1_damage(stream, size)
-                    tool = "`rosbag reindex`"
                 else:
-                    continue
+                    stream.seek(len(_ROS1_MAGIC))
+                    found = _ros1_damage(stream, size)
             if found is not None:
-                inside = f" ({file.name})" if file != path else ""
                 state = "truncated" if found.startswith("it ends") else "truncated or corrupt"
                 return (
-                    f"the file{inside} is {state}: {found}",
-                    f"a recording cut short (the recorder stopped, or the disk filled); {tool} "
-                    "may salvage its whole records",
+                    f"the file{_inside(file, path)} is {state}: {found}",
+                    f"a recording cut short (the recorder stopped, or the disk filled); "
+                    f"{_SALVAGE[kind]} may salvage its whole records",
                 )
     except OSError:
         return None
+    return None
+
+
+def storage_damage(path: Path) -> tuple[str, str] | None:
+    """Where the bag ``path`` is damaged although a reader opens it, with a hint: a storage
+    file cut short (as :func:`reader_failure` finds), an MCAP message record that readers skip
+    (its channel is not declared, or its log time lies outside its chunk's range), or a
+    sqlite3 file that fails SQLite's ``quick_check``; None when none is found.  It reads every
+    record: call it once a bag is known to be damaged (its counts do not add up)."""
+    found = _damage(path) or sqlite_damage(path)
+    if found is not None:
+        return found
+    try:
+        for file, kind in _storage_files(path):
+            if kind != "mcap":
+                continue
+            with open(file, "rb") as stream:
+                lost = _mcap_lost_message(stream)
+            if lost is not None:
+                return (
+                    f"the file{_inside(file, path)} is corrupt: {lost}",
+                    "a byte changed in a copy (the file has no checksums to tell); "
+                    "compare it with the robot's own",
+                )
+    except OSError:
+        return None
+    return None
+
+
+def sqlite_damage(path: Path) -> tuple[str, str] | None:
+    """SQLite's own ``PRAGMA quick_check`` of the bag's sqlite3 files (a pass over their
+    pages, cheaper than the query that reads the messages): what it finds in the first file
+    it fails on, with a hint; None when they pass (or there are none)."""
+    import sqlite3
+
+    try:
+        files = [file for file, kind in _storage_files(path) if kind == "sqlite3"]
+    except OSError:
+        return None
+    for file in files:
+        try:
+            uri = f"{file.resolve().as_uri()}?immutable=1"
+            with contextlib.closing(sqlite3.connect(uri, uri=True)) as database:
+                results = [str(row[0]) for row in database.execute("PRAGMA quick_check(3)")]
+        except sqlite3.Error as exc:
+            results = [str(exc)]
+        if results != ["ok"]:
+            return (
+                f"the file{_inside(file, path)} is corrupt: SQLite's quick_check finds "
+                + "; ".join(" ".join(result.split()) for result in results),
+                "a damaged database (a crash while recording, or a bad copy); `sqlite3 FILE "
+                '".recover"` may salvage its rows into a new file',
+            )
+    return None
+
+
+_SALVAGE = {"mcap": "`mcap recover`", "ros1": "`rosbag reindex`"}
+_SQLITE_MAGIC = b"SQLite format 3\x00"
+
+
+def _storage_files(path: Path) -> list[tuple[Path, str]]:
+    """The storage files of the bag ``path`` (itself, or a bag directory's files), each with
+    its kind by its first bytes: ``"mcap"``, ``"ros1"``, ``"sqlite3"`` or ``""``."""
+    found: list[tuple[Path, str]] = []
+    for file in sorted(path.iterdir()) if path.is_dir() else [path]:
+        if not file.is_file():
+            continue
+        with open(file, "rb") as stream:
+            start = stream.read(len(_SQLITE_MAGIC))
+        if start.startswith(_MCAP_MAGIC):
+            found.append((file, "mcap"))
+        elif start.startswith(_ROS1_MAGIC):
+            found.append((file, "ros1"))
+        else:
+            found.append((file, "sqlite3" if start == _SQLITE_MAGIC else ""))
+    return found
+
+
+def _inside(file: Path, path: Path) -> str:
+    """`` (NAME)`` when ``file`` is a file of the bag directory ``path``."""
+    return f" ({file.name})" if file != path else ""
+
+
+def _mcap_lost_message(stream: Any) -> str | None:
+    """The first message record of a whole MCAP file that readers skip, in words: one on a
+    channel the file does not declare, or one in a chunk whose log time lies outside the
+    chunk's range (readers pick a chunk's messages by that range)."""
+    from rosbags.rosbag2.storage_mcap import decompress
+
+    channels: set[int] = set()
+    offset = len(_MCAP_MAGIC)
+    stream.seek(offset)
+    for number in range(1, _SCAN_RECORDS):
+        head = stream.read(9)
+        if len(head) < 9 or head[0] == 0x02:  # the footer
+            return None
+        body = stream.read(int.from_bytes(head[1:], "little"))
+        where = f"record {number} ({_MCAP_RECORDS.get(head[0], 'unknown')}, at byte {offset})"
+        offset += 9 + len(body)
+        if head[0] == 0x04 and len(body) >= 2:
+            channels.add(int.from_bytes(body[:2], "little"))
+        elif head[0] == 0x05 and len(body) >= 22:
+            channel = int.from_bytes(body[:2], "little")
+            if channel not in channels:
+                return f"{where} is a message on channel {channel}, which the file does not declare"
+        elif head[0] == 0x06 and len(body) >= 40:
+            begin, end, size = (int.from_bytes(body[at : at + 8], "little") for at in (0, 8, 16))
+            named = int.from_bytes(body[28:32], "little")
+            compression = body[32 : 32 + named].decode("utf-8", "replace")
+            packed = int.from_bytes(body[32 + named : 40 + named], "little")
+            try:
+                records = decompress(body[40 + named : 40 + named + packed], compression, size, 0)
+            except Exception:  # a chunk that does not unpack is damaged another way
+                return f"{where} does not decompress ({compression or 'uncompressed'})"
+            lost = _chunk_lost_message(records, channels, begin, end)
+            if lost is not None:
+                return f"{where}: {lost}"
+    return None
+
+
+def _chunk_lost_message(records: bytes, channels: set[int], begin: int, end: int) -> str | None:
+    """The first message record of a chunk's (uncompressed) ``records`` that readers skip."""
+    at = 0
+    while at + 9 <= len(records):
+        kind, length = records[at], int.from_bytes(records[at + 1 : at + 9], "little")
+        body = records[at + 9 : at + 9 + length]
+        if kind == 0x04 and len(body) >= 2:
+            channels.add(int.from_bytes(body[:2], "little"))
+        elif kind == 0x05 and len(body) >= 22:
+            channel = int.from_bytes(body[:2], "little")
+            log_time = int.from_bytes(body[6:14], "little")
+            where = f"its message record at byte {at:,} of the unpacked chunk"
+            if channel not in channels:
+                return f"{where} is on channel {channel}, which the file does not declare"
+            if not begin <= log_time <= end:
+                return (
+                    f"{where} has log time {log_time:,} ns, outside the chunk's "
+                    f"{begin:,}-{end:,} ns"
+                )
+        at += 9 + length
     return None
 
 

@@ -39,7 +39,8 @@ import numpy.typing as npt
 
 from tlmpc.base.errors import UsageError, error
 from tlmpc.base.extras import require
-from tlmpc.importers.bag_damage import reader_failure
+from tlmpc.importers.bag_counts import counted_messages
+from tlmpc.importers.bag_damage import reader_failure, sqlite_damage
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -699,7 +700,8 @@ def _opened_bag(
     path: Path, topic: str | None, *, limit: bool = True
 ) -> Iterator[tuple[Any, list[Any], str]]:
     """The open reader, the chosen pose connections and their topic (diagnostics M060–M066;
-    M066 for a declared count over the limit only with ``limit``)."""
+    M066 for a declared count over the limit only with ``limit``).  A sqlite3 bag passes
+    SQLite's ``quick_check`` first (M060): a damaged database can answer with fewer rows."""
     require("rosbags.highlevel", "reading a ROS bag or MCAP log", file=str(path))
     from rosbags.highlevel import AnyReader
     from rosbags.typesys import Stores, get_typestore
@@ -719,6 +721,9 @@ def _opened_bag(
             or "expected a ROS 1 .bag, a ROS 2 bag directory (sqlite3 or MCAP) or a .mcap file",
         ) from None
     try:
+        damage = sqlite_damage(path)
+        if damage is not None:
+            raise _fail("M060", f"cannot open the bag: {damage[0]}", file, hint=damage[1])
         chosen, topic = _chosen_connections(reader, topic, file)
         declared = sum(int(c.msgcount) for c in chosen)
         if limit and declared > MAX_LOG_SAMPLES:
@@ -776,12 +781,13 @@ def _pose_chunks(
     reader: Any, chosen: list[Any], frame: str | None, file: str, size: int
 ) -> Iterator[tuple[list[int], list[float], list[float]]]:
     """The poses (stamp ns, x, y) of ``chosen`` in stored order, ``size`` at a time, in
-    ``frame`` when given; counts them against :data:`MAX_LOG_SAMPLES` as they come."""
+    ``frame`` when given; counts them against :data:`MAX_LOG_SAMPLES` as they come, and at the
+    end against the counts the bag declares (M065, :func:`counted_messages`)."""
     tree: Any = None
     count = 0
     try:
         batch: list[tuple[int, float, float, float, str]] = []
-        for connection, log_time, raw in reader.messages(connections=chosen):
+        for connection, log_time, raw in counted_messages(reader, chosen, Path(file)):
             message: Any = reader.deserialize(raw, connection.msgtype)
             pose: Any = message
             for part in POSE_TYPES[connection.msgtype].split("."):
@@ -887,7 +893,7 @@ def _tf_tree(reader: Any, logged: list[str], frame: str, file: str) -> Any:
             "--transform X,Y,YAW instead of --frame",
         )
     collector = TransformCollector(file)
-    for connection, _, raw in reader.messages(connections=connections):
+    for connection, _, raw in counted_messages(reader, connections, Path(file)):
         message: Any = reader.deserialize(raw, connection.msgtype)
         static = connection.topic.rstrip("/").endswith("tf_static")
         for transform in message.transforms:

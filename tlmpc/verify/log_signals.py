@@ -138,6 +138,7 @@ def _bag_signals(path: Path, reactive: Reactive) -> dict[str, Signal]:
     from rosbags.highlevel import AnyReader
     from rosbags.typesys import Stores, get_typestore
 
+    from tlmpc.importers.bag_counts import counted_messages
     from tlmpc.importers.bag_damage import reader_failure
     from tlmpc.importers.logs import MAX_LOG_SAMPLES, _bag_paths, stamp_seconds
 
@@ -176,7 +177,7 @@ def _bag_signals(path: Path, reactive: Reactive) -> dict[str, Signal]:
                     )
                 )
             samples: list[tuple[int, Any]] = []
-            for connection, log_time, raw in reader.messages(connections=chosen):
+            for connection, log_time, raw in counted_messages(reader, chosen, path):
                 message: Any = reader.deserialize(raw, connection.msgtype)
                 try:
                     value = _field(message, dotted)
