@@ -143,6 +143,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         duration=duration,
         dt=dt,
         heading=args.heading,
+        source=str(args.out),
     )
     verdict = verify_document(result.trace)
     if args.output is not None:

@@ -292,6 +292,14 @@ PATH_TYPE = "nav_msgs/msg/Path"
 MAX_STAMP_SECONDS = 2**31
 
 
+def _fits_a_stamp(seconds: float) -> bool:
+    """Whether a ROS 2 stamp holds the time ``seconds`` (as it is written: whole
+    nanoseconds); a time too large for nanoseconds to be counted (1e300) does not."""
+    if not 0.0 <= seconds < MAX_STAMP_SECONDS:
+        return False
+    return _stamp_nanoseconds(seconds) < MAX_STAMP_SECONDS * 1_000_000_000
+
+
 def _stamp_nanoseconds(seconds: float) -> int:
     """The time as the whole nanoseconds a stamp holds (rounded, as the stamp is written)."""
     return round(seconds * 1e9)
@@ -312,9 +320,7 @@ def path_mcap(
     from tlmpc.base.errors import UsageError, error
 
     # the stamp as written is compared (rounded to whole nanoseconds)
-    late = [
-        w.t for w in points if not 0 <= _stamp_nanoseconds(w.t) < MAX_STAMP_SECONDS * 1_000_000_000
-    ]
+    late = [w.t for w in points if not _fits_a_stamp(w.t)]
     if late:
         raise UsageError(
             error(

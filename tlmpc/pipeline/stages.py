@@ -18,7 +18,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
-from tlmpc.base.errors import Diagnostic, InvalidInputError, TlmpcError, error
+from tlmpc.base.errors import (
+    EXIT_INCONCLUSIVE,
+    Diagnostic,
+    InvalidInputError,
+    TlmpcError,
+    error,
+)
 from tlmpc.base.memo import current_memo, memo_scope
 from tlmpc.base.pages import plain_pages
 from tlmpc.base.progress import heartbeat
@@ -31,6 +37,7 @@ if TYPE_CHECKING:
     from tlmpc.mission.model import Mission
     from tlmpc.planning.model import Witness
     from tlmpc.verify.clearance import Clearance
+    from tlmpc.verify.model import Verdict
 
 
 T = TypeVar("T")
@@ -383,17 +390,19 @@ def _verify(c: Compilation) -> StageResult:
     document = c.get(TRACE)
     verdict = verify_document(dict(document))
     verdict_json = verdict_to_json(verdict)
-    if not verdict_json["satisfied"]:
+    if not verdict.satisfied:
         # The compiler's guarantee failed: that is a bug in tlmpc, never the user's fault.
-        counterexample = _counterexample_text(verdict_json.get("counterexample"))
+        answer = _verdict_text(verdict)
         raise SelfCheckError(
             error(
                 "I001",
                 f"the compiled trajectory does not satisfy the task (self-check failed): "
-                f"{counterexample}",
+                f"the verifier's answer is {answer}",
                 hint="please report this mission; the artifacts were not written",
             ),
-            reason=f"does not satisfy the task: {counterexample}",
+            reason=f"does not {'decide' if verdict.outcome == 'inconclusive' else 'satisfy'} "
+            f"the task: the verifier's answer is {answer}",
+            outcome=verdict.outcome,
         )
     certificate = verdict_json["certificate"]
     bound = certificate["max_speed"]
@@ -468,11 +477,15 @@ def _sampled_for_certificate(
     return denser, dense_verdict
 
 
-def _counterexample_text(counterexample: Any) -> str:
-    """The verifier's counterexample in words (its message), else as it is."""
-    if isinstance(counterexample, Mapping) and isinstance(counterexample.get("message"), str):
-        return str(counterexample["message"])
-    return str(counterexample)
+def _verdict_text(verdict: Verdict) -> str:
+    """The verifier's answer in its own words (as `tlmpc verify` prints it): its outcome and
+    every violation (of the task or of the workspace), or for an inconclusive verdict what
+    each conjunct has seen so far."""
+    if verdict.violations:
+        details = [violation.message for violation in verdict.violations]
+    else:
+        details = [f"{r.conjunct}: {r.outcome}: {r.progress}" for r in verdict.conjuncts]
+    return f"{verdict.outcome}" + (f" ({'; '.join(details)})" if details else "")
 
 
 def _outruns(trace: Mapping[str, Any], speed: float) -> bool:
@@ -539,13 +552,22 @@ def _plot(c: Compilation) -> StageResult:
 
 class SelfCheckError(TlmpcError):
     """The verifier rejected a trace the compiler produced (an internal error, exit 3);
-    ``reason`` says what is wrong with the trajectory, whoever made it."""
+    ``reason`` says what is wrong with the trajectory, whoever made it, and ``outcome`` is the
+    verifier's (``violated`` also for a trace faster than ``max_speed``)."""
 
     exit_code = 3
 
-    def __init__(self, diagnostic: Diagnostic, *, reason: str) -> None:
+    def __init__(self, diagnostic: Diagnostic, *, reason: str, outcome: str = "violated") -> None:
         super().__init__(diagnostic)
         self.reason = reason
+        self.outcome = outcome
+
+
+class InconclusiveTraceError(InvalidInputError):
+    """A trajectory read from a folder on which the verifier's answer is ``inconclusive``
+    (exit 4, as `tlmpc verify` gives it)."""
+
+    exit_code = EXIT_INCONCLUSIVE
 
 
 _STATIC: frozenset[World] = frozenset({"static"})
@@ -847,8 +869,28 @@ def compilation_from_artifacts(directory: Path, needed: Sequence[Product[Any]]) 
     cross_check(directory, documents)
     for product in needed:
         products[product] = product.read(documents[product.artifact])
+    _refuse_unguaranteed(directory, documents, products)
     source = Path(str(documents.get("mission.json", {}).get("source") or directory))
     return Compilation(source=source, products=products, documents=documents)
+
+
+def _refuse_unguaranteed(
+    directory: Path, documents: Mapping[str, Any], products: Mapping[Product[Any], Any]
+) -> None:
+    """Refuse (U042, at the artifact) a witness or controllers read from ``directory`` that
+    break what the control stage guarantees: inside a compile a stage that fails on them is a
+    bug in tlmpc (exit 3), but an edited artifact is the user's input."""
+    from tlmpc.control.recheck import refuse_edited
+
+    controllers_document = documents.get(CONTROLLERS.artifact)
+    refuse_edited(
+        directory,
+        products.get(MISSION),
+        products.get(ABSTRACTION),
+        products.get(WITNESS),
+        products.get(CONTROLLERS),
+        None if controllers_document is None else controllers_document["steps"],
+    )
 
 
 def run_stage_from_artifacts(
@@ -874,7 +916,8 @@ def run_stage_from_artifacts(
     except SelfCheckError as exc:
         # artifacts read from a folder may have been edited by hand: a trace that fails its
         # re-check is the folder's answer (as `tlmpc verify` gives it), not a compiler bug
-        raise InvalidInputError(
+        answer = InconclusiveTraceError if exc.outcome == "inconclusive" else InvalidInputError
+        raise answer(
             error(
                 "U077",
                 f"the trajectory in {TRACE.artifact} {exc.reason}",

@@ -17,14 +17,14 @@ one, else ``end: open``).
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from tlmpc.abstraction.model import triangle_inradius
-from tlmpc.base.errors import UsageError, error
+from tlmpc.base.errors import Diagnostic, UsageError, error
 from tlmpc.runtime.disturbance import Disturbance
 from tlmpc.runtime.executor import Executor, RunPlan
 from tlmpc.runtime.model import Progress, Recovery
@@ -91,10 +91,12 @@ def run_closed_loop(
     duration: float | None = None,
     dt: float | None = None,
     heading: float = 0.0,
+    source: str | None = None,
 ) -> ClosedLoopRun:
     """Simulate ``executor`` under ``disturbance`` (|w| <= ``bound``; see the module doc).
 
     Give ``cycles`` (laps of the cycle, or dwell times of a stay) or ``duration`` (seconds).
+    ``source`` names the compiled output in diagnostics.
     """
     robot = executor.mission.robot
     speed = robot.max_speed + bound
@@ -107,15 +109,8 @@ def run_closed_loop(
         horizon = TIME_CAP_FACTOR * max(nominal, step_time)
         expected = nominal / step_time
     if not expected <= MAX_SAMPLES:
-        raise UsageError(
-            error(
-                "R024",
-                f"the run would take about {expected:.3g} samples at dt {step_time:g} s, "
-                f"more than {MAX_SAMPLES:,}",
-                hint="give a larger --dt (or leave it out for the mesh's own), fewer --cycles "
-                "or a shorter --duration",
-            )
-        )
+        length = duration if duration is not None else nominal
+        raise UsageError(_over_budget(expected, length, step_time, dt is not None, cycles, source))
     pose = initial_pose(executor, heading)
     t = 0.0
     samples: list[tuple[float, float, float]] = []
@@ -182,6 +177,48 @@ def run_closed_loop(
         dt=step_time,
         completed=completed,
     )
+
+
+def _over_budget(
+    expected: float,
+    length: float,
+    step_time: float,
+    given: bool,
+    cycles: int | None,
+    source: str | None,
+) -> Diagnostic:
+    """R024: a run of ``length`` seconds, ``expected`` samples of ``step_time`` (the ``--dt``
+    given, or the default from the mesh), would pass :data:`MAX_SAMPLES`; what would fit
+    instead.  Located at ``--dt`` when given, else at the output whose plan sets the default
+    dt and the run's nominal length."""
+    place: str | None = source
+    if given:
+        period, place = f"--dt {step_time:g} s", f"--dt {step_time:g}"
+    else:
+        period = (
+            f"the default dt {step_time:g} s (a tenth of the smallest inradius of the plan's "
+            "triangles over max_speed + the disturbance bound)"
+        )
+    fewer = ", fewer --cycles" if cycles is not None and cycles > 1 else ""
+    return error(
+        "R024",
+        f"the run would take about {expected:.3g} samples, more than the budget of "
+        f"{MAX_SAMPLES:,}: {length:.4g} s at {period}",
+        hint=f"give --dt {_three_digits(length / MAX_SAMPLES, math.ceil):g} or larger{fewer}, "
+        f"or --duration {_three_digits(MAX_SAMPLES * step_time, math.floor):g} or shorter",
+        file=place,
+    )
+
+
+def _three_digits(value: float, rounding: Callable[[float], int]) -> float:
+    """``value`` rounded to three significant digits by ``rounding`` (math.ceil: a value
+    that is no smaller, math.floor: no larger), so a hint's printed value keeps its promise."""
+    if not 0.0 < value < math.inf:
+        return value
+    scale = 10.0 ** (math.floor(math.log10(value)) - 2)
+    if not 0.0 < scale < math.inf:  # (at the ends of the double range: as it is)
+        return value
+    return float(f"{rounding(value / scale) * scale:.3g}")
 
 
 def _trace_document(

@@ -187,12 +187,22 @@ class Executor:
                     hint="compile the mission without --until (or up to the control stage)",
                 )
             )
+        mission = mission_from_json(artifacts["mission.json"])
+        abstraction = abstraction_from_json(artifacts["abstraction.json"])
+        witness = witness_from_json(artifacts["witness.json"])
+        controllers = controllers_from_json(artifacts["controllers.json"])
+        if isinstance(output, str | os.PathLike):
+            # a folder's artifacts may have been edited: run only what the control stage wrote
+            from tlmpc.control.recheck import refuse_edited
+
+            steps = artifacts["controllers.json"]["steps"]
+            refuse_edited(Path(output), mission, abstraction, witness, controllers, steps)
         return cls(
-            mission=mission_from_json(artifacts["mission.json"]),
-            abstraction=abstraction_from_json(artifacts["abstraction.json"]),
+            mission=mission,
+            abstraction=abstraction,
             automaton=automaton_from_json(artifacts["automaton.json"]),
-            witness=witness_from_json(artifacts["witness.json"]),
-            controllers=controllers_from_json(artifacts["controllers.json"]),
+            witness=witness,
+            controllers=controllers,
         )
 
     # --- reports -------------------------------------------------------------------------
