@@ -217,7 +217,9 @@ def test_edited_controllers_are_refused_at_the_file(
     assert (copy / "trace.json").read_bytes() == trace  # nothing written
 
 
-@pytest.mark.parametrize("name", ["ten_times_faster", "reversed", "other_exit_edge", "mid_plan_stay"])
+@pytest.mark.parametrize(
+    "name", ["ten_times_faster", "reversed", "other_exit_edge", "mid_plan_stay"]
+)
 def test_simulate_and_the_executor_refuse_edited_controllers_too(
     compiled: Path, tmp_path: Path, name: str
 ) -> None:

@@ -264,3 +264,24 @@ def test_the_last_second_a_ros2_stamp_holds_is_written() -> None:
     path = store.deserialize_cdr(message.data, "nav_msgs/msg/Path")
     stamp = path.poses[-1].header.stamp
     assert (stamp.sec, stamp.nanosec) == (2**31 - 1, 500_000_000)
+
+
+def test_flag_and_stamp_refusals_are_located(tmp_path: Path) -> None:
+    """M084 at the flag as given, M085 at the trajectory whose time no stamp holds."""
+    pytest.importorskip("mcap")
+    pytest.importorskip("rosbags")
+    slow = (
+        "version: 1\nworkspace: {boundary: {rect: [0, 0, 10, 10]}}\n"
+        "regions: {a: {rect: [8, 8, 9, 9]}}\nrobot: {start: [1, 1], max_speed: 4.0e-9}\n"
+        "task: [visit a]\n"
+    )
+    out = compiled(tmp_path, slow)
+    target = str(tmp_path / "p.mcap")
+    code, _, err = run("export-plan", str(out), "--format", "path-mcap", "-o", target)
+    assert code == 2, err
+    assert err.startswith(f"{out / 'trace.json'}: error[M085]: "), err
+    code, _, err = run(
+        "export-plan", str(out), "--format", "path-mcap", "-o", target, "--frame-id", ""
+    )
+    assert code == 2, err
+    assert err.startswith("--frame-id '': error[M084]: "), err

@@ -52,6 +52,7 @@ def _georeference(text: str) -> object:
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Read the plan and write the chosen format."""
     import math
+    import shlex
 
     from tlmpc.base.errors import EXIT_OK, UsageError, error
     from tlmpc.exports.formats import geojson, path_mcap, waypoints_csv, waypoints_yaml
@@ -78,6 +79,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
                     "direction characters",
                     hint=f"give a plain {flag} such as "
                     + ("map" if flag == "--frame-id" else "/plan"),
+                    file=f"{flag} {shlex.quote(plain_name(value))}",
                 )
             )
     if args.output is not None:
@@ -99,6 +101,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
                 "M086",
                 f"--georeference applies to geojson, not to {args.format}",
                 hint="the other formats are in the map frame, as a navigation stack expects",
+                file="--georeference",
             )
         )
     if args.format == "path-mcap" and args.output is None:
@@ -125,7 +128,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
                 )
             ) from None
     else:
-        data = path_mcap(plan, points, args.topic, args.frame_id)
+        data = path_mcap(plan, points, args.topic, args.frame_id, source=args.out / "trace.json")
     from tlmpc.io.report import Reporter
 
     reporter = Reporter.for_args(args, out, err)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import io
 import json
 import math
+from pathlib import Path
 from typing import Any
 
 import yaml
@@ -306,11 +307,17 @@ def _stamp_nanoseconds(seconds: float) -> int:
 
 
 def path_mcap(
-    plan: Plan, points: list[Waypoint], topic: str = "/plan", frame_id: str = "map"
+    plan: Plan,
+    points: list[Waypoint],
+    topic: str = "/plan",
+    frame_id: str = "map",
+    *,
+    source: Path | None = None,
 ) -> bytes:
     """An MCAP file with one ``nav_msgs/msg/Path`` (CDR, ROS 2 schema) on ``topic``.
 
-    Pose stamps are the plan's times; the message's log time is the first of them.
+    Pose stamps are the plan's times; the message's log time is the first of them.  A time
+    no stamp holds is M085, at ``source`` (the trajectory read) when given.
     """
     require("mcap.writer", "writing a nav_msgs/Path MCAP file")
     require("rosbags.typesys", "writing a nav_msgs/Path MCAP file")
@@ -328,6 +335,7 @@ def path_mcap(
                 f"a plan time ({late[0]:g} s) does not fit a ROS 2 time stamp "
                 f"(0 to {MAX_STAMP_SECONDS - 1:,} s and 999,999,999 ns)",
                 hint="export this plan as waypoints-yaml, waypoints-csv or geojson",
+                file=None if source is None else str(source),
             )
         )
 
