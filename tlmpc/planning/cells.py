@@ -34,8 +34,9 @@ A *cell stay* uses the radial law u = kappa (c - x), affine on the whole cell, w
 kappa = max_speed / R (R the largest distance from c to a corner): on every side it pushes
 inward by kappa times c's distance to the side's line, so its width is r / R (r the smallest
 such distance), and under any push of norm d < kappa r the state converges into the disc of
-radius d / kappa about c, inside the cell. The centre c maximises r / R (a pattern search from
-the area centroid, a fixed number of halvings).
+radius d / kappa about c, inside the cell. The centre c is the best r / R a pattern search
+finds (:func:`stay_centre`: from the area centroid, a fixed number of halvings and a budget
+of moves, so its work is bounded by the cell's sides).
 """
 
 from __future__ import annotations
@@ -65,6 +66,15 @@ MAX_TRIANGLES = 12_000
 COLLINEAR = 1e-8
 #: The stay centre's pattern search halves its step this many times.
 CENTRE_HALVINGS = 40
+#: The most moves the stay centre's pattern search makes, over all its step sizes: its budget.
+#: A search along the axes stalls at a coarse step on a crease of r / R (where two sides, or
+#: two corners, tie) and may then climb along the crease at a fine step, one step at a time:
+#: up to the cell's size over that step (about 2^CENTRE_HALVINGS) moves, for gains in the
+#: last digits. So the search stops moving at this budget (the centre it has reached is
+#: sound: its width is r / R there) and evaluates r / R at most
+#: :func:`centre_evaluations` times. The searches on the cells of the tests' missions
+#: (Example 1's among them) move at most 850 times.
+CENTRE_MOVES = 1_024
 
 
 @dataclass(frozen=True, slots=True)
@@ -337,13 +347,45 @@ def _fan_widths(moves: list[list[list[Vector]]], turns: FloatArray) -> FloatArra
 
 def _stay(cells: Cells, cell: int) -> CellStay:
     polygon = [cells._point(v) for v in cells.cells[cell].boundary]
+    found = stay_centre(polygon)
+    cx, cy = found.centre
+    reach = max(math.hypot(px - cx, py - cy) for px, py in polygon)
+    return CellStay(cell=cell, centre=found.centre, rate=1.0 / reach, width=found.width)
+
+
+@dataclass(frozen=True, slots=True)
+class CentreSearch:
+    """The centre of a convex polygon's radial stay found by :func:`stay_centre`: the centre,
+    its width r / R (at least 0), the search's moves (at most :data:`CENTRE_MOVES`) and its
+    evaluations of r / R (at most :func:`centre_evaluations`)."""
+
+    centre: Vector
+    width: float
+    moves: int
+    evaluations: int
+
+
+def centre_evaluations() -> int:
+    """The most evaluations of r / R one :func:`stay_centre` makes: the centroid's, and four
+    round each move and round each step size's last position."""
+    return 1 + 4 * (CENTRE_MOVES + CENTRE_HALVINGS)
+
+
+def stay_centre(polygon: list[Vector]) -> CentreSearch:
+    """The centre c of the radial stay of the convex ``polygon`` (counter-clockwise), as far
+    as a pattern search finds the largest r / R (r: c's smallest distance to a side's line, R:
+    its largest to a corner): from the area centroid, along the axes, CENTRE_HALVINGS
+    halvings of its step, within :data:`CENTRE_MOVES` moves in all."""
     lines = []
     for k in range(len(polygon)):
         (ax, ay), (bx, by) = polygon[k], polygon[(k + 1) % len(polygon)]
         length = math.hypot(bx - ax, by - ay)
         lines.append(((ay - by) / length, (bx - ax) / length, ax, ay))
+    evaluations = 0
 
     def ratio(x: float, y: float) -> float:
+        nonlocal evaluations
+        evaluations += 1
         inside = min(nx * (x - ax) + ny * (y - ay) for nx, ny, ax, ay in lines)
         reach = max(math.hypot(px - x, py - y) for px, py in polygon)
         return inside / reach if reach > 0.0 else 0.0
@@ -351,18 +393,19 @@ def _stay(cells: Cells, cell: int) -> CellStay:
     cx, cy = _centroid(polygon)
     best = ratio(cx, cy)
     step = max(math.hypot(px - cx, py - cy) for px, py in polygon) / 4.0
+    moves = 0
     for _ in range(CENTRE_HALVINGS):
         moved = True
-        while moved:
+        while moved and moves < CENTRE_MOVES:
             moved = False
             for dx, dy in ((step, 0.0), (-step, 0.0), (0.0, step), (0.0, -step)):
                 value = ratio(cx + dx, cy + dy)
                 if value > best:
                     best, cx, cy, moved = value, cx + dx, cy + dy, True
+                    moves += 1
                     break
         step /= 2.0
-    reach = max(math.hypot(px - cx, py - cy) for px, py in polygon)
-    return CellStay(cell=cell, centre=(cx, cy), rate=1.0 / reach, width=max(best, 0.0))
+    return CentreSearch(centre=(cx, cy), width=max(best, 0.0), moves=moves, evaluations=evaluations)
 
 
 def _centroid(polygon: list[Vector]) -> Vector:
