@@ -543,10 +543,10 @@ def test_a_dip_across_another_facet_before_the_exit_is_reported(scale: float) ->
 def test_the_recheck_finds_every_broken_vertex_condition(v: np.ndarray, exit_edge: int) -> None:
     """The re-check after solving rejects a field that breaks any one vertex condition."""
     from tlmpc.control.geometry import affine_law
-    from tlmpc.control.synthesize import _violated_condition
+    from tlmpc.control.synthesize import violated_condition
 
     controller = _exit_controller(v, exit_edge, 1.0)
-    assert _violated_condition(controller, 1.0) is None
+    assert violated_condition(controller, 1.0) is None
     geometry = triangle_geometry(v)
 
     def with_velocity(vertex: int, velocity: np.ndarray) -> StepController:
@@ -558,7 +558,7 @@ def test_the_recheck_finds_every_broken_vertex_condition(v: np.ndarray, exit_edg
     too_fast = with_velocity(
         0, controller.velocities[0] * 1.01 / np.linalg.norm(controller.velocities[0])
     )
-    assert _violated_condition(too_fast, 1.0) is not None
+    assert violated_condition(too_fast, 1.0) is not None
     for vertex in range(3):
         for facet in range(3):
             if facet == vertex:
@@ -566,9 +566,9 @@ def test_the_recheck_finds_every_broken_vertex_condition(v: np.ndarray, exit_edg
             tangent = v[(facet + 2) % 3] - v[(facet + 1) % 3]
             sliding = with_velocity(vertex, 0.5 * tangent / np.linalg.norm(tangent))
             # Along a facet: neither across the exit nor strictly inside another facet.
-            assert _violated_condition(sliding, 1.0) is not None, (vertex, facet)
+            assert violated_condition(sliding, 1.0) is not None, (vertex, facet)
     backwards = with_velocity(exit_edge, -0.5 * geometry.normals[exit_edge])
-    assert _violated_condition(backwards, 1.0) is not None
+    assert violated_condition(backwards, 1.0) is not None
 
 
 def _scipy_constraints(program: VertexProgram) -> object:

@@ -139,11 +139,11 @@ def test_the_vertex_programs_own_fields_reject_the_disturbance(disturbance: floa
     from tlmpc.control.synthesize import (
         _affine_controller,
         _assign_runs,
-        _violated_condition,
         plan_steps,
         run_push,
         solve_vertex_program,
         vertex_program,
+        violated_condition,
     )
     from tlmpc.pipeline.stages import ABSTRACTION, MISSION, WITNESS, compile_mission
 
@@ -161,4 +161,4 @@ def test_the_vertex_programs_own_fields_reject_the_disturbance(disturbance: floa
         if step.through is not None:
             continue
         field = _affine_controller(index, step, velocities[[column[r] for r in step.runs]], robot)
-        assert _violated_condition(field, robot.max_speed, disturbance) is None, index
+        assert violated_condition(field, robot.max_speed, disturbance) is None, index

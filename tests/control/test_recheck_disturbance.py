@@ -17,7 +17,7 @@ import yaml
 
 import tlmpc
 from tlmpc.control.io import controllers_from_json
-from tlmpc.control.synthesize import _violated_condition
+from tlmpc.control.synthesize import violated_condition
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -63,7 +63,7 @@ def test_the_recheck_flags_exactly_the_fields_a_disturbance_beats(fraction: floa
     speed = controllers.max_speed
     disturbance = fraction * speed
     exits = [s for s in controllers.steps if s.exit_edge is not None and s.kind != "vertex"]
-    flagged = [_violated_condition(s, speed, disturbance) is not None for s in exits]
+    flagged = [violated_condition(s, speed, disturbance) is not None for s in exits]
     expected = [_robust_margin(s) <= disturbance + 1e-9 * speed for s in exits]
     assert flagged == expected
     assert any(expected), "a field solved without a disturbance is beaten by some push"
@@ -74,7 +74,7 @@ def test_fields_solved_for_a_disturbance_pass_its_recheck() -> None:
     for step in controllers.steps:
         if step.exit_edge is not None:
             assert _robust_margin(step) > 0.1 * controllers.max_speed
-        assert _violated_condition(step, controllers.max_speed, 0.1) is None
+        assert violated_condition(step, controllers.max_speed, 0.1) is None
 
 
 def _exit_time(step: Any, push: float) -> float | None:

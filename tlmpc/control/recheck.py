@@ -2,7 +2,7 @@
 
 ``tlmpc stage`` runs a stage alone on the artifacts of an output folder, which may have been
 edited by hand.  The controllers the control stage writes meet every condition of its own
-re-check (C030: :func:`tlmpc.control.synthesize._violated_condition` for a triangle's field,
+re-check (C030: :func:`tlmpc.control.synthesize.violated_condition` for a triangle's field,
 :func:`tlmpc.control.cells.violated` for a cell's) on the triangles of the abstraction, and
 state exit speeds and exit-time bounds their fields achieve; the witness it reads starts in
 a triangle holding the robot's start and passes the checks of
@@ -27,7 +27,7 @@ from tlmpc.base.errors import TlmpcError, UsageError, error
 from tlmpc.control.cells import violated as violated_cell_row
 from tlmpc.control.geometry import triangle_geometry
 from tlmpc.control.model import EXIT, KEPT, Controllers, StepController
-from tlmpc.control.synthesize import RECHECK_TOLERANCE, _violated_condition, plan_steps
+from tlmpc.control.synthesize import RECHECK_TOLERANCE, plan_steps, violated_condition
 from tlmpc.mission.model import Mission, Robot
 from tlmpc.planning.mission import on_cells
 from tlmpc.planning.model import Witness
@@ -149,7 +149,7 @@ def _affine_problem(
         controller.next_triangle
     ):
         return f"exit facet {controller.exit_edge} does not lead to the next triangle"
-    problem = _violated_condition(controller, robot.max_speed, robot.disturbance)
+    problem = violated_condition(controller, robot.max_speed, robot.disturbance)
     if problem is None:
         problem = _law_problem(
             controller.vertices,

@@ -471,7 +471,7 @@ def run_push(robot: Robot) -> float:
     return 0.0
 
 
-def _violated_condition(
+def violated_condition(
     controller: StepController,
     max_speed: float,
     disturbance: float = 0.0,
@@ -759,7 +759,7 @@ def synthesize(
             continue  # the pursuit law's guarantees hold by construction (docs/control.md)
         # (The step's geometry is that of the controller's own vertex array: not again.)
         own = steps[position].geometry
-        problem = _violated_condition(controller, robot.max_speed, robot.disturbance, own)
+        problem = violated_condition(controller, robot.max_speed, robot.disturbance, own)
         if problem is None:
             continue
         # A needle: the solver's tolerance swamps the little its sliver corners can push.
@@ -767,7 +767,7 @@ def synthesize(
         # meets every row to rounding where any field can.
         step = steps[position]
         rebuilt = _geometric_controller(position, step, robot)
-        if _violated_condition(rebuilt, robot.max_speed, robot.disturbance) is None:
+        if violated_condition(rebuilt, robot.max_speed, robot.disturbance) is None:
             controllers[position] = rebuilt
             jumps.extend(_own_velocity_jumps(abstraction, steps, position, loop_start))
             continue
