@@ -203,12 +203,15 @@ def _chains_of(lines: Sequence[Any]) -> tuple[FloatArray, IntArray]:
     return points, starts
 
 
-def _needs_noding(rings: list[Any]) -> bool:
-    """True when some ring crosses or touches another (then the linework must be noded)."""
+def _needs_noding(rings: list[Any], grid: float) -> bool:
+    """True when some ring crosses, touches or comes within a grid step of another (then the
+    linework must be noded: a corner snapped a hair beside another ring's slanted side is on
+    it for the snap-rounding noder, but would reach Triangle as a vertex a rounding error
+    from a segment, which it cannot mesh)."""
     if len(rings) <= 1:
         return False
     tree = shapely.STRtree(rings)
-    pairs = tree.query(rings, predicate="intersects")
+    pairs = tree.query(rings, predicate="dwithin", distance=grid)
     return bool(np.any(pairs[0] != pairs[1]))
 
 
@@ -315,7 +318,7 @@ def pslg(
             raise OverBudget(cuts.work)
         linework = shapely.union_all([noded, *cuts.segments], grid_size=grid)
         points, starts = _chains_of(list(shapely.get_parts(linework)))
-    elif _needs_noding([*free_rings, *region_rings]):
+    elif _needs_noding([*free_rings, *region_rings], grid):
         clipped = [shapely.intersection(shapely.boundary(r), free, grid_size=grid) for r in regions]
         linework = shapely.union_all(
             [*free_rings, *(c for c in clipped if not c.is_empty)], grid_size=grid
