@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import functools
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -101,6 +102,16 @@ def _no_free_space(name: str, **where: Any) -> Diagnostic:
     )
 
 
+@functools.lru_cache(maxsize=16)
+def satisfiable_anywhere(formula: Formula) -> bool:
+    """Whether some trajectory on some map satisfies ``formula`` (its automaton over every
+    letter has an edge).  Kept for the formulas last asked: a planner that tries several
+    meshes asks why each failed, about the same task each time."""
+    from tlmpc.automata.translate import translate
+
+    return bool(translate(formula).edges)
+
+
 def explain_no_plan(
     abstraction: Abstraction,
     automaton: Automaton,
@@ -116,11 +127,10 @@ def explain_no_plan(
     triangle); ``start_label`` is the start point's own label under the closed convention
     (None under the right-continuous one, where the start reads its first triangle's label).
     """
-    from tlmpc.automata.translate import translate
     from tlmpc.planning.boundary import POINT
 
     text = to_text(formula)
-    if not translate(formula).edges:
+    if not satisfiable_anywhere(formula):
         return [
             error(
                 "P001",
