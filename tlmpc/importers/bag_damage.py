@@ -194,13 +194,10 @@ def _mcap_lost_message(stream: Any) -> str | None:
         body = stream.read(int.from_bytes(head[1:], "little"))
         where = f"record {number} ({_MCAP_RECORDS.get(head[0], 'unknown')}, at byte {offset})"
         offset += 9 + len(body)
-        if head[0] == 0x04 and len(body) >= 2:
-            channels.add(int.from_bytes(body[:2], "little"))
-        elif head[0] == 0x05 and len(body) >= 22:
-            channel = int.from_bytes(body[:2], "little")
-            if channel not in channels:
-                return f"{where} is a message on channel {channel}, which the file does not declare"
-        elif head[0] == 0x06 and len(body) >= 40:
+        skipped = _skipped_message(head[0], body, channels, None)
+        if skipped is not None:
+            return f"{where} {skipped}"
+        if head[0] == 0x06 and len(body) >= 40:
             begin, end, size = (int.from_bytes(body[at : at + 8], "little") for at in (0, 8, 16))
             named = int.from_bytes(body[28:32], "little")
             compression = body[32 : 32 + named].decode("utf-8", "replace")
@@ -220,21 +217,29 @@ def _chunk_lost_message(records: bytes, channels: set[int], begin: int, end: int
     at = 0
     while at + 9 <= len(records):
         kind, length = records[at], int.from_bytes(records[at + 1 : at + 9], "little")
-        body = records[at + 9 : at + 9 + length]
-        if kind == 0x04 and len(body) >= 2:
-            channels.add(int.from_bytes(body[:2], "little"))
-        elif kind == 0x05 and len(body) >= 22:
-            channel = int.from_bytes(body[:2], "little")
-            log_time = int.from_bytes(body[6:14], "little")
-            where = f"its message record at byte {at:,} of the unpacked chunk"
-            if channel not in channels:
-                return f"{where} is on channel {channel}, which the file does not declare"
-            if not begin <= log_time <= end:
-                return (
-                    f"{where} has log time {log_time:,} ns, outside the chunk's "
-                    f"{begin:,}-{end:,} ns"
-                )
+        skipped = _skipped_message(kind, records[at + 9 : at + 9 + length], channels, (begin, end))
+        if skipped is not None:
+            return f"its message record at byte {at:,} of the unpacked chunk {skipped}"
         at += 9 + length
+    return None
+
+
+def _skipped_message(
+    opcode: int, body: bytes, channels: set[int], window: tuple[int, int] | None
+) -> str | None:
+    """Why readers skip the MCAP record ``opcode``/``body`` if it is a message (in words,
+    after the record's place), else None; a channel record joins ``channels``.  A message in a
+    chunk must also lie in the chunk's log-time ``window``."""
+    if opcode == 0x04 and len(body) >= 2:
+        channels.add(int.from_bytes(body[:2], "little"))
+    elif opcode == 0x05 and len(body) >= 22:
+        channel = int.from_bytes(body[:2], "little")
+        if channel not in channels:
+            return f"is on channel {channel}, which the file does not declare"
+        log_time = int.from_bytes(body[6:14], "little")
+        if window is not None and not window[0] <= log_time <= window[1]:
+            begin, end = window
+            return f"has log time {log_time:,} ns, outside the chunk's {begin:,}-{end:,} ns"
     return None
 
 
