@@ -240,6 +240,32 @@ def test_simulate_and_the_executor_refuse_edited_controllers_too(
     assert executor(compiled) is not None  # the untouched folder runs
 
 
+@pytest.fixture(scope="module")
+def on_cells(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    # half max_speed pushes: Example 1 is planned on convex cells, every step a cell's field
+    text = EXAMPLE1.replace("max_speed: 1.0}", "max_speed: 1.0, disturbance: 0.5}")
+    assert text != EXAMPLE1
+    return _compile(tmp_path_factory.mktemp("guarantees_cells"), text)
+
+
+def test_a_cell_piece_whose_law_misses_its_vertex_velocities_is_refused(
+    on_cells: Path, tmp_path: Path
+) -> None:
+    copy = _copy(on_cells, tmp_path)
+    path = copy / "controllers.json"
+
+    def shift_last_piece(document: Doc) -> None:
+        cell = document["steps"][0]["cell"]
+        assert document["steps"][0]["kind"] == "cell"
+        cell["g"][-1] = [cell["g"][-1][0] + 0.05, cell["g"][-1][1]]
+
+    _edit(path, shift_last_piece)
+    code, _, err = run_cli("stage", "simulate", str(copy))
+    assert code == 2, err
+    assert err.startswith(f"{path}: error[U042]: controllers.json"), err
+    assert "K and g do not give the vertex velocities" in err
+
+
 def test_ten_times_faster_controllers_name_the_speed(compiled: Path, tmp_path: Path) -> None:
     copy = _copy(compiled, tmp_path)
     _edit(copy / "controllers.json", _scaled(10.0))

@@ -116,6 +116,8 @@ def controllers_problem(
     for controller in controllers.steps:
         if controller.is_cell:
             problem = _cell_problem(controller, abstraction, robot)
+        elif not np.array_equal(controller.vertices, abstraction.corners(controller.triangle)):
+            problem = "its vertices are not the triangle's corners"
         elif controller.is_vertex:
             problem = _pursuit_problem(controller, abstraction, robot)
         else:
@@ -139,9 +141,8 @@ def _start_problem(
 def _affine_problem(
     controller: StepController, abstraction: Abstraction, robot: Robot
 ) -> str | None:
-    """A triangle's exit or stay field against the mesh and the C030 conditions."""
-    if not np.array_equal(controller.vertices, abstraction.corners(controller.triangle)):
-        return "its vertices are not the triangle's corners"
+    """A triangle's exit or stay field (on the triangle's corners) against the mesh and the
+    C030 conditions."""
     if controller.exit_edge is None:
         if controller.next_triangle is not None:
             return "a stay names a next triangle"
@@ -175,9 +176,7 @@ def _pursuit_problem(
     controller: StepController, abstraction: Abstraction, robot: Robot
 ) -> str | None:
     """A vertex passage: pursuit of a corner the step's triangle shares with the next one, at
-    a speed within the bound, in the time it states."""
-    if not np.array_equal(controller.vertices, abstraction.corners(controller.triangle)):
-        return "its vertices are not the triangle's corners"
+    a speed within the bound, in the time it states (on the triangle's corners)."""
     corners = abstraction.vertices[abstraction.triangles[controller.triangle]]
     target = np.asarray(controller.target, dtype=np.float64)
     shared = controller.next_triangle is not None and any(
@@ -215,15 +214,11 @@ def _cell_problem(controller: StepController, abstraction: Abstraction, robot: R
             if across not in (KEPT, EXIT) and piece_of.get(there) != across:
                 return f"piece {piece} names a wrong neighbour across facet {facet}"
     problem = violated_cell_row(controller, robot.max_speed, robot.disturbance)
-    for piece in range(len(field.triangles)):
-        if problem is None:
-            problem = _law_problem(
-                field.vertices[piece],
-                field.velocities[piece],
-                field.gains[piece],
-                field.offsets[piece],
-                robot.max_speed,
-            )
+    pieces = zip(field.vertices, field.velocities, field.gains, field.offsets, strict=True)
+    for vertices, velocities, gain, offset in pieces:
+        if problem is not None:
+            return problem
+        problem = _law_problem(vertices, velocities, gain, offset, robot.max_speed)
     if problem is not None or field.direction is None:
         return problem
     xi = np.asarray(field.direction, dtype=np.float64)
