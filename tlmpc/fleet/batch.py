@@ -31,7 +31,7 @@ from tlmpc.base.errors import (
     UsageError,
     error,
 )
-from tlmpc.fleet.job import Job, Options, error_fields, run_job
+from tlmpc.fleet.job import Job, Options, error_fields, run_job, working_folder
 
 MAPPING_FORMAT = "tlmpc.fleet-missions/1"
 
@@ -160,6 +160,10 @@ def make_jobs(
     from tlmpc.verify.trace_input import load_log_mission, positions_document
 
     documents: dict[Path, dict[str, Any] | TlmpcError] = {}
+    # relative paths are the batch's: a Dask worker resolves them against this folder
+    folder = working_folder()
+    if cache is not None and folder is not None:
+        cache = Path(folder) / cache
     jobs: list[Job] = []
     failed: list[dict[str, Any]] = []
     for log in logs:
@@ -197,6 +201,7 @@ def make_jobs(
                 document=document,
                 options=options,
                 cache=None if cache is None else str(cache),
+                folder=folder,
             )
         )
     return jobs, failed

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import time
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass, field
@@ -38,13 +39,35 @@ class Options:
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Job:
-    """Verify ``log`` (the path as the user gave it) against ``document`` (its mission)."""
+    """Verify ``log`` (the path as the user gave it) against ``document`` (its mission).
+
+    ``folder`` is the batch's working folder, which a relative ``log`` is relative to: a Dask
+    worker started in another folder reads the log there (see :func:`log_path`)."""
 
     log: str
     mission: str
     document: Mapping[str, Any] = field(repr=False)
     options: Options = Options()
     cache: str | None = None
+    folder: str | None = None
+
+
+def working_folder() -> str | None:
+    """This process's working folder, None when it no longer exists."""
+    try:
+        return os.getcwd()
+    except OSError:
+        return None
+
+
+def log_path(job: Job) -> Path:
+    """Where this process reads ``job.log``: the path as given, unless it is relative and this
+    process works in another folder than the batch did (a Dask worker started elsewhere),
+    then that path under the batch's folder."""
+    given = Path(job.log)
+    if given.is_absolute() or job.folder is None or working_folder() == job.folder:
+        return given
+    return Path(job.folder) / given
 
 
 def job_key(job: Job, log_digest: str, *, named: bool = False) -> str:
@@ -129,9 +152,10 @@ def verify_job(job: Job) -> dict[str, Any]:
     from tlmpc.fleet.stream import verify_log
 
     options = job.options
+    path = log_path(job)
     try:
         streamed = verify_log(
-            Path(job.log),
+            path,
             job.document,
             convention=options.boundary,
             topic=options.topic,
@@ -142,7 +166,12 @@ def verify_job(job: Job) -> dict[str, Any]:
             loop_from=options.loop_from,
         )
     except TlmpcError as exc:
-        return error_fields(exc)
+        fields = error_fields(exc)
+        if path != Path(job.log):
+            # the readers name the path they read; the record names the log as the batch was
+            # given it, as in a process working in the batch's folder
+            fields["error"]["message"] = fields["error"]["message"].replace(str(path), job.log)
+        return fields
     return record_of(streamed.verdict, streamed.start_time)
 
 
@@ -154,7 +183,7 @@ def run_job(job: Job) -> dict[str, Any]:
     digest = None
     if cache is not None:
         try:
-            digest = content_digest(Path(job.log))
+            digest = content_digest(log_path(job))
         except (OSError, TlmpcError):
             digest = None  # unreadable, or not a file to read: verify_job says why
         if digest is not None:

@@ -55,10 +55,18 @@ def line(record: Mapping[str, Any]) -> str:
 
 
 def ordered(records: Sequence[Mapping[str, Any]], logs: Sequence[str]) -> list[dict[str, Any]]:
-    """The records in the batch's own order (the order logs were named and found)."""
-    rank = {log: index for index, log in enumerate(logs)}
-    rows = sorted(records, key=lambda r: (rank.get(r["log"], len(rank)), r["log"]))
-    return [{name: row.get(name) for name in FIELDS} for row in rows]
+    """The records in the batch's own order (the order logs were named and found): a log
+    named more than once has a record at each of its places."""
+    places: dict[str, list[int]] = {}
+    for index, log in enumerate(logs):
+        places.setdefault(log, []).append(index)
+    # the records of one log differ in `seconds` alone: any of them may take any of its places
+    placed = []
+    for record in records:
+        free = places.get(record["log"])
+        placed.append((free.pop() if free else len(logs), record["log"], record))
+    placed.sort(key=lambda entry: (entry[0], entry[1]))
+    return [{name: row.get(name) for name in FIELDS} for _, _, row in placed]
 
 
 def summary(records: Sequence[Mapping[str, Any]], wall: float) -> dict[str, Any]:
