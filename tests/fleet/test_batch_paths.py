@@ -51,8 +51,8 @@ def test_a_dask_worker_elsewhere_reads_relative_paths_in_the_batch_folder(
             n_workers=1,
             processes=True,
             threads_per_worker=1,
-            dashboard_address=None,
-            worker_dashboard_address=None,
+            dashboard_address=":0",  # any free port: 8787 may be taken
+            worker_dashboard_address=":0",
         ) as cluster,
         Client(cluster) as client,
     ):

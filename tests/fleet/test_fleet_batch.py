@@ -82,7 +82,7 @@ def test_jobs_one_two_and_dask_agree_with_the_oracle(
             n_workers=1,
             processes=False,
             threads_per_worker=2,
-            dashboard_address=None,
+            dashboard_address=":0",  # any free port: 8787 may be taken
             protocol="tcp://",
         ) as cluster,
         Client(cluster),
@@ -266,7 +266,7 @@ def test_a_held_out_fleet_of_three_hundred_logs(tmp_path: Path) -> None:
             n_workers=1,
             processes=False,
             threads_per_worker=2,
-            dashboard_address=None,
+            dashboard_address=":0",  # any free port: 8787 may be taken
             protocol="tcp://",
         ) as cluster,
         Client(cluster),
