@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import errno
 import importlib
 import io
 import os
@@ -27,7 +28,14 @@ from typing import Any, TextIO
 
 from tlmpc.base import settled, startup
 from tlmpc.base.depth import nesting_room
-from tlmpc.base.errors import EXIT_INTERNAL, EXIT_USAGE, TlmpcError, error, printable
+from tlmpc.base.errors import (
+    EXIT_INTERNAL,
+    EXIT_USAGE,
+    Diagnostic,
+    TlmpcError,
+    error,
+    printable,
+)
 from tlmpc.base.startup import EXIT_INTERRUPTED, EXIT_TERMINATED
 from tlmpc.base.version import __version__
 from tlmpc.io.report import Reporter, exit_code_epilog
@@ -396,6 +404,35 @@ def _input_file(args: argparse.Namespace) -> str | None:
     return None
 
 
+#: Why a path the user gave cannot be reached, by ``errno``: a probe such as
+#: ``Path.is_file()`` answers False only for a missing entry and lets these through.
+_PATH_HINTS = {
+    errno.ENAMETOOLONG: "a name in the path is longer than the file system allows "
+    "(255 bytes a name on most); shorten it",
+    errno.EACCES: "you have no permission to enter a folder of the path or to read the file",
+    errno.EPERM: "the operation is not permitted on this path",
+    errno.ELOOP: "the path's symbolic links lead back to themselves",
+    errno.ENOENT: "check the path",
+    errno.ENOTDIR: "a part of the path is a file, not a folder",
+    errno.EISDIR: "the path is a folder, not a file",
+}
+
+
+def _unreachable_path(exc: BaseException) -> Diagnostic | None:
+    """U001 for an operating-system error on a path the run was given (a name too long, a
+    folder it may not enter) that no reader caught, else None: such a path is the user's
+    input, not a bug."""
+    if not isinstance(exc, OSError) or exc.errno not in _PATH_HINTS or exc.filename is None:
+        return None
+    path = os.fsdecode(exc.filename)
+    return error(
+        "U001",
+        f"cannot access {path}: {exc.strerror or exc}",
+        hint=_PATH_HINTS[exc.errno],
+        file=path,
+    )
+
+
 def _main(argv: Sequence[str] | None, out: TextIO, err: TextIO) -> int:
     arguments = list(sys.argv[1:] if argv is None else argv)
     parser = build_parser(only=next((w for w in arguments if not w.startswith("-")), None))
@@ -450,6 +487,10 @@ def _main(argv: Sequence[str] | None, out: TextIO, err: TextIO) -> int:
                     )
                 ]
             )
+            return reporter.finish(EXIT_USAGE)
+        unreachable = _unreachable_path(exc)
+        if unreachable is not None:
+            reporter.diagnose([unreachable])
             return reporter.finish(EXIT_USAGE)
         # a bug: say so, never a bare traceback without context
         err.write(

@@ -20,6 +20,7 @@ and a hint.
 
 from __future__ import annotations
 
+import bisect
 import contextlib
 import os
 import reprlib
@@ -29,6 +30,7 @@ from pathlib import Path
 from typing import IO, Any
 
 from tlmpc.base.errors import Diagnostic, UsageError, error
+from tlmpc.io.scalar_places import line_starts
 
 #: Pieces in which files are read (a bounded read never asks for more than it may keep).
 CHUNK = 4 * 1024 * 1024
@@ -228,6 +230,39 @@ def yaml_syntax_error(exc: Any, code: str, file: str) -> Diagnostic:
     )
 
 
+def yaml_error(exc: Any, code: str, file: str, text: str) -> Diagnostic:
+    """The diagnostic of any error a YAML parser raised reading ``text``: at the parser's mark,
+    or, for a character YAML does not allow (a reader error, which has no mark and whose
+    offset libyaml counts in bytes, PyYAML in characters), at that character."""
+    import yaml
+
+    if isinstance(exc, yaml.MarkedYAMLError):
+        return yaml_syntax_error(exc, code, file)
+    found = None
+    if isinstance(exc, yaml.reader.ReaderError):
+        found = yaml.reader.Reader.NON_PRINTABLE.search(text)
+    if found is None:
+        return error(
+            code,
+            f"YAML syntax error: {brief(str(exc))}",
+            hint="check the file is YAML text",
+            file=file,
+            line=1,
+            col=1,
+        )
+    starts = line_starts(text)
+    line = bisect.bisect_right(starts, found.start())
+    return error(
+        code,
+        f"YAML syntax error: the character U+{ord(found.group()):04X} is not allowed in YAML",
+        hint="delete it: YAML text holds no control characters but tab and line breaks, "
+        'nor U+FFFE or U+FFFF; a double-quoted string can hold one as an escape ("\\x07")',
+        file=file,
+        line=line,
+        col=found.start() - starts[line - 1] + 1,
+    )
+
+
 def load_small_yaml(
     text: str,
     file: str,
@@ -254,7 +289,14 @@ def load_small_yaml(
                 line=limit.line,
             )
         ) from None
-    except yaml.MarkedYAMLError as exc:
-        raise UsageError(yaml_syntax_error(exc, code, file)) from None
-    except (yaml.YAMLError, RecursionError, ValueError) as exc:
-        raise UsageError(error(code, f"not valid YAML: {brief(str(exc))}", file=file)) from None
+    except yaml.YAMLError as exc:
+        raise UsageError(yaml_error(exc, code, file, text)) from None
+    except (RecursionError, ValueError) as exc:  # a tagged value that does not read
+        raise UsageError(
+            error(
+                code,
+                f"not valid YAML: {brief(str(exc))}",
+                hint="write plain values, without YAML tags such as !!float or !!binary",
+                file=file,
+            )
+        ) from None

@@ -164,8 +164,10 @@ def refuse_overwriting(out: Path, names: list[str], source: Path | None = None) 
         with contextlib.suppress(OSError):
             source_id = os.stat(source)
     if source is not None:
+        # realpath, not Path.resolve(): the latter raises RuntimeError on a link loop
+        # (Python < 3.13), which the reader of the mission reports as U001 afterwards
         with contextlib.suppress(OSError):
-            if out.resolve() in Path(source).resolve().parents:
+            if Path(os.path.realpath(out)) in Path(os.path.realpath(source)).parents:
                 raise UsageError(
                     error(
                         "U031",

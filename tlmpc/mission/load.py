@@ -196,6 +196,77 @@ def _point_problem(path: Path, doc: PositionedDocument, file: str) -> list[Diagn
     return [d for err in alone.iter_errors(point) for d in _describe(err, doc, file, path)]
 
 
+#: What a JSON type is called in a hint, with an example where one helps.
+_TYPE_WORDS = {
+    "number": "a number, such as 2.5",
+    "integer": "a whole number",
+    "string": "text",
+    "array": "a list, [...]",
+    "object": "a mapping of keys to values",
+    "boolean": "true or false",
+    "null": "null",
+}
+
+
+def _expected(err: ValidationError) -> str:
+    """The hint of a schema problem: what the failed keyword asks for, and what the schema
+    says the value is part of (the nearest ``description`` on the way to the keyword)."""
+    parts = [_asked(str(err.validator), err.validator_value)]
+    description = _nearest_description(list(err.absolute_schema_path))
+    parts.append(f"it belongs to: {description}" if description else "see docs/mission-format.md")
+    return "; ".join(part for part in parts if part)
+
+
+#: What a bound keyword of the schema asks for, by keyword.
+_BOUNDS = {
+    "minItems": "give at least {} items",
+    "maxItems": "give at most {} items",
+    "minimum": "write a number of at least {}",
+    "exclusiveMinimum": "write a number above {}",
+    "maximum": "write a number of at most {}",
+    "minLength": "write at least {} characters",
+    "minProperties": "give at least {} keys",
+}
+
+
+def _asked(keyword: str, wanted: Any) -> str:
+    """What the schema keyword ``keyword`` with value ``wanted`` asks for, in words ("" for a
+    keyword whose own message says it)."""
+    if keyword == "type":
+        types = [wanted] if isinstance(wanted, str) else list(wanted)
+        return "write " + " or ".join(_TYPE_WORDS.get(t, str(t)) for t in types)
+    if keyword == "enum":
+        return "write one of: " + ", ".join(str(choice) for choice in wanted)
+    if keyword == "const":
+        return f"write {wanted}"
+    return _BOUNDS.get(keyword, "").format(wanted)
+
+
+def _nearest_description(schema_path: list[Any]) -> str | None:
+    """The last ``description`` below the root met walking the mission schema along
+    ``schema_path`` (which jsonschema gives with each ``$ref`` already followed, so the walk
+    follows them too)."""
+    root: Any = load_schema("mission")
+    node: Any = root
+    found: str | None = None
+    for key in schema_path:
+        while isinstance(node, dict):
+            if node is not root and isinstance(node.get("description"), str):
+                found = node["description"]  # the root's is the whole mission's: no help
+            reference = node.get("$ref")
+            if key in node or not isinstance(reference, str) or not reference.startswith("#/"):
+                break
+            node = root
+            for part in reference[2:].split("/"):
+                node = node.get(part) if isinstance(node, dict) else None
+        in_dict = isinstance(node, dict) and key in node
+        in_list = isinstance(node, list) and isinstance(key, int) and 0 <= key < len(node)
+        if not (in_dict or in_list):
+            break
+        node = node[key]
+    return found
+
+
 def _describe(
     err: ValidationError, doc: PositionedDocument, file: str, prefix: Path = ()
 ) -> list[Diagnostic]:
@@ -302,7 +373,7 @@ def _describe(
         "minLength": "S009",
     }.get(str(err.validator), "S000")
     message = err.message
-    hint: str | None = None
+    hint: str | None = _expected(err)
     if err.validator == "const" and path == ("version",):
         message = f"unsupported mission format version {err.instance!r}"
         hint = "this tlmpc reads `version: 1`"

@@ -17,7 +17,7 @@ from typing import Any
 import yaml
 
 from tlmpc.base.errors import Diagnostic, error
-from tlmpc.io.inputs import yaml_syntax_error
+from tlmpc.io.inputs import yaml_error
 from tlmpc.io.scalar_places import ScalarPlaces, line_starts, scalar_places
 from tlmpc.mission.bulk import STEM, BulkList, cut_out
 
@@ -220,7 +220,13 @@ class _Converter:
         try:
             value = self.constructor.construct_object(node, deep=True)
         except (yaml.YAMLError, ValueError, OverflowError) as exc:
-            self.problem("Y004", f"cannot read the value {event.value!r}: {exc}", event, path)
+            self.problem(
+                "Y004",
+                f"cannot read the value {event.value!r}: {exc}",
+                event,
+                path,
+                hint="a mission needs no YAML tags (!!float, !!python/...): write the plain value",
+            )
             return None
         if isinstance(value, int) and not isinstance(value, bool) and abs(value) > 10**15:
             value = float("inf") if value > 0 else float("-inf")
@@ -359,7 +365,13 @@ class _Converter:
             if isinstance(event, yaml.DocumentStartEvent):
                 documents += 1
                 if documents > 1:
-                    self.problem("Y001", "YAML syntax error: expected a single document", event)
+                    self.problem(
+                        "Y001",
+                        "YAML syntax error: expected a single document",
+                        event,
+                        hint="a mission file holds one document: remove this `---` and what "
+                        "follows it, or move it to a file of its own",
+                    )
                     raise _TooBig
                 continue
             if isinstance(
@@ -377,7 +389,11 @@ class _Converter:
             if isinstance(event, yaml.AliasEvent):
                 if event.anchor not in self.anchors:
                     self.problem(
-                        "Y001", f"YAML syntax error: undefined alias {event.anchor!r}", event
+                        "Y001",
+                        f"YAML syntax error: undefined alias {event.anchor!r}",
+                        event,
+                        hint=f"an alias *{event.anchor} names an anchor &{event.anchor} given "
+                        "earlier in the file; define it first or write the value out",
                     )
                     raise _TooBig
                 value, size = self.anchors[event.anchor]
@@ -392,7 +408,11 @@ class _Converter:
                 continue
             if len(path) > MAX_DEPTH:
                 self.problem(
-                    "Y003", f"the document is nested more than {MAX_DEPTH} levels deep", event
+                    "Y003",
+                    f"the document is nested more than {MAX_DEPTH} levels deep",
+                    event,
+                    hint="no mission nests deeper than a few levels: a point is [x, y], a "
+                    "polygon a list of points; look for unbalanced brackets",
                 )
                 raise _TooBig
             self.doc.values[path] = _mark(event)
@@ -454,7 +474,13 @@ class _Converter:
             parent.key = _BAD_KEY
             return
         if not isinstance(event, yaml.ScalarEvent):
-            self.problem("Y006", "mapping keys must be plain names", event, parent.path)
+            self.problem(
+                "Y006",
+                "mapping keys must be plain names",
+                event,
+                parent.path,
+                hint="write the key as a name (`home:`), not a list, a mapping or an alias",
+            )
             parent.key = _BAD_KEY
             return
         key = str(event.value)
@@ -569,7 +595,7 @@ def _read_positioned(
             elif outcome is None or not converter.lists:  # a limit stopped it, or all met
                 return _result(converter, outcome, file)
     converter = _Converter(file, lazy=lazy)
-    return _result(converter, _convert(converter, text), file)
+    return _result(converter, _convert(converter, text), file, text=text)
 
 
 def _unmet_before(converter: _Converter, cut: str, mark: Any) -> bool:
@@ -641,14 +667,15 @@ def _limit_before(converter: _Converter, text: str, exc: yaml.YAMLError) -> yaml
 
 
 def _result(
-    converter: _Converter, outcome: bool | yaml.YAMLError | None, file: str
+    converter: _Converter, outcome: bool | yaml.YAMLError | None, file: str, *, text: str = ""
 ) -> tuple[PositionedDocument | None, list[Diagnostic]]:
+    """The document or the problems of one reading; ``text`` is what was read, to place a
+    character YAML refuses (only the reading of the original text can meet one: the bulk
+    reading's answers stand only at a parser's mark)."""
     if outcome is None:
         return None, converter.problems
-    if isinstance(outcome, yaml.MarkedYAMLError):
-        return None, [yaml_syntax_error(outcome, "Y001", file)]
     if isinstance(outcome, yaml.YAMLError):
-        return None, [error("Y001", f"YAML syntax error: {outcome}", file=file, line=1, col=1)]
+        return None, [yaml_error(outcome, "Y001", file, text)]
     if not outcome or (converter.doc.data is None and not converter.problems):
         return None, [
             error(

@@ -42,12 +42,17 @@ def read_text(path: str) -> str:
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:
+        line_start = data.rfind(b"\n", 0, exc.start) + 1
+        # the column counts the characters before the byte, as a reader of the text would
+        col = len(data[line_start : exc.start].decode("utf-8", errors="replace")) + 1
         raise UsageError(
             error(
                 "Q001",
                 "the specification is not UTF-8 text",
                 hint=f"byte {exc.start} cannot be decoded; save the file as UTF-8",
                 file=path,
+                line=data.count(b"\n", 0, exc.start) + 1,
+                col=col,
             )
         ) from None
 
