@@ -181,8 +181,18 @@ def check_strategy(spec: GameSpec, machine: MealyMachine) -> None:
             )
 
 
-def check_counterstrategy(spec: GameSpec, counter: CounterStrategy) -> None:
-    """Assert that the environment's counterstrategy defeats every system strategy."""
+def check_counterstrategy(
+    spec: GameSpec, counter: CounterStrategy, held: Mapping[str, Value] | None = None
+) -> None:
+    """Assert that the environment's counterstrategy defeats every system strategy.
+
+    ``held``: outputs that no part of ``spec`` reads, which the counterstrategy keeps at one
+    value; only the system's answers with those values must be covered."""
+    held = held or {}
+
+    def kept(y: Mapping[str, Value]) -> bool:
+        return all(y[name] == value for name, value in held.items())
+
     outputs = spec.owned("sys")
     env_init, sys_init = spec.select("env", "init"), spec.select("sys", "init")
     env_safety, sys_safety = spec.select("env", "safety"), spec.select("sys", "safety")
@@ -196,7 +206,7 @@ def check_counterstrategy(spec: GameSpec, counter: CounterStrategy) -> None:
         assert holds(env_init, x0)
         for y in valuations(outputs):
             s = {**x0, **y}
-            if holds(sys_init, s):
+            if kept(y) and holds(sys_init, s):
                 assert any(dict(t) == s for t in starts), f"initial answer {y} not covered"
     else:
         assert starts
@@ -215,7 +225,7 @@ def check_counterstrategy(spec: GameSpec, counter: CounterStrategy) -> None:
         assert holds(env_safety, state, {**state, **x})
         for y in valuations(outputs):
             nxt = {**x, **y}
-            if holds(sys_safety, state, nxt):
+            if kept(y) and holds(sys_safety, state, nxt):
                 targets = [t for t in counter.answers[node] if dict(states[t]) == nxt]
                 assert targets, f"node {node}: the answer {y} is not covered"
                 edges.extend((node, t) for t in targets)

@@ -28,6 +28,7 @@ from tlmpc.reactive.fragment import reading
 from tlmpc.reactive.parts import mission_parts
 from tlmpc.reactive.synthesize import Synthesis, synthesize
 from tlmpc.synth.solver import Game, solve
+from tlmpc.synth.spec import Part, support
 
 spot = pytest.importorskip("spot")
 
@@ -201,20 +202,29 @@ def _check_explicitly(found: Synthesis, mission: Mission) -> None:
             assert all(holds(p.formula, letter) for p in first), (state, letter)
         return
     assert found.counter is not None
-    check_counterstrategy(spec, found.counter)
     assert found.core is not None
     core_sources = {id(p) for p in found.core}
 
-    def keeping(sources: set[int]) -> bool:
-        parts = tuple(
+    def kept_parts(sources: set[int]) -> tuple[Part, ...]:
+        return tuple(
             p
             for p in spec.parts
             if p.owner == "env"
             or id(p) not in found.game.sources
             or id(found.game.sources[id(p)]) in sources
         )
-        return solve(Game.build(spec.with_parts(parts))).realizable
 
+    def keeping(sources: set[int]) -> bool:
+        return solve(Game.build(spec.with_parts(kept_parts(sources)))).realizable
+
+    # the counterstrategy defeats the core (the robot's variables no part of the core's game
+    # reads are held at their lowest values)
+    core_spec = spec.with_parts(kept_parts(core_sources))
+    read = {name for p in core_spec.parts for name, _ in support(p.formula)}
+    held: dict[str, int | bool] = {
+        v.name: False if v.low is None else v.low for v in spec.owned("sys") if v.name not in read
+    }
+    check_counterstrategy(core_spec, found.counter, held)
     assert not keeping(core_sources)
     for part in found.core:
         assert keeping(core_sources - {id(part)})

@@ -15,7 +15,8 @@
     inaccessibility), so that a visit is a visit and not a touch;
   - a region that occurs only negatively (avoid it) labels its **grown** shape, the region
     dilated by m (when the robot starts within m of it, except within 2 m of the start);
-  - a region of both polarities, or not in the task, keeps its shape.
+  - a region of both polarities, or not in the task, keeps its shape, and so does a region
+    a reactive mission's assumptions name (:func:`region_polarities`).
 
 A task is monotone in each proposition of one polarity, so a run that satisfies it with the
 cores and grown shapes satisfies it with the true regions: planning here is sound, and
@@ -35,7 +36,7 @@ from typing import Any
 
 import shapely
 
-from tlmpc.ltl.polarity import polarities
+from tlmpc.ltl.polarity import Polarity, polarities
 from tlmpc.mission.body import ARC_SEGMENTS, conservative_offset, obstacle_offset
 from tlmpc.mission.cspace import erode, workspace_free_space
 from tlmpc.mission.grid import grid_size
@@ -144,6 +145,22 @@ def deepens_goals(mission: Mission) -> bool:
     return requested is None or requested > 0.0
 
 
+def region_polarities(mission: Mission) -> dict[str, Polarity]:
+    """Each region's polarity as the layout reads it: its polarity in the task, except that a
+    region a reactive mission's assumptions name is ``both`` (it keeps its shape).
+
+    The assumptions are the environment's promise about the true regions.  Where the mesh
+    labels a core or a grown shape instead, the game's assumption differs from the real one:
+    an environment that keeps the real promise can break the game's (the strategy then has
+    no answer and the robot stops), and one that keeps the game's can break the real one."""
+    signs = polarities(mission.formula)
+    if mission.reactive is not None:
+        for part in mission.reactive.assumptions:
+            for name in polarities(part.formula):
+                signs[name] = "both"
+    return signs
+
+
 def planning_layout(
     mission: Mission, margin: float, *, deep: bool = True, scale: float = 1.0
 ) -> PlanningLayout | None:
@@ -181,7 +198,7 @@ def planning_layout(
         keep_start = start.buffer(grid, quad_segs=ARC_SEGMENTS)
         kept = shapely.union(exact.intersection(near_start), keep_start)
         free = shapely.make_valid(shapely.union(free, kept))
-    signs = polarities(mission.formula) if margin > 0.0 or deep else {}
+    signs = region_polarities(mission) if margin > 0.0 or deep else {}
     shapes: list[Any] = []
     for region in mission.regions:
         shape = shapely.Polygon(region.polygon)
@@ -206,7 +223,7 @@ def planning_layout(
 def _point_layout(mission: Mission, scale: float = 1.0) -> PlanningLayout | None:
     """A point robot without margin: the mission's free space, its goals' cores at the goal
     depth, every other region as it is; None when the task visits no region."""
-    signs = polarities(mission.formula)
+    signs = region_polarities(mission)
     shapes: list[Any] = []
     for region in mission.regions:
         shape: Any = None

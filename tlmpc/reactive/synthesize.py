@@ -9,21 +9,22 @@ task harder, so none would ever be needed).
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from typing import Any
 
 from tlmpc.abstraction.model import Abstraction
-from tlmpc.base.errors import Diagnostic, InvalidInputError, error
+from tlmpc.base.errors import Diagnostic, InvalidInputError, UsageError, error
 from tlmpc.mission.model import Mission, TaskPart
 from tlmpc.reactive.explain import counter_play, counter_play_steps, place
 from tlmpc.reactive.faces import Faces, faces_of
 from tlmpc.reactive.fragment import reading
 from tlmpc.reactive.game import MissionGame, build_game
 from tlmpc.reactive.parts import mission_parts
-from tlmpc.synth.core import minimal_core
+from tlmpc.synth.core import Core, minimal_core
 from tlmpc.synth.counter import CounterStrategy, extract_counterstrategy
 from tlmpc.synth.solver import Game, Solution, solve
-from tlmpc.synth.spec import Part
+from tlmpc.synth.spec import Part, support
 from tlmpc.synth.strategy import MealyMachine, extract, to_json
 from tlmpc.synth.symbolic import Encoding
 from tlmpc.synth.symbolic_strategy import (
@@ -66,7 +67,8 @@ class Synthesis:
     """The outcome: the solved game; the strategy when realizable (``symbolic`` always, the
     explicit ``strategy`` when it has at most :data:`EXPLICIT_TRANSITIONS` transitions, and
     the explicit machine's ``size`` counted symbolically), else a core (task parts) and the
-    environment's counterstrategy."""
+    environment's counterstrategy in the core's game (None, with the notes ``untold`` says,
+    when it is too large to show)."""
 
     game: MissionGame
     solution: Solution
@@ -75,6 +77,8 @@ class Synthesis:
     size: LoopSize | None = None
     core: tuple[TaskPart, ...] | None = None
     counter: CounterStrategy | None = None
+    #: why an unrealizable mission has no counterstrategy to show (Q062, notes)
+    untold: tuple[Diagnostic, ...] = ()
 
     @property
     def realizable(self) -> bool:
@@ -99,13 +103,45 @@ def synthesize(
             symbolic=symbolic_strategy(solution),
             size=size,
         )
-    counter = extract_counterstrategy(solution)
     core = minimal_core(game.spec, encoding, group=lambda part: _source_key(game, part))
     parts: dict[int, TaskPart] = {}
     for part in core.parts:
         source = game.sources[id(part)]
         parts.setdefault(id(source), source)
-    return Synthesis(game=game, solution=solution, core=tuple(parts.values()), counter=counter)
+    counter: CounterStrategy | None = None
+    untold: tuple[Diagnostic, ...] = ()
+    try:
+        counter = core_counterstrategy(core, encoding)
+    except UsageError as exc:
+        if exc.diagnostics[0].code != "Q062":
+            raise
+        # too large to show: the answer and the core still stand (a note, as in tlmpc synth)
+        untold = tuple(dataclasses.replace(d, severity="note") for d in exc.diagnostics)
+    return Synthesis(
+        game=game,
+        solution=solution,
+        core=tuple(parts.values()),
+        counter=counter,
+        untold=untold,
+    )
+
+
+def core_counterstrategy(core: Core, encoding: Encoding) -> CounterStrategy:
+    """The environment's strategy in the core's game (not the whole game's, which may starve
+    a goal outside the core: its play would not defeat the core it is shown with).
+
+    The robot's variables that no part of the core's game reads (the memory of the parts
+    left out, actions no core part names) are held at their lowest values: they change
+    nothing in that game, and left free every node would have an answer per value of each."""
+    game = core.game(encoding)
+    read = {name for part in core.spec.parts for name, _ in support(part.formula)}
+    for variable in core.spec.owned("sys"):
+        if variable.name not in read:
+            lowest = False if variable.is_bool else variable.low
+            assert lowest is not None
+            game.sys_init &= encoding.value_cube(variable, lowest, primed=False)
+            game.sys_safety &= encoding.value_cube(variable, lowest, primed=True)
+    return extract_counterstrategy(solve(game))
 
 
 def strategy_to_json(synthesis: Synthesis) -> dict[str, Any]:
@@ -221,4 +257,5 @@ def unrealizable(synthesis: Synthesis, mission: Mission) -> list[Diagnostic]:
         )
         for line in play
     ]
+    found += [dataclasses.replace(d, file=mission.source) for d in synthesis.untold]
     return found

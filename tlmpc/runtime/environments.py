@@ -43,11 +43,13 @@ def readings(sensors: Sequence[str]) -> list[Reading]:
 
 @dataclass(frozen=True, slots=True)
 class Change:
-    """A reading the environment gives at ``time`` (``line``: where a file gave it)."""
+    """A reading the environment gives at ``time`` (``line``: where a file gave it, its first
+    row at that time; ``lines``: the row of each sensor read at that time)."""
 
     time: float
     reading: Reading
     line: int | None = None
+    lines: tuple[tuple[str, int], ...] = ()
 
 
 class Environment:

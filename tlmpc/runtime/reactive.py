@@ -285,6 +285,24 @@ class ReactiveExecutor:
 
     # --- online use: pose in, velocity out -------------------------------------------------
 
+    def _reading(self, sensors: Mapping[str, bool]) -> dict[str, bool]:
+        """The readings of the mission's sensors, each given and none other (a misspelt name
+        would otherwise be dropped silently and the sensor read as missing)."""
+        known = self.machine.sensors
+        missing = [s for s in known if s not in sensors]
+        unknown = sorted(str(s) for s in sensors if s not in known)
+        if missing or unknown:
+            said = [f"no reading of {', '.join(missing)}"] if missing else []
+            said += [f"no sensor called {', '.join(unknown)}"] if unknown else []
+            raise UsageError(
+                error(
+                    "Q125",
+                    f"the readings {dict(sensors)!r} do not fit the mission: {'; '.join(said)}",
+                    hint=f"pass one value per sensor of the mission: {', '.join(known)}",
+                )
+            )
+        return {s: bool(sensors[s]) for s in known}
+
     def command(
         self, point: Sequence[float] | FloatArray, t: float, sensors: Mapping[str, bool]
     ) -> tuple[float, float]:
@@ -304,7 +322,7 @@ class ReactiveExecutor:
             )
         if self._locator is None:
             self._locator = Locator.of(self.abstraction)
-        reading = {s: bool(sensors[s]) for s in self.machine.sensors}
+        reading = self._reading(sensors)
         if self.node < 0:
             found = self._locator.locate(where)
             if found is None:

@@ -13,7 +13,9 @@ from dataclasses import dataclass
 from typing import Any
 
 from tlmpc.base.errors import InvalidInputError, UsageError, error
+from tlmpc.ltl.ast import Prop
 from tlmpc.ltl.printer import to_text
+from tlmpc.mission.model import TaskPart
 from tlmpc.runtime.assumptions import AssumptionTracker, letter_of
 from tlmpc.runtime.environments import Change, Environment, ScriptedEnvironment
 from tlmpc.runtime.reactive import ReactiveExecutor
@@ -93,6 +95,16 @@ def _letter(executor: ReactiveExecutor, reading: dict[str, bool]) -> frozenset[s
     return letter_of(executor.face_regions(), [s for s, v in reading.items() if v])
 
 
+def _breaking_line(change: Change | None, broken: TaskPart) -> int | None:
+    """The sensor file's line of the reading that breaks ``broken``: the first row of the
+    instant that reads a sensor the assumption names (else the instant's first row)."""
+    if change is None:
+        return None
+    named = {node.name for node in broken.formula.walk() if isinstance(node, Prop)}
+    rows = [row for sensor, row in change.lines if sensor in named]
+    return min(rows) if rows else change.line
+
+
 def _read(
     executor: ReactiveExecutor,
     tracker: AssumptionTracker,
@@ -120,7 +132,7 @@ def _read(
                 hint="the sensor file must keep the mission's assumptions: change the reading, "
                 "or its time (the robot's position at that time is the simulation's)",
                 file=environment.source,
-                line=change.line if change is not None else None,
+                line=_breaking_line(change, broken),
                 col=1 if change is not None and change.line is not None else None,
             )
         )

@@ -255,10 +255,11 @@ def _instants(timed: Timed, sensors: Sequence[str], name: str) -> list[Change]:
             break
         current[sensor] = value
         reading = {s: current.get(s, False) for s in sensors}
+        lines = tuple((read, row) for read, (_, row) in read_now.items())
         if changes and changes[-1].time == t:
-            changes[-1] = Change(t, reading, changes[-1].line)
+            changes[-1] = Change(t, reading, changes[-1].line, lines)
         else:
-            changes.append(Change(t, reading, line))
+            changes.append(Change(t, reading, line, lines))
         last = t
     if problems:
         raise InvalidInputError(problems)
