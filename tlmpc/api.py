@@ -172,11 +172,18 @@ class Compiled:
 
     def write(self, out: str | os.PathLike[str], *, force: bool = False) -> Path:
         """Write every artifact (and the figure, when drawn) into ``out`` atomically."""
-        from tlmpc.io.outdir import check_destination, commit, staging_directory, write_artifacts
+        from tlmpc.io.outdir import (
+            check_destination,
+            commit,
+            refuse_deleting_foreign,
+            staging_directory,
+            write_artifacts,
+        )
 
         _expect_path(out, "out must be a path", "Compiled.write")
         destination = Path(out)
         check_destination(destination, force=force)
+        refuse_deleting_foreign(destination, force=force)
         with staging_directory(destination) as staging:
             write_artifacts(staging, dict(self.artifacts))
             commit(staging, destination, force=force)

@@ -356,3 +356,51 @@ def test_check_destination_rejects_files(tmp_path: Path) -> None:
     with pytest.raises(UsageError) as caught:
         check_destination(target, force=True)
     assert caught.value.diagnostics[0].code == "U011"
+
+
+def test_a_users_file_in_a_previous_output_is_never_deleted(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    assert run_cli("compile", str(SPEC), "-o", str(out), "-q", "--until", "plan")[0] == 0
+    assert (out / "witness.json").is_file()
+    (out / "notes.md").write_text("my notes")
+    (out / "run1").mkdir()
+    (out / "run1" / "robot.bag").write_bytes(b"a log")
+    before = snapshot(out)
+    code, _, err = compile_to(out)
+    assert code == 2
+    assert err.startswith(f"{out}: error[U012]"), err
+    assert "notes.md, run1" in err
+    assert snapshot(out) == before  # nothing replaced, nothing deleted
+    with pytest.raises(UsageError) as caught:  # known before any stage runs
+        output.refuse_deleting_foreign(out, force=False)
+    assert caught.value.diagnostics[0].code == "U012"
+    output.refuse_deleting_foreign(out, force=True)
+    # with --force the artifacts are replaced one by one: the user's files stay, the previous
+    # run's artifacts this one does not write go (they would be taken for its own)
+    code, _, err = compile_to(out, "--force")
+    assert code == 0, err
+    assert (out / "notes.md").read_text() == "my notes"
+    assert (out / "run1" / "robot.bag").read_bytes() == b"a log"
+    assert (out / MARKER).is_file()
+    assert (out / "mission.json").is_file()
+    assert not (out / "witness.json").exists()
+
+
+def test_what_tlmpc_writes_into_an_output_is_replaced_whole(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    assert run_cli("compile", str(SPEC), "-o", str(out), "-q", "--until", "plan")[0] == 0
+    (out / "view.html").write_text("<html></html>")  # `tlmpc view out` writes it there
+    assert compile_to(out)[0] == 0
+    assert sorted(p.name for p in out.iterdir()) == [MARKER, "mission.json", "summary.json"]
+
+
+def test_a_users_file_arriving_during_the_run_is_kept(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    assert compile_to(out)[0] == 0
+    with staging_directory(out) as staging:
+        write_artifacts(staging, {"summary.json": {"format": "x"}})
+        (out / "notes.md").write_text("mine")  # after the checks, before the swap
+        with pytest.raises(UsageError) as caught:
+            commit(staging, out, force=False)
+    assert caught.value.diagnostics[0].code == "U012"
+    assert (out / "notes.md").read_text() == "mine"

@@ -71,6 +71,7 @@ def _run_locked(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         check_destination,
         clean_stale,
         commit,
+        refuse_deleting_foreign,
         refuse_overwriting,
         staging_directory,
         write_artifacts,
@@ -86,6 +87,7 @@ def _run_locked(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         require("matplotlib.backends.backend_agg", "drawing a PNG figure (--png)")
     check_destination(destination, force=args.force)
     refuse_overwriting(destination, sorted(KNOWN_ARTIFACTS), args.mission)
+    refuse_deleting_foreign(destination, force=args.force)
     for note in clean_stale(destination):
         reporter.note(f"tlmpc: note: {note}")
 

@@ -48,6 +48,32 @@ _MARKER_TEXT = MARKER_FORMAT + "1\n"
 
 #: Every file name ``tlmpc compile`` may write (used by ``--force`` and documentation only).
 KNOWN_ARTIFACTS = frozenset({*ARTIFACT_SCHEMAS, "automaton.hoa", "plan.png", "plan.svg"})
+#: What tlmpc itself writes into an output: its artifacts, its marker, ``tlmpc view``'s page.
+_OWN_NAMES = frozenset({*KNOWN_ARTIFACTS, MARKER, "view.html"})
+
+
+def foreign_entries(out: Path) -> list[str]:
+    """The entries of the tlmpc output ``out`` that tlmpc did not write (a note, a log the user
+    put there): replacing the output whole would delete them."""
+    try:
+        return sorted(entry.name for entry in out.iterdir() if entry.name not in _OWN_NAMES)
+    except OSError:
+        return []
+
+
+def _holds_foreign(out: Path, names: list[str]) -> UsageError:
+    shown = ", ".join(names[:5]) + (f" and {len(names) - 5} more" if len(names) > 5 else "")
+    return UsageError(
+        error(
+            "U012",
+            f"{out} is a tlmpc output that also holds files tlmpc did not write ({shown}); "
+            "replacing it would delete them",
+            hint="move them out of it, or pass --force to replace the artifacts one by one "
+            "and keep them",
+            file=str(out),
+        )
+    )
+
 
 _HINTS = {
     errno.EACCES: "you have no permission to write there; choose another -o",
@@ -153,6 +179,17 @@ def check_destination(out: Path, *, force: bool) -> None:
                 file=str(out),
             )
         )
+
+
+def refuse_deleting_foreign(out: Path, *, force: bool) -> None:
+    """Refuse (U012) to replace the tlmpc output ``out`` whole while it holds entries tlmpc
+    did not write (with ``force`` they are kept: the artifacts go in one by one)."""
+    out = _absolute(out)
+    if force or not out.is_dir() or out.is_symlink() or not is_tlmpc_output(out):
+        return
+    foreign = foreign_entries(out)
+    if foreign:
+        raise _holds_foreign(out, foreign)
 
 
 def refuse_overwriting(out: Path, names: list[str], source: Path | None = None) -> None:
@@ -500,16 +537,27 @@ def _commit(staging: Path, out: Path, *, force: bool) -> None:
         raise UsageError(
             error("U030", f"{out} became a symbolic link; nothing was written", file=str(out))
         )
-    if out.exists() and not is_tlmpc_output(out):
-        if not force:  # checked before compiling too; a race must not lose user files
+    marked = out.exists() and is_tlmpc_output(out)
+    foreign = foreign_entries(out) if marked else []
+    if out.exists() and (not marked or foreign):
+        # checked before compiling too; a race must not lose user files
+        if not force:
+            if foreign:
+                raise _holds_foreign(out, foreign)
             raise UsageError(
                 error("U012", f"{out} changed and is no longer a tlmpc output", file=str(out))
             )
-        refuse_overwriting(out, [p.name for p in staging.iterdir() if p.name != MARKER])
+        written = [p.name for p in staging.iterdir() if p.name != MARKER]
+        refuse_overwriting(out, written)
+        # a previous output's artifacts this run did not write would be taken for its own
+        stale = [out / name for name in sorted(KNOWN_ARTIFACTS - set(written))] if marked else []
         with _signals_blocked():  # the files arrive all together, like a swapped output
             for item in staging.iterdir():
                 if item.name != MARKER:
                     os.replace(item, out / item.name)
+            for path in stale:
+                if path.is_file() and not path.is_symlink():
+                    path.unlink()
             settled.settle()
         return
     with _signals_blocked():
