@@ -258,15 +258,22 @@ def test_a_window_far_into_a_loop_reads_as_one_whole_periods_nearer() -> None:
     assert far  # (not vacuous: it fails while the robot is in a for half a second)
 
 
-def test_a_loop_too_short_for_the_log_before_it_is_refused(tmp_path: Path) -> None:
-    # a 10-ms loop after 1e5 s: a window sliding over the log meets 2e7 copies of it
+def test_a_window_far_past_its_instant_on_a_short_loop_is_refused(tmp_path: Path) -> None:
+    # a 10-ms loop after 1e5 s: a window starting 1e4 s after its instant meets a million
+    # copies of it
     points = [[0.0, 0.0, 1.0], [1e5, 3.0, 1.0], [1e5 + 0.005, 5.0, 1.0], [1e5 + 0.01, 3.0, 1.0]]
     trace = tmp_path / "trace.json"
-    trace.write_text(json.dumps(_document(points, "G F[0,1] a", loop_start=1, end="loop")))
+    trace.write_text(json.dumps(_document(points, "G F[1e4,10001] a", loop_start=1, end="loop")))
     out, err = io.StringIO(), io.StringIO()
     assert main(["verify", str(trace)], out, err) == 2
     assert "error[V040]" in err.getvalue()
     assert f"{trace}:" in err.getvalue()
+    # a window from its instant needs the loop laid out a period past the log, not a copy
+    # for every period of the log before the loop: a is first entered at 1e5 + 0.0025 s (x =
+    # 4 on the way out to 5), so `F[0,1] a` fails at 0 until loosened by that less 1 s
+    verdict = verify_document(_document(points, "G F[0,1] a", loop_start=1, end="loop"))
+    assert verdict.outcome == "violated"
+    assert verdict.time_robustness == pytest.approx(-(1e5 + 0.0025 - 1.0), abs=1e-6)
 
 
 def test_a_timed_stretch_starts_where_every_message_places_the_entry() -> None:

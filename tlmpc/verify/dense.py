@@ -29,9 +29,10 @@ each end is computed on its own.
   ``x U[0,c] y = (x U y) & F[0,c] y``: exact identities of the non-strict until (by cases on
   the witness, for every threshold of the real-valued reading).
 * A loop repeats with its period ``P``: windows are evaluated on the trace unrolled far
-  enough, from the copy ``a`` reaches; a window longer than ``a + P + (loop start - T_0)``
-  meets nothing new and is cut there (so ``b = inf`` needs finitely many copies).  A window
-  meeting more than :data:`MAX_UNROLLED` pieces of the copies is refused.  A stay or an open
+  enough, from the copy ``a`` reaches.  A window that starts in the loop sees nothing new
+  past ``a + P`` and is cut there; one that starts before the loop, at the wrap instant (so
+  ``b = inf`` needs finitely many copies, and a long trace before the loop none more).  A
+  window meeting more than :data:`MAX_UNROLLED` pieces of the copies is refused.  A stay or an open
   log: the tail takes part in every window that reaches past the last instant.
 """
 
@@ -153,16 +154,13 @@ def _placeholders(node: Formula) -> tuple[Formula, list[Formula]]:
 
 def _range_reduce(values: FloatArray, first: IntArray, last: IntArray, use_max: bool) -> FloatArray:
     """``max`` (or ``min``) of ``values[first[q] : last[q] + 1]`` for every query (sparse
-    table); an empty range gives the operation's neutral element."""
+    table); an empty range gives the operation's neutral element.
+
+    The table's levels are built one at a time and each answers its own queries before the
+    next replaces it: memory stays a few copies of ``values``, not one per level (a window
+    over 200,000 pieces would hold 18 of them), and no level past the longest range is built."""
     op = np.maximum if use_max else np.minimum
     neutral = -np.inf if use_max else np.inf
-    n = len(values)
-    table = [values]
-    width = 1
-    while 2 * width <= n:
-        previous = table[-1]
-        table.append(op(previous[: len(previous) - width], previous[width:]))
-        width *= 2
     length = last - first + 1
     empty = length <= 0
     safe_length = np.where(empty, 1, length)
@@ -171,13 +169,32 @@ def _range_reduce(values: FloatArray, first: IntArray, last: IntArray, use_max: 
     level -= (1 << level) > safe_length
     result = np.full(len(first), neutral)
     safe_first = np.where(empty, 0, first)
-    for k in np.unique(level[~empty]).tolist():
+    needed = set(np.unique(level[~empty]).tolist())
+    row, width = values, 1  # row k: op over values[i : i + 2**k]
+    for k in range(max(needed, default=-1) + 1):
+        if k:
+            row = op(row[: len(row) - width], row[width:])
+            width *= 2
+        if k not in needed:
+            continue
         chosen = (level == k) & ~empty
-        row = table[k]
         left = row[safe_first[chosen]]
         right = row[last[chosen] - (1 << k) + 1]
         result[chosen] = op(left, right)
     return result
+
+
+def _sorted_union(runs: list[FloatArray]) -> FloatArray:
+    """The sorted distinct values of ``runs``, each already sorted: what ``np.unique`` of
+    their concatenation gives, with a stable sort that merges the runs in linear time
+    instead of sorting afresh."""
+    merged = np.sort(np.concatenate(runs), kind="stable")
+    if len(merged) < 2:
+        return merged
+    distinct = np.empty(len(merged), dtype=bool)
+    distinct[0] = True
+    np.not_equal(merged[1:], merged[:-1], out=distinct[1:])
+    return merged[distinct]
 
 
 class DenseSemantics:
@@ -396,19 +413,29 @@ class DenseSemantics:
         self, signal: Signal, low: float, high: float, *, right_closed: bool, use_max: bool
     ) -> Signal:
         """``max`` (``F[low,high]``) or ``min`` (``G[low,high]``) of ``signal`` over the window
-        ``[t + low, t + high]`` (``[t + low, t + high)`` unless ``right_closed``)."""
+        ``[t + low, t + high]`` (``[t + low, t + high)`` unless ``right_closed``).
+
+        On a loop a window sees nothing new past a full period after both its start and the
+        loop's.  One that starts in the loop (``t + low`` at or after the loop's first
+        instant) is cut to ``[t + low, t + low + P]``; one that starts before it, to the wrap
+        instant (everything after it repeats the loop, which the window holds whole).  So the
+        loop is laid out a period past ``low`` beyond the trace, however long the trace before
+        the loop is."""
         domain = self.domain
-        if domain.loop_time is not None:
-            # Past a full period after both the window's start and the loop's, nothing is new.
-            reach = low + domain.period + (domain.loop_time - domain.start)
-            if high > reach:
-                high, right_closed = reach, True
+        whole: tuple[float, float, bool] | None = None  # (cutoff, high, right_closed)
+        if domain.loop_time is not None and high > low + domain.period:
+            cutoff = domain.loop_time - low  # windows starting before it: cut at the wrap
+            if cutoff > domain.start:
+                whole = (cutoff, high, right_closed)
+            high, right_closed = low + domain.period, True
         starts, ends, lo, hi, is_point = self._extended(signal, low, high)
         instants = starts[is_point]
         candidates = [signal.times, instants - low]
         if math.isfinite(high):
             candidates.append(instants - high)
-        grid = np.unique(np.concatenate(candidates))
+        if whole is not None and math.isfinite(whole[1]):
+            candidates.append(signal.times - whole[1])  # (the trace's own instants only)
+        grid = _sorted_union(candidates)
         if domain.loop_time is None:
             grid = grid[(grid >= domain.start) & (grid <= domain.end)]
         else:
@@ -416,14 +443,7 @@ class DenseSemantics:
         # A piece meets the window's left end iff t <= key (instant) / t < key (stretch):
         # with the stretch's key one float lower, both read "key >= t".
         left_key = np.where(is_point, starts - low, np.nextafter(ends - low, -np.inf))
-        # ... and its right end iff key <= t.
-        shifted = starts - high
-        if right_closed:
-            right_key = np.where(is_point, shifted, np.nextafter(shifted, np.inf))
-        else:
-            right_key = np.nextafter(shifted, np.inf)
         left_key = np.maximum.accumulate(left_key)
-        right_key = np.maximum.accumulate(right_key)
         queries = np.empty(2 * len(grid))
         queries[0::2] = grid
         queries[1:-1:2] = (grid[:-1] + grid[1:]) / 2.0
@@ -432,13 +452,40 @@ class DenseSemantics:
         else:
             queries[-1] = (grid[-1] + domain.end) / 2.0
         first = np.searchsorted(left_key, queries, side="left").astype(np.int64)
-        last = (np.searchsorted(right_key, queries, side="right") - 1).astype(np.int64)
+        last = self._last_met(starts, is_point, queries, high, right_closed)
+        if whole is not None:
+            cutoff, whole_high, whole_closed = whole
+            before = queries < cutoff
+            # (what such a window meets past the wrap instant only repeats what it holds)
+            last[before] = self._last_met(
+                starts, is_point, queries[before], whole_high, whole_closed
+            )
         out_lo = _range_reduce(lo, first, last, use_max)
         out_hi = out_lo if signal.lo is signal.hi else _range_reduce(hi, first, last, use_max)
         if domain.loop_time is None:
             # On the tail the window lies wholly in it: its constant value.
             out_lo[-1], out_hi[-1] = signal.lo[-1], signal.hi[-1]
         return self._compact(grid, out_lo, out_hi)
+
+    @staticmethod
+    def _last_met(
+        starts: FloatArray,
+        is_point: npt.NDArray[np.bool_],
+        queries: FloatArray,
+        high: float,
+        right_closed: bool,
+    ) -> IntArray:
+        """For each query ``t``, the last piece that starts in the window's right end
+        ``t + high`` (before it, unless ``right_closed``)."""
+        # A piece meets the window's right end iff key <= t.
+        shifted = starts - high
+        if right_closed:
+            right_key = np.where(is_point, shifted, np.nextafter(shifted, np.inf))
+        else:
+            right_key = np.nextafter(shifted, np.inf)
+        right_key = np.maximum.accumulate(right_key)
+        found: IntArray = (np.searchsorted(right_key, queries, side="right") - 1).astype(np.int64)
+        return found
 
     def bounded_until(self, left: Signal, right: Signal, low: float, high: float) -> Signal:
         """``left U[low,high] right``."""

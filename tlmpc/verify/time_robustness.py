@@ -23,7 +23,8 @@ sits under ``<->`` (both polarities) have none.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+import sys
+from collections.abc import Callable, Sequence
 from typing import assert_never
 
 from tlmpc.ltl.ast import (
@@ -142,15 +143,18 @@ def reach(formula: Formula) -> float:
 
 
 def horizon(formula: Formula, duration: float) -> float:
-    """How far a search for the time robustness must look: the trace's duration plus every
-    finite bound."""
+    """How far a search for the time robustness must look: past the trace's duration plus
+    every finite bound (the largest float when that sum is past it)."""
     bounds = [
         n.interval.high
         for n in bounded_operators(formula)
         if isinstance(n, BoundedEventually | BoundedGlobally | BoundedUntil)
         and math.isfinite(n.interval.high)
     ]
-    return duration + sum(bounds) + 1.0
+    total = duration + sum(bounds)
+    # Strictly past every edge however large the sum: past 2**53 s a "+ 1" is rounded away,
+    # and an edge exactly at the horizon would read as "any amount" (inf).
+    return min(math.nextafter(total + 1.0, math.inf), sys.float_info.max)
 
 
 def time_robustness(
@@ -188,7 +192,8 @@ def time_robustness(
     # outcome == satisfied: good(low) holds, good(high) fails; find the edge.
     # outcome == violated: good(low) fails, good(high) holds.
     for _ in range(STEPS):
-        middle = (low + high) / 2.0
+        # (low + high) / 2 overflows to inf once both pass half the largest float
+        middle = low + (high - low) / 2.0
         if (outcome == "satisfied") == good(middle):
             low = middle
         else:
@@ -196,4 +201,35 @@ def time_robustness(
     # The edge is known to reach / 2**STEPS; ten significant digits say no more than that (and
     # print -0.5 rather than -0.49999999999999983).
     found = low if outcome == "satisfied" else -high
-    return float(f"{found:.10g}")
+    shown = float(f"{found:.10g}")
+    return shown if math.isfinite(shown) else found  # (rounded past the largest float)
+
+
+def conjunction_robustness(
+    conjuncts: Sequence[tuple[Formula, str, float | None]], outcome: str
+) -> float | None:
+    """The time robustness of a conjunction whose verdict is ``outcome``, from each conjunct's
+    ``(formula, verdict, time robustness)``: what :func:`time_robustness` finds for the whole,
+    without searching it again.  Tightening distributes over ``&`` and the verdict of ``&`` is
+    the least of its conjuncts', so the conjunction tightened by ``d`` is satisfied exactly when
+    every conjunct is (the least slack), and loosened by ``d`` it stops failing exactly when
+    every failing conjunct does (the least, an untimed failing one never: ``-inf``)."""
+    timed = [c for c in conjuncts if bounded_operators(c[0])]
+    if outcome == "inconclusive" or not timed:
+        return None
+    try:
+        for formula, _, _ in timed:
+            tighten(formula, 0.0)
+    except BothPolarities:
+        return None
+    if outcome == "satisfied":
+        slacks = [slack for _, _, slack in timed]
+    else:
+        slacks = [
+            slack if bounded_operators(formula) else -math.inf
+            for formula, verdict, slack in conjuncts
+            if verdict == "violated"
+        ]
+    if any(slack is None for slack in slacks):
+        return None  # (a conjunct's verdict contradicts the conjunction's)
+    return min(slack for slack in slacks if slack is not None)

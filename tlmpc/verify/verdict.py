@@ -35,7 +35,12 @@ from tlmpc.verify.progress import Timeline, conjunct_reports, runs, timed_progre
 from tlmpc.verify.robustness import piece_atoms, speed_excess, tube_atoms, tube_radii
 from tlmpc.verify.semantics import PieceEnding, Semantics, Timing
 from tlmpc.verify.signals import Signal, change_times, counted_from, signal_labels, with_cuts
-from tlmpc.verify.time_robustness import horizon, reach, time_robustness
+from tlmpc.verify.time_robustness import (
+    conjunction_robustness,
+    horizon,
+    reach,
+    time_robustness,
+)
 from tlmpc.verify.trace_input import TraceInput
 
 FloatArray = npt.NDArray[np.float64]
@@ -674,12 +679,13 @@ def _verify_trace(trace: TraceInput) -> Verdict:
         for report, conjunct in zip(reports, conjuncts, strict=True)
     ]
     violations = _timed_violations(conjuncts, reports, violations, truth, trace, found.times, line)
-    if len(reports) == 1:
-        task_slack = reports[0].time_robustness  # the task is its one conjunct
-    else:
-        task_slack = time_robustness(
-            trace.formula, task_outcome, outcome_of, horizon(trace.formula, duration)
-        )
+    task_slack = conjunction_robustness(
+        [
+            (c, report.outcome, report.time_robustness)
+            for c, report in zip(conjuncts, reports, strict=True)
+        ],
+        task_outcome,
+    )
     excursions, workspace_rho = workspace_violations(trace)
     judged = task_outcome if reactive is None else reactive.outcome
     outcome: Outcome = "violated" if excursions else judged
