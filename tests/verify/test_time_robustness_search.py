@@ -71,6 +71,7 @@ def test_bounds_up_to_the_largest_float(ltl: str, expected: float) -> None:
         ("F[0,20] b & G F b", 11.0),  # an untimed conjunct that holds: any amount
         ("F[0,5] b & F[0,3] c", -4.0),  # both must be loosened: by 4 and by 1
         ("F[0,5] b & F[0,30] c", -4.0),  # a satisfied conjunct does not count
+        ("F[0,5] b & G F b", -4.0),  # nor does an untimed one that holds
         ("F[0,20] b & G !b", -math.inf),  # an untimed conjunct that fails: no loosening helps
         ("F[0,20] b & (F[0,1] a <-> a)", None),  # a bound under <->: no direction
         ("F[0,5] b & (F[0,1] a <-> a)", None),  # (also in a conjunct that holds)
