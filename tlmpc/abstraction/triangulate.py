@@ -36,6 +36,9 @@ STEINER_PER_VERTEX = 50
 #: Segments at most this many grid steps long are contracted to a point (two neighbouring
 #: pixels are at most the square root of two apart).
 CLOSE_PIXELS = 2.0
+#: A hole seed lies at least this many grid steps inside its piece of obstacle space:
+#: snapping moves the sides around it by at most a step's half diagonal each time.
+SEED_DEPTH = 2.0
 
 
 def _snapped(points: Sequence[tuple[float, float]], grid: float) -> Any:
@@ -130,6 +133,28 @@ def _polygons(geometry: Any) -> list[ShapelyPolygon]:
             result.extend(_polygons(part))
         return result
     return []
+
+
+def _hole_seed(piece: ShapelyPolygon, grid: float) -> tuple[Any, float]:
+    """A point of ``piece`` for Triangle to carve it out from, and its distance to the
+    piece's boundary.
+
+    Triangle eats every triangle it reaches from a seed without crossing a segment, so a
+    seed must lie in ``piece`` after snapping moved its sides.  The representative point can
+    lie in a sliver of the piece (a hair from its side, so in the free space beside it once
+    snapped: the whole piece of free space is then eaten); the pole of inaccessibility is
+    taken instead when the representative point is not :data:`SEED_DEPTH` grid steps deep.
+    """
+    point = piece.representative_point()
+    depth = float(piece.boundary.distance(point))
+    if depth > SEED_DEPTH * grid:
+        return point, depth
+    from shapely.ops import polylabel
+
+    minx, miny, maxx, maxy = piece.bounds
+    deepest = polylabel(piece, tolerance=max(1e-3 * max(maxx - minx, maxy - miny), grid))
+    deepest_depth = float(piece.boundary.distance(deepest))
+    return (deepest, deepest_depth) if deepest_depth > depth else (point, depth)
 
 
 def _rings(polygon: ShapelyPolygon) -> list[Any]:
@@ -356,15 +381,19 @@ def pslg(
                 # one seed per piece: a hole may hold another piece of free space, which
                 # splits the rest of the hole into several pieces (a ring, or more)
                 for piece in _polygons(inside):
-                    point = piece.representative_point()
+                    point, _ = _hole_seed(piece, grid)
                     seeds.append((point.x, point.y))
     if len(parts) > 1:
         # Pieces of free space may also enclose obstacle space between them that is no hole
         # of any one piece (pieces touching at corners): seed every bounded gap as well.
         hull = shapely.convex_hull(free)
         for gap in _polygons(hull.difference(free)):
-            point = gap.representative_point()
-            seeds.append((point.x, point.y))
+            point, depth = _hole_seed(gap, grid)
+            # A gap no deeper than the snapping moves a vertex is a rounding sliver between
+            # a hull edge and the pieces' sides along it, not space they enclose (that would
+            # be a gap below the grid, G031): a seed there could land in a piece once snapped.
+            if depth > SEED_DEPTH * grid:
+                seeds.append((point.x, point.y))
     return (
         vertices.astype(np.float64),
         edges.astype(np.int64),

@@ -59,6 +59,10 @@ ARC_STEP = 2.0 * math.pi / 32
 #: that the chords, not the vertices, lie at the distance: 0.48 % more at corners).
 QUAD_SEGS = 8
 
+#: Features of an eroded free space thinner than twice this (relative to the map's
+#: coordinates) are overlay artefacts, not space (the snapping grid is a billionth).
+SPIKE_WIDTH = 1e-12
+
 
 def erode(free: Any, distance: float, *, slack: float = 0.0, through: Point | None = None) -> Any:
     """``free`` shrunk to the points at least ``distance`` (plus ``slack``) from its
@@ -91,11 +95,25 @@ def erode(free: Any, distance: float, *, slack: float = 0.0, through: Point | No
             reach / math.cos(math.pi / (4 * QUAD_SEGS)), quad_segs=QUAD_SEGS
         )
         mitred = boundary.buffer(reach, join_style="mitre", mitre_limit=2.0)
-        eroded = _polygonal(free.difference(round_band.intersection(mitred)))
-        if keeps_distance(eroded, free, reach):
-            return eroded
+        # GEOS can return an invalid mitred buffer (nested shells beside a wall thinner than
+        # the distance), on which the overlay raises or erodes wrongly: the exact
+        # construction below needs no buffer.
+        if round_band.is_valid and mitred.is_valid:
+            eroded = _polygonal(free.difference(round_band.intersection(mitred)))
+            if keeps_distance(eroded, free, reach):
+                return eroded
     near = obstacle_reach(free, reach, through)
-    return free if near is None else _polygonal(free.difference(near))
+    if near is None:
+        return free
+    eroded = _polygonal(free.difference(near))
+    if not keeps_distance(eroded, free, reach):
+        # The overlay can leave a spike of no width running out to an obstacle's corner
+        # where two sides of the reach coincide: an opening far below the snapping grid
+        # removes it and nothing else (it keeps a subset of ``eroded``).
+        width = SPIKE_WIDTH * _scale(free, reach)
+        opened = eroded.buffer(-width, join_style="mitre").buffer(width, join_style="mitre")
+        eroded = _polygonal(opened.intersection(eroded))
+    return eroded
 
 
 def _polygonal(geometry: Any) -> Any:
@@ -114,8 +132,12 @@ def keeps_distance(inner: Any, free: Any, distance: float) -> bool:
         return True
     tree = shapely.STRtree(walls)
     _, gaps = tree.query_nearest(mine, return_distance=True, all_matches=False)
-    scale = max(float(np.abs(shapely.get_coordinates(free)).max()), distance)
-    return bool(np.min(gaps) >= distance - 1e-12 * scale)
+    return bool(np.min(gaps) >= distance - 1e-12 * _scale(free, distance))
+
+
+def _scale(free: Any, distance: float) -> float:
+    """The magnitude the rounding of distances in ``free`` is relative to."""
+    return max(float(np.abs(shapely.get_coordinates(free)).max()), distance)
 
 
 def _segments(geometry: Any) -> Any:
