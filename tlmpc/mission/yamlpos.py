@@ -124,6 +124,12 @@ NUMBER_LIKE_TEXT = "Y010"
 _NUMBER_LIKE = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)")
 
 
+def _json_number(text: str) -> float:
+    """A JSON number without a decimal point but with an exponent (``1e-9``, ``2E3``), as
+    JSON reads it: a float (``json.loads("1e3")`` is ``1000.0``)."""
+    return float(text)
+
+
 #: Plain numbers that YAML 1.1 reads exactly as Python does (no octal, no ``_``, no
 #: sexagesimal, at most 15 digits so they are finite and within the integer limit).
 _FAST_INT = re.compile(r"-?(?:0|[1-9][0-9]{0,14})")
@@ -184,6 +190,8 @@ class _Converter:
         self.constructor = yaml.SafeLoader("")
         self.resolver = yaml.resolver.Resolver()
         self.anchors: dict[str, tuple[Any, int]] = {}
+        #: A ``.json`` file's plain ``1e-9`` is a JSON number (YAML 1.1 would read text).
+        self.json_numbers = file.lower().endswith(".json")
 
     def problem(
         self, code: str, message: str, at: Any, path: Path | None = None, **kw: Any
@@ -207,6 +215,8 @@ class _Converter:
             tag = self.resolver.resolve(yaml.ScalarNode, event.value, event.implicit)  # type: ignore[no-untyped-call]
         if tag == "tag:yaml.org,2002:str":
             if not event.style and _NUMBER_LIKE.fullmatch(event.value):
+                if self.json_numbers:
+                    return _json_number(event.value)
                 self.problem(
                     NUMBER_LIKE_TEXT,
                     f"{event.value!r} is text in YAML 1.1, not a number",
