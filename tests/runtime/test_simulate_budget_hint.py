@@ -62,3 +62,23 @@ def test_a_given_dt_is_refused_at_the_flag(compiled: Path, monkeypatch: pytest.M
     assert float(value) > 0.0001
     code, _, again = run("simulate", str(compiled), "--dt", value)
     assert code != 2, again
+
+
+@pytest.mark.parametrize(("spec", "timed"), [("deadline.yaml", True), ("example1.yaml", False)])
+def test_a_task_with_time_bounds_has_a_quarter_of_the_budget(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, spec: str, timed: bool
+) -> None:
+    # the verifier searches each bound's windows over the whole trace: four times a sample's
+    # cost, so a quarter of the samples
+    out = tmp_path / "out"
+    code, _, err = run("compile", str(ROOT / "specs" / spec), "-o", str(out), "-q")
+    assert code == 0, err
+    monkeypatch.setattr(closed_loop, "MAX_SAMPLES", 4 * BUDGET)
+    monkeypatch.setattr(closed_loop, "MAX_TIMED_SAMPLES", BUDGET)
+    dt = 0.5  # a run of 2.5 budgets of samples: past the timed budget, within the other
+    code, _, err = run("simulate", str(out), "--dt", str(dt), "--duration", str(2.5 * BUDGET * dt))
+    if timed:
+        assert code == 2, err
+        assert f"more than the budget of {BUDGET:,} (a task with time bounds)" in err, err
+    else:
+        assert "R024" not in err, err
