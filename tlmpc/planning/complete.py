@@ -22,7 +22,7 @@ from typing import Protocol
 from tlmpc.abstraction.model import Abstraction
 from tlmpc.abstraction.refine import split_triangles
 from tlmpc.automata.model import Automaton
-from tlmpc.base.errors import NoPlanError, TlmpcError, error
+from tlmpc.base.errors import Diagnostic, NoPlanError, TlmpcError, error
 from tlmpc.ltl.ast import Formula
 from tlmpc.mission.model import Options, TaskPart
 from tlmpc.planning.boundary import start_cells, task_formula, task_letters
@@ -144,21 +144,22 @@ def plan_complete(
                 parts=parts(),
                 file=file,
                 fallback=no_bounce,
-                feasible=_feasibility(abstraction, options, start_point),
+                no_plan_reasons=_no_plan_reasons(abstraction, options, start_point),
             )
         ) from None
 
 
-def _feasibility(
+def _no_plan_reasons(
     abstraction: Abstraction, options: Options, start_point: tuple[float, float]
-) -> Callable[[Formula], bool]:
-    """Whether the planner (U-turns allowed) finds a plan for a task formula on this map."""
+) -> Callable[[Formula], Sequence[Diagnostic] | None]:
+    """Why the planner (U-turns allowed) finds no plan for a task formula on this map, or
+    None when it finds one."""
     from tlmpc.automata.translate import translate
 
     convention = options.boundary
     letters = task_letters(abstraction, convention, start_point)
 
-    def feasible(formula: Formula) -> bool:
+    def no_plan_reasons(formula: Formula) -> Sequence[Diagnostic] | None:
         try:
             plan(
                 abstraction,
@@ -168,11 +169,11 @@ def _feasibility(
                 start_point=start_point,
                 bounces=True,
             )
-        except NoPlanError:
-            return False
-        return True
+        except NoPlanError as failure:
+            return failure.diagnostics
+        return None
 
-    return feasible
+    return no_plan_reasons
 
 
 def _refined(

@@ -211,34 +211,50 @@ def explain_infeasible(
     parts: Sequence[TaskPart],
     file: str | None,
     fallback: Sequence[Diagnostic],
-    feasible: Callable[[Formula], bool],
+    no_plan_reasons: Callable[[Formula], Sequence[Diagnostic] | None],
 ) -> list[Diagnostic]:
     """Why no trajectory in the plane satisfies the task, blaming the parts that fail.
 
     Called only once planning *with U-turns* failed, which is exact (see docs/planning.md).
     The blamed parts are a minimal set of task parts (phrases, top-level LTL conjuncts) that
     already has no plan on this map: dropping any one of them would make the rest possible.
-    ``feasible(formula)`` tells whether the planner finds a plan for a conjunction of parts
-    (the caller's planner: this module explains, it does not plan).
+    ``no_plan_reasons(formula)`` is the planner's explanation why a conjunction of parts has
+    no plan, or None when it has one (the caller's planner: this module explains, it does
+    not plan).  When the whole task's reason is exact (``fallback`` holds a P001, P002, P003
+    or P006), the blamed parts are a minimal set that still has that reason, and the reason
+    is stated for them alone.
     """
     if not parts:
         return list(fallback)
     from tlmpc.planning.boundary import start_cells
 
+    exact_codes = {d.code for d in fallback if d.code in _EXACT}
+
+    def fails_alike(reasons: Sequence[Diagnostic] | None) -> bool:
+        # Parts that fail for another reason than the whole task's exact one cannot carry
+        # that reason: a start in a forbidden region is not the fault of an unreachable goal.
+        if reasons is None:
+            return False
+        return not exact_codes or any(d.code in exact_codes for d in reasons)
+
     core = list(parts)
+    core_reasons: Sequence[Diagnostic] = fallback
     if 1 < len(parts) <= MAX_CORE_PARTS:
         for part in list(parts):
             rest = [p for p in core if p is not part]
-            if rest and not feasible(conjoin([p.formula for p in rest])):
-                core = rest
+            if not rest:
+                continue
+            reasons = no_plan_reasons(conjoin([p.formula for p in rest]))
+            if fails_alike(reasons):
+                core, core_reasons = rest, reasons or ()
     blamed = conjoin([p.formula for p in core])
     first = core[0]
     where: dict[str, Any] = {"file": file, "line": first.line, "col": first.col}
     quoted = ", ".join(f"`{p.text}`" + _at(file, p) for p in core)
-    exact = [d for d in fallback if d.code in _EXACT]
+    exact = [d for d in core_reasons if d.code in exact_codes]
     if exact:
-        # The reason is already exact (e.g. the start violates an invariant); point it at
-        # the parts that cause it.
+        # The reason is exact (e.g. the start violates an invariant) and worded for the
+        # blamed parts; point it at them.
         involved = f"; the parts involved: {quoted}" if len(core) > 1 else ""
         return [dataclasses.replace(d, hint=(d.hint or "") + involved, **where) for d in exact]
     cells = [c.triangle for c in start_cells(abstraction, start_point)]
