@@ -41,3 +41,18 @@ def test_a_yaml_string_is_one_line_that_reads_back_exactly() -> None:
         written = yaml_string(text)
         assert "\n" not in written
         assert yaml.load(written, Loader=yaml.SafeLoader) == text
+
+
+@pytest.mark.parametrize("template", ["reach-avoid", "patrol", "map"])
+@pytest.mark.parametrize("output", ["", ".", "..", "/", "{dir}/", "{dir}/new/", "{dir}/new/."])
+def test_an_output_naming_a_directory_or_nothing_is_refused(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, template: str, output: str
+) -> None:
+    """`-o` names the mission's file: a name with no file in it (empty, `.`, a trailing
+    `/`) is refused, exit 2, and nothing is written anywhere under the folder."""
+    monkeypatch.chdir(tmp_path)
+    target = output.format(dir=tmp_path)
+    err = io.StringIO()
+    assert main(["new", template, "-o", target], out=io.StringIO(), err=err) == 2
+    assert "error[U093]" in err.getvalue()
+    assert list(tmp_path.rglob("*")) == []

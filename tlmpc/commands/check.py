@@ -94,19 +94,10 @@ def _check_file(path: Path) -> tuple[dict[str, Any], list[Any], list[Any], str]:
         diagnostics = _contradictions(path, mission)
         if not diagnostics and mission.reactive is not None:
             diagnostics, entry["gr1"] = _gr1_reading(mission)
-        if not diagnostics:
-            from tlmpc.mission.body import body_radius
-            from tlmpc.mission.holes import workspace_notes
-
-            merged, notices = workspace_notes(mission)
-            if body_radius(mission.robot) > 0.0:  # shapely only for a body
-                from tlmpc.mission.cspace import body_diagnostics
-
-                body = body_diagnostics(merged)
-                diagnostics = [d for d in body if d.severity == "error"]
-                notices += [d for d in body if d.severity != "error"]
-            if not diagnostics:
-                diagnostics = _subgrid(merged)
+        # the geometry is checked whatever the task says: compile reports its problems
+        # (R001, G030, G031) at load and abstraction, before it ever looks for a plan
+        geometry, notices = _geometry(mission)
+        diagnostics = diagnostics + geometry
     if diagnostics:
         return entry, diagnostics, notices, "invalid"
     entry["ok"] = True
@@ -114,6 +105,26 @@ def _check_file(path: Path) -> tuple[dict[str, Any], list[Any], list[Any], str]:
         entry["ltl"] = to_text(mission.formula)
         entry["avoid_scopes"] = _scopes(mission)
     return entry, diagnostics, notices, "valid"
+
+
+def _geometry(mission: Any) -> tuple[list[Any], list[Any]]:
+    """The workspace's problems as compile's load and abstraction stages find them: the
+    body's (R001) first, then, when the body fits, features snapping would reshape
+    (G030/G031); and the notes (merged holes, narrow passages)."""
+    from tlmpc.mission.body import body_radius
+    from tlmpc.mission.holes import workspace_notes
+
+    merged, notices = workspace_notes(mission)
+    problems: list[Any] = []
+    if body_radius(mission.robot) > 0.0:  # shapely only for a body
+        from tlmpc.mission.cspace import body_diagnostics
+
+        body = body_diagnostics(merged)
+        problems = [d for d in body if d.severity == "error"]
+        notices += [d for d in body if d.severity != "error"]
+    if not problems:
+        problems = _subgrid(merged)
+    return problems, notices
 
 
 def _subgrid(mission: Any) -> list[Any]:

@@ -24,7 +24,8 @@ TEMPLATES = ("reach-avoid", "patrol", "map")
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Register the command's flags."""
     parser.add_argument("template", choices=TEMPLATES, help="which mission to start from")
-    parser.add_argument("-o", "--output", type=Path, help="the file to write (default: print)")
+    # a string, not a Path: Path drops the trailing "/" that says the user named a directory
+    parser.add_argument("-o", "--output", help="the file to write (default: print)")
 
 
 def schema_line() -> str:
@@ -102,6 +103,25 @@ def map_metadata(image: Path) -> str:
     )
 
 
+def _file_name(output: str) -> Path:
+    """``-o OUTPUT`` as the file to write; refused (U093) when it names no file: empty, a
+    directory (``dir/``, ``.``, ``..``, ``/``), where a mission cannot be written."""
+    import os
+
+    from tlmpc.base.errors import UsageError, error
+
+    if os.path.basename(output) in ("", ".", ".."):
+        raise UsageError(
+            error(
+                "U093",
+                f"cannot write {output!r}: it names a directory or nothing, not a file",
+                hint="give the mission's file name with -o, such as -o mission.yaml",
+                file=output or None,
+            )
+        )
+    return Path(output)
+
+
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Print the template or write it to a new file."""
     from tlmpc.base.errors import EXIT_OK, UsageError, error
@@ -111,7 +131,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     reporter = Reporter.for_args(args, out, err)
     if args.output is None:
         return reporter.finish(EXIT_OK, text=template_text(args.template))
-    target: Path = args.output
+    target = _file_name(args.output)
     written: dict[Path, bytes]
     if args.template == "map":
         # the mission names a map: write one beside it, or the mission does not compile

@@ -533,11 +533,28 @@ def _listing(props: Sequence[Prop]) -> str:
     return names[0] if len(names) == 1 else ", ".join(names[:-1]) + " and " + names[-1]
 
 
-def _unknown_phrase(phrase: str, file: str | None, line: int, col: int) -> Diagnostic:
+#: Words of the phrases besides :data:`KEYWORDS` that a did-you-mean may suggest.
+_PHRASE_WORDS = KEYWORDS | {"within", "every", "least", "longer", "than", "after", "for"}
+#: How close a misspelt word in a phrase must be to a phrase word to be suggested: closer than
+#: difflib's default, since there a name (`dock`) stands where a word could (`do`).
+_TYPO_CUTOFF = 0.75
+
+
+def _unknown_phrase(
+    phrase: str,
+    file: str | None,
+    line: int,
+    col: int,
+    stopped: tuple[int, int] = (1, 1),
+) -> Diagnostic:
+    """T001 at ``line``:``col``; ``stopped`` is where in the phrase the parser stopped (its
+    line and column), whose word, when misspelt, the hint suggests a phrase word for."""
     first = phrase.strip().split(" ", 1)[0].lower() if phrase.strip() else ""
     close = difflib.get_close_matches(first, _LEADING_WORDS, n=1)
+    if not close or close[0] == first:
+        close = _misspelt_word(phrase, *stopped)
     hint = "known phrases: " + "; ".join(KNOWN_PHRASES)
-    if close and close[0] != first:
+    if close:
         hint = f"did you mean {close[0]!r}? " + hint
     return error(
         "T001",
@@ -547,6 +564,19 @@ def _unknown_phrase(phrase: str, file: str | None, line: int, col: int) -> Diagn
         line=line,
         col=col,
     )
+
+
+def _misspelt_word(phrase: str, line: int, column: int) -> list[str]:
+    """The phrase word (at most one) the word at ``line``:``column`` of ``phrase`` is a
+    misspelling of: `thne` for `then`, `avoidng` for `avoiding`; none for a phrase word."""
+    lines = phrase.split("\n")
+    if not 1 <= line <= len(lines):
+        return []
+    match = re.match(r"[A-Za-z_][A-Za-z0-9_]*", lines[line - 1][column - 1 :])
+    if match is None or match.group().lower() in _PHRASE_WORDS:
+        return []
+    word = match.group().lower()
+    return difflib.get_close_matches(word, sorted(_PHRASE_WORDS), n=1, cutoff=_TYPO_CUTOFF)
 
 
 _IDENTIFIER = re.compile(r"(?<![A-Za-z0-9_])[A-Za-z_][A-Za-z0-9_]*")
@@ -697,7 +727,9 @@ def _compile(
         if repaired:
             found = [_reserved(w, lowering, groups, known) for w in repaired]
             raise InvalidInputError(found) from None
-        problem = _unknown_phrase(phrase, file, *lowering.at(exc.line, exc.column))
+        problem = _unknown_phrase(
+            phrase, file, *lowering.at(exc.line, exc.column), stopped=(exc.line, exc.column)
+        )
         if words:
             names = ", ".join(sorted({repr(str(w)) for w in words}))
             note = f"note: {names} cannot be named in a task phrase (a keyword there); "
@@ -713,7 +745,45 @@ def _compile(
     formula = lowering.lower(tree.children[0])  # type: ignore[arg-type]
     if lowering.problems:
         raise InvalidInputError(lowering.problems)
+    written = _written_size(formula)
+    if written > MAX_PHRASE_NODES:
+        raise InvalidInputError(
+            error(
+                "T005",
+                f"the phrase means a formula of {written:,} operators and names written out "
+                f"(at most {MAX_PHRASE_NODES:,}): each region of a step repeats the rest of "
+                "the sequence",
+                hint="use fewer steps or fewer regions per step (a group step such as "
+                "`all rooms` counts each member), or split the task into several phrases",
+                file=file,
+                line=line,
+                col=col,
+            )
+        )
     return formula, lowering.scopes
+
+
+#: The most nodes a phrase's formula may have written out as a tree.  The sequence reading
+#: shares each step's rest among the step's regions, but printing, checking and translating
+#: the formula walk it as a tree, whose size multiplies by the regions of every step.
+MAX_PHRASE_NODES = 50_000
+
+
+def _written_size(formula: Formula) -> int:
+    """The node count of ``formula`` as a tree, counted over its shared nodes once each."""
+    sizes: dict[int, int] = {}
+    # post-order without recursion: a phrase may nest a step per word
+    stack: list[tuple[Formula, bool]] = [(formula, False)]
+    while stack:
+        node, expanded = stack.pop()
+        if id(node) in sizes:
+            continue
+        if expanded:
+            sizes[id(node)] = 1 + sum(sizes[id(child)] for child in node.children())
+            continue
+        stack.append((node, True))
+        stack.extend((child, False) for child in node.children() if id(child) not in sizes)
+    return sizes[id(formula)]
 
 
 def compile_phrases(
