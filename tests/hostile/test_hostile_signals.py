@@ -100,6 +100,11 @@ def _outcome(number: int, code: int, err: str, folder: Path, whole: set[str]) ->
         return "clean"
     if code == -number and err == "":
         return "before the interpreter ran"
+    if err.startswith(INIT_FAILED) and err.rstrip().endswith("<no Python frame>"):
+        # a Ctrl-C while CPython installs its own signal handling, before any Python code
+        # (no frame at all): the interpreter gives up with its fatal error
+        assert number == signal.SIGINT, (code, err)
+        return "while the interpreter initialised"
     frames = FRAME.findall(err)
     assert number == signal.SIGINT, (code, err)
     # "KeyboardInterrupt", or "KeyboardInterrupt: " when it came while the interpreter set
@@ -108,6 +113,9 @@ def _outcome(number: int, code: int, err: str, folder: Path, whole: set[str]) ->
     assert all(_before_the_guard(file, int(line)) for file, line in frames), err
     return "in the interpreter's start-up"
 
+
+#: How the interpreter reports a Ctrl-C that came while it set up its signal handling.
+INIT_FAILED = "Fatal Python error: init_interp_main: can't initialize signals\n"
 
 #: How the interpreter begins its report of an exception it drops in its start-up and goes on:
 #: raised in a callback of its import machinery, where an exception cannot propagate, or

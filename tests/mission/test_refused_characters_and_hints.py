@@ -10,16 +10,17 @@ import json
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from robot_data import image_from_free, write_map
 
 from tlmpc.cli import main
 
 ROOT = Path(__file__).resolve().parents[2]
 SPEC = (ROOT / "specs" / "reach-avoid.yaml").read_text()
-MAP = ROOT.parent / "shared" / "data" / "maps"
 
 #: Characters YAML refuses anywhere in a stream (YAML 1.1, section 5.1: the printable set).
 REFUSED = [chr(c) for c in (*range(0x00, 0x09), 0x0B, 0x0C, *range(0x0E, 0x20), 0x7F)] + [
@@ -66,10 +67,16 @@ def test_a_refused_character_is_placed_where_it_is(
     assert diagnostic["hint"]
 
 
+def _room_map(folder: Path) -> Path:
+    """A map_server map of a walled room, 2 m square at 0.05 m a cell."""
+    free = np.zeros((40, 40), dtype=bool)
+    free[2:-2, 2:-2] = True
+    return write_map(folder, "room", image_from_free(free), resolution=0.05)
+
+
 def test_a_refused_character_in_a_map_yaml_is_located(tmp_path: Path) -> None:
-    text = (MAP / "depot.yaml").read_text().replace("negate: 0", "negate: 0 \x00")
-    (tmp_path / "depot.pgm").symlink_to(MAP / "depot.pgm")
-    path = tmp_path / "depot.yaml"
+    path = _room_map(tmp_path)
+    text = path.read_text().replace("negate: 0", "negate: 0 \x00")
     path.write_text(text)
     err = io.StringIO()
     code = main(
@@ -145,9 +152,8 @@ def test_a_schema_hint_says_what_is_asked_and_where() -> None:
 
 
 def test_a_map_value_that_does_not_read_has_a_hint(tmp_path: Path) -> None:
-    text = (MAP / "depot.yaml").read_text().replace("resolution: 0.05", "resolution: !!float abc")
-    (tmp_path / "depot.pgm").symlink_to(MAP / "depot.pgm")
-    path = tmp_path / "depot.yaml"
+    path = _room_map(tmp_path)
+    text = path.read_text().replace("resolution: 0.05", "resolution: !!float abc")
     path.write_text(text)
     err = io.StringIO()
     argv = ["import-map", str(path), "-o", str(tmp_path / "m.yaml")]
