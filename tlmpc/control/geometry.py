@@ -42,6 +42,22 @@ class TriangleGeometry:
         return (lengths[:, None] * self.vertices).sum(axis=0) / lengths.sum()  # type: ignore[no-any-return]
 
 
+#: Ulps of the largest coordinate a length measured from absolute coordinates may carry.
+COORDINATE_ULPS = 8
+
+
+def coordinate_rounding(points: FloatArray) -> float:
+    """The rounding of a length measured from the absolute coordinates of ``points``: a
+    height (a facet's offset less a dot product with the opposite vertex), a signed distance
+    of a point to a facet, a width along a unit direction (the difference of two dot
+    products).  Each dot product rounds by a few ulps of the largest coordinate whatever the
+    length, so two evaluations in a different order (vector by vector, or a matrix product)
+    differ by that much, and a point snapped onto a facet lies off it by as much: for a
+    triangle of size 1e-8 at 4.5 from the origin, about 1e-7 of its size.  The bound is
+    8 ε |x|∞, ε the double precision epsilon."""
+    return COORDINATE_ULPS * float(np.finfo(np.float64).eps) * float(np.abs(points).max())
+
+
 def triangle_geometry(vertices: FloatArray) -> TriangleGeometry:
     """Geometry of a counter-clockwise triangle.
 

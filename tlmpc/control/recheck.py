@@ -25,7 +25,7 @@ from tlmpc.abstraction.model import Abstraction, FloatArray
 from tlmpc.abstraction.starts import start_cells
 from tlmpc.base.errors import TlmpcError, UsageError, error
 from tlmpc.control.cells import violated as violated_cell_row
-from tlmpc.control.geometry import triangle_geometry
+from tlmpc.control.geometry import coordinate_rounding, triangle_geometry
 from tlmpc.control.model import EXIT, KEPT, Controllers, StepController
 from tlmpc.control.synthesize import RECHECK_TOLERANCE, plan_steps, violated_condition
 from tlmpc.mission.model import Mission, Robot
@@ -166,10 +166,11 @@ def _affine_problem(
     if controller.exit_edge is None:
         # a stay's exit speed is its least inward speed on the facets away from each vertex
         inward = min(-float(across[i, j]) for i in range(3) for j in range(3) if j != i)
-        return _stated_problem(controller, inward, math.inf, robot)
+        return _stated_problem(controller, inward, math.inf, robot, 0.0)
     exit_speed = float(across[:, controller.exit_edge].min())
     height = float(geometry.heights[controller.exit_edge])
-    return _stated_problem(controller, exit_speed, height, robot)
+    rounding = coordinate_rounding(controller.vertices)
+    return _stated_problem(controller, exit_speed, height, robot, rounding)
 
 
 def _pursuit_problem(
@@ -224,7 +225,9 @@ def _cell_problem(controller: StepController, abstraction: Abstraction, robot: R
     xi = np.asarray(field.direction, dtype=np.float64)
     exit_speed = float((field.velocities.reshape(-1, 2) @ xi).min())
     along = field.vertices.reshape(-1, 2) @ xi
-    return _stated_problem(controller, exit_speed, float(along.max() - along.min()), robot)
+    width = float(along.max() - along.min())
+    rounding = coordinate_rounding(field.vertices)
+    return _stated_problem(controller, exit_speed, width, robot, rounding)
 
 
 def _law_problem(
@@ -249,22 +252,23 @@ def _law_problem(
 
 
 def _stated_problem(
-    controller: StepController, exit_speed: float, width: float, robot: Robot
+    controller: StepController, exit_speed: float, width: float, robot: Robot, rounding: float
 ) -> str | None:
     """Whether the step claims more than its field achieves: an exit speed above the least
     speed across the exit (``exit_speed``), or an exit-time bound below the time to cross
-    ``width`` at that speed less the disturbance (both to the re-check's tolerance on
-    speeds: the C030 conditions leave the exit speed more than that above the disturbance)."""
+    ``width`` less its ``rounding`` at that speed less the disturbance (both to the re-check's
+    tolerance on speeds: the C030 conditions leave the exit speed more than that above the
+    disturbance)."""
     slack = RECHECK_TOLERANCE * robot.max_speed
     if not controller.exit_speed <= exit_speed + slack:
         return f"exit_speed {controller.exit_speed:g} is more than its field's {exit_speed:g}"
     if math.isinf(width):
         return None  # a stay: it never leaves
-    least_time = width / (exit_speed + slack - robot.disturbance)
+    least_time = max(width - rounding, 0.0) / (exit_speed + slack - robot.disturbance)
     if not controller.exit_time_bound >= least_time * (1.0 - RECHECK_TOLERANCE):
         return (
-            f"exit_time_bound {controller.exit_time_bound:g} is shorter than its field "
-            f"guarantees ({least_time:g})"
+            f"exit_time_bound {controller.exit_time_bound:.12g} is shorter than its field "
+            f"guarantees ({least_time:.12g})"
         )
     return None
 

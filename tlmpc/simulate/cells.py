@@ -17,13 +17,15 @@ import numpy as np
 
 from tlmpc.abstraction.model import FloatArray
 from tlmpc.base.errors import SolverError, error
-from tlmpc.control.geometry import triangle_geometry
+from tlmpc.control.geometry import coordinate_rounding, triangle_geometry
 from tlmpc.control.model import EXIT, KEPT, CellField, StepController
 from tlmpc.simulate.matrix import augmented, expm_small
 
 #: Grid points per piece that bracket its exit before root finding.
 GRID_POINTS = 256
-#: How far beyond a facet (relative to the piece's size) a state may lie before it counts.
+#: How far outside a piece a state still counts as in it (relative to the piece's size) and
+#: beyond a facet it counts as past it (relative to the piece's extent across that facet),
+#: each besides the rounding of the coordinates.
 SLACK = 1e-9
 #: Pieces a move may cross before the simulation gives up (a field that circles is a bug).
 MAX_PIECES = 100_000
@@ -44,16 +46,20 @@ def locate(
     field: CellField, point: FloatArray, velocity_hint: bool = True, outside: bool = False
 ) -> int | None:
     """The piece holding ``point``: of the pieces holding it (to within :data:`SLACK` of
-    their size; every piece with ``outside``), the one whose smallest barycentric weight is
-    largest, at ``point`` or, with ``velocity_hint``, a little ahead along the field (on a
-    shared facet: the one the field enters); the first of equals; None when none holds it."""
+    their size and the rounding of the coordinates, :func:`coordinate_rounding`; every piece
+    with ``outside``), the one whose smallest barycentric weight is largest, at ``point`` or,
+    with ``velocity_hint``, a little ahead along the field (on a shared facet: the one the
+    field enters); the first of equals; None when none holds it."""
+    # A crossing snapped onto a facet lies off it by the rounding of its coordinates, which
+    # on a piece of size 1e-8 far from the origin is far more than SLACK of its size.
+    rounding = max(coordinate_rounding(field.vertices), coordinate_rounding(point))
     best, best_value = None, -math.inf
     for piece in range(len(field.triangles)):
         geometry = triangle_geometry(field.vertices[piece])
         weights = geometry.barycentric(point)
         scale = float(geometry.heights.max())
         lowest = float(weights.min())
-        if not outside and lowest < -SLACK * max(scale, 1.0):
+        if not outside and (weights < -SLACK * max(scale, 1.0) - rounding / geometry.heights).any():
             continue
         value = lowest
         if velocity_hint:
@@ -122,9 +128,12 @@ def _move(
     triangles: list[int] = []
     crossings: list[bool] = []
     now, x = 0.0, np.asarray(x0, dtype=np.float64)
+    rounding = coordinate_rounding(field.vertices)
     for _ in range(MAX_PIECES):
         geometry = triangle_geometry(field.vertices[piece])
-        size = float(geometry.heights.max())
+        # per facet: a needle's largest height would let the state run past its thin side by
+        # more than the flow's bound reaches
+        beyond = SLACK * geometry.heights + rounding
         centre = field.vertices[piece].mean(axis=0)
         matrix = augmented(field.gains[piece], field.gains[piece] @ centre + field.offsets[piece])
         reach = float((field.vertices[piece] @ xi).max() - xi @ x)
@@ -137,7 +146,7 @@ def _move(
         for k in range(1, GRID_POINTS + 1):
             state = step @ previous
             heights = geometry.normals @ state[:2] - offsets
-            if (heights > SLACK * size).any():
+            if (heights > beyond).any():
                 found = k
                 break
             previous = state
