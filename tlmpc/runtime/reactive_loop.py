@@ -13,7 +13,6 @@ from dataclasses import dataclass
 from typing import Any
 
 from tlmpc.base.errors import InvalidInputError, UsageError, error
-from tlmpc.ltl.ast import Prop
 from tlmpc.ltl.printer import to_text
 from tlmpc.mission.model import TaskPart
 from tlmpc.runtime.assumptions import AssumptionTracker, letter_of
@@ -100,7 +99,7 @@ def _breaking_line(change: Change | None, broken: TaskPart) -> int | None:
     instant that reads a sensor the assumption names (else the instant's first row)."""
     if change is None:
         return None
-    named = {node.name for node in broken.formula.walk() if isinstance(node, Prop)}
+    named = broken.formula.props()
     rows = [row for sensor, row in change.lines if sensor in named]
     return min(rows) if rows else change.line
 
