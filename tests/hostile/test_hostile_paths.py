@@ -4,6 +4,7 @@ at the path, never an internal error."""
 
 from __future__ import annotations
 
+import errno
 import json
 import os
 from pathlib import Path
@@ -88,6 +89,27 @@ def test_a_folder_the_user_may_not_enter_is_u001(tmp_path: Path) -> None:
             assert "error[U090]" not in result.err
     finally:
         locked.chmod(0o700)
+
+
+def test_a_folder_the_user_may_not_enter_is_u001_whoever_runs_the_test(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # as root every folder opens: the kernel's answer to another user is given by the probe
+    locked = tmp_path / "locked"
+    real_stat = Path.stat
+
+    def refused(path: Path, **kwargs: bool) -> os.stat_result:
+        if path == locked or locked in path.parents:
+            raise PermissionError(errno.EACCES, os.strerror(errno.EACCES), str(path))
+        return real_stat(path, **kwargs)
+
+    monkeypatch.setattr(Path, "stat", refused)  # what is_dir, is_file and exists ask
+    result = run("export", str(locked / "out"))
+    assert result.code == 2, result.err
+    place, _, message = result.err.partition(": error[U001]: ")
+    assert Path(place) == locked / "out" or locked in Path(place).parents, result.err
+    assert message.startswith(f"cannot access {place}: Permission denied"), result.err
+    assert "hint: you have no permission to enter a folder of the path" in result.err
 
 
 def test_compiling_a_mission_that_is_a_link_loop_is_u001(tmp_path: Path) -> None:
