@@ -559,6 +559,42 @@ def _as_yaml_float(text: str) -> str:
     return f"{mantissa}e{exponent}"
 
 
+#: A JSON string literal, and a UTF-16 surrogate pair escaped in one (``\ud83d\ude00``).
+_JSON_STRING = re.compile(r'"(?:[^"\\\n]|\\.)*"')
+_SURROGATE_PAIR = re.compile(r"\\u([dD][89abAB][0-9a-fA-F]{2})\\u([dD][c-fC-F][0-9a-fA-F]{2})")
+#: Inside a string: a surrogate pair escape, or any other escape (skipped whole, so that the
+#: ``\\`` of ``"\\ud83d"`` is not read as the start of one).
+_STRING_ESCAPE = re.compile(_SURROGATE_PAIR.pattern + r"|\\.")
+
+
+def json_surrogate_pairs(text: str) -> str:
+    r"""``text`` with each surrogate pair escape in a JSON string written as the one YAML
+    escape of its character (``\U0001F600``), padded after the string to keep columns.
+
+    JSON writers (Python's ``json.dumps`` by default) escape a character beyond U+FFFF as two
+    UTF-16 escapes; libyaml refuses each half of the pair.  The padding is two spaces after
+    the string's closing quote per pair, where JSON and YAML flow both allow white space, so
+    everything after it on the line keeps its column."""
+    if not _SURROGATE_PAIR.search(text):
+        return text
+
+    def one_string(literal: re.Match[str]) -> str:
+        pairs = 0
+
+        def one_escape(escape: re.Match[str]) -> str:
+            nonlocal pairs
+            if escape.group(1) is None:
+                return escape.group()
+            pairs += 1
+            high, low = int(escape.group(1), 16), int(escape.group(2), 16)
+            return f"\\U{0x10000 + ((high - 0xD800) << 10) + (low - 0xDC00):08X}"
+
+        rewritten = _STRING_ESCAPE.sub(one_escape, literal.group())
+        return rewritten + "  " * pairs
+
+    return _JSON_STRING.sub(one_string, text)
+
+
 def load_positioned(
     text: str, file: str, *, lazy: bool = False
 ) -> tuple[PositionedDocument | None, list[Diagnostic]]:
@@ -566,7 +602,11 @@ def load_positioned(
 
     ``lazy``: the plain numbers of lists get no position while reading (a tenth of the time
     on large maps); the first question about one reads the text again with every position.
+    A ``.json`` file's surrogate pair escapes read as JSON reads them
+    (:func:`json_surrogate_pairs`).
     """
+    if file.lower().endswith(".json"):
+        text = json_surrogate_pairs(text)
     doc, problems = _load_positioned(text, file, lazy)
     if doc is not None:
         doc.source = text
