@@ -36,10 +36,27 @@ MISSION_FILES = [
     "mission.yml",
     "robots/kitchen.mission.yaml",
     "warehouse-mission.yaml",
+    "night_mission.yaml",
+    "missions.yaml",
     "missions/night.yaml",
+    "missions/site-map.yaml",  # a map beside its mission: check reads it as a map
     "deploy/missions/a/b.yaml",
+    "-x.mission.yaml",
 ]
-OTHER_FILES = ["config/settings.yaml", ".github/workflows/ci.yml", "emission.txt", "mission.json"]
+# `mission` inside a longer word is no mission
+OTHER_FILES = [
+    "config/settings.yaml",
+    ".github/workflows/ci.yml",
+    "emission.txt",
+    "mission.json",
+    "config/permissions.yaml",
+    ".github/permissions.yml",
+    "transmission.yaml",
+    "emissions.yaml",
+    "docs/submission.yaml",
+    "missionary.yml",
+    "submissions/a.yaml",
+]
 
 
 def _readme_hook_config() -> str:
@@ -65,8 +82,9 @@ def test_published_hooks_match_mission_files() -> None:
             assert pattern.search(name), (pattern.pattern, name)
         for name in OTHER_FILES:
             assert not pattern.search(name), (pattern.pattern, name)
-    for hook in _hooks():
-        assert hook["entry"] == "tlmpc check"
+    for hook in [*_hooks(), readme_hook]:
+        # `--`: a file named like a flag (`-x.mission.yaml`) is still a file
+        assert hook["entry"] == "tlmpc check --"
 
 
 def test_repository_checks_its_own_specs() -> None:
@@ -75,6 +93,14 @@ def test_repository_checks_its_own_specs() -> None:
     pattern = re.compile(hook["files"])
     for spec in (ROOT / "specs").glob("*.yaml"):
         assert pattern.search(f"specs/{spec.name}")
+    # the deliberately broken fixtures under tests/mission/bad/ are left out
+    exclude = re.compile(hook["exclude"])
+    fixtures = sorted((ROOT / "tests" / "mission" / "bad").glob("*.yaml"))
+    assert fixtures
+    for fixture in fixtures:
+        name = fixture.relative_to(ROOT).as_posix()
+        assert pattern.search(name)
+        assert exclude.search(name)
 
 
 def _environment(tmp_path: Path) -> dict[str, str]:
@@ -152,8 +178,26 @@ def test_readme_instructions_block_a_broken_mission_in_a_fresh_repository(
     _commit_blocks_broken_and_passes_good(repo, env, "robots/kitchen.mission.yaml")
     # a YAML file that is not a mission is left alone
     (repo / "settings.yaml").write_text("a: [1\n")
+    (repo / "config").mkdir()
+    (repo / "config" / "permissions.yaml").write_text("users: [a]\n")
     _git(repo, env, "add", "-A")
     assert _git(repo, env, "commit", "-m", "other yaml").returncode == 0
+    # `tlmpc new map` writes a map beside the mission, under missions/: checked as a map
+    (repo / "missions").mkdir()
+    made = subprocess.run(
+        ["tlmpc", "new", "map", "-o", "missions/site.yaml"],
+        cwd=repo,
+        env=env,
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert made.returncode == 0, made.stderr
+    _git(repo, env, "add", "-A")
+    mapped = _git(repo, env, "commit", "-m", "a mission on a map")
+    assert mapped.returncode == 0, mapped.stdout + mapped.stderr
+    # a file named like a flag is a file
+    _commit_blocks_broken_and_passes_good(repo, env, "-x.mission.yaml")
 
 
 @pytest.mark.slow

@@ -2,6 +2,9 @@
 
 Imports only the mission loader (lark, PyYAML, jsonschema, shapely) and tlmpc's own pure-Python
 automata (for the contradiction check); never scipy, clarabel, triangle, cvxpy or matplotlib.
+A ROS map_server map YAML among the files (the map a mission names, a keepout mask: a hook's
+``files:`` pattern picks them up beside the missions) is checked as a map, with the reader
+``tlmpc import-map`` uses (which also loads numpy and Pillow).
 Exit 0 when every file is valid, 1 when some file is invalid, 2 when some file could not be read
 (unreadable wins over invalid: the run could not do its job).
 """
@@ -9,6 +12,7 @@ Exit 0 when every file is valid, 1 when some file is invalid, 2 when some file c
 from __future__ import annotations
 
 import argparse
+from collections import Counter
 from pathlib import Path
 from typing import Any, TextIO
 
@@ -35,12 +39,12 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     report = Reporter.for_args(args, out, err)
     results: list[dict[str, Any]] = []
     explained: list[str] = []
-    unreadable = invalid = 0
+    tally: Counter[tuple[str, str]] = Counter()  # (kind, status): how many files
     for path in args.files:
         try:
-            entry, diagnostics, notices, status = _check_file(path)
+            entry, diagnostics, notices, status, kind = _check_file(path)
         except RecursionError:  # deeper than any stage handles: this file, not the batch
-            entry, notices, status = _entry(path), [], "unreadable"
+            entry, notices, status, kind = _entry(path), [], "unreadable", "mission"
             diagnostics = [
                 error(
                     "U036",
@@ -49,27 +53,41 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
                     file=str(path),
                 )
             ]
-        unreadable += status == "unreadable"
-        invalid += status == "invalid"
+        tally[kind, status] += 1
         entry["diagnostics"] = [d.to_json() for d in [*diagnostics, *notices]]
         results.append(entry)
         report.diagnose([*diagnostics, *notices])
-        if entry["ok"] and args.explain:
+        if entry["ok"] and args.explain and kind == "mission":  # a map has no formula
             explained.append(f"{path}: {entry['ltl']}\n")
             explained.extend(f"  {scope}\n" for scope in entry.get("avoid_scopes", []))
             explained.extend(f"  {line}\n" for line in entry.get("gr1", []))
+    statuses = {status for _, status in +tally}
     # unreadable wins over invalid: the run could not do its job
-    code = EXIT_USAGE if unreadable else (EXIT_NEGATIVE if invalid else EXIT_OK)
+    code = (
+        EXIT_USAGE
+        if "unreadable" in statuses
+        else (EXIT_NEGATIVE if "invalid" in statuses else EXIT_OK)
+    )
     report.finish(code, {"files": results}, "".join(explained))
     if not args.json:  # the tally comes last, after the explanations
-        valid = len(results) - invalid - unreadable
-        summary = f"{valid} of {len(results)} mission file(s) valid"
-        if invalid:
-            summary += f", {invalid} invalid"
-        if unreadable:
-            summary += f", {unreadable} unreadable"
-        report.note(summary)
+        report.note(_summary(tally))
     return code
+
+
+def _summary(tally: Counter[tuple[str, str]]) -> str:
+    """``3 of 4 mission file(s) valid, 1 invalid``, and the maps' own count when there are
+    any (an unreadable file counts as a mission: what it is was never seen)."""
+    parts = []
+    for kind in ("mission", "map"):
+        total = sum(n for (k, _), n in tally.items() if k == kind)
+        if not total and (kind == "map" or tally):
+            continue
+        part = f"{tally[kind, 'valid']} of {total} {kind} file(s) valid"
+        for status in ("invalid", "unreadable"):
+            if tally[kind, status]:
+                part += f", {tally[kind, status]} {status}"
+        parts.append(part)
+    return "; ".join(parts)
 
 
 def _entry(path: Path) -> dict[str, Any]:
@@ -77,10 +95,10 @@ def _entry(path: Path) -> dict[str, Any]:
     return {"file": str(path), "ok": False, "diagnostics": [], "ltl": None}
 
 
-def _check_file(path: Path) -> tuple[dict[str, Any], list[Any], list[Any], str]:
-    """One file's entry, its problems and its notes, and whether it is ``"valid"``,
-    ``"invalid"`` or ``"unreadable"``."""
-    from tlmpc.base.errors import UsageError
+def _check_file(path: Path) -> tuple[dict[str, Any], list[Any], list[Any], str, str]:
+    """One file's entry, its problems and its notes, whether it is ``"valid"``,
+    ``"invalid"`` or ``"unreadable"``, and whether it is a ``"mission"`` or a ``"map"``."""
+    from tlmpc.base.errors import UsageError, best_first
     from tlmpc.ltl.printer import to_text
     from tlmpc.mission.load import inspect_file
 
@@ -89,7 +107,9 @@ def _check_file(path: Path) -> tuple[dict[str, Any], list[Any], list[Any], str]:
     try:
         mission, diagnostics = inspect_file(path)
     except UsageError as exc:
-        return entry, list(exc.diagnostics), notices, "unreadable"
+        return entry, list(exc.diagnostics), notices, "unreadable", "mission"
+    if mission is None and _is_map(path):
+        return (*_check_map(path, entry), "map")
     if mission is not None and not diagnostics:
         diagnostics = _contradictions(path, mission)
         if not diagnostics and mission.reactive is not None:
@@ -97,14 +117,53 @@ def _check_file(path: Path) -> tuple[dict[str, Any], list[Any], list[Any], str]:
         # the geometry is checked whatever the task says: compile reports its problems
         # (R001, G030, G031) at load and abstraction, before it ever looks for a plan
         geometry, notices = _geometry(mission)
-        diagnostics = diagnostics + geometry
+        # best first over the whole file, as compile reports them (errors, then by place)
+        diagnostics = best_first(diagnostics + geometry)
     if diagnostics:
-        return entry, diagnostics, notices, "invalid"
+        return entry, diagnostics, notices, "invalid", "mission"
     entry["ok"] = True
     if mission is not None:
         entry["ltl"] = to_text(mission.formula)
         entry["avoid_scopes"] = _scopes(mission)
-    return entry, diagnostics, notices, "valid"
+    return entry, diagnostics, notices, "valid", "mission"
+
+
+def _is_map(path: Path) -> bool:
+    """Whether the file that is no valid mission is a map_server map YAML: map keys and
+    none of a mission's top-level keys (a mission with a typo stays a mission)."""
+    from tlmpc.importers.map_keys import looks_like_map
+    from tlmpc.io.schema_check import load_schema
+
+    return looks_like_map(path, foreign_keys=frozenset(load_schema("mission")["properties"]))
+
+
+def _check_map(
+    path: Path, entry: dict[str, Any]
+) -> tuple[dict[str, Any], list[Any], list[Any], str]:
+    """A map YAML checked as ``tlmpc import-map`` reads it (M001-M006, at their keys); when
+    it reads, a note (M020) that it is a map, not a mission, and was checked as one."""
+    from tlmpc.base.errors import Diagnostic, UsageError
+    from tlmpc.importers.occupancy import read_map
+
+    try:
+        grid = read_map(path)
+    except UsageError as exc:
+        problems = list(exc.diagnostics)
+        # the YAML itself unreadable, or Pillow missing: the map could not be checked at all
+        unreadable = any(d.code in ("M001", "U060") for d in problems)
+        return entry, problems, [], "unreadable" if unreadable else "invalid"
+    rows, cols = grid.shape
+    note = Diagnostic(
+        code="M020",
+        severity="note",
+        message=f"a ROS map_server map, not a mission: checked as a map ({cols}x{rows} cells "
+        f"of {grid.resolution:g} m), valid",
+        hint="a mission uses a map through `workspace: {map: FILE}`; to leave maps out of a "
+        "pre-commit hook, narrow its `files:` or add `exclude:`",
+        file=str(path),
+    )
+    entry["ok"] = True
+    return entry, [], [note], "valid"
 
 
 def _geometry(mission: Any) -> tuple[list[Any], list[Any]]:

@@ -167,5 +167,14 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         replace_file(path, data)
     if len(written) > 1:
         reporter.note(f"wrote the map {', '.join(str(p) for p in written if p != target)}")
-    reporter.note(f"wrote {target}: edit it, then `tlmpc check {target}`")
+    reporter.note(f"wrote {target}: edit it, then `tlmpc check {_shell_word(target)}`")
     return reporter.finish(EXIT_OK)
+
+
+def _shell_word(path: Path) -> str:
+    """``path`` as one word a POSIX shell passes to tlmpc as that file: quoted when it holds
+    spaces, quotes or wildcards, and not taken for a flag when it starts with ``-``."""
+    import shlex
+
+    name = str(path)
+    return shlex.quote(f"./{name}" if name.startswith("-") else name)

@@ -29,6 +29,7 @@ import numpy as np
 import numpy.typing as npt
 
 from tlmpc.base.errors import UsageError, error
+from tlmpc.importers.map_keys import KEY_EXAMPLES, MAX_MAP_YAML_BYTES
 from tlmpc.io.inputs import brief, load_small_yaml, open_regular, read_text
 from tlmpc.io.outputs import yaml_float
 
@@ -39,9 +40,6 @@ OCCUPIED = 100
 
 #: Maps larger than this many cells are refused (a 16k x 16k grid is already 1 GB of floats).
 MAX_CELLS = 64_000_000
-
-#: A map YAML is a handful of keys; anything larger is not one.
-MAX_MAP_YAML_BYTES = 1024 * 1024
 
 #: The largest image file read (a 64-million-cell 16-bit PGM is 128 MB).
 MAX_IMAGE_BYTES = 512 * 1024 * 1024
@@ -126,15 +124,6 @@ _KEY_HINTS = {
     "mode": "use trinary, scale or raw",
 }
 
-#: A value to write for each required key, for the hint of a map that lacks it.
-_KEY_EXAMPLES = {
-    "image": "map.pgm",
-    "resolution": "0.05",
-    "origin": "[0.0, 0.0, 0.0]",
-    "occupied_thresh": "0.65",
-    "free_thresh": "0.25",
-}
-
 
 @dataclass(frozen=True, slots=True)
 class _MapText:
@@ -179,7 +168,7 @@ def _missing(key: str, file: str, written: _MapText) -> UsageError:
         f"the map has no `{key}`",
         file,
         hint="a map_server map needs image, resolution, origin, occupied_thresh and "
-        f"free_thresh: add `{key}: {_KEY_EXAMPLES[key]}`",
+        f"free_thresh: add `{key}: {KEY_EXAMPLES[key]}`",
         at=written.at(key),
     )
 
@@ -311,10 +300,16 @@ def _pixels(
     Problems are reported in the map YAML ``file``, at ``at`` (where it names the image)."""
     import warnings
 
-    from PIL import Image, UnidentifiedImageError
+    from tlmpc.base.extras import require
 
     def fail(code: str, message: str, hint: str) -> UsageError:
         return _fail(code, message, file, hint=hint, at=at)
+
+    try:
+        Image = require("PIL.Image", "reading a map image")
+    except UsageError as exc:  # placed where the map YAML names the image
+        raise fail("U060", exc.diagnostics[0].message, exc.diagnostics[0].hint or "") from None
+    from PIL import UnidentifiedImageError
 
     if not path.exists():
         raise fail(

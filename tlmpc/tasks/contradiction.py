@@ -19,7 +19,7 @@ from dataclasses import dataclass
 from tlmpc.automata.translate import translate
 from tlmpc.base.errors import Diagnostic, error
 from tlmpc.base.graphs import csr, strong_components
-from tlmpc.ltl.ast import And, Const, Formula, Not, Or, Prop, bounded_operators, conjoin
+from tlmpc.ltl.ast import And, Formula, Or, Prop, bounded_operators, conjoin, is_temporal
 from tlmpc.ltl.printer import to_text
 from tlmpc.ltl.transform import substitute
 
@@ -61,7 +61,9 @@ def is_satisfiable(formula: Formula) -> bool:
 
 
 def _temporal_size(formula: Formula) -> int:
-    return sum(1 for node in formula.walk() if not isinstance(node, (Prop, Not, And, Or, Const)))
+    """How many temporal operators ``formula`` has: the unit of the check's budget
+    (``->`` and ``<->`` are connectives, as ``&`` and ``|`` are)."""
+    return sum(1 for node in formula.walk() if is_temporal(node))
 
 
 def _conjuncts(formula: Formula) -> list[Formula]:
