@@ -124,10 +124,13 @@ def test_verify_refuses_a_bowtie_workspace_with_exit_2(tmp_path: Any) -> None:
 
     trace = tmp_path / "trace.json"
     document = {**_document({"a": [[1, 1], [2, 1], [2, 2]]}), "workspace": {"boundary": BOWTIE}}
-    trace.write_text(json.dumps(document))
+    text = json.dumps(document)
+    trace.write_text(text)
     err = io.StringIO()
     assert main(["verify", str(trace)], out=io.StringIO(), err=err) == 2
-    assert f"{trace}: error[V004]: workspace boundary: the polygon is self-intersecting" in (
+    # placed at the boundary's value in the file (one line: its column is its offset + 1)
+    column = text.index('"boundary": ') + len('"boundary": ') + 1
+    assert f"{trace}:1:{column}: error[V004]: workspace boundary: the polygon is self-inters" in (
         err.getvalue()
     )
     assert "Traceback" not in err.getvalue()

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import io
 import json
+import re
 from collections.abc import Sequence
 from fractions import Fraction
 from pathlib import Path
@@ -363,25 +364,25 @@ def test_json_output_validates_and_exit_codes(tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("change", "code", "where"),
     [
-        ({"signals": {"alarm": [[0, "maybe"]]}}, "V030", "$.signals.alarm"),
-        ({"signals": {"alarm": [[0, 2]]}}, "V030", "$.signals.alarm"),
-        ({"signals": {"alarm": [[1, True], [0, False]]}}, "V031", "$.signals.alarm"),
-        ({"signals": {"alarm": [[0, True], [0, False]]}}, "V031", "$.signals.alarm"),
-        ({"signals": {"alarm": [[float("nan"), True]]}}, "V031", "$.signals.alarm"),
-        ({"signals": {"alarm": [["0", True]]}}, "V031", "$.signals.alarm"),
+        ({"signals": {"alarm": [[0, "maybe"]]}}, "V030", "$.signals.alarm[0][1]"),
+        ({"signals": {"alarm": [[0, 2]]}}, "V030", "$.signals.alarm[0][1]"),
+        ({"signals": {"alarm": [[1, True], [0, False]]}}, "V031", "$.signals.alarm[1][0]"),
+        ({"signals": {"alarm": [[0, True], [0, False]]}}, "V031", "$.signals.alarm[1][0]"),
+        ({"signals": {"alarm": [[float("nan"), True]]}}, "V031", "$.signals.alarm[0][0]"),
+        ({"signals": {"alarm": [["0", True]]}}, "V031", "$.signals.alarm[0][0]"),
         ({"signals": {"siren": [[0, True]]}}, "V033", "$.signals.siren"),
         ({"signals": {"alarm": []}}, "V033", "$.signals.alarm"),
         ({"signals": {"alarm": [[0]]}}, "V033", "$.signals.alarm"),
-        ({"signals": [1, 2]}, "V033", None),
-        ({"sensors": ["lab"]}, "V033", None),
-        ({"sensors": "alarm"}, "V033", None),
-        ({"assumptions": ["G !siren"]}, "V034", None),
-        ({"assumptions": [3]}, "V034", None),
-        ({"assumptions": "G !alarm"}, "V034", None),
+        ({"signals": [1, 2]}, "V033", "$.signals"),
+        ({"sensors": ["lab"]}, "V033", "$.sensors[0]"),
+        ({"sensors": "alarm"}, "V033", "$.sensors"),
+        ({"assumptions": ["G !siren"]}, "V034", "$.assumptions[0]"),
+        ({"assumptions": [3]}, "V034", "$.assumptions[0]"),
+        ({"assumptions": "G !alarm"}, "V034", "$.assumptions"),
     ],
 )
 def test_hostile_signals_are_located(
-    tmp_path: Path, change: dict[str, Any], code: str, where: str | None
+    tmp_path: Path, change: dict[str, Any], code: str, where: str
 ) -> None:
     doc = {**document(corridor([(0, False)]), "G(alarm -> !lab)", [], sensors=["alarm"]), **change}
     path = tmp_path / "t.json"
@@ -393,6 +394,18 @@ def test_hostile_signals_are_located(
     assert found["code"] == code
     assert found.get("path") == where
     assert found["file"] == str(path)
+    # placed in the file: at the value the path names (json's own reading of the text there)
+    text = path.read_text()
+    offset = sum(len(line) + 1 for line in text.split("\n")[: found["line"] - 1])
+    offset += found["col"] - 1
+    named: Any = json.loads(text)
+    for key in re.findall(r"\.(\w+)|\[(\d+)\]", where[1:]):
+        named = named[key[0] or int(key[1])]
+    if named == "G !siren":
+        assert text[offset:].startswith("siren")  # the unknown name inside the formula
+    else:
+        value, _ = json.JSONDecoder().raw_decode(text, offset)
+        assert json.dumps(value) == json.dumps(named)
 
 
 def test_assumption_parse_errors_are_diagnostics(tmp_path: Path) -> None:

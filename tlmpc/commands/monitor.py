@@ -14,7 +14,7 @@ import json
 import math
 import sys
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import IO, TYPE_CHECKING, Any, TextIO
 
@@ -200,7 +200,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
                 if pose is None:
                     continue
                 try:
-                    monitor.add(*pose, line=number)
+                    monitor.add(*pose, line=number, column=_cell_place(raw, csv))
                 except UsageError as exc:
                     raise UsageError(
                         [
@@ -253,6 +253,22 @@ def _pose(
         return pose
     t, x, y = apply_transform(np.array([pose], dtype=np.float64), transform)[0].tolist()
     return t, x, y
+
+
+def _cell_place(raw: str, csv: CsvLines) -> Callable[[int], dict[str, int]]:
+    """Where the line ``raw`` writes a pose's cell (0 time, 1 x, 2 y): its column, found when
+    a diagnostic needs it — the value of ``t``, ``x`` or ``y`` in a JSON line, the cell in a
+    CSV line."""
+    from tlmpc.io.json_places import json_path, json_place
+
+    def place(cell: int) -> dict[str, int]:
+        if raw.lstrip().startswith("{"):
+            found = json_place(raw, json_path("txy"[cell]))
+            return {"col": found[1]} if found is not None else {}
+        column = csv.column(raw, cell)
+        return {"col": column} if column is not None else {}
+
+    return place
 
 
 def _json_pose(raw: str, name: str, number: int) -> tuple[float, float, float]:

@@ -20,7 +20,7 @@ constant in the length of the log.
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -97,9 +97,18 @@ class Monitor:
 
     # -- input --------------------------------------------------------------------------------
 
-    def add(self, t: float, x: float, y: float, *, line: int | None = None) -> None:
+    def add(
+        self,
+        t: float,
+        x: float,
+        y: float,
+        *,
+        line: int | None = None,
+        column: Callable[[int], Mapping[str, Any]] | None = None,
+    ) -> None:
         """The next pose; the verifier's own sample checks (V003, V005, V020, V024; exit 2)
-        refuse a pose it would refuse."""
+        refuse a pose it would refuse, at ``line`` and at the place ``column`` gives for
+        the pose's cell at fault (0 time, 1 x, 2 y)."""
         # with the pose before it: the order checks need both (that one passed already)
         poses = [(t, x, y, line)] if self.last_pose is None else [self.last_pose, (t, x, y, line)]
         numbers = np.array([pose[:3] for pose in poses], dtype=np.float64)
@@ -111,6 +120,11 @@ class Monitor:
             file=None,
             lines=None if None in lines else [int(n) for n in lines if n is not None],
             first=self.samples - (len(poses) - 1),
+            place=(
+                None
+                if column is None
+                else lambda index, cell: column(cell) if index == len(poses) - 1 else {}
+            ),
         )
         if found:
             raise UsageError(found)

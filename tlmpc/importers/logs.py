@@ -26,10 +26,11 @@ This module imports nothing from the planning stages; ``rosbags`` is imported on
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import math
 import re
 from array import array
-from collections.abc import Generator, Iterator, Sequence
+from collections.abc import Callable, Generator, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -67,6 +68,29 @@ class Log:
     lines: tuple[int, ...] = ()  # CSV line of each sample (empty for bags)
     source: str = ""
     topic: str | None = None
+    #: a CSV log's separator (None: runs of blanks) and columns of t, x, y
+    layout: tuple[str | None, tuple[int, int, int]] | None = None
+
+
+class SampleColumns:
+    """Where each cell of a CSV log's samples is written, for diagnostics: called with a
+    sample's index and its cell (0 time, 1 x, 2 y), the column of that cell on the sample's
+    line.  The log's lines are read again on the first call only: a log that has no problem
+    never pays for it."""
+
+    def __init__(self, path: Path, log: Log) -> None:
+        self.path = path
+        self.log = log
+        self._lines: list[str] | None = None
+
+    def __call__(self, index: int, cell: int) -> dict[str, int]:
+        if self.log.layout is None or index >= len(self.log.lines):
+            return {}
+        if self._lines is None:
+            self._lines = read_log_lines(self.path)
+        separator, indices = self.log.layout
+        raw = self._lines[self.log.lines[index] - 1]
+        return {"col": _cell_column(raw, separator, indices[cell])}
 
 
 def is_log(path: Path) -> bool:
@@ -172,9 +196,7 @@ def read_log(
         log = read_bag(path, topic, frame)
     if transform is None:
         return log
-    return Log(
-        samples=_apply(log.samples, transform), lines=log.lines, source=log.source, topic=log.topic
-    )
+    return dataclasses.replace(log, samples=_apply(log.samples, transform))
 
 
 # --- lines -----------------------------------------------------------------------------------
@@ -309,7 +331,17 @@ def _is_number(cell: str) -> bool:
     return True
 
 
-def _pick(names: list[str], wanted: str, file: str, line: int) -> int:
+#: The column (1-based) where cell i of a log's line starts, or None when not known.
+CellColumn = Callable[[int], "int | None"]
+
+
+def _unknown_column(_: int) -> int | None:
+    return None
+
+
+def _pick(
+    names: list[str], wanted: str, file: str, line: int, column: CellColumn = _unknown_column
+) -> int:
     if wanted.isdigit():
         index = int(wanted) - 1
         if not 0 <= index < len(names):
@@ -317,7 +349,9 @@ def _pick(names: list[str], wanted: str, file: str, line: int) -> int:
                 "M052",
                 f"column {wanted} does not exist: the log has {len(names)} columns",
                 file,
+                hint="--columns numbers count the columns from 1",
                 line=line,
+                col=column(0),
             )
         return index
     lowered = [n.lower() for n in names]
@@ -329,10 +363,13 @@ def _pick(names: list[str], wanted: str, file: str, line: int) -> int:
         file,
         hint="choose with --columns TIME,X,Y (names or 1-based numbers)",
         line=line,
+        col=column(0),
     )
 
 
-def _guess(names: list[str], file: str, line: int) -> tuple[int, int, int]:
+def _guess(
+    names: list[str], file: str, line: int, column: CellColumn = _unknown_column
+) -> tuple[int, int, int]:
     lowered = [n.lower() for n in names]
 
     def find(exact: tuple[str, ...], suffixes: tuple[str, ...], what: str) -> int:
@@ -354,6 +391,7 @@ def _guess(names: list[str], file: str, line: int) -> tuple[int, int, int]:
             file,
             hint="name the columns t (or time), x, y, or choose them with --columns TIME,X,Y",
             line=line,
+            col=column(hits[0] if hits else 0),
         )
 
     time_index = find(TIME_NAMES, ("_time", ".time", ".stamp", "_stamp"), "time")
@@ -376,15 +414,20 @@ def parse_columns(text: str) -> tuple[str, str, str]:
 
 
 def _layout(
-    cells: list[str], columns: Sequence[str] | None, file: str, number: int
+    cells: list[str],
+    columns: Sequence[str] | None,
+    file: str,
+    number: int,
+    column: CellColumn = _unknown_column,
 ) -> tuple[bool, tuple[int, int, int]]:
-    """Whether the first data line is a header, and the columns of t, x, y."""
+    """Whether the first data line (line ``number``, cut into ``cells``, whose starts are
+    ``column``) is a header, and the columns of t, x, y."""
     header = not all(_is_number(c) for c in cells if c)
     if header:
         if columns is not None:
-            chosen = tuple(_pick(cells, c, file, number) for c in columns)
+            chosen = tuple(_pick(cells, c, file, number, column) for c in columns)
             return True, (chosen[0], chosen[1], chosen[2])
-        return True, _guess(cells, file, number)
+        return True, _guess(cells, file, number, column)
     if columns is not None:
         if not all(c.isdigit() for c in columns):
             raise _fail(
@@ -393,8 +436,9 @@ def _layout(
                 file,
                 hint="for example --columns 1,2,3",
                 line=number,
+                col=column(0),
             )
-        chosen = tuple(_pick(cells, c, file, number) for c in columns)
+        chosen = tuple(_pick(cells, c, file, number, column) for c in columns)
         return False, (chosen[0], chosen[1], chosen[2])
     if len(cells) != 3:
         raise _fail(
@@ -403,6 +447,7 @@ def _layout(
             file,
             hint="add a header line naming t (or time), x, y, or pass --columns",
             line=number,
+            col=column(3 if len(cells) > 3 else 0),
         )
     return False, (0, 1, 2)
 
@@ -421,6 +466,11 @@ def _cell_column(raw: str, separator: str | None, index: int) -> int:
     return start + 1
 
 
+def _columns_of(raw: str, separator: str | None) -> CellColumn:
+    """Where each cell of the line ``raw`` starts (see :func:`_cell_column`)."""
+    return lambda index: _cell_column(raw, separator, index)
+
+
 def _row(
     raw: str, separator: str | None, indices: tuple[int, int, int], file: str, number: int
 ) -> list[float]:
@@ -435,6 +485,7 @@ def _row(
             hint="every row needs the time and position columns; is the line cut short? "
             "Complete or delete it",
             line=number,
+            col=len(raw.rstrip()) + 1,
         )
     try:
         return [_number(cells[i]) for i in indices]
@@ -466,7 +517,9 @@ def read_csv_log(path: Path, columns: Sequence[str] | None = None) -> Log:
         if first:
             first = False
             separator = next((s for s in _SEPARATORS if s in stripped), None)
-            header, indices = _layout(_split(stripped, separator), columns, file, number)
+            header, indices = _layout(
+                _split(stripped, separator), columns, file, number, _columns_of(raw, separator)
+            )
             if header:
                 continue
         assert indices is not None
@@ -481,7 +534,8 @@ def read_csv_log(path: Path, columns: Sequence[str] | None = None) -> Log:
                 line=number,
             )
     samples = np.asarray(rows, dtype=np.float64).reshape(-1, 3)
-    return Log(samples=samples, lines=tuple(lines), source=file)
+    layout = (separator, indices) if indices is not None else None
+    return Log(samples=samples, lines=tuple(lines), source=file, layout=layout)
 
 
 #: Bytes read at a time by :func:`iter_csv_chunks`.
@@ -536,7 +590,11 @@ def iter_csv_chunks(
                             continue
                         separator = next((s for s in _SEPARATORS if s in stripped), None)
                         header, indices = _layout(
-                            _split(stripped, separator), columns, file, first_number + offset
+                            _split(stripped, separator),
+                            columns,
+                            file,
+                            first_number + offset,
+                            _columns_of(raw, separator),
                         )
                         skip = offset + 1 if header else offset
                         lines, first_number = lines[skip:], first_number + skip
@@ -606,12 +664,23 @@ class CsvLines:
         if self.indices is None:
             self.separator = next((s for s in _SEPARATORS if s in stripped), None)
             header, self.indices = _layout(
-                _split(stripped, self.separator), self.columns, self.file, number
+                _split(stripped, self.separator),
+                self.columns,
+                self.file,
+                number,
+                _columns_of(raw, self.separator),
             )
             if header:
                 return None
         t, x, y = _row(raw, self.separator, self.indices, self.file, number)
         return t, x, y
+
+    def column(self, raw: str, cell: int) -> int | None:
+        """The column of cell ``cell`` (0 time, 1 x, 2 y) on the line ``raw`` (None before the
+        columns are known)."""
+        if self.indices is None:
+            return None
+        return _cell_column(raw, self.separator, self.indices[cell])
 
 
 # --- ROS bags ---------------------------------------------------------------------------------
@@ -785,9 +854,11 @@ def _pose_chunks(
     end against the counts the bag declares (M065, :func:`counted_messages`)."""
     tree: Any = None
     count = 0
+    reading: str | None = None  # the message being read, in words
     try:
         batch: list[tuple[int, float, float, float, str]] = []
         for connection, log_time, raw in counted_messages(reader, chosen, Path(file)):
+            reading = f"pose message {count + 1} on {connection.topic}, log time {log_time} ns"
             message: Any = reader.deserialize(raw, connection.msgtype)
             pose: Any = message
             for part in POSE_TYPES[connection.msgtype].split("."):
@@ -816,8 +887,26 @@ def _pose_chunks(
     except UsageError:
         raise
     except Exception as exc:
-        problem, hint = reader_failure(exc, Path(file))
-        raise _fail("M065", f"cannot read the bag's messages: {problem}", file, hint=hint) from None
+        raise unreadable_message(exc, Path(file), reading) from None
+
+
+#: The hint of a message that does not decode, when the reader finds no damage in the file.
+UNDECODABLE_HINT = (
+    "the message's bytes do not decode as its type: the bag is damaged, or was recorded with "
+    "another definition of the type; compare it with the robot's own copy"
+)
+
+
+def unreadable_message(exc: BaseException, path: Path, reading: str | None) -> UsageError:
+    """M065 for a bag whose messages cannot be read (``exc``, raised by the reader while
+    ``reading`` the message so described), with where the file is damaged when that is found."""
+    problem, hint = reader_failure(exc, path)
+    return _fail(
+        "M065",
+        f"cannot read the bag's messages: {problem}" + (f" ({reading})" if reading else ""),
+        str(path),
+        hint=hint or UNDECODABLE_HINT,
+    )
 
 
 def _emit(

@@ -267,6 +267,14 @@ def read_json(
     text = read_text(
         path, limit=MAX_ARTIFACT_BYTES, code="U001", too_large_code="U040", what="artifact"
     )
+    return parse_json(text, path, expected_format, finite=finite)
+
+
+def parse_json(
+    text: str, path: Path, expected_format: str | None = None, *, finite: bool = True
+) -> dict[str, Any]:
+    """The artifact whose text (read from ``path``) is ``text``: :func:`read_json` for a
+    caller that keeps the text, to place its own diagnostics in it."""
     try:
         document = json.loads(text, parse_constant=_no_constant if finite else None)
         if finite and _HUGE_EXPONENT.search(text) and _has_non_finite(document):
@@ -296,7 +304,20 @@ def read_json(
             )
         ) from None
     if not isinstance(document, dict):
-        raise UsageError(error("U003", "expected a JSON object", file=str(path)))
+        from tlmpc.io.json_places import json_place
+
+        line, col = json_place(text, "$") or (None, None)
+        raise UsageError(
+            error(
+                "U003",
+                "expected a JSON object, found "
+                + ("an array" if isinstance(document, list) else json.dumps(document)[:40]),
+                hint='an artifact is a JSON object {"format": ..., ...}',
+                file=str(path),
+                line=line,
+                col=col,
+            )
+        )
     if expected_format is not None:
         fmt = document.get("format")
         if not isinstance(fmt, str) or not fmt.startswith(expected_format):

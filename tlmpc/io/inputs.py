@@ -152,11 +152,18 @@ def read_text(
     try:
         return raw.decode(encoding)
     except UnicodeDecodeError as exc:
-        raise _refuse(
-            code,
-            f"the {what} {path} is not {encoding} text ({exc.reason} at byte {exc.start})",
-            str(path),
-            "save it as UTF-8 text",
+        # placed at the first bad byte: its line, and its column in the characters before it
+        before = raw[: exc.start].decode(encoding, errors="replace")
+        line = before.count("\n") + 1
+        raise UsageError(
+            error(
+                code,
+                f"the {what} {path} is not {encoding} text ({exc.reason} at byte {exc.start})",
+                hint="save it as UTF-8 text",
+                file=str(path),
+                line=line,
+                col=len(before) - before.rfind("\n"),
+            )
         ) from None
 
 
@@ -292,11 +299,41 @@ def load_small_yaml(
     except yaml.YAMLError as exc:
         raise UsageError(yaml_error(exc, code, file, text)) from None
     except (RecursionError, ValueError) as exc:  # a tagged value that does not read
+        mark = _unreadable_value(text)
         raise UsageError(
             error(
                 code,
                 f"not valid YAML: {brief(str(exc))}",
                 hint="write plain values, without YAML tags such as !!float or !!binary",
                 file=file,
+                line=mark.line + 1 if mark is not None else None,
+                col=mark.column + 1 if mark is not None else None,
             )
         ) from None
+
+
+def _unreadable_value(text: str) -> Any:
+    """The start mark of the first scalar of the YAML ``text``, in document order, that
+    YAML cannot construct (a tagged value such as ``!!float abc``), or None."""
+    import yaml
+
+    loader = yaml.SafeLoader(text)
+    try:
+        root = loader.get_single_node()
+        stack = [root] if root is not None else []
+        while stack:
+            node = stack.pop()
+            if isinstance(node, yaml.ScalarNode):
+                try:
+                    loader.construct_object(node, deep=True)
+                except (ValueError, yaml.YAMLError):
+                    return node.start_mark
+            elif isinstance(node, yaml.SequenceNode):
+                stack.extend(reversed(node.value))
+            elif isinstance(node, yaml.MappingNode):
+                stack.extend(reversed([part for pair in node.value for part in pair]))
+    except (RecursionError, ValueError, yaml.YAMLError):
+        return None
+    finally:
+        loader.dispose()
+    return None

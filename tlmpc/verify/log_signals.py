@@ -139,10 +139,15 @@ def _bag_signals(path: Path, reactive: Reactive) -> dict[str, Signal]:
     from rosbags.typesys import Stores, get_typestore
 
     from tlmpc.importers.bag_counts import counted_messages
-    from tlmpc.importers.bag_damage import reader_failure
-    from tlmpc.importers.logs import MAX_LOG_SAMPLES, _bag_paths, stamp_seconds
+    from tlmpc.importers.logs import (
+        MAX_LOG_SAMPLES,
+        _bag_paths,
+        stamp_seconds,
+        unreadable_message,
+    )
 
     file = str(path)
+    reading: str | None = None  # the message being read, in words
     reader = AnyReader([_bag_paths(path)], default_typestore=get_typestore(Stores.ROS2_HUMBLE))
     reader.open()
     try:
@@ -178,6 +183,9 @@ def _bag_signals(path: Path, reactive: Reactive) -> dict[str, Signal]:
                 )
             samples: list[tuple[int, Any]] = []
             for connection, log_time, raw in counted_messages(reader, chosen, path):
+                reading = (
+                    f"message {len(samples) + 1} on {connection.topic}, log time {log_time} ns"
+                )
                 message: Any = reader.deserialize(raw, connection.msgtype)
                 try:
                     value = _field(message, dotted)
@@ -204,10 +212,7 @@ def _bag_signals(path: Path, reactive: Reactive) -> dict[str, Signal]:
     except UsageError:
         raise
     except Exception as exc:
-        problem, hint = reader_failure(exc, path)
-        raise UsageError(
-            error("M065", f"cannot read the bag's messages: {problem}", hint=hint, file=file)
-        ) from None
+        raise unreadable_message(exc, path, reading) from None
     finally:
         reader.close()
     return found

@@ -9,7 +9,8 @@ stamps (V020), a time or coordinate beyond 1e12 (V024).  All problems are report
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -26,10 +27,21 @@ MAX_PER_KIND = 3
 MAX_MAGNITUDE = 1e12
 
 
+#: Where a sample's cell is written, for a reader that knows more than its line: given the
+#: sample's index (counted in the samples checked) and the cell (0 time, 1 x, 2 y), the fields
+#: of the diagnostic that place it — ``col`` (a CSV cell's column), or ``path`` (the JSON path
+#: of a trace's number, placed in its text by the trace reader).
+CellPlace = Callable[[int, int], Mapping[str, Any]]
+
+
 def _where(index: int, lines: Sequence[int] | None, first: int) -> tuple[str, int | None]:
     if lines is not None and index < len(lines):
         return f"sample {first + index} (line {lines[index]})", lines[index]
     return f"sample {first + index}", None
+
+
+def _at(place: CellPlace | None, index: int, cell: int) -> Mapping[str, Any]:
+    return place(index, cell) if place is not None else {}
 
 
 def sample_diagnostics(
@@ -40,10 +52,11 @@ def sample_diagnostics(
     file: str | None,
     lines: Sequence[int] | None = None,
     first: int = 0,
+    place: CellPlace | None = None,
 ) -> list[Diagnostic]:
     """Every problem with the samples ``(t[i], x[i], y[i])`` (empty list: they are usable);
     ``first``: the number of the first of them in its log (a live log's samples come one by
-    one)."""
+    one); ``place``: where the offending cell of a sample is written (see :data:`CellPlace`)."""
     found: list[Diagnostic] = []
     if len(t) == 0:
         return [
@@ -58,16 +71,15 @@ def sample_diagnostics(
     bad = np.flatnonzero(~np.all(np.isfinite(values), axis=1))
     for index in bad[:MAX_PER_KIND].tolist():
         what, line = _where(index, lines, first)
-        columns = [
-            n for n, v in zip("txy", values[index].tolist(), strict=True) if not np.isfinite(v)
-        ]
+        cells = np.flatnonzero(~np.isfinite(values[index])).tolist()
         found.append(
             error(
                 "V003",
-                f"{what} has a non-finite {'/'.join(columns)} (NaN or infinity)",
+                f"{what} has a non-finite {'/'.join('txy'[c] for c in cells)} (NaN or infinity)",
                 hint="drop or repair the sample; the verifier does not guess missing values",
                 file=file,
                 line=line,
+                **_at(place, index, cells[0]),
             )
         )
     if len(bad):
@@ -75,6 +87,7 @@ def sample_diagnostics(
     far = np.flatnonzero(np.any(np.abs(values) > MAX_MAGNITUDE, axis=1))
     for index in far[:MAX_PER_KIND].tolist():
         what, line = _where(index, lines, first)
+        cell = int(np.flatnonzero(np.abs(values[index]) > MAX_MAGNITUDE)[0])
         found.append(
             error(
                 "V024",
@@ -84,6 +97,7 @@ def sample_diagnostics(
                 "positions the mission's units",
                 file=file,
                 line=line,
+                **_at(place, index, cell),
             )
         )
     if len(far):
@@ -98,6 +112,7 @@ def sample_diagnostics(
                 hint="sort the samples by time (the verifier does not reorder a log)",
                 file=file,
                 line=line,
+                **_at(place, index, 0),
             )
         )
     repeated = np.flatnonzero(steps == 0) + 1
@@ -113,6 +128,7 @@ def sample_diagnostics(
                 hint="drop duplicate samples; two positions at one instant are not a trajectory",
                 file=file,
                 line=line,
+                **_at(place, index, 0),
             )
         )
     return found
@@ -125,8 +141,9 @@ def check_samples(
     *,
     file: str | None,
     lines: Sequence[int] | None = None,
+    place: CellPlace | None = None,
 ) -> None:
     """Raise :class:`UsageError` (exit 2) with every problem of the samples, if any."""
-    found = sample_diagnostics(t, x, y, file=file, lines=lines)
+    found = sample_diagnostics(t, x, y, file=file, lines=lines, place=place)
     if found:
         raise UsageError(found)

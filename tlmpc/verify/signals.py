@@ -12,6 +12,7 @@ piece of the run has one value of every signal: the value at the piece's first i
 
 from __future__ import annotations
 
+import contextlib
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -21,6 +22,8 @@ import numpy as np
 import numpy.typing as npt
 
 from tlmpc.base.errors import Diagnostic, UsageError, error
+from tlmpc.io.inputs import brief
+from tlmpc.io.json_places import json_path
 
 FloatArray = npt.NDArray[np.float64]
 BoolArray = npt.NDArray[np.bool_]
@@ -72,6 +75,13 @@ class Where:
     #: the JSON path or the bag topic the samples are under
     path: str | None = None
 
+    def cell(self, index: int, cell: int) -> str | None:
+        """The JSON path of cell ``cell`` (0 time, 1 value) of sample ``index``, when the
+        samples are the ``[t, value]`` rows of a JSON array (else :attr:`path` as it is)."""
+        if self.lines is None and self.path is not None and self.path.startswith("$"):
+            return f"{self.path}[{index}][{cell}]"
+        return self.path
+
     def sample(self, index: int) -> tuple[str, int | None]:
         """Words for sample ``index``, and its line."""
         if self.lines is not None and index < len(self.lines):
@@ -88,9 +98,10 @@ def make_signal(name: str, times: Sequence[Any], values: Sequence[Any], where: W
     words = [as_boolean(v) for v in values]
     if None not in words and all(type(t) is float or type(t) is int for t in times):
         # the common case, without per-sample bookkeeping
-        clock = np.asarray(times, dtype=np.float64)
-        if np.isfinite(clock).all():
-            return _increasing(name, clock, np.asarray(words, dtype=bool), where, found)
+        with contextlib.suppress(OverflowError):  # an integer too large: said where below
+            clock = np.asarray(times, dtype=np.float64)
+            if np.isfinite(clock).all():
+                return _increasing(name, clock, np.asarray(words, dtype=bool), where, found)
     clock, bits = _checked(name, times, values, where, found)  # says where and why
     return _increasing(name, clock, bits, where, found)
 
@@ -108,30 +119,42 @@ def _checked(
             found.append(
                 error(
                     "V030",
-                    f"signal {name!r}, {what}: {v!r} is not a boolean",
+                    f"signal {name!r}, {what}: {brief(v)} is not a boolean",
                     hint="sensor and action values are true/false (or 1/0)",
                     file=where.file,
                     line=line,
-                    path=where.path,
+                    path=where.cell(index, 1),
                 )
             )
         bits[index] = bool(bit)
-        number = t if isinstance(t, int | float) and not isinstance(t, bool) else None
-        if number is None or not math.isfinite(number):
+        number = _finite_time(t)
+        if number is None:
             if sum(d.code == "V031" for d in found) < MAX_LISTED:
                 what, line = where.sample(index)
                 found.append(
                     error(
                         "V031",
-                        f"signal {name!r}, {what}: time {t!r} is not a finite number",
+                        f"signal {name!r}, {what}: time {brief(t)} is not a finite number",
+                        hint="a signal's times are finite numbers of seconds, increasing",
                         file=where.file,
                         line=line,
-                        path=where.path,
+                        path=where.cell(index, 0),
                     )
                 )
             continue
         clock[index] = number
     return clock, bits
+
+
+def _finite_time(value: Any) -> float | None:
+    """``value`` as a finite time, or None (not a number, not finite, too large a float)."""
+    if not isinstance(value, int | float) or isinstance(value, bool):
+        return None
+    try:
+        number = float(value)
+    except OverflowError:  # an integer beyond any float
+        return None
+    return number if math.isfinite(number) else None
 
 
 def _increasing(
@@ -150,7 +173,7 @@ def _increasing(
                     hint="a signal's samples are in strictly increasing time",
                     file=where.file,
                     line=line,
-                    path=where.path,
+                    path=where.cell(index + 1, 0),
                 )
             )
     if found:
@@ -175,11 +198,17 @@ def signals_of_document(
         return {}
     if not isinstance(raw, dict):
         raise UsageError(
-            error("V033", "`signals` is not an object of name -> [[t, value], ...]", file=file)
+            error(
+                "V033",
+                "`signals` is not an object of name -> [[t, value], ...]",
+                hint='write the signals as {"alarm": [[0, false], [3.5, true]], ...}',
+                file=file,
+                path=json_path("signals"),
+            )
         )
     found: dict[str, Signal] = {}
     for name, points in raw.items():
-        path = f"$.signals.{name}"
+        path = json_path("signals", name)
         if name not in names:
             raise UsageError(
                 error(
@@ -199,6 +228,7 @@ def signals_of_document(
                 error(
                     "V033",
                     f"signal {name!r} is not a non-empty list of [t, value] change points",
+                    hint="write it as [[t, value], ...], e.g. [[0, false], [3.5, true]]",
                     file=file,
                     path=path,
                 )

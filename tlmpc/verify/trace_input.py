@@ -6,20 +6,22 @@ traces) and shared error types are used.
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 import numpy.typing as npt
 
-from tlmpc.base.errors import UsageError, error
+from tlmpc.base.errors import Diagnostic, UsageError, error
+from tlmpc.io.json_places import json_path
 from tlmpc.ltl.ast import Formula
 from tlmpc.verify.model import Ending
-from tlmpc.verify.samples import MAX_MAGNITUDE, check_samples
+from tlmpc.verify.samples import MAX_MAGNITUDE, CellPlace, check_samples
 from tlmpc.verify.signals import Signal, signals_of_document
 
 if TYPE_CHECKING:
@@ -71,26 +73,67 @@ class TraceInput:
 
 
 def _fail(
-    code: str, message: str, file: str | None, hint: str | None = None, line: int | None = None
+    code: str,
+    message: str,
+    file: str | None,
+    hint: str | None = None,
+    line: int | None = None,
+    path: str | None = None,
 ) -> UsageError:
-    return UsageError(error(code, message, hint=hint, file=file, line=line))
+    return UsageError(error(code, message, hint=hint, file=file, line=line, path=path))
 
 
-def _polygon(value: Any, what: str, file: str | None) -> FloatArray:
+#: What a polygon of a trace is: the hint of every V004 about its shape.
+_POLYGON_HINT = (
+    "a polygon is a list of at least 3 [x, y] points, finite and within 1e12, listed in order "
+    "around the shape"
+)
+
+
+def _polygon(value: Any, what: str, file: str | None, path: str) -> FloatArray:
+    """``value`` as a polygon's ``[x, y]`` rows (V004 at ``path`` when it is not one)."""
     try:
         array = np.asarray(value, dtype=np.float64)
     except OverflowError:  # an integer too large for a float
-        raise _fail("V004", f"{what} has a non-finite coordinate", file) from None
+        raise _fail(
+            "V004", f"{what} has a non-finite coordinate", file, _POLYGON_HINT, path=path
+        ) from None
     except (TypeError, ValueError):
-        raise _fail("V004", f"{what} is not a list of [x, y] points", file) from None
+        raise _fail(
+            "V004", f"{what} is not a list of [x, y] points", file, _POLYGON_HINT, path=path
+        ) from None
     if array.ndim != 2 or array.shape[1] != 2 or array.shape[0] < 3:
-        raise _fail("V004", f"{what} is not a polygon (at least 3 [x, y] points)", file)
+        raise _fail(
+            "V004",
+            f"{what} is not a polygon (at least 3 [x, y] points)",
+            file,
+            _POLYGON_HINT,
+            path=path,
+        )
     if not np.all(np.isfinite(array)):
-        raise _fail("V004", f"{what} has a non-finite coordinate", file)
+        raise _fail("V004", f"{what} has a non-finite coordinate", file, _POLYGON_HINT, path=path)
+    if np.any(np.abs(array) > MAX_MAGNITUDE):
+        # as a sample's (V024): the shape checks' squared differences would overflow
+        raise _fail(
+            "V004",
+            f"{what} has a coordinate beyond {MAX_MAGNITUDE:g}",
+            file,
+            _POLYGON_HINT,
+            path=path,
+        )
     return array
 
 
-def _check_simple(polygon: FloatArray, what: str, file: str | None) -> None:
+def _polygon_list(value: Any, what: str, file: str | None, path: str) -> list[Any]:
+    """``value``, a list of polygons (holes), or empty when left out (V004 when it is not)."""
+    if value is None:
+        return []
+    if not isinstance(value, list):
+        raise _fail("V004", f"{what} is not a list of polygons", file, _POLYGON_HINT, path=path)
+    return value
+
+
+def _check_simple(polygon: FloatArray, what: str, file: str | None, path: str) -> None:
     """Refuse (V004) a polygon a mission would refuse: fewer than 3 distinct points, zero
     area, or edges that cross or touch — by the mission loader's own check, so a trace takes
     the shapes a mission takes (shapely's overlays fail on a self-intersecting workspace)."""
@@ -98,7 +141,7 @@ def _check_simple(polygon: FloatArray, what: str, file: str | None) -> None:
 
     _, problems = check_shape(polygon.tolist(), (), what, file or "<input>", lambda _: (0, 0))
     if problems:
-        raise _fail("V004", problems[0].message, file, hint=problems[0].hint)
+        raise _fail("V004", problems[0].message, file, hint=problems[0].hint, path=path)
 
 
 def _polygons(named: Mapping[str, Any], file: str | None) -> dict[str, FloatArray]:
@@ -118,30 +161,106 @@ def _polygons(named: Mapping[str, Any], file: str | None) -> dict[str, FloatArra
         )
     except (TypeError, ValueError, OverflowError):
         fine = False
+    if fine:
+        fine = bool(np.all(np.abs(flat) <= MAX_MAGNITUDE))
     if not fine:
-        return {str(k): _polygon(v, f"region {k!r}", file) for k, v in named.items()}
+        return {
+            str(k): _polygon(v, f"region {k!r}", file, json_path("regions", str(k)))
+            for k, v in named.items()
+        }
     # Plain slices (np.split costs microseconds per piece).
     bounds = [0, *itertools.accumulate(lengths)]
     pieces = [flat[a:b] for a, b in itertools.pairwise(bounds)]
     return {str(k): piece for k, piece in zip(named, pieces, strict=True)}
 
 
-def _samples(rows: Any, file: str | None, lines: list[int] | None = None) -> FloatArray:
+#: The hint of a trace's malformed ``points`` (V002).
+_POINTS_HINT = 'write the samples as "points": [[t, x, y], ...], numbers in increasing time'
+
+
+def _points_row(rows: list[Any]) -> int:
+    """The index of the first of ``rows`` that is not three numbers (or one past the last)."""
+    for index, row in enumerate(rows):
+        try:
+            if np.asarray(row, dtype=np.float64).shape != (3,):
+                return index
+        except (TypeError, ValueError, OverflowError):
+            return index
+    return len(rows)
+
+
+def _huge_number(rows: Any) -> tuple[int, int] | None:
+    """The row and cell of the first integer of the rows ``rows`` too large for a float
+    (None when ``rows`` is not a list of rows)."""
+    if not isinstance(rows, list):
+        return None
+    for index, row in enumerate(rows):
+        for cell, value in enumerate(row if isinstance(row, list) else []):
+            if isinstance(value, int) and not isinstance(value, bool):
+                try:
+                    float(value)
+                except OverflowError:
+                    return index, cell
+    return None
+
+
+def _samples(
+    rows: Any,
+    file: str | None,
+    lines: list[int] | None = None,
+    place: CellPlace | None = None,
+) -> FloatArray:
+    """The ``[t, x, y]`` rows (V002, V024 and :func:`check_samples`' codes); ``place``: where
+    a sample's cell is written (a CSV's columns), else its JSON path under ``points``."""
+    # rows of a trace.json's `points` when no reader says where they came from
+    where = json_path("points") if place is None and lines is None else None
+    if where is not None:
+
+        def place(index: int, cell: int) -> dict[str, Any]:
+            return {"path": json_path("points", index, cell)}
+
     try:
         array = np.asarray(rows, dtype=np.float64)
     except OverflowError:  # an integer too large for a float: beyond any time or place
+        huge = _huge_number(rows)
         raise _fail(
-            "V024",
-            f"a sample has a time or coordinate beyond {MAX_MAGNITUDE:g} (an integer too "
-            "large for a number)",
+            "V024" if huge is not None else "V002",
+            (f"sample {huge[0]} has" if huge is not None else "`points` is")
+            + f" a number beyond {MAX_MAGNITUDE:g} (an integer too large for a float)",
             file,
+            hint="a corrupt sample, or times in nanoseconds: times are seconds and positions "
+            "the mission's units"
+            if huge is not None
+            else _POINTS_HINT,
+            path=(json_path("points", *huge) if huge is not None else where) if where else None,
         ) from None
     except (TypeError, ValueError):
-        raise _fail("V002", "points must be rows of three numbers [t, x, y]", file) from None
-    if array.ndim != 2 or array.shape[1] != 3:
-        raise _fail("V002", "points must be rows of three numbers [t, x, y]", file)
-    check_samples(array[:, 0], array[:, 1], array[:, 2], file=file, lines=lines)
+        array = None
+    if array is None or array.ndim != 2 or array.shape[1] != 3:
+        if isinstance(rows, list) and not rows:
+            array = np.zeros((0, 3))
+        else:
+            row = _points_row(rows) if isinstance(rows, list) else None
+            raise _fail(
+                "V002",
+                "points must be rows of three numbers [t, x, y]"
+                + (f" (sample {row} is not)" if row is not None else ""),
+                file,
+                _POINTS_HINT,
+                path=json_path("points", row) if where and row is not None else where,
+            )
+    try:
+        check_samples(array[:, 0], array[:, 1], array[:, 2], file=file, lines=lines, place=place)
+    except UsageError as exc:
+        raise UsageError([_with_path(d, where) for d in exc.diagnostics]) from None
     return array
+
+
+def _with_path(diagnostic: Diagnostic, path: str | None) -> Diagnostic:
+    """``diagnostic``, at ``path`` when it has no place of its own."""
+    if path is None or diagnostic.line is not None or diagnostic.path is not None:
+        return diagnostic
+    return dataclasses.replace(diagnostic, path=path)
 
 
 def certifying_speed(speed: Any) -> float | None:
@@ -151,42 +270,109 @@ def certifying_speed(speed: Any) -> float | None:
     that is not a positive finite number vouches for nothing.  (Whether the samples themselves
     move faster is checked by the certificate, which then says where.)
     """
-    if isinstance(speed, bool) or not isinstance(speed, int | float) or not math.isfinite(speed):
+    if isinstance(speed, bool) or not isinstance(speed, int | float):
         return None
-    return float(speed) if speed > 0 else None
+    try:
+        value = float(speed)
+    except OverflowError:  # an integer too large for a float
+        return None
+    return value if math.isfinite(value) and value > 0 else None
 
 
 def _formula(
-    text: Any, names: set[str], file: str | None, *, assumption: int | None = None
+    text: Any,
+    names: set[str],
+    file: str | None,
+    *,
+    assumption: int | None = None,
+    source: str | None = None,
 ) -> Formula:
+    """The formula ``text`` (the task, or assumption number ``assumption``), its diagnostics
+    placed in the string that holds it in ``source``, the document's JSON text, when given."""
+    path = json_path("ltl") if assumption is None else json_path("assumptions", assumption)
     if not isinstance(text, str):
         if assumption is not None:
-            raise _fail("V034", f"assumption {assumption} is not an LTL string", file)
-        raise _fail("V006", "the trace has no `ltl` task", file)
+            raise _fail(
+                "V034",
+                f"assumption {assumption} is not an LTL string",
+                file,
+                hint='write each assumption as an LTL formula in a string, e.g. "G F !alarm"',
+                path=path,
+            )
+        raise _fail(
+            "V006",
+            "the trace has no `ltl` task"
+            + ("" if text is None else f" (`ltl` is {type(text).__name__}, not a string)"),
+            file,
+            hint='give the task as an LTL formula in a string, e.g. "ltl": "F a & G !b"',
+            path=path,
+        )
     from tlmpc.base.errors import InvalidInputError
     from tlmpc.ltl.parser import parse_ltl  # lark: only when a formula is read as text
 
     try:
         formula = parse_ltl(text, file=file)
     except InvalidInputError as exc:
-        raise UsageError(exc.diagnostics) from None
+        raise UsageError([_in_string(d, text, path, source) for d in exc.diagnostics]) from None
     unknown = sorted(formula.props() - names)
-    if unknown and assumption is not None:
-        raise _fail(
+    if not unknown:
+        return formula
+    first = _name_position(text, unknown[0])
+    if assumption is not None:
+        problem = error(
             "V034",
             f"assumption {assumption} names unknown propositions: {', '.join(unknown)}",
-            file,
             hint="an assumption speaks of the trace's regions, sensors and actions",
+            file=file,
+            line=first[0],
+            col=first[1],
         )
-    if unknown:
-        raise _fail(
+    else:
+        problem = error(
             "V007",
             f"the task names unknown regions: {', '.join(unknown)}",
-            file,
             hint="every region in `ltl` must be defined under `regions` (a reactive trace's "
             "sensors and actions under `sensors` and `actions`)",
+            file=file,
+            line=first[0],
+            col=first[1],
         )
-    return formula
+    raise UsageError(_in_string(problem, text, path, source))
+
+
+def _name_position(text: str, name: str) -> tuple[int | None, int | None]:
+    """The line and column (in ``text``, lines ending at ``\\n``) of the first whole-word
+    occurrence of the proposition ``name``."""
+    import re
+
+    found = re.search(rf"(?<![\w.]){re.escape(name)}(?![\w.])", text)
+    if found is None:
+        return None, None
+    before = text[: found.start()]
+    return before.count("\n") + 1, found.start() - before.rfind("\n")
+
+
+def _in_string(diagnostic: Diagnostic, value: str, path: str, source: str | None) -> Diagnostic:
+    """A diagnostic about the formula string ``value`` (its line and column counted in the
+    string), placed at ``path`` and, with the document's JSON text ``source``, at the line
+    and column of that character in the file; without it, at the path alone."""
+    from tlmpc.io.json_places import parse_json_path, string_char_places, text_place, value_offset
+
+    within = diagnostic.line, diagnostic.col
+    placed = dataclasses.replace(diagnostic, path=path, line=None, col=None)
+    if source is None:
+        return placed
+    start = value_offset(source, parse_json_path(path) or [])
+    places = string_char_places(source, start) if start is not None else None
+    if places is None:
+        return placed
+    offset = 0
+    if within[0] is not None:
+        lines = value.split("\n")
+        line = min(max(within[0], 1), len(lines))
+        offset = sum(len(part) + 1 for part in lines[: line - 1]) + (within[1] or 1) - 1
+    line, col = text_place(source, places[min(max(offset, 0), len(places) - 1)])
+    return dataclasses.replace(placed, line=line, col=col)
 
 
 def _names(
@@ -195,8 +381,15 @@ def _names(
     value = document.get(key)
     if value is None:
         return ()
+    path = json_path(key)
     if not isinstance(value, list) or not all(isinstance(v, str) and v for v in value):
-        raise _fail("V033", f"`{key}` is not a list of names", file)
+        raise _fail(
+            "V033",
+            f"`{key}` is not a list of names",
+            file,
+            hint=f'write `{key}` as a list of names, e.g. "{key}": ["alarm"]',
+            path=path,
+        )
     clash = sorted(set(value) & regions)
     if clash or len(set(value)) != len(value):
         twice = clash or sorted(v for v in set(value) if value.count(v) > 1)
@@ -204,6 +397,8 @@ def _names(
             "V033",
             f"`{key}` names {', '.join(map(repr, twice))} twice (or also as a region)",
             file,
+            hint="a name is a region, a sensor or an action, once",
+            path=json_path(key, value.index(twice[0])),
         )
     return tuple(value)
 
@@ -213,16 +408,24 @@ def _reactive_fields(
     regions: set[str],
     file: str | None,
     signals: Mapping[str, Signal] | None,
+    source: str | None,
 ) -> dict[str, Any]:
     """The sensors, actions, assumptions and signals of a reactive trace (all empty else)."""
     sensors = _names(document, "sensors", regions, file)
     actions = _names(document, "actions", regions | set(sensors), file)
     texts = document.get("assumptions") or []
     if not isinstance(texts, list):
-        raise _fail("V034", "`assumptions` is not a list of LTL strings", file)
+        raise _fail(
+            "V034",
+            "`assumptions` is not a list of LTL strings",
+            file,
+            hint='write the assumptions as a list of LTL strings, e.g. ["G F !alarm"]',
+            path=json_path("assumptions"),
+        )
     known = regions | set(sensors) | set(actions)
     assumptions = tuple(
-        _formula(text, known, file, assumption=index) for index, text in enumerate(texts)
+        _formula(text, known, file, assumption=index, source=source)
+        for index, text in enumerate(texts)
     )
     if signals is None:
         signals = signals_of_document(document, [*sensors, *actions], file)
@@ -240,9 +443,41 @@ def from_document(
     file: str | None = None,
     convention: str | None = None,
     signals: Mapping[str, Signal] | None = None,
+    source: str | None = None,
 ) -> TraceInput:
     """Validate a ``tlmpc.trace/1`` document (``signals``, read from a log, replace the
-    document's own)."""
+    document's own).
+
+    Each diagnostic names the value it is about by its JSON path; with ``source``, the
+    document's JSON text, it is placed at that value's line and column too."""
+    try:
+        return _validated(document, file, convention, signals, source)
+    except UsageError as exc:
+        if source is None:
+            raise
+        raise UsageError([_placed(d, source) for d in exc.diagnostics]) from None
+
+
+def _placed(diagnostic: Diagnostic, source: str) -> Diagnostic:
+    """``diagnostic`` at the line and column of the value its JSON path names in ``source``
+    (unless it has a line already)."""
+    from tlmpc.io.json_places import json_place
+
+    if diagnostic.path is None or diagnostic.line is not None:
+        return diagnostic
+    found = json_place(source, diagnostic.path)
+    if found is None:
+        return diagnostic
+    return dataclasses.replace(diagnostic, line=found[0], col=found[1])
+
+
+def _validated(
+    document: Mapping[str, Any],
+    file: str | None,
+    convention: str | None,
+    signals: Mapping[str, Signal] | None,
+    source: str | None,
+) -> TraceInput:
     fmt = document.get("format")
     if not isinstance(fmt, str) or not fmt.startswith("tlmpc.trace/"):
         raise _fail(
@@ -250,54 +485,114 @@ def from_document(
             f"not a tlmpc trace (format {fmt!r})",
             file,
             hint="pass a trace.json written by `tlmpc compile`, or a CSV with --mission",
+            path=json_path("format"),
         )
     regions_doc = document.get("regions")
     if not isinstance(regions_doc, dict):
-        raise _fail("V004", "the trace has no `regions`", file)
+        raise _fail(
+            "V004",
+            "the trace has no `regions`",
+            file,
+            hint='give the regions as an object of name -> polygon, e.g. "regions": '
+            '{"a": [[0, 0], [1, 0], [1, 1]]}',
+            path=json_path("regions"),
+        )
     regions = _polygons(regions_doc, file)
     for name, polygon in regions.items():
-        _check_simple(polygon, f"region {name!r}", file)
+        _check_simple(polygon, f"region {name!r}", file, json_path("regions", name))
     samples = _samples(document.get("points"), file)
     loop = document.get("loop_start")
     if loop is not None and (
         not isinstance(loop, int) or isinstance(loop, bool) or not 0 <= loop < len(samples)
     ):
-        raise _fail("V008", f"loop_start {loop!r} is not a sample index", file)
+        raise _fail(
+            "V008",
+            f"loop_start {loop!r} is not a sample index",
+            file,
+            hint=f"loop_start is null, or the index (0 to {len(samples) - 1}) of the sample "
+            "from which the run repeats",
+            path=json_path("loop_start"),
+        )
     workspace = document.get("workspace") or {}
     if not isinstance(workspace, dict):
-        raise _fail("V004", "the trace's `workspace` is not a mapping {boundary, holes}", file)
+        raise _fail(
+            "V004",
+            "the trace's `workspace` is not a mapping {boundary, holes}",
+            file,
+            hint='write it as "workspace": {"boundary": [[x, y], ...], "holes": [...]}',
+            path=json_path("workspace"),
+        )
     boundary = workspace.get("boundary")
-    boundary_polygon = _polygon(boundary, "workspace boundary", file) if boundary else None
+    boundary_path = json_path("workspace", "boundary")
+    boundary_polygon = (
+        _polygon(boundary, "workspace boundary", file, boundary_path) if boundary else None
+    )
+    holes_path = ("workspace", "holes")
     holes = tuple(
-        _polygon(h, f"hole {i}", file) for i, h in enumerate(workspace.get("holes") or [])
+        _polygon(h, f"hole {i}", file, json_path(*holes_path, i))
+        for i, h in enumerate(
+            _polygon_list(workspace.get("holes"), "`workspace.holes`", file, json_path(*holes_path))
+        )
     )
     components_doc = workspace.get("components") or []
     if not isinstance(components_doc, list) or not all(
         isinstance(c, dict) and "boundary" in c for c in components_doc
     ):
-        raise _fail("V004", "workspace.components is not a list of {boundary, holes}", file)
+        raise _fail(
+            "V004",
+            "workspace.components is not a list of {boundary, holes}",
+            file,
+            hint='write it as "components": [{"boundary": [[x, y], ...], "holes": [...]}]',
+            path=json_path("workspace", "components"),
+        )
     components = tuple(
         (
-            _polygon(c["boundary"], f"boundary of component {k}", file),
+            _polygon(
+                c["boundary"],
+                f"boundary of component {k}",
+                file,
+                json_path("workspace", "components", k, "boundary"),
+            ),
             tuple(
-                _polygon(h, f"hole {i} of component {k}", file)
-                for i, h in enumerate(c.get("holes") or [])
+                _polygon(
+                    h,
+                    f"hole {i} of component {k}",
+                    file,
+                    json_path("workspace", "components", k, "holes", i),
+                )
+                for i, h in enumerate(
+                    _polygon_list(
+                        c.get("holes"),
+                        f"`holes` of component {k}",
+                        file,
+                        json_path("workspace", "components", k, "holes"),
+                    )
+                )
             ),
         )
         for k, c in enumerate(components_doc)
     )
     if boundary_polygon is not None:
-        _check_simple(boundary_polygon, "workspace boundary", file)
+        _check_simple(boundary_polygon, "workspace boundary", file, boundary_path)
     for i, hole in enumerate(holes):
-        _check_simple(hole, f"hole {i}", file)
+        _check_simple(hole, f"hole {i}", file, json_path(*holes_path, i))
     for k, (outer, inner) in enumerate(components):
-        _check_simple(outer, f"boundary of component {k}", file)
+        component_path = ("workspace", "components", k)
+        _check_simple(
+            outer, f"boundary of component {k}", file, json_path(*component_path, "boundary")
+        )
         for i, hole in enumerate(inner):
-            _check_simple(hole, f"hole {i} of component {k}", file)
+            _check_simple(
+                hole, f"hole {i} of component {k}", file, json_path(*component_path, "holes", i)
+            )
     chosen = convention or document.get("boundary") or "right"
     if chosen not in ("right", "closed"):
         raise _fail(
-            "V009", f"unknown boundary convention {chosen!r}", file, hint="use right or closed"
+            "V009",
+            f"unknown boundary convention {chosen!r}",
+            file,
+            hint="use right or closed",
+            path=json_path("boundary"),
         )
     speed = document.get("max_speed")
     end = document.get("end")
@@ -314,15 +609,16 @@ def from_document(
             f"`end` is {end!r} with loop_start {loop!r}",
             file,
             hint="`end` is stay or open without a loop_start, loop with one (or leave it out)",
+            path=json_path("end"),
         )
     ending: Ending = "loop" if loop is not None else ("stay" if end == "stay" else "open")
-    reactive = _reactive_fields(document, set(regions), file, signals)
+    reactive = _reactive_fields(document, set(regions), file, signals, source)
     propositions = set(regions) | set(reactive["sensors"]) | set(reactive["actions"])
     return TraceInput(
         times=samples[:, 0].copy(),
         points=samples[:, 1:].copy(),
         loop_start=loop,
-        formula=_formula(document.get("ltl"), propositions, file),
+        formula=_formula(document.get("ltl"), propositions, file, source=source),
         regions=regions,
         boundary_polygon=boundary_polygon,
         holes=holes,
@@ -339,14 +635,19 @@ def from_document(
 def _radius(value: Any, file: str | None) -> float:
     if value is None:
         return 0.0
-    if (
-        not isinstance(value, int | float)
-        or isinstance(value, bool)
-        or not np.isfinite(value)
-        or value < 0
-    ):
-        raise _fail("V004", f"radius {value!r} is not a number >= 0", file)
-    return float(value)
+    try:
+        radius = float(value) if isinstance(value, int | float) else math.nan
+    except OverflowError:  # an integer too large for a float
+        radius = math.inf
+    if isinstance(value, bool) or not math.isfinite(radius) or radius < 0:
+        raise _fail(
+            "V004",
+            f"radius {value!r} is not a number >= 0",
+            file,
+            hint="radius is the robot body's radius, a finite number >= 0 (0: a point robot)",
+            path=json_path("radius"),
+        )
+    return radius
 
 
 def read_csv(path: Path, columns: Sequence[str] | None = None) -> tuple[FloatArray, list[int]]:
@@ -365,41 +666,61 @@ MAX_CSV_ROWS = 2_000_000
 MAX_CSV_LINE = 4096
 
 
-def _csv_extent(path: Path) -> tuple[int, int, int]:
-    """Bytes, rows and longest line of a CSV file, read in chunks until a limit is passed."""
+class _CsvExtent(NamedTuple):
+    """What the size checks see of a CSV file (read until a limit is passed)."""
+
+    size: int
+    rows: int
+    longest: int
+    #: the number of the first line longer than :data:`MAX_CSV_LINE`, if one was met
+    long_line: int | None
+
+
+def _csv_extent(path: Path) -> _CsvExtent:
+    """Bytes, rows and longest line of a CSV file, read in chunks until a limit is passed;
+    lines end where the log readers end them (see :func:`tlmpc.importers.logs.split_lines`)."""
     rows = 0
     longest = 0
     current = 0
     size = 0
+    long_line = None
+    after_cr = False  # the chunk before ended with a CR: a LF now is the rest of its CR LF
     try:
         with open(path, "rb") as stream:  # chunks: /dev/zero or a huge log stop early
             while chunk := stream.read(1 << 20):
                 size += len(chunk)
-                lines = chunk.split(b"\n")
+                text = chunk[1:] if after_cr and chunk.startswith(b"\n") else chunk
+                after_cr = chunk.endswith(b"\r")
+                # a line ends at LF, CR LF or a lone CR (as the log readers end it); two
+                # replaces and a split are three times as fast as a regular expression's split
+                lines = text.replace(b"\r\n", b"\n").replace(b"\r", b"\n").split(b"\n")
+                ended = [current + len(lines[0]), *map(len, lines[1:-1])][: len(lines) - 1]
+                for offset, length in enumerate(ended):
+                    if length > MAX_CSV_LINE and long_line is None:
+                        long_line = rows + 1 + offset
+                longest = max(longest, *ended) if ended else longest
                 rows += len(lines) - 1
-                if len(lines) == 1:
-                    current += len(lines[0])
-                else:
-                    longest = max(longest, current + len(lines[0]), *map(len, lines[1:-1]))
-                    current = len(lines[-1])
+                current = len(lines[-1]) if len(lines) > 1 else current + len(lines[0])
+                if current > MAX_CSV_LINE and long_line is None:
+                    long_line = rows + 1
                 longest = max(longest, current)
                 if size > MAX_CSV_BYTES or rows > MAX_CSV_ROWS or longest > MAX_CSV_LINE:
                     break
     except OSError as exc:
         raise _fail("U001", f"cannot read {path}: {exc.strerror or exc}", str(path)) from None
-    return size, rows, longest
+    return _CsvExtent(size, rows, longest, long_line)
 
 
 def is_large_csv(path: Path) -> bool:
     """Whether the whole-log reader refuses the CSV for its size alone (U038): a log to
     stream instead."""
-    size, rows, longest = _csv_extent(path)
+    size, rows, longest, _ = _csv_extent(path)
     return (size > MAX_CSV_BYTES or rows > MAX_CSV_ROWS) and longest <= MAX_CSV_LINE
 
 
 def check_csv_file(path: Path) -> None:
     """Refuse (U038) a CSV trace too large to verify, reading it in chunks (never whole)."""
-    size, rows, longest = _csv_extent(path)
+    size, rows, longest, long_line = _csv_extent(path)
     if size > MAX_CSV_BYTES or rows > MAX_CSV_ROWS:
         raise _fail(
             "U038",
@@ -412,9 +733,11 @@ def check_csv_file(path: Path) -> None:
     if longest > MAX_CSV_LINE:
         raise _fail(
             "U038",
-            f"the CSV trace has a line longer than {MAX_CSV_LINE} bytes",
+            f"the CSV trace has a line longer than {MAX_CSV_LINE} bytes"
+            + (f" (line {long_line})" if long_line is not None else ""),
             str(path),
             hint="a CSV trace has short t,x,y rows; is this the right file?",
+            line=long_line,
         )
 
 
@@ -458,10 +781,15 @@ def read_trace(
             str(path),
             hint="point the link at a trace.json, a log or a folder of logs",
         )
-    from tlmpc.io.artifacts import read_json
+    from tlmpc.io.artifacts import MAX_ARTIFACT_BYTES, parse_json
+    from tlmpc.io.inputs import read_text
 
+    text = read_text(
+        path, limit=MAX_ARTIFACT_BYTES, code="U001", too_large_code="U040", what="artifact"
+    )
     # non-finite numbers are read, so that the verifier reports the sample where it is
-    return from_document(read_json(path, finite=False), file=str(path), convention=convention)
+    document = parse_json(text, path, finite=False)
+    return from_document(document, file=str(path), convention=convention, source=text)
 
 
 def load_log_mission(mission_path: Path) -> Mission:
@@ -549,7 +877,9 @@ def _log_trace(
         transform=options.transform,
         frame=options.frame,
     )
-    samples = _samples(log.samples, str(path), list(log.lines) or None)
+    from tlmpc.importers.logs import SampleColumns
+
+    samples = _samples(log.samples, str(path), list(log.lines) or None, SampleColumns(path, log))
     document = _mission_fields(mission)
     document["points"] = samples.tolist()
     signals = None
