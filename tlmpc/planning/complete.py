@@ -1,6 +1,10 @@
 """Complete planning: a plan whenever some continuous trajectory satisfies the task.
 
 1. Plan on D without bounces (the usual case: nothing changes, the mesh stays as built).
+   If that fails (or its product is beyond the budget, P040), ask whether the task can be
+   accepted at all on the letters the robot can reach (:mod:`tlmpc.planning.reach`, a search
+   over the triangles): when it cannot, no step below finds a plan, and the explanation
+   follows at once, whatever the budgets.
 2. If that fails, plan with bounces allowed.  That product is stutter-equivalent to the face
    graph of the region arrangement (see docs/planning.md), so failing here means that no
    trajectory in the plane satisfies the task: the explanation is computed against it.
@@ -22,15 +26,21 @@ from typing import Protocol
 from tlmpc.abstraction.model import Abstraction
 from tlmpc.abstraction.refine import split_triangles
 from tlmpc.automata.model import Automaton
-from tlmpc.base.errors import Diagnostic, NoPlanError, TlmpcError, error
+from tlmpc.base.errors import Diagnostic, NoPlanError, TlmpcError, UsageError, error
 from tlmpc.ltl.ast import Formula
 from tlmpc.mission.model import Options, TaskPart
-from tlmpc.planning.boundary import start_cells, task_formula, task_letters
+from tlmpc.planning.boundary import start_cells, start_point_label, task_formula, task_letters
 from tlmpc.planning.budget import check_product_size
-from tlmpc.planning.explain import explain_infeasible
+from tlmpc.planning.explain import (
+    explain_infeasible,
+    explain_no_plan,
+    invariant_mask,
+    invariants,
+)
 from tlmpc.planning.model import Witness
 from tlmpc.planning.passages import passage_turns
 from tlmpc.planning.plan import plan
+from tlmpc.planning.reach import cannot_accept_on_reach
 from tlmpc.planning.timing import MoveTimes
 
 
@@ -111,6 +121,7 @@ def plan_complete(
             on_cells=on_cells,
         )
 
+    out_of_reach: bool | None = None  # asked once, when needed
     try:
         return abstraction, attempt(abstraction)
     except NoPlanError as first:
@@ -119,58 +130,132 @@ def plan_complete(
         # frames hold every product searched on the way until the compile's paused collector
         # runs (Example 8 on convex cells peaked 0.6 GB higher).
         no_bounce = first.diagnostics
-    try:
-        return _refined(abstraction, attempt, start_point, passages=False)
-    except NoPlanError:
-        if reject:
-            raise NoPlanError(no_bounce) from None  # no law here reaches a point under a push
-    # The one place vertex passages come in: no plan exists along edges alone.
-    try:
-        return abstraction, attempt(abstraction, passages=True)
-    except NoPlanError:
-        pass
-    try:
-        return _refined(abstraction, attempt, start_point, passages=True)
-    except NoPlanError:
-        if not explain:
-            raise NoPlanError(no_bounce) from None
-        raise NoPlanError(
-            explain_infeasible(
-                abstraction,
-                automaton,
-                formula=formula,
-                options=options,
-                start_point=start_point,
-                parts=parts(),
-                file=file,
-                fallback=no_bounce,
-                no_plan_reasons=_no_plan_reasons(abstraction, options, start_point),
-            )
-        ) from None
+    except UsageError:
+        # A product beyond the budget (P040) is no answer where a cheap one exists.
+        if not _out_of_reach(abstraction, automaton, formula, options, start_point, resume):
+            raise
+        out_of_reach = True
+        no_bounce = tuple(_why_not(abstraction, automaton, formula, options, start_point))
+    # The searches with U-turns and vertex passages decide what the reachable letters leave
+    # open; when the task cannot be accepted on those at all, none of them finds a plan (and
+    # the passages' budget, P060, must not stand in for that answer).
+    if out_of_reach is None:
+        out_of_reach = _out_of_reach(abstraction, automaton, formula, options, start_point, resume)
+    if not out_of_reach:
+        try:
+            return _refined(abstraction, attempt, start_point, passages=False)
+        except NoPlanError:
+            if reject:
+                raise NoPlanError(no_bounce) from None  # no law here reaches a point under a push
+        # The one place vertex passages come in: no plan exists along edges alone.
+        try:
+            return abstraction, attempt(abstraction, passages=True)
+        except NoPlanError:
+            pass
+        try:
+            return _refined(abstraction, attempt, start_point, passages=True)
+        except NoPlanError:
+            pass
+    if reject or not explain:
+        raise NoPlanError(no_bounce) from None
+    raise NoPlanError(
+        explain_infeasible(
+            abstraction,
+            automaton,
+            formula=formula,
+            options=options,
+            start_point=start_point,
+            parts=parts(),
+            file=file,
+            fallback=no_bounce,
+            no_plan_reasons=_no_plan_reasons(abstraction, options, start_point),
+        )
+    ) from None
+
+
+def _why_not(
+    abstraction: Abstraction,
+    automaton: Automaton,
+    formula: Formula,
+    options: Options,
+    start_point: tuple[float, float],
+) -> list[Diagnostic]:
+    """The explanation :func:`tlmpc.planning.plan.plan` gives when it finds no plan, without
+    building a product."""
+    closed = options.boundary == "closed"
+    return explain_no_plan(
+        abstraction,
+        automaton,
+        formula,
+        invariant_mask(abstraction, formula),
+        starts=start_cells(abstraction, start_point),
+        start_label=start_point_label(abstraction, start_point) if closed else None,
+    )
+
+
+def _out_of_reach(
+    abstraction: Abstraction,
+    automaton: Automaton,
+    formula: Formula,
+    options: Options,
+    start_point: tuple[float, float],
+    resume: frozenset[int] | None = None,
+) -> bool:
+    """Whether the task cannot be accepted on the letters the robot can reach at all
+    (:func:`tlmpc.planning.reach.cannot_accept_on_reach`): then no plan exists."""
+    return cannot_accept_on_reach(
+        abstraction,
+        automaton,
+        allowed=invariant_mask(abstraction, formula),
+        required=invariants(formula),
+        starts=start_cells(abstraction, start_point),
+        start_point=start_point,
+        convention=options.boundary,
+        resume=resume,
+    )
 
 
 def _no_plan_reasons(
     abstraction: Abstraction, options: Options, start_point: tuple[float, float]
 ) -> Callable[[Formula], Sequence[Diagnostic] | None]:
-    """Why the planner (U-turns allowed) finds no plan for a task formula on this map, or
-    None when it finds one."""
+    """Why no trajectory satisfies a task formula on this map (U-turns and vertex passages
+    allowed), or None when one does or the budget leaves it open: a blamed set then only
+    grows, it never holds parts that have a plan."""
     from tlmpc.automata.translate import translate
 
     convention = options.boundary
     letters = task_letters(abstraction, convention, start_point)
 
     def no_plan_reasons(formula: Formula) -> Sequence[Diagnostic] | None:
-        try:
+        automaton = translate(task_formula(formula, convention), letters=letters)
+
+        def attempt(*, passages: bool) -> None:
+            check_product_size(abstraction, automaton)
             plan(
                 abstraction,
-                translate(task_formula(formula, convention), letters=letters),
+                automaton,
                 formula=formula,
                 options=options,
                 start_point=start_point,
                 bounces=True,
+                passages=passages,
             )
+
+        if _out_of_reach(abstraction, automaton, formula, options, start_point):
+            return _why_not(abstraction, automaton, formula, options, start_point)
+        try:
+            attempt(passages=False)
+            return None
         except NoPlanError as failure:
-            return failure.diagnostics
+            reasons = failure.diagnostics
+        except UsageError:
+            return None  # beyond the budget: not known to have no plan
+        try:
+            attempt(passages=True)
+        except NoPlanError:
+            return reasons
+        except UsageError:
+            return None
         return None
 
     return no_plan_reasons

@@ -19,6 +19,7 @@ from tlmpc.ltl.printer import to_text
 from tlmpc.ltl.transform import nnf
 from tlmpc.mission.model import Options, TaskPart
 from tlmpc.planning.boundary import StartCell
+from tlmpc.planning.reach import passable_vertices, reachable_triangles
 
 BoolArray = npt.NDArray[np.bool_]
 
@@ -49,25 +50,6 @@ def invariant_mask(abstraction: Abstraction, formula: Formula) -> BoolArray:
         dtype=bool,
     )
     return letter_ok[abstraction.letter_of]
-
-
-def _reachable(
-    abstraction: Abstraction, allowed: BoolArray, sources: Sequence[int] | None = None
-) -> BoolArray:
-    m = abstraction.num_triangles
-    neighbors = abstraction.neighbors
-    seen = np.zeros(m, dtype=bool)
-    start = np.array([abstraction.start] if sources is None else list(sources), dtype=np.int64)
-    frontier = np.unique(start[allowed[start]]) if len(start) else start
-    seen[frontier] = True
-    # Breadth-first, one layer of triangles per round, through edges between allowed ones.
-    while len(frontier):
-        ahead = neighbors[frontier].reshape(-1)
-        ahead = ahead[ahead >= 0]
-        ahead = np.unique(ahead[allowed[ahead] & ~seen[ahead]])
-        seen[ahead] = True
-        frontier = ahead
-    return seen
 
 
 def _positive_props(formula: Formula) -> list[str]:
@@ -183,7 +165,7 @@ def explain_no_plan(
                 hint=f"`{text}` constrains the first instant; move the start or the task",
             )
         ]
-    problems = _region_facts(abstraction, formula, {}, cells)
+    problems = _region_facts(abstraction, formula, {}, cells, closed=start_label is not None)
     if problems:
         return problems
     return [
@@ -258,7 +240,10 @@ def explain_infeasible(
         involved = f"; the parts involved: {quoted}" if len(core) > 1 else ""
         return [dataclasses.replace(d, hint=(d.hint or "") + involved, **where) for d in exact]
     cells = [c.triangle for c in start_cells(abstraction, start_point)]
-    facts = "; ".join(d.message for d in _region_facts(abstraction, blamed, where, cells))
+    closed = options.boundary == "closed"
+    facts = "; ".join(
+        d.message for d in _region_facts(abstraction, blamed, where, cells, closed=closed)
+    )
     if len(core) == 1:
         headline = error(
             "P010",
@@ -298,14 +283,20 @@ def _region_facts(
     formula: Formula,
     where: dict[str, Any],
     cells: Sequence[int] | None = None,
+    *,
+    closed: bool = False,
 ) -> list[Diagnostic]:
-    """Regions the blamed parts need that have no free space or cannot be reached."""
+    """Regions the blamed parts need that have no free space or cannot be reached (across
+    edges or through mesh vertices, as vertex passages go; ``closed``: under the closed
+    convention, not through a corner of a region the task forbids)."""
     allowed = invariant_mask(abstraction, formula)
     sources = [abstraction.start] if cells is None else list(cells)
     if not any(allowed[t] for t in sources):
         return []
-    reachable_ok = _reachable(abstraction, allowed, sources)
-    reachable_any = _reachable(abstraction, np.ones(abstraction.num_triangles, dtype=bool), sources)
+    passable = passable_vertices(abstraction, invariants(formula), closed=closed)
+    reachable_ok = reachable_triangles(abstraction, allowed, sources, passable)
+    everywhere = np.ones(abstraction.num_triangles, dtype=bool)
+    reachable_any = reachable_triangles(abstraction, everywhere, sources)
     facts: list[Diagnostic] = []
     for name in _positive_props(formula):
         with_region = np.array([name in letter for letter in abstraction.letters], dtype=bool)

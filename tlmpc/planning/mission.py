@@ -9,7 +9,7 @@ Only this module knows how the pieces of planning fit together for a mission:
   the mesh, so under ``closed`` every attempt, the fallback included, reads the crossing and
   start letters and the rewritten task (:mod:`tlmpc.planning.boundary`);
 * **completeness**: U-turn refinement and vertex passages (:func:`plan_complete`);
-* the product-size budget (:func:`check_product_size`).
+* the product-size budget (:func:`check_product_size`, charged by :func:`plan_complete`).
 
 A re-plan of a run under way (``resume``) keeps the mesh and automaton the run was compiled
 with (the executor's triangles and automaton states refer to them) and so never drops the
@@ -121,9 +121,8 @@ def plan_mission(
     def attempt(
         mesh: Abstraction, task: Automaton, formula: Formula = skeleton, explain: bool = True
     ) -> Planned:
-        from tlmpc.planning.budget import check_product_size
-
-        check_product_size(mesh, task)  # a diagnostic, not an exhausted machine
+        # plan_complete charges every mesh against the budget (P040) before building its
+        # product, and answers an unreachable goal exactly even beyond it
         first = complete(mesh, task, formula, explain, None)
         ratio = mission.robot.disturbance / mission.robot.max_speed
         if witness_realisable(first.abstraction, first.witness, ratio):
