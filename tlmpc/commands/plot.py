@@ -102,7 +102,7 @@ def _read_log(
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Read the artifacts of ``args.out`` and write the picture(s) next to them."""
     from tlmpc.base.errors import EXIT_OK
-    from tlmpc.io.artifacts import read_artifacts, read_json
+    from tlmpc.io.artifacts import read_artifact, read_artifacts
     from tlmpc.io.outdir import replace_file
     from tlmpc.io.report import Reporter
 
@@ -120,7 +120,9 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     log: list[list[float]] | None = None
     verdict: dict[str, Any] | None = None
     if args.verdict is not None:
-        verdict = read_json(args.verdict, "tlmpc.verdict/")
+        # checked against the verdict schema, as the verdict.json of an output is: the
+        # scene trusts every field it draws
+        verdict = read_artifact(args.verdict, "verdict")
     if args.log is not None:
         from tlmpc.verify import verdict_to_json, verify_trace
 

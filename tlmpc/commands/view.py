@@ -44,7 +44,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     from tlmpc.base.errors import EXIT_OK, UsageError, error
     from tlmpc.io.artifacts import ARTIFACT_SCHEMAS
     from tlmpc.io.outdir import replace_file
-    from tlmpc.io.outputs import refuse_input_as_output
+    from tlmpc.io.outputs import plain_name, refuse_input_as_output
     from tlmpc.io.report import Reporter
     from tlmpc.view import render_html, scene_from_log, scene_from_output
 
@@ -81,7 +81,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         )
     replace_file(target, page.encode("utf-8"))
     report = Reporter.for_args(args, out, err)
-    return report.finish(EXIT_OK, {"written": [str(target)]}, f"wrote {target}\n")
+    return report.finish(EXIT_OK, {"written": [str(target)]}, f"wrote {plain_name(str(target))}\n")
 
 
 def _page_beside(log: Path) -> Path:

@@ -11,7 +11,7 @@ from typing import Any
 import yaml
 
 from tlmpc.base.extras import require
-from tlmpc.exports.georeference import Georeference, to_lon_lat
+from tlmpc.exports.georeference import Georeference, Subdivision, encircles_pole
 from tlmpc.exports.plan import Plan, Waypoint
 from tlmpc.io.outputs import csv_cell, yaml_float
 
@@ -171,8 +171,9 @@ def geojson(
         }
     )
     if georeference is not None:
+        subdivision = Subdivision(georeference)
         for feature in features:
-            _georeferenced(feature, georeference)
+            _georeferenced(feature, subdivision)
     collection: dict[str, Any] = {"type": "FeatureCollection", "features": features}
     # strict JSON: a non-finite number (only an edited output has one) is refused, not
     # written as the NaN no GeoJSON reader accepts
@@ -185,55 +186,77 @@ def _sheet(longitude: float) -> int:
     return math.floor((longitude + 180.0) / 360.0)
 
 
-def _georeferenced(feature: dict[str, Any], reference: Georeference) -> None:
+def _georeferenced(feature: dict[str, Any], subdivision: Subdivision) -> None:
     """The feature's geometry in ``[longitude, latitude]``, cut at the antimeridian.
 
-    Each point is mapped by :func:`to_lon_lat` and its longitude unwrapped to within 180
+    Each point is mapped by :func:`~tlmpc.exports.georeference.to_lon_lat`, and points are
+    added along every edge of a polygon or the trajectory so that the straight lon/lat
+    segments written lie within :data:`~tlmpc.exports.georeference.EDGE_TOLERANCE` of the
+    map's own straight edges
+    (:class:`~tlmpc.exports.georeference.Subdivision`); an added point of the trajectory
+    gets the time interpolated along its step.  Longitudes are unwrapped to within 180
     degrees of the map origin's, so a geometry stays connected where the map crosses the
     antimeridian; there RFC 7946 §3.1.9 asks for it to be cut in parts none of which crosses
     it.  Polygons are cut along ±180 (a MultiPolygon), a trajectory becomes a
     MultiLineString whose parts end and start on the antimeridian (its ``times`` then one
     list per part, the crossing's time interpolated), and every longitude written is in
-    [-180, 180].  Rings are oriented again in longitude and latitude."""
+    [-180, 180].  Rings are oriented again in longitude and latitude.  A ring around a pole,
+    which no GeoJSON polygon holds, is M088."""
     geometry = feature["geometry"]
     kind, coordinates = geometry["type"], geometry["coordinates"]
-
-    def unwrapped(x: float, y: float) -> tuple[float, float]:
-        longitude, latitude = to_lon_lat(reference, float(x), float(y))
-        return reference.longitude + math.remainder(longitude - reference.longitude, 360.0), (
-            latitude
-        )
 
     def wrapped(longitude: float, latitude: float) -> list[float]:
         return [longitude - 360.0 * _sheet(longitude), latitude]
 
     if kind == "Point":
-        geometry["coordinates"] = wrapped(*unwrapped(*coordinates))
+        geometry["coordinates"] = wrapped(*subdivision.lon_lat(*coordinates))
     elif kind == "MultiPoint":
-        geometry["coordinates"] = [wrapped(*unwrapped(*p)) for p in coordinates]
+        geometry["coordinates"] = [wrapped(*subdivision.lon_lat(*p)) for p in coordinates]
     elif kind == "LineString":
-        parts, times = _cut_line(
-            [unwrapped(*p) for p in coordinates], feature["properties"].get("times")
-        )
+        import numpy as np
+
+        points, at = subdivision.path(coordinates)
+        given = feature["properties"].get("times")
+        times = None if given is None else np.interp(at, range(len(given)), given).tolist()
+        parts, part_times = _cut_line(points, times)
         if len(parts) > 1:
             geometry["type"], geometry["coordinates"] = "MultiLineString", parts
-            if times is not None:
-                feature["properties"]["times"] = times
         else:
             geometry["coordinates"] = parts[0]
+        if part_times is not None:
+            feature["properties"]["times"] = part_times if len(parts) > 1 else part_times[0]
     else:
         from shapely.geometry import Polygon
 
         polygons = [coordinates] if kind == "Polygon" else coordinates
-        lon_lat = [
-            Polygon(
-                [unwrapped(*p) for p in rings[0]], [[unwrapped(*p) for p in r] for r in rings[1:]]
-            )
-            for rings in polygons
-        ]
+        lon_lat = []
+        for rings in polygons:
+            mapped = [subdivision.path(ring)[0] for ring in rings]
+            if any(encircles_pole(ring) for ring in mapped):
+                raise _around_a_pole(feature)
+            lon_lat.append(Polygon(mapped[0], mapped[1:]))
         feature["geometry"] = _polygonal_geometry(
             [piece for polygon in lon_lat for piece in _cut_polygon(polygon)]
         )
+
+
+def _around_a_pole(feature: dict[str, Any]) -> Exception:
+    from tlmpc.base.errors import UsageError, error
+
+    properties = feature["properties"]
+    what = properties["kind"]
+    if what == "region":
+        what = f"region {properties['name']!r}"
+    return UsageError(
+        error(
+            "M088",
+            f"with this --georeference the {what} goes around a pole, which no GeoJSON "
+            "polygon can hold",
+            hint="export without --georeference (map metres), or place the map's origin "
+            "where the map does not reach a pole",
+            file="--georeference",
+        )
+    )
 
 
 def _cut_polygon(polygon: Any) -> list[Any]:

@@ -32,6 +32,7 @@ from tlmpc.base.errors import (
     Diagnostic,
     TlmpcError,
     best_first,
+    printable,
 )
 from tlmpc.base.startup import EXIT_INTERRUPTED, EXIT_TERMINATED
 
@@ -117,8 +118,10 @@ class Reporter:
             self.err.write(diagnostic.format() + "\n")
 
     def note(self, text: str) -> None:
-        """A status or progress line on standard error (never part of the result)."""
-        self.err.write(text + "\n")
+        """A status or progress line on standard error (never part of the result): one line,
+        whatever the names it quotes hold (a newline in a file name is escaped, as in a
+        diagnostic, so no name can start a line that reads like one)."""
+        self.err.write(printable(text, keep="") + "\n")
         self.err.flush()
 
     def stream(self, text: str) -> None:

@@ -77,13 +77,27 @@ def render_png(
 def png_style() -> Iterator[None]:
     """Matplotlib settings the PNG is drawn with: no path simplification, and text laid out
     at the font's own advance widths (hinting would round each glyph to whole pixels and
-    make a name wider than its layout box)."""
+    make a name wider than its layout box).
+
+    Every text is drawn as it is written, as the SVG draws it: matplotlib would otherwise read
+    the part of a mission's name between two dollar signs as mathtext (a different picture,
+    or a parse error).  A character DejaVu Sans lacks is drawn as its placeholder box, which
+    the layout measured at the widest glyph, so matplotlib's warning about it is not the
+    user's business."""
+    import warnings
+
     import matplotlib
 
     matplotlib.use("Agg", force=False)
     from matplotlib import rc_context
 
-    with rc_context({"path.simplify": False, "text.hinting": "no_hinting"}):
+    with (
+        rc_context(
+            {"path.simplify": False, "text.hinting": "no_hinting", "text.parse_math": False}
+        ),
+        warnings.catch_warnings(),
+    ):
+        warnings.filterwarnings("ignore", "Glyph .* missing from font", UserWarning)
         yield
 
 
