@@ -266,7 +266,8 @@ def read_output(directory: str | os.PathLike[str]) -> Compiled:
     Each JSON artifact is checked against its schema; raises
     :class:`~tlmpc.base.errors.UsageError` when the directory holds no tlmpc output.
     """
-    from tlmpc.io.artifacts import ARTIFACT_SCHEMAS, cross_check, read_artifact
+    from tlmpc.io.artifacts import ARTIFACT_SCHEMAS, MAX_ARTIFACT_BYTES, cross_check, read_artifact
+    from tlmpc.io.inputs import read_text
 
     _expect_path(directory, "directory must be a path", "read_output")
     root = Path(directory)
@@ -275,7 +276,14 @@ def read_output(directory: str | os.PathLike[str]) -> Compiled:
         if (root / name).is_file():
             artifacts[name] = read_artifact(root / name, schema)
     if (root / "automaton.hoa").is_file():
-        artifacts["automaton.hoa"] = (root / "automaton.hoa").read_text(encoding="utf-8")
+        # bounded and decoded as every artifact is (U001 at its first byte that is not UTF-8)
+        artifacts["automaton.hoa"] = read_text(
+            root / "automaton.hoa",
+            limit=MAX_ARTIFACT_BYTES,
+            code="U001",
+            too_large_code="U040",
+            what="artifact",
+        )
     if "mission.json" not in artifacts:
         raise UsageError(
             error(

@@ -56,7 +56,7 @@ def test_simulate_writes_a_checked_trace(guard: Path, tmp_path: Path, kind: str)
     assert validation_errors(trace, "trace") == []
     assert trace["end"] == "open"
     assert trace["loop_start"] is None
-    assert trace["sensors"] == ["person", "alarm"]
+    assert trace["sensors"] == ["alarm", "person"]  # by name, as mission.json keeps them
     assert trace["actions"] == ["camera"]
     assert trace["assumptions"] == ["G F !person", "!alarm"]
     for points in trace["signals"].values():

@@ -4,7 +4,10 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
-from typing import Any, TextIO
+from typing import TYPE_CHECKING, Any, TextIO
+
+if TYPE_CHECKING:
+    from tlmpc.pipeline.stages import CompileResult
 
 NAME = "stage"
 HELP = "run one compiler stage alone from its input artifacts"
@@ -47,32 +50,48 @@ def _bytes(content: Any) -> bytes:
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Run the stage and write what it produced."""
     from tlmpc.base.errors import EXIT_OK, UsageError, error
-    from tlmpc.io.outdir import MARKER, is_tlmpc_output, replace_file
+    from tlmpc.io.outdir import MARKER, is_tlmpc_output, output_lock, replace_files
     from tlmpc.io.report import Reporter
     from tlmpc.pipeline.stages import run_stage_from_artifacts
 
+    if not args.directory.is_dir():
+        raise UsageError(
+            error(
+                "U020",
+                f"{args.directory} is not a directory: there are no artifacts to read",
+                hint="pass the directory given to `tlmpc compile -o`",
+                file=str(args.directory),
+            )
+        )
     target: Path = args.out if args.out is not None else args.directory
     if not target.is_dir():
         raise UsageError(
             error("U074", f"{target} is not a directory", hint="create it first", file=str(target))
         )
     reporter = Reporter.for_args(args, out, err)
-    result = run_stage_from_artifacts(args.name, args.directory)
-    reporter.diagnose(result.warnings)
-    if args.out is not None and not args.force and not is_tlmpc_output(target):
-        existing = sorted(name for name in result.artifacts if (target / name).exists())
-        if existing:
-            raise UsageError(
-                error(
-                    "U012",
-                    f"{target} is not a tlmpc output (it has no {MARKER} file) and holds "
-                    f"{', '.join(existing)}, which this stage would replace",
-                    hint="choose another -o, or pass --force to replace those files",
-                    file=str(target),
+    # the folder written into is held from the reading to the last file, as `tlmpc compile`
+    # holds it: a compile replacing it meanwhile would drop what this stage wrote
+    with output_lock(target):
+        result = run_stage_from_artifacts(args.name, args.directory)
+        reporter.diagnose(result.warnings)
+        if args.out is not None and not args.force and not is_tlmpc_output(target):
+            existing = sorted(name for name in result.artifacts if (target / name).exists())
+            if existing:
+                raise UsageError(
+                    error(
+                        "U012",
+                        f"{target} is not a tlmpc output (it has no {MARKER} file) and holds "
+                        f"{', '.join(existing)}, which this stage would replace",
+                        hint="choose another -o, or pass --force to replace those files",
+                        file=str(target),
+                    )
                 )
-            )
-    for name, content in result.artifacts.items():
-        replace_file(target / name, _bytes(content))
+        files = {target / name: _bytes(content) for name, content in result.artifacts.items()}
+        summary = _summary_after(target, result)
+        if summary is not None:
+            files[target / "summary.json"] = _bytes(summary)
+        # all or none: a refused or failed file leaves the others as they were
+        replace_files(files)
     report = result.reports[0]
     if not args.json:
         written = ", ".join(sorted(result.artifacts)) or "nothing"
@@ -85,6 +104,35 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         "directory": str(target),
     }
     return reporter.finish(EXIT_OK, document)
+
+
+def _summary_after(target: Path, result: CompileResult) -> dict[str, Any] | None:
+    """The summary.json of ``target`` with what this stage determined replaced: its own stage
+    record, the plan or the verdict it wrote, its summary keys; None when ``target`` holds no
+    summary (or one that does not match its schema, which is left as it is)."""
+    from tlmpc.base.errors import UsageError
+    from tlmpc.io.artifacts import read_artifact
+
+    path = target / "summary.json"
+    if not path.is_file():
+        return None
+    try:
+        summary = read_artifact(path, "summary")
+    except UsageError:
+        return None
+    fresh = result.summary()
+    record = fresh["stages"][0]
+    names = [stage["name"] for stage in summary["stages"]]
+    if record["name"] in names:
+        summary["stages"][names.index(record["name"])] = record
+    else:
+        summary["stages"].append(record)
+    summary["total_seconds"] = round(sum(stage["seconds"] for stage in summary["stages"]), 6)
+    summary["artifacts"] = sorted({*summary["artifacts"], *result.artifacts})
+    for key in ("plan", "verdict", *result.extras):
+        if key in fresh:
+            summary[key] = fresh[key]
+    return summary
 
 
 def _plain(value: Any) -> Any:

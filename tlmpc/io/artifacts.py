@@ -234,8 +234,30 @@ def _no_constant(name: str) -> Any:
     raise ValueError(f"{name} is not a JSON number (tlmpc writes non-finite numbers as strings)")
 
 
-#: A number with an exponent of three digits or more may overflow to infinity when read.
-_HUGE_EXPONENT = re.compile(r"[0-9][eE]\+?[0-9]{3}")
+#: A number that may overflow to infinity when read: an exponent of three digits or more, or
+#: more than 308 digits before its point (no exponent at all).
+_HUGE_NUMBER = re.compile(r"[0-9][eE]\+?[0-9]{3}|[0-9]{309}")
+
+
+def _huge_number_place(text: str) -> tuple[int, int]:
+    """Line and column of the first number of ``text`` that overflows (or has more digits than
+    Python reads, 4,300); 1, 1 when there is none."""
+    for found in _HUGE_NUMBER.finditer(text):
+        start, end = found.start(), found.end()
+        while start > 0 and text[start - 1] in _NUMBER_CHARACTERS:
+            start -= 1
+        while end < len(text) and text[end] in _NUMBER_CHARACTERS:
+            end += 1
+        try:
+            finite = math.isfinite(float(text[start:end]))
+        except ValueError:
+            finite = False
+        if not finite or end - start > 4300:
+            return text.count("\n", 0, start) + 1, start - text.rfind("\n", 0, start)
+    return 1, 1
+
+
+_NUMBER_CHARACTERS = frozenset("0123456789.-+eE")
 
 
 def _has_non_finite(document: Any) -> bool:
@@ -277,7 +299,7 @@ def parse_json(
     caller that keeps the text, to place its own diagnostics in it."""
     try:
         document = json.loads(text, parse_constant=_no_constant if finite else None)
-        if finite and _HUGE_EXPONENT.search(text) and _has_non_finite(document):
+        if finite and _HUGE_NUMBER.search(text) and _has_non_finite(document):
             raise ValueError("a number too large for a float (it reads as infinity)")
     except RecursionError:
         raise UsageError(
@@ -290,8 +312,16 @@ def parse_json(
         ) from None
     except ValueError as exc:  # e.g. an integer of more than 4,300 digits
         if not isinstance(exc, json.JSONDecodeError):
+            number_line, number_col = _huge_number_place(text)
             raise UsageError(
-                error("U002", f"not readable JSON: {exc}", file=str(path), line=1, col=1)
+                error(
+                    "U002",
+                    f"not readable JSON: {exc}",
+                    hint="artifacts are written by `tlmpc compile`; was this file edited?",
+                    file=str(path),
+                    line=number_line,
+                    col=number_col,
+                )
             ) from None
         raise UsageError(
             error(
@@ -348,8 +378,10 @@ ARTIFACT_SCHEMAS = {
 
 
 def read_artifact(path: Path, schema: str) -> dict[str, Any]:
-    """The artifact at ``path``, checked against ``schema`` (U071, exit 2, when it fails)."""
-    document = read_json(path)
+    """The artifact at ``path``, checked against ``schema`` (U071, exit 2, when it fails);
+    another kind of artifact under its name is U003."""
+    expected = next((fmt for fmt, name in ARTIFACT_SCHEMAS.values() if name == schema), None)
+    document = read_json(path, expected)
     problems = validation_errors(document, schema)
     if problems:
         raise UsageError(
@@ -437,6 +469,49 @@ def _indices(values: Any, bound: int, low: int = 0) -> bool:
     return True
 
 
+def _mesh_problem(abstraction: Mapping[str, Any]) -> str | None:
+    """What makes the (index-checked) triangles of ``abstraction`` not one mesh, or None: a
+    triangle not counter-clockwise, or a neighbour that does not share the edge opposite the
+    vertex it stands for, or does not name the triangle back."""
+    import numpy as np  # here, not at the top: `tlmpc check` never reads artifacts
+
+    vertices = np.asarray(abstraction["vertices"], dtype=np.float64).reshape(-1, 2)
+    triangles = np.asarray(abstraction["triangles"], dtype=np.int64).reshape(-1, 3)
+    neighbors = np.asarray(abstraction["neighbors"], dtype=np.int64).reshape(-1, 3)
+    a, b, c = (vertices[triangles[:, corner]] for corner in range(3))
+    twice_area = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (
+        c[:, 0] - a[:, 0]
+    )
+    flat = np.flatnonzero(~(twice_area > 0.0))
+    if flat.size:
+        return f"triangle {int(flat[0])} is not counter-clockwise with a positive area"
+    for corner in range(3):  # facet `corner` is the edge opposite that vertex
+        inner = np.flatnonzero(neighbors[:, corner] >= 0)
+        outer = neighbors[inner, corner]
+        back = neighbors[outer] == inner[:, None]
+        facet = np.argmax(back, axis=1)
+        rows = np.arange(inner.size)
+        mine = np.sort(triangles[inner][:, [(corner + 1) % 3, (corner + 2) % 3]], axis=1)
+        theirs = np.sort(
+            np.stack(
+                [
+                    triangles[outer, (facet + 1) % 3],
+                    triangles[outer, (facet + 2) % 3],
+                ],
+                axis=1,
+            ),
+            axis=1,
+        )
+        wrong = np.flatnonzero(~back[rows, facet] | np.any(mine != theirs, axis=1))
+        if wrong.size:
+            triangle = int(inner[wrong[0]])
+            return (
+                f"triangle {triangle}'s neighbour {int(outer[wrong[0]])} across facet {corner} "
+                "does not share that edge with it"
+            )
+    return None
+
+
 def cross_check(directory: Path, documents: Mapping[str, Mapping[str, Any]]) -> None:
     """Refuse (U042) artifacts of ``directory`` that contradict each other: indices out of
     range, a task naming a region the output lacks, a trace or controllers of another
@@ -487,6 +562,25 @@ def cross_check(directory: Path, documents: Mapping[str, Mapping[str, Any]]) -> 
         for ok, what in checks:
             if not ok:
                 raise _tampered(path, f"abstraction.json is inconsistent: not every {what}")
+        problem = _mesh_problem(abstraction)
+        if problem is not None:
+            raise _tampered(path, f"abstraction.json is not one mesh: {problem}")
+    automaton = documents.get("automaton.json")
+    if automaton is not None:
+        state_count = len(automaton["states"])
+        sets = automaton["acceptance"]["sets"]
+        if not (
+            _indices(automaton["initial"], state_count)
+            and all(
+                _indices([edge["src"], edge["dst"]], state_count) and _indices(edge["marks"], sets)
+                for edge in automaton["edges"]
+            )
+        ):
+            raise _tampered(
+                directory / "automaton.json",
+                "automaton.json is inconsistent: not every initial state and edge names one "
+                "of its states (and acceptance sets)",
+            )
     mission = documents.get("mission.json")
     if mission is not None:
         path = directory / "mission.json"

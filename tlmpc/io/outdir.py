@@ -592,7 +592,35 @@ def replace_file(path: Path, data: bytes) -> None:
     device, a directory, a FIFO), and turns I/O errors into U033.  A replaced file keeps its
     permissions; a new one gets ``0666`` minus the umask.
     """
-    path = _absolute(path)
+    replace_files({path: data})
+
+
+def replace_files(contents: Mapping[Path, bytes]) -> None:
+    """:func:`replace_file` for several files that belong together: every target is checked
+    and every new file written beside its target before the first is renamed into place, so
+    a refused target (U034) or a failed write (U033) leaves all of them as they were."""
+    targets = [(_absolute(path), data) for path, data in contents.items()]
+    modes = [_replaceable_mode(path) for path, _ in targets]
+    # the data is in memory: a signal waits for the few system calls below, so it finds
+    # either the old files or the new ones and never a temporary file beside them
+    with _signals_blocked():
+        written: list[tuple[str, Path]] = []
+        try:
+            for (path, data), mode in zip(targets, modes, strict=True):
+                written.append((_written_beside(path, data, mode), path))
+            for temporary, path in written:
+                try:
+                    os.replace(temporary, path)
+                except OSError as exc:
+                    raise io_error(exc, path, "write") from None
+        finally:
+            for temporary, _ in written:
+                Path(temporary).unlink(missing_ok=True)
+
+
+def _replaceable_mode(path: Path) -> int:
+    """The permissions a new ``path`` gets (its own when it is a regular file); U034 when it
+    exists and is a link or not a regular file."""
     try:
         info: os.stat_result | None = os.lstat(path)
     except FileNotFoundError:
@@ -609,22 +637,23 @@ def replace_file(path: Path, data: bytes) -> None:
                 file=str(path),
             )
         )
-    mode = stat.S_IMODE(info.st_mode) if info is not None else 0o666 & ~_umask()
-    # the data is in memory: a signal waits for the few system calls below, so it finds
-    # either the old file or the new one and never a temporary file beside it
-    with _signals_blocked():
-        try:
-            handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
-        except OSError as exc:
-            raise io_error(exc, path.parent, "create a temporary file in") from None
-        try:
-            with os.fdopen(handle, "wb") as stream:
-                stream.write(data)
-            os.chmod(temporary, mode)
-            os.replace(temporary, path)
-        except OSError as exc:
-            Path(temporary).unlink(missing_ok=True)
-            raise io_error(exc, path, "write") from None
-        except BaseException:
-            Path(temporary).unlink(missing_ok=True)
-            raise
+    return stat.S_IMODE(info.st_mode) if info is not None else 0o666 & ~_umask()
+
+
+def _written_beside(path: Path, data: bytes, mode: int) -> str:
+    """A temporary file beside ``path`` holding ``data`` with ``mode``; its name."""
+    try:
+        handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    except OSError as exc:
+        raise io_error(exc, path.parent, "create a temporary file in") from None
+    try:
+        with os.fdopen(handle, "wb") as stream:
+            stream.write(data)
+        os.chmod(temporary, mode)
+    except OSError as exc:
+        Path(temporary).unlink(missing_ok=True)
+        raise io_error(exc, path, "write") from None
+    except BaseException:
+        Path(temporary).unlink(missing_ok=True)
+        raise
+    return temporary

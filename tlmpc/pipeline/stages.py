@@ -23,6 +23,7 @@ from tlmpc.base.errors import (
     Diagnostic,
     InvalidInputError,
     TlmpcError,
+    UsageError,
     error,
 )
 from tlmpc.base.memo import current_memo, memo_scope
@@ -865,6 +866,8 @@ def compilation_from_artifacts(directory: Path, needed: Sequence[Product[Any]]) 
                 )
             )
         documents[product.artifact] = read_artifact(path, product.schema)
+    if MISSION.artifact in documents:
+        _refuse_unusable_shapes(directory / MISSION.artifact, documents[MISSION.artifact])
     # before any is used: the artifacts must agree (indices in range, one mission)
     cross_check(directory, documents)
     for product in needed:
@@ -872,6 +875,76 @@ def compilation_from_artifacts(directory: Path, needed: Sequence[Product[Any]]) 
     _refuse_unguaranteed(directory, documents, products)
     source = Path(str(documents.get("mission.json", {}).get("source") or directory))
     return Compilation(source=source, products=products, documents=documents)
+
+
+def _refuse_unusable_shapes(path: Path, document: Mapping[str, Any]) -> None:
+    """Refuse (U042, at mission.json) the shapes a mission file could not hold: a polygon that
+    is not simple, has no area or too few corners, a region or hole outside the boundary, a
+    start outside the workspace.  The load stage refused them in the mission; an edited
+    mission.json would otherwise reach the triangulation and GEOS (exit 3)."""
+    from tlmpc.mission.geometry import check_layout, check_shape
+    from tlmpc.mission.shapes import CheckedShape
+
+    file = str(path)
+    found: list[Diagnostic] = []
+
+    def unplaced(keys: tuple[str | int, ...]) -> tuple[int, int]:
+        return (0, 0)  # positions in the mission's YAML; the refusal names the JSON path
+
+    def checked(points: Any, keys: tuple[str | int, ...], what: str) -> CheckedShape | None:
+        shape, problems = check_shape(points, keys, what, file, unplaced)
+        found.extend(problems)
+        return shape
+
+    workspace = document["workspace"]
+    boundary = checked(workspace["boundary"], ("workspace", "boundary"), "workspace boundary")
+    holes = [
+        checked(hole, ("workspace", "holes", i), f"hole {i + 1}")
+        for i, hole in enumerate(workspace["holes"])
+    ]
+    components = [
+        (
+            checked(c["boundary"], ("workspace", "components", k, "boundary"), f"component {k}"),
+            [
+                checked(hole, ("workspace", "components", k, "holes", i), f"hole {i + 1}")
+                for i, hole in enumerate(c["holes"])
+            ],
+        )
+        for k, c in enumerate(workspace.get("components", ()))
+    ]
+    regions = {
+        name: checked(points, ("regions", name), f"region {name!r}")
+        for name, points in document["regions"].items()
+    }
+    if document["robot"].get("footprint"):
+        checked(document["robot"]["footprint"], ("robot", "footprint"), "robot footprint")
+    if not found:  # every shape usable: their relations
+        start = document["robot"]["start"]
+        found = check_layout(
+            boundary,
+            [h for h in holes if h is not None],
+            {name: shape for name, shape in regions.items() if shape is not None},
+            (float(start[0]), float(start[1])),
+            ("robot", "start"),
+            file,
+            unplaced,
+            components=[
+                (b, [h for h in hs if h is not None]) for b, hs in components if b is not None
+            ],
+        )
+    refused = [
+        error(
+            "U042",
+            f"mission.json holds a shape no mission can: {problem.message}",
+            hint="this output was edited or damaged; compile the mission again",
+            file=file,
+            path=problem.path,
+        )
+        for problem in found
+        if problem.severity == "error"
+    ]
+    if refused:
+        raise UsageError(refused)
 
 
 def _refuse_unguaranteed(

@@ -125,7 +125,9 @@ def build_game(
 ) -> MissionGame:
     """The GR(1) game of a reactive mission (``pieces``: the GR(1) reading of its parts)."""
     assert mission.reactive is not None
-    sensors = mission.reactive.sensor_names
+    # by name, as mission.json keeps them: the game (and the strategy's variable order, hence
+    # its bytes) is then the same whether the mission comes from its file or from mission.json
+    sensors = tuple(sorted(mission.reactive.sensor_names))
     actions = mission.reactive.actions
     letters = _Letters(faces, sensors, actions)
     count = max(faces.count, 1)

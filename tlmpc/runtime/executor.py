@@ -272,7 +272,7 @@ class Executor:
         """The command for ``pose`` at time ``t``: ``(vx, vy)``, or ``(v, omega)`` for a
         unicycle.  Updates the plan step, the task progress and recovers when needed."""
         expected = 3 if self.is_unicycle else 2
-        if not _finite_numbers(pose, expected, t):
+        if not finite_numbers(pose, expected, t):
             shape = "(x, y, theta)" if self.is_unicycle else "(x, y)"
             raise UsageError(
                 error(
@@ -544,7 +544,7 @@ class Executor:
         )
 
 
-def _finite_numbers(pose: Any, expected: int, t: Any) -> bool:
+def finite_numbers(pose: Any, expected: int, t: Any) -> bool:
     """Whether ``pose`` is ``expected`` finite numbers and ``t`` a finite number (anything
     else, None or text or an integer too large for a float, is not)."""
     try:

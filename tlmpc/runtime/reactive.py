@@ -40,7 +40,7 @@ from tlmpc.control.model import StepController
 from tlmpc.mission.model import Mission
 from tlmpc.planning.model import Witness
 from tlmpc.reactive.faces import faces_of
-from tlmpc.runtime.executor import CompiledOutput
+from tlmpc.runtime.executor import CompiledOutput, finite_numbers
 from tlmpc.runtime.locate import Locator
 from tlmpc.runtime.strategy_machine import Stepper, strategy_stepper
 from tlmpc.simulate.exact import exit_step
@@ -289,16 +289,29 @@ class ReactiveExecutor:
         """The readings of the mission's sensors, each given and none other (a misspelt name
         would otherwise be dropped silently and the sensor read as missing)."""
         known = self.machine.sensors
+        hint = f"pass one value, true or false, per sensor of the mission: {', '.join(known)}"
+        if not isinstance(sensors, Mapping):
+            raise UsageError(
+                error(
+                    "Q125",
+                    f"the readings are a mapping of sensor names to true or false, not "
+                    f"{repr(sensors)[:60]}",
+                    hint=hint,
+                )
+            )
         missing = [s for s in known if s not in sensors]
         unknown = sorted(str(s) for s in sensors if s not in known)
-        if missing or unknown:
+        # a reading is a truth value: "no" or None read by their truth would be guesses
+        unread = [s for s in known if s in sensors and not _truth_value(sensors[s])]
+        if missing or unknown or unread:
             said = [f"no reading of {', '.join(missing)}"] if missing else []
             said += [f"no sensor called {', '.join(unknown)}"] if unknown else []
+            said += [f"not true or false: {', '.join(unread)}"] if unread else []
             raise UsageError(
                 error(
                     "Q125",
                     f"the readings {dict(sensors)!r} do not fit the mission: {'; '.join(said)}",
-                    hint=f"pass one value per sensor of the mission: {', '.join(known)}",
+                    hint=hint,
                 )
             )
         return {s: bool(sensors[s]) for s in known}
@@ -310,16 +323,16 @@ class ReactiveExecutor:
         ``sensors``: the events the readings and the position make are taken first (a
         sensor change, an arrival in the goal face, both, or a due stutter step).  A robot
         found in a face it was not heading for is ``off_course`` and gets zero velocity."""
-        where = np.asarray(point, dtype=np.float64)
-        if where.shape != (2,) or not np.all(np.isfinite(where)) or not math.isfinite(t):
+        if isinstance(point, str | bytes) or not finite_numbers(point, 2, t):
             raise UsageError(
                 error(
                     "Q125",
                     f"a position is (x, y) of finite numbers with a finite time, not "
-                    f"{tuple(point)!r} at t={t!r}",
+                    f"{repr(point)[:60]} at t={repr(t)[:30]}",
                     hint="pass the robot's (reference) point in the mission's frame",
                 )
             )
+        where = np.asarray(point, dtype=np.float64)
         if self._locator is None:
             self._locator = Locator.of(self.abstraction)
         reading = self._reading(sensors)
@@ -590,3 +603,10 @@ def executor_summary(executor: ReactiveExecutor) -> dict[str, Any]:
     for event in executor.events:
         kinds[event.kind] = kinds.get(event.kind, 0) + 1
     return {"events": len(executor.events), "by_kind": kinds, "solves": executor.solves}
+
+
+def _truth_value(reading: Any) -> bool:
+    """Whether ``reading`` is a sensor's truth value: a bool (numpy's too) or 0 or 1."""
+    if isinstance(reading, bool | np.bool_):
+        return True
+    return isinstance(reading, int | np.integer) and reading in (0, 1)

@@ -55,6 +55,34 @@ def strategy_stepper(
     return SymbolicMachine.of_json(document, sensors, actions, file)
 
 
+def _refuse_broken_graph(document: Mapping[str, Any], variables: Sequence[str], file: str) -> None:
+    """Refuse (Q123) an explicit machine the executor could not step: a node without a value
+    of every variable, a transition or initial node naming no node (an edited file)."""
+    nodes = document["nodes"]
+
+    def is_node(index: Any) -> bool:
+        return type(index) is int and 0 <= index < len(nodes)
+
+    for number, node in enumerate(nodes):
+        missing = [name for name in variables if name not in node["state"]]
+        if missing:
+            problem = f"node {number} has no value of {', '.join(missing)}"
+            break
+    else:
+        ends = [end for pair in document["transitions"] for end in pair]
+        if all(map(is_node, [*ends, *document["initial"]])):
+            return
+        problem = "a transition or an initial node names no node"
+    raise UsageError(
+        error(
+            "Q123",
+            f"strategy.json is not a strategy tlmpc writes: {problem}",
+            hint="the file was edited or damaged: compile the mission again",
+            file=file,
+        )
+    )
+
+
 @dataclass(frozen=True)
 class StrategyMachine(NodeBehaviour):
     """The Mealy machine of ``strategy.json`` with its transitions indexed by visible input.
@@ -103,6 +131,7 @@ class StrategyMachine(NodeBehaviour):
                     file=file,
                 )
             )
+        _refuse_broken_graph(document, [*inputs, *outputs], file)
         sensors, actions = inputs[:count], outputs[1 : 1 + len(actions)]
         visible = (*sensors, FACE, MOVED)
         nodes = tuple(dict(node["state"]) for node in document["nodes"])
