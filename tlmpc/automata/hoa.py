@@ -37,8 +37,15 @@ def _label(guard: Formula, index: dict[str, int]) -> str:
     raise ValueError(f"guards are propositional, got {guard!r}")
 
 
+def _escaped(text: str) -> str:
+    """``text`` for a double-quoted string of HOA or DOT: each backslash and quote escaped by a
+    backslash, which both formats read back (Graphviz would otherwise take a backslash that
+    ends a name for an escape of the next quote and end the string there)."""
+    return text.replace("\\", "\\\\").replace('"', '\\"')
+
+
 def _quote(text: str) -> str:
-    return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    return '"' + _escaped(text) + '"'
 
 
 def to_hoa(automaton: Automaton) -> str:
@@ -327,13 +334,13 @@ def to_dot(automaton: Automaton) -> str:
     for state in range(automaton.num_states):
         shape = "doublecircle" if state in accepting else "circle"
         name = automaton.state_names[state] if state < len(automaton.state_names) else ""
-        label = f"{state}\\n{name}".replace('"', '\\"')
+        label = f"{state}\\n{_escaped(name)}"  # a DOT line break, then the name
         lines.append(f'  {state} [shape={shape}, label="{label}"];')
     for edge in automaton.edges:
         label = to_text(edge.guard)
         if edge.marks and not automaton.state_based:
             label += " {" + ",".join(str(m) for m in sorted(edge.marks)) + "}"
-        label = label.replace('"', '\\"')
+        label = _escaped(label)
         lines.append(f'  {edge.src} -> {edge.dst} [label="{label}"];')
     lines.append("}")
     return "\n".join(lines) + "\n"

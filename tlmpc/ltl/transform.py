@@ -13,6 +13,7 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from typing import assert_never
 
+from tlmpc.base.errors import UsageError, error
 from tlmpc.ltl.ast import (
     FALSE,
     TRUE,
@@ -51,38 +52,112 @@ _SAME: dict[type, Callable[[Formula, Formula], Formula]] = {
 }
 
 
+#: The most operators and names a negation normal form may have.  ``a <-> b`` is written
+#: ``(a & b) | (!a & !b)``, both sides twice, so a chain of n equivalences has about 2^n of
+#: them: past this size building (and then translating) it would take minutes and gigabytes.
+MAX_NORMAL_FORM_SIZE = 200_000
+
+
+def normal_form_size(formula: Formula, negate: bool = False) -> int:
+    """An upper bound of the number of operators and names :func:`nnf` writes for ``formula``
+    (its negation when ``negate``; exact but for the ``&``/``|`` it flattens), counted in time
+    linear in the formula's own size."""
+    # iterative, so that it takes formulas as deep as the parser does (L005) from any stack;
+    # keyed by id: a node's operands are alive as long as the formula is
+    sizes: dict[tuple[int, bool], int] = {}
+    stack: list[tuple[Formula, bool, bool]] = [(formula, negate, False)]
+    while stack:
+        node, negated, operands_done = stack.pop()
+        operands = _nnf_children(node, negated)
+        if operands_done:
+            own = _own_size(node, negated)
+            sizes[(id(node), negated)] = own + sum(sizes[(id(a), f)] for a, f in operands)
+        elif (id(node), negated) not in sizes:
+            stack.append((node, negated, True))
+            stack.extend((a, f, False) for a, f in operands if (id(a), f) not in sizes)
+    return sizes[(id(formula), negate)]
+
+
+def _own_size(node: Formula, negated: bool) -> int:
+    match node:
+        case Prop():
+            return 2 if negated else 1
+        case Not():
+            return 0
+        case Equiv():
+            return 3  # the disjunction of two conjunctions
+        case BoundedUntil():
+            return 2 if negated else 1
+        case _:
+            return 1
+
+
+def _nnf_children(node: Formula, negated: bool) -> list[tuple[Formula, bool]]:
+    """The operands :func:`nnf` puts into the normal form of ``node``, with their polarity."""
+    match node:
+        case Not(arg):
+            return [(arg, not negated)]
+        case Implies(left, right):
+            return [(left, not negated), (right, negated)]
+        case Equiv(left, right):
+            return [(left, False), (left, True), (right, False), (right, True)]
+        case BoundedUntil(left, right, _):
+            return [(left, False), (right, False)]
+        case _:
+            return [(child, negated) for child in node.children()]
+
+
 def nnf(formula: Formula, negate: bool = False) -> Formula:
     """Negation normal form of ``formula`` (of its negation when ``negate``).
 
     The result has no ``->``/``<->`` and negations only directly above propositions.
+
+    Raises:
+        UsageError: P041, the normal form would have more than
+            :data:`MAX_NORMAL_FORM_SIZE` operators and names (chains of ``<->``).
     """
+    if normal_form_size(formula, negate) > MAX_NORMAL_FORM_SIZE:
+        raise UsageError(
+            error(
+                "P041",
+                "the formula's negation normal form would have more than "
+                f"{MAX_NORMAL_FORM_SIZE:,} operators and names, more than the translation's "
+                "budget: each `<->` writes both of its sides twice",
+                hint="write fewer nested `<->` (a chain of n equivalences doubles n times), "
+                "or split the task into smaller missions",
+            )
+        )
+    return _nnf(formula, negate)
+
+
+def _nnf(formula: Formula, negate: bool) -> Formula:
     match formula:
         case Const(value):
             return Const(value != negate)
         case Prop(name):
             return Not(formula) if negate else Prop(name)
         case Not(arg):
-            return nnf(arg, not negate)
+            return _nnf(arg, not negate)
         case And(args) | Or(args):
-            parts = [nnf(a, negate) for a in args]
+            parts = [_nnf(a, negate) for a in args]
             use_and = isinstance(formula, And) != negate
             return conjoin(parts) if use_and else disjoin(parts)
         case Implies(left, right):
             # a -> b  ==  !a | b ;  !(a -> b)  ==  a & !b
             if negate:
-                return conjoin([nnf(left), nnf(right, True)])
-            return disjoin([nnf(left, True), nnf(right)])
+                return conjoin([_nnf(left, False), _nnf(right, True)])
+            return disjoin([_nnf(left, True), _nnf(right, False)])
         case Equiv(left, right):
             # a <-> b == (a & b) | (!a & !b);  !(a <-> b) == (a & !b) | (!a & b)
-            a, na = nnf(left), nnf(left, True)
-            b, nb = nnf(right), nnf(right, True)
+            a, na = _nnf(left, False), _nnf(left, True)
+            b, nb = _nnf(right, False), _nnf(right, True)
             if negate:
                 return disjoin([conjoin([a, nb]), conjoin([na, b])])
             return disjoin([conjoin([a, b]), conjoin([na, nb])])
         case Eventually(arg):
-            return Globally(nnf(arg, True)) if negate else Eventually(nnf(arg))
+            return Globally(_nnf(arg, True)) if negate else Eventually(_nnf(arg, False))
         case Globally(arg):
-            return Eventually(nnf(arg, True)) if negate else Globally(nnf(arg))
+            return Eventually(_nnf(arg, True)) if negate else Globally(_nnf(arg, False))
         case (
             Until(left, right)
             | Release(left, right)
@@ -90,17 +165,17 @@ def nnf(formula: Formula, negate: bool = False) -> Formula:
             | StrongRelease(left, right)
         ):
             build = _DUAL[type(formula)] if negate else _SAME[type(formula)]
-            return build(nnf(left, negate), nnf(right, negate))
+            return build(_nnf(left, negate), _nnf(right, negate))
         case BoundedEventually(arg, interval):
             if negate:
-                return BoundedGlobally(nnf(arg, True), interval)
-            return BoundedEventually(nnf(arg), interval)
+                return BoundedGlobally(_nnf(arg, True), interval)
+            return BoundedEventually(_nnf(arg, False), interval)
         case BoundedGlobally(arg, interval):
             if negate:
-                return BoundedEventually(nnf(arg, True), interval)
-            return BoundedGlobally(nnf(arg), interval)
+                return BoundedEventually(_nnf(arg, True), interval)
+            return BoundedGlobally(_nnf(arg, False), interval)
         case BoundedUntil(left, right, interval):
-            until = BoundedUntil(nnf(left), nnf(right), interval)
+            until = BoundedUntil(_nnf(left, False), _nnf(right, False), interval)
             return Not(until) if negate else until
         case _:
             assert_never(formula)
