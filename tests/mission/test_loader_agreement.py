@@ -72,3 +72,14 @@ def test_libyaml_and_the_pure_parser_read_alike(text: str, lazy: bool) -> None:
     fast = _reading(text, yaml.CSafeLoader, lazy)
     pure = _reading(text, yaml.SafeLoader, lazy)
     assert fast == pure
+
+
+@pytest.mark.parametrize("escape", ["\\U0011FFFF", "\\UFFFFFFFF", "\\U00110000"])
+def test_a_bad_escape_is_refused_alike(escape: str) -> None:
+    """An escape past U+10FFFF makes PyYAML's pure-Python scanner raise from chr():
+    both readers refuse it as Y001 at the same place, never an internal error."""
+    text = f'version: 1\nname: "a {escape} b"\n'
+    fast = _reading(text, yaml.CSafeLoader, False)
+    pure = _reading(text, yaml.SafeLoader, False)
+    assert fast == pure
+    assert fast[1][0][:2] == ("Y001", 2)

@@ -160,3 +160,25 @@ def test_a_map_value_that_does_not_read_has_a_hint(tmp_path: Path) -> None:
     assert main(argv, out=io.StringIO(), err=err) == 2
     assert "error[M002]" in err.getvalue()
     assert "\n  hint: " in err.getvalue()
+
+
+@pytest.mark.parametrize("escape", ["\\q", "\\ud83d", "\\udc00", "\\u12", "\\x4", "\\U0011FFFF"])
+def test_a_bad_escape_gets_a_hint_about_escapes(tmp_path: Path, escape: str) -> None:
+    """The oracle: PyYAML's pure-Python reader refuses the same string (or, for a lone
+    surrogate half, reads a string no UTF-8 file can hold)."""
+    entry = f'title: "a {escape} b"'
+    try:
+        yaml.load(entry, Loader=yaml.SafeLoader)["title"].encode("utf-8")
+        pytest.fail(f"{escape} is a good escape")
+    except (yaml.YAMLError, UnicodeEncodeError, ValueError):
+        pass
+    text = SPEC.replace("version: 1", f"version: 1\n{entry}", 1)
+    path = tmp_path / "mission.yaml"
+    path.write_text(text)
+    err = io.StringIO()
+    assert main(["check", str(path)], io.StringIO(), err) == 1
+    first = err.getvalue().splitlines()
+    line = text.splitlines().index(entry) + 1
+    assert first[0].startswith(f"{path}:{line}:")
+    assert "error[Y001]" in first[0]
+    assert "escape" in first[1]

@@ -103,7 +103,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Read the artifacts of ``args.out`` and write the picture(s) next to them."""
     from tlmpc.base.errors import EXIT_OK
     from tlmpc.io.artifacts import read_artifact, read_artifacts
-    from tlmpc.io.outdir import replace_file
+    from tlmpc.io.outdir import replace_files
     from tlmpc.io.report import Reporter
 
     directory: Path = args.out
@@ -130,19 +130,18 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         if verdict is None:
             verdict = verdict_to_json(verify_trace(trace))
     stem = "log" if log is not None else "plan"
-    written = []
+    pictures: dict[str, bytes] = {}
     if args.format in ("svg", "both"):
         from tlmpc.render.plot import render_svg
 
-        svg = render_svg(artifacts, zoom=args.zoom, log=log, verdict=verdict)
-        replace_file(directory / f"{stem}.svg", svg)
-        written.append(f"{stem}.svg")
+        pictures[f"{stem}.svg"] = render_svg(artifacts, zoom=args.zoom, log=log, verdict=verdict)
     if args.format in ("png", "both"):
         from tlmpc.render.plot import render_png
 
-        png = render_png(artifacts, zoom=args.zoom, log=log, verdict=verdict)
-        replace_file(directory / f"{stem}.png", png)
-        written.append(f"{stem}.png")
+        pictures[f"{stem}.png"] = render_png(artifacts, zoom=args.zoom, log=log, verdict=verdict)
+    # both pictures or neither: a refused or failed one leaves the other as it was
+    replace_files({directory / name: picture for name, picture in pictures.items()})
+    written = list(pictures)
     tail = ""
     if verdict is not None:
         marks = sum(

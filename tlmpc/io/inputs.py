@@ -227,6 +227,12 @@ def yaml_syntax_error(exc: Any, code: str, file: str) -> Diagnostic:
     hint = "check indentation (spaces only, no tabs), quotes and brackets"
     if "\t" in problem or "tab" in problem:
         hint = "YAML does not allow tabs for indentation: use spaces"
+    elif "escape" in problem or "hexdecimal" in problem or "hexadecimal" in problem:
+        hint = (
+            "a double-quoted string's backslash starts an escape (\\\\, \\\", \\n, \\t, "
+            "\\xXX, \\uXXXX but no lone half of a surrogate pair, \\UXXXXXXXX): write a "
+            "backslash as \\\\, or quote the text with single quotes"
+        )
     return error(
         code,
         f"YAML syntax error: {problem}",

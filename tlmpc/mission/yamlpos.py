@@ -680,6 +680,15 @@ def _convert(converter: _Converter, text: str) -> bool | yaml.YAMLError | None:
         return None
     except yaml.YAMLError as exc:
         return _limit_before(converter, text, exc)
+    except (ValueError, OverflowError):
+        # PyYAML's pure-Python scanner reads an escape past U+10FFFF (``"\U0011FFFF"``) with
+        # chr(), which raises; libyaml refuses it as a scanner error at the escape
+        return yaml.scanner.ScannerError(
+            "while parsing a quoted scalar",
+            None,
+            "found invalid Unicode character escape code",
+            loader.get_mark(),
+        )
 
 
 def _limit_before(converter: _Converter, text: str, exc: yaml.YAMLError) -> yaml.YAMLError | None:
@@ -709,8 +718,8 @@ def _limit_before(converter: _Converter, text: str, exc: yaml.YAMLError) -> yaml
     except _TooBig:
         converter.problems.extend(probe.problems)
         return None
-    except yaml.YAMLError:
-        pass  # the text stops inside a value: the parser's error stands
+    except (yaml.YAMLError, ValueError, OverflowError):
+        pass  # the text stops inside a value, or an escape past U+10FFFF: the error stands
     finally:
         loader.dispose()
     return exc
