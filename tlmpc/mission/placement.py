@@ -10,31 +10,19 @@ is printed as ``file:line:col``.
 from __future__ import annotations
 
 import dataclasses
-import re
 from collections.abc import Sequence
 from pathlib import Path as FilePath
 
 from tlmpc.base.errors import Diagnostic
+from tlmpc.io import json_places
 from tlmpc.mission.yamlpos import Path, load_positioned
-
-#: One step of a JSON path as :func:`tlmpc.mission.yamlpos.json_path` writes it.
-_STEP = re.compile(r"\.([^.\[\]]+)|\[(\d+)\]")
 
 
 def parse_json_path(text: str) -> Path | None:
-    """``("regions", "p1", 0)`` for ``$.regions.p1[0]``; None for text that is not one."""
-    if not text.startswith("$"):
-        return None
-    steps: list[str | int] = []
-    at = 1
-    while at < len(text):
-        match = _STEP.match(text, at)
-        if match is None:
-            return None
-        key, index = match.groups()
-        steps.append(int(index) if index is not None else key)
-        at = match.end()
-    return tuple(steps)
+    """``("regions", "p1", 0)`` for ``$.regions.p1[0]``; None for text that is not one
+    (:func:`tlmpc.io.json_places.parse_json_path`)."""
+    keys = json_places.parse_json_path(text)
+    return None if keys is None else tuple(keys)
 
 
 def placed(

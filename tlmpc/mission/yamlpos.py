@@ -17,6 +17,7 @@ from typing import Any
 import yaml
 
 from tlmpc.base.errors import Diagnostic, error
+from tlmpc.io import json_places
 from tlmpc.io.inputs import yaml_error
 from tlmpc.io.scalar_places import ScalarPlaces, line_starts, scalar_places
 from tlmpc.mission.bulk import STEM, BulkList, cut_out
@@ -105,11 +106,9 @@ class PositionedDocument:
 
 
 def json_path(path: Path) -> str:
-    """``$.regions.p1[0]`` for ``("regions", "p1", 0)``."""
-    text = "$"
-    for part in path:
-        text += f"[{part}]" if isinstance(part, int) else f".{part}"
-    return text
+    """``$.regions.p1[0]`` for ``("regions", "p1", 0)`` (:func:`tlmpc.io.json_places.json_path`:
+    a key that is no identifier is written ``["..."]``)."""
+    return json_places.json_path(*path)
 
 
 def _mark(node: Any) -> tuple[int, int]:
