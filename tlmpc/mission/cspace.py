@@ -349,8 +349,24 @@ def splitting_pinches(mission: Mission, cspace: Any, home: Any = None) -> list[P
     return found
 
 
-def _lines(mission: Mission, text: str | None) -> dict[tuple[Any, ...], int]:
-    """Lines of the robot start, boundary, holes and regions in the mission file."""
+def _imported_from(name: str, workspace: dict[str, Any]) -> tuple[Any, ...]:
+    """Where the mask that region ``name`` came from is named (``keepout_K`` from the
+    keepout mask, ``speed_V_K`` from the speed mask), else the map itself."""
+    mask = name.split("_", 1)[0]
+    if mask in ("keepout", "speed") and mask in workspace:
+        return ("workspace", mask)
+    return ("workspace", "map")
+
+
+def _places(mission: Mission, text: str | None) -> dict[tuple[Any, ...], tuple[int, int]]:
+    """(line, col) in the mission file of the robot start, boundary, holes and regions, keyed
+    by their paths in a mission that draws its workspace.
+
+    A workspace taken from a map (``workspace: {map: ...}``) has its boundary and holes where
+    the map is named, and each region imported from a mask where that mask is named: neither
+    is written in the mission, whose nearest written ancestor (``regions:``) would point at
+    another region.
+    """
     from tlmpc.mission.yamlpos import load_positioned
 
     if mission.source is None:
@@ -360,18 +376,28 @@ def _lines(mission: Mission, text: str | None) -> dict[tuple[Any, ...], int]:
     except OSError:
         return {}
     doc = load_positioned(source, mission.source)[0]
-    if doc is None:
+    if doc is None or not isinstance(doc.data, dict):
         return {}
+    workspace = doc.data.get("workspace")
+    workspace = workspace if isinstance(workspace, dict) else {}
+    on_map = "map" in workspace
+    written = doc.data.get("regions")
+    written = written if isinstance(written, dict) else {}
     keys: list[tuple[Any, ...]] = [("robot", "start"), ("workspace", "boundary")]
     keys += [("workspace", "holes", i) for i in range(len(mission.workspace.holes))]
     keys += [("regions", r.name) for r in mission.regions]
-    lines: dict[tuple[Any, ...], int] = {}
+    places: dict[tuple[Any, ...], tuple[int, int]] = {}
     for key in keys:
+        at = key
+        if on_map and key[0] == "workspace":
+            at = ("workspace", "map")
+        elif on_map and key[0] == "regions" and key[1] not in written:
+            at = _imported_from(key[1], workspace)
         try:
-            lines[key] = doc.value_at(key)[0]
+            places[key] = doc.value_at(at)
         except (KeyError, IndexError, TypeError):
             continue
-    return lines
+    return places
 
 
 def _nearest_obstacle(mission: Mission, point: Point) -> tuple[float, str]:
@@ -409,13 +435,14 @@ def body_diagnostics(mission: Mission, text: str | None = None) -> list[Diagnost
     radius = body_radius(mission.robot)
     if radius <= 0.0:
         return []
-    lines = _lines(mission, text)
+    places = _places(mission, text)
     file = mission.source
     cspace = configuration_space(mission)
     problems: list[Diagnostic] = []
     start = shapely.Point(mission.robot.start)
     if not start_fits(mission):
         distance, name = _nearest_obstacle(mission, mission.robot.start)
+        line, col = places.get(("robot", "start"), (None, None))
         problems.append(
             error(
                 "R001",
@@ -423,7 +450,8 @@ def body_diagnostics(mission: Mission, text: str | None = None) -> list[Diagnost
                 f"body (radius {radius:g}) overlaps it",
                 hint="move the start away from the obstacle or give a smaller robot.radius",
                 file=file,
-                line=lines.get(("robot", "start")),
+                line=line,
+                col=col,
             )
         )
         return problems
@@ -443,6 +471,7 @@ def body_diagnostics(mission: Mission, text: str | None = None) -> list[Diagnost
             break
         ring = max(pinch.rings)
         key = ("workspace", "holes", ring - 1) if ring > 0 else ("workspace", "boundary")
+        line, col = places.get(key, (None, None))
         problems.append(
             Diagnostic(
                 code="R002",
@@ -450,7 +479,8 @@ def body_diagnostics(mission: Mission, text: str | None = None) -> list[Diagnost
                 message=_too_narrow(pinch, mission, radius),
                 hint="widen the passage, or give a smaller robot.radius / footprint",
                 file=file,
-                line=lines.get(key),
+                line=line,
+                col=col,
             )
         )
     raw = workspace_free_space(mission)
@@ -467,7 +497,7 @@ def body_diagnostics(mission: Mission, text: str | None = None) -> list[Diagnost
     for region, shape, reachable in zip(mission.regions, shapes, easy, strict=True):
         if reachable:
             continue
-        line = lines.get(("regions", region.name))
+        line, col = places.get(("regions", region.name), (None, None))
         if not cspace.intersects(shape) or cspace.intersection(shape).area <= 0.0:
             if raw.intersection(shape).area > 0.0:
                 problems.append(
@@ -479,6 +509,7 @@ def body_diagnostics(mission: Mission, text: str | None = None) -> list[Diagnost
                         hint="enlarge the region or give a smaller robot.radius / footprint",
                         file=file,
                         line=line,
+                        col=col,
                     )
                 )
             continue
@@ -497,6 +528,7 @@ def body_diagnostics(mission: Mission, text: str | None = None) -> list[Diagnost
                 hint="widen the passages to it, or give a smaller robot.radius / footprint",
                 file=file,
                 line=line,
+                col=col,
             )
         )
     return problems

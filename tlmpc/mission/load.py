@@ -6,22 +6,23 @@ where they would be meaningless (the geometry of a shape that failed the schema,
 
 from __future__ import annotations
 
+import dataclasses
 import difflib
 import gc
 import math
 import re
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from itertools import chain
 from pathlib import Path as FilePath
 from typing import TYPE_CHECKING, Any
 
 from tlmpc.base.depth import NESTING_LIMIT
-from tlmpc.base.errors import Diagnostic, InvalidInputError, best_first, error
+from tlmpc.base.errors import Diagnostic, InvalidInputError, UsageError, best_first, error
 from tlmpc.io.scalar_places import ScalarPlaces
 from tlmpc.io.schema_check import MISSION_COORDINATE_LIMIT, is_valid, load_schema
 from tlmpc.ltl.ast import Formula, Prop, bounded_operators, conjoin
 from tlmpc.ltl.keywords import KEYWORDS
-from tlmpc.ltl.transform import substitute
+from tlmpc.ltl.transform import MAX_NORMAL_FORM_SIZE, nnf, normal_form_size, substitute
 from tlmpc.mission.geometry import check_layout, check_shape
 from tlmpc.mission.model import (
     Component,
@@ -465,9 +466,12 @@ def _check_task(
     if problems or not parts:
         return None, problems
     formula = substitute(conjoin(parts), group_expansion(groups))
+    ltl_part = parts[-1] if isinstance(ltl, str) else None
     if _depth(formula) > NESTING_LIMIT:
-        ltl_part = parts[-1] if isinstance(ltl, str) else None
         return None, [_too_deep(formula, ltl_part, data, doc, file, groups, known)]
+    too_large = _normal_form_too_large(formula, ltl_part, data, doc, file, groups, known)
+    if too_large is not None:
+        return None, [too_large]
     return formula, []
 
 
@@ -482,6 +486,27 @@ def _depth(formula: Formula) -> int:
     return deepest
 
 
+def _largest_part(
+    ltl: Formula | None,
+    data: Mapping[str, Any],
+    groups: Mapping[str, list[str]],
+    kinds: NameKinds,
+    measure: Callable[[Formula], int],
+) -> tuple[Path, str]:
+    """The path and name of the task entry (a phrase, or ``ltl``) whose formula, its groups
+    expanded, ``measure`` finds largest: the one to blame when the whole task is too large."""
+    expansion = group_expansion(groups)
+    where: Path = ("ltl",)
+    what = "`ltl`"
+    largest = -1 if ltl is None else measure(substitute(ltl, expansion))
+    for index, phrase in enumerate(data.get("task") or ()):
+        part = compile_phrase(phrase, groups=groups, kinds=kinds)
+        size = measure(substitute(part, expansion))
+        if size > largest:
+            where, what, largest = ("task", index), f"task phrase {index + 1}", size
+    return where, what
+
+
 def _too_deep(
     formula: Formula,
     ltl: Formula | None,
@@ -494,15 +519,7 @@ def _too_deep(
     """L005 for a task whose formula is nested deeper than the LTL reader accepts (a long
     ``then`` chain), placed at its deepest phrase (or at ``ltl``): every later stage reads
     the formula back, so the mission is refused before them."""
-    expansion = group_expansion(groups)
-    where: Path = ("ltl",)
-    what = "`ltl`"
-    deepest = -1 if ltl is None else _depth(substitute(ltl, expansion))
-    for index, phrase in enumerate(data.get("task") or ()):
-        part = compile_phrase(phrase, groups=groups, kinds=kinds)
-        depth = _depth(substitute(part, expansion))
-        if depth > deepest:
-            where, what, deepest = ("task", index), f"task phrase {index + 1}", depth
+    where, what = _largest_part(ltl, data, groups, kinds, _depth)
     line, col = _ltl_position(doc, where)
     return error(
         "L005",
@@ -515,6 +532,31 @@ def _too_deep(
         col=col,
         path=json_path(where),
     )
+
+
+def _normal_form_too_large(
+    formula: Formula,
+    ltl: Formula | None,
+    data: Mapping[str, Any],
+    doc: PositionedDocument,
+    file: str,
+    groups: Mapping[str, list[str]],
+    kinds: NameKinds,
+) -> Diagnostic | None:
+    """P041 for a task whose negation normal form is beyond the translation's budget (a chain
+    of ``<->``), placed at the phrase (or ``ltl``) with the largest normal form: every
+    command that translates the task would refuse it, at no place in the file."""
+    if normal_form_size(formula) <= MAX_NORMAL_FORM_SIZE:
+        return None
+    try:
+        nnf(formula)  # raises the translation's own refusal
+    except UsageError as exc:
+        refusal = exc.diagnostics[0]
+    else:
+        return None
+    where, _ = _largest_part(ltl, data, groups, kinds, normal_form_size)
+    line, col = _ltl_position(doc, where)
+    return dataclasses.replace(refusal, file=file, line=line, col=col, path=json_path(where))
 
 
 def _unknown_names(
