@@ -64,7 +64,7 @@ def test_a_dask_worker_elsewhere_reads_relative_paths_in_the_batch_folder(
     assert rows_of(tmp_path / "dask.jsonl") == local
     assert [row["verdict"] for row in local] == ["error", "violated"]
     broken, crossing = local
-    assert broken["error"]["message"].startswith("logs/broken.csv:3: error[V003]")
+    assert broken["error"]["message"].startswith("logs/broken.csv:3:3: error[V003]")
     assert crossing["first_violation"]["t"] == pytest.approx(8.0)
     # the worker stored both records in the batch's cache folder, none in its own
     assert len(list((tmp_path / "cache").rglob("*.json"))) == 2

@@ -27,12 +27,13 @@ over the clearance, not with the sampling rate.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import math
 from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import IO, Any
 
 import numpy as np
 import numpy.typing as npt
@@ -42,7 +43,7 @@ from tlmpc.verify import Verdict, declare_ending, from_document, verify_trace
 from tlmpc.verify.clock import at
 from tlmpc.verify.model import Certificate
 from tlmpc.verify.robustness import speed_excess
-from tlmpc.verify.samples import MAX_PER_KIND, sample_diagnostics
+from tlmpc.verify.samples import MAX_PER_KIND, CellPlace, sample_diagnostics
 from tlmpc.verify.trace_input import certifying_speed
 
 FloatArray = npt.NDArray[np.float64]
@@ -205,32 +206,130 @@ class StreamedVerdict:
     start_time: float
 
 
+class _CsvCells:
+    """Where the cells of a streamed CSV log's samples are written, for its diagnostics
+    (:data:`tlmpc.verify.samples.CellPlace`, by line number instead of sample index).
+
+    The chunks carry their samples' line numbers, not the lines, so the log is read a second
+    time, a block at a time, from the first problem placed on: a clean log never pays for it.
+    The lines come from the readers' own line splitter and the columns from the live reader's
+    (:meth:`tlmpc.importers.logs.CsvLines.column`), so a cell is placed as a whole log's is.
+    Only the lines from the oldest one still asked about on are held (:meth:`forget_before`)."""
+
+    def __init__(self, path: Path, columns: Sequence[str] | None, block_bytes: int) -> None:
+        from tlmpc.importers.logs import CsvLines, LogLines
+
+        self.path = path
+        self.block_bytes = block_bytes
+        self._splitter = LogLines(str(path))
+        self._layout = CsvLines(str(path), columns)
+        self._opened: contextlib.ExitStack | None = None
+        self._stream: IO[bytes] | None = None
+        self._first = 1  # the number of the first line held
+        self._held: list[str] = []
+        self._wanted = 1  # no line before this one is asked about
+        self._ended = False
+
+    def forget_before(self, number: int) -> None:
+        """No line before line ``number`` will be asked about again."""
+        self._wanted = max(self._wanted, number)
+        drop = min(max(self._wanted - self._first, 0), len(self._held))
+        del self._held[:drop]
+        self._first += drop
+
+    def place(self, number: int, cell: int) -> dict[str, int]:
+        """The column of cell ``cell`` (0 time, 1 x, 2 y) of the sample on line ``number``."""
+        while number >= self._first + len(self._held) and not self._ended:
+            self._read_block()
+        if not self._first <= number < self._first + len(self._held):
+            return {}
+        column = self._layout.column(self._held[number - self._first], cell)
+        return {} if column is None else {"col": column}
+
+    def _read_block(self) -> None:
+        if self._stream is None:
+            from tlmpc.io.inputs import open_regular
+
+            self._opened = contextlib.ExitStack()
+            self._stream = self._opened.enter_context(
+                open_regular(self.path, code="M050", what="log")
+            )
+        data = self._stream.read(self.block_bytes)
+        lines = self._splitter.feed(data) if data else self._splitter.finish()
+        self._ended = not data
+        number = self._first + len(self._held)
+        for raw in lines:
+            if self._layout.indices is None:
+                # the header (or first row) the first reading accepted fixes the columns
+                self._layout.parse(raw, number)
+            number += 1
+        self._held.extend(lines)
+        self.forget_before(self._wanted)
+
+    def close(self) -> None:
+        """Close the second reading of the log, if it began."""
+        if self._opened is not None:
+            self._opened.close()
+
+
 def _checked_chunks(
-    chunks: Iterable[tuple[FloatArray, tuple[int, ...]]], file: str
+    chunks: Iterable[tuple[FloatArray, tuple[int, ...]]],
+    file: str,
+    cells: _CsvCells | None = None,
 ) -> Iterator[FloatArray]:
     """The chunks, with the log's sample checks across chunk boundaries; every problem is
-    collected (a few of each kind) and raised at the end."""
+    collected (a few of each kind) and raised at the end, placed at its cell's column by
+    ``cells`` when the log is a CSV."""
     previous: FloatArray | None = None
     previous_line: tuple[int, ...] = ()
     found: list[Diagnostic] = []
-    for samples, lines in chunks:
-        joined = samples if previous is None else np.vstack([previous, samples])
-        joined_lines = lines if previous is None or not lines else previous_line + lines
-        problems = sample_diagnostics(
-            joined[:, 0], joined[:, 1], joined[:, 2], file=file, lines=joined_lines or None
-        )
-        for problem in problems:
-            if sum(d.code == problem.code for d in found) < MAX_PER_KIND:
-                found.append(problem)
-        if len(samples):
-            previous = samples[-1:].copy()
-            previous_line = lines[-1:] if lines else ()
-        if not found:
-            yield samples
+    counted = 0  # the samples before the current chunk, numbered as the whole log numbers them
+    try:
+        for samples, lines in chunks:
+            joined = samples if previous is None else np.vstack([previous, samples])
+            joined_lines = lines if previous is None or not lines else previous_line + lines
+            place: CellPlace | None = None
+            if cells is not None and joined_lines:
+                cells.forget_before(joined_lines[0])
+                place = _by_line(cells, joined_lines)
+            problems = sample_diagnostics(
+                joined[:, 0],
+                joined[:, 1],
+                joined[:, 2],
+                file=file,
+                lines=joined_lines or None,
+                first=counted - (len(joined) - len(samples)),
+                place=place,
+            )
+            counted += len(samples)
+            for problem in problems:
+                if sum(d.code == problem.code for d in found) < MAX_PER_KIND:
+                    found.append(problem)
+            if len(samples):
+                previous = samples[-1:].copy()
+                previous_line = lines[-1:] if lines else ()
+            if not found:
+                yield samples
+    finally:
+        if cells is not None:
+            cells.close()
     if previous is None and not found:
         found = sample_diagnostics(np.zeros(0), np.zeros(0), np.zeros(0), file=file)
     if found:
         raise UsageError(found)
+
+
+def _by_line(cells: _CsvCells, lines: Sequence[int]) -> CellPlace:
+    """``cells`` asked by sample index, for samples written on ``lines``."""
+    return lambda index, cell: cells.place(lines[index], cell) if index < len(lines) else {}
+
+
+def _is_csv(path: Path) -> bool:
+    """Whether ``path`` is read as a CSV log: chosen by name, as the whole reader chooses (a
+    FIFO named .csv is a CSV log it refuses)."""
+    from tlmpc.importers.logs import CSV_SUFFIXES
+
+    return path.suffix.lower() in CSV_SUFFIXES and not path.is_dir()
 
 
 def _log_chunks(
@@ -244,15 +343,13 @@ def _log_chunks(
     whole_bag: bool,
 ) -> Iterator[tuple[FloatArray, tuple[int, ...]]]:
     from tlmpc.importers.logs import (
-        CSV_SUFFIXES,
         apply_transform,
         iter_bag_chunks,
         iter_csv_chunks,
         read_log,
     )
 
-    # chosen by name, as the whole reader chooses (a FIFO named .csv is a CSV log it refuses)
-    if path.suffix.lower() in CSV_SUFFIXES and not path.is_dir():
+    if _is_csv(path):
         if topic is not None or frame is not None:
             read_log(path, topic=topic, frame=frame)  # raises the reader's own diagnostic
         for chunk in iter_csv_chunks(path, columns, block_bytes):
@@ -342,7 +439,8 @@ def _verify_log(
         block_bytes=block_bytes,
         whole_bag=whole_bag,
     )
-    for samples in _checked_chunks(chunks, file):
+    cells = _CsvCells(path, columns, block_bytes) if _is_csv(path) else None
+    for samples in _checked_chunks(chunks, file, cells):
         joined = samples if last is None else np.vstack([last, samples])
         if len(joined) > 1:
             max_gap = max(max_gap, float(np.diff(joined[:, 0]).max()))
