@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import io
 import json
+import random
 from pathlib import Path
 from typing import Any
 
@@ -278,7 +279,7 @@ def test_bag_hostile_values_and_missing_topics(tmp_path: Path) -> None:
     assert "Traceback" not in err
     found = json.loads(out)["diagnostics"][0]
     assert found["code"] == "V030"
-    assert "sample 1 at /alarm" in found["message"]
+    assert "sample 1 (message 2 on /alarm, log time 1000000000 ns)" in found["message"]
     missing = write_bag(tmp_path / "m.bag", "ros1", POSES, {"/siren": [(0, False)]})
     status, _, err = verify("--mission", str(unbound), str(missing))
     assert status == 2
@@ -319,7 +320,7 @@ def test_bag_strings_and_repeated_stamps(tmp_path: Path) -> None:
     assert status == 2
     found = json.loads(out)["diagnostics"][0]
     assert found["code"] == "V031"
-    assert "sample 2 at /alarm" in found["message"]
+    assert "sample 2 (message 3 on /alarm, log time 1000000000 ns)" in found["message"]
 
 
 def test_a_sensor_topic_missing_messages_is_refused(tmp_path: Path) -> None:
@@ -340,3 +341,36 @@ def test_a_sensor_topic_missing_messages_is_refused(tmp_path: Path) -> None:
     assert status == 2, err
     assert "error[M065]" in err
     assert "declares 3 messages on /alarm (metadata.yaml), but 2 could be read" in err
+
+
+@pytest.mark.parametrize("kind", ["ros1", "mcap"])
+def test_a_refused_bag_sensor_sample_names_its_message(tmp_path: Path, kind: str) -> None:
+    """A sensor's bad sample in a bag (V030 not a boolean, V031 a repeated stamp) names its
+    message: the topic, its number there and its log time, as written here."""
+    pytest.importorskip("rosbags")
+    rng = random.Random(f"signal-{kind}")
+    path = mission(tmp_path, sensors="  alarm: null")
+    for case in range(4):
+        count = rng.randrange(3, 7)
+        times = sorted(rng.sample(range(1, 5 * SECOND), count))
+        values: list[Any] = [rng.choice([0, 1]) for _ in range(count)]
+        bad = rng.randrange(1, count)
+        if case % 2:  # a repeated log time (a Bool has no header: its log time stamps it)
+            times[bad] = times[bad - 1]
+            code = "V031"
+        else:
+            values[bad] = rng.choice([2, 7, -1])
+            code = "V030"
+        bag = write_bag(
+            tmp_path / (f"s{case}.bag" if kind == "ros1" else f"s{case}"),
+            kind,
+            POSES,
+            {"/alarm": list(zip(times, values, strict=True))},
+            bool_type="std_msgs/msg/Int32",
+        )
+        status, out, _ = verify("--mission", str(path), str(bag), "--json")
+        assert status == 2
+        (diagnostic,) = json.loads(out)["diagnostics"]
+        assert diagnostic["code"] == code
+        expected = f"sample {bad} (message {bad + 1} on /alarm, log time {times[bad]} ns)"
+        assert expected in diagnostic["message"], (expected, diagnostic)

@@ -259,16 +259,24 @@ def _cell_place(raw: str, csv: CsvLines) -> Callable[[int], dict[str, int]]:
     """Where the line ``raw`` writes a pose's cell (0 time, 1 x, 2 y): its column, found when
     a diagnostic needs it — the value of ``t``, ``x`` or ``y`` in a JSON line, the cell in a
     CSV line."""
-    from tlmpc.io.json_places import json_path, json_place
 
     def place(cell: int) -> dict[str, int]:
         if raw.lstrip().startswith("{"):
-            found = json_place(raw, json_path("txy"[cell]))
-            return {"col": found[1]} if found is not None else {}
+            found = _json_value_column(raw, "txy"[cell])
+            return {"col": found} if found is not None else {}
         column = csv.column(raw, cell)
         return {"col": column} if column is not None else {}
 
     return place
+
+
+def _json_value_column(raw: str, key: str) -> int | None:
+    """The column of the value of ``key`` in the JSON object on the line ``raw`` (of the
+    object itself when it has no ``key``)."""
+    from tlmpc.io.json_places import json_path, json_place
+
+    found = json_place(raw, json_path(key))
+    return found[1] if found is not None else None
 
 
 def _json_pose(raw: str, name: str, number: int) -> tuple[float, float, float]:
@@ -277,21 +285,27 @@ def _json_pose(raw: str, name: str, number: int) -> tuple[float, float, float]:
     from tlmpc.base.errors import UsageError, error
 
     col: int | None = None
+    problem = ""
     try:
         record = json.loads(raw, parse_int=float)
         values = (record["t"], record["x"], record["y"])
         # numbers only: float() would also take "5", true and "1_0"
-        if not all(isinstance(v, float) for v in values):
-            raise TypeError
-        return values[0], values[1], values[2]
+        wrong = [key for key, v in zip("txy", values, strict=True) if not isinstance(v, float)]
+        if not wrong:
+            return values[0], values[1], values[2]
+        problem = f" ({wrong[0]} is not a number)"
+        col = _json_value_column(raw, wrong[0])
     except json.JSONDecodeError as exc:
         col = exc.colno if exc.lineno == 1 else None
-    except (ValueError, KeyError, TypeError, RecursionError):
+    except KeyError as exc:
+        problem = f" (it has no {exc.args[0]})"
+        col = _json_value_column(raw, exc.args[0])  # the object's own column
+    except (ValueError, TypeError, RecursionError):
         pass
     raise UsageError(
         error(
             "M053",
-            'a JSON line must be an object {"t": ..., "x": ..., "y": ...} of numbers',
+            'a JSON line must be an object {"t": ..., "x": ..., "y": ...} of numbers' + problem,
             hint='for example {"t": 12.5, "x": 3.2, "y": 1.0}; correct or delete the line',
             file=name,
             line=number,

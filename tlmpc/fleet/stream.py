@@ -43,7 +43,7 @@ from tlmpc.verify import Verdict, declare_ending, from_document, verify_trace
 from tlmpc.verify.clock import at
 from tlmpc.verify.model import Certificate
 from tlmpc.verify.robustness import speed_excess
-from tlmpc.verify.samples import MAX_PER_KIND, CellPlace, sample_diagnostics
+from tlmpc.verify.samples import MAX_PER_KIND, CellPlace, SampleOrigin, sample_diagnostics
 from tlmpc.verify.trace_input import certifying_speed
 
 FloatArray = npt.NDArray[np.float64]
@@ -276,6 +276,7 @@ def _checked_chunks(
     chunks: Iterable[tuple[FloatArray, tuple[int, ...]]],
     file: str,
     cells: _CsvCells | None = None,
+    origin: SampleOrigin | None = None,
 ) -> Iterator[FloatArray]:
     """The chunks, with the log's sample checks across chunk boundaries; every problem is
     collected (a few of each kind) and raised at the end, placed at its cell's column by
@@ -300,6 +301,7 @@ def _checked_chunks(
                 lines=joined_lines or None,
                 first=counted - (len(joined) - len(samples)),
                 place=place,
+                origin=origin,
             )
             counted += len(samples)
             for problem in problems:
@@ -440,7 +442,11 @@ def _verify_log(
         whole_bag=whole_bag,
     )
     cells = _CsvCells(path, columns, block_bytes) if _is_csv(path) else None
-    for samples in _checked_chunks(chunks, file, cells):
+    from tlmpc.importers.logs import SampleMessages
+
+    # a bag's samples are named by their messages (looked up only for a diagnostic)
+    origin = None if _is_csv(path) else SampleMessages(path, topic, by_stamp=whole_bag)
+    for samples in _checked_chunks(chunks, file, cells, origin):
         joined = samples if last is None else np.vstack([last, samples])
         if len(joined) > 1:
             max_gap = max(max_gap, float(np.diff(joined[:, 0]).max()))

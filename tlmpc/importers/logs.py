@@ -70,6 +70,9 @@ class Log:
     topic: str | None = None
     #: a CSV log's separator (None: runs of blanks) and columns of t, x, y
     layout: tuple[str | None, tuple[int, int, int]] | None = None
+    #: a bag's message of each sample: its 0-based number among the topic's pose messages
+    #: in the order the bag stores them (samples are in stamp order); None for a CSV
+    messages: npt.NDArray[np.int64] | None = field(default=None, compare=False)
 
 
 class SampleColumns:
@@ -91,6 +94,52 @@ class SampleColumns:
         separator, indices = self.log.layout
         raw = self._lines[self.log.lines[index] - 1]
         return {"col": _cell_column(raw, separator, indices[cell])}
+
+
+class SampleMessages:
+    """Where each sample of a bag's log came from, for diagnostics: called with a sample's
+    index, its pose message in words — the topic, the message's number on it and its log
+    time, as M065 names a message (:func:`message_words`).  The bag's log times are read again
+    (without decoding a message) on the first call only: a log that has no problem never pays
+    for it.  ``messages``: each sample's message number (:attr:`Log.messages`); without it,
+    the samples are the messages in stamp order (``by_stamp``, a bag read whole and sorted:
+    the order is found again on the first call) or in stored order (a bag read as a stream).
+    """
+
+    def __init__(
+        self,
+        path: Path,
+        topic: str | None,
+        messages: npt.NDArray[np.int64] | None = None,
+        *,
+        by_stamp: bool = False,
+    ) -> None:
+        self.path = path
+        self.topic = topic
+        self.messages = messages
+        self.by_stamp = by_stamp
+        self._log_times: array[int] | None = None  # 8 bytes a message
+        self._chosen_topic = ""
+
+    def __call__(self, index: int) -> str:
+        if self.messages is None and self.by_stamp:
+            self.messages = read_bag(self.path, self.topic).messages
+        number = int(self.messages[index]) if self.messages is not None else index
+        if self._log_times is None:
+            self._log_times = array("q")
+            with _opened_bag(self.path, self.topic, limit=False) as (reader, chosen, topic):
+                self._chosen_topic = topic
+                for _, log_time, _ in reader.messages(connections=chosen):
+                    self._log_times.append(int(log_time))
+        if not 0 <= number < len(self._log_times):
+            return f"pose message {number + 1} on {self._chosen_topic}"
+        return message_words(number, self._chosen_topic, self._log_times[number])
+
+
+def message_words(number: int, topic: str, log_time: int, kind: str = "pose message") -> str:
+    """A bag's message (a ``kind``) in words: the ``number`` th (0-based) stored on ``topic``,
+    logged at ``log_time`` (ns) — what a diagnostic about it names."""
+    return f"{kind} {number + 1} on {topic}, log time {log_time} ns"
 
 
 def is_log(path: Path) -> bool:
@@ -712,7 +761,8 @@ def read_bag(path: Path, topic: str | None = None, frame: str | None = None) -> 
             stamps.extend(chunk[0])
             xs.extend(chunk[1])
             ys.extend(chunk[2])
-    return Log(samples=_sorted_samples(stamps, xs, ys), source=str(path), topic=chosen_topic)
+    samples, messages = _sorted_samples(stamps, xs, ys)
+    return Log(samples=samples, source=str(path), topic=chosen_topic, messages=messages)
 
 
 #: Poses per chunk of :func:`iter_bag_chunks` (and of the whole reader's gathering).
@@ -858,7 +908,7 @@ def _pose_chunks(
     try:
         batch: list[tuple[int, float, float, float, str]] = []
         for connection, log_time, raw in counted_messages(reader, chosen, Path(file)):
-            reading = f"pose message {count + 1} on {connection.topic}, log time {log_time} ns"
+            reading = message_words(count, connection.topic, log_time)
             message: Any = reader.deserialize(raw, connection.msgtype)
             pose: Any = message
             for part in POSE_TYPES[connection.msgtype].split("."):
@@ -999,8 +1049,11 @@ def _tf_tree(reader: Any, logged: list[str], frame: str, file: str) -> Any:
     return collector.tree()
 
 
-def _sorted_samples(stamps: array[int], xs: array[float], ys: array[float]) -> FloatArray:
-    """Sorted by integer nanoseconds (exact, stable), then seconds.
+def _sorted_samples(
+    stamps: array[int], xs: array[float], ys: array[float]
+) -> tuple[FloatArray, npt.NDArray[np.int64]]:
+    """Sorted by integer nanoseconds (exact, stable), then seconds; with the stored number of
+    each sample's message (:attr:`Log.messages`).
 
     Repeated stamps are kept: the verifier refuses them (V020) as it does in a CSV log, since
     two poses at one instant are not a trajectory and keeping one would hide the other."""
@@ -1010,7 +1063,7 @@ def _sorted_samples(stamps: array[int], xs: array[float], ys: array[float]) -> F
     samples[:, 0] = stamp_seconds(nanoseconds[order])
     samples[:, 1] = np.frombuffer(xs, dtype=np.float64)[order] if len(xs) else 0.0
     samples[:, 2] = np.frombuffer(ys, dtype=np.float64)[order] if len(ys) else 0.0
-    return samples
+    return samples, order.astype(np.int64, copy=False)
 
 
 #: The bits of a float64 below its sign (see :func:`stamp_seconds`).

@@ -15,7 +15,7 @@ missing from the log is left unknown (the verdict may then be inconclusive).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -133,6 +133,14 @@ def _stamp(message: Any, log_time: int) -> int:
     return int(log_time)
 
 
+def _origin(samples: Sequence[tuple[int, Any, int, int]], topic: str) -> Callable[[int], str]:
+    """The message of each of a topic's ``samples`` (stamp, value, stored number, log time),
+    in words, as the pose samples name theirs."""
+    from tlmpc.importers.logs import message_words
+
+    return lambda index: message_words(samples[index][2], topic, samples[index][3], "message")
+
+
 def _bag_signals(path: Path, reactive: Reactive) -> dict[str, Signal]:
     # the pose reader has already opened this bag (and said why, if it could not)
     from rosbags.highlevel import AnyReader
@@ -142,6 +150,7 @@ def _bag_signals(path: Path, reactive: Reactive) -> dict[str, Signal]:
     from tlmpc.importers.logs import (
         MAX_LOG_SAMPLES,
         _bag_paths,
+        message_words,
         stamp_seconds,
         unreadable_message,
     )
@@ -181,11 +190,10 @@ def _bag_signals(path: Path, reactive: Reactive) -> dict[str, Signal]:
                         file=file,
                     )
                 )
-            samples: list[tuple[int, Any]] = []
+            # (stamp, value, stored number, log time): the last two name a refused sample
+            samples: list[tuple[int, Any, int, int]] = []
             for connection, log_time, raw in counted_messages(reader, chosen, path):
-                reading = (
-                    f"message {len(samples) + 1} on {connection.topic}, log time {log_time} ns"
-                )
+                reading = message_words(len(samples), connection.topic, log_time, "message")
                 message: Any = reader.deserialize(raw, connection.msgtype)
                 try:
                     value = _field(message, dotted)
@@ -200,14 +208,14 @@ def _bag_signals(path: Path, reactive: Reactive) -> dict[str, Signal]:
                             file=file,
                         )
                     ) from None
-                samples.append((_stamp(message, log_time), value))
+                samples.append((_stamp(message, log_time), value, len(samples), int(log_time)))
             samples.sort(key=lambda sample: sample[0])  # stable: repeated stamps stay, refused
-            stamps = np.asarray([stamp for stamp, _ in samples], dtype=np.int64)
+            stamps = np.asarray([sample[0] for sample in samples], dtype=np.int64)
             found[name] = make_signal(
                 name,
                 stamp_seconds(stamps).tolist(),  # stamps 1 ns apart stay apart, as poses do
-                [value for _, value in samples],
-                Where(file, path=topic),
+                [sample[1] for sample in samples],
+                Where(file, path=topic, origin=_origin(samples, topic)),
             )
     except UsageError:
         raise

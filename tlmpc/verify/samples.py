@@ -33,10 +33,30 @@ MAX_MAGNITUDE = 1e12
 #: of a trace's number, placed in its text by the trace reader).
 CellPlace = Callable[[int, int], Mapping[str, Any]]
 
+#: Where a sample came from, in words, for a log with no lines (a bag: the topic, number and
+#: log time of its message): given the sample's index in its log (``first`` counted in), the
+#: words said after the sample's number.
+SampleOrigin = Callable[[int], str]
 
-def _where(index: int, lines: Sequence[int] | None, first: int) -> tuple[str, int | None]:
+
+#: Said after the hint of a sample placed by its :data:`SampleOrigin`, whose two numbers differ.
+_ORIGIN_NOTE = (
+    "samples are counted from 0 in time order, a bag's messages from 1 in the order it "
+    "stores them on their topic"
+)
+
+
+def _hint(hint: str, origin: SampleOrigin | None) -> str:
+    return f"{hint} ({_ORIGIN_NOTE})" if origin is not None else hint
+
+
+def _where(
+    index: int, lines: Sequence[int] | None, first: int, origin: SampleOrigin | None = None
+) -> tuple[str, int | None]:
     if lines is not None and index < len(lines):
         return f"sample {first + index} (line {lines[index]})", lines[index]
+    if origin is not None:
+        return f"sample {first + index} ({origin(first + index)})", None
     return f"sample {first + index}", None
 
 
@@ -53,10 +73,12 @@ def sample_diagnostics(
     lines: Sequence[int] | None = None,
     first: int = 0,
     place: CellPlace | None = None,
+    origin: SampleOrigin | None = None,
 ) -> list[Diagnostic]:
     """Every problem with the samples ``(t[i], x[i], y[i])`` (empty list: they are usable);
     ``first``: the number of the first of them in its log (a live log's samples come one by
-    one); ``place``: where the offending cell of a sample is written (see :data:`CellPlace`)."""
+    one); ``place``: where the offending cell of a sample is written (see :data:`CellPlace`);
+    ``origin``: where a sample without a line came from (see :data:`SampleOrigin`)."""
     found: list[Diagnostic] = []
     if len(t) == 0:
         return [
@@ -70,13 +92,16 @@ def sample_diagnostics(
     values = np.column_stack([t, x, y])
     bad = np.flatnonzero(~np.all(np.isfinite(values), axis=1))
     for index in bad[:MAX_PER_KIND].tolist():
-        what, line = _where(index, lines, first)
+        what, line = _where(index, lines, first, origin)
         cells = np.flatnonzero(~np.isfinite(values[index])).tolist()
         found.append(
             error(
                 "V003",
                 f"{what} has a non-finite {'/'.join('txy'[c] for c in cells)} (NaN or infinity)",
-                hint="drop or repair the sample; the verifier does not guess missing values",
+                hint=_hint(
+                    "drop or repair the sample; the verifier does not guess missing values",
+                    origin,
+                ),
                 file=file,
                 line=line,
                 **_at(place, index, cells[0]),
@@ -86,15 +111,18 @@ def sample_diagnostics(
         return found  # order checks on NaN times would only repeat the same rows
     far = np.flatnonzero(np.any(np.abs(values) > MAX_MAGNITUDE, axis=1))
     for index in far[:MAX_PER_KIND].tolist():
-        what, line = _where(index, lines, first)
+        what, line = _where(index, lines, first, origin)
         cell = int(np.flatnonzero(np.abs(values[index]) > MAX_MAGNITUDE)[0])
         found.append(
             error(
                 "V024",
                 f"{what} has a time or coordinate beyond {MAX_MAGNITUDE:g} "
                 f"({', '.join(f'{v:g}' for v in values[index].tolist())})",
-                hint="a corrupt sample, or times in nanoseconds: times are seconds and "
-                "positions the mission's units",
+                hint=_hint(
+                    "a corrupt sample, or times in nanoseconds: times are seconds and "
+                    "positions the mission's units",
+                    origin,
+                ),
                 file=file,
                 line=line,
                 **_at(place, index, cell),
@@ -104,12 +132,15 @@ def sample_diagnostics(
         return found  # differences of such values overflow
     steps = np.diff(t)
     for index in (np.flatnonzero(steps < 0)[:MAX_PER_KIND] + 1).tolist():
-        what, line = _where(index, lines, first)
+        what, line = _where(index, lines, first, origin)
         found.append(
             error(
                 "V005",
                 f"time goes backwards at {what}: t = {t[index - 1]:g} then {t[index]:g}",
-                hint="sort the samples by time (the verifier does not reorder a log)",
+                hint=_hint(
+                    "sort the samples by time (the verifier does not reorder a log)",
+                    origin,
+                ),
                 file=file,
                 line=line,
                 **_at(place, index, 0),
@@ -117,7 +148,7 @@ def sample_diagnostics(
         )
     repeated = np.flatnonzero(steps == 0) + 1
     for index in repeated[:MAX_PER_KIND].tolist():
-        what, line = _where(index, lines, first)
+        what, line = _where(index, lines, first, origin)
         same = bool(x[index] == x[index - 1] and y[index] == y[index - 1])
         found.append(
             error(
@@ -125,7 +156,10 @@ def sample_diagnostics(
                 f"{what} repeats the time stamp t = {t[index]:g} "
                 + ("(same position)" if same else "at a different position")
                 + (f"; {len(repeated)} repeated time stamps in all" if len(repeated) > 1 else ""),
-                hint="drop duplicate samples; two positions at one instant are not a trajectory",
+                hint=_hint(
+                    "drop duplicate samples; two positions at one instant are not a trajectory",
+                    origin,
+                ),
                 file=file,
                 line=line,
                 **_at(place, index, 0),
@@ -142,8 +176,9 @@ def check_samples(
     file: str | None,
     lines: Sequence[int] | None = None,
     place: CellPlace | None = None,
+    origin: SampleOrigin | None = None,
 ) -> None:
     """Raise :class:`UsageError` (exit 2) with every problem of the samples, if any."""
-    found = sample_diagnostics(t, x, y, file=file, lines=lines, place=place)
+    found = sample_diagnostics(t, x, y, file=file, lines=lines, place=place, origin=origin)
     if found:
         raise UsageError(found)

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import contextlib
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -74,6 +74,8 @@ class Where:
     lines: Sequence[int] | None = None
     #: the JSON path or the bag topic the samples are under
     path: str | None = None
+    #: a bag's message of each sample, in words (given the sample's index), or None
+    origin: Callable[[int], str] | None = field(default=None, compare=False)
 
     def cell(self, index: int, cell: int) -> str | None:
         """The JSON path of cell ``cell`` (0 time, 1 value) of sample ``index``, when the
@@ -86,6 +88,8 @@ class Where:
         """Words for sample ``index``, and its line."""
         if self.lines is not None and index < len(self.lines):
             return f"sample {index} (line {self.lines[index]})", self.lines[index]
+        if self.origin is not None:
+            return f"sample {index} ({self.origin(index)})", None
         return f"sample {index}" + (f" at {self.path}" if self.path else ""), None
 
 

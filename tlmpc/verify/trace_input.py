@@ -21,7 +21,7 @@ from tlmpc.base.errors import Diagnostic, UsageError, error
 from tlmpc.io.json_places import json_path
 from tlmpc.ltl.ast import Formula
 from tlmpc.verify.model import Ending
-from tlmpc.verify.samples import MAX_MAGNITUDE, CellPlace, check_samples
+from tlmpc.verify.samples import MAX_MAGNITUDE, CellPlace, SampleOrigin, check_samples
 from tlmpc.verify.signals import Signal, signals_of_document
 
 if TYPE_CHECKING:
@@ -209,11 +209,13 @@ def _samples(
     file: str | None,
     lines: list[int] | None = None,
     place: CellPlace | None = None,
+    origin: SampleOrigin | None = None,
 ) -> FloatArray:
     """The ``[t, x, y]`` rows (V002, V024 and :func:`check_samples`' codes); ``place``: where
-    a sample's cell is written (a CSV's columns), else its JSON path under ``points``."""
+    a sample's cell is written (a CSV's columns), else its JSON path under ``points``;
+    ``origin``: where a sample came from, for a log without lines (a bag's messages)."""
     # rows of a trace.json's `points` when no reader says where they came from
-    where = json_path("points") if place is None and lines is None else None
+    where = json_path("points") if place is None and lines is None and origin is None else None
     if where is not None:
 
         def place(index: int, cell: int) -> dict[str, Any]:
@@ -250,7 +252,15 @@ def _samples(
                 path=json_path("points", row) if where and row is not None else where,
             )
     try:
-        check_samples(array[:, 0], array[:, 1], array[:, 2], file=file, lines=lines, place=place)
+        check_samples(
+            array[:, 0],
+            array[:, 1],
+            array[:, 2],
+            file=file,
+            lines=lines,
+            place=place,
+            origin=origin,
+        )
     except UsageError as exc:
         raise UsageError([_with_path(d, where) for d in exc.diagnostics]) from None
     return array
@@ -877,9 +887,12 @@ def _log_trace(
         transform=options.transform,
         frame=options.frame,
     )
-    from tlmpc.importers.logs import SampleColumns
+    from tlmpc.importers.logs import SampleColumns, SampleMessages
 
-    samples = _samples(log.samples, str(path), list(log.lines) or None, SampleColumns(path, log))
+    origin = SampleMessages(path, options.topic, log.messages) if log.messages is not None else None
+    samples = _samples(
+        log.samples, str(path), list(log.lines) or None, SampleColumns(path, log), origin
+    )
     document = _mission_fields(mission)
     document["points"] = samples.tolist()
     signals = None
