@@ -226,6 +226,8 @@ def _scopes(mission: Any) -> list[str]:
 
 def _contradictions(path: Path, mission: Any) -> list[Any]:
     """A T011/L020 diagnostic when no behaviour at all satisfies the mission's task."""
+    from tlmpc.base.errors import UsageError
+    from tlmpc.mission.load import place_translation_refusal
     from tlmpc.tasks import compile_phrase
     from tlmpc.tasks.contradiction import TaskPart, find_contradiction
 
@@ -250,5 +252,12 @@ def _contradictions(path: Path, mission: Any) -> list[Any]:
                 col=col,
             )
         )
-    found = find_contradiction(parts, groups=mission.groups, file=file)
+    try:
+        found = find_contradiction(parts, groups=mission.groups, file=file)
+    except UsageError as exc:
+        if any(d.code != "P041" for d in exc.diagnostics):
+            raise
+        # the task's automaton is beyond the translation's budget: this file's problem, at
+        # the entry to blame, not the run's
+        return [place_translation_refusal(d, mission) for d in exc.diagnostics]
     return [found] if found is not None else []

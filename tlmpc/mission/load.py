@@ -559,6 +559,90 @@ def _normal_form_too_large(
     return dataclasses.replace(refusal, file=file, line=line, col=col, path=json_path(where))
 
 
+def place_translation_refusal(
+    refusal: Diagnostic, mission: Mission, text: str | None = None
+) -> Diagnostic:
+    """``refusal`` (P041, the task's automaton beyond the translation's budget) placed in the
+    mission's file: at the task entry (a phrase, or ``ltl``) whose automaton alone is beyond
+    the budget, or, when none is, at the ``task:`` key (``ltl:`` without phrases) with a hint
+    that the conjunction of the entries is what is too large.
+
+    ``text`` is the mission's YAML when it is not read from ``mission.source``; a refusal
+    that already has a line, or whose mission text cannot be read any more, is returned as it
+    is.
+    """
+    if refusal.line is not None or mission.source is None:
+        return refusal
+    file = mission.source
+    if text is None:
+        try:
+            text = _read(file)
+        except (InvalidInputError, UsageError):  # gone or changed since it was loaded
+            return refusal
+    doc = load_positioned(text, file, lazy=True)[0]
+    if doc is None or not isinstance(doc.data, Mapping):
+        return refusal
+    data = doc.data
+    groups = {name: list(members) for name, members in mission.groups.items()}
+    reactive = mission.reactive
+    kinds = NameKinds(
+        regions=frozenset(mission.region_names),
+        groups=frozenset(groups),
+        sensors=frozenset(reactive.sensor_names if reactive else ()),
+        actions=frozenset(reactive.actions if reactive else ()),
+    )
+    ltl = mission.ltl if mission.ltl and mission.ltl.strip() else None
+    ltl_part = None if ltl is None else _parse_task_ltl(ltl)
+    entries = len(mission.task) + (ltl is not None)
+    # the entry with the largest normal form is the likeliest culprit: its translation alone,
+    # within the same budget, tells whether it is one
+    where, _ = _largest_part(ltl_part, data, groups, kinds, normal_form_size)
+    if entries == 1 or _translation_refused(where, ltl_part, data, groups, kinds):
+        line, col = _ltl_position(doc, where)
+        return dataclasses.replace(refusal, file=file, line=line, col=col, path=json_path(where))
+    key: Path = ("task",) if mission.task else ("ltl",)
+    line, col = doc.key_at(key)
+    return dataclasses.replace(
+        refusal,
+        file=file,
+        line=line,
+        col=col,
+        path=json_path(key),
+        hint=f"no entry alone is too large: the conjunction of the task's {entries} entries "
+        "is; split the task into smaller missions, or write fewer independent goals "
+        "(each `F a` or `G F a` beside the others can double the automaton)",
+    )
+
+
+def _parse_task_ltl(text: str) -> Formula:
+    from tlmpc.ltl.parser import parse_ltl  # lark: only for missions with `ltl`
+
+    return parse_ltl(text)
+
+
+def _translation_refused(
+    where: Path,
+    ltl: Formula | None,
+    data: Mapping[str, Any],
+    groups: Mapping[str, list[str]],
+    kinds: NameKinds,
+) -> bool:
+    """Whether the translation refuses (P041) the task entry at ``where`` alone."""
+    from tlmpc.automata.translate import translate
+
+    part = (
+        ltl
+        if where == ("ltl",)
+        else compile_phrase(data["task"][where[1]], groups=groups, kinds=kinds)
+    )
+    assert part is not None  # the largest part is `ltl` only when the mission has one
+    try:
+        translate(substitute(part, group_expansion(groups)), simplify=False)
+    except UsageError as exc:
+        return any(d.code == "P041" for d in exc.diagnostics)
+    return False
+
+
 def _unknown_names(
     formulas: list[Formula], known: set[str], file: str, reactive: bool
 ) -> list[Diagnostic]:

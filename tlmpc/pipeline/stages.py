@@ -811,6 +811,17 @@ def _placed(
     from tlmpc.mission.placement import placed
 
     source = str(compilation.source)
+    mission = compilation.find(MISSION)
+    if mission is not None and any(d.code == "P041" and d.file is None for d in diagnostics):
+        from tlmpc.mission.load import place_translation_refusal
+
+        # the translation knows the formula, not which entry of the file wrote it
+        diagnostics = tuple(
+            place_translation_refusal(d, mission, compilation.text)
+            if d.code == "P041" and d.file is None
+            else d
+            for d in diagnostics
+        )
     named = tuple(
         d if d.file is not None else dataclasses.replace(d, file=source) for d in diagnostics
     )
