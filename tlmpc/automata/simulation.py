@@ -229,6 +229,7 @@ def simulation(
         for letters, _marks, _dst in out[state]:
             enabled[state] |= letters
     # simulators[p]: bitmask of the states still believed to simulate p.
+    work.charge(deadline, n * n)
     simulators = [0] * n
     for p in range(n):
         for q in range(n):
@@ -292,6 +293,7 @@ def simulation(
                         matched = 0
                         row = pre.get((index, marks))
                         if row is not None:
+                            work.charge(deadline, good.bit_count())  # the loop below
                             rest = good
                             while rest:
                                 low = rest & -rest
@@ -306,6 +308,7 @@ def simulation(
             if current != simulators[p]:
                 simulators[p] = current
                 changed = True
+    work.charge(deadline, n * n)
     return [[q == p or bool(simulators[p] >> q & 1) for q in range(n)] for p in range(n)]
 
 

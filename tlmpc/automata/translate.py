@@ -59,6 +59,11 @@ UNITS_PER_NODE = 100
 #: edges than this (each takes about 2.5 KiB until the reductions are done: about 750 MiB), or
 #: a state more than :data:`~tlmpc.automata.terms.MAX_TERMS` expansion terms.
 MAX_RAW_EDGES = 300_000
+#: ... or whose states, before any reduction, take more work units than this to expand (each
+#: state its terms, their obligations and promises, and their pairwise domination check): many
+#: independent goals over a map's exclusive letters (`visit p0, ..., visit p13`: 16,384 states)
+#: stay under the edges' budget while their exploration takes minutes.
+MAX_EXPLORATION_UNITS = 1_000_000
 
 #: Emptiness checks of the rewriting give up (answer "not shown empty") past this many states.
 MAX_EMPTINESS_STATES = 400
@@ -266,6 +271,7 @@ def _explore(
     states: dict[State, int] = {}
     names: list[str] = []
     raw_edges: list[tuple[int, int, Cube, int]] = []
+    explored = 0  # work units of the states expanded (MAX_EXPLORATION_UNITS)
     if initial is not None:
         states[initial] = 0
         names.append(_state_name(initial))
@@ -279,8 +285,14 @@ def _explore(
                 if deadline is not None:  # an optional check: it gives up
                     raise OutOfBudget from None
                 raise _too_large(text, len(states), state_limit=exc.limit) from None
+            units = _expansion_units(expansion)
             if deadline is not None:
-                work.charge(deadline, _expansion_units(expansion))
+                work.charge(deadline, units)
+            explored += units
+            if explored > MAX_EXPLORATION_UNITS:
+                if deadline is not None:
+                    raise OutOfBudget
+                raise _too_large(text, len(states), explored=explored)
             terms: list[tuple[Cube, State, int]] = []
             for pos, neg, nxt, promises in expansion:
                 target = simplify_state(nxt)
@@ -400,12 +412,15 @@ def _expansion_units(expansion: list[Expansion]) -> int:
     return 1 + terms + sizes + min(terms, MAX_DOMINATION_TERMS) ** 2
 
 
-def _too_large(text: str, states: int, *, state_limit: int | None = None) -> UsageError:
-    too_many = (
-        f"more than {MAX_RAW_EDGES:,} edges"
-        if state_limit is None
-        else f"a state with more than {state_limit:,} edges"
-    )
+def _too_large(
+    text: str, states: int, *, state_limit: int | None = None, explored: int | None = None
+) -> UsageError:
+    if explored is not None:
+        too_many = f"states taking more than {MAX_EXPLORATION_UNITS:,} units of work to expand"
+    elif state_limit is None:
+        too_many = f"more than {MAX_RAW_EDGES:,} edges"
+    else:
+        too_many = f"a state with more than {state_limit:,} edges"
     return UsageError(
         error(
             "P041",
