@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import io
 import json
+import math
+import re
 from pathlib import Path
 from typing import Any
 
@@ -17,6 +19,7 @@ from tlmpc.cli import main
 
 ROOT = Path(__file__).resolve().parents[2]
 MISSION = ROOT / "specs" / "example1.yaml"
+NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|[-+]?(?:inf|nan)", re.I)
 
 
 def run_cli(*argv: str) -> tuple[int, str, str]:
@@ -84,3 +87,60 @@ def test_another_documents_format_is_refused(compiled: tuple[Path, dict[str, Any
     code, _, err = run_cli("plot", str(out), "--verdict", str(path))
     assert code == 2
     assert "error[U071]" in err
+
+
+# A violation's position is a point of a trace, which the verifier reads within ±1e12 only;
+# one farther out is refused by the verdict schema (U071) and never reaches the picture, where
+# it would write `inf` into the path data.
+def _with_position(
+    compiled: tuple[Path, dict[str, Any]], position: list[float], name: str
+) -> tuple[Path, Path]:
+    out, verdict = compiled
+    edited = json.loads(json.dumps(verdict))
+    edited["workspace_violation"]["position"] = position
+    path = out.parent / name
+    path.write_text(json.dumps(edited))
+    return out, path
+
+
+def _path_numbers(svg: str) -> list[str]:
+    return [n for d in re.findall(r' d="([^"]*)"', svg) for n in NUMBER.findall(d)]
+
+
+@pytest.mark.parametrize("position", [[1e308, -1e308], [1.5, -1e13], [2e12, 3.0]])
+def test_a_position_beyond_what_the_verifier_reads_is_refused(
+    compiled: tuple[Path, dict[str, Any]], position: list[float]
+) -> None:
+    out, path = _with_position(compiled, position, "far.json")
+    before = (out / "plan.svg").read_bytes()
+    code, _, err = run_cli("plot", str(out), "--verdict", str(path))
+    assert code == 2, err
+    assert f"{path}: error[U071]" in err
+    assert "position" in err
+    assert (out / "plan.svg").read_bytes() == before
+
+
+def test_a_position_at_the_bound_is_drawn_with_finite_numbers(
+    compiled: tuple[Path, dict[str, Any]],
+) -> None:
+    out, path = _with_position(compiled, [1e12, -1e12], "edge.json")
+    code, _, err = run_cli("plot", str(out), "--verdict", str(path))
+    assert code == 0, err
+    numbers = _path_numbers((out / "plan.svg").read_text())
+    assert numbers
+    assert all(math.isfinite(float(n)) for n in numbers)
+
+
+def test_a_listed_violation_beyond_the_bound_is_refused(
+    compiled: tuple[Path, dict[str, Any]],
+) -> None:
+    out, verdict = compiled
+    edited = json.loads(json.dumps(verdict))
+    far = {"conjunct": "G inside", "time": 1.0, "position": [0.0, -1e300], "message": "far"}
+    edited["violations"] = [*edited["violations"], far]
+    path = out.parent / "listed.json"
+    path.write_text(json.dumps(edited))
+    code, _, err = run_cli("plot", str(out), "--verdict", str(path))
+    assert code == 2, err
+    assert f"{path}: error[U071]" in err
+    assert "violations[" in err
