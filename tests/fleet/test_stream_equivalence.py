@@ -139,6 +139,22 @@ def test_a_still_robot_keeps_two_samples() -> None:
     assert kept[:, 0].tolist() == [0.0, 9999.0]
 
 
+@pytest.mark.parametrize("where", [(1.0, 1.0), (4.0, 2.0), (0.0, 0.0), (8.5, 6.0)])
+def test_a_robot_still_on_a_boundary_keeps_two_samples_and_its_departure(
+    where: tuple[float, float],
+) -> None:
+    """On a region's corner, a shared edge, the workspace's corner, an edge: the anchor's disc
+    is empty there, and still no sample at the anchor leaves it (the log's samples standing
+    still were all kept, so memory grew with the sampling rate)."""
+    reducer = Reducer(document("F a", "right", 0.0))
+    t = np.arange(10_000, dtype=float)
+    still = np.column_stack([t, np.full_like(t, where[0]), np.full_like(t, where[1])])
+    away = np.array([[10_000.0, 5.0, 7.0]])
+    reducer.feed(np.vstack([still, away]))
+    kept = reducer.finish()
+    assert kept[:, 0].tolist() == [0.0, 9999.0, 10_000.0]
+
+
 def test_every_boundary_crossing_keeps_its_segment() -> None:
     # A line through region a sampled every 0.01: the segments that cross x = 1 and x = 4
     # are kept with both ends, the long stretches between are not.

@@ -166,7 +166,9 @@ class Reducer:
             stop = min(len(samples), index + window)
             block = samples[index:stop]
             offsets = np.hypot(block[:, 1] - self.anchor[1], block[:, 2] - self.anchor[2])
-            out = ~(offsets < self.reach)
+            # a sample at the anchor itself never leaves it, even where the anchor's disc is
+            # empty (on a boundary): a robot standing still there keeps two samples
+            out = ~((offsets < self.reach) | (offsets == 0.0))
             if self.pin_time is not None:
                 out |= block[:, 0] - self.origin >= self.pin_time
             if not out.any():
