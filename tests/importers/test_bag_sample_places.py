@@ -116,3 +116,30 @@ def test_a_clean_bag_is_read_once(
     assert status == 2
     assert "pose message 3 on /odom" in envelope["diagnostics"][0]["message"]
     assert len(opened) == clean_opens + 1
+
+
+@pytest.mark.parametrize(("kind", "shuffled"), [("ros1", False), ("mcap", True)])
+def test_a_streamed_bad_sample_names_its_message(
+    tmp_path: Path, mission: Path, monkeypatch: pytest.MonkeyPatch, kind: str, shuffled: bool
+) -> None:
+    """The streamed reading (a big bag) names it as the whole reader does, across chunk
+    boundaries, in stored order and when the bag has to be read whole and sorted."""
+    monkeypatch.setattr(logs, "BAG_STREAM_FROM", 0)  # every bag streams
+    rng = random.Random(f"stream-{kind}")
+    count = logs.BAG_CHUNK + 50  # two chunks
+    stamps = [(i + 1) * 1_000_000 for i in range(count)]
+    if shuffled:  # out of order: read again whole and sorted
+        stamps[-2], stamps[5] = stamps[5], stamps[-2]
+    log_times = [(i + 1) * 1_000 + rng.randrange(999) for i in range(count)]
+    rows = [(ns, 5.0, 5.0) for ns in stamps]
+    bad = count - 3  # in the second chunk
+    rows[bad] = (rows[bad][0], float("nan"), 5.0)
+    path = tmp_path / ("log.bag" if kind == "ros1" else "log")
+    write_bag(path, kind, {"/odom": ("nav_msgs/msg/Odometry", rows)}, {"/odom": log_times})
+    code, document = verify(str(path), "--mission", str(mission))
+    assert code == 2
+    (diagnostic,) = document["diagnostics"]
+    sample = sorted(range(count), key=lambda i: rows[i][0]).index(bad)
+    expected = f"sample {sample} (pose message {bad + 1} on /odom, log time {log_times[bad]} ns)"
+    assert diagnostic["code"] == "V003"
+    assert expected in diagnostic["message"], diagnostic
