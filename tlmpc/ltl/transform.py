@@ -13,7 +13,7 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from typing import assert_never
 
-from tlmpc.base.errors import UsageError, error
+from tlmpc.base.errors import Diagnostic, UsageError, error
 from tlmpc.ltl.ast import (
     FALSE,
     TRUE,
@@ -107,26 +107,33 @@ def _nnf_children(node: Formula, negated: bool) -> list[tuple[Formula, bool]]:
             return [(child, negated) for child in node.children()]
 
 
+def normal_form_refusal(formula: Formula, negate: bool = False) -> Diagnostic | None:
+    """P041 when the negation normal form of ``formula`` (of its negation when ``negate``)
+    would have more than :data:`MAX_NORMAL_FORM_SIZE` operators and names; None otherwise."""
+    if normal_form_size(formula, negate) <= MAX_NORMAL_FORM_SIZE:
+        return None
+    return error(
+        "P041",
+        "the formula's negation normal form would have more than "
+        f"{MAX_NORMAL_FORM_SIZE:,} operators and names, more than the translation's "
+        "budget: each `<->` writes both of its sides twice",
+        hint="write fewer nested `<->` (a chain of n equivalences doubles n times), "
+        "or split the task into smaller missions",
+    )
+
+
 def nnf(formula: Formula, negate: bool = False) -> Formula:
     """Negation normal form of ``formula`` (of its negation when ``negate``).
 
     The result has no ``->``/``<->`` and negations only directly above propositions.
 
     Raises:
-        UsageError: P041, the normal form would have more than
+        UsageError: P041 (:func:`normal_form_refusal`), the normal form would have more than
             :data:`MAX_NORMAL_FORM_SIZE` operators and names (chains of ``<->``).
     """
-    if normal_form_size(formula, negate) > MAX_NORMAL_FORM_SIZE:
-        raise UsageError(
-            error(
-                "P041",
-                "the formula's negation normal form would have more than "
-                f"{MAX_NORMAL_FORM_SIZE:,} operators and names, more than the translation's "
-                "budget: each `<->` writes both of its sides twice",
-                hint="write fewer nested `<->` (a chain of n equivalences doubles n times), "
-                "or split the task into smaller missions",
-            )
-        )
+    refusal = normal_form_refusal(formula, negate)
+    if refusal is not None:
+        raise UsageError(refusal)
     return _nnf(formula, negate)
 
 

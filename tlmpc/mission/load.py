@@ -22,7 +22,7 @@ from tlmpc.io.scalar_places import ScalarPlaces
 from tlmpc.io.schema_check import MISSION_COORDINATE_LIMIT, is_valid, load_schema
 from tlmpc.ltl.ast import Formula, Prop, bounded_operators, conjoin
 from tlmpc.ltl.keywords import KEYWORDS
-from tlmpc.ltl.transform import MAX_NORMAL_FORM_SIZE, nnf, normal_form_size, substitute
+from tlmpc.ltl.transform import normal_form_refusal, normal_form_size, substitute
 from tlmpc.mission.geometry import check_layout, check_shape
 from tlmpc.mission.model import (
     Component,
@@ -546,13 +546,8 @@ def _normal_form_too_large(
     """P041 for a task whose negation normal form is beyond the translation's budget (a chain
     of ``<->``), placed at the phrase (or ``ltl``) with the largest normal form: every
     command that translates the task would refuse it, at no place in the file."""
-    if normal_form_size(formula) <= MAX_NORMAL_FORM_SIZE:
-        return None
-    try:
-        nnf(formula)  # raises the translation's own refusal
-    except UsageError as exc:
-        refusal = exc.diagnostics[0]
-    else:
+    refusal = normal_form_refusal(formula)
+    if refusal is None:
         return None
     where, _ = _largest_part(ltl, data, groups, kinds, normal_form_size)
     line, col = _ltl_position(doc, where)

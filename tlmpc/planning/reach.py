@@ -16,7 +16,7 @@ find a plan.  When it does not refuse, the product decides.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import replace
 
 import numpy as np
@@ -29,24 +29,31 @@ from tlmpc.automata.model import Automaton
 from tlmpc.automata.simplify import trim
 from tlmpc.ltl.ast import Formula
 from tlmpc.planning.boundary import StartCell, start_point_label, task_letters
-from tlmpc.planning.contacts import vertex_point_letters
+from tlmpc.planning.contacts import Letter, vertex_point_letters
 from tlmpc.planning.model import POINT
 
 BoolArray = npt.NDArray[np.bool_]
 
 
 def passable_vertices(
-    abstraction: Abstraction, required: Sequence[Formula], *, closed: bool
+    abstraction: Abstraction,
+    required: Sequence[Formula],
+    *,
+    closed: bool,
+    corner_letters: Mapping[int, Letter] | None = None,
 ) -> BoolArray:
     """Mesh vertices a trajectory may pass through under the invariants ``required``.
 
     Under the closed convention the instant at a contact vertex reads every region whose
     closure holds it, so a corner of a region the task forbids is no way through; under the
-    right-continuous convention that instant reads the triangle entered.
+    right-continuous convention that instant reads the triangle entered.  ``corner_letters``:
+    :func:`tlmpc.planning.contacts.vertex_point_letters` when the caller has it already.
     """
     passable = np.ones(abstraction.vertices.shape[0], dtype=bool)
     if closed and required:
-        for vertex, letter in vertex_point_letters(abstraction).items():
+        if corner_letters is None:
+            corner_letters = vertex_point_letters(abstraction)
+        for vertex, letter in corner_letters.items():
             if not all(holds(p, set(letter)) for p in required):
                 passable[vertex] = False
     return passable
@@ -113,9 +120,11 @@ def cannot_accept_on_reach(
     """
     closed = convention == "closed"
     sources = [abstraction.start] if resume is not None else [c.triangle for c in starts]
-    reached = reachable_triangles(
-        abstraction, allowed, sources, passable_vertices(abstraction, required, closed=closed)
+    corner_letters = vertex_point_letters(abstraction) if closed else {}
+    passable = passable_vertices(
+        abstraction, required, closed=closed, corner_letters=corner_letters
     )
+    reached = reachable_triangles(abstraction, allowed, sources, passable)
     names = {
         name
         for index in np.unique(abstraction.letter_of[reached]).tolist()
@@ -124,7 +133,7 @@ def cannot_accept_on_reach(
     if closed:
         names.update(start_point_label(abstraction, start_point))
         corners = set(np.unique(abstraction.triangles[reached]).tolist())
-        for vertex, letter in vertex_point_letters(abstraction).items():
+        for vertex, letter in corner_letters.items():
             if vertex in corners:
                 names.update(letter)
     names.add(POINT)
