@@ -7,8 +7,12 @@ from pathlib import Path
 
 import pytest
 
-from tlmpc.base.errors import Diagnostic, NoPlanError
+from tlmpc.abstraction.model import Abstraction
+from tlmpc.automata.model import Automaton
+from tlmpc.base.errors import Diagnostic, NoPlanError, UsageError, error
 from tlmpc.pipeline.stages import compile_mission
+from tlmpc.planning import budget as budget_module
+from tlmpc.planning import complete as complete_module
 
 MAP = """\
 version: 1
@@ -113,3 +117,27 @@ def test_a_region_the_body_cannot_enter_is_named_not_an_overlap(tmp_path: Path, 
     assert first.code == "P010"
     assert "region 'corner' has no free space the robot can be in" in (first.hint or "")
     assert "overlap" not in first.message + (first.hint or "")
+
+
+def test_a_part_kept_because_the_rest_was_beyond_the_budget_is_not_called_needed(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    task = "task:\n  - visit a\n  - avoid c\n  - " + json.dumps("patrol a, b") + "\n"
+    first, _lines = _no_plan(tmp_path, "", task)
+    assert (first.hint or "").startswith("each is possible without the others")
+
+    real_check = budget_module.check_product_size
+
+    def beyond_without_c(abstraction: Abstraction, automaton: Automaton) -> object:
+        # the patrol alone (no `c` in its automaton) is left beyond the budget
+        if "c" not in automaton.aps:
+            raise UsageError(error("P040", "beyond the budget (test)"))
+        return real_check(abstraction, automaton)
+
+    monkeypatch.setattr(complete_module, "check_product_size", beyond_without_c)
+    first, _lines = _no_plan(tmp_path, "", task)
+    assert first.code == "P011"
+    assert "`avoid c`" in first.message, "kept: the rest without it is undecided"
+    hint = first.hint or ""
+    assert "each is possible without the others" not in hint
+    assert "`avoid c`, without which the rest is beyond the planner's budget" in hint

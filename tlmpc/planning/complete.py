@@ -32,6 +32,7 @@ from tlmpc.mission.model import Options, TaskPart
 from tlmpc.planning.boundary import start_cells, start_point_label, task_formula, task_letters
 from tlmpc.planning.budget import check_product_size
 from tlmpc.planning.explain import (
+    Undecided,
     explain_infeasible,
     explain_no_plan,
     invariant_mask,
@@ -217,16 +218,16 @@ def _out_of_reach(
 
 def _no_plan_reasons(
     abstraction: Abstraction, options: Options, start_point: tuple[float, float]
-) -> Callable[[Formula], Sequence[Diagnostic] | None]:
+) -> Callable[[Formula], Sequence[Diagnostic] | Undecided | None]:
     """Why no trajectory satisfies a task formula on this map (U-turns and vertex passages
-    allowed), or None when one does or the budget leaves it open: a blamed set then only
-    grows, it never holds parts that have a plan."""
+    allowed), None when one does, or :attr:`Undecided.BEYOND_BUDGET` when the budget leaves
+    it open: a blamed set then only grows, it never holds parts that have a plan."""
     from tlmpc.automata.translate import translate
 
     convention = options.boundary
     letters = task_letters(abstraction, convention, start_point)
 
-    def no_plan_reasons(formula: Formula) -> Sequence[Diagnostic] | None:
+    def no_plan_reasons(formula: Formula) -> Sequence[Diagnostic] | Undecided | None:
         automaton = translate(task_formula(formula, convention), letters=letters)
 
         def attempt(*, passages: bool) -> None:
@@ -249,13 +250,13 @@ def _no_plan_reasons(
         except NoPlanError as failure:
             reasons = failure.diagnostics
         except UsageError:
-            return None  # beyond the budget: not known to have no plan
+            return Undecided.BEYOND_BUDGET  # not known to have a plan, nor to have none
         try:
             attempt(passages=True)
         except NoPlanError:
             return reasons
         except UsageError:
-            return None
+            return Undecided.BEYOND_BUDGET
         return None
 
     return no_plan_reasons

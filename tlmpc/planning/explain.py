@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import enum
 import functools
 from collections.abc import Callable, Sequence
 from typing import Any
@@ -177,6 +178,13 @@ def explain_no_plan(
     ]
 
 
+class Undecided(enum.Enum):
+    """A conjunction of task parts whose search the planner's budget stopped: not known to
+    have a plan, nor to have none."""
+
+    BEYOND_BUDGET = "beyond the planner's budget"
+
+
 #: Codes of explanations that are exact facts about the whole task (kept as they are).
 _EXACT = {"P001", "P002", "P003", "P006"}
 #: A minimal blamed set of parts is sought only for tasks of at most this many parts.
@@ -193,18 +201,19 @@ def explain_infeasible(
     parts: Sequence[TaskPart],
     file: str | None,
     fallback: Sequence[Diagnostic],
-    no_plan_reasons: Callable[[Formula], Sequence[Diagnostic] | None],
+    no_plan_reasons: Callable[[Formula], Sequence[Diagnostic] | Undecided | None],
 ) -> list[Diagnostic]:
     """Why no trajectory in the plane satisfies the task, blaming the parts that fail.
 
     Called only once planning *with U-turns* failed, which is exact (see docs/planning.md).
     The blamed parts are a minimal set of task parts (phrases, top-level LTL conjuncts) that
-    already has no plan on this map: dropping any one of them would make the rest possible.
+    already has no plan on this map: dropping any one of them makes the rest possible, or
+    leaves a task the planner's budget could not decide (the hint then says so).
     ``no_plan_reasons(formula)`` is the planner's explanation why a conjunction of parts has
-    no plan, or None when it has one (the caller's planner: this module explains, it does
-    not plan).  When the whole task's reason is exact (``fallback`` holds a P001, P002, P003
-    or P006), the blamed parts are a minimal set that still has that reason, and the reason
-    is stated for them alone.
+    no plan, None when it has one, or :attr:`Undecided.BEYOND_BUDGET` (the caller's planner:
+    this module explains, it does not plan).  When the whole task's reason is exact
+    (``fallback`` holds a P001, P002, P003 or P006), the blamed parts are a minimal set that
+    still has that reason, and the reason is stated for them alone.
     """
     if not parts:
         return list(fallback)
@@ -212,22 +221,26 @@ def explain_infeasible(
 
     exact_codes = {d.code for d in fallback if d.code in _EXACT}
 
-    def fails_alike(reasons: Sequence[Diagnostic] | None) -> bool:
+    def fails_alike(reasons: Sequence[Diagnostic] | Undecided | None) -> bool:
         # Parts that fail for another reason than the whole task's exact one cannot carry
         # that reason: a start in a forbidden region is not the fault of an unreachable goal.
-        if reasons is None:
+        if reasons is None or isinstance(reasons, Undecided):
             return False
         return not exact_codes or any(d.code in exact_codes for d in reasons)
 
     core = list(parts)
     core_reasons: Sequence[Diagnostic] = fallback
+    # Parts kept because the rest without them was beyond the budget, not shown possible.
+    kept_undecided: set[int] = set()
     if 1 < len(parts) <= MAX_CORE_PARTS:
         for part in list(parts):
             rest = [p for p in core if p is not part]
             if not rest:
                 continue
             reasons = no_plan_reasons(conjoin([p.formula for p in rest]))
-            if fails_alike(reasons):
+            if isinstance(reasons, Undecided):
+                kept_undecided.add(id(part))
+            elif fails_alike(reasons):
                 core, core_reasons = rest, reasons or ()
     blamed = conjoin([p.formula for p in core])
     first = core[0]
@@ -257,11 +270,24 @@ def explain_infeasible(
         headline = error(
             "P011",
             f"these parts of the task cannot all hold on this map: {quoted}",
-            hint="each is possible without the others; "
+            hint=_without_each(core, kept_undecided)
             + (facts or "relax one of them or change the map"),
             **where,
         )
     return [headline]
+
+
+def _without_each(core: Sequence[TaskPart], kept_undecided: set[int]) -> str:
+    """What is known of the blamed parts without each one of them."""
+    undecided = [f"`{p.text}`" for p in core if id(p) in kept_undecided]
+    if not undecided:
+        return "each is possible without the others; "
+    return (
+        "the others are possible without each of them but "
+        + ", ".join(undecided)
+        + ", without which the rest is beyond the planner's budget to decide (it may not be "
+        "needed); "
+    )
 
 
 def _at(file: str | None, part: TaskPart) -> str:
