@@ -1,7 +1,12 @@
 """Translator benchmark: sizes and times beside Spot's (per family), and TGBA/BA sizes beside
 spin's measured sizes (per formula).
 
-``python bench/bench_automata.py [--spot-only | --no-spot] [--no-spin]``.
+``python bench/bench_automata.py [--spot-only | --no-spot] [--no-spin] [--quick]``.
+
+``--quick`` prints the same tables from a sample, in well under a minute: the first
+:data:`QUICK_FAMILY` formulas of each Spot family (and :data:`QUICK_BATCH` of each seeded
+batch), one translation per formula, and live ``spin -f`` runs cut at :data:`QUICK_SPIN_TIMEOUT`
+seconds.
 
 Formulas and spin's reference numbers (trimmed state count and ``spin -f`` time, Debian spin
 6.5.2, from ``research/spin-sizes.md``) live in ``tests/automata/formulas.txt`` so the tests use
@@ -10,6 +15,7 @@ the same set.  When ``spin`` is installed, a live ``spin -f`` time is measured t
 
 from __future__ import annotations
 
+import argparse
 import shutil
 import statistics
 import subprocess
@@ -19,6 +25,11 @@ from pathlib import Path
 from typing import Any
 
 FORMULAS = Path(__file__).resolve().parent.parent / "tests" / "automata" / "formulas.txt"
+
+#: ``--quick``: formulas kept of each Spot family, of each seeded batch, and the live spin cut.
+QUICK_FAMILY = 10
+QUICK_BATCH = 2
+QUICK_SPIN_TIMEOUT = 0.25
 
 
 def load_formulas(path: Path = FORMULAS) -> list[tuple[str, int | None, str]]:
@@ -56,7 +67,7 @@ def _clear_caches() -> None:
 def run(
     repeats: int = 3, *, live_spin: bool = True, spin_timeout: float = 5.0
 ) -> list[dict[str, Any]]:
-    """One row per formula: sizes, median translation time, spin's reference numbers."""
+    """One row per formula: sizes, median translation CPU time, spin's reference numbers."""
     from tlmpc.automata import degeneralize, translate
     from tlmpc.ltl import parse_ltl
 
@@ -67,12 +78,13 @@ def run(
         times = []
         ba_times = []
         for _ in range(max(1, repeats)):
+            # CPU time of the process: on a shared machine wall time measures the others too.
             _clear_caches()
-            started = time.perf_counter()
+            started = time.process_time()
             tgba = translate(formula)
-            middle = time.perf_counter()
+            middle = time.process_time()
             ba = degeneralize(tgba)
-            ba_times.append(time.perf_counter() - middle)
+            ba_times.append(time.process_time() - middle)
             times.append(middle - started)
         row: dict[str, Any] = {
             "name": name,
@@ -167,13 +179,16 @@ _GENERATE = (
 )
 
 
-def large_random_set(batches: tuple[tuple[int, int, int, int], ...] = LARGE_BATCHES) -> list[str]:
+def large_random_set(
+    batches: tuple[tuple[int, int, int, int], ...] = LARGE_BATCHES, per_batch: int | None = None
+) -> list[str]:
     """A seeded set (one process per batch: Spot 2.13's ``randltl`` fails on a second call
-    in one process)."""
+    in one process); with ``per_batch``, only the first that many formulas of each batch."""
     texts: list[str] = []
-    for batch in batches:
+    for aps, count, seed, size in batches:
+        count = count if per_batch is None else min(count, per_batch)
         done = subprocess.run(
-            [sys.executable, "-c", _GENERATE, *map(str, batch)],
+            [sys.executable, "-c", _GENERATE, *map(str, (aps, count, seed, size))],
             capture_output=True,
             text=True,
             check=True,
@@ -188,6 +203,8 @@ def run_spot(
     held_out: int = 500,
     budget: int | None = None,
     large: bool = True,
+    per_family: int | None = None,
+    per_batch: int | None = None,
 ) -> list[dict[str, Any]]:
     """Per family: formulas, total states (tlmpc, Spot), formulas larger than Spot, the
     largest tlmpc translation time (wall clock, and CPU time of the process; the translator's
@@ -200,7 +217,9 @@ def run_spot(
     tlmpc's HOA.  ``held-out`` continues the random stream (formulas not tuned on; its few
     larger-than-Spot formulas were looked at once); ``random 2-5 APs`` (with ``large``) is
     the larger seeded set of :data:`LARGE_BATCHES`, ``fresh 2-5 APs`` and ``fresh held-out
-    2-5 APs`` those of :data:`FRESH_BATCHES` and :data:`HELD_OUT_BATCHES`.
+    2-5 APs`` those of :data:`FRESH_BATCHES` and :data:`HELD_OUT_BATCHES`.  ``per_family`` and
+    ``per_batch`` keep only the first formulas of each family and seeded batch (a sample of the
+    same sets, for ``--quick``).
     """
     import spot
 
@@ -210,12 +229,18 @@ def run_spot(
 
     families = _spot_families()
     groups = families.families(random_count=random_count, random_seed=0, held_out=held_out)
+    if per_family is not None:
+        groups = {family: texts[:per_family] for family, texts in groups.items()}
     if large:
-        groups["random 2-5 APs"] = large_random_set()
-        groups["fresh 2-5 APs"] = large_random_set(FRESH_BATCHES)
-        groups["fresh held-out 2-5 APs"] = large_random_set(HELD_OUT_BATCHES)
-        groups["tuning 2-5 APs"] = large_random_set(TUNING_BATCHES)
-        groups["last held-out 2-5 APs"] = large_random_set(LAST_HELD_OUT_BATCHES)
+        seeded = {
+            "random 2-5 APs": LARGE_BATCHES,
+            "fresh 2-5 APs": FRESH_BATCHES,
+            "fresh held-out 2-5 APs": HELD_OUT_BATCHES,
+            "tuning 2-5 APs": TUNING_BATCHES,
+            "last held-out 2-5 APs": LAST_HELD_OUT_BATCHES,
+        }
+        for family, batches in seeded.items():
+            groups[family] = large_random_set(batches, per_batch)
     rows = []
     for family, texts in groups.items():
         ours_total = theirs_total = larger = wrong = unchecked = 0
@@ -257,17 +282,19 @@ def run_spot(
     return rows
 
 
-def _spot_markdown(rows: list[dict[str, Any]]) -> str:
+def _spot_markdown(
+    rows: list[dict[str, Any]], before: dict[str, tuple[int, int, int, int, float]] = BEFORE
+) -> str:
     lines = [
         "| family | formulas | tlmpc states (before) | Spot states | larger than Spot (before)"
         " | larger % | max s (before) | max CPU s | Spot max s | not equivalent |",
         "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for r in rows:
-        before = BEFORE.get(r["family"])
-        old_states = f" ({before[1]})" if before else ""
-        old_larger = f" ({before[3]})" if before else ""
-        old_time = f" ({before[4]})" if before else ""
+        earlier = before.get(r["family"])
+        old_states = f" ({earlier[1]})" if earlier else ""
+        old_larger = f" ({earlier[3]})" if earlier else ""
+        old_time = f" ({earlier[4]})" if earlier else ""
         unchecked = r["not checked (Spot's 32-set limit)"]
         beyond = f" ({unchecked} beyond Spot's 32 sets)" if unchecked else ""
         lines.append(
@@ -281,7 +308,7 @@ def _spot_markdown(rows: list[dict[str, Any]]) -> str:
 
 def _markdown(rows: list[dict[str, Any]]) -> str:
     live = any("spin_seconds" in r for r in rows)
-    head = "| name | TGBA st | edges | acc | BA st | spin trim st | ms | BA ms |"
+    head = "| name | TGBA st | edges | acc | BA st | spin trim st | CPU ms | BA CPU ms |"
     sep = "|---|---:|---:|---:|---:|---:|---:|---:|"
     if live:
         head += " spin ms (live) |"
@@ -306,13 +333,35 @@ def _markdown(rows: list[dict[str, Any]]) -> str:
     slow = [r["name"] for r in rows if r["seconds"] + r["ba_seconds"] > 0.1]
     lines.append("")
     lines.append(f"BA larger than spin's trimmed count: {', '.join(worse) or 'none'}")
-    lines.append(f"over 100 ms (TGBA + BA): {', '.join(slow) or 'none'}")
+    lines.append(f"over 100 CPU ms (TGBA + BA): {', '.join(slow) or 'none'}")
     return "\n".join(lines)
 
 
-if __name__ == "__main__":
-    if "--no-spot" not in sys.argv:
-        print(_spot_markdown(run_spot()))
+def main(argv: list[str] | None = None) -> None:
+    """Print the Spot table, the per-formula table, or both."""
+    parser = argparse.ArgumentParser(description=__doc__)
+    only = parser.add_mutually_exclusive_group()
+    only.add_argument("--spot-only", action="store_true", help="only the table against Spot")
+    only.add_argument("--no-spot", action="store_true", help="only the per-formula table")
+    parser.add_argument("--no-spin", action="store_true", help="no live spin -f runs")
+    parser.add_argument("--quick", action="store_true", help="a sample, in well under a minute")
+    args = parser.parse_args(argv)
+    if not args.no_spot:
+        if args.quick:
+            # A sample: the bracketed numbers of whole families would not compare.
+            sample = run_spot(per_family=QUICK_FAMILY, per_batch=QUICK_BATCH)
+            print(_spot_markdown(sample, before={}))
+        else:
+            print(_spot_markdown(run_spot()))
         print()
-    if "--spot-only" not in sys.argv:
-        print(_markdown(run(live_spin="--no-spin" not in sys.argv)))
+    if not args.spot_only:
+        rows = run(
+            repeats=1 if args.quick else 3,
+            live_spin=not args.no_spin,
+            spin_timeout=QUICK_SPIN_TIMEOUT if args.quick else 5.0,
+        )
+        print(_markdown(rows))
+
+
+if __name__ == "__main__":
+    main()

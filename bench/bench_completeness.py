@@ -2,11 +2,16 @@
 
     python bench/bench_completeness.py BASELINE_ROOT [--repeats 5]
 
-For every ``specs/*.yaml`` (and the dead-end mission that needs a U-turn) each tree compiles the
-mission in its own fresh interpreter (``compile_mission`` up to ``verify``, nothing written),
-alternating trees round by round so that machine load hits both alike.  Prints the final
-triangle count (after any U-turn splits) and the median compile CPU seconds per tree
-(process time: on a shared machine wall time mostly measures the other processes).
+For every ``specs/*.yaml`` and two dead-end missions (a strip one unit wide, planned on the
+default quality mesh, and the same strip on the coarse mesh, ``min_angle: null`` and
+``goal_depth: 0``, where the strip is one triangle wide and the plan needs a U-turn) each tree
+compiles the mission in its own fresh interpreter (``compile_mission`` up to ``verify``,
+nothing written), alternating trees round by round so that machine load hits both alike.
+Prints the final triangle count (after every refinement of the plan stage) with the U-turn
+splits in brackets, and the median compile CPU seconds per tree (process time: on a shared
+machine wall time mostly measures the other processes).  The baseline must have this tree's
+module layout (``tlmpc.base``, ``tlmpc.pipeline.stages``); BASELINE_ROOT ``.`` measures this
+tree alone (one run of its own is the quickest check of the triangle counts).
 """
 
 from __future__ import annotations
@@ -33,6 +38,11 @@ robot: {start: [9, 1], max_speed: 1.0}
 task: [visit tip then base]
 """
 
+#: The same strip on the coarse mesh: one triangle wide, so the plan must turn around in it.
+DEAD_END_COARSE = DEAD_END.replace(
+    "name: dead-end\n", "name: dead-end-coarse\noptions: {min_angle: null, goal_depth: 0}\n"
+)
+
 CHILD = """\
 import json, sys, time
 sys.path.insert(0, sys.argv[1])
@@ -44,7 +54,8 @@ for path in sys.argv[2:]:
     started = time.process_time()
     try:
         result = compile_mission(path, until="verify")
-        triangles = result.compilation.get(ABSTRACTION).num_triangles
+        mesh = result.compilation.get(ABSTRACTION)
+        triangles = f"{mesh.num_triangles} ({mesh.stats.get('split_for_u_turns', 0)})"
     except TlmpcError as exc:
         triangles = exc.diagnostics[0].code
     rows[path] = [triangles, time.process_time() - started]
@@ -72,15 +83,16 @@ def main() -> None:
     args = parser.parse_args()
     scratch = Path(tempfile.mkdtemp())
     (scratch / "dead-end.yaml").write_text(DEAD_END)
+    (scratch / "dead-end-coarse.yaml").write_text(DEAD_END_COARSE)
     missions = [str(p) for p in sorted((ROOT / "specs").glob("*.yaml"))]
-    missions.append(str(scratch / "dead-end.yaml"))
+    missions += [str(scratch / "dead-end.yaml"), str(scratch / "dead-end-coarse.yaml")]
     trees = {"baseline": args.baseline.resolve(), "this tree": ROOT}
     runs: dict[str, list[dict[str, list[object]]]] = {name: [] for name in trees}
     for _ in range(args.repeats):
         for name, root in trees.items():
             runs[name].append(_run(root, missions))
     print(
-        "| mission | triangles (baseline) | triangles (this tree) "
+        "| mission | triangles (U-turn splits), baseline | triangles (U-turn splits), this tree "
         "| CPU s (baseline) | CPU s (this tree) | change |"
     )
     print("|---|---|---|---|---|---|")

@@ -8,11 +8,15 @@ without U-turns on that mesh); then the largest ratio at which ``tlmpc compile``
 the control stage) succeeds, found by bisection on the compiler itself (to 2^-16), and
 whether the goal depth had to yield (A040) there.
 
-    python bench/bench_supported.py
+    python bench/bench_supported.py [--quick]
+
+``--quick`` prints the same table for :data:`QUICK_MISSIONS` alone, bisecting to
+2^-:data:`QUICK_STEPS`: a check in well under a minute, not the published numbers.
 """
 
 from __future__ import annotations
 
+import argparse
 import sys
 import time
 from pathlib import Path
@@ -23,6 +27,11 @@ if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
 SPECS = ("example1", "example6", "example7", "example8", "patrol", "reach-avoid", "deadline")
+#: Bisection steps on the compiler: the largest compiling ratio to 2^-STEPS.
+STEPS = 16
+#: ``--quick``: one shipped spec and one of our own, and a coarser bisection.
+QUICK_MISSIONS = ("example1", "rooms")
+QUICK_STEPS = 6
 
 #: Missions of our own: wide corners along some route, a needle-prone corridor, a stay.
 OWN: dict[str, dict[str, Any]] = {
@@ -102,10 +111,10 @@ def _compiles(document: dict[str, Any], ratio: float) -> tuple[bool, bool]:
     return True, any(w.code == "A040" for w in compiled.warnings)
 
 
-def _largest_compiling(document: dict[str, Any]) -> tuple[float, bool]:
+def _largest_compiling(document: dict[str, Any], steps: int = STEPS) -> tuple[float, bool]:
     low, high = 0.0, 1.0  # C033 refuses a disturbance of max_speed or more
     yielded = False
-    for _ in range(16):
+    for _ in range(steps):
         middle = (low + high) / 2.0
         ok, warned = _compiles(document, middle)
         if ok:
@@ -115,29 +124,38 @@ def _largest_compiling(document: dict[str, Any]) -> tuple[float, bool]:
     return low, yielded
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
+    """Print one row per mission."""
+    from bench.tables import markdown_table
+
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--quick", action="store_true", help="two missions, a coarser bisection")
+    args = parser.parse_args(argv)
+    names = QUICK_MISSIONS if args.quick else (*SPECS, *OWN)
+    steps = QUICK_STEPS if args.quick else STEPS
+
     def show(value: float | None) -> str:
         return "-" if value is None else f"{value:.5f}"
 
     rows = []
-    for name in (*SPECS, *OWN):
+    for name in names:
         started = time.perf_counter()
         document = _document(name)
-        bounds = _mesh_bounds(document)
-        largest, yielded = _largest_compiling(document)
+        cores, half, quarter, margin = (show(bound) for bound in _mesh_bounds(document))
+        largest, yielded = _largest_compiling(document, steps)
         rows.append(
-            [
-                name,
-                *(show(bound) for bound in bounds),
-                f"{largest:.5f}",
-                "yes" if yielded else "no",
-                f"{time.perf_counter() - started:.1f}",
-            ]
+            {
+                "mission": name,
+                "cores": cores,
+                "half": half,
+                "quarter": quarter,
+                "margin depth": margin,
+                "compiles up to": f"{largest:.5f}",
+                "A040": "yes" if yielded else "no",
+                "s": f"{time.perf_counter() - started:.1f}",
+            }
         )
-    header = ["mission", "cores", "half", "quarter", "margin depth", "compiles up to", "A040", "s"]
-    widths = [max(len(str(r[k])) for r in [header, *rows]) for k in range(len(header))]
-    for row in [header, ["-" * w for w in widths], *rows]:
-        print("| " + " | ".join(str(c).ljust(w) for c, w in zip(row, widths, strict=True)) + " |")
+    print(markdown_table(rows))
 
 
 if __name__ == "__main__":
