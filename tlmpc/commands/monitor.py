@@ -192,9 +192,12 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     transform = parse_transform(args.transform) if args.transform else None
     csv = CsvLines(name, columns)
     reader = LogLines(name)
+    # Standard input needs no following: a read waits for the pipe's writer, and the pipe's
+    # end is final (polling it again would wait forever).
+    follow = args.follow and args.log != "-"
     with _opened(args.log) as stream:
         try:
-            lines = _lines(stream, reader, args.follow, args.idle)
+            lines = _lines(stream, reader, follow, args.idle)
             for number, raw in enumerate(lines, start=1):
                 pose = _pose(raw, csv, transform, name, number)
                 if pose is None:

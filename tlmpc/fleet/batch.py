@@ -16,7 +16,14 @@ import fnmatch
 import os
 import signal
 from collections.abc import Generator, Iterator, Mapping, Sequence
-from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from concurrent.futures import (
+    FIRST_COMPLETED,
+    CancelledError,
+    Future,
+    ProcessPoolExecutor,
+    wait,
+)
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -59,7 +66,7 @@ def discover(paths: Sequence[Path]) -> list[Path]:
         _first_visit(path, searched)
         for folder, names, files in os.walk(path, followlinks=True):
             here = Path(folder)
-            bags = [n for n in names if _is_bag_dir(here / n)]
+            bags = [n for n in names if not n.startswith(".") and _is_bag_dir(here / n)]
             inside.extend(here / n for n in bags)
             names[:] = [
                 n
@@ -133,10 +140,14 @@ def read_mapping(path: Path) -> list[MissionRule] | None:
 
 
 def match(rules: Sequence[MissionRule], log: Path) -> Path | None:
-    """The mission of the first rule whose pattern matches the log's path or its name."""
-    text = log.as_posix()
+    """The mission of the first rule whose pattern matches the log's path, or the path's last
+    parts: ``husky*/*.csv`` matches ``logs/husky1/run.csv`` however the folder holding
+    ``husky1`` was named on the command line (``logs/``, ``./logs``, an absolute path), and
+    ``*.csv`` the file name alone."""
+    parts = log.as_posix().split("/")
+    tails = ["/".join(parts[start:]) for start in range(len(parts))]
     for rule in rules:
-        if fnmatch.fnmatchcase(text, rule.pattern) or fnmatch.fnmatchcase(log.name, rule.pattern):
+        if any(fnmatch.fnmatchcase(tail, rule.pattern) for tail in tails):
             return rule.mission
     return None
 
@@ -218,14 +229,39 @@ def error_record(log: Path, mission: Path | None, exc: TlmpcError) -> dict[str, 
     }
 
 
+class _InternalError(TlmpcError):
+    """A log's verification met a tlmpc bug (I000, exit 3): its record carries it."""
+
+    exit_code = EXIT_INTERNAL
+
+
 def _internal(job: Job, exc: BaseException) -> dict[str, Any]:
-    record = error_record(Path(job.log), Path(job.mission), UsageError([]))
-    record["error"] = {
-        "code": "I000",
-        "message": f"internal error: {type(exc).__name__}: {exc}",
-        "exit_code": EXIT_INTERNAL,
-    }
-    return record
+    """The record of a log whose verification raised ``exc`` (a bug, never the log's fault):
+    an ``error`` record with I000, so the batch goes on and exits 3."""
+    return error_record(
+        Path(job.log),
+        Path(job.mission),
+        _InternalError(
+            error(
+                "I000",
+                f"internal error: {type(exc).__name__}: {exc}",
+                hint="please report it with the log that caused it",
+                file=job.log,
+            )
+        ),
+    )
+
+
+def _worker_died(job: Job) -> dict[str, Any]:
+    """The record of a log whose worker process ended while verifying it, alone in its pool
+    (killed by a signal, or by the system for want of memory)."""
+    return _internal(
+        job,
+        BrokenProcessPool(
+            "the worker process verifying this log ended abruptly (killed by a signal, or "
+            "out of memory)"
+        ),
+    )
 
 
 def _local(jobs: Sequence[Job]) -> Generator[dict[str, Any], None, None]:
@@ -240,29 +276,81 @@ def _pool(jobs: Sequence[Job], workers: int) -> Generator[dict[str, Any], None, 
     # At most a few jobs in flight per worker: a million logs never sit in memory as futures.
     limit = 4 * workers
     queue = iter(jobs)
-    pool = ProcessPoolExecutor(max_workers=workers, initializer=_worker_start)
+    pool = _start_pool(workers)
     finished = False
     try:
         running: dict[Future[dict[str, Any]], Job] = {}
-        # the workers are forked by the first submit: they start with the signals held
-        with _signals_held():
-            for job in queue:
-                running[pool.submit(run_job, job)] = job
-                if len(running) >= limit:
-                    break
+        _submit(pool, running, queue, limit)
         while running:
             done, _ = wait(running, return_when=FIRST_COMPLETED)
-            for future in done:
-                job = running.pop(future)
-                exc = future.exception()
-                yield _internal(job, exc) if exc is not None else future.result()
-                following = next(queue, None)
-                if following is not None:
-                    running[pool.submit(run_job, following)] = following
+            if any(isinstance(f.exception(), BrokenProcessPool) for f in done):
+                # A worker died (killed, or out of memory): every job in flight fails with it,
+                # whichever worker had it.  Each of those runs again alone, so only the log
+                # whose worker dies again is told so; the rest go on in a new pool.
+                done, _ = wait(running)
+                broken = [f for f in done if isinstance(f.exception(), BrokenProcessPool)]
+                lost = [running.pop(f) for f in broken]
+                for future in [f for f in done if f in running]:
+                    yield _record(running.pop(future), future)
+                pool.shutdown(wait=True, cancel_futures=True)
+                for job in lost:
+                    yield _alone(job)
+                pool = _start_pool(workers)
+            else:
+                for future in done:
+                    yield _record(running.pop(future), future)
+            _submit(pool, running, queue, limit)
         finished = True
     finally:
         if not finished:  # interrupted, or the caller stopped early: no log is finished
             _stop_workers(pool)
+        pool.shutdown(wait=True, cancel_futures=True)
+
+
+def _start_pool(workers: int) -> ProcessPoolExecutor:
+    return ProcessPoolExecutor(max_workers=workers, initializer=_worker_start)
+
+
+def _submit(
+    pool: ProcessPoolExecutor,
+    running: dict[Future[dict[str, Any]], Job],
+    queue: Iterator[Job],
+    limit: int,
+) -> None:
+    """Fill the pool up to ``limit`` jobs in flight."""
+    # a worker is forked by a submit: it starts with the signals held
+    with _signals_held():
+        while len(running) < limit:
+            job = next(queue, None)
+            if job is None:
+                return
+            try:
+                running[pool.submit(run_job, job)] = job
+            except BrokenProcessPool as exc:  # a worker died since the last wait: as above
+                failed: Future[dict[str, Any]] = Future()
+                failed.set_exception(exc)
+                running[failed] = job
+                return
+
+
+def _record(job: Job, future: Future[dict[str, Any]]) -> dict[str, Any]:
+    exc = future.exception()
+    return _internal(job, exc) if exc is not None else future.result()
+
+
+def _alone(job: Job) -> dict[str, Any]:
+    """``job`` verified in a pool of its own (see :func:`_pool`)."""
+    pool = _start_pool(1)
+    try:
+        with _signals_held():
+            future = pool.submit(run_job, job)
+        if isinstance(future.exception(), BrokenProcessPool):
+            return _worker_died(job)
+        return _record(job, future)
+    except BaseException:  # interrupted: its worker stops now, as the pool's do
+        _stop_workers(pool)
+        raise
+    finally:
         pool.shutdown(wait=True, cancel_futures=True)
 
 
@@ -318,7 +406,9 @@ def dask_client(address: str) -> Any:
         ) from None
     try:
         return Client(address, timeout="10s")
-    except (OSError, TimeoutError, ValueError) as exc:
+    # (TypeError, ImportError: a protocol distributed knows but cannot use here, such as
+    # tls:// without a security configuration or ucx:// without its package)
+    except (OSError, TimeoutError, ValueError, TypeError, ImportError) as exc:
         raise UsageError(
             error(
                 "F002",
@@ -334,11 +424,32 @@ def _dask(jobs: Sequence[Job], client: Any) -> Generator[dict[str, Any], None, N
 
     futures = {client.submit(run_job, job, pure=False): job for job in jobs}
     for future in as_completed(futures):
-        job = futures[future]
+        yield _dask_record(futures[future], future)
+
+
+def _dask_record(job: Job, future: Any) -> dict[str, Any]:
+    """The record of a finished Dask task: its own, an internal error's, or (the cluster lost
+    before the task ended, or before its result could be fetched) an F002 record."""
+    try:
         if future.status == "error":
-            yield _internal(job, future.exception())
-        else:
-            yield future.result()
+            return _internal(job, future.exception())
+        return dict(future.result())
+    except CancelledError:  # distributed's FutureCancelledError: the scheduler went away
+        pass
+    return error_record(
+        Path(job.log),
+        Path(job.mission),
+        UsageError(
+            error(
+                "F002",
+                "the Dask cluster was lost before this log was verified (the connection to "
+                "its scheduler ended)",
+                hint="run the batch again once the scheduler is back: the cache keeps the "
+                "logs already verified",
+                file=job.log,
+            )
+        ),
+    )
 
 
 def run(

@@ -150,10 +150,16 @@ def error_fields(exc: TlmpcError) -> dict[str, Any]:
 def verify_job(job: Job) -> dict[str, Any]:
     """The record of ``job`` without the cache (raises nothing for a bad log)."""
     from tlmpc.fleet.stream import verify_log
+    from tlmpc.importers.logs import is_log
 
     options = job.options
     path = log_path(job)
     try:
+        if not is_log(path):
+            # a trace.json carries its own task and map: read as `tlmpc verify TRACE` reads it
+            verdict = _verify_trace_file(path, options)
+            # checked against no mission file: the report draws it on no mission's map
+            return {**record_of(verdict, float(verdict.stats["start_time"])), "mission": None}
         streamed = verify_log(
             path,
             job.document,
@@ -173,6 +179,15 @@ def verify_job(job: Job) -> dict[str, Any]:
             fields["error"]["message"] = fields["error"]["message"].replace(str(path), job.log)
         return fields
     return record_of(streamed.verdict, streamed.start_time)
+
+
+def _verify_trace_file(path: Path, options: Options) -> Verdict:
+    """The verdict of a ``trace.json`` in a batch (whole: a compiled trace is small)."""
+    from tlmpc.verify import declare_ending, read_trace, verify_trace
+
+    trace = read_trace(path, None, options.boundary)
+    trace = declare_ending(trace, assume_stay=options.assume_stay, loop_from=options.loop_from)
+    return verify_trace(trace)
 
 
 def run_job(job: Job) -> dict[str, Any]:

@@ -14,9 +14,12 @@ visible escapes); the page loads nothing (no script, no network).
 
 from __future__ import annotations
 
+import contextlib
+import hashlib
 import html
 import math
 import re
+import shlex
 from collections import Counter, defaultdict
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -25,8 +28,9 @@ from typing import Any
 from urllib.parse import quote
 
 from tlmpc.base.errors import Diagnostic, UsageError, error, printable
-from tlmpc.fleet.job import Job
+from tlmpc.fleet.job import Job, Options
 from tlmpc.fleet.output import check_output, visible, write_atomically
+from tlmpc.verify.trace_input import LogOptions
 
 DATE = re.compile(r"\d{4}-\d{2}-\d{2}")
 
@@ -35,6 +39,15 @@ VIEW_LIMIT = 1000
 
 #: Columns of a heat map's grid.
 HEAT_COLUMNS = 48
+
+#: Hexadecimal digits of a page's SHA-256 in its view's name.
+VIEW_DIGITS = 16
+
+#: The names of views this report writes (``STEM-DIGEST.html``), and those earlier versions
+#: wrote (``NNNNN-STEM.html``): what :func:`_remove_unlinked` may remove.
+VIEW_NAME = re.compile(
+    rf"[A-Za-z0-9._-]{{0,60}}-[0-9a-f]{{{VIEW_DIGITS}}}\.html|[0-9]{{5}}-[A-Za-z0-9._-]{{0,60}}\.html"
+)
 
 STYLE = """
 body { font: 14px system-ui, sans-serif; color: #222; margin: 16px 24px; }
@@ -294,8 +307,17 @@ def check_report(path: Path) -> None:
     _check_views_folder(views_folder(path))
 
 
-def _views(rows: Sequence[Mapping[str, Any]], folder: Path, link_base: str) -> Views:
-    """Write each log's own view (violated first, at most :data:`VIEW_LIMIT`)."""
+def _views(
+    rows: Sequence[Mapping[str, Any]],
+    folder: Path,
+    link_base: str,
+    reading: Mapping[str, Options],
+) -> Views:
+    """Write each log's own view (violated first, at most :data:`VIEW_LIMIT`), read as the
+    batch read it (``reading``: each log's options).
+
+    A page is named after its log and its own bytes, so it never replaces a page an earlier
+    report links to: a run cut short leaves that report and its pages as they were."""
     from tlmpc.base.errors import TlmpcError
     from tlmpc.view import render_html, scene_from_log
 
@@ -305,14 +327,29 @@ def _views(rows: Sequence[Mapping[str, Any]], folder: Path, link_base: str) -> V
     )
     links: dict[str, str] = {}
     refused: dict[str, Diagnostic] = {}
-    for index, row in enumerate(order[:VIEW_LIMIT]):
+    for row in order[:VIEW_LIMIT]:
+        options = reading.get(row["log"], Options())
         try:
-            page = render_html(scene_from_log(Path(row["log"]), Path(row["mission"])))
+            scene = scene_from_log(
+                Path(row["log"]),
+                Path(row["mission"]),
+                LogOptions(
+                    topic=options.topic,
+                    columns=options.columns,
+                    transform=options.transform,
+                    frame=options.frame,
+                ),
+                convention=options.boundary,
+                assume_stay=options.assume_stay,
+                loop_from=options.loop_from,
+            )
         except TlmpcError as exc:  # too large for a view (a streamed log): the report says so
             if exc.diagnostics:
                 refused[row["log"]] = exc.diagnostics[0]
             continue
-        name = f"{index:05d}-{re.sub(r'[^A-Za-z0-9._-]+', '_', Path(row['log']).stem)[:60]}.html"
+        page = render_html(scene).encode("utf-8")
+        stem = re.sub(r"[^A-Za-z0-9._-]+", "_", Path(row["log"]).stem)[:60]
+        name = f"{stem}-{hashlib.sha256(page).hexdigest()[:VIEW_DIGITS]}.html"
         _check_views_folder(folder)
         try:
             folder.mkdir(parents=True, exist_ok=True)
@@ -320,9 +357,37 @@ def _views(rows: Sequence[Mapping[str, Any]], folder: Path, link_base: str) -> V
             raise UsageError(
                 error("F007", f"cannot write {folder}: {exc.strerror or exc}", file=str(folder))
             ) from None
-        write_atomically(folder / name, page.encode("utf-8"))
+        write_atomically(folder / name, page)
         links[row["log"]] = f"{link_base}/{name}"
     return Views(links, refused)
+
+
+def _remove_unlinked(folder: Path, views: Views) -> None:
+    """Remove the pages of earlier reports from the views folder, once the new report is in
+    place: every file named as a view that this report does not link to."""
+    linked = {link.rsplit("/", 1)[-1] for link in views.links.values()}
+    try:
+        entries = list(folder.iterdir())
+    except OSError:
+        return  # no folder (no view written), or one that cannot be listed: nothing to tidy
+    for entry in entries:
+        if entry.name not in linked and VIEW_NAME.fullmatch(entry.name) and entry.is_file():
+            with contextlib.suppress(OSError):
+                entry.unlink()
+
+
+def _view_command(row: Mapping[str, Any], options: Options) -> str:
+    """The ``tlmpc view`` command that draws ``row``'s log as the batch read it."""
+    words = ["tlmpc", "view", "--log", row["log"], "--mission", row["mission"]]
+    if options.topic is not None:
+        words += ["--topic", options.topic]
+    if options.columns is not None:
+        words += ["--columns", ",".join(options.columns)]
+    if options.transform is not None:
+        words += ["--transform", ",".join(repr(v) for v in options.transform)]
+    if options.frame is not None:
+        words += ["--frame", options.frame]
+    return " ".join(shlex.quote(word) for word in words)
 
 
 def render_report(
@@ -331,10 +396,13 @@ def render_report(
     *,
     group: str | None = None,
     views: Views | None = None,
+    reading: Mapping[str, Options] | None = None,
 ) -> str:
-    """The page for ``rows`` (the batch's records), ``documents`` the missions by path."""
+    """The page for ``rows`` (the batch's records), ``documents`` the missions by path,
+    ``reading`` each log's reading options (for the command that draws a log without a page)."""
     pattern = group_pattern(group)
     views = views or Views()
+    reading = reading or {}
     root = _common_root([r["log"] for r in rows])
     places = {r["log"]: robot_and_day(r["log"], root, pattern) for r in rows}
     verdicts = Counter(r["verdict"] for r in rows)
@@ -361,10 +429,8 @@ def render_report(
                 f"<br>{_e(refused.hint)}" if refused.hint else ""
             )
         elif row.get("mission"):
-            view = (
-                f'<span class="formula">tlmpc view --log {_e(row["log"])} '
-                f"--mission {_e(row['mission'])}</span>"
-            )
+            command = _view_command(row, reading.get(row["log"], Options()))
+            view = f'<span class="formula">{_e(command)}</span>'
         else:
             view = ""
         problem = _e(row["error"]["message"]) if row.get("error") else ""
@@ -403,7 +469,9 @@ def write_report(
 ) -> None:
     """Write the report at ``path`` and the logs' views in ``<path stem>.views/`` beside it."""
     documents = {job.mission: job.document for job in jobs}
+    reading = {job.log: job.options for job in jobs}
     folder = views_folder(path)
-    views = _views(rows, folder, folder.name)
-    page = render_report(rows, documents, group=group, views=views)
+    views = _views(rows, folder, folder.name, reading)
+    page = render_report(rows, documents, group=group, views=views, reading=reading)
     write_atomically(path, page.encode("utf-8"))
+    _remove_unlinked(folder, views)

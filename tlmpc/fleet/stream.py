@@ -43,7 +43,13 @@ from tlmpc.verify import Verdict, declare_ending, from_document, verify_trace
 from tlmpc.verify.clock import at
 from tlmpc.verify.model import Certificate
 from tlmpc.verify.robustness import speed_excess
-from tlmpc.verify.samples import MAX_PER_KIND, CellPlace, SampleOrigin, sample_diagnostics
+from tlmpc.verify.samples import (
+    MAX_MAGNITUDE,
+    MAX_PER_KIND,
+    CellPlace,
+    SampleOrigin,
+    sample_diagnostics,
+)
 from tlmpc.verify.trace_input import certifying_speed
 
 FloatArray = npt.NDArray[np.float64]
@@ -289,8 +295,13 @@ def _checked_chunks(
     counted = 0  # the samples before the current chunk, numbered as the whole log numbers them
     try:
         for samples, lines in chunks:
-            joined = samples if previous is None else np.vstack([previous, samples])
-            joined_lines = lines if previous is None or not lines else previous_line + lines
+            # The previous chunk's last sample is joined for the order checks across the two;
+            # one that is not finite or too large was reported with its own chunk, and then
+            # the log gets no order checks (as a whole log's), so it is not checked again.
+            joined, joined_lines = samples, lines
+            if previous is not None and _usable(previous[0]):
+                joined = np.vstack([previous, samples])
+                joined_lines = previous_line + lines if lines else lines
             place: CellPlace | None = None
             if cells is not None and joined_lines:
                 cells.forget_before(joined_lines[0])
@@ -320,7 +331,27 @@ def _checked_chunks(
     if previous is None and not found:
         found = sample_diagnostics(np.zeros(0), np.zeros(0), np.zeros(0), file=file)
     if found:
-        raise UsageError(found)
+        raise UsageError(_as_whole_log(found))
+
+
+def _usable(sample: FloatArray) -> bool:
+    """Whether a sample passes the checks of its own: finite, and not beyond the size the
+    verifier takes (V003, V024)."""
+    return bool(np.all(np.isfinite(sample)) and np.all(np.abs(sample) <= MAX_MAGNITUDE))
+
+
+#: The kinds of sample problems in the order a whole log's checks report them.
+_KINDS = ("V002", "V003", "V024", "V005", "V020")
+
+
+def _as_whole_log(found: Sequence[Diagnostic]) -> list[Diagnostic]:
+    """The problems a whole log's checks report (:func:`sample_diagnostics`), whichever chunk
+    they were found in: a sample that is not finite leaves out every other kind, one too
+    large the order checks; kind by kind, each in the log's order."""
+    for kind, leaves_out in (("V003", ("V024", "V005", "V020")), ("V024", ("V005", "V020"))):
+        if any(d.code == kind for d in found):
+            found = [d for d in found if d.code not in leaves_out]
+    return sorted(found, key=lambda d: _KINDS.index(d.code))
 
 
 def _by_line(cells: _CsvCells, lines: Sequence[int]) -> CellPlace:

@@ -165,16 +165,30 @@ def scene_from_output(directory: Path) -> dict[str, Any]:
 
 
 def scene_from_log(
-    log: Path, mission_path: Path, options: LogOptions | None = None
+    log: Path,
+    mission_path: Path,
+    options: LogOptions | None = None,
+    *,
+    convention: str | None = None,
+    assume_stay: bool = False,
+    loop_from: float | None = None,
 ) -> dict[str, Any]:
     """The scene of a robot's log (any format ``tlmpc verify`` reads) verified against a
-    mission."""
+    mission, read and ended as ``tlmpc verify`` reads it with the same flags (``options``,
+    ``--boundary``, ``--assume-stay``, ``--loop-from``)."""
     from tlmpc.ltl.printer import to_text
     from tlmpc.mission.load import load_mission
-    from tlmpc.verify import LogOptions, read_trace, verdict_to_json, verify_trace
+    from tlmpc.verify import (
+        LogOptions,
+        declare_ending,
+        read_trace,
+        verdict_to_json,
+        verify_trace,
+    )
 
     mission = load_mission(mission_path)
-    trace = read_trace(log, mission, None, options or LogOptions())
+    trace = read_trace(log, mission, convention, options or LogOptions())
+    trace = declare_ending(trace, assume_stay=assume_stay, loop_from=loop_from)
     verdict = verdict_to_json(verify_trace(trace))
     samples = [
         [float(t), float(x), float(y)]
