@@ -66,6 +66,54 @@ def _expect_path(value: Any, what: str, function: str) -> None:
         raise UsageError(error("U075", f"tlmpc.{function}: the path holds a NUL character"))
 
 
+class _NotPlain(Exception):
+    """A value of a mission dict that is no YAML value, and its JSON path."""
+
+    def __init__(self, path: str, what: str) -> None:
+        super().__init__(path, what)
+        self.path = path
+        self.what = what
+
+
+#: How deep a mission dict may nest (a mission nests a handful of levels; a dict that holds
+#: itself would never end).
+_MAX_PLAIN_DEPTH = 64
+
+
+def _plain(value: Any, path: str, depth: int = 0) -> Any:
+    """``value`` as the plain values YAML writes: any mapping a dict, a tuple or list (or a
+    numpy array) a list, a subclass of ``str``, ``int`` or ``float`` (an enum member, numpy's
+    ``float64``) its plain value; :class:`_NotPlain` for anything else."""
+    import numbers
+
+    if depth > _MAX_PLAIN_DEPTH:
+        raise _NotPlain(path, f"nested more than {_MAX_PLAIN_DEPTH} levels (or holds itself)")
+    if value is None or type(value) in (bool, int, float, str):
+        return value
+    if isinstance(value, bool):
+        return bool(value)
+    if isinstance(value, str):
+        return str.__str__(value)
+    if isinstance(value, numbers.Integral):
+        return int(value)
+    if isinstance(value, numbers.Real):
+        return float(value)
+    if isinstance(value, Mapping):
+        plain: dict[Any, Any] = {}
+        for key, item in value.items():
+            name = _plain(key, path, depth + 1)
+            if isinstance(name, list | dict):
+                raise _NotPlain(path, f"a key that is a {type(key).__name__}")
+            plain[name] = _plain(item, f"{path}.{key}", depth + 1)
+        return plain
+    if isinstance(value, list | tuple):
+        return [_plain(item, f"{path}[{i}]", depth + 1) for i, item in enumerate(value)]
+    tolist = getattr(value, "tolist", None)  # a numpy array or scalar
+    if callable(tolist) and type(value).__module__.split(".")[0] == "numpy":
+        return _plain(tolist(), path, depth + 1)
+    raise _NotPlain(path, f"a value of type {type(value).__name__}")
+
+
 def _mission_text(mission: MissionSource, function: str) -> tuple[str | None, Path]:
     """(YAML text or None when ``mission`` is a file, the path diagnostics will name)."""
     _expect(mission, (*_PATH, Mapping), "the mission must be a path, YAML text or a dict", function)
@@ -73,16 +121,19 @@ def _mission_text(mission: MissionSource, function: str) -> tuple[str | None, Pa
         import yaml
 
         try:
-            return yaml.safe_dump(dict(mission), sort_keys=False), Path("<mission>")
-        except (yaml.YAMLError, TypeError, ValueError, RecursionError) as exc:
+            document = _plain(mission, "$")
+        except _NotPlain as refused:
             raise UsageError(
                 error(
                     "U075",
-                    f"tlmpc.{function}: the mission dict holds a value YAML cannot write: "
-                    f"{str(exc)[:80]}",
-                    hint="use plain dicts, lists, strings and numbers",
+                    f"tlmpc.{function}: the mission dict holds a value YAML cannot write at "
+                    f"{refused.path if len(refused.path) <= 80 else refused.path[:79] + '…'}: "
+                    f"{refused.what}",
+                    hint="use dicts (any mapping), lists (or tuples, numpy arrays), strings and "
+                    "numbers",
                 )
             ) from None
+        return yaml.safe_dump(document, sort_keys=False), Path("<mission>")
     if isinstance(mission, os.PathLike):
         return None, Path(mission)
     if "\x00" in mission:
@@ -348,13 +399,18 @@ def translate(formula: str) -> Automaton:
 
 
 def check(mission: MissionSource) -> list[Diagnostic]:
-    """Every problem of ``mission`` (schema, geometry, task), best first; empty when valid."""
-    from tlmpc.mission.load import check_file, check_text
+    """What ``tlmpc check`` reports for ``mission``: every problem (schema, geometry, task,
+    a contradictory task, a reactive part outside GR(1)) best first, then its notes and
+    warnings; empty when valid and nothing to note.  A path to a map_server map YAML is
+    checked as a map.  Raises :class:`~tlmpc.base.errors.UsageError` when the file cannot be
+    read."""
+    from tlmpc.commands.check import check_source
 
     text, source = _mission_text(mission, "check")
-    if text is None:
-        return check_file(source)
-    return check_text(text, str(source))
+    _, problems, notices, status, _ = check_source(source, text)
+    if status == "unreadable":
+        raise UsageError(problems)
+    return [*problems, *notices]
 
 
 def executor(output: Compiled | str | os.PathLike[str]) -> Executor:

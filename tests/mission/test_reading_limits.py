@@ -273,8 +273,11 @@ def test_large_boundary_geometry_is_checked_without_pairwise_loops() -> None:
 
 
 def test_yaml_11_integer_forms_match_pyyaml() -> None:
-    text = "a: [012, 0x1f, 1_000, 0o17, -0, +5, 190:20:30, 0b101, 007, 1.5, -.5, 1_0.5]\n"
+    text = "a: [0x1f, 1_000, 0o17, -0, +5, 0b101, 007, 1.5, -.5, 1_0.5]\n"
     doc, problems = load_positioned(text, "x")
     assert problems == []
     assert doc is not None
     assert _same(doc.data, yaml.safe_load(text))
+    # the forms YAML 1.1 reads in another base than their decimal digits are refused
+    doc, problems = load_positioned("a: [012, 190:20:30]\n", "x")
+    assert [(p.code, p.col) for p in problems] == [("Y011", 5), ("Y011", 10)]

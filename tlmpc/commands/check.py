@@ -33,7 +33,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """Check every file; report all problems of all files."""
-    from tlmpc.base.errors import EXIT_NEGATIVE, EXIT_OK, EXIT_USAGE, error
+    from tlmpc.base.errors import EXIT_NEGATIVE, EXIT_OK, EXIT_USAGE
     from tlmpc.io.report import Reporter
 
     report = Reporter.for_args(args, out, err)
@@ -41,18 +41,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     explained: list[str] = []
     tally: Counter[tuple[str, str]] = Counter()  # (kind, status): how many files
     for path in args.files:
-        try:
-            entry, diagnostics, notices, status, kind = _check_file(path)
-        except RecursionError:  # deeper than any stage handles: this file, not the batch
-            entry, notices, status, kind = _entry(path), [], "unreadable", "mission"
-            diagnostics = [
-                error(
-                    "U036",
-                    "the mission is nested too deeply to process",
-                    hint="flatten it (split a long sequence of steps, or nest fewer formulas)",
-                    file=str(path),
-                )
-            ]
+        entry, diagnostics, notices, status, kind = check_source(path)
         tally[kind, status] += 1
         entry["diagnostics"] = [d.to_json() for d in [*diagnostics, *notices]]
         results.append(entry)
@@ -95,9 +84,42 @@ def _entry(path: Path) -> dict[str, Any]:
     return {"file": str(path), "ok": False, "diagnostics": [], "ltl": None}
 
 
-def _check_file(path: Path) -> tuple[dict[str, Any], list[Any], list[Any], str, str]:
-    """One file's entry, its problems and its notes, whether it is ``"valid"``,
-    ``"invalid"`` or ``"unreadable"``, and whether it is a ``"mission"`` or a ``"map"``."""
+def check_source(
+    path: Path, text: str | None = None
+) -> tuple[dict[str, Any], list[Any], list[Any], str, str]:
+    """Check one mission (or map) as ``tlmpc check`` does: its JSON entry, its problems (best
+    first) and its notes, whether it is ``"valid"``, ``"invalid"`` or ``"unreadable"``, and
+    whether it is a ``"mission"`` or a ``"map"``.  ``text``, when given, is the mission's YAML,
+    read instead of the file ``path`` (which then only names it in diagnostics)."""
+    from tlmpc.base.errors import error
+
+    try:
+        return _check_file(path, text)
+    except RecursionError:  # deeper than any stage handles: this file, not the batch
+        problem = error(
+            "U036",
+            "the mission is nested too deeply to process",
+            hint="flatten it (split a long sequence of steps, or nest fewer formulas)",
+            file=str(path),
+        )
+        return _entry(path), [problem], [], "unreadable", "mission"
+
+
+def _inspect_text(text: str, file: str) -> tuple[Any, list[Any]]:
+    """The mission in ``text`` (None when invalid) and its problems, best first, as
+    :func:`tlmpc.mission.load.inspect_file` gives them for a file."""
+    from tlmpc.base.errors import InvalidInputError
+    from tlmpc.mission.load import load_mission_text
+
+    try:
+        return load_mission_text(text, file), []
+    except InvalidInputError as exc:
+        return None, list(exc.diagnostics)
+
+
+def _check_file(
+    path: Path, text: str | None = None
+) -> tuple[dict[str, Any], list[Any], list[Any], str, str]:
     from tlmpc.base.errors import UsageError, best_first
     from tlmpc.ltl.printer import to_text
     from tlmpc.mission.load import inspect_file
@@ -105,10 +127,13 @@ def _check_file(path: Path) -> tuple[dict[str, Any], list[Any], list[Any], str, 
     entry = _entry(path)
     notices: list[Any] = []
     try:
-        mission, diagnostics = inspect_file(path)
+        if text is None:
+            mission, diagnostics = inspect_file(path)
+        else:
+            mission, diagnostics = _inspect_text(text, str(path))
     except UsageError as exc:
         return entry, list(exc.diagnostics), notices, "unreadable", "mission"
-    if mission is None and _is_map(path):
+    if mission is None and text is None and _is_map(path):
         return (*_check_map(path, entry), "map")
     if mission is not None and not diagnostics:
         diagnostics = _contradictions(path, mission)
@@ -116,7 +141,7 @@ def _check_file(path: Path) -> tuple[dict[str, Any], list[Any], list[Any], str, 
             diagnostics, entry["gr1"] = _gr1_reading(mission)
         # the geometry is checked whatever the task says: compile reports its problems
         # (R001, G030, G031) at load and abstraction, before it ever looks for a plan
-        geometry, notices = _geometry(mission)
+        geometry, notices = _geometry(mission, text)
         # best first over the whole file, as compile reports them (errors, then by place)
         diagnostics = best_first(diagnostics + geometry)
     if diagnostics:
@@ -166,27 +191,28 @@ def _check_map(
     return entry, [], [note], "valid"
 
 
-def _geometry(mission: Any) -> tuple[list[Any], list[Any]]:
+def _geometry(mission: Any, text: str | None = None) -> tuple[list[Any], list[Any]]:
     """The workspace's problems as compile's load and abstraction stages find them: the
     body's (R001) first, then, when the body fits, features snapping would reshape
-    (G030/G031); and the notes (merged holes, narrow passages)."""
+    (G030/G031); and the notes (merged holes, narrow passages).  ``text`` is the mission's
+    YAML when it is not read from its file: they are placed on its lines."""
     from tlmpc.mission.body import body_radius
     from tlmpc.mission.holes import workspace_notes
 
-    merged, notices = workspace_notes(mission)
+    merged, notices = workspace_notes(mission, text)
     problems: list[Any] = []
     if body_radius(mission.robot) > 0.0:  # shapely only for a body
         from tlmpc.mission.cspace import body_diagnostics
 
-        body = body_diagnostics(merged)
+        body = body_diagnostics(merged, text)
         problems = [d for d in body if d.severity == "error"]
         notices += [d for d in body if d.severity != "error"]
     if not problems:
-        problems = _subgrid(merged)
+        problems = _subgrid(merged, text)
     return problems, notices
 
 
-def _subgrid(mission: Any) -> list[Any]:
+def _subgrid(mission: Any, text: str | None) -> list[Any]:
     """What compile refuses before triangulating (G030/G031): features snapping would
     reshape.  A pure-Python look first: when every coordinate is on the grid (decimals, the
     usual case) nothing moves and numpy and shapely stay unloaded."""
@@ -194,9 +220,11 @@ def _subgrid(mission: Any) -> list[Any]:
 
     if features_on_grid(mission):
         return []
+    from tlmpc.mission.placement import placed
     from tlmpc.mission.resolution import subgrid_problems
 
-    return list(subgrid_problems(mission))
+    # placed on the file's lines already, or (``text``, no file) on the text's
+    return list(placed(subgrid_problems(mission), mission.source, text))
 
 
 def _gr1_reading(mission: Any) -> tuple[list[Any], list[str]]:

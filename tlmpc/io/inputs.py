@@ -23,6 +23,7 @@ from __future__ import annotations
 import bisect
 import contextlib
 import os
+import re
 import reprlib
 import stat
 from collections.abc import Iterator
@@ -276,6 +277,33 @@ def yaml_error(exc: Any, code: str, file: str, text: str) -> Diagnostic:
     )
 
 
+#: The characters YAML 1.1 (PyYAML, libyaml) reads as line breaks that YAML 1.2, JSON and text
+#: editors read as ordinary characters: a comment would end at one and the rest of its line be
+#: read as keys and values nobody sees, and every later line number would differ from the
+#: editor's.
+_FOREIGN_BREAK = re.compile("[\x85\u2028\u2029]")
+
+
+def foreign_line_break(text: str, code: str, file: str) -> Diagnostic | None:
+    """The diagnostic (``code``) of the first U+0085, U+2028 or U+2029 in the YAML ``text``,
+    or None.  Its line and column are the editor's: every line break before it is one that
+    both YAML and editors count."""
+    found = _FOREIGN_BREAK.search(text)
+    if found is None:
+        return None
+    starts = line_starts(text[: found.start()])
+    return error(
+        code,
+        f"YAML syntax error: the character U+{ord(found.group()):04X} is a line break to YAML "
+        "1.1 but not to editors or YAML 1.2",
+        hint="delete it or write a newline; a double-quoted string can hold one as an escape "
+        '("\\u2028", "\\N" for U+0085)',
+        file=file,
+        line=len(starts),
+        col=found.start() - starts[-1] + 1,
+    )
+
+
 def load_small_yaml(
     text: str,
     file: str,
@@ -289,6 +317,9 @@ def load_small_yaml(
     built."""
     import yaml
 
+    foreign = foreign_line_break(text, code, file)
+    if foreign is not None:
+        raise UsageError(foreign)
     try:
         _check_yaml_events(text, max_values, max_depth)
         return yaml.safe_load(text)

@@ -18,7 +18,7 @@ import yaml
 
 from tlmpc.base.errors import Diagnostic, error
 from tlmpc.io import json_places
-from tlmpc.io.inputs import yaml_error
+from tlmpc.io.inputs import foreign_line_break, yaml_error
 from tlmpc.io.scalar_places import ScalarPlaces, line_starts, scalar_places
 from tlmpc.mission.bulk import STEM, BulkList, cut_out
 
@@ -121,6 +121,34 @@ def _mark(node: Any) -> tuple[int, int]:
 #: mission loader keeps it only where the schema refuses the text.
 NUMBER_LIKE_TEXT = "Y010"
 _NUMBER_LIKE = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)")
+#: Plain numbers YAML 1.1 reads in another base than the decimal one YAML 1.2, JSON and
+#: Python read: a leading zero is octal (``010`` is 8), a colon is base 60 (``1:30`` is 90).
+_OCTAL = re.compile(r"[-+]?0[0-7_]+")
+_NUMBER_TAGS = frozenset(("tag:yaml.org,2002:int", "tag:yaml.org,2002:float"))
+#: The tags a mapping or list may carry: the ones it has anyway (``!`` is "no tag").
+_COLLECTION_TAGS = frozenset(("!", "tag:yaml.org,2002:map", "tag:yaml.org,2002:seq"))
+_TAG_HINT = "a mission needs no YAML tags (!!float, !!set, !!python/...): write the plain value"
+
+
+def _other_base(text: str, value: float) -> tuple[str, str] | None:
+    """The message and hint for a plain number YAML 1.1 read as ``value`` from ``text`` in
+    another base than decimal, or None for a decimal (or hexadecimal, or binary) number."""
+    if ":" in text:
+        return (
+            f"{text!r} is the base-60 number {value} in YAML 1.1 (YAML 1.2 and JSON read it "
+            "as text)",
+            f"write the number in decimal ({value} if that is meant), or quote the text ('{text}')",
+        )
+    if _OCTAL.fullmatch(text):
+        digits = text.replace("_", "")
+        decimal = int(digits, 10)
+        if decimal != value:
+            return (
+                f"{text!r} is the octal number {value} in YAML 1.1, not {decimal}",
+                f"write {decimal} without the leading zero ({value} if the octal number is "
+                f"meant), or quote the text ('{text}')",
+            )
+    return None
 
 
 def _json_number(text: str) -> float:
@@ -229,14 +257,21 @@ class _Converter:
         try:
             value = self.constructor.construct_object(node, deep=True)
         except (yaml.YAMLError, ValueError, OverflowError) as exc:
+            # a constructor's problem alone: its mark (the value's place) is the diagnostic's
+            reason = getattr(exc, "problem", None) or str(exc)
             self.problem(
                 "Y004",
-                f"cannot read the value {event.value!r}: {exc}",
+                f"cannot read the value {event.value!r}: {reason}",
                 event,
                 path,
-                hint="a mission needs no YAML tags (!!float, !!python/...): write the plain value",
+                hint=_TAG_HINT,
             )
             return None
+        if event.tag is None and not event.style and tag in _NUMBER_TAGS:
+            other_base = _other_base(event.value, value)
+            if other_base is not None:
+                self.problem("Y011", other_base[0], event, path, hint=other_base[1])
+                return None
         if isinstance(value, int) and not isinstance(value, bool) and abs(value) > 10**15:
             value = float("inf") if value > 0 else float("-inf")
         if isinstance(value, float) and not math.isfinite(value):
@@ -263,6 +298,18 @@ class _Converter:
         lazy = self.lazy
         for event in events:
             kind = type(event)
+            if (
+                (kind is mapping_start or kind is sequence_start)
+                and event.tag is not None
+                and event.tag not in _COLLECTION_TAGS
+            ):
+                self.problem(
+                    "Y004",
+                    f"cannot read the {'mapping' if kind is mapping_start else 'list'} tagged "
+                    f"{event.tag.replace('tag:yaml.org,2002:', '!!')!r}",
+                    event,
+                    hint=_TAG_HINT,
+                )
             if (kind is mapping_start or kind is sequence_start) and stack:
                 # A container as a list item or as the value of a named key: as below.
                 frame = stack[-1]
@@ -333,8 +380,9 @@ class _Converter:
                 items = frame.container
                 if type(items) is dict and frame.key is _NO_KEY:  # a key: as below, directly
                     key = str(event.value)
-                    if key in frame.seen or (self.lists and STEM in key):
-                        self._key(frame, event)  # a duplicate, or a placeholder as a key
+                    if key in frame.seen or key == "<<" or (self.lists and STEM in key):
+                        # a duplicate, a merge key, or a placeholder as a key
+                        self._key(frame, event)
                     elif lazy and frame.path:  # below the top level: no position (see _key)
                         frame.seen[key] = None
                         frame.unplaced = True
@@ -493,6 +541,16 @@ class _Converter:
             parent.key = _BAD_KEY
             return
         key = str(event.value)
+        if key == "<<" and not event.style and event.tag is None:
+            self.problem(
+                "Y006",
+                "YAML merge keys (`<<`) are not read in a mission",
+                event,
+                parent.path,
+                hint="write the keys out (an alias `*name` may still stand for a whole value)",
+            )
+            parent.key = _BAD_KEY
+            return
         if self.lists and STEM in key:
             self.mismatch = True
         if key in parent.seen:
@@ -604,6 +662,9 @@ def load_positioned(
     A ``.json`` file's surrogate pair escapes read as JSON reads them
     (:func:`json_surrogate_pairs`).
     """
+    foreign = foreign_line_break(text, "Y001", file)
+    if foreign is not None:
+        return None, [foreign]
     if file.lower().endswith(".json"):
         text = json_surrogate_pairs(text)
     doc, problems = _load_positioned(text, file, lazy)

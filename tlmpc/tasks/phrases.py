@@ -79,7 +79,7 @@ KEYWORDS = frozenset(
         "of",
     }
 )
-#: ``one of``, ``come back`` and ``go to`` are keywords only as a pair, one space apart.
+#: ``one of``, ``come back`` and ``go to`` are keywords only as a pair of words.
 _PAIR_SECOND = {"one": "of", "come": "back", "go": "to"}
 _NOUNS = frozenset({"area", "areas", "region", "regions", "room", "rooms"})
 
@@ -138,13 +138,9 @@ class _Reader:
         return index < len(self.tokens) and self.tokens[index].kind == _COMMA
 
     def _pair(self, first: str, offset: int = 0) -> bool:
-        """``first`` and its partner word, exactly one space apart (``go to``, ``one of``)."""
-        if self._word(offset) != first or self._word(offset + 1) != _PAIR_SECOND[first]:
-            return False
-        token = self.tokens[self.at + offset]
-        return self.phrase[token.start + len(first)] == " " and (
-            self.tokens[self.at + offset + 1].start == token.start + len(first) + 1
-        )
+        """``first`` and its partner word next (``go to``, ``one of``): two word tokens in a
+        row have only whitespace between them, as the grammar's two-word keywords ask."""
+        return self._word(offset) == first and self._word(offset + 1) == _PAIR_SECOND[first]
 
     def _take(self, *words: str) -> bool:
         if self._word() in words:
