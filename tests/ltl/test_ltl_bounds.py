@@ -46,6 +46,17 @@ def test_parse(text: str, tree: Formula) -> None:
     assert parse_ltl(to_text(tree)) == tree
 
 
+@pytest.mark.parametrize("gap", ["\n", "\r\n", "\n    ", " \n\t"])
+def test_a_bound_may_be_written_over_lines(gap: str) -> None:
+    assert parse_ltl(f"G (a -> F[0,{gap}5] b)") == parse_ltl("G (a -> F[0,5] b)")
+    assert parse_ltl(f"a U[{gap}1 ,{gap}2{gap}] b") == parse_ltl("a U[1,2] b")
+    with pytest.raises(InvalidInputError) as caught:
+        parse_ltl(f"F a & G[3,{gap}2] b", file="m.yaml", line=4, col=1)
+    (diagnostic,) = caught.value.diagnostics
+    assert (diagnostic.code, diagnostic.line, diagnostic.col) == ("L041", 4, 8)
+    assert "\n" not in diagnostic.message, "the bound shown on one line"
+
+
 def test_bounded_operators_bind_like_their_namesakes() -> None:
     assert parse_ltl("F[0,1] a U[0,2] b & c") == parse_ltl("((F[0,1] a) U[0,2] b) & c")
     assert parse_ltl("a U[0,1] b U c") == parse_ltl("a U[0,1] (b U c)")

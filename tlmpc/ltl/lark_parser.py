@@ -83,6 +83,7 @@ _INTERVAL_HINT = "write a closed interval of seconds [a,b] with 0 <= a <= b, e.g
 def _interval_problem(text: str) -> tuple[str, str, Interval | None]:
     """``(code, message, interval)``: the interval of ``[a,b]`` text, or why it is none."""
     body = text[1:-1]
+    text = " ".join(text.split())  # as shown: a bound written over lines on one line
     parts = body.split(",")
     if len(parts) != 2:
         return "L040", f"the time bound {text} needs exactly two bounds [a,b]", None
