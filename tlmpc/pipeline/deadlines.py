@@ -68,7 +68,9 @@ def check_time_bounds(
         return None
     from tlmpc.verify.trace_input import from_document
 
-    outcome, slacks = bound_slacks(from_document(dict(trace)))
+    outcome, slacks = bound_slacks(
+        from_document(dict(trace)), deadlines=_positive_deadlines(mission.formula)
+    )
     bounds = _bounds(mission, abstraction)
     if outcome == "satisfied":
         return {"bounds": bound_report(mission.formula, slacks, bounds)}
@@ -135,7 +137,8 @@ def bound_report(
 ) -> list[dict[str, Any]]:
     """``summary.json``'s ``bounds``: per bounded operator of ``formula`` (pre-order) its
     ``slack``; for a deadline (``F[0,T]``, ``U[0,T]`` occurring positively) the plan's
-    exact ``time`` for it (``T - slack``: the tightest deadline the trajectory meets); and
+    exact ``time`` for it (the tightest deadline the trajectory meets: ``T - slack``, as the
+    verifier found it when it was asked, see :func:`bound_slacks`); and
     where the proof search bounds that operator's own window, its ``lower_bound`` (the
     earliest any trajectory can do it, seconds).  None where a number has no meaning."""
     deadlines = _positive_deadlines(formula)
@@ -147,7 +150,9 @@ def bound_report(
     for index, found in enumerate(slacks):
         high = deadlines.get(index)
         time = None
-        if high is not None and found.slack is not None and math.isfinite(found.slack):
+        if high is not None and found.time is not None:
+            time = found.time
+        elif high is not None and found.slack is not None and math.isfinite(found.slack):
             time = high - found.slack
         report.append(
             {

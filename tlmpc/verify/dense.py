@@ -128,6 +128,25 @@ class Domain:
         assert self.loop_time is not None
         return self.end - self.loop_time
 
+    def periods_back(self, low: float, high: float) -> tuple[float, float]:
+        """A window ``[t + low, t + high]`` moved back by whole periods, as far as it still
+        starts in the loop for every ``t`` of the domain: the same values (the loop repeats).
+
+        Far out the floats no longer tell a period's instants apart (``t + 1e17`` is rounded
+        to 16 s): the window is laid out where they do.  The remainder of ``low`` by the
+        period is exact (``fmod``), so the window keeps its phase; its width is kept too (a
+        window wider than a period is cut to one anyway)."""
+        assert self.loop_time is not None
+        period = self.period
+        into_loop = self.loop_time - self.start  # t + low is in the loop for every t
+        if not low >= into_loop + period:
+            return low, high
+        moved = math.fmod(low, period)
+        moved += period * math.ceil((into_loop - moved) / period)
+        while moved < into_loop:  # (the product rounded down)
+            moved += period
+        return moved, moved + (high - low)
+
 
 def _placeholders(node: Formula) -> tuple[Formula, list[Formula]]:
     """``node`` with its operands replaced by propositions ``#0``, ``#1``, ... ."""
@@ -422,6 +441,8 @@ class DenseSemantics:
         loop is laid out a period past ``low`` beyond the trace, however long the trace before
         the loop is."""
         domain = self.domain
+        if domain.loop_time is not None:
+            low, high = domain.periods_back(low, high)
         whole: tuple[float, float, bool] | None = None  # (cutoff, high, right_closed)
         if domain.loop_time is not None and high > low + domain.period:
             cutoff = domain.loop_time - low  # windows starting before it: cut at the wrap

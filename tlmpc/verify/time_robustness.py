@@ -56,6 +56,10 @@ from tlmpc.ltl.ast import (
 #: times, to about a millionth of a millionth of it.
 STEPS = 40
 
+#: A deadline's time is first bracketed by window ends this many times apart (2^10: at most
+#: about a hundred steps up to the largest float, each bracket 2^10 times its lower end).
+GALLOP = 1024.0
+
 
 class BothPolarities(ValueError):
     """A time bound under ``<->``: tightening it has no direction."""
@@ -72,13 +76,25 @@ def _shrink(interval: Interval, amount: float) -> Interval | None:
 
 
 def tighten(
-    formula: Formula, amount: float, positive: bool = True, *, only: Formula | None = None
+    formula: Formula,
+    amount: float,
+    positive: bool = True,
+    *,
+    only: Formula | None = None,
+    high: float | None = None,
 ) -> Formula:
     """``formula`` with every finite bound made ``amount`` seconds harder to meet (with
-    ``only``: that bounded node alone, the very object, not an equal one elsewhere)."""
+    ``only``: that bounded node alone, the very object, not an equal one elsewhere; with
+    ``only`` and ``high``: that node's window ends at ``high`` instead, exactly, whatever
+    ``amount`` says)."""
 
     def again(f: Formula, sign: bool = positive) -> Formula:
-        return tighten(f, amount, sign, only=only)
+        return tighten(f, amount, sign, only=only, high=high)
+
+    def moved(interval: Interval, by: float) -> Interval | None:
+        if high is not None and only is not None:
+            return Interval(interval.low, high)
+        return _shrink(interval, by)
 
     if only is not None and formula is not only and isinstance(formula, BOUNDED):
         # another bound: kept as it is, its operands still searched for ``only``
@@ -100,6 +116,8 @@ def tighten(
         case Implies(left, right):
             return Implies(again(left, not positive), again(right))
         case Equiv(left, right):
+            if only is not None and not any(node is only for node in formula.walk()):
+                return formula  # the one bound that moves is elsewhere: nothing here does
             if bounded_operators(formula):
                 raise BothPolarities(str(formula))
             return formula
@@ -110,15 +128,15 @@ def tighten(
         case StrongRelease(left, right):
             return StrongRelease(again(left), again(right))
         case BoundedEventually(arg, interval):
-            window = _shrink(interval, amount if positive else -amount)
+            window = moved(interval, amount if positive else -amount)
             return FALSE if window is None else BoundedEventually(again(arg), window)
         case BoundedUntil(left, right, interval):
-            window = _shrink(interval, amount if positive else -amount)
+            window = moved(interval, amount if positive else -amount)
             if window is None:
                 return FALSE
             return BoundedUntil(again(left), again(right), window)
         case BoundedGlobally(arg, interval):
-            window = _shrink(interval, -amount if positive else amount)
+            window = moved(interval, -amount if positive else amount)
             return TRUE if window is None else BoundedGlobally(again(arg), window)
         case _:
             assert_never(formula)
@@ -142,14 +160,16 @@ def reach(formula: Formula) -> float:
             assert_never(formula)
 
 
-def horizon(formula: Formula, duration: float) -> float:
+def horizon(formula: Formula, duration: float, *, without: Formula | None = None) -> float:
     """How far a search for the time robustness must look: past the trace's duration plus
-    every finite bound (the largest float when that sum is past it)."""
+    every finite bound (the largest float when that sum is past it); ``without`` (a bounded
+    node of ``formula``, the very object): every finite bound but that one's."""
     bounds = [
         n.interval.high
         for n in bounded_operators(formula)
         if isinstance(n, BoundedEventually | BoundedGlobally | BoundedUntil)
         and math.isfinite(n.interval.high)
+        and n is not without
     ]
     total = duration + sum(bounds)
     # Strictly past every edge however large the sum: past 2**53 s a "+ 1" is rounded away,
@@ -171,6 +191,10 @@ def time_robustness(
     if outcome == "inconclusive" or not bounded_operators(formula):
         return None
     try:
+        # Tightened by 0 every window keeps its operand, so this meets every `<->` that any
+        # amount of the search can: a larger amount empties an outer window (replaced by a
+        # constant) and hides the `<->` below it until the bisection tries a smaller one.
+        tighten(formula, 0.0, only=only)
         if outcome == "satisfied":
 
             def good(amount: float) -> bool:
@@ -203,6 +227,55 @@ def time_robustness(
     found = low if outcome == "satisfied" else -high
     shown = float(f"{found:.10g}")
     return shown if math.isfinite(shown) else found  # (rounded past the largest float)
+
+
+def tightest_deadline(
+    formula: Formula,
+    deadline: BoundedEventually | BoundedUntil,
+    outcome_of: Callable[[Formula], str],
+    duration: float,
+) -> float | None:
+    """The earliest far end ``h`` of ``deadline``'s window (a node of the satisfied
+    ``formula`` whose satisfaction only grows with that end: an ``F[0,T]`` or ``U[0,T]``
+    occurring positively) for which ``formula`` is still satisfied, the other bounds kept:
+    the time the trace meets that deadline at.
+
+    That is ``T`` less the bound's slack, searched here on the window's end itself: ``T -
+    slack`` cancels when ``T`` dwarfs the trace (the slack of ``F[0,1e12] b``, found to a
+    2^-40 of 1e12 s and shown to ten digits, would put ``b`` at 0 s).  The end sought lies
+    before the trace's duration plus the other bounds: past them the trace has nothing new
+    for the window (a stay is constant, a loop repeats).  Up to that end, ends growing
+    :data:`GALLOP` times from the trace's duration bracket it (a few steps, however large
+    the other bounds), and :data:`STEPS` halvings narrow the bracket to 2^-30 of the end
+    found.  None when the formula is not satisfied at the range's end (a window the range
+    does not cover): the caller keeps ``T - slack``."""
+    low = deadline.interval.low
+
+    def good(end: float) -> bool:
+        return outcome_of(tighten(formula, 0.0, only=deadline, high=end)) == "satisfied"
+
+    top = max(low, min(deadline.interval.high, horizon(formula, duration, without=deadline)))
+    try:
+        if not good(top):
+            return None
+        if good(low):
+            return low
+    except BothPolarities:
+        return None
+    early, late = low, top  # fails at `early`, holds at `late`
+    reach_out = low + duration + 1.0
+    while reach_out < late:
+        if good(reach_out):
+            late = reach_out
+            break
+        early, reach_out = reach_out, low + (reach_out - low) * GALLOP
+    for _ in range(STEPS):
+        middle = early + (late - early) / 2.0
+        if good(middle):
+            late = middle
+        else:
+            early = middle
+    return late  # (not rounded to fewer digits: that could end it before the edge, unmet)
 
 
 def conjunction_robustness(

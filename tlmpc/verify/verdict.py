@@ -6,7 +6,7 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import math
-from collections.abc import Callable, Iterator, Mapping, Set
+from collections.abc import Callable, Collection, Iterator, Mapping, Set
 from typing import Any
 
 import numpy as np
@@ -14,7 +14,14 @@ import numpy.typing as npt
 import shapely
 
 from tlmpc.base.errors import UsageError, error
-from tlmpc.ltl.ast import And, BoundedEventually, Formula, Globally, bounded_operators
+from tlmpc.ltl.ast import (
+    And,
+    BoundedEventually,
+    BoundedUntil,
+    Formula,
+    Globally,
+    bounded_operators,
+)
 from tlmpc.ltl.printer import to_text
 from tlmpc.verify.blame import Prefixes, assume_guarantee
 from tlmpc.verify.clock import Clock, since_first
@@ -39,6 +46,7 @@ from tlmpc.verify.time_robustness import (
     conjunction_robustness,
     horizon,
     reach,
+    tightest_deadline,
     time_robustness,
 )
 from tlmpc.verify.trace_input import TraceInput
@@ -584,6 +592,10 @@ class BoundSlack:
 
     bound: str
     slack: float | None
+    #: For a deadline asked about (see :func:`bound_slacks`) of a satisfied task: the time
+    #: the trace meets it at, the earliest far end of its window that still holds (None:
+    #: not asked, or not found; then ``T - slack`` says it, to the slack's precision).
+    time: float | None = None
 
 
 @contextlib.contextmanager
@@ -604,29 +616,45 @@ def _loop_limit(trace: TraceInput) -> Iterator[None]:
         ) from None
 
 
-def bound_slacks(trace: TraceInput) -> tuple[Outcome, tuple[BoundSlack, ...]]:
+def bound_slacks(
+    trace: TraceInput, deadlines: Collection[int] = ()
+) -> tuple[Outcome, tuple[BoundSlack, ...]]:
     """The task's verdict on ``trace`` and the slack of each of its bounded operators
-    (pre-order): the time robustness of the task with that one bound moved.
+    (pre-order): the time robustness of the task with that one bound moved; for those whose
+    index is in ``deadlines`` (each an ``F[0,T]`` or ``U[0,T]`` occurring only positively)
+    also the time the trace meets it at, when the task is satisfied.
 
     Raises:
         UsageError: V040, a window would unroll the trace's loop too far."""
     with _loop_limit(trace):
-        return _bound_slacks(trace)
+        return _bound_slacks(trace, deadlines)
 
 
-def _bound_slacks(trace: TraceInput) -> tuple[Outcome, tuple[BoundSlack, ...]]:
+def _bound_slacks(
+    trace: TraceInput, deadlines: Collection[int]
+) -> tuple[Outcome, tuple[BoundSlack, ...]]:
     found = _truth_of(trace)
     outcome_of = found.outcome_function()
     outcome = _outcome(*found.truth.at_start(trace.formula))
-    span = horizon(trace.formula, float(found.times[-1]))
-    slacks = tuple(
-        BoundSlack(
-            bound=to_text(node),
-            slack=time_robustness(trace.formula, outcome, outcome_of, span, only=node),
+    duration = float(found.times[-1])
+    span = horizon(trace.formula, duration)
+    slacks = []
+    for index, node in enumerate(bounded_operators(trace.formula)):
+        time = None
+        if (
+            index in deadlines
+            and outcome == "satisfied"
+            and isinstance(node, BoundedEventually | BoundedUntil)
+        ):
+            time = tightest_deadline(trace.formula, node, outcome_of, duration)
+        slacks.append(
+            BoundSlack(
+                bound=to_text(node),
+                slack=time_robustness(trace.formula, outcome, outcome_of, span, only=node),
+                time=time,
+            )
         )
-        for node in bounded_operators(trace.formula)
-    )
-    return outcome, slacks
+    return outcome, tuple(slacks)
 
 
 def verify_trace(trace: TraceInput) -> Verdict:
