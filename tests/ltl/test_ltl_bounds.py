@@ -68,6 +68,8 @@ def test_bounded_operators_bind_like_their_namesakes() -> None:
         ("F[5,1] a", "L041", 2),
         ("F[-1,2] a", "L042", 2),
         ("F[0,-2] a", "L042", 2),
+        ("F[0,-inf] a", "L042", 2),
+        ("G[-Infinity,2] a", "L042", 2),
         ("G[nan,2] a", "L043", 2),
         ("F[inf,inf] a", "L043", 2),
         ("F[1] a", "L040", 2),

@@ -75,7 +75,7 @@ _BINARY_TEMPORAL: dict[str, Callable[..., Formula]] = {
 
 
 _NUMBER = re.compile(r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
-_INFINITY = re.compile(r"\+?(?:inf|infinity|∞)", re.IGNORECASE)
+_INFINITY = re.compile(r"([+-]?)(?:inf|infinity|∞)", re.IGNORECASE)
 _NOT_A_NUMBER = re.compile(r"[+-]?nan", re.IGNORECASE)
 _INTERVAL_HINT = "write a closed interval of seconds [a,b] with 0 <= a <= b, e.g. F[0,30] dock"
 
@@ -100,8 +100,8 @@ def _interval_problem(text: str) -> tuple[str, str, Interval | None]:
                     None,
                 )
             bounds.append(value)
-        elif _INFINITY.fullmatch(part):
-            bounds.append(math.inf)
+        elif infinity := _INFINITY.fullmatch(part):
+            bounds.append(-math.inf if infinity.group(1) == "-" else math.inf)
         elif _NOT_A_NUMBER.fullmatch(part):
             return "L043", f"the time bound {text} is not a number (NaN)", None
         else:
