@@ -25,6 +25,7 @@ from tlmpc.ltl.keywords import KEYWORDS
 from tlmpc.ltl.transform import normal_form_refusal, normal_form_size, substitute
 from tlmpc.mission.geometry import check_layout, check_shape
 from tlmpc.mission.model import (
+    MOTION_NAMES,
     Component,
     Mission,
     Options,
@@ -697,6 +698,19 @@ def _reactive(
                         "S013",
                         f"{name!r} is declared as a {key[:-1]} and as a {taken[name]}",
                         hint="a name means one thing: rename one of them",
+                        file=file,
+                        line=line,
+                        col=col,
+                    )
+                )
+            elif name in MOTION_NAMES:
+                line, col = doc.key_at((key, name))
+                problems.append(
+                    error(
+                        "S013",
+                        f"the {key[:-1]} {name!r} has the name of a variable of the robot's "
+                        f"motion in the reactive game ({', '.join(MOTION_NAMES)})",
+                        hint=f"rename the {key[:-1]} (e.g. {name}_{key[:-1]})",
                         file=file,
                         line=line,
                         col=col,

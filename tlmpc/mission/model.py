@@ -171,6 +171,15 @@ class TaskPart:
     col: int | None = None
 
 
+#: The variables a reactive mission's game gives the robot's motion: the face it is in, the
+#: face it heads for, and whether the last step crossed into another face.  They share the
+#: game's name space with the sensors and actions, so no sensor or action may take them (S013).
+FACE = "face"
+GOAL = "goal"
+MOVED = "moved"
+MOTION_NAMES = (FACE, GOAL, MOVED)
+
+
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Sensor:
     """An environment proposition the robot reads (reactive missions).
@@ -206,6 +215,11 @@ class Reactive:
     def sensor_names(self) -> tuple[str, ...]:
         """Sensor names in file order."""
         return tuple(s.name for s in self.sensors)
+
+    def motion_clashes(self) -> tuple[str, ...]:
+        """The sensors and actions named like a variable of the robot's motion
+        (:data:`MOTION_NAMES`), which the game could not tell apart from it."""
+        return tuple(n for n in (*self.sensor_names, *self.actions) if n in MOTION_NAMES)
 
     def to_json(self) -> dict[str, Any]:
         """The ``reactive`` object of ``mission.json``."""

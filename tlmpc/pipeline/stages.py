@@ -501,26 +501,36 @@ def _outruns(trace: Mapping[str, Any], speed: float) -> bool:
 
 
 def _synthesize(c: Compilation) -> StageResult:
+    from tlmpc.abstraction.io import abstraction_document
     from tlmpc.reactive.synthesize import (
         counterstrategy_to_json,
         strategy_to_json,
-        synthesize,
+        synthesize_on_regions,
         unrealizable,
     )
     from tlmpc.reactive.unrealizable import UnrealizableError
 
     mission = c.get(MISSION)
-    synthesis = synthesize(mission, c.get(ABSTRACTION))
+    built = c.get(ABSTRACTION)
+    # unrealizable on the goal cores or grown regions: solved again on the regions as they
+    # are, whose mesh (and abstraction.json) then replaces the built one
+    synthesis, abstraction, notes = synthesize_on_regions(mission, built)
+    artifacts: dict[str, Any] = {}
+    if abstraction is not built:
+        artifacts["abstraction.json"] = abstraction_document(abstraction)
     if not synthesis.realizable:
-        shown = dict(c.documents)
+        shown = {**c.documents, **artifacts}
         if synthesis.counter is not None:
-            shown["counterstrategy.json"] = counterstrategy_to_json(synthesis, c.get(ABSTRACTION))
+            shown["counterstrategy.json"] = counterstrategy_to_json(synthesis, abstraction)
         raise UnrealizableError(unrealizable(synthesis, mission), shown)
     assert synthesis.size is not None
     assert synthesis.symbolic is not None
     game = synthesis.game
+    artifacts["strategy.json"] = strategy_to_json(synthesis)
     return StageResult(
-        artifacts={"strategy.json": strategy_to_json(synthesis)},
+        products=provide(ABSTRACTION, abstraction),
+        warnings=notes,
+        artifacts=artifacts,
         sizes={
             "faces": game.faces.count,
             "variables": len(game.spec.variables),
@@ -580,6 +590,9 @@ STAGES: tuple[Stage, ...] = (
         name="synthesize",
         run=_synthesize,
         requires=(MISSION, ABSTRACTION),
+        # the mesh of the regions as they are, when the goal cores or grown regions leave
+        # the robot no strategy
+        provides=(ABSTRACTION,),
         aliases=("strategy", "game"),
         worlds=frozenset({"reactive"}),
     ),
@@ -982,8 +995,13 @@ def run_stage_from_artifacts(
 ) -> CompileResult:
     """Run the one stage ``name`` on the input artifacts found in ``directory``."""
     stage = stage_named(name)
-    compilation = compilation_from_artifacts(directory, stage.requires)
-    mission = compilation.find(MISSION)
+    # the mission's kind first (also for a stage that does not read mission.json): a stage of
+    # the other kind would ask for artifacts that no compile of this mission writes
+    mission = (
+        compilation_from_artifacts(directory, (MISSION,)).get(MISSION)
+        if (directory / MISSION.artifact).is_file()
+        else None
+    )
     if mission is not None and world_of(mission) not in stage.worlds:
         raise MissingProductError(
             error(
@@ -995,6 +1013,7 @@ def run_stage_from_artifacts(
                 file=str(directory / MISSION.artifact),
             )
         )
+    compilation = compilation_from_artifacts(directory, stage.requires)
     try:
         return run_stages([stage], compilation, progress=progress)
     except SelfCheckError as exc:

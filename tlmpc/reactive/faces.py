@@ -62,3 +62,17 @@ def faces_of(abstraction: Abstraction) -> Faces:
     return Faces(
         face_of=face_of, adjacent=tuple(tuple(sorted(a)) for a in adjacent), letters=letters
     )
+
+
+def start_faces(
+    abstraction: Abstraction, face_of: IntArray, point: tuple[float, float], located: int
+) -> list[int]:
+    """The faces a robot at ``point`` may enter first: the face of the triangle ``located``
+    holding it, then, by number, those of the other triangles whose closure holds the point
+    (a start on the boundary of faces: under the right-continuous convention its label at
+    t = 0 is the one of the face it moves into, docs/semantics.md, "Starts on a boundary")."""
+    from tlmpc.abstraction.starts import start_cells
+
+    first = int(face_of[located])
+    others = {int(face_of[cell.triangle]) for cell in start_cells(abstraction, point)}
+    return [first, *sorted(others - {first})]

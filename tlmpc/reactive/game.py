@@ -135,10 +135,16 @@ def build_game(
     variables: list[Variable] = [Variable(s, "env") for s in sensors]
     variables += [Variable(FACE, "env", 0, count - 1), Variable(MOVED, "env")]
     monitors: list[tuple[str, Automaton, Piece]] = []
+    # a monitor's variable must not take a sensor's or an action's name (they are identifiers
+    # like it): the game keys its variables by name
+    taken = {*sensors, *actions, FACE, GOAL, MOVED}
     for index, piece in enumerate(pieces):
         if piece.kind == "monitor":
             assert piece.automaton is not None
             name = f"{'assumed' if piece.owner == 'env' else 'task'}_monitor_{index}"
+            while name in taken:
+                name += "_"
+            taken.add(name)
             monitors.append((name, piece.automaton, piece))
     variables += [
         Variable(name, "env", 0, max(a.num_states - 1, 1))

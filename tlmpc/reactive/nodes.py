@@ -11,12 +11,10 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 
+from tlmpc.mission.model import FACE, GOAL, MOVED
+
 #: A value of a game variable: a bool, or an integer of a bounded range.
 Value = int | bool
-
-FACE = "face"
-GOAL = "goal"
-MOVED = "moved"
 
 
 class NodeBehaviour:

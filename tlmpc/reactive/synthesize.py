@@ -10,6 +10,7 @@ task harder, so none would ever be needed).
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -17,7 +18,7 @@ from tlmpc.abstraction.model import Abstraction
 from tlmpc.base.errors import Diagnostic, InvalidInputError, UsageError, error
 from tlmpc.mission.model import Mission, TaskPart
 from tlmpc.reactive.explain import counter_play, counter_play_steps, place
-from tlmpc.reactive.faces import Faces, faces_of
+from tlmpc.reactive.faces import Faces, faces_of, start_faces
 from tlmpc.reactive.fragment import reading
 from tlmpc.reactive.game import MissionGame, build_game
 from tlmpc.reactive.parts import mission_parts
@@ -43,7 +44,16 @@ EXPLICIT_TRANSITIONS = 10_000
 
 def mission_game(mission: Mission, abstraction: Abstraction) -> MissionGame:
     """The game of ``mission`` on the faces of ``abstraction`` (Q102 for a part outside GR(1),
-    Q103 under the closed convention)."""
+    Q103 under the closed convention), the robot starting in the face of
+    ``abstraction.start``."""
+    return mission_games(mission, abstraction)[0]
+
+
+def mission_games(mission: Mission, abstraction: Abstraction) -> list[MissionGame]:
+    """The games of ``mission``, one per face the robot may enter first: a start on the
+    boundary of faces lies in a triangle of each, and under the right-continuous convention
+    its label at t = 0 is the one of the face it moves into (docs/semantics.md, "Starts on a
+    boundary").  The face of ``abstraction.start`` comes first, then the others by number."""
     pieces, problems = reading(mission_parts(mission), mission.source)
     if mission.options.boundary == "closed":
         problems.append(
@@ -55,11 +65,22 @@ def mission_game(mission: Mission, abstraction: Abstraction) -> MissionGame:
                 file=mission.source,
             )
         )
+    assert mission.reactive is not None
+    # the loader refuses these names; they come from an edited mission.json
+    for name in mission.reactive.motion_clashes():
+        problems.append(
+            error(
+                "S013",
+                f"the sensor or action {name!r} has the name of a variable of the robot's motion",
+                hint="rename it in the mission and compile again",
+                file=mission.source,
+            )
+        )
     if problems:
         raise InvalidInputError(problems)
     faces: Faces = faces_of(abstraction)
-    start_face = int(faces.face_of[abstraction.start])
-    return build_game(mission, faces, start_face, pieces)
+    firsts = start_faces(abstraction, faces.face_of, mission.robot.start, abstraction.start)
+    return [build_game(mission, faces, face, pieces) for face in firsts]
 
 
 @dataclass(frozen=True)
@@ -89,11 +110,25 @@ class Synthesis:
 def synthesize(
     mission: Mission, abstraction: Abstraction, *, explicit_transitions: int = EXPLICIT_TRANSITIONS
 ) -> Synthesis:
-    """Solve the mission's game: its strategy, or a core and a counterstrategy."""
-    game = mission_game(mission, abstraction)
-    encoding = Encoding(game.spec)
-    solution = solve(Game.build(game.spec, encoding))
-    if solution.realizable:
+    """Solve the mission's game: its strategy, or a core and a counterstrategy.
+
+    A robot that starts on the boundary of faces wins when it wins entering one of them
+    first (the first such face in :func:`mission_games`' order, preferring one where the
+    environment can keep its initial assumptions: elsewhere the win is vacuous and the
+    strategy has no start to run); a core is then unrealizable whichever it enters, and its
+    counterstrategy is the one from the first face."""
+    games = mission_games(mission, abstraction)
+    encoding = Encoding(games[0].spec)
+    solved: list[tuple[MissionGame, Solution, bool]] = []
+    for game in games:
+        built = Game.build(game.spec, encoding)
+        solved.append((game, solve(built), built.env_init != encoding.bdd.false))
+        if solved[-1][1].realizable and solved[-1][2]:
+            break
+    # a start the environment can keep first, then a vacuous one
+    winners = sorted((not kept, k) for k, (_, won, kept) in enumerate(solved) if won.realizable)
+    if winners:
+        game, solution, _ = solved[winners[0][1]]
         size = reachable_size(solution)
         machine = extract(solution) if size.transitions <= explicit_transitions else None
         return Synthesis(
@@ -103,7 +138,14 @@ def synthesize(
             symbolic=symbolic_strategy(solution),
             size=size,
         )
-    core = minimal_core(game.spec, encoding, group=lambda part: _source_key(game, part))
+    game, solution, _ = solved[0]
+    sources = {key: source for other in games for key, source in other.sources.items()}
+    core = minimal_core(
+        game.spec,
+        encoding,
+        group=lambda part: _source_key(sources, part),
+        alternatives=[other.spec for other in games[1:]],
+    )
     parts: dict[int, TaskPart] = {}
     for part in core.parts:
         source = game.sources[id(part)]
@@ -123,6 +165,65 @@ def synthesize(
         core=tuple(parts.values()),
         counter=counter,
         untold=untold,
+    )
+
+
+def synthesize_on_regions(
+    mission: Mission, abstraction: Abstraction
+) -> tuple[Synthesis, Abstraction, tuple[Diagnostic, ...]]:
+    """Solve the mission on ``abstraction`` (the abstraction stage's mesh, which labels goal
+    cores and grown avoided regions), then, while unrealizable, on meshes closer to the
+    mission's regions: the goals as they are (the margin kept), then without the margin.
+
+    Cores and grown regions are sound for a strategy (the task is monotone in a region of
+    one polarity: a run that meets it with them meets it with the true regions), but not
+    for "unrealizable": the robot may start inside a goal outside its core, or need the rim
+    between a grown region and a wall.  So the answer comes from the first mesh that is
+    realizable, else from the true regions.  Returns the synthesis, the mesh it was solved
+    on, and a note (A030) or warning (R008) when that is not ``abstraction``."""
+    from tlmpc.abstraction import build_abstraction
+    from tlmpc.abstraction.layout import deepens_goals, planning_layout
+    from tlmpc.mission.body import requested_margin
+
+    synthesis = synthesize(mission, abstraction)
+    notes: tuple[Diagnostic, ...] = ()
+    margin = requested_margin(mission)
+    rungs: list[tuple[float, Diagnostic]] = []
+    if deepens_goals(mission) and margin > 0.0:
+        rungs.append((margin, _shallow_note(mission)))
+    if margin > 0.0:
+        rungs.append((0.0, _marginless_note(mission, margin)))
+    elif deepens_goals(mission):
+        rungs.append((0.0, _shallow_note(mission)))
+    for rung_margin, note in rungs:
+        if synthesis.realizable:
+            break
+        layout = planning_layout(mission, rung_margin, deep=False)
+        abstraction = build_abstraction(mission, layout)
+        synthesis = synthesize(mission, abstraction)
+        notes = (note,) if synthesis.realizable else ()
+    return synthesis, abstraction, notes
+
+
+def _shallow_note(mission: Mission) -> Diagnostic:
+    return Diagnostic(
+        code="A030",
+        severity="note",
+        message="no robot strategy meets the task entering the goals as deep as the goal "
+        "depth asks; the strategy enters them only as deep as the margin asks",
+        hint="set options.goal_depth to a smaller depth (0: the margin's) to synthesise with it",
+        file=mission.source,
+    )
+
+
+def _marginless_note(mission: Mission, margin: float) -> Diagnostic:
+    return Diagnostic(
+        code="R008",
+        severity="warning",
+        message=f"no robot strategy meets the task keeping the margin {margin:g}; the "
+        "strategy does without it",
+        hint="lower options.margin to synthesise with a smaller one",
+        file=mission.source,
     )
 
 
@@ -211,9 +312,9 @@ def counterstrategy_to_json(synthesis: Synthesis, abstraction: Abstraction) -> d
     }
 
 
-def _source_key(game: MissionGame, part: Part) -> int | None:
+def _source_key(sources: Mapping[int, TaskPart], part: Part) -> int | None:
     """The task part a game part comes from (None: a rule of the motion, never dropped)."""
-    source = game.sources.get(id(part))
+    source = sources.get(id(part))
     return None if source is None else id(source)
 
 

@@ -39,7 +39,7 @@ from tlmpc.control.geometry import triangle_geometry
 from tlmpc.control.model import StepController
 from tlmpc.mission.model import Mission
 from tlmpc.planning.model import Witness
-from tlmpc.reactive.faces import faces_of
+from tlmpc.reactive.faces import faces_of, start_faces
 from tlmpc.runtime.executor import CompiledOutput, finite_numbers
 from tlmpc.runtime.locate import Locator
 from tlmpc.runtime.strategy_machine import Stepper, strategy_stepper
@@ -130,7 +130,7 @@ class ReactiveExecutor:
         self.node = -1
         self.time = 0.0
         self.point = np.asarray(mission.robot.start, dtype=np.float64)
-        self.triangle = abstraction.start
+        self.triangle = self._entered_first(mission.robot.start, abstraction.start)
         self._came_from: int | None = None  # the triangle before the last crossing
         self.face = int(self.face_of[self.triangle])
         self.legs: list[Leg] = []
@@ -141,6 +141,26 @@ class ReactiveExecutor:
         self.status = "following"
         self._locator: Locator | None = None
         self._inside_faces, self._portals = _face_graph(abstraction, self.face_of)
+
+    def _entered_first(self, point: Sequence[float] | FloatArray, located: int) -> int:
+        """The triangle the robot at ``point`` (found in ``located``) enters first: on the
+        boundary of faces, one of the first face the strategy serves, in the order the game
+        tried them (:func:`~tlmpc.reactive.faces.start_faces`)."""
+        from tlmpc.abstraction.starts import start_cells
+
+        where = (float(point[0]), float(point[1]))
+        faces = start_faces(self.abstraction, self.face_of, where, located)
+        if len(faces) == 1:
+            return located
+        readings = [
+            dict(zip(self.machine.sensors, values, strict=True))
+            for values in itertools.product((False, True), repeat=len(self.machine.sensors))
+        ]
+        cells = [located, *(c.triangle for c in start_cells(self.abstraction, where))]
+        for face in faces:
+            if any(self.machine.start(reading, face) is not None for reading in readings):
+                return next(t for t in cells if int(self.face_of[t]) == face)
+        return located
 
     @classmethod
     def from_output(cls, output: CompiledOutput | str | os.PathLike[str]) -> ReactiveExecutor:
@@ -342,6 +362,7 @@ class ReactiveExecutor:
                 raise UsageError(
                     error("Q125", f"the start {tuple(point)!r} is outside the free space")
                 )
+            found = self._entered_first(where, found)
             self.triangle, self.face = found, int(self.face_of[found])
             self.point, self.time = where, float(t)
             if not self.start(reading):

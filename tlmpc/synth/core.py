@@ -20,7 +20,7 @@ empty section, which would ask every state to win.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Hashable
+from collections.abc import Callable, Hashable, Sequence
 from dataclasses import dataclass
 
 from tlmpc.synth.solver import Game, StartRule, solve, start_rule
@@ -58,19 +58,25 @@ def minimal_core(
     enc: Encoding | None = None,
     *,
     group: Callable[[Part], Hashable | None] | None = None,
+    alternatives: Sequence[GameSpec] = (),
 ) -> Core:
     """A minimal core of an unrealizable ``spec`` (raises ValueError if it is realizable).
 
     With ``group``, the guarantees that share a key are dropped together (the game parts one
     phrase of a mission became), and a guarantee whose key is None is never dropped (a rule
     of the robot's motion); the core then lists the kept groups' parts.
+
+    ``alternatives`` are games the system may play instead of ``spec`` (the same variables
+    and groups, other parts that are never dropped: a reactive mission whose robot starts on
+    the boundary of faces chooses the face it enters first).  The core is then unrealizable
+    in ``spec`` and in every alternative, and without any one of its parts some of them is
+    realizable; its ``spec`` is ``spec``'s core game.
     """
     enc = enc or Encoding(spec)
     key = group or id
     start = start_rule(spec)
     held = held_parts(spec, start)
     held_ids = {id(p) for p in held}
-    fixed = tuple(p for p in spec.parts if id(p) not in held_ids and key(p) is None)
     members: dict[Hashable, list[Part]] = {}
     for part in spec.parts:
         if id(part) not in held_ids and key(part) is not None:
@@ -78,15 +84,21 @@ def minimal_core(
     kept = list(members)
     solves = 0
 
-    def trial_spec(groups: list[Hashable]) -> GameSpec:
-        chosen = held_ids | {id(p) for p in fixed} | {id(p) for g in groups for p in members[g]}
-        return spec.with_parts(tuple(p for p in spec.parts if id(p) in chosen))
+    def trial_spec(game: GameSpec, groups: list[Hashable]) -> GameSpec:
+        chosen = set(groups)
+        held_here = {id(p) for p in held_parts(game, start)}
+        return game.with_parts(
+            tuple(p for p in game.parts if id(p) in held_here or key(p) is None or key(p) in chosen)
+        )
 
     def unrealizable(groups: list[Hashable]) -> bool:
         nonlocal solves
-        solves += 1
-        trial = Game.build(trial_spec(groups), enc, start=start)
-        return not solve(trial, keep_layers=False).realizable
+        for game in (spec, *alternatives):
+            solves += 1
+            trial = Game.build(trial_spec(game, groups), enc, start=start)
+            if solve(trial, keep_layers=False).realizable:
+                return False
+        return True
 
     if not unrealizable(kept):
         raise ValueError("the specification is realizable: it has no unrealizability core")
@@ -103,7 +115,7 @@ def minimal_core(
             break
         chunk = max(1, chunk // 2)
     enc.spec = spec
-    core_spec = trial_spec(kept)
+    core_spec = trial_spec(spec, kept)
     return Core(
         parts=tuple(p for g in kept for p in members[g]),
         held=held,
