@@ -61,10 +61,7 @@ def read_plan(directory: Path) -> Plan:
     for name in ("trace.json", "mission.json"):
         if not (directory / name).exists():
             raise _fail(
-                "M080",
-                f"{directory} has no {name}",
-                str(directory),
-                hint="run `tlmpc compile MISSION -o DIR` first and export from DIR",
+                "M080", f"{directory} has no {name}", str(directory), _missing_hint(directory)
             )
     # each checked against its schema (finite numbers) and against the others
     documents = read_artifacts(directory, ("trace.json", "mission.json", "controllers.json"))
@@ -94,6 +91,25 @@ def read_plan(directory: Path) -> Plan:
     if len(plan.samples) == 0 or not np.all(np.isfinite(plan.samples)):
         raise _fail("M081", f"the trajectory in {directory} is empty or not finite", str(directory))
     return plan
+
+
+def _missing_hint(directory: Path) -> str:
+    """What to run to get a plan into ``directory``, from what it holds."""
+    if (directory / "counterstrategy.json").exists():
+        return (
+            "an unrealizable reactive mission has no plan: its counterstrategy.json holds the "
+            "environment's winning play (`tlmpc plot DIR` and `tlmpc view DIR` draw it)"
+        )
+    if (directory / "strategy.json").exists():
+        # a reactive mission's path depends on what the robot senses: there is no one plan
+        return (
+            "a reactive mission compiles to a strategy, not a plan: run it with "
+            "`tlmpc simulate DIR --sensors ... -o TRACE` and check or draw the run with "
+            "`tlmpc verify TRACE` or `tlmpc view --log TRACE --mission MISSION`"
+        )
+    if (directory / "controllers.json").exists():
+        return "the compile stopped before its trajectory: run `tlmpc stage simulate DIR`"
+    return "run `tlmpc compile MISSION -o DIR` first and export from DIR"
 
 
 def _passage_corners(controllers: Any, trace: Any, samples: FloatArray) -> tuple[int, ...]:

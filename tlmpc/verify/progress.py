@@ -60,8 +60,15 @@ def runs(mask: BoolArray) -> list[tuple[int, int]]:
 
 
 def _at(line: Timeline, k: int) -> tuple[float, tuple[float, float]]:
-    """When piece ``k`` starts (from the first sample) and where."""
-    x, y = line.positions[k].tolist()
+    """When piece ``k`` starts (from the first sample) and where the robot is then.
+
+    An open stretch carries its midpoint as position (that point labels it), but it starts
+    at the instant of the piece before it (a sample or a crossing, under the closed
+    convention): the robot is at that instant's position when the stretch begins."""
+    first = k
+    while first > 0 and line.starts[first - 1] == line.starts[k]:
+        first -= 1
+    x, y = line.positions[first].tolist()
     return float(line.starts[k]), (float(x), float(y))
 
 
