@@ -91,3 +91,52 @@ def test_a_file_that_is_neither_is_refused_as_verify_refuses_it_alone(tmp_path: 
     alone = json.loads(run_cli("verify", str(other), "--json")[1])["diagnostics"][0]["code"]
     for line in results.read_text().splitlines():
         assert json.loads(line)["error"]["code"] == alone == "V001"
+
+
+REACTIVE = MISSION.replace('ltl: "F far"', "sensors: {alarm: null}\ntask: [visit far]")
+
+
+def _traces(tmp_path: Path) -> tuple[Path, Path]:
+    avoid = tmp_path / "avoid.json"
+    avoid.write_text(json.dumps(_trace("G !hazard & F goal")))
+    reach = tmp_path / "reach.json"
+    reach.write_text(json.dumps(_trace("F goal")))
+    return avoid, reach
+
+
+def _verdicts(results: Path) -> dict[str, str]:
+    return {r["log"]: r["verdict"] for r in map(json.loads, results.read_text().splitlines())}
+
+
+def test_a_batch_of_traces_needs_no_mission(tmp_path: Path) -> None:
+    avoid, reach = _traces(tmp_path)
+    results = tmp_path / "r.jsonl"
+    code, _, err = run_cli(
+        "verify", str(avoid), str(reach), "--no-cache", "--results", str(results)
+    )
+    assert code == 1, err
+    assert _verdicts(results) == {str(avoid): "violated", str(reach): "satisfied"}
+    # a log among them still needs one
+    log = tmp_path / "log.csv"
+    log.write_text("t,x,y\n0,1,1\n1,2,2\n")
+    code, _, err = run_cli("verify", str(avoid), str(log), "--no-cache")
+    assert code == 2
+    assert "error[V010]" in err
+
+
+def test_no_mission_given_applies_to_a_trace(tmp_path: Path) -> None:
+    avoid, reach = _traces(tmp_path)
+    # a reactive mission (refused for logs in a batch) and a mapping without a rule for them
+    (tmp_path / "reactive.yaml").write_text(REACTIVE)
+    (tmp_path / "m.yaml").write_text(MISSION)
+    (tmp_path / "map.yaml").write_text(
+        "format: tlmpc.fleet-missions/1\nmissions:\n  - {logs: '*.csv', mission: m.yaml}\n"
+    )
+    for mission in ("reactive.yaml", "map.yaml"):
+        results = tmp_path / f"{mission}.jsonl"
+        code, _, err = run_cli(
+            "verify", str(avoid), str(reach), "--mission", str(tmp_path / mission),
+            "--no-cache", "--results", str(results),
+        )  # fmt: skip
+        assert code == 1, err
+        assert _verdicts(results) == {str(avoid): "violated", str(reach): "satisfied"}

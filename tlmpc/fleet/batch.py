@@ -152,8 +152,11 @@ def match(rules: Sequence[MissionRule], log: Path) -> Path | None:
     return None
 
 
-def missions_for(logs: Sequence[Path], mission: Path) -> dict[Path, Path | None]:
-    """Each log's mission file (None: no rule of the mapping file matches it)."""
+def missions_for(logs: Sequence[Path], mission: Path | None) -> dict[Path, Path | None]:
+    """Each log's mission file (None: no rule of the mapping file matches it, or no
+    ``mission`` was given: a batch of ``trace.json`` files needs none)."""
+    if mission is None:
+        return dict.fromkeys(logs)
     rules = read_mapping(mission)
     if rules is None:
         return dict.fromkeys(logs, mission)
@@ -168,6 +171,7 @@ def make_jobs(
 ) -> tuple[list[Job], list[dict[str, Any]]]:
     """A job per log, each mission read once; logs without a usable mission become error
     records right away."""
+    from tlmpc.importers.logs import is_log
     from tlmpc.verify.trace_input import load_log_mission, positions_document
 
     documents: dict[Path, dict[str, Any] | TlmpcError] = {}
@@ -178,7 +182,20 @@ def make_jobs(
     jobs: list[Job] = []
     failed: list[dict[str, Any]] = []
     for log in logs:
-        mission = missions[log]
+        if not is_log(log):
+            # a trace.json carries its own task and map: no mission applies to it
+            jobs.append(
+                Job(
+                    log=str(log),
+                    mission=None,
+                    document={},
+                    options=options,
+                    cache=None if cache is None else str(cache),
+                    folder=folder,
+                )
+            )
+            continue
+        mission = missions.get(log)
         if mission is None:
             failed.append(
                 error_record(
@@ -240,7 +257,7 @@ def _internal(job: Job, exc: BaseException) -> dict[str, Any]:
     an ``error`` record with I000, so the batch goes on and exits 3."""
     return error_record(
         Path(job.log),
-        Path(job.mission),
+        None if job.mission is None else Path(job.mission),
         _InternalError(
             error(
                 "I000",
@@ -438,7 +455,7 @@ def _dask_record(job: Job, future: Any) -> dict[str, Any]:
         pass
     return error_record(
         Path(job.log),
-        Path(job.mission),
+        None if job.mission is None else Path(job.mission),
         UsageError(
             error(
                 "F002",

@@ -48,7 +48,7 @@ def run_batch(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         summary_table,
         write_results,
     )
-    from tlmpc.importers.logs import parse_columns, parse_transform
+    from tlmpc.importers.logs import is_log, parse_columns, parse_transform
     from tlmpc.io.report import Reporter
 
     report = Reporter.for_args(args, out, err)
@@ -66,14 +66,6 @@ def run_batch(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         from tlmpc.fleet.report import group_pattern
 
         group_pattern(args.group)  # a bad --group fails before any log is verified
-    if args.mission is None:
-        raise UsageError(
-            error(
-                "V010",
-                "verifying logs needs --mission (a mission file or a mission mapping)",
-                file="<command line>",
-            )
-        )
     options = Options(
         boundary=args.boundary,
         topic=args.topic,
@@ -86,6 +78,15 @@ def run_batch(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     logs = discover(args.trace)
     if not logs:
         raise no_logs(args.trace)
+    if args.mission is None and any(is_log(log) for log in logs):
+        # (a trace.json carries its own task and map: a batch of them needs no mission)
+        raise UsageError(
+            error(
+                "V010",
+                "verifying logs needs --mission (a mission file or a mission mapping)",
+                file="<command line>",
+            )
+        )
     cache = None if args.no_cache else (args.cache or default_cache_dir())
     missions = missions_for(logs, args.mission)
     _refuse_overwriting(args.results, args.report, [*logs, args.mission, *missions.values()])

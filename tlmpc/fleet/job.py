@@ -39,13 +39,14 @@ class Options:
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class Job:
-    """Verify ``log`` (the path as the user gave it) against ``document`` (its mission).
+    """Verify ``log`` (the path as the user gave it) against ``document`` (its mission;
+    ``mission`` None: a ``trace.json``, verified against its own task and map).
 
     ``folder`` is the batch's working folder, which a relative ``log`` is relative to: a Dask
     worker started in another folder reads the log there (see :func:`log_path`)."""
 
     log: str
-    mission: str
+    mission: str | None
     document: Mapping[str, Any] = field(repr=False)
     options: Options = Options()
     cache: str | None = None

@@ -468,7 +468,7 @@ def write_report(
     path: Path, rows: Sequence[Mapping[str, Any]], jobs: Sequence[Job], *, group: str | None
 ) -> None:
     """Write the report at ``path`` and the logs' views in ``<path stem>.views/`` beside it."""
-    documents = {job.mission: job.document for job in jobs}
+    documents = {job.mission: job.document for job in jobs if job.mission is not None}
     reading = {job.log: job.options for job in jobs}
     folder = views_folder(path)
     views = _views(rows, folder, folder.name, reading)
