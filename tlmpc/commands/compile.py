@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import argparse
 import gc
+from collections.abc import Mapping
 from pathlib import Path
-from typing import TextIO
+from typing import Any, TextIO
 
 NAME = "compile"
 HELP = "compile a mission into a verified plan, controllers and trajectory"
@@ -142,14 +143,19 @@ def _run_locked(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             tail = f"; trace verifies (robustness {verdict['robustness']:.4g})"
         bounds = summary.get("bounds")
         if bounds:  # each time bound with its slack on the trajectory
-            held = ", ".join(f"{b['bound']} by {_seconds(b['slack'])}" for b in bounds)
+            held = ", ".join(_held(b) for b in bounds)
             tail += f"; time bounds held: {held}"
         reporter.note(f"wrote {len(artifacts)} artifacts to {destination}{tail}")
     return reporter.finish(EXIT_OK, summary)
 
 
-def _seconds(slack: object) -> str:
-    """A bound's slack as printed: ``13.34 s``, ``any amount`` (``inf``), ``-`` (none)."""
+def _held(bound: Mapping[str, Any]) -> str:
+    """A bound and its slack as printed: ``F[0,45] dock by 13.34 s``, ``... by any amount``
+    (``inf``); a bound without a slack (it occurs both ways, under ``<->``: moving it helps
+    one side and hurts the other) is printed alone."""
+    slack = bound["slack"]
     if isinstance(slack, int | float):
-        return f"{slack:.4g} s"
-    return "any amount" if slack == "inf" else "-"
+        return f"{bound['bound']} by {slack:.4g} s"
+    if slack == "inf":
+        return f"{bound['bound']} by any amount"
+    return str(bound["bound"])

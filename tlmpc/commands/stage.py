@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+from collections.abc import Iterable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TextIO
 
@@ -53,6 +54,7 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     from tlmpc.io.outdir import MARKER, is_tlmpc_output, output_lock, replace_files
     from tlmpc.io.report import Reporter
     from tlmpc.pipeline.stages import run_stage_from_artifacts
+    from tlmpc.reactive.unrealizable import UnrealizableError
 
     if not args.directory.is_dir():
         raise UsageError(
@@ -72,10 +74,11 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     # the folder written into is held from the reading to the last file, as `tlmpc compile`
     # holds it: a compile replacing it meanwhile would drop what this stage wrote
     with output_lock(target):
-        result = run_stage_from_artifacts(args.name, args.directory)
-        reporter.diagnose(result.warnings)
-        if args.out is not None and not args.force and not is_tlmpc_output(target):
-            existing = sorted(name for name in result.artifacts if (target / name).exists())
+
+        def refuse_foreign(names: Iterable[str]) -> None:
+            if args.out is None or args.force or is_tlmpc_output(target):
+                return
+            existing = sorted(name for name in names if (target / name).exists())
             if existing:
                 raise UsageError(
                     error(
@@ -86,6 +89,24 @@ def run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
                         file=str(target),
                     )
                 )
+
+        try:
+            result = run_stage_from_artifacts(args.name, args.directory)
+        except UnrealizableError as failure:
+            # as `tlmpc compile` does: the environment's winning play is written (tlmpc
+            # plot / view draw it), and the answer is still exit 1
+            refuse_foreign(failure.produced)
+            replace_files(
+                {target / name: _bytes(failure.artifacts[name]) for name in failure.produced}
+            )
+            if not args.json and failure.produced:
+                reporter.note(
+                    f"{args.name}: wrote {', '.join(sorted(failure.produced))} to {target} "
+                    "(the environment's winning play: tlmpc plot / tlmpc view)"
+                )
+            raise
+        reporter.diagnose(result.warnings)
+        refuse_foreign(result.artifacts)
         files = {target / name: _bytes(content) for name, content in result.artifacts.items()}
         summary = _summary_after(target, result)
         if summary is not None:

@@ -66,6 +66,11 @@ _NUMBER_TYPES = frozenset((int, float))
 _WITHIN_LIMIT = MISSION_COORDINATE_LIMIT.__ge__
 
 
+def _is_name(value: Any) -> bool:
+    """The schema's rule for a name: an identifier that is not an LTL keyword."""
+    return isinstance(value, str) and bool(_NAME.match(value)) and value not in KEYWORDS
+
+
 def _number(value: Any) -> bool:
     return (
         isinstance(value, int | float)
@@ -126,16 +131,52 @@ def _number_like_where_refused(
     return list(dict.fromkeys(found))  # one finding per value, in the schema's order
 
 
-def _schema_diagnostics(doc: PositionedDocument, file: str) -> list[Diagnostic]:
+class _Refusals:
+    """The values the schema refused, by path: later checks skip each of them, what it
+    contains, and (for a whole-section check) what contains it."""
+
+    def __init__(self, paths: list[Path]) -> None:
+        self._refused = set(paths)
+        # every path on the way to a refused value: a container with a refused part
+        self._touched = {path[:depth] for path in paths for depth in range(len(path) + 1)}
+
+    def readable(self, path: Path) -> bool:
+        """Neither the value at ``path`` nor one of its containers was refused: its parts
+        that passed may be read one by one."""
+        return not any(path[:depth] in self._refused for depth in range(len(path) + 1))
+
+    def clean(self, path: Path) -> bool:
+        """The value at ``path`` passed the schema whole: nothing in it or around it refused."""
+        return path not in self._touched and self.readable(path)
+
+
+def _refused_paths(err: ValidationError) -> list[Path]:
+    """The paths of the values a schema problem refuses: the missing or unknown key, or the
+    badly named one, rather than the mapping that holds it; both entries of the task for a
+    mission without one."""
+    path: Path = tuple(err.absolute_path)
+    instance = err.instance
+    if err.validator == "required" and isinstance(instance, dict):
+        required: Any = err.validator_value
+        return [(*path, key) for key in required if key not in instance]
+    if err.validator == "additionalProperties" and isinstance(instance, dict):
+        allowed = err.schema.get("properties", {}) if isinstance(err.schema, dict) else {}
+        return [(*path, key) for key in instance if key not in allowed]
+    if "propertyNames" in err.absolute_schema_path and isinstance(instance, str):
+        return [(*path, instance)]
+    if err.validator == "anyOf" and not path:
+        return [("task",), ("ltl",)]  # S003: neither is there
+    return [path]
+
+
+def _schema_diagnostics(doc: PositionedDocument, file: str) -> tuple[list[Diagnostic], list[Path]]:
+    """The schema's problems, and the paths of the values they refuse."""
     data = doc.data
     regions = data.get("regions") if isinstance(data, dict) else None
     if (
         isinstance(regions, dict)
         and len(regions) > 1
-        and all(
-            isinstance(k, str) and _NAME.match(k) and k not in KEYWORDS and _plain_shape(v)
-            for k, v in regions.items()
-        )
+        and all(_is_name(k) and _plain_shape(v) for k, v in regions.items())
     ):
         # Maps with thousands of rooms: every region already has the schema's shape, so
         # validate the rest of the document with one representative region (same verdict,
@@ -157,13 +198,15 @@ def _schema_diagnostics(doc: PositionedDocument, file: str) -> list[Diagnostic]:
         data = {**data, "workspace": small}
     problems = [p for path in bad for p in _point_problem(path, doc, file)]
     if not problems and is_valid(data, "mission"):
-        return []  # jsonschema (a tenth of a second to import) is needed only to word problems
+        return [], []  # jsonschema (a tenth of a second to import) only words problems
     import jsonschema
 
+    refused = list(bad)
     validator = jsonschema.Draft202012Validator(load_schema("mission"))
     for err in validator.iter_errors(data):
         problems.extend(_describe(err, doc, file))
-    return problems
+        refused.extend(_refused_paths(err))
+    return problems, refused
 
 
 #: Point lists longer than this with a bad point are checked point by point, not by the schema.
@@ -379,6 +422,8 @@ def _describe(
     if err.validator == "const" and path == ("version",):
         message = f"unsupported mission format version {err.instance!r}"
         hint = "this tlmpc reads `version: 1`"
+    elif _text_read_as_other(err):
+        message, hint = _yaml11_word(err.instance, doc, line, col)
     elif err.validator in ("pattern", "not"):
         message = f"{err.instance!r} is not a valid name"
         hint = (
@@ -396,6 +441,42 @@ def _describe(
             path=json_path(path),
         )
     ]
+
+
+#: The plain words YAML 1.1 reads as booleans or null (PyYAML's resolver), not as text.
+_YAML11_WORDS = frozenset(
+    f(word)
+    for word in ("yes", "no", "on", "off", "true", "false", "null")
+    for f in (str.lower, str.title, str.upper)
+) | {"~"}
+
+
+def _text_read_as_other(err: ValidationError) -> bool:
+    """A value the schema wants as text (a name, a phrase) that YAML read as a boolean or null."""
+    if err.validator != "type" or not (err.instance is None or isinstance(err.instance, bool)):
+        return False
+    wanted: Any = err.validator_value
+    return "string" in ([wanted] if isinstance(wanted, str) else list(wanted))
+
+
+def _yaml11_word(value: Any, doc: PositionedDocument, line: int, col: int) -> tuple[str, str]:
+    """The message and hint of a word such as ``yes`` written where text is wanted: YAML 1.1
+    reads it as a boolean (or null), so a name ``yes`` must be quoted."""
+    reading = "null" if value is None else f"the boolean {str(value).lower()}"
+    lines = doc.source.splitlines()
+    written = (
+        re.match(r"[^\s,\[\]{}#]+", lines[line - 1][col - 1 :]) if 0 < line <= len(lines) else None
+    )
+    if written is None or written.group(0) not in _YAML11_WORDS:
+        if value is None:
+            return "an empty value (null) is not text", "write text, e.g. a name"
+        return f"{reading} is not text", "write text; quote a word to make it text"
+    word = written.group(0)
+    return (
+        f"{word} is read by YAML as {reading}, not as text",
+        f"quote it: '{word}' (YAML 1.1 reads yes, no, on, off, true, false as booleans and "
+        "null, ~ as null)",
+    )
 
 
 def _ltl_position(doc: PositionedDocument, path: Path) -> tuple[int, int]:
@@ -791,16 +872,28 @@ def _task_places(
     return tuple(places)
 
 
+#: What ``_shapes`` finds: the boundary, holes and regions that passed, the problems, the
+#: further pieces, and whether the regions' (and a map's groups') names are all known.
+Shapes = tuple[
+    CheckedShape | None, list[CheckedShape], dict[str, CheckedShape], list[Diagnostic], Pieces, bool
+]
+
+
 def _shapes(
-    data: Mapping[str, Any], doc: PositionedDocument, file: str
-) -> tuple[
-    CheckedShape | None, list[CheckedShape], dict[str, CheckedShape], list[Diagnostic], Pieces
-]:
+    data: Mapping[str, Any], doc: PositionedDocument, file: str, refusals: _Refusals
+) -> Shapes:
+    """The workspace's and the regions' shapes, each checked when it passed the schema (a
+    map only when the workspace, the robot, the regions and the groups passed it whole)."""
     problems: list[Diagnostic] = []
-    workspace = data.get("workspace") or {}
+    workspace = data.get("workspace") if refusals.readable(("workspace",)) else None
+    told = not isinstance(workspace, dict)  # refused or missing: the schema said so
+    if not isinstance(workspace, dict):
+        workspace = {}
     if "map" in workspace:
-        return _map_shapes(data, doc, file)
-    if "boundary" not in workspace:
+        if not all(refusals.clean((key,)) for key in ("workspace", "robot", "regions", "groups")):
+            return None, [], {}, [], [], False
+        return (*_map_shapes(data, doc, file), True)
+    if "boundary" not in workspace and not told:
         line, col = doc.value_at(("workspace",))
         problems.append(
             error(
@@ -813,57 +906,53 @@ def _shapes(
                 path="$.workspace",
             )
         )
-        return None, [], {}, problems, []
-    boundary, found = check_shape(
-        workspace.get("boundary"),
-        ("workspace", "boundary"),
-        "workspace boundary",
-        file,
-        doc.value_at,
-    )
-    problems.extend(found)
-    holes: list[CheckedShape] = []
-    for index, hole in enumerate(workspace.get("holes") or []):
-        checked, found = check_shape(
-            hole, ("workspace", "holes", index), f"hole {index}", file, doc.value_at
-        )
+
+    def check(shape: Any, path: Path, what: str) -> CheckedShape | None:
+        if not refusals.clean(path):
+            return None  # the schema's problem is told; its geometry would mean nothing
+        checked, found = check_shape(shape, path, what, file, doc.value_at)
         problems.extend(found)
+        return checked
+
+    def items(value: Any, path: Path) -> list[tuple[int, Any]]:
+        """The entries of the list at ``path`` that passed the schema, with their indices."""
+        if not isinstance(value, list) or not refusals.readable(path):
+            return []
+        return [(i, item) for i, item in enumerate(value) if refusals.clean((*path, i))]
+
+    boundary = (
+        check(workspace["boundary"], ("workspace", "boundary"), "workspace boundary")
+        if "boundary" in workspace
+        else None
+    )
+    holes: list[CheckedShape] = []
+    for index, hole in items(workspace.get("holes"), ("workspace", "holes")):
+        checked = check(hole, ("workspace", "holes", index), f"hole {index}")
         if checked is not None:
             holes.append(checked)
     components: Pieces = []
-    for number, component in enumerate(workspace.get("components") or []):
+    listed = workspace.get("components")
+    for number, component in enumerate(listed if isinstance(listed, list) else []):
         where: Path = ("workspace", "components", number)
-        piece, found = check_shape(
-            component["boundary"],
-            (*where, "boundary"),
-            f"boundary of component {number}",
-            file,
-            doc.value_at,
+        if not isinstance(component, dict) or not refusals.readable(where):
+            continue
+        piece = check(
+            component.get("boundary"), (*where, "boundary"), f"boundary of component {number}"
         )
-        problems.extend(found)
         piece_holes: list[CheckedShape] = []
-        for index, hole in enumerate(component.get("holes") or []):
-            checked, found = check_shape(
-                hole,
-                (*where, "holes", index),
-                f"hole {index} of component {number}",
-                file,
-                doc.value_at,
-            )
-            problems.extend(found)
+        for index, hole in items(component.get("holes"), (*where, "holes")):
+            checked = check(hole, (*where, "holes", index), f"hole {index} of component {number}")
             if checked is not None:
                 piece_holes.append(checked)
         if piece is not None:
             components.append((piece, piece_holes))
     regions: dict[str, CheckedShape] = {}
-    for name, shape in (data.get("regions") or {}).items():
-        checked, found = check_shape(
-            shape, ("regions", name), f"region {name!r}", file, doc.value_at
-        )
-        problems.extend(found)
+    declared = data.get("regions") if refusals.readable(("regions",)) else None
+    for name, shape in (declared if isinstance(declared, dict) else {}).items():
+        checked = check(shape, ("regions", name), f"region {name!r}")
         if checked is not None:
             regions[name] = checked
-    return boundary, holes, regions, problems, components
+    return boundary, holes, regions, problems, components, True
 
 
 def _map_shapes(
@@ -971,11 +1060,16 @@ def _bounds(shape: CheckedShape) -> tuple[float, float, float, float]:
 
 
 def _groups(
-    data: Mapping[str, Any], doc: PositionedDocument, file: str, names: set[str]
+    data: Mapping[str, Any],
+    doc: PositionedDocument,
+    file: str,
+    names: set[str],
+    refusals: _Refusals,
 ) -> tuple[dict[str, list[str]], list[Diagnostic]]:
+    """The groups that passed the schema, and S011/S012 for each."""
     problems: list[Diagnostic] = []
     groups: dict[str, list[str]] = {}
-    for group, members in (data.get("groups") or {}).items():
+    for group, members in _passed_keys(data, "groups", refusals).items():
         if group in names:
             line, col = doc.key_at(("groups", group))
             problems.append(
@@ -1038,14 +1132,23 @@ def _load_data(text: str, file: str, stem: str) -> tuple[Mission | None, list[Di
                 col=1,
             )
         ]
-    problems.extend(_number_like_where_refused(number_like, _schema_diagnostics(doc, file)))
-    if problems:
-        return None, problems
+    schema_problems, refused = _schema_diagnostics(doc, file)
+    problems.extend(_number_like_where_refused(number_like, schema_problems))
+    refusals = _Refusals(refused)
+    if not refusals.readable(()):
+        return None, problems  # the document as a whole: nothing below it can be read
     data: dict[str, Any] = doc.data
-    boundary, holes, regions, found, components = _shapes(data, doc, file)
+    # Every later check reads only values that passed the schema: ``checked`` holds the
+    # robot's and the workspace's keys that did (the shapes are taken one by one).
+    checked = {
+        **data,
+        "robot": _passed_keys(data, "robot", refusals),
+        "workspace": _passed_keys(data, "workspace", refusals),
+    }
+    boundary, holes, regions, found, components, names_complete = _shapes(data, doc, file, refusals)
     problems.extend(found)
-    robot = data["robot"]
-    start = (float(robot["start"][0]), float(robot["start"][1]))
+    robot = checked["robot"]
+    start = (float(robot["start"][0]), float(robot["start"][1])) if "start" in robot else None
     problems.extend(
         check_layout(
             boundary,
@@ -1058,17 +1161,30 @@ def _load_data(text: str, file: str, stem: str) -> tuple[Mission | None, list[Di
             components=components,
         )
     )
-    body, found = _body(data, doc, file)
+    body, found = _body(checked, doc, file)
     problems.extend(found)
-    problems.extend(_speed(data, doc, file, boundary, components))
-    names = set(regions) | set(data["regions"])
-    groups, found = _groups(data, doc, file, names)
+    problems.extend(_speed(checked, doc, file, boundary, components))
+    declared = data.get("regions") if refusals.readable(("regions",)) else None
+    names = set(regions) | set(declared if isinstance(declared, dict) else ())
+    groups, found = _groups(data, doc, file, names, refusals)
     problems.extend(found)
+    # The names a task may use are complete only when every declaration passed the schema:
+    # otherwise a name refused (or a map not read) would come back as a false L010.
+    names_complete = (
+        names_complete
+        and isinstance(declared, dict)
+        and all(map(_is_name, declared))
+        and all(refusals.clean((key,)) for key in _DECLARATIONS)
+    )
+    if not names_complete:
+        return None, problems
     reactive, kinds, found = _reactive(data, doc, file, names, groups)
     problems.extend(found)
+    if not (refusals.clean(("task",)) and refusals.clean(("ltl",))):
+        return None, problems
     formula, found = _check_task(data, doc, file, names, groups, kinds)
     problems.extend(found)
-    if problems or boundary is None or formula is None:
+    if problems or boundary is None or formula is None or start is None:
         return None, problems
     options = data.get("options") or {}
     defaults = Options()
@@ -1116,6 +1232,19 @@ def _load_data(text: str, file: str, stem: str) -> tuple[Mission | None, list[Di
         reactive=reactive,
     )
     return mission, []
+
+
+#: The keys whose names a task or an assumption may use: checked only when all passed.
+_DECLARATIONS = ("groups", "sensors", "actions", "assumptions")
+
+
+def _passed_keys(data: Mapping[str, Any], key: str, refusals: _Refusals) -> dict[str, Any]:
+    """The entries of the mapping ``data[key]`` that passed the schema ({} when it is no
+    mapping, or was refused as a whole)."""
+    section = data.get(key)
+    if not isinstance(section, dict) or not refusals.readable((key,)):
+        return {}
+    return {name: value for name, value in section.items() if refusals.clean((key, name))}
 
 
 def _read(path: str | FilePath) -> str:

@@ -196,7 +196,7 @@ def _load(c: Compilation) -> StageResult:
         loaded = load_mission_text(c.text, str(c.source))
     else:
         loaded = load_mission(c.source)
-    mission, notes = workspace_notes(loaded)  # holes merged; narrow passages
+    mission, notes = workspace_notes(loaded, c.text)  # holes merged; narrow passages
     notes += _body_notes(mission, c.text)
     return StageResult(
         products=provide(MISSION, mission),
@@ -519,10 +519,12 @@ def _synthesize(c: Compilation) -> StageResult:
     if abstraction is not built:
         artifacts["abstraction.json"] = abstraction_document(abstraction)
     if not synthesis.realizable:
-        shown = {**c.documents, **artifacts}
         if synthesis.counter is not None:
-            shown["counterstrategy.json"] = counterstrategy_to_json(synthesis, abstraction)
-        raise UnrealizableError(unrealizable(synthesis, mission), shown)
+            artifacts["counterstrategy.json"] = counterstrategy_to_json(synthesis, abstraction)
+        # compile writes every artifact so far (the environment's play is drawn on them);
+        # `tlmpc stage synthesize` only what this stage made
+        shown = {**c.documents, **artifacts}
+        raise UnrealizableError(unrealizable(synthesis, mission), shown, produced=artifacts)
     assert synthesis.size is not None
     assert synthesis.symbolic is not None
     game = synthesis.game
