@@ -98,3 +98,7 @@ def test_a_body_passes_a_narrow_way_the_margin_would_close(tmp_path: Path) -> No
     assert code == 0, err
     assert "R008" in err
     assert (out / "strategy.json").is_file()
+    # the margin is the default (the radius), written nowhere: placed where options would be
+    # read from, the document's start (not the file name alone)
+    (warning,) = [line for line in err.splitlines() if "warning[R008]" in line]
+    assert warning.startswith(f"{tmp_path / 'm.yaml'}:1:1: warning[R008]"), warning

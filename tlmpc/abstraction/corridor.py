@@ -27,10 +27,10 @@ from collections.abc import Collection
 
 import numpy as np
 import shapely
-import triangle
 
 from tlmpc.abstraction.model import Abstraction, FloatArray, triangle_inradius
 from tlmpc.abstraction.refine import with_splits
+from tlmpc.abstraction.triangulate import triangulate_in_frame
 
 #: Triangle's quality bound inside the corridor (degrees).
 MIN_ANGLE = 25.0
@@ -153,7 +153,7 @@ def _refine_once(
     if inner:
         data["holes"] = np.asarray(inner, dtype=np.float64)
     steiner = STEINER_PER_TRIANGLE * len(corridor)
-    result = triangle.triangulate(data, f"pq{MIN_ANGLE:g}YYAaS{steiner}Q")
+    result = triangulate_in_frame(data, f"pq{MIN_ANGLE:g}YYAaS{steiner}Q")
     made = np.asarray(result["vertices"], dtype=np.float64)
     pieces_of = np.asarray(result["triangles"], dtype=np.int64)
     owners = np.rint(np.asarray(result["triangle_attributes"], dtype=np.float64)[:, 0])

@@ -41,6 +41,47 @@ CLOSE_PIXELS = 2.0
 SEED_DEPTH = 2.0
 
 
+def exact_shift(values: FloatArray) -> float:
+    """An offset ``o`` whose subtraction is exact for every one of ``values`` (Sterbenz: ``x - o``
+    is exact when ``o / 2 <= x <= 2 o``), as near them as that allows: their least magnitude
+    when they all lie on one side of zero within a factor of two of it, else 0."""
+    if not len(values):
+        return 0.0
+    low, high = float(values.min()), float(values.max())
+    if low > 0.0 and high <= 2.0 * low:
+        return low
+    if high < 0.0 and low >= 2.0 * high:
+        return high
+    return 0.0
+
+
+def triangulate_in_frame(data: dict[str, Any], options: str) -> dict[str, Any]:
+    """``triangle.triangulate(data, options)`` with the coordinates moved next to the origin.
+
+    Triangle's refinement computes new points (circumcentres, segment midpoints) in absolute
+    coordinates: far from the origin (a map of a centimetre at a million metres) they lose
+    the digits that tell the features apart, and Triangle crashes the process. The vertices,
+    hole seeds and region points are shifted by an offset whose subtraction is exact
+    (:func:`exact_shift` per axis), so the geometry Triangle sees is the input's bit for bit;
+    the output's vertices are shifted back, which gives the input vertices (Triangle keeps
+    them first and in order, ``p``) bit for bit: ``(x - o) + o`` is ``x`` when ``x - o`` is
+    exact."""
+    given = np.asarray(data["vertices"], dtype=np.float64)
+    shift = np.array([exact_shift(given[:, 0]), exact_shift(given[:, 1])])
+    if not shift.any():
+        return dict(triangle.triangulate(data, options))
+    local = dict(data)
+    local["vertices"] = given - shift
+    for key in ("holes", "regions"):
+        if key in data:
+            moved = np.array(data[key], dtype=np.float64)
+            moved[:, :2] -= shift
+            local[key] = moved
+    result = dict(triangle.triangulate(local, options))
+    result["vertices"] = np.asarray(result["vertices"], dtype=np.float64) + shift
+    return result
+
+
 def _snapped(points: Sequence[tuple[float, float]], grid: float) -> Any:
     return shapely.set_precision(ShapelyPolygon(points), grid)
 
@@ -442,7 +483,7 @@ def _triangulate(
     data: dict[str, Any] = {"vertices": vertices, "segments": segments}
     if len(seeds):
         data["holes"] = seeds
-    result = triangle.triangulate(data, options)
+    result = triangulate_in_frame(data, options)
     points = np.asarray(result["vertices"], dtype=np.float64)
     triangles = np.asarray(result["triangles"], dtype=np.int64)
     neighbors = np.asarray(result["neighbors"], dtype=np.int64)

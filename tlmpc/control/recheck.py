@@ -113,9 +113,10 @@ def controllers_problem(
     problem = _start_problem(controllers.steps[0].triangle, abstraction, robot.start)
     if problem is not None:
         return f"the first step {problem}"
-    for controller in controllers.steps:
+    steps = controllers.steps
+    for k, controller in enumerate(steps):
         if controller.is_cell:
-            problem = _cell_problem(controller, abstraction, robot)
+            problem = _cell_problem(controller, abstraction, robot, _following(controllers, k))
         elif not np.array_equal(controller.vertices, abstraction.corners(controller.triangle)):
             problem = "its vertices are not the triangle's corners"
         elif controller.is_vertex:
@@ -125,6 +126,15 @@ def controllers_problem(
         if problem is not None:
             return f"step {controller.step} (triangle {controller.triangle}): {problem}"
     return None
+
+
+def _following(controllers: Controllers, k: int) -> StepController | None:
+    """The step after step ``k``: the next one, after the last the loop's first (None after
+    a final step that does not loop)."""
+    if k + 1 < len(controllers.steps):
+        return controllers.steps[k + 1]
+    loop = controllers.loop_start
+    return None if loop is None else controllers.steps[loop]
 
 
 def _start_problem(
@@ -198,13 +208,28 @@ def _pursuit_problem(
     return None
 
 
-def _cell_problem(controller: StepController, abstraction: Abstraction, robot: Robot) -> str | None:
-    """A cell's field: its pieces the mesh's triangles and neighbours, its rows (C030), each
-    piece's law, and the exit speed along xi and the time to cross the cell it states."""
+def _cell_problem(
+    controller: StepController,
+    abstraction: Abstraction,
+    robot: Robot,
+    following: StepController | None,
+) -> str | None:
+    """A cell's field: its pieces the mesh's triangles and neighbours, its exit facets exactly
+    the sides it shares with the cell of the ``following`` step (none for a stay), its rows
+    (C030), each piece's law, and the exit speed along xi and the time to cross the cell it
+    states."""
     field = controller.cell
     if field is None:
         return "a cell step without its cell field"
     piece_of = {triangle: k for k, triangle in enumerate(field.triangles)}
+    # where the field may leave to: the next step's cell (a move's interface is every side
+    # the two cells share); a facet marked exit elsewhere would not be asked to push inward
+    if field.direction is None or following is None:
+        entered: set[int] = set()
+    elif following.cell is not None:
+        entered = set(following.cell.triangles)
+    else:
+        entered = {following.triangle}
     for piece, triangle in enumerate(field.triangles):
         if not np.array_equal(field.vertices[piece], abstraction.corners(triangle)):
             return f"the vertices of piece {piece} are not the corners of triangle {triangle}"
@@ -214,6 +239,12 @@ def _cell_problem(controller: StepController, abstraction: Abstraction, robot: R
                 return f"piece {piece} leaves the cell across facet {facet} inside it"
             if across not in (KEPT, EXIT) and piece_of.get(there) != across:
                 return f"piece {piece} names a wrong neighbour across facet {facet}"
+            if (across == EXIT) != (there in entered):
+                return (
+                    f"piece {piece} marks facet {facet} "
+                    + ("an exit, but it does not lead" if across == EXIT else "kept, but it leads")
+                    + " into the next step's cell"
+                )
     problem = violated_cell_row(controller, robot.max_speed, robot.disturbance)
     pieces = zip(field.vertices, field.velocities, field.gains, field.offsets, strict=True)
     for vertices, velocities, gain, offset in pieces:

@@ -1,7 +1,9 @@
 """Read ROS map_server / nav2 occupancy-grid maps (``map.yaml`` + image) into cell values.
 
 The conversion follows nav2's ``map_io`` exactly: a pixel's *shade* is the mean of its colour
-channels divided by the channel maximum; ``occ = shade`` when ``negate`` else ``1 - shade``;
+channels divided by the channel maximum (255, or 65535 for a 16-bit image; in ``trinary`` mode
+an alpha channel is averaged in with the three colour channels); ``occ = shade`` when
+``negate`` else ``1 - shade``;
 
 * ``trinary`` (default): ``occ > occupied_thresh`` → 100, ``occ < free_thresh`` → 0, else -1;
 * ``scale``: a transparent pixel → -1; ``occ > occupied_thresh`` → 100;
@@ -294,8 +296,9 @@ def read_metadata(path: Path) -> dict[str, Any]:
 
 def _pixels(
     path: Path, file: str, at: tuple[int, int] | None = None
-) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.bool_] | None]:
-    """Shade in [0, 1] per pixel (mean of colour channels) and, if any, opacity per pixel.
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64] | None]:
+    """Shade in [0, 1] per pixel (mean of colour channels) and, if the image has an alpha
+    channel, its alpha in [0, 1] per pixel (1: opaque).
 
     Problems are reported in the map YAML ``file``, at ``at`` (where it names the image)."""
     import warnings
@@ -377,15 +380,25 @@ def _pixels(
     if mode == "1":
         return array.astype(np.float64), None
     if mode in ("I;16", "I;16B", "I;16L", "I"):
-        top = 65535.0 if mode != "I" else float(max(int(array.max(initial=0)), 1))
-        return array.astype(np.float64) / top, None
+        # 16-bit greyscale (Pillow reads a 16-bit PGM as "I", its values rescaled to 0..65535
+        # whatever the file's maxval): the channel maximum is 65535, as for map_server. Not
+        # the image's own brightest pixel: a map whose lightest cells are unknown grey would
+        # turn them free.
+        if array.size and (int(array.min()) < 0 or int(array.max()) > 65535):
+            raise fail(
+                "M006",
+                f"the map image {path} has pixel values beyond 16 bits "
+                f"({int(array.min())} to {int(array.max())})",
+                hint=_IMAGE_HINT,
+            )
+        return array.astype(np.float64) / 65535.0, None
     if mode == "P":
         raise fail("M006", "palette images are not supported", hint="save as greyscale")
     top = 255.0
-    alpha: npt.NDArray[np.bool_] | None = None
+    alpha: npt.NDArray[np.float64] | None = None
     if array.ndim == 3:
         if mode in ("LA", "RGBA", "La", "RGBa"):
-            alpha = array[..., -1] == 255
+            alpha = array[..., -1].astype(np.float64) / top
             array = array[..., :-1]
         shade = array.astype(np.float64).mean(axis=2) / top
     else:
@@ -409,14 +422,22 @@ def _reason(exc: BaseException) -> str:
 
 def cell_values(
     shade: npt.NDArray[np.float64],
-    opaque: npt.NDArray[np.bool_] | None,
+    alpha: npt.NDArray[np.float64] | None,
     *,
     mode: str,
     negate: bool,
     occupied_thresh: float,
     free_thresh: float,
 ) -> npt.NDArray[np.int16]:
-    """nav2's pixel → cell conversion (image rows, not yet flipped)."""
+    """nav2's pixel → cell conversion (image rows, not yet flipped) of the colour channels'
+    ``shade`` and, for an image with an alpha channel, its ``alpha`` (1: opaque).
+
+    As in nav2's ``map_io``, ``trinary`` averages the alpha in with the three colour channels
+    (a grey channel counts as all three): a transparent pixel is darker, so a white one is
+    not free; ``scale`` makes every pixel that is not fully opaque unknown; ``raw`` ignores
+    the alpha."""
+    if alpha is not None and mode == "trinary":
+        shade = (3.0 * shade + alpha) / 4.0
     occ = shade if negate else 1.0 - shade
     values = np.full(shade.shape, UNKNOWN, dtype=np.int16)
     if mode == "raw":
@@ -434,8 +455,8 @@ def cell_values(
         if span > 0:
             scaled = np.rint((occ - free_thresh) / span * 100.0)
             values[between] = scaled[between].astype(np.int16)
-        if opaque is not None:
-            values[~opaque] = UNKNOWN
+        if alpha is not None:
+            values[alpha < 1.0] = UNKNOWN
     return values
 
 
@@ -446,14 +467,14 @@ def read_map(path: Path) -> OccupancyGrid:
     if not image_path.is_absolute():
         image_path = path.parent / image_path
     named = meta["places"].get("image")
-    shade, opaque = _pixels(image_path, str(path), named)
+    shade, alpha = _pixels(image_path, str(path), named)
     if shade.ndim != 2 or shade.size == 0:
         raise _fail(
             "M006", f"the map image {image_path} has no pixels", str(path), _IMAGE_HINT, named
         )
     values = cell_values(
         shade,
-        opaque,
+        alpha,
         mode=meta["mode"],
         negate=meta["negate"],
         occupied_thresh=meta["occupied_thresh"],

@@ -645,6 +645,11 @@ def _cross_check_results(
         loop = controllers["loop_start"]
         if loop is not None and not 0 <= loop < len(steps):
             raise _tampered(path, "controllers.json: loop_start is not a step")
+        # a stay never leaves: it ends the plan, which then has no moving cycle
+        if any(s["stay"] for s in steps[:-1]) or (loop is not None and steps[-1]["stay"]):
+            raise _tampered(
+                path, "controllers.json: a stay that is not the plan's end (no step follows one)"
+            )
         if triangles is not None and not all(
             _indices([s["triangle"], s["next_triangle"] or 0], triangles) for s in steps
         ):

@@ -49,6 +49,11 @@ def obstacle_offset(mission: Mission) -> float:
     return radius + mission.workspace.map_tolerance if radius > 0.0 else 0.0
 
 
+#: Where a diagnostic about the margin is placed: at ``options.margin``, or, when it is the
+#: default (the body radius), at its nearest written parent.
+MARGIN_PATH = "$.options.margin"
+
+
 def requested_margin(mission: Mission) -> float:
     """``options.margin`` as given, else the default: the body radius (0 for a point robot)."""
     if mission.options.margin is not None:

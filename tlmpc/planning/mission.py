@@ -237,20 +237,25 @@ def plan_mission(
         return _with_cells_bound(tried[best], max(known) if known else None, mission)
 
     holding = holding_skeleton(mission.formula)
-    if resume is None and holding != skeleton:
-        # Durations ("stay in X for at least T s") are met by a plan that stays for good,
-        # when there is one; else the skeleton's plan, whose bounds are then checked.
+    durations = resume is None and holding != skeleton
+
+    def held(mesh: Abstraction) -> Planned | None:
+        """The plan of the task's durations held for good on ``mesh`` (None: it has none);
+        tried on every mesh before the skeleton's, since the skeleton's plan may leave a goal
+        at once and miss the duration."""
+        if not durations:
+            return None
         try:
-            return realisable_depth(
-                attempt(
-                    abstraction,
-                    automaton_for(mission, abstraction, formula=holding),
-                    holding,
-                    False,
-                ),
-                holding,
-                False,
-            )
+            return attempt(mesh, automaton_for(mission, mesh, formula=holding), holding, False)
+        except NoPlanError:
+            return None
+
+    # Durations ("stay in X for at least T s") are met by a plan that stays for good, when
+    # there is one; else the skeleton's plan, whose bounds are then checked.
+    staying = held(abstraction)
+    if staying is not None:
+        try:
+            return realisable_depth(staying, holding, False)
         except NoPlanError:
             pass
 
@@ -265,7 +270,7 @@ def plan_mission(
         # margin asks (overlapping goals' cores may not meet where the regions do)
         shallow = abstraction_for(mission, margin, deep=False)
         try:
-            planned = attempt(shallow, automaton_for(mission, shallow))
+            planned = held(shallow) or attempt(shallow, automaton_for(mission, shallow))
         except NoPlanError as again:
             first = again.with_traceback(None)
         else:
@@ -280,10 +285,12 @@ def plan_mission(
         raise _with_body_notes(first, mission) from None
     plain = abstraction_for(mission, 0.0, deep=False)
     try:
-        planned = attempt(plain, automaton_for(mission, plain))
+        planned = held(plain) or attempt(plain, automaton_for(mission, plain))
     except NoPlanError as again:
         raise _with_body_notes(again, mission) from None
     planned = _with_cells_supported(planned, mission, start_point)
+    from tlmpc.mission.body import MARGIN_PATH
+
     reason = first.diagnostics[0].message if first.diagnostics else "no plan"
     note = Diagnostic(
         code="R008",
@@ -292,6 +299,7 @@ def plan_mission(
         hint="the R006/R007 warnings, if any, say where the path comes closer; lower "
         "options.margin to plan with a smaller one",
         file=mission.source,
+        path=MARGIN_PATH,
     )
     return replace(planned, notes=(note,))
 

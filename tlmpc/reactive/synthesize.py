@@ -16,6 +16,7 @@ from typing import Any
 
 from tlmpc.abstraction.model import Abstraction
 from tlmpc.base.errors import Diagnostic, InvalidInputError, UsageError, error
+from tlmpc.mission.body import MARGIN_PATH
 from tlmpc.mission.model import Mission, TaskPart
 from tlmpc.reactive.explain import counter_play, counter_play_steps, place
 from tlmpc.reactive.faces import Faces, faces_of, start_faces
@@ -224,6 +225,7 @@ def _marginless_note(mission: Mission, margin: float) -> Diagnostic:
         "strategy does without it",
         hint="lower options.margin to synthesise with a smaller one",
         file=mission.source,
+        path=MARGIN_PATH,
     )
 
 

@@ -24,7 +24,7 @@ import numpy as np
 from tlmpc.abstraction.model import Abstraction, FloatArray
 from tlmpc.base.content import ContentEquality
 from tlmpc.base.errors import SolverError, error
-from tlmpc.control.geometry import largest_of, triangle_geometry
+from tlmpc.control.geometry import coordinate_rounding, largest_of, triangle_geometry
 from tlmpc.control.model import Controllers, StepController
 from tlmpc.mission.model import Mission
 from tlmpc.simulate.cells import cell_step
@@ -156,7 +156,7 @@ class _ExitFrame:
     edge_offset: float  # n·x on the exit facet (map coordinates)
     corners: list[list[float]]
     tallest: float
-    scale: float  # the triangle's largest coordinate plus its tallest height
+    rounding: float  # of a distance to a facet measured from the corners' coordinates
     center: FloatArray
     matrix: FloatArray  # the augmented matrix of the field relative to ``center``
     matrix_norm: float  # its column norm
@@ -186,12 +186,13 @@ def _exit_frame(controller: StepController) -> _ExitFrame:
     # simulation must report, not hide by snapping the crossing onto the planned edge.
     others = [j for j in range(3) if j != controller.exit_edge]
     other_normals = geometry.normals[others]
+    rounding = coordinate_rounding(geometry.vertices)
     return _ExitFrame(
         normal=normal,
         edge_offset=geometry.offsets[controller.exit_edge],
         corners=corners,
         tallest=tallest,
-        scale=largest_of([abs(c) for corner in corners for c in corner]) + tallest,
+        rounding=rounding,
         center=center,
         matrix=matrix,
         matrix_norm=column_norm(matrix),
@@ -199,7 +200,9 @@ def _exit_frame(controller: StepController) -> _ExitFrame:
         others=others,
         other_normals=other_normals,
         other_offsets=geometry.offsets[others] - other_normals @ center,
-        slack=WRONG_FACET_TOLERANCE * tallest,
+        # a state is beyond a facet only past the coordinates' rounding: an entry snapped
+        # onto the shared edge lies off it by that much, also where the edge meets a kept facet
+        slack=WRONG_FACET_TOLERANCE * tallest + rounding,
     )
 
 
@@ -212,8 +215,11 @@ def _exit_step(
     if frame is None:
         frame = _exit_frame(controller)
     normal, corners, center, matrix = frame.normal, frame.corners, frame.center, frame.matrix
-    if frame.edge_offset - normal.dot(x0) <= 1e-12 * frame.scale:
-        return [0.0], [x0]  # already on the exit edge (to rounding): the crossing is now
+    if frame.edge_offset - normal.dot(x0) <= frame.rounding:
+        # already on the exit edge to the rounding of the coordinates (a few ulps of the
+        # largest; not a fraction of it, which far from the origin is a sizeable part of a
+        # small triangle): the crossing is now
+        return [0.0], [x0]
     offset = frame.offset
     y0 = x0 - center
     # (numpy's scalar: its division semantics, as computed per step before the frames)

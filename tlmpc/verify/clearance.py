@@ -24,6 +24,7 @@ from shapely.ops import polylabel
 
 from tlmpc.base.errors import Diagnostic
 from tlmpc.ltl.polarity import polarities
+from tlmpc.mission.body import MARGIN_PATH
 from tlmpc.verify.trace_input import TraceInput
 
 
@@ -194,6 +195,7 @@ def margin_warnings(clearance: Clearance, margin: float, file: str | None) -> li
                 f"{max(value, 0.0):.4g}{body} from {what} near ({x:.6g}, {y:.6g})",
                 hint="the geometry leaves no wider way there; widen it or lower options.margin",
                 file=file,
+                path=MARGIN_PATH,
             )
         )
     for name, depth in clearance.depth.items():
@@ -209,6 +211,7 @@ def margin_warnings(clearance: Clearance, margin: float, file: str | None) -> li
                 f"(at ({x:.6g}, {y:.6g})), less than the {wanted:.4g} asked",
                 hint="its deep part is out of reach with the margin; lower options.margin",
                 file=file,
+                path=MARGIN_PATH,
             )
         )
     return found
