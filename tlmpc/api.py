@@ -80,14 +80,19 @@ class _NotPlain(Exception):
 _MAX_PLAIN_DEPTH = 64
 
 
-def _plain(value: Any, path: str, depth: int = 0) -> Any:
-    """``value`` as the plain values YAML writes: any mapping a dict, a tuple or list (or a
-    numpy array) a list, a subclass of ``str``, ``int`` or ``float`` (an enum member, numpy's
-    ``float64``) its plain value; :class:`_NotPlain` for anything else."""
+def _plain(value: Any, keys: tuple[str | int, ...] = (), depth: int = 0) -> Any:
+    """``value`` (at ``keys`` in the mission dict) as the plain values YAML writes: any mapping
+    a dict, a tuple or list (or a numpy array) a list, a subclass of ``str``, ``int`` or
+    ``float`` (an enum member, numpy's ``float64``) its plain value; :class:`_NotPlain`, with
+    the value's JSON path, for anything else."""
     import numbers
 
+    from tlmpc.io.json_places import json_path
+
     if depth > _MAX_PLAIN_DEPTH:
-        raise _NotPlain(path, f"nested more than {_MAX_PLAIN_DEPTH} levels (or holds itself)")
+        raise _NotPlain(
+            json_path(*keys), f"nested more than {_MAX_PLAIN_DEPTH} levels (or holds itself)"
+        )
     if value is None or type(value) in (bool, int, float, str):
         return value
     if isinstance(value, bool):
@@ -101,17 +106,17 @@ def _plain(value: Any, path: str, depth: int = 0) -> Any:
     if isinstance(value, Mapping):
         plain: dict[Any, Any] = {}
         for key, item in value.items():
-            name = _plain(key, path, depth + 1)
+            name = _plain(key, keys, depth + 1)
             if isinstance(name, list | dict):
-                raise _NotPlain(path, f"a key that is a {type(key).__name__}")
-            plain[name] = _plain(item, f"{path}.{key}", depth + 1)
+                raise _NotPlain(json_path(*keys), f"a key that is a {type(key).__name__}")
+            plain[name] = _plain(item, (*keys, str(name)), depth + 1)
         return plain
     if isinstance(value, list | tuple):
-        return [_plain(item, f"{path}[{i}]", depth + 1) for i, item in enumerate(value)]
+        return [_plain(item, (*keys, i), depth + 1) for i, item in enumerate(value)]
     tolist = getattr(value, "tolist", None)  # a numpy array or scalar
     if callable(tolist) and type(value).__module__.split(".")[0] == "numpy":
-        return _plain(tolist(), path, depth + 1)
-    raise _NotPlain(path, f"a value of type {type(value).__name__}")
+        return _plain(tolist(), keys, depth + 1)
+    raise _NotPlain(json_path(*keys), f"a value of type {type(value).__name__}")
 
 
 def _mission_text(mission: MissionSource, function: str) -> tuple[str | None, Path]:
@@ -121,7 +126,7 @@ def _mission_text(mission: MissionSource, function: str) -> tuple[str | None, Pa
         import yaml
 
         try:
-            document = _plain(mission, "$")
+            document = _plain(mission)
         except _NotPlain as refused:
             raise UsageError(
                 error(

@@ -73,6 +73,8 @@ def test_a_dict_of_other_types_means_the_plain_mission(make: object) -> None:
         (("regions", "a"), {1, 2}, "$.regions.a"),
         (("robot", "start"), [object(), 1], "$.robot.start[0]"),
         (("regions",), {(1, 2): {"rect": [1, 1, 2, 2]}}, "$.regions"),
+        # a key that is no identifier is written as JSON paths write it
+        (("regions", "my room"), {"rect": [1, 1, object()]}, '$.regions["my room"].rect[2]'),
     ],
 )
 def test_other_values_are_refused_at_their_path(
