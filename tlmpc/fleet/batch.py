@@ -255,9 +255,8 @@ class _InternalError(TlmpcError):
 def _internal(job: Job, exc: BaseException) -> dict[str, Any]:
     """The record of a log whose verification raised ``exc`` (a bug, never the log's fault):
     an ``error`` record with I000, so the batch goes on and exits 3."""
-    return error_record(
-        Path(job.log),
-        None if job.mission is None else Path(job.mission),
+    return _job_error(
+        job,
         _InternalError(
             error(
                 "I000",
@@ -267,6 +266,11 @@ def _internal(job: Job, exc: BaseException) -> dict[str, Any]:
             )
         ),
     )
+
+
+def _job_error(job: Job, exc: TlmpcError) -> dict[str, Any]:
+    """The error record of ``job`` (its mission None for a ``trace.json``)."""
+    return error_record(Path(job.log), None if job.mission is None else Path(job.mission), exc)
 
 
 def _worker_died(job: Job) -> dict[str, Any]:
@@ -453,9 +457,8 @@ def _dask_record(job: Job, future: Any) -> dict[str, Any]:
         return dict(future.result())
     except CancelledError:  # distributed's FutureCancelledError: the scheduler went away
         pass
-    return error_record(
-        Path(job.log),
-        None if job.mission is None else Path(job.mission),
+    return _job_error(
+        job,
         UsageError(
             error(
                 "F002",
