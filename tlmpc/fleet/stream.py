@@ -48,6 +48,7 @@ from tlmpc.verify.samples import (
     MAX_PER_KIND,
     CellPlace,
     SampleOrigin,
+    as_whole_log,
     sample_diagnostics,
 )
 from tlmpc.verify.trace_input import certifying_speed
@@ -331,27 +332,13 @@ def _checked_chunks(
     if previous is None and not found:
         found = sample_diagnostics(np.zeros(0), np.zeros(0), np.zeros(0), file=file)
     if found:
-        raise UsageError(_as_whole_log(found))
+        raise UsageError(as_whole_log(found))
 
 
 def _usable(sample: FloatArray) -> bool:
     """Whether a sample passes the checks of its own: finite, and not beyond the size the
     verifier takes (V003, V024)."""
     return bool(np.all(np.isfinite(sample)) and np.all(np.abs(sample) <= MAX_MAGNITUDE))
-
-
-#: The kinds of sample problems in the order a whole log's checks report them.
-_KINDS = ("V002", "V003", "V024", "V005", "V020")
-
-
-def _as_whole_log(found: Sequence[Diagnostic]) -> list[Diagnostic]:
-    """The problems a whole log's checks report (:func:`sample_diagnostics`), whichever chunk
-    they were found in: a sample that is not finite leaves out every other kind, one too
-    large the order checks; kind by kind, each in the log's order."""
-    for kind, leaves_out in (("V003", ("V024", "V005", "V020")), ("V024", ("V005", "V020"))):
-        if any(d.code == kind for d in found):
-            found = [d for d in found if d.code not in leaves_out]
-    return sorted(found, key=lambda d: _KINDS.index(d.code))
 
 
 def _by_line(cells: _CsvCells, lines: Sequence[int]) -> CellPlace:

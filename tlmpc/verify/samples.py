@@ -168,6 +168,23 @@ def sample_diagnostics(
     return found
 
 
+#: The kinds of sample problems in the order :func:`sample_diagnostics` reports them; a
+#: sample that is not finite (V003) leaves out every later kind, one too large (V024) the
+#: order checks (their differences would only repeat it, or overflow).
+_KINDS = ("V002", "V003", "V024", "V005", "V020")
+_LEAVES_OUT = {"V003": ("V024", "V005", "V020"), "V024": ("V005", "V020")}
+
+
+def as_whole_log(found: Sequence[Diagnostic]) -> list[Diagnostic]:
+    """The problems :func:`sample_diagnostics` reports for a whole log, from those it found
+    in its pieces (a log checked chunk by chunk): the kinds a problem leaves out are dropped,
+    and the rest come kind by kind, each in the log's order."""
+    for kind, leaves_out in _LEAVES_OUT.items():
+        if any(d.code == kind for d in found):
+            found = [d for d in found if d.code not in leaves_out]
+    return sorted(found, key=lambda d: _KINDS.index(d.code))
+
+
 def check_samples(
     t: FloatArray,
     x: FloatArray,
