@@ -8,6 +8,8 @@ from __future__ import annotations
 import io
 from pathlib import Path
 
+from reactive_missions import GUARD_UNREALIZABLE
+
 from tlmpc.cli import main
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -58,28 +60,9 @@ def test_a_folder_without_an_output_asks_for_a_compile(tmp_path: Path) -> None:
     assert "run `tlmpc compile MISSION -o DIR` first" in _hint(err)
 
 
-UNREALIZABLE = """\
-version: 1
-name: guard-unrealizable
-workspace:
-  boundary: {rect: [0, 0, 10, 6]}
-  holes: [{rect: [4, 2, 6, 4]}]
-regions:
-  home: {rect: [0.5, 0.5, 2, 2]}
-  lab: {rect: [4, 4.5, 6, 6]}
-sensors:
-  alarm: null
-robot: {start: [1, 1], max_speed: 1.0}
-task:
-  - visit home infinitely often
-  - never enter lab while alarm
-  - visit lab infinitely often
-"""
-
-
 def test_an_unrealizable_output_points_to_its_counterstrategy(tmp_path: Path) -> None:
     source = tmp_path / "guard.yaml"
-    source.write_text(UNREALIZABLE)
+    source.write_text(GUARD_UNREALIZABLE)
     out = tmp_path / "out"
     code, err = _run("compile", str(source), "-o", str(out), "-q")
     assert code == 1, err

@@ -15,6 +15,7 @@ from pathlib import Path
 
 import jsonschema
 import shapely
+from reactive_missions import GUARD_UNREALIZABLE
 
 from tlmpc.abstraction import build_abstraction
 from tlmpc.cli import main
@@ -23,24 +24,6 @@ from tlmpc.mission import load_mission
 from tlmpc.reactive.synthesize import synthesize
 from tlmpc.render.scene import play_marks
 from tlmpc.render.svg import PLAY_COLOUR
-
-MISSION = """\
-version: 1
-name: guard-unrealizable
-workspace:
-  boundary: {rect: [0, 0, 10, 6]}
-  holes: [{rect: [4, 2, 6, 4]}]
-regions:
-  home: {rect: [0.5, 0.5, 2, 2]}
-  lab: {rect: [4, 4.5, 6, 6]}
-sensors:
-  alarm: null
-robot: {start: [1, 1], max_speed: 1.0}
-task:
-  - visit home infinitely often
-  - never enter lab while alarm
-  - visit lab infinitely often
-"""
 
 
 def run(*argv: str) -> tuple[int, str, str]:
@@ -51,7 +34,7 @@ def run(*argv: str) -> tuple[int, str, str]:
 
 def test_the_unrealizable_output_draws_the_environments_play(tmp_path: Path) -> None:
     source = tmp_path / "guard.yaml"
-    source.write_text(MISSION)
+    source.write_text(GUARD_UNREALIZABLE)
     out = tmp_path / "out"
     code, _, err = run("compile", str(source), "-o", str(out))
     assert code == 1, err

@@ -11,29 +11,12 @@ from pathlib import Path
 from typing import Any
 
 import jsonschema
+from reactive_missions import GUARD_UNREALIZABLE
 
 from tlmpc.cli import main
 from tlmpc.io.schema_check import load_schema
 from tlmpc.mission.io import mission_from_json
 from tlmpc.mission.parts import task_parts
-
-MISSION = """\
-version: 1
-name: guard-unrealizable
-workspace:
-  boundary: {rect: [0, 0, 10, 6]}
-  holes: [{rect: [4, 2, 6, 4]}]
-regions:
-  home: {rect: [0.5, 0.5, 2, 2]}
-  lab: {rect: [4, 4.5, 6, 6]}
-sensors:
-  alarm: null
-robot: {start: [1, 1], max_speed: 1.0}
-task:
-  - visit home infinitely often
-  - never enter lab while alarm
-  - visit lab infinitely often
-"""
 
 
 def run(*argv: str) -> tuple[int, list[dict[str, Any]]]:
@@ -44,7 +27,7 @@ def run(*argv: str) -> tuple[int, list[dict[str, Any]]]:
 
 def test_the_stage_writes_the_counterstrategy_and_places_nothing_falsely(tmp_path: Path) -> None:
     source = tmp_path / "guard.yaml"
-    source.write_text(MISSION)
+    source.write_text(GUARD_UNREALIZABLE)
     whole, staged = tmp_path / "whole", tmp_path / "staged"
     code, compiled = run("compile", str(source), "-o", str(whole))
     assert code == 1
@@ -70,7 +53,7 @@ def test_the_stage_writes_the_counterstrategy_and_places_nothing_falsely(tmp_pat
 
 def test_the_parts_of_a_mission_read_back_have_no_positions(tmp_path: Path) -> None:
     source = tmp_path / "guard.yaml"
-    source.write_text(MISSION.replace("task:", "ltl: G F home & G !lab\ntask:"))
+    source.write_text(GUARD_UNREALIZABLE.replace("task:", "ltl: G F home & G !lab\ntask:"))
     out = tmp_path / "out"
     code, _ = run("compile", str(source), "-o", str(out), "--until", "load")
     assert code == 0
